@@ -1,0 +1,36 @@
+#pragma once
+#include <string>
+#include <vector>
+
+#include "lucent/scene.hpp"
+
+namespace lucent {
+
+/// A linear RGB float image, row 0 at the top.
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgb;  ///< width * height * 3
+  float* pixel(int x, int y) { return &rgb[(static_cast<size_t>(y) * width + x) * 3]; }
+  const float* pixel(int x, int y) const { return &rgb[(static_cast<size_t>(y) * width + x) * 3]; }
+};
+
+/// How 8-bit outputs encode linear values.
+struct DisplaySettings {
+  Transfer transfer = Transfer::Srgb;
+  double gamma = 2.2;
+  double exposure = 0;  ///< stops
+  ToneMap tonemap = ToneMap::Clamp;
+};
+
+/// Writes `image` in the format named by the extension: .png (8-bit, display-encoded), .pfm or
+/// .exr (linear float). Throws lucent::Error naming the path on failure.
+void write_image(const std::string& path, const Image& image, const DisplaySettings& display = {});
+
+/// Reads .pfm, .exr (linear) or an 8-bit format (decoded from sRGB to linear).
+Image read_image(const std::string& path);
+
+/// Linear value to 8-bit display value.
+unsigned char encode_display(double linear, const DisplaySettings& display);
+
+}  // namespace lucent

@@ -1,0 +1,8 @@
+#pragma once
+// lucent: a physically based OpenCL path tracer. Umbrella header.
+#include "lucent/device.hpp"
+#include "lucent/error.hpp"
+#include "lucent/image.hpp"
+#include "lucent/render.hpp"
+#include "lucent/scene.hpp"
+#include "lucent/version.hpp"

@@ -1,0 +1,46 @@
+#pragma once
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "lucent/image.hpp"
+#include "lucent/scene.hpp"
+
+namespace lucent {
+
+struct RenderProgress {
+  std::uint64_t samples_done = 0;   ///< per pixel
+  std::uint64_t samples_target = 0; ///< per pixel (0 when only a time limit is set)
+  double elapsed = 0;               ///< seconds
+  double time_limit = 0;            ///< seconds (0: none)
+  double samples_per_second = 0;    ///< camera samples (all pixels) per second
+};
+
+struct RenderOptions {
+  std::string device;             ///< selector, see select_device()
+  int spp = 0;                    ///< 0: the scene's integrator.spp
+  double time_limit = 0;          ///< seconds; 0: none
+  const std::atomic<bool>* cancel = nullptr;  ///< set to stop after the current pass
+  std::function<void(const RenderProgress&)> on_progress;
+  double pass_seconds = 0.25;     ///< target duration of one launch
+};
+
+struct RenderResult {
+  Image mean;                      ///< per-pixel mean radiance
+  Image variance;                  ///< per-pixel sample variance (of one sample)
+  std::vector<std::uint32_t> samples;  ///< finite samples per pixel
+  std::uint64_t spp = 0;           ///< samples per pixel launched
+  std::uint64_t nonfinite = 0;     ///< NaN/Inf samples dropped and counted
+  std::uint64_t rays = 0;          ///< rays traced, shadow rays included
+  double seconds = 0;              ///< rendering time (kernel passes)
+  double build_seconds = 0;        ///< kernel compile time
+  bool cancelled = false;
+  std::string device;
+};
+
+/// Renders `scene` with the OpenCL megakernel.
+RenderResult render(const Scene& scene, const RenderOptions& options = {});
+
+}  // namespace lucent

@@ -1,0 +1,122 @@
+#pragma once
+// The scene description shared by the kernel renderer and the reference integrator. Everything is
+// in double precision and world space; the renderer converts to the device's float layout.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace lucent {
+
+struct Camera {
+  glm::dvec3 position{0, 0, 5};
+  glm::dvec3 look_at{0, 0, 0};
+  glm::dvec3 up{0, 1, 0};
+  double fov_degrees = 45;     ///< vertical field of view
+  double roll_degrees = 0;     ///< rotation about the viewing direction
+  double aperture = 0;         ///< thin-lens aperture radius (0: pinhole)
+  double focus_distance = 0;   ///< distance to the plane in focus (0: distance to look_at)
+};
+
+enum class FilterType { Box, Tent, Gaussian };
+enum class Transfer { Srgb, Gamma, Linear };
+enum class ToneMap { Clamp, Reinhard, Aces };
+
+struct Filter {
+  FilterType type = FilterType::Box;
+  double radius = 0.5;  ///< in pixels
+};
+
+struct Film {
+  int width = 512;
+  int height = 512;
+  Filter filter;
+  Transfer transfer = Transfer::Srgb;
+  double gamma = 2.2;     ///< used when transfer is Gamma
+  double exposure = 0;    ///< in stops, applied to 8-bit outputs
+  ToneMap tonemap = ToneMap::Clamp;
+};
+
+enum class IntegratorType { Path, Whitted, Direct, Albedo, Normal, Depth, Ao };
+
+struct Integrator {
+  IntegratorType type = IntegratorType::Path;
+  int max_depth = 8;
+  int rr_depth = 4;       ///< Russian roulette from this depth
+  int spp = 16;
+  std::uint32_t seed = 0;
+};
+
+enum class MaterialType { Diffuse, Mirror, Dielectric, Conductor, Plastic };
+
+struct Material {
+  std::string name;
+  MaterialType type = MaterialType::Diffuse;
+  glm::dvec3 albedo{0.8, 0.8, 0.8};
+  int albedo_texture = -1;            ///< index into Scene::textures, -1 for none
+  glm::dvec3 emission{0, 0, 0};
+  glm::dvec3 specular{1, 1, 1};       ///< mirror reflectance / glass tint / glossy F0 colour
+  double ior = 1.5;
+  double roughness = 0.1;             ///< GGX alpha
+  bool emissive() const { return emission.x > 0 || emission.y > 0 || emission.z > 0; }
+};
+
+struct Sphere {
+  glm::dvec3 center{0, 0, 0};
+  double radius = 1;
+  int material = 0;
+};
+
+/// One triangle of the scene's single, world-space triangle list.
+struct Triangle {
+  int v[3] = {0, 0, 0};            ///< indices into Scene::positions
+  int n[3] = {-1, -1, -1};         ///< indices into Scene::normals, -1 when absent
+  int uv[3] = {-1, -1, -1};        ///< indices into Scene::uvs, -1 when absent
+  int material = 0;
+};
+
+enum class LightType { Point, Environment, EnvironmentMap };
+
+/// Explicit lights. Emissive shapes are area lights without an entry here.
+struct Light {
+  LightType type = LightType::Point;
+  glm::dvec3 position{0, 0, 0};
+  glm::dvec3 intensity{0, 0, 0};   ///< point: W/sr
+  glm::dvec3 radiance{0, 0, 0};    ///< environment radiance, or the scale of a map
+  int texture = -1;                ///< environment map
+};
+
+struct Texture {
+  std::string path;
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgba;  ///< linear RGBA, row 0 at the top of the image
+};
+
+struct Scene {
+  std::string path;  ///< the file the scene came from, for messages
+  Camera camera;
+  Film film;
+  Integrator integrator;
+  std::vector<Material> materials;
+  std::vector<Sphere> spheres;
+  std::vector<glm::dvec3> positions;
+  std::vector<glm::dvec3> normals;
+  std::vector<glm::dvec2> uvs;
+  std::vector<Triangle> triangles;
+  std::vector<Light> lights;
+  std::vector<Texture> textures;
+
+  /// Index of the material named `name`, or -1.
+  int find_material(const std::string& name) const;
+};
+
+/// Loads a JSON scene (format: README.md, "Scene format"). Throws lucent::Error naming the file
+/// and the JSON path of the first problem (`scene.json: /shapes/3/radius: must be > 0, got -1`).
+Scene load_scene(const std::string& path);
+
+/// Parses a JSON scene held in memory; `path` is used for messages and relative file names.
+Scene parse_scene(const std::string& json_text, const std::string& path);
+
+}  // namespace lucent

@@ -1,0 +1,41 @@
+/* lucent kernel: perspective camera with vertical field of view and thin-lens depth of field. */
+#ifndef LUCENT_CAMERA_CL
+#define LUCENT_CAMERA_CL
+
+/* Uniform point on the unit disk (Shirley-Chiu concentric mapping). */
+static inline float2 sample_concentric_disk(float u1, float u2) {
+  float a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f;
+  if (a == 0.0f && b == 0.0f) return (float2)(0.0f, 0.0f);
+  float r, phi;
+  if (fabs(a) > fabs(b)) {
+    r = a;
+    phi = (LC_PI / 4.0f) * (b / a);
+  } else {
+    r = b;
+    phi = (LC_PI / 2.0f) - (LC_PI / 4.0f) * (a / b);
+  }
+  return (float2)(r * cos(phi), r * sin(phi));
+}
+
+/* Ray through film position (fx, fy) in pixels, (0,0) = top-left corner of the image. */
+static inline lc_ray camera_generate_ray(__global const lc_camera* cam, float fx, float fy,
+                                         lc_uint width, lc_uint height, float lu, float lv) {
+  float ndc_x = (2.0f * fx / (float)width - 1.0f) * cam->tan_half_fov * cam->aspect;
+  float ndc_y = (1.0f - 2.0f * fy / (float)height) * cam->tan_half_fov;
+  float3 right = lc_load3(cam->right), up = lc_load3(cam->up), fwd = lc_load3(cam->forward);
+  float3 dir = normalize(fwd + ndc_x * right + ndc_y * up);
+  lc_ray ray;
+  ray.o = lc_load3(cam->position);
+  ray.d = dir;
+  if (cam->lens_radius > 0.0f) {
+    /* the focal plane is perpendicular to the viewing direction at focus_distance */
+    float ft = cam->focus_distance / dot(dir, fwd);
+    float3 focus = ray.o + ft * dir;
+    float2 lens = cam->lens_radius * sample_concentric_disk(lu, lv);
+    ray.o = ray.o + lens.x * right + lens.y * up;
+    ray.d = normalize(focus - ray.o);
+  }
+  return ray;
+}
+
+#endif

@@ -1,0 +1,70 @@
+/* lucent kernel: surface interaction at the closest hit: position, normals, texture coordinates. */
+#ifndef LUCENT_GEOM_INTERACTION_CL
+#define LUCENT_GEOM_INTERACTION_CL
+
+typedef struct {
+  float3 p;       /* hit position, recomputed from the primitive (not o + t d)            */
+  float3 perr;    /* bound on the absolute error of p, per component                      */
+  float3 ng;      /* geometric normal, facing the incoming ray                            */
+  float3 ns;      /* shading normal, on the same side as ng                               */
+  float2 uv;      /* texture coordinates                                                  */
+  lc_uint material;
+  lc_uint light;  /* light index if the primitive emits, else LC_INVALID                  */
+  int front;      /* 1 when the ray hit the outside (the side the stored normal points to) */
+} lc_interaction;
+
+static inline lc_interaction interaction_from_hit(const lc_scene* s, lc_ray ray, const lc_hit* hit) {
+  lc_interaction it;
+  if (hit->prim & LC_PRIM_SPHERE_BIT) {
+    __global const lc_sphere* sp = &s->spheres[hit->prim & ~LC_PRIM_SPHERE_BIT];
+    float3 c = lc_load3(sp->center);
+    float3 p = ray.o + hit->t * ray.d;
+    float3 n = normalize(p - c);
+    it.p = c + sp->radius * n; /* reproject onto the surface */
+    /* a few ulps of |c| + r: the float representation limit of this sphere's surface */
+    it.perr = (fabs(c) + sp->radius) * (8.0f / 16777216.0f);
+    it.ng = n;
+    it.ns = n;
+    /* equirectangular uv: u along longitude around +y, v from the south to the north pole */
+    it.uv = (float2)(0.5f + atan2(n.z, n.x) * (0.5f * LC_INV_PI),
+                     0.5f + asin(clamp(n.y, -1.0f, 1.0f)) * LC_INV_PI);
+    it.material = sp->material;
+    it.light = sp->light;
+  } else {
+    __global const lc_triangle* tri = &s->triangles[hit->prim];
+    float3 v0 = lc_load3(tri->v0), v1 = lc_load3(tri->v1), v2 = lc_load3(tri->v2);
+    float b1 = hit->b1, b2 = hit->b2, b0 = 1.0f - b1 - b2;
+    it.p = b0 * v0 + b1 * v1 + b2 * v2;
+    /* gamma(7) bound of the barycentric interpolation (pbrt-v4, section 6.8) */
+    it.perr = (fabs(b0 * v0) + fabs(b1 * v1) + fabs(b2 * v2)) * (7.0f / 16777216.0f * 1.0001f);
+    float3 ng = normalize(cross(v1 - v0, v2 - v0));
+    it.ng = ng;
+    it.ns = ng;
+    it.uv = (float2)(b1, b2);
+    if (tri->flags & (LC_TRI_HAS_NORMALS | LC_TRI_HAS_UVS)) {
+      __global const lc_triangle_attr* a = &s->tri_attrs[hit->prim];
+      if (tri->flags & LC_TRI_HAS_NORMALS) {
+        float3 ns = b0 * lc_load3(a->n) + b1 * lc_load3(a->n + 3) + b2 * lc_load3(a->n + 6);
+        float len = length(ns);
+        if (len > 0.0f) {
+          ns /= len;
+          /* interpolated normals stay on the geometric side */
+          it.ns = dot(ns, ng) < 0.0f ? -ns : ns;
+        }
+      }
+      if (tri->flags & LC_TRI_HAS_UVS)
+        it.uv = (float2)(b0 * a->uv[0] + b1 * a->uv[2] + b2 * a->uv[4],
+                         b0 * a->uv[1] + b1 * a->uv[3] + b2 * a->uv[5]);
+    }
+    it.material = tri->material;
+    it.light = tri->light;
+  }
+  it.front = dot(ray.d, it.ng) < 0.0f;
+  if (!it.front) {
+    it.ng = -it.ng;
+    it.ns = -it.ns;
+  }
+  return it;
+}
+
+#endif

@@ -1,0 +1,157 @@
+#include "cl/context.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+
+#include "lucent/error.hpp"
+
+namespace lucent::cl_util {
+
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+std::string trim(std::string s) {
+  while (!s.empty() && (s.back() == '\0' || std::isspace(static_cast<unsigned char>(s.back()))))
+    s.pop_back();
+  size_t i = 0;
+  while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
+  return s.substr(i);
+}
+
+std::string type_name(cl_device_type t) {
+  if (t & CL_DEVICE_TYPE_GPU) return "GPU";
+  if (t & CL_DEVICE_TYPE_CPU) return "CPU";
+  if (t & CL_DEVICE_TYPE_ACCELERATOR) return "accelerator";
+  return "other";
+}
+
+const char kNoPlatform[] =
+    "no OpenCL platform found: install an OpenCL driver (Debian: pocl-opencl-icd for the CPU)";
+
+}  // namespace
+
+std::vector<Device> enumerate_devices() {
+  std::vector<cl::Platform> platforms;
+  try {
+    cl::Platform::get(&platforms);
+  } catch (const cl::Error& e) {
+    if (e.err() == -1001 || e.err() == CL_INVALID_VALUE) throw Error(kNoPlatform);
+    throw Error(describe(e));
+  }
+  if (platforms.empty()) throw Error(kNoPlatform);
+  std::vector<Device> out;
+  try {
+    for (auto& p : platforms) {
+      std::vector<cl::Device> devices;
+      try {
+        p.getDevices(CL_DEVICE_TYPE_ALL, &devices);
+      } catch (const cl::Error& e) {
+        if (e.err() == CL_DEVICE_NOT_FOUND) continue;
+        throw;
+      }
+      for (auto& d : devices) {
+        Device dev{p, d, {}};
+        DeviceInfo& i = dev.info;
+        i.index = static_cast<int>(out.size());
+        i.platform = trim(p.getInfo<CL_PLATFORM_NAME>());
+        i.name = trim(d.getInfo<CL_DEVICE_NAME>());
+        i.type = type_name(d.getInfo<CL_DEVICE_TYPE>());
+        i.vendor = trim(d.getInfo<CL_DEVICE_VENDOR>());
+        i.driver_version = trim(d.getInfo<CL_DRIVER_VERSION>());
+        i.opencl_c_version = trim(d.getInfo<CL_DEVICE_OPENCL_C_VERSION>());
+        i.compute_units = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
+        i.global_memory = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+        std::string ext = d.getInfo<CL_DEVICE_EXTENSIONS>();
+        i.fp64 = ext.find("cl_khr_fp64") != std::string::npos;
+        out.push_back(std::move(dev));
+      }
+    }
+  } catch (const cl::Error& e) {
+    throw Error(describe(e));
+  }
+  if (out.empty()) throw Error("no OpenCL device found on any platform");
+  return out;
+}
+
+Device pick_device(const std::string& selector_in) {
+  std::string selector = selector_in;
+  std::string origin = "--device";
+  if (selector.empty()) {
+    const char* env = std::getenv("LUCENT_DEVICE");
+    if (env && *env) {
+      selector = env;
+      origin = "LUCENT_DEVICE";
+    }
+  }
+  auto devices = enumerate_devices();
+  if (selector.empty()) {
+    for (auto& d : devices)
+      if (d.info.type == "GPU") return d;
+    for (auto& d : devices)
+      if (d.info.type == "CPU") return d;
+    return devices.front();
+  }
+  bool numeric = std::all_of(selector.begin(), selector.end(),
+                             [](unsigned char c) { return std::isdigit(c); });
+  if (numeric) {
+    long index = std::strtol(selector.c_str(), nullptr, 10);
+    if (index >= 0 && index < static_cast<long>(devices.size())) return devices[index];
+    throw Error(origin + " " + selector + ": no device with this index (" +
+                std::to_string(devices.size()) + " device(s); see `lucent devices`)");
+  }
+  std::string want = lower(selector);
+  for (auto& d : devices)
+    if (lower(d.info.name).find(want) != std::string::npos) return d;
+  throw Error(origin + " '" + selector + "': no device name contains it (see `lucent devices`)");
+}
+
+Context::Context(const std::string& selector) : device(pick_device(selector)) {
+  try {
+    context = cl::Context(device.device);
+    queue = cl::CommandQueue(context, device.device);
+  } catch (const cl::Error& e) {
+    throw Error(describe(e));
+  }
+}
+
+cl::Program build_program(const Context& ctx, const std::string& source, const std::string& options) {
+  cl::Program program;
+  try {
+    program = cl::Program(ctx.context, source);
+  } catch (const cl::Error& e) {
+    throw Error(describe(e));
+  }
+  try {
+    program.build({ctx.device.device}, options.c_str());
+  } catch (const cl::Error& e) {
+    std::string log;
+    try {
+      log = trim(program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(ctx.device.device));
+    } catch (const cl::Error&) {
+    }
+    std::string msg;
+    if (!log.empty()) msg = "kernel build log:\n" + log + "\n";
+    msg += describe(e);
+    throw Error(msg);
+  }
+  return program;
+}
+
+}  // namespace lucent::cl_util
+
+namespace lucent {
+
+std::vector<DeviceInfo> list_devices() {
+  std::vector<DeviceInfo> out;
+  for (auto& d : cl_util::enumerate_devices()) out.push_back(d.info);
+  return out;
+}
+
+DeviceInfo select_device(const std::string& selector) { return cl_util::pick_device(selector).info; }
+
+}  // namespace lucent

@@ -1,0 +1,35 @@
+#pragma once
+#include <string>
+#include <vector>
+
+#include "cl/opencl.hpp"
+#include "lucent/device.hpp"
+
+namespace lucent::cl_util {
+
+struct Device {
+  cl::Platform platform;
+  cl::Device device;
+  DeviceInfo info;
+};
+
+/// Every device of every platform, in `lucent devices` order. Throws lucent::Error.
+std::vector<Device> enumerate_devices();
+
+/// See lucent::select_device.
+Device pick_device(const std::string& selector);
+
+/// A context and an in-order queue on one device.
+struct Context {
+  Device device;
+  cl::Context context;
+  cl::CommandQueue queue;
+  explicit Context(const std::string& selector);
+};
+
+/// Builds `source` (already assembled, with #line markers) for the context's device. On a build
+/// failure throws lucent::Error holding the build log, whose lines name kernels/<file>:<line>,
+/// followed by "clBuildProgram: CL_BUILD_PROGRAM_FAILURE".
+cl::Program build_program(const Context& ctx, const std::string& source, const std::string& options);
+
+}  // namespace lucent::cl_util

@@ -1,0 +1,206 @@
+// lucent: the command-line front end. A thin layer over the library; every failure ends with one
+// line on stderr ("lucent: error: ...") and a non-zero exit status.
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/commands.hpp"
+#include "lucent/lucent.hpp"
+
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+
+extern "C" void on_sigint(int) { g_interrupted.store(true); }
+
+std::string format_duration(double s) {
+  char buf[32];
+  if (s < 60) {
+    std::snprintf(buf, sizeof buf, "%.1fs", s);
+  } else {
+    int m = static_cast<int>(s / 60);
+    std::snprintf(buf, sizeof buf, "%dm%02ds", m, static_cast<int>(s - 60 * m));
+  }
+  return buf;
+}
+
+std::string format_bytes(std::uint64_t b) {
+  char buf[32];
+  double g = double(b) / (1024.0 * 1024.0 * 1024.0);
+  if (g >= 1)
+    std::snprintf(buf, sizeof buf, "%.1f GiB", g);
+  else
+    std::snprintf(buf, sizeof buf, "%.0f MiB", double(b) / (1024.0 * 1024.0));
+  return buf;
+}
+
+/// Fails early (before rendering) when the output cannot be written.
+void check_output_path(const std::string& out) {
+  namespace fs = std::filesystem;
+  std::string ext = fs::path(out).extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".png" && ext != ".pfm" && ext != ".exr")
+    throw lucent::Error(out + ": unknown output format '" + ext + "' (use .png, .pfm or .exr)");
+  std::error_code ec;
+  if (fs::is_directory(out, ec)) throw lucent::Error(out + ": is a directory");
+  bool existed = fs::exists(out, ec);
+  errno = 0;
+  std::FILE* f = std::fopen(out.c_str(), "ab");
+  if (!f)
+    throw lucent::Error(out + ": cannot write output (" + std::string(std::strerror(errno)) + ")");
+  std::fclose(f);
+  if (!existed) fs::remove(out, ec);
+}
+
+int cmd_devices() {
+  auto devices = lucent::list_devices();
+  std::printf("%-3s %-28s %-40s %-5s %4s %10s  %-22s %s\n", "#", "platform", "device", "type", "CUs",
+              "memory", "OpenCL C", "fp64");
+  for (const auto& d : devices)
+    std::printf("%-3d %-28s %-40s %-5s %4u %10s  %-22s %s\n", d.index, d.platform.c_str(),
+                d.name.c_str(), d.type.c_str(), d.compute_units, format_bytes(d.global_memory).c_str(),
+                d.opencl_c_version.c_str(), d.fp64 ? "yes" : "no");
+  return 0;
+}
+
+struct RenderArgs {
+  std::string scene;
+  std::string output;
+  int spp = 0;
+  int width = 0;
+  int height = 0;
+  std::string device;
+  long long seed = -1;
+  double time_limit = 0;
+  std::string integrator;
+  bool quiet = false;
+};
+
+int cmd_render(const RenderArgs& a) {
+  check_output_path(a.output);
+  lucent::Scene scene = lucent::load_scene(a.scene);
+  if (a.width > 0) scene.film.width = a.width;
+  if (a.height > 0) scene.film.height = a.height;
+  if (a.seed >= 0) scene.integrator.seed = static_cast<std::uint32_t>(a.seed);
+  if (!a.integrator.empty()) scene.integrator.type = lucent::cli::parse_integrator(a.integrator);
+
+  lucent::RenderOptions opt;
+  opt.device = a.device;
+  opt.spp = a.spp;
+  opt.time_limit = a.time_limit;
+  opt.cancel = &g_interrupted;
+  const bool tty = isatty(STDERR_FILENO);
+  double last_print = -10;
+  bool printed = false;
+  if (!a.quiet) {
+    opt.on_progress = [&](const lucent::RenderProgress& p) {
+      if (p.elapsed < 1.0) return;  // short renders stay silent
+      if (!tty && p.elapsed - last_print < 2.0) return;
+      last_print = p.elapsed;
+      double frac = p.samples_target > 0 ? double(p.samples_done) / double(p.samples_target)
+                                         : (p.time_limit > 0 ? p.elapsed / p.time_limit : 0);
+      frac = std::min(1.0, frac);
+      double eta = frac > 0 ? p.elapsed * (1 - frac) / frac : 0;
+      std::fprintf(stderr, "%s%5.1f%%  %llu spp  %.2f Msamples/s  elapsed %s  ETA %s%s",
+                   tty ? "\r" : "", 100 * frac, static_cast<unsigned long long>(p.samples_done),
+                   p.samples_per_second * 1e-6, format_duration(p.elapsed).c_str(),
+                   format_duration(eta).c_str(), tty ? "   " : "\n");
+      std::fflush(stderr);
+      printed = true;
+    };
+  }
+  auto previous = std::signal(SIGINT, on_sigint);
+  lucent::RenderResult r = lucent::render(scene, opt);
+  std::signal(SIGINT, previous);
+  if (printed && tty) std::fprintf(stderr, "\n");
+
+  lucent::DisplaySettings display{scene.film.transfer, scene.film.gamma, scene.film.exposure,
+                                  scene.film.tonemap};
+  lucent::write_image(a.output, r.mean, display);
+  if (r.nonfinite > 0)
+    std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
+                 static_cast<unsigned long long>(r.nonfinite));
+  if (!a.quiet)
+    std::fprintf(stderr, "%s: %dx%d, %llu spp in %.2f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s) on %s\n",
+                 a.output.c_str(), scene.film.width, scene.film.height,
+                 static_cast<unsigned long long>(r.spp), r.seconds,
+                 r.seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / r.seconds * 1e-6 : 0,
+                 r.seconds > 0 ? double(r.rays) / r.seconds * 1e-6 : 0, r.build_seconds,
+                 r.device.c_str());
+  if (r.cancelled) {
+    std::fprintf(stderr, "lucent: interrupted: wrote %s with the %llu spp accumulated so far\n",
+                 a.output.c_str(), static_cast<unsigned long long>(r.spp));
+    return 130;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"lucent: a physically based OpenCL path tracer", "lucent"};
+  app.set_version_flag("--version", std::string("lucent ") + lucent::kVersion);
+  app.require_subcommand(1);
+
+  RenderArgs ra;
+  CLI::App* render = app.add_subcommand("render", "Render a JSON scene to an image");
+  render->add_option("scene", ra.scene, "Scene file (JSON)")->required();
+  render->add_option("-o,--output", ra.output, "Output image: .png (8-bit sRGB), .pfm or .exr (linear)")
+      ->required();
+  render->add_option("--spp", ra.spp, "Samples per pixel (default: the scene's integrator.spp)")
+      ->check(CLI::Range(1, 1 << 24));
+  render->add_option("--time", ra.time_limit, "Stop after this many seconds of rendering")
+      ->check(CLI::PositiveNumber);
+  render->add_option("--width", ra.width, "Image width (overrides the scene)")->check(CLI::Range(1, 16384));
+  render->add_option("--height", ra.height, "Image height (overrides the scene)")->check(CLI::Range(1, 16384));
+  render->add_option("--device", ra.device, "OpenCL device: index or name substring (env LUCENT_DEVICE)");
+  render->add_option("--seed", ra.seed, "Random seed (overrides the scene)")->check(CLI::Range(0LL, 0xffffffffLL));
+  render->add_option("--integrator", ra.integrator,
+                     "Override the integrator: path, whitted, direct, albedo, normal, depth, ao");
+  render->add_flag("-q,--quiet", ra.quiet, "No progress line or summary");
+
+  CLI::App* devices = app.add_subcommand("devices", "List OpenCL devices");
+
+  lucent::cli::register_extra_commands(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string msg = e.what();
+    for (auto& c : msg)
+      if (c == '\n') c = ' ';
+    std::fprintf(stderr, "lucent: error: %s (see lucent --help)\n", msg.c_str());
+    return 2;
+  }
+
+  try {
+    if (*render) return cmd_render(ra);
+    if (*devices) return cmd_devices();
+    return lucent::cli::run_extra_commands(app);
+  } catch (const lucent::Error& e) {
+    std::fprintf(stderr, "lucent: error: %s\n", e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "lucent: error: out of memory\n");
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lucent: error: %s\n", e.what());
+    return 1;
+  }
+}

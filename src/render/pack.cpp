@@ -1,0 +1,237 @@
+#include "render/pack.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "lucent/error.hpp"
+#include "scene/loaders.hpp"
+
+namespace lucent::render_detail {
+
+namespace {
+
+void put3(float* dst, const glm::dvec3& v) {
+  dst[0] = static_cast<float>(v.x);
+  dst[1] = static_cast<float>(v.y);
+  dst[2] = static_cast<float>(v.z);
+}
+
+double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+lc_uint material_type(MaterialType t) {
+  switch (t) {
+    case MaterialType::Mirror: return LC_MAT_MIRROR;
+    case MaterialType::Dielectric: return LC_MAT_DIELECTRIC;
+    case MaterialType::Conductor: return LC_MAT_CONDUCTOR;
+    case MaterialType::Plastic: return LC_MAT_PLASTIC;
+    default: return LC_MAT_DIFFUSE;
+  }
+}
+
+lc_uint integrator_type(IntegratorType t) {
+  switch (t) {
+    case IntegratorType::Whitted: return LC_INTEGRATOR_WHITTED;
+    case IntegratorType::Direct: return LC_INTEGRATOR_DIRECT;
+    case IntegratorType::Albedo: return LC_INTEGRATOR_ALBEDO;
+    case IntegratorType::Normal: return LC_INTEGRATOR_NORMAL;
+    case IntegratorType::Depth: return LC_INTEGRATOR_DEPTH;
+    case IntegratorType::Ao: return LC_INTEGRATOR_AO;
+    default: return LC_INTEGRATOR_PATH;
+  }
+}
+
+lc_uint filter_type(FilterType t) {
+  switch (t) {
+    case FilterType::Tent: return LC_FILTER_TENT;
+    case FilterType::Gaussian: return LC_FILTER_GAUSSIAN;
+    default: return LC_FILTER_BOX;
+  }
+}
+
+bool finite3(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+}  // namespace
+
+lc_camera pack_camera(const Camera& c, int width, int height) {
+  lc_camera cam{};
+  glm::dvec3 fwd = glm::normalize(c.look_at - c.position);
+  glm::dvec3 right = glm::normalize(glm::cross(fwd, c.up));
+  glm::dvec3 up = glm::cross(right, fwd);
+  if (c.roll_degrees != 0) {
+    glm::dmat4 r = glm::rotate(glm::dmat4(1.0), glm::radians(c.roll_degrees), fwd);
+    right = glm::dvec3(r * glm::dvec4(right, 0.0));
+    up = glm::dvec3(r * glm::dvec4(up, 0.0));
+  }
+  put3(cam.position, c.position);
+  put3(cam.right, right);
+  put3(cam.up, up);
+  put3(cam.forward, fwd);
+  cam.tan_half_fov = static_cast<float>(std::tan(glm::radians(c.fov_degrees) * 0.5));
+  cam.aspect = static_cast<float>(width) / static_cast<float>(height);
+  cam.lens_radius = static_cast<float>(c.aperture);
+  cam.focus_distance = static_cast<float>(
+      c.focus_distance > 0 ? c.focus_distance : glm::length(c.look_at - c.position));
+  return cam;
+}
+
+PackedScene pack_scene(const Scene& scene) {
+  PackedScene p;
+  lc_params& P = p.params;
+  P.camera = pack_camera(scene.camera, scene.film.width, scene.film.height);
+  P.width = static_cast<lc_uint>(scene.film.width);
+  P.height = static_cast<lc_uint>(scene.film.height);
+  P.seed = scene.integrator.seed;
+  P.max_depth = static_cast<lc_uint>(scene.integrator.max_depth);
+  P.rr_depth = static_cast<lc_uint>(scene.integrator.rr_depth);
+  P.integrator = integrator_type(scene.integrator.type);
+  P.filter = filter_type(scene.film.filter.type);
+  P.filter_radius = static_cast<float>(scene.film.filter.radius);
+  P.env_light = -1;
+
+  if (scene.materials.empty() && (!scene.spheres.empty() || !scene.triangles.empty()))
+    throw Error(scene.path + ": shapes need at least one material");
+  for (const Material& m : scene.materials) {
+    lc_material d{};
+    put3(d.albedo, m.albedo);
+    d.albedo_tex = m.albedo_texture;
+    put3(d.emission, m.emission);
+    d.type = material_type(m.type);
+    put3(d.specular, m.specular);
+    d.ior = static_cast<float>(m.ior);
+    d.roughness = static_cast<float>(m.roughness);
+    p.materials.push_back(d);
+  }
+
+  std::vector<double> power;
+  auto add_light = [&](lc_light l, double pw) {
+    p.lights.push_back(l);
+    power.push_back(std::max(0.0, pw));
+    return static_cast<lc_uint>(p.lights.size() - 1);
+  };
+
+  for (const Sphere& s : scene.spheres) {
+    lc_sphere d{};
+    put3(d.center, s.center);
+    d.radius = static_cast<float>(s.radius);
+    d.material = static_cast<lc_uint>(s.material);
+    d.light = LC_INVALID;
+    const Material& m = scene.materials[s.material];
+    if (m.emissive()) {
+      lc_light l{};
+      l.type = LC_LIGHT_SPHERE;
+      put3(l.position, s.center);
+      put3(l.intensity, m.emission);
+      l.prim = static_cast<lc_uint>(p.spheres.size());
+      l.area = static_cast<float>(4 * M_PI * s.radius * s.radius);
+      l.texture = -1;
+      d.light = add_light(l, luminance(m.emission) * M_PI * l.area);
+    }
+    p.spheres.push_back(d);
+  }
+
+  for (size_t i = 0; i < scene.triangles.size(); ++i) {
+    const Triangle& t = scene.triangles[i];
+    glm::dvec3 v[3] = {scene.positions[t.v[0]], scene.positions[t.v[1]], scene.positions[t.v[2]]};
+    double area = 0.5 * glm::length(glm::cross(v[1] - v[0], v[2] - v[0]));
+    if (!finite3(v[0]) || !finite3(v[1]) || !finite3(v[2]) || !(area > 0) || !std::isfinite(area)) {
+      ++p.skipped_triangles;
+      continue;
+    }
+    lc_triangle d{};
+    put3(d.v0, v[0]);
+    put3(d.v1, v[1]);
+    put3(d.v2, v[2]);
+    d.material = static_cast<lc_uint>(t.material);
+    d.light = LC_INVALID;
+    lc_triangle_attr a{};
+    bool has_n = t.n[0] >= 0 && t.n[1] >= 0 && t.n[2] >= 0;
+    bool has_uv = t.uv[0] >= 0 && t.uv[1] >= 0 && t.uv[2] >= 0;
+    for (int k = 0; k < 3; ++k) {
+      if (has_n) put3(a.n + 3 * k, scene.normals[t.n[k]]);
+      if (has_uv) {
+        a.uv[2 * k] = static_cast<float>(scene.uvs[t.uv[k]].x);
+        a.uv[2 * k + 1] = static_cast<float>(scene.uvs[t.uv[k]].y);
+      }
+    }
+    d.flags = (has_n ? LC_TRI_HAS_NORMALS : 0u) | (has_uv ? LC_TRI_HAS_UVS : 0u);
+    const Material& m = scene.materials[t.material];
+    if (m.emissive()) {
+      lc_light l{};
+      l.type = LC_LIGHT_TRIANGLE;
+      put3(l.intensity, m.emission);
+      l.prim = static_cast<lc_uint>(p.triangles.size());
+      l.area = static_cast<float>(area);
+      l.texture = -1;
+      d.light = add_light(l, luminance(m.emission) * M_PI * area);
+    }
+    p.triangles.push_back(d);
+    p.tri_attrs.push_back(a);
+  }
+  if (p.skipped_triangles > 0)
+    scene_detail::warn(scene.path + ": skipped " + std::to_string(p.skipped_triangles) +
+                       " degenerate or non-finite triangle(s)");
+
+  p.bvh = bvh::build(p.triangles, p.spheres);
+
+  // scene radius, for the power of environment lights
+  double radius = 1;
+  if (!p.bvh.nodes.empty()) {
+    const lc_bvh_node& r = p.bvh.nodes[0];
+    glm::dvec3 d(r.bmax[0] - r.bmin[0], r.bmax[1] - r.bmin[1], r.bmax[2] - r.bmin[2]);
+    radius = std::max(1e-6, 0.5 * glm::length(d));
+  }
+  for (const Light& l : scene.lights) {
+    lc_light d{};
+    d.texture = -1;
+    d.prim = LC_INVALID;
+    if (l.type == LightType::Point) {
+      d.type = LC_LIGHT_POINT;
+      put3(d.position, l.position);
+      put3(d.intensity, l.intensity);
+      add_light(d, luminance(l.intensity) * 4 * M_PI);
+    } else {
+      d.type = l.type == LightType::Environment ? LC_LIGHT_ENV : LC_LIGHT_ENV_MAP;
+      put3(d.intensity, l.radiance);
+      d.texture = l.texture;
+      if (l.type == LightType::Environment) put3(P.env_radiance, l.radiance);
+      P.env_light = static_cast<lc_int>(add_light(d, luminance(l.radiance) * M_PI * 4 * M_PI * radius * radius));
+    }
+  }
+  double total = 0;
+  for (double w : power) total += w;
+  double acc = 0;
+  for (size_t i = 0; i < p.lights.size(); ++i) {
+    double pdf = total > 0 ? power[i] / total : 1.0 / p.lights.size();
+    p.lights[i].pdf_select = static_cast<float>(pdf);
+    acc += pdf;
+    p.light_cdf.push_back(static_cast<float>(acc));
+  }
+  if (!p.light_cdf.empty()) p.light_cdf.back() = 1.0f;
+
+  for (const Texture& t : scene.textures) {
+    lc_texture d{};
+    d.offset = static_cast<lc_uint>(p.texels.size());
+    d.width = static_cast<lc_uint>(t.width);
+    d.height = static_cast<lc_uint>(t.height);
+    p.textures.push_back(d);
+    for (size_t i = 0; i + 3 < t.rgba.size(); i += 4)
+      p.texels.push_back({t.rgba[i], t.rgba[i + 1], t.rgba[i + 2], t.rgba[i + 3]});
+  }
+
+  P.num_triangles = static_cast<lc_uint>(p.triangles.size());
+  P.num_spheres = static_cast<lc_uint>(p.spheres.size());
+  P.num_lights = static_cast<lc_uint>(p.lights.size());
+  P.num_nodes = static_cast<lc_uint>(p.bvh.nodes.size());
+  return p;
+}
+
+std::string feature_defines(const Scene& scene, const PackedScene& packed) {
+  std::string d;
+  if (!packed.textures.empty()) d += " -D LC_HAS_TEXTURES";
+  (void)scene;
+  return d;
+}
+
+}  // namespace lucent::render_detail

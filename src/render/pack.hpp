@@ -1,0 +1,36 @@
+#pragma once
+// Scene -> device buffers: the float, 16-byte aligned layout of kernels/shared/types.h.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "bvh/bvh.hpp"
+#include "lucent/scene.hpp"
+#include "shared/types.h"
+
+namespace lucent::render_detail {
+
+struct PackedScene {
+  lc_params params{};
+  std::vector<lc_triangle> triangles;
+  std::vector<lc_triangle_attr> tri_attrs;
+  std::vector<lc_sphere> spheres;
+  std::vector<lc_material> materials;
+  std::vector<lc_light> lights;
+  std::vector<float> light_cdf;  ///< cumulative selection probabilities, last = 1
+  std::vector<lc_texture> textures;
+  std::vector<std::array<float, 4>> texels;
+  bvh::Bvh bvh;
+  std::size_t skipped_triangles = 0;  ///< degenerate or non-finite, left out with a warning
+};
+
+/// The camera basis (right, up, forward, with roll applied) as the kernel uses it.
+lc_camera pack_camera(const Camera& camera, int width, int height);
+
+/// Converts and validates the scene, builds the BVH and the light table.
+PackedScene pack_scene(const Scene& scene);
+
+/// OpenCL build options (-D LC_HAS_...) for the features the packed scene uses.
+std::string feature_defines(const Scene& scene, const PackedScene& packed);
+
+}  // namespace lucent::render_detail

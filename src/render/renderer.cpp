@@ -1,0 +1,166 @@
+// The kernel renderer: packs the scene into OpenCL buffers, builds the megakernel for the
+// scene's features and launches progressive passes, accumulating in double on the host.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "cl/context.hpp"
+#include "cl/kernel_source.hpp"
+#include "lucent/error.hpp"
+#include "lucent/render.hpp"
+#include "render/pack.hpp"
+
+namespace lucent {
+
+namespace {
+
+constexpr size_t kWorkGroupSize = 64;  // fixed: each new size costs PoCL a work-group compile
+
+template <typename T>
+cl::Buffer make_buffer(const cl::Context& ctx, const std::vector<T>& v) {
+  // OpenCL forbids empty buffers: keep one zeroed element
+  size_t bytes = std::max<size_t>(1, v.size()) * sizeof(T);
+  cl::Buffer b(ctx, CL_MEM_READ_ONLY, bytes);
+  return b;
+}
+
+template <typename T>
+void upload(cl::CommandQueue& q, cl::Buffer& b, const std::vector<T>& v) {
+  if (!v.empty()) q.enqueueWriteBuffer(b, CL_FALSE, 0, v.size() * sizeof(T), v.data());
+}
+
+}  // namespace
+
+RenderResult render(const Scene& scene, const RenderOptions& options) {
+  using clock = std::chrono::steady_clock;
+  render_detail::PackedScene packed = render_detail::pack_scene(scene);
+  cl_util::Context ctx(options.device);
+  RenderResult result;
+  result.device = ctx.device.info.name;
+  const int width = scene.film.width, height = scene.film.height;
+  const size_t npix = static_cast<size_t>(width) * height;
+  const std::uint64_t target_spp =
+      options.spp > 0 ? static_cast<std::uint64_t>(options.spp)
+                      : (options.time_limit > 0 ? 0 : static_cast<std::uint64_t>(scene.integrator.spp));
+
+  auto tb = clock::now();
+  std::string source = detail::assemble_kernel_source("megakernel.cl");
+  std::string build_options = "-cl-std=CL1.2" + render_detail::feature_defines(scene, packed);
+  cl::Program program = cl_util::build_program(ctx, source, build_options);
+  result.build_seconds = std::chrono::duration<double>(clock::now() - tb).count();
+
+  std::vector<double> sum(npix * 3, 0.0), sumsq(npix * 3, 0.0);
+  std::vector<std::uint32_t> count(npix, 0);
+  try {
+    cl::Kernel kernel(program, "lucent_render");
+    cl::CommandQueue& q = ctx.queue;
+    std::vector<lc_params> params_v{packed.params};
+    cl::Buffer b_params = make_buffer(ctx.context, params_v);
+    cl::Buffer b_nodes = make_buffer(ctx.context, packed.bvh.nodes);
+    cl::Buffer b_refs = make_buffer(ctx.context, packed.bvh.prim_refs);
+    cl::Buffer b_tris = make_buffer(ctx.context, packed.triangles);
+    cl::Buffer b_attrs = make_buffer(ctx.context, packed.tri_attrs);
+    cl::Buffer b_spheres = make_buffer(ctx.context, packed.spheres);
+    cl::Buffer b_mats = make_buffer(ctx.context, packed.materials);
+    cl::Buffer b_lights = make_buffer(ctx.context, packed.lights);
+    cl::Buffer b_cdf = make_buffer(ctx.context, packed.light_cdf);
+    cl::Buffer b_tex = make_buffer(ctx.context, packed.textures);
+    cl::Buffer b_texels = make_buffer(ctx.context, packed.texels);
+    cl::Buffer b_sum(ctx.context, CL_MEM_WRITE_ONLY, npix * sizeof(cl_float4));
+    cl::Buffer b_sumsq(ctx.context, CL_MEM_WRITE_ONLY, npix * sizeof(cl_float4));
+    cl::Buffer b_counters(ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
+    upload(q, b_nodes, packed.bvh.nodes);
+    upload(q, b_refs, packed.bvh.prim_refs);
+    upload(q, b_tris, packed.triangles);
+    upload(q, b_attrs, packed.tri_attrs);
+    upload(q, b_spheres, packed.spheres);
+    upload(q, b_mats, packed.materials);
+    upload(q, b_lights, packed.lights);
+    upload(q, b_cdf, packed.light_cdf);
+    upload(q, b_tex, packed.textures);
+    upload(q, b_texels, packed.texels);
+    int arg = 0;
+    for (cl::Buffer* b : {&b_params, &b_nodes, &b_refs, &b_tris, &b_attrs, &b_spheres, &b_mats,
+                          &b_lights, &b_cdf, &b_tex, &b_texels, &b_sum, &b_sumsq, &b_counters})
+      kernel.setArg(arg++, *b);
+
+    const size_t global = (npix + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
+    std::vector<cl_float4> h_sum(npix), h_sumsq(npix);
+    std::uint64_t done = 0;
+    std::uint32_t pass_spp = 1;
+    double render_seconds = 0;
+    auto t_start = clock::now();
+    for (;;) {
+      if (target_spp > 0 && done >= target_spp) break;
+      if (options.time_limit > 0 && render_seconds >= options.time_limit && done > 0) break;
+      if (options.cancel && options.cancel->load() && done > 0) {
+        result.cancelled = true;
+        break;
+      }
+      std::uint32_t n = pass_spp;
+      if (target_spp > 0) n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, target_spp - done));
+      lc_params P = packed.params;
+      P.sample_offset = static_cast<lc_uint>(done);
+      P.samples_per_pass = n;
+      lc_uint zero[LC_COUNTER_COUNT] = {0, 0, 0, 0};
+      auto tp = clock::now();
+      q.enqueueWriteBuffer(b_params, CL_FALSE, 0, sizeof(P), &P);
+      q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(zero), zero);
+      q.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(kWorkGroupSize));
+      q.enqueueReadBuffer(b_sum, CL_FALSE, 0, npix * sizeof(cl_float4), h_sum.data());
+      q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, npix * sizeof(cl_float4), h_sumsq.data());
+      lc_uint counters[LC_COUNTER_COUNT];
+      q.enqueueReadBuffer(b_counters, CL_TRUE, 0, sizeof(counters), counters);
+      double pass_time = std::chrono::duration<double>(clock::now() - tp).count();
+      render_seconds += pass_time;
+      for (size_t i = 0; i < npix; ++i) {
+        for (int c = 0; c < 3; ++c) {
+          sum[i * 3 + c] += h_sum[i].s[c];
+          sumsq[i * 3 + c] += h_sumsq[i].s[c];
+        }
+        count[i] += static_cast<std::uint32_t>(h_sum[i].s[3]);
+      }
+      result.nonfinite += counters[LC_COUNTER_NONFINITE];
+      result.rays += counters[LC_COUNTER_RAYS];
+      done += n;
+      // next pass: aim at pass_seconds per launch
+      double per_spp = pass_time / n;
+      double want = per_spp > 0 ? options.pass_seconds / per_spp : 2.0 * n;
+      pass_spp = static_cast<std::uint32_t>(std::clamp(want, 1.0, std::min(4.0 * n, 65536.0)));
+      if (options.time_limit > 0 && per_spp > 0) {
+        double left = options.time_limit - render_seconds;
+        pass_spp = static_cast<std::uint32_t>(std::clamp(left / per_spp, 1.0, double(pass_spp)));
+      }
+      if (options.on_progress) {
+        RenderProgress pr;
+        pr.samples_done = done;
+        pr.samples_target = target_spp;
+        pr.elapsed = std::chrono::duration<double>(clock::now() - t_start).count();
+        pr.time_limit = options.time_limit;
+        pr.samples_per_second = render_seconds > 0 ? double(done) * npix / render_seconds : 0;
+        options.on_progress(pr);
+      }
+    }
+    result.spp = done;
+    result.seconds = render_seconds;
+  } catch (const cl::Error& e) {
+    throw Error(cl_util::describe(e));
+  }
+
+  result.mean = Image{width, height, std::vector<float>(npix * 3)};
+  result.variance = Image{width, height, std::vector<float>(npix * 3)};
+  result.samples = count;
+  for (size_t i = 0; i < npix; ++i) {
+    double n = count[i];
+    for (int c = 0; c < 3; ++c) {
+      double s = sum[i * 3 + c], s2 = sumsq[i * 3 + c];
+      double mean = n > 0 ? s / n : 0;
+      double var = n > 1 ? std::max(0.0, (s2 - s * mean) / (n - 1)) : 0;
+      result.mean.rgb[i * 3 + c] = static_cast<float>(mean);
+      result.variance.rgb[i * 3 + c] = static_cast<float>(var);
+    }
+  }
+  return result;
+}
+
+}  // namespace lucent

@@ -1,0 +1,29 @@
+#pragma once
+// Internal scene loading pieces: OBJ/MTL meshes and textures, called by the JSON loader.
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "lucent/scene.hpp"
+
+namespace lucent::scene_detail {
+
+/// Warnings go through this hook (stderr by default) so tests can capture them.
+void warn(const std::string& message);
+void set_warning_sink(void (*sink)(const std::string&));
+
+/// Loads an OBJ file (and its MTL) into `scene`: positions, normals and UVs are transformed by
+/// `transform` (normals by its inverse transpose; a mirroring transform keeps faces' orientation)
+/// and appended to the scene's triangle list. When `material_override` >= 0 every face uses it;
+/// otherwise MTL materials become scene materials named "<obj file name>:<mtl name>" and faces
+/// without one use a default diffuse material. Missing MTL or texture files give a warning naming
+/// the file and fall back. Throws lucent::Error naming the file (and line) of a parse error.
+void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform,
+              int material_override);
+
+/// Loads an image (PNG, JPG, BMP, TGA: 8-bit decoded from sRGB to linear; HDR, PFM, EXR kept
+/// linear) as a scene texture, reusing an already loaded one with the same path. Returns its
+/// index. Throws lucent::Error naming the file when it cannot be read.
+int load_texture(Scene& scene, const std::string& path);
+
+}  // namespace lucent::scene_detail
