@@ -46,6 +46,7 @@ struct Integrator {
   int rr_depth = 4;       ///< Russian roulette from this depth
   int spp = 16;
   std::uint32_t seed = 0;
+  double ao_distance = 0;  ///< ambient occlusion ray length; 0: unbounded
 };
 
 enum class MaterialType { Diffuse, Mirror, Dielectric, Conductor, Plastic };

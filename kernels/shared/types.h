@@ -192,7 +192,7 @@ typedef struct LC_ALIGN16 lc_params {
   lc_int env_light;          /* index of the environment light or -1              */
   lc_uint filter;            /* LC_FILTER_*                                        */
   float filter_radius;       /* in pixels                                          */
-  float ray_epsilon_scale;   /* reserved                                           */
+  float ao_distance;         /* ambient occlusion ray length (INFINITY: unbounded) */
   lc_uint flags;
 } lc_params; /* total: 144 bytes */
 LC_STATIC_ASSERT(sizeof(lc_params) == 144, params_size);

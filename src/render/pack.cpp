@@ -89,6 +89,8 @@ PackedScene pack_scene(const Scene& scene) {
   P.filter = filter_type(scene.film.filter.type);
   P.filter_radius = static_cast<float>(scene.film.filter.radius);
   P.env_light = -1;
+  P.ao_distance = scene.integrator.ao_distance > 0 ? static_cast<float>(scene.integrator.ao_distance)
+                                                   : INFINITY;
 
   if (scene.materials.empty() && (!scene.spheres.empty() || !scene.triangles.empty()))
     throw Error(scene.path + ": shapes need at least one material");

@@ -237,7 +237,7 @@ class Parser {
   }
 
   void parse_integrator(const json& j, const std::string& p, Integrator& in) {
-    check_keys(j, p, {"type", "max_depth", "rr_depth", "spp", "seed"});
+    check_keys(j, p, {"type", "max_depth", "rr_depth", "spp", "seed", "ao_distance"});
     if (j.contains("type")) {
       std::string t = choice(j["type"], p + "/type",
                              {"path", "whitted", "direct", "albedo", "normal", "depth", "ao"});
@@ -250,6 +250,7 @@ class Parser {
     if (j.contains("spp")) in.spp = static_cast<int>(integer(j["spp"], p + "/spp", 1, 1 << 24));
     if (j.contains("seed"))
       in.seed = static_cast<std::uint32_t>(integer(j["seed"], p + "/seed", 0, 0xffffffffL));
+    if (j.contains("ao_distance")) in.ao_distance = positive(j["ao_distance"], p + "/ao_distance");
   }
 
   static IntegratorType parse_integrator_type(const std::string& t) {
