@@ -11,6 +11,10 @@
 #include "film/texture.cl"
 #include "film/filter.cl"
 #include "camera/camera.cl"
+#include "bsdf/fresnel.cl"
+#include "bsdf/microfacet.cl"
+#include "bsdf/bsdf.cl"
+#include "light/light.cl"
 #include "integrator/path.cl"
 
 __kernel void lucent_render(__global const lc_params* params, __global const lc_bvh_node* nodes,
@@ -43,20 +47,25 @@ __kernel void lucent_render(__global const lc_params* params, __global const lc_
   float3 sum = (float3)(0.0f), sumsq = (float3)(0.0f);
   lc_uint accepted = 0, nonfinite = 0, rays = 0;
   for (lc_uint k = 0; k < params->samples_per_pass; ++k) {
-    lc_uint sample = params->sample_offset + k;
-    lc_uint seed = params->seed;
-    float2 off = filter_sample(params->filter, params->filter_radius,
-                               lc_rand(gid, sample, LC_DIM_FILTER, seed),
-                               lc_rand(gid, sample, LC_DIM_FILTER + 1, seed));
+    lc_rng rng;
+    rng.pixel = gid;
+    rng.sample = params->sample_offset + k;
+    rng.seed = params->seed;
+    float2 off = filter_sample(params->filter, params->filter_radius, lc_rand(&rng, LC_DIM_FILTER),
+                               lc_rand(&rng, LC_DIM_FILTER + 1));
     lc_ray ray = camera_generate_ray(&params->camera, (float)px + 0.5f + off.x,
                                      (float)py + 0.5f + off.y, width, height,
-                                     lc_rand(gid, sample, LC_DIM_LENS, seed),
-                                     lc_rand(gid, sample, LC_DIM_LENS + 1, seed));
+                                     lc_rand(&rng, LC_DIM_LENS), lc_rand(&rng, LC_DIM_LENS + 1));
     float3 L;
-    if (params->integrator == LC_INTEGRATOR_DIRECT)
+    lc_uint integrator = params->integrator;
+    if (integrator == LC_INTEGRATOR_PATH)
+      L = integrator_path(&s, ray, &rng, &rays);
+    else if (integrator == LC_INTEGRATOR_WHITTED)
+      L = integrator_whitted(&s, ray, &rays);
+    else if (integrator == LC_INTEGRATOR_DIRECT)
       L = integrator_direct(&s, ray, &rays);
     else
-      L = integrator_path(&s, ray, gid, sample, &rays);
+      L = integrator_aov(&s, ray, &rng, &rays);
     if (lc_isfinite3(L)) {
       sum += L;
       sumsq += L * L;

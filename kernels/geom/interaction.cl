@@ -64,6 +64,8 @@ static inline lc_interaction interaction_from_hit(const lc_scene* s, lc_ray ray,
     it.ng = -it.ng;
     it.ns = -it.ns;
   }
+  /* an interpolated normal facing away from the viewer: fall back to the geometric one */
+  if (dot(ray.d, it.ns) >= 0.0f) it.ns = it.ng;
   return it;
 }
 

@@ -1,21 +1,57 @@
-/* lucent kernel: integrators. One work-item computes the radiance of one camera sample. */
+/* lucent kernel: integrators (docs/rendering-model.md). One call computes the radiance of one
+ * camera sample; random numbers come from lc_rand(pixel, sample, dimension) with the dimension
+ * layout of shared/rng.h. */
 #ifndef LUCENT_INTEGRATOR_PATH_CL
 #define LUCENT_INTEGRATOR_PATH_CL
 
-static inline float lc_rand(lc_uint pixel, lc_uint sample, lc_uint dim, lc_uint seed) {
-  return lc_rng_uniform(pixel, sample, dim, seed);
+typedef struct {
+  lc_uint pixel, sample, seed;
+} lc_rng;
+
+static inline float lc_rand(const lc_rng* r, lc_uint dim) {
+  return lc_rng_uniform(r->pixel, r->sample, dim, r->seed);
 }
 
-static inline float3 material_albedo(const lc_scene* s, __global const lc_material* m, float2 uv) {
-  float3 a = lc_load3(m->albedo);
-#ifdef LC_HAS_TEXTURES
-  if (m->albedo_tex >= 0) a = texture_lookup(s, m->albedo_tex, uv).xyz;
-#endif
-  return a;
+/* Power heuristic with beta = 2. */
+static inline float mis_power(float a, float b) {
+  if (isinf(a)) return 1.0f;
+  float a2 = a * a, b2 = b * b;
+  return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
 }
 
-/* Direct light from every point light at it, for a Lambertian surface of albedo a. */
-static inline float3 light_point_direct(const lc_scene* s, const lc_interaction* it, float3 albedo) {
+/* Local shading frame around n. */
+typedef struct {
+  float3 t, b, n;
+} lc_frame;
+static inline lc_frame frame_from(float3 n) {
+  lc_frame f;
+  f.n = n;
+  lc_onb(n, &f.t, &f.b);
+  return f;
+}
+static inline float3 frame_to_local(const lc_frame* f, float3 v) {
+  return (float3)(dot(v, f->t), dot(v, f->b), dot(v, f->n));
+}
+static inline float3 frame_to_world(const lc_frame* f, float3 v) {
+  return v.x * f->t + v.y * f->b + v.z * f->n;
+}
+
+/* Unoccluded test between a surface point and a sampled light point (or direction). */
+static inline int shadow_visible(const lc_scene* s, const lc_interaction* it, float3 wi, float dist,
+                                 lc_uint* rays) {
+  lc_ray sr;
+  sr.o = lc_spawn_origin(it->p, it->perr, dot(wi, it->ng) > 0.0f ? it->ng : -it->ng);
+  sr.d = wi;
+  ++*rays;
+  /* stop short of the light's own surface by its position error (relative) */
+  float tmax = isinf(dist) ? INFINITY : dist * (1.0f - 2e-4f);
+  return !scene_occluded(s, sr, tmax);
+}
+
+/* Sum over point lights of f * cos * I / r^2 (direct and whitted integrators). With diffuse_only
+ * the BSDF is albedo / pi (whitted's diffuse term). */
+static inline float3 point_lights_direct(const lc_scene* s, const lc_interaction* it, const lc_bsdf* b,
+                                         const lc_frame* fr, float3 wo_l, int diffuse_only, lc_uint* rays) {
   float3 sum = (float3)(0.0f);
   __global const lc_params* P = s->params;
   for (lc_uint i = 0; i < P->num_lights; ++i) {
@@ -25,72 +61,213 @@ static inline float3 light_point_direct(const lc_scene* s, const lc_interaction*
     float d2 = dot(to, to);
     float dist = sqrt(d2);
     float3 wi = to / dist;
-    float cos_s = dot(wi, it->ns);
-    if (cos_s <= 0.0f || dot(wi, it->ng) <= 0.0f) continue;
+    if (dot(wi, it->ng) <= 0.0f) continue;
+    float3 wi_l = frame_to_local(fr, wi);
+    if (wi_l.z <= 0.0f) continue;
+    float3 f;
+    if (diffuse_only) {
+      f = b->albedo * LC_INV_PI;
+    } else {
+      float pdf;
+      f = bsdf_eval(b, wo_l, wi_l, &pdf);
+    }
+    if (lc_max3(f) <= 0.0f) continue;
     lc_ray sr;
     sr.o = lc_spawn_origin(it->p, it->perr, it->ng);
     sr.d = wi;
+    ++*rays;
     if (scene_occluded(s, sr, dist)) continue;
-    sum += lc_load3(L->intensity) * (cos_s / d2);
+    sum += f * lc_load3(L->intensity) * (wi_l.z / d2);
   }
-  return albedo * LC_INV_PI * sum;
+  return sum;
 }
 
-static inline float3 integrator_path(const lc_scene* s, lc_ray ray, lc_uint pixel, lc_uint sample,
-                                     lc_uint* rays) {
+static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng* rng, lc_uint* rays) {
   __global const lc_params* P = s->params;
   float3 L = (float3)(0.0f), beta = (float3)(1.0f);
+  float prev_pdf = 0.0f;
+  int prev_delta = 1; /* the camera ray: emitters count fully */
+  float3 prev_p = ray.o;
   for (lc_uint depth = 0;; ++depth) {
     lc_hit hit;
     ++*rays;
     if (!scene_intersect(s, ray, INFINITY, &hit)) {
-      L += beta * lc_load3(P->env_radiance);
+      float pdf_l;
+      float3 Le = env_radiance(s, ray.d, &pdf_l);
+      L += beta * Le * (prev_delta ? 1.0f : mis_power(prev_pdf, pdf_l));
       break;
     }
     lc_interaction it = interaction_from_hit(s, ray, &hit);
     __global const lc_material* m = &s->materials[it.material];
-    if (it.front) L += beta * lc_load3(m->emission);
-    if (depth + 1 >= P->max_depth) break;
-    lc_uint dim = LC_DIM_BOUNCE + depth * LC_DIMS_PER_BOUNCE;
-    float3 albedo = material_albedo(s, m, it.uv);
-    if (m->type == LC_MAT_MIRROR) {
-      beta *= lc_load3(m->specular);
-      ray.d = ray.d - 2.0f * dot(ray.d, it.ns) * it.ns;
-      ray.o = lc_spawn_origin(it.p, it.perr, it.ng);
-    } else {
-      L += beta * light_point_direct(s, &it, albedo);
-      *rays += P->num_lights;
-      float u1 = lc_rand(pixel, sample, dim + LC_DIM_BSDF_UV, P->seed);
-      float u2 = lc_rand(pixel, sample, dim + LC_DIM_BSDF_UV + 1, P->seed);
-      float r = sqrt(u1), phi = 2.0f * LC_PI * u2;
-      float3 t, b;
-      lc_onb(it.ns, &t, &b);
-      float3 wi = r * cos(phi) * t + r * sin(phi) * b + sqrt(fmax(0.0f, 1.0f - u1)) * it.ns;
-      if (dot(wi, it.ng) <= 0.0f) break;
-      beta *= albedo; /* cosine-weighted sampling: f cos / pdf = albedo */
-      ray.o = lc_spawn_origin(it.p, it.perr, it.ng);
-      ray.d = normalize(wi);
+    if (it.front && it.light != LC_INVALID) {
+      float3 Le = lc_load3(m->emission);
+      float w = 1.0f;
+      if (!prev_delta) {
+        float pdf_l = light_pdf_area(s, it.light, prev_p, hit.t, dot(-ray.d, it.ng));
+        w = mis_power(prev_pdf, pdf_l);
+      }
+      L += beta * Le * w;
     }
-    if (depth + 1 >= P->rr_depth) {
+    if (depth + 2 > P->max_depth) break;
+    lc_uint dim = LC_DIM_BOUNCE + depth * LC_DIMS_PER_BOUNCE;
+    lc_bsdf b = bsdf_from_material(s, m, it.uv);
+    lc_frame fr = frame_from(it.ns);
+    float3 wo_l = frame_to_local(&fr, -ray.d);
+    if (wo_l.z <= 0.0f) break;
+
+    /* next-event estimation */
+    if (!bsdf_is_delta(&b) && P->num_lights > 0) {
+      lc_light_sample ls;
+      if (light_sample(s, it.p, lc_rand(rng, dim + LC_DIM_LIGHT_SELECT),
+                       lc_rand(rng, dim + LC_DIM_LIGHT_UV), lc_rand(rng, dim + LC_DIM_LIGHT_UV + 1), &ls) &&
+          ls.pdf > 0.0f && dot(ls.wi, it.ng) > 0.0f) {
+        float3 wi_l = frame_to_local(&fr, ls.wi);
+        float pdf_b;
+        float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf_b);
+        if (lc_max3(f) > 0.0f && shadow_visible(s, &it, ls.wi, ls.dist, rays)) {
+          float w = ls.delta ? 1.0f : mis_power(ls.pdf, pdf_b);
+          L += beta * f * ls.L * (wi_l.z * w / ls.pdf);
+        }
+      }
+    }
+
+    /* continue the path */
+    lc_bsdf_sample bs;
+    if (!bsdf_sample(&b, wo_l, it.front, lc_rand(rng, dim + LC_DIM_BSDF_LOBE),
+                     lc_rand(rng, dim + LC_DIM_BSDF_UV), lc_rand(rng, dim + LC_DIM_BSDF_UV + 1), &bs))
+      break;
+    float3 wi = normalize(frame_to_world(&fr, bs.wi));
+    int transmit = bs.wi.z < 0.0f;
+    float side = dot(wi, it.ng);
+    if (transmit ? side >= 0.0f : side <= 0.0f) break; /* shading normal leak: drop */
+    beta *= bs.weight;
+    if (!(lc_max3(beta) > 0.0f)) break;
+    prev_delta = bs.delta;
+    prev_pdf = bs.pdf;
+    prev_p = it.p;
+    ray.o = lc_spawn_origin(it.p, it.perr, transmit ? -it.ng : it.ng);
+    ray.d = wi;
+    if (depth + 2 > P->rr_depth) {
       float q = fmin(0.95f, lc_max3(beta));
-      if (lc_rand(pixel, sample, dim + LC_DIM_RR, P->seed) >= q) break;
+      if (lc_rand(rng, dim + LC_DIM_RR) >= q) break;
       beta /= q;
     }
   }
   return L;
 }
 
-/* First-renders integrator: direct light from point lights plus visible emission, no bounces. */
-static inline float3 integrator_direct(const lc_scene* s, lc_ray ray, lc_uint* rays) {
+#define LC_WHITTED_STACK 32
+
+typedef struct {
+  lc_ray ray;
+  float3 w;
+  lc_uint segments; /* segments of the path including this ray */
+} lc_whitted_entry;
+
+/* Deterministic recursive ray tracing with an explicit stack (depth-first; at most one pending
+ * sibling per level, so LC_WHITTED_STACK bounds max_depth). */
+static inline float3 integrator_whitted(const lc_scene* s, lc_ray ray, lc_uint* rays) {
   __global const lc_params* P = s->params;
+  lc_whitted_entry stack[LC_WHITTED_STACK];
+  int sp = 0;
+  stack[sp].ray = ray;
+  stack[sp].w = (float3)(1.0f);
+  stack[sp].segments = 1;
+  ++sp;
+  float3 L = (float3)(0.0f);
+  while (sp > 0) {
+    lc_whitted_entry e = stack[--sp];
+    lc_hit hit;
+    ++*rays;
+    if (!scene_intersect(s, e.ray, INFINITY, &hit)) {
+      float pdf;
+      L += e.w * env_radiance(s, e.ray.d, &pdf);
+      continue;
+    }
+    lc_interaction it = interaction_from_hit(s, e.ray, &hit);
+    __global const lc_material* m = &s->materials[it.material];
+    if (it.front) L += e.w * lc_load3(m->emission);
+    lc_bsdf b = bsdf_from_material(s, m, it.uv);
+    lc_frame fr = frame_from(it.ns);
+    float3 wo_l = frame_to_local(&fr, -e.ray.d);
+    if (b.type == LC_MAT_DIFFUSE || b.type == LC_MAT_PLASTIC)
+      L += e.w * point_lights_direct(s, &it, &b, &fr, wo_l, 1, rays);
+    if (e.segments >= P->max_depth || b.type == LC_MAT_DIFFUSE || wo_l.z <= 0.0f) continue;
+    float3 refl = normalize(frame_to_world(&fr, (float3)(-wo_l.x, -wo_l.y, wo_l.z)));
+    float3 w_refl = (float3)(0.0f), w_refr = (float3)(0.0f);
+    float3 refr = (float3)(0.0f);
+    float ct;
+    if (b.type == LC_MAT_MIRROR || b.type == LC_MAT_CONDUCTOR) {
+      w_refl = b.specular;
+    } else if (b.type == LC_MAT_PLASTIC) {
+      w_refl = b.specular * fresnel_dielectric(wo_l.z, b.ior, &ct);
+    } else if (b.type == LC_MAT_DIELECTRIC) {
+      float eta = it.front ? b.ior : 1.0f / b.ior;
+      float F = fresnel_dielectric(wo_l.z, eta, &ct);
+      w_refl = (float3)(F);
+      if (F < 1.0f) {
+        w_refr = b.specular * (1.0f - F);
+        refr = normalize(frame_to_world(&fr, (float3)(-wo_l.x / eta, -wo_l.y / eta, -ct)));
+      }
+    }
+    if (lc_max3(w_refr) > 0.0f && dot(refr, it.ng) < 0.0f && sp < LC_WHITTED_STACK) {
+      stack[sp].ray.o = lc_spawn_origin(it.p, it.perr, -it.ng);
+      stack[sp].ray.d = refr;
+      stack[sp].w = e.w * w_refr;
+      stack[sp].segments = e.segments + 1;
+      ++sp;
+    }
+    if (lc_max3(w_refl) > 0.0f && dot(refl, it.ng) > 0.0f && sp < LC_WHITTED_STACK) {
+      stack[sp].ray.o = lc_spawn_origin(it.p, it.perr, it.ng);
+      stack[sp].ray.d = refl;
+      stack[sp].w = e.w * w_refl;
+      stack[sp].segments = e.segments + 1;
+      ++sp;
+    }
+  }
+  return L;
+}
+
+/* Emission at the first hit plus point lights through the full BSDF. */
+static inline float3 integrator_direct(const lc_scene* s, lc_ray ray, lc_uint* rays) {
   lc_hit hit;
   ++*rays;
-  if (!scene_intersect(s, ray, INFINITY, &hit)) return lc_load3(P->env_radiance);
+  if (!scene_intersect(s, ray, INFINITY, &hit)) {
+    float pdf;
+    return env_radiance(s, ray.d, &pdf);
+  }
   lc_interaction it = interaction_from_hit(s, ray, &hit);
   __global const lc_material* m = &s->materials[it.material];
   float3 L = it.front ? lc_load3(m->emission) : (float3)(0.0f);
-  *rays += P->num_lights;
-  return L + light_point_direct(s, &it, material_albedo(s, m, it.uv));
+  lc_bsdf b = bsdf_from_material(s, m, it.uv);
+  lc_frame fr = frame_from(it.ns);
+  float3 wo_l = frame_to_local(&fr, -ray.d);
+  if (wo_l.z > 0.0f && !bsdf_is_delta(&b)) L += point_lights_direct(s, &it, &b, &fr, wo_l, 0, rays);
+  return L;
+}
+
+/* Arbitrary output variables of the first hit. */
+static inline float3 integrator_aov(const lc_scene* s, lc_ray ray, const lc_rng* rng, lc_uint* rays) {
+  __global const lc_params* P = s->params;
+  lc_hit hit;
+  ++*rays;
+  if (!scene_intersect(s, ray, INFINITY, &hit)) return (float3)(0.0f);
+  lc_interaction it = interaction_from_hit(s, ray, &hit);
+  if (P->integrator == LC_INTEGRATOR_DEPTH) return (float3)(hit.t);
+  if (P->integrator == LC_INTEGRATOR_NORMAL) return it.ns;
+  __global const lc_material* m = &s->materials[it.material];
+  lc_bsdf b = bsdf_from_material(s, m, it.uv);
+  if (P->integrator == LC_INTEGRATOR_ALBEDO) return bsdf_albedo_aov(&b);
+  /* ambient occlusion */
+  lc_frame fr = frame_from(it.ns);
+  float3 wi = frame_to_world(&fr, sample_cosine_hemisphere(lc_rand(rng, LC_DIM_BOUNCE + LC_DIM_BSDF_UV),
+                                                             lc_rand(rng, LC_DIM_BOUNCE + LC_DIM_BSDF_UV + 1)));
+  if (dot(wi, it.ng) <= 0.0f) return (float3)(0.0f);
+  lc_ray sr;
+  sr.o = lc_spawn_origin(it.p, it.perr, it.ng);
+  sr.d = normalize(wi);
+  ++*rays;
+  return scene_occluded(s, sr, P->ao_distance) ? (float3)(0.0f) : (float3)(1.0f);
 }
 
 #endif

@@ -212,6 +212,31 @@ PackedScene pack_scene(const Scene& scene) {
   }
   if (!p.light_cdf.empty()) p.light_cdf.back() = 1.0f;
 
+  // environment maps: a CDF over texels (luminance x sin(theta)) after the light CDF
+  for (lc_light& l : p.lights) {
+    if (l.type != LC_LIGHT_ENV_MAP) continue;
+    const Texture& t = scene.textures.at(static_cast<size_t>(l.texture));
+    l.prim = static_cast<lc_uint>(p.light_cdf.size());
+    std::vector<double> w(static_cast<size_t>(t.width) * t.height);
+    double total_w = 0;
+    for (int y = 0; y < t.height; ++y) {
+      double sin_t = std::sin(M_PI * (y + 0.5) / t.height);
+      for (int x = 0; x < t.width; ++x) {
+        const float* px = &t.rgba[(static_cast<size_t>(y) * t.width + x) * 4];
+        double lum = std::max(0.0, luminance({px[0], px[1], px[2]}));
+        w[static_cast<size_t>(y) * t.width + x] = lum * sin_t;
+        total_w += lum * sin_t;
+      }
+    }
+    double run = 0;
+    p.light_cdf.push_back(0.0f);
+    for (double v : w) {
+      run += total_w > 0 ? v / total_w : 1.0 / w.size();
+      p.light_cdf.push_back(static_cast<float>(run));
+    }
+    p.light_cdf.back() = 1.0f;
+  }
+
   for (const Texture& t : scene.textures) {
     lc_texture d{};
     d.offset = static_cast<lc_uint>(p.texels.size());
@@ -231,8 +256,18 @@ PackedScene pack_scene(const Scene& scene) {
 
 std::string feature_defines(const Scene& scene, const PackedScene& packed) {
   std::string d;
+  auto has_mat = [&](MaterialType t) {
+    for (const Material& m : scene.materials)
+      if (m.type == t) return true;
+    return false;
+  };
   if (!packed.textures.empty()) d += " -D LC_HAS_TEXTURES";
-  (void)scene;
+  if (has_mat(MaterialType::Mirror)) d += " -D LC_HAS_MIRROR";
+  if (has_mat(MaterialType::Dielectric)) d += " -D LC_HAS_DIELECTRIC";
+  if (has_mat(MaterialType::Conductor)) d += " -D LC_HAS_CONDUCTOR";
+  if (has_mat(MaterialType::Plastic)) d += " -D LC_HAS_PLASTIC";
+  for (const lc_light& l : packed.lights)
+    if (l.type == LC_LIGHT_ENV_MAP) d += " -D LC_HAS_ENV_MAP";
   return d;
 }
 
