@@ -47,6 +47,7 @@ struct Integrator {
   int spp = 16;
   std::uint32_t seed = 0;
   double ao_distance = 0;  ///< ambient occlusion ray length; 0: unbounded
+  bool mis = true;         ///< path: combine light and BSDF sampling (false: light sampling only)
 };
 
 enum class MaterialType { Diffuse, Mirror, Dielectric, Conductor, Plastic };

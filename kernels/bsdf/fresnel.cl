@@ -7,12 +7,13 @@
  * the refracted direction (> 0) to cos_t. */
 static inline float fresnel_dielectric(float cos_i, float eta, float* cos_t) {
   cos_i = clamp(cos_i, 0.0f, 1.0f);
-  float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
-  if (sin2_t >= 1.0f) {
+  /* cos_t = sqrt(1 - (1 - cos_i^2) / eta^2), written so that eta = 1 gives cos_t = cos_i exactly */
+  float k = eta * eta - 1.0f + cos_i * cos_i;
+  if (k <= 0.0f) {
     *cos_t = 0.0f;
     return 1.0f;
   }
-  float ct = sqrt(fmax(0.0f, 1.0f - sin2_t));
+  float ct = sqrt(k) / eta;
   *cos_t = ct;
   float rs = (cos_i - eta * ct) / (cos_i + eta * ct);
   float rp = (eta * cos_i - ct) / (eta * cos_i + ct);

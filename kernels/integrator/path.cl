@@ -91,10 +91,11 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
   for (lc_uint depth = 0;; ++depth) {
     lc_hit hit;
     ++*rays;
+    const int no_mis = (P->flags & LC_FLAG_NO_MIS) != 0;
     if (!scene_intersect(s, ray, INFINITY, &hit)) {
       float pdf_l;
       float3 Le = env_radiance(s, ray.d, &pdf_l);
-      L += beta * Le * (prev_delta ? 1.0f : mis_power(prev_pdf, pdf_l));
+      L += beta * Le * (prev_delta ? 1.0f : (no_mis ? 0.0f : mis_power(prev_pdf, pdf_l)));
       break;
     }
     lc_interaction it = interaction_from_hit(s, ray, &hit);
@@ -104,7 +105,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
       float w = 1.0f;
       if (!prev_delta) {
         float pdf_l = light_pdf_area(s, it.light, prev_p, hit.t, dot(-ray.d, it.ng));
-        w = mis_power(prev_pdf, pdf_l);
+        w = no_mis ? 0.0f : mis_power(prev_pdf, pdf_l);
       }
       L += beta * Le * w;
     }
@@ -125,7 +126,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
         float pdf_b;
         float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf_b);
         if (lc_max3(f) > 0.0f && shadow_visible(s, &it, ls.wi, ls.dist, rays)) {
-          float w = ls.delta ? 1.0f : mis_power(ls.pdf, pdf_b);
+          float w = (ls.delta || no_mis) ? 1.0f : mis_power(ls.pdf, pdf_b);
           L += beta * f * ls.L * (wi_l.z * w / ls.pdf);
         }
       }

@@ -201,6 +201,9 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, num_triangles) == 96, params_num_triangl
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, env_radiance) == 112, params_env_radiance);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, filter) == 128, params_filter);
 
+/* lc_params.flags */
+#define LC_FLAG_NO_MIS 1u /* path: light sampling only for area lights (no BSDF-hit emission) */
+
 /* Counters accumulated by one launch (atomics on the device). */
 #define LC_COUNTER_NONFINITE 0 /* samples whose radiance was NaN or Inf (not added to the film) */
 #define LC_COUNTER_RAYS 1      /* rays traced, shadow rays included                              */

@@ -89,6 +89,7 @@ PackedScene pack_scene(const Scene& scene) {
   P.filter = filter_type(scene.film.filter.type);
   P.filter_radius = static_cast<float>(scene.film.filter.radius);
   P.env_light = -1;
+  P.flags = scene.integrator.mis ? 0u : LC_FLAG_NO_MIS;
   P.ao_distance = scene.integrator.ao_distance > 0 ? static_cast<float>(scene.integrator.ao_distance)
                                                    : INFINITY;
 

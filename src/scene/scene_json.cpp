@@ -2,6 +2,7 @@
 // "<file>: <JSON pointer>: <what is wrong>" (or "<file>:<line>:<col>: ..." for syntax errors).
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -114,6 +115,9 @@ class Parser {
   long integer(const json& j, const std::string& ptr, long lo, long hi) const {
     if (!j.is_number_integer() && !j.is_number_unsigned())
       fail(ptr, "must be an integer, got " + type_name(j) + " " + show(j));
+    if (j.is_number_unsigned() && j.get<std::uint64_t>() > static_cast<std::uint64_t>(hi))
+      fail(ptr, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                    std::to_string(j.get<std::uint64_t>()));
     long v = j.get<long>();
     if (v < lo || v > hi)
       fail(ptr, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
@@ -237,7 +241,7 @@ class Parser {
   }
 
   void parse_integrator(const json& j, const std::string& p, Integrator& in) {
-    check_keys(j, p, {"type", "max_depth", "rr_depth", "spp", "seed", "ao_distance"});
+    check_keys(j, p, {"type", "max_depth", "rr_depth", "spp", "seed", "ao_distance", "mis"});
     if (j.contains("type")) {
       std::string t = choice(j["type"], p + "/type",
                              {"path", "whitted", "direct", "albedo", "normal", "depth", "ao"});
@@ -250,6 +254,10 @@ class Parser {
     if (j.contains("spp")) in.spp = static_cast<int>(integer(j["spp"], p + "/spp", 1, 1 << 24));
     if (j.contains("seed"))
       in.seed = static_cast<std::uint32_t>(integer(j["seed"], p + "/seed", 0, 0xffffffffL));
+    if (j.contains("mis")) {
+      if (!j["mis"].is_boolean()) fail(p + "/mis", "must be true or false, got " + type_name(j["mis"]));
+      in.mis = j["mis"].get<bool>();
+    }
     if (j.contains("ao_distance")) in.ao_distance = positive(j["ao_distance"], p + "/ao_distance");
   }
 
@@ -506,6 +514,45 @@ class Parser {
   fs::path dir_;
 };
 
+/// Line and column (1-based) of the byte before `byte` (a 1-based count of bytes read).
+std::string line_col(const std::string& text, size_t byte) {
+  size_t line = 1, col = 1;
+  for (size_t i = 0; i + 1 < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return std::to_string(line) + ":" + std::to_string(col);
+}
+
+/// Finds where a parse stops for a reason json::parse reports without a position (a number
+/// literal out of double range, such as 1e999): a SAX pass that only records the error.
+struct ErrorLocator : nlohmann::json_sax<json> {
+  size_t byte = 0;
+  std::string token;
+  bool null() override { return true; }
+  bool boolean(bool) override { return true; }
+  bool number_integer(number_integer_t) override { return true; }
+  bool number_unsigned(number_unsigned_t) override { return true; }
+  bool number_float(number_float_t, const string_t&) override { return true; }
+  bool string(string_t&) override { return true; }
+  bool binary(binary_t&) override { return true; }
+  bool start_object(std::size_t) override { return true; }
+  bool key(string_t&) override { return true; }
+  bool end_object() override { return true; }
+  bool start_array(std::size_t) override { return true; }
+  bool end_array() override { return true; }
+  bool parse_error(std::size_t position, const std::string& last_token,
+                   const nlohmann::detail::exception&) override {
+    byte = position;
+    token = last_token;
+    return false;
+  }
+};
+
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& path) {
@@ -513,21 +560,20 @@ Scene parse_scene(const std::string& text, const std::string& path) {
   try {
     root = json::parse(text);
   } catch (const json::parse_error& e) {
-    // byte offset to line:column
-    size_t line = 1, col = 1;
-    for (size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
     std::string what = e.what();
     auto pos = what.find("syntax error");
     if (pos != std::string::npos) what = what.substr(pos);
-    throw Error(path + ":" + std::to_string(line) + ":" + std::to_string(col) +
-                ": invalid JSON: " + what);
+    throw Error(path + ":" + line_col(text, e.byte) + ": invalid JSON: " + what);
+  } catch (const json::exception& e) {
+    // e.g. out_of_range 406, "number overflow parsing '1e999'": locate it with a SAX pass
+    ErrorLocator locator;
+    json::sax_parse(text, &locator);
+    size_t len = locator.token.size();
+    size_t start = locator.byte > len ? locator.byte - len + 1 : 1;  // the token's first byte
+    throw Error(path + ":" + line_col(text, start) + ": " +
+                (locator.token.empty() ? std::string(e.what())
+                                       : "number out of range (not a finite double): " +
+                                             locator.token));
   }
   Scene scene;
   scene.path = path;

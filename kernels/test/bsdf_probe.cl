@@ -1,0 +1,58 @@
+/* lucent test kernel: evaluates the device's Fresnel and BSDF code on inputs given by the host
+ * (tests/test_kernel_bsdf.cpp). */
+#define LC_HAS_MIRROR
+#define LC_HAS_DIELECTRIC
+#define LC_HAS_CONDUCTOR
+#define LC_HAS_PLASTIC
+#include "shared/types.h"
+#include "shared/rng.h"
+#include "util/math.cl"
+#include "geom/sphere.cl"
+#include "geom/triangle.cl"
+#include "bvh/traverse.cl"
+#include "film/texture.cl"
+#include "bsdf/fresnel.cl"
+#include "bsdf/microfacet.cl"
+#include "bsdf/bsdf.cl"
+
+/* in: (cos_i, eta) pairs; out: (F, cos_t) pairs */
+__kernel void probe_fresnel(__global const float2* in, __global float2* out) {
+  size_t i = get_global_id(0);
+  float ct;
+  float F = fresnel_dielectric(in[i].x, in[i].y, &ct);
+  out[i] = (float2)(F, ct);
+}
+
+/* Samples `n` directions of the material for wo and returns (wi.xyz, pdf) and (weight.xyz,
+ * delta) per sample; random numbers from the shared RNG with pixel = 0, sample = index. */
+__kernel void probe_bsdf_sample(__global const lc_material* mat, float4 wo_in, int front,
+                                __global float4* out_wi, __global float4* out_weight) {
+  lc_uint i = (lc_uint)get_global_id(0);
+  lc_bsdf b;
+  b.type = mat->type;
+  b.albedo = lc_load3(mat->albedo);
+  b.specular = lc_load3(mat->specular);
+  b.ior = mat->ior;
+  b.alpha = fmax(mat->roughness, 1e-3f);
+  lc_bsdf_sample bs;
+  float3 wo = normalize(wo_in.xyz);
+  int ok = bsdf_sample(&b, wo, front, lc_rng_uniform(0u, i, 0u, 7u), lc_rng_uniform(0u, i, 1u, 7u),
+                       lc_rng_uniform(0u, i, 2u, 7u), &bs);
+  out_wi[i] = ok ? (float4)(bs.wi, bs.pdf) : (float4)(0.0f, 0.0f, 0.0f, -1.0f);
+  out_weight[i] = ok ? (float4)(bs.weight, (float)bs.delta) : (float4)(0.0f);
+}
+
+/* Evaluates f and pdf for (wo, wi) pairs. */
+__kernel void probe_bsdf_eval(__global const lc_material* mat, __global const float4* wo_in,
+                              __global const float4* wi_in, __global float4* out) {
+  size_t i = get_global_id(0);
+  lc_bsdf b;
+  b.type = mat->type;
+  b.albedo = lc_load3(mat->albedo);
+  b.specular = lc_load3(mat->specular);
+  b.ior = mat->ior;
+  b.alpha = fmax(mat->roughness, 1e-3f);
+  float pdf;
+  float3 f = bsdf_eval(&b, wo_in[i].xyz, wi_in[i].xyz, &pdf);
+  out[i] = (float4)(f, pdf);
+}

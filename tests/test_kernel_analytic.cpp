@@ -1,0 +1,297 @@
+// Known-answer tests of the megakernel's path tracer (issue 4 item 8). Each compares a render
+// with a closed-form value through a per-pixel z-test: z = |mean - expected| / sqrt(var / n),
+// which must stay below the Sidak-corrected two-sided threshold for alpha = 1e-3 over all pixel
+// channels (about 5 for the 1-4k values tested here; the threshold is computed, not guessed).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "support.hpp"
+
+namespace {
+
+using lucent::RenderResult;
+
+// Two-sided normal quantile for probability p (Acklam's rational approximation, |error| < 1e-9).
+double normal_quantile(double p) {
+  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
+                             1.383577518672690e+02, -3.066479806614716e+01, 2.506628277459239e+00};
+  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                             6.680131188771972e+01, -1.328068155288572e+01};
+  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                             -2.549732539343734e+00, 4.374664141464968e+00, 2.938163982698783e+00};
+  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                             3.754408661907416e+00};
+  double q, r;
+  if (p < 0.02425) {
+    q = std::sqrt(-2 * std::log(p));
+    return (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+           ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
+  }
+  if (p > 1 - 0.02425) return -normal_quantile(1 - p);
+  q = p - 0.5;
+  r = q * q;
+  return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+         (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1);
+}
+
+// z threshold of a two-sided test at family-wise alpha over m tests (Sidak).
+double sidak_z(double alpha, int m) {
+  double per = 1 - std::pow(1 - alpha, 1.0 / m);
+  return normal_quantile(1 - per / 2);
+}
+
+// Every pixel channel of `r` agrees with expected(x, y, c) by the z-test above. `floor` is an
+// absolute standard-error floor for pixels whose estimate has no variance.
+void expect_matches(const RenderResult& r, const std::function<double(int, int, int)>& expected,
+                    double floor = 1e-6) {
+  const int w = r.mean.width, h = r.mean.height;
+  const double zmax = sidak_z(1e-3, w * h * 3);
+  int failures = 0;
+  double worst = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        double e = expected(x, y, c);
+        double n = r.samples[static_cast<size_t>(y) * w + x];
+        double se = std::sqrt(r.variance.pixel(x, y)[c] / n) + floor + 1e-6 * std::abs(e);
+        double z = std::abs(r.mean.pixel(x, y)[c] - e) / se;
+        worst = std::max(worst, z);
+        if (z > zmax && ++failures <= 5)
+          ADD_FAILURE() << "pixel (" << x << "," << y << ") channel " << c << ": "
+                        << r.mean.pixel(x, y)[c] << " vs expected " << e << " (z = " << z << ")";
+      }
+  EXPECT_EQ(failures, 0) << "worst z " << worst << ", threshold " << zmax;
+  EXPECT_EQ(r.nonfinite, 0u);
+}
+
+// The camera model of docs/rendering-model.md, for computing expected pixel values: the point
+// where the ray through film position (fx, fy) meets the plane z = 0.
+struct PinholeToPlane {
+  double pos[3], fwd[3], right[3], up[3], tan_half, aspect;
+  int w, h;
+  PinholeToPlane(const double p[3], const double look[3], const double upv[3], double fov, int w_,
+                 int h_)
+      : w(w_), h(h_) {
+    for (int i = 0; i < 3; ++i) {
+      pos[i] = p[i];
+      fwd[i] = look[i] - p[i];
+    }
+    normalize(fwd);
+    cross(fwd, upv, right);
+    normalize(right);
+    cross(right, fwd, up);
+    tan_half = std::tan(fov * M_PI / 360);
+    aspect = double(w) / h;
+  }
+  static void normalize(double* v) {
+    double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int i = 0; i < 3; ++i) v[i] /= l;
+  }
+  static void cross(const double* a, const double* b, double* o) {
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+  }
+  // plane point hit through film position; returns false when the ray misses z = 0
+  bool hit(double fx, double fy, double* q) const {
+    double nx = (2 * fx / w - 1) * tan_half * aspect, ny = (1 - 2 * fy / h) * tan_half;
+    double d[3];
+    for (int i = 0; i < 3; ++i) d[i] = fwd[i] + nx * right[i] + ny * up[i];
+    if (d[2] == 0) return false;
+    double t = -pos[2] / d[2];
+    if (t <= 0) return false;
+    for (int i = 0; i < 3; ++i) q[i] = pos[i] + t * d[i];
+    return true;
+  }
+  // mean of f over the pixel's box-filter footprint (16x16 midpoint rule)
+  double pixel_mean(int x, int y, const std::function<double(const double*)>& f) const {
+    double sum = 0;
+    for (int j = 0; j < 16; ++j)
+      for (int i = 0; i < 16; ++i) {
+        double q[3];
+        if (hit(x + (i + 0.5) / 16, y + (j + 0.5) / 16, q)) sum += f(q);
+      }
+    return sum / 256;
+  }
+};
+
+const char* kPlane = R"({"type": "triangles", "material": "plane",
+  "positions": [[-50,-50,0],[50,-50,0],[50,50,0],[-50,50,0]], "indices": [0,1,2, 0,2,3]})";
+
+// Path integrator, one point light over a diffuse plane: L = albedo/pi * I cos / r^2. With no
+// other surface there is no indirect light, so any max_depth gives the direct value.
+TEST(KernelAnalytic, PathPointLightOverPlane) {
+  std::string scene = std::string(R"({
+    "camera": {"position": [1, -2, 4], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 30},
+    "film": {"width": 24, "height": 24},
+    "integrator": {"type": "path", "max_depth": 6},
+    "materials": {"plane": {"type": "diffuse", "albedo": [0.7, 0.5, 0.3]}},
+    "shapes": [)") + kPlane + R"(],
+    "lights": [{"type": "point", "position": [0.5, 0.3, 1.5], "intensity": [20, 20, 20]}]})";
+  RenderResult r = lucent::test::render_json(scene, 32);
+  const double pos[3] = {1, -2, 4}, look[3] = {0, 0, 0}, up[3] = {0, 0, 1};
+  PinholeToPlane cam(pos, look, up, 30, 24, 24);
+  const double albedo[3] = {0.7, 0.5, 0.3};
+  expect_matches(r, [&](int x, int y, int c) {
+    return cam.pixel_mean(x, y, [&](const double* q) {
+      double dx = 0.5 - q[0], dy = 0.3 - q[1], dz = 1.5 - q[2];
+      double r2 = dx * dx + dy * dy + dz * dz;
+      return albedo[c] / M_PI * 20 * (dz / std::sqrt(r2)) / r2;
+    });
+  });
+}
+
+// Irradiance from a spherical emitter of radiance L and radius R whose centre is at distance D
+// from a plane point, fully above the horizon: E = pi L (R/D)^2 cos(theta). The plane's radiance
+// is albedo/pi * E. Run with MIS, without MIS, and for a tiny bright sphere of the same power
+// (cone sampling keeps it noise-free).
+void sphere_irradiance_case(double R, double Le, bool mis) {
+  char buf[2048];
+  std::snprintf(buf, sizeof buf, R"({
+    "camera": {"position": [0, -3, 1], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 12},
+    "film": {"width": 16, "height": 16},
+    "integrator": {"type": "path", "max_depth": 2, "mis": %s},
+    "materials": {"plane": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [%g, %g, %g]}},
+    "shapes": [%s, {"type": "sphere", "center": [0.2, 0.1, 2], "radius": %g, "material": "lamp"}]})",
+                mis ? "true" : "false", Le, Le, Le, kPlane, R);
+  RenderResult r = lucent::test::render_json(buf, 64);
+  const double pos[3] = {0, -3, 1}, look[3] = {0, 0, 0}, up[3] = {0, 0, 1};
+  PinholeToPlane cam(pos, look, up, 12, 16, 16);
+  expect_matches(r, [&](int x, int y, int) {
+    return cam.pixel_mean(x, y, [&](const double* q) {
+      double dx = 0.2 - q[0], dy = 0.1 - q[1], dz = 2 - q[2];
+      double D2 = dx * dx + dy * dy + dz * dz;
+      return 0.5 / M_PI * M_PI * Le * (R * R / D2) * (dz / std::sqrt(D2));
+    });
+  });
+}
+
+TEST(KernelAnalytic, SphereEmitterIrradianceWithMis) { sphere_irradiance_case(0.5, 4.0, true); }
+TEST(KernelAnalytic, SphereEmitterIrradianceLightSamplingOnly) { sphere_irradiance_case(0.5, 4.0, false); }
+TEST(KernelAnalytic, TinyBrightSphereEmitter) { sphere_irradiance_case(0.005, 4.0 * 1e4, true); }
+
+// A mirror showing a known emitter: camera -> mirror -> emitting quad. The pixel is exactly
+// reflectance * Le per channel (one deterministic path; float tolerance).
+TEST(KernelAnalytic, MirrorShowsKnownEmitter) {
+  std::string scene = std::string(R"({
+    "camera": {"position": [0, -3, 3], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 10},
+    "film": {"width": 8, "height": 8},
+    "integrator": {"type": "path", "max_depth": 3},
+    "materials": {"plane": {"type": "mirror", "reflectance": [0.9, 0.5, 0.2]},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [2, 3, 4]}},
+    "shapes": [)") + kPlane + R"(,
+      {"type": "triangles", "material": "lamp",
+       "positions": [[-20, 8, -5], [20, 8, -5], [20, 8, 30], [-20, 8, 30]], "indices": [0, 1, 2, 0, 2, 3]}]})";
+  RenderResult r = lucent::test::render_json(scene, 4);
+  const double expected[3] = {0.9 * 2, 0.5 * 3, 0.2 * 4};
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.mean.pixel(x, y)[c], expected[c], 1e-5) << x << "," << y;
+}
+
+// White furnace: an albedo-1 diffuse sphere in a constant environment renders the environment's
+// value everywhere (unbounded depth, Russian roulette keeps it unbiased).
+TEST(KernelAnalytic, WhiteFurnace) {
+  RenderResult r = lucent::test::render_json(R"({
+    "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 40},
+    "film": {"width": 16, "height": 16},
+    "integrator": {"type": "path", "max_depth": 1000, "rr_depth": 3},
+    "materials": {"white": {"type": "diffuse", "albedo": [1, 1, 1]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "white"}],
+    "lights": [{"type": "environment", "radiance": [0.5, 0.5, 0.5]}]})", 64);
+  expect_matches(r, [](int, int, int) { return 0.5; });
+}
+
+// A closed box (inward-facing triangles) of albedo rho and emission Le seen from inside
+// renders Le / (1 - rho) at unbounded depth.
+TEST(KernelAnalytic, ClosedBoxRendersLeOverOneMinusRho) {
+  // cube [-1,1]^3, faces wound so that the front (normal) side faces the inside
+  RenderResult r = lucent::test::render_json(R"({
+    "camera": {"position": [0.2, -0.3, 0.1], "look_at": [0, 1, 0.3], "up": [0, 0, 1], "fov": 90},
+    "film": {"width": 16, "height": 16},
+    "integrator": {"type": "path", "max_depth": 100000, "rr_depth": 4},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.25, 0.75], "emission": [0.25, 0.3, 0.1]}},
+    "shapes": [{"type": "triangles", "material": "m",
+      "positions": [[-1,-1,-1],[1,-1,-1],[1,1,-1],[-1,1,-1],[-1,-1,1],[1,-1,1],[1,1,1],[-1,1,1]],
+      "indices": [0,1,2, 0,2,3,  4,6,5, 4,7,6,  0,4,5, 0,5,1,  3,2,6, 3,6,7,  0,3,7, 0,7,4,  1,5,6, 1,6,2]}]})",
+                                              64);
+  const double Le[3] = {0.25, 0.3, 0.1}, rho[3] = {0.5, 0.25, 0.75};
+  expect_matches(r, [&](int, int, int c) { return Le[c] / (1 - rho[c]); });
+}
+
+// MIS on and off (light sampling only) estimate the same image: a two-sample z-test per pixel
+// on a scene with a sphere light, a quad light and glossy and diffuse surfaces.
+TEST(KernelAnalytic, MisOnAndOffConvergeToTheSameMean) {
+  auto scene = [](bool mis) {
+    return std::string(R"({
+      "camera": {"position": [0, -4, 2.5], "look_at": [0, 0, 0.5], "up": [0, 0, 1], "fov": 45},
+      "film": {"width": 20, "height": 16},
+      "integrator": {"type": "path", "max_depth": 4, "mis": )") + (mis ? "true" : "false") + R"(},
+      "materials": {"plane": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
+                    "gloss": {"type": "conductor", "specular": [0.9, 0.8, 0.6], "roughness": 0.2},
+                    "plastic": {"type": "plastic", "albedo": [0.2, 0.4, 0.7], "roughness": 0.1},
+                    "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [6, 6, 6]},
+                    "panel": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [2, 3, 4]}},
+      "shapes": [)" + std::string(kPlane) + R"(,
+        {"type": "sphere", "center": [-0.8, 0, 0.6], "radius": 0.6, "material": "gloss"},
+        {"type": "sphere", "center": [0.8, 0.3, 0.5], "radius": 0.5, "material": "plastic"},
+        {"type": "sphere", "center": [1.5, -1, 2.5], "radius": 0.3, "material": "lamp"},
+        {"type": "triangles", "material": "panel",
+         "positions": [[-2, 1, 3], [0, 1, 3], [0, 2, 3], [-2, 2, 3]], "indices": [0, 2, 1, 0, 3, 2]}]})";
+  };
+  RenderResult a = lucent::test::render_json(scene(true), 256);
+  RenderResult b = lucent::test::render_json(scene(false), 256);
+  const int w = a.mean.width, h = a.mean.height;
+  const double zmax = sidak_z(1e-3, w * h * 3);
+  int failures = 0;
+  double mean_a = 0, mean_b = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        size_t i = static_cast<size_t>(y) * w + x;
+        double se = std::sqrt(a.variance.pixel(x, y)[c] / a.samples[i] +
+                              b.variance.pixel(x, y)[c] / b.samples[i]) + 1e-6;
+        double z = std::abs(a.mean.pixel(x, y)[c] - b.mean.pixel(x, y)[c]) / se;
+        if (z > zmax) ++failures;
+        mean_a += a.mean.pixel(x, y)[c];
+        mean_b += b.mean.pixel(x, y)[c];
+      }
+  EXPECT_EQ(failures, 0);
+  EXPECT_NEAR(mean_a / mean_b, 1.0, 0.01);
+  EXPECT_GT(mean_a, 0);
+}
+
+// The same seed gives the same image whatever the number of progressive passes.
+TEST(KernelAnalytic, SameSeedSameImageWhateverThePasses) {
+  const char* json = R"({
+    "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 40},
+    "film": {"width": 16, "height": 16, "filter": {"type": "gaussian"}},
+    "integrator": {"type": "path", "max_depth": 4, "seed": 7},
+    "materials": {"w": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]},
+                  "l": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [3, 3, 3]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "w"},
+               {"type": "sphere", "center": [1, 2, 1], "radius": 0.4, "material": "l"}],
+    "lights": [{"type": "environment", "radiance": [0.2, 0.2, 0.2]}]})";
+  lucent::Scene scene = lucent::parse_scene(json, "seed.json");
+  lucent::RenderOptions one_pass, many_passes;
+  one_pass.spp = many_passes.spp = 24;
+  one_pass.pass_seconds = 1e9;     // grows to all remaining samples after the first pass
+  many_passes.pass_seconds = 1e-9; // one sample per pass
+  RenderResult a = lucent::render(scene, one_pass), b = lucent::render(scene, many_passes);
+  ASSERT_EQ(a.spp, 24u);
+  ASSERT_EQ(b.spp, 24u);
+  double worst = 0;
+  for (size_t i = 0; i < a.mean.rgb.size(); ++i)
+    worst = std::max(worst, double(std::abs(a.mean.rgb[i] - b.mean.rgb[i])) / (1e-3 + std::abs(a.mean.rgb[i])));
+  EXPECT_LT(worst, 1e-5);  // only float summation order differs
+  scene.integrator.seed = 8;
+  RenderResult c = lucent::render(scene, one_pass);
+  double diff = 0;
+  for (size_t i = 0; i < a.mean.rgb.size(); ++i) diff += std::abs(a.mean.rgb[i] - c.mean.rgb[i]);
+  EXPECT_GT(diff, 1e-3);  // another seed, another image
+}
+
+}  // namespace
