@@ -183,6 +183,12 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::string msg = e.what();
+    // CLI11 reports a missing argument before an unexpected one: name the unknown option first
+    for (const std::string& extra : app.remaining(true))
+      if (extra.size() > 1 && extra[0] == '-') {
+        msg = "unknown option " + extra;
+        break;
+      }
     for (auto& c : msg)
       if (c == '\n') c = ' ';
     std::fprintf(stderr, "lucent: error: %s (see lucent --help)\n", msg.c_str());

@@ -1,5 +1,6 @@
 // JSON scene loading and validation. Every problem is reported as
 // "<file>: <JSON pointer>: <what is wrong>" (or "<file>:<line>:<col>: ..." for syntax errors).
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -528,11 +529,10 @@ std::string line_col(const std::string& text, size_t byte) {
   return std::to_string(line) + ":" + std::to_string(col);
 }
 
-/// Finds where a parse stops for a reason json::parse reports without a position (a number
-/// literal out of double range, such as 1e999): a SAX pass that only records the error.
+/// Finds where a parse stops for a reason json::parse reports without a place (a number literal
+/// out of double range, such as 1e999): a SAX pass that only records the error's byte count.
 struct ErrorLocator : nlohmann::json_sax<json> {
   size_t byte = 0;
-  std::string token;
   bool null() override { return true; }
   bool boolean(bool) override { return true; }
   bool number_integer(number_integer_t) override { return true; }
@@ -545,10 +545,9 @@ struct ErrorLocator : nlohmann::json_sax<json> {
   bool end_object() override { return true; }
   bool start_array(std::size_t) override { return true; }
   bool end_array() override { return true; }
-  bool parse_error(std::size_t position, const std::string& last_token,
+  bool parse_error(std::size_t position, const std::string&,
                    const nlohmann::detail::exception&) override {
     byte = position;
-    token = last_token;
     return false;
   }
 };
@@ -565,15 +564,17 @@ Scene parse_scene(const std::string& text, const std::string& path) {
     if (pos != std::string::npos) what = what.substr(pos);
     throw Error(path + ":" + line_col(text, e.byte) + ": invalid JSON: " + what);
   } catch (const json::exception& e) {
-    // e.g. out_of_range 406, "number overflow parsing '1e999'": locate it with a SAX pass
+    // out_of_range 406, "number overflow parsing '1e999'", comes without a place: a SAX pass
+    // finds where the parser stopped, just after the literal, and we step back to its start.
     ErrorLocator locator;
     json::sax_parse(text, &locator);
-    size_t len = locator.token.size();
-    size_t start = locator.byte > len ? locator.byte - len + 1 : 1;  // the token's first byte
-    throw Error(path + ":" + line_col(text, start) + ": " +
-                (locator.token.empty() ? std::string(e.what())
-                                       : "number out of range (not a finite double): " +
-                                             locator.token));
+    size_t i = std::min(locator.byte, text.size());
+    while (i > 0 && std::strchr("0123456789+-.eE", text[i - 1]) && text[i - 1] != '\0') --i;
+    std::string literal = text.substr(i, std::min(locator.byte, text.size()) - i);
+    throw Error(path + ":" + line_col(text, i + 1) + ": " +
+                (e.id == 406 && !literal.empty()
+                     ? "number out of range (not a finite double): " + literal
+                     : std::string(e.what())));
   }
   Scene scene;
   scene.path = path;

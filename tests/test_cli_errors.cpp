@@ -1,0 +1,200 @@
+// Error paths of the CLI: each gives exactly one line on stderr starting with "lucent: error:",
+// nothing on stdout and a non-zero exit status (never a crash, a hang or an uncaught exception).
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <string>
+
+#include "support.hpp"
+
+namespace {
+
+using lucent::test::CommandResult;
+using lucent::test::run_cli;
+namespace fs = std::filesystem;
+
+/// A small valid scene written to a fresh directory; returns its path.
+std::string small_scene() {
+  std::string path = lucent::test::temp_dir() + "/scene.json";
+  lucent::test::write_file(path, R"({
+    "film": {"width": 8, "height": 8},
+    "integrator": {"type": "albedo", "spp": 1},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]
+  })");
+  return path;
+}
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+/// Checks the error contract and returns the message after "lucent: error: ".
+std::string expect_one_error_line(const CommandResult& r) {
+  EXPECT_NE(r.status, 0);
+  EXPECT_LT(r.status, 128) << "killed by a signal";
+  EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("lucent: error: ", 0), 0u) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  std::string msg = r.err.substr(std::min(r.err.size(), sizeof("lucent: error: ") - 1));
+  while (!msg.empty() && msg.back() == '\n') msg.pop_back();
+  return msg;
+}
+
+TEST(CliErrors, MissingSceneFile) {
+  std::string dir = lucent::test::temp_dir();
+  CommandResult r = run_cli("render " + q(dir + "/nope.json") + " -o " + q(dir + "/out.png"));
+  std::string msg = expect_one_error_line(r);
+  EXPECT_EQ(msg, dir + "/nope.json: cannot open scene file (No such file or directory)");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_FALSE(fs::exists(dir + "/out.png"));
+}
+
+TEST(CliErrors, SceneIsADirectory) {
+  std::string dir = lucent::test::temp_dir();
+  std::string msg =
+      expect_one_error_line(run_cli("render " + q(dir) + " -o " + q(dir + "/out.png")));
+  EXPECT_EQ(msg, dir + ": is a directory, not a scene file");
+}
+
+TEST(CliErrors, MalformedJsonGivesFileLineColumn) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/bad.json", "{\n  \"film\": {\"width\": 8,\n  \"height\": 8]\n}\n");
+  std::string msg =
+      expect_one_error_line(run_cli("render " + q(dir + "/bad.json") + " -o " + q(dir + "/o.png")));
+  // the parser stops at the ']' that should have been a '}': line 3, column 14
+  EXPECT_EQ(msg.rfind(dir + "/bad.json:3:14: invalid JSON: syntax error", 0), 0u) << msg;
+  EXPECT_FALSE(fs::exists(dir + "/o.png"));
+}
+
+TEST(CliErrors, SchemaErrorGivesFileAndPointer) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/bad.json", R"({
+    "materials": {"m": {"type": "diffuse"}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"},
+               {"type": "sphere", "center": [0, 0, 0], "radius": -2, "material": "m"}]})");
+  std::string msg =
+      expect_one_error_line(run_cli("render " + q(dir + "/bad.json") + " -o " + q(dir + "/o.png")));
+  EXPECT_EQ(msg, dir + "/bad.json: /shapes/1/radius: must be > 0, got -2");
+}
+
+TEST(CliErrors, UnknownOptionIsNamed) {
+  std::string scene = small_scene();
+  std::string out = lucent::test::temp_dir() + "/o.png";
+  // also when a required argument is missing: the unknown option is what the user got wrong
+  for (const std::string& args : {"render " + q(scene) + " -o " + q(out) + " --bogus",
+                                  std::string("render --bogus"), std::string("--bogus"),
+                                  std::string("devices --bogus=3")}) {
+    CommandResult r = run_cli(args);
+    std::string msg = expect_one_error_line(r);
+    EXPECT_NE(msg.find("unknown option --bogus"), std::string::npos) << args << ": " << msg;
+    EXPECT_EQ(r.status, 2) << args;
+  }
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(CliErrors, BadArgumentsAreParseErrors) {
+  std::string scene = small_scene();
+  std::string out = lucent::test::temp_dir() + "/o.png";
+  for (const std::string& args :
+       {std::string(""), std::string("frobnicate"), "render " + q(scene),
+        "render " + q(scene) + " -o " + q(out) + " --spp 0",
+        "render " + q(scene) + " -o " + q(out) + " --width abc",
+        "render " + q(scene) + " -o " + q(out) + " --seed -1",
+        "render " + q(scene) + " -o " + q(out) + " --time -2",
+        "render " + q(scene) + " -o " + q(out) + " --spp",
+        "render " + q(scene) + " -o " + q(out) + " extra"}) {
+    CommandResult r = run_cli(args);
+    expect_one_error_line(r);
+    EXPECT_EQ(r.status, 2) << args;
+  }
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(CliErrors, UnknownIntegrator) {
+  std::string scene = small_scene();
+  std::string out = lucent::test::temp_dir() + "/o.png";
+  std::string msg = expect_one_error_line(
+      run_cli("render " + q(scene) + " -o " + q(out) + " --integrator bdpt"));
+  EXPECT_EQ(msg.rfind("--integrator bdpt: unknown integrator", 0), 0u) << msg;
+}
+
+TEST(CliErrors, UnwritableOutputPath) {
+  std::string scene = small_scene();
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/regular_file", "x");
+  fs::create_directories(dir + "/subdir.png");
+  struct Case {
+    std::string output, message;
+  };
+  // A path under a regular file and a missing directory fail even for root, who ignores
+  // permission bits.
+  for (const Case& c :
+       {Case{dir + "/regular_file/x.png", dir + "/regular_file/x.png: cannot write output (Not a directory)"},
+        Case{dir + "/missing/dir/x.png",
+             dir + "/missing/dir/x.png: cannot write output (No such file or directory)"},
+        Case{dir + "/subdir.png", dir + "/subdir.png: is a directory"}}) {
+    CommandResult r = run_cli("render " + q(scene) + " -o " + q(c.output));
+    EXPECT_EQ(expect_one_error_line(r), c.message);
+  }
+  EXPECT_FALSE(fs::exists(dir + "/missing"));
+}
+
+TEST(CliErrors, ReadOnlyDirectoryWhenNotRoot) {
+  if (::geteuid() == 0) GTEST_SKIP() << "root writes into read-only directories";
+  std::string scene = small_scene();
+  std::string dir = lucent::test::temp_dir() + "/ro";
+  fs::create_directories(dir);
+  ::chmod(dir.c_str(), 0555);
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(dir + "/x.png"));
+  ::chmod(dir.c_str(), 0755);
+  EXPECT_EQ(expect_one_error_line(r), dir + "/x.png: cannot write output (Permission denied)");
+}
+
+TEST(CliErrors, UnknownOutputExtension) {
+  std::string scene = small_scene();
+  std::string dir = lucent::test::temp_dir();
+  EXPECT_EQ(expect_one_error_line(run_cli("render " + q(scene) + " -o " + q(dir + "/x.bmp"))),
+            dir + "/x.bmp: unknown output format '.bmp' (use .png, .pfm or .exr)");
+  EXPECT_EQ(expect_one_error_line(run_cli("render " + q(scene) + " -o " + q(dir + "/x"))),
+            dir + "/x: unknown output format '' (use .png, .pfm or .exr)");
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+// ocl-icd reads the ICDs to load from OCL_ICD_VENDORS when it is set: an empty directory hides
+// every driver, PoCL included (checked here through `lucent devices` first).
+TEST(CliErrors, NoOpenClPlatform) {
+  std::string empty = lucent::test::temp_dir() + "/vendors";
+  fs::create_directories(empty);
+  std::string env = "OCL_ICD_VENDORS=" + q(empty);
+  CommandResult r = run_cli("devices", env);
+  std::string msg = expect_one_error_line(r);
+  EXPECT_EQ(msg.rfind("no OpenCL platform found", 0), 0u) << msg;
+
+  std::string scene = small_scene();
+  std::string out = lucent::test::temp_dir() + "/o.png";
+  r = run_cli("render " + q(scene) + " -o " + q(out), env);
+  msg = expect_one_error_line(r);
+  EXPECT_EQ(msg.rfind("no OpenCL platform found", 0), 0u) << msg;
+  EXPECT_FALSE(fs::exists(out));
+
+  // and the same command without the override finds a device: the override is what hid it
+  EXPECT_EQ(run_cli("devices").status, 0);
+}
+
+TEST(CliErrors, NoMatchingDevice) {
+  std::string scene = small_scene();
+  std::string out = lucent::test::temp_dir() + "/o.png";
+  std::string base = "render " + q(scene) + " -o " + q(out);
+  EXPECT_EQ(expect_one_error_line(run_cli(base + " --device no-such-device-xyz")),
+            "--device 'no-such-device-xyz': no device name contains it (see `lucent devices`)");
+  std::string msg = expect_one_error_line(run_cli(base + " --device 999"));
+  EXPECT_EQ(msg.rfind("--device 999: no device with this index (", 0), 0u) << msg;
+  EXPECT_EQ(expect_one_error_line(run_cli(base, "LUCENT_DEVICE=no-such-device-xyz")),
+            "LUCENT_DEVICE 'no-such-device-xyz': no device name contains it (see `lucent devices`)");
+  msg = expect_one_error_line(run_cli(base, "LUCENT_DEVICE=999"));
+  EXPECT_EQ(msg.rfind("LUCENT_DEVICE 999: no device with this index (", 0), 0u) << msg;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace

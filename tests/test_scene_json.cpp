@@ -1,0 +1,497 @@
+// The JSON scene loader: every validation error names the file and the JSON pointer of the
+// problem (or line:column for syntax errors), and the full format parses to what it says.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "support.hpp"
+
+namespace {
+
+using lucent::Scene;
+
+/// The message of the lucent::Error that parsing `json` as "scene.json" throws, or "" if none.
+std::string error_of(const std::string& json) {
+  try {
+    lucent::parse_scene(json, "scene.json");
+  } catch (const lucent::Error& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    return std::string("unexpected exception type: ") + e.what();
+  }
+  return "";
+}
+
+/// A scene with one diffuse material "m" and the given extra top-level members.
+std::string with_material(const std::string& extra) {
+  return R"({"materials": {"m": {"type": "diffuse"}})" + (extra.empty() ? "" : ", " + extra) + "}";
+}
+
+/// A scene with one triangle list whose transform is `transform` (a JSON array).
+std::string with_transform(const std::string& transform) {
+  return with_material(R"("shapes": [{"type": "triangles", "material": "m",
+      "positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1,2], "transform": )" +
+                       transform + "}]");
+}
+
+// Starts with `prefix`: for messages whose tail (an allowed-values list, a library's wording)
+// may grow.
+#define EXPECT_STARTS_WITH(s, prefix) \
+  EXPECT_EQ(std::string(s).substr(0, std::string(prefix).size()), std::string(prefix)) << (s)
+
+// ---------------------------------------------------------------------------------------------
+// Syntax
+
+TEST(SceneJson, SyntaxErrorGivesLineAndColumn) {
+  // the second comma on line 3 is at column 17
+  std::string e = error_of("{\n  \"film\": {\"width\": 3,\n    \"height\": 4,,\n  }\n}");
+  EXPECT_STARTS_WITH(e, "scene.json:3:17: invalid JSON: syntax error");
+}
+
+TEST(SceneJson, TruncatedFileGivesLineAndColumn) {
+  std::string e = error_of("{\"film\": {\"width\": 3,\n  \"height\": 4\n");
+  EXPECT_STARTS_WITH(e, "scene.json:3:1: invalid JSON: syntax error");
+  EXPECT_NE(e.find("end of input"), std::string::npos) << e;
+}
+
+TEST(SceneJson, EmptyFileIsASyntaxError) {
+  EXPECT_STARTS_WITH(error_of(""), "scene.json:1:1: invalid JSON: syntax error");
+}
+
+TEST(SceneJson, RootMustBeAnObject) {
+  EXPECT_EQ(error_of("[1, 2]"), "scene.json: /: must be an object, got an array");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Wrong types
+
+TEST(SceneJson, WrongTypeInteger) {
+  EXPECT_EQ(error_of(R"({"film": {"width": "512"}})"),
+            "scene.json: /film/width: must be an integer, got a string \"512\"");
+  EXPECT_EQ(error_of(R"({"film": {"height": 1.5}})"),
+            "scene.json: /film/height: must be an integer, got a number 1.5");
+  EXPECT_EQ(error_of(R"({"integrator": {"spp": true}})"),
+            "scene.json: /integrator/spp: must be an integer, got a boolean true");
+}
+
+TEST(SceneJson, WrongTypeNumberAndVector) {
+  EXPECT_EQ(error_of(R"({"camera": {"fov": "wide"}})"),
+            "scene.json: /camera/fov: must be a number, got a string \"wide\"");
+  EXPECT_EQ(error_of(R"({"camera": {"position": [0, 1]}})"),
+            "scene.json: /camera/position: must be an array of 3 numbers, got an array [0,1]");
+  EXPECT_EQ(error_of(R"({"camera": {"position": [0, null, 1]}})"),
+            "scene.json: /camera/position/1: must be a number, got null null");
+  EXPECT_EQ(error_of(R"({"materials": {"m": {"type": "diffuse", "albedo": "red"}}})"),
+            "scene.json: /materials/m/albedo: must be an array of 3 numbers, got a string \"red\"");
+}
+
+TEST(SceneJson, WrongTypeContainers) {
+  EXPECT_EQ(error_of(R"({"camera": [0, 0, 5]})"),
+            "scene.json: /camera: must be an object, got an array");
+  EXPECT_EQ(error_of(R"({"materials": [{"type": "diffuse"}]})"),
+            "scene.json: /materials: must be an object, got an array");
+  EXPECT_EQ(error_of(R"({"shapes": {"type": "sphere"}})"),
+            "scene.json: /shapes: must be an array, got an object");
+  EXPECT_EQ(error_of(R"({"lights": "sun"})"), "scene.json: /lights: must be an array, got a string");
+  EXPECT_EQ(error_of(with_material(R"("shapes": [{"type": "sphere", "center": [0,0,0],
+                                      "radius": 1, "material": 0}])")),
+            "scene.json: /shapes/0/material: must be a string, got a number 0");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Unknown keys and missing fields
+
+TEST(SceneJson, UnknownKeys) {
+  EXPECT_STARTS_WITH(error_of(R"({"shape": []})"), "scene.json: /shape: unknown key (allowed: ");
+  EXPECT_STARTS_WITH(error_of(R"({"camera": {"fov_deg": 40}})"),
+                     "scene.json: /camera/fov_deg: unknown key (allowed: ");
+  // a key that another material type has: roughness is not a diffuse parameter
+  EXPECT_STARTS_WITH(error_of(R"({"materials": {"m": {"type": "diffuse", "roughness": 0.2}}})"),
+                     "scene.json: /materials/m/roughness: unknown key (allowed: ");
+  EXPECT_STARTS_WITH(error_of(with_material(R"("shapes": [{"type": "sphere", "center": [0,0,0],
+                                               "radus": 1, "material": "m"}])")),
+                     "scene.json: /shapes/0/radus: unknown key (allowed: ");
+}
+
+TEST(SceneJson, MissingFields) {
+  EXPECT_EQ(error_of(with_material(
+                R"("shapes": [{"type": "sphere", "center": [0,0,0], "material": "m"}])")),
+            "scene.json: /shapes/0: missing required field 'radius'");
+  EXPECT_EQ(error_of(R"({"materials": {"m": {"albedo": [1, 1, 1]}}})"),
+            "scene.json: /materials/m: missing required field 'type'");
+  EXPECT_EQ(error_of(with_material(R"("shapes": [{"type": "triangles", "material": "m",
+                                      "positions": [[0,0,0],[1,0,0],[0,1,0]]}])")),
+            "scene.json: /shapes/0: missing required field 'indices'");
+  EXPECT_EQ(error_of(R"({"lights": [{"type": "point", "intensity": [1, 1, 1]}]})"),
+            "scene.json: /lights/0: missing required field 'position'");
+  EXPECT_EQ(error_of(R"({"shapes": [{"center": [0, 0, 0]}]})"),
+            "scene.json: /shapes/0: missing required field 'type'");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Values out of their domain
+
+TEST(SceneJson, NegativeRadiusNamesTheShape) {
+  std::string spheres;
+  for (int i = 0; i < 3; ++i)
+    spheres += R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}, )";
+  std::string bad = R"({"type": "sphere", "center": [0, 0, 0], "radius": -1, "material": "m"})";
+  EXPECT_EQ(error_of(with_material("\"shapes\": [" + spheres + bad + "]")),
+            "scene.json: /shapes/3/radius: must be > 0, got -1");
+  EXPECT_EQ(error_of(with_material(R"("shapes": [{"type": "sphere", "center": [0,0,0],
+                                      "radius": 0, "material": "m"}])")),
+            "scene.json: /shapes/0/radius: must be > 0, got 0");
+}
+
+TEST(SceneJson, OtherDomainErrors) {
+  EXPECT_EQ(error_of(R"({"camera": {"fov": 180}})"),
+            "scene.json: /camera/fov: must be in (0, 180) degrees, got 180");
+  EXPECT_EQ(error_of(R"({"camera": {"position": [1, 2, 3], "look_at": [1, 2, 3]}})"),
+            "scene.json: /camera/look_at: must differ from the camera position");
+  EXPECT_EQ(error_of(R"({"camera": {"position": [0, 5, 0], "look_at": [0, 0, 0]}})"),
+            "scene.json: /camera/up: must not be parallel to the viewing direction");
+  EXPECT_EQ(error_of(R"({"camera": {"up": [0, 0, 0]}})"),
+            "scene.json: /camera/up: must be a non-zero vector");
+  EXPECT_EQ(error_of(R"({"camera": {"aperture": -0.5}})"),
+            "scene.json: /camera/aperture: must be >= 0, got -0.5");
+  EXPECT_EQ(error_of(R"({"materials": {"m": {"type": "diffuse", "albedo": [0.5, -0.1, 0]}}})"),
+            "scene.json: /materials/m/albedo/1: must be >= 0, got -0.1");
+  EXPECT_EQ(error_of(R"({"materials": {"m": {"type": "conductor", "roughness": 1.5}}})"),
+            "scene.json: /materials/m/roughness: must be in [0, 1], got 1.5");
+  EXPECT_EQ(error_of(R"({"materials": {"m": {"type": "dielectric", "ior": 0}}})"),
+            "scene.json: /materials/m/ior: must be > 0, got 0");
+  EXPECT_EQ(error_of(R"({"materials": {"": {"type": "diffuse"}}})"),
+            "scene.json: /materials/: material names must not be empty");
+  EXPECT_EQ(error_of(R"({"lights": [{"type": "environment", "radiance": [1, 1, 1]},
+                                    {"type": "environment", "radiance": [1, 1, 1]}]})"),
+            "scene.json: /lights/1: only one environment light is allowed");
+  EXPECT_EQ(error_of(R"({"lights": [{"type": "environment", "radiance": [1,1,1], "scale": 2}]})"),
+            "scene.json: /lights/0/scale: only allowed with file");
+  EXPECT_EQ(error_of(R"({"film": {"filter": {"type": "gaussian", "radius": -2}}})"),
+            "scene.json: /film/filter/radius: must be > 0, got -2");
+}
+
+TEST(SceneJson, TriangleListErrors) {
+  auto tri = [](const std::string& body) {
+    return error_of(with_material(R"("shapes": [{"type": "triangles", "material": "m", )" +
+                                  body + "}]"));
+  };
+  EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1,3])"),
+            "scene.json: /shapes/0/indices/2: must be in [0, 2], got 3");
+  EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1])"),
+            "scene.json: /shapes/0/indices: must be an array whose length is a multiple of 3");
+  EXPECT_EQ(tri(R"("positions": [], "indices": [])"),
+            "scene.json: /shapes/0/positions: must be a non-empty array of [x, y, z]");
+  EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1,2],
+                   "normals": [[0,0,1],[0,0,1]])"),
+            "scene.json: /shapes/0/normals: must have one entry per position (3)");
+  EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1,2],
+                   "uvs": [[0,0],[1,0],[0,1,2]])"),
+            "scene.json: /shapes/0/uvs/2: must be an array of 2 numbers");
+  EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,"x"],[0,1,0]], "indices": [0,1,2])"),
+            "scene.json: /shapes/0/positions/1/2: must be a number, got a string \"x\"");
+}
+
+// ---------------------------------------------------------------------------------------------
+// NaN and infinities
+
+TEST(SceneJson, NanAndInfinityAsStrings) {
+  for (const char* s : {"NaN", "nan", "Infinity", "inf", "-Infinity", "-inf"}) {
+    EXPECT_EQ(error_of(std::string(R"({"camera": {"fov": ")") + s + "\"}}"),
+              std::string("scene.json: /camera/fov: must be a finite number, got ") + s);
+  }
+  EXPECT_EQ(error_of(with_material(R"("shapes": [{"type": "sphere", "center": [0, "NaN", 0],
+                                      "radius": 1, "material": "m"}])")),
+            "scene.json: /shapes/0/center/1: must be a finite number, got NaN");
+}
+
+TEST(SceneJson, HugeLiteralsAreReportedWithLineAndColumn) {
+  // 1e999 overflows a double: the JSON library rejects it while parsing, before any pointer
+  // exists, so the place is given as line:column of the literal.
+  EXPECT_EQ(error_of("{\"integrator\":\n {\"spp\": 1e999}}"),
+            "scene.json:2:10: number out of range (not a finite double): 1e999");
+  EXPECT_EQ(error_of(R"({"camera": {"fov": -1e999}})"),
+            "scene.json:1:20: number out of range (not a finite double): -1e999");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Names and enumerations
+
+TEST(SceneJson, UnknownMaterialName) {
+  EXPECT_EQ(error_of(with_material(R"("shapes": [{"type": "sphere", "center": [0,0,0],
+                                      "radius": 1, "material": "gold"}])")),
+            "scene.json: /shapes/0/material: unknown material 'gold'");
+  EXPECT_EQ(error_of(with_material(R"("shapes": [{"type": "triangles", "material": "Gold",
+      "positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1,2]}])")),
+            "scene.json: /shapes/0/material: unknown material 'Gold'");
+}
+
+TEST(SceneJson, BadEnumValues) {
+  EXPECT_STARTS_WITH(error_of(R"({"film": {"filter": {"type": "sinc"}}})"),
+                     "scene.json: /film/filter/type: unknown value 'sinc' (expected one of: box");
+  EXPECT_STARTS_WITH(error_of(R"({"film": {"transfer": "rec709"}})"),
+                     "scene.json: /film/transfer: unknown value 'rec709' (expected one of: ");
+  EXPECT_STARTS_WITH(error_of(R"({"film": {"tonemap": "filmic"}})"),
+                     "scene.json: /film/tonemap: unknown value 'filmic' (expected one of: ");
+  EXPECT_STARTS_WITH(error_of(R"({"integrator": {"type": "bdpt"}})"),
+                     "scene.json: /integrator/type: unknown value 'bdpt' (expected one of: ");
+  EXPECT_STARTS_WITH(error_of(R"({"materials": {"m": {"type": "velvet"}}})"),
+                     "scene.json: /materials/m/type: unknown value 'velvet' (expected one of: ");
+  EXPECT_STARTS_WITH(error_of(R"({"shapes": [{"type": "cube"}]})"),
+                     "scene.json: /shapes/0/type: unknown value 'cube' (expected one of: ");
+  EXPECT_STARTS_WITH(error_of(R"({"lights": [{"type": "spot"}]})"),
+                     "scene.json: /lights/0/type: unknown value 'spot' (expected one of: ");
+  // enumerations are case-sensitive
+  EXPECT_STARTS_WITH(error_of(R"({"integrator": {"type": "Path"}})"),
+                     "scene.json: /integrator/type: unknown value 'Path'");
+}
+
+TEST(SceneJson, OutOfRangeIntegers) {
+  EXPECT_EQ(error_of(R"({"film": {"width": 0}})"),
+            "scene.json: /film/width: must be in [1, 16384], got 0");
+  EXPECT_EQ(error_of(R"({"film": {"height": 16385}})"),
+            "scene.json: /film/height: must be in [1, 16384], got 16385");
+  EXPECT_EQ(error_of(R"({"integrator": {"spp": 0}})"),
+            "scene.json: /integrator/spp: must be in [1, 16777216], got 0");
+  EXPECT_EQ(error_of(R"({"integrator": {"max_depth": -3}})"),
+            "scene.json: /integrator/max_depth: must be in [1, 100000], got -3");
+  EXPECT_EQ(error_of(R"({"integrator": {"seed": -1}})"),
+            "scene.json: /integrator/seed: must be in [0, 4294967295], got -1");
+  EXPECT_EQ(error_of(R"({"integrator": {"seed": 4294967296}})"),
+            "scene.json: /integrator/seed: must be in [0, 4294967295], got 4294967296");
+  // beyond the signed 64-bit range: reported as written, not wrapped around to -1
+  EXPECT_EQ(error_of(R"({"integrator": {"seed": 18446744073709551615}})"),
+            "scene.json: /integrator/seed: must be in [0, 4294967295], got 18446744073709551615");
+  EXPECT_EQ(error_of(R"({"film": {"width": 9223372036854775808}})"),
+            "scene.json: /film/width: must be in [1, 16384], got 9223372036854775808");
+}
+
+TEST(SceneJson, BadTransformSteps) {
+  EXPECT_EQ(error_of(with_transform(R"({"scale": 2})")),
+            "scene.json: /shapes/0/transform: must be an array of transform steps, got an object");
+  EXPECT_EQ(error_of(with_transform(R"([{"scale": 2, "translate": [1, 0, 0]}])")),
+            "scene.json: /shapes/0/transform/0: each step must hold exactly one of scale, rotate, "
+            "translate, matrix");
+  EXPECT_EQ(error_of(with_transform(R"([{"scale": 2}, {"shear": [1, 0, 0]}])")),
+            "scene.json: /shapes/0/transform/1/shear: unknown transform step (allowed: scale, "
+            "rotate, translate, matrix)");
+  EXPECT_EQ(error_of(with_transform(R"([{"scale": [1, 0, 1]}])")),
+            "scene.json: /shapes/0/transform/0/scale: must not be zero");
+  EXPECT_EQ(error_of(with_transform(R"([{"rotate": {"axis": [0, 1, 0]}}])")),
+            "scene.json: /shapes/0/transform/0/rotate: missing required field 'degrees'");
+  EXPECT_EQ(error_of(with_transform(R"([{"rotate": {"axis": [0, 0, 0], "degrees": 30}}])")),
+            "scene.json: /shapes/0/transform/0/rotate/axis: must be a non-zero vector");
+  EXPECT_EQ(error_of(with_transform(R"([{"translate": [1, 2]}])")),
+            "scene.json: /shapes/0/transform/0/translate: must be an array of 3 numbers, got an "
+            "array [1,2]");
+  EXPECT_EQ(error_of(with_transform(R"([{"matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0]]}])")),
+            "scene.json: /shapes/0/transform/0/matrix: must be 4 rows of 4 numbers");
+  EXPECT_EQ(error_of(with_transform(R"([{"matrix": [[1,0,0,0],[0,1,0],[0,0,1,0],[0,0,0,1]]}])")),
+            "scene.json: /shapes/0/transform/0/matrix/1: must be a row of 4 numbers");
+  EXPECT_EQ(error_of(with_transform(R"([{"matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,1,1]]}])")),
+            "scene.json: /shapes/0/transform/0/matrix: the last row must be [0, 0, 0, 1] (affine "
+            "transforms only)");
+  EXPECT_EQ(error_of(with_transform(R"([{"matrix": [[1,0,0,0],[2,0,0,0],[0,0,1,0],[0,0,0,1]]}])")),
+            "scene.json: /shapes/0/transform/0/matrix: must be invertible");
+  EXPECT_EQ(error_of(with_transform(R"([{"matrix": [[1,0,0,"inf"],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}])")),
+            "scene.json: /shapes/0/transform/0/matrix/0/3: must be a finite number, got inf");
+}
+
+TEST(SceneJson, LoadSceneNamesTheFile) {
+  std::string dir = lucent::test::temp_dir();
+  try {
+    lucent::load_scene(dir + "/missing.json");
+    FAIL() << "no error for a missing file";
+  } catch (const lucent::Error& e) {
+    EXPECT_STARTS_WITH(e.what(), dir + "/missing.json: cannot open scene file");
+  }
+  try {
+    lucent::load_scene(dir);
+    FAIL() << "no error for a directory";
+  } catch (const lucent::Error& e) {
+    EXPECT_EQ(std::string(e.what()), dir + ": is a directory, not a scene file");
+  }
+  lucent::test::write_file(dir + "/bad.json", R"({"film": {"width": -4}})");
+  try {
+    lucent::load_scene(dir + "/bad.json");
+    FAIL() << "no error for a bad scene";
+  } catch (const lucent::Error& e) {
+    EXPECT_EQ(std::string(e.what()), dir + "/bad.json: /film/width: must be in [1, 16384], got -4");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The whole format
+
+void expect_vec(const glm::dvec3& got, const glm::dvec3& want, double tol = 1e-12) {
+  EXPECT_NEAR(got.x, want.x, tol);
+  EXPECT_NEAR(got.y, want.y, tol);
+  EXPECT_NEAR(got.z, want.z, tol);
+}
+
+TEST(SceneJson, FullFormatParses) {
+  const char* text = R"({
+    "camera": {"position": [0, 1, 6], "look_at": [0, 1, 0], "up": [0, 1, 0], "fov": 35,
+               "roll": 5, "aperture": 0.05, "focus_distance": 5.5},
+    "film": {"width": 64, "height": 48, "filter": {"type": "tent", "radius": 1.25},
+             "transfer": "gamma", "gamma": 2.4, "exposure": -0.5, "tonemap": "aces"},
+    "integrator": {"type": "whitted", "max_depth": 12, "rr_depth": 3, "spp": 7, "seed": 4000000000,
+                   "ao_distance": 2.5},
+    "materials": {
+      "wall":  {"type": "diffuse", "albedo": [0.25, 0.5, 0.75]},
+      "lamp":  {"type": "diffuse", "albedo": [0, 0, 0], "emission": [4, 3, 2]},
+      "glass": {"type": "dielectric", "ior": 1.33, "tint": [0.9, 1, 0.95]},
+      "chrome": {"type": "mirror", "reflectance": [0.8, 0.85, 0.9]},
+      "gold":  {"type": "conductor", "specular": [1, 0.78, 0.34], "roughness": 0.2},
+      "paint": {"type": "plastic", "albedo": [0.1, 0.2, 0.3], "specular": [0.5, 0.5, 0.5],
+                "roughness": 0.05, "ior": 1.6}
+    },
+    "shapes": [
+      {"type": "sphere", "center": [1, 2, 3], "radius": 0.5, "material": "glass"},
+      {"type": "triangles", "material": "wall",
+       "positions": [[1, 0, 0], [0, 1, 0], [0, 0, 0]], "indices": [2, 0, 1],
+       "normals": [[0, 0, 1], [0, 0, 1], [0, 0, 1]], "uvs": [[1, 0], [0, 1], [0, 0]],
+       "transform": [{"scale": 2}, {"rotate": {"axis": [0, 0, 3], "degrees": 90}},
+                     {"translate": [1, 2, 3]},
+                     {"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 10], [0, 0, 0, 1]]}]},
+      {"type": "triangles", "material": "lamp",
+       "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, 1, 2],
+       "normals": [[0, 0, 1], [0, 0, 1], [0, 0, 1]],
+       "transform": [{"matrix": [[-1, 0, 0, 5], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}]},
+      {"type": "triangles", "material": "gold",
+       "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, 1, 2],
+       "normals": [[0, 0, 1], [0, 0, 1], [0, 0, 1]],
+       "transform": [{"scale": [1, 1, -1]}]}
+    ],
+    "lights": [
+      {"type": "point", "position": [0, 5, 0], "intensity": [10, 20, 30]},
+      {"type": "environment", "radiance": [0.1, 0.2, 0.3]}
+    ]
+  })";
+  Scene s = lucent::parse_scene(text, "full.json");
+  EXPECT_EQ(s.path, "full.json");
+
+  expect_vec(s.camera.position, {0, 1, 6});
+  expect_vec(s.camera.look_at, {0, 1, 0});
+  EXPECT_EQ(s.camera.fov_degrees, 35);
+  EXPECT_EQ(s.camera.roll_degrees, 5);
+  EXPECT_EQ(s.camera.aperture, 0.05);
+  EXPECT_EQ(s.camera.focus_distance, 5.5);
+
+  EXPECT_EQ(s.film.width, 64);
+  EXPECT_EQ(s.film.height, 48);
+  EXPECT_EQ(s.film.filter.type, lucent::FilterType::Tent);
+  EXPECT_EQ(s.film.filter.radius, 1.25);
+  EXPECT_EQ(s.film.transfer, lucent::Transfer::Gamma);
+  EXPECT_EQ(s.film.gamma, 2.4);
+  EXPECT_EQ(s.film.exposure, -0.5);
+  EXPECT_EQ(s.film.tonemap, lucent::ToneMap::Aces);
+
+  EXPECT_EQ(s.integrator.type, lucent::IntegratorType::Whitted);
+  EXPECT_EQ(s.integrator.max_depth, 12);
+  EXPECT_EQ(s.integrator.rr_depth, 3);
+  EXPECT_EQ(s.integrator.spp, 7);
+  EXPECT_EQ(s.integrator.seed, 4000000000u);
+  EXPECT_EQ(s.integrator.ao_distance, 2.5);
+
+  ASSERT_EQ(s.materials.size(), 6u);
+  int wall = s.find_material("wall"), lamp = s.find_material("lamp"),
+      glass = s.find_material("glass"), chrome = s.find_material("chrome"),
+      gold = s.find_material("gold"), paint = s.find_material("paint");
+  ASSERT_TRUE(wall >= 0 && lamp >= 0 && glass >= 0 && chrome >= 0 && gold >= 0 && paint >= 0);
+  EXPECT_EQ(s.find_material("nothing"), -1);
+  EXPECT_EQ(s.materials[wall].type, lucent::MaterialType::Diffuse);
+  expect_vec(s.materials[wall].albedo, {0.25, 0.5, 0.75});
+  EXPECT_FALSE(s.materials[wall].emissive());
+  EXPECT_TRUE(s.materials[lamp].emissive());
+  expect_vec(s.materials[lamp].emission, {4, 3, 2});
+  EXPECT_EQ(s.materials[glass].type, lucent::MaterialType::Dielectric);
+  EXPECT_EQ(s.materials[glass].ior, 1.33);
+  expect_vec(s.materials[glass].specular, {0.9, 1, 0.95});
+  EXPECT_EQ(s.materials[chrome].type, lucent::MaterialType::Mirror);
+  expect_vec(s.materials[chrome].specular, {0.8, 0.85, 0.9});
+  EXPECT_EQ(s.materials[gold].type, lucent::MaterialType::Conductor);
+  EXPECT_EQ(s.materials[gold].roughness, 0.2);
+  expect_vec(s.materials[gold].specular, {1, 0.78, 0.34});
+  EXPECT_EQ(s.materials[paint].type, lucent::MaterialType::Plastic);
+  expect_vec(s.materials[paint].albedo, {0.1, 0.2, 0.3});
+  EXPECT_EQ(s.materials[paint].ior, 1.6);
+  EXPECT_EQ(s.materials[paint].roughness, 0.05);
+
+  ASSERT_EQ(s.spheres.size(), 1u);
+  expect_vec(s.spheres[0].center, {1, 2, 3});
+  EXPECT_EQ(s.spheres[0].radius, 0.5);
+  EXPECT_EQ(s.spheres[0].material, glass);
+
+  ASSERT_EQ(s.triangles.size(), 3u);
+  ASSERT_EQ(s.positions.size(), 9u);
+  ASSERT_EQ(s.normals.size(), 9u);
+  ASSERT_EQ(s.uvs.size(), 3u);
+
+  // Steps apply in the order listed: scale 2, rotate 90 degrees about +z, translate (1, 2, 3),
+  // then the matrix (a translation by 10 along z, given row by row). By hand:
+  // (1,0,0) -> (2,0,0) -> (0,2,0) -> (1,4,3) -> (1,4,13); (0,1,0) -> (0,2,0) -> (-2,0,0) ->
+  // (-1,2,3) -> (-1,2,13); (0,0,0) -> (1,2,13).
+  const lucent::Triangle& t0 = s.triangles[0];
+  EXPECT_EQ(t0.material, wall);
+  expect_vec(s.positions[t0.v[0]], {1, 2, 13});
+  expect_vec(s.positions[t0.v[1]], {1, 4, 13});
+  expect_vec(s.positions[t0.v[2]], {-1, 2, 13});
+  for (int k = 0; k < 3; ++k) expect_vec(s.normals[t0.n[k]], {0, 0, 1});
+  EXPECT_EQ(s.uvs[t0.uv[0]], glm::dvec2(0, 0));  // indices [2, 0, 1] pick uvs 2, 0, 1
+  EXPECT_EQ(s.uvs[t0.uv[1]], glm::dvec2(1, 0));
+  EXPECT_EQ(s.uvs[t0.uv[2]], glm::dvec2(0, 1));
+
+  // A mirroring matrix (x -> 5 - x) keeps each face's front: the triangle's geometric normal,
+  // (v1 - v0) x (v2 - v0), still agrees with its transformed vertex normals (+z here).
+  auto geometric_normal = [&](const lucent::Triangle& t) {
+    glm::dvec3 a = s.positions[t.v[0]], b = s.positions[t.v[1]], c = s.positions[t.v[2]];
+    return glm::normalize(glm::cross(b - a, c - a));
+  };
+  const lucent::Triangle& t1 = s.triangles[1];
+  EXPECT_EQ(t1.material, lamp);
+  std::vector<glm::dvec3> corners = {s.positions[t1.v[0]], s.positions[t1.v[1]],
+                                     s.positions[t1.v[2]]};
+  for (const glm::dvec3& want : {glm::dvec3(5, 0, 0), glm::dvec3(4, 0, 0), glm::dvec3(5, 1, 0)}) {
+    bool found = false;
+    for (const glm::dvec3& c : corners) found = found || glm::length(c - want) < 1e-12;
+    EXPECT_TRUE(found) << "corner (" << want.x << ", " << want.y << ", " << want.z << ")";
+  }
+  expect_vec(geometric_normal(t1), {0, 0, 1});
+  for (int k = 0; k < 3; ++k) expect_vec(s.normals[t1.n[k]], {0, 0, 1});
+
+  // Mirroring z flips the surface: the normals become -z and the winding follows them.
+  const lucent::Triangle& t2 = s.triangles[2];
+  expect_vec(geometric_normal(t2), {0, 0, -1});
+  for (int k = 0; k < 3; ++k) expect_vec(s.normals[t2.n[k]], {0, 0, -1});
+
+  ASSERT_EQ(s.lights.size(), 2u);
+  EXPECT_EQ(s.lights[0].type, lucent::LightType::Point);
+  expect_vec(s.lights[0].position, {0, 5, 0});
+  expect_vec(s.lights[0].intensity, {10, 20, 30});
+  EXPECT_EQ(s.lights[1].type, lucent::LightType::Environment);
+  expect_vec(s.lights[1].radiance, {0.1, 0.2, 0.3});
+}
+
+TEST(SceneJson, DefaultsWhenKeysAreLeftOut) {
+  Scene s = lucent::parse_scene("{}", "empty.json");
+  EXPECT_EQ(s.film.width, 512);
+  EXPECT_EQ(s.film.height, 512);
+  EXPECT_EQ(s.integrator.type, lucent::IntegratorType::Path);
+  EXPECT_TRUE(s.materials.empty());
+  EXPECT_TRUE(s.spheres.empty());
+  EXPECT_TRUE(s.triangles.empty());
+  // focus distance defaults to the distance to look_at: (0, 0, 5) -> origin
+  EXPECT_DOUBLE_EQ(s.camera.focus_distance, 5.0);
+  // a filter's default radius depends on its type
+  EXPECT_EQ(lucent::parse_scene(R"({"film": {"filter": {"type": "box"}}})", "f.json").film.filter.radius,
+            0.5);
+  EXPECT_EQ(
+      lucent::parse_scene(R"({"film": {"filter": {"type": "gaussian"}}})", "f.json").film.filter.radius,
+      1.5);
+}
+
+}  // namespace
