@@ -11,11 +11,14 @@
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "cli/commands.hpp"
+#include "lucent/compare.hpp"
 #include "lucent/lucent.hpp"
+#include "lucent/reference.hpp"
 
 namespace {
 
@@ -84,7 +87,35 @@ struct RenderArgs {
   double time_limit = 0;
   std::string integrator;
   bool quiet = false;
+  bool reference = false;  ///< the scalar reference integrator instead of the kernel
+  std::vector<std::string> aovs;  ///< extra outputs: albedo, normal, depth, variance
 };
+
+/// <output stem>.<name>.exr beside the main output.
+std::string aov_path(const std::string& output, const std::string& name) {
+  std::filesystem::path p(output);
+  return (p.parent_path() / (p.stem().string() + "." + name + ".exr")).string();
+}
+
+/// Renders and writes the requested AOV images (linear EXR) after the main render.
+void write_aovs(const RenderArgs& a, const lucent::Scene& scene, const lucent::RenderOptions& opt,
+                const lucent::RenderResult& main_result) {
+  for (const std::string& name : a.aovs) {
+    std::string path = aov_path(a.output, name);
+    if (name == "variance") {
+      lucent::write_image(path, main_result.variance);
+    } else {
+      lucent::Scene s = scene;
+      s.integrator.type = lucent::cli::parse_integrator(name);
+      lucent::RenderOptions o = opt;
+      o.on_progress = nullptr;
+      o.spp = static_cast<int>(std::max<std::uint64_t>(1, main_result.spp));
+      o.time_limit = 0;
+      lucent::write_image(path, lucent::render(s, o).mean);
+    }
+    if (!a.quiet) std::fprintf(stderr, "%s: %s AOV\n", path.c_str(), name.c_str());
+  }
+}
 
 int cmd_render(const RenderArgs& a) {
   check_output_path(a.output);
@@ -120,13 +151,27 @@ int cmd_render(const RenderArgs& a) {
     };
   }
   auto previous = std::signal(SIGINT, on_sigint);
-  lucent::RenderResult r = lucent::render(scene, opt);
+  lucent::RenderResult r;
+  if (a.reference) {
+    if (a.time_limit > 0) throw lucent::Error("--time is not supported with --reference");
+    lucent::ReferenceOptions ro;
+    ro.spp = a.spp;
+    ro.cancel = &g_interrupted;
+    r = lucent::render_reference(scene, ro);
+  } else {
+    r = lucent::render(scene, opt);
+  }
   std::signal(SIGINT, previous);
   if (printed && tty) std::fprintf(stderr, "\n");
 
   lucent::DisplaySettings display{scene.film.transfer, scene.film.gamma, scene.film.exposure,
                                   scene.film.tonemap};
-  lucent::write_image(a.output, r.mean, display);
+  std::string ext = std::filesystem::path(a.output).extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".exr")
+    lucent::write_render_exr(a.output, r);  // with var.R/G/B and n layers (docs/compare.md)
+  else
+    lucent::write_image(a.output, r.mean, display);
   if (r.nonfinite > 0)
     std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
                  static_cast<unsigned long long>(r.nonfinite));
@@ -137,6 +182,7 @@ int cmd_render(const RenderArgs& a) {
                  r.seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / r.seconds * 1e-6 : 0,
                  r.seconds > 0 ? double(r.rays) / r.seconds * 1e-6 : 0, r.build_seconds,
                  r.device.c_str());
+  if (!r.cancelled && !a.reference) write_aovs(a, scene, opt, r);
   if (r.cancelled) {
     std::fprintf(stderr, "lucent: interrupted: wrote %s with the %llu spp accumulated so far\n",
                  a.output.c_str(), static_cast<unsigned long long>(r.spp));
@@ -168,6 +214,12 @@ int main(int argc, char** argv) {
   render->add_option("--integrator", ra.integrator,
                      "Override the integrator: path, whitted, direct, albedo, normal, depth, ao");
   render->add_flag("-q,--quiet", ra.quiet, "No progress line or summary");
+  render->add_option("--aov", ra.aovs,
+                     "Also write AOV images <stem>.<name>.exr: albedo, normal, depth, variance")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"albedo", "normal", "depth", "variance"}));
+  render->add_flag("--reference", ra.reference,
+                   "Render with the scalar CPU reference integrator instead of the kernel");
 
   CLI::App* devices = app.add_subcommand("devices", "List OpenCL devices");
 
