@@ -35,7 +35,9 @@ struct RenderResult {
   std::uint64_t nonfinite = 0;     ///< NaN/Inf samples dropped and counted
   std::uint64_t rays = 0;          ///< rays traced, shadow rays included
   double seconds = 0;              ///< rendering time (kernel passes)
-  double build_seconds = 0;        ///< kernel compile time
+  double build_seconds = 0;        ///< kernel source assembly and build (or cache load) time
+  bool program_cache_hit = false;  ///< the program came from lucent's binary cache
+  std::string build_options;       ///< OpenCL build options, feature defines included
   bool cancelled = false;
   std::string device;
 };

@@ -6,6 +6,7 @@
 
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
+#include "cl/program_cache.hpp"
 #include "lucent/error.hpp"
 #include "lucent/render.hpp"
 #include "render/pack.hpp"
@@ -46,8 +47,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   auto tb = clock::now();
   std::string source = detail::assemble_kernel_source("megakernel.cl");
   std::string build_options = "-cl-std=CL1.2" + render_detail::feature_defines(scene, packed);
-  cl::Program program = cl_util::build_program(ctx, source, build_options);
+  cl_util::ProgramBuildInfo build_info;
+  cl::Program program = cl_util::build_program_cached(ctx, source, build_options, &build_info);
   result.build_seconds = std::chrono::duration<double>(clock::now() - tb).count();
+  result.program_cache_hit = build_info.cache_hit;
+  result.build_options = build_options;
 
   std::vector<double> sum(npix * 3, 0.0), sumsq(npix * 3, 0.0);
   std::vector<std::uint32_t> count(npix, 0);

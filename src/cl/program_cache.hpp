@@ -1,0 +1,32 @@
+#pragma once
+// On-disk cache of built OpenCL program binaries.
+//
+// Key: lucent version, platform and device names, driver version, build options and the full
+// kernel source; the file name is a 64-bit hash of the key and the file repeats the key, so a
+// hash collision, a truncated or corrupt file, or a stale entry (another driver or lucent
+// version) is detected and rebuilt. Directory: LUCENT_CACHE_DIR, else $XDG_CACHE_HOME/lucent,
+// else ~/.cache/lucent. LUCENT_CACHE_DIR=off disables the cache.
+#include <string>
+
+#include "cl/context.hpp"
+
+namespace lucent::cl_util {
+
+struct ProgramBuildInfo {
+  bool cache_hit = false;
+  double seconds = 0;
+  std::string cache_file;  ///< "" when the cache is disabled
+  std::string note;        ///< why an entry was rejected, if one was
+};
+
+/// The cache directory in use ("" when disabled).
+std::string program_cache_dir();
+
+/// Builds `source` with `options`, through the cache.
+cl::Program build_program_cached(const Context& ctx, const std::string& source, const std::string& options,
+                                 ProgramBuildInfo* info = nullptr);
+
+/// Removes every cache entry; returns how many files were removed.
+int clear_program_cache();
+
+}  // namespace lucent::cl_util

@@ -1,0 +1,137 @@
+// lucent's on-disk program cache: hits on a second build, keys on options, detects corrupt and
+// truncated entries and rebuilds them (the rebuilt program still runs).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "cl/kernel_source.hpp"
+#include "cl/program_cache.hpp"
+#include "support.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using lucent::cl_util::ProgramBuildInfo;
+
+struct CacheDir {
+  std::string dir = lucent::test::temp_dir() + "/cache";
+  std::string old;
+  bool had = false;
+  CacheDir() {
+    if (const char* e = std::getenv("LUCENT_CACHE_DIR")) {
+      had = true;
+      old = e;
+    }
+    setenv("LUCENT_CACHE_DIR", dir.c_str(), 1);
+  }
+  ~CacheDir() {
+    if (had)
+      setenv("LUCENT_CACHE_DIR", old.c_str(), 1);
+    else
+      unsetenv("LUCENT_CACHE_DIR");
+  }
+};
+
+// Runs the layout probe kernel: a built program that really works returns sizeof(lc_material).
+unsigned run_probe(lucent::cl_util::Context& ctx, cl::Program& p) {
+  cl::Kernel k(p, "lucent_layout_probe");
+  cl::Buffer out(ctx.context, CL_MEM_WRITE_ONLY, 4096);
+  k.setArg(0, out);
+  ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1), cl::NullRange);
+  unsigned v = 0;
+  ctx.queue.enqueueReadBuffer(out, CL_TRUE, 0, sizeof v, &v);
+  return v;
+}
+
+TEST(ProgramCache, HitsMissesAndRebuildsCorruptEntries) {
+  CacheDir cache;
+  EXPECT_EQ(lucent::cl_util::program_cache_dir(), cache.dir);
+  lucent::cl_util::Context ctx("");
+  std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
+  ProgramBuildInfo a, b, c;
+  cl::Program p1 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &a);
+  EXPECT_FALSE(a.cache_hit);
+  ASSERT_TRUE(fs::exists(a.cache_file)) << a.cache_file;
+  cl::Program p2 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &b);
+  EXPECT_TRUE(b.cache_hit);
+  EXPECT_EQ(run_probe(ctx, p2), 64u);
+
+  // other options, other entry
+  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2 -D LC_UNUSED", &c);
+  EXPECT_FALSE(c.cache_hit);
+  EXPECT_NE(c.cache_file, a.cache_file);
+
+  // flip a byte in the middle of the binary: checksum mismatch, rebuilt, still runs
+  {
+    std::fstream f(a.cache_file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(0, std::ios::end);
+    auto size = static_cast<long>(f.tellg());
+    f.seekp(size - 17);
+    char x = 0;
+    f.seekg(size - 17);
+    f.read(&x, 1);
+    x = static_cast<char>(x ^ 0x5a);
+    f.seekp(size - 17);
+    f.write(&x, 1);
+  }
+  ProgramBuildInfo d;
+  cl::Program p3 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &d);
+  EXPECT_FALSE(d.cache_hit);
+  EXPECT_NE(d.note.find("checksum"), std::string::npos) << d.note;
+  EXPECT_EQ(run_probe(ctx, p3), 64u);
+  ProgramBuildInfo e;
+  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &e);
+  EXPECT_TRUE(e.cache_hit) << "the rebuilt entry is written back";
+
+  // truncate: detected
+  fs::resize_file(a.cache_file, fs::file_size(a.cache_file) / 2);
+  ProgramBuildInfo f;
+  cl::Program p4 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &f);
+  EXPECT_FALSE(f.cache_hit);
+  EXPECT_FALSE(f.note.empty());
+  EXPECT_EQ(run_probe(ctx, p4), 64u);
+
+  // garbage file with the right name: bad header, rebuilt
+  lucent::test::write_file(a.cache_file, "not a cache entry");
+  ProgramBuildInfo g;
+  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &g);
+  EXPECT_FALSE(g.cache_hit);
+  EXPECT_NE(g.note.find("header"), std::string::npos) << g.note;
+
+  // clear removes the entries
+  EXPECT_GE(lucent::cl_util::clear_program_cache(), 2);
+  ProgramBuildInfo h;
+  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &h);
+  EXPECT_FALSE(h.cache_hit);
+}
+
+TEST(ProgramCache, CanBeDisabled) {
+  CacheDir cache;
+  setenv("LUCENT_CACHE_DIR", "off", 1);
+  EXPECT_EQ(lucent::cl_util::program_cache_dir(), "");
+  lucent::cl_util::Context ctx("");
+  ProgramBuildInfo a;
+  cl::Program p = lucent::cl_util::build_program_cached(
+      ctx, lucent::detail::assemble_kernel_source("test/layout_probe.cl"), "-cl-std=CL1.2", &a);
+  EXPECT_FALSE(a.cache_hit);
+  EXPECT_TRUE(a.cache_file.empty());
+  EXPECT_EQ(run_probe(ctx, p), 64u);
+}
+
+TEST(ProgramCache, CliClearsTheCache) {
+  std::string dir = lucent::test::temp_dir() + "/clicache";
+  auto r = lucent::test::run_cli("cache dir", "LUCENT_CACHE_DIR='" + dir + "'");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find(dir), std::string::npos);
+  fs::create_directories(dir);
+  lucent::test::write_file(dir + "/0123456789abcdef.bin", "x");
+  r = lucent::test::run_cli("cache clear", "LUCENT_CACHE_DIR='" + dir + "'");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("removed 1"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir + "/0123456789abcdef.bin"));
+}
+
+}  // namespace
