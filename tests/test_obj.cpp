@@ -1,0 +1,575 @@
+// OBJ/MTL loading (src/scene/obj.cpp) on small files written by the tests: triangulation, negative
+// indices, missing normals/UVs/MTL/textures, CRLF, usemtl per face, errors naming file and line,
+// transforms (normals by the inverse transpose, mirroring keeps orientation) and the MTL mapping
+// of docs/obj-mtl.md.
+#include <gtest/gtest.h>
+#include <stb/stb_image_write.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "lucent/error.hpp"
+#include "scene/loaders.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::Material;
+using lucent::MaterialType;
+using lucent::Scene;
+using lucent::Triangle;
+
+std::vector<std::string>& captured() {
+  static std::vector<std::string> v;
+  return v;
+}
+
+// Collects scene_detail::warn messages while alive.
+struct CaptureWarnings {
+  CaptureWarnings() {
+    captured().clear();
+    lucent::scene_detail::set_warning_sink([](const std::string& m) { captured().push_back(m); });
+  }
+  ~CaptureWarnings() { lucent::scene_detail::set_warning_sink(nullptr); }
+  const std::vector<std::string>& all() const { return captured(); }
+  int count(const std::string& needle) const {
+    return static_cast<int>(std::count_if(all().begin(), all().end(), [&](const std::string& w) {
+      return w.find(needle) != std::string::npos;
+    }));
+  }
+  std::string dump() const {
+    std::string s;
+    for (const auto& w : all()) s += "  " + w + "\n";
+    return s;
+  }
+};
+
+void load(Scene& scene, const std::string& path, const glm::dmat4& xf = glm::dmat4(1.0),
+          int material_override = -1) {
+  lucent::scene_detail::load_obj(scene, path, xf, material_override);
+}
+
+std::string write(const std::string& dir, const std::string& name, const std::string& text) {
+  std::filesystem::create_directories(std::filesystem::path(dir + "/" + name).parent_path());
+  lucent::test::write_file(dir + "/" + name, text);
+  return dir + "/" + name;
+}
+
+glm::dvec3 pos(const Scene& s, const Triangle& t, int k) { return s.positions[t.v[k]]; }
+glm::dvec3 geometric_normal(const Scene& s, const Triangle& t) {
+  return glm::cross(pos(s, t, 1) - pos(s, t, 0), pos(s, t, 2) - pos(s, t, 0));
+}
+double area(const Scene& s, const Triangle& t) { return 0.5 * glm::length(geometric_normal(s, t)); }
+
+// The triangle's corners as a sorted list, to identify it whatever its vertex order.
+std::array<std::array<double, 3>, 3> corners(const Scene& s, const Triangle& t) {
+  std::array<std::array<double, 3>, 3> c;
+  for (int k = 0; k < 3; ++k) c[k] = {pos(s, t, k).x, pos(s, t, k).y, pos(s, t, k).z};
+  std::sort(c.begin(), c.end());
+  return c;
+}
+
+// tinyobjloader reads numbers as float: compare colours to single precision
+#define EXPECT_COLOUR(a, ...) \
+  EXPECT_NEAR(glm::length((a) - glm::dvec3(__VA_ARGS__)), 0.0, 1e-6) << #a
+
+const Material& material_named(const Scene& s, const std::string& name) {
+  int i = s.find_material(name);
+  EXPECT_GE(i, 0) << "no material named " << name;
+  static Material none;
+  return i >= 0 ? s.materials[i] : none;
+}
+
+TEST(Obj, QuadsAndNgonsAreTriangulatedKeepingAreaAndOrientation) {
+  std::string dir = lucent::test::temp_dir();
+  std::string path = write(dir, "poly.obj",
+                           "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\n"
+                           "v 0 0 1\nv 2 0 1\nv 3 1 1\nv 1 2 1\nv -1 1 1\n"
+                           "f 1 2 3 4\n"
+                           "f 5 6 7 8 9\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  EXPECT_TRUE(w.all().empty()) << w.dump();
+  ASSERT_EQ(s.triangles.size(), 2u + 3u);
+  double quad = 0, penta = 0;  // areas by plane: the quad is 2 x 1, the pentagon 5 (shoelace)
+  for (const Triangle& t : s.triangles) {
+    glm::dvec3 n = geometric_normal(s, t);
+    EXPECT_GT(n.z, 0) << "counter-clockwise polygons face +z";
+    (pos(s, t, 0).z == 0 ? quad : penta) += area(s, t);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(t.n[k], -1);
+      EXPECT_EQ(t.uv[k], -1);
+    }
+  }
+  EXPECT_NEAR(quad, 2.0, 1e-12);
+  EXPECT_NEAR(penta, 5.0, 1e-12);
+}
+
+TEST(Obj, NegativeIndicesAreRelativeToTheVerticesSoFar) {
+  std::string dir = lucent::test::temp_dir();
+  std::string a = write(dir, "abs.obj",
+                        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                        "f 1/1 2/2 3/3\n"
+                        "v 5 0 0\nv 6 0 0\nv 6 1 0\n"
+                        "f 5/1 6/2 7/3\nf 1/1 3/3 4/2\n");
+  std::string b = write(dir, "rel.obj",
+                        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                        "f -4/-3 -3/-2 -2/-1\n"
+                        "v 5 0 0\nv 6 0 0\nv 6 1 0\n"
+                        "f -3/-3 -2/-2 -1/-1\nf -7/-3 -5/-1 -4/-2\n");
+  Scene sa, sb;
+  load(sa, a);
+  load(sb, b);
+  ASSERT_EQ(sa.triangles.size(), 3u);
+  ASSERT_EQ(sb.triangles.size(), 3u);
+  std::multiset<std::vector<double>> ta, tb;
+  for (auto* p : {&sa, &sb})
+    for (const Triangle& t : p->triangles) {
+      std::vector<double> key;
+      for (int k = 0; k < 3; ++k) {
+        glm::dvec3 v = pos(*p, t, k);
+        glm::dvec2 uv = p->uvs[t.uv[k]];
+        key.insert(key.end(), {v.x, v.y, v.z, uv.x, uv.y});
+      }
+      (p == &sa ? ta : tb).insert(key);
+    }
+  EXPECT_EQ(ta, tb);
+}
+
+TEST(Obj, MissingNormalsOrUvsArePerTriangle) {
+  std::string dir = lucent::test::temp_dir();
+  std::string path = write(dir, "mixed.obj",
+                           "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                           "vt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\n"
+                           "f 1 2 3\n"
+                           "f 1/1 2/2 4/3\n"
+                           "f 2//1 3//1 4//1\n"
+                           "f 1/1/1 3/3/1 4/2/1\n");
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), 4u);
+  std::map<std::array<std::array<double, 3>, 3>, const Triangle*> by_corners;
+  for (const Triangle& t : s.triangles) by_corners[corners(s, t)] = &t;
+  auto find = [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) -> const Triangle& {
+    std::array<std::array<double, 3>, 3> k = {{{a.x, a.y, a.z}, {b.x, b.y, b.z}, {c.x, c.y, c.z}}};
+    std::sort(k.begin(), k.end());
+    EXPECT_TRUE(by_corners.count(k));
+    return *by_corners[k];
+  };
+  const Triangle& none = find({0, 0, 0}, {1, 0, 0}, {1, 1, 0});
+  const Triangle& uv = find({0, 0, 0}, {1, 0, 0}, {0, 1, 0});
+  const Triangle& n = find({1, 0, 0}, {1, 1, 0}, {0, 1, 0});
+  const Triangle& both = find({0, 0, 0}, {1, 1, 0}, {0, 1, 0});
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(none.n[k], -1);
+    EXPECT_EQ(none.uv[k], -1);
+    EXPECT_EQ(uv.n[k], -1);
+    ASSERT_GE(uv.uv[k], 0);
+    ASSERT_GE(n.n[k], 0);
+    EXPECT_EQ(n.uv[k], -1);
+    ASSERT_GE(both.n[k], 0);
+    ASSERT_GE(both.uv[k], 0);
+    EXPECT_EQ(s.normals[n.n[k]], glm::dvec3(0, 0, 1));
+  }
+  // each corner keeps its own uv: position (0,1,0) of the "uv" triangle has vt 3 = (1, 1)
+  for (int k = 0; k < 3; ++k)
+    if (pos(s, uv, k) == glm::dvec3(0, 1, 0)) {
+      EXPECT_EQ(s.uvs[uv.uv[k]], glm::dvec2(1, 1));
+    }
+}
+
+TEST(Obj, MissingMtlWarnsOnceAndUsesOneDefaultMaterial) {
+  std::string dir = lucent::test::temp_dir();
+  std::string path = write(dir, "nomtl.obj",
+                           "mtllib nothere.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n"
+                           "usemtl paint\nf 1 2 3\nusemtl other\nf 1 3 2\n");
+  CaptureWarnings w;
+  Scene s;
+  s.materials.push_back(Material{});  // a material of the scene's own, left alone
+  load(s, path);
+  load(s, path);
+  ASSERT_EQ(w.all().size(), 2u) << "one warning per load:\n" << w.dump();
+  EXPECT_EQ(w.count("nothere.mtl"), 2) << w.dump();
+  EXPECT_EQ(w.count(path), 2) << w.dump();
+  ASSERT_EQ(s.triangles.size(), 4u);
+  ASSERT_EQ(s.materials.size(), 2u) << "the default material is added once";
+  const Material& d = s.materials[1];
+  EXPECT_EQ(d.type, MaterialType::Diffuse);
+  EXPECT_EQ(d.albedo, glm::dvec3(0.8));
+  EXPECT_EQ(d.albedo_texture, -1);
+  EXPECT_FALSE(d.emissive());
+  for (const Triangle& t : s.triangles) EXPECT_EQ(t.material, 1);
+}
+
+TEST(Obj, CrlfFilesLoadLikeLfFiles) {
+  std::string dir = lucent::test::temp_dir();
+  const unsigned char px[] = {200, 100, 50};
+  ASSERT_TRUE(stbi_write_png((dir + "/tex.png").c_str(), 1, 1, 3, px, 3));
+  std::string obj =
+      "# comment\nmtllib m.mtl\ng body\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+      "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+      "usemtl skin\nf 1/1/1 2/2/1 3/3/1 4/4/1\ng cloth\nusemtl red\nf 1/1/1 3/3/1 2/2/1\n";
+  std::string mtl =
+      "newmtl skin\nKd 1 1 1\nmap_Kd tex.png\nmap_bump \n\nnewmtl red\nKd 0.7 0.1 0.1\nillum 1\n";
+  auto crlf = [](std::string s) {
+    std::string out;
+    for (char c : s) out += c == '\n' ? std::string("\r\n") : std::string(1, c);
+    return out;
+  };
+  std::string lf_dir = dir + "/lf", crlf_dir = dir + "/crlf";
+  write(lf_dir, "m.obj", obj);
+  write(lf_dir, "m.mtl", mtl);
+  write(crlf_dir, "m.obj", crlf(obj));
+  write(crlf_dir, "m.mtl", crlf(mtl));
+  std::filesystem::copy_file(dir + "/tex.png", lf_dir + "/tex.png");
+  std::filesystem::copy_file(dir + "/tex.png", crlf_dir + "/tex.png");
+  CaptureWarnings w;
+  Scene a, b;
+  load(a, lf_dir + "/m.obj");
+  load(b, crlf_dir + "/m.obj");
+  EXPECT_TRUE(w.all().empty()) << w.dump();
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.normals, b.normals);
+  EXPECT_EQ(a.uvs, b.uvs);
+  ASSERT_EQ(a.triangles.size(), 3u);
+  ASSERT_EQ(b.triangles.size(), 3u);
+  ASSERT_EQ(b.materials.size(), 2u);
+  for (const Scene* s : {&a, &b}) {
+    const Material& skin = material_named(*s, "m.obj:skin");
+    const Material& red = material_named(*s, "m.obj:red");
+    EXPECT_COLOUR(red.albedo, 0.7, 0.1, 0.1);
+    ASSERT_EQ(skin.albedo_texture, 0) << "texture name read without the carriage return";
+    ASSERT_EQ(s->textures.size(), 1u);
+    EXPECT_EQ(s->textures[0].width, 1);
+  }
+}
+
+TEST(Obj, UsemtlAppliesPerFaceAcrossGroups) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "m.mtl",
+        "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n");
+  std::string path = write(dir, "faces.obj",
+                           "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 2 0\n"
+                           "g first\nusemtl red\nf 1 2 3\nusemtl blue\nf 1 3 4\n"
+                           "g second\nf 2 5 3\nusemtl red\nf 3 5 4\nusemtl unknown\nf 1 2 5\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), 5u);
+  ASSERT_EQ(w.count("'unknown'"), 1) << w.dump();
+  EXPECT_EQ(w.all().size(), 1u) << w.dump();
+  int red = s.find_material("faces.obj:red"), blue = s.find_material("faces.obj:blue");
+  ASSERT_GE(red, 0);
+  ASSERT_GE(blue, 0);
+  EXPECT_EQ(s.materials[red].albedo, glm::dvec3(1, 0, 0));
+  EXPECT_EQ(s.materials[blue].albedo, glm::dvec3(0, 0, 1));
+  std::map<std::set<int>, int> want = {{{1, 2, 3}, red}, {{1, 3, 4}, blue}, {{2, 5, 3}, blue},
+                                       {{3, 5, 4}, red}};
+  // vertex k of the file is scene position k - 1 (the first mesh of the scene)
+  int unknown_faces = 0;
+  for (const Triangle& t : s.triangles) {
+    std::set<int> key = {t.v[0] + 1, t.v[1] + 1, t.v[2] + 1};
+    if (want.count(key)) {
+      EXPECT_EQ(t.material, want[key]) << "face " << *key.begin();
+    } else {
+      EXPECT_EQ(key, (std::set<int>{1, 2, 5}));
+      const Material& m = s.materials[t.material];
+      EXPECT_EQ(m.albedo, glm::dvec3(0.8)) << "an unknown usemtl falls back to the default";
+      ++unknown_faces;
+    }
+  }
+  EXPECT_EQ(unknown_faces, 1);
+}
+
+TEST(Obj, TexturesAreRelativeToTheMtlFileAndMissingOnesWarn) {
+  std::string dir = lucent::test::temp_dir();
+  std::filesystem::create_directories(dir + "/lib/tex");
+  const unsigned char px[] = {255, 255, 255, 0, 0, 0};
+  ASSERT_TRUE(stbi_write_png((dir + "/lib/tex/t.png").c_str(), 2, 1, 3, px, 6));
+  write(dir, "lib/m.mtl",
+        "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd tex/t.png\n"
+        "newmtl b\nKd 0.2 0.2 0.2\nmap_Kd tex/t.png\n"
+        "newmtl c\nKd 0.3 0.4 0.5\nmap_Kd tex/nothere.png\nmap_d tex/alpha.dds\n");
+  std::string path = write(dir, "mesh.obj",
+                           "mtllib lib/m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n"
+                           "usemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\nusemtl c\nf 2 1 3\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.textures.size(), 1u) << "both materials share the texture";
+  EXPECT_EQ(s.textures[0].width, 2);
+  EXPECT_EQ(material_named(s, "mesh.obj:a").albedo_texture, 0);
+  EXPECT_EQ(material_named(s, "mesh.obj:b").albedo_texture, 0);
+  const Material& c = material_named(s, "mesh.obj:c");
+  EXPECT_EQ(c.albedo_texture, -1);
+  EXPECT_COLOUR(c.albedo, 0.3, 0.4, 0.5) << ": a missing texture falls back to Kd";
+  EXPECT_EQ(w.count("nothere.png"), 1) << w.dump();
+  EXPECT_EQ(w.count("alpha.dds"), 1) << w.dump();
+  EXPECT_EQ(w.all().size(), 2u) << w.dump();
+  for (const auto& msg : w.all()) EXPECT_NE(msg.find("m.mtl"), std::string::npos) << msg;
+}
+
+TEST(Obj, UnreadableTextureWarnsAndFallsBack) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "junk.png", "not an image");
+  write(dir, "m.mtl", "newmtl a\nKd 0.1 0.2 0.3\nmap_Kd junk.png\n");
+  std::string path = write(dir, "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  EXPECT_EQ(w.count("junk.png"), 1) << w.dump();
+  EXPECT_EQ(material_named(s, "m.obj:a").albedo_texture, -1);
+  EXPECT_COLOUR(material_named(s, "m.obj:a").albedo, 0.1, 0.2, 0.3);
+}
+
+// The lucent::Error of loading the OBJ file `path`; "" when it loads.
+std::string load_error(const std::string& path) {
+  try {
+    Scene s;
+    load(s, path);
+  } catch (const lucent::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Obj, MalformedFilesAreErrorsNamingFileAndLine) {
+  std::string dir = lucent::test::temp_dir();
+  const std::string head = "# a triangle\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\n";  // 5 lines
+  struct Case {
+    const char* name;
+    std::string face;
+    std::string needle;
+  } cases[] = {
+      {"zero.obj", "f 1 2 0\n", "index"},
+      {"word.obj", "f 1 2 x\n", "index"},
+      {"range.obj", "f 1 2 4\n", "out of range"},
+      {"negative.obj", "f -4 1 2\n", "out of range"},
+      {"texcoord.obj", "f 1/1 2/1 3/2\n", "texture coordinate"},
+      {"normal.obj", "f 1//1 2//1 3//1\n", "normal"},
+  };
+  for (const Case& c : cases) {
+    std::string path = write(dir, c.name, head + "f 1 2 3\n" + c.face);  // the face: line 7
+    std::string err = load_error(path);
+    ASSERT_FALSE(err.empty()) << c.name << " loaded";
+    EXPECT_NE(err.find(path + ":7:"), std::string::npos) << c.name << ": " << err;
+    EXPECT_NE(err.find(c.needle), std::string::npos) << c.name << ": " << err;
+    EXPECT_EQ(err.find('\n'), std::string::npos) << "one line: " << err;
+  }
+  std::string missing = dir + "/nothere.obj";
+  std::string err = load_error(missing);
+  EXPECT_NE(err.find(missing), std::string::npos) << err;
+}
+
+TEST(Obj, TransformMovesPositionsAndNormalsByTheInverseTranspose) {
+  std::string dir = lucent::test::temp_dir();
+  // a sloped triangle whose vertex normals are its face normal
+  glm::dvec3 a(0, 0, 0), b(1, 0, 1), c(0, 1, 0.5);
+  glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "v 0 0 0\nv 1 0 1\nv 0 1 0.5\nvn %.17g %.17g %.17g\nf 1//1 2//1 3//1\n",
+                n.x, n.y, n.z);
+  std::string path = write(dir, "slope.obj", buf);
+  glm::dmat4 xf = glm::translate(glm::dmat4(1.0), glm::dvec3(3, -2, 1)) *
+                  glm::rotate(glm::dmat4(1.0), 0.7, glm::normalize(glm::dvec3(1, 2, 3))) *
+                  glm::scale(glm::dmat4(1.0), glm::dvec3(2, 0.5, 3));
+  Scene s;
+  load(s, path, xf);
+  ASSERT_EQ(s.triangles.size(), 1u);
+  const Triangle& t = s.triangles[0];
+  glm::dvec3 in[3] = {a, b, c};
+  for (int k = 0; k < 3; ++k) {
+    glm::dvec3 want = glm::dvec3(xf * glm::dvec4(in[k], 1.0));
+    EXPECT_NEAR(glm::length(pos(s, t, k) - want), 0.0, 1e-6) << "vertex " << k;
+  }
+  // the transformed normal is unit length, perpendicular to the transformed triangle and on the
+  // side of its geometric normal (non-uniform scale: the plain matrix would tilt it)
+  glm::dvec3 ng = glm::normalize(geometric_normal(s, t));
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_GE(t.n[k], 0);
+    glm::dvec3 nn = s.normals[t.n[k]];
+    EXPECT_NEAR(glm::length(nn), 1.0, 1e-9);
+    EXPECT_NEAR(glm::dot(nn, ng), 1.0, 1e-6);
+  }
+  glm::dvec3 naive = glm::normalize(glm::dmat3(xf) * n);
+  EXPECT_LT(glm::dot(naive, ng), 0.99) << "the test transform must tell the two apart";
+}
+
+// A unit cube around the origin, faces counter-clockwise from outside, with outward normals and
+// per-face UVs equal to two of the corner's coordinates + 0.5.
+const char* kCube =
+    "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n"
+    "v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n"
+    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+    "vn 0 0 1\nvn 0 0 -1\nvn 1 0 0\nvn -1 0 0\nvn 0 1 0\nvn 0 -1 0\n"
+    "f 5/1/1 6/2/1 7/3/1 8/4/1\nf 2/2/2 1/1/2 4/4/2 3/3/2\nf 6/4/3 2/1/3 3/2/3 7/3/3\n"
+    "f 1/1/4 5/2/4 8/3/4 4/4/4\nf 8/1/5 7/2/5 3/3/5 4/4/5\nf 1/1/6 2/2/6 6/3/6 5/4/6\n";
+
+void expect_outward(const Scene& s, const glm::dvec3& centre, const std::string& what) {
+  ASSERT_EQ(s.triangles.size(), 12u);
+  for (const Triangle& t : s.triangles) {
+    glm::dvec3 ng = glm::normalize(geometric_normal(s, t));
+    glm::dvec3 mid = (pos(s, t, 0) + pos(s, t, 1) + pos(s, t, 2)) / 3.0;
+    EXPECT_GT(glm::dot(ng, mid - centre), 0) << what << ": a face turned inwards";
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_GE(t.n[k], 0);
+      EXPECT_NEAR(glm::dot(s.normals[t.n[k]], ng), 1.0, 1e-9) << what << ": normal and face disagree";
+    }
+  }
+}
+
+TEST(Obj, MirroringTransformKeepsOrientationAndCornerAttributes) {
+  std::string dir = lucent::test::temp_dir();
+  std::string path = write(dir, "cube.obj", kCube);
+  Scene plain;
+  load(plain, path);
+  expect_outward(plain, glm::dvec3(0), "identity");
+
+  // the course's mapping of the character: (x, z, y) * 20 + (0, -10, 0), a Y/Z swap
+  glm::dmat4 swap(0.0);
+  swap[0][0] = 20;             // x' = 20 x
+  swap[2][1] = 20;             // y' = 20 z - 10
+  swap[1][2] = 20;             // z' = 20 y
+  swap[3] = glm::dvec4(0, -10, 0, 1);
+  ASSERT_LT(glm::determinant(glm::dmat3(swap)), 0);
+  Scene mirrored;
+  load(mirrored, path, swap);
+  expect_outward(mirrored, glm::dvec3(0, -10, 0), "Y/Z swap");
+
+  // a reflection through x = 0
+  Scene flipped;
+  load(flipped, path, glm::scale(glm::dmat4(1.0), glm::dvec3(-1, 1, 1)));
+  expect_outward(flipped, glm::dvec3(0), "x reflection");
+
+  // every corner keeps its own position, normal and uv when two are swapped: compare each
+  // mirrored corner with the untransformed one it came from
+  glm::dmat4 inv = glm::inverse(swap);
+  std::map<std::array<double, 5>, int> corner_set;
+  for (const Triangle& t : plain.triangles)
+    for (int k = 0; k < 3; ++k) {
+      glm::dvec3 p = pos(plain, t, k);
+      glm::dvec2 uv = plain.uvs[t.uv[k]];
+      corner_set[{p.x, p.y, p.z, uv.x, uv.y}]++;
+    }
+  for (const Triangle& t : mirrored.triangles)
+    for (int k = 0; k < 3; ++k) {
+      glm::dvec3 p = glm::dvec3(inv * glm::dvec4(pos(mirrored, t, k), 1.0));
+      glm::dvec3 r(std::round(p.x * 2) / 2, std::round(p.y * 2) / 2, std::round(p.z * 2) / 2);
+      glm::dvec2 uv = mirrored.uvs[t.uv[k]];
+      EXPECT_TRUE(corner_set.count({r.x, r.y, r.z, uv.x, uv.y}))
+          << "corner (" << r.x << ", " << r.y << ", " << r.z << ") lost its uv";
+    }
+}
+
+TEST(Obj, MtlMaterialsMapToLucentMaterials) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "m.mtl",
+        "newmtl matte\nKd 0.5 0.4 0.3\nKs 0 0 0\nNs 10\nillum 2\n"
+        "newmtl shiny\nKd 0.2 0.3 0.4\nKs 0.5 0.5 0.5\nNs 98\nillum 2\n"
+        "newmtl flat\nKd 0.7 0.7 0.7\nKs 0.5 0.5 0.5\nillum 1\n"
+        "newmtl rough\nKd 0.5 0.5 0.5\nKs 0.04 0.04 0.04\nNs 0\nNi 1.7\nillum 2\n"
+        "newmtl chrome\nKd 0 0 0\nKs 0.9 0.8 0.7\nillum 3\n"
+        "newmtl glass\nKd 0 0 0\nKs 1 1 1\nNi 1.33\nillum 7\n"
+        "newmtl faded\nKd 0.5 0.5 0.5\nd 0.5\nNi 1.6\nillum 2\n"
+        "newmtl noni\nKd 0.5 0.5 0.5\nillum 4\n"
+        "newmtl lamp\nKd 0.78 0.78 0.78\nKs 0 0 0\nKe 17 12 4\nillum 2\n");
+  std::string obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n";
+  const char* names[] = {"matte", "shiny", "flat", "rough", "chrome", "glass", "faded", "noni", "lamp"};
+  for (const char* n : names) obj += std::string("usemtl ") + n + "\nf 1 2 3\n";
+  std::string path = write(dir, "m.obj", obj);
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  EXPECT_TRUE(w.all().empty()) << w.dump();
+  ASSERT_EQ(s.triangles.size(), 9u);
+  ASSERT_EQ(s.materials.size(), 9u);
+  for (size_t i = 0; i < 9; ++i)
+    EXPECT_EQ(s.materials[s.triangles[i].material].name, std::string("m.obj:") + names[i]);
+
+  const Material& matte = material_named(s, "m.obj:matte");
+  EXPECT_EQ(matte.type, MaterialType::Diffuse) << "Ks 0: no specular layer";
+  EXPECT_COLOUR(matte.albedo, 0.5, 0.4, 0.3);
+  EXPECT_FALSE(matte.emissive());
+
+  const Material& shiny = material_named(s, "m.obj:shiny");
+  EXPECT_EQ(shiny.type, MaterialType::Plastic);
+  EXPECT_COLOUR(shiny.albedo, 0.2, 0.3, 0.4);
+  EXPECT_COLOUR(shiny.specular, 0.5, 0.5, 0.5);
+  EXPECT_NEAR(shiny.roughness, std::sqrt(2.0 / 100.0), 1e-6);  // alpha = sqrt(2 / (Ns + 2))
+  EXPECT_NEAR(shiny.ior, 1.5, 1e-12) << "no Ni: 1.5";
+
+  EXPECT_EQ(material_named(s, "m.obj:flat").type, MaterialType::Diffuse) << "illum 1: no specular";
+
+  const Material& rough = material_named(s, "m.obj:rough");
+  EXPECT_EQ(rough.type, MaterialType::Plastic);
+  EXPECT_NEAR(rough.roughness, 1.0, 1e-12);
+  EXPECT_NEAR(rough.ior, 1.7, 1e-6);
+
+  const Material& chrome = material_named(s, "m.obj:chrome");
+  EXPECT_EQ(chrome.type, MaterialType::Mirror);
+  EXPECT_COLOUR(chrome.specular, 0.9, 0.8, 0.7);
+
+  const Material& glass = material_named(s, "m.obj:glass");
+  EXPECT_EQ(glass.type, MaterialType::Dielectric);
+  EXPECT_NEAR(glass.ior, 1.33, 1e-6);
+  EXPECT_EQ(glass.specular, glm::dvec3(1.0)) << "clear glass";
+
+  const Material& faded = material_named(s, "m.obj:faded");
+  EXPECT_EQ(faded.type, MaterialType::Dielectric) << "d < 1";
+  EXPECT_NEAR(faded.ior, 1.6, 1e-6);
+
+  const Material& noni = material_named(s, "m.obj:noni");
+  EXPECT_EQ(noni.type, MaterialType::Dielectric);
+  EXPECT_NEAR(noni.ior, 1.5, 1e-12) << "no Ni: 1.5";
+
+  const Material& lamp = material_named(s, "m.obj:lamp");
+  EXPECT_EQ(lamp.type, MaterialType::Diffuse);
+  EXPECT_EQ(lamp.emission, glm::dvec3(17, 12, 4));
+  EXPECT_COLOUR(lamp.albedo, 0.78, 0.78, 0.78);
+}
+
+TEST(Obj, MaterialOverrideIgnoresTheMtl) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "m.mtl", "newmtl red\nKd 1 0 0\nmap_Kd nothere.png\n");
+  std::string path = write(dir, "m.obj",
+                           "mtllib m.mtl\nmtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n"
+                           "usemtl red\nf 1 2 3\nusemtl nosuch\nf 1 3 2\n");
+  CaptureWarnings w;
+  Scene s;
+  s.materials.push_back(Material{});
+  s.materials.push_back(Material{});
+  load(s, path, glm::dmat4(1.0), 1);
+  EXPECT_TRUE(w.all().empty()) << w.dump();
+  EXPECT_EQ(s.materials.size(), 2u);
+  EXPECT_TRUE(s.textures.empty());
+  ASSERT_EQ(s.triangles.size(), 2u);
+  for (const Triangle& t : s.triangles) EXPECT_EQ(t.material, 1);
+}
+
+TEST(Obj, MeshesAppendToTheScene) {
+  std::string dir = lucent::test::temp_dir();
+  std::string path = write(dir, "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 3/1/1\n");
+  Scene s;
+  s.positions = {glm::dvec3(9), glm::dvec3(8)};
+  s.normals = {glm::dvec3(0, 1, 0)};
+  s.uvs = {glm::dvec2(0.5), glm::dvec2(0.25), glm::dvec2(0.75)};
+  load(s, path, glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, 5)));
+  ASSERT_EQ(s.triangles.size(), 1u);
+  const Triangle& t = s.triangles[0];
+  EXPECT_EQ(t.v[0], 2);
+  EXPECT_EQ(t.n[0], 1);
+  EXPECT_EQ(t.uv[0], 3);
+  EXPECT_EQ(s.positions[t.v[1]], glm::dvec3(1, 0, 5));
+}
+
+}  // namespace
