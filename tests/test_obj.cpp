@@ -95,24 +95,28 @@ TEST(Obj, QuadsAndNgonsAreTriangulatedKeepingAreaAndOrientation) {
                            "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\n"
                            "v 0 0 1\nv 2 0 1\nv 3 1 1\nv 1 2 1\nv -1 1 1\n"
                            "f 1 2 3 4\n"
-                           "f 5 6 7 8 9\n");
+                           "f 5 6 7 8 9\n"
+                           // a concave L (area 3) starting at a vertex a fan would get wrong
+                           "v 2 1 2\nv 1 1 2\nv 1 2 2\nv 0 2 2\nv 0 0 2\nv 2 0 2\n"
+                           "f 10 11 12 13 14 15\n");
   CaptureWarnings w;
   Scene s;
   load(s, path);
   EXPECT_TRUE(w.all().empty()) << w.dump();
-  ASSERT_EQ(s.triangles.size(), 2u + 3u);
-  double quad = 0, penta = 0;  // areas by plane: the quad is 2 x 1, the pentagon 5 (shoelace)
+  ASSERT_EQ(s.triangles.size(), 2u + 3u + 4u);
+  double area_by_z[3] = {0, 0, 0};  // the quad is 2 x 1, the pentagon 5 (shoelace), the L 3
   for (const Triangle& t : s.triangles) {
     glm::dvec3 n = geometric_normal(s, t);
     EXPECT_GT(n.z, 0) << "counter-clockwise polygons face +z";
-    (pos(s, t, 0).z == 0 ? quad : penta) += area(s, t);
+    area_by_z[static_cast<int>(pos(s, t, 0).z)] += area(s, t);
     for (int k = 0; k < 3; ++k) {
       EXPECT_EQ(t.n[k], -1);
       EXPECT_EQ(t.uv[k], -1);
     }
   }
-  EXPECT_NEAR(quad, 2.0, 1e-12);
-  EXPECT_NEAR(penta, 5.0, 1e-12);
+  EXPECT_NEAR(area_by_z[0], 2.0, 1e-12);
+  EXPECT_NEAR(area_by_z[1], 5.0, 1e-12);
+  EXPECT_NEAR(area_by_z[2], 3.0, 1e-12);
 }
 
 TEST(Obj, NegativeIndicesAreRelativeToTheVerticesSoFar) {
