@@ -19,8 +19,15 @@ IntegratorType parse_integrator(const std::string& n) {
               ": unknown integrator (expected path, whitted, direct, albedo, normal, depth, ao)");
 }
 
-void register_extra_commands(CLI::App&) {}
+// cmd_info.cpp
+CLI::App* add_info_command(CLI::App& app);
+int run_info_command();
 
-int run_extra_commands(CLI::App&) { return 0; }
+void register_extra_commands(CLI::App& app) { add_info_command(app); }
+
+int run_extra_commands(CLI::App& app) {
+  if (app.got_subcommand("info")) return run_info_command();
+  return 0;
+}
 
 }  // namespace lucent::cli

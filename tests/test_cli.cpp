@@ -1,0 +1,268 @@
+// The command-line front end: --version, --help, the render options, the progress line and
+// SIGINT (the image accumulated so far is written, exit status 130).
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "support.hpp"
+
+namespace {
+
+using lucent::test::CommandResult;
+using lucent::test::run_cli;
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+std::string read_all(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) out.push_back(line);
+  return out;
+}
+
+// A plane of albedo (0.25, 0.5, 0.75) filling the view, lit by a point light; path traced by
+// default, so the image is noisy and depends on the seed. Exact image comparisons use 2 spp: the
+// renderer always runs that as two passes of 1, so the float sums are the same every time.
+std::string plane_scene(int seed = 0, int spp = 2, const std::string& integrator = "path") {
+  std::string path = lucent::test::temp_dir() + "/plane.json";
+  lucent::test::write_file(path, R"({
+    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 20},
+    "film": {"width": 16, "height": 16, "filter": {"type": "gaussian"}},
+    "integrator": {"type": ")" + integrator + R"(", "spp": )" + std::to_string(spp) +
+                                         R"(, "seed": )" + std::to_string(seed) + R"(},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.25, 0.5, 0.75]}},
+    "shapes": [{"type": "triangles", "material": "m",
+                "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]],
+                "indices": [0,1,2, 0,2,3]},
+               {"type": "sphere", "center": [0.3, 0.2, 0.5], "radius": 0.3, "material": "m"}],
+    "lights": [{"type": "point", "position": [0.7, 0.4, 2.0], "intensity": [20, 20, 20]},
+               {"type": "environment", "radiance": [0.2, 0.2, 0.2]}]
+  })");
+  return path;
+}
+
+lucent::Image render_to(const std::string& scene, const std::string& extra) {
+  std::string out = lucent::test::temp_dir() + "/out.pfm";
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(out) + " --quiet " + extra);
+  EXPECT_EQ(r.status, 0) << r.err;
+  return lucent::read_image(out);
+}
+
+TEST(Cli, Version) {
+  CommandResult r = run_cli("--version");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.out, std::string("lucent ") + lucent::kVersion + "\n");
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST(Cli, HelpOnEachSubcommand) {
+  CommandResult r = run_cli("--help");
+  ASSERT_EQ(r.status, 0);
+  // the subcommands listed by the top-level help
+  std::vector<std::string> commands;
+  bool in_list = false;
+  for (const std::string& line : lines_of(r.out)) {
+    if (line.rfind("Subcommands:", 0) == 0) {
+      in_list = true;
+      continue;
+    }
+    if (in_list && line.rfind("  ", 0) == 0) {
+      std::istringstream in(line);
+      std::string name;
+      in >> name;
+      commands.push_back(name);
+    }
+  }
+  for (const char* expected : {"render", "devices", "info"})
+    EXPECT_NE(std::find(commands.begin(), commands.end(), expected), commands.end())
+        << expected << " missing from:\n" << r.out;
+  for (const std::string& c : commands) {
+    for (const char* flag : {"--help", "-h"}) {
+      CommandResult h = run_cli(c + " " + flag);
+      EXPECT_EQ(h.status, 0) << c << " " << flag << ": " << h.err;
+      EXPECT_NE(h.out.find("Usage: lucent " + c), std::string::npos) << h.out;
+      EXPECT_TRUE(h.err.empty()) << h.err;
+    }
+  }
+  CommandResult h = run_cli("render --help");
+  for (const char* option : {"--output", "--spp", "--width", "--height", "--seed", "--device",
+                             "--quiet", "--time", "--integrator", "LUCENT_DEVICE"})
+    EXPECT_NE(h.out.find(option), std::string::npos) << option << " missing from:\n" << h.out;
+}
+
+TEST(Cli, WidthAndHeightSetTheImageSize) {
+  std::string scene = plane_scene();
+  std::string dir = lucent::test::temp_dir();
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(dir + "/a.png") +
+                            " --width 37 --height 23 --spp 1 --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  lucent::Image png = lucent::read_image(dir + "/a.png");
+  EXPECT_EQ(png.width, 37);
+  EXPECT_EQ(png.height, 23);
+  lucent::Image pfm = render_to(scene, "--width 5 --spp 1");
+  EXPECT_EQ(pfm.width, 5);
+  EXPECT_EQ(pfm.height, 16);  // from the scene
+  for (const std::string ext : {".exr", ".PNG"}) {
+    r = run_cli("render " + q(scene) + " -o " + q(dir + "/b" + ext) + " --height 9 --spp 1 -q");
+    ASSERT_EQ(r.status, 0) << ext << ": " << r.err;
+    lucent::Image img = lucent::read_image(dir + "/b" + ext);
+    EXPECT_EQ(img.width, 16) << ext;
+    EXPECT_EQ(img.height, 9) << ext;
+  }
+}
+
+// Same seed, same image; --seed replaces the scene's seed.
+TEST(Cli, SeedSelectsTheRandomSequence) {
+  std::string seed0 = plane_scene(0), seed7 = plane_scene(7);
+  lucent::Image a = render_to(seed0, "--seed 7");
+  lucent::Image b = render_to(seed0, "--seed 7");
+  lucent::Image c = render_to(seed7, "");
+  lucent::Image d = render_to(seed0, "--seed 8");
+  lucent::Image e = render_to(seed0, "");
+  ASSERT_EQ(a.rgb.size(), 16u * 16u * 3u);
+  EXPECT_EQ(a.rgb, b.rgb);
+  EXPECT_EQ(a.rgb, c.rgb) << "--seed 7 differs from the scene's seed 7";
+  EXPECT_NE(a.rgb, d.rgb);
+  EXPECT_NE(a.rgb, e.rgb) << "--seed had no effect";
+}
+
+TEST(Cli, SppIsReported) {
+  std::string scene = plane_scene(0, 4);
+  std::string out = lucent::test::temp_dir() + "/o.pfm";
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(out) + " --spp 3");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> lines = lines_of(r.err);
+  ASSERT_EQ(lines.size(), 1u) << r.err;  // a render this short has no progress line
+  EXPECT_EQ(lines[0].rfind(out + ": 16x16, 3 spp in ", 0), 0u) << lines[0];
+  r = run_cli("render " + q(scene) + " -o " + q(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.rfind(out + ": 16x16, 4 spp in ", 0), 0u) << r.err;  // the scene's spp
+}
+
+TEST(Cli, IntegratorOverride) {
+  std::string scene = plane_scene();
+  // the albedo integrator returns the first hit's albedo, exactly
+  lucent::Image albedo = render_to(scene, "--integrator albedo --spp 2");
+  for (size_t i = 0; i < albedo.rgb.size(); i += 3) {
+    EXPECT_FLOAT_EQ(albedo.rgb[i], 0.25f);
+    EXPECT_FLOAT_EQ(albedo.rgb[i + 1], 0.5f);
+    EXPECT_FLOAT_EQ(albedo.rgb[i + 2], 0.75f);
+  }
+  lucent::Image path = render_to(scene, "--spp 2");
+  EXPECT_NE(path.rgb, albedo.rgb);
+  // and the other way round: a scene asking for albedo, rendered with --integrator path
+  lucent::Image back = render_to(plane_scene(0, 2, "albedo"), "--integrator path");
+  EXPECT_EQ(back.rgb, path.rgb);
+}
+
+// A render longer than a second prints a progress line (percent, samples/s, elapsed, ETA);
+// --time stops it (the scene asks for 2^24 spp); --quiet silences everything.
+TEST(Cli, ProgressLineAndTimeLimit) {
+  std::string scene = plane_scene(0, 1 << 24);
+  std::string out = lucent::test::temp_dir() + "/o.png";
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(out) + " --time 1.5 --width 64");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> lines = lines_of(r.err);
+  ASSERT_GE(lines.size(), 2u) << r.err;
+  std::regex progress(
+      R"(^ *\d+\.\d%  \d+ spp  \d+\.\d\d Msamples/s  elapsed \d+(\.\d|m\d\d)s  ETA \d+(\.\d|m\d\d)s$)");
+  for (size_t i = 0; i + 1 < lines.size(); ++i)
+    EXPECT_TRUE(std::regex_match(lines[i], progress)) << "progress line: " << lines[i];
+  EXPECT_EQ(lines.back().rfind(out + ": 64x16, ", 0), 0u) << lines.back();
+  lucent::Image img = lucent::read_image(out);
+  EXPECT_EQ(img.width, 64);
+
+  r = run_cli("render " + q(scene) + " -o " + q(out) + " --time 1.5 --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(r.out, "");
+}
+
+// SIGINT while rendering: the image accumulated so far is written and the exit status is 130.
+// The signal is sent once the progress line shows the render loop is running (not after a fixed
+// delay), and --time bounds the render should the signal be lost.
+TEST(Cli, SigintWritesThePartialImage) {
+  std::string scene = plane_scene(0, 1 << 24);
+  std::string dir = lucent::test::temp_dir();
+  std::string out = dir + "/partial.pfm", err_path = dir + "/stderr";
+  pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    int fd = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int null = ::open("/dev/null", O_RDWR);
+    if (fd < 0 || null < 0) ::_exit(126);
+    ::dup2(null, 0);
+    ::dup2(null, 1);
+    ::dup2(fd, 2);
+    ::signal(SIGINT, SIG_DFL);
+    ::execl(LUCENT_CLI_PATH, "lucent", "render", scene.c_str(), "-o", out.c_str(), "--time", "120",
+            "--width", "64", "--height", "48", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  using clock = std::chrono::steady_clock;
+  auto wait_for = [&](double seconds, auto done) {
+    auto end = clock::now() + std::chrono::duration<double>(seconds);
+    while (clock::now() < end) {
+      if (done()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  };
+  int status = 0;
+  bool exited = false;
+  auto reaped = [&] {
+    if (!exited && ::waitpid(pid, &status, WNOHANG) == pid) exited = true;
+    return exited;
+  };
+  bool running = wait_for(90, [&] {
+    return reaped() || read_all(err_path).find("Msamples/s  elapsed") != std::string::npos;
+  });
+  ASSERT_TRUE(running && !exited) << "no progress line: " << read_all(err_path);
+  ASSERT_EQ(::kill(pid, SIGINT), 0);
+  if (!wait_for(60, reaped)) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    FAIL() << "lucent did not stop after SIGINT";
+  }
+  std::string err = read_all(err_path);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(
+      err, m,
+      std::regex("lucent: interrupted: wrote " + out + " with the (\\d+) spp accumulated so far\n$")))
+      << err;
+  EXPECT_GE(std::stoll(m[1]), 1);
+  lucent::Image img = lucent::read_image(out);
+  ASSERT_EQ(img.width, 64);
+  ASSERT_EQ(img.height, 48);
+  double sum = 0;
+  for (float v : img.rgb) {
+    ASSERT_TRUE(std::isfinite(v));
+    sum += v;
+  }
+  EXPECT_GT(sum, 0) << "the partial image is black";
+}
+
+}  // namespace

@@ -1,0 +1,181 @@
+// `lucent info SCENE`: scene and BVH statistics and the kernel feature defines.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include "render/pack.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::test::CommandResult;
+using lucent::test::run_cli;
+
+/// "key   value" lines of the report, keyed by section and key ("lights/point" -> "1").
+std::map<std::string, std::string> parse_report(const std::string& out) {
+  std::map<std::string, std::string> m;
+  std::istringstream in(out);
+  std::string section;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty()) continue;
+    bool indented = line[0] == ' ';
+    // key and value are separated by two or more spaces
+    size_t start = line.find_first_not_of(' ');
+    size_t gap = line.find("  ", start);
+    std::string key = line.substr(start, gap == std::string::npos ? std::string::npos : gap - start);
+    std::string value;
+    if (gap != std::string::npos) value = line.substr(line.find_first_not_of(' ', gap));
+    if (!indented) section = key;
+    m[indented ? section + "/" + key : key] = value;
+  }
+  return m;
+}
+
+long long leading_int(const std::string& s) { return std::stoll(s); }
+
+TEST(CliInfo, SceneAndBvhStatistics) {
+  std::string dir = lucent::test::temp_dir();
+  // a 4x2 texture: 8 texels of 16 bytes (float RGBA) on the device
+  lucent::Image tex{4, 2, std::vector<float>(4 * 2 * 3, 0.5f)};
+  lucent::write_image(dir + "/tex.png", tex);
+  std::string scene = dir + "/scene.json";
+  lucent::test::write_file(scene, R"({
+    "film": {"width": 40, "height": 30},
+    "integrator": {"type": "direct", "max_depth": 3, "spp": 9, "seed": 5},
+    "materials": {
+      "white": {"type": "diffuse", "albedo": [0.8, 0.8, 0.8]},
+      "wood":  {"type": "diffuse", "albedo": {"texture": "tex.png"}},
+      "lamp":  {"type": "diffuse", "emission": [5, 5, 5]},
+      "chrome": {"type": "mirror"},
+      "glass": {"type": "dielectric", "ior": 1.5}
+    },
+    "shapes": [
+      {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "chrome"},
+      {"type": "sphere", "center": [3, 0, 0], "radius": 1, "material": "glass"},
+      {"type": "sphere", "center": [0, 4, 0], "radius": 0.5, "material": "lamp"},
+      {"type": "triangles", "material": "white",
+       "positions": [[-5,-1,-5],[5,-1,-5],[5,-1,5],[-5,-1,5]], "indices": [0,1,2, 0,2,3]},
+      {"type": "triangles", "material": "lamp",
+       "positions": [[-1,5,-1],[1,5,-1],[1,5,1],[-1,5,1],[0,6,0]],
+       "indices": [0,2,1, 0,3,2, 0,1,4]},
+      {"type": "triangles", "material": "wood",
+       "positions": [[0,0,3],[1,0,3],[2,0,3]], "indices": [0,1,2]}
+    ],
+    "lights": [
+      {"type": "point", "position": [0, 3, 3], "intensity": [10, 10, 10]},
+      {"type": "point", "position": [0, 3, -3], "intensity": [10, 10, 10]},
+      {"type": "environment", "radiance": [0.1, 0.1, 0.1]}
+    ]
+  })");
+  CommandResult r = run_cli("info '" + scene + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::map<std::string, std::string> m = parse_report(r.out);
+
+  EXPECT_EQ(m["scene"], scene);
+  EXPECT_EQ(m["film"], "40x30");
+  EXPECT_EQ(m["integrator"], "direct, max_depth 3, spp 9, seed 5");
+
+  EXPECT_EQ(m["shapes/spheres"], "3");
+  EXPECT_EQ(m["shapes/triangle lists"], "3");
+  EXPECT_EQ(m["shapes/meshes"], "0");
+  // 2 + 3 + 1 triangles; the last is degenerate (collinear corners) and left out of the BVH
+  EXPECT_EQ(m["shapes/triangles"], "6 (1 degenerate or non-finite, skipped)");
+  EXPECT_EQ(m["shapes/vertices"], "12 (normals 0, uvs 0)");
+
+  EXPECT_EQ(m["materials"], "5");
+  EXPECT_EQ(m["materials/diffuse"], "3");
+  EXPECT_EQ(m["materials/mirror"], "1");
+  EXPECT_EQ(m["materials/dielectric"], "1");
+  EXPECT_EQ(m["materials/emissive"], "1");
+
+  EXPECT_EQ(m["textures"], "1 (128 B on the device)");
+  EXPECT_NE(r.out.find("  4x2  128 B"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("tex.png"), std::string::npos) << r.out;
+
+  // 2 point lights, the environment, the emissive sphere and 3 emissive triangles
+  EXPECT_EQ(m["lights"], "7");
+  EXPECT_EQ(m["lights/point"], "2");
+  EXPECT_EQ(m["lights/emissive spheres"], "1");
+  EXPECT_EQ(m["lights/emissive triangles"], "3");
+  EXPECT_EQ(m["lights/environment"], "1");
+  EXPECT_EQ(m["lights/environment map"], "0");
+
+  // BVH: 3 spheres + 5 valid triangles. A binary BVH over n primitives in single-primitive or
+  // larger leaves has 2 * leaves - 1 nodes, leaves * mean leaf size = n, and depth at least
+  // log2(leaves).
+  long long prims = leading_int(m["BVH/primitives"]);
+  long long nodes = leading_int(m["BVH/nodes"]);
+  long long leaves = leading_int(m["BVH/leaves"]);
+  long long depth = leading_int(m["BVH/max depth"]);
+  EXPECT_EQ(prims, 8);
+  EXPECT_GE(leaves, 1);
+  EXPECT_EQ(nodes, 2 * leaves - 1);
+  EXPECT_GE(depth, static_cast<long long>(std::ceil(std::log2(double(leaves)))));
+  EXPECT_LE(depth, leaves);
+  double mean = 0;
+  size_t max_leaf = 0;
+  ASSERT_EQ(std::sscanf(m["BVH/leaf size"].c_str(), "mean %lf, max %zu", &mean, &max_leaf), 2)
+      << m["BVH/leaf size"];
+  EXPECT_NEAR(mean * leaves, double(prims), 0.01 * leaves);
+  EXPECT_GE(double(max_leaf), mean);
+  EXPECT_LE(max_leaf, size_t(prims));
+  EXPECT_NE(m["BVH/build time"].find(" ms"), std::string::npos);
+  EXPECT_GT(std::stod(m["BVH/SAH cost"]), 0.0);
+
+  // the same numbers as the library's build of the same scene
+  lucent::Scene s = lucent::load_scene(scene);
+  lucent::render_detail::PackedScene packed = lucent::render_detail::pack_scene(s);
+  EXPECT_EQ(size_t(nodes), packed.bvh.stats.nodes);
+  EXPECT_EQ(size_t(leaves), packed.bvh.stats.leaves);
+  EXPECT_EQ(size_t(nodes), packed.bvh.nodes.size());
+
+  // kernel: where sources come from and the feature defines of this scene
+  std::string defines = lucent::render_detail::feature_defines(s, packed);
+  EXPECT_NE(defines.find("-D LC_HAS_TEXTURES"), std::string::npos) << defines;
+  if (!defines.empty() && defines[0] == ' ') defines.erase(0, 1);
+  EXPECT_EQ(m["kernel/feature defines"], defines);
+  EXPECT_FALSE(m["kernel/sources"].empty());
+}
+
+TEST(CliInfo, EmptySceneAndNoFeatures) {
+  std::string scene = lucent::test::temp_dir() + "/empty.json";
+  lucent::test::write_file(scene, "{}");
+  CommandResult r = run_cli("info '" + scene + "'", "env -u LUCENT_KERNEL_DIR");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::map<std::string, std::string> m = parse_report(r.out);
+  EXPECT_EQ(m["shapes/spheres"], "0");
+  EXPECT_EQ(m["shapes/triangles"], "0");
+  EXPECT_EQ(m["lights"], "0");
+  EXPECT_EQ(m["BVH/primitives"], "0");
+  EXPECT_EQ(m["BVH/nodes"].substr(0, 2), "0 ");
+  EXPECT_EQ(m["kernel/sources"], "embedded");
+  EXPECT_EQ(m["kernel/feature defines"], "(none)");
+}
+
+// info needs no OpenCL device: it works with every driver hidden.
+TEST(CliInfo, NeedsNoOpenClPlatform) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = dir + "/s.json";
+  lucent::test::write_file(scene, R"({"materials": {"m": {"type": "diffuse"}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]})");
+  CommandResult r = run_cli("info '" + scene + "'", "OCL_ICD_VENDORS='" + dir + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(parse_report(r.out)["BVH/primitives"], "1");
+}
+
+TEST(CliInfo, BadSceneIsOneErrorLine) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/bad.json", R"({"film": {"width": 0}})");
+  CommandResult r = run_cli("info '" + dir + "/bad.json'");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err, "lucent: error: " + dir + "/bad.json: /film/width: must be in [1, 16384], got 0\n");
+  EXPECT_EQ(r.out, "");
+  r = run_cli("info");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+}
+
+}  // namespace

@@ -1,0 +1,192 @@
+// Kernel sources: embedded in the binary (the CLI works from any directory), loaded from
+// LUCENT_KERNEL_DIR when set, and a build failure shows the log with kernels/<file>:<line>.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cl/kernel_source.hpp"
+#include "support.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using lucent::test::CommandResult;
+using lucent::test::run_cli;
+
+// A diffuse plane filling the view, rendered with the albedo integrator: every pixel is the
+// albedo, (0.6, 0.6, 0.6).
+const char kPlaneScene[] = R"({
+  "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 20},
+  "film": {"width": 6, "height": 4},
+  "integrator": {"type": "albedo", "spp": 2},
+  "materials": {"m": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}},
+  "shapes": [{"type": "triangles", "material": "m",
+              "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]],
+              "indices": [0,1,2, 0,2,3]}]
+})";
+
+std::string read_all(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+/// Writes the kernel sources this build embeds into a fresh directory and returns it.
+std::string kernel_copy() {
+  std::string dir = lucent::test::temp_dir() + "/kernels";
+  for (int i = 0; i < lucent::detail::kEmbeddedKernelFileCount; ++i) {
+    const auto& f = lucent::detail::kEmbeddedKernelFiles[i];
+    fs::path p = fs::path(dir) / f.path;
+    fs::create_directories(p.parent_path());
+    lucent::test::write_file(p.string(), f.content);
+  }
+  return dir;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+std::string join(const std::vector<std::string>& lines) {
+  std::string s;
+  for (const auto& l : lines) s += l + "\n";
+  return s;
+}
+
+/// Renders kPlaneScene with the CLI (in `cwd` when given) to a PFM file; returns the result.
+CommandResult render_plane(const std::string& env, const std::string& out,
+                           const std::string& cwd = "") {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/plane.json", kPlaneScene);
+  std::string prefix = cwd.empty() ? env : "cd '" + cwd + "' && " + env;
+  return run_cli("render '" + dir + "/plane.json' -o '" + out + "' --quiet", prefix);
+}
+
+TEST(KernelSource, EmbeddedSourcesWorkFromAnyDirectory) {
+  std::string cwd = lucent::test::temp_dir();  // an empty directory: no kernels/ beside it
+  std::string out = cwd + "/plane.pfm";
+  CommandResult r = render_plane("env -u LUCENT_KERNEL_DIR", out, cwd);
+  ASSERT_EQ(r.status, 0) << r.err;
+  lucent::Image img = lucent::read_image(out);
+  ASSERT_EQ(img.width, 6);
+  ASSERT_EQ(img.height, 4);
+  for (float v : img.rgb) EXPECT_NEAR(v, 0.6f, 1e-6f);
+}
+
+TEST(KernelSource, AssembledSourceHasLineMarkers) {
+  ::unsetenv("LUCENT_KERNEL_DIR");
+  EXPECT_EQ(lucent::detail::kernel_source_origin(), "embedded");
+  std::string src = lucent::detail::assemble_kernel_source("megakernel.cl");
+  EXPECT_EQ(src.rfind("#line 1 \"kernels/megakernel.cl\"\n", 0), 0u);
+  EXPECT_NE(src.find("#line 1 \"kernels/shared/types.h\"\n"), std::string::npos);
+  EXPECT_NE(src.find("#line 1 \"kernels/util/math.cl\"\n"), std::string::npos);
+  EXPECT_EQ(src.find("#include \""), std::string::npos) << "an #include was left unexpanded";
+  // after an included file, numbering resumes at the line after the #include
+  std::vector<std::string> mk = lines_of(lucent::detail::read_kernel_file("megakernel.cl"));
+  for (size_t i = 0; i < mk.size(); ++i)
+    if (mk[i].rfind("#include \"util/math.cl\"", 0) == 0) {
+      std::string marker = "#line " + std::to_string(i + 2) + " \"kernels/megakernel.cl\"\n";
+      EXPECT_NE(src.find(marker), std::string::npos) << marker;
+    }
+  EXPECT_THROW(lucent::detail::read_kernel_file("no/such/file.cl"), lucent::Error);
+}
+
+TEST(KernelSource, KernelDirOverridesTheEmbeddedCopy) {
+  std::string dir = kernel_copy();
+  // an observable change: the kernel reports the colour (0.25, 0.5, 0.75) for every sample
+  std::vector<std::string> mk = lines_of(read_all(dir + "/megakernel.cl"));
+  bool changed = false;
+  for (std::string& line : mk)
+    if (line.find("out_sum[gid] =") != std::string::npos) {
+      line = "  out_sum[gid] = (float4)(0.25f, 0.5f, 0.75f, 1.0f) * (float)params->samples_per_pass;";
+      changed = true;
+    }
+  ASSERT_TRUE(changed) << "megakernel.cl no longer writes out_sum[gid]: update this test";
+  lucent::test::write_file(dir + "/megakernel.cl", join(mk));
+
+  std::string out = lucent::test::temp_dir() + "/plane.pfm";
+  CommandResult r = render_plane("LUCENT_KERNEL_DIR='" + dir + "'", out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  lucent::Image img = lucent::read_image(out);
+  ASSERT_EQ(img.rgb.size(), 6u * 4u * 3u);
+  for (size_t i = 0; i < img.rgb.size(); i += 3) {
+    EXPECT_NEAR(img.rgb[i], 0.25f, 1e-6f);
+    EXPECT_NEAR(img.rgb[i + 1], 0.5f, 1e-6f);
+    EXPECT_NEAR(img.rgb[i + 2], 0.75f, 1e-6f);
+  }
+
+  // the library reads the same directory
+  ::setenv("LUCENT_KERNEL_DIR", dir.c_str(), 1);
+  EXPECT_EQ(lucent::detail::kernel_source_origin(), dir);
+  EXPECT_NE(lucent::detail::read_kernel_file("megakernel.cl").find("0.25f, 0.5f, 0.75f"),
+            std::string::npos);
+  ::unsetenv("LUCENT_KERNEL_DIR");
+  EXPECT_EQ(lucent::detail::read_kernel_file("megakernel.cl").find("0.25f, 0.5f, 0.75f"),
+            std::string::npos);
+}
+
+TEST(KernelSource, MissingFileInKernelDir) {
+  std::string dir = kernel_copy();
+  fs::remove(dir + "/util/math.cl");
+  CommandResult r = render_plane("LUCENT_KERNEL_DIR='" + dir + "'",
+                                 lucent::test::temp_dir() + "/o.pfm");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err, "lucent: error: " + dir +
+                       "/util/math.cl: cannot read kernel source (LUCENT_KERNEL_DIR is set)\n");
+
+  r = render_plane("LUCENT_KERNEL_DIR='" + dir + "/nowhere'", lucent::test::temp_dir() + "/o.pfm");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err, "lucent: error: " + dir +
+                       "/nowhere/megakernel.cl: cannot read kernel source (LUCENT_KERNEL_DIR is "
+                       "set)\n");
+}
+
+/// Inserts `bad` as line `line` (1-based) of kernels/<file> in `dir`; line 0 appends it.
+int inject(const std::string& dir, const std::string& file, int line, const std::string& bad) {
+  std::vector<std::string> lines = lines_of(read_all(dir + "/" + file));
+  if (line <= 0) line = static_cast<int>(lines.size()) + 1;
+  lines.insert(lines.begin() + (line - 1), bad);
+  lucent::test::write_file(dir + "/" + file, join(lines));
+  return line;
+}
+
+void expect_build_failure(const CommandResult& r, const std::string& where) {
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("lucent: error: kernel build log:\n"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(where), std::string::npos) << "no '" << where << "' in:\n" << r.err;
+  std::vector<std::string> lines = lines_of(r.err);
+  while (!lines.empty() && lines.back().empty()) lines.pop_back();
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines.back(), "clBuildProgram: CL_BUILD_PROGRAM_FAILURE");
+}
+
+TEST(KernelSource, BuildFailureInTheMainFileNamesItsLine) {
+  std::string dir = kernel_copy();
+  std::vector<std::string> mk = lines_of(read_all(dir + "/megakernel.cl"));
+  int at = 0;  // just before the kernel function, after every #include
+  for (size_t i = 0; i < mk.size() && at == 0; ++i)
+    if (mk[i].find("__kernel") != std::string::npos) at = static_cast<int>(i) + 1;
+  ASSERT_GT(at, 0);
+  int line = inject(dir, "megakernel.cl", at, "lucent_injected_error here;");
+  CommandResult r = render_plane("LUCENT_KERNEL_DIR='" + dir + "'",
+                                 lucent::test::temp_dir() + "/o.pfm");
+  expect_build_failure(r, "kernels/megakernel.cl:" + std::to_string(line) + ":");
+}
+
+TEST(KernelSource, BuildFailureInAnIncludedFileNamesItsLine) {
+  std::string dir = kernel_copy();
+  int line = inject(dir, "util/math.cl", 0, "float lucent_injected_error(void) { return 1.0f +; }");
+  CommandResult r = render_plane("LUCENT_KERNEL_DIR='" + dir + "'",
+                                 lucent::test::temp_dir() + "/o.pfm");
+  expect_build_failure(r, "kernels/util/math.cl:" + std::to_string(line) + ":");
+}
+
+}  // namespace
