@@ -19,13 +19,20 @@ IntegratorType parse_integrator(const std::string& n) {
               ": unknown integrator (expected path, whitted, direct, albedo, normal, depth, ao)");
 }
 
+// cmd_compare.cpp
+CLI::App* add_compare_command(CLI::App& app);
+int run_compare_command();
 // cmd_info.cpp
 CLI::App* add_info_command(CLI::App& app);
 int run_info_command();
 
-void register_extra_commands(CLI::App& app) { add_info_command(app); }
+void register_extra_commands(CLI::App& app) {
+  add_compare_command(app);
+  add_info_command(app);
+}
 
 int run_extra_commands(CLI::App& app) {
+  if (app.got_subcommand("compare")) return run_compare_command();
   if (app.got_subcommand("info")) return run_info_command();
   return 0;
 }

@@ -1,0 +1,68 @@
+#pragma once
+// Statistical comparison of two Monte Carlo images (docs/compare.md), and the EXR layout that
+// carries what it needs: per-pixel means, sample variances and sample counts.
+#include <cstddef>
+#include <string>
+
+#include "lucent/render.hpp"
+
+namespace lucent {
+
+struct CompareOptions {
+  /// Family-wise significance: the probability that two renders of the same expected image fail
+  /// the per-pixel test anywhere. Each of the m pixel-channels is tested at the Sidak level
+  /// 1 - (1 - alpha)^(1/m), two-sided.
+  double alpha = 0.01;
+  /// The comparison passes when at least this fraction of the pixels pass (all their channels)
+  /// and the image-mean test passes.
+  double min_pass_fraction = 0.995;
+  /// Added in quadrature to every pixel's standard error: abs_epsilon + rel_epsilon * |mean|.
+  /// It makes zero-variance pixels (deterministic images, constant regions) a tolerance test,
+  /// |A - B| <= z * (abs_epsilon + rel_epsilon * max(|A|, |B|)), and absorbs float rounding.
+  double abs_epsilon = 1e-5;
+  double rel_epsilon = 1e-4;
+  /// Also test the mean of each channel over the whole image (z-test with the summed variances,
+  /// Sidak over the three channels at `alpha`): far more sensitive to a small global bias.
+  bool image_mean_test = true;
+};
+
+struct CompareResult {
+  int width = 0, height = 0;
+  bool passed = false;
+  bool statistical = false;   ///< at least one image carried variances
+  double z_threshold = 0;     ///< per pixel-channel, from alpha and the number of tests
+  std::size_t tested = 0;     ///< pixel-channels tested (3 per pixel)
+  std::size_t failed_channels = 0;
+  std::size_t failed_pixels = 0;
+  double pass_fraction = 0;   ///< pixels whose three channels pass
+  double required_fraction = 0;  ///< CompareOptions::min_pass_fraction
+  double max_z = 0;           ///< largest |z| over all pixel-channels
+  int max_z_x = 0, max_z_y = 0, max_z_channel = 0;
+  double mean_a[3] = {0, 0, 0}, mean_b[3] = {0, 0, 0};  ///< image means per channel
+  double mean_z[3] = {0, 0, 0};  ///< z of the difference of the image means
+  double mean_z_threshold = 0;
+  bool mean_test_passed = true;
+  double rmse = 0;            ///< sqrt(mean over pixel-channels of (A - B)^2)
+  double relmse = 0;          ///< mean of (A - B)^2 / (B^2 + 0.01)
+  double max_abs_error = 0;   ///< largest |A - B|
+  std::string summary() const;  ///< multi-line report, as `lucent compare` prints it
+};
+
+/// Compares two images pixel by pixel. `variance` and `samples` may be empty (a deterministic
+/// image: variance 0); a pixel with fewer than 2 samples also counts as variance 0. Throws
+/// lucent::Error when the sizes differ.
+CompareResult compare_images(const RenderResult& a, const RenderResult& b,
+                             const CompareOptions& options = {});
+
+/// Upper two-sided critical value of the standard normal: P(|Z| > z) = p.
+double normal_two_sided_critical(double p);
+
+/// Writes an OpenEXR file with channels R, G, B (mean), var.R, var.G, var.B (sample variance of
+/// one sample, float) and n (finite samples, uint), ZIP compressed. Throws lucent::Error.
+void write_render_exr(const std::string& path, const RenderResult& result);
+
+/// Reads an image for comparison: an EXR with the layers above (variance and counts filled in),
+/// or any image read_image() understands (variance and samples left empty). Throws lucent::Error.
+RenderResult read_render(const std::string& path);
+
+}  // namespace lucent

@@ -1,0 +1,65 @@
+// `lucent compare A B`: the statistical comparison of two renders (docs/compare.md). Prints the
+// metrics and PASS or FAIL; exits 0 on PASS, 1 on FAIL or error.
+#include <cstdio>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "lucent/compare.hpp"
+#include "lucent/error.hpp"
+
+namespace lucent::cli {
+
+namespace {
+
+struct CompareArgs {
+  std::string a, b;
+  CompareOptions options;
+  bool no_mean_test = false;
+};
+
+CompareArgs& args() {
+  static CompareArgs a;
+  return a;
+}
+
+}  // namespace
+
+CLI::App* add_compare_command(CLI::App& app) {
+  CompareArgs& a = args();
+  CLI::App* cmd = app.add_subcommand(
+      "compare", "Compare two renders statistically (z-test per pixel; EXR with var.*/n layers)");
+  cmd->add_option("a", a.a, "First image (.exr with variance layers, or any image)")->required();
+  cmd->add_option("b", a.b, "Second image, the reference for relMSE")->required();
+  cmd->add_option("--alpha", a.options.alpha, "Family-wise significance level (default 0.01)")
+      ->check(CLI::Range(1e-12, 0.5));
+  cmd->add_option("--min-pass", a.options.min_pass_fraction,
+                  "Fraction of pixels that must pass (default 0.995)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--abs-epsilon", a.options.abs_epsilon,
+                  "Absolute error allowed where variances are zero (default 1e-5)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--rel-epsilon", a.options.rel_epsilon,
+                  "Relative error allowed where variances are zero (default 1e-4)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--no-mean-test", a.no_mean_test, "Skip the test of the image means");
+  return cmd;
+}
+
+int run_compare_command() {
+  CompareArgs& a = args();
+  a.options.image_mean_test = !a.no_mean_test;
+  RenderResult ra = read_render(a.a), rb = read_render(a.b);
+  if (ra.mean.width != rb.mean.width || ra.mean.height != rb.mean.height)
+    throw Error(a.b + ": size " + std::to_string(rb.mean.width) + "x" + std::to_string(rb.mean.height) +
+                " differs from " + a.a + " (" + std::to_string(ra.mean.width) + "x" +
+                std::to_string(ra.mean.height) + ")");
+  CompareResult r = compare_images(ra, rb, a.options);
+  std::printf("A             %s%s\nB             %s%s\n", a.a.c_str(),
+              ra.variance.rgb.empty() ? " (no variance layers)" : "", a.b.c_str(),
+              rb.variance.rgb.empty() ? " (no variance layers)" : "");
+  std::fputs(r.summary().c_str(), stdout);
+  return r.passed ? 0 : 1;
+}
+
+}  // namespace lucent::cli

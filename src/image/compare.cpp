@@ -1,0 +1,149 @@
+// Statistical comparison of two Monte Carlo images: per pixel-channel z-tests of the difference
+// of the means with both standard errors, Sidak-corrected over the image, plus an image-mean
+// test and the usual error metrics. See docs/compare.md.
+#include "lucent/compare.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "lucent/error.hpp"
+
+namespace lucent {
+
+double normal_two_sided_critical(double p) {
+  if (!(p < 1)) return 0;
+  if (!(p > 0)) return INFINITY;
+  // P(|Z| > z) = erfc(z / sqrt 2) decreases in z: bisect
+  double lo = 0, hi = 40;
+  for (int i = 0; i < 200; ++i) {
+    double mid = 0.5 * (lo + hi);
+    if (std::erfc(mid / std::sqrt(2.0)) > p)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+namespace {
+
+/// Variance of the mean of pixel i, channel c (0 when unknown).
+double variance_of_mean(const RenderResult& r, size_t i, int c) {
+  if (r.variance.rgb.empty()) return 0;
+  double n = r.samples.empty() ? 1.0 : static_cast<double>(r.samples[i]);
+  if (n < 2) return 0;
+  return std::max(0.0, static_cast<double>(r.variance.rgb[i * 3 + c])) / n;
+}
+
+void check_layers(const RenderResult& r, const char* which) {
+  size_t npix = static_cast<size_t>(r.mean.width) * r.mean.height;
+  if (r.mean.rgb.size() != npix * 3)
+    throw Error(std::string("compare: image ") + which + " has inconsistent pixel data");
+  if (!r.variance.rgb.empty() && r.variance.rgb.size() != npix * 3)
+    throw Error(std::string("compare: image ") + which + " has a variance layer of the wrong size");
+  if (!r.samples.empty() && r.samples.size() != npix)
+    throw Error(std::string("compare: image ") + which + " has a sample-count layer of the wrong size");
+}
+
+}  // namespace
+
+CompareResult compare_images(const RenderResult& a, const RenderResult& b, const CompareOptions& o) {
+  if (a.mean.width != b.mean.width || a.mean.height != b.mean.height)
+    throw Error("compare: image sizes differ: " + std::to_string(a.mean.width) + "x" +
+                std::to_string(a.mean.height) + " and " + std::to_string(b.mean.width) + "x" +
+                std::to_string(b.mean.height));
+  check_layers(a, "A");
+  check_layers(b, "B");
+  CompareResult r;
+  r.width = a.mean.width;
+  r.height = a.mean.height;
+  r.statistical = !a.variance.rgb.empty() || !b.variance.rgb.empty();
+  const size_t npix = static_cast<size_t>(r.width) * r.height;
+  r.tested = npix * 3;
+  if (npix == 0) {
+    r.passed = true;
+    return r;
+  }
+  // Sidak: each of m tests at 1 - (1 - alpha)^(1/m)
+  double per_test = -std::expm1(std::log1p(-o.alpha) / static_cast<double>(r.tested));
+  r.z_threshold = normal_two_sided_critical(per_test);
+
+  double sq = 0, rel = 0, sum_var[3] = {0, 0, 0};
+  for (size_t i = 0; i < npix; ++i) {
+    bool pixel_ok = true;
+    for (int c = 0; c < 3; ++c) {
+      double va = a.mean.rgb[i * 3 + c], vb = b.mean.rgb[i * 3 + c];
+      double d = va - vb;
+      double var = variance_of_mean(a, i, c) + variance_of_mean(b, i, c);
+      double eps = o.abs_epsilon + o.rel_epsilon * std::max(std::abs(va), std::abs(vb));
+      double z = d / std::sqrt(var + eps * eps);
+      bool ok = std::isfinite(z) && std::abs(z) <= r.z_threshold;
+      if (!ok) {
+        ++r.failed_channels;
+        pixel_ok = false;
+      }
+      double az = std::isfinite(z) ? std::abs(z) : INFINITY;
+      if (az > r.max_z || (i == 0 && c == 0)) {
+        r.max_z = az;
+        r.max_z_x = static_cast<int>(i % r.width);
+        r.max_z_y = static_cast<int>(i / r.width);
+        r.max_z_channel = c;
+      }
+      r.mean_a[c] += va;
+      r.mean_b[c] += vb;
+      sum_var[c] += var;
+      sq += d * d;
+      rel += d * d / (vb * vb + 0.01);
+      r.max_abs_error = std::max(r.max_abs_error, std::isfinite(d) ? std::abs(d) : INFINITY);
+    }
+    if (!pixel_ok) ++r.failed_pixels;
+  }
+  const double n = static_cast<double>(npix);
+  r.rmse = std::sqrt(sq / (3 * n));
+  r.relmse = rel / (3 * n);
+  r.pass_fraction = 1.0 - static_cast<double>(r.failed_pixels) / n;
+  r.required_fraction = o.min_pass_fraction;
+
+  r.mean_z_threshold = normal_two_sided_critical(-std::expm1(std::log1p(-o.alpha) / 3));
+  r.mean_test_passed = true;
+  for (int c = 0; c < 3; ++c) {
+    r.mean_a[c] /= n;
+    r.mean_b[c] /= n;
+    double eps = o.abs_epsilon + o.rel_epsilon * std::max(std::abs(r.mean_a[c]), std::abs(r.mean_b[c]));
+    r.mean_z[c] = (r.mean_a[c] - r.mean_b[c]) / std::sqrt(sum_var[c] / (n * n) + eps * eps);
+    if (o.image_mean_test && !(std::abs(r.mean_z[c]) <= r.mean_z_threshold)) r.mean_test_passed = false;
+  }
+  r.passed = r.pass_fraction >= o.min_pass_fraction && r.mean_test_passed;
+  return r;
+}
+
+std::string CompareResult::summary() const {
+  char buf[1024];
+  std::string s;
+  std::snprintf(buf, sizeof buf, "size          %dx%d (%s)\n", width, height,
+                statistical ? "z-test with per-pixel variances" : "no variances: tolerance test");
+  s += buf;
+  std::snprintf(buf, sizeof buf, "mean A        %.6g %.6g %.6g\nmean B        %.6g %.6g %.6g\n",
+                mean_a[0], mean_a[1], mean_a[2], mean_b[0], mean_b[1], mean_b[2]);
+  s += buf;
+  std::snprintf(buf, sizeof buf, "image-mean z  %.3f %.3f %.3f (threshold %.3f)%s\n", mean_z[0],
+                mean_z[1], mean_z[2], mean_z_threshold, mean_test_passed ? "" : "  FAIL");
+  s += buf;
+  std::snprintf(buf, sizeof buf, "RMSE          %.6g\nrelMSE        %.6g\nmax abs error %.6g\n", rmse,
+                relmse, max_abs_error);
+  s += buf;
+  std::snprintf(buf, sizeof buf, "max |z|       %.3f at (%d, %d) channel %c (threshold %.3f)\n", max_z,
+                max_z_x, max_z_y, "RGB"[max_z_channel], z_threshold);
+  s += buf;
+  std::snprintf(buf, sizeof buf, "failed        %zu of %zu pixel-channels, %zu pixels\n",
+                failed_channels, tested, failed_pixels);
+  s += buf;
+  std::snprintf(buf, sizeof buf, "pixels passed %.4f%% (required %.4f%%)\n", 100 * pass_fraction,
+                100 * required_fraction);
+  s += buf;
+  s += passed ? "PASS\n" : "FAIL\n";
+  return s;
+}
+
+}  // namespace lucent

@@ -1,0 +1,182 @@
+// The statistical image comparison (lucent/compare.hpp), the EXR layout with variance and sample
+// counts, and `lucent compare`.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "lucent/compare.hpp"
+#include "lucent/reference.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::CompareOptions;
+using lucent::CompareResult;
+using lucent::RenderResult;
+
+// A small noisy scene: a diffuse sphere on a plane under a point light and an environment.
+const char* kScene = R"({
+  "camera": {"position": [0, 1, 5], "look_at": [0, 0.3, 0], "fov": 35},
+  "film": {"width": 32, "height": 24},
+  "integrator": {"type": "path", "max_depth": 4},
+  "materials": {"a": {"type": "diffuse", "albedo": [0.7, 0.5, 0.3]},
+                "b": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}},
+  "shapes": [{"type": "sphere", "center": [0, 0.5, 0], "radius": 0.8, "material": "a"},
+             {"type": "sphere", "center": [0, -1000, 0], "radius": 999.7, "material": "b"}],
+  "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [20, 20, 20]},
+             {"type": "environment", "radiance": [0.3, 0.35, 0.4]}]
+})";
+
+RenderResult render_ref(std::uint32_t seed, int spp = 32) {
+  lucent::Scene scene = lucent::parse_scene(kScene, lucent::test::temp_dir() + "/scene.json");
+  scene.integrator.seed = seed;
+  lucent::ReferenceOptions o;
+  o.spp = spp;
+  return lucent::render_reference(scene, o);
+}
+
+RenderResult constant_image(int w, int h, float v) {
+  RenderResult r;
+  r.mean = lucent::Image{w, h, std::vector<float>(static_cast<size_t>(w) * h * 3, v)};
+  return r;
+}
+
+// Standard normal quantiles: P(|Z| > 1.959964) = 0.05, P(|Z| > 2.575829) = 0.01.
+TEST(Compare, NormalCriticalValues) {
+  EXPECT_NEAR(lucent::normal_two_sided_critical(0.05), 1.959964, 1e-5);
+  EXPECT_NEAR(lucent::normal_two_sided_critical(0.01), 2.575829, 1e-5);
+  EXPECT_NEAR(lucent::normal_two_sided_critical(1e-6), 4.891638, 1e-5);
+}
+
+TEST(Compare, IdenticalImagesPass) {
+  RenderResult a = render_ref(1);
+  CompareResult c = lucent::compare_images(a, a);
+  EXPECT_TRUE(c.passed) << c.summary();
+  EXPECT_EQ(c.failed_channels, 0u);
+  EXPECT_EQ(c.rmse, 0.0);
+  EXPECT_EQ(c.max_abs_error, 0.0);
+  EXPECT_TRUE(c.statistical);
+}
+
+// Two independent renders (different seeds) of the same scene have the same expected image: the
+// test must pass (its false-alarm rate is alpha = 1%; these seeds are fixed), and their RMSE
+// must be non-zero.
+TEST(Compare, IndependentRendersOfTheSameScenePass) {
+  RenderResult a = render_ref(1), b = render_ref(2);
+  CompareResult c = lucent::compare_images(a, b);
+  EXPECT_TRUE(c.passed) << c.summary();
+  EXPECT_GT(c.rmse, 0.0);
+  EXPECT_GT(c.max_z, 0.5);  // the noise is really there
+}
+
+// A 2% brightness change of the noisy pixels only (those with a variance) is a bias the
+// image-mean test sees, although each pixel's noise hides it: with the mean test off, the
+// per-pixel test alone lets it through.
+TEST(Compare, SmallGlobalBiasFails) {
+  RenderResult a = render_ref(1, 64), b = render_ref(2, 64);
+  for (size_t i = 0; i < b.mean.rgb.size(); ++i)
+    if (b.variance.rgb[i] > 0) b.mean.rgb[i] *= 1.02f;
+  CompareResult c = lucent::compare_images(a, b);
+  EXPECT_FALSE(c.passed) << c.summary();
+  EXPECT_FALSE(c.mean_test_passed);
+  CompareOptions o;
+  o.image_mean_test = false;
+  CompareResult per_pixel = lucent::compare_images(a, b, o);
+  EXPECT_TRUE(per_pixel.passed) << per_pixel.summary();
+}
+
+// A localized error: a block of 4x4 pixels 50% too bright fails the per-pixel test there.
+TEST(Compare, LocalErrorFailsPixels) {
+  RenderResult a = render_ref(1, 64), b = render_ref(2, 64);
+  for (int y = 8; y < 12; ++y)
+    for (int x = 8; x < 12; ++x)
+      for (int c = 0; c < 3; ++c) b.mean.pixel(x, y)[c] *= 1.5f;
+  CompareOptions o;
+  o.image_mean_test = false;
+  CompareResult c = lucent::compare_images(a, b, o);
+  EXPECT_FALSE(c.passed) << c.summary();
+  EXPECT_GE(c.failed_pixels, 8u);
+  EXPECT_LE(c.failed_pixels, 16u);
+  EXPECT_GE(c.max_z_x, 8);
+  EXPECT_LT(c.max_z_x, 12);
+}
+
+// Deterministic images (no variances) are compared by tolerance: abs_epsilon + rel_epsilon |v|
+// scaled by the z threshold.
+TEST(Compare, DeterministicImagesUseTheTolerance) {
+  RenderResult a = constant_image(8, 8, 0.5f), b = constant_image(8, 8, 0.5f + 1e-6f),
+               c = constant_image(8, 8, 0.51f);
+  CompareResult r1 = lucent::compare_images(a, b);
+  EXPECT_TRUE(r1.passed) << r1.summary();
+  EXPECT_FALSE(r1.statistical);
+  CompareResult r2 = lucent::compare_images(a, c);
+  EXPECT_FALSE(r2.passed) << r2.summary();
+  EXPECT_NEAR(r2.max_abs_error, 0.01, 1e-6);
+  EXPECT_NEAR(r2.rmse, 0.01, 1e-6);
+  EXPECT_NEAR(r2.relmse, 0.0001 / (0.51 * 0.51 + 0.01), 1e-8);
+}
+
+TEST(Compare, NonFiniteValuesFail) {
+  RenderResult a = constant_image(4, 4, 1.0f), b = constant_image(4, 4, 1.0f);
+  b.mean.rgb[5] = NAN;
+  CompareOptions o;
+  o.min_pass_fraction = 1.0;
+  EXPECT_FALSE(lucent::compare_images(a, b, o).passed);
+}
+
+TEST(Compare, SizeMismatchIsAnError) {
+  EXPECT_THROW(lucent::compare_images(constant_image(4, 4, 1), constant_image(4, 5, 1)), lucent::Error);
+}
+
+// write_render_exr / read_render keep mean, variance and sample counts exactly.
+TEST(Compare, ExrRoundTripKeepsStatistics) {
+  RenderResult a = render_ref(3, 8);
+  a.samples[7] = 5;  // counts need not be equal
+  std::string path = lucent::test::temp_dir() + "/a.exr";
+  lucent::write_render_exr(path, a);
+  RenderResult b = lucent::read_render(path);
+  ASSERT_EQ(b.mean.width, a.mean.width);
+  ASSERT_EQ(b.mean.height, a.mean.height);
+  EXPECT_EQ(b.mean.rgb, a.mean.rgb);
+  EXPECT_EQ(b.variance.rgb, a.variance.rgb);
+  EXPECT_EQ(b.samples, a.samples);
+  // and the general reader still reads its colour
+  lucent::Image plain = lucent::read_image(path);
+  EXPECT_EQ(plain.rgb, a.mean.rgb);
+}
+
+// `lucent render --reference -o x.exr` writes the statistics layers; `lucent compare` prints the
+// metrics and exits 0 on PASS, 1 on FAIL; errors name the file.
+TEST(Compare, CommandLine) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/s.json", kScene);
+  auto r1 = lucent::test::run_cli("render --reference -q --spp 16 --seed 1 '" + dir + "/s.json' -o '" + dir + "/a.exr'");
+  ASSERT_EQ(r1.status, 0) << r1.err;
+  auto r2 = lucent::test::run_cli("render --reference -q --spp 16 --seed 2 '" + dir + "/s.json' -o '" + dir + "/b.exr'");
+  ASSERT_EQ(r2.status, 0) << r2.err;
+  RenderResult a = lucent::read_render(dir + "/a.exr");
+  ASSERT_EQ(a.samples.size(), 32u * 24u);
+  EXPECT_EQ(a.samples[0], 16u);
+  EXPECT_FALSE(a.variance.rgb.empty());
+
+  auto same = lucent::test::run_cli("compare '" + dir + "/a.exr' '" + dir + "/b.exr'");
+  EXPECT_EQ(same.status, 0) << same.out << same.err;
+  EXPECT_NE(same.out.find("PASS"), std::string::npos);
+  EXPECT_NE(same.out.find("RMSE"), std::string::npos);
+  EXPECT_NE(same.out.find("relMSE"), std::string::npos);
+  EXPECT_NE(same.out.find("max abs error"), std::string::npos);
+
+  RenderResult c = a;
+  for (float& v : c.mean.rgb) v *= 1.2f;
+  lucent::write_render_exr(dir + "/c.exr", c);
+  auto differ = lucent::test::run_cli("compare '" + dir + "/a.exr' '" + dir + "/c.exr'");
+  EXPECT_EQ(differ.status, 1);
+  EXPECT_NE(differ.out.find("FAIL"), std::string::npos);
+
+  auto missing = lucent::test::run_cli("compare '" + dir + "/a.exr' '" + dir + "/nope.exr'");
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.err.find("nope.exr"), std::string::npos);
+  EXPECT_EQ(lucent::test::count_lines(missing.err), 1);
+}
+
+}  // namespace

@@ -1,0 +1,275 @@
+// The reference integrator (src/reference/) checked against closed-form answers. Statistical
+// checks use lucent::compare_images against a deterministic expected image: per pixel-channel
+// z = (render - expected) / sqrt(var / n + eps^2), Sidak-corrected two-sided test at family-wise
+// alpha = 0.01 (|z| < ~4.65 for 32x32 pixels), 99.5% of the pixels required to pass (the sample
+// variance of heavy-tailed estimators can be underestimated in a few pixels), plus the test of
+// the image mean per channel (|z| < 2.93), which catches a bias of a fraction of a percent. Each
+// test states any further tolerance.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "lucent/compare.hpp"
+#include "lucent/reference.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::RenderResult;
+
+RenderResult render_ref(const std::string& json, int spp) {
+  lucent::Scene scene = lucent::parse_scene(json, lucent::test::temp_dir() + "/scene.json");
+  lucent::ReferenceOptions o;
+  o.spp = spp;
+  return lucent::render_reference(scene, o);
+}
+
+/// A deterministic image of the same size whose pixel (x, y) is f(x, y).
+RenderResult expected_image(const RenderResult& like,
+                            const std::function<glm::dvec3(int, int)>& f) {
+  RenderResult e;
+  e.mean = like.mean;
+  for (int y = 0; y < like.mean.height; ++y)
+    for (int x = 0; x < like.mean.width; ++x) {
+      glm::dvec3 v = f(x, y);
+      for (int c = 0; c < 3; ++c) e.mean.pixel(x, y)[c] = static_cast<float>(v[c]);
+    }
+  return e;
+}
+
+/// The default comparison: 99.5% of the pixels pass and the image means agree.
+void expect_matches(const RenderResult& got, const RenderResult& expected) {
+  lucent::CompareResult c = lucent::compare_images(got, expected);
+  EXPECT_TRUE(c.passed) << c.summary();
+  EXPECT_EQ(got.nonfinite, 0u);
+}
+
+// White furnace: every surface reflects all it receives (diffuse albedo 1, mirror reflectance 1,
+// clear glass), lit by a uniform environment L: the constant L solves the rendering equation, so
+// every pixel's expected value is L, at unbounded depth (max_depth 10000, Russian roulette).
+TEST(ReferenceAnalytic, WhiteFurnace) {
+  const char* scene = R"({
+    "camera": {"position": [0, 1, 6], "look_at": [0, 0.3, 0], "fov": 40},
+    "film": {"width": 32, "height": 32},
+    "integrator": {"type": "path", "max_depth": 10000, "rr_depth": 3},
+    "materials": {"white": {"type": "diffuse", "albedo": [1, 1, 1]},
+                  "mirror": {"type": "mirror"},
+                  "glass": {"type": "dielectric", "ior": 1.5}},
+    "shapes": [
+      {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "white"},
+      {"type": "sphere", "center": [1.6, 0.2, 0.3], "radius": 0.7, "material": "glass"},
+      {"type": "sphere", "center": [-1.5, 0.3, 0.2], "radius": 0.6, "material": "mirror"},
+      {"type": "triangles", "material": "white",
+       "positions": [[-4,-1,-4],[4,-1,-4],[4,-1,4],[-4,-1,4]], "indices": [0,2,1, 0,3,2]}],
+    "lights": [{"type": "environment", "radiance": [0.5, 0.75, 1.0]}]
+  })";
+  RenderResult r = render_ref(scene, 64);
+  expect_matches(r, expected_image(r, [](int, int) { return glm::dvec3(0.5, 0.75, 1.0); }));
+}
+
+// Point light over a diffuse plane z = 0, camera straight above: L = albedo / pi * I cos / r^2.
+// A box filter of radius 1e-4 pixel makes each pixel the radiance at its centre (the
+// difference is below 1e-5 relative); direct and path (max_depth 2) must both give it: relative
+// error below 1e-4 everywhere.
+TEST(ReferenceAnalytic, PointLightOverPlane) {
+  const double albedo = 0.6, I = 50, lx = 0.7, ly = 0.4, lz = 2.0;
+  for (const char* integrator : {"direct", "path"}) {
+    std::string scene = std::string(R"({
+      "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 20},
+      "film": {"width": 24, "height": 16, "filter": {"type": "box", "radius": 0.0001}},
+      "integrator": {"type": ")") + integrator + R"(", "max_depth": 2},
+      "materials": {"white": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}},
+      "shapes": [{"type": "triangles", "material": "white",
+                  "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]],
+                  "indices": [0,1,2, 0,2,3]}],
+      "lights": [{"type": "point", "position": [0.7, 0.4, 2.0], "intensity": [50, 50, 50]}]
+    })";
+    RenderResult r = render_ref(scene, 4);
+    const double t = std::tan(10.0 * M_PI / 180.0);
+    double worst = 0;
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 24; ++x) {
+        double px = (2.0 * (x + 0.5) / 24 - 1) * t * 1.5 * 5.0, py = (1 - 2.0 * (y + 0.5) / 16) * t * 5.0;
+        double dx = lx - px, dy = ly - py, r2 = dx * dx + dy * dy + lz * lz;
+        double expected = albedo / M_PI * I * (lz / std::sqrt(r2)) / r2;
+        worst = std::max(worst, std::abs(r.mean.pixel(x, y)[1] - expected) / expected);
+      }
+    EXPECT_LT(worst, 1e-4) << integrator;
+  }
+}
+
+// A spherical emitter (radius R, radiance Le, centre at height d above the plane z = 0) fully
+// above a diffuse plane gives E = pi Le R^2 cos(theta) / D^2 at a point at distance D from the
+// centre (pi Le (R/d)^2 right below it). The camera sees a small patch around the origin with a
+// tiny box filter, so a pixel's expected value is albedo / pi * E at its centre; path tracing with
+// max_depth 2 (direct light only: light sampling and BSDF sampling with MIS).
+TEST(ReferenceAnalytic, SphericalEmitterIrradiance) {
+  const double albedo = 0.5, Le = 3, R = 0.5, d = 2;
+  const char* scene = R"({
+    "camera": {"position": [2, 0, 2], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 10},
+    "film": {"width": 32, "height": 32, "filter": {"type": "box", "radius": 0.0001}},
+    "integrator": {"type": "path", "max_depth": 2},
+    "materials": {"white": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [3, 3, 3]}},
+    "shapes": [{"type": "triangles", "material": "white",
+                "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]],
+                "indices": [0,1,2, 0,2,3]},
+               {"type": "sphere", "center": [0, 0, 2], "radius": 0.5, "material": "lamp"}]
+  })";
+  RenderResult r = render_ref(scene, 64);
+  // the camera basis, as the model defines it, to find where each pixel centre meets the plane
+  glm::dvec3 pos(2, 0, 2), fwd = glm::normalize(-pos), right = glm::normalize(glm::cross(fwd, {0, 0, 1}));
+  glm::dvec3 up = glm::cross(right, fwd);
+  const double t = std::tan(5.0 * M_PI / 180.0);
+  RenderResult e = expected_image(r, [&](int x, int y) {
+    double nx = (2.0 * (x + 0.5) / 32 - 1) * t, ny = (1 - 2.0 * (y + 0.5) / 32) * t;
+    glm::dvec3 dir = glm::normalize(fwd + nx * right + ny * up);
+    glm::dvec3 p = pos + (-pos.z / dir.z) * dir;
+    glm::dvec3 to = glm::dvec3(0, 0, d) - p;
+    double D = glm::length(to);
+    double E = M_PI * Le * R * R * (to.z / D) / (D * D);
+    return glm::dvec3(albedo / M_PI * E);
+  });
+  expect_matches(r, e);
+}
+
+// A closed cube whose inward-facing walls (triangle fronts) all have albedo rho and emission Le:
+// the radiance everywhere inside is Le / (1 - rho) at unbounded depth, and
+// Le (1 - rho^k) / (1 - rho) with max_depth k (k segments: k - 1 bounces).
+TEST(ReferenceAnalytic, ClosedEmissiveBox) {
+  auto scene = [](int max_depth) {
+    return std::string(R"({
+      "camera": {"position": [0.1, -0.2, 0.3], "look_at": [1, 0.5, -0.2], "fov": 100},
+      "film": {"width": 24, "height": 24},
+      "integrator": {"type": "path", "rr_depth": 2, "max_depth": )") +
+           std::to_string(max_depth) + R"(},
+      "materials": {"wall": {"type": "diffuse", "albedo": [0.5, 0.25, 0.75], "emission": [1, 2, 0.5]}},
+      "shapes": [{"type": "triangles", "material": "wall",
+        "positions": [[-1,-1,-1],[1,-1,-1],[1,1,-1],[-1,1,-1],[-1,-1,1],[1,-1,1],[1,1,1],[-1,1,1]],
+        "indices": [0,1,2, 0,2,3,  4,6,5, 4,7,6,  0,4,5, 0,5,1,  3,2,6, 3,6,7,  0,3,7, 0,7,4,
+                    1,5,6, 1,6,2]}]
+    })";
+  };
+  const glm::dvec3 rho(0.5, 0.25, 0.75), Le(1, 2, 0.5);
+  RenderResult r = render_ref(scene(100000), 64);
+  expect_matches(r, expected_image(r, [&](int, int) { return Le / (glm::dvec3(1.0) - rho); }));
+  RenderResult r3 = render_ref(scene(3), 64);
+  expect_matches(r3, expected_image(r3, [&](int, int) {
+    return Le * (glm::dvec3(1.0) - rho * rho * rho) / (glm::dvec3(1.0) - rho);
+  }));
+}
+
+// Surfaces emit from their front side only: inside an emissive sphere (seen from its back side)
+// with a black environment, nothing is seen (exactly 0).
+TEST(ReferenceAnalytic, SphereEmitsOutwardsOnly) {
+  const char* scene = R"({
+    "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "fov": 60},
+    "film": {"width": 8, "height": 8},
+    "integrator": {"type": "path", "max_depth": 5},
+    "materials": {"lamp": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5], "emission": [1, 1, 1]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 2, "material": "lamp"}]
+  })";
+  RenderResult r = render_ref(scene, 16);
+  for (float v : r.mean.rgb) EXPECT_EQ(v, 0.0f);
+}
+
+// Fresnel reflectance of the exact formula at known points: normal incidence ((eta-1)/(eta+1))^2,
+// grazing incidence 1, Brewster's angle (tan = eta) where the p-polarized part vanishes, total
+// internal reflection beyond the critical angle, ior 1 transparent, and reciprocity
+// F(cos_i, eta) = F(cos_t, 1/eta). Tolerance 1e-12 (double arithmetic).
+TEST(ReferenceAnalytic, FresnelDielectric) {
+  using lucent::reference::fresnel_dielectric;
+  EXPECT_NEAR(fresnel_dielectric(1.0, 1.5), 0.04, 1e-12);
+  EXPECT_NEAR(fresnel_dielectric(1.0, 1 / 1.5), 0.04, 1e-12);
+  EXPECT_NEAR(fresnel_dielectric(0.0, 1.5), 1.0, 1e-12);
+  double tb = std::atan(1.5), ci = std::cos(tb), ct = std::sqrt(1 - std::sin(tb) * std::sin(tb) / 2.25);
+  double rs = (ci - 1.5 * ct) / (ci + 1.5 * ct);
+  EXPECT_NEAR(fresnel_dielectric(ci, 1.5), 0.5 * rs * rs, 1e-12);
+  double critical = std::asin(1 / 1.5);
+  EXPECT_EQ(fresnel_dielectric(std::cos(critical + 0.01), 1 / 1.5), 1.0);
+  EXPECT_LT(fresnel_dielectric(std::cos(critical - 0.01), 1 / 1.5), 1.0);
+  EXPECT_NEAR(fresnel_dielectric(0.3, 1.0), 0.0, 1e-12);
+  for (double c : {0.1, 0.4, 0.8}) {
+    double cos_t = std::sqrt(1 - (1 - c * c) / (1.33 * 1.33));
+    EXPECT_NEAR(fresnel_dielectric(c, 1.33), fresnel_dielectric(cos_t, 1 / 1.33), 1e-12);
+  }
+}
+
+// A glass slab (two parallel faces of a closed solid, ior 1.5) seen at normal incidence in front
+// of an emitter of radiance Le, black environment: with F = 0.04 at each face the transmitted
+// radiance, summed over internal reflections, is Le (1 - F)^2 / (1 - F^2) = Le (1 - F)/(1 + F)
+// (the 1/2.25 on entry and 2.25 on exit cancel). The camera sees the slab within 0.25 degrees of
+// normal incidence (F changes by < 1e-5 there).
+TEST(ReferenceAnalytic, GlassSlabAtNormalIncidence) {
+  const char* scene = R"({
+    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 0.5},
+    "film": {"width": 16, "height": 16},
+    "integrator": {"type": "path", "max_depth": 1000},
+    "materials": {"glass": {"type": "dielectric", "ior": 1.5},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1, 2, 4]}},
+    "shapes": [
+      {"type": "triangles", "material": "glass",
+       "positions": [[-5,-5,1],[5,-5,1],[5,5,1],[-5,5,1], [-5,-5,0.5],[5,-5,0.5],[5,5,0.5],[-5,5,0.5]],
+       "indices": [0,1,2, 0,2,3,  4,6,5, 4,7,6]},
+      {"type": "triangles", "material": "lamp",
+       "positions": [[-5,-5,-1],[5,-5,-1],[5,5,-1],[-5,5,-1]], "indices": [0,1,2, 0,2,3]}]
+  })";
+  RenderResult r = render_ref(scene, 256);
+  const double F = 0.04, k = (1 - F) / (1 + F);
+  expect_matches(r, expected_image(r, [&](int, int) { return k * glm::dvec3(1, 2, 4); }));
+}
+
+// A mirror (reflectance rho) showing an emitter: the camera looks down at a mirror plane; every
+// reflected ray meets an emitting quad (front facing down) above the camera, so every pixel is
+// rho * Le exactly.
+TEST(ReferenceAnalytic, MirrorShowsEmitter) {
+  const char* scene = R"({
+    "camera": {"position": [0, 0, 2], "look_at": [0, 0, 0], "fov": 30},
+    "film": {"width": 16, "height": 16},
+    "integrator": {"type": "path", "max_depth": 4},
+    "materials": {"mirror": {"type": "mirror", "reflectance": [0.5, 0.6, 0.7]},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1, 2, 3]}},
+    "shapes": [
+      {"type": "triangles", "material": "mirror",
+       "positions": [[-5,-5,0],[5,-5,0],[5,5,0],[-5,5,0]], "indices": [0,1,2, 0,2,3]},
+      {"type": "triangles", "material": "lamp",
+       "positions": [[-5,-5,3],[5,-5,3],[5,5,3],[-5,5,3]], "indices": [0,2,1, 0,3,2]}]
+  })";
+  RenderResult r = render_ref(scene, 4);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      EXPECT_NEAR(r.mean.pixel(x, y)[0], 0.5 * 1, 1e-6);
+      EXPECT_NEAR(r.mean.pixel(x, y)[1], 0.6 * 2, 1e-6);
+      EXPECT_NEAR(r.mean.pixel(x, y)[2], 0.7 * 3, 1e-6);
+    }
+}
+
+// The AOV integrators at known points: a plane z = 0 seen from straight above at height 5 gives
+// depth 5 / cos(angle off axis), normal (0, 0, 1), albedo; ambient occlusion of an open plane
+// is 1, and 0 on a miss. Tolerance 1e-6 (tiny filter).
+TEST(ReferenceAnalytic, AovsOnAPlane) {
+  auto scene = [](const char* integrator) {
+    return std::string(R"({
+      "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
+      "film": {"width": 8, "height": 8, "filter": {"type": "box", "radius": 0.0001}},
+      "integrator": {"type": ")") + integrator + R"("},
+      "materials": {"m": {"type": "plastic", "albedo": [0.1, 0.2, 0.3]}},
+      "shapes": [{"type": "triangles", "material": "m",
+                  "positions": [[-9,-9,0],[9,-9,0],[9,9,0],[-9,9,0]], "indices": [0,1,2, 0,2,3]}]
+    })";
+  };
+  RenderResult depth = render_ref(scene("depth"), 2), normal = render_ref(scene("normal"), 2);
+  RenderResult albedo = render_ref(scene("albedo"), 2), ao = render_ref(scene("ao"), 16);
+  const double t = std::tan(15.0 * M_PI / 180.0);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      double nx = (2.0 * (x + 0.5) / 8 - 1) * t, ny = (1 - 2.0 * (y + 0.5) / 8) * t;
+      EXPECT_NEAR(depth.mean.pixel(x, y)[0], 5 * std::sqrt(1 + nx * nx + ny * ny), 1e-5);
+      EXPECT_NEAR(normal.mean.pixel(x, y)[2], 1.0, 1e-6);
+      EXPECT_NEAR(albedo.mean.pixel(x, y)[2], 0.3, 1e-6);
+      EXPECT_NEAR(ao.mean.pixel(x, y)[0], 1.0, 1e-6);
+    }
+}
+
+}  // namespace
