@@ -6,6 +6,7 @@
 #include <stb/stb_image_write.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <vector>
 
@@ -114,6 +115,65 @@ TEST(Texture, HdrAndPfmStayLinear) {
     expect_texel(t, 0, 0, {3.5f, 0.25f, 1.0f, 1.0f}, 1e-6f, name);
     expect_texel(t, 1, 0, {0.5f, 2.0f, 0.125f, 1.0f}, 1e-6f, name);
   }
+}
+
+// A 16-bit RGB PNG written by hand (stb_image_write has no 16-bit writer): zlib stream of stored
+// (uncompressed) deflate blocks, CRC-32 and Adler-32 computed here.
+std::uint32_t crc32(const std::string& data) {
+  std::uint32_t c = 0xFFFFFFFFu;
+  for (unsigned char b : data) {
+    c ^= b;
+    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+  }
+  return ~c;
+}
+
+std::string be32(std::uint32_t v) {
+  return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+}
+
+void write_png16(const std::string& path, int w, int h, const std::vector<std::uint16_t>& rgb) {
+  std::string raw;
+  for (int y = 0; y < h; ++y) {
+    raw += '\0';  // filter: none
+    for (int i = 0; i < w * 3; ++i) {
+      std::uint16_t v = rgb[static_cast<size_t>(y) * w * 3 + i];
+      raw += char(v >> 8);
+      raw += char(v & 0xFF);
+    }
+  }
+  ASSERT_LT(raw.size(), 65536u) << "one stored block";
+  std::uint32_t a = 1, b = 0;
+  for (unsigned char c : raw) {
+    a = (a + c) % 65521;
+    b = (b + a) % 65521;
+  }
+  std::uint16_t len = static_cast<std::uint16_t>(raw.size()), nlen = static_cast<std::uint16_t>(~len);
+  std::string z = "\x78\x01";
+  z += '\x01';  // final stored block
+  z += {char(len & 0xFF), char(len >> 8), char(nlen & 0xFF), char(nlen >> 8)};
+  z += raw + be32((b << 16) | a);
+  auto chunk = [](const std::string& tag, const std::string& data) {
+    return be32(static_cast<std::uint32_t>(data.size())) + tag + data + be32(crc32(tag + data));
+  };
+  std::string ihdr = be32(w) + be32(h) + std::string("\x10\x02\x00\x00\x00", 5);  // 16-bit RGB
+  std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) + chunk("IDAT", z) +
+                    chunk("IEND", "");
+  lucent::test::write_file(path, png);
+}
+
+TEST(Texture, SixteenBitPngKeepsItsPrecision) {
+  std::string path = lucent::test::temp_dir() + "/t16.png";
+  // 1000/65535 lies between two 8-bit codes; 32896/65535 = 128/255 exactly
+  write_png16(path, 2, 1, {1000, 32896, 65535, 0, 50000, 32896});
+  Scene scene;
+  const lucent::Texture& t = scene.textures[load_texture(scene, path)];
+  ASSERT_EQ(t.width, 2);
+  ASSERT_EQ(t.height, 1);
+  // 1000/65535 = 0.0152590 is on the linear segment: / 12.92 = 0.0011810 (8 bits: 0.0009106 or
+  // 0.0012141); 50000/65535 = 0.7629511 -> ((c + 0.055) / 1.055)^2.4 = 0.5429248
+  expect_texel(t, 0, 0, {0.0011810f, k128, 1.0f, 1.0f}, 2e-7f, "16-bit png");
+  expect_texel(t, 1, 0, {0.0f, 0.5429248f, k128, 1.0f}, 2e-7f, "16-bit png");
 }
 
 TEST(Texture, SamePathLoadsOnce) {

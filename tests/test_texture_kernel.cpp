@@ -4,6 +4,7 @@
 // corner of the image, bilinear filtering between texel centres, repeat wrapping.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -186,6 +187,27 @@ TEST(TextureKernel, OneTexelTextureIsConstant) {
   lucent::Scene s = three_textures();
   std::vector<cl_float4> got = lookup(s, {{2, 0.0f, 0.0f}, {2, 0.37f, 0.91f}, {2, -4.2f, 17.5f}});
   for (const cl_float4& g : got) expect_value(g, host_texel(s.textures[2], 0, 0), "1x1 texture");
+}
+
+TEST(TextureKernel, NonFiniteUvStaysInsideTheTexture) {
+  lucent::Scene s = three_textures();
+  const float nan = std::nanf(""), inf = INFINITY;
+  std::vector<cl_float4> got =
+      lookup(s, {{1, nan, 0.5f}, {1, 0.5f, nan}, {1, inf, -inf}, {0, nan, nan}});
+  for (size_t i = 0; i < got.size(); ++i) {
+    const lucent::Texture& t = s.textures[i < 3 ? 1 : 0];
+    // every value is a convex mix of the texture's texels: within their range
+    for (int c = 0; c < 4; ++c) {
+      float lo = 1e30f, hi = -1e30f;
+      for (size_t k = c; k < t.rgba.size(); k += 4) {
+        lo = std::min(lo, t.rgba[k]);
+        hi = std::max(hi, t.rgba[k]);
+      }
+      EXPECT_TRUE(std::isfinite(got[i].s[c])) << "query " << i;
+      EXPECT_GE(got[i].s[c], lo - 1e-4f) << "query " << i;
+      EXPECT_LE(got[i].s[c], hi + 1e-4f) << "query " << i;
+    }
+  }
 }
 
 }  // namespace

@@ -15,6 +15,8 @@ static inline float4 texture_texel(const lc_scene* s, __global const lc_texture*
 static inline float4 texture_lookup(const lc_scene* s, int index, float2 uv) {
   __global const lc_texture* tex = &s->textures[index];
   float u = uv.x - floor(uv.x), v = uv.y - floor(uv.y);
+  if (!isfinite(u)) u = 0.0f; /* a NaN or infinite uv must not index outside the texture */
+  if (!isfinite(v)) v = 0.0f;
   float x = u * (float)tex->width - 0.5f;
   float y = (1.0f - v) * (float)tex->height - 0.5f;
   float fx = floor(x), fy = floor(y);
