@@ -1,9 +1,12 @@
 /* lucent kernel: scene description on the device and BVH2 traversal.
- * Node layout: shared/types.h (lc_bvh_node, 32 bytes). Leaves hold primitive references: a
- * triangle index, or a sphere index with LC_PRIM_SPHERE_BIT set. */
+ * Node layout: shared/types.h (lc_bvh_node, 32 bytes, depth-first, children adjacent). Leaves
+ * hold primitive references: a triangle index, or a sphere index with LC_PRIM_SPHERE_BIT set.
+ * Traversal is ordered (nearer child first) with a stack of (node, entry distance) pairs, so a
+ * popped node is dropped without touching its box once a closer hit is known. */
 #ifndef LUCENT_BVH_TRAVERSE_CL
 #define LUCENT_BVH_TRAVERSE_CL
 
+/* Deep enough for any tree of src/bvh/bvh_build.cpp, which caps the depth at 64. */
 #define LC_BVH_STACK_SIZE 64
 
 typedef struct {
@@ -26,20 +29,34 @@ typedef struct {
   float b1, b2; /* triangle barycentrics of v1 and v2 */
 } lc_hit;
 
+/* 1 / d per component, +INFINITY where d is 0 (either sign) or so small that 1 / d overflows. */
+static inline float3 bvh_inv_dir(float3 d) {
+  float3 inv = 1.0f / d;
+  return select(inv, (float3)(INFINITY), isinf(inv));
+}
+
 /*
- * Slab test. inv_d may hold ±INFINITY for axis-parallel rays; (bmin - o) * inv_d is then ±inf
- * or, when the origin lies on the slab plane, 0 * inf = NaN. fmin/fmax return the non-NaN
- * operand, so a NaN never decides the outcome (the ray is treated as inside that slab).
+ * Slab test: the distance at which the ray enters the box within [tmin, tmax], or INFINITY on a
+ * miss. With inv_d = +INFINITY on an axis the ray does not move along, (b - o) * inv_d is -inf or
+ * +inf, or NaN (0 * inf) when the origin lies on that face plane. The selects below return t0 for
+ * the near and t1 for the far distance whenever either is NaN, and the comparisons with enter and
+ * exit keep the old value for a NaN: an origin on a face plane of a slab it does not move along
+ * counts as inside that slab (boxes are closed), and no NaN decides anything.
  */
-static inline float bvh_box_entry(const __global lc_bvh_node* n, float3 o, float3 inv_d, float tmin,
-                                  float tmax) {
-  float3 bmin = lc_load3(n->bmin), bmax = lc_load3(n->bmax);
-  float3 t0 = (bmin - o) * inv_d;
-  float3 t1 = (bmax - o) * inv_d;
-  float3 tn = fmin(t0, t1), tf = fmax(t0, t1);
-  float enter = fmax(fmax(tn.x, tn.y), fmax(tn.z, tmin));
-  float exit_ = fmin(fmin(tf.x, tf.y), fmin(tf.z, tmax));
-  /* robust: 1 + 2*gamma(3) widening of the exit distance (pbrt-v4) */
+static inline float bvh_box_entry(__global const lc_bvh_node* n, float3 o, float3 inv_d,
+                                  float tmin, float tmax) {
+  float3 t0 = (vload3(0, n->bmin) - o) * inv_d;
+  float3 t1 = (vload3(0, n->bmax) - o) * inv_d;
+  float3 tn = select(t0, t1, t1 < t0);
+  float3 tf = select(t1, t0, t0 > t1);
+  float enter = tmin, exit_ = tmax;
+  enter = tn.x > enter ? tn.x : enter;
+  enter = tn.y > enter ? tn.y : enter;
+  enter = tn.z > enter ? tn.z : enter;
+  exit_ = tf.x < exit_ ? tf.x : exit_;
+  exit_ = tf.y < exit_ ? tf.y : exit_;
+  exit_ = tf.z < exit_ ? tf.z : exit_;
+  /* conservative against rounding in t0, t1: widen the exit by 1 + 2 gamma(3) (pbrt-v4) */
   exit_ *= 1.0000004f;
   return enter <= exit_ ? enter : INFINITY;
 }
@@ -48,7 +65,7 @@ static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tr
                                      float3 d, float tmin, lc_hit* hit) {
   if (ref & LC_PRIM_SPHERE_BIT) {
     __global const lc_sphere* sp = &s->spheres[ref & ~LC_PRIM_SPHERE_BIT];
-    float t = sphere_intersect(lc_load3(sp->center), sp->radius, o, d, tmin, hit->t);
+    float t = sphere_intersect(vload3(0, sp->center), sp->radius, o, d, tmin, hit->t);
     if (t < hit->t) {
       hit->t = t;
       hit->prim = ref;
@@ -58,7 +75,7 @@ static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tr
   }
   __global const lc_triangle* tri = &s->triangles[ref];
   float t, b1, b2;
-  if (triangle_intersect(tr, o, lc_load3(tri->v0), lc_load3(tri->v1), lc_load3(tri->v2), tmin,
+  if (triangle_intersect(tr, o, vload3(0, tri->v0), vload3(0, tri->v1), vload3(0, tri->v2), tmin,
                          hit->t, &t, &b1, &b2)) {
     hit->t = t;
     hit->prim = ref;
@@ -69,51 +86,51 @@ static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tr
   return 0;
 }
 
-/* Closest hit in (tmin, tmax). With any_hit set, returns at the first hit (shadow rays). */
+/* Closest hit with t in (tmin, tmax). With any_hit set, returns at the first hit found (shadow
+ * rays); hit then holds that hit, not necessarily the closest. */
 static inline int bvh_trace(const lc_scene* s, float3 o, float3 d, float tmin, float tmax,
                             int any_hit, lc_hit* hit) {
   hit->t = tmax;
   hit->prim = LC_INVALID;
   hit->b1 = hit->b2 = 0.0f;
   if (s->params->num_nodes == 0) return 0;
+  __global const lc_bvh_node* nodes = s->nodes;
+  float3 inv_d = bvh_inv_dir(d);
+  if (bvh_box_entry(&nodes[0], o, inv_d, tmin, tmax) == INFINITY) return 0;
   lc_tri_ray tr = triangle_ray_setup(d);
-  float3 inv_d = 1.0f / d;
-  lc_uint stack[LC_BVH_STACK_SIZE];
+  lc_uint stack_node[LC_BVH_STACK_SIZE];
+  float stack_t[LC_BVH_STACK_SIZE];
   int sp = 0;
   lc_uint node = 0;
-  if (bvh_box_entry(&s->nodes[0], o, inv_d, tmin, hit->t) == INFINITY) return 0;
   for (;;) {
-    __global const lc_bvh_node* n = &s->nodes[node];
-    if (n->count > 0) {
-      for (lc_uint i = 0; i < n->count; ++i) {
-        if (bvh_intersect_prim(s, s->prim_refs[n->left_first + i], &tr, o, d, tmin, hit) &&
-            any_hit)
+    __global const lc_bvh_node* n = &nodes[node];
+    lc_uint count = n->count, first = n->left_first;
+    if (count > 0) {
+      for (lc_uint i = 0; i < count; ++i)
+        if (bvh_intersect_prim(s, s->prim_refs[first + i], &tr, o, d, tmin, hit) && any_hit)
           return 1;
-      }
     } else {
-      lc_uint l = n->left_first, r = l + 1;
-      float tl = bvh_box_entry(&s->nodes[l], o, inv_d, tmin, hit->t);
-      float trr = bvh_box_entry(&s->nodes[r], o, inv_d, tmin, hit->t);
-      if (tl > trr) {
-        float tt = tl;
-        tl = trr;
-        trr = tt;
-        lc_uint tn = l;
-        l = r;
-        r = tn;
-      }
-      if (tl != INFINITY) {
-        if (trr != INFINITY && sp < LC_BVH_STACK_SIZE) stack[sp++] = r;
-        node = l;
+      float tl = bvh_box_entry(&nodes[first], o, inv_d, tmin, hit->t);
+      float tr_ = bvh_box_entry(&nodes[first + 1], o, inv_d, tmin, hit->t);
+      lc_uint near_ = tl <= tr_ ? first : first + 1;
+      float t_near = fmin(tl, tr_), t_far = fmax(tl, tr_);
+      if (t_near != INFINITY) {
+        if (t_far != INFINITY && sp < LC_BVH_STACK_SIZE) {
+          stack_node[sp] = (near_ == first) ? first + 1 : first;
+          stack_t[sp] = t_far;
+          ++sp;
+        }
+        node = near_;
         continue;
       }
     }
-    /* pop, skipping nodes now farther than the closest hit */
+    /* pop the nearest pending node that may still hold a closer hit */
     for (;;) {
       if (sp == 0) return hit->prim != LC_INVALID;
-      node = stack[--sp];
-      if (bvh_box_entry(&s->nodes[node], o, inv_d, tmin, hit->t) != INFINITY) break;
+      --sp;
+      if (stack_t[sp] < hit->t) break;
     }
+    node = stack_node[sp];
   }
 }
 

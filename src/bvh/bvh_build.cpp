@@ -1,34 +1,460 @@
-// Placeholder builder (object median split) until the binned SAH builder lands.
+// Binned SAH BVH builder (Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies",
+// 2007): 32 bins per axis over the centroid bounds, all three axes, multithreaded by handing
+// large subtrees to a small pool of std::threads. The tree is built into a scratch array and
+// flattened depth-first with adjacent children (lc_bvh_node, kernels/shared/types.h).
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <numeric>
+#include <condition_variable>
+#include <cstring>
+#include <memory>
+#include <mutex>
+#include <thread>
 
 #include "bvh/bvh.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace lucent::bvh {
 
 namespace {
 
-struct Box {
-  float lo[3] = {INFINITY, INFINITY, INFINITY};
-  float hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  void grow(const float* p) {
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], p[a]);
-      hi[a] = std::max(hi[a], p[a]);
-    }
+constexpr int kBins = 32;
+constexpr float kTraversalCost = 1.0f;    // relative to one primitive intersection
+constexpr std::size_t kSpawnSize = 2048;  // subtrees at least this large go to the shared queue
+constexpr lc_uint kChunk = 512;           // node pairs are taken from the shared counter in chunks
+constexpr std::size_t kParallelBinSize = 1u << 17;  // nodes this large bin on every thread
+constexpr unsigned kMaxDepth = 64;        // = LC_BVH_STACK_SIZE in kernels/bvh/traverse.cl
+
+// Four floats, one SIMD register where SSE2 is there (lane 3 is unused by the math below).
+#if defined(__SSE2__)
+struct V4 {
+  __m128 v;
+  static V4 load(const float* p) { return {_mm_load_ps(p)}; }
+  static V4 splat(float x) { return {_mm_set1_ps(x)}; }
+  static V4 xyz(float x, float y, float z) { return {_mm_setr_ps(x, y, z, 0.0f)}; }
+  void store(float* p) const { _mm_store_ps(p, v); }
+  V4 xyz_only() const {  // lane 3 set to 0
+    return {_mm_and_ps(v, _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)))};
   }
-  void grow(const Box& b) {
-    grow(b.lo);
-    grow(b.hi);
-  }
-  double area() const {
-    double d[3];
-    for (int a = 0; a < 3; ++a) d[a] = std::max(0.0, double(hi[a]) - lo[a]);
-    return 2 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
+  // index of the bin per lane: trunc(clamp(this, 0, top)); NaN goes to 0
+  void bins(float top, int* out) const {
+    __m128 f = _mm_min_ps(_mm_max_ps(v, _mm_setzero_ps()), _mm_set1_ps(top));
+    _mm_store_si128(reinterpret_cast<__m128i*>(out), _mm_cvttps_epi32(f));
   }
 };
+inline V4 operator+(V4 a, V4 b) { return {_mm_add_ps(a.v, b.v)}; }
+inline V4 operator-(V4 a, V4 b) { return {_mm_sub_ps(a.v, b.v)}; }
+inline V4 operator*(V4 a, V4 b) { return {_mm_mul_ps(a.v, b.v)}; }
+inline V4 vmin(V4 a, V4 b) { return {_mm_min_ps(a.v, b.v)}; }
+inline V4 vmax(V4 a, V4 b) { return {_mm_max_ps(a.v, b.v)}; }
+#else
+struct V4 {
+  float f[4];
+  static V4 load(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
+  static V4 splat(float x) { return {{x, x, x, x}}; }
+  static V4 xyz(float x, float y, float z) { return {{x, y, z, 0.0f}}; }
+  void store(float* p) const {
+    for (int a = 0; a < 4; ++a) p[a] = f[a];
+  }
+  V4 xyz_only() const { return {{f[0], f[1], f[2], 0.0f}}; }
+  void bins(float top, int* out) const {
+    for (int a = 0; a < 4; ++a) {
+      float x = f[a] > 0.0f ? f[a] : 0.0f;
+      out[a] = static_cast<int>(x < top ? x : top);
+    }
+  }
+};
+inline V4 operator+(V4 a, V4 b) { return {{a.f[0] + b.f[0], a.f[1] + b.f[1], a.f[2] + b.f[2], a.f[3] + b.f[3]}}; }
+inline V4 operator-(V4 a, V4 b) { return {{a.f[0] - b.f[0], a.f[1] - b.f[1], a.f[2] - b.f[2], a.f[3] - b.f[3]}}; }
+inline V4 operator*(V4 a, V4 b) { return {{a.f[0] * b.f[0], a.f[1] * b.f[1], a.f[2] * b.f[2], a.f[3] * b.f[3]}}; }
+inline V4 vmin(V4 a, V4 b) {
+  V4 r;
+  for (int i = 0; i < 4; ++i) r.f[i] = b.f[i] < a.f[i] ? b.f[i] : a.f[i];
+  return r;
+}
+inline V4 vmax(V4 a, V4 b) {
+  V4 r;
+  for (int i = 0; i < 4; ++i) r.f[i] = b.f[i] > a.f[i] ? b.f[i] : a.f[i];
+  return r;
+}
+#endif
+
+struct Box {
+  V4 lo = V4::splat(INFINITY), hi = V4::splat(-INFINITY);
+  void grow(V4 l, V4 h) {
+    lo = vmin(lo, l);
+    hi = vmax(hi, h);
+  }
+  void grow(const Box& b) { grow(b.lo, b.hi); }
+  void grow_point(V4 p) { grow(p, p); }
+  void get(float* l, float* h) const {
+    alignas(16) float a[4], b[4];
+    lo.store(a);
+    hi.store(b);
+    for (int k = 0; k < 3; ++k) {
+      l[k] = a[k];
+      h[k] = b[k];
+    }
+  }
+  float area() const {
+    alignas(16) float d[4];
+    vmax(hi - lo, V4::splat(0.0f)).store(d);
+    return 2 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
+  }
+  float max_extent() const {
+    alignas(16) float d[4];
+    (hi - lo).store(d);
+    return std::max(d[0], std::max(d[1], d[2]));  // NaN-free when the box is
+  }
+};
+
+// One primitive: its bounds and its reference (32 bytes). The reference rides in lane 3 of lo.
+struct PrimRef {
+  V4 lo, hi;
+  lc_uint id() const {
+    alignas(16) float f[4];
+    lo.store(f);
+    lc_uint i;
+    std::memcpy(&i, &f[3], sizeof i);
+    return i;
+  }
+  V4 centroid2() const { return lo.xyz_only() + hi; }  // twice the centroid, lane 3 = 0
+};
+static_assert(sizeof(PrimRef) == 32, "PrimRef should stay 32 bytes");
+
+struct Task {
+  lc_uint node;  // index in the scratch node array
+  std::size_t begin, end;
+  unsigned depth;  // root: 1
+  Box box;         // bounds of the primitives
+  Box cbox;        // bounds of their doubled centroids
+};
+
+// Maps a doubled centroid to one bin per axis; identical in binning and partitioning. Small nodes
+// use fewer bins (as many as primitives): cheaper, and no worse.
+struct BinMap {
+  int bins;
+  V4 lo, scale;
+  BinMap(const Box& cbox, std::size_t n)
+      : bins(static_cast<int>(std::min<std::size_t>(kBins, std::max<std::size_t>(n, 4)))) {
+    alignas(16) float l[4], h[4], s[4] = {0, 0, 0, 0};
+    cbox.lo.store(l);
+    cbox.hi.store(h);
+    for (int a = 0; a < 3; ++a) {
+      float ext = h[a] - l[a];
+      s[a] = ext > 0 ? bins * (1 - 1e-6f) / ext : 0.0f;
+    }
+    lo = V4::xyz(l[0], l[1], l[2]);
+    scale = V4::load(s);
+  }
+  bool usable(int a) const {
+    alignas(16) float s[4];
+    scale.store(s);
+    return s[a] > 0;
+  }
+  void operator()(V4 c2, int* k) const { ((c2 - lo) * scale).bins(float(bins - 1), k); }
+};
+
+// Bins of one node; only the first n of each axis are initialised and used.
+struct Bins {
+  struct BinBox {  // trivially constructible
+    V4 lo, hi;
+  };
+  int n;
+  BinBox box[3][kBins];
+  lc_uint count[3][kBins];
+  explicit Bins(int bins) : n(bins) {
+    for (int a = 0; a < 3; ++a)
+      for (int k = 0; k < n; ++k) {
+        box[a][k] = {V4::splat(INFINITY), V4::splat(-INFINITY)};
+        count[a][k] = 0;
+      }
+  }
+  void grow(int a, int k, V4 lo, V4 hi) {
+    box[a][k].lo = vmin(box[a][k].lo, lo);
+    box[a][k].hi = vmax(box[a][k].hi, hi);
+    ++count[a][k];
+  }
+  void add(const Bins& o) {
+    for (int a = 0; a < 3; ++a)
+      for (int k = 0; k < n; ++k) {
+        box[a][k].lo = vmin(box[a][k].lo, o.box[a][k].lo);
+        box[a][k].hi = vmax(box[a][k].hi, o.box[a][k].hi);
+        count[a][k] += o.count[a][k];
+      }
+  }
+};
+
+void bin_range(const PrimRef* refs, std::size_t n, const BinMap& map, Bins& bins) {
+  alignas(16) int k[4];
+  for (std::size_t i = 0; i < n; ++i) {
+    const PrimRef& p = refs[i];
+    map(p.centroid2(), k);
+    for (int a = 0; a < 3; ++a) bins.grow(a, k[a], p.lo, p.hi);
+  }
+}
+
+unsigned ceil_log2(std::size_t n) {
+  unsigned l = 0;
+  while ((std::size_t(1) << l) < n) ++l;
+  return l;
+}
+
+class Builder {
+ public:
+  Builder(std::vector<PrimRef>& refs, const BuildOptions& options, unsigned threads)
+      : refs_(refs),
+        max_leaf_(static_cast<std::size_t>(std::max(1, options.max_leaf_size))),
+        threads_(threads) {
+    // every task allocates node pairs from its own chunks: at most one partly used chunk per task
+    std::size_t tasks = 2 * refs.size() / kSpawnSize + 2;
+    capacity_ = 2 * refs.size() + tasks * kChunk;
+    nodes_.reset(new lc_bvh_node[capacity_]);
+  }
+
+  // Builds the tree over refs_, whose bounds and centroid bounds are given; returns the number
+  // of scratch nodes.
+  std::size_t run(const Box& box, const Box& cbox) {
+    Task root{0, 0, refs_.size(), 1, box, cbox};
+    queue_.push_back(root);
+    pending_ = 1;
+    std::vector<std::thread> pool;
+    for (unsigned i = 1; i < threads_; ++i) pool.emplace_back([this] { worker(); });
+    worker();
+    for (auto& t : pool) t.join();
+    return 1 + 2 * interior_.load();
+  }
+
+  const lc_bvh_node* nodes() const { return nodes_.get(); }
+  std::size_t max_depth() const { return max_depth_.load(); }
+
+ private:
+  void worker() {
+    for (;;) {
+      Task t;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [this] { return !queue_.empty() || pending_ == 0; });
+        if (queue_.empty()) return;
+        t = queue_.back();
+        queue_.pop_back();
+      }
+      build_subtree(t);
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (--pending_ == 0) cv_.notify_all();
+      }
+    }
+  }
+
+  void spawn(const Task& t) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      queue_.push_back(t);
+      ++pending_;
+    }
+    cv_.notify_one();
+  }
+
+  void make_leaf(const Task& t) {
+    lc_bvh_node& n = nodes_[t.node];
+    n.left_first = static_cast<lc_uint>(t.begin);
+    n.count = static_cast<lc_uint>(t.end - t.begin);
+    std::size_t d = max_depth_.load(std::memory_order_relaxed);
+    while (t.depth > d && !max_depth_.compare_exchange_weak(d, t.depth)) {
+    }
+  }
+
+  // Bins the task's primitives, in parallel on the caller and helper threads for big nodes.
+  void bin(const Task& t, const BinMap& map, Bins& bins) {
+    std::size_t n = t.end - t.begin;
+    unsigned parts = n >= kParallelBinSize ? threads_ : 1;
+    if (parts <= 1) {
+      bin_range(refs_.data() + t.begin, n, map, bins);
+      return;
+    }
+    std::vector<Bins> partial(parts - 1, Bins(map.bins));
+    std::vector<std::thread> helpers;
+    std::size_t step = (n + parts - 1) / parts;
+    for (unsigned p = 1; p < parts; ++p) {
+      std::size_t b = std::min(n, p * step), e = std::min(n, (p + 1) * step);
+      helpers.emplace_back(
+          [&, b, e, p] { bin_range(refs_.data() + t.begin + b, e - b, map, partial[p - 1]); });
+    }
+    bin_range(refs_.data() + t.begin, std::min(n, step), map, bins);
+    for (auto& h : helpers) h.join();
+    for (auto& p : partial) bins.add(p);
+  }
+
+  // Splits at the object median along the widest axis (the depth guard and equal centroids).
+  std::size_t median_split(const Task& t, Task& l, Task& r) {
+    int axis = 0;
+    alignas(16) float ext[4];
+    (t.cbox.hi - t.cbox.lo).store(ext);
+    for (int a = 1; a < 3; ++a)
+      if (ext[a] > ext[axis]) axis = a;
+    std::size_t mid = t.begin + (t.end - t.begin) / 2;
+    if (ext[axis] > 0)
+      std::nth_element(refs_.begin() + t.begin, refs_.begin() + mid, refs_.begin() + t.end,
+                       [axis](const PrimRef& x, const PrimRef& y) {
+                         alignas(16) float cx[4], cy[4];
+                         x.centroid2().store(cx);
+                         y.centroid2().store(cy);
+                         return cx[axis] < cy[axis];
+                       });
+    for (std::size_t i = t.begin; i < t.end; ++i) {
+      Task& side = i < mid ? l : r;
+      side.box.grow(refs_[i].lo, refs_[i].hi);
+      side.cbox.grow_point(refs_[i].centroid2());
+    }
+    return mid;
+  }
+
+  void build_subtree(Task root) {
+    std::vector<Task> stack{root};
+    lc_uint chunk_next = 0, chunk_end = 0;
+    std::size_t interior = 0;
+    while (!stack.empty()) {
+      Task t = stack.back();
+      stack.pop_back();
+      lc_bvh_node& node = nodes_[t.node];
+      t.box.get(node.bmin, node.bmax);
+      std::size_t n = t.end - t.begin;
+      if (n == 1) {
+        make_leaf(t);
+        continue;
+      }
+      float cext = t.cbox.max_extent();
+      Task l{0, t.begin, 0, t.depth + 1, {}, {}}, r{0, 0, t.end, t.depth + 1, {}, {}};
+      std::size_t mid;
+      bool guard = t.depth + ceil_log2((n + max_leaf_ - 1) / max_leaf_) + 1 >= kMaxDepth;
+      if (!(cext > 0) || guard) {
+        if (n <= max_leaf_) {
+          make_leaf(t);
+          continue;
+        }
+        mid = median_split(t, l, r);
+      } else {
+        BinMap map(t.cbox, n);
+        Bins bins(map.bins);
+        bin(t, map, bins);
+        // sweep: right-to-left areas, then left-to-right with the SAH
+        float best = INFINITY;
+        int best_axis = -1, best_k = 0;
+        for (int a = 0; a < 3; ++a) {
+          if (!map.usable(a)) continue;
+          const int nb = map.bins;
+          float right_area[kBins];
+          std::size_t right_count[kBins];
+          Box acc;
+          std::size_t cnt = 0;
+          for (int k = nb - 1; k > 0; --k) {
+            acc.grow(bins.box[a][k].lo, bins.box[a][k].hi);
+            cnt += bins.count[a][k];
+            right_area[k] = acc.area();
+            right_count[k] = cnt;
+          }
+          Box lacc;
+          std::size_t lcnt = 0;
+          for (int k = 1; k < nb; ++k) {
+            lacc.grow(bins.box[a][k - 1].lo, bins.box[a][k - 1].hi);
+            lcnt += bins.count[a][k - 1];
+            if (lcnt == 0 || right_count[k] == 0) continue;
+            float c = lacc.area() * float(lcnt) + right_area[k] * float(right_count[k]);
+            if (c < best) {
+              best = c;
+              best_axis = a;
+              best_k = k;
+            }
+          }
+        }
+        float area = t.box.area();
+        float split_cost = kTraversalCost * area + best;  // both scaled by the node's area
+        float leaf_cost = float(n) * area;
+        if (n <= max_leaf_ && (best_axis < 0 || leaf_cost <= split_cost)) {
+          make_leaf(t);
+          continue;
+        }
+        if (best_axis < 0) {
+          mid = median_split(t, l, r);
+        } else {
+          // partition, growing the children's bounds on the way
+          std::size_t i = t.begin, j = t.end;
+          const int a = best_axis;
+          alignas(16) int k[4];
+          while (i < j) {
+            V4 c = refs_[i].centroid2();
+            map(c, k);
+            if (k[a] < best_k) {
+              l.box.grow(refs_[i].lo, refs_[i].hi);
+              l.cbox.grow_point(c);
+              ++i;
+            } else {
+              --j;
+              r.box.grow(refs_[i].lo, refs_[i].hi);
+              r.cbox.grow_point(c);
+              std::swap(refs_[i], refs_[j]);
+            }
+          }
+          mid = i;
+        }
+      }
+      l.end = mid;
+      r.begin = mid;
+      if (chunk_next == chunk_end) {
+        chunk_next = next_node_.fetch_add(kChunk);
+        chunk_end = chunk_next + kChunk;
+      }
+      lc_uint left = chunk_next;
+      chunk_next += 2;
+      ++interior;
+      node.left_first = left;
+      node.count = 0;
+      l.node = left;
+      r.node = left + 1;
+      // the larger child continues here, the other goes to the pool when it is big enough
+      Task& big = (l.end - l.begin) >= (r.end - r.begin) ? l : r;
+      Task& small = &big == &l ? r : l;
+      if (threads_ > 1 && small.end - small.begin >= kSpawnSize)
+        spawn(small);
+      else
+        stack.push_back(small);
+      stack.push_back(big);
+    }
+    interior_ += interior;
+  }
+
+  std::vector<PrimRef>& refs_;
+  std::size_t max_leaf_;
+  unsigned threads_;
+  std::size_t capacity_;
+  std::unique_ptr<lc_bvh_node[]> nodes_;  // scratch tree, not zeroed
+  std::atomic<lc_uint> next_node_{2};     // node 0 is the root; pairs start at even indices
+  std::atomic<std::size_t> interior_{0};
+  std::atomic<std::size_t> max_depth_{0};
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::vector<Task> queue_;
+  std::size_t pending_ = 0;
+};
+
+template <class F>
+void parallel_for(std::size_t n, unsigned threads, F f) {
+  if (threads <= 1 || n < 4096) {
+    f(std::size_t(0), n, 0u);
+    return;
+  }
+  std::vector<std::thread> pool;
+  std::size_t step = (n + threads - 1) / threads;
+  for (unsigned p = 1; p < threads; ++p)
+    pool.emplace_back(f, std::min(n, p * step), std::min(n, (p + 1) * step), p);
+  f(std::size_t(0), std::min(n, step), 0u);
+  for (auto& t : pool) t.join();
+}
 
 }  // namespace
 
@@ -50,84 +476,93 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
           const BuildOptions& options) {
   auto t0 = std::chrono::steady_clock::now();
   Bvh out;
-  std::vector<Box> boxes;
-  std::vector<lc_uint> refs;
-  for (size_t i = 0; i < tris.size(); ++i) {
-    Box b;
-    b.grow(tris[i].v0);
-    b.grow(tris[i].v1);
-    b.grow(tris[i].v2);
-    boxes.push_back(b);
-    refs.push_back(static_cast<lc_uint>(i));
-  }
-  for (size_t i = 0; i < spheres.size(); ++i) {
-    Box b;
-    const lc_sphere& s = spheres[i];
-    for (int a = 0; a < 3; ++a) {
-      b.lo[a] = s.center[a] - s.radius;
-      b.hi[a] = s.center[a] + s.radius;
+  const std::size_t nt = tris.size(), n = nt + spheres.size();
+  out.stats.primitives = n;
+  if (n == 0) return out;
+  unsigned threads = options.threads > 0 ? static_cast<unsigned>(options.threads)
+                                         : std::max(1u, std::thread::hardware_concurrency());
+
+  // primitive bounds, and the root's bounds and centroid bounds, one slice per thread
+  std::vector<PrimRef> refs(n);
+  std::vector<Box> part_box(threads), part_cbox(threads);
+  parallel_for(n, threads, [&](std::size_t b, std::size_t e, unsigned p) {
+    Box box, cbox;
+    for (std::size_t i = b; i < e; ++i) {
+      alignas(16) float lo[4], hi[4];
+      lc_uint id;
+      if (i < nt) {
+        const lc_triangle& t = tris[i];
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::min(t.v0[a], std::min(t.v1[a], t.v2[a]));
+          hi[a] = std::max(t.v0[a], std::max(t.v1[a], t.v2[a]));
+        }
+        id = static_cast<lc_uint>(i);
+      } else {
+        const lc_sphere& s = spheres[i - nt];
+        float rad = std::fabs(s.radius);
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = s.center[a] - rad;
+          hi[a] = s.center[a] + rad;
+        }
+        id = static_cast<lc_uint>(i - nt) | LC_PRIM_SPHERE_BIT;
+      }
+      std::memcpy(&lo[3], &id, sizeof id);
+      hi[3] = 0;
+      PrimRef& r = refs[i];
+      r.lo = V4::load(lo);
+      r.hi = V4::load(hi);
+      box.grow(r.lo, r.hi);
+      cbox.grow_point(r.centroid2());
     }
-    boxes.push_back(b);
-    refs.push_back(static_cast<lc_uint>(i) | LC_PRIM_SPHERE_BIT);
+    part_box[p] = box;
+    part_cbox[p] = cbox;
+  });
+  Box box, cbox;
+  for (unsigned p = 0; p < threads; ++p) {
+    box.grow(part_box[p]);
+    cbox.grow(part_cbox[p]);
   }
-  std::vector<lc_uint> order(boxes.size());
-  std::iota(order.begin(), order.end(), 0u);
-  if (order.empty()) return out;
-  struct Task {
-    size_t node, begin, end, depth;
+
+  Builder builder(refs, options, threads);
+  std::size_t count = builder.run(box, cbox);
+  const lc_bvh_node* tmp = builder.nodes();
+
+  // flatten depth-first: a node's children are adjacent and its left subtree follows them
+  out.nodes.resize(count);
+  out.prim_refs.resize(n);
+  parallel_for(n, threads, [&](std::size_t b, std::size_t e, unsigned) {
+    for (std::size_t i = b; i < e; ++i) out.prim_refs[i] = refs[i].id();
+  });
+  struct Item {
+    lc_uint src, dst;
   };
-  out.nodes.push_back({});
-  std::vector<Task> stack{{0, 0, order.size(), 1}};
+  std::vector<Item> stack{{0, 0}};
+  lc_uint next = 1;
   while (!stack.empty()) {
-    Task t = stack.back();
+    Item it = stack.back();
     stack.pop_back();
-    Box b, cb;
-    for (size_t i = t.begin; i < t.end; ++i) {
-      b.grow(boxes[order[i]]);
-      float c[3];
-      for (int a = 0; a < 3; ++a) c[a] = 0.5f * (boxes[order[i]].lo[a] + boxes[order[i]].hi[a]);
-      cb.grow(c);
+    const lc_bvh_node& s = tmp[it.src];
+    lc_bvh_node& d = out.nodes[it.dst];
+    d = s;
+    if (s.count == 0) {
+      d.left_first = next;
+      next += 2;
+      stack.push_back({s.left_first + 1, d.left_first + 1});
+      stack.push_back({s.left_first, d.left_first});
     }
-    lc_bvh_node& n = out.nodes[t.node];
-    for (int a = 0; a < 3; ++a) {
-      n.bmin[a] = b.lo[a];
-      n.bmax[a] = b.hi[a];
-    }
-    size_t count = t.end - t.begin;
-    out.stats.max_depth = std::max(out.stats.max_depth, t.depth);
-    if (count <= static_cast<size_t>(options.max_leaf_size)) {
-      n.left_first = static_cast<lc_uint>(t.begin);
-      n.count = static_cast<lc_uint>(count);
-      continue;
-    }
-    int axis = 0;
-    for (int a = 1; a < 3; ++a)
-      if (cb.hi[a] - cb.lo[a] > cb.hi[axis] - cb.lo[axis]) axis = a;
-    size_t mid = (t.begin + t.end) / 2;
-    std::nth_element(order.begin() + t.begin, order.begin() + mid, order.begin() + t.end,
-                     [&](lc_uint x, lc_uint y) {
-                       return boxes[x].lo[axis] + boxes[x].hi[axis] < boxes[y].lo[axis] + boxes[y].hi[axis];
-                     });
-    size_t left = out.nodes.size();
-    out.nodes[t.node].left_first = static_cast<lc_uint>(left);
-    out.nodes[t.node].count = 0;
-    out.nodes.push_back({});
-    out.nodes.push_back({});
-    stack.push_back({left + 1, mid, t.end, t.depth + 1});
-    stack.push_back({left, t.begin, mid, t.depth + 1});
   }
-  out.prim_refs.resize(order.size());
-  for (size_t i = 0; i < order.size(); ++i) out.prim_refs[i] = refs[order[i]];
-  out.stats.primitives = order.size();
-  out.stats.nodes = out.nodes.size();
-  for (const auto& n : out.nodes)
-    if (n.count) {
-      ++out.stats.leaves;
-      out.stats.max_leaf_size = std::max<size_t>(out.stats.max_leaf_size, n.count);
+
+  BuildStats& st = out.stats;
+  st.nodes = out.nodes.size();
+  st.max_depth = builder.max_depth();
+  for (const auto& nd : out.nodes)
+    if (nd.count) {
+      ++st.leaves;
+      st.max_leaf_size = std::max<std::size_t>(st.max_leaf_size, nd.count);
     }
-  out.stats.mean_leaf_size = double(order.size()) / double(out.stats.leaves);
-  out.stats.sah_cost = sah_cost(out.nodes);
-  out.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  st.mean_leaf_size = double(n) / double(st.leaves);
+  st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  st.sah_cost = sah_cost(out.nodes);  // not part of the build time
   return out;
 }
 

@@ -1,0 +1,316 @@
+// lucent_bench: BVH build speed and quality, and kernel traversal speed, on the Stanford bunny,
+// the dragon (../shared/assets/meshes, skipped when absent) and a generated 1M-triangle mesh.
+// When built with Embree 3 the same rays are traced through Embree (rtcIntersect1, 2 threads) and
+// lucent's speed is reported as a fraction of Embree's. Figures: BENCHMARKS.md.
+//
+// usage: lucent_bench [--runs N] [--width W] [--height H] [--device SELECTOR] [--threads N]
+//                     [--build-only]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <tiny_obj_loader.h>
+
+#include "bvh/bvh.hpp"
+#include "bvh/device_tracer.hpp"
+#include "bvh/test_meshes.hpp"
+#include "cl/context.hpp"
+#include "lucent/error.hpp"
+
+#ifdef LUCENT_BENCH_EMBREE
+#include <embree3/rtcore.h>
+#endif
+
+namespace {
+
+using lucent::bvh::TraceHit;
+using lucent::bvh::TraceRay;
+
+struct Options {
+  int runs = 5;
+  int width = 640, height = 480;
+  int threads = 0;          // BVH build threads, 0: all cores
+  bool build_only = false;  // skip the traversal figures
+  std::string device;
+};
+
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+bool load_obj(const std::string& path, std::vector<lc_triangle>& out) {
+  std::ifstream probe(path);
+  if (!probe) return false;
+  tinyobj::ObjReaderConfig cfg;
+  cfg.triangulate = true;
+  cfg.vertex_color = false;
+  tinyobj::ObjReader reader;
+  if (!reader.ParseFromFile(path, cfg)) {
+    std::fprintf(stderr, "%s: %s\n", path.c_str(), reader.Error().c_str());
+    return false;
+  }
+  const auto& v = reader.GetAttrib().vertices;
+  for (const auto& shape : reader.GetShapes()) {
+    const auto& idx = shape.mesh.indices;
+    for (std::size_t i = 0; i + 2 < idx.size(); i += 3) {
+      lc_triangle t{};
+      float* dst[3] = {t.v0, t.v1, t.v2};
+      for (int k = 0; k < 3; ++k)
+        for (int a = 0; a < 3; ++a) dst[k][a] = v[3 * idx[i + k].vertex_index + a];
+      t.light = LC_INVALID;
+      // leave out zero-area triangles, as src/render/pack.cpp does
+      double e1[3], e2[3];
+      for (int a = 0; a < 3; ++a) {
+        e1[a] = double(t.v1[a]) - t.v0[a];
+        e2[a] = double(t.v2[a]) - t.v0[a];
+      }
+      double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+             cz = e1[0] * e2[1] - e1[1] * e2[0];
+      if (cx * cx + cy * cy + cz * cz > 0) out.push_back(t);
+    }
+  }
+  return true;
+}
+
+struct V3 {
+  double x, y, z;
+};
+V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
+double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+V3 normalize(V3 a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
+V3 load(const float* p) { return {p[0], p[1], p[2]}; }
+
+TraceRay make_ray(V3 o, V3 d) {
+  TraceRay r{};
+  r.o[0] = float(o.x), r.o[1] = float(o.y), r.o[2] = float(o.z);
+  r.d[0] = float(d.x), r.d[1] = float(d.y), r.d[2] = float(d.z);
+  r.tmax = INFINITY;
+  return r;
+}
+
+// A camera at 2.2 bounding radii looking at the centre of the mesh, 40 degrees vertical fov.
+std::vector<TraceRay> primary_rays(const lc_bvh_node& root, int w, int h) {
+  V3 lo = load(root.bmin), hi = load(root.bmax);
+  V3 c = 0.5 * (lo + hi);
+  double radius = 0.5 * std::sqrt(dot(hi - lo, hi - lo));
+  V3 fwd = normalize(V3{-0.35, -0.3, -1});
+  V3 pos = c - 2.2 * radius * fwd;
+  V3 right = normalize(cross(fwd, V3{0, 1, 0}));
+  V3 up = cross(right, fwd);
+  double th = std::tan(20.0 * M_PI / 180.0), aspect = double(w) / h;
+  std::vector<TraceRay> rays;
+  rays.reserve(std::size_t(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      double sx = (2 * (x + 0.5) / w - 1) * th * aspect, sy = (1 - 2 * (y + 0.5) / h) * th;
+      rays.push_back(make_ray(pos, normalize(fwd + sx * right + sy * up)));
+    }
+  return rays;
+}
+
+// Cosine-distributed rays leaving the primary hit points (geometric normal towards the camera).
+std::vector<TraceRay> diffuse_rays(const std::vector<TraceRay>& primary,
+                                   const std::vector<TraceHit>& hits,
+                                   const std::vector<lc_triangle>& tris, double scale) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u01(0, 1);
+  std::vector<TraceRay> out;
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    if (hits[i].prim == LC_INVALID) continue;
+    const lc_triangle& t = tris[hits[i].prim];
+    V3 d = load(primary[i].d);
+    V3 p = load(primary[i].o) + double(hits[i].t) * d;
+    V3 n = normalize(cross(load(t.v1) - load(t.v0), load(t.v2) - load(t.v0)));
+    if (dot(n, d) > 0) n = -1.0 * n;
+    V3 a = std::fabs(n.x) > 0.5 ? V3{0, 1, 0} : V3{1, 0, 0};
+    V3 tu = normalize(cross(a, n)), tv = cross(n, tu);
+    double r = std::sqrt(u01(rng)), phi = 2 * M_PI * u01(rng);
+    V3 dir = normalize(r * std::cos(phi) * tu + r * std::sin(phi) * tv +
+                       std::sqrt(std::max(0.0, 1 - r * r)) * n);
+    out.push_back(make_ray(p + 1e-5 * scale * n, dir));
+  }
+  return out;
+}
+
+#ifdef LUCENT_BENCH_EMBREE
+struct Embree {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  double build_seconds = 0;
+  explicit Embree(const std::vector<lc_triangle>& tris) {
+    device = rtcNewDevice("threads=2");
+    double t0 = now();
+    scene = rtcNewScene(device);
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * tris.size()));
+    unsigned* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), tris.size()));
+    for (std::size_t i = 0; i < tris.size(); ++i) {
+      std::memcpy(v + 9 * i, tris[i].v0, 12);
+      std::memcpy(v + 9 * i + 3, tris[i].v1, 12);
+      std::memcpy(v + 9 * i + 6, tris[i].v2, 12);
+      for (int k = 0; k < 3; ++k) idx[3 * i + k] = unsigned(3 * i + k);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(scene);
+    build_seconds = now() - t0;
+  }
+  ~Embree() {
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+  }
+  // seconds to trace all rays with rtcIntersect1 on 2 threads; fills hits
+  double trace(const std::vector<TraceRay>& rays, std::vector<TraceHit>& hits) {
+    hits.assign(rays.size(), TraceHit{});
+    double t0 = now();
+    auto work = [&](std::size_t b, std::size_t e) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      for (std::size_t i = b; i < e; ++i) {
+        RTCRayHit rh{};
+        const TraceRay& r = rays[i];
+        rh.ray.org_x = r.o[0], rh.ray.org_y = r.o[1], rh.ray.org_z = r.o[2];
+        rh.ray.dir_x = r.d[0], rh.ray.dir_y = r.d[1], rh.ray.dir_z = r.d[2];
+        rh.ray.tnear = 0, rh.ray.tfar = r.tmax, rh.ray.mask = ~0u;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(scene, &ctx, &rh);
+        hits[i].t = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar;
+        hits[i].prim = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? LC_INVALID : rh.hit.primID;
+      }
+    };
+    std::size_t half = rays.size() / 2;
+    std::thread other(work, half, rays.size());
+    work(0, half);
+    other.join();
+    return now() - t0;
+  }
+};
+#endif
+
+void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, const Options& opt,
+                lucent::cl_util::Context& ctx) {
+  std::printf("\n== %s: %zu triangles\n", name.c_str(), tris.size());
+  std::vector<double> times;
+  lucent::bvh::Bvh bvh;
+  for (int r = 0; r < opt.runs; ++r) {
+    lucent::bvh::BuildOptions bo;
+    bo.threads = opt.threads;
+    bvh = lucent::bvh::build(tris, {}, bo);
+    times.push_back(bvh.stats.seconds);
+  }
+  std::sort(times.begin(), times.end());
+  const auto& s = bvh.stats;
+  double median = times[times.size() / 2];
+  std::printf("build: median %.1f ms (best %.1f ms) over %d runs = %.2f Mtris/s\n", median * 1e3,
+              times.front() * 1e3, opt.runs, tris.size() / median * 1e-6);
+  std::printf("tree:  %zu nodes, %zu leaves, mean leaf %.2f, max leaf %zu, max depth %zu, "
+              "SAH cost %.2f\n",
+              s.nodes, s.leaves, s.mean_leaf_size, s.max_leaf_size, s.max_depth, s.sah_cost);
+  if (opt.build_only) return;
+
+  lucent::bvh::DeviceTracer tracer(ctx, tris, {}, bvh);
+  const lc_bvh_node& root = bvh.nodes[0];
+  double scale = 0;
+  for (int a = 0; a < 3; ++a) scale = std::max(scale, double(root.bmax[a] - root.bmin[a]));
+  auto primary = primary_rays(root, opt.width, opt.height);
+  tracer.trace(primary);  // warm-up: PoCL compiles the work-group function on first launch
+  auto time_trace = [&](const std::vector<TraceRay>& rays, std::vector<TraceHit>& hits) {
+    double best = INFINITY;
+    for (int r = 0; r < 3; ++r) {
+      hits = tracer.trace(rays);
+      best = std::min(best, tracer.last_kernel_seconds());
+    }
+    return best;
+  };
+  std::vector<TraceHit> phits, dhits;
+  double tp = time_trace(primary, phits);
+  auto diffuse = diffuse_rays(primary, phits, tris, scale);
+  double td = time_trace(diffuse, dhits);
+  std::size_t ph = 0, dh = 0;
+  for (auto& h : phits) ph += h.prim != LC_INVALID;
+  for (auto& h : dhits) dh += h.prim != LC_INVALID;
+  double mp = primary.size() / tp * 1e-6, md = diffuse.size() / td * 1e-6;
+  std::printf("lucent kernel: primary %zu rays (%.0f%% hit) %.2f Mrays/s; diffuse %zu rays "
+              "(%.0f%% hit) %.2f Mrays/s\n",
+              primary.size(), 100.0 * ph / primary.size(), mp, diffuse.size(),
+              100.0 * dh / std::max<std::size_t>(1, diffuse.size()), md);
+#ifdef LUCENT_BENCH_EMBREE
+  Embree em(tris);
+  std::vector<TraceHit> eh;
+  em.trace(primary, eh);  // warm-up
+  double ep = INFINITY, ed = INFINITY;
+  for (int r = 0; r < 3; ++r) ep = std::min(ep, em.trace(primary, eh));
+  std::size_t agree = 0, total = eh.size();
+  for (std::size_t i = 0; i < eh.size(); ++i)
+    agree += (eh[i].prim == LC_INVALID) == (phits[i].prim == LC_INVALID);
+  for (int r = 0; r < 3; ++r) ed = std::min(ed, em.trace(diffuse, eh));
+  double emp = primary.size() / ep * 1e-6, emd = diffuse.size() / ed * 1e-6;
+  std::printf("embree %d.%d.%d (rtcIntersect1, 2 threads, build %.1f ms): primary %.2f Mrays/s, "
+              "diffuse %.2f Mrays/s; hit/miss agreement on primary rays %.4f%%\n",
+              RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, em.build_seconds * 1e3, emp,
+              emd, 100.0 * agree / total);
+  std::printf("lucent / embree: primary %.3f, diffuse %.3f\n", mp / emp, md / emd);
+#endif
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options opt;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "lucent_bench: %s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--runs") opt.runs = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--width") opt.width = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--height") opt.height = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--device") opt.device = next();
+    else if (a == "--threads") opt.threads = std::max(0, std::atoi(next().c_str()));
+    else if (a == "--build-only") opt.build_only = true;
+    else {
+      std::fprintf(stderr, "usage: lucent_bench [--runs N] [--width W] [--height H] [--device S] "
+                           "[--threads N] [--build-only]\n");
+      return 2;
+    }
+  }
+  try {
+    lucent::cl_util::Context ctx(opt.device);
+    std::printf("device: %s (%s); host threads: %u\n", ctx.device.info.name.c_str(),
+                ctx.device.info.platform.c_str(), std::thread::hardware_concurrency());
+    const std::string dir = std::string(LUCENT_SHARED_DIR) + "/assets/meshes/";
+    for (const char* name : {"stanford-bunny.obj", "dragon.obj"}) {
+      std::vector<lc_triangle> tris;
+      if (!load_obj(dir + name, tris)) {
+        std::printf("\n== %s: not found in %s, skipped\n", name, dir.c_str());
+        continue;
+      }
+      bench_mesh(name, tris, opt, ctx);
+    }
+    // 1000 x 500 x 2 = 1M triangles: a bumpy torus
+    auto torus = lucent::bvh::meshes::torus(1000, 500, 1.0f, 0.35f, 0.15f).triangles();
+    bench_mesh("generated bumpy torus", torus, opt, ctx);
+  } catch (const lucent::Error& e) {
+    std::fprintf(stderr, "lucent_bench: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,45 @@
+/* lucent test and benchmark kernel: traces a buffer of rays through the real scene traversal
+ * (bvh/traverse.cl) and returns what it found. Used by tests/test_bvh_trace.cpp (against a brute
+ * force reference on the host) and bench/ (rays per second).
+ *   rays[2 i]     = (origin, tmax)      rays[2 i + 1] = (direction, unused)
+ *   hits[i]       = (t, as_float(prim), b1, b2); prim = LC_INVALID on a miss. With any_hit set
+ *                   only the occlusion answer is meaningful: prim != LC_INVALID when occluded. */
+#include "shared/types.h"
+#include "util/math.cl"
+#include "geom/sphere.cl"
+#include "geom/triangle.cl"
+#include "bvh/traverse.cl"
+
+__kernel void lucent_trace_rays(__global const lc_params* params,
+                                __global const lc_bvh_node* nodes,
+                                __global const lc_uint* prim_refs,
+                                __global const lc_triangle* triangles,
+                                __global const lc_sphere* spheres, __global const float4* rays,
+                                __global float4* hits, lc_uint count, lc_uint any_hit) {
+  lc_uint i = (lc_uint)get_global_id(0);
+  if (i >= count) return;
+  lc_scene s;
+  s.params = params;
+  s.nodes = nodes;
+  s.prim_refs = prim_refs;
+  s.triangles = triangles;
+  s.tri_attrs = 0;
+  s.spheres = spheres;
+  s.materials = 0;
+  s.lights = 0;
+  s.light_cdf = 0;
+  s.textures = 0;
+  s.texels = 0;
+  float4 a = rays[2 * i], b = rays[2 * i + 1];
+  lc_ray ray;
+  ray.o = a.xyz;
+  ray.d = b.xyz;
+  lc_hit hit;
+  if (any_hit) {
+    int occluded = scene_occluded(&s, ray, a.w);
+    hits[i] = (float4)(0.0f, as_float(occluded ? 0u : LC_INVALID), 0.0f, 0.0f);
+  } else {
+    scene_intersect(&s, ray, a.w, &hit);
+    hits[i] = (float4)(hit.t, as_float(hit.prim), hit.b1, hit.b2);
+  }
+}

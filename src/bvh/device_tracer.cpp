@@ -1,0 +1,69 @@
+#include "bvh/device_tracer.hpp"
+
+#include <chrono>
+
+#include "cl/kernel_source.hpp"
+#include "lucent/error.hpp"
+
+namespace lucent::bvh {
+
+namespace {
+
+template <class T>
+cl::Buffer upload(const cl_util::Context& ctx, const std::vector<T>& v) {
+  // OpenCL refuses empty buffers: keep one zeroed element
+  std::vector<T> data = v.empty() ? std::vector<T>(1) : v;
+  return cl::Buffer(ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data.size() * sizeof(T),
+                    data.data());
+}
+
+}  // namespace
+
+DeviceTracer::DeviceTracer(const cl_util::Context& ctx, const std::vector<lc_triangle>& triangles,
+                           const std::vector<lc_sphere>& spheres, const Bvh& bvh)
+    : ctx_(ctx) {
+  cl::Program program = cl_util::build_program(
+      ctx, detail::assemble_kernel_source("test/trace_rays.cl"), "-cl-std=CL1.2");
+  try {
+    kernel_ = cl::Kernel(program, "lucent_trace_rays");
+    lc_params p{};
+    p.num_triangles = static_cast<lc_uint>(triangles.size());
+    p.num_spheres = static_cast<lc_uint>(spheres.size());
+    p.num_nodes = static_cast<lc_uint>(bvh.nodes.size());
+    params_ = upload(ctx, std::vector<lc_params>{p});
+    nodes_ = upload(ctx, bvh.nodes);
+    refs_ = upload(ctx, bvh.prim_refs);
+    tris_ = upload(ctx, triangles);
+    spheres_ = upload(ctx, spheres);
+  } catch (const cl::Error& e) {
+    throw Error(cl_util::describe(e));
+  }
+}
+
+std::vector<TraceHit> DeviceTracer::trace(const std::vector<TraceRay>& rays, bool any_hit) {
+  std::vector<TraceHit> hits(rays.size());
+  if (rays.empty()) return hits;
+  try {
+    cl::Buffer rb(ctx_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                  rays.size() * sizeof(TraceRay), const_cast<TraceRay*>(rays.data()));
+    cl::Buffer hb(ctx_.context, CL_MEM_WRITE_ONLY, hits.size() * sizeof(TraceHit));
+    int a = 0;
+    for (cl::Buffer* b : {&params_, &nodes_, &refs_, &tris_, &spheres_, &rb, &hb})
+      kernel_.setArg(a++, *b);
+    kernel_.setArg(a++, static_cast<cl_uint>(rays.size()));
+    kernel_.setArg(a++, static_cast<cl_uint>(any_hit ? 1 : 0));
+    ctx_.queue.finish();
+    auto t0 = std::chrono::steady_clock::now();
+    ctx_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(rays.size()),
+                                    cl::NullRange);
+    ctx_.queue.finish();
+    kernel_seconds_ =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ctx_.queue.enqueueReadBuffer(hb, CL_TRUE, 0, hits.size() * sizeof(TraceHit), hits.data());
+  } catch (const cl::Error& e) {
+    throw Error(cl_util::describe(e));
+  }
+  return hits;
+}
+
+}  // namespace lucent::bvh
