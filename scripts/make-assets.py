@@ -7,8 +7,8 @@
 - assets/textures/wood.png: 256x256 procedural wood boards (grain lines, seams), tiling seamlessly.
 - assets/cube/cube.obj + cube.mtl: a unit cube, one quad per face with UVs spanning the texture
   and normals, material map_Kd ../textures/checker.png.
-- assets/floor/floor.obj + floor.mtl: a 10x10 quad in the y = 0 plane with UVs 0..4 (the texture
-  repeats four times), material map_Kd ../textures/wood.png.
+- assets/floor/floor.obj + floor.mtl: a 10x10 quad in the y = 0 plane with UVs 0..2 (the texture
+  repeats twice each way), material map_Kd ../textures/wood.png.
 
 Deterministic: running it again gives the same bytes. Usage: scripts/make-assets.py [root]
 """
@@ -65,9 +65,9 @@ def wood(x, y, size=256, planks=4):
     lx = (x % width + 0.5) / width           # 0..1 across the board
     py = (y + 0.5) / size                    # 0..1 along the board
     phase = (k * 0.37) % 1.0
-    wobble = 0.06 * math.sin(2 * math.pi * (py + phase)) + 0.02 * math.sin(2 * math.pi * (3 * py + 2 * phase))
+    wobble = 0.03 * math.sin(2 * math.pi * (py + phase)) + 0.01 * math.sin(2 * math.pi * (3 * py + 2 * phase))
     grain = 0.5 + 0.5 * math.sin(2 * math.pi * (5.0 + k) * (lx + wobble + phase))
-    fine = 0.5 + 0.5 * math.sin(2 * math.pi * 31.0 * (lx + 0.5 * wobble))
+    fine = 0.5 + 0.5 * math.sin(2 * math.pi * 9.0 * (lx + 0.5 * wobble))
     t = 0.6 * grain ** 4 + 0.15 * fine + 0.1 * ((k * 0.53) % 1.0)
     if x % width in (0, width - 1):
         t = 1.3                              # the seam between two boards
@@ -114,16 +114,16 @@ illum 1
 map_Kd ../textures/checker.png
 """
 
-FLOOR_OBJ = """# lucent asset (scripts/make-assets.py): a 10x10 floor at y = 0, its texture repeated 4 times
+FLOOR_OBJ = """# lucent asset (scripts/make-assets.py): a 10x10 floor at y = 0, its texture repeated twice each way
 mtllib floor.mtl
 v -5 0  5
 v  5 0  5
 v  5 0 -5
 v -5 0 -5
 vt 0 0
-vt 4 0
-vt 4 4
-vt 0 4
+vt 2 0
+vt 2 2
+vt 0 2
 vn 0 1 0
 usemtl wood
 f 1/1/1 2/2/1 3/3/1 4/4/1
