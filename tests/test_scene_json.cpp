@@ -323,6 +323,26 @@ TEST(SceneJson, LoadSceneNamesTheFile) {
   }
 }
 
+// A mesh or texture that cannot be loaded: the scene file and the JSON pointer, then the loader's
+// own message naming the file it could not read.
+TEST(SceneJson, MissingMeshAndTextureFiles) {
+  std::string dir = lucent::test::temp_dir();
+  std::string e = error_of(with_material(R"("shapes": [{"type": "sphere", "center": [0,0,0],
+      "radius": 1, "material": "m"}, {"type": "mesh", "file": ")" + dir + R"(/nope.obj"}])"));
+  EXPECT_STARTS_WITH(e, "scene.json: /shapes/1/file: " + dir + "/nope.obj: ");
+  e = error_of(R"({"materials": {"m": {"type": "diffuse", "albedo": {"texture": ")" + dir +
+               R"(/nope.png"}}}})");
+  EXPECT_STARTS_WITH(e, "scene.json: /materials/m/albedo/texture: " + dir + "/nope.png: ");
+  // relative paths are taken from the scene file's directory
+  lucent::test::write_file(dir + "/scene.json", R"({"shapes": [{"type": "mesh", "file": "m.obj"}]})");
+  try {
+    lucent::load_scene(dir + "/scene.json");
+    FAIL() << "no error for a missing mesh";
+  } catch (const lucent::Error& ex) {
+    EXPECT_STARTS_WITH(ex.what(), dir + "/scene.json: /shapes/0/file: " + dir + "/m.obj: ");
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // The whole format
 

@@ -24,7 +24,10 @@ namespace {
 
 std::atomic<bool> g_interrupted{false};
 
-extern "C" void on_sigint(int) { g_interrupted.store(true); }
+extern "C" void on_sigint(int) {
+  g_interrupted.store(true);     // the render stops after the current pass and writes the image
+  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C stops at once
+}
 
 std::string format_duration(double s) {
   char buf[32];

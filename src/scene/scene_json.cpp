@@ -407,7 +407,11 @@ class Parser {
       int mat = j.contains("material") ? material_ref(j["material"], p + "/material", scene) : -1;
       glm::dmat4 xf = j.contains("transform") ? parse_transform(j["transform"], p + "/transform")
                                               : glm::dmat4(1.0);
-      scene_detail::load_obj(scene, file, xf, mat);
+      try {
+        scene_detail::load_obj(scene, file, xf, mat);
+      } catch (const Error& e) {
+        fail(p + "/file", e.what());  // "<scene>: /shapes/2/file: <obj>:<line>: ..."
+      }
     } else {
       check_keys(j, p, {"type", "positions", "indices", "normals", "uvs", "material", "transform"});
       parse_triangles(j, p, scene);
