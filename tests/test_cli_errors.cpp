@@ -59,7 +59,8 @@ TEST(CliErrors, SceneIsADirectory) {
 
 TEST(CliErrors, MalformedJsonGivesFileLineColumn) {
   std::string dir = lucent::test::temp_dir();
-  lucent::test::write_file(dir + "/bad.json", "{\n  \"film\": {\"width\": 8,\n  \"height\": 8]\n}\n");
+  lucent::test::write_file(dir + "/bad.json",
+                           "{\n  \"film\": {\"width\": 8,\n  \"height\": 8]\n}\n");
   std::string msg =
       expect_one_error_line(run_cli("render " + q(dir + "/bad.json") + " -o " + q(dir + "/o.png")));
   // the parser stops at the ']' that should have been a '}': line 3, column 14
@@ -82,9 +83,9 @@ TEST(CliErrors, UnknownOptionIsNamed) {
   std::string scene = small_scene();
   std::string out = lucent::test::temp_dir() + "/o.png";
   // also when a required argument is missing: the unknown option is what the user got wrong
-  for (const std::string& args : {"render " + q(scene) + " -o " + q(out) + " --bogus",
-                                  std::string("render --bogus"), std::string("--bogus"),
-                                  std::string("devices --bogus=3")}) {
+  for (const std::string& args :
+       {"render " + q(scene) + " -o " + q(out) + " --bogus", std::string("render --bogus"),
+        std::string("--bogus"), std::string("devices --bogus=3")}) {
     CommandResult r = run_cli(args);
     std::string msg = expect_one_error_line(r);
     EXPECT_NE(msg.find("unknown option --bogus"), std::string::npos) << args << ": " << msg;
@@ -96,14 +97,13 @@ TEST(CliErrors, UnknownOptionIsNamed) {
 TEST(CliErrors, BadArgumentsAreParseErrors) {
   std::string scene = small_scene();
   std::string out = lucent::test::temp_dir() + "/o.png";
-  for (const std::string& args :
-       {std::string(""), std::string("frobnicate"), "render " + q(scene),
-        "render " + q(scene) + " -o " + q(out) + " --spp 0",
-        "render " + q(scene) + " -o " + q(out) + " --width abc",
-        "render " + q(scene) + " -o " + q(out) + " --seed -1",
-        "render " + q(scene) + " -o " + q(out) + " --time -2",
-        "render " + q(scene) + " -o " + q(out) + " --spp",
-        "render " + q(scene) + " -o " + q(out) + " extra"}) {
+  for (const std::string& args : {std::string(""), std::string("frobnicate"), "render " + q(scene),
+                                  "render " + q(scene) + " -o " + q(out) + " --spp 0",
+                                  "render " + q(scene) + " -o " + q(out) + " --width abc",
+                                  "render " + q(scene) + " -o " + q(out) + " --seed -1",
+                                  "render " + q(scene) + " -o " + q(out) + " --time -2",
+                                  "render " + q(scene) + " -o " + q(out) + " --spp",
+                                  "render " + q(scene) + " -o " + q(out) + " extra"}) {
     CommandResult r = run_cli(args);
     expect_one_error_line(r);
     EXPECT_EQ(r.status, 2) << args;
@@ -114,8 +114,8 @@ TEST(CliErrors, BadArgumentsAreParseErrors) {
 TEST(CliErrors, UnknownIntegrator) {
   std::string scene = small_scene();
   std::string out = lucent::test::temp_dir() + "/o.png";
-  std::string msg = expect_one_error_line(
-      run_cli("render " + q(scene) + " -o " + q(out) + " --integrator bdpt"));
+  std::string msg =
+      expect_one_error_line(run_cli("render " + q(scene) + " -o " + q(out) + " --integrator bdpt"));
   EXPECT_EQ(msg.rfind("--integrator bdpt: unknown integrator", 0), 0u) << msg;
 }
 
@@ -130,7 +130,8 @@ TEST(CliErrors, UnwritableOutputPath) {
   // A path under a regular file and a missing directory fail even for root, who ignores
   // permission bits.
   for (const Case& c :
-       {Case{dir + "/regular_file/x.png", dir + "/regular_file/x.png: cannot write output (Not a directory)"},
+       {Case{dir + "/regular_file/x.png",
+             dir + "/regular_file/x.png: cannot write output (Not a directory)"},
         Case{dir + "/missing/dir/x.png",
              dir + "/missing/dir/x.png: cannot write output (No such file or directory)"},
         Case{dir + "/subdir.png", dir + "/subdir.png: is a directory"}}) {
@@ -190,8 +191,9 @@ TEST(CliErrors, NoMatchingDevice) {
             "--device 'no-such-device-xyz': no device name contains it (see `lucent devices`)");
   std::string msg = expect_one_error_line(run_cli(base + " --device 999"));
   EXPECT_EQ(msg.rfind("--device 999: no device with this index (", 0), 0u) << msg;
-  EXPECT_EQ(expect_one_error_line(run_cli(base, "LUCENT_DEVICE=no-such-device-xyz")),
-            "LUCENT_DEVICE 'no-such-device-xyz': no device name contains it (see `lucent devices`)");
+  EXPECT_EQ(
+      expect_one_error_line(run_cli(base, "LUCENT_DEVICE=no-such-device-xyz")),
+      "LUCENT_DEVICE 'no-such-device-xyz': no device name contains it (see `lucent devices`)");
   msg = expect_one_error_line(run_cli(base, "LUCENT_DEVICE=999"));
   EXPECT_EQ(msg.rfind("LUCENT_DEVICE 999: no device with this index (", 0), 0u) << msg;
   EXPECT_FALSE(fs::exists(out));

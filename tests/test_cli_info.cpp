@@ -25,7 +25,8 @@ std::map<std::string, std::string> parse_report(const std::string& out) {
     // key and value are separated by two or more spaces
     size_t start = line.find_first_not_of(' ');
     size_t gap = line.find("  ", start);
-    std::string key = line.substr(start, gap == std::string::npos ? std::string::npos : gap - start);
+    std::string key =
+        line.substr(start, gap == std::string::npos ? std::string::npos : gap - start);
     std::string value;
     if (gap != std::string::npos) value = line.substr(line.find_first_not_of(' ', gap));
     if (!indented) section = key;
@@ -171,7 +172,8 @@ TEST(CliInfo, BadSceneIsOneErrorLine) {
   lucent::test::write_file(dir + "/bad.json", R"({"film": {"width": 0}})");
   CommandResult r = run_cli("info '" + dir + "/bad.json'");
   EXPECT_EQ(r.status, 1);
-  EXPECT_EQ(r.err, "lucent: error: " + dir + "/bad.json: /film/width: must be in [1, 16384], got 0\n");
+  EXPECT_EQ(r.err,
+            "lucent: error: " + dir + "/bad.json: /film/width: must be in [1, 16384], got 0\n");
   EXPECT_EQ(r.out, "");
   r = run_cli("info");
   EXPECT_EQ(r.status, 2);

@@ -145,7 +145,8 @@ TEST(Devices, CliTableHasOneRowPerDevice) {
   std::istringstream in(r.out);
   std::string header;
   std::getline(in, header);
-  for (const char* column : {"#", "platform", "device", "type", "CUs", "memory", "OpenCL C", "fp64"})
+  for (const char* column :
+       {"#", "platform", "device", "type", "CUs", "memory", "OpenCL C", "fp64"})
     EXPECT_NE(header.find(column), std::string::npos) << column << " in: " << header;
   std::vector<std::string> rows;
   for (std::string line; std::getline(in, line);)
@@ -188,10 +189,9 @@ TEST(Devices, SelectByIndex) {
     lucent::select_device(std::to_string(raw.size()));
     FAIL() << "an index past the last device was accepted";
   } catch (const lucent::Error& e) {
-    EXPECT_EQ(std::string(e.what()), "--device " + std::to_string(raw.size()) +
-                                         ": no device with this index (" +
-                                         std::to_string(raw.size()) +
-                                         " device(s); see `lucent devices`)");
+    EXPECT_EQ(std::string(e.what()),
+              "--device " + std::to_string(raw.size()) + ": no device with this index (" +
+                  std::to_string(raw.size()) + " device(s); see `lucent devices`)");
   }
 }
 

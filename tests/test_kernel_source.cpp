@@ -106,7 +106,8 @@ TEST(KernelSource, KernelDirOverridesTheEmbeddedCopy) {
   bool changed = false;
   for (std::string& line : mk)
     if (line.find("out_sum[gid] =") != std::string::npos) {
-      line = "  out_sum[gid] = (float4)(0.25f, 0.5f, 0.75f, 1.0f) * (float)params->samples_per_pass;";
+      line =
+          "  out_sum[gid] = (float4)(0.25f, 0.5f, 0.75f, 1.0f) * (float)params->samples_per_pass;";
       changed = true;
     }
   ASSERT_TRUE(changed) << "megakernel.cl no longer writes out_sum[gid]: update this test";
@@ -136,8 +137,8 @@ TEST(KernelSource, KernelDirOverridesTheEmbeddedCopy) {
 TEST(KernelSource, MissingFileInKernelDir) {
   std::string dir = kernel_copy();
   fs::remove(dir + "/util/math.cl");
-  CommandResult r = render_plane("LUCENT_KERNEL_DIR='" + dir + "'",
-                                 lucent::test::temp_dir() + "/o.pfm");
+  CommandResult r =
+      render_plane("LUCENT_KERNEL_DIR='" + dir + "'", lucent::test::temp_dir() + "/o.pfm");
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(r.err, "lucent: error: " + dir +
                        "/util/math.cl: cannot read kernel source (LUCENT_KERNEL_DIR is set)\n");
@@ -176,16 +177,16 @@ TEST(KernelSource, BuildFailureInTheMainFileNamesItsLine) {
     if (mk[i].find("__kernel") != std::string::npos) at = static_cast<int>(i) + 1;
   ASSERT_GT(at, 0);
   int line = inject(dir, "megakernel.cl", at, "lucent_injected_error here;");
-  CommandResult r = render_plane("LUCENT_KERNEL_DIR='" + dir + "'",
-                                 lucent::test::temp_dir() + "/o.pfm");
+  CommandResult r =
+      render_plane("LUCENT_KERNEL_DIR='" + dir + "'", lucent::test::temp_dir() + "/o.pfm");
   expect_build_failure(r, "kernels/megakernel.cl:" + std::to_string(line) + ":");
 }
 
 TEST(KernelSource, BuildFailureInAnIncludedFileNamesItsLine) {
   std::string dir = kernel_copy();
   int line = inject(dir, "util/math.cl", 0, "float lucent_injected_error(void) { return 1.0f +; }");
-  CommandResult r = render_plane("LUCENT_KERNEL_DIR='" + dir + "'",
-                                 lucent::test::temp_dir() + "/o.pfm");
+  CommandResult r =
+      render_plane("LUCENT_KERNEL_DIR='" + dir + "'", lucent::test::temp_dir() + "/o.pfm");
   expect_build_failure(r, "kernels/util/math.cl:" + std::to_string(line) + ":");
 }
 

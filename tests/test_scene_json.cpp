@@ -95,7 +95,8 @@ TEST(SceneJson, WrongTypeContainers) {
             "scene.json: /materials: must be an object, got an array");
   EXPECT_EQ(error_of(R"({"shapes": {"type": "sphere"}})"),
             "scene.json: /shapes: must be an array, got an object");
-  EXPECT_EQ(error_of(R"({"lights": "sun"})"), "scene.json: /lights: must be an array, got a string");
+  EXPECT_EQ(error_of(R"({"lights": "sun"})"),
+            "scene.json: /lights: must be an array, got a string");
   EXPECT_EQ(error_of(with_material(R"("shapes": [{"type": "sphere", "center": [0,0,0],
                                       "radius": 1, "material": 0}])")),
             "scene.json: /shapes/0/material: must be a string, got a number 0");
@@ -176,8 +177,8 @@ TEST(SceneJson, OtherDomainErrors) {
 
 TEST(SceneJson, TriangleListErrors) {
   auto tri = [](const std::string& body) {
-    return error_of(with_material(R"("shapes": [{"type": "triangles", "material": "m", )" +
-                                  body + "}]"));
+    return error_of(
+        with_material(R"("shapes": [{"type": "triangles", "material": "m", )" + body + "}]"));
   };
   EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1,3])"),
             "scene.json: /shapes/0/indices/2: must be in [0, 2], got 3");
@@ -296,8 +297,9 @@ TEST(SceneJson, BadTransformSteps) {
             "transforms only)");
   EXPECT_EQ(error_of(with_transform(R"([{"matrix": [[1,0,0,0],[2,0,0,0],[0,0,1,0],[0,0,0,1]]}])")),
             "scene.json: /shapes/0/transform/0/matrix: must be invertible");
-  EXPECT_EQ(error_of(with_transform(R"([{"matrix": [[1,0,0,"inf"],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}])")),
-            "scene.json: /shapes/0/transform/0/matrix/0/3: must be a finite number, got inf");
+  EXPECT_EQ(
+      error_of(with_transform(R"([{"matrix": [[1,0,0,"inf"],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}])")),
+      "scene.json: /shapes/0/transform/0/matrix/0/3: must be a finite number, got inf");
 }
 
 TEST(SceneJson, LoadSceneNamesTheFile) {
@@ -328,13 +330,15 @@ TEST(SceneJson, LoadSceneNamesTheFile) {
 TEST(SceneJson, MissingMeshAndTextureFiles) {
   std::string dir = lucent::test::temp_dir();
   std::string e = error_of(with_material(R"("shapes": [{"type": "sphere", "center": [0,0,0],
-      "radius": 1, "material": "m"}, {"type": "mesh", "file": ")" + dir + R"(/nope.obj"}])"));
+      "radius": 1, "material": "m"}, {"type": "mesh", "file": ")" +
+                                         dir + R"(/nope.obj"}])"));
   EXPECT_STARTS_WITH(e, "scene.json: /shapes/1/file: " + dir + "/nope.obj: ");
   e = error_of(R"({"materials": {"m": {"type": "diffuse", "albedo": {"texture": ")" + dir +
                R"(/nope.png"}}}})");
   EXPECT_STARTS_WITH(e, "scene.json: /materials/m/albedo/texture: " + dir + "/nope.png: ");
   // relative paths are taken from the scene file's directory
-  lucent::test::write_file(dir + "/scene.json", R"({"shapes": [{"type": "mesh", "file": "m.obj"}]})");
+  lucent::test::write_file(dir + "/scene.json",
+                           R"({"shapes": [{"type": "mesh", "file": "m.obj"}]})");
   try {
     lucent::load_scene(dir + "/scene.json");
     FAIL() << "no error for a missing mesh";
@@ -507,11 +511,12 @@ TEST(SceneJson, DefaultsWhenKeysAreLeftOut) {
   // focus distance defaults to the distance to look_at: (0, 0, 5) -> origin
   EXPECT_DOUBLE_EQ(s.camera.focus_distance, 5.0);
   // a filter's default radius depends on its type
-  EXPECT_EQ(lucent::parse_scene(R"({"film": {"filter": {"type": "box"}}})", "f.json").film.filter.radius,
-            0.5);
   EXPECT_EQ(
-      lucent::parse_scene(R"({"film": {"filter": {"type": "gaussian"}}})", "f.json").film.filter.radius,
-      1.5);
+      lucent::parse_scene(R"({"film": {"filter": {"type": "box"}}})", "f.json").film.filter.radius,
+      0.5);
+  EXPECT_EQ(lucent::parse_scene(R"({"film": {"filter": {"type": "gaussian"}}})", "f.json")
+                .film.filter.radius,
+            1.5);
 }
 
 }  // namespace

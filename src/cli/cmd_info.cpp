@@ -78,8 +78,8 @@ std::map<std::string, int> shape_entries(const std::string& path) {
 }  // namespace
 
 CLI::App* add_info_command(CLI::App& app) {
-  CLI::App* cmd = app.add_subcommand(
-      "info", "Print scene statistics, its BVH and the kernel feature defines");
+  CLI::App* cmd =
+      app.add_subcommand("info", "Print scene statistics, its BVH and the kernel feature defines");
   cmd->add_option("scene", args().scene, "Scene file (JSON)")->required();
   return cmd;
 }
