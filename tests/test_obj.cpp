@@ -373,6 +373,8 @@ TEST(Obj, MalformedFilesAreErrorsNamingFileAndLine) {
   std::string missing = dir + "/nothere.obj";
   std::string err = load_error(missing);
   EXPECT_NE(err.find(missing), std::string::npos) << err;
+  err = load_error(dir);
+  EXPECT_NE(err.find(dir + ": "), std::string::npos) << "a directory: " << err;
 }
 
 TEST(Obj, TransformMovesPositionsAndNormalsByTheInverseTranspose) {

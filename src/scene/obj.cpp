@@ -245,6 +245,8 @@ class MaterialMapper {
 
 void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform,
               int material_override) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw Error(path + ": cannot open OBJ file: is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot open OBJ file: " + std::strerror(errno));
   const bool use_mtl = material_override < 0;
