@@ -25,6 +25,7 @@ struct RenderOptions {
   const std::atomic<bool>* cancel = nullptr;  ///< set to stop after the current pass
   std::function<void(const RenderProgress&)> on_progress;
   double pass_seconds = 0.25;     ///< target duration of one launch
+  bool fast_math = false;         ///< build with -cl-fast-relaxed-math (default: IEEE math)
 };
 
 struct RenderResult {

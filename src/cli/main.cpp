@@ -92,6 +92,7 @@ struct RenderArgs {
   bool quiet = false;
   bool reference = false;  ///< the scalar reference integrator instead of the kernel
   std::vector<std::string> aovs;  ///< extra outputs: albedo, normal, depth, variance
+  bool fast_math = false;
 };
 
 /// <output stem>.<name>.exr beside the main output.
@@ -132,6 +133,7 @@ int cmd_render(const RenderArgs& a) {
   opt.device = a.device;
   opt.spp = a.spp;
   opt.time_limit = a.time_limit;
+  opt.fast_math = a.fast_math;
   opt.cancel = &g_interrupted;
   const bool tty = isatty(STDERR_FILENO);
   double last_print = -10;
@@ -217,6 +219,8 @@ int main(int argc, char** argv) {
   render->add_option("--integrator", ra.integrator,
                      "Override the integrator: path, whitted, direct, albedo, normal, depth, ao");
   render->add_flag("-q,--quiet", ra.quiet, "No progress line or summary");
+  render->add_flag("--fast-math", ra.fast_math,
+                   "Build the kernel with -cl-fast-relaxed-math (faster, not IEEE; see BENCHMARKS.md)");
   render->add_option("--aov", ra.aovs,
                      "Also write AOV images <stem>.<name>.exr: albedo, normal, depth, variance")
       ->delimiter(',')
