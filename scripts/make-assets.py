@@ -65,7 +65,8 @@ def wood(x, y, size=256, planks=4):
     lx = (x % width + 0.5) / width           # 0..1 across the board
     py = (y + 0.5) / size                    # 0..1 along the board
     phase = (k * 0.37) % 1.0
-    wobble = 0.03 * math.sin(2 * math.pi * (py + phase)) + 0.01 * math.sin(2 * math.pi * (3 * py + 2 * phase))
+    wobble = (0.03 * math.sin(2 * math.pi * (py + phase))
+              + 0.01 * math.sin(2 * math.pi * (3 * py + 2 * phase)))
     grain = 0.5 + 0.5 * math.sin(2 * math.pi * (5.0 + k) * (lx + wobble + phase))
     fine = 0.5 + 0.5 * math.sin(2 * math.pi * 9.0 * (lx + 0.5 * wobble))
     t = 0.6 * grain ** 4 + 0.15 * fine + 0.1 * ((k * 0.53) % 1.0)
@@ -75,7 +76,7 @@ def wood(x, y, size=256, planks=4):
     return tuple(max(0, min(255, int(round(255 * (l + (d - l) * t))))) for l, d in zip(light, dark))
 
 
-CUBE_OBJ = """# lucent asset (scripts/make-assets.py): a unit cube centred at the origin, one quad per face
+CUBE_OBJ = """# scripts/make-assets.py: a unit cube centred at the origin, one quad per face
 mtllib cube.mtl
 v -0.5 -0.5 -0.5
 v  0.5 -0.5 -0.5
@@ -114,7 +115,7 @@ illum 1
 map_Kd ../textures/checker.png
 """
 
-FLOOR_OBJ = """# lucent asset (scripts/make-assets.py): a 10x10 floor at y = 0, its texture repeated twice each way
+FLOOR_OBJ = """# scripts/make-assets.py: a 10x10 floor at y = 0, its texture repeated twice each way
 mtllib floor.mtl
 v -5 0  5
 v  5 0  5
@@ -138,7 +139,8 @@ map_Kd ../textures/wood.png
 
 
 def main():
-    root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "assets")
+    default = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "assets")
+    root = sys.argv[1] if len(sys.argv) > 1 else default
     write_png(os.path.join(root, "textures", "checker.png"), 256, 256, checker)
     write_png(os.path.join(root, "textures", "wood.png"), 256, 256, wood)
     for rel, text in (("cube/cube.obj", CUBE_OBJ), ("cube/cube.mtl", CUBE_MTL),

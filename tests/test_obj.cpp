@@ -260,8 +260,7 @@ TEST(Obj, CrlfFilesLoadLikeLfFiles) {
 
 TEST(Obj, UsemtlAppliesPerFaceAcrossGroups) {
   std::string dir = lucent::test::temp_dir();
-  write(dir, "m.mtl",
-        "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n");
+  write(dir, "m.mtl", "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n");
   std::string path = write(dir, "faces.obj",
                            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 2 0\n"
                            "g first\nusemtl red\nf 1 2 3\nusemtl blue\nf 1 3 4\n"
@@ -277,8 +276,8 @@ TEST(Obj, UsemtlAppliesPerFaceAcrossGroups) {
   ASSERT_GE(blue, 0);
   EXPECT_EQ(s.materials[red].albedo, glm::dvec3(1, 0, 0));
   EXPECT_EQ(s.materials[blue].albedo, glm::dvec3(0, 0, 1));
-  std::map<std::set<int>, int> want = {{{1, 2, 3}, red}, {{1, 3, 4}, blue}, {{2, 5, 3}, blue},
-                                       {{3, 5, 4}, red}};
+  std::map<std::set<int>, int> want = {
+      {{1, 2, 3}, red}, {{1, 3, 4}, blue}, {{2, 5, 3}, blue}, {{3, 5, 4}, red}};
   // vertex k of the file is scene position k - 1 (the first mesh of the scene)
   int unknown_faces = 0;
   for (const Triangle& t : s.triangles) {
@@ -327,7 +326,8 @@ TEST(Obj, UnreadableTextureWarnsAndFallsBack) {
   std::string dir = lucent::test::temp_dir();
   write(dir, "junk.png", "not an image");
   write(dir, "m.mtl", "newmtl a\nKd 0.1 0.2 0.3\nmap_Kd junk.png\n");
-  std::string path = write(dir, "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\n");
+  std::string path =
+      write(dir, "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\n");
   CaptureWarnings w;
   Scene s;
   load(s, path);
@@ -383,8 +383,9 @@ TEST(Obj, TransformMovesPositionsAndNormalsByTheInverseTranspose) {
   glm::dvec3 a(0, 0, 0), b(1, 0, 1), c(0, 1, 0.5);
   glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
   char buf[512];
-  std::snprintf(buf, sizeof buf, "v 0 0 0\nv 1 0 1\nv 0 1 0.5\nvn %.17g %.17g %.17g\nf 1//1 2//1 3//1\n",
-                n.x, n.y, n.z);
+  std::snprintf(buf, sizeof buf,
+                "v 0 0 0\nv 1 0 1\nv 0 1 0.5\nvn %.17g %.17g %.17g\nf 1//1 2//1 3//1\n", n.x, n.y,
+                n.z);
   std::string path = write(dir, "slope.obj", buf);
   glm::dmat4 xf = glm::translate(glm::dmat4(1.0), glm::dvec3(3, -2, 1)) *
                   glm::rotate(glm::dmat4(1.0), 0.7, glm::normalize(glm::dvec3(1, 2, 3))) *
@@ -429,7 +430,8 @@ void expect_outward(const Scene& s, const glm::dvec3& centre, const std::string&
     EXPECT_GT(glm::dot(ng, mid - centre), 0) << what << ": a face turned inwards";
     for (int k = 0; k < 3; ++k) {
       ASSERT_GE(t.n[k], 0);
-      EXPECT_NEAR(glm::dot(s.normals[t.n[k]], ng), 1.0, 1e-9) << what << ": normal and face disagree";
+      EXPECT_NEAR(glm::dot(s.normals[t.n[k]], ng), 1.0, 1e-9)
+          << what << ": normal and face disagree";
     }
   }
 }
@@ -443,9 +445,9 @@ TEST(Obj, MirroringTransformKeepsOrientationAndCornerAttributes) {
 
   // the course's mapping of the character: (x, z, y) * 20 + (0, -10, 0), a Y/Z swap
   glm::dmat4 swap(0.0);
-  swap[0][0] = 20;             // x' = 20 x
-  swap[2][1] = 20;             // y' = 20 z - 10
-  swap[1][2] = 20;             // z' = 20 y
+  swap[0][0] = 20;  // x' = 20 x
+  swap[2][1] = 20;  // y' = 20 z - 10
+  swap[1][2] = 20;  // z' = 20 y
   swap[3] = glm::dvec4(0, -10, 0, 1);
   ASSERT_LT(glm::determinant(glm::dmat3(swap)), 0);
   Scene mirrored;
@@ -490,7 +492,8 @@ TEST(Obj, MtlMaterialsMapToLucentMaterials) {
         "newmtl noni\nKd 0.5 0.5 0.5\nillum 4\n"
         "newmtl lamp\nKd 0.78 0.78 0.78\nKs 0 0 0\nKe 17 12 4\nillum 2\n");
   std::string obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n";
-  const char* names[] = {"matte", "shiny", "flat", "rough", "chrome", "glass", "faded", "noni", "lamp"};
+  const char* names[] = {"matte", "shiny", "flat", "rough", "chrome",
+                         "glass", "faded", "noni", "lamp"};
   for (const char* n : names) obj += std::string("usemtl ") + n + "\nf 1 2 3\n";
   std::string path = write(dir, "m.obj", obj);
   CaptureWarnings w;
@@ -564,7 +567,8 @@ TEST(Obj, MaterialOverrideIgnoresTheMtl) {
 
 TEST(Obj, MeshesAppendToTheScene) {
   std::string dir = lucent::test::temp_dir();
-  std::string path = write(dir, "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 3/1/1\n");
+  std::string path =
+      write(dir, "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 3/1/1\n");
   Scene s;
   s.positions = {glm::dvec3(9), glm::dvec3(8)};
   s.normals = {glm::dvec3(0, 1, 0)};

@@ -145,8 +145,8 @@ TEST(ObjAssets, CourseSceneMirrorsTheCharacterKeepingItsOrientation) {
   CaptureWarnings w;
   Scene course = lucent::load_scene(lucent::test::source_path("scenes/course.json"));
   Scene plain;
-  lucent::scene_detail::load_obj(plain, lucent::test::shared_asset("beautiful-girl/BeautifulGirl.obj"),
-                                 glm::dmat4(1.0), -1);
+  lucent::scene_detail::load_obj(
+      plain, lucent::test::shared_asset("beautiful-girl/BeautifulGirl.obj"), glm::dmat4(1.0), -1);
   ASSERT_EQ(course.triangles.size(), plain.triangles.size());
   double before = agreeing_fraction(plain, 0), after = agreeing_fraction(course, 0);
   EXPECT_GT(before, 0.9) << "the model's windings and normals mostly agree";

@@ -38,9 +38,10 @@ constexpr float k10 = 0.0030353f, k64 = 0.0512695f, k128 = 0.2158605f, k200 = 0.
 
 TEST(Texture, PngDecodesSrgbToLinearAndKeepsAlphaLinear) {
   std::string path = lucent::test::temp_dir() + "/t.png";
-  // 2x2 RGBA: top row (0,10,128,a255) (255,64,200,a128); bottom row (128,128,128,a0) (10,200,64,a255)
-  const unsigned char px[] = {0,   10,  128, 255, 255, 64, 200, 128,
-                              128, 128, 128, 0,   10,  200, 64, 255};
+  // 2x2 RGBA: top row (0,10,128,a255) (255,64,200,a128); bottom row (128,128,128,a0)
+  // (10,200,64,a255)
+  const unsigned char px[] = {0,   10,  128, 255, 255, 64,  200, 128,
+                              128, 128, 128, 0,   10,  200, 64,  255};
   ASSERT_TRUE(stbi_write_png(path.c_str(), 2, 2, 4, px, 2 * 4));
   Scene scene;
   int i = load_texture(scene, path);
@@ -128,9 +129,7 @@ std::uint32_t crc32(const std::string& data) {
   return ~c;
 }
 
-std::string be32(std::uint32_t v) {
-  return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
-}
+std::string be32(std::uint32_t v) { return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; }
 
 void write_png16(const std::string& path, int w, int h, const std::vector<std::uint16_t>& rgb) {
   std::string raw;
@@ -148,7 +147,8 @@ void write_png16(const std::string& path, int w, int h, const std::vector<std::u
     a = (a + c) % 65521;
     b = (b + a) % 65521;
   }
-  std::uint16_t len = static_cast<std::uint16_t>(raw.size()), nlen = static_cast<std::uint16_t>(~len);
+  std::uint16_t len = static_cast<std::uint16_t>(raw.size()),
+                nlen = static_cast<std::uint16_t>(~len);
   std::string z = "\x78\x01";
   z += '\x01';  // final stored block
   z += {char(len & 0xFF), char(len >> 8), char(nlen & 0xFF), char(nlen >> 8)};

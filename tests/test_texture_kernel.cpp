@@ -54,12 +54,14 @@ std::vector<cl_float4> lookup(const lucent::Scene& scene, const std::vector<Quer
     uv.push_back({{e.u, e.v}});
   }
   auto& c = p.ctx.context;
-  cl::Buffer b_tex(c, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, packed.textures.size() * sizeof(lc_texture),
-                   packed.textures.data());
+  cl::Buffer b_tex(c, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                   packed.textures.size() * sizeof(lc_texture), packed.textures.data());
   cl::Buffer b_texels(c, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                       packed.texels.size() * sizeof(cl_float4), packed.texels.data());
-  cl::Buffer b_index(c, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, index.size() * sizeof(cl_int), index.data());
-  cl::Buffer b_uv(c, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, uv.size() * sizeof(cl_float2), uv.data());
+  cl::Buffer b_index(c, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, index.size() * sizeof(cl_int),
+                     index.data());
+  cl::Buffer b_uv(c, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, uv.size() * sizeof(cl_float2),
+                  uv.data());
   cl::Buffer b_out(c, CL_MEM_WRITE_ONLY, q.size() * sizeof(cl_float4));
   cl::Kernel k(p.program, "probe_texture_lookup");
   k.setArg(0, b_tex);
@@ -144,13 +146,15 @@ TEST(TextureKernel, BilinearMixBetweenTexelCentres) {
       q.push_back({0, x / t.width, 1.0f - y / t.height});
       std::vector<float> r(4);
       for (int c = 0; c < 4; ++c)
-        r[c] = (1 - fx) * (1 - fy) * host_texel(t, 1, 0)[c] + fx * (1 - fy) * host_texel(t, 2, 0)[c] +
-               (1 - fx) * fy * host_texel(t, 1, 1)[c] + fx * fy * host_texel(t, 2, 1)[c];
+        r[c] = (1 - fx) * (1 - fy) * host_texel(t, 1, 0)[c] +
+               fx * (1 - fy) * host_texel(t, 2, 0)[c] + (1 - fx) * fy * host_texel(t, 1, 1)[c] +
+               fx * fy * host_texel(t, 2, 1)[c];
       want.push_back(r);
     }
   std::vector<cl_float4> got = lookup(s, q);
   for (size_t i = 0; i < q.size(); ++i)
-    expect_value(got[i], want[i], "uv (" + std::to_string(q[i].u) + ", " + std::to_string(q[i].v) + ")");
+    expect_value(got[i], want[i],
+                 "uv (" + std::to_string(q[i].u) + ", " + std::to_string(q[i].v) + ")");
 }
 
 TEST(TextureKernel, RepeatWrapping) {

@@ -34,7 +34,8 @@ TEST(TextureRender, TexturedObjQuadShowsTheImageUpright) {
     "film": {"width": 32, "height": 32},
     "integrator": {"type": "albedo", "spp": 4},
     "materials": {},
-    "shapes": [{"type": "mesh", "file": ")" + dir + R"(/quad.obj"}]
+    "shapes": [{"type": "mesh", "file": ")" +
+                     dir + R"(/quad.obj"}]
   })";
   lucent::RenderResult r = lucent::test::render_json(json, 4);
   struct Probe {
@@ -43,8 +44,10 @@ TEST(TextureRender, TexturedObjQuadShowsTheImageUpright) {
     const char* what;
   };
   const float k128 = 0.2158605f;  // 8-bit sRGB 128 in linear
-  const Probe probes[] = {{7, 7, 1, 0, 0, "top-left red"},      {24, 8, 0, 1, 0, "top-right green"},
-                          {8, 24, 0, 0, 1, "bottom-left blue"}, {23, 23, k128, k128, k128, "bottom-right grey"}};
+  const Probe probes[] = {{7, 7, 1, 0, 0, "top-left red"},
+                          {24, 8, 0, 1, 0, "top-right green"},
+                          {8, 24, 0, 0, 1, "bottom-left blue"},
+                          {23, 23, k128, k128, k128, "bottom-right grey"}};
   for (const Probe& p : probes) {
     // pixels 6..10 of each quadrant see only texels of one block (bilinear between same colours)
     const float* c = r.mean.pixel(p.x, p.y);

@@ -57,7 +57,8 @@ class MtlReader : public tinyobj::MaterialReader {
     std::string mtl_warn, mtl_err;
     tinyobj::LoadMtl(map, materials, &in, &mtl_warn, &mtl_err);
     for (size_t i = before; i < materials->size(); ++i) origin.push_back(p.string());
-    for (const std::string& w : lines_of(mtl_warn + mtl_err)) warnings.push_back(p.string() + ": " + w);
+    for (const std::string& w : lines_of(mtl_warn + mtl_err))
+      warnings.push_back(p.string() + ": " + w);
     (void)warn;
     return true;
   }
@@ -138,7 +139,8 @@ fs::path texture_path(const std::string& mtl_path, const std::string& name) {
 class MaterialMapper {
  public:
   MaterialMapper(Scene& scene, const std::string& obj_path,
-                 const std::vector<tinyobj::material_t>& mats, const std::vector<std::string>& origin)
+                 const std::vector<tinyobj::material_t>& mats,
+                 const std::vector<std::string>& origin)
       : scene_(scene), mats_(mats), origin_(origin), index_(mats.size(), -1) {
     obj_name_ = fs::path(obj_path).filename().string();
   }
@@ -193,7 +195,8 @@ class MaterialMapper {
       m.type = MaterialType::Plastic;
       m.specular = ks;
       m.ior = ior;
-      m.roughness = std::clamp(std::sqrt(2.0 / (std::max(0.0, double(t.shininess)) + 2.0)), 1e-3, 1.0);
+      m.roughness =
+          std::clamp(std::sqrt(2.0 / (std::max(0.0, double(t.shininess)) + 2.0)), 1e-3, 1.0);
     } else {
       m.type = MaterialType::Diffuse;
     }
@@ -214,12 +217,18 @@ class MaterialMapper {
     }
     // maps lucent does not use: only a missing file is worth a word
     const std::pair<const char*, const std::string*> unused[] = {
-        {"map_Ka", &t.ambient_texname},   {"map_Ks", &t.specular_texname},
-        {"map_Ns", &t.specular_highlight_texname}, {"map_bump", &t.bump_texname},
-        {"disp", &t.displacement_texname}, {"map_d", &t.alpha_texname},
-        {"refl", &t.reflection_texname},  {"map_Ke", &t.emissive_texname},
-        {"norm", &t.normal_texname},      {"map_Pr", &t.roughness_texname},
-        {"map_Pm", &t.metallic_texname},  {"map_Ps", &t.sheen_texname}};
+        {"map_Ka", &t.ambient_texname},
+        {"map_Ks", &t.specular_texname},
+        {"map_Ns", &t.specular_highlight_texname},
+        {"map_bump", &t.bump_texname},
+        {"disp", &t.displacement_texname},
+        {"map_d", &t.alpha_texname},
+        {"refl", &t.reflection_texname},
+        {"map_Ke", &t.emissive_texname},
+        {"norm", &t.normal_texname},
+        {"map_Pr", &t.roughness_texname},
+        {"map_Pm", &t.metallic_texname},
+        {"map_Ps", &t.sheen_texname}};
     for (const auto& [key, file] : unused) {
       if (file->empty()) continue;
       fs::path p = texture_path(mtl_path, *file);
@@ -291,7 +300,8 @@ void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform
       if (!use_mtl || !reader.missing.empty()) continue;
       size_t a = w.find('\''), b = w.rfind('\'');
       std::string name = (a != std::string::npos && b > a) ? w.substr(a + 1, b - a - 1) : w;
-      warn(path + ": usemtl '" + name + "' names no material of the MTL file; faces use the default material");
+      warn(path + ": usemtl '" + name +
+           "' names no material of the MTL file; faces use the default material");
       continue;
     }
     warn(path + ": " + w);
@@ -340,8 +350,9 @@ void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform
         std::swap(t.n[1], t.n[2]);
         std::swap(t.uv[1], t.uv[2]);
       }
-      t.material = use_mtl ? mapper.get(f < s.mesh.material_ids.size() ? s.mesh.material_ids[f] : -1)
-                           : material_override;
+      t.material = use_mtl
+                       ? mapper.get(f < s.mesh.material_ids.size() ? s.mesh.material_ids[f] : -1)
+                       : material_override;
       scene.triangles.push_back(t);
       ++faces;
     }
