@@ -155,11 +155,11 @@ TEST(Cli, SppIsReported) {
   CommandResult r = run_cli("render " + q(scene) + " -o " + q(out) + " --spp 3");
   ASSERT_EQ(r.status, 0) << r.err;
   std::vector<std::string> lines = lines_of(r.err);
-  ASSERT_EQ(lines.size(), 1u) << r.err;  // a render this short has no progress line
-  EXPECT_EQ(lines[0].rfind(out + ": 16x16, 3 spp in ", 0), 0u) << lines[0];
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines.back().rfind(out + ": 16x16, 3 spp in ", 0), 0u) << lines.back();
   r = run_cli("render " + q(scene) + " -o " + q(out));
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_EQ(r.err.rfind(out + ": 16x16, 4 spp in ", 0), 0u) << r.err;  // the scene's spp
+  EXPECT_NE(r.err.find(out + ": 16x16, 4 spp in "), std::string::npos) << r.err;  // the scene's
 }
 
 TEST(Cli, IntegratorOverride) {
