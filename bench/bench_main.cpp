@@ -4,7 +4,7 @@
 // lucent's speed is reported as a fraction of Embree's. Figures: BENCHMARKS.md.
 //
 // usage: lucent_bench [--runs N] [--width W] [--height H] [--device SELECTOR] [--threads N]
-//                     [--build-only]
+//                     [--build-only] [--only NAME] [--no-embree] [--traversal-cost C]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -39,6 +39,9 @@ struct Options {
   int width = 640, height = 480;
   int threads = 0;          // BVH build threads, 0: all cores
   bool build_only = false;  // skip the traversal figures
+  std::string only;         // run only the meshes whose name contains this
+  bool embree = true;       // compare with Embree when built with it
+  float traversal_cost = lucent::bvh::BuildOptions().traversal_cost;
   std::string device;
 };
 
@@ -209,6 +212,7 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
   for (int r = 0; r < opt.runs; ++r) {
     lucent::bvh::BuildOptions bo;
     bo.threads = opt.threads;
+    bo.traversal_cost = opt.traversal_cost;
     bvh = lucent::bvh::build(tris, {}, bo);
     times.push_back(bvh.stats.seconds);
   }
@@ -249,6 +253,7 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
               primary.size(), 100.0 * ph / primary.size(), mp, diffuse.size(),
               100.0 * dh / std::max<std::size_t>(1, diffuse.size()), md);
 #ifdef LUCENT_BENCH_EMBREE
+  if (!opt.embree) return;
   Embree em(tris);
   std::vector<TraceHit> eh;
   em.trace(primary, eh);  // warm-up
@@ -286,9 +291,13 @@ int main(int argc, char** argv) {
     else if (a == "--device") opt.device = next();
     else if (a == "--threads") opt.threads = std::max(0, std::atoi(next().c_str()));
     else if (a == "--build-only") opt.build_only = true;
+    else if (a == "--only") opt.only = next();
+    else if (a == "--no-embree") opt.embree = false;
+    else if (a == "--traversal-cost") opt.traversal_cost = float(std::atof(next().c_str()));
     else {
       std::fprintf(stderr, "usage: lucent_bench [--runs N] [--width W] [--height H] [--device S] "
-                           "[--threads N] [--build-only]\n");
+                           "[--threads N] [--build-only] [--only NAME] [--no-embree] "
+                           "[--traversal-cost C]\n");
       return 2;
     }
   }
@@ -297,7 +306,11 @@ int main(int argc, char** argv) {
     std::printf("device: %s (%s); host threads: %u\n", ctx.device.info.name.c_str(),
                 ctx.device.info.platform.c_str(), std::thread::hardware_concurrency());
     const std::string dir = std::string(LUCENT_SHARED_DIR) + "/assets/meshes/";
+    auto wanted = [&](const std::string& name) {
+      return opt.only.empty() || name.find(opt.only) != std::string::npos;
+    };
     for (const char* name : {"stanford-bunny.obj", "dragon.obj"}) {
+      if (!wanted(name)) continue;
       std::vector<lc_triangle> tris;
       if (!load_obj(dir + name, tris)) {
         std::printf("\n== %s: not found in %s, skipped\n", name, dir.c_str());
@@ -306,8 +319,10 @@ int main(int argc, char** argv) {
       bench_mesh(name, tris, opt, ctx);
     }
     // 1000 x 500 x 2 = 1M triangles: a bumpy torus
-    auto torus = lucent::bvh::meshes::torus(1000, 500, 1.0f, 0.35f, 0.15f).triangles();
-    bench_mesh("generated bumpy torus", torus, opt, ctx);
+    if (wanted("generated bumpy torus")) {
+      auto torus = lucent::bvh::meshes::torus(1000, 500, 1.0f, 0.35f, 0.15f).triangles();
+      bench_mesh("generated bumpy torus", torus, opt, ctx);
+    }
   } catch (const lucent::Error& e) {
     std::fprintf(stderr, "lucent_bench: %s\n", e.what());
     return 1;

@@ -92,9 +92,19 @@ void check_bvh(const Bvh& b, const std::vector<lc_triangle>& tris,
     std::size_t depth;
   };
   // depth-first layout: the children of the k-th interior node met in preorder are the pair that
-  // follows all pairs of the interior nodes before it
+  // follows all pairs of the interior nodes before it; pairs start at even indices, node 1 being
+  // an unreferenced empty padding node when the root is not a leaf
   std::vector<Item> stack{{0, 1}};
-  lc_uint expected_pair = 1;
+  lc_uint expected_pair = 2;
+  if (b.nodes[0].count == 0) {
+    ASSERT_GE(b.nodes.size(), 4u);
+    const lc_bvh_node& pad = b.nodes[1];
+    EXPECT_EQ(pad.count, 0u);
+    EXPECT_GT(pad.bmin[0], pad.bmax[0]) << "the padding node should be an empty box";
+    visited[1] = 1;
+  } else {
+    EXPECT_EQ(b.nodes.size(), 1u);
+  }
   std::size_t leaves = 0, max_depth = 0, max_leaf_seen = 0;
   double sah = 0, root_area = node_area(b.nodes[0]);
   int failures = 0;
@@ -106,6 +116,9 @@ void check_bvh(const Bvh& b, const std::vector<lc_triangle>& tris,
     ASSERT_EQ(visited[it.node]++, 0) << "node " << it.node << " reached twice";
     max_depth = std::max(max_depth, it.depth);
     if (root_area > 0) sah += node_area(nd) / root_area * (nd.count ? nd.count : 1.0);
+    if (nd.count == 0) {
+      EXPECT_EQ(nd.left_first % 2, 0u) << "pair of node " << it.node;
+    }
     if (nd.count == 0) {
       ASSERT_EQ(nd.left_first, expected_pair) << "node " << it.node << ": not depth-first";
       expected_pair += 2;
@@ -152,7 +165,7 @@ void check_bvh(const Bvh& b, const std::vector<lc_triangle>& tris,
     ASSERT_EQ(visited[i], 1) << "node " << i << " unreachable";
   EXPECT_LE(max_depth, 64u) << "deeper than the kernel's traversal stack";
   const auto& s = b.stats;
-  EXPECT_EQ(s.nodes, b.nodes.size());
+  EXPECT_EQ(s.nodes, b.nodes.size() - (b.nodes.size() > 1 ? 1 : 0));  // without the padding
   EXPECT_EQ(s.leaves, leaves);
   EXPECT_EQ(s.nodes, 2 * leaves - 1);
   EXPECT_EQ(s.max_depth, max_depth);

@@ -10,6 +10,9 @@ namespace lucent::bvh {
 struct BuildOptions {
   int max_leaf_size = 4;  ///< a leaf is forced to split above this many primitives
   int threads = 0;        ///< 0: hardware concurrency
+  /// SAH cost of one traversal step relative to one primitive intersection: larger values give
+  /// larger leaves and fewer nodes.
+  float traversal_cost = 1.0f;
 };
 
 struct BuildStats {

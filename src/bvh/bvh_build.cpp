@@ -23,7 +23,6 @@ namespace lucent::bvh {
 namespace {
 
 constexpr int kBins = 32;
-constexpr float kTraversalCost = 1.0f;    // relative to one primitive intersection
 constexpr std::size_t kSpawnSize = 2048;  // subtrees at least this large go to the shared queue
 constexpr lc_uint kChunk = 512;           // node pairs are taken from the shared counter in chunks
 constexpr std::size_t kParallelBinSize = 1u << 17;  // nodes this large bin on every thread
@@ -209,7 +208,8 @@ class Builder {
   Builder(std::vector<PrimRef>& refs, const BuildOptions& options, unsigned threads)
       : refs_(refs),
         max_leaf_(static_cast<std::size_t>(std::max(1, options.max_leaf_size))),
-        threads_(threads) {
+        threads_(threads),
+        traversal_cost_(options.traversal_cost) {
     // every task allocates node pairs from its own chunks: at most one partly used chunk per task
     std::size_t tasks = 2 * refs.size() / kSpawnSize + 2;
     capacity_ = 2 * refs.size() + tasks * kChunk;
@@ -373,7 +373,7 @@ class Builder {
           }
         }
         float area = t.box.area();
-        float split_cost = kTraversalCost * area + best;  // both scaled by the node's area
+        float split_cost = traversal_cost_ * area + best;  // both scaled by the node's area
         float leaf_cost = float(n) * area;
         if (n <= max_leaf_ && (best_axis < 0 || leaf_cost <= split_cost)) {
           make_leaf(t);
@@ -431,6 +431,7 @@ class Builder {
   std::vector<PrimRef>& refs_;
   std::size_t max_leaf_;
   unsigned threads_;
+  float traversal_cost_;
   std::size_t capacity_;
   std::unique_ptr<lc_bvh_node[]> nodes_;  // scratch tree, not zeroed
   std::atomic<lc_uint> next_node_{2};     // node 0 is the root; pairs start at even indices
@@ -527,8 +528,18 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
   std::size_t count = builder.run(box, cbox);
   const lc_bvh_node* tmp = builder.nodes();
 
-  // flatten depth-first: a node's children are adjacent and its left subtree follows them
-  out.nodes.resize(count);
+  // flatten depth-first: a node's children are adjacent and its left subtree follows them. Node 1
+  // is padding (an empty box, never referenced) so that every sibling pair starts at an even
+  // index: with a 64-byte aligned buffer, the two boxes a traversal step tests share one cache
+  // line.
+  const lc_uint first_pair = count > 1 ? 2 : 1;
+  out.nodes.resize(count + (first_pair - 1));
+  if (count > 1) {
+    lc_bvh_node& pad = out.nodes[1];
+    for (int a = 0; a < 3; ++a) pad.bmin[a] = INFINITY, pad.bmax[a] = -INFINITY;
+    pad.left_first = 0;
+    pad.count = 0;
+  }
   out.prim_refs.resize(n);
   parallel_for(n, threads, [&](std::size_t b, std::size_t e, unsigned) {
     for (std::size_t i = b; i < e; ++i) out.prim_refs[i] = refs[i].id();
@@ -537,7 +548,7 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
     lc_uint src, dst;
   };
   std::vector<Item> stack{{0, 0}};
-  lc_uint next = 1;
+  lc_uint next = first_pair;
   while (!stack.empty()) {
     Item it = stack.back();
     stack.pop_back();
@@ -553,7 +564,7 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
   }
 
   BuildStats& st = out.stats;
-  st.nodes = out.nodes.size();
+  st.nodes = count;  // the padding node left out
   st.max_depth = builder.max_depth();
   for (const auto& nd : out.nodes)
     if (nd.count) {
