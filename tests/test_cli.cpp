@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -200,6 +201,25 @@ TEST(Cli, ProgressLineAndTimeLimit) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err, "");
   EXPECT_EQ(r.out, "");
+}
+
+// On a terminal the progress line is redrawn in place ('\r') and the summary starts a new line.
+// `script` (util-linux) gives the CLI a pseudo-terminal.
+TEST(Cli, ProgressLineOnATerminal) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1)";
+  std::string scene = plane_scene(0, 1 << 24);
+  std::string dir = lucent::test::temp_dir();
+  std::string out = dir + "/o.png", log = dir + "/tty.log";
+  std::string inner = std::string("'") + LUCENT_CLI_PATH + "' render " + q(scene) + " -o " +
+                      q(out) + " --time 1.5 --width 64";
+  std::string cmd = "script -qec " + q(inner) + " /dev/null </dev/null >" + q(log) + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << read_all(log);
+  std::string text = read_all(log);
+  EXPECT_TRUE(
+      std::regex_search(text, std::regex(R"(\r *\d+\.\d%  \d+ spp  .* Msamples/s  elapsed )")))
+      << text;
+  EXPECT_NE(text.find("\n" + out + ": 64x16, "), std::string::npos) << text;
+  EXPECT_EQ(text.find("lucent: error"), std::string::npos) << text;
 }
 
 // SIGINT while rendering: the image accumulated so far is written and the exit status is 130.
