@@ -373,6 +373,26 @@ TEST(KernelVsReference, ShadingNormals) {
   EXPECT_AGREE(b);
 }
 
+// A floor that is a sphere of radius 1000 (as in scenes/default.json) lit by a sphere light only.
+// Large primitives need large ray offsets; a shadow ray from an offset origin must not let the
+// light's own sphere hide the sampled point near its silhouette. PENDING KERNEL FIX: the kernel is
+// about 5% darker here (the reference matches the closed form of
+// ReferenceAnalytic.SphericalEmitterIrradiance, which has the same kind of floor).
+TEST(KernelVsReference, LargeSphereFloorUnderSphereLight_PendingKernelFix) {
+  Both b = render_both(
+      scene_from(R"({
+        "camera": {"position": [0, 1.2, 8], "look_at": [0, 0.6, 0], "fov": 35},
+        "film": {"width": 32, "height": 24},
+        "integrator": {"type": "path", "max_depth": 2},
+        "materials": {"floor": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
+                      "sky": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [6, 5.5, 5]}},
+        "shapes": [{"type": "sphere", "center": [0, -1000, 0], "radius": 1000, "material": "floor"},
+                   {"type": "sphere", "center": [-6, 9, 3], "radius": 1.5, "material": "sky"}]
+      })"),
+      256);
+  EXPECT_AGREE(b);
+}
+
 // Negative control: the same scene with the floor's albedo 3% lower in the reference must fail.
 TEST(KernelVsReference, DetectsAThreePercentAlbedoChange) {
   Scene s = scene_from(scene_json(R"({"type": "path", "max_depth": 5})", kDiffuseMats, kSpheres,

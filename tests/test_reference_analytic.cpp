@@ -99,39 +99,55 @@ TEST(ReferenceAnalytic, PointLightOverPlane) {
   }
 }
 
-// A spherical emitter (radius R, radiance Le, centre at height d above the plane z = 0) fully
-// above a diffuse plane gives E = pi Le R^2 cos(theta) / D^2 at a point at distance D from the
-// centre (pi Le (R/d)^2 right below it). The camera sees a small patch around the origin with a
-// tiny box filter, so a pixel's expected value is albedo / pi * E at its centre; path tracing with
-// max_depth 2 (direct light only: light sampling and BSDF sampling with MIS).
+// A spherical emitter (radius R, radiance Le, centre c) fully above the tangent plane of a
+// diffuse surface point p with normal n gives E = pi Le R^2 cos(theta) / D^2, D = |c - p|,
+// cos(theta) = n . (c - p) / D (pi Le (R/d)^2 right below it). The camera sees a small patch
+// around the origin with a tiny box filter, so a pixel's expected value is albedo / pi * E at
+// its centre; path tracing with max_depth 2 (direct light only: light sampling and BSDF sampling
+// with MIS). The floor is a plane, then a sphere of radius 1000 tangent to it at the origin (large
+// primitives need large ray offsets, which must not make the light hide itself).
 TEST(ReferenceAnalytic, SphericalEmitterIrradiance) {
-  const double albedo = 0.5, Le = 3, R = 0.5, d = 2;
-  const char* scene = R"({
-    "camera": {"position": [2, 0, 2], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 10},
-    "film": {"width": 32, "height": 32, "filter": {"type": "box", "radius": 0.0001}},
-    "integrator": {"type": "path", "max_depth": 2},
-    "materials": {"white": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
-                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [3, 3, 3]}},
-    "shapes": [{"type": "triangles", "material": "white",
-                "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]],
-                "indices": [0,1,2, 0,2,3]},
-               {"type": "sphere", "center": [0, 0, 2], "radius": 0.5, "material": "lamp"}]
-  })";
-  RenderResult r = render_ref(scene, 64);
-  // the camera basis, as the model defines it, to find where each pixel centre meets the plane
-  glm::dvec3 pos(2, 0, 2), fwd = glm::normalize(-pos), right = glm::normalize(glm::cross(fwd, {0, 0, 1}));
-  glm::dvec3 up = glm::cross(right, fwd);
-  const double t = std::tan(5.0 * M_PI / 180.0);
-  RenderResult e = expected_image(r, [&](int x, int y) {
-    double nx = (2.0 * (x + 0.5) / 32 - 1) * t, ny = (1 - 2.0 * (y + 0.5) / 32) * t;
-    glm::dvec3 dir = glm::normalize(fwd + nx * right + ny * up);
-    glm::dvec3 p = pos + (-pos.z / dir.z) * dir;
-    glm::dvec3 to = glm::dvec3(0, 0, d) - p;
-    double D = glm::length(to);
-    double E = M_PI * Le * R * R * (to.z / D) / (D * D);
-    return glm::dvec3(albedo / M_PI * E);
-  });
-  expect_matches(r, e);
+  const double albedo = 0.5, Le = 3, R = 0.5;
+  const glm::dvec3 c(0, 0, 2);
+  for (bool sphere_floor : {false, true}) {
+    SCOPED_TRACE(sphere_floor ? "sphere floor" : "plane floor");
+    std::string floor = sphere_floor
+                            ? R"({"type": "sphere", "center": [0, 0, -1000], "radius": 1000, "material": "white"})"
+                            : R"({"type": "triangles", "material": "white",
+                                  "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]],
+                                  "indices": [0,1,2, 0,2,3]})";
+    std::string scene = R"({
+      "camera": {"position": [2, 0, 2], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 10},
+      "film": {"width": 32, "height": 32, "filter": {"type": "box", "radius": 0.0001}},
+      "integrator": {"type": "path", "max_depth": 2},
+      "materials": {"white": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
+                    "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [3, 3, 3]}},
+      "shapes": [)" + floor + R"(,
+                 {"type": "sphere", "center": [0, 0, 2], "radius": 0.5, "material": "lamp"}]
+    })";
+    RenderResult r = render_ref(scene, 64);
+    // the camera basis, as the model defines it, to find where each pixel centre meets the floor
+    glm::dvec3 pos(2, 0, 2), fwd = glm::normalize(-pos), right = glm::normalize(glm::cross(fwd, {0, 0, 1}));
+    glm::dvec3 up = glm::cross(right, fwd);
+    const double t = std::tan(5.0 * M_PI / 180.0);
+    RenderResult e = expected_image(r, [&](int x, int y) {
+      double nx = (2.0 * (x + 0.5) / 32 - 1) * t, ny = (1 - 2.0 * (y + 0.5) / 32) * t;
+      glm::dvec3 dir = glm::normalize(fwd + nx * right + ny * up), p, n(0, 0, 1);
+      if (sphere_floor) {
+        glm::dvec3 f = pos - glm::dvec3(0, 0, -1000);
+        double b = glm::dot(f, dir), cc = glm::dot(f, f) - 1e6;
+        p = pos + (-b - std::sqrt(b * b - cc)) * dir;
+        n = glm::normalize(p - glm::dvec3(0, 0, -1000));
+      } else {
+        p = pos + (-pos.z / dir.z) * dir;
+      }
+      glm::dvec3 to = c - p;
+      double D = glm::length(to);
+      double E = M_PI * Le * R * R * (glm::dot(n, to) / D) / (D * D);
+      return glm::dvec3(albedo / M_PI * E);
+    });
+    expect_matches(r, e);
+  }
 }
 
 // A closed cube whose inward-facing walls (triangle fronts) all have albedo rho and emission Le:

@@ -166,7 +166,7 @@ bool World::hit_prim(int prim, const Ray& r, double tmax, Hit& hit) const {
   return true;
 }
 
-bool World::intersect(const Ray& ray, double tmax, Hit& hit) const {
+bool World::intersect(const Ray& ray, double tmax, Hit& hit, int skip) const {
   if (nodes_.empty()) return false;
   dvec3 inv;
   for (int a = 0; a < 3; ++a) inv[a] = ray.d[a] != 0 ? 1.0 / ray.d[a] : 1e300;
@@ -179,7 +179,7 @@ bool World::intersect(const Ray& ray, double tmax, Hit& hit) const {
     if (!hit_box(n.box, ray, inv, tmax)) continue;
     if (n.left < 0) {
       for (int i = n.first; i < n.first + n.count; ++i)
-        if (hit_prim(order_[i], ray, tmax, hit)) {
+        if (order_[i] != skip && hit_prim(order_[i], ray, tmax, hit)) {
           tmax = hit.t;
           found = true;
         }
@@ -191,9 +191,9 @@ bool World::intersect(const Ray& ray, double tmax, Hit& hit) const {
   return found;
 }
 
-bool World::occluded(const Ray& ray, double tmax) const {
+bool World::occluded(const Ray& ray, double tmax, int skip) const {
   Hit h;
-  return intersect(ray, tmax, h);
+  return intersect(ray, tmax, h, skip);
 }
 
 Surface World::surface(const Ray& ray, const Hit& hit) const {

@@ -156,9 +156,9 @@ class Renderer {
     ++t_rays;
     return world_.intersect(r, kInf, h);
   }
-  bool blocked(const Ray& r, double tmax) const {
+  bool blocked(const Ray& r, double tmax, int skip = -1) const {
     ++t_rays;
-    return world_.occluded(r, tmax);
+    return world_.occluded(r, tmax, skip);
   }
 
   static Ray spawn(const Surface& s, const dvec3& wi) {
@@ -254,8 +254,11 @@ class Renderer {
     if (cos_l <= 0) return dvec3(0.0);
     dvec3 f = b.eval(wo, wi);
     if (max3(f) <= 0) return dvec3(0.0);
+    // The light's own primitive cannot hide a point of it that faces us (a sphere is convex), so
+    // it is left out of the shadow test: near its silhouette, the ray from the offset origin
+    // would otherwise graze it just before the sampled point.
     Ray r = spawn(s, wi);
-    if (blocked(r, glm::length(y - r.o) * (1 - 1e-7))) return dvec3(0.0);
+    if (blocked(r, glm::length(y - r.o) * (1 - 1e-7), al.prim)) return dvec3(0.0);
     const Prim& p = world_.prims[al.prim];
     int mat = p.sphere ? scene_.spheres[p.index].material : scene_.triangles[p.index].material;
     double pl = area_light_pdf(al.prim, dist, cos_l);

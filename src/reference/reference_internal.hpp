@@ -81,10 +81,10 @@ class World {
   std::vector<int> prim_light;  ///< per prim: index into area_lights or -1
   dvec3 bounds_lo{0.0}, bounds_hi{0.0};
 
-  /// Closest hit with t in (0, tmax).
-  bool intersect(const Ray& ray, double tmax, Hit& hit) const;
-  /// Any hit with t in (0, tmax).
-  bool occluded(const Ray& ray, double tmax) const;
+  /// Closest hit with t in (0, tmax), ignoring primitive `skip` (if >= 0).
+  bool intersect(const Ray& ray, double tmax, Hit& hit, int skip = -1) const;
+  /// Any hit with t in (0, tmax), ignoring primitive `skip` (if >= 0).
+  bool occluded(const Ray& ray, double tmax, int skip = -1) const;
   Surface surface(const Ray& ray, const Hit& hit) const;
 
   /// Uniformly distributed point on primitive `prim`, with its outward (front) normal.
