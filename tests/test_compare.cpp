@@ -99,6 +99,9 @@ TEST(Compare, LocalErrorFailsPixels) {
   EXPECT_LE(c.failed_pixels, 16u);
   EXPECT_GE(c.max_z_x, 8);
   EXPECT_LT(c.max_z_x, 12);
+  // the z image shows where: strongly negative (A < B) inside the block
+  EXPECT_LT(c.z.pixel(9, 9)[0], -c.z_threshold);
+  EXPECT_GT(c.z.pixel(20, 20)[0], -c.z_threshold);
 }
 
 // Deterministic images (no variances) are compared by tolerance: abs_epsilon + rel_epsilon |v|
@@ -159,12 +162,14 @@ TEST(Compare, CommandLine) {
   EXPECT_EQ(a.samples[0], 16u);
   EXPECT_FALSE(a.variance.rgb.empty());
 
-  auto same = lucent::test::run_cli("compare '" + dir + "/a.exr' '" + dir + "/b.exr'");
+  auto same = lucent::test::run_cli("compare '" + dir + "/a.exr' '" + dir + "/b.exr' --zmap '" +
+                                    dir + "/z.pfm'");
   EXPECT_EQ(same.status, 0) << same.out << same.err;
   EXPECT_NE(same.out.find("PASS"), std::string::npos);
   EXPECT_NE(same.out.find("RMSE"), std::string::npos);
   EXPECT_NE(same.out.find("relMSE"), std::string::npos);
   EXPECT_NE(same.out.find("max abs error"), std::string::npos);
+  EXPECT_EQ(lucent::read_image(dir + "/z.pfm").width, 32);
 
   RenderResult c = a;
   for (float& v : c.mean.rgb) v *= 1.2f;

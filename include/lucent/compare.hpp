@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <string>
 
+#include "lucent/image.hpp"
 #include "lucent/render.hpp"
 
 namespace lucent {
@@ -45,6 +46,7 @@ struct CompareResult {
   double rmse = 0;            ///< sqrt(mean over pixel-channels of (A - B)^2)
   double relmse = 0;          ///< mean of (A - B)^2 / (B^2 + 0.01)
   double max_abs_error = 0;   ///< largest |A - B|
+  Image z;                    ///< per pixel-channel z = (A - B) / standard error (signed)
   std::string summary() const;  ///< multi-line report, as `lucent compare` prints it
 };
 

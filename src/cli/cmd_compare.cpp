@@ -7,6 +7,7 @@
 
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
+#include "lucent/image.hpp"
 
 namespace lucent::cli {
 
@@ -16,6 +17,7 @@ struct CompareArgs {
   std::string a, b;
   CompareOptions options;
   bool no_mean_test = false;
+  std::string zmap;
 };
 
 CompareArgs& args() {
@@ -43,6 +45,8 @@ CLI::App* add_compare_command(CLI::App& app) {
                   "Relative error allowed where variances are zero (default 1e-4)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-mean-test", a.no_mean_test, "Skip the test of the image means");
+  cmd->add_option("--zmap", a.zmap,
+                  "Write the per-pixel z values (signed, per channel) to this .exr or .pfm file");
   return cmd;
 }
 
@@ -55,6 +59,7 @@ int run_compare_command() {
                 " differs from " + a.a + " (" + std::to_string(ra.mean.width) + "x" +
                 std::to_string(ra.mean.height) + ")");
   CompareResult r = compare_images(ra, rb, a.options);
+  if (!a.zmap.empty()) write_image(a.zmap, r.z);
   std::printf("A             %s%s\nB             %s%s\n", a.a.c_str(),
               ra.variance.rgb.empty() ? " (no variance layers)" : "", a.b.c_str(),
               rb.variance.rgb.empty() ? " (no variance layers)" : "");

@@ -66,6 +66,7 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b, const
     return r;
   }
   // Sidak: each of m tests at 1 - (1 - alpha)^(1/m)
+  r.z = Image{r.width, r.height, std::vector<float>(npix * 3)};
   double per_test = -std::expm1(std::log1p(-o.alpha) / static_cast<double>(r.tested));
   r.z_threshold = normal_two_sided_critical(per_test);
 
@@ -78,6 +79,7 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b, const
       double var = variance_of_mean(a, i, c) + variance_of_mean(b, i, c);
       double eps = o.abs_epsilon + o.rel_epsilon * std::max(std::abs(va), std::abs(vb));
       double z = d / std::sqrt(var + eps * eps);
+      r.z.rgb[i * 3 + c] = static_cast<float>(z);
       bool ok = std::isfinite(z) && std::abs(z) <= r.z_threshold;
       if (!ok) {
         ++r.failed_channels;
