@@ -91,14 +91,14 @@ const char* kLampShapes = R"({"type": "sphere", "center": [1.2, 2.2, 1.0], "radi
 TEST(KernelVsReference, DirectDiffusePointLights) {
   Both b = render_both(scene_from(scene_json(R"({"type": "direct"})", kDiffuseMats, kSpheres,
                                              std::string(kPointLights) + ", " + kEnv)),
-                       64);
+                       128);
   EXPECT_AGREE(b);
 }
 
 TEST(KernelVsReference, PathDiffusePointLightsEnvironment) {
   Both b = render_both(scene_from(scene_json(R"({"type": "path", "max_depth": 5})", kDiffuseMats,
                                              kSpheres, std::string(kPointLights) + ", " + kEnv)),
-                       128);
+                       256);
   EXPECT_AGREE(b);
 }
 
@@ -108,7 +108,7 @@ TEST(KernelVsReference, PathMirror) {
                             std::string(kDiffuseMats) + R"(, "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]})",
                             std::string(kSpheres) + R"(, {"type": "sphere", "center": [0, 0.45, 1.2], "radius": 0.45, "material": "mirror"})",
                             std::string(kPointLights) + ", " + kEnv)),
-      128);
+      256);
   EXPECT_AGREE(b);
 }
 
@@ -117,7 +117,7 @@ TEST(KernelVsReference, PathAreaLights) {
   Both b = render_both(scene_from(scene_json(R"({"type": "path", "max_depth": 4})",
                                              std::string(kDiffuseMats) + ", " + kLamps,
                                              std::string(kSpheres) + ", " + kLampShapes, "")),
-                       128);
+                       256);
   EXPECT_AGREE(b);
 }
 
@@ -125,7 +125,7 @@ TEST(KernelVsReference, FilterTent) {
   Scene s = scene_from(scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
                                   std::string(kSpheres) + ", " + kLampShapes, kPointLights, "",
                                   R"({"width": 32, "height": 32, "filter": {"type": "tent", "radius": 1.5}})"));
-  Both b = render_both(s, 64);
+  Both b = render_both(s, 128);
   EXPECT_AGREE(b);
 }
 
@@ -133,7 +133,7 @@ TEST(KernelVsReference, FilterGaussian) {
   Scene s = scene_from(scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
                                   std::string(kSpheres) + ", " + kLampShapes, kPointLights, "",
                                   R"({"width": 32, "height": 32, "filter": {"type": "gaussian", "radius": 2}})"));
-  Both b = render_both(s, 64);
+  Both b = render_both(s, 128);
   EXPECT_AGREE(b);
 }
 
@@ -141,7 +141,7 @@ TEST(KernelVsReference, FilterWideBox) {
   Scene s = scene_from(scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
                                   std::string(kSpheres) + ", " + kLampShapes, kPointLights, "",
                                   R"({"width": 32, "height": 32, "filter": {"type": "box", "radius": 1.25}})"));
-  Both b = render_both(s, 64);
+  Both b = render_both(s, 128);
   EXPECT_AGREE(b);
 }
 
@@ -150,7 +150,7 @@ TEST(KernelVsReference, ThinLens) {
       R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
       std::string(kSpheres) + ", " + kLampShapes, kPointLights,
       R"({"position": [0, 1.2, 5], "look_at": [0, 0.4, 0], "fov": 38, "aperture": 0.25, "focus_distance": 4})"));
-  Both b = render_both(s, 128);
+  Both b = render_both(s, 256);
   EXPECT_AGREE(b);
 }
 
@@ -166,10 +166,9 @@ TEST(KernelVsReference, CameraAspect) {
 }
 
 // Roll: the model turns right and up' counter-clockwise as seen looking along forward (right
-// moves towards up'). PENDING KERNEL FIX: src/render/pack.cpp rotates by +roll about forward
-// (right-hand rule), which turns them clockwise seen from the camera; the kernel with roll r
-// matches the reference with roll -r.
-TEST(KernelVsReference, CameraRoll_PendingKernelFix) {
+// moves towards up'). (The first kernel turned them the other way: roll r matched the reference's
+// -r.)
+TEST(KernelVsReference, CameraRoll) {
   Scene s = scene_from(scene_json(
       R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
       std::string(kSpheres) + ", " + kLampShapes, kPointLights,
@@ -200,7 +199,7 @@ TEST(KernelVsReference, TexturedDiffuse) {
     }
   s.textures.push_back(t);
   s.materials[s.find_material("tex")].albedo_texture = 0;
-  Both b = render_both(s, 64);
+  Both b = render_both(s, 128);
   EXPECT_AGREE(b);
 }
 
@@ -216,7 +215,7 @@ TEST(KernelVsReference, PathDielectric) {
                             std::string(kSpheres) + ", " + kLampShapes +
                                 R"(, {"type": "sphere", "center": [0.1, 0.5, 1.3], "radius": 0.5, "material": "glass"})",
                             kEnv)),
-      256);
+      512);
   EXPECT_AGREE(b);
 }
 
@@ -231,7 +230,7 @@ TEST(KernelVsReference, PathConductor) {
               R"(, {"type": "sphere", "center": [-0.7, 0.6, 0.3], "radius": 0.6, "material": "rough"},
                    {"type": "sphere", "center": [0.8, 0.5, 0.6], "radius": 0.5, "material": "shiny"})",
           std::string(kPointLights) + ", " + kEnv)),
-      256);
+      512);
   EXPECT_AGREE(b);
 }
 
@@ -246,7 +245,7 @@ TEST(KernelVsReference, PathPlastic) {
               R"(, {"type": "sphere", "center": [-0.7, 0.6, 0.3], "radius": 0.6, "material": "plastic"},
                    {"type": "sphere", "center": [0.8, 0.5, 0.6], "radius": 0.5, "material": "gloss"})",
           std::string(kPointLights) + ", " + kEnv)),
-      256);
+      512);
   EXPECT_AGREE(b);
 }
 
@@ -260,7 +259,7 @@ TEST(KernelVsReference, DirectGlossy) {
           R"({"type": "sphere", "center": [-0.7, 0.6, 0.3], "radius": 0.6, "material": "plastic"},
              {"type": "sphere", "center": [0.8, 0.5, 0.6], "radius": 0.5, "material": "metal"})",
           kPointLights)),
-      32);
+      64);
   EXPECT_AGREE(b);
 }
 
@@ -279,7 +278,7 @@ TEST(KernelVsReference, Whitted) {
                    {"type": "sphere", "center": [1.2, 0.5, 0.3], "radius": 0.5, "material": "metal"},
                    {"type": "sphere", "center": [0.3, 0.3, 1.4], "radius": 0.3, "material": "plastic"})",
           std::string(kPointLights) + ", " + kEnv)),
-      32);
+      64);
   EXPECT_AGREE(b);
 }
 
@@ -300,7 +299,7 @@ TEST(KernelVsReference, Aovs) {
        {R"({"type": "albedo"})", R"({"type": "normal"})", R"({"type": "depth"})",
         R"({"type": "ao"})", R"({"type": "ao", "ao_distance": 0.5})"}) {
     SCOPED_TRACE(integrator);
-    Both b = render_both(scene_from(scene_json(integrator, mats, shapes, kEnv)), 32);
+    Both b = render_both(scene_from(scene_json(integrator, mats, shapes, kEnv)), 64);
     EXPECT_AGREE(b);
   }
 }
@@ -369,7 +368,7 @@ TEST(KernelVsReference, ShadingNormals) {
              "normals": [[-1,0,0],[1,0,0],[0,1,0],[0,-1,0],[0,0,1],[0,0,-1]],
              "indices": [0,4,2, 4,1,2, 1,5,2, 5,0,2, 4,0,3, 1,4,3, 5,1,3, 0,5,3]})",
           std::string(kPointLights) + ", " + kEnv)),
-      128);
+      256);
   EXPECT_AGREE(b);
 }
 
@@ -398,12 +397,12 @@ TEST(KernelVsReference, DetectsAThreePercentAlbedoChange) {
   Scene s = scene_from(scene_json(R"({"type": "path", "max_depth": 5})", kDiffuseMats, kSpheres,
                                   std::string(kPointLights) + ", " + kEnv));
   lucent::RenderOptions ko;
-  ko.spp = 128;
+  ko.spp = 256;
   RenderResult k = lucent::render(s, ko);
   s.integrator.seed ^= 0x9e3779b9u;
   s.materials[s.find_material("floor")].albedo *= 0.97;
   lucent::ReferenceOptions ro;
-  ro.spp = 128;
+  ro.spp = 256;
   RenderResult r = lucent::render_reference(s, ro);
   CompareResult c = lucent::compare_images(k, r);
   EXPECT_FALSE(c.passed) << c.summary();
