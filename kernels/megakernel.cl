@@ -1,6 +1,7 @@
 /* lucent: the megakernel. One work-item per pixel; each launch adds samples_per_pass samples per
  * pixel, starting at sample_offset, and writes their sum and sum of squares for the host to
- * accumulate. Features are switched on by defines chosen from the scene (LC_HAS_*). */
+ * accumulate. Features are switched on by defines chosen from the scene (LC_HAS_*, listed in
+ * src/render/pack.cpp, feature_defines); a scene compiles only the code it uses. */
 #include "shared/types.h"
 #include "shared/rng.h"
 #include "util/math.cl"
@@ -58,14 +59,19 @@ __kernel void lucent_render(__global const lc_params* params, __global const lc_
                                      lc_rand(&rng, LC_DIM_LENS), lc_rand(&rng, LC_DIM_LENS + 1));
     float3 L;
     lc_uint integrator = params->integrator;
-    if (integrator == LC_INTEGRATOR_PATH)
-      L = integrator_path(&s, ray, &rng, &rays);
-    else if (integrator == LC_INTEGRATOR_WHITTED)
-      L = integrator_whitted(&s, ray, &rays);
-    else if (integrator == LC_INTEGRATOR_DIRECT)
-      L = integrator_direct(&s, ray, &rays);
-    else
-      L = integrator_aov(&s, ray, &rng, &rays);
+    L = (float3)(0.0f);
+#ifdef LC_HAS_INTEGRATOR_PATH
+    if (integrator == LC_INTEGRATOR_PATH) L = integrator_path(&s, ray, &rng, &rays);
+#endif
+#ifdef LC_HAS_INTEGRATOR_WHITTED
+    if (integrator == LC_INTEGRATOR_WHITTED) L = integrator_whitted(&s, ray, &rays);
+#endif
+#ifdef LC_HAS_INTEGRATOR_DIRECT
+    if (integrator == LC_INTEGRATOR_DIRECT) L = integrator_direct(&s, ray, &rays);
+#endif
+#ifdef LC_HAS_INTEGRATOR_AOV
+    if (integrator >= LC_INTEGRATOR_ALBEDO) L = integrator_aov(&s, ray, &rng, &rays);
+#endif
     if (lc_isfinite3(L)) {
       sum += L;
       sumsq += L * L;

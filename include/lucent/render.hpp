@@ -26,6 +26,7 @@ struct RenderOptions {
   std::function<void(const RenderProgress&)> on_progress;
   double pass_seconds = 0.25;     ///< target duration of one launch
   bool fast_math = false;         ///< build with -cl-fast-relaxed-math (default: IEEE math)
+  bool specialize = true;         ///< compile only the features the scene uses (false: all)
 };
 
 struct RenderResult {

@@ -27,6 +27,7 @@ static inline lc_ray camera_generate_ray(__global const lc_camera* cam, float fx
   lc_ray ray;
   ray.o = lc_load3(cam->position);
   ray.d = dir;
+#ifdef LC_HAS_THIN_LENS
   if (cam->lens_radius > 0.0f) {
     /* the focal plane is perpendicular to the viewing direction at focus_distance */
     float ft = cam->focus_distance / dot(dir, fwd);
@@ -35,6 +36,7 @@ static inline lc_ray camera_generate_ray(__global const lc_camera* cam, float fx
     ray.o = ray.o + lens.x * right + lens.y * up;
     ray.d = normalize(focus - ray.o);
   }
+#endif
   return ray;
 }
 

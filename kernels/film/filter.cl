@@ -12,8 +12,11 @@ static inline float filter_sample_tent(float u, float r) {
 /* Offset from the pixel centre, in pixels. Gaussian: standard deviation radius / 3, truncated at
  * radius (Box-Muller, resampled radially). */
 static inline float2 filter_sample(lc_uint type, float radius, float u1, float u2) {
+#ifdef LC_HAS_FILTER_TENT
   if (type == LC_FILTER_TENT)
     return (float2)(filter_sample_tent(u1, radius), filter_sample_tent(u2, radius));
+#endif
+#ifdef LC_HAS_FILTER_GAUSSIAN
   if (type == LC_FILTER_GAUSSIAN) {
     float sigma = radius / 3.0f;
     /* truncated radial Gaussian: invert the CDF of r restricted to [0, radius] */
@@ -22,6 +25,7 @@ static inline float2 filter_sample(lc_uint type, float radius, float u1, float u
     float phi = 2.0f * LC_PI * u2;
     return (float2)(r * cos(phi), r * sin(phi));
   }
+#endif
   return (float2)((u1 - 0.5f) * 2.0f * radius, (u2 - 0.5f) * 2.0f * radius);
 }
 

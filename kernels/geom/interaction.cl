@@ -15,6 +15,11 @@ typedef struct {
 
 static inline lc_interaction interaction_from_hit(const lc_scene* s, lc_ray ray, const lc_hit* hit) {
   lc_interaction it;
+  it.p = it.perr = it.ng = it.ns = (float3)(0.0f);
+  it.uv = (float2)(0.0f);
+  it.material = 0;
+  it.light = LC_INVALID;
+#ifdef LC_HAS_SPHERES
   if (hit->prim & LC_PRIM_SPHERE_BIT) {
     __global const lc_sphere* sp = &s->spheres[hit->prim & ~LC_PRIM_SPHERE_BIT];
     float3 c = lc_load3(sp->center);
@@ -30,7 +35,10 @@ static inline lc_interaction interaction_from_hit(const lc_scene* s, lc_ray ray,
                      0.5f + asin(clamp(n.y, -1.0f, 1.0f)) * LC_INV_PI);
     it.material = sp->material;
     it.light = sp->light;
-  } else {
+  } else
+#endif
+  {
+#ifdef LC_HAS_TRIANGLES
     __global const lc_triangle* tri = &s->triangles[hit->prim];
     float3 v0 = lc_load3(tri->v0), v1 = lc_load3(tri->v1), v2 = lc_load3(tri->v2);
     float b1 = hit->b1, b2 = hit->b2, b0 = 1.0f - b1 - b2;
@@ -41,8 +49,10 @@ static inline lc_interaction interaction_from_hit(const lc_scene* s, lc_ray ray,
     it.ng = ng;
     it.ns = ng;
     it.uv = (float2)(b1, b2);
+#if defined(LC_HAS_SMOOTH_NORMALS) || defined(LC_HAS_UVS)
     if (tri->flags & (LC_TRI_HAS_NORMALS | LC_TRI_HAS_UVS)) {
       __global const lc_triangle_attr* a = &s->tri_attrs[hit->prim];
+#ifdef LC_HAS_SMOOTH_NORMALS
       if (tri->flags & LC_TRI_HAS_NORMALS) {
         float3 ns = b0 * lc_load3(a->n) + b1 * lc_load3(a->n + 3) + b2 * lc_load3(a->n + 6);
         float len = length(ns);
@@ -52,12 +62,17 @@ static inline lc_interaction interaction_from_hit(const lc_scene* s, lc_ray ray,
           it.ns = dot(ns, ng) < 0.0f ? -ns : ns;
         }
       }
+#endif
+#ifdef LC_HAS_UVS
       if (tri->flags & LC_TRI_HAS_UVS)
         it.uv = (float2)(b0 * a->uv[0] + b1 * a->uv[2] + b2 * a->uv[4],
                          b0 * a->uv[1] + b1 * a->uv[3] + b2 * a->uv[5]);
+#endif
     }
+#endif
     it.material = tri->material;
     it.light = tri->light;
+#endif
   }
   it.front = dot(ray.d, it.ng) < 0.0f;
   if (!it.front) {

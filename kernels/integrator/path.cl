@@ -36,11 +36,14 @@ static inline float3 frame_to_world(const lc_frame* f, float3 v) {
   return v.x * f->t + v.y * f->b + v.z * f->n;
 }
 
-/* Unoccluded test between a surface point and a sampled light point (or direction). */
-static inline int shadow_visible(const lc_scene* s, const lc_interaction* it, float3 wi, float dist,
-                                 lc_uint* rays) {
+/* Unoccluded test from a spawned origin o towards a sampled light point (or direction) at
+ * distance dist from o. Light samples are taken from o itself, not from the surface point: the
+ * offset of o is large on huge spheres (it scales with their float precision), and a direction
+ * computed from the surface point would, seen from o, pass just inside a sphere light near its
+ * silhouette. */
+static inline int shadow_visible(const lc_scene* s, float3 o, float3 wi, float dist, lc_uint* rays) {
   lc_ray sr;
-  sr.o = lc_spawn_origin(it->p, it->perr, dot(wi, it->ng) > 0.0f ? it->ng : -it->ng);
+  sr.o = o;
   sr.d = wi;
   ++*rays;
   /* stop short of the light's own surface by its position error (relative) */
@@ -53,11 +56,13 @@ static inline int shadow_visible(const lc_scene* s, const lc_interaction* it, fl
 static inline float3 point_lights_direct(const lc_scene* s, const lc_interaction* it, const lc_bsdf* b,
                                          const lc_frame* fr, float3 wo_l, int diffuse_only, lc_uint* rays) {
   float3 sum = (float3)(0.0f);
+#ifdef LC_HAS_POINT_LIGHTS
   __global const lc_params* P = s->params;
   for (lc_uint i = 0; i < P->num_lights; ++i) {
     __global const lc_light* L = &s->lights[i];
     if (L->type != LC_LIGHT_POINT) continue;
-    float3 to = lc_load3(L->position) - it->p;
+    float3 o = lc_spawn_origin(it->p, it->perr, it->ng);
+    float3 to = lc_load3(L->position) - o;
     float d2 = dot(to, to);
     float dist = sqrt(d2);
     float3 wi = to / dist;
@@ -73,12 +78,13 @@ static inline float3 point_lights_direct(const lc_scene* s, const lc_interaction
     }
     if (lc_max3(f) <= 0.0f) continue;
     lc_ray sr;
-    sr.o = lc_spawn_origin(it->p, it->perr, it->ng);
+    sr.o = o;
     sr.d = wi;
     ++*rays;
     if (scene_occluded(s, sr, dist)) continue;
     sum += f * lc_load3(L->intensity) * (wi_l.z / d2);
   }
+#endif
   return sum;
 }
 
@@ -116,16 +122,17 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     float3 wo_l = frame_to_local(&fr, -ray.d);
     if (wo_l.z <= 0.0f) break;
 
-    /* next-event estimation */
+    /* next-event estimation, from the origin that the shadow ray will use */
+    float3 o = lc_spawn_origin(it.p, it.perr, it.ng);
     if (!bsdf_is_delta(&b) && P->num_lights > 0) {
       lc_light_sample ls;
-      if (light_sample(s, it.p, lc_rand(rng, dim + LC_DIM_LIGHT_SELECT),
+      if (light_sample(s, o, lc_rand(rng, dim + LC_DIM_LIGHT_SELECT),
                        lc_rand(rng, dim + LC_DIM_LIGHT_UV), lc_rand(rng, dim + LC_DIM_LIGHT_UV + 1), &ls) &&
           ls.pdf > 0.0f && dot(ls.wi, it.ng) > 0.0f) {
         float3 wi_l = frame_to_local(&fr, ls.wi);
         float pdf_b;
         float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf_b);
-        if (lc_max3(f) > 0.0f && shadow_visible(s, &it, ls.wi, ls.dist, rays)) {
+        if (lc_max3(f) > 0.0f && shadow_visible(s, o, ls.wi, ls.dist, rays)) {
           float w = (ls.delta || no_mis) ? 1.0f : mis_power(ls.pdf, pdf_b);
           L += beta * f * ls.L * (wi_l.z * w / ls.pdf);
         }
@@ -145,8 +152,8 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     if (!(lc_max3(beta) > 0.0f)) break;
     prev_delta = bs.delta;
     prev_pdf = bs.pdf;
-    prev_p = it.p;
-    ray.o = lc_spawn_origin(it.p, it.perr, transmit ? -it.ng : it.ng);
+    ray.o = transmit ? lc_spawn_origin(it.p, it.perr, -it.ng) : o;
+    prev_p = ray.o; /* light pdfs for MIS are evaluated from where light sampling sampled */
     ray.d = wi;
     if (depth + 2 > P->rr_depth) {
       float q = fmin(0.95f, lc_max3(beta));

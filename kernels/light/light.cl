@@ -73,14 +73,19 @@ static inline float3 env_radiance(const lc_scene* s, float3 d, float* pdf) {
     return env_map_radiance(s, L, d, &texel);
   }
 #endif
+#ifdef LC_HAS_ENV
   *pdf = L->pdf_select * (0.25f * LC_INV_PI);
   return lc_load3(L->intensity);
+#else
+  return (float3)(0.0f);
+#endif
 }
 
 /* Solid-angle pdf (with selection) that light sampling from p picks the point seen along wi on
  * emitter `light` at distance dist with light-side cosine cos_l (> 0). */
 static inline float light_pdf_area(const lc_scene* s, lc_uint light, float3 p, float dist, float cos_l) {
   __global const lc_light* L = &s->lights[light];
+#ifdef LC_HAS_SPHERE_LIGHTS
   if (L->type == LC_LIGHT_SPHERE) {
     __global const lc_sphere* sp = &s->spheres[L->prim];
     float3 d = lc_load3(sp->center) - p;
@@ -91,9 +96,12 @@ static inline float light_pdf_area(const lc_scene* s, lc_uint light, float3 p, f
     float one_minus = sin2 / (1.0f + cosmax);
     return L->pdf_select / (2.0f * LC_PI * one_minus);
   }
+#endif
+#ifdef LC_HAS_TRIANGLE_LIGHTS
   /* triangle, area sampling */
-  if (cos_l <= 0.0f) return 0.0f;
-  return L->pdf_select * dist * dist / (cos_l * L->area);
+  if (L->type == LC_LIGHT_TRIANGLE && cos_l > 0.0f) return L->pdf_select * dist * dist / (cos_l * L->area);
+#endif
+  return 0.0f;
 }
 
 static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, float u2,
@@ -103,6 +111,7 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
   lc_uint li = lc_cdf_search(s->light_cdf, P->num_lights, us);
   __global const lc_light* L = &s->lights[li];
   ls->delta = 0;
+#ifdef LC_HAS_POINT_LIGHTS
   if (L->type == LC_LIGHT_POINT) {
     float3 to = lc_load3(L->position) - p;
     float d2 = dot(to, to);
@@ -114,6 +123,8 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
     ls->delta = 1;
     return 1;
   }
+#endif
+#ifdef LC_HAS_SPHERE_LIGHTS
   if (L->type == LC_LIGHT_SPHERE) {
     __global const lc_sphere* sp = &s->spheres[L->prim];
     float3 c = lc_load3(sp->center);
@@ -148,6 +159,8 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
     ls->pdf = L->pdf_select / (2.0f * LC_PI * one_minus_cosmax);
     return 1;
   }
+#endif
+#ifdef LC_HAS_TRIANGLE_LIGHTS
   if (L->type == LC_LIGHT_TRIANGLE) {
     __global const lc_triangle* tri = &s->triangles[L->prim];
     float3 v0 = lc_load3(tri->v0), v1 = lc_load3(tri->v1), v2 = lc_load3(tri->v2);
@@ -167,6 +180,7 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
     ls->pdf = L->pdf_select * d2 / (cos_l * L->area);
     return 1;
   }
+#endif
 #ifdef LC_HAS_ENV_MAP
   if (L->type == LC_LIGHT_ENV_MAP) {
     __global const lc_texture* tex = &s->textures[L->texture];
@@ -188,12 +202,16 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
     return ls->pdf > 0.0f;
   }
 #endif
-  /* constant environment */
-  ls->wi = sample_uniform_sphere(u1, u2);
-  ls->dist = INFINITY;
-  ls->L = lc_load3(L->intensity);
-  ls->pdf = L->pdf_select * (0.25f * LC_INV_PI);
-  return 1;
+#ifdef LC_HAS_ENV
+  if (L->type == LC_LIGHT_ENV) {
+    ls->wi = sample_uniform_sphere(u1, u2);
+    ls->dist = INFINITY;
+    ls->L = lc_load3(L->intensity);
+    ls->pdf = L->pdf_select * (0.25f * LC_INV_PI);
+    return 1;
+  }
+#endif
+  return 0;
 }
 
 #endif

@@ -93,6 +93,7 @@ struct RenderArgs {
   bool reference = false;  ///< the scalar reference integrator instead of the kernel
   std::vector<std::string> aovs;  ///< extra outputs: albedo, normal, depth, variance
   bool fast_math = false;
+  bool no_specialize = false;
 };
 
 /// <output stem>.<name>.exr beside the main output.
@@ -134,6 +135,7 @@ int cmd_render(const RenderArgs& a) {
   opt.spp = a.spp;
   opt.time_limit = a.time_limit;
   opt.fast_math = a.fast_math;
+  opt.specialize = !a.no_specialize;
   opt.cancel = &g_interrupted;
   const bool tty = isatty(STDERR_FILENO);
   double last_print = -10;
@@ -221,6 +223,8 @@ int main(int argc, char** argv) {
   render->add_flag("-q,--quiet", ra.quiet, "No progress line or summary");
   render->add_flag("--fast-math", ra.fast_math,
                    "Build the kernel with -cl-fast-relaxed-math (faster, not IEEE; see BENCHMARKS.md)");
+  render->add_flag("--no-specialize", ra.no_specialize,
+                   "Compile the full kernel instead of only the features the scene uses");
   render->add_option("--aov", ra.aovs,
                      "Also write AOV images <stem>.<name>.exr: albedo, normal, depth, variance")
       ->delimiter(',')

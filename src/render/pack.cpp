@@ -60,9 +60,11 @@ lc_camera pack_camera(const Camera& c, int width, int height) {
   glm::dvec3 right = glm::normalize(glm::cross(fwd, c.up));
   glm::dvec3 up = glm::cross(right, fwd);
   if (c.roll_degrees != 0) {
-    glm::dmat4 r = glm::rotate(glm::dmat4(1.0), glm::radians(c.roll_degrees), fwd);
-    right = glm::dvec3(r * glm::dvec4(right, 0.0));
-    up = glm::dvec3(r * glm::dvec4(up, 0.0));
+    // counter-clockwise as seen looking along forward: right turns towards up
+    double a = glm::radians(c.roll_degrees);
+    glm::dvec3 r2 = std::cos(a) * right + std::sin(a) * up;
+    up = -std::sin(a) * right + std::cos(a) * up;
+    right = r2;
   }
   put3(cam.position, c.position);
   put3(cam.right, right);
@@ -255,20 +257,69 @@ PackedScene pack_scene(const Scene& scene) {
   return p;
 }
 
-std::string feature_defines(const Scene& scene, const PackedScene& packed) {
-  std::string d;
+std::vector<std::string> scene_features(const Scene& scene, const PackedScene& packed) {
+  std::vector<std::string> f;
+  auto add = [&](bool on, const char* name) {
+    if (on) f.push_back(name);
+  };
   auto has_mat = [&](MaterialType t) {
     for (const Material& m : scene.materials)
       if (m.type == t) return true;
     return false;
   };
-  if (!packed.textures.empty()) d += " -D LC_HAS_TEXTURES";
-  if (has_mat(MaterialType::Mirror)) d += " -D LC_HAS_MIRROR";
-  if (has_mat(MaterialType::Dielectric)) d += " -D LC_HAS_DIELECTRIC";
-  if (has_mat(MaterialType::Conductor)) d += " -D LC_HAS_CONDUCTOR";
-  if (has_mat(MaterialType::Plastic)) d += " -D LC_HAS_PLASTIC";
-  for (const lc_light& l : packed.lights)
-    if (l.type == LC_LIGHT_ENV_MAP) d += " -D LC_HAS_ENV_MAP";
+  auto has_light = [&](lc_uint type) {
+    for (const lc_light& l : packed.lights)
+      if (l.type == type) return true;
+    return false;
+  };
+  bool textured = false;
+  for (const Material& m : scene.materials) textured = textured || m.albedo_texture >= 0;
+  bool smooth = false, uvs = false;
+  for (const lc_triangle& t : packed.triangles) {
+    smooth = smooth || (t.flags & LC_TRI_HAS_NORMALS);
+    uvs = uvs || (t.flags & LC_TRI_HAS_UVS);
+  }
+  IntegratorType it = scene.integrator.type;
+  bool aov = it == IntegratorType::Albedo || it == IntegratorType::Normal ||
+             it == IntegratorType::Depth || it == IntegratorType::Ao;
+  add(!packed.spheres.empty(), "LC_HAS_SPHERES");
+  add(!packed.triangles.empty(), "LC_HAS_TRIANGLES");
+  add(smooth, "LC_HAS_SMOOTH_NORMALS");
+  add(uvs && textured, "LC_HAS_UVS");
+  add(textured, "LC_HAS_TEXTURES");
+  add(has_mat(MaterialType::Mirror), "LC_HAS_MIRROR");
+  add(has_mat(MaterialType::Dielectric), "LC_HAS_DIELECTRIC");
+  add(has_mat(MaterialType::Conductor), "LC_HAS_CONDUCTOR");
+  add(has_mat(MaterialType::Plastic), "LC_HAS_PLASTIC");
+  add(has_light(LC_LIGHT_POINT), "LC_HAS_POINT_LIGHTS");
+  add(has_light(LC_LIGHT_SPHERE), "LC_HAS_SPHERE_LIGHTS");
+  add(has_light(LC_LIGHT_TRIANGLE), "LC_HAS_TRIANGLE_LIGHTS");
+  add(has_light(LC_LIGHT_ENV), "LC_HAS_ENV");
+  add(has_light(LC_LIGHT_ENV_MAP), "LC_HAS_ENV_MAP");
+  add(scene.camera.aperture > 0, "LC_HAS_THIN_LENS");
+  add(scene.film.filter.type == FilterType::Tent, "LC_HAS_FILTER_TENT");
+  add(scene.film.filter.type == FilterType::Gaussian, "LC_HAS_FILTER_GAUSSIAN");
+  add(it == IntegratorType::Path, "LC_HAS_INTEGRATOR_PATH");
+  add(it == IntegratorType::Whitted, "LC_HAS_INTEGRATOR_WHITTED");
+  add(it == IntegratorType::Direct, "LC_HAS_INTEGRATOR_DIRECT");
+  add(aov, "LC_HAS_INTEGRATOR_AOV");
+  return f;
+}
+
+const std::vector<std::string>& all_features() {
+  static const std::vector<std::string> all = {
+      "LC_HAS_SPHERES", "LC_HAS_TRIANGLES", "LC_HAS_SMOOTH_NORMALS", "LC_HAS_UVS", "LC_HAS_TEXTURES",
+      "LC_HAS_MIRROR", "LC_HAS_DIELECTRIC", "LC_HAS_CONDUCTOR", "LC_HAS_PLASTIC",
+      "LC_HAS_POINT_LIGHTS", "LC_HAS_SPHERE_LIGHTS", "LC_HAS_TRIANGLE_LIGHTS", "LC_HAS_ENV",
+      "LC_HAS_ENV_MAP", "LC_HAS_THIN_LENS", "LC_HAS_FILTER_TENT", "LC_HAS_FILTER_GAUSSIAN",
+      "LC_HAS_INTEGRATOR_PATH", "LC_HAS_INTEGRATOR_WHITTED", "LC_HAS_INTEGRATOR_DIRECT",
+      "LC_HAS_INTEGRATOR_AOV"};
+  return all;
+}
+
+std::string feature_defines(const Scene& scene, const PackedScene& packed, bool specialize) {
+  std::string d;
+  for (const std::string& f : specialize ? scene_features(scene, packed) : all_features()) d += " -D " + f;
   return d;
 }
 

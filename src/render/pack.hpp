@@ -30,7 +30,13 @@ lc_camera pack_camera(const Camera& camera, int width, int height);
 /// Converts and validates the scene, builds the BVH and the light table.
 PackedScene pack_scene(const Scene& scene);
 
-/// OpenCL build options (-D LC_HAS_...) for the features the packed scene uses.
-std::string feature_defines(const Scene& scene, const PackedScene& packed);
+/// The kernel features (LC_HAS_... defines) the scene uses.
+std::vector<std::string> scene_features(const Scene& scene, const PackedScene& packed);
+
+/// Every kernel feature: what --no-specialize compiles.
+const std::vector<std::string>& all_features();
+
+/// OpenCL build options (" -D LC_HAS_..." ...) for the scene's features, or for all of them.
+std::string feature_defines(const Scene& scene, const PackedScene& packed, bool specialize = true);
 
 }  // namespace lucent::render_detail

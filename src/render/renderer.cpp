@@ -46,7 +46,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
 
   auto tb = clock::now();
   std::string source = detail::assemble_kernel_source("megakernel.cl");
-  std::string build_options = "-cl-std=CL1.2" + render_detail::feature_defines(scene, packed);
+  std::string build_options = "-cl-std=CL1.2" + render_detail::feature_defines(scene, packed, options.specialize);
   if (options.fast_math) build_options += " -cl-fast-relaxed-math";
   cl_util::ProgramBuildInfo build_info;
   cl::Program program = cl_util::build_program_cached(ctx, source, build_options, &build_info);
