@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include <unistd.h>
+
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
@@ -34,12 +36,26 @@ void upload(cl::CommandQueue& q, cl::Buffer& b, const std::vector<T>& v) {
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   using clock = std::chrono::steady_clock;
+  const int width = scene.film.width, height = scene.film.height;
+  const size_t npix = static_cast<size_t>(width) * height;
+  // host: double sums, sums of squares and counts, the pass read-back and the two result images
+  const double host_bytes = double(npix) * (6 * sizeof(double) + sizeof(std::uint32_t) +
+                                            2 * sizeof(cl_float4) + 6 * sizeof(float));
+  const double host_memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
+  if (host_memory > 0 && host_bytes > 0.8 * host_memory)
+    throw Error(scene.path + ": a " + std::to_string(width) + "x" + std::to_string(height) +
+                " film needs " + std::to_string(static_cast<long long>(host_bytes / (1 << 20))) +
+                " MiB of host memory; this machine has " +
+                std::to_string(static_cast<long long>(host_memory / (1 << 20))) + " MiB");
   render_detail::PackedScene packed = render_detail::pack_scene(scene);
   cl_util::Context ctx(options.device);
   RenderResult result;
   result.device = ctx.device.info.name;
-  const int width = scene.film.width, height = scene.film.height;
-  const size_t npix = static_cast<size_t>(width) * height;
+  const cl_ulong max_alloc = ctx.device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+  if (npix * sizeof(cl_float4) > max_alloc)
+    throw Error(scene.path + ": a " + std::to_string(width) + "x" + std::to_string(height) +
+                " film needs a " + std::to_string(npix * sizeof(cl_float4) >> 20) +
+                " MiB buffer; the device allows " + std::to_string(max_alloc >> 20) + " MiB per buffer");
   const std::uint64_t target_spp =
       options.spp > 0 ? static_cast<std::uint64_t>(options.spp)
                       : (options.time_limit > 0 ? 0 : static_cast<std::uint64_t>(scene.integrator.spp));
@@ -90,6 +106,17 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
       kernel.setArg(arg++, *b);
 
     const size_t global = (npix + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
+    {
+      // Warm-up launch with no samples: some drivers (PoCL) compile the work-group function at
+      // the first enqueue; count that as build time, not render time.
+      auto tw = clock::now();
+      lc_params P0 = packed.params;
+      P0.samples_per_pass = 0;
+      q.enqueueWriteBuffer(b_params, CL_FALSE, 0, sizeof(P0), &P0);
+      q.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(kWorkGroupSize));
+      q.finish();
+      result.build_seconds += std::chrono::duration<double>(clock::now() - tw).count();
+    }
     std::vector<cl_float4> h_sum(npix), h_sumsq(npix);
     std::uint64_t done = 0;
     std::uint32_t pass_spp = 1;
