@@ -5,6 +5,7 @@
 //
 // usage: lucent_bench [--runs N] [--width W] [--height H] [--device SELECTOR] [--threads N]
 //                     [--build-only] [--only NAME] [--no-embree] [--traversal-cost C]
+//                     [--reorder]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -42,6 +43,7 @@ struct Options {
   std::string only;         // run only the meshes whose name contains this
   bool embree = true;       // compare with Embree when built with it
   float traversal_cost = lucent::bvh::BuildOptions().traversal_cost;
+  bool reorder = false;  // trace triangles stored in leaf order (bvh::reorder_triangles)
   std::string device;
 };
 
@@ -226,7 +228,9 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
               s.nodes, s.leaves, s.mean_leaf_size, s.max_leaf_size, s.max_depth, s.sah_cost);
   if (opt.build_only) return;
 
-  lucent::bvh::DeviceTracer tracer(ctx, tris, {}, bvh);
+  std::vector<lc_triangle> stored = tris;
+  if (opt.reorder) lucent::bvh::reorder_triangles(bvh, stored);
+  lucent::bvh::DeviceTracer tracer(ctx, stored, {}, bvh);
   const lc_bvh_node& root = bvh.nodes[0];
   double scale = 0;
   for (int a = 0; a < 3; ++a) scale = std::max(scale, double(root.bmax[a] - root.bmin[a]));
@@ -242,7 +246,7 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
   };
   std::vector<TraceHit> phits, dhits;
   double tp = time_trace(primary, phits);
-  auto diffuse = diffuse_rays(primary, phits, tris, scale);
+  auto diffuse = diffuse_rays(primary, phits, stored, scale);
   double td = time_trace(diffuse, dhits);
   std::size_t ph = 0, dh = 0;
   for (auto& h : phits) ph += h.prim != LC_INVALID;
@@ -293,18 +297,22 @@ int main(int argc, char** argv) {
     else if (a == "--build-only") opt.build_only = true;
     else if (a == "--only") opt.only = next();
     else if (a == "--no-embree") opt.embree = false;
+    else if (a == "--reorder") opt.reorder = true;
     else if (a == "--traversal-cost") opt.traversal_cost = float(std::atof(next().c_str()));
     else {
       std::fprintf(stderr, "usage: lucent_bench [--runs N] [--width W] [--height H] [--device S] "
                            "[--threads N] [--build-only] [--only NAME] [--no-embree] "
-                           "[--traversal-cost C]\n");
+                           "[--traversal-cost C] [--reorder]\n");
       return 2;
     }
   }
   try {
     lucent::cl_util::Context ctx(opt.device);
-    std::printf("device: %s (%s); host threads: %u\n", ctx.device.info.name.c_str(),
-                ctx.device.info.platform.c_str(), std::thread::hardware_concurrency());
+    std::string load;
+    std::ifstream("/proc/loadavg") >> load;  // other work on the machine skews every figure
+    std::printf("device: %s (%s); host threads: %u; load average at start: %s\n",
+                ctx.device.info.name.c_str(), ctx.device.info.platform.c_str(),
+                std::thread::hardware_concurrency(), load.empty() ? "?" : load.c_str());
     const std::string dir = std::string(LUCENT_SHARED_DIR) + "/assets/meshes/";
     auto wanted = [&](const std::string& name) {
       return opt.only.empty() || name.find(opt.only) != std::string::npos;

@@ -322,4 +322,33 @@ TEST(BvhBuild, SahBeatsMedianSplits) {
   EXPECT_LT(b.stats.sah_cost, median_cost);
 }
 
+// reorder_triangles: the triangles in leaf order, prim_refs rewritten, spheres untouched, and a
+// valid tree over the permuted triangles.
+TEST(BvhBuild, ReorderTrianglesIntoLeafOrder) {
+  auto t = random_soup(3000, 9);
+  auto s = random_spheres(500, 10);
+  Bvh b = lucent::bvh::build(t, s);
+  std::vector<lc_uint> old_refs = b.prim_refs;
+  std::vector<lc_triangle> moved = t;
+  std::vector<lc_uint> new_to_old = lucent::bvh::reorder_triangles(b, moved);
+  ASSERT_EQ(new_to_old.size(), t.size());
+  std::vector<int> seen(t.size(), 0);
+  for (std::size_t i = 0; i < moved.size(); ++i) {
+    ASSERT_LT(new_to_old[i], t.size());
+    ++seen[new_to_old[i]];
+    EXPECT_EQ(0, std::memcmp(&moved[i], &t[new_to_old[i]], sizeof(lc_triangle)));
+  }
+  for (int c : seen) ASSERT_EQ(c, 1);
+  lc_uint next = 0;
+  for (std::size_t i = 0; i < b.prim_refs.size(); ++i) {
+    if (old_refs[i] & LC_PRIM_SPHERE_BIT) {
+      EXPECT_EQ(b.prim_refs[i], old_refs[i]);
+    } else {
+      EXPECT_EQ(b.prim_refs[i], next++);  // leaf order
+      EXPECT_EQ(new_to_old[b.prim_refs[i]], old_refs[i]);
+    }
+  }
+  check_bvh(b, moved, s, 4);
+}
+
 }  // namespace

@@ -9,7 +9,8 @@
 //
 // Per ray the kernel's answer passes when: on a miss, no primitive is surely hit in (0, tmax); on
 // a hit, its primitive is possibly hit at a distance within kTol (relative) of the kernel's t and
-// no surely-hit primitive is closer than that t by more than kTol. Barycentrics of triangle hits
+// no surely-hit primitive is closer than that t by more than kTol. Any-hit (shadow) rays pass when
+// "occluded" comes with some primitive possibly hit before tmax, and "free" with none surely hit. Barycentrics of triangle hits
 // agree within 1e-4. Exact agreement (same primitive as the closest surely-hit one) is also
 // required for all but 0.1% of the rays, so the tolerances cannot hide a systematic error.
 //
@@ -105,7 +106,7 @@ Verdict judge(const Scene& s, const TraceRay& r, const TraceHit& k, bool any_hit
   double best_sure = INFINITY;
   lc_uint best_prim = LC_INVALID;
   RefHit at_kernel;
-  bool kernel_possible = false;
+  bool kernel_possible = false, possible_block = false;
   for (std::size_t i = 0; i < n; ++i) {
     lc_uint ref = i < s.tris.size() ? lc_uint(i) : lc_uint(i - s.tris.size()) | LC_PRIM_SPHERE_BIT;
     RefHit h = ref_prim(s, ref, o, d);
@@ -114,6 +115,7 @@ Verdict judge(const Scene& s, const TraceRay& r, const TraceHit& k, bool any_hit
       best_sure = h.t;
       best_prim = ref;
     }
+    if (h.margin > -kMargin && h.t < tmax * (1 + kTol) + kTol) possible_block = true;
     if (ref == k.prim && h.margin > -kMargin) {
       at_kernel = h;
       kernel_possible = true;
@@ -126,8 +128,7 @@ Verdict judge(const Scene& s, const TraceRay& r, const TraceHit& k, bool any_hit
     bool sure_block = best_sure < tmax * (1 - kTol) - kTol;
     v.exact = occluded == (best_prim != LC_INVALID);
     if (!occluded && sure_block) v.ok = false, v.why = "not occluded, reference finds a blocker";
-    // an occluded answer needs some primitive possibly hit before tmax: checked by the closest-
-    // hit runs of the same rays
+    if (occluded && !possible_block) v.ok = false, v.why = "occluded, reference finds no blocker";
     return v;
   }
   v.exact = k.prim == best_prim;

@@ -1,6 +1,9 @@
 /* lucent kernel: ray/sphere intersection that stays precise far from the origin and for small
  * spheres far from the ray origin (Haines et al., "Precision Improvements for Ray/Sphere
- * Intersection", Ray Tracing Gems ch. 7). The ray direction is unit length. */
+ * Intersection", Ray Tracing Gems ch. 7). The ray direction is unit length. The discriminant
+ * r^2 - |l|^2 (l: centre to its closest point on the ray line) and the root pair c / q, q avoid the
+ * cancellation of b^2 - c; tests/test_bvh_trace.cpp (SphereSets: spheres of radius 0.5-2 at 1e5
+ * from the origin) fails with the textbook b^2 - c form. */
 #ifndef LUCENT_GEOM_SPHERE_CL
 #define LUCENT_GEOM_SPHERE_CL
 

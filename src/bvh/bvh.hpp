@@ -36,6 +36,12 @@ struct Bvh {
 Bvh build(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere>& spheres,
           const BuildOptions& options = {});
 
+/// Puts the triangles in the order in which the leaves reference them (neighbouring leaves then
+/// read neighbouring memory in the kernel) and rewrites bvh.prim_refs to match; spheres are left
+/// as they are. Returns, for each new triangle index, its old index: callers permute arrays kept
+/// parallel to the triangles with it and remap stored triangle indices (lights).
+std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& triangles);
+
 /// SAH cost of a built tree (same convention as BuildStats::sah_cost).
 double sah_cost(const std::vector<lc_bvh_node>& nodes);
 

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
 
 #include "bvh/bvh.hpp"
@@ -269,10 +270,14 @@ class Builder {
     }
   }
 
-  // Bins the task's primitives, in parallel on the caller and helper threads for big nodes.
+  // Bins the task's primitives; big nodes bin on helper threads too while no other task runs.
   void bin(const Task& t, const BinMap& map, Bins& bins) {
     std::size_t n = t.end - t.begin;
-    unsigned parts = n >= kParallelBinSize ? threads_ : 1;
+    unsigned parts = 1;
+    if (n >= kParallelBinSize && threads_ > 1) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (pending_ == 1) parts = threads_;  // the other workers are idle (near the root)
+    }
     if (parts <= 1) {
       bin_range(refs_.data() + t.begin, n, map, bins);
       return;
@@ -471,6 +476,22 @@ double sah_cost(const std::vector<lc_bvh_node>& nodes) {
   double cost = 0;
   for (const auto& n : nodes) cost += area(n) / root * (n.count ? double(n.count) : 1.0);
   return cost;
+}
+
+std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& triangles) {
+  std::vector<lc_uint> new_to_old;
+  new_to_old.reserve(triangles.size());
+  for (lc_uint& ref : bvh.prim_refs) {
+    if (ref & LC_PRIM_SPHERE_BIT) continue;
+    new_to_old.push_back(ref);
+    ref = static_cast<lc_uint>(new_to_old.size() - 1);
+  }
+  if (new_to_old.size() != triangles.size())
+    throw std::logic_error("reorder_triangles: the BVH was not built over these triangles");
+  std::vector<lc_triangle> out(triangles.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = triangles[new_to_old[i]];
+  triangles.swap(out);
+  return new_to_old;
 }
 
 Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& spheres,
