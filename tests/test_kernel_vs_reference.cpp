@@ -121,6 +121,42 @@ TEST(KernelVsReference, PathAreaLights) {
   EXPECT_AGREE(b);
 }
 
+// Light sampling only (integrator.mis false): the same expected image.
+TEST(KernelVsReference, PathAreaLightsWithoutMis) {
+  Both b = render_both(scene_from(scene_json(R"({"type": "path", "max_depth": 4, "mis": false})",
+                                             std::string(kDiffuseMats) + ", " + kLamps,
+                                             std::string(kSpheres) + ", " + kLampShapes, "")),
+                       256);
+  EXPECT_AGREE(b);
+}
+
+// Emission on non-diffuse materials, emitters seen from their back side (dark), a triangle
+// emitter facing away from the scene, in a box of walls, with long paths: max_depth 24,
+// Russian roulette from the second segment.
+TEST(KernelVsReference, LongPathsAndBackFacingEmitters) {
+  Both b = render_both(
+      scene_from(scene_json(
+          R"({"type": "path", "max_depth": 24, "rr_depth": 2})",
+          std::string(kDiffuseMats) +
+              R"(, "wall": {"type": "diffuse", "albedo": [0.85, 0.8, 0.75]},
+                   "glow": {"type": "plastic", "albedo": [0.3, 0.3, 0.3], "roughness": 0.3, "emission": [2, 1, 0.5]},
+                   "hot": {"type": "conductor", "specular": [0.9, 0.8, 0.7], "roughness": 0.3, "emission": [0.5, 1, 2]},
+                   "panel": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5], "emission": [4, 4, 4]})",
+          R"({"type": "sphere", "center": [-0.8, 0.5, 0.2], "radius": 0.5, "material": "glow"},
+             {"type": "sphere", "center": [0.8, 0.5, 0.2], "radius": 0.5, "material": "hot"},
+             {"type": "triangles", "material": "wall",
+              "positions": [[-3,0,-3],[3,0,-3],[3,3,-3],[-3,3,-3],[-3,0,3],[-3,3,3],[3,0,3],[3,3,3]],
+              "indices": [0,1,2, 0,2,3,  0,3,5, 0,5,4,  1,6,7, 1,7,2,  3,2,7, 3,7,5]},
+             {"type": "triangles", "material": "panel",
+              "positions": [[-0.5,2.9,-0.5],[0.5,2.9,-0.5],[0.5,2.9,0.5],[-0.5,2.9,0.5]],
+              "indices": [0,1,2, 0,2,3]},
+             {"type": "triangles", "material": "panel",
+              "positions": [[-1.5,1.2,-1],[-0.5,1.2,-1],[-1,2,-1]], "indices": [0,2,1]})",
+          "")),
+      256);
+  EXPECT_AGREE(b);
+}
+
 TEST(KernelVsReference, FilterTent) {
   Scene s = scene_from(scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
                                   std::string(kSpheres) + ", " + kLampShapes, kPointLights, "",
