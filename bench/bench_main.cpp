@@ -6,6 +6,8 @@
 // usage: lucent_bench [--runs N] [--width W] [--height H] [--device SELECTOR] [--threads N]
 //                     [--build-only] [--only NAME] [--no-embree] [--traversal-cost C]
 //                     [--reorder]
+#include <tiny_obj_loader.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,8 +19,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <tiny_obj_loader.h>
 
 #include "bvh/bvh.hpp"
 #include "bvh/device_tracer.hpp"
@@ -92,7 +92,9 @@ V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
 double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+V3 cross(V3 a, V3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 V3 normalize(V3 a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
 V3 load(const float* p) { return {p[0], p[1], p[2]}; }
 
@@ -223,9 +225,10 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
   double median = times[times.size() / 2];
   std::printf("build: median %.1f ms (best %.1f ms) over %d runs = %.2f Mtris/s\n", median * 1e3,
               times.front() * 1e3, opt.runs, tris.size() / median * 1e-6);
-  std::printf("tree:  %zu nodes, %zu leaves, mean leaf %.2f, max leaf %zu, max depth %zu, "
-              "SAH cost %.2f\n",
-              s.nodes, s.leaves, s.mean_leaf_size, s.max_leaf_size, s.max_depth, s.sah_cost);
+  std::printf(
+      "tree:  %zu nodes, %zu leaves, mean leaf %.2f, max leaf %zu, max depth %zu, "
+      "SAH cost %.2f\n",
+      s.nodes, s.leaves, s.mean_leaf_size, s.max_leaf_size, s.max_depth, s.sah_cost);
   if (opt.build_only) return;
 
   std::vector<lc_triangle> stored = tris;
@@ -252,10 +255,11 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
   for (auto& h : phits) ph += h.prim != LC_INVALID;
   for (auto& h : dhits) dh += h.prim != LC_INVALID;
   double mp = primary.size() / tp * 1e-6, md = diffuse.size() / td * 1e-6;
-  std::printf("lucent kernel: primary %zu rays (%.0f%% hit) %.2f Mrays/s; diffuse %zu rays "
-              "(%.0f%% hit) %.2f Mrays/s\n",
-              primary.size(), 100.0 * ph / primary.size(), mp, diffuse.size(),
-              100.0 * dh / std::max<std::size_t>(1, diffuse.size()), md);
+  std::printf(
+      "lucent kernel: primary %zu rays (%.0f%% hit) %.2f Mrays/s; diffuse %zu rays "
+      "(%.0f%% hit) %.2f Mrays/s\n",
+      primary.size(), 100.0 * ph / primary.size(), mp, diffuse.size(),
+      100.0 * dh / std::max<std::size_t>(1, diffuse.size()), md);
 #ifdef LUCENT_BENCH_EMBREE
   if (!opt.embree) return;
   Embree em(tris);
@@ -268,10 +272,11 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
     agree += (eh[i].prim == LC_INVALID) == (phits[i].prim == LC_INVALID);
   for (int r = 0; r < 3; ++r) ed = std::min(ed, em.trace(diffuse, eh));
   double emp = primary.size() / ep * 1e-6, emd = diffuse.size() / ed * 1e-6;
-  std::printf("embree %d.%d.%d (rtcIntersect1, 2 threads, build %.1f ms): primary %.2f Mrays/s, "
-              "diffuse %.2f Mrays/s; hit/miss agreement on primary rays %.4f%%\n",
-              RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, em.build_seconds * 1e3, emp,
-              emd, 100.0 * agree / total);
+  std::printf(
+      "embree %d.%d.%d (rtcIntersect1, 2 threads, build %.1f ms): primary %.2f Mrays/s, "
+      "diffuse %.2f Mrays/s; hit/miss agreement on primary rays %.4f%%\n",
+      RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, em.build_seconds * 1e3, emp, emd,
+      100.0 * agree / total);
   std::printf("lucent / embree: primary %.3f, diffuse %.3f\n", mp / emp, md / emd);
 #endif
 }
@@ -289,20 +294,31 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--runs") opt.runs = std::max(1, std::atoi(next().c_str()));
-    else if (a == "--width") opt.width = std::max(1, std::atoi(next().c_str()));
-    else if (a == "--height") opt.height = std::max(1, std::atoi(next().c_str()));
-    else if (a == "--device") opt.device = next();
-    else if (a == "--threads") opt.threads = std::max(0, std::atoi(next().c_str()));
-    else if (a == "--build-only") opt.build_only = true;
-    else if (a == "--only") opt.only = next();
-    else if (a == "--no-embree") opt.embree = false;
-    else if (a == "--reorder") opt.reorder = true;
-    else if (a == "--traversal-cost") opt.traversal_cost = float(std::atof(next().c_str()));
+    if (a == "--runs")
+      opt.runs = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--width")
+      opt.width = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--height")
+      opt.height = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--device")
+      opt.device = next();
+    else if (a == "--threads")
+      opt.threads = std::max(0, std::atoi(next().c_str()));
+    else if (a == "--build-only")
+      opt.build_only = true;
+    else if (a == "--only")
+      opt.only = next();
+    else if (a == "--no-embree")
+      opt.embree = false;
+    else if (a == "--reorder")
+      opt.reorder = true;
+    else if (a == "--traversal-cost")
+      opt.traversal_cost = float(std::atof(next().c_str()));
     else {
-      std::fprintf(stderr, "usage: lucent_bench [--runs N] [--width W] [--height H] [--device S] "
-                           "[--threads N] [--build-only] [--only NAME] [--no-embree] "
-                           "[--traversal-cost C] [--reorder]\n");
+      std::fprintf(stderr,
+                   "usage: lucent_bench [--runs N] [--width W] [--height H] [--device S] "
+                   "[--threads N] [--build-only] [--only NAME] [--no-embree] "
+                   "[--traversal-cost C] [--reorder]\n");
       return 2;
     }
   }

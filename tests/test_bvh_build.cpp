@@ -15,8 +15,8 @@
 
 namespace {
 
-using lucent::bvh::Bvh;
 using lucent::bvh::BuildOptions;
+using lucent::bvh::Bvh;
 
 lc_triangle tri(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy,
                 float cz) {
@@ -233,8 +233,8 @@ TEST(BvhBuild, ZeroExtentBoxes) {
   std::uniform_real_distribution<float> u(0, 1);
   for (int i = 0; i < 500; ++i) {
     float x = u(rng), y = u(rng), z = u(rng);
-    t.push_back(tri(x, y, z, x, y, z, x, y, z));            // a point
-    t.push_back(tri(x, y, z, x + 0.01f, y, z, x, y, z));    // a segment
+    t.push_back(tri(x, y, z, x, y, z, x, y, z));                  // a point
+    t.push_back(tri(x, y, z, x + 0.01f, y, z, x, y, z));          // a segment
     t.push_back(tri(x, y, z, x + 0.01f, y, z, x, y + 0.01f, z));  // flat in z
   }
   build_and_check(t, {});
@@ -312,9 +312,11 @@ TEST(BvhBuild, SahBeatsMedianSplits) {
     for (int a = 1; a < 3; ++a)
       if (nd.bmax[a] - nd.bmin[a] > nd.bmax[axis] - nd.bmin[axis]) axis = a;
     std::size_t mid = (j.b + j.e) / 2;
-    std::nth_element(idx.begin() + j.b, idx.begin() + mid, idx.begin() + j.e, [&](lc_uint x, lc_uint y) {
-      return t[x].v0[axis] + t[x].v1[axis] + t[x].v2[axis] < t[y].v0[axis] + t[y].v1[axis] + t[y].v2[axis];
-    });
+    std::nth_element(idx.begin() + j.b, idx.begin() + mid, idx.begin() + j.e,
+                     [&](lc_uint x, lc_uint y) {
+                       return t[x].v0[axis] + t[x].v1[axis] + t[x].v2[axis] <
+                              t[y].v0[axis] + t[y].v1[axis] + t[y].v2[axis];
+                     });
     jobs.push_back({j.b, mid});
     jobs.push_back({mid, j.e});
   }

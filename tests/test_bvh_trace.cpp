@@ -10,12 +10,14 @@
 // Per ray the kernel's answer passes when: on a miss, no primitive is surely hit in (0, tmax); on
 // a hit, its primitive is possibly hit at a distance within kTol (relative) of the kernel's t and
 // no surely-hit primitive is closer than that t by more than kTol. Any-hit (shadow) rays pass when
-// "occluded" comes with some primitive possibly hit before tmax, and "free" with none surely hit. Barycentrics of triangle hits
-// agree within 1e-4. Exact agreement (same primitive as the closest surely-hit one) is also
-// required for all but 0.1% of the rays, so the tolerances cannot hide a systematic error.
+// "occluded" comes with some primitive possibly hit before tmax, and "free" with none surely hit.
+// Barycentrics of triangle hits agree within 1e-4. Exact agreement (same primitive as the closest
+// surely-hit one) is also required for all but 0.1% of the rays, so the tolerances cannot hide a
+// systematic error.
 //
 // Closed meshes: rays aimed exactly at shared vertices and edges (from inside, or from outside
-// through a convex mesh) must hit, a triangle that owns the vertex or edge, at the expected distance.
+// through a convex mesh) must hit, a triangle that owns the vertex or edge, at the expected
+// distance.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -45,7 +47,9 @@ D3 operator-(D3 a, D3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 D3 operator+(D3 a, D3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 D3 operator*(double s, D3 a) { return {s * a.x, s * a.y, s * a.z}; }
 double dot(D3 a, D3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-D3 cross(D3 a, D3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+D3 cross(D3 a, D3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 D3 d3(const float* p) { return {p[0], p[1], p[2]}; }
 
 struct Scene {
@@ -144,7 +148,8 @@ Verdict judge(const Scene& s, const TraceRay& r, const TraceHit& k, bool any_hit
   double tk = k.t;
   if (std::fabs(tk - at_kernel.t) > kTol * (at_kernel.t + 1)) {
     v.ok = false;
-    v.why = "t differs: kernel " + std::to_string(tk) + ", reference " + std::to_string(at_kernel.t);
+    v.why =
+        "t differs: kernel " + std::to_string(tk) + ", reference " + std::to_string(at_kernel.t);
   } else if (best_sure < tk - tol) {
     v.ok = false;
     v.why = "a closer primitive is surely hit";
@@ -218,8 +223,8 @@ std::vector<TraceRay> random_rays(int n, unsigned seed, bool finite = false, dou
   std::uniform_real_distribution<double> u(lo, hi), t(0.05, 1.0);
   std::vector<TraceRay> rays;
   for (int i = 0; i < n; ++i)
-    rays.push_back(make_ray({u(rng), u(rng), u(rng)}, random_dir(rng),
-                            finite ? float(t(rng)) : INFINITY));
+    rays.push_back(
+        make_ray({u(rng), u(rng), u(rng)}, random_dir(rng), finite ? float(t(rng)) : INFINITY));
   return rays;
 }
 
@@ -269,7 +274,8 @@ TEST_F(BvhTrace, SphereSets) {
   std::mt19937 rng(16);
   std::uniform_real_distribution<double> u(1.0e5 - 10, 1.0e5 + 60);
   std::vector<TraceRay> rays;
-  for (int i = 0; i < 10000; ++i) rays.push_back(make_ray({u(rng), u(rng), u(rng)}, random_dir(rng)));
+  for (int i = 0; i < 10000; ++i)
+    rays.push_back(make_ray({u(rng), u(rng), u(rng)}, random_dir(rng)));
   compare(far, rays, false, "far spheres");
 }
 
@@ -292,9 +298,12 @@ TEST_F(BvhTrace, AxisParallelRays) {
   for (int i = 0; i < 12000; ++i) {
     D3 d{0, 0, 0};
     double sign = (i & 1) ? 1.0 : -1.0;
-    if (i % 6 < 2) d.x = sign;
-    else if (i % 6 < 4) d.y = sign;
-    else d.z = sign;
+    if (i % 6 < 2)
+      d.x = sign;
+    else if (i % 6 < 4)
+      d.y = sign;
+    else
+      d.z = sign;
     rays.push_back(make_ray({u(rng), u(rng), u(rng)}, d));
   }
   compare(s, rays, false, "axis-parallel");
@@ -310,7 +319,8 @@ TEST_F(BvhTrace, RaysStartingOnBoxFaces) {
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<TraceRay> rays;
   for (int i = 0; i < 12000; ++i) {
-    const lc_bvh_node& nd = b.nodes[std::uniform_int_distribution<std::size_t>(0, b.nodes.size() - 1)(rng)];
+    const lc_bvh_node& nd =
+        b.nodes[std::uniform_int_distribution<std::size_t>(0, b.nodes.size() - 1)(rng)];
     int axis = i % 3;
     float o[3];
     for (int a = 0; a < 3; ++a) o[a] = float(nd.bmin[a] + u(rng) * (nd.bmax[a] - nd.bmin[a]));
@@ -334,7 +344,9 @@ struct EdgeTarget {
 
 // True when face f of mesh m has vertex a and b.
 bool owns(const lucent::bvh::meshes::IndexedMesh& m, lc_uint f, EdgeTarget e) {
-  auto has = [&](lc_uint v) { return m.faces[f][0] == v || m.faces[f][1] == v || m.faces[f][2] == v; };
+  auto has = [&](lc_uint v) {
+    return m.faces[f][0] == v || m.faces[f][1] == v || m.faces[f][2] == v;
+  };
   return has(e.a) && has(e.b);
 }
 
@@ -419,7 +431,8 @@ TEST_F(BvhTrace, TorusVerticesAndEdgesFromInside) {
         ring.push_back(make_ray(o, p - o));
         ring_t.push_back(e);
       }
-      for (EdgeTarget e : {EdgeTarget{id(i, j), id(i + 1, j)}, EdgeTarget{id(i, j), id(i + 1, j + 1)}}) {
+      for (EdgeTarget e :
+           {EdgeTarget{id(i, j), id(i + 1, j)}, EdgeTarget{id(i, j), id(i + 1, j + 1)}}) {
         D3 p = 0.5 * (d3(m.positions[e.a].data()) + d3(m.positions[e.b].data()));
         cross.push_back(make_ray(oh, p - oh));
         cross_t.push_back(e);
@@ -470,7 +483,7 @@ TEST_F(BvhTrace, AxisAlignedCubeRaysInFacePlanes) {
   Bvh b = lucent::bvh::build(s.tris, s.spheres);
   std::vector<TraceRay> rays;
   std::vector<double> expect;
-  for (int axis = 0; axis < 3; ++axis)          // direction of travel
+  for (int axis = 0; axis < 3; ++axis)                        // direction of travel
     for (int plane_axis = 0; plane_axis < 3; ++plane_axis) {  // the face plane the ray lies in
       if (plane_axis == axis) continue;
       int other = 3 - axis - plane_axis;

@@ -27,8 +27,8 @@ struct BuildStats {
 };
 
 struct Bvh {
-  std::vector<lc_bvh_node> nodes;   ///< nodes[0] is the root; empty when there is no primitive
-  std::vector<lc_uint> prim_refs;   ///< triangle index, or sphere index | LC_PRIM_SPHERE_BIT
+  std::vector<lc_bvh_node> nodes;  ///< nodes[0] is the root; empty when there is no primitive
+  std::vector<lc_uint> prim_refs;  ///< triangle index, or sphere index | LC_PRIM_SPHERE_BIT
   BuildStats stats;
 };
 

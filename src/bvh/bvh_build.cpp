@@ -27,7 +27,7 @@ constexpr int kBins = 32;
 constexpr std::size_t kSpawnSize = 2048;  // subtrees at least this large go to the shared queue
 constexpr lc_uint kChunk = 512;           // node pairs are taken from the shared counter in chunks
 constexpr std::size_t kParallelBinSize = 1u << 17;  // nodes this large bin on every thread
-constexpr unsigned kMaxDepth = 64;        // = LC_BVH_STACK_SIZE in kernels/bvh/traverse.cl
+constexpr unsigned kMaxDepth = 64;  // = LC_BVH_STACK_SIZE in kernels/bvh/traverse.cl
 
 // Four floats, one SIMD register where SSE2 is there (lane 3 is unused by the math below).
 #if defined(__SSE2__)
@@ -68,9 +68,15 @@ struct V4 {
     }
   }
 };
-inline V4 operator+(V4 a, V4 b) { return {{a.f[0] + b.f[0], a.f[1] + b.f[1], a.f[2] + b.f[2], a.f[3] + b.f[3]}}; }
-inline V4 operator-(V4 a, V4 b) { return {{a.f[0] - b.f[0], a.f[1] - b.f[1], a.f[2] - b.f[2], a.f[3] - b.f[3]}}; }
-inline V4 operator*(V4 a, V4 b) { return {{a.f[0] * b.f[0], a.f[1] * b.f[1], a.f[2] * b.f[2], a.f[3] * b.f[3]}}; }
+inline V4 operator+(V4 a, V4 b) {
+  return {{a.f[0] + b.f[0], a.f[1] + b.f[1], a.f[2] + b.f[2], a.f[3] + b.f[3]}};
+}
+inline V4 operator-(V4 a, V4 b) {
+  return {{a.f[0] - b.f[0], a.f[1] - b.f[1], a.f[2] - b.f[2], a.f[3] - b.f[3]}};
+}
+inline V4 operator*(V4 a, V4 b) {
+  return {{a.f[0] * b.f[0], a.f[1] * b.f[1], a.f[2] * b.f[2], a.f[3] * b.f[3]}};
+}
 inline V4 vmin(V4 a, V4 b) {
   V4 r;
   for (int i = 0; i < 4; ++i) r.f[i] = b.f[i] < a.f[i] ? b.f[i] : a.f[i];

@@ -57,8 +57,7 @@ std::vector<TraceHit> DeviceTracer::trace(const std::vector<TraceRay>& rays, boo
     ctx_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(rays.size()),
                                     cl::NullRange);
     ctx_.queue.finish();
-    kernel_seconds_ =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    kernel_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ctx_.queue.enqueueReadBuffer(hb, CL_TRUE, 0, hits.size() * sizeof(TraceHit), hits.data());
   } catch (const cl::Error& e) {
     throw Error(cl_util::describe(e));

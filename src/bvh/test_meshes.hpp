@@ -34,13 +34,13 @@ struct IndexedMesh {
 /// Icosahedron subdivided `levels` times, projected onto the sphere (20 * 4^levels faces).
 inline IndexedMesh icosphere(int levels, float radius = 1.0f, const float* center = nullptr) {
   const double p = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<std::array<double, 3>> v = {{-1, p, 0}, {1, p, 0},  {-1, -p, 0}, {1, -p, 0},
-                                          {0, -1, p}, {0, 1, p},  {0, -1, -p}, {0, 1, -p},
-                                          {p, 0, -1}, {p, 0, 1},  {-p, 0, -1}, {-p, 0, 1}};
+  std::vector<std::array<double, 3>> v = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0},
+                                          {0, -1, p}, {0, 1, p}, {0, -1, -p}, {0, 1, -p},
+                                          {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
   std::vector<std::array<lc_uint, 3>> f = {
-      {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+      {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
       {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-      {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+      {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (auto& x : v) {
     double l = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
     for (double& c : x) c /= l;
