@@ -1,0 +1,117 @@
+#pragma once
+// Convergence studies: render a ladder of sample counts (or time budgets) for several speed and
+// accuracy settings, measure each render's error against a reference image, fit the rate at which
+// the error falls and tell biased settings (error that stops falling) from unbiased ones.
+// `lucent converge` is the front end; BENCHMARKS.md ("Convergence") shows a run.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "lucent/render.hpp"
+#include "lucent/scene.hpp"
+
+namespace lucent {
+
+/// One speed/accuracy setting: knobs applied on top of the scene and the render options.
+/// Syntax (parse_converge_setting): knobs joined by '+', e.g. "max_depth=2+fast-math".
+///   default            the scene as it is
+///   fast-math          RenderOptions::fast_math
+///   no-specialize      RenderOptions::specialize = false
+///   no-mis / mis       integrator.mis off / on
+///   max_depth=N        integrator.max_depth (N >= 1)
+///   rr_depth=N         integrator.rr_depth (N >= 1)
+///   filter=TYPE[:R]    film.filter: box, tent or gaussian, optional radius R in pixels (> 0)
+///   integrator=NAME    path, whitted, direct, ao, ...
+/// The setting's name is the text it was parsed from.
+struct ConvergeSetting {
+  std::string name = "default";
+  bool fast_math = false;
+  bool specialize = true;
+  int mis = -1;              ///< -1: the scene's; 0 off; 1 on
+  int max_depth = 0;         ///< 0: the scene's
+  int rr_depth = 0;          ///< 0: the scene's
+  int filter = -1;           ///< -1: the scene's; else a FilterType
+  double filter_radius = 0;  ///< 0: the scene's (or the filter's default when the type changes)
+  int integrator = -1;       ///< -1: the scene's; else an IntegratorType
+
+  /// Applies the setting to a copy of the scene and of the options.
+  void apply(Scene& scene, RenderOptions& options) const;
+};
+
+/// Parses one setting (syntax above). Throws lucent::Error naming the knob that is wrong.
+ConvergeSetting parse_converge_setting(const std::string& text);
+
+/// One rung of the ladder: one render of one setting, compared with the reference.
+struct ConvergePoint {
+  std::string setting;
+  std::uint64_t spp = 0;          ///< samples per pixel rendered
+  double seconds = 0;             ///< render time (RenderResult::seconds, kernel build excluded)
+  double samples_per_second = 0;  ///< camera samples (all pixels) per second
+  double rays_per_second = 0;
+  double rmse = 0;    ///< as compare_images(): sqrt(mean (A - R)^2)
+  double relmse = 0;  ///< as compare_images(): mean (A - R)^2 / (R^2 + 0.01)
+  /// The relMSE that noise alone explains: mean over pixel-channels of (var_A / n_A + var_R /
+  /// n_R) / (R^2 + 0.01), from the per-pixel sample variances of the render and the reference.
+  /// The expected relMSE of an unbiased setting; 0 when the render has fewer than 2 samples per
+  /// pixel (no variance estimate).
+  double noise_relmse = 0;
+};
+
+/// The error curve of one setting, fitted on log-log axes.
+struct ConvergeFit {
+  std::string setting;
+  std::size_t points = 0;
+  double slope_time = 0;      ///< least-squares slope of log(relMSE) against log(seconds)
+  double slope_spp = 0;       ///< least-squares slope of log(relMSE) against log(spp)
+  double tail_slope_spp = 0;  ///< the same over the last three rungs (flattens when biased)
+  /// relMSE / noise_relmse at the last rung: about 1 when the error is all noise.
+  double excess_ratio = 0;
+  /// Biased: at the last rung the error is more than twice what the noise explains, i.e. the
+  /// squared bias exceeds the variance and the curve has turned flat. (Without a variance
+  /// estimate, a tail slope flatter than -0.5 decides.)
+  bool biased = false;
+  double bias_relmse = 0;  ///< relMSE - noise_relmse at the last rung: the floor
+  /// Render time at which the noise (extrapolated as 1/t from the last rung) falls below the
+  /// floor: where the error stops decreasing. 0 when not biased.
+  double floor_seconds = 0;
+  std::string verdict;  ///< one line, e.g. "unbiased" or "biased: error stops decreasing at ..."
+};
+
+/// Fits one setting's points (in ladder order). Needs at least two points for the slopes.
+ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points);
+
+struct ConvergeOptions {
+  std::vector<ConvergeSetting> settings;  ///< empty: {default}
+  std::vector<int> spp_ladder;            ///< samples per pixel of each rung
+  std::vector<double> time_ladder;        ///< seconds per rung; used instead of spp_ladder if set
+  RenderOptions render;                   ///< device, cancel, pass_seconds (spp/time are set)
+  /// Called after each rung (progress output).
+  std::function<void(const ConvergePoint&)> on_point;
+};
+
+struct ConvergeResult {
+  std::vector<ConvergePoint> points;  ///< setting by setting, each in ladder order
+  std::vector<ConvergeFit> fits;      ///< one per setting, in the order given
+};
+
+/// Renders every setting at every rung and compares each render with `reference` (which must
+/// have the scene's film size; its variance and samples may be empty). Throws lucent::Error.
+ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference,
+                               const ConvergeOptions& options);
+
+/// The seed a reference render should use so that its random numbers are independent of the
+/// ladder's (the scene's seed would replay the ladder's samples and hide their error).
+std::uint32_t reference_seed(std::uint32_t scene_seed);
+
+/// Powers of two from 1 to max_spp (max_spp included when it is not a power of two).
+std::vector<int> default_spp_ladder(int max_spp);
+
+/// CSV: setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s; one row a point.
+std::string convergence_csv(const ConvergeResult& result);
+
+/// SVG: relMSE against render time on log-log axes, one path (with point markers) per setting,
+/// axis labels, decade ticks and a legend.
+std::string convergence_svg(const ConvergeResult& result, const std::string& title);
+
+}  // namespace lucent

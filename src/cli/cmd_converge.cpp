@@ -1,0 +1,207 @@
+// `lucent converge SCENE`: error against a reference for a ladder of sample counts or time budgets
+// and several speed/accuracy settings; prints the table and the fitted slopes, writes a CSV and an
+// SVG plot (lucent/converge.hpp).
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "lucent/compare.hpp"
+#include "lucent/converge.hpp"
+#include "lucent/error.hpp"
+#include "lucent/reference.hpp"
+
+namespace lucent::cli {
+
+namespace {
+
+struct ConvergeArgs {
+  std::string scene;
+  std::string csv, plot, reference, save_reference, device;
+  int reference_spp = 0;
+  bool reference_cpu = false;
+  std::vector<std::string> settings;
+  std::vector<int> spp_ladder;
+  std::vector<double> time_ladder;
+  int max_spp = 64;
+  int width = 0, height = 0;
+  bool quiet = false;
+};
+
+ConvergeArgs& args() {
+  static ConvergeArgs a;
+  return a;
+}
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_converge_sigint(int) {
+  g_stop.store(true);
+  std::signal(SIGINT, SIG_DFL);
+}
+
+/// Fails before any rendering when `path` cannot be written.
+void check_writable(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory");
+  bool existed = std::filesystem::exists(path, ec);
+  errno = 0;
+  std::FILE* f = std::fopen(path.c_str(), "ab");
+  if (!f) throw Error(path + ": cannot write (" + std::string(std::strerror(errno)) + ")");
+  std::fclose(f);
+  if (!existed) std::filesystem::remove(path, ec);
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  f << text;
+  if (!f) throw Error(path + ": cannot write");
+}
+
+}  // namespace
+
+CLI::App* add_converge_command(CLI::App& app) {
+  ConvergeArgs& a = args();
+  CLI::App* cmd = app.add_subcommand(
+      "converge", "Error against a reference for a ladder of spp or time budgets and settings");
+  cmd->add_option("scene", a.scene, "Scene file (JSON)")->required();
+  cmd->add_option("--csv", a.csv,
+                  "Write setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s");
+  cmd->add_option("--plot", a.plot, "Write an SVG plot of relMSE against time (log-log)");
+  auto* ref = cmd->add_option("--reference", a.reference,
+                              "Reference image (.exr with var.*/n layers, .pfm, ...)");
+  auto* ref_spp = cmd->add_option("--reference-spp", a.reference_spp,
+                                  "Render the reference with this many spp (default: 16 x the "
+                                  "largest rung, at least 256; 1024 with --time-ladder)")
+                      ->check(CLI::Range(1, 1 << 24));
+  auto* ref_cpu = cmd->add_flag("--reference-cpu", a.reference_cpu,
+                                "Render the reference with the scalar reference integrator");
+  ref->excludes(ref_spp)->excludes(ref_cpu);
+  cmd->add_option("--save-reference", a.save_reference,
+                  "Write the rendered reference to this .exr (reuse it with --reference)");
+  cmd->add_option("--settings", a.settings,
+                  "Comma-separated settings, knobs joined by +: default, fast-math, "
+                  "no-specialize, no-mis, mis, max_depth=N, rr_depth=N, "
+                  "filter=box|tent|gaussian[:R], integrator=NAME (default: default)")
+      ->delimiter(',');
+  auto* spp = cmd->add_option("--spp-ladder", a.spp_ladder, "Samples per pixel of each rung")
+                  ->delimiter(',')
+                  ->check(CLI::Range(1, 1 << 24));
+  auto* time = cmd->add_option("--time-ladder", a.time_ladder, "Seconds of rendering per rung")
+                   ->delimiter(',')
+                   ->check(CLI::PositiveNumber);
+  spp->excludes(time);
+  cmd->add_option("--max-spp", a.max_spp,
+                  "Default ladder: powers of two from 1 to this (default 64)")
+      ->check(CLI::Range(1, 1 << 20));
+  cmd->add_option("--width", a.width, "Image width (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  cmd->add_option("--height", a.height, "Image height (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  cmd->add_option("--device", a.device, "OpenCL device: index or name substring");
+  cmd->add_flag("-q,--quiet", a.quiet, "Print only the slopes");
+  return cmd;
+}
+
+int run_converge_command() {
+  ConvergeArgs& a = args();
+  if (!a.csv.empty()) check_writable(a.csv);
+  if (!a.plot.empty()) check_writable(a.plot);
+  if (!a.save_reference.empty()) check_writable(a.save_reference);
+
+  ConvergeOptions opt;
+  std::set<std::string> seen;
+  for (const std::string& s : a.settings) {
+    if (!seen.insert(s).second) throw Error("--settings: '" + s + "' is given twice");
+    opt.settings.push_back(parse_converge_setting(s));
+  }
+  if (opt.settings.empty()) opt.settings.push_back(ConvergeSetting{});
+  opt.time_ladder = a.time_ladder;
+  opt.spp_ladder = a.time_ladder.empty()
+                       ? (a.spp_ladder.empty() ? default_spp_ladder(a.max_spp) : a.spp_ladder)
+                       : std::vector<int>{};
+  opt.render.device = a.device;
+  opt.render.cancel = &g_stop;
+
+  Scene scene = load_scene(a.scene);
+  if (a.width > 0) scene.film.width = a.width;
+  if (a.height > 0) scene.film.height = a.height;
+
+  auto previous = std::signal(SIGINT, on_converge_sigint);
+  RenderResult reference;
+  if (!a.reference.empty()) {
+    reference = read_render(a.reference);
+    if (reference.mean.width != scene.film.width || reference.mean.height != scene.film.height)
+      throw Error(a.reference + ": size " + std::to_string(reference.mean.width) + "x" +
+                  std::to_string(reference.mean.height) + " differs from the scene's film (" +
+                  std::to_string(scene.film.width) + "x" + std::to_string(scene.film.height) + ")");
+  } else {
+    int largest = 0;
+    for (int s : opt.spp_ladder) largest = std::max(largest, s);
+    int spp = a.reference_spp > 0 ? a.reference_spp
+                                  : (opt.time_ladder.empty() ? std::max(256, 16 * largest) : 1024);
+    Scene rs = scene;
+    rs.integrator.seed = reference_seed(scene.integrator.seed);  // independent of the ladder
+    if (!a.quiet)
+      std::fprintf(stderr, "reference: %d spp with the %s (seed %u)...\n", spp,
+                   a.reference_cpu ? "reference integrator" : "kernel",
+                   static_cast<unsigned>(rs.integrator.seed));
+    if (a.reference_cpu) {
+      ReferenceOptions ro;
+      ro.spp = spp;
+      ro.cancel = &g_stop;
+      reference = render_reference(rs, ro);
+    } else {
+      RenderOptions ro = opt.render;
+      ro.spp = spp;
+      reference = render(rs, ro);
+    }
+    if (reference.cancelled || g_stop.load())
+      throw Error("interrupted while rendering the reference");
+    if (!a.quiet)
+      std::fprintf(stderr, "reference: %llu spp in %.1f s\n",
+                   static_cast<unsigned long long>(reference.spp), reference.seconds);
+    if (!a.save_reference.empty()) write_render_exr(a.save_reference, reference);
+  }
+
+  if (!a.quiet) {
+    std::printf("%-22s %7s %9s %10s %11s %11s %11s\n", "setting", "spp", "seconds", "Msamples/s",
+                "RMSE", "relMSE", "noise");
+    std::fflush(stdout);
+    opt.on_point = [](const ConvergePoint& p) {
+      std::printf("%-22s %7llu %9.3f %10.3f %11.4e %11.4e %11.4e\n", p.setting.c_str(),
+                  static_cast<unsigned long long>(p.spp), p.seconds, p.samples_per_second * 1e-6,
+                  p.rmse, p.relmse, p.noise_relmse);
+      std::fflush(stdout);
+    };
+  }
+  ConvergeResult result = run_convergence(scene, reference, opt);
+  std::signal(SIGINT, previous);
+
+  std::printf("%sslope of log(relMSE) against log(time) (about -1 when unbiased; RMSE: half):\n",
+              a.quiet ? "" : "\n");
+  for (const ConvergeFit& f : result.fits)
+    std::printf("  %-22s %6.2f  (against spp %5.2f, last 3 rungs %5.2f)  %s\n", f.setting.c_str(),
+                f.slope_time, f.slope_spp, f.tail_slope_spp, f.verdict.c_str());
+
+  if (!a.csv.empty()) write_text(a.csv, convergence_csv(result));
+  if (!a.plot.empty()) {
+    std::string title = std::filesystem::path(a.scene).filename().string() + ", " +
+                        std::to_string(scene.film.width) + "x" + std::to_string(scene.film.height) +
+                        ": relMSE against render time";
+    write_text(a.plot, convergence_svg(result, title));
+  }
+  if (g_stop.load()) {
+    std::fprintf(stderr, "lucent: interrupted: the results cover the rungs rendered so far\n");
+    return 130;
+  }
+  return 0;
+}
+
+}  // namespace lucent::cli

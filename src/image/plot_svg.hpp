@@ -1,0 +1,27 @@
+#pragma once
+// A minimal hand-written SVG line plot on log-log axes (used by `lucent converge`).
+#include <string>
+#include <vector>
+
+namespace lucent::plot {
+
+struct Series {
+  std::string name;
+  std::vector<double> x, y;  ///< points; those not finite and > 0 are left out
+};
+
+struct LogLogPlot {
+  std::string title, x_label, y_label;
+  int width = 760, height = 480;
+  std::vector<Series> series;
+};
+
+/// The plot as a standalone SVG document: decade gridlines and labels (10^k), minor ticks, axis
+/// labels, a legend, and exactly one <path> element per series (axes, ticks and the frame are
+/// <line>/<rect> elements), with a <circle> marker at each point.
+std::string log_log_svg(const LogLogPlot& plot);
+
+/// Text with &, <, >, " and ' escaped for XML.
+std::string xml_escape(const std::string& text);
+
+}  // namespace lucent::plot

@@ -1,0 +1,316 @@
+// Convergence studies (lucent/converge.hpp): error against a reference for a ladder of sample
+// counts or time budgets, fitted on log-log axes.
+#include "lucent/converge.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "image/plot_svg.hpp"
+#include "lucent/compare.hpp"
+#include "lucent/error.hpp"
+
+namespace lucent {
+
+namespace {
+
+int parse_positive_int(const std::string& knob, const std::string& value, int max) {
+  char* end = nullptr;
+  long v = std::strtol(value.c_str(), &end, 10);
+  if (value.empty() || *end != '\0' || v < 1 || v > max)
+    throw Error("setting " + knob + "=" + value + ": expected an integer from 1 to " +
+                std::to_string(max));
+  return static_cast<int>(v);
+}
+
+/// Least-squares slope of log(y) against log(x) over the points where both are > 0.
+double log_log_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (!(x[i] > 0) || !(y[i] > 0) || !std::isfinite(x[i]) || !std::isfinite(y[i])) continue;
+    double lx = std::log(x[i]), ly = std::log(y[i]);
+    n += 1;
+    sx += lx;
+    sy += ly;
+    sxx += lx * lx;
+    sxy += lx * ly;
+  }
+  double den = n * sxx - sx * sx;
+  if (n < 2 || !(std::abs(den) > 1e-12)) return 0;
+  return (n * sxy - sx * sy) / den;
+}
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+/// The relMSE explained by noise: sum over pixel-channels of the variances of both means,
+/// weighted as relMSE weights squared errors. 0 when `a` has no variance estimate.
+double noise_relmse(const RenderResult& a, const RenderResult& ref) {
+  const std::size_t npix = static_cast<std::size_t>(a.mean.width) * a.mean.height;
+  if (npix == 0 || a.variance.rgb.size() != npix * 3 || a.samples.size() != npix) return 0;
+  const bool ref_var = ref.variance.rgb.size() == npix * 3 && ref.samples.size() == npix;
+  double sum = 0;
+  std::size_t usable = 0;
+  for (std::size_t i = 0; i < npix; ++i) {
+    if (a.samples[i] >= 2) ++usable;
+    for (int c = 0; c < 3; ++c) {
+      double var = a.samples[i] >= 2 ? a.variance.rgb[i * 3 + c] / double(a.samples[i]) : 0;
+      if (ref_var && ref.samples[i] >= 2)
+        var += ref.variance.rgb[i * 3 + c] / double(ref.samples[i]);
+      double r = ref.mean.rgb[i * 3 + c];
+      sum += var / (r * r + 0.01);
+    }
+  }
+  if (usable * 2 < npix) return 0;  // most pixels without a variance estimate: none
+  return sum / (3.0 * double(npix));
+}
+
+}  // namespace
+
+void ConvergeSetting::apply(Scene& scene, RenderOptions& options) const {
+  if (fast_math) options.fast_math = true;
+  if (!specialize) options.specialize = false;
+  if (mis >= 0) scene.integrator.mis = mis != 0;
+  if (max_depth > 0) scene.integrator.max_depth = max_depth;
+  if (rr_depth > 0) scene.integrator.rr_depth = rr_depth;
+  if (integrator >= 0) scene.integrator.type = static_cast<IntegratorType>(integrator);
+  if (filter >= 0) {
+    FilterType t = static_cast<FilterType>(filter);
+    if (t != scene.film.filter.type) scene.film.filter.radius = t == FilterType::Box ? 0.5 : 1.5;
+    scene.film.filter.type = t;
+  }
+  if (filter_radius > 0) scene.film.filter.radius = filter_radius;
+}
+
+ConvergeSetting parse_converge_setting(const std::string& text) {
+  ConvergeSetting s;
+  s.name = text;
+  if (text.empty()) throw Error("empty setting (expected e.g. default, fast-math, max_depth=2)");
+  std::stringstream ss(text);
+  std::string knob;
+  while (std::getline(ss, knob, '+')) {
+    std::string key = knob, value;
+    std::size_t eq = knob.find('=');
+    if (eq != std::string::npos) {
+      key = knob.substr(0, eq);
+      value = knob.substr(eq + 1);
+    }
+    for (char& c : key)
+      if (c == '-') c = '_';
+    auto no_value = [&] {
+      if (eq != std::string::npos) throw Error("setting " + knob + ": " + key + " takes no value");
+    };
+    if (key == "default") {
+      no_value();
+    } else if (key == "fast_math") {
+      no_value();
+      s.fast_math = true;
+    } else if (key == "no_specialize") {
+      no_value();
+      s.specialize = false;
+    } else if (key == "no_mis") {
+      no_value();
+      s.mis = 0;
+    } else if (key == "mis") {
+      no_value();
+      s.mis = 1;
+    } else if (key == "max_depth") {
+      s.max_depth = parse_positive_int(key, value, 1000);
+    } else if (key == "rr_depth") {
+      s.rr_depth = parse_positive_int(key, value, 1000);
+    } else if (key == "filter") {
+      std::string type = value, radius;
+      std::size_t colon = value.find(':');
+      if (colon != std::string::npos) {
+        type = value.substr(0, colon);
+        radius = value.substr(colon + 1);
+      }
+      if (type == "box")
+        s.filter = static_cast<int>(FilterType::Box);
+      else if (type == "tent")
+        s.filter = static_cast<int>(FilterType::Tent);
+      else if (type == "gaussian")
+        s.filter = static_cast<int>(FilterType::Gaussian);
+      else
+        throw Error("setting " + knob + ": unknown filter '" + type +
+                    "' (expected box, tent or gaussian, optionally :RADIUS)");
+      if (!radius.empty()) {
+        char* end = nullptr;
+        double r = std::strtod(radius.c_str(), &end);
+        if (*end != '\0' || !(r > 0) || r > 8)
+          throw Error("setting " + knob + ": filter radius must be a number in (0, 8] pixels");
+        s.filter_radius = r;
+      }
+    } else if (key == "integrator") {
+      static const char* const names[] = {"path",   "whitted", "direct", "albedo",
+                                          "normal", "depth",   "ao"};
+      int found = -1;
+      for (int i = 0; i < 7; ++i)
+        if (value == names[i]) found = i;
+      if (found < 0)
+        throw Error("setting " + knob +
+                    ": unknown integrator (expected path, whitted, direct, albedo, normal, depth, "
+                    "ao)");
+      s.integrator = found;
+    } else {
+      throw Error("setting '" + text + "': unknown knob '" + knob +
+                  "' (expected default, fast-math, no-specialize, no-mis, mis, max_depth=N, "
+                  "rr_depth=N, filter=box|tent|gaussian[:R], integrator=NAME, joined by +)");
+    }
+  }
+  return s;
+}
+
+std::uint32_t reference_seed(std::uint32_t scene_seed) { return scene_seed ^ 0x5bd1e995u; }
+
+std::vector<int> default_spp_ladder(int max_spp) {
+  std::vector<int> out;
+  for (int s = 1; s <= max_spp && s > 0; s *= 2) out.push_back(s);
+  if (max_spp >= 1 && (out.empty() || out.back() != max_spp)) out.push_back(max_spp);
+  return out;
+}
+
+ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
+  ConvergeFit f;
+  f.points = points.size();
+  if (points.empty()) {
+    f.verdict = "no points";
+    return f;
+  }
+  f.setting = points.front().setting;
+  std::vector<double> t, spp, e;
+  for (const ConvergePoint& p : points) {
+    t.push_back(p.seconds);
+    spp.push_back(static_cast<double>(p.spp));
+    e.push_back(p.relmse);
+  }
+  f.slope_time = log_log_slope(t, e);
+  f.slope_spp = log_log_slope(spp, e);
+  std::size_t k = std::min<std::size_t>(3, points.size());
+  f.tail_slope_spp = log_log_slope(std::vector<double>(spp.end() - k, spp.end()),
+                                   std::vector<double>(e.end() - k, e.end()));
+  const ConvergePoint& last = points.back();
+  if (last.noise_relmse > 0) {
+    f.excess_ratio = last.relmse / last.noise_relmse;
+    f.biased = f.excess_ratio > 2.0;
+  } else {
+    f.biased = points.size() >= 3 && f.tail_slope_spp > -0.5;
+  }
+  f.bias_relmse = std::max(0.0, last.relmse - last.noise_relmse);
+  if (!f.biased) {
+    f.verdict =
+        last.noise_relmse > 0
+            ? "unbiased (error/noise " + fmt("%.2f", f.excess_ratio) + " at the last rung)"
+            : "unbiased (no variance estimate; tail slope " + fmt("%.2f", f.tail_slope_spp) + ")";
+    return f;
+  }
+  std::string where;
+  if (last.noise_relmse > 0 && f.bias_relmse > 0 && last.seconds > 0) {
+    // noise ~ c / t: it falls to the floor at t = noise * t_last / bias
+    double ratio = last.noise_relmse / f.bias_relmse;
+    f.floor_seconds = last.seconds * ratio;
+    where = " (noise falls below it after ~" + fmt("%.3g", f.floor_seconds) + " s, ~" +
+            fmt("%.3g", std::max(1.0, double(last.spp) * ratio)) + " spp)";
+  }
+  f.verdict = "biased: error stops decreasing at ~relMSE " + fmt("%.2e", f.bias_relmse) + where;
+  return f;
+}
+
+ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference,
+                               const ConvergeOptions& options) {
+  if (reference.mean.width != scene.film.width || reference.mean.height != scene.film.height)
+    throw Error("the reference image is " + std::to_string(reference.mean.width) + "x" +
+                std::to_string(reference.mean.height) + ", the scene renders " +
+                std::to_string(scene.film.width) + "x" + std::to_string(scene.film.height));
+  std::vector<ConvergeSetting> settings = options.settings;
+  if (settings.empty()) settings.push_back(ConvergeSetting{});
+  const bool by_time = !options.time_ladder.empty();
+  const std::size_t rungs = by_time ? options.time_ladder.size() : options.spp_ladder.size();
+  if (rungs == 0) throw Error("converge: the ladder is empty");
+  for (int s : options.spp_ladder)
+    if (s < 1) throw Error("converge: spp ladder values must be >= 1, got " + std::to_string(s));
+  for (double t : options.time_ladder)
+    if (!(t > 0)) throw Error("converge: time ladder values must be > 0 seconds");
+
+  ConvergeResult result;
+  CompareOptions co;
+  co.image_mean_test = false;
+  bool cancelled = false;
+  for (const ConvergeSetting& setting : settings) {
+    Scene s = scene;
+    RenderOptions o = options.render;
+    setting.apply(s, o);
+    std::vector<ConvergePoint> pts;
+    for (std::size_t i = 0; i < rungs && !cancelled; ++i) {
+      o.spp = by_time ? 0 : options.spp_ladder[i];
+      o.time_limit = by_time ? options.time_ladder[i] : 0;
+      RenderResult r = render(s, o);
+      if (r.cancelled) {
+        cancelled = true;
+        break;
+      }
+      CompareResult c = compare_images(r, reference, co);
+      ConvergePoint p;
+      p.setting = setting.name;
+      p.spp = r.spp;
+      p.seconds = r.seconds;
+      double samples = double(r.spp) * s.film.width * s.film.height;
+      p.samples_per_second = r.seconds > 0 ? samples / r.seconds : 0;
+      p.rays_per_second = r.seconds > 0 ? double(r.rays) / r.seconds : 0;
+      p.rmse = c.rmse;
+      p.relmse = c.relmse;
+      p.noise_relmse = noise_relmse(r, reference);
+      if (options.on_point) options.on_point(p);
+      pts.push_back(p);
+    }
+    if (!pts.empty()) {
+      result.fits.push_back(fit_convergence(pts));
+      result.points.insert(result.points.end(), pts.begin(), pts.end());
+    }
+    if (cancelled) break;
+  }
+  return result;
+}
+
+std::string convergence_csv(const ConvergeResult& result) {
+  std::string out = "setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s\n";
+  char buf[256];
+  for (const ConvergePoint& p : result.points) {
+    std::string name = p.setting;
+    if (name.find_first_of(",\"\n") != std::string::npos) {
+      std::string q = "\"";
+      for (char c : name) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+      name = q + "\"";
+    }
+    std::snprintf(buf, sizeof buf, ",%llu,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n",
+                  static_cast<unsigned long long>(p.spp), p.seconds, p.samples_per_second, p.rmse,
+                  p.relmse, p.noise_relmse, p.rays_per_second);
+    out += name + buf;
+  }
+  return out;
+}
+
+std::string convergence_svg(const ConvergeResult& result, const std::string& title) {
+  plot::LogLogPlot plot;
+  plot.title = title;
+  plot.x_label = "render time (s, kernel build excluded)";
+  plot.y_label = "relMSE against the reference";
+  for (const ConvergeFit& f : result.fits) {
+    plot::Series s;
+    s.name = f.setting + " (slope " + fmt("%.2f", f.slope_time) + (f.biased ? ", biased)" : ")");
+    for (const ConvergePoint& p : result.points)
+      if (p.setting == f.setting) {
+        s.x.push_back(p.seconds);
+        s.y.push_back(p.relmse);
+      }
+    plot.series.push_back(std::move(s));
+  }
+  return plot::log_log_svg(plot);
+}
+
+}  // namespace lucent

@@ -1,0 +1,365 @@
+// lucent converge (lucent/converge.hpp): setting syntax, the log-log fit and the bias verdict on
+// synthetic curves, then kernel ladders against a kernel reference (error falls as 1/spp for the
+// scene's own setting; a shallow max_depth is flagged biased), the CSV, the SVG plot and the CLI.
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "lucent/converge.hpp"
+#include "lucent/error.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::ConvergeFit;
+using lucent::ConvergePoint;
+using lucent::ConvergeSetting;
+
+// Diffuse spheres on a diffuse floor under a uniform sky: a quarter of the light is indirect
+// (interreflections between the spheres and the floor), and with a single environment light
+// there is no light selection to make the variance heavy-tailed.
+const char* kScene = R"({
+  "camera": {"position": [0, 1.0, 4], "look_at": [0, 0.5, 0], "fov": 45},
+  "film": {"width": 32, "height": 24},
+  "integrator": {"type": "path", "max_depth": 8, "rr_depth": 8, "spp": 16, "seed": 3},
+  "materials": {"white": {"type": "diffuse", "albedo": [0.8, 0.8, 0.8]},
+                "red": {"type": "diffuse", "albedo": [0.8, 0.3, 0.2]}},
+  "shapes": [
+    {"type": "sphere", "center": [0, -100, 0], "radius": 100, "material": "white"},
+    {"type": "sphere", "center": [-0.6, 0.6, 0], "radius": 0.6, "material": "red"},
+    {"type": "sphere", "center": [0.7, 0.5, -0.3], "radius": 0.5, "material": "white"}
+  ],
+  "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
+})";
+
+std::string read_file(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, sep);) out.push_back(item);
+  return out;
+}
+
+/// A minimal XML well-formedness check: declaration, comments, start/end/empty tags with quoted
+/// attributes, properly nested, one root element, only the predefined or numeric entities.
+/// Returns "" when well formed, else what is wrong. Counts the start tags named `count_tag`.
+std::string check_xml(const std::string& x, const std::string& count_tag, int* count) {
+  std::vector<std::string> stack;
+  int roots = 0;
+  *count = 0;
+  size_t i = 0;
+  auto is_name = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == ':' ||
+           c == '.';
+  };
+  auto check_text = [](const std::string& t) -> std::string {
+    for (size_t k = 0; k < t.size(); ++k) {
+      if (t[k] == '<') return "'<' in text";
+      if (t[k] != '&') continue;
+      size_t semi = t.find(';', k);
+      if (semi == std::string::npos) return "unterminated entity";
+      std::string e = t.substr(k + 1, semi - k - 1);
+      if (e != "amp" && e != "lt" && e != "gt" && e != "quot" && e != "apos" &&
+          !(e.size() > 1 && e[0] == '#'))
+        return "unknown entity &" + e + ";";
+    }
+    return "";
+  };
+  while (i < x.size()) {
+    size_t lt = x.find('<', i);
+    std::string text = x.substr(i, lt == std::string::npos ? std::string::npos : lt - i);
+    if (std::string e = check_text(text); !e.empty()) return e;
+    if (stack.empty() && text.find_first_not_of(" \t\r\n") != std::string::npos)
+      return "text outside the root element";
+    if (lt == std::string::npos) break;
+    if (x.compare(lt, 5, "<?xml") == 0) {
+      if (lt != 0) return "XML declaration not at the start";
+      size_t end = x.find("?>", lt);
+      if (end == std::string::npos) return "unterminated declaration";
+      i = end + 2;
+      continue;
+    }
+    if (x.compare(lt, 4, "<!--") == 0) {
+      size_t end = x.find("-->", lt);
+      if (end == std::string::npos) return "unterminated comment";
+      i = end + 3;
+      continue;
+    }
+    size_t j = lt + 1;
+    bool closing = j < x.size() && x[j] == '/';
+    if (closing) ++j;
+    size_t name_start = j;
+    while (j < x.size() && is_name(x[j])) ++j;
+    std::string name = x.substr(name_start, j - name_start);
+    if (name.empty()) return "tag without a name at " + std::to_string(lt);
+    if (closing) {
+      while (j < x.size() && std::isspace(static_cast<unsigned char>(x[j]))) ++j;
+      if (j >= x.size() || x[j] != '>') return "malformed end tag </" + name;
+      if (stack.empty() || stack.back() != name) return "mismatched end tag </" + name + ">";
+      stack.pop_back();
+      i = j + 1;
+      continue;
+    }
+    // attributes: name="value" or name='value'
+    bool empty = false;
+    for (;;) {
+      while (j < x.size() && std::isspace(static_cast<unsigned char>(x[j]))) ++j;
+      if (j >= x.size()) return "unterminated tag <" + name;
+      if (x[j] == '>') break;
+      if (x.compare(j, 2, "/>") == 0) {
+        empty = true;
+        ++j;
+        break;
+      }
+      size_t a = j;
+      while (j < x.size() && is_name(x[j])) ++j;
+      if (j == a) return "bad attribute in <" + name;
+      if (j >= x.size() || x[j] != '=') return "attribute without a value in <" + name;
+      ++j;
+      if (j >= x.size() || (x[j] != '"' && x[j] != '\'')) return "unquoted attribute in <" + name;
+      size_t close = x.find(x[j], j + 1);
+      if (close == std::string::npos) return "unterminated attribute in <" + name;
+      if (std::string e = check_text(x.substr(j + 1, close - j - 1)); !e.empty()) return e;
+      j = close + 1;
+    }
+    if (name == count_tag) ++*count;
+    if (stack.empty()) ++roots;
+    if (!empty) stack.push_back(name);
+    i = j + 1;
+  }
+  if (!stack.empty()) return "unclosed <" + stack.back() + ">";
+  if (roots != 1) return std::to_string(roots) + " root elements";
+  return "";
+}
+
+std::vector<ConvergePoint> synthetic(const std::vector<double>& relmse,
+                                     const std::vector<double>& noise) {
+  std::vector<ConvergePoint> pts;
+  for (size_t i = 0; i < relmse.size(); ++i) {
+    ConvergePoint p;
+    p.setting = "s";
+    p.spp = 1u << (i + 2);
+    p.seconds = 0.01 * double(p.spp);
+    p.relmse = relmse[i];
+    p.noise_relmse = noise[i];
+    pts.push_back(p);
+  }
+  return pts;
+}
+
+TEST(Converge, SettingSyntax) {
+  ConvergeSetting d = lucent::parse_converge_setting("default");
+  EXPECT_EQ(d.name, "default");
+  EXPECT_FALSE(d.fast_math);
+  EXPECT_TRUE(d.specialize);
+  EXPECT_EQ(d.max_depth, 0);
+
+  ConvergeSetting s = lucent::parse_converge_setting("max_depth=2+fast-math+no-mis+filter=box:0.7");
+  EXPECT_EQ(s.name, "max_depth=2+fast-math+no-mis+filter=box:0.7");
+  EXPECT_EQ(s.max_depth, 2);
+  EXPECT_TRUE(s.fast_math);
+  EXPECT_EQ(s.mis, 0);
+  EXPECT_EQ(s.filter, static_cast<int>(lucent::FilterType::Box));
+  EXPECT_DOUBLE_EQ(s.filter_radius, 0.7);
+
+  lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
+  lucent::RenderOptions opt;
+  s.apply(scene, opt);
+  EXPECT_EQ(scene.integrator.max_depth, 2);
+  EXPECT_FALSE(scene.integrator.mis);
+  EXPECT_EQ(scene.film.filter.type, lucent::FilterType::Box);
+  EXPECT_DOUBLE_EQ(scene.film.filter.radius, 0.7);
+  EXPECT_TRUE(opt.fast_math);
+  EXPECT_TRUE(opt.specialize);
+  lucent::parse_converge_setting("no-specialize").apply(scene, opt);
+  EXPECT_FALSE(opt.specialize);
+
+  for (const char* bad : {"", "bogus", "max_depth=0", "max_depth=x", "max_depth", "fast-math=1",
+                          "filter=round", "filter=box:-1", "default+nope"}) {
+    try {
+      lucent::parse_converge_setting(bad);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const lucent::Error& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(Converge, DefaultLadder) {
+  EXPECT_EQ(lucent::default_spp_ladder(64), (std::vector<int>{1, 2, 4, 8, 16, 32, 64}));
+  EXPECT_EQ(lucent::default_spp_ladder(48), (std::vector<int>{1, 2, 4, 8, 16, 32, 48}));
+  EXPECT_EQ(lucent::default_spp_ladder(1), (std::vector<int>{1}));
+}
+
+TEST(Converge, FitOfSyntheticCurves) {
+  // pure noise, relMSE = 0.5 / spp: slope exactly -1 against spp and against time (t ~ spp)
+  std::vector<double> e, floor_e, flat_noise;
+  for (int i = 0; i < 5; ++i) {
+    double n = 0.5 / double(1 << (i + 2));
+    e.push_back(n);
+    floor_e.push_back(n + 0.05);  // plus a squared bias of 0.05
+  }
+  ConvergeFit f = lucent::fit_convergence(synthetic(e, e));
+  EXPECT_NEAR(f.slope_spp, -1.0, 1e-9);
+  EXPECT_NEAR(f.slope_time, -1.0, 1e-9);
+  EXPECT_NEAR(f.excess_ratio, 1.0, 1e-9);
+  EXPECT_FALSE(f.biased) << f.verdict;
+
+  ConvergeFit b = lucent::fit_convergence(synthetic(floor_e, e));
+  EXPECT_TRUE(b.biased);
+  EXPECT_NEAR(b.bias_relmse, 0.05, 1e-9);
+  EXPECT_GT(b.tail_slope_spp, -0.5);  // flattened
+  // the noise (0.5/spp) equals the floor at 10 spp, i.e. 0.1 s with 0.01 s per spp
+  EXPECT_NEAR(b.floor_seconds, 0.1, 1e-9);
+  EXPECT_NE(b.verdict.find("biased: error stops decreasing at ~relMSE 5.00e-02"), std::string::npos)
+      << b.verdict;
+
+  // without variance estimates the tail slope decides
+  std::vector<double> zero(5, 0.0);
+  EXPECT_FALSE(lucent::fit_convergence(synthetic(e, zero)).biased);
+  EXPECT_TRUE(lucent::fit_convergence(synthetic(floor_e, zero)).biased);
+}
+
+TEST(Converge, KernelLadderAgainstKernelReference) {
+  lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
+  lucent::Scene ref_scene = scene;
+  ref_scene.integrator.seed = lucent::reference_seed(scene.integrator.seed);
+  ASSERT_NE(ref_scene.integrator.seed, scene.integrator.seed);
+  lucent::RenderOptions ro;
+  ro.spp = 1024;
+  lucent::RenderResult reference = lucent::render(ref_scene, ro);
+
+  lucent::ConvergeOptions opt;
+  opt.spp_ladder = {4, 8, 16, 32, 64};
+  for (const char* s : {"default", "max_depth=1", "max_depth=2"})
+    opt.settings.push_back(lucent::parse_converge_setting(s));
+  lucent::ConvergeResult r = lucent::run_convergence(scene, reference, opt);
+  ASSERT_EQ(r.points.size(), 15u);
+  ASSERT_EQ(r.fits.size(), 3u);
+
+  // The scene's own setting: the error is noise, which halves with each doubling of spp. Every
+  // relMSE sums 2304 pixel-channel squared errors, so its relative spread is a few percent
+  // (the rungs share samples); a factor 2 per rung leaves a wide margin for "decreasing", and
+  // [-1.15, -0.85] for the fitted slope is about 5 of its standard deviations (the 1024-spp
+  // reference's own noise adds 6% at the last rung, pulling the slope towards -0.97).
+  for (size_t i = 1; i < 5; ++i) EXPECT_LT(r.points[i].relmse, r.points[i - 1].relmse) << i;
+  const ConvergeFit& d = r.fits[0];
+  EXPECT_EQ(d.setting, "default");
+  EXPECT_GT(d.slope_spp, -1.15);
+  EXPECT_LT(d.slope_spp, -0.85);
+  EXPECT_FALSE(d.biased) << d.verdict;
+  EXPECT_GT(d.excess_ratio, 0.7);
+  EXPECT_LT(d.excess_ratio, 1.4);
+
+  // max_depth 1 and 2 miss the indirect light that the depth-8 reference has: the error stops
+  // at the squared bias, many times the noise at 64 spp
+  for (int k = 1; k <= 2; ++k) {
+    const ConvergeFit& f = r.fits[k];
+    const ConvergePoint& last = r.points[5 * k + 4];
+    EXPECT_TRUE(f.biased) << f.setting << ": " << f.verdict;
+    EXPECT_GT(f.bias_relmse, 5 * last.noise_relmse) << f.setting;
+    EXPECT_GT(f.tail_slope_spp, -0.5) << f.setting;
+    EXPECT_NE(f.verdict.find("biased: error stops decreasing at ~"), std::string::npos);
+  }
+
+  // CSV: the header, then one row per setting and rung in order
+  std::vector<std::string> lines = split(lucent::convergence_csv(r), '\n');
+  ASSERT_EQ(lines.size(), 16u);
+  EXPECT_EQ(lines[0], "setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s");
+  const char* names[] = {"default", "max_depth=1", "max_depth=2"};
+  for (size_t i = 1; i < lines.size(); ++i) {
+    std::vector<std::string> f = split(lines[i], ',');
+    ASSERT_EQ(f.size(), 8u) << lines[i];
+    EXPECT_EQ(f[0], names[(i - 1) / 5]);
+    EXPECT_EQ(std::stoi(f[1]), opt.spp_ladder[(i - 1) % 5]);
+    EXPECT_GE(std::stod(f[2]), 0.0);
+    EXPECT_NEAR(std::stod(f[5]), r.points[i - 1].relmse, 1e-5 * r.points[i - 1].relmse);
+    EXPECT_NEAR(std::stod(f[4]), r.points[i - 1].rmse, 1e-5 * r.points[i - 1].rmse);
+  }
+
+  // SVG: well formed, one <path> per setting, the settings in the legend
+  std::string svg = lucent::convergence_svg(r, "t.json & friends <test>");
+  int paths = 0;
+  std::string problem = check_xml(svg, "path", &paths);
+  EXPECT_EQ(problem, "");
+  EXPECT_EQ(paths, 3);
+  for (const char* n : names)
+    EXPECT_NE(svg.find(std::string(">") + n + " (slope"), std::string::npos);
+}
+
+TEST(Converge, XmlCheckerRejectsMalformedDocuments) {
+  int n = 0;
+  EXPECT_EQ(check_xml("<svg><path d=\"M0 0\"/></svg>", "path", &n), "");
+  EXPECT_EQ(n, 1);
+  EXPECT_NE(check_xml("<svg><g></svg>", "path", &n), "");
+  EXPECT_NE(check_xml("<svg><path d=M0/></svg>", "path", &n), "");
+  EXPECT_NE(check_xml("<svg>a & b</svg>", "path", &n), "");
+  EXPECT_NE(check_xml("<svg/><svg/>", "path", &n), "");
+}
+
+TEST(Converge, CommandWritesCsvAndPlot) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/t.json", kScene);
+  lucent::test::CommandResult r = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --spp-ladder 2,4,8 --reference-spp 256 --settings " +
+      "default,max_depth=1 --csv '" + dir + "/c.csv' --plot '" + dir +
+      "/c.svg' --save-reference '" + dir + "/ref.exr'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("max_depth=1"), std::string::npos);
+  EXPECT_NE(r.out.find("biased: error stops decreasing"), std::string::npos) << r.out;
+  std::vector<std::string> csv = split(read_file(dir + "/c.csv"), '\n');
+  EXPECT_EQ(csv.size(), 7u);
+  int paths = 0;
+  EXPECT_EQ(check_xml(read_file(dir + "/c.svg"), "path", &paths), "");
+  EXPECT_EQ(paths, 2);
+
+  // the saved reference is reused: same size, so it is accepted
+  lucent::test::CommandResult again = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --spp-ladder 2 -q --reference '" + dir + "/ref.exr'");
+  EXPECT_EQ(again.status, 0) << again.err;
+  EXPECT_EQ(lucent::test::count_lines(again.err), 0) << again.err;
+}
+
+TEST(Converge, CommandErrors) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/t.json", kScene);
+  lucent::test::CommandResult bad = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --settings default,bogus --spp-ladder 2");
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_EQ(lucent::test::count_lines(bad.err), 1) << bad.err;
+  EXPECT_NE(bad.err.find("bogus"), std::string::npos) << bad.err;
+
+  lucent::test::CommandResult twice = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --settings default,default --spp-ladder 2");
+  EXPECT_EQ(twice.status, 1);
+  EXPECT_NE(twice.err.find("twice"), std::string::npos) << twice.err;
+
+  // a reference of another size names the file
+  lucent::test::CommandResult size = lucent::test::run_cli(
+      "converge '" + dir +
+      "/t.json' --width 16 --spp-ladder 2 --reference-spp 4 --save-reference '" + dir +
+      "/small.exr'");
+  ASSERT_EQ(size.status, 0) << size.err;
+  lucent::test::CommandResult mismatch = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --spp-ladder 2 --reference '" + dir + "/small.exr'");
+  EXPECT_EQ(mismatch.status, 1);
+  EXPECT_EQ(lucent::test::count_lines(mismatch.err), 1) << mismatch.err;
+  EXPECT_NE(mismatch.err.find("small.exr: size 16x24 differs"), std::string::npos) << mismatch.err;
+
+  lucent::test::CommandResult both =
+      lucent::test::run_cli("converge '" + dir + "/t.json' --reference x.exr --reference-cpu");
+  EXPECT_EQ(both.status, 2);
+}
+
+}  // namespace
