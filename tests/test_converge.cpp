@@ -331,6 +331,27 @@ TEST(Converge, CommandWritesCsvAndPlot) {
   EXPECT_EQ(lucent::test::count_lines(again.err), 0) << again.err;
 }
 
+TEST(Converge, CommandTimeLadderAndCpuReference) {
+  // The kernel against the independent reference integrator: the same expected image, so the
+  // error is noise (error/noise near 1, "unbiased"); a time ladder gives one row per budget.
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/t.json", kScene);
+  lucent::test::CommandResult r = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --time-ladder 0.01,0.03 --reference-cpu " +
+      "--reference-spp 1024 --csv '" + dir + "/c.csv'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("with the reference integrator"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("unbiased (error/noise"), std::string::npos) << r.out;
+  std::vector<std::string> csv = split(read_file(dir + "/c.csv"), '\n');
+  ASSERT_EQ(csv.size(), 3u);
+  for (size_t i = 1; i < csv.size(); ++i) {
+    std::vector<std::string> f = split(csv[i], ',');
+    ASSERT_EQ(f.size(), 8u);
+    EXPECT_EQ(f[0], "default");
+    EXPECT_GE(std::stoi(f[1]), 1);
+  }
+}
+
 TEST(Converge, CommandErrors) {
   std::string dir = lucent::test::temp_dir();
   lucent::test::write_file(dir + "/t.json", kScene);

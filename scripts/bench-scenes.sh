@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Render speed per scene: Msamples/s and Mrays/s at each scene's resolution with a fixed spp, and
+# the kernel build time cold (empty lucent and PoCL caches) and warm (the same caches, second run).
+# Every figure is the best of RUNS repetitions (the machine is shared). Prints a Markdown table.
+#
+#   scripts/bench-scenes.sh [BUILD_DIR] [SPP] [RUNS]     (defaults: build, 16, 3)
+#
+# Scenes: scenes/*.json; those that need ../shared assets are skipped when /work/shared (or
+# ../shared beside the project) is absent. Environment: LUCENT_DEVICE selects the device.
+set -euo pipefail
+
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${1:-$root/build}
+spp=${2:-16}
+runs=${3:-3}
+lucent=$build/lucent
+[[ -x $lucent ]] || { echo "bench-scenes: $lucent not found (build the lucent_cli target)" >&2; exit 1; }
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+# "out: WxH, N spp in S s (A Msamples/s, B Mrays/s, build C s) on DEVICE" -> "A B C"
+parse() {
+  sed -n 's/.*spp in [0-9.]* s (\([0-9.]*\) Msamples\/s, \([0-9.]*\) Mrays\/s, build \([0-9.]*\) s) on .*/\1 \2 \3/p' "$1"
+}
+min() { awk -v a="$1" -v b="$2" 'BEGIN { print (a == "" || b + 0 < a + 0) ? b : a }'; }
+
+device=""
+echo "Machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores;" \
+  "load average at start: $(cut -d' ' -f1-3 /proc/loadavg); $spp spp, best of $runs."
+echo
+echo "| scene | film | spp | Msamples/s | Mrays/s | rays/sample | build cold (s) | build warm (s) |"
+echo "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+for scene in "$root"/scenes/*.json; do
+  name=$(basename "$scene" .json)
+  if grep -q '/shared/' "$scene" && [[ ! -d /work/shared && ! -d $root/../shared ]]; then
+    echo "| $name | | | (skipped: needs ../shared) | | | | |"
+    continue
+  fi
+  best_ms="" best_mr="" best_cold="" best_warm="" film=""
+  for ((i = 0; i < runs; ++i)); do
+    cache=$work/cache-$name-$i
+    mkdir -p "$cache/lucent" "$cache/pocl"
+    for pass in cold warm; do
+      log=$work/log
+      LUCENT_CACHE_DIR=$cache/lucent POCL_CACHE_DIR=$cache/pocl \
+        "$lucent" render "$scene" --spp "$spp" -o "$work/out.pfm" 2>"$log" >/dev/null ||
+        { echo "bench-scenes: $name failed: $(tail -1 "$log")" >&2; exit 1; }
+      read -r ms mr build_s < <(parse "$log")
+      film=$(sed -n 's/.*: \([0-9]*x[0-9]*\), .*/\1/p' "$log" | tail -1)
+      device=$(sed -n 's/.* on \(.*\)$/\1/p' "$log" | tail -1)
+      if [[ -z $best_ms ]] || awk -v a="$ms" -v b="$best_ms" 'BEGIN { exit !(a + 0 > b + 0) }'; then
+        best_ms=$ms
+        best_mr=$mr
+      fi
+      if [[ $pass == cold ]]; then best_cold=$(min "$best_cold" "$build_s"); fi
+      if [[ $pass == warm ]]; then best_warm=$(min "$best_warm" "$build_s"); fi
+    done
+    rm -rf "$cache"
+  done
+  rps=$(awk -v a="$best_mr" -v b="$best_ms" 'BEGIN { printf "%.2f", (b > 0 ? a / b : 0) }')
+  echo "| $name | $film | $spp | $best_ms | $best_mr | $rps | $best_cold | $best_warm |"
+done
+echo
+echo "Device: $device. Load average at the end: $(cut -d' ' -f1-3 /proc/loadavg)."
