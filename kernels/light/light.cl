@@ -53,7 +53,7 @@ static inline float env_map_pdf(const lc_scene* s, __global const lc_light* L, f
   __global const lc_texture* tex = &s->textures[L->texture];
   __global const float* cdf = s->light_cdf + L->prim;
   float p = cdf[texel + 1] - cdf[texel];
-  float sin_t = sqrt(fmax(0.0f, 1.0f - d.y * d.y));
+  float sin_t = sqrt(d.x * d.x + d.z * d.z); /* not sqrt(1 - y^2): precise near the poles */
   if (sin_t <= 0.0f) return 0.0f;
   return p * (float)(tex->width * tex->height) / (2.0f * LC_PI * LC_PI * sin_t);
 }

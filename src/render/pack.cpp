@@ -208,7 +208,10 @@ PackedScene pack_scene(const Scene& scene) {
   for (double w : power) total += w;
   double acc = 0;
   for (size_t i = 0; i < p.lights.size(); ++i) {
-    double pdf = total > 0 ? power[i] / total : 1.0 / p.lights.size();
+    // 90% by power, 10% uniform: a defensive mixture, so that no light starves when one
+    // power estimate dwarfs the others (an environment behind a 1000-unit floor sphere)
+    double uniform = 1.0 / p.lights.size();
+    double pdf = total > 0 ? 0.9 * power[i] / total + 0.1 * uniform : uniform;
     p.lights[i].pdf_select = static_cast<float>(pdf);
     acc += pdf;
     p.light_cdf.push_back(static_cast<float>(acc));

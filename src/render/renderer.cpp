@@ -11,6 +11,7 @@
 #include "cl/program_cache.hpp"
 #include "lucent/error.hpp"
 #include "lucent/render.hpp"
+#include "render/device_scene.hpp"
 #include "render/pack.hpp"
 
 namespace lucent {
@@ -18,19 +19,6 @@ namespace lucent {
 namespace {
 
 constexpr size_t kWorkGroupSize = 64;  // fixed: each new size costs PoCL a work-group compile
-
-template <typename T>
-cl::Buffer make_buffer(const cl::Context& ctx, const std::vector<T>& v) {
-  // OpenCL forbids empty buffers: keep one zeroed element
-  size_t bytes = std::max<size_t>(1, v.size()) * sizeof(T);
-  cl::Buffer b(ctx, CL_MEM_READ_ONLY, bytes);
-  return b;
-}
-
-template <typename T>
-void upload(cl::CommandQueue& q, cl::Buffer& b, const std::vector<T>& v) {
-  if (!v.empty()) q.enqueueWriteBuffer(b, CL_FALSE, 0, v.size() * sizeof(T), v.data());
-}
 
 }  // namespace
 
@@ -75,35 +63,15 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   try {
     cl::Kernel kernel(program, "lucent_render");
     cl::CommandQueue& q = ctx.queue;
-    std::vector<lc_params> params_v{packed.params};
-    cl::Buffer b_params = make_buffer(ctx.context, params_v);
-    cl::Buffer b_nodes = make_buffer(ctx.context, packed.bvh.nodes);
-    cl::Buffer b_refs = make_buffer(ctx.context, packed.bvh.prim_refs);
-    cl::Buffer b_tris = make_buffer(ctx.context, packed.triangles);
-    cl::Buffer b_attrs = make_buffer(ctx.context, packed.tri_attrs);
-    cl::Buffer b_spheres = make_buffer(ctx.context, packed.spheres);
-    cl::Buffer b_mats = make_buffer(ctx.context, packed.materials);
-    cl::Buffer b_lights = make_buffer(ctx.context, packed.lights);
-    cl::Buffer b_cdf = make_buffer(ctx.context, packed.light_cdf);
-    cl::Buffer b_tex = make_buffer(ctx.context, packed.textures);
-    cl::Buffer b_texels = make_buffer(ctx.context, packed.texels);
+    render_detail::DeviceScene dev(ctx, packed);
     cl::Buffer b_sum(ctx.context, CL_MEM_WRITE_ONLY, npix * sizeof(cl_float4));
     cl::Buffer b_sumsq(ctx.context, CL_MEM_WRITE_ONLY, npix * sizeof(cl_float4));
     cl::Buffer b_counters(ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
-    upload(q, b_nodes, packed.bvh.nodes);
-    upload(q, b_refs, packed.bvh.prim_refs);
-    upload(q, b_tris, packed.triangles);
-    upload(q, b_attrs, packed.tri_attrs);
-    upload(q, b_spheres, packed.spheres);
-    upload(q, b_mats, packed.materials);
-    upload(q, b_lights, packed.lights);
-    upload(q, b_cdf, packed.light_cdf);
-    upload(q, b_tex, packed.textures);
-    upload(q, b_texels, packed.texels);
-    int arg = 0;
-    for (cl::Buffer* b : {&b_params, &b_nodes, &b_refs, &b_tris, &b_attrs, &b_spheres, &b_mats,
-                          &b_lights, &b_cdf, &b_tex, &b_texels, &b_sum, &b_sumsq, &b_counters})
-      kernel.setArg(arg++, *b);
+    int arg = dev.set_args(kernel);
+    kernel.setArg(arg++, b_sum);
+    kernel.setArg(arg++, b_sumsq);
+    kernel.setArg(arg++, b_counters);
+    cl::Buffer& b_params = dev.params;
 
     const size_t global = (npix + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
     {

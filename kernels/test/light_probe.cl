@@ -1,0 +1,82 @@
+/* lucent test kernel: the device's light sampling (kernels/light/light.cl) against its pdfs, for
+ * tests/test_kernel_light_sampling.cpp. Scene arguments as in kernels/megakernel.cl. */
+#define LC_HAS_SPHERES
+#define LC_HAS_TRIANGLES
+#define LC_HAS_POINT_LIGHTS
+#define LC_HAS_SPHERE_LIGHTS
+#define LC_HAS_TRIANGLE_LIGHTS
+#define LC_HAS_ENV
+#define LC_HAS_ENV_MAP
+#include "shared/types.h"
+#include "shared/rng.h"
+#include "util/math.cl"
+#include "geom/sphere.cl"
+#include "geom/triangle.cl"
+#include "bvh/traverse.cl"
+#include "light/light.cl"
+
+#define LC_PROBE_SCENE_ARGS                                                                   \
+  __global const lc_params *params, __global const lc_bvh_node *nodes,                        \
+      __global const lc_uint *prim_refs, __global const lc_triangle *triangles,               \
+      __global const lc_triangle_attr *tri_attrs, __global const lc_sphere *spheres,          \
+      __global const lc_material *materials, __global const lc_light *lights,                 \
+      __global const float *light_cdf, __global const lc_texture *textures,                   \
+      __global const float4 *texels
+
+#define LC_PROBE_SCENE_INIT \
+  lc_scene s;               \
+  s.params = params;        \
+  s.nodes = nodes;          \
+  s.prim_refs = prim_refs;  \
+  s.triangles = triangles;  \
+  s.tri_attrs = tri_attrs;  \
+  s.spheres = spheres;      \
+  s.materials = materials;  \
+  s.lights = lights;        \
+  s.light_cdf = light_cdf;  \
+  s.textures = textures;    \
+  s.texels = texels;
+
+/* out[i] = (wi, pdf) of sample i from point p, pdf = -1 when no sample was produced */
+__kernel void probe_light_sample(LC_PROBE_SCENE_ARGS, float4 p, __global float4* out) {
+  LC_PROBE_SCENE_INIT
+  lc_uint i = (lc_uint)get_global_id(0);
+  lc_light_sample ls;
+  int ok = light_sample(&s, p.xyz, lc_rng_uniform(0u, i, 0u, 3u), lc_rng_uniform(0u, i, 1u, 3u),
+                        lc_rng_uniform(0u, i, 2u, 3u), &ls);
+  /* delta (point) lights have no density: reported as not produced */
+  out[i] = ok && !ls.delta && ls.pdf > 0.0f ? (float4)(ls.wi, ls.pdf) : (float4)(0.0f, 0.0f, 0.0f, -1.0f);
+}
+
+/* pdf[i]: the solid-angle density with which light_sample from p produces direction dirs[i],
+ * summed over all lights (each light's own pdf, occlusion ignored), through the pdf functions
+ * the integrator uses for MIS. */
+__kernel void probe_light_pdf(LC_PROBE_SCENE_ARGS, float4 p, __global const float4* dirs,
+                              __global float* pdf) {
+  LC_PROBE_SCENE_INIT
+  size_t i = get_global_id(0);
+  float3 d = normalize(dirs[i].xyz);
+  float sum = 0.0f;
+  for (lc_uint l = 0; l < params->num_lights; ++l) {
+    __global const lc_light* L = &lights[l];
+    if (L->type == LC_LIGHT_SPHERE) {
+      __global const lc_sphere* sp = &spheres[L->prim];
+      float t = sphere_intersect(lc_load3(sp->center), sp->radius, p.xyz, d, 0.0f, INFINITY);
+      if (t < INFINITY) sum += light_pdf_area(&s, l, p.xyz, t, 1.0f);
+    } else if (L->type == LC_LIGHT_TRIANGLE) {
+      __global const lc_triangle* tri = &triangles[L->prim];
+      float3 v0 = lc_load3(tri->v0), v1 = lc_load3(tri->v1), v2 = lc_load3(tri->v2);
+      lc_tri_ray tr = triangle_ray_setup(d);
+      float t, b1, b2;
+      if (triangle_intersect(&tr, p.xyz, v0, v1, v2, 0.0f, INFINITY, &t, &b1, &b2)) {
+        float3 n = normalize(cross(v1 - v0, v2 - v0));
+        sum += light_pdf_area(&s, l, p.xyz, t, -dot(d, n));
+      }
+    } else if (L->type == LC_LIGHT_ENV || L->type == LC_LIGHT_ENV_MAP) {
+      float e;
+      env_radiance(&s, d, &e);
+      sum += e;
+    }
+  }
+  pdf[i] = sum;
+}

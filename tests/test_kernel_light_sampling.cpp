@@ -1,0 +1,248 @@
+// The device's light sampling against the pdfs the integrator uses for MIS: a chi-square test
+// of the sampled directions (sphere lights by cone, triangles by area, environment maps by
+// texel, and a power-proportional mixture), through kernels/test/light_probe.cl.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "cl/kernel_source.hpp"
+#include "cl/program_cache.hpp"
+#include "render/device_scene.hpp"
+#include "support.hpp"
+
+namespace {
+
+// Regularized upper incomplete gamma Q(a, x) (series / continued fraction).
+double gamma_q(double a, double x) {
+  if (x <= 0) return 1;
+  double gln = std::lgamma(a);
+  if (x < a + 1) {
+    double sum = 1 / a, del = sum, ap = a;
+    for (int n = 0; n < 10000; ++n) {
+      ap += 1;
+      del *= x / ap;
+      sum += del;
+      if (std::abs(del) < std::abs(sum) * 1e-15) break;
+    }
+    return 1 - sum * std::exp(-x + a * std::log(x) - gln);
+  }
+  double b = x + 1 - a, c = 1e300, d = 1 / b, h = d;
+  for (int i = 1; i < 10000; ++i) {
+    double an = -i * (i - a);
+    b += 2;
+    d = an * d + b;
+    if (std::abs(d) < 1e-300) d = 1e-300;
+    c = b + an / c;
+    if (std::abs(c) < 1e-300) c = 1e-300;
+    d = 1 / d;
+    double del = d * c;
+    h *= del;
+    if (std::abs(del - 1) < 1e-15) break;
+  }
+  return std::exp(-x + a * std::log(x) - gln) * h;
+}
+
+struct Probe {
+  lucent::cl_util::Context ctx{""};
+  cl::Program program = lucent::cl_util::build_program_cached(
+      ctx, lucent::detail::assemble_kernel_source("test/light_probe.cl"), "-cl-std=CL1.2");
+};
+
+Probe& probe() {
+  static Probe p;
+  return p;
+}
+
+// Samples N directions from point (0,0,0) with the scene's lights, bins them over
+// (cos theta, phi) of the whole sphere (the lights sit near the equator, z ~ 0, where the bins
+// are regular), and compares with N times the integral of the probe's pdf over each bin (see
+// the quadrature below). Bins with expected count < 5 are pooled. Fails when
+// the p-value is below 1e-4. Also: the pdf integral equals the fraction of successful samples
+// (within 1%), and each sample's reported pdf equals the pdf function at its direction.
+void chi_square_lights(const std::string& json, const char* name, bool single_light = true) {
+  lucent::Scene scene = lucent::parse_scene(json, lucent::test::temp_dir() + "/lights.json");
+  lucent::render_detail::PackedScene packed = lucent::render_detail::pack_scene(scene);
+  Probe& pr = probe();
+  lucent::render_detail::DeviceScene dev(pr.ctx, packed);
+  const int N = 1 << 18, NT = 48, NP = 96, SUB = 4;
+  const cl_float4 p = {{0, 0, 0, 0}};
+
+  cl::Buffer out(pr.ctx.context, CL_MEM_WRITE_ONLY, N * sizeof(cl_float4));
+  cl::Kernel ks(pr.program, "probe_light_sample");
+  int a = dev.set_args(ks);
+  ks.setArg(a++, p);
+  ks.setArg(a++, out);
+  pr.ctx.queue.enqueueNDRangeKernel(ks, cl::NullRange, cl::NDRange(N), cl::NullRange);
+  std::vector<cl_float4> s(N);
+  pr.ctx.queue.enqueueReadBuffer(out, CL_TRUE, 0, N * sizeof(cl_float4), s.data());
+
+  std::vector<double> observed(NT * NP, 0.0);
+  int produced = 0;
+  for (const auto& v : s) {
+    if (v.s[3] < 0) continue;
+    ++produced;
+    double z = std::clamp<double>(v.s[2], -1, 1);
+    int ti = std::min(NT - 1, int((z + 1) / 2 * NT));
+    double phi = std::atan2(v.s[1], v.s[0]);
+    if (phi < 0) phi += 2 * M_PI;
+    int pi = std::min(NP - 1, int(phi / (2 * M_PI) * NP));
+    observed[ti * NP + pi] += 1;
+  }
+
+  // the probe's pdf at a list of directions
+  auto eval_pdf = [&](const std::vector<cl_float4>& dirs) {
+    cl::Buffer bd(pr.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(cl_float4),
+                  const_cast<cl_float4*>(dirs.data()));
+    cl::Buffer bp(pr.ctx.context, CL_MEM_WRITE_ONLY, dirs.size() * sizeof(float));
+    cl::Kernel ke(pr.program, "probe_light_pdf");
+    int arg = dev.set_args(ke);
+    ke.setArg(arg++, p);
+    ke.setArg(arg++, bd);
+    ke.setArg(arg++, bp);
+    pr.ctx.queue.enqueueNDRangeKernel(ke, cl::NullRange, cl::NDRange(dirs.size()), cl::NullRange);
+    std::vector<float> pdf(dirs.size());
+    pr.ctx.queue.enqueueReadBuffer(bp, CL_TRUE, 0, pdf.size() * sizeof(float), pdf.data());
+    return pdf;
+  };
+  // sub x sub midpoint directions of cell (ti, pi) in (z, phi)
+  auto cell_dirs = [&](int ti, int pi, int sub, std::vector<cl_float4>& dirs) {
+    for (int i = 0; i < sub; ++i)
+      for (int j = 0; j < sub; ++j) {
+        double z = -1 + 2 * (ti + (i + 0.5) / sub) / NT, phi = 2 * M_PI * (pi + (j + 0.5) / sub) / NP;
+        double r = std::sqrt(std::max(0.0, 1 - z * z));
+        dirs.push_back({{float(r * std::cos(phi)), float(r * std::sin(phi)), float(z), 0}});
+      }
+  };
+
+  // the reported pdf of some samples against the pdf function at their directions. A sample
+  // reports the pdf of the light that produced it; with one light that is the whole density,
+  // with several it is one term of the sum.
+  std::vector<cl_float4> sample_dirs;
+  std::vector<int> picked;
+  for (int i = 0; i < N && picked.size() < 4000; i += 97)
+    if (s[i].s[3] > 0) {
+      picked.push_back(i);
+      sample_dirs.push_back(s[i]);
+    }
+  std::vector<float> sample_pdf = eval_pdf(sample_dirs);
+  for (size_t k = 0; k < picked.size(); ++k) {
+    double reported = s[picked[k]].s[3], evaluated = sample_pdf[k];
+    if (single_light)
+      ASSERT_NEAR(reported, evaluated, 2e-3 * reported) << name << ": sample " << picked[k];
+    else
+      ASSERT_LE(reported, evaluated * (1 + 2e-3)) << name << ": sample " << picked[k];
+  }
+
+  // Expected counts: N times the pdf integrated over each cell by a 4x4 midpoint rule, refined
+  // to 48x48 where the 16 values differ by more than 1% (light edges, texel edges) and in the
+  // neighbours of such cells, so that the quadrature error stays well below the counting noise.
+  const double cell_area = (2.0 / NT) * (2 * M_PI / NP);  // dz dphi = solid angle
+  std::vector<cl_float4> dirs;
+  for (int ti = 0; ti < NT; ++ti)
+    for (int pi = 0; pi < NP; ++pi) cell_dirs(ti, pi, SUB, dirs);
+  std::vector<float> pdf = eval_pdf(dirs);
+  std::vector<double> expected(NT * NP, 0.0);
+  std::vector<int> refine;
+  for (int c = 0; c < NT * NP; ++c) {
+    float lo = pdf[c * SUB * SUB], hi = lo;
+    double sum = 0;
+    for (int k = 0; k < SUB * SUB; ++k) {
+      lo = std::min(lo, pdf[c * SUB * SUB + k]);
+      hi = std::max(hi, pdf[c * SUB * SUB + k]);
+      sum += pdf[c * SUB * SUB + k];
+    }
+    expected[c] = sum / (SUB * SUB) * cell_area * N;
+    if (hi > lo * 1.01f) refine.push_back(c);
+  }
+  // an edge that clips a cell's corner may miss all 16 points: refine the neighbours too
+  std::vector<char> mark(NT * NP, 0);
+  for (int c : refine)
+    for (int dt = -1; dt <= 1; ++dt)
+      for (int dp = -1; dp <= 1; ++dp) {
+        int t = c / NP + dt, ph = (c % NP + dp + NP) % NP;
+        if (t >= 0 && t < NT) mark[t * NP + ph] = 1;
+      }
+  refine.clear();
+  for (int c = 0; c < NT * NP; ++c)
+    if (mark[c]) refine.push_back(c);
+  const int FINE = 48;
+  for (size_t start = 0; start < refine.size(); start += 256) {
+    std::vector<cl_float4> fine;
+    size_t end = std::min(refine.size(), start + 256);
+    for (size_t k = start; k < end; ++k) cell_dirs(refine[k] / NP, refine[k] % NP, FINE, fine);
+    std::vector<float> fp = eval_pdf(fine);
+    for (size_t k = start; k < end; ++k) {
+      double sum = 0;
+      for (int m = 0; m < FINE * FINE; ++m) sum += fp[(k - start) * FINE * FINE + m];
+      expected[refine[k]] = sum / (FINE * FINE) * cell_area * N;
+    }
+  }
+  double integral = 0;
+  for (double e : expected) integral += e / N;
+  EXPECT_NEAR(integral, double(produced) / N, 0.01) << name << ": pdf integral vs sampling success";
+
+  double pool_o = 0, pool_e = 0, chi2 = 0;
+  int cells = 0;
+  for (int i = 0; i < NT * NP; ++i) {
+    if (expected[i] < 5) {
+      pool_o += observed[i];
+      pool_e += expected[i];
+      continue;
+    }
+    chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+    ++cells;
+  }
+  if (pool_e >= 5) {
+    chi2 += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
+    ++cells;
+  }
+  ASSERT_GE(cells, 20) << name << ": too few populated bins for a meaningful test";
+  double pval = gamma_q((cells - 1) / 2.0, chi2 / 2.0);
+  EXPECT_GT(pval, 1e-4) << name << ": chi2 " << chi2 << " over " << cells << " cells";
+}
+
+const char* kMats = R"("materials": {"lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [2, 3, 4]},
+                                      "dim": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [0.5, 0.5, 0.5]}})";
+
+TEST(KernelLightSampling, SphereLightCone) {
+  chi_square_lights(std::string("{") + kMats + R"(, "shapes": [
+      {"type": "sphere", "center": [2, 0.3, 0.2], "radius": 0.5, "material": "lamp"}]})",
+                    "sphere, small cone");
+}
+
+TEST(KernelLightSampling, SphereLightWideCone) {
+  chi_square_lights(std::string("{") + kMats + R"(, "shapes": [
+      {"type": "sphere", "center": [0.1, 0.7, -0.2], "radius": 0.6, "material": "lamp"}]})",
+                    "sphere, wide cone");
+}
+
+TEST(KernelLightSampling, TriangleLightsByArea) {
+  chi_square_lights(std::string("{") + kMats + R"(, "shapes": [
+      {"type": "triangles", "material": "lamp", "positions": [[1, -1, -0.5], [1.5, 1, -0.8], [0.8, 0.2, 1], [1.1, -1.2, 1]],
+       "indices": [0, 2, 1, 0, 3, 2]}]})",
+                    "triangles");
+}
+
+TEST(KernelLightSampling, EnvironmentMap) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::Image env{24, 12, std::vector<float>(24 * 12 * 3)};
+  for (int y = 0; y < 12; ++y)
+    for (int x = 0; x < 24; ++x)
+      for (int c = 0; c < 3; ++c)
+        env.pixel(x, y)[c] = float(0.05 + ((x * 7 + y * 3) % 11) * 0.3 + (x == 5 && y == 3 ? 40 : 0));
+  lucent::write_image(dir + "/env.pfm", env);
+  chi_square_lights(R"({"lights": [{"type": "environment", "file": ")" + dir + R"(/env.pfm"}]})",
+                    "environment map");
+}
+
+TEST(KernelLightSampling, PowerProportionalMixture) {
+  chi_square_lights(std::string("{") + kMats + R"(, "shapes": [
+      {"type": "sphere", "center": [2, 0.3, 0.2], "radius": 0.5, "material": "lamp"},
+      {"type": "sphere", "center": [-1, 1.5, -0.2], "radius": 0.3, "material": "dim"},
+      {"type": "triangles", "material": "lamp", "positions": [[-1, -2, -1], [1, -2, -1], [0, -2, 1]], "indices": [0, 1, 2]}],
+    "lights": [{"type": "environment", "radiance": [0.2, 0.2, 0.2]}, {"type": "point", "position": [0, 0, 3], "intensity": [1, 1, 1]}]})",
+                    "mixture", false);
+}
+
+}  // namespace
