@@ -61,8 +61,10 @@ static inline float3 point_lights_direct(const lc_scene* s, const lc_interaction
   for (lc_uint i = 0; i < P->num_lights; ++i) {
     __global const lc_light* L = &s->lights[i];
     if (L->type != LC_LIGHT_POINT) continue;
+    /* irradiance from the surface point itself; the shadow ray leaves from the offset origin
+     * (a point light has no surface that the few-ulp parallel shift could graze) */
     float3 o = lc_spawn_origin(it->p, it->perr, it->ng);
-    float3 to = lc_load3(L->position) - o;
+    float3 to = lc_load3(L->position) - it->p;
     float d2 = dot(to, to);
     float dist = sqrt(d2);
     float3 wi = to / dist;
