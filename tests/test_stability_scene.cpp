@@ -1,0 +1,501 @@
+// Numerical stability of the kernel path tracer at the extremes (issue 5 item 5): scenes scaled
+// from 1e-4 to 1e6, translated far from the origin, camera rays grazing a plane, degenerate and
+// non-finite input triangles, extreme indices of refraction and albedos, a tiny very bright light
+// and 1000-segment paths.
+//
+// Tests (stated per test below):
+// - image against image: lucent::compare_images with its defaults (docs/compare.md): per
+//   pixel-channel two-sample z-test, z = (A - B) / sqrt(var_A / n_A + var_B / n_B + eps^2) with
+//   eps = 1e-5 + 1e-4 |value|, two-sided, Sidak-corrected over all pixel-channels at family-wise
+//   alpha = 0.01 (|z| < ~4.5 for 24x24); passes when >= 99.5% of the pixels pass and the image
+//   means per channel agree (|z| < 2.93). The two renders use different seeds, so they are
+//   independent samples.
+// - image against a closed form: a per pixel-channel one-sample z-test, Sidak at alpha = 1e-3,
+//   with a standard-error floor of 1e-4 relative (float rounding).
+// Every render must also have no dropped NaN/Inf sample (RenderResult::nonfinite == 0) and finite
+// pixel values.
+//
+// All renders compile every kernel feature (RenderOptions::specialize = false), so the whole file
+// builds one program.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "lucent/compare.hpp"
+#include "lucent/reference.hpp"
+#include "scene/loaders.hpp"
+#include "support.hpp"
+
+namespace {
+
+using glm::dvec3;
+using lucent::CompareResult;
+using lucent::RenderResult;
+using lucent::Scene;
+
+Scene scene_from(const std::string& json) {
+  return lucent::parse_scene(json, lucent::test::temp_dir() + "/scene.json");
+}
+
+RenderResult render(const Scene& scene, int spp, std::uint32_t seed) {
+  Scene s = scene;
+  s.integrator.seed = seed;
+  lucent::RenderOptions o;
+  o.spp = spp;
+  o.specialize = false;
+  return lucent::render(s, o);
+}
+
+bool all_finite(const RenderResult& r) {
+  for (int y = 0; y < r.mean.height; ++y)
+    for (int x = 0; x < r.mean.width; ++x)
+      for (int c = 0; c < 3; ++c)
+        if (!std::isfinite(r.mean.pixel(x, y)[c]) || !std::isfinite(r.variance.pixel(x, y)[c]))
+          return false;
+  return true;
+}
+
+#define EXPECT_CLEAN(r)           \
+  do {                            \
+    EXPECT_EQ((r).nonfinite, 0u); \
+    EXPECT_TRUE(all_finite(r));   \
+  } while (0)
+
+#define EXPECT_SAME_IMAGE(a, b, what)                           \
+  do {                                                          \
+    CompareResult cmp_ = lucent::compare_images(a, b);          \
+    EXPECT_TRUE(cmp_.passed) << what << "\n" << cmp_.summary(); \
+    EXPECT_CLEAN(a);                                            \
+    EXPECT_CLEAN(b);                                            \
+  } while (0)
+
+// Two-sided normal quantile for probability p by bisection on erfc (tests only).
+double sidak_z(double alpha, int m) {
+  double per = 1 - std::pow(1 - alpha, 1.0 / m);
+  double lo = 0, hi = 40;
+  for (int i = 0; i < 200; ++i) {
+    double mid = 0.5 * (lo + hi);
+    (std::erfc(mid / std::sqrt(2.0)) > per ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+// Every pixel-channel of r agrees with expected(x, y, c): one-sample z-test as described above.
+void expect_matches(const RenderResult& r, const std::function<double(int, int, int)>& expected) {
+  const int w = r.mean.width, h = r.mean.height;
+  const double zmax = sidak_z(1e-3, w * h * 3);
+  int failures = 0;
+  double worst = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        double e = expected(x, y, c);
+        double n = r.samples[static_cast<size_t>(y) * w + x];
+        double se = std::sqrt(r.variance.pixel(x, y)[c] / n) + 1e-6 + 1e-4 * std::abs(e);
+        double z = std::abs(r.mean.pixel(x, y)[c] - e) / se;
+        worst = std::max(worst, z);
+        if (!(z <= zmax) && ++failures <= 5)
+          ADD_FAILURE() << "pixel (" << x << "," << y << ") channel " << c << ": "
+                        << r.mean.pixel(x, y)[c] << " vs expected " << e << " (z = " << z << ")";
+      }
+  EXPECT_EQ(failures, 0) << "worst z " << worst << ", threshold " << zmax;
+  EXPECT_CLEAN(r);
+}
+
+// ------------------------------------------------------------------------------------------
+// The small test scene: a floor quad, two diffuse spheres, a standing triangle, a closed box mesh
+// (12 triangles, rotated), a point light and an emissive sphere (out of view), path integrator.
+
+std::string base_scene_json() {
+  // box: 0.5 x 0.5 x 0.5 standing on the floor at (0, 0, 1.25), rotated 30 degrees about y
+  std::string pos;
+  const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
+  for (int i = 0; i < 8; ++i) {
+    double x = (i & 1) ? 0.25 : -0.25, y = (i & 2) ? 0.5 : 0.0, z = (i & 4) ? 0.25 : -0.25;
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "%s[%.17g, %.17g, %.17g]", i ? ", " : "", c * x + s * z, y,
+                  -s * x + c * z + 1.25);
+    pos += buf;
+  }
+  return R"({
+    "camera": {"position": [0, 1.2, 5], "look_at": [0, 0.4, 0], "fov": 38},
+    "film": {"width": 24, "height": 24},
+    "integrator": {"type": "path", "max_depth": 4},
+    "materials": {"floor": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
+                  "red": {"type": "diffuse", "albedo": [0.8, 0.25, 0.2]},
+                  "blue": {"type": "diffuse", "albedo": [0.2, 0.3, 0.8]},
+                  "green": {"type": "diffuse", "albedo": [0.3, 0.7, 0.3]},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [6, 5, 4]}},
+    "shapes": [{"type": "triangles", "material": "floor",
+                "positions": [[-3,0,-3],[3,0,-3],[3,0,3],[-3,0,3]], "indices": [0,2,1, 0,3,2]},
+               {"type": "sphere", "center": [-0.8, 0.6, 0], "radius": 0.6, "material": "red"},
+               {"type": "sphere", "center": [0.9, 0.5, 0.4], "radius": 0.5, "material": "blue"},
+               {"type": "triangles", "material": "blue",
+                "positions": [[-2,0,-1.5],[2,0,-1.5],[0,2,-1.8]], "indices": [0,1,2]},
+               {"type": "triangles", "material": "green", "positions": [)" +
+         pos + R"(],
+                "indices": [0,2,3, 0,3,1, 4,5,7, 4,7,6, 0,1,5, 0,5,4, 2,6,7, 2,7,3,
+                            0,4,6, 0,6,2, 1,3,7, 1,7,5]},
+               {"type": "sphere", "center": [1.2, 2.2, 1.0], "radius": 0.3, "material": "lamp"}],
+    "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [30, 28, 25]}]
+  })";
+}
+
+// x -> s x + t for every position (camera, shapes, lights); radii scale by s and point
+// intensities by s^2, so that the image is unchanged (emitted radiance is scale-free).
+Scene transformed(Scene scene, double s, dvec3 t) {
+  auto f = [&](dvec3 p) { return s * p + t; };
+  scene.camera.position = f(scene.camera.position);
+  scene.camera.look_at = f(scene.camera.look_at);
+  for (auto& p : scene.positions) p = f(p);
+  for (auto& sp : scene.spheres) {
+    sp.center = f(sp.center);
+    sp.radius *= s;
+  }
+  for (auto& l : scene.lights) {
+    l.position = f(l.position);
+    l.intensity *= s * s;
+  }
+  return scene;
+}
+
+constexpr int kSpp = 256;
+
+// "1em4" for 1e-4, "1e6" for 1e6: test names
+std::string exp_name(double v) {
+  int e = static_cast<int>(std::lround(std::log10(v)));
+  return (e < 0 ? "1em" : "1e") + std::to_string(std::abs(e));
+}
+
+// Item 1: the scene scaled by s renders the image of s = 1.
+class StabilityScale : public ::testing::TestWithParam<double> {};
+
+TEST_P(StabilityScale, SameImageAsUnitScene) {
+  static const RenderResult unit = render(scene_from(base_scene_json()), kSpp, 1);
+  const double s = GetParam();
+  RenderResult r = render(transformed(scene_from(base_scene_json()), s, dvec3(0)), kSpp, 2);
+  EXPECT_SAME_IMAGE(r, unit, "A = scaled by " << s << ", B = unit scene");
+}
+
+INSTANTIATE_TEST_SUITE_P(Scales, StabilityScale, ::testing::Values(1e-4, 1e-2, 1e2, 1e4, 1e6),
+                         [](const ::testing::TestParamInfo<double>& i) {
+                           return exp_name(i.param);
+                         });
+
+// Negative control: the comparison above sees a 5% change of the point light's intensity.
+TEST(StabilityScale, NegativeControlBrighterPointLight) {
+  Scene a = scene_from(base_scene_json());
+  Scene b = a;
+  b.lights[0].intensity *= 1.05;
+  CompareResult cmp = lucent::compare_images(render(a, kSpp, 1), render(b, kSpp, 2));
+  EXPECT_FALSE(cmp.passed) << cmp.summary();
+}
+
+// Item 2: the scene (objects of size 10-120) translated by an offset on every axis renders the
+// image of the untranslated scene. At 1e5 the float spacing of coordinates is 2^-7 = 0.0078,
+// 1/1300 of the smallest object and 1/500 of a pixel's footprint.
+class StabilityTranslate : public ::testing::TestWithParam<double> {};
+
+TEST_P(StabilityTranslate, SameImageAsAtOrigin) {
+  const double s = 20;
+  static const RenderResult at_origin =
+      render(transformed(scene_from(base_scene_json()), s, dvec3(0)), kSpp, 1);
+  const double t = GetParam();
+  RenderResult r = render(transformed(scene_from(base_scene_json()), s, dvec3(t)), kSpp, 2);
+  EXPECT_SAME_IMAGE(r, at_origin, "A = translated by " << t << ", B = at the origin");
+}
+
+INSTANTIATE_TEST_SUITE_P(Offsets, StabilityTranslate, ::testing::Values(1e3, 1e5),
+                         [](const ::testing::TestParamInfo<double>& i) {
+                           return exp_name(i.param);
+                         });
+
+// Item 3: camera rays grazing a diffuse plane z = 0 (vertices at +-1e7), cos(theta) between the
+// view ray and the plane's normal from 5e-7 to 1.5e-6 over the image (camera 1 above the plane,
+// looking at a point 1e6 away, vertical field of view 1e-6 rad). Lights: a constant environment
+// L_env (the plane sees its whole upper hemisphere: radiance albedo L_env) and a point light of
+// intensity I at height H = 1e8 above (1e6, 0, 0) (radiance albedo/pi I H / r^3). Expected value
+// per pixel from the hit point of the pixel's centre ray (double precision); over one pixel's
+// footprint the point light's term varies by < 1e-5 relative. One-sample z-test (see the top).
+TEST(StabilityGrazing, DiffusePlaneAtGrazingView) {
+  const double H = 1e8, I = 3e16, Lenv = 0.2, albedo[3] = {0.7, 0.5, 0.3};
+  const double fov = 2 * std::atan(0.5e-6) * 180 / M_PI;
+  char buf[2048];
+  std::snprintf(buf, sizeof buf, R"({
+    "camera": {"position": [0, 0, 1], "look_at": [1e6, 0, 0], "up": [0, 0, 1], "fov": %.17g},
+    "film": {"width": 16, "height": 16},
+    "integrator": {"type": "path", "max_depth": 3},
+    "materials": {"plane": {"type": "diffuse", "albedo": [0.7, 0.5, 0.3]}},
+    "shapes": [{"type": "triangles", "material": "plane",
+                "positions": [[-1e7,-1e7,0],[1e7,-1e7,0],[1e7,1e7,0],[-1e7,1e7,0]],
+                "indices": [0,1,2, 0,2,3]}],
+    "lights": [{"type": "point", "position": [1e6, 0, %.17g], "intensity": [%.17g, %.17g, %.17g]},
+               {"type": "environment", "radiance": [%g, %g, %g]}]})",
+                fov, H, I, I, I, Lenv, Lenv, Lenv);
+  // 256 samples: the environment is chosen for about 5% of the light samples, and a pixel's
+  // sample variance needs a few of them
+  RenderResult r = render(scene_from(buf), 256, 3);
+  // the camera model of docs/rendering-model.md, in double
+  const dvec3 pos(0, 0, 1), fwd = glm::normalize(dvec3(1e6, 0, -1));
+  const dvec3 right = glm::normalize(glm::cross(fwd, dvec3(0, 0, 1)));
+  const dvec3 up = glm::cross(right, fwd);
+  const double th = std::tan(fov * M_PI / 360);
+  double min_cos = 1, max_cos = 0;
+  expect_matches(r, [&](int x, int y, int c) {
+    dvec3 d = glm::normalize(fwd + (2 * (x + 0.5) / 16 - 1) * th * right +
+                             (1 - 2 * (y + 0.5) / 16) * th * up);
+    min_cos = std::min(min_cos, -d.z);
+    max_cos = std::max(max_cos, -d.z);
+    dvec3 q = pos + (-pos.z / d.z) * d;
+    dvec3 to(1e6 - q.x, -q.y, H);
+    double rr = glm::length(to);
+    return albedo[c] * Lenv + albedo[c] / M_PI * I * H / (rr * rr * rr);
+  });
+  EXPECT_LT(min_cos, 0.6e-6);
+  EXPECT_GT(max_cos, 1.4e-6);
+}
+
+// ------------------------------------------------------------------------------------------
+// Item 4: degenerate and non-finite triangles are dropped by pack_scene with one warning; the
+// image is then the image without them, bit for bit (same seed, same packed scene).
+
+std::vector<std::string>& captured() {
+  static std::vector<std::string> c;
+  return c;
+}
+struct CaptureWarnings {
+  CaptureWarnings() {
+    captured().clear();
+    lucent::scene_detail::set_warning_sink([](const std::string& m) { captured().push_back(m); });
+  }
+  ~CaptureWarnings() { lucent::scene_detail::set_warning_sink(nullptr); }
+};
+
+TEST(StabilityInput, DegenerateAndNonFiniteTrianglesAreSkipped) {
+  Scene clean = scene_from(base_scene_json());
+  Scene dirty = clean;
+  const double nan = std::nan(""), inf = INFINITY;
+  const int green = dirty.find_material("green"), lamp = dirty.find_material("lamp");
+  ASSERT_GE(green, 0);
+  ASSERT_GE(lamp, 0);
+  auto add = [&](dvec3 a, dvec3 b, dvec3 c, int material) {
+    int base = static_cast<int>(dirty.positions.size());
+    dirty.positions.insert(dirty.positions.end(), {a, b, c});
+    lucent::Triangle t;
+    t.v[0] = base;
+    t.v[1] = base + 1;
+    t.v[2] = base + 2;
+    t.material = material;
+    dirty.triangles.push_back(t);
+  };
+  add({0, 1, 0}, {0, 1, 0}, {0, 1, 0}, green);              // one point
+  add({-1, 0.5, 0}, {-1, 0.5, 0}, {1, 0.7, 0.5}, green);    // duplicate vertex
+  add({-1, 0.25, 1}, {0, 0.375, 1}, {2, 0.625, 1}, green);  // collinear
+  add({-1, 0.3, 1}, {0, 0.3, 1}, {0.5, 0.3, 1}, lamp);      // collinear, emissive
+  add({nan, 0, 0}, {1, 0, 0}, {0, 1, 0}, green);            // NaN vertex
+  add({0, 0.5, 2}, {1, nan, 2}, {0, 1, 2}, lamp);           // NaN vertex, emissive
+  add({0, 0.5, 2}, {1, 0.5, 2}, {0, inf, 2}, green);        // infinite vertex
+  add({-inf, 0.5, 2}, {inf, 0.5, 2}, {0, 1, 2}, green);     // infinite, NaN area
+  CaptureWarnings warnings;
+  RenderResult a = render(clean, 64, 5), b = render(dirty, 64, 5);
+  ASSERT_EQ(captured().size(), 1u);
+  EXPECT_NE(captured()[0].find("skipped 8 degenerate or non-finite triangle(s)"), std::string::npos)
+      << captured()[0];
+  EXPECT_CLEAN(a);
+  EXPECT_CLEAN(b);
+  ASSERT_EQ(a.mean.width, b.mean.width);
+  double worst = 0;
+  for (int y = 0; y < a.mean.height; ++y)
+    for (int x = 0; x < a.mean.width; ++x)
+      for (int c = 0; c < 3; ++c)
+        worst = std::max(worst, double(std::abs(a.mean.pixel(x, y)[c] - b.mean.pixel(x, y)[c])));
+  EXPECT_EQ(worst, 0.0);
+}
+
+// A triangle with area in double that collapses to one point in float (sides of 1e-5 at 1e4 from
+// the origin, where floats are 1e-3 apart) is kept by pack_scene. Emissive, with enough power to
+// be chosen for about half of the light samples, it must neither produce NaN nor change the
+// expected image: two-sample z-test against the scene without it (see the top).
+TEST(StabilityInput, EmitterDegenerateOnlyInFloat) {
+  Scene clean = scene_from(base_scene_json());
+  Scene dirty = clean;
+  lucent::Material hot;
+  hot.name = "hot";
+  hot.albedo = dvec3(0);
+  hot.emission = dvec3(2e12);
+  dirty.materials.push_back(hot);
+  int base = static_cast<int>(dirty.positions.size());
+  dirty.positions.insert(dirty.positions.end(), {dvec3(1e4, 1e4, 1e4), dvec3(1e4 + 1e-5, 1e4, 1e4),
+                                                 dvec3(1e4, 1e4 + 1e-5, 1e4)});
+  lucent::Triangle t;
+  t.v[0] = base;
+  t.v[1] = base + 1;
+  t.v[2] = base + 2;
+  t.material = static_cast<int>(dirty.materials.size()) - 1;
+  dirty.triangles.push_back(t);
+  CaptureWarnings warnings;
+  RenderResult a = render(dirty, kSpp, 6), b = render(clean, kSpp, 7);
+  EXPECT_TRUE(captured().empty());
+  EXPECT_SAME_IMAGE(a, b, "A = with the float-degenerate emitter, B = without");
+}
+
+// ------------------------------------------------------------------------------------------
+// Item 5: materials and lights at the extremes.
+
+std::string glass_scene(const std::string& glass_material, bool with_glass, bool point_light) {
+  return std::string(R"({
+    "camera": {"position": [0, 1.2, 5], "look_at": [0, 0.4, 0], "fov": 38},
+    "film": {"width": 24, "height": 24},
+    "integrator": {"type": "path", "max_depth": 64},
+    "materials": {"floor": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
+                  "red": {"type": "diffuse", "albedo": [0.8, 0.25, 0.2]},
+                  "glass": )") +
+         glass_material + R"(,
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [6, 5, 4]}},
+    "shapes": [{"type": "triangles", "material": "floor",
+                "positions": [[-3,0,-3],[3,0,-3],[3,0,3],[-3,0,3]], "indices": [0,2,1, 0,3,2]},
+               {"type": "sphere", "center": [-0.8, 0.6, 0], "radius": 0.6, "material": "red"},
+               )" +
+         (with_glass
+              ? R"({"type": "sphere", "center": [0.3, 0.5, 1.3], "radius": 0.5, "material": "glass"},
+               )"
+              : "") +
+         R"({"type": "sphere", "center": [1.2, 2.2, 1.0], "radius": 0.5, "material": "lamp"}],
+    "lights": [{"type": "environment", "radiance": [0.3, 0.35, 0.4]})" +
+         (point_light ? R"(, {"type": "point", "position": [2, 4, 3], "intensity": [30, 28, 25]})"
+                      : "") +
+         "]}";
+}
+
+// A glass sphere of ior 1 is invisible. Area and environment lights only: a point light's shadow
+// ray cannot pass a specular surface, so with a point light the sphere would (correctly, for a
+// path tracer without caustic paths from point lights) cast a shadow. max_depth 64: the two extra
+// segments through the sphere do not truncate the paths measurably.
+TEST(StabilityMaterial, GlassOfIor1IsInvisible) {
+  const char* glass = R"({"type": "dielectric", "ior": 1.0, "tint": [1, 1, 1]})";
+  RenderResult with = render(scene_from(glass_scene(glass, true, false)), kSpp, 8);
+  RenderResult without = render(scene_from(glass_scene(glass, false, false)), kSpp, 9);
+  EXPECT_SAME_IMAGE(with, without, "A = with the ior-1 sphere, B = without");
+}
+
+// Kernel against the independent reference (same two-sample test, reference with another seed).
+void expect_kernel_matches_reference(const Scene& scene, int spp) {
+  RenderResult k = render(scene, spp, 10);
+  Scene rs = scene;
+  rs.integrator.seed = 11;
+  lucent::ReferenceOptions ro;
+  ro.spp = spp;
+  ro.threads = 2;
+  RenderResult r = lucent::render_reference(rs, ro);
+  EXPECT_SAME_IMAGE(k, r, "A = kernel, B = reference");
+}
+
+// ior 1/1.5 (an air bubble: total internal reflection on the outside for cos < 0.745) and
+// ior 1.5 (total internal reflection inside), ior 10.
+TEST(StabilityMaterial, GlassIorInverseAndTen) {
+  for (const char* ior : {"0.6666666666666666", "1.5", "10"}) {
+    SCOPED_TRACE(std::string("ior ") + ior);
+    std::string glass =
+        std::string(R"({"type": "dielectric", "ior": )") + ior + R"(, "tint": [1, 1, 1]})";
+    Scene s = scene_from(glass_scene(glass, true, true));
+    s.integrator.max_depth = 12;
+    expect_kernel_matches_reference(s, 128);
+  }
+}
+
+// Diffuse albedo 0 (black) and 1 (white) spheres, kernel against the reference.
+TEST(StabilityMaterial, AlbedoZeroAndOne) {
+  Scene s = scene_from(glass_scene(R"({"type": "diffuse", "albedo": [1, 1, 1]})", true, true));
+  s.materials[s.find_material("red")].albedo = dvec3(0);
+  s.integrator.max_depth = 12;
+  expect_kernel_matches_reference(s, 128);
+}
+
+// A tiny, very bright sphere light of fixed power: radius 1e-4 with radiance scaled by
+// (0.1 / 1e-4)^2 lights a plane exactly as radius 0.1 does (outside a uniform sphere its
+// irradiance is pi L (R / D)^2 cos theta, the same for the same L R^2; no occluder, so no
+// penumbra). Two-sample z-test.
+TEST(StabilityLight, TinyBrightSphereMatchesLargerSphere) {
+  auto scene = [](double r, double le) {
+    char buf[1024];
+    std::snprintf(buf, sizeof buf, R"({
+      "camera": {"position": [0, -3, 1], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 40},
+      "film": {"width": 16, "height": 16},
+      "integrator": {"type": "path", "max_depth": 3},
+      "materials": {"plane": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
+                    "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [%.17g, %.17g, %.17g]}},
+      "shapes": [{"type": "triangles", "material": "plane",
+                  "positions": [[-50,-50,0],[50,-50,0],[50,50,0],[-50,50,0]], "indices": [0,1,2, 0,2,3]},
+                 {"type": "sphere", "center": [0.2, 0.1, 2], "radius": %.17g, "material": "lamp"}]})",
+                  le, 0.8 * le, 0.6 * le, r);
+    return scene_from(buf);
+  };
+  RenderResult big = render(scene(0.1, 10), kSpp, 12);
+  RenderResult tiny = render(scene(1e-4, 10 * 1e6), kSpp, 13);
+  EXPECT_SAME_IMAGE(tiny, big, "A = radius 1e-4, B = radius 0.1");
+}
+
+// The same tiny sphere in the full test scene (shadows, interreflection) matches a point light
+// of the same intensity, I = pi r^2 L.
+TEST(StabilityLight, TinyBrightSphereMatchesPointLight) {
+  Scene tiny = scene_from(base_scene_json());
+  const int lamp = tiny.find_material("lamp");
+  const double r = 1e-4, scale = (0.3 / r) * (0.3 / r);
+  tiny.materials[lamp].emission *= scale;
+  tiny.spheres.back().radius = r;
+  Scene point = scene_from(base_scene_json());
+  lucent::Light l;
+  l.type = lucent::LightType::Point;
+  l.position = point.spheres.back().center;
+  l.intensity = M_PI * 0.3 * 0.3 * point.materials[lamp].emission;
+  point.spheres.pop_back();
+  point.lights.push_back(l);
+  RenderResult a = render(tiny, kSpp, 14), b = render(point, kSpp, 15);
+  EXPECT_SAME_IMAGE(a, b, "A = sphere of radius 1e-4, B = point light");
+}
+
+// A closed box (12 inward-facing triangles) whose walls all emit Le and reflect with albedo rho,
+// camera inside: every pixel's expected value is Le (1 - rho^N) / (1 - rho) for max_depth N
+// (N terms of the Neumann series). One-sample z-test (see the top).
+std::string closed_box(double rho, int max_depth, int rr_depth, int size) {
+  char buf[2048];
+  std::snprintf(buf, sizeof buf, R"({
+    "camera": {"position": [0.1, 0.2, 0.3], "look_at": [0.5, -0.2, -1], "fov": 70},
+    "film": {"width": %d, "height": %d},
+    "integrator": {"type": "path", "max_depth": %d, "rr_depth": %d},
+    "materials": {"wall": {"type": "diffuse", "albedo": [%.17g, %.17g, %.17g], "emission": [1, 0.5, 0.25]}},
+    "shapes": [{"type": "triangles", "material": "wall",
+                "positions": [[-1,-1,-1],[1,-1,-1],[-1,1,-1],[1,1,-1],[-1,-1,1],[1,-1,1],[-1,1,1],[1,1,1]],
+                "indices": [0,3,2, 0,1,3, 4,7,5, 4,6,7, 0,5,1, 0,4,5, 2,7,6, 2,3,7,
+                            0,6,4, 0,2,6, 1,7,3, 1,5,7]}]})",
+                size, size, max_depth, rr_depth, rho, rho, rho);
+  return buf;
+}
+
+void expect_closed_box(double rho, int max_depth, int rr_depth, int size, int spp) {
+  RenderResult r = render(scene_from(closed_box(rho, max_depth, rr_depth, size)), spp, 16);
+  const double le[3] = {1, 0.5, 0.25}, k = (1 - std::pow(rho, max_depth)) / (1 - rho);
+  expect_matches(r, [&](int, int, int c) { return le[c] * k; });
+}
+
+// albedo 0.99, 1000 segments on every path (Russian roulette from depth 1000): 100 Le.
+TEST(StabilityDepth, ClosedBoxAlbedo099Depth1000) { expect_closed_box(0.99, 1000, 1000, 6, 4); }
+
+// albedo 0.9, depth 1000 with Russian roulette from depth 4: 10 Le.
+TEST(StabilityDepth, ClosedBoxAlbedo09Depth1000RussianRoulette) {
+  expect_closed_box(0.9, 1000, 4, 12, 1024);
+}
+
+// albedo 0.99 with Russian roulette: finite, no NaN. No z-test: with survival capped at 0.95
+// (docs/rendering-model.md) the throughput grows by 0.99 / 0.95 per surviving bounce and the
+// estimator, though unbiased, has infinite variance (0.95 (0.99 / 0.95)^2 > 1): sample means
+// sit below 100 Le most of the time and the sample variance means nothing.
+TEST(StabilityDepth, ClosedBoxAlbedo099RussianRouletteStaysFinite) {
+  RenderResult r = render(scene_from(closed_box(0.99, 1000, 4, 16)), 16, 17);
+  EXPECT_CLEAN(r);
+}
+
+}  // namespace
