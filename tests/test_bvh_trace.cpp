@@ -261,7 +261,7 @@ void add_spheres(Scene& sc, int n, unsigned seed, float rmin, float rmax, float 
 
 TEST_F(BvhTrace, RandomTriangleSoup) {
   Scene s = soup(1000, 11, 0.06f);
-  compare(s, random_rays(30000, 12), false, "soup");
+  compare(s, random_rays(20000, 12), false, "soup");
 }
 
 TEST_F(BvhTrace, SphereSets) {
