@@ -25,7 +25,6 @@ namespace {
 
 constexpr int kBins = 32;
 constexpr std::size_t kSpawnSize = 2048;  // subtrees at least this large go to the shared queue
-constexpr lc_uint kChunk = 512;           // node pairs are taken from the shared counter in chunks
 constexpr std::size_t kParallelBinSize = 1u << 17;  // nodes this large bin on every thread
 constexpr unsigned kMaxDepth = 64;  // = LC_BVH_STACK_SIZE in kernels/bvh/traverse.cl
 
@@ -132,8 +131,12 @@ struct PrimRef {
 };
 static_assert(sizeof(PrimRef) == 32, "PrimRef should stay 32 bytes");
 
+// A node to build. Scratch node slots are handed out without any shared counter: a node of k
+// primitives has at most 2k - 2 descendants, so it owns the block [block, block + 2k - 2) and
+// splits it exactly between its two children (pair, left block of 2a - 2, right block of 2b - 2).
 struct Task {
-  lc_uint node;  // index in the scratch node array
+  lc_uint node;   // index in the scratch node array
+  lc_uint block;  // first slot of the block for the node's descendants
   std::size_t begin, end;
   unsigned depth;  // root: 1
   Box box;         // bounds of the primitives
@@ -217,16 +220,13 @@ class Builder {
         max_leaf_(static_cast<std::size_t>(std::max(1, options.max_leaf_size))),
         threads_(threads),
         traversal_cost_(options.traversal_cost) {
-    // every task allocates node pairs from its own chunks: at most one partly used chunk per task
-    std::size_t tasks = 2 * refs.size() / kSpawnSize + 2;
-    capacity_ = 2 * refs.size() + tasks * kChunk;
-    nodes_.reset(new lc_bvh_node[capacity_]);
+    nodes_.reset(new lc_bvh_node[std::max<std::size_t>(1, 2 * refs.size() - 1)]);
   }
 
   // Builds the tree over refs_, whose bounds and centroid bounds are given; returns the number
   // of scratch nodes.
   std::size_t run(const Box& box, const Box& cbox) {
-    Task root{0, 0, refs_.size(), 1, box, cbox};
+    Task root{0, 1, 0, refs_.size(), 1, box, cbox};
     queue_.push_back(root);
     pending_ = 1;
     std::vector<std::thread> pool;
@@ -327,7 +327,6 @@ class Builder {
 
   void build_subtree(Task root) {
     std::vector<Task> stack{root};
-    lc_uint chunk_next = 0, chunk_end = 0;
     std::size_t interior = 0;
     while (!stack.empty()) {
       Task t = stack.back();
@@ -340,7 +339,7 @@ class Builder {
         continue;
       }
       float cext = t.cbox.max_extent();
-      Task l{0, t.begin, 0, t.depth + 1, {}, {}}, r{0, 0, t.end, t.depth + 1, {}, {}};
+      Task l{0, 0, t.begin, 0, t.depth + 1, {}, {}}, r{0, 0, 0, t.end, t.depth + 1, {}, {}};
       std::size_t mid;
       bool guard = t.depth + ceil_log2((n + max_leaf_ - 1) / max_leaf_) + 1 >= kMaxDepth;
       if (!(cext > 0) || guard) {
@@ -416,17 +415,14 @@ class Builder {
       }
       l.end = mid;
       r.begin = mid;
-      if (chunk_next == chunk_end) {
-        chunk_next = next_node_.fetch_add(kChunk);
-        chunk_end = chunk_next + kChunk;
-      }
-      lc_uint left = chunk_next;
-      chunk_next += 2;
+      lc_uint left = t.block;
       ++interior;
       node.left_first = left;
       node.count = 0;
       l.node = left;
       r.node = left + 1;
+      l.block = left + 2;
+      r.block = static_cast<lc_uint>(left + 2 * (l.end - l.begin));
       // the larger child continues here, the other goes to the pool when it is big enough
       Task& big = (l.end - l.begin) >= (r.end - r.begin) ? l : r;
       Task& small = &big == &l ? r : l;
@@ -443,9 +439,7 @@ class Builder {
   std::size_t max_leaf_;
   unsigned threads_;
   float traversal_cost_;
-  std::size_t capacity_;
-  std::unique_ptr<lc_bvh_node[]> nodes_;  // scratch tree, not zeroed
-  std::atomic<lc_uint> next_node_{2};     // node 0 is the root; pairs start at even indices
+  std::unique_ptr<lc_bvh_node[]> nodes_;  // scratch tree (2n - 1 slots, not zeroed)
   std::atomic<std::size_t> interior_{0};
   std::atomic<std::size_t> max_depth_{0};
   std::mutex mutex_;
