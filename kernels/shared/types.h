@@ -98,7 +98,9 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle_attr, uv) == 36, triangle_attr_uv);
 /* Primitive references stored in BVH leaves: a triangle index, or a sphere index with this bit. */
 #define LC_PRIM_SPHERE_BIT 0x80000000u
 
-/* BVH2 node, flattened depth-first; children of an interior node are adjacent. */
+/* BVH2 node. nodes[0] is the root; nodes[1] is unused padding so that every sibling pair starts
+ * at an even index and the two boxes of a traversal step share one 64-byte cache line; children
+ * of an interior node are adjacent (left at an even index, right = left + 1). */
 typedef struct LC_ALIGN16 lc_bvh_node {
   float bmin[3];      /* bounds minimum                                                    */
   lc_uint left_first; /* interior: index of the left child (right = left + 1); leaf: first
