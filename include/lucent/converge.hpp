@@ -67,9 +67,12 @@ struct ConvergeFit {
   double tail_slope_spp = 0;  ///< the same over the last three rungs (flattens when biased)
   /// relMSE / noise_relmse at the last rung: about 1 when the error is all noise.
   double excess_ratio = 0;
-  /// Biased: at the last rung the error is more than twice what the noise explains, i.e. the
-  /// squared bias exceeds the variance and the curve has turned flat. (Without a variance
-  /// estimate, a tail slope flatter than -0.5 decides.)
+  /// Biased: at the last rung the error exceeds what the noise explains by more than 30%
+  /// (kBiasRatio), i.e. the squared bias is over 0.3 x the variance and the curve is turning flat
+  /// towards it. (Without a variance estimate, a tail slope flatter than -0.5 decides.) An
+  /// unbiased setting stays near 1: the measured error and the variance estimate come from the
+  /// same samples, over every pixel-channel.
+  static constexpr double kBiasRatio = 1.3;
   bool biased = false;
   double bias_relmse = 0;  ///< relMSE - noise_relmse at the last rung: the floor
   /// Render time at which the noise (extrapolated as 1/t from the last rung) falls below the

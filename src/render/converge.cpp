@@ -197,7 +197,7 @@ ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
   const ConvergePoint& last = points.back();
   if (last.noise_relmse > 0) {
     f.excess_ratio = last.relmse / last.noise_relmse;
-    f.biased = f.excess_ratio > 2.0;
+    f.biased = f.excess_ratio > ConvergeFit::kBiasRatio;
   } else {
     f.biased = points.size() >= 3 && f.tail_slope_spp > -0.5;
   }
@@ -214,8 +214,11 @@ ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
     // noise ~ c / t: it falls to the floor at t = noise * t_last / bias
     double ratio = last.noise_relmse / f.bias_relmse;
     f.floor_seconds = last.seconds * ratio;
-    where = " (noise falls below it after ~" + fmt("%.3g", f.floor_seconds) + " s, ~" +
-            fmt("%.3g", std::max(1.0, double(last.spp) * ratio)) + " spp)";
+    if (f.floor_seconds < points.front().seconds)
+      where = " (the bias dominates from the first rung on)";
+    else
+      where = " (the noise falls below it after ~" + fmt("%.3g", f.floor_seconds) + " s, ~" +
+              fmt("%.3g", double(last.spp) * ratio) + " spp)";
   }
   f.verdict = "biased: error stops decreasing at ~relMSE " + fmt("%.2e", f.bias_relmse) + where;
   return f;
