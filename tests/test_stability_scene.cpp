@@ -315,6 +315,25 @@ TEST(StabilityInput, DegenerateAndNonFiniteTrianglesAreSkipped) {
   EXPECT_EQ(worst, 0.0);
 }
 
+// Spheres with a NaN centre or radius (possible through the API only: the JSON loader rejects
+// non-finite numbers) are never hit: no crash, no NaN, the image of the scene without them (same
+// seed: bit for bit). pack_scene gives no warning for them (it does for triangles).
+TEST(StabilityInput, NonFiniteSpheresAreNeverHit) {
+  Scene clean = scene_from(base_scene_json());
+  Scene dirty = clean;
+  lucent::Sphere sp;
+  sp.center = dvec3(std::nan(""), 0, 0);
+  dirty.spheres.push_back(sp);
+  sp.center = dvec3(0, 0.5, 0);
+  sp.radius = std::nan("");
+  dirty.spheres.push_back(sp);
+  RenderResult a = render(clean, 64, 5), b = render(dirty, 64, 5);
+  EXPECT_CLEAN(a);
+  EXPECT_CLEAN(b);
+  CompareResult cmp = lucent::compare_images(a, b);
+  EXPECT_EQ(cmp.max_abs_error, 0.0) << cmp.summary();
+}
+
 // A triangle with area in double that collapses to one point in float (sides of 1e-5 at 1e4 from
 // the origin, where floats are 1e-3 apart) is kept by pack_scene. Emissive, with enough power to
 // be chosen for about half of the light samples, it must neither produce NaN nor change the
@@ -403,6 +422,23 @@ TEST(StabilityMaterial, GlassIorInverseAndTen) {
     Scene s = scene_from(glass_scene(glass, true, true));
     s.integrator.max_depth = 12;
     expect_kernel_matches_reference(s, 128);
+  }
+}
+
+// The same, close up: the glass sphere fills most of the image, so that the reflected and the
+// refracted parts of the floor, the lamp and the sky weigh on many pixels (Fresnel at every
+// angle of incidence, total internal reflection inside for ior 1.5 and 10, outside for 1/1.5).
+TEST(StabilityMaterial, GlassCloseUpIorInverseAndTen) {
+  for (const char* ior : {"0.6666666666666666", "1.5", "10"}) {
+    SCOPED_TRACE(std::string("ior ") + ior);
+    std::string glass =
+        std::string(R"({"type": "dielectric", "ior": )") + ior + R"(, "tint": [1, 1, 1]})";
+    Scene s = scene_from(glass_scene(glass, true, true));
+    s.camera.position = dvec3(0.5, 1.1, 2.9);
+    s.camera.look_at = dvec3(0.3, 0.5, 1.3);
+    s.camera.fov_degrees = 30;
+    s.integrator.max_depth = 12;
+    expect_kernel_matches_reference(s, 256);
   }
 }
 
