@@ -8,11 +8,12 @@ namespace {
 
 template <typename T>
 cl::Buffer make_buffer(const cl_util::Context& ctx, const std::vector<T>& v) {
-  // OpenCL forbids empty buffers: keep one (zeroed) element
-  size_t bytes = std::max<size_t>(1, v.size()) * sizeof(T);
-  cl::Buffer b(ctx.context, CL_MEM_READ_ONLY, bytes);
-  if (!v.empty()) ctx.queue.enqueueWriteBuffer(b, CL_FALSE, 0, v.size() * sizeof(T), v.data());
-  return b;
+  // OpenCL forbids empty buffers: keep one element. The data is copied when the buffer is
+  // created (CL_MEM_COPY_HOST_PTR), so `v` may be a temporary: an asynchronous write from it
+  // would read freed memory (AddressSanitizer caught exactly that).
+  if (v.empty()) return cl::Buffer(ctx.context, CL_MEM_READ_ONLY, sizeof(T));
+  return cl::Buffer(ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T),
+                    const_cast<T*>(v.data()));
 }
 
 }  // namespace

@@ -12,7 +12,7 @@ struct DeviceScene {
   cl::Buffer params, nodes, prim_refs, triangles, tri_attrs, spheres, materials, lights, light_cdf,
       textures, texels;
 
-  /// Creates the buffers and enqueues their upload on ctx.queue (non-blocking).
+  /// Creates the buffers with their contents (copied at creation).
   DeviceScene(const cl_util::Context& ctx, const PackedScene& packed);
 
   /// Sets kernel arguments first .. first + kArgCount - 1; returns the next argument index.
