@@ -12,7 +12,7 @@ struct Series {
 
 struct LogLogPlot {
   std::string title, x_label, y_label;
-  int width = 760, height = 480;
+  int width = 900, height = 500;
   std::vector<Series> series;
 };
 
