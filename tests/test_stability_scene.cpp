@@ -258,6 +258,47 @@ TEST(StabilityGrazing, DiffusePlaneAtGrazingView) {
   EXPECT_GT(max_cos, 1.4e-6);
 }
 
+// A sphere light (radius 0.5, 2 above) over a plane, translated by t on every axis: next-event
+// estimation must not shadow the light with itself. A point sampled on the light is only known to
+// a few ulps of t (1e-3 at 1e4), which the shadow ray's end must allow for.
+// - t = 1e3: the two-sample z-test against the untranslated scene (see the top).
+// - t = 1e4: float spacing is 1e-3, and the ray origin must leave the plane by ~20 ulps (its
+//   error bound), 0.02 closer to the light: ~1% brighter by construction. Tolerance test: the
+//   image mean within 2% of the untranslated one. (Before the fix in shadow_visible the shadow
+//   rays hit the light itself and the image was 20% too dark.)
+Scene sphere_light_over_plane(double t) {
+  char buf[2048];
+  std::snprintf(buf, sizeof buf, R"({
+      "camera": {"position": [%.17g, %.17g, %.17g], "look_at": [%.17g, %.17g, %.17g],
+                 "up": [0, 0, 1], "fov": 40},
+      "film": {"width": 16, "height": 16},
+      "integrator": {"type": "path", "max_depth": 2},
+      "materials": {"plane": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
+                    "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [4, 4, 4]}},
+      "shapes": [{"type": "triangles", "material": "plane",
+                  "positions": [[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],
+                                [%.17g,%.17g,%.17g]], "indices": [0,1,2, 0,2,3]},
+                 {"type": "sphere", "center": [%.17g, %.17g, %.17g], "radius": 0.5,
+                  "material": "lamp"}]})",
+                t, t - 3, t + 1, t, t, t, t - 5, t - 5, t, t + 5, t - 5, t, t + 5, t + 5, t, t - 5,
+                t + 5, t, t + 0.2, t + 0.1, t + 2);
+  return scene_from(buf);
+}
+
+TEST(StabilityTranslateLight, SphereLightOverPlaneAt1e3) {
+  RenderResult a = render(sphere_light_over_plane(1e3), kSpp, 2);
+  RenderResult b = render(sphere_light_over_plane(0), kSpp, 1);
+  EXPECT_SAME_IMAGE(a, b, "A = translated by 1e3, B = at the origin");
+}
+
+TEST(StabilityTranslateLight, SphereLightOverPlaneAt1e4) {
+  RenderResult a = render(sphere_light_over_plane(1e4), kSpp, 2);
+  RenderResult b = render(sphere_light_over_plane(0), kSpp, 1);
+  CompareResult cmp = lucent::compare_images(a, b);
+  EXPECT_NEAR(cmp.mean_a[1] / cmp.mean_b[1], 1.0, 0.02) << cmp.summary();
+  EXPECT_CLEAN(a);
+}
+
 // ------------------------------------------------------------------------------------------
 // Item 4: degenerate and non-finite triangles are dropped by pack_scene with one warning; the
 // image is then the image without them, bit for bit (same seed, same packed scene).
