@@ -2,6 +2,8 @@
 // LUCENT_KERNEL_DIR when set, and a build failure shows the log with kernels/<file>:<line>.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -81,7 +83,28 @@ TEST(KernelSource, EmbeddedSourcesWorkFromAnyDirectory) {
   for (float v : img.rgb) EXPECT_NEAR(v, 0.6f, 1e-6f);
 }
 
+// Restores LUCENT_KERNEL_DIR as it was when the test started (a planted-bug run sets it for
+// the whole test program; a test that left it unset would hide the planted kernel from every
+// later test).
+struct KernelDirGuard {
+  std::string saved;
+  bool had = false;
+  KernelDirGuard() {
+    if (const char* v = std::getenv("LUCENT_KERNEL_DIR")) {
+      had = true;
+      saved = v;
+    }
+  }
+  ~KernelDirGuard() {
+    if (had)
+      ::setenv("LUCENT_KERNEL_DIR", saved.c_str(), 1);
+    else
+      ::unsetenv("LUCENT_KERNEL_DIR");
+  }
+};
+
 TEST(KernelSource, AssembledSourceHasLineMarkers) {
+  KernelDirGuard guard;
   ::unsetenv("LUCENT_KERNEL_DIR");
   EXPECT_EQ(lucent::detail::kernel_source_origin(), "embedded");
   std::string src = lucent::detail::assemble_kernel_source("megakernel.cl");
@@ -125,6 +148,7 @@ TEST(KernelSource, KernelDirOverridesTheEmbeddedCopy) {
   }
 
   // the library reads the same directory
+  KernelDirGuard guard;
   ::setenv("LUCENT_KERNEL_DIR", dir.c_str(), 1);
   EXPECT_EQ(lucent::detail::kernel_source_origin(), dir);
   EXPECT_NE(lucent::detail::read_kernel_file("megakernel.cl").find("0.25f, 0.5f, 0.75f"),
