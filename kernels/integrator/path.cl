@@ -161,8 +161,11 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     ray.o = transmit ? lc_spawn_origin(it.p, it.perr, -it.ng) : o;
     prev_p = ray.o; /* light pdfs for MIS are evaluated from where light sampling sampled */
     ray.d = wi;
-    if (depth + 2 > P->rr_depth) {
-      float q = fmin(0.95f, lc_max3(beta));
+    /* Russian roulette: survive with probability max(beta) while it is below 1, so the
+     * throughput after the division never exceeds 1 (a cap such as min(0.95, max(beta)) makes
+     * beta grow like (albedo / 0.95)^n on albedos above 0.95: unbiased, infinite variance) */
+    float q = lc_max3(beta);
+    if (depth + 2 > P->rr_depth && q < 1.0f) {
       if (lc_rand(rng, dim + LC_DIM_RR) >= q) break;
       beta /= q;
     }
