@@ -119,7 +119,11 @@ int run_converge_command() {
   std::set<std::string> seen;
   for (const std::string& s : a.settings) {
     if (!seen.insert(s).second) throw Error("--settings: '" + s + "' is given twice");
-    opt.settings.push_back(parse_converge_setting(s));
+    try {
+      opt.settings.push_back(parse_converge_setting(s));
+    } catch (const Error& e) {
+      throw Error(std::string("--settings: ") + e.what());
+    }
   }
   if (opt.settings.empty()) opt.settings.push_back(ConvergeSetting{});
   opt.time_ladder = a.time_ladder;
