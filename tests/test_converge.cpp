@@ -310,6 +310,30 @@ TEST(Converge, KernelLadderAgainstKernelReference) {
   EXPECT_EQ(paths, 3);
   for (const char* n : names)
     EXPECT_NE(svg.find(std::string(">") + n + " (slope"), std::string::npos);
+
+  // The raster plot: the SVG's size, white background, each series drawn in its colour (sRGB
+  // #1f77b4, #d62728, #2ca02c in the image's linear values)
+  lucent::Image img = lucent::convergence_image(r, "t.json");
+  ASSERT_EQ(img.width, 900);
+  ASSERT_EQ(img.height, 500);
+  EXPECT_FLOAT_EQ(img.pixel(0, 0)[0], 1.0f);
+  const int srgb[3][3] = {{0x1f, 0x77, 0xb4}, {0xd6, 0x27, 0x28}, {0x2c, 0xa0, 0x2c}};
+  for (const auto& c : srgb) {
+    float lin[3];
+    for (int k = 0; k < 3; ++k) {
+      double v = c[k] / 255.0;
+      lin[k] = static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+    }
+    int count = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        const float* p = img.pixel(x, y);
+        if (std::abs(p[0] - lin[0]) < 0.01f && std::abs(p[1] - lin[1]) < 0.01f &&
+            std::abs(p[2] - lin[2]) < 0.01f)
+          ++count;
+      }
+    EXPECT_GT(count, 100) << "colour " << c[0] << "," << c[1] << "," << c[2];
+  }
 }
 
 TEST(Converge, XmlCheckerRejectsMalformedDocuments) {
@@ -352,10 +376,13 @@ TEST(Converge, CommandTimeLadderAndCpuReference) {
   lucent::test::write_file(dir + "/t.json", kScene);
   lucent::test::CommandResult r = lucent::test::run_cli(
       "converge '" + dir + "/t.json' --time-ladder 0.01,0.03 --reference-cpu " +
-      "--reference-spp 1024 --csv '" + dir + "/c.csv'");
+      "--reference-spp 1024 --csv '" + dir + "/c.csv' --plot '" + dir + "/c.png'");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("with the reference integrator"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("unbiased (error/noise"), std::string::npos) << r.out;
+  lucent::Image png = lucent::read_image(dir + "/c.png");
+  EXPECT_EQ(png.width, 900);
+  EXPECT_EQ(png.height, 500);
   std::vector<std::string> csv = split(read_file(dir + "/c.csv"), '\n');
   ASSERT_EQ(csv.size(), 3u);
   for (size_t i = 1; i < csv.size(); ++i) {
@@ -391,6 +418,12 @@ TEST(Converge, CommandErrors) {
   EXPECT_EQ(mismatch.status, 1);
   EXPECT_EQ(lucent::test::count_lines(mismatch.err), 1) << mismatch.err;
   EXPECT_NE(mismatch.err.find("small.exr: size 16x24 differs"), std::string::npos) << mismatch.err;
+
+  lucent::test::CommandResult pdf = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --spp-ladder 2 --plot '" + dir + "/p.pdf'");
+  EXPECT_EQ(pdf.status, 1);
+  EXPECT_NE(pdf.err.find("p.pdf: unknown plot format '.pdf' (use .svg or .png)"), std::string::npos)
+      << pdf.err;
 
   lucent::test::CommandResult both =
       lucent::test::run_cli("converge '" + dir + "/t.json' --reference x.exr --reference-cpu");

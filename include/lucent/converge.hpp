@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "lucent/image.hpp"
 #include "lucent/render.hpp"
 #include "lucent/scene.hpp"
 
@@ -116,5 +117,8 @@ std::string convergence_csv(const ConvergeResult& result);
 /// SVG: relMSE against render time on log-log axes, one path (with point markers) per setting,
 /// axis labels, decade ticks and a legend.
 std::string convergence_svg(const ConvergeResult& result, const std::string& title);
+
+/// The same plot as a linear RGB image (write it with write_image(), e.g. as a PNG).
+Image convergence_image(const ConvergeResult& result, const std::string& title);
 
 }  // namespace lucent

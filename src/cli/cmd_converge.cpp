@@ -3,6 +3,7 @@
 // SVG plot (lucent/converge.hpp).
 #include <CLI/CLI.hpp>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include "lucent/compare.hpp"
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
+#include "lucent/image.hpp"
 #include "lucent/reference.hpp"
 
 namespace lucent::cli {
@@ -73,7 +75,8 @@ CLI::App* add_converge_command(CLI::App& app) {
   cmd->add_option("scene", a.scene, "Scene file (JSON)")->required();
   cmd->add_option("--csv", a.csv,
                   "Write setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s");
-  cmd->add_option("--plot", a.plot, "Write an SVG plot of relMSE against time (log-log)");
+  cmd->add_option("--plot", a.plot,
+                  "Write a plot of relMSE against time (log-log): .svg, or .png (raster)");
   auto* ref = cmd->add_option("--reference", a.reference,
                               "Reference image (.exr with var.*/n layers, .pfm, ...)");
   auto* ref_spp = cmd->add_option("--reference-spp", a.reference_spp,
@@ -112,7 +115,13 @@ CLI::App* add_converge_command(CLI::App& app) {
 int run_converge_command() {
   ConvergeArgs& a = args();
   if (!a.csv.empty()) check_writable(a.csv);
-  if (!a.plot.empty()) check_writable(a.plot);
+  if (!a.plot.empty()) {
+    std::string ext = std::filesystem::path(a.plot).extension().string();
+    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".svg" && ext != ".png")
+      throw Error(a.plot + ": unknown plot format '" + ext + "' (use .svg or .png)");
+    check_writable(a.plot);
+  }
   if (!a.save_reference.empty()) check_writable(a.save_reference);
 
   ConvergeOptions opt;
@@ -199,7 +208,12 @@ int run_converge_command() {
     std::string title = std::filesystem::path(a.scene).filename().string() + ", " +
                         std::to_string(scene.film.width) + "x" + std::to_string(scene.film.height) +
                         ": relMSE against render time";
-    write_text(a.plot, convergence_svg(result, title));
+    std::string ext = std::filesystem::path(a.plot).extension().string();
+    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".png")
+      write_image(a.plot, convergence_image(result, title));
+    else
+      write_text(a.plot, convergence_svg(result, title));
   }
   if (g_stop.load()) {
     std::fprintf(stderr, "lucent: interrupted: the results cover the rungs rendered so far\n");

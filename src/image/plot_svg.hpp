@@ -3,6 +3,8 @@
 #include <string>
 #include <vector>
 
+#include "lucent/image.hpp"
+
 namespace lucent::plot {
 
 struct Series {
@@ -20,6 +22,10 @@ struct LogLogPlot {
 /// labels, a legend, and exactly one <path> element per series (axes, ticks and the frame are
 /// <line>/<rect> elements), with a <circle> marker at each point.
 std::string log_log_svg(const LogLogPlot& plot);
+
+/// The same plot as a linear RGB image (for write_image(), e.g. a PNG): lines, markers and
+/// text (stb_easy_font) drawn at 3x the size and box-filtered down.
+Image log_log_image(const LogLogPlot& plot);
 
 /// Text with &, <, >, " and ' escaped for XML.
 std::string xml_escape(const std::string& text);

@@ -298,7 +298,9 @@ std::string convergence_csv(const ConvergeResult& result) {
   return out;
 }
 
-std::string convergence_svg(const ConvergeResult& result, const std::string& title) {
+namespace {
+
+plot::LogLogPlot convergence_plot(const ConvergeResult& result, const std::string& title) {
   plot::LogLogPlot plot;
   plot.title = title;
   plot.x_label = "render time (s, kernel build excluded)";
@@ -313,7 +315,17 @@ std::string convergence_svg(const ConvergeResult& result, const std::string& tit
       }
     plot.series.push_back(std::move(s));
   }
-  return plot::log_log_svg(plot);
+  return plot;
+}
+
+}  // namespace
+
+std::string convergence_svg(const ConvergeResult& result, const std::string& title) {
+  return plot::log_log_svg(convergence_plot(result, title));
+}
+
+Image convergence_image(const ConvergeResult& result, const std::string& title) {
+  return plot::log_log_image(convergence_plot(result, title));
 }
 
 }  // namespace lucent
