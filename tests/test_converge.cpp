@@ -376,13 +376,17 @@ TEST(Converge, CommandTimeLadderAndCpuReference) {
   lucent::test::write_file(dir + "/t.json", kScene);
   lucent::test::CommandResult r = lucent::test::run_cli(
       "converge '" + dir + "/t.json' --time-ladder 0.01,0.03 --reference-cpu " +
-      "--reference-spp 1024 --csv '" + dir + "/c.csv' --plot '" + dir + "/c.png'");
+      "--reference-spp 1024 --csv '" + dir + "/c.csv' --plot '" + dir + "/c.png' --plot '" + dir +
+      "/c.svg'");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("with the reference integrator"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("unbiased (error/noise"), std::string::npos) << r.out;
   lucent::Image png = lucent::read_image(dir + "/c.png");
   EXPECT_EQ(png.width, 900);
   EXPECT_EQ(png.height, 500);
+  int paths = 0;
+  EXPECT_EQ(check_xml(read_file(dir + "/c.svg"), "path", &paths), "");
+  EXPECT_EQ(paths, 1);
   std::vector<std::string> csv = split(read_file(dir + "/c.csv"), '\n');
   ASSERT_EQ(csv.size(), 3u);
   for (size_t i = 1; i < csv.size(); ++i) {

@@ -26,7 +26,8 @@ namespace {
 
 struct ConvergeArgs {
   std::string scene;
-  std::string csv, plot, reference, save_reference, device;
+  std::string csv, reference, save_reference, device;
+  std::vector<std::string> plots;
   int reference_spp = 0;
   bool reference_cpu = false;
   std::vector<std::string> settings;
@@ -60,6 +61,12 @@ void check_writable(const std::string& path) {
   if (!existed) std::filesystem::remove(path, ec);
 }
 
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
 void write_text(const std::string& path, const std::string& text) {
   std::ofstream f(path, std::ios::binary);
   f << text;
@@ -75,8 +82,9 @@ CLI::App* add_converge_command(CLI::App& app) {
   cmd->add_option("scene", a.scene, "Scene file (JSON)")->required();
   cmd->add_option("--csv", a.csv,
                   "Write setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s");
-  cmd->add_option("--plot", a.plot,
-                  "Write a plot of relMSE against time (log-log): .svg, or .png (raster)");
+  cmd->add_option("--plot", a.plots,
+                  "Write a plot of relMSE against time (log-log): .svg, or .png (raster); may be "
+                  "given more than once");
   auto* ref = cmd->add_option("--reference", a.reference,
                               "Reference image (.exr with var.*/n layers, .pfm, ...)");
   auto* ref_spp = cmd->add_option("--reference-spp", a.reference_spp,
@@ -115,12 +123,11 @@ CLI::App* add_converge_command(CLI::App& app) {
 int run_converge_command() {
   ConvergeArgs& a = args();
   if (!a.csv.empty()) check_writable(a.csv);
-  if (!a.plot.empty()) {
-    std::string ext = std::filesystem::path(a.plot).extension().string();
-    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (const std::string& plot : a.plots) {
+    std::string ext = lower_extension(plot);
     if (ext != ".svg" && ext != ".png")
-      throw Error(a.plot + ": unknown plot format '" + ext + "' (use .svg or .png)");
-    check_writable(a.plot);
+      throw Error(plot + ": unknown plot format '" + ext + "' (use .svg or .png)");
+    check_writable(plot);
   }
   if (!a.save_reference.empty()) check_writable(a.save_reference);
 
@@ -204,16 +211,14 @@ int run_converge_command() {
                 f.slope_time, f.slope_spp, f.tail_slope_spp, f.verdict.c_str());
 
   if (!a.csv.empty()) write_text(a.csv, convergence_csv(result));
-  if (!a.plot.empty()) {
-    std::string title = std::filesystem::path(a.scene).filename().string() + ", " +
-                        std::to_string(scene.film.width) + "x" + std::to_string(scene.film.height) +
-                        ": relMSE against render time";
-    std::string ext = std::filesystem::path(a.plot).extension().string();
-    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".png")
-      write_image(a.plot, convergence_image(result, title));
+  const std::string title = std::filesystem::path(a.scene).filename().string() + ", " +
+                            std::to_string(scene.film.width) + "x" +
+                            std::to_string(scene.film.height) + ": relMSE against render time";
+  for (const std::string& plot : a.plots) {
+    if (lower_extension(plot) == ".png")
+      write_image(plot, convergence_image(result, title));
     else
-      write_text(a.plot, convergence_svg(result, title));
+      write_text(plot, convergence_svg(result, title));
   }
   if (g_stop.load()) {
     std::fprintf(stderr, "lucent: interrupted: the results cover the rungs rendered so far\n");
