@@ -180,13 +180,18 @@ PackedScene pack_scene(const Scene& scene) {
 
   p.bvh = bvh::build(p.triangles, p.spheres);
 
-  // scene radius, for the power of environment lights
+  // Radius of the region that matters, for the power of environment lights: the scene's
+  // bounding radius, but no more than the camera's distance to what it looks at (a ground sphere
+  // of radius 1000 would otherwise make the sky outweigh every point light a thousandfold).
+  // Selection probabilities change only the variance, never the expected value.
   double radius = 1;
   if (!p.bvh.nodes.empty()) {
     const lc_bvh_node& r = p.bvh.nodes[0];
     glm::dvec3 d(r.bmax[0] - r.bmin[0], r.bmax[1] - r.bmin[1], r.bmax[2] - r.bmin[2]);
     radius = std::max(1e-6, 0.5 * glm::length(d));
   }
+  double view = glm::length(scene.camera.look_at - scene.camera.position);
+  if (view > 0 && std::isfinite(view)) radius = std::min(radius, view);
   for (const Light& l : scene.lights) {
     lc_light d{};
     d.texture = -1;
