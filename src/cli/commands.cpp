@@ -25,6 +25,9 @@ int run_compare_command();
 // cmd_info.cpp
 CLI::App* add_info_command(CLI::App& app);
 int run_info_command();
+// cmd_cache.cpp
+CLI::App* add_cache_command(CLI::App& app);
+int run_cache_command();
 // cmd_converge.cpp
 CLI::App* add_converge_command(CLI::App& app);
 int run_converge_command();
@@ -32,12 +35,14 @@ int run_converge_command();
 void register_extra_commands(CLI::App& app) {
   add_compare_command(app);
   add_info_command(app);
+  add_cache_command(app);
   add_converge_command(app);
 }
 
 int run_extra_commands(CLI::App& app) {
   if (app.got_subcommand("compare")) return run_compare_command();
   if (app.got_subcommand("info")) return run_info_command();
+  if (app.got_subcommand("cache")) return run_cache_command();
   if (app.got_subcommand("converge")) return run_converge_command();
   return 0;
 }
