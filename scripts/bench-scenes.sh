@@ -6,7 +6,8 @@
 #   scripts/bench-scenes.sh [BUILD_DIR] [SPP] [RUNS]     (defaults: build, 16, 3)
 #
 # Scenes: scenes/*.json; those that need ../shared assets are skipped when /work/shared (or
-# ../shared beside the project) is absent. Environment: LUCENT_DEVICE selects the device.
+# ../shared beside the project) is absent. Environment: LUCENT_DEVICE selects the device;
+# LUCENT_BENCH_FLAGS adds render options (e.g. "--no-specialize" or "--fast-math").
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -44,7 +45,7 @@ for scene in "$root"/scenes/*.json; do
     for pass in cold warm; do
       log=$work/log
       LUCENT_CACHE_DIR=$cache/lucent POCL_CACHE_DIR=$cache/pocl \
-        "$lucent" render "$scene" --spp "$spp" -o "$work/out.pfm" 2>"$log" >/dev/null ||
+        "$lucent" render "$scene" --spp "$spp" ${LUCENT_BENCH_FLAGS:-} -o "$work/out.pfm" 2>"$log" >/dev/null ||
         { echo "bench-scenes: $name failed: $(tail -1 "$log")" >&2; exit 1; }
       read -r ms mr build_s < <(parse "$log")
       film=$(sed -n 's/.*: \([0-9]*x[0-9]*\), .*/\1/p' "$log" | tail -1)
