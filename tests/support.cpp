@@ -1,13 +1,18 @@
 #include "support.hpp"
 
+#include <gtest/gtest.h>
+
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "lucent/compare.hpp"
 
 namespace lucent::test {
 
@@ -88,6 +93,62 @@ int count_lines(const std::string& s) {
   while (std::getline(in, line))
     if (!line.empty()) ++n;
   return n;
+}
+
+double sidak_z(double alpha, int m) {
+  // per-test level 1 - (1 - alpha)^(1/m), computed without cancellation
+  return normal_two_sided_critical(-std::expm1(std::log1p(-alpha) / m));
+}
+
+double chi2_pvalue(double chi2, int dof) {
+  const double a = dof / 2.0, x = chi2 / 2.0;
+  if (x <= 0) return 1;
+  const double gln = std::lgamma(a);
+  if (x < a + 1) {  // series for P, then Q = 1 - P
+    double sum = 1 / a, del = sum, ap = a;
+    for (int n = 0; n < 10000; ++n) {
+      ap += 1;
+      del *= x / ap;
+      sum += del;
+      if (std::abs(del) < std::abs(sum) * 1e-15) break;
+    }
+    return 1 - sum * std::exp(-x + a * std::log(x) - gln);
+  }
+  double b = x + 1 - a, c = 1e300, d = 1 / b, h = d;  // continued fraction for Q (Lentz)
+  for (int i = 1; i < 10000; ++i) {
+    double an = -i * (i - a);
+    b += 2;
+    d = an * d + b;
+    if (std::abs(d) < 1e-300) d = 1e-300;
+    c = b + an / c;
+    if (std::abs(c) < 1e-300) c = 1e-300;
+    d = 1 / d;
+    double del = d * c;
+    h *= del;
+    if (std::abs(del - 1) < 1e-15) break;
+  }
+  return std::exp(-x + a * std::log(x) - gln) * h;
+}
+
+void expect_matches(const RenderResult& r, const std::function<double(int, int, int)>& expected) {
+  const int w = r.mean.width, h = r.mean.height;
+  const double zmax = sidak_z(1e-3, w * h * 3);
+  int failures = 0;
+  double worst = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        double e = expected(x, y, c);
+        double n = r.samples[static_cast<size_t>(y) * w + x];
+        double se = std::sqrt(r.variance.pixel(x, y)[c] / n) + 1e-6 + 1e-4 * std::abs(e);
+        double z = std::abs(r.mean.pixel(x, y)[c] - e) / se;
+        worst = std::max(worst, z);
+        if (!(z <= zmax) && ++failures <= 5)  // NaN fails too
+          ADD_FAILURE() << "pixel (" << x << "," << y << ") channel " << c << ": "
+                        << r.mean.pixel(x, y)[c] << " vs expected " << e << " (z = " << z << ")";
+      }
+  EXPECT_EQ(failures, 0) << "worst z " << worst << ", threshold " << zmax;
+  EXPECT_EQ(r.nonfinite, 0u);
 }
 
 }  // namespace lucent::test

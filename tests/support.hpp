@@ -1,5 +1,6 @@
 #pragma once
 // Helpers shared by the tests: running the CLI, temporary files, rendering small scenes.
+#include <functional>
 #include <string>
 
 #include "lucent/lucent.hpp"
@@ -33,5 +34,18 @@ RenderResult render_json(const std::string& json, int spp);
 
 /// Number of lines in `s` that are not empty.
 int count_lines(const std::string& s);
+
+/// z threshold of a two-sided test at family-wise significance alpha over m tests (Sidak).
+double sidak_z(double alpha, int m);
+
+/// P(chi-square with `dof` degrees of freedom > chi2): the regularized upper incomplete gamma
+/// function Q(dof/2, chi2/2), by series or continued fraction.
+double chi2_pvalue(double chi2, int dof);
+
+/// One-sample z-test of a render against closed-form pixel values: every pixel channel must have
+/// |mean - expected| / se below sidak_z(1e-3, pixels * 3), with se = sqrt(var / n) plus a floor of
+/// 1e-6 + 1e-4 |expected| (float rounding of near-zero-variance estimators is not a sampling
+/// error). Also: no non-finite sample. Reports the first failing pixels with ADD_FAILURE.
+void expect_matches(const RenderResult& r, const std::function<double(int, int, int)>& expected);
 
 }  // namespace lucent::test

@@ -14,60 +14,8 @@ namespace {
 
 using lucent::RenderResult;
 
-// Two-sided normal quantile for probability p (Acklam's rational approximation, |error| < 1e-9).
-double normal_quantile(double p) {
-  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
-                             1.383577518672690e+02, -3.066479806614716e+01, 2.506628277459239e+00};
-  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
-                             6.680131188771972e+01, -1.328068155288572e+01};
-  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
-                             -2.549732539343734e+00, 4.374664141464968e+00, 2.938163982698783e+00};
-  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
-                             3.754408661907416e+00};
-  double q, r;
-  if (p < 0.02425) {
-    q = std::sqrt(-2 * std::log(p));
-    return (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-           ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
-  }
-  if (p > 1 - 0.02425) return -normal_quantile(1 - p);
-  q = p - 0.5;
-  r = q * q;
-  return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
-         (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1);
-}
-
-// z threshold of a two-sided test at family-wise alpha over m tests (Sidak).
-double sidak_z(double alpha, int m) {
-  double per = 1 - std::pow(1 - alpha, 1.0 / m);
-  return normal_quantile(1 - per / 2);
-}
-
-// Every pixel channel of `r` agrees with expected(x, y, c) by the z-test above. `floor` is an
-// absolute standard-error floor for pixels whose estimate has no variance.
-void expect_matches(const RenderResult& r, const std::function<double(int, int, int)>& expected,
-                    double floor = 1e-6) {
-  const int w = r.mean.width, h = r.mean.height;
-  const double zmax = sidak_z(1e-3, w * h * 3);
-  int failures = 0;
-  double worst = 0;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) {
-        double e = expected(x, y, c);
-        double n = r.samples[static_cast<size_t>(y) * w + x];
-        // + 1e-4 relative: float rounding of a near-zero-variance estimator (e.g. the 24-bit
-        // random numbers against a float CDF of 2048 texels) is not a sampling error
-        double se = std::sqrt(r.variance.pixel(x, y)[c] / n) + floor + 1e-4 * std::abs(e);
-        double z = std::abs(r.mean.pixel(x, y)[c] - e) / se;
-        worst = std::max(worst, z);
-        if (z > zmax && ++failures <= 5)
-          ADD_FAILURE() << "pixel (" << x << "," << y << ") channel " << c << ": "
-                        << r.mean.pixel(x, y)[c] << " vs expected " << e << " (z = " << z << ")";
-      }
-  EXPECT_EQ(failures, 0) << "worst z " << worst << ", threshold " << zmax;
-  EXPECT_EQ(r.nonfinite, 0u);
-}
+using lucent::test::expect_matches;
+using lucent::test::sidak_z;
 
 // The camera model of docs/rendering-model.md, for computing expected pixel values: the point
 // where the ray through film position (fx, fy) meets the plane z = 0.

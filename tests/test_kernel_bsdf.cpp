@@ -9,6 +9,7 @@
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
 #include "shared/types.h"
+#include "support.hpp"
 
 namespace {
 
@@ -62,36 +63,6 @@ TEST(KernelBsdf, FresnelDielectricKnownValues) {
   for (int i = 14; i < 20; ++i) EXPECT_NEAR(out[i].s[0], 0.0, 1e-6);
 }
 
-// Regularized upper incomplete gamma Q(a, x) = P(chi2_{2a} > 2x), by series / continued fraction
-// (Numerical Recipes' gammq, written out here).
-double gamma_q(double a, double x) {
-  if (x <= 0) return 1;
-  double gln = std::lgamma(a);
-  if (x < a + 1) {
-    double sum = 1 / a, del = sum, ap = a;
-    for (int n = 0; n < 1000; ++n) {
-      ap += 1;
-      del *= x / ap;
-      sum += del;
-      if (std::abs(del) < std::abs(sum) * 1e-14) break;
-    }
-    return 1 - sum * std::exp(-x + a * std::log(x) - gln);
-  }
-  double b = x + 1 - a, c = 1 / 1e-300, d = 1 / b, h = d;
-  for (int i = 1; i < 1000; ++i) {
-    double an = -i * (i - a);
-    b += 2;
-    d = an * d + b;
-    if (std::abs(d) < 1e-300) d = 1e-300;
-    c = b + an / c;
-    if (std::abs(c) < 1e-300) c = 1e-300;
-    d = 1 / d;
-    double del = d * c;
-    h *= del;
-    if (std::abs(del - 1) < 1e-14) break;
-  }
-  return std::exp(-x + a * std::log(x) - gln) * h;
-}
 
 struct ChiSquareCase {
   const char* name;
@@ -198,7 +169,7 @@ void chi_square(const ChiSquareCase& tc) {
   double chi2 = 0;
   for (auto& c : cells) chi2 += (c.first - c.second) * (c.first - c.second) / c.second;
   int dof = int(cells.size()) - 1;
-  double pval = gamma_q(dof / 2.0, chi2 / 2.0);
+  double pval = lucent::test::chi2_pvalue(chi2, dof);
   EXPECT_GT(pval, 1e-4) << tc.name << ": chi2 " << chi2 << " with " << dof << " dof";
 
   // weights: f cos / pdf of the evaluation code at the sampled direction

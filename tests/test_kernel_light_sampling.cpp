@@ -13,35 +13,6 @@
 
 namespace {
 
-// Regularized upper incomplete gamma Q(a, x) (series / continued fraction).
-double gamma_q(double a, double x) {
-  if (x <= 0) return 1;
-  double gln = std::lgamma(a);
-  if (x < a + 1) {
-    double sum = 1 / a, del = sum, ap = a;
-    for (int n = 0; n < 10000; ++n) {
-      ap += 1;
-      del *= x / ap;
-      sum += del;
-      if (std::abs(del) < std::abs(sum) * 1e-15) break;
-    }
-    return 1 - sum * std::exp(-x + a * std::log(x) - gln);
-  }
-  double b = x + 1 - a, c = 1e300, d = 1 / b, h = d;
-  for (int i = 1; i < 10000; ++i) {
-    double an = -i * (i - a);
-    b += 2;
-    d = an * d + b;
-    if (std::abs(d) < 1e-300) d = 1e-300;
-    c = b + an / c;
-    if (std::abs(c) < 1e-300) c = 1e-300;
-    d = 1 / d;
-    double del = d * c;
-    h *= del;
-    if (std::abs(del - 1) < 1e-15) break;
-  }
-  return std::exp(-x + a * std::log(x) - gln) * h;
-}
 
 struct Probe {
   lucent::cl_util::Context ctx{""};
@@ -198,7 +169,7 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
     ++cells;
   }
   ASSERT_GE(cells, 20) << name << ": too few populated bins for a meaningful test";
-  double pval = gamma_q((cells - 1) / 2.0, chi2 / 2.0);
+  double pval = lucent::test::chi2_pvalue(chi2, cells - 1);
   EXPECT_GT(pval, 1e-4) << name << ": chi2 " << chi2 << " over " << cells << " cells";
 }
 
