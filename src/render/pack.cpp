@@ -270,9 +270,13 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
   auto add = [&](bool on, const char* name) {
     if (on) f.push_back(name);
   };
+  // materials some primitive uses (a declared but unused material costs nothing)
+  std::vector<char> used(scene.materials.size(), 0);
+  for (const lc_sphere& sp : packed.spheres) used[sp.material] = 1;
+  for (const lc_triangle& t : packed.triangles) used[t.material] = 1;
   auto has_mat = [&](MaterialType t) {
-    for (const Material& m : scene.materials)
-      if (m.type == t) return true;
+    for (size_t i = 0; i < scene.materials.size(); ++i)
+      if (used[i] && scene.materials[i].type == t) return true;
     return false;
   };
   auto has_light = [&](lc_uint type) {
@@ -281,7 +285,8 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
     return false;
   };
   bool textured = false;
-  for (const Material& m : scene.materials) textured = textured || m.albedo_texture >= 0;
+  for (size_t i = 0; i < scene.materials.size(); ++i)
+    textured = textured || (used[i] && scene.materials[i].albedo_texture >= 0);
   bool smooth = false, uvs = false;
   for (const lc_triangle& t : packed.triangles) {
     smooth = smooth || (t.flags & LC_TRI_HAS_NORMALS);

@@ -1,0 +1,94 @@
+// Feature-specialised kernels: the build options carry exactly the features the scene uses
+// (a scene without glass compiles no dielectric code), --no-specialize carries all of them, and
+// both kernels render the same image.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "render/pack.hpp"
+#include "support.hpp"
+
+namespace {
+
+const char* kDiffuseScene = R"({
+  "camera": {"position": [0, 1, 5], "look_at": [0, 0.5, 0], "fov": 40},
+  "film": {"width": 16, "height": 12},
+  "integrator": {"type": "path", "max_depth": 4},
+  "materials": {"w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]}},
+  "shapes": [{"type": "sphere", "center": [0, 0.5, 0], "radius": 0.5, "material": "w"},
+             {"type": "sphere", "center": [0, -100, 0], "radius": 100, "material": "w"}],
+  "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [20, 20, 20]}]})";
+
+std::vector<std::string> features_of(const std::string& json) {
+  lucent::Scene s = lucent::parse_scene(json, "features.json");
+  return lucent::render_detail::scene_features(s, lucent::render_detail::pack_scene(s));
+}
+
+bool has(const std::vector<std::string>& v, const std::string& f) {
+  return std::find(v.begin(), v.end(), f) != v.end();
+}
+
+TEST(Features, DiffuseSpheresAndAPointLightCompileOnlyThat) {
+  std::vector<std::string> f = features_of(kDiffuseScene);
+  std::vector<std::string> expected = {"LC_HAS_SPHERES", "LC_HAS_POINT_LIGHTS", "LC_HAS_INTEGRATOR_PATH"};
+  std::sort(f.begin(), f.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(f, expected);
+  // and the render really is built with those options only
+  lucent::RenderResult r = lucent::test::render_json(kDiffuseScene, 1);
+  EXPECT_EQ(r.build_options.find("LC_HAS_DIELECTRIC"), std::string::npos) << r.build_options;
+  EXPECT_EQ(r.build_options.find("LC_HAS_TEXTURES"), std::string::npos) << r.build_options;
+  EXPECT_NE(r.build_options.find("-D LC_HAS_SPHERES"), std::string::npos) << r.build_options;
+}
+
+TEST(Features, EachUsedFeatureAppears) {
+  std::string glass = kDiffuseScene;
+  glass.replace(glass.find(R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]})"),
+                std::string(R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]})").size(),
+                R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]}, "g": {"type": "dielectric", "ior": 1.5})");
+  // a glass material that is declared but used by no shape costs nothing
+  EXPECT_FALSE(has(features_of(glass), "LC_HAS_DIELECTRIC"));
+  std::string used = glass;
+  used.replace(used.find(R"("radius": 0.5, "material": "w")"), std::string(R"("radius": 0.5, "material": "w")").size(),
+               R"("radius": 0.5, "material": "g")");
+  std::vector<std::string> f = features_of(used);
+  EXPECT_TRUE(has(f, "LC_HAS_DIELECTRIC"));
+  EXPECT_FALSE(has(f, "LC_HAS_MIRROR"));
+
+  std::string rich = R"({
+    "camera": {"position": [0, 1, 5], "look_at": [0, 0.5, 0], "fov": 40, "aperture": 0.1},
+    "film": {"width": 8, "height": 8, "filter": {"type": "tent"}},
+    "integrator": {"type": "whitted"},
+    "materials": {"m": {"type": "mirror"}, "l": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1, 1, 1]}},
+    "shapes": [{"type": "triangles", "material": "l", "positions": [[0,0,0],[1,0,0],[0,1,0]],
+                "normals": [[0,0,1],[0,0,1],[0,0,1]], "indices": [0, 1, 2]},
+               {"type": "sphere", "center": [0, 0, -2], "radius": 1, "material": "m"}],
+    "lights": [{"type": "environment", "radiance": [0.1, 0.1, 0.1]}]})";
+  f = features_of(rich);
+  for (const char* want : {"LC_HAS_TRIANGLES", "LC_HAS_SPHERES", "LC_HAS_SMOOTH_NORMALS", "LC_HAS_MIRROR",
+                           "LC_HAS_TRIANGLE_LIGHTS", "LC_HAS_ENV", "LC_HAS_THIN_LENS", "LC_HAS_FILTER_TENT",
+                           "LC_HAS_INTEGRATOR_WHITTED"})
+    EXPECT_TRUE(has(f, want)) << want;
+  for (const char* not_want : {"LC_HAS_POINT_LIGHTS", "LC_HAS_SPHERE_LIGHTS", "LC_HAS_TEXTURES",
+                               "LC_HAS_FILTER_GAUSSIAN", "LC_HAS_INTEGRATOR_PATH", "LC_HAS_DIELECTRIC"})
+    EXPECT_FALSE(has(f, not_want)) << not_want;
+}
+
+TEST(Features, FullKernelHasEveryFeatureAndRendersTheSameImage) {
+  lucent::Scene s = lucent::parse_scene(kDiffuseScene, "features.json");
+  lucent::RenderOptions spec, full;
+  spec.spp = full.spp = 16;
+  full.specialize = false;
+  lucent::RenderResult a = lucent::render(s, spec), b = lucent::render(s, full);
+  for (const std::string& f : lucent::render_detail::all_features())
+    EXPECT_NE(b.build_options.find("-D " + f), std::string::npos) << f;
+  EXPECT_LT(a.build_options.size(), b.build_options.size());
+  // the same seed and the same arithmetic on the paths this scene takes: equal up to rounding
+  double worst = 0;
+  for (size_t i = 0; i < a.mean.rgb.size(); ++i)
+    worst = std::max(worst, std::abs(double(a.mean.rgb[i]) - b.mean.rgb[i]) / (1e-3 + std::abs(a.mean.rgb[i])));
+  EXPECT_LT(worst, 1e-4);
+}
+
+}  // namespace
