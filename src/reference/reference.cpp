@@ -36,11 +36,6 @@ constexpr std::uint32_t kDimExtra = 0x40000000u;
 /// Rays traced by the calling thread.
 thread_local std::uint64_t t_rays = 0;
 
-struct LightRef {
-  enum Kind { Point, Env, Area } kind;
-  int index;  ///< Scene::lights for Point and Env, World::area_lights for Area
-};
-
 struct CameraFrame {
   dvec3 pos, right, up, fwd;
   double tan_half = 0, aspect = 1, lens = 0, focus = 0;
@@ -50,17 +45,7 @@ struct CameraFrame {
 class Renderer {
  public:
   explicit Renderer(const Scene& s) : scene_(s), world_(s) {
-    for (size_t i = 0; i < s.lights.size(); ++i) {
-      const Light& l = s.lights[i];
-      if (l.type == LightType::Point) {
-        lights_.push_back({LightRef::Point, static_cast<int>(i)});
-      } else {
-        env_ = static_cast<int>(i);
-        lights_.push_back({LightRef::Env, static_cast<int>(i)});
-      }
-    }
-    for (size_t i = 0; i < world_.area_lights.size(); ++i)
-      lights_.push_back({LightRef::Area, static_cast<int>(i)});
+    lights_ = light_list(world_, env_);
     setup_camera();
   }
 
@@ -186,14 +171,6 @@ class Renderer {
 
   dvec3 emitted(const Surface& s) const { return s.front ? material(s).emission : dvec3(0.0); }
 
-  /// Selection probability times area density of the area light on prim, as a solid-angle pdf
-  /// seen from a point at distance `dist` whose direction makes cosine `cos_l` with the light.
-  double area_light_pdf(int prim, double dist, double cos_l) const {
-    int li = world_.prim_light[prim];
-    if (li < 0 || cos_l <= 0) return 0;
-    return dist * dist / (cos_l * world_.area_lights[li].area * lights_.size());
-  }
-
   static double power_heuristic(double a, double b) {
     if (std::isinf(a)) return 1;
     return a * a / (a * a + b * b);
@@ -226,43 +203,30 @@ class Renderer {
                      int depth) const {
     if (lights_.empty()) return dvec3(0.0);
     const double n = static_cast<double>(lights_.size());
-    size_t k = std::min(lights_.size() - 1,
-                        static_cast<size_t>(rng.bounce(depth, LC_DIM_LIGHT_SELECT) * n));
-    const LightRef& lr = lights_[k];
-    double u1 = rng.bounce(depth, LC_DIM_LIGHT_UV), u2 = rng.bounce(depth, LC_DIM_LIGHT_UV + 1);
+    LightSample ls = ref::sample_light(world_, lights_, s.p, rng.bounce(depth, LC_DIM_LIGHT_SELECT),
+                                       rng.bounce(depth, LC_DIM_LIGHT_UV),
+                                       rng.bounce(depth, LC_DIM_LIGHT_UV + 1));
+    const LightRef& lr = lights_[ls.light];
     if (lr.kind == LightRef::Point) return n * point_light(s, b, wo, scene_.lights[lr.index]);
+    if (!ls.valid) return dvec3(0.0);
+    const dvec3& wi = ls.wi;
+    dvec3 f = b.eval(wo, wi);
+    if (max3(f) <= 0) return dvec3(0.0);
     if (lr.kind == LightRef::Env) {
-      // uniform direction on the sphere
-      double z = 1 - 2 * u1, rr = std::sqrt(std::max(0.0, 1 - z * z)), phi = 2 * kPi * u2;
-      dvec3 wi(rr * std::cos(phi), rr * std::sin(phi), z);
-      dvec3 f = b.eval(wo, wi);
-      if (max3(f) <= 0) return dvec3(0.0);
       dvec3 Le = environment(wi);
       if (max3(Le) <= 0) return dvec3(0.0);
       if (blocked(spawn(s, wi), kInf)) return dvec3(0.0);
-      double pl = 1 / (4 * kPi * n);
-      return f * Le * power_heuristic(pl, b.pdf(wo, wi)) / pl;
+      return f * Le * power_heuristic(ls.pdf, b.pdf(wo, wi)) / ls.pdf;
     }
     const AreaLight& al = world_.area_lights[lr.index];
-    dvec3 y, ny;
-    world_.sample_area(al.prim, u1, u2, y, ny);
-    dvec3 to = y - s.p;
-    double dist = glm::length(to);
-    if (dist <= 0) return dvec3(0.0);
-    dvec3 wi = to / dist;
-    double cos_l = -glm::dot(ny, wi);  // > 0: the point's front side faces us
-    if (cos_l <= 0) return dvec3(0.0);
-    dvec3 f = b.eval(wo, wi);
-    if (max3(f) <= 0) return dvec3(0.0);
     // The light's own primitive cannot hide a point of it that faces us (a sphere is convex), so
     // it is left out of the shadow test: near its silhouette, the ray from the offset origin
     // would otherwise graze it just before the sampled point.
     Ray r = spawn(s, wi);
-    if (blocked(r, glm::length(y - r.o) * (1 - 1e-7), al.prim)) return dvec3(0.0);
+    if (blocked(r, glm::length(ls.y - r.o) * (1 - 1e-7), al.prim)) return dvec3(0.0);
     const Prim& p = world_.prims[al.prim];
     int mat = p.sphere ? scene_.spheres[p.index].material : scene_.triangles[p.index].material;
-    double pl = area_light_pdf(al.prim, dist, cos_l);
-    return f * scene_.materials[mat].emission * power_heuristic(pl, b.pdf(wo, wi)) / pl;
+    return f * scene_.materials[mat].emission * power_heuristic(ls.pdf, b.pdf(wo, wi)) / ls.pdf;
   }
 
   // ----------------------------------------------------------------------------------------
@@ -278,7 +242,7 @@ class Renderer {
       if (!trace(ray, hit)) {
         dvec3 Le = environment(ray.d);
         double w = 1;
-        if (!prev_delta && env_ >= 0) w = power_heuristic(prev_pdf, 1 / (4 * kPi * lights_.size()));
+        if (!prev_delta && env_ >= 0) w = power_heuristic(prev_pdf, env_light_pdf(lights_.size()));
         L += beta * Le * w;
         break;
       }
@@ -287,7 +251,8 @@ class Renderer {
       if (max3(Le) > 0) {
         double w = 1;
         if (!prev_delta)
-          w = power_heuristic(prev_pdf, area_light_pdf(s.prim, hit.t, glm::dot(s.ng, -ray.d)));
+          w = power_heuristic(prev_pdf, area_light_pdf(world_, lights_.size(), s.prim, hit.t,
+                                                       glm::dot(s.ng, -ray.d)));
         L += beta * Le * w;
       }
       if (depth + 1 >= in.max_depth) break;
@@ -412,6 +377,65 @@ class Renderer {
 };
 
 }  // namespace
+
+std::vector<LightRef> light_list(const World& world, int& env) {
+  std::vector<LightRef> lights;
+  env = -1;
+  for (size_t i = 0; i < world.scene.lights.size(); ++i) {
+    if (world.scene.lights[i].type == LightType::Point) {
+      lights.push_back({LightRef::Point, static_cast<int>(i)});
+    } else {
+      env = static_cast<int>(i);
+      lights.push_back({LightRef::Env, static_cast<int>(i)});
+    }
+  }
+  for (size_t i = 0; i < world.area_lights.size(); ++i)
+    lights.push_back({LightRef::Area, static_cast<int>(i)});
+  return lights;
+}
+
+double area_light_pdf(const World& world, size_t nlights, int prim, double dist, double cos_l) {
+  int li = world.prim_light[prim];
+  if (li < 0 || cos_l <= 0) return 0;
+  return dist * dist / (cos_l * world.area_lights[li].area * nlights);
+}
+
+LightSample sample_light(const World& world, const std::vector<LightRef>& lights, const dvec3& p,
+                         double u_select, double u1, double u2) {
+  LightSample ls;
+  if (lights.empty()) return ls;
+  const double n = static_cast<double>(lights.size());
+  ls.light = static_cast<int>(std::min(lights.size() - 1, static_cast<size_t>(u_select * n)));
+  const LightRef& lr = lights[ls.light];
+  if (lr.kind == LightRef::Point) {
+    dvec3 to = world.scene.lights[lr.index].position - p;
+    ls.dist = glm::length(to);
+    ls.delta = true;
+    ls.pdf = 1 / n;
+    ls.valid = ls.dist > 0;
+    if (ls.valid) ls.wi = to / ls.dist;
+    return ls;
+  }
+  if (lr.kind == LightRef::Env) {
+    // uniform direction on the sphere
+    double z = 1 - 2 * u1, rr = std::sqrt(std::max(0.0, 1 - z * z)), phi = 2 * kPi * u2;
+    ls.wi = dvec3(rr * std::cos(phi), rr * std::sin(phi), z);
+    ls.pdf = env_light_pdf(lights.size());
+    ls.valid = true;
+    return ls;
+  }
+  const AreaLight& al = world.area_lights[lr.index];
+  world.sample_area(al.prim, u1, u2, ls.y, ls.ny);
+  dvec3 to = ls.y - p;
+  ls.dist = glm::length(to);
+  if (ls.dist <= 0) return ls;
+  ls.wi = to / ls.dist;
+  double cos_l = -glm::dot(ls.ny, ls.wi);  // > 0: the point's front side faces us
+  if (cos_l <= 0) return ls;
+  ls.pdf = area_light_pdf(world, lights.size(), al.prim, ls.dist, cos_l);
+  ls.valid = true;
+  return ls;
+}
 
 }  // namespace ref
 

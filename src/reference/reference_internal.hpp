@@ -98,6 +98,42 @@ class World {
   bool hit_prim(int prim, const Ray& ray, double tmax, Hit& hit) const;
 };
 
+/// One light of next-event estimation's list.
+struct LightRef {
+  enum Kind { Point, Env, Area } kind;
+  int index;  ///< Scene::lights for Point and Env, World::area_lights for Area
+};
+
+/// Next-event estimation's lights, each chosen with probability 1 / size: point lights and the
+/// environment in Scene::lights order, then the area lights. `env` receives the Scene::lights
+/// index of the environment, or -1.
+std::vector<LightRef> light_list(const World& world, int& env);
+
+/// A light and a direction towards it, drawn by sample_light.
+struct LightSample {
+  int light = -1;          ///< index into the light list
+  dvec3 wi{0.0};           ///< unit direction from the shading point
+  dvec3 y{0.0}, ny{0.0};   ///< area lights: the sampled point and its front normal
+  double dist = kInf;      ///< distance to the light's point (kInf for the environment)
+  double pdf = 0;          ///< solid-angle pdf times the selection probability (1 / size)
+  bool delta = false;      ///< point light: pdf is the selection probability alone
+  bool valid = false;      ///< false when the sampled point does not face the shading point
+};
+
+/// Chooses a light uniformly with u_select, then a direction from p: the environment uniformly
+/// over the sphere, area lights by a uniform point of their area (a whole sphere's surface; the
+/// half that faces away gives an invalid sample). Occlusion is not tested.
+LightSample sample_light(const World& world, const std::vector<LightRef>& lights, const dvec3& p,
+                         double u_select, double u1, double u2);
+
+/// Solid-angle pdf with which sample_light returns a direction towards the environment.
+inline double env_light_pdf(size_t nlights) { return 1 / (4 * kPi * nlights); }
+
+/// Selection probability times area density of the area light on prim, as a solid-angle pdf
+/// seen from a point at distance `dist` whose direction makes cosine `cos_l` with the light's
+/// front normal; 0 when prim is no light or cos_l <= 0.
+double area_light_pdf(const World& world, size_t nlights, int prim, double dist, double cos_l);
+
 /// Bilinear, repeating lookup of a texture's RGB; uv (0, 0) is the bottom-left corner.
 dvec3 texture_rgb(const Texture& tex, dvec2 uv);
 
