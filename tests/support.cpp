@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "lucent/compare.hpp"
+#include "scene/loaders.hpp"
 
 namespace lucent::test {
 
@@ -93,6 +94,30 @@ int count_lines(const std::string& s) {
   while (std::getline(in, line))
     if (!line.empty()) ++n;
   return n;
+}
+
+namespace {
+std::vector<std::string>& captured_warnings() {
+  static std::vector<std::string> v;
+  return v;
+}
+}  // namespace
+
+CaptureWarnings::CaptureWarnings() {
+  captured_warnings().clear();
+  scene_detail::set_warning_sink([](const std::string& m) { captured_warnings().push_back(m); });
+}
+CaptureWarnings::~CaptureWarnings() { scene_detail::set_warning_sink(nullptr); }
+const std::vector<std::string>& CaptureWarnings::all() const { return captured_warnings(); }
+int CaptureWarnings::count(const std::string& needle) const {
+  int n = 0;
+  for (const auto& w : all()) n += w.find(needle) != std::string::npos;
+  return n;
+}
+std::string CaptureWarnings::dump() const {
+  std::string s;
+  for (const auto& w : all()) s += "  " + w + "\n";
+  return s;
 }
 
 double sidak_z(double alpha, int m) {

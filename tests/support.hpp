@@ -2,6 +2,7 @@
 // Helpers shared by the tests: running the CLI, temporary files, rendering small scenes.
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "lucent/lucent.hpp"
 
@@ -41,6 +42,20 @@ double sidak_z(double alpha, int m);
 /// P(chi-square with `dof` degrees of freedom > chi2): the regularized upper incomplete gamma
 /// function Q(dof/2, chi2/2), by series or continued fraction.
 double chi2_pvalue(double chi2, int dof);
+
+/// Collects scene loading warnings (scene_detail::warn) while alive, instead of printing them.
+class CaptureWarnings {
+ public:
+  CaptureWarnings();
+  ~CaptureWarnings();
+  CaptureWarnings(const CaptureWarnings&) = delete;
+  CaptureWarnings& operator=(const CaptureWarnings&) = delete;
+  const std::vector<std::string>& all() const;
+  /// How many warnings contain `needle`.
+  int count(const std::string& needle) const;
+  /// All warnings, one per indented line (for failure messages).
+  std::string dump() const;
+};
 
 /// One-sample z-test of a render against closed-form pixel values: every pixel channel must have
 /// |mean - expected| / se below sidak_z(1e-3, pixels * 3), with se = sqrt(var / n) plus a floor of

@@ -28,30 +28,7 @@ using lucent::MaterialType;
 using lucent::Scene;
 using lucent::Triangle;
 
-std::vector<std::string>& captured() {
-  static std::vector<std::string> v;
-  return v;
-}
-
-// Collects scene_detail::warn messages while alive.
-struct CaptureWarnings {
-  CaptureWarnings() {
-    captured().clear();
-    lucent::scene_detail::set_warning_sink([](const std::string& m) { captured().push_back(m); });
-  }
-  ~CaptureWarnings() { lucent::scene_detail::set_warning_sink(nullptr); }
-  const std::vector<std::string>& all() const { return captured(); }
-  int count(const std::string& needle) const {
-    return static_cast<int>(std::count_if(all().begin(), all().end(), [&](const std::string& w) {
-      return w.find(needle) != std::string::npos;
-    }));
-  }
-  std::string dump() const {
-    std::string s;
-    for (const auto& w : all()) s += "  " + w + "\n";
-    return s;
-  }
-};
+using lucent::test::CaptureWarnings;
 
 void load(Scene& scene, const std::string& path, const glm::dmat4& xf = glm::dmat4(1.0),
           int material_override = -1) {

@@ -16,24 +16,7 @@ namespace {
 
 using lucent::Scene;
 
-std::vector<std::string>& captured() {
-  static std::vector<std::string> v;
-  return v;
-}
-
-struct CaptureWarnings {
-  CaptureWarnings() {
-    captured().clear();
-    lucent::scene_detail::set_warning_sink([](const std::string& m) { captured().push_back(m); });
-  }
-  ~CaptureWarnings() { lucent::scene_detail::set_warning_sink(nullptr); }
-  const std::vector<std::string>& all() const { return captured(); }
-  std::string dump() const {
-    std::string s;
-    for (const auto& w : all()) s += "  " + w + "\n";
-    return s;
-  }
-};
+using lucent::test::CaptureWarnings;
 
 // Triangles a fan triangulation of the file's faces gives: sum over `f` lines of (corners - 2),
 // counted here independently of the loader.

@@ -279,17 +279,7 @@ TEST(StabilityTranslateLight, SphereLightOverPlaneAt1e4) {
 // Item 4: degenerate and non-finite triangles are dropped by pack_scene with one warning; the
 // image is then the image without them, bit for bit (same seed, same packed scene).
 
-std::vector<std::string>& captured() {
-  static std::vector<std::string> c;
-  return c;
-}
-struct CaptureWarnings {
-  CaptureWarnings() {
-    captured().clear();
-    lucent::scene_detail::set_warning_sink([](const std::string& m) { captured().push_back(m); });
-  }
-  ~CaptureWarnings() { lucent::scene_detail::set_warning_sink(nullptr); }
-};
+using lucent::test::CaptureWarnings;
 
 TEST(StabilityInput, DegenerateAndNonFiniteTrianglesAreSkipped) {
   Scene clean = scene_from(base_scene_json());
@@ -318,9 +308,9 @@ TEST(StabilityInput, DegenerateAndNonFiniteTrianglesAreSkipped) {
   add({-inf, 0.5, 2}, {inf, 0.5, 2}, {0, 1, 2}, green);     // infinite, NaN area
   CaptureWarnings warnings;
   RenderResult a = render(clean, 64, 5), b = render(dirty, 64, 5);
-  ASSERT_EQ(captured().size(), 1u);
-  EXPECT_NE(captured()[0].find("skipped 8 degenerate or non-finite triangle(s)"), std::string::npos)
-      << captured()[0];
+  ASSERT_EQ(warnings.all().size(), 1u);
+  EXPECT_NE(warnings.all()[0].find("skipped 8 degenerate or non-finite triangle(s)"), std::string::npos)
+      << warnings.all()[0];
   EXPECT_CLEAN(a);
   EXPECT_CLEAN(b);
   ASSERT_EQ(a.mean.width, b.mean.width);
@@ -374,7 +364,7 @@ TEST(StabilityInput, EmitterDegenerateOnlyInFloat) {
   dirty.triangles.push_back(t);
   CaptureWarnings warnings;
   RenderResult a = render(dirty, kSpp, 6), b = render(clean, kSpp, 7);
-  EXPECT_TRUE(captured().empty());
+  EXPECT_TRUE(warnings.all().empty());
   EXPECT_SAME_IMAGE(a, b, "A = with the float-degenerate emitter, B = without");
 }
 
