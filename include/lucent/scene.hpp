@@ -38,7 +38,7 @@ struct Film {
   ToneMap tonemap = ToneMap::Clamp;
 };
 
-enum class IntegratorType { Path, Whitted, Direct, Albedo, Normal, Depth, Ao };
+enum class IntegratorType { Path, Whitted, Direct, Albedo, Normal, Depth, Ao, Primitive };
 
 struct Integrator {
   IntegratorType type = IntegratorType::Path;

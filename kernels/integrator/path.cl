@@ -271,6 +271,12 @@ static inline float3 integrator_aov(const lc_scene* s, lc_ray ray, const lc_rng*
   if (!scene_intersect(s, ray, INFINITY, &hit)) return (float3)(0.0f);
   lc_interaction it = interaction_from_hit(s, ray, &hit);
   if (P->integrator == LC_INTEGRATOR_DEPTH) return (float3)(hit.t);
+  if (P->integrator == LC_INTEGRATOR_PRIMITIVE) {
+    /* scene order: spheres first, then the scene's triangle list (exact in float below 2^24) */
+    lc_uint id = (hit.prim & LC_PRIM_SPHERE_BIT) ? (hit.prim & ~LC_PRIM_SPHERE_BIT)
+                                                 : P->num_spheres + s->tri_attrs[hit.prim].source_index;
+    return (float3)((float)(id + 1u));
+  }
   if (P->integrator == LC_INTEGRATOR_NORMAL) return it.ns;
   __global const lc_material* m = &s->materials[it.material];
   lc_bsdf b = bsdf_from_material(s, m, it.uv);

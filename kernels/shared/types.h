@@ -90,7 +90,8 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, flags) == 44, triangle_flags);
 typedef struct LC_ALIGN16 lc_triangle_attr {
   float n[9];  /* vertex normals n0, n1, n2 (world space, unit)  */
   float uv[6]; /* texture coordinates uv0, uv1, uv2              */
-  lc_uint pad0;
+  lc_uint source_index; /* index in the scene's triangle list (degenerate triangles are
+                           dropped at packing, so it can differ from the packed index) */
 } lc_triangle_attr; /* total: 64 bytes */
 LC_STATIC_ASSERT(sizeof(lc_triangle_attr) == 64, triangle_attr_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle_attr, uv) == 36, triangle_attr_uv);
@@ -171,6 +172,7 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_camera, forward) == 48, camera_forward);
 #define LC_INTEGRATOR_NORMAL 4u
 #define LC_INTEGRATOR_DEPTH 5u
 #define LC_INTEGRATOR_AO 6u
+#define LC_INTEGRATOR_PRIMITIVE 7u /* scene-order primitive index + 1 of the first hit */
 
 #define LC_FILTER_BOX 0u
 #define LC_FILTER_TENT 1u

@@ -58,6 +58,7 @@ const char* integrator_name(IntegratorType t) {
     case IntegratorType::Normal: return "normal";
     case IntegratorType::Depth: return "depth";
     case IntegratorType::Ao: return "ao";
+    case IntegratorType::Primitive: return "primitive";
     default: return "path";
   }
 }

@@ -15,8 +15,10 @@ IntegratorType parse_integrator(const std::string& n) {
   if (n == "normal") return IntegratorType::Normal;
   if (n == "depth") return IntegratorType::Depth;
   if (n == "ao") return IntegratorType::Ao;
+  if (n == "primitive") return IntegratorType::Primitive;
   throw Error("--integrator " + n +
-              ": unknown integrator (expected path, whitted, direct, albedo, normal, depth, ao)");
+              ": unknown integrator (expected path, whitted, direct, albedo, normal, depth, ao, "
+              "primitive)");
 }
 
 // cmd_compare.cpp

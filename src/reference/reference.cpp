@@ -59,7 +59,8 @@ class Renderer {
       case IntegratorType::Albedo:
       case IntegratorType::Normal:
       case IntegratorType::Depth:
-      case IntegratorType::Ao: return aov(ray, rng);
+      case IntegratorType::Ao:
+      case IntegratorType::Primitive: return aov(ray, rng);
     }
     return dvec3(0.0);
   }
@@ -361,6 +362,10 @@ class Renderer {
         return s.ns;
       case IntegratorType::Depth:
         return dvec3(hit.t);
+      case IntegratorType::Primitive: {  // spheres first, then the scene's triangle list
+        const Prim& p = world_.prims[hit.prim];
+        return dvec3(double((p.sphere ? 0 : scene_.spheres.size()) + p.index + 1));
+      }
       default: {  // ambient occlusion
         double u1 = rng.bounce(0, LC_DIM_BSDF_UV), u2 = rng.bounce(0, LC_DIM_BSDF_UV + 1);
         dvec3 a = std::abs(s.ns.x) > 0.5 ? dvec3(0, 1, 0) : dvec3(1, 0, 0);

@@ -38,6 +38,7 @@ lc_uint integrator_type(IntegratorType t) {
     case IntegratorType::Normal: return LC_INTEGRATOR_NORMAL;
     case IntegratorType::Depth: return LC_INTEGRATOR_DEPTH;
     case IntegratorType::Ao: return LC_INTEGRATOR_AO;
+    case IntegratorType::Primitive: return LC_INTEGRATOR_PRIMITIVE;
     default: return LC_INTEGRATOR_PATH;
   }
 }
@@ -161,6 +162,7 @@ PackedScene pack_scene(const Scene& scene) {
       }
     }
     d.flags = (has_n ? LC_TRI_HAS_NORMALS : 0u) | (has_uv ? LC_TRI_HAS_UVS : 0u);
+    a.source_index = static_cast<lc_uint>(i);
     const Material& m = scene.materials[t.material];
     if (m.emissive()) {
       lc_light l{};
@@ -294,7 +296,7 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
   }
   IntegratorType it = scene.integrator.type;
   bool aov = it == IntegratorType::Albedo || it == IntegratorType::Normal ||
-             it == IntegratorType::Depth || it == IntegratorType::Ao;
+             it == IntegratorType::Depth || it == IntegratorType::Ao || it == IntegratorType::Primitive;
   add(!packed.spheres.empty(), "LC_HAS_SPHERES");
   add(!packed.triangles.empty(), "LC_HAS_TRIANGLES");
   add(smooth, "LC_HAS_SMOOTH_NORMALS");

@@ -245,7 +245,7 @@ class Parser {
     check_keys(j, p, {"type", "max_depth", "rr_depth", "spp", "seed", "ao_distance", "mis"});
     if (j.contains("type")) {
       std::string t = choice(j["type"], p + "/type",
-                             {"path", "whitted", "direct", "albedo", "normal", "depth", "ao"});
+                             {"path", "whitted", "direct", "albedo", "normal", "depth", "ao", "primitive"});
       in.type = parse_integrator_type(t);
     }
     if (j.contains("max_depth"))
@@ -269,6 +269,7 @@ class Parser {
     if (t == "normal") return IntegratorType::Normal;
     if (t == "depth") return IntegratorType::Depth;
     if (t == "ao") return IntegratorType::Ao;
+    if (t == "primitive") return IntegratorType::Primitive;
     return IntegratorType::Path;
   }
 
