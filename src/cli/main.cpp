@@ -219,7 +219,7 @@ int main(int argc, char** argv) {
   render->add_option("--device", ra.device, "OpenCL device: index or name substring (env LUCENT_DEVICE)");
   render->add_option("--seed", ra.seed, "Random seed (overrides the scene)")->check(CLI::Range(0LL, 0xffffffffLL));
   render->add_option("--integrator", ra.integrator,
-                     "Override the integrator: path, whitted, direct, albedo, normal, depth, ao");
+                     "Override the integrator: path, whitted, direct, albedo, normal, depth, ao, primitive");
   render->add_flag("-q,--quiet", ra.quiet, "No progress line or summary");
   render->add_flag("--fast-math", ra.fast_math,
                    "Build the kernel with -cl-fast-relaxed-math (faster, not IEEE; see BENCHMARKS.md)");
