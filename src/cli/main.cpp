@@ -1,5 +1,6 @@
 // lucent: the command-line front end. A thin layer over the library; every failure ends with one
 // line on stderr ("lucent: error: ...") and a non-zero exit status.
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -48,6 +49,14 @@ std::string format_bytes(std::uint64_t b) {
   else
     std::snprintf(buf, sizeof buf, "%.0f MiB", double(b) / (1024.0 * 1024.0));
   return buf;
+}
+
+/// Peak resident memory of this process so far, in MiB (host side: scene, BVH, film, and the
+/// driver's own allocations; a GPU's device memory is not included).
+double peak_host_mib() {
+  struct rusage ru {};
+  if (getrusage(RUSAGE_SELF, &ru) != 0) return 0;
+  return double(ru.ru_maxrss) / 1024.0;  // Linux reports KiB
 }
 
 /// Fails early (before rendering) when the output cannot be written.
@@ -183,12 +192,12 @@ int cmd_render(const RenderArgs& a) {
     std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
                  static_cast<unsigned long long>(r.nonfinite));
   if (!a.quiet)
-    std::fprintf(stderr, "%s: %dx%d, %llu spp in %.2f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s) on %s\n",
+    std::fprintf(stderr, "%s: %dx%d, %llu spp in %.2f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak host memory %.0f MiB) on %s\n",
                  a.output.c_str(), scene.film.width, scene.film.height,
                  static_cast<unsigned long long>(r.spp), r.seconds,
                  r.seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / r.seconds * 1e-6 : 0,
                  r.seconds > 0 ? double(r.rays) / r.seconds * 1e-6 : 0, r.build_seconds,
-                 r.device.c_str());
+                 peak_host_mib(), r.device.c_str());
   if (!r.cancelled && !a.reference) write_aovs(a, scene, opt, r);
   if (r.cancelled) {
     std::fprintf(stderr, "lucent: interrupted: wrote %s with the %llu spp accumulated so far\n",
