@@ -18,31 +18,12 @@
 #include "light/light.cl"
 #include "integrator/path.cl"
 
-__kernel void lucent_render(__global const lc_params* params, __global const lc_bvh_node* nodes,
-                            __global const lc_uint* prim_refs,
-                            __global const lc_triangle* triangles,
-                            __global const lc_triangle_attr* tri_attrs,
-                            __global const lc_sphere* spheres,
-                            __global const lc_material* materials,
-                            __global const lc_light* lights, __global const float* light_cdf,
-                            __global const lc_texture* textures, __global const float4* texels,
-                            __global float4* out_sum, __global float4* out_sumsq,
+__kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global float4* out_sum, __global float4* out_sumsq,
                             __global lc_uint* counters) {
   lc_uint gid = (lc_uint)get_global_id(0);
   lc_uint width = params->width, height = params->height;
   if (gid >= width * height) return;
-  lc_scene s;
-  s.params = params;
-  s.nodes = nodes;
-  s.prim_refs = prim_refs;
-  s.triangles = triangles;
-  s.tri_attrs = tri_attrs;
-  s.spheres = spheres;
-  s.materials = materials;
-  s.lights = lights;
-  s.light_cdf = light_cdf;
-  s.textures = textures;
-  s.texels = texels;
+  lc_scene s = LC_SCENE_FROM_KERNEL_ARGS;
 
   lc_uint px = gid % width, py = gid / width;
   float3 sum = (float3)(0.0f), sumsq = (float3)(0.0f);

@@ -13,16 +13,23 @@ typedef struct {
   float alpha;     /* GGX alpha, clamped */
 } lc_bsdf;
 
-static inline lc_bsdf bsdf_from_material(const lc_scene* s, __global const lc_material* m, float2 uv) {
+/* The BSDF of material m with its untextured albedo. */
+static inline lc_bsdf bsdf_from_material_untextured(__global const lc_material* m) {
   lc_bsdf b;
   b.type = m->type;
   b.albedo = lc_load3(m->albedo);
-#ifdef LC_HAS_TEXTURES
-  if (m->albedo_tex >= 0) b.albedo = texture_lookup(s, m->albedo_tex, uv).xyz;
-#endif
   b.specular = lc_load3(m->specular);
   b.ior = m->ior;
   b.alpha = fmax(m->roughness, 1e-3f);
+  return b;
+}
+
+/* The BSDF of material m at texture coordinates uv. */
+static inline lc_bsdf bsdf_from_material(const lc_scene* s, __global const lc_material* m, float2 uv) {
+  lc_bsdf b = bsdf_from_material_untextured(m);
+#ifdef LC_HAS_TEXTURES
+  if (m->albedo_tex >= 0) b.albedo = texture_lookup(s, m->albedo_tex, uv).xyz;
+#endif
   return b;
 }
 

@@ -23,6 +23,20 @@ typedef struct {
   __global const float4* texels;
 } lc_scene;
 
+/* The scene's kernel arguments, in the order of src/render/device_scene.cpp (DeviceScene). */
+#define LC_SCENE_KERNEL_ARGS                                                                  \
+  __global const lc_params *params, __global const lc_bvh_node *nodes,                        \
+      __global const lc_uint *prim_refs, __global const lc_triangle *triangles,               \
+      __global const lc_triangle_attr *tri_attrs, __global const lc_sphere *spheres,          \
+      __global const lc_material *materials, __global const lc_light *lights,                 \
+      __global const float *light_cdf, __global const lc_texture *textures,                   \
+      __global const float4 *texels
+
+/* The lc_scene of a kernel declared with LC_SCENE_KERNEL_ARGS. */
+#define LC_SCENE_FROM_KERNEL_ARGS                                                             \
+  {params, nodes, prim_refs, triangles, tri_attrs, spheres, materials, lights, light_cdf,     \
+   textures, texels}
+
 typedef struct {
   float t;
   lc_uint prim; /* primitive reference (LC_PRIM_SPHERE_BIT for spheres), LC_INVALID on a miss */

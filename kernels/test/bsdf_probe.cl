@@ -28,12 +28,7 @@ __kernel void probe_fresnel(__global const float2* in, __global float2* out) {
 __kernel void probe_bsdf_sample(__global const lc_material* mat, float4 wo_in, int front,
                                 __global float4* out_wi, __global float4* out_weight) {
   lc_uint i = (lc_uint)get_global_id(0);
-  lc_bsdf b;
-  b.type = mat->type;
-  b.albedo = lc_load3(mat->albedo);
-  b.specular = lc_load3(mat->specular);
-  b.ior = mat->ior;
-  b.alpha = fmax(mat->roughness, 1e-3f);
+  lc_bsdf b = bsdf_from_material_untextured(mat);
   lc_bsdf_sample bs;
   float3 wo = normalize(wo_in.xyz);
   int ok = bsdf_sample(&b, wo, front, lc_rng_uniform(0u, i, 0u, 7u), lc_rng_uniform(0u, i, 1u, 7u),
@@ -46,12 +41,7 @@ __kernel void probe_bsdf_sample(__global const lc_material* mat, float4 wo_in, i
 __kernel void probe_bsdf_eval(__global const lc_material* mat, __global const float4* wo_in,
                               __global const float4* wi_in, __global float4* out) {
   size_t i = get_global_id(0);
-  lc_bsdf b;
-  b.type = mat->type;
-  b.albedo = lc_load3(mat->albedo);
-  b.specular = lc_load3(mat->specular);
-  b.ior = mat->ior;
-  b.alpha = fmax(mat->roughness, 1e-3f);
+  lc_bsdf b = bsdf_from_material_untextured(mat);
   float pdf;
   float3 f = bsdf_eval(&b, wo_in[i].xyz, wi_in[i].xyz, &pdf);
   out[i] = (float4)(f, pdf);

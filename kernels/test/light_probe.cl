@@ -15,31 +15,9 @@
 #include "bvh/traverse.cl"
 #include "light/light.cl"
 
-#define LC_PROBE_SCENE_ARGS                                                                   \
-  __global const lc_params *params, __global const lc_bvh_node *nodes,                        \
-      __global const lc_uint *prim_refs, __global const lc_triangle *triangles,               \
-      __global const lc_triangle_attr *tri_attrs, __global const lc_sphere *spheres,          \
-      __global const lc_material *materials, __global const lc_light *lights,                 \
-      __global const float *light_cdf, __global const lc_texture *textures,                   \
-      __global const float4 *texels
-
-#define LC_PROBE_SCENE_INIT \
-  lc_scene s;               \
-  s.params = params;        \
-  s.nodes = nodes;          \
-  s.prim_refs = prim_refs;  \
-  s.triangles = triangles;  \
-  s.tri_attrs = tri_attrs;  \
-  s.spheres = spheres;      \
-  s.materials = materials;  \
-  s.lights = lights;        \
-  s.light_cdf = light_cdf;  \
-  s.textures = textures;    \
-  s.texels = texels;
-
 /* out[i] = (wi, pdf) of sample i from point p, pdf = -1 when no sample was produced */
-__kernel void probe_light_sample(LC_PROBE_SCENE_ARGS, float4 p, __global float4* out) {
-  LC_PROBE_SCENE_INIT
+__kernel void probe_light_sample(LC_SCENE_KERNEL_ARGS, float4 p, __global float4* out) {
+  lc_scene s = LC_SCENE_FROM_KERNEL_ARGS;
   lc_uint i = (lc_uint)get_global_id(0);
   lc_light_sample ls;
   int ok = light_sample(&s, p.xyz, lc_rng_uniform(0u, i, 0u, 3u), lc_rng_uniform(0u, i, 1u, 3u),
@@ -51,9 +29,9 @@ __kernel void probe_light_sample(LC_PROBE_SCENE_ARGS, float4 p, __global float4*
 /* pdf[i]: the solid-angle density with which light_sample from p produces direction dirs[i],
  * summed over all lights (each light's own pdf, occlusion ignored), through the pdf functions
  * the integrator uses for MIS. */
-__kernel void probe_light_pdf(LC_PROBE_SCENE_ARGS, float4 p, __global const float4* dirs,
+__kernel void probe_light_pdf(LC_SCENE_KERNEL_ARGS, float4 p, __global const float4* dirs,
                               __global float* pdf) {
-  LC_PROBE_SCENE_INIT
+  lc_scene s = LC_SCENE_FROM_KERNEL_ARGS;
   size_t i = get_global_id(0);
   float3 d = normalize(dirs[i].xyz);
   float sum = 0.0f;
