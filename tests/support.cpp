@@ -125,6 +125,26 @@ double sidak_z(double alpha, int m) {
   return normal_two_sided_critical(-std::expm1(std::log1p(-alpha) / m));
 }
 
+PooledChi2 pooled_chi2(const std::vector<double>& observed, const std::vector<double>& expected,
+                       double min_expected) {
+  PooledChi2 r;
+  for (size_t i = 0; i < expected.size(); ++i) {
+    if (expected[i] < min_expected) {
+      r.pooled_observed += observed[i];
+      r.pooled_expected += expected[i];
+      continue;
+    }
+    r.chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+    ++r.cells;
+  }
+  if (r.pooled_expected >= min_expected) {
+    const double d = r.pooled_observed - r.pooled_expected;
+    r.chi2 += d * d / r.pooled_expected;
+    ++r.cells;
+  }
+  return r;
+}
+
 double chi2_pvalue(double chi2, int dof) {
   const double a = dof / 2.0, x = chi2 / 2.0;
   if (x <= 0) return 1;

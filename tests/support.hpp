@@ -43,6 +43,18 @@ double sidak_z(double alpha, int m);
 /// function Q(dof/2, chi2/2), by series or continued fraction.
 double chi2_pvalue(double chi2, int dof);
 
+/// Pearson's chi-square statistic of observed against expected counts, with every cell whose
+/// expected count is below `min_expected` pooled into one (counted as a cell only when the pool
+/// reaches min_expected itself).
+struct PooledChi2 {
+  double chi2 = 0;
+  int cells = 0;               ///< cells in the statistic (dof = cells - 1)
+  double pooled_observed = 0;  ///< observed count in the small cells
+  double pooled_expected = 0;  ///< expected count in the small cells
+};
+PooledChi2 pooled_chi2(const std::vector<double>& observed, const std::vector<double>& expected,
+                       double min_expected = 5);
+
 /// Collects scene loading warnings (scene_detail::warn) while alive, instead of printing them.
 class CaptureWarnings {
  public:

@@ -154,23 +154,10 @@ void chi_square(const ChiSquareCase& tc) {
   }
   EXPECT_NEAR(integral, double(produced) / N, 0.01) << tc.name << ": pdf integral vs sampling success";
 
-  // pool small bins
-  std::vector<std::pair<double, double>> cells;  // (observed, expected)
-  double pool_o = 0, pool_e = 0;
-  for (int i = 0; i < NT * NP; ++i) {
-    if (expected[i] < 5) {
-      pool_o += observed[i];
-      pool_e += expected[i];
-    } else {
-      cells.push_back({observed[i], expected[i]});
-    }
-  }
-  if (pool_e >= 5) cells.push_back({pool_o, pool_e});
-  double chi2 = 0;
-  for (auto& c : cells) chi2 += (c.first - c.second) * (c.first - c.second) / c.second;
-  int dof = int(cells.size()) - 1;
-  double pval = lucent::test::chi2_pvalue(chi2, dof);
-  EXPECT_GT(pval, 1e-4) << tc.name << ": chi2 " << chi2 << " with " << dof << " dof";
+  lucent::test::PooledChi2 c = lucent::test::pooled_chi2(observed, expected);
+  int dof = c.cells - 1;
+  double pval = lucent::test::chi2_pvalue(c.chi2, dof);
+  EXPECT_GT(pval, 1e-4) << tc.name << ": chi2 " << c.chi2 << " with " << dof << " dof";
 
   // weights: f cos / pdf of the evaluation code at the sampled direction
   std::vector<cl_float4> some_wi, some_wo;

@@ -153,24 +153,10 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
   for (double e : expected) integral += e / N;
   EXPECT_NEAR(integral, double(produced) / N, 0.01) << name << ": pdf integral vs sampling success";
 
-  double pool_o = 0, pool_e = 0, chi2 = 0;
-  int cells = 0;
-  for (int i = 0; i < NT * NP; ++i) {
-    if (expected[i] < 5) {
-      pool_o += observed[i];
-      pool_e += expected[i];
-      continue;
-    }
-    chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-    ++cells;
-  }
-  if (pool_e >= 5) {
-    chi2 += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
-    ++cells;
-  }
-  ASSERT_GE(cells, 20) << name << ": too few populated bins for a meaningful test";
-  double pval = lucent::test::chi2_pvalue(chi2, cells - 1);
-  EXPECT_GT(pval, 1e-4) << name << ": chi2 " << chi2 << " over " << cells << " cells";
+  lucent::test::PooledChi2 c = lucent::test::pooled_chi2(observed, expected);
+  ASSERT_GE(c.cells, 20) << name << ": too few populated bins for a meaningful test";
+  double pval = lucent::test::chi2_pvalue(c.chi2, c.cells - 1);
+  EXPECT_GT(pval, 1e-4) << name << ": chi2 " << c.chi2 << " over " << c.cells << " cells";
 }
 
 const char* kMats = R"("materials": {"lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [2, 3, 4]},

@@ -117,26 +117,13 @@ void chi_square(const char* name, const Frame& frame, double z_lo, int NT, int N
   const double tol = 5 * std::sqrt(frac * (1 - frac) / N) + 2e-3 * std::max(frac, integral);
   EXPECT_NEAR(integral, frac, tol) << name << ": pdf integral vs sampling success";
 
-  double pool_o = 0, pool_e = 0, chi2 = 0;
-  int cells = 0;
-  for (int i = 0; i < NT * NP; ++i) {
-    if (expected[i] < 5) {
-      pool_o += observed[i];
-      pool_e += expected[i];
-      continue;
-    }
-    chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-    ++cells;
+  lucent::test::PooledChi2 c = lucent::test::pooled_chi2(observed, expected);
+  if (c.pooled_expected < 5) {
+    EXPECT_LE(c.pooled_observed, 20) << name << ": many samples where the pdf is ~0";
   }
-  if (pool_e >= 5) {
-    chi2 += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
-    ++cells;
-  } else {
-    EXPECT_LE(pool_o, 20) << name << ": many samples where the pdf is ~0";
-  }
-  ASSERT_GE(cells, 20) << name << ": too few populated bins for a meaningful test";
-  double pval = lucent::test::chi2_pvalue(chi2, cells - 1);
-  EXPECT_GT(pval, 1e-4) << name << ": chi2 " << chi2 << " over " << cells << " cells";
+  ASSERT_GE(c.cells, 20) << name << ": too few populated bins for a meaningful test";
+  double pval = lucent::test::chi2_pvalue(c.chi2, c.cells - 1);
+  EXPECT_GT(pval, 1e-4) << name << ": chi2 " << c.chi2 << " over " << c.cells << " cells";
 }
 
 // ------------------------------------------------------------------------------------------
