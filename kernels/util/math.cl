@@ -2,6 +2,31 @@
 #ifndef LUCENT_UTIL_MATH_CL
 #define LUCENT_UTIL_MATH_CL
 
+/*
+ * Precision of ray and geometry arithmetic (--precision): lc_real is float by default and double
+ * when the build defines LC_DOUBLE (devices with fp64). Buffers always hold float; values loaded
+ * from them are widened with lc_load3r / lc_real3_from_float3. LC_REAL(x) writes a literal in the
+ * chosen precision.
+ */
+#ifdef LC_DOUBLE
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+typedef double lc_real;
+typedef double2 lc_real2;
+typedef double3 lc_real3;
+typedef double4 lc_real4;
+#define LC_REAL(x) (x)
+#define lc_real3_from_float3(v) convert_double3(v)
+#define lc_float3_from_real3(v) convert_float3(v)
+#else
+typedef float lc_real;
+typedef float2 lc_real2;
+typedef float3 lc_real3;
+typedef float4 lc_real4;
+#define LC_REAL(x) (x##f)
+#define lc_real3_from_float3(v) (v)
+#define lc_float3_from_real3(v) (v)
+#endif
+
 #define LC_PI 3.14159265358979323846f
 #define LC_INV_PI 0.31830988618379067154f
 #define LC_INF INFINITY
@@ -12,6 +37,9 @@ typedef struct {
 } lc_ray;
 
 static inline float3 lc_load3(const __global float* p) { return (float3)(p[0], p[1], p[2]); }
+static inline lc_real3 lc_load3r(const __global float* p) {
+  return (lc_real3)((lc_real)p[0], (lc_real)p[1], (lc_real)p[2]);
+}
 static inline float3 lc_load3c(__constant float* p) { return (float3)(p[0], p[1], p[2]); }
 static inline float lc_max3(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
 static inline float lc_luminance(float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
