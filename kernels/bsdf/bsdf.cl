@@ -77,8 +77,7 @@ static inline float3 bsdf_eval(const lc_bsdf* b, float3 wo, float3 wi, float* pd
 }
 
 static inline float3 sample_cosine_hemisphere(float u1, float u2) {
-  float r = sqrt(u1), phi = 2.0f * LC_PI * u2;
-  return (float3)(r * cos(phi), r * sin(phi), sqrt(fmax(0.0f, 1.0f - u1)));
+  return (float3)(sqrt(u1) * lc_unit_circle(u2), sqrt(fmax(0.0f, 1.0f - u1)));
 }
 
 typedef struct {

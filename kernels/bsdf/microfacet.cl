@@ -31,8 +31,8 @@ static inline float3 ggx_sample_vndf(float3 wo, float alpha, float u1, float u2)
   float lensq = vh.x * vh.x + vh.y * vh.y;
   float3 t1 = lensq > 0.0f ? (float3)(-vh.y, vh.x, 0.0f) / sqrt(lensq) : (float3)(1.0f, 0.0f, 0.0f);
   float3 t2 = cross(vh, t1);
-  float r = sqrt(u1), phi = 2.0f * LC_PI * u2;
-  float p1 = r * cos(phi), p2 = r * sin(phi);
+  float2 p = sqrt(u1) * lc_unit_circle(u2);
+  float p1 = p.x, p2 = p.y;
   float s = 0.5f * (1.0f + vh.z);
   p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * p2;
   float3 nh = p1 * t1 + p2 * t2 + sqrt(fmax(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;

@@ -6,15 +6,16 @@
 static inline float2 sample_concentric_disk(float u1, float u2) {
   float a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f;
   if (a == 0.0f && b == 0.0f) return (float2)(0.0f, 0.0f);
+  /* angles in units of pi: sinpi/cospi need no general range reduction (util/math.cl) */
   float r, phi;
   if (fabs(a) > fabs(b)) {
     r = a;
-    phi = (LC_PI / 4.0f) * (b / a);
+    phi = 0.25f * (b / a);
   } else {
     r = b;
-    phi = (LC_PI / 2.0f) - (LC_PI / 4.0f) * (a / b);
+    phi = 0.5f - 0.25f * (a / b);
   }
-  return (float2)(r * cos(phi), r * sin(phi));
+  return (float2)(r * cospi(phi), r * sinpi(phi));
 }
 
 /* Ray through film position (fx, fy) in pixels, (0,0) = top-left corner of the image. */

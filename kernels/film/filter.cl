@@ -19,11 +19,11 @@ static inline float2 filter_sample(lc_uint type, float radius, float u1, float u
 #ifdef LC_HAS_FILTER_GAUSSIAN
   if (type == LC_FILTER_GAUSSIAN) {
     float sigma = radius / 3.0f;
-    /* truncated radial Gaussian: invert the CDF of r restricted to [0, radius] */
-    float tail = 1.0f - exp(-0.5f * radius * radius / (sigma * sigma));
+    /* truncated radial Gaussian: invert the CDF of r restricted to [0, radius]; its mass within
+     * radius = 3 sigma is 1 - exp(-9 / 2) */
+    const float tail = 0.98889100346175773f;
     float r = sigma * sqrt(-2.0f * log(1.0f - u1 * tail));
-    float phi = 2.0f * LC_PI * u2;
-    return (float2)(r * cos(phi), r * sin(phi));
+    return r * lc_unit_circle(u2);
   }
 #endif
   return (float2)((u1 - 0.5f) * 2.0f * radius, (u2 - 0.5f) * 2.0f * radius);

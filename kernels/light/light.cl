@@ -30,8 +30,7 @@ static inline lc_uint lc_cdf_search(__global const float* cdf, lc_uint n, float 
 static inline float3 sample_uniform_sphere(float u1, float u2) {
   float z = 1.0f - 2.0f * u1;
   float r = sqrt(fmax(0.0f, 1.0f - z * z));
-  float phi = 2.0f * LC_PI * u2;
-  return (float3)(r * cos(phi), r * sin(phi), z);
+  return (float3)(r * lc_unit_circle(u2), z);
 }
 
 /* ---- environment map: equirectangular, nearest texel (docs/rendering-model.md) ---- */
@@ -144,11 +143,11 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
     float cos_a = sin2t / sqrt(sin2max) + cos_t * sqrt(fmax(0.0f, 1.0f - sin2t / sin2max));
     cos_a = clamp(cos_a, -1.0f, 1.0f);
     float sin_a = sqrt(fmax(0.0f, 1.0f - cos_a * cos_a));
-    float phi = 2.0f * LC_PI * u2;
+    float2 cs = sin_a * lc_unit_circle(u2);
     float3 wc = -d / dc; /* from the centre towards p */
     float3 t, b;
     lc_onb(wc, &t, &b);
-    float3 n = sin_a * cos(phi) * t + sin_a * sin(phi) * b + cos_a * wc;
+    float3 n = cs.x * t + cs.y * b + cos_a * wc;
     float3 q = c + r * n;
     float3 to = q - p;
     float dist = length(to);
@@ -192,10 +191,11 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
     lc_uint x = k % tex->width, y = k / tex->width;
     float u = ((float)x + clamp(fx, 0.0f, 0.99999f)) / (float)tex->width;
     float v = ((float)y + u2) / (float)tex->height;
-    float theta = v * LC_PI, phi = (u - 0.5f) * 2.0f * LC_PI;
-    float st = sin(theta);
+    /* theta = pi v, phi = 2 pi (u - 1/2) */
+    float st = sinpi(v);
     if (!(st > 0.0f)) return 0;
-    ls->wi = (float3)(st * sin(phi), cos(theta), -st * cos(phi));
+    float2 cp = lc_unit_circle(u - 0.5f);
+    ls->wi = (float3)(st * cp.y, cospi(v), -st * cp.x);
     ls->dist = INFINITY;
     ls->L = lc_load3(L->intensity) * s->texels[tex->offset + k].xyz;
     ls->pdf = L->pdf_select * (hi - lo) * (float)n / (2.0f * LC_PI * LC_PI * st);
