@@ -338,6 +338,11 @@ TEST(Obj, MalformedFilesAreErrorsNamingFileAndLine) {
       {"negative.obj", "f -4 1 2\n", "out of range"},
       {"texcoord.obj", "f 1/1 2/1 3/2\n", "texture coordinate"},
       {"normal.obj", "f 1//1 2//1 3//1\n", "normal"},
+      {"vword.obj", "v 1 abc 0\n", "'abc' is not a number"},
+      {"vshort.obj", "v 1 2\n", "vertex line has 2 numbers, needs 3"},
+      {"vnword.obj", "vn 0 1 0x\n", "'0x' is not a number"},
+      {"vtword.obj", "vt u 0\n", "texture coordinate line: 'u' is not"},
+      {"vhuge.obj", "v 1e999 0 0\n", "out of range"},
   };
   for (const Case& c : cases) {
     std::string path = write(dir, c.name, head + "f 1 2 3\n" + c.face);  // the face: line 7

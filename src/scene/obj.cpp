@@ -3,6 +3,7 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -99,6 +100,50 @@ std::string find_bad_face(const std::string& path) {
                  " is out of range (" + std::to_string(counts[k]) + " defined so far)";
       }
     }
+  }
+  return "";
+}
+
+// tinyobjloader reads a coordinate that is not a number ("v 1 abc 0") as 0 and a missing one as
+// 0 without a word: check the v, vn and vt lines ourselves and name the first bad one.
+std::string find_bad_vertex_line(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (long ln = 1; std::getline(in, line); ++ln) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream ls(line);
+    std::string tag, tok;
+    ls >> tag;
+    int need;
+    const char* what;
+    if (tag == "v") {
+      need = 3, what = "vertex";
+    } else if (tag == "vn") {
+      need = 3, what = "normal";
+    } else if (tag == "vt") {
+      need = 1, what = "texture coordinate";
+    } else {
+      continue;
+    }
+    int n = 0;
+    while (ls >> tok) {
+      if (tok[0] == '#') break;
+      const char* b = tok.c_str() + (tok[0] == '+' ? 1 : 0);
+      const char* e = tok.c_str() + tok.size();
+      double x;
+      auto [ptr, ec] = std::from_chars(b, e, x);
+      if (ec == std::errc::result_out_of_range) {
+        return path + ":" + std::to_string(ln) + ": " + what + " line: '" + tok +
+               "' is out of range";
+      }
+      if (ec != std::errc() || ptr != e)
+        return path + ":" + std::to_string(ln) + ": " + what + " line: '" + tok +
+               "' is not a number";
+      ++n;
+    }
+    if (n < need)
+      return path + ":" + std::to_string(ln) + ": " + what + " line has " + std::to_string(n) +
+             " numbers, needs " + std::to_string(need);
   }
   return "";
 }
@@ -267,6 +312,7 @@ void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform
   bool ok = tinyobj::LoadObj(&attrib, &shapes, &mats, &twarn, &terr, &in, &reader,
                              /*triangulate=*/true, /*default_vcols_fallback=*/false);
   if (!ok) throw_parse_error(path, terr);
+  if (std::string bad = find_bad_vertex_line(path); !bad.empty()) throw Error(bad);
 
   const long nv = static_cast<long>(attrib.vertices.size() / 3);
   const long nn = static_cast<long>(attrib.normals.size() / 3);
