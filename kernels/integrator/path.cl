@@ -41,8 +41,11 @@ static inline float3 frame_to_world(const lc_frame* f, float3 v) {
  * offset of o is large on huge spheres (it scales with their float precision), and a direction
  * computed from the surface point would, seen from o, pass just inside a sphere light near its
  * silhouette. */
-/* Relative shortening of shadow rays (see shadow_visible): float's, and double's scaled by the
- * ratio of their epsilons. */
+/* Relative shortening of shadow rays (see shadow_visible): float's 2e-4, and for double about
+ * 2e-4 times the ratio of the two epsilons (3.7e-13), rounded up. The sampled light point must
+ * then be computed in lc_real throughout (kernels/light/light.cl): a float barycentric sum or a
+ * float sin/cos pair puts it ~1e-7 off the light's surface, which this margin does not cover
+ * (the Cornell box's NEE was 15% too dark in double until they were lc_real). */
 #ifdef LC_DOUBLE
 #define LC_SHADOW_REL_MARGIN 1e-12
 #else
