@@ -243,6 +243,35 @@ TEST(PrecisionDouble, ThinLensMatchesReference) {
   EXPECT_SAME_IMAGE(k, r, "A = kernel in double, B = reference");
 }
 
+// The Whitted integrator in double (reflected and refracted rays spawned from its explicit
+// stack, point lights through the diffuse term), 32x32 at 64 spp: same test.
+TEST(PrecisionDouble, WhittedMatchesReference) {
+  REQUIRE_FP64();
+  Scene s = scene_from(R"({
+    "camera": {"position": [0, 1.2, 5], "look_at": [0, 0.4, 0], "fov": 38},
+    "film": {"width": 32, "height": 32},
+    "integrator": {"type": "whitted", "max_depth": 6},
+    "materials": {"floor": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
+                  "glass": {"type": "dielectric", "ior": 1.5, "tint": [1, 0.9, 0.8]},
+                  "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]},
+                  "plastic": {"type": "plastic", "albedo": [0.2, 0.5, 0.8], "roughness": 0.2}},
+    "shapes": [{"type": "triangles", "material": "floor",
+                "positions": [[-6,0,-6],[6,0,-6],[6,0,6],[-6,0,6]], "indices": [0,2,1, 0,3,2]},
+               {"type": "sphere", "center": [-1.2, 0.5, 0.3], "radius": 0.5, "material": "glass"},
+               {"type": "sphere", "center": [0, 0.5, 0], "radius": 0.5, "material": "mirror"},
+               {"type": "sphere", "center": [0.3, 0.3, 1.4], "radius": 0.3, "material": "plastic"}],
+    "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [30, 28, 25]},
+               {"type": "environment", "radiance": [0.25, 0.3, 0.4]}]
+  })");
+  RenderResult k = render(s, 64, 31, Precision::Double);
+  Scene rs = s;
+  rs.integrator.seed = 32;
+  lucent::ReferenceOptions ro;
+  ro.spp = 64;
+  RenderResult r = lucent::render_reference(rs, ro);
+  EXPECT_SAME_IMAGE(k, r, "A = kernel in double, B = reference");
+}
+
 // ------------------------------------------------------------------------------------------
 // Stability at the extremes (tests/test_stability_scene.cpp): where float is limited, double is
 // not.
