@@ -18,6 +18,7 @@ namespace lucent {
 /// Syntax (parse_converge_setting): knobs joined by '+', e.g. "max_depth=2+fast-math".
 ///   default            the scene as it is
 ///   fast-math          RenderOptions::fast_math
+///   double / float     RenderOptions::precision (precision=double|float also accepted)
 ///   no-specialize      RenderOptions::specialize = false
 ///   no-mis / mis       integrator.mis off / on
 ///   max_depth=N        integrator.max_depth (N >= 1)
@@ -28,6 +29,7 @@ namespace lucent {
 struct ConvergeSetting {
   std::string name = "default";
   bool fast_math = false;
+  int precision = -1;        ///< -1: the options'; else a Precision
   bool specialize = true;
   int mis = -1;              ///< -1: the scene's; 0 off; 1 on
   int max_depth = 0;         ///< 0: the scene's

@@ -18,6 +18,16 @@ struct RenderProgress {
   double samples_per_second = 0;    ///< camera samples (all pixels) per second
 };
 
+/// Arithmetic of rays and geometry in the kernel (docs/rendering-model.md, "Precision"): float,
+/// or double on devices with fp64 (radiance, BSDFs, textures and buffers stay float).
+enum class Precision { Float, Double };
+
+/// "float" or "double".
+const char* precision_name(Precision p);
+
+/// Parses "float" or "double"; throws lucent::Error naming `what` (e.g. "--precision") otherwise.
+Precision parse_precision(const std::string& text, const std::string& what = "--precision");
+
 struct RenderOptions {
   std::string device;             ///< selector, see select_device()
   int spp = 0;                    ///< 0: the scene's integrator.spp
@@ -27,6 +37,7 @@ struct RenderOptions {
   double pass_seconds = 0.25;     ///< target duration of one launch
   bool fast_math = false;         ///< build with -cl-fast-relaxed-math (default: IEEE math)
   bool specialize = true;         ///< compile only the features the scene uses (false: all)
+  Precision precision = Precision::Float;  ///< Double: build with -D LC_DOUBLE (needs fp64)
 };
 
 struct RenderResult {

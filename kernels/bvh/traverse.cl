@@ -38,15 +38,15 @@ typedef struct {
    textures, texels}
 
 typedef struct {
-  float t;
+  lc_real t;
   lc_uint prim; /* primitive reference (LC_PRIM_SPHERE_BIT for spheres), LC_INVALID on a miss */
-  float b1, b2; /* triangle barycentrics of v1 and v2 */
+  lc_real b1, b2; /* triangle barycentrics of v1 and v2 */
 } lc_hit;
 
 /* 1 / d per component, +INFINITY where d is 0 (either sign) or so small that 1 / d overflows. */
-static inline float3 bvh_inv_dir(float3 d) {
-  float3 inv = 1.0f / d;
-  return select(inv, (float3)(INFINITY), isinf(inv));
+static inline lc_real3 bvh_inv_dir(lc_real3 d) {
+  lc_real3 inv = LC_REAL(1.0) / d;
+  return select(inv, (lc_real3)(INFINITY), isinf(inv));
 }
 
 /*
@@ -57,13 +57,13 @@ static inline float3 bvh_inv_dir(float3 d) {
  * exit keep the old value for a NaN: an origin on a face plane of a slab it does not move along
  * counts as inside that slab (boxes are closed), and no NaN decides anything.
  */
-static inline float bvh_box_entry(__global const lc_bvh_node* n, float3 o, float3 inv_d,
-                                  float tmin, float tmax) {
-  float3 t0 = (vload3(0, n->bmin) - o) * inv_d;
-  float3 t1 = (vload3(0, n->bmax) - o) * inv_d;
-  float3 tn = select(t0, t1, t1 < t0);
-  float3 tf = select(t1, t0, t0 > t1);
-  float enter = tmin, exit_ = tmax;
+static inline lc_real bvh_box_entry(__global const lc_bvh_node* n, lc_real3 o, lc_real3 inv_d,
+                                    lc_real tmin, lc_real tmax) {
+  lc_real3 t0 = (lc_real3_from_float3(vload3(0, n->bmin)) - o) * inv_d;
+  lc_real3 t1 = (lc_real3_from_float3(vload3(0, n->bmax)) - o) * inv_d;
+  lc_real3 tn = select(t0, t1, t1 < t0);
+  lc_real3 tf = select(t1, t0, t0 > t1);
+  lc_real enter = tmin, exit_ = tmax;
   enter = tn.x > enter ? tn.x : enter;
   enter = tn.y > enter ? tn.y : enter;
   enter = tn.z > enter ? tn.z : enter;
@@ -71,15 +71,20 @@ static inline float bvh_box_entry(__global const lc_bvh_node* n, float3 o, float
   exit_ = tf.y < exit_ ? tf.y : exit_;
   exit_ = tf.z < exit_ ? tf.z : exit_;
   /* conservative against rounding in t0, t1: widen the exit by 1 + 2 gamma(3) (pbrt-v4) */
+#ifdef LC_DOUBLE
+  exit_ *= 1.0000000000000007; /* the same in double */
+#else
   exit_ *= 1.0000004f;
+#endif
   return enter <= exit_ ? enter : INFINITY;
 }
 
-static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tri_ray* tr, float3 o,
-                                     float3 d, float tmin, lc_hit* hit) {
+static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tri_ray* tr,
+                                     lc_real3 o, lc_real3 d, lc_real tmin, lc_hit* hit) {
   if (ref & LC_PRIM_SPHERE_BIT) {
     __global const lc_sphere* sp = &s->spheres[ref & ~LC_PRIM_SPHERE_BIT];
-    float t = sphere_intersect(vload3(0, sp->center), sp->radius, o, d, tmin, hit->t);
+    lc_real t = sphere_intersect(lc_real3_from_float3(vload3(0, sp->center)), sp->radius, o, d,
+                                 tmin, hit->t);
     if (t < hit->t) {
       hit->t = t;
       hit->prim = ref;
@@ -88,8 +93,10 @@ static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tr
     return 0;
   }
   __global const lc_triangle* tri = &s->triangles[ref];
-  float t, b1, b2;
-  if (triangle_intersect(tr, o, vload3(0, tri->v0), vload3(0, tri->v1), vload3(0, tri->v2), tmin,
+  lc_real t, b1, b2;
+  if (triangle_intersect(tr, o, lc_real3_from_float3(vload3(0, tri->v0)),
+                         lc_real3_from_float3(vload3(0, tri->v1)),
+                         lc_real3_from_float3(vload3(0, tri->v2)), tmin,
                          hit->t, &t, &b1, &b2)) {
     hit->t = t;
     hit->prim = ref;
@@ -102,18 +109,18 @@ static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tr
 
 /* Closest hit with t in (tmin, tmax). With any_hit set, returns at the first hit found (shadow
  * rays); hit then holds that hit, not necessarily the closest. */
-static inline int bvh_trace(const lc_scene* s, float3 o, float3 d, float tmin, float tmax,
+static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real tmin, lc_real tmax,
                             int any_hit, lc_hit* hit) {
   hit->t = tmax;
   hit->prim = LC_INVALID;
-  hit->b1 = hit->b2 = 0.0f;
+  hit->b1 = hit->b2 = LC_REAL(0.0);
   if (s->params->num_nodes == 0) return 0;
   __global const lc_bvh_node* nodes = s->nodes;
-  float3 inv_d = bvh_inv_dir(d);
+  lc_real3 inv_d = bvh_inv_dir(d);
   if (bvh_box_entry(&nodes[0], o, inv_d, tmin, tmax) == INFINITY) return 0;
   lc_tri_ray tr = triangle_ray_setup(d);
   lc_uint stack_node[LC_BVH_STACK_SIZE];
-  float stack_t[LC_BVH_STACK_SIZE];
+  lc_real stack_t[LC_BVH_STACK_SIZE];
   int sp = 0;
   lc_uint node = 0;
   for (;;) {
@@ -124,10 +131,10 @@ static inline int bvh_trace(const lc_scene* s, float3 o, float3 d, float tmin, f
         if (bvh_intersect_prim(s, s->prim_refs[first + i], &tr, o, d, tmin, hit) && any_hit)
           return 1;
     } else {
-      float tl = bvh_box_entry(&nodes[first], o, inv_d, tmin, hit->t);
-      float tr_ = bvh_box_entry(&nodes[first + 1], o, inv_d, tmin, hit->t);
+      lc_real tl = bvh_box_entry(&nodes[first], o, inv_d, tmin, hit->t);
+      lc_real tr_ = bvh_box_entry(&nodes[first + 1], o, inv_d, tmin, hit->t);
       lc_uint near_ = tl <= tr_ ? first : first + 1;
-      float t_near = fmin(tl, tr_), t_far = fmax(tl, tr_);
+      lc_real t_near = fmin(tl, tr_), t_far = fmax(tl, tr_);
       if (t_near != INFINITY) {
         if (t_far != INFINITY && sp < LC_BVH_STACK_SIZE) {
           stack_node[sp] = (near_ == first) ? first + 1 : first;
@@ -148,14 +155,14 @@ static inline int bvh_trace(const lc_scene* s, float3 o, float3 d, float tmin, f
   }
 }
 
-static inline int scene_intersect(const lc_scene* s, lc_ray ray, float tmax, lc_hit* hit) {
-  return bvh_trace(s, ray.o, ray.d, 0.0f, tmax, 0, hit);
+static inline int scene_intersect(const lc_scene* s, lc_ray ray, lc_real tmax, lc_hit* hit) {
+  return bvh_trace(s, ray.o, ray.d, LC_REAL(0.0), tmax, 0, hit);
 }
 
 /* 1 when something blocks the segment from ray.o to ray.o + dist * ray.d. */
-static inline int scene_occluded(const lc_scene* s, lc_ray ray, float dist) {
+static inline int scene_occluded(const lc_scene* s, lc_ray ray, lc_real dist) {
   lc_hit hit;
-  return bvh_trace(s, ray.o, ray.d, 0.0f, dist, 1, &hit);
+  return bvh_trace(s, ray.o, ray.d, LC_REAL(0.0), dist, 1, &hit);
 }
 
 #endif

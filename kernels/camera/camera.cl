@@ -18,23 +18,25 @@ static inline float2 sample_concentric_disk(float u1, float u2) {
   return (float2)(r * cospi(phi), r * sinpi(phi));
 }
 
-/* Ray through film position (fx, fy) in pixels, (0,0) = top-left corner of the image. */
+/* Ray through film position (fx, fy) in pixels, (0,0) = top-left corner of the image. In lc_real
+ * from the film position on (--precision double: double origin and direction). */
 static inline lc_ray camera_generate_ray(__global const lc_camera* cam, float fx, float fy,
                                          lc_uint width, lc_uint height, float lu, float lv) {
-  float ndc_x = (2.0f * fx / (float)width - 1.0f) * cam->tan_half_fov * cam->aspect;
-  float ndc_y = (1.0f - 2.0f * fy / (float)height) * cam->tan_half_fov;
-  float3 right = lc_load3(cam->right), up = lc_load3(cam->up), fwd = lc_load3(cam->forward);
-  float3 dir = normalize(fwd + ndc_x * right + ndc_y * up);
+  lc_real ndc_x =
+      (LC_REAL(2.0) * fx / (lc_real)width - LC_REAL(1.0)) * cam->tan_half_fov * cam->aspect;
+  lc_real ndc_y = (LC_REAL(1.0) - LC_REAL(2.0) * fy / (lc_real)height) * cam->tan_half_fov;
+  lc_real3 right = lc_load3r(cam->right), up = lc_load3r(cam->up), fwd = lc_load3r(cam->forward);
+  lc_real3 dir = normalize(fwd + ndc_x * right + ndc_y * up);
   lc_ray ray;
-  ray.o = lc_load3(cam->position);
+  ray.o = lc_load3r(cam->position);
   ray.d = dir;
 #ifdef LC_HAS_THIN_LENS
   if (cam->lens_radius > 0.0f) {
     /* the focal plane is perpendicular to the viewing direction at focus_distance */
-    float ft = cam->focus_distance / dot(dir, fwd);
-    float3 focus = ray.o + ft * dir;
+    lc_real ft = cam->focus_distance / dot(dir, fwd);
+    lc_real3 focus = ray.o + ft * dir;
     float2 lens = cam->lens_radius * sample_concentric_disk(lu, lv);
-    ray.o = ray.o + lens.x * right + lens.y * up;
+    ray.o = ray.o + (lc_real)lens.x * right + (lc_real)lens.y * up;
     ray.d = normalize(focus - ray.o);
   }
 #endif

@@ -8,21 +8,21 @@
 #define LUCENT_GEOM_SPHERE_CL
 
 /* Returns the nearest t in (tmin, tmax) or INFINITY. */
-static inline float sphere_intersect(float3 center, float radius, float3 o, float3 d, float tmin,
-                                     float tmax) {
-  float3 f = o - center;
-  float b = -dot(f, d);
+static inline lc_real sphere_intersect(lc_real3 center, lc_real radius, lc_real3 o, lc_real3 d,
+                                       lc_real tmin, lc_real tmax) {
+  lc_real3 f = o - center;
+  lc_real b = -dot(f, d);
   /* discriminant from the distance of the centre to the ray line: no catastrophic cancellation */
-  float3 l = f + b * d;
-  float r2 = radius * radius;
-  float disc = r2 - dot(l, l);
-  if (disc < 0.0f) return INFINITY;
-  float c = dot(f, f) - r2;
-  float q = b + copysign(sqrt(disc), b);
-  float t0 = c / q;
-  float t1 = q;
+  lc_real3 l = f + b * d;
+  lc_real r2 = radius * radius;
+  lc_real disc = r2 - dot(l, l);
+  if (disc < LC_REAL(0.0)) return INFINITY;
+  lc_real c = dot(f, f) - r2;
+  lc_real q = b + copysign(sqrt(disc), b);
+  lc_real t0 = c / q;
+  lc_real t1 = q;
   if (t0 > t1) {
-    float tmp = t0;
+    lc_real tmp = t0;
     t0 = t1;
     t1 = tmp;
   }

@@ -41,7 +41,19 @@ static inline float3 frame_to_world(const lc_frame* f, float3 v) {
  * offset of o is large on huge spheres (it scales with their float precision), and a direction
  * computed from the surface point would, seen from o, pass just inside a sphere light near its
  * silhouette. */
-static inline int shadow_visible(const lc_scene* s, float3 o, float3 wi, float dist, lc_uint* rays) {
+/* Relative shortening of shadow rays (see shadow_visible): float's 2e-4, and for double about
+ * 2e-4 times the ratio of the two epsilons (3.7e-13), rounded up. The sampled light point must
+ * then be computed in lc_real throughout (kernels/light/light.cl): a float barycentric sum or a
+ * float sin/cos pair puts it ~1e-7 off the light's surface, which this margin does not cover
+ * (the Cornell box's NEE was 15% too dark in double until they were lc_real). */
+#ifdef LC_DOUBLE
+#define LC_SHADOW_REL_MARGIN 1e-12
+#else
+#define LC_SHADOW_REL_MARGIN 2e-4f
+#endif
+
+static inline int shadow_visible(const lc_scene* s, lc_real3 o, lc_real3 wi, lc_real dist,
+                                 lc_uint* rays) {
   lc_ray sr;
   sr.o = o;
   sr.d = wi;
@@ -49,9 +61,11 @@ static inline int shadow_visible(const lc_scene* s, float3 o, float3 wi, float d
   /* stop short of the light's own surface by its position error: relative to the distance, and
    * a few ulps of the sampled point's coordinates (it is only known to those: at 1e4 from the
    * origin a point on a sphere light 2 away is 1e-3 off, 2.5 times 2e-4 dist, and the shadow ray
-   * hit the light itself: 20% too dark, tests/test_stability_scene.cpp StabilityTranslateLight) */
-  float tmax = isinf(dist) ? INFINITY
-                           : dist * (1.0f - 2e-4f) - 8.0f * FLT_EPSILON * (lc_max3(fabs(o)) + dist);
+   * hit the light itself: 20% too dark, tests/test_stability_scene.cpp StabilityTranslateLight);
+   * both margins scale with lc_real's precision */
+  lc_real tmax = isinf(dist) ? (lc_real)INFINITY
+                             : dist * (LC_REAL(1.0) - LC_SHADOW_REL_MARGIN) -
+                                   LC_REAL(8.0) * LC_REAL_EPSILON * (lc_max3r(fabs(o)) + dist);
   return !scene_occluded(s, sr, tmax);
 }
 
@@ -67,13 +81,13 @@ static inline float3 point_lights_direct(const lc_scene* s, const lc_interaction
     if (L->type != LC_LIGHT_POINT) continue;
     /* irradiance from the surface point itself; the shadow ray leaves from the offset origin
      * (a point light has no surface that the few-ulp parallel shift could graze) */
-    float3 o = lc_spawn_origin(it->p, it->perr, it->ng);
-    float3 to = lc_load3(L->position) - it->p;
-    float d2 = dot(to, to);
-    float dist = sqrt(d2);
-    float3 wi = to / dist;
-    if (dot(wi, it->ng) <= 0.0f) continue;
-    float3 wi_l = frame_to_local(fr, wi);
+    lc_real3 o = lc_spawn_origin(it->p, it->perr, it->ng);
+    lc_real3 to = lc_load3r(L->position) - it->p;
+    lc_real d2 = dot(to, to);
+    lc_real dist = sqrt(d2);
+    lc_real3 wi = to / dist;
+    if (dot(wi, it->ng) <= LC_REAL(0.0)) continue;
+    float3 wi_l = frame_to_local(fr, lc_float3_from_real3(wi));
     if (wi_l.z <= 0.0f) continue;
     float3 f;
     if (diffuse_only) {
@@ -88,7 +102,7 @@ static inline float3 point_lights_direct(const lc_scene* s, const lc_interaction
     sr.d = wi;
     ++*rays;
     if (scene_occluded(s, sr, dist)) continue;
-    sum += f * lc_load3(L->intensity) * (wi_l.z / d2);
+    sum += f * lc_load3(L->intensity) * (wi_l.z / (float)d2);
   }
 #endif
   return sum;
@@ -99,14 +113,14 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
   float3 L = (float3)(0.0f), beta = (float3)(1.0f);
   float prev_pdf = 0.0f;
   int prev_delta = 1; /* the camera ray: emitters count fully */
-  float3 prev_p = ray.o;
+  lc_real3 prev_p = ray.o;
   for (lc_uint depth = 0;; ++depth) {
     lc_hit hit;
     ++*rays;
     const int no_mis = (P->flags & LC_FLAG_NO_MIS) != 0;
     if (!scene_intersect(s, ray, INFINITY, &hit)) {
       float pdf_l;
-      float3 Le = env_radiance(s, ray.d, &pdf_l);
+      float3 Le = env_radiance(s, lc_float3_from_real3(ray.d), &pdf_l);
       L += beta * Le * (prev_delta ? 1.0f : (no_mis ? 0.0f : mis_power(prev_pdf, pdf_l)));
       break;
     }
@@ -125,17 +139,17 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     lc_uint dim = LC_DIM_BOUNCE + depth * LC_DIMS_PER_BOUNCE;
     lc_bsdf b = bsdf_from_material(s, m, it.uv);
     lc_frame fr = frame_from(it.ns);
-    float3 wo_l = frame_to_local(&fr, -ray.d);
+    float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
     if (wo_l.z <= 0.0f) break;
 
     /* next-event estimation, from the origin that the shadow ray will use */
-    float3 o = lc_spawn_origin(it.p, it.perr, it.ng);
+    lc_real3 o = lc_spawn_origin(it.p, it.perr, it.ng);
     if (!bsdf_is_delta(&b) && P->num_lights > 0) {
       lc_light_sample ls;
       if (light_sample(s, o, lc_rand(rng, dim + LC_DIM_LIGHT_SELECT),
                        lc_rand(rng, dim + LC_DIM_LIGHT_UV), lc_rand(rng, dim + LC_DIM_LIGHT_UV + 1), &ls) &&
-          ls.pdf > 0.0f && dot(ls.wi, it.ng) > 0.0f) {
-        float3 wi_l = frame_to_local(&fr, ls.wi);
+          ls.pdf > 0.0f && dot(ls.wi, it.ng) > LC_REAL(0.0)) {
+        float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
         float pdf_b;
         float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf_b);
         if (lc_max3(f) > 0.0f && shadow_visible(s, o, ls.wi, ls.dist, rays)) {
@@ -150,10 +164,10 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     if (!bsdf_sample(&b, wo_l, it.front, lc_rand(rng, dim + LC_DIM_BSDF_LOBE),
                      lc_rand(rng, dim + LC_DIM_BSDF_UV), lc_rand(rng, dim + LC_DIM_BSDF_UV + 1), &bs))
       break;
-    float3 wi = normalize(frame_to_world(&fr, bs.wi));
+    lc_real3 wi = normalize(lc_real3_from_float3(frame_to_world(&fr, bs.wi)));
     int transmit = bs.wi.z < 0.0f;
-    float side = dot(wi, it.ng);
-    if (transmit ? side >= 0.0f : side <= 0.0f) break; /* shading normal leak: drop */
+    lc_real side = dot(wi, it.ng);
+    if (transmit ? side >= LC_REAL(0.0) : side <= LC_REAL(0.0)) break; /* shading normal leak */
     beta *= bs.weight;
     if (!(lc_max3(beta) > 0.0f)) break;
     prev_delta = bs.delta;
@@ -198,7 +212,7 @@ static inline float3 integrator_whitted(const lc_scene* s, lc_ray ray, lc_uint* 
     ++*rays;
     if (!scene_intersect(s, e.ray, INFINITY, &hit)) {
       float pdf;
-      L += e.w * env_radiance(s, e.ray.d, &pdf);
+      L += e.w * env_radiance(s, lc_float3_from_real3(e.ray.d), &pdf);
       continue;
     }
     lc_interaction it = interaction_from_hit(s, e.ray, &hit);
@@ -206,13 +220,14 @@ static inline float3 integrator_whitted(const lc_scene* s, lc_ray ray, lc_uint* 
     if (it.front) L += e.w * lc_load3(m->emission);
     lc_bsdf b = bsdf_from_material(s, m, it.uv);
     lc_frame fr = frame_from(it.ns);
-    float3 wo_l = frame_to_local(&fr, -e.ray.d);
+    float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-e.ray.d));
     if (b.type == LC_MAT_DIFFUSE || b.type == LC_MAT_PLASTIC)
       L += e.w * point_lights_direct(s, &it, &b, &fr, wo_l, 1, rays);
     if (e.segments >= P->max_depth || b.type == LC_MAT_DIFFUSE || wo_l.z <= 0.0f) continue;
-    float3 refl = normalize(frame_to_world(&fr, (float3)(-wo_l.x, -wo_l.y, wo_l.z)));
+    lc_real3 refl =
+        normalize(lc_real3_from_float3(frame_to_world(&fr, (float3)(-wo_l.x, -wo_l.y, wo_l.z))));
     float3 w_refl = (float3)(0.0f), w_refr = (float3)(0.0f);
-    float3 refr = (float3)(0.0f);
+    lc_real3 refr = (lc_real3)(LC_REAL(0.0));
     float ct;
     if (b.type == LC_MAT_MIRROR || b.type == LC_MAT_CONDUCTOR) {
       w_refl = b.specular;
@@ -224,17 +239,18 @@ static inline float3 integrator_whitted(const lc_scene* s, lc_ray ray, lc_uint* 
       w_refl = (float3)(F);
       if (F < 1.0f) {
         w_refr = b.specular * (1.0f - F);
-        refr = normalize(frame_to_world(&fr, (float3)(-wo_l.x / eta, -wo_l.y / eta, -ct)));
+        refr = normalize(
+            lc_real3_from_float3(frame_to_world(&fr, (float3)(-wo_l.x / eta, -wo_l.y / eta, -ct))));
       }
     }
-    if (lc_max3(w_refr) > 0.0f && dot(refr, it.ng) < 0.0f && sp < LC_WHITTED_STACK) {
+    if (lc_max3(w_refr) > 0.0f && dot(refr, it.ng) < LC_REAL(0.0) && sp < LC_WHITTED_STACK) {
       stack[sp].ray.o = lc_spawn_origin(it.p, it.perr, -it.ng);
       stack[sp].ray.d = refr;
       stack[sp].w = e.w * w_refr;
       stack[sp].segments = e.segments + 1;
       ++sp;
     }
-    if (lc_max3(w_refl) > 0.0f && dot(refl, it.ng) > 0.0f && sp < LC_WHITTED_STACK) {
+    if (lc_max3(w_refl) > 0.0f && dot(refl, it.ng) > LC_REAL(0.0) && sp < LC_WHITTED_STACK) {
       stack[sp].ray.o = lc_spawn_origin(it.p, it.perr, it.ng);
       stack[sp].ray.d = refl;
       stack[sp].w = e.w * w_refl;
@@ -251,14 +267,14 @@ static inline float3 integrator_direct(const lc_scene* s, lc_ray ray, lc_uint* r
   ++*rays;
   if (!scene_intersect(s, ray, INFINITY, &hit)) {
     float pdf;
-    return env_radiance(s, ray.d, &pdf);
+    return env_radiance(s, lc_float3_from_real3(ray.d), &pdf);
   }
   lc_interaction it = interaction_from_hit(s, ray, &hit);
   __global const lc_material* m = &s->materials[it.material];
   float3 L = it.front ? lc_load3(m->emission) : (float3)(0.0f);
   lc_bsdf b = bsdf_from_material(s, m, it.uv);
   lc_frame fr = frame_from(it.ns);
-  float3 wo_l = frame_to_local(&fr, -ray.d);
+  float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
   if (wo_l.z > 0.0f && !bsdf_is_delta(&b)) L += point_lights_direct(s, &it, &b, &fr, wo_l, 0, rays);
   return L;
 }
@@ -270,7 +286,7 @@ static inline float3 integrator_aov(const lc_scene* s, lc_ray ray, const lc_rng*
   ++*rays;
   if (!scene_intersect(s, ray, INFINITY, &hit)) return (float3)(0.0f);
   lc_interaction it = interaction_from_hit(s, ray, &hit);
-  if (P->integrator == LC_INTEGRATOR_DEPTH) return (float3)(hit.t);
+  if (P->integrator == LC_INTEGRATOR_DEPTH) return (float3)((float)hit.t);
   if (P->integrator == LC_INTEGRATOR_PRIMITIVE) {
     /* scene order: spheres first, then the scene's triangle list (exact in float below 2^24) */
     lc_uint id = (hit.prim & LC_PRIM_SPHERE_BIT) ? (hit.prim & ~LC_PRIM_SPHERE_BIT)
@@ -285,10 +301,11 @@ static inline float3 integrator_aov(const lc_scene* s, lc_ray ray, const lc_rng*
   lc_frame fr = frame_from(it.ns);
   float3 wi = frame_to_world(&fr, sample_cosine_hemisphere(lc_rand(rng, LC_DIM_BOUNCE + LC_DIM_BSDF_UV),
                                                              lc_rand(rng, LC_DIM_BOUNCE + LC_DIM_BSDF_UV + 1)));
-  if (dot(wi, it.ng) <= 0.0f) return (float3)(0.0f);
+  lc_real3 wir = lc_real3_from_float3(wi);
+  if (dot(wir, it.ng) <= LC_REAL(0.0)) return (float3)(0.0f);
   lc_ray sr;
   sr.o = lc_spawn_origin(it.p, it.perr, it.ng);
-  sr.d = normalize(wi);
+  sr.d = normalize(wir);
   ++*rays;
   return scene_occluded(s, sr, P->ao_distance) ? (float3)(0.0f) : (float3)(1.0f);
 }

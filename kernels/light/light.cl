@@ -6,8 +6,8 @@
 #define LUCENT_LIGHT_LIGHT_CL
 
 typedef struct {
-  float3 wi;   /* unit direction towards the light                          */
-  float dist;  /* distance to the sampled point (INFINITY for environments) */
+  lc_real3 wi;  /* unit direction towards the light                          */
+  lc_real dist; /* distance to the sampled point (INFINITY for environments) */
   float3 L;    /* radiance arriving (I / r^2 for point lights)              */
   float pdf;   /* solid-angle pdf including the selection probability;
                   for point lights the selection probability                */
@@ -82,17 +82,19 @@ static inline float3 env_radiance(const lc_scene* s, float3 d, float* pdf) {
 
 /* Solid-angle pdf (with selection) that light sampling from p picks the point seen along wi on
  * emitter `light` at distance dist with light-side cosine cos_l (> 0). */
-static inline float light_pdf_area(const lc_scene* s, lc_uint light, float3 p, float dist, float cos_l) {
+static inline float light_pdf_area(const lc_scene* s, lc_uint light, lc_real3 p, lc_real dist,
+                                   float cos_l) {
   __global const lc_light* L = &s->lights[light];
 #ifdef LC_HAS_SPHERE_LIGHTS
   if (L->type == LC_LIGHT_SPHERE) {
     __global const lc_sphere* sp = &s->spheres[L->prim];
-    float3 d = lc_load3(sp->center) - p;
-    float dc2 = dot(d, d), r2 = sp->radius * sp->radius;
+    lc_real3 d = lc_load3r(sp->center) - p;
+    lc_real r = sp->radius;
+    lc_real dc2 = dot(d, d), r2 = r * r;
     if (dc2 <= r2) return 0.0f;
-    float sin2 = r2 / dc2;
-    float cosmax = sqrt(fmax(0.0f, 1.0f - sin2));
-    float one_minus = sin2 / (1.0f + cosmax);
+    lc_real sin2 = r2 / dc2;
+    lc_real cosmax = sqrt(fmax(LC_REAL(0.0), LC_REAL(1.0) - sin2));
+    lc_real one_minus = sin2 / (LC_REAL(1.0) + cosmax);
     return L->pdf_select / (2.0f * LC_PI * one_minus);
   }
 #endif
@@ -103,7 +105,7 @@ static inline float light_pdf_area(const lc_scene* s, lc_uint light, float3 p, f
   return 0.0f;
 }
 
-static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, float u2,
+static inline int light_sample(const lc_scene* s, lc_real3 p, float us, float u1, float u2,
                                lc_light_sample* ls) {
   __global const lc_params* P = s->params;
   if (P->num_lights == 0) return 0;
@@ -112,12 +114,12 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
   ls->delta = 0;
 #ifdef LC_HAS_POINT_LIGHTS
   if (L->type == LC_LIGHT_POINT) {
-    float3 to = lc_load3(L->position) - p;
-    float d2 = dot(to, to);
-    if (!(d2 > 0.0f)) return 0;
+    lc_real3 to = lc_load3r(L->position) - p;
+    lc_real d2 = dot(to, to);
+    if (!(d2 > LC_REAL(0.0))) return 0;
     ls->dist = sqrt(d2);
     ls->wi = to / ls->dist;
-    ls->L = lc_load3(L->intensity) / d2;
+    ls->L = lc_load3(L->intensity) / (float)d2;
     ls->pdf = L->pdf_select;
     ls->delta = 1;
     return 1;
@@ -126,32 +128,35 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
 #ifdef LC_HAS_SPHERE_LIGHTS
   if (L->type == LC_LIGHT_SPHERE) {
     __global const lc_sphere* sp = &s->spheres[L->prim];
-    float3 c = lc_load3(sp->center);
-    float r = sp->radius;
-    float3 d = c - p;
-    float dc2 = dot(d, d);
+    lc_real3 c = lc_load3r(sp->center);
+    lc_real r = sp->radius;
+    lc_real3 d = c - p;
+    lc_real dc2 = dot(d, d);
     if (dc2 <= r * r) return 0; /* inside: the emitting side faces away */
-    float dc = sqrt(dc2);
-    float sin2max = r * r / dc2;
-    float cosmax = sqrt(fmax(0.0f, 1.0f - sin2max));
-    float one_minus_cosmax = sin2max / (1.0f + cosmax);
+    lc_real dc = sqrt(dc2);
+    lc_real sin2max = r * r / dc2;
+    lc_real cosmax = sqrt(fmax(LC_REAL(0.0), LC_REAL(1.0) - sin2max));
+    lc_real one_minus_cosmax = sin2max / (LC_REAL(1.0) + cosmax);
     /* cone sampling (pbrt-v4 Sphere::Sample), precise for tiny cones */
-    float one_minus_cos_t = one_minus_cosmax * u1;
-    float cos_t = 1.0f - one_minus_cos_t;
-    float sin2t = one_minus_cos_t * (2.0f - one_minus_cos_t);
+    lc_real one_minus_cos_t = one_minus_cosmax * u1;
+    lc_real cos_t = LC_REAL(1.0) - one_minus_cos_t;
+    lc_real sin2t = one_minus_cos_t * (LC_REAL(2.0) - one_minus_cos_t);
     /* angle alpha at the sphere centre between -d and the sampled point */
-    float cos_a = sin2t / sqrt(sin2max) + cos_t * sqrt(fmax(0.0f, 1.0f - sin2t / sin2max));
-    cos_a = clamp(cos_a, -1.0f, 1.0f);
-    float sin_a = sqrt(fmax(0.0f, 1.0f - cos_a * cos_a));
-    float2 cs = sin_a * lc_unit_circle(u2);
-    float3 wc = -d / dc; /* from the centre towards p */
-    float3 t, b;
-    lc_onb(wc, &t, &b);
-    float3 n = cs.x * t + cs.y * b + cos_a * wc;
-    float3 q = c + r * n;
-    float3 to = q - p;
-    float dist = length(to);
-    if (!(dist > 0.0f)) return 0;
+    lc_real cos_a = sin2t / sqrt(sin2max) +
+                    cos_t * sqrt(fmax(LC_REAL(0.0), LC_REAL(1.0) - sin2t / sin2max));
+    cos_a = clamp(cos_a, LC_REAL(-1.0), LC_REAL(1.0));
+    lc_real sin_a = sqrt(fmax(LC_REAL(0.0), LC_REAL(1.0) - cos_a * cos_a));
+    /* phi's sine and cosine in lc_real: in float |n| is 1 only to a float ulp, which puts q
+     * ~1e-7 r off the sphere (covered by shadow_visible's float margin, not by its double one) */
+    lc_real2 cs = sin_a * lc_unit_circler((lc_real)u2);
+    lc_real3 wc = -d / dc; /* from the centre towards p */
+    lc_real3 t, b;
+    lc_onbr(wc, &t, &b);
+    lc_real3 n = cs.x * t + cs.y * b + cos_a * wc;
+    lc_real3 q = c + r * n;
+    lc_real3 to = q - p;
+    lc_real dist = length(to);
+    if (!(dist > LC_REAL(0.0))) return 0;
     ls->wi = to / dist;
     ls->dist = dist;
     ls->L = lc_load3(L->intensity);
@@ -162,18 +167,20 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
 #ifdef LC_HAS_TRIANGLE_LIGHTS
   if (L->type == LC_LIGHT_TRIANGLE) {
     __global const lc_triangle* tri = &s->triangles[L->prim];
-    float3 v0 = lc_load3(tri->v0), v1 = lc_load3(tri->v1), v2 = lc_load3(tri->v2);
-    float su = sqrt(u1);
-    float b0 = 1.0f - su, b1 = u2 * su;
-    float3 q = b0 * v0 + b1 * v1 + (1.0f - b0 - b1) * v2;
-    float3 nl = normalize(cross(v1 - v0, v2 - v0));
-    float3 to = q - p;
-    float d2 = dot(to, to);
-    float dist = sqrt(d2);
-    if (!(dist > 0.0f)) return 0;
+    lc_real3 v0 = lc_load3r(tri->v0), v1 = lc_load3r(tri->v1), v2 = lc_load3r(tri->v2);
+    /* barycentrics in lc_real: in float their sum is off 1 by an ulp, which puts q ~1e-7 |v| off
+     * the light's plane (covered by shadow_visible's float margin, not by its double one) */
+    lc_real su = sqrt((lc_real)u1);
+    lc_real b0 = LC_REAL(1.0) - su, b1 = u2 * su;
+    lc_real3 q = b0 * v0 + b1 * v1 + (LC_REAL(1.0) - b0 - b1) * v2;
+    lc_real3 nl = normalize(cross(v1 - v0, v2 - v0));
+    lc_real3 to = q - p;
+    lc_real d2 = dot(to, to);
+    lc_real dist = sqrt(d2);
+    if (!(dist > LC_REAL(0.0))) return 0;
     ls->wi = to / dist;
-    float cos_l = -dot(ls->wi, nl);
-    if (cos_l <= 0.0f) return 0; /* one-sided emitter seen from behind */
+    lc_real cos_l = -dot(ls->wi, nl);
+    if (cos_l <= LC_REAL(0.0)) return 0; /* one-sided emitter seen from behind */
     ls->dist = dist;
     ls->L = lc_load3(L->intensity);
     ls->pdf = L->pdf_select * d2 / (cos_l * L->area);
@@ -195,7 +202,7 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
     float st = sinpi(v);
     if (!(st > 0.0f)) return 0;
     float2 cp = lc_unit_circle(u - 0.5f);
-    ls->wi = (float3)(st * cp.y, cospi(v), -st * cp.x);
+    ls->wi = lc_real3_from_float3((float3)(st * cp.y, cospi(v), -st * cp.x));
     ls->dist = INFINITY;
     ls->L = lc_load3(L->intensity) * s->texels[tex->offset + k].xyz;
     ls->pdf = L->pdf_select * (hi - lo) * (float)n / (2.0f * LC_PI * LC_PI * st);
@@ -204,7 +211,7 @@ static inline int light_sample(const lc_scene* s, float3 p, float us, float u1, 
 #endif
 #ifdef LC_HAS_ENV
   if (L->type == LC_LIGHT_ENV) {
-    ls->wi = sample_uniform_sphere(u1, u2);
+    ls->wi = lc_real3_from_float3(sample_uniform_sphere(u1, u2));
     ls->dist = INFINITY;
     ls->L = lc_load3(L->intensity);
     ls->pdf = L->pdf_select * (0.25f * LC_INV_PI);

@@ -47,12 +47,12 @@ static inline float3 spawn_direction(float3 n, float u1, float u2) {
   return normalize(s * cos(phi) * t + s * sin(phi) * b + c * n);
 }
 
-static inline float spawn_trace(__global const lc_sphere* sp, __global const lc_triangle* tri,
-                                float3 o, float3 d) {
-  if (sp) return sphere_intersect(lc_load3(sp->center), sp->radius, o, d, 0.0f, INFINITY);
+static inline lc_real spawn_trace(__global const lc_sphere* sp, __global const lc_triangle* tri,
+                                  lc_real3 o, lc_real3 d) {
+  if (sp) return sphere_intersect(lc_load3r(sp->center), sp->radius, o, d, 0.0f, INFINITY);
   lc_tri_ray tr = triangle_ray_setup(d);
-  float t, b1, b2;
-  if (triangle_intersect(&tr, o, lc_load3(tri->v0), lc_load3(tri->v1), lc_load3(tri->v2), 0.0f,
+  lc_real t, b1, b2;
+  if (triangle_intersect(&tr, o, lc_load3r(tri->v0), lc_load3r(tri->v1), lc_load3r(tri->v2), 0.0f,
                          INFINITY, &t, &b1, &b2))
     return t;
   return INFINITY;
@@ -100,14 +100,15 @@ __kernel void stability_spawn(__global const lc_sphere* spheres, lc_uint num_sph
     if (U(2) < 0.5f) { /* from outside, aimed at a surface point, from 1e-3 r to 10 r away */
       float3 q = c + r * u;
       float3 w = u + spawn_uniform_sphere(U(3), U(4));
-      ray.o = q + (r * pow(10.0f, -3.0f + 4.0f * U(5))) * normalize(w);
-      ray.d = normalize(q - ray.o);
+      float3 o = q + (r * pow(10.0f, -3.0f + 4.0f * U(5))) * normalize(w);
+      ray.o = lc_real3_from_float3(o);
+      ray.d = lc_real3_from_float3(normalize(q - o));
     } else { /* from inside */
       inside = 1;
-      ray.o = c + (0.99f * r * U(3)) * u;
-      ray.d = spawn_uniform_sphere(U(4), U(5));
+      ray.o = lc_real3_from_float3(c + (0.99f * r * U(3)) * u);
+      ray.d = lc_real3_from_float3(spawn_uniform_sphere(U(4), U(5)));
     }
-    hit.t = sphere_intersect(c, r, ray.o, ray.d, 0.0f, INFINITY);
+    hit.t = sphere_intersect(lc_real3_from_float3(c), r, ray.o, ray.d, 0.0f, INFINITY);
     hit.prim = prim | LC_PRIM_SPHERE_BIT;
     hit.b1 = hit.b2 = 0.0f;
   } else {
@@ -120,11 +121,13 @@ __kernel void stability_spawn(__global const lc_sphere* spheres, lc_uint num_sph
     float3 n = normalize(cross(v1 - v0, v2 - v0));
     if (U(2) < 0.5f) n = -n;
     float3 w = n + spawn_uniform_sphere(U(3), U(4));
-    ray.o = q + (size * pow(10.0f, -3.0f + 4.0f * U(5))) * normalize(w);
-    ray.d = normalize(q - ray.o);
+    float3 o = q + (size * pow(10.0f, -3.0f + 4.0f * U(5))) * normalize(w);
+    ray.o = lc_real3_from_float3(o);
+    ray.d = lc_real3_from_float3(normalize(q - o));
     lc_tri_ray tr = triangle_ray_setup(ray.d);
     hit.t = INFINITY;
-    if (!triangle_intersect(&tr, ray.o, v0, v1, v2, 0.0f, INFINITY, &hit.t, &hit.b1, &hit.b2))
+    if (!triangle_intersect(&tr, ray.o, lc_real3_from_float3(v0), lc_real3_from_float3(v1),
+                            lc_real3_from_float3(v2), 0.0f, INFINITY, &hit.t, &hit.b1, &hit.b2))
       hit.t = INFINITY;
     hit.prim = prim - num_spheres;
   }
@@ -139,23 +142,29 @@ __kernel void stability_spawn(__global const lc_sphere* spheres, lc_uint num_sph
   inside = !it.front;
 
   for (int side = 0; side < 2; ++side) {
-    float3 n = side == 0 ? it.ng : -it.ng;
-    float3 o = lc_spawn_origin(it.p, it.perr, n);
-    float3 d = spawn_direction(n, U(6 + 2 * side), U(7 + 2 * side));
+    lc_real3 n = side == 0 ? it.ng : -it.ng;
+    lc_real3 o = lc_spawn_origin(it.p, it.perr, n);
+    float3 dir = spawn_direction(lc_float3_from_real3(n), U(6 + 2 * side), U(7 + 2 * side));
+    lc_real3 d = lc_real3_from_float3(dir);
+#ifdef LC_DOUBLE
+    d = normalize(d); /* unit in double, as the renderer's directions */
+#endif
     if (!(dot(d, n) > 0.0f)) continue; /* the renderer drops such directions */
     atomic_inc(&counters[1]);
-    float t = spawn_trace(sp, tri, o, d);
+    lc_real t = spawn_trace(sp, tri, o, d);
     /* into the sphere: the reflection side of an inside hit, the transmission side of an
      * outside hit */
     int enters = sp && (inside ? side == 0 : side == 1);
+    float kind = (float)(side + 2 * inside + (tri ? 4 : 0));
+    float3 pf = lc_float3_from_real3(it.p), df = lc_float3_from_real3(d);
     if (!enters) {
-      if (t < INFINITY) spawn_fail(counters, 2, example, it.p, (float)(side + 2 * inside + (tri ? 4 : 0)), d, t);
+      if (t < INFINITY) spawn_fail(counters, 2, example, pf, kind, df, t);
     } else {
-      float chord = 2.0f * r * dot(d, n);
+      lc_real chord = 2.0f * r * dot(d, n);
       if (t < 0.5f * chord)
-        spawn_fail(counters, 2, example, it.p, (float)(side + 2 * inside + (tri ? 4 : 0)), d, t);
+        spawn_fail(counters, 2, example, pf, kind, df, t);
       else if (!(t < INFINITY) && chord > 1e-3f * r)
-        spawn_fail(counters, 3, example, it.p, (float)(side + 2 * inside + (tri ? 4 : 0)), d, t);
+        spawn_fail(counters, 3, example, pf, kind, df, t);
     }
   }
 #undef U

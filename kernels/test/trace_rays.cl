@@ -32,14 +32,14 @@ __kernel void lucent_trace_rays(__global const lc_params* params,
   s.texels = 0;
   float4 a = rays[2 * i], b = rays[2 * i + 1];
   lc_ray ray;
-  ray.o = a.xyz;
-  ray.d = b.xyz;
+  ray.o = lc_real3_from_float3(a.xyz);
+  ray.d = lc_real3_from_float3(b.xyz);
   lc_hit hit;
   if (any_hit) {
     int occluded = scene_occluded(&s, ray, a.w);
     hits[i] = (float4)(0.0f, as_float(occluded ? 0u : LC_INVALID), 0.0f, 0.0f);
   } else {
     scene_intersect(&s, ray, a.w, &hit);
-    hits[i] = (float4)(hit.t, as_float(hit.prim), hit.b1, hit.b2);
+    hits[i] = (float4)((float)hit.t, as_float(hit.prim), (float)hit.b1, (float)hit.b2);
   }
 }

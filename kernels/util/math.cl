@@ -17,6 +17,9 @@ typedef double4 lc_real4;
 #define LC_REAL(x) (x)
 #define lc_real3_from_float3(v) convert_double3(v)
 #define lc_float3_from_real3(v) convert_float3(v)
+/* unit roundoff (half an ulp of 1) and machine epsilon of lc_real */
+#define LC_REAL_U (1.0 / 9007199254740992.0)
+#define LC_REAL_EPSILON DBL_EPSILON
 #else
 typedef float lc_real;
 typedef float2 lc_real2;
@@ -25,6 +28,8 @@ typedef float4 lc_real4;
 #define LC_REAL(x) (x##f)
 #define lc_real3_from_float3(v) (v)
 #define lc_float3_from_real3(v) (v)
+#define LC_REAL_U (1.0f / 16777216.0f)
+#define LC_REAL_EPSILON FLT_EPSILON
 #endif
 
 #define LC_PI 3.14159265358979323846f
@@ -32,8 +37,8 @@ typedef float4 lc_real4;
 #define LC_INF INFINITY
 
 typedef struct {
-  float3 o;
-  float3 d; /* unit length */
+  lc_real3 o;
+  lc_real3 d; /* unit length */
 } lc_ray;
 
 static inline float3 lc_load3(const __global float* p) { return (float3)(p[0], p[1], p[2]); }
@@ -42,6 +47,7 @@ static inline lc_real3 lc_load3r(const __global float* p) {
 }
 static inline float3 lc_load3c(__constant float* p) { return (float3)(p[0], p[1], p[2]); }
 static inline float lc_max3(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
+static inline lc_real lc_max3r(lc_real3 v) { return fmax(v.x, fmax(v.y, v.z)); }
 static inline float lc_luminance(float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 static inline int lc_isfinite3(float3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
@@ -53,6 +59,12 @@ static inline float2 lc_unit_circle(float u) {
   return (float2)(cospi(x), sinpi(x));
 }
 
+/* The same in lc_real. */
+static inline lc_real2 lc_unit_circler(lc_real u) {
+  lc_real x = LC_REAL(2.0) * u;
+  return (lc_real2)(cospi(x), sinpi(x));
+}
+
 /* Orthonormal basis around unit n (Duff et al. 2017, "Building an Orthonormal Basis, Revisited"). */
 static inline void lc_onb(float3 n, float3* t, float3* b) {
   float s = copysign(1.0f, n.z);
@@ -62,9 +74,19 @@ static inline void lc_onb(float3 n, float3* t, float3* b) {
   *b = (float3)(c, s + n.y * n.y * a, -n.y);
 }
 
+/* The same in lc_real (light sampling geometry). */
+static inline void lc_onbr(lc_real3 n, lc_real3* t, lc_real3* b) {
+  lc_real s = copysign(LC_REAL(1.0), n.z);
+  lc_real a = LC_REAL(-1.0) / (s + n.z);
+  lc_real c = n.x * n.y * a;
+  *t = (lc_real3)(LC_REAL(1.0) + s * n.x * n.x * a, s * c, -s * n.x);
+  *b = (lc_real3)(c, s + n.y * n.y * a, -n.y);
+}
+
 /* One ulp further along the sign of n (nothing where n is 0). */
-static inline float lc_nudge(float x, float n) {
-  return n > 0.0f ? nextafter(x, INFINITY) : (n < 0.0f ? nextafter(x, -INFINITY) : x);
+static inline lc_real lc_nudge(lc_real x, lc_real n) {
+  return n > LC_REAL(0.0) ? nextafter(x, (lc_real)INFINITY)
+                          : (n < LC_REAL(0.0) ? nextafter(x, -(lc_real)INFINITY) : x);
 }
 
 /*
@@ -76,16 +98,19 @@ static inline float lc_nudge(float x, float n) {
  *    primitive's coordinates, which perr's component along n alone need not cover (a floor at
  *    y = 0 has perr.y = 0 however large it is);
  *  - then one ulp further per component (pbrt-v4), so that rounding p + d n cannot undo it.
+ * Everything is in lc_real: with --precision double, perr holds double's error bounds (a few ulps
+ * of double, set by interaction_from_hit) and the ulp is double's, so the offset is ~5e8 times
+ * smaller than in float.
  * This replaces Wächter and Binder's integer offset (Ray Tracing Gems ch. 6), which added an
  * absolute 1/65536 to coordinates below 1/32 (up to 14% of the rays entering spheres of radius
  * < 1e-2 near the origin missed their far side; a scene of size 1e-4 rendered 4% too bright) and
  * 256 ulps elsewhere (2 units at 1e5: a scene of size 100 translated to 1e5 rendered 2.4% too
  * bright). Found by tests/test_stability_spawn.cpp and tests/test_stability_scene.cpp.
  */
-static inline float3 lc_spawn_origin(float3 p, float3 perr, float3 n) {
-  float d = dot(fabs(n), perr) + 2.0f * lc_max3(perr);
-  float3 o = p + d * n;
-  return (float3)(lc_nudge(o.x, n.x), lc_nudge(o.y, n.y), lc_nudge(o.z, n.z));
+static inline lc_real3 lc_spawn_origin(lc_real3 p, lc_real3 perr, lc_real3 n) {
+  lc_real d = dot(fabs(n), perr) + LC_REAL(2.0) * lc_max3r(perr);
+  lc_real3 o = p + d * n;
+  return (lc_real3)(lc_nudge(o.x, n.x), lc_nudge(o.y, n.y), lc_nudge(o.z, n.z));
 }
 
 #endif

@@ -68,6 +68,14 @@ std::vector<Device> enumerate_devices() {
         i.global_memory = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
         std::string ext = d.getInfo<CL_DEVICE_EXTENSIONS>();
         i.fp64 = ext.find("cl_khr_fp64") != std::string::npos;
+        if (!i.fp64) {
+          // fp64 is optional: the extension, or (OpenCL 1.2+) a non-empty double FP config; a
+          // driver that rejects the query has none
+          try {
+            i.fp64 = d.getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>() != 0;
+          } catch (const cl::Error&) {
+          }
+        }
         out.push_back(std::move(dev));
       }
     }

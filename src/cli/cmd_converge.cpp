@@ -98,7 +98,7 @@ CLI::App* add_converge_command(CLI::App& app) {
                   "Write the rendered reference to this .exr (reuse it with --reference)");
   cmd->add_option("--settings", a.settings,
                   "Comma-separated settings, knobs joined by +: default, fast-math, "
-                  "no-specialize, no-mis, mis, max_depth=N, rr_depth=N, "
+                  "double, float, no-specialize, no-mis, mis, max_depth=N, rr_depth=N, "
                   "filter=box|tent|gaussian[:R], integrator=NAME (default: default)")
       ->delimiter(',');
   auto* spp = cmd->add_option("--spp-ladder", a.spp_ladder, "Samples per pixel of each rung")

@@ -20,6 +20,9 @@ namespace {
 
 struct InfoArgs {
   std::string scene;
+  std::string precision = "float";
+  bool fast_math = false;
+  bool no_specialize = false;
 };
 
 InfoArgs& args() {
@@ -82,6 +85,13 @@ CLI::App* add_info_command(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("info", "Print scene statistics, its BVH and the kernel feature defines");
   cmd->add_option("scene", args().scene, "Scene file (JSON)")->required();
+  cmd->add_option("--precision", args().precision,
+                  "Show the build options for this precision: float (default) or double")
+      ->check(CLI::IsMember({"float", "double"}));
+  cmd->add_flag("--fast-math", args().fast_math,
+                "Show the build options with -cl-fast-relaxed-math");
+  cmd->add_flag("--no-specialize", args().no_specialize,
+                "Show the build options of the full kernel");
   return cmd;
 }
 
@@ -148,9 +158,20 @@ int run_info_command() {
 
   std::string defines = render_detail::feature_defines(scene, packed);
   if (!defines.empty() && defines[0] == ' ') defines.erase(0, 1);
+  RenderOptions options;
+  options.precision = parse_precision(args().precision);
+  options.fast_math = args().fast_math;
+  options.specialize = !args().no_specialize;
   std::printf("\nkernel\n");
   std::printf("  sources             %s\n", detail::kernel_source_origin().c_str());
   std::printf("  feature defines     %s\n", defines.empty() ? "(none)" : defines.c_str());
+  std::printf("  precision           %s%s\n", precision_name(options.precision),
+              options.precision == Precision::Double ? " (rays and geometry in double; needs fp64)"
+                                                     : "");
+  std::printf("  math                %s\n",
+              options.fast_math ? "fast (-cl-fast-relaxed-math)" : "IEEE");
+  std::printf("  build options       %s\n",
+              render_detail::build_options(scene, packed, options).c_str());
   return 0;
 }
 

@@ -102,6 +102,7 @@ struct RenderArgs {
   bool reference = false;  ///< the scalar reference integrator instead of the kernel
   std::vector<std::string> aovs;  ///< extra outputs: albedo, normal, depth, variance
   bool fast_math = false;
+  std::string precision = "float";
   bool no_specialize = false;
 };
 
@@ -144,6 +145,7 @@ int cmd_render(const RenderArgs& a) {
   opt.spp = a.spp;
   opt.time_limit = a.time_limit;
   opt.fast_math = a.fast_math;
+  opt.precision = lucent::parse_precision(a.precision);
   opt.specialize = !a.no_specialize;
   opt.cancel = &g_interrupted;
   const bool tty = isatty(STDERR_FILENO);
@@ -232,6 +234,10 @@ int main(int argc, char** argv) {
   render->add_flag("-q,--quiet", ra.quiet, "No progress line or summary");
   render->add_flag("--fast-math", ra.fast_math,
                    "Build the kernel with -cl-fast-relaxed-math (faster, not IEEE; see BENCHMARKS.md)");
+  render->add_option("--precision", ra.precision,
+                     "Ray and geometry arithmetic: float (default) or double (devices with fp64; "
+                     "slower, precise at extreme scales; see BENCHMARKS.md)")
+      ->check(CLI::IsMember({"float", "double"}));
   render->add_flag("--no-specialize", ra.no_specialize,
                    "Compile the full kernel instead of only the features the scene uses");
   render->add_option("--aov", ra.aovs,

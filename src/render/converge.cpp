@@ -74,6 +74,7 @@ double noise_relmse(const RenderResult& a, const RenderResult& ref) {
 
 void ConvergeSetting::apply(Scene& scene, RenderOptions& options) const {
   if (fast_math) options.fast_math = true;
+  if (precision >= 0) options.precision = static_cast<Precision>(precision);
   if (!specialize) options.specialize = false;
   if (mis >= 0) scene.integrator.mis = mis != 0;
   if (max_depth > 0) scene.integrator.max_depth = max_depth;
@@ -110,6 +111,11 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
     } else if (key == "fast_math") {
       no_value();
       s.fast_math = true;
+    } else if (key == "double" || key == "float") {
+      no_value();
+      s.precision = static_cast<int>(parse_precision(key, "setting " + knob));
+    } else if (key == "precision") {
+      s.precision = static_cast<int>(parse_precision(value, "setting " + knob));
     } else if (key == "no_specialize") {
       no_value();
       s.specialize = false;
@@ -159,8 +165,9 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
       s.integrator = found;
     } else {
       throw Error("setting '" + text + "': unknown knob '" + knob +
-                  "' (expected default, fast-math, no-specialize, no-mis, mis, max_depth=N, "
-                  "rr_depth=N, filter=box|tent|gaussian[:R], integrator=NAME, joined by +)");
+                  "' (expected default, fast-math, double, float, no-specialize, no-mis, mis, "
+                  "max_depth=N, rr_depth=N, filter=box|tent|gaussian[:R], integrator=NAME, "
+                  "joined by +)");
     }
   }
   return s;

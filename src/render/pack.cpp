@@ -338,4 +338,31 @@ std::string feature_defines(const Scene& scene, const PackedScene& packed, bool 
   return d;
 }
 
+std::string build_options(const Scene& scene, const PackedScene& packed,
+                          const RenderOptions& options) {
+  std::string o = "-cl-std=CL1.2" + feature_defines(scene, packed, options.specialize);
+  if (options.precision == Precision::Double) o += " -D LC_DOUBLE";
+  if (options.fast_math) o += " -cl-fast-relaxed-math";
+  return o;
+}
+
+void check_precision_support(const DeviceInfo& device, Precision precision) {
+  if (precision == Precision::Double && !device.fp64)
+    throw Error("--precision double: device '" + device.name +
+                "' has no double-precision floating point (cl_khr_fp64); use --precision float "
+                "or pick another device with --device");
+}
+
 }  // namespace lucent::render_detail
+
+namespace lucent {
+
+const char* precision_name(Precision p) { return p == Precision::Double ? "double" : "float"; }
+
+Precision parse_precision(const std::string& text, const std::string& what) {
+  if (text == "float") return Precision::Float;
+  if (text == "double") return Precision::Double;
+  throw Error(what + ": unknown precision '" + text + "' (expected float or double)");
+}
+
+}  // namespace lucent

@@ -5,6 +5,8 @@
 #include <vector>
 
 #include "bvh/bvh.hpp"
+#include "lucent/device.hpp"
+#include "lucent/render.hpp"
 #include "lucent/scene.hpp"
 #include "shared/types.h"
 
@@ -38,5 +40,15 @@ const std::vector<std::string>& all_features();
 
 /// OpenCL build options (" -D LC_HAS_..." ...) for the scene's features, or for all of them.
 std::string feature_defines(const Scene& scene, const PackedScene& packed, bool specialize = true);
+
+/// The megakernel's full OpenCL build options for these render options: -cl-std, the feature
+/// defines, -D LC_DOUBLE with Precision::Double, -cl-fast-relaxed-math with fast_math. They are
+/// part of the program cache key, so each precision has its own cached binary.
+std::string build_options(const Scene& scene, const PackedScene& packed,
+                          const RenderOptions& options);
+
+/// Throws lucent::Error (one line naming the device) when `precision` needs what the device lacks:
+/// Precision::Double needs fp64 (cl_khr_fp64 / CL_DEVICE_DOUBLE_FP_CONFIG).
+void check_precision_support(const DeviceInfo& device, Precision precision);
 
 }  // namespace lucent::render_detail

@@ -39,6 +39,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   cl_util::Context ctx(options.device);
   RenderResult result;
   result.device = ctx.device.info.name;
+  render_detail::check_precision_support(ctx.device.info, options.precision);
   const cl_ulong max_alloc = ctx.device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
   if (npix * sizeof(cl_float4) > max_alloc)
     throw Error(scene.path + ": a " + std::to_string(width) + "x" + std::to_string(height) +
@@ -50,8 +51,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
 
   auto tb = clock::now();
   std::string source = detail::assemble_kernel_source("megakernel.cl");
-  std::string build_options = "-cl-std=CL1.2" + render_detail::feature_defines(scene, packed, options.specialize);
-  if (options.fast_math) build_options += " -cl-fast-relaxed-math";
+  std::string build_options = render_detail::build_options(scene, packed, options);
   cl_util::ProgramBuildInfo build_info;
   cl::Program program = cl_util::build_program_cached(ctx, source, build_options, &build_info);
   result.build_seconds = std::chrono::duration<double>(clock::now() - tb).count();
