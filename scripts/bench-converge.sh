@@ -18,11 +18,13 @@
 #     (the CSV's noise_relmse) the fraction spp / (spp + ref_spp) is the reference's. With
 #     REF_FACTOR 8 that share is about 11% of the target at N*; it is subtracted, not ignored;
 #  4. the spp and render time (kernel build excluded) at which the corrected relMSE crosses the
-#     target, interpolated linearly on log-log axes between the two rungs around it, or
-#     extrapolated from the least-squares slope of the last three rungs when no rung reaches it.
+#     target, interpolated linearly on log-log axes between the two rungs around it, or, when no
+#     rung reaches it, extrapolated from the top rung with the least-squares slope of relMSE
+#     against spp over all rungs (time: at the top rung's samples per second).
 #
 # Scenes: scenes/*.json; those that need ../shared assets are skipped when it is absent.
-# Environment: LUCENT_DEVICE selects the device; BENCH_CONVERGE_SCENES="a b" limits the scenes.
+# Environment: LUCENT_DEVICE selects the device; BENCH_CONVERGE_SCENES="a b" limits the scenes;
+# BENCH_CONVERGE_KEEP=DIR keeps each scene's ladder CSV as DIR/SCENE.csv.
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -74,6 +76,7 @@ def slope(xs, ys):
     return sum((a - mx) * (b - my) for a, b in zip(lx, ly)) / sum((a - mx) ** 2 for a in lx)
 
 how, n_hit, t_hit = "", float("nan"), float("nan")
+top = pts[-1]
 for i in range(1, len(pts)):
     a, b = pts[i - 1], pts[i]
     if a[2] > target >= b[2]:
@@ -85,15 +88,14 @@ if not how:
     if pts[0][2] <= target:
         n_hit, t_hit, how = pts[0][0], pts[0][1], "reached at the first rung"
     else:
-        tail = [p for p in pts[-3:] if p[2] > 0]
-        sn = slope([p[0] for p in tail], [p[2] for p in tail])
-        st = slope([p[1] for p in tail], [p[2] for p in tail])
-        last = tail[-1]
-        n_hit = last[0] * (target / last[2]) ** (1 / sn) if sn < 0 else float("inf")
-        t_hit = last[1] * (target / last[2]) ** (1 / st) if st < 0 else float("inf")
-        how = "**extrapolated** (slope %.2f vs spp, %.2f vs time, last 3 rungs%s)" % (
-            sn, st, ", capped at %g s" % float(sys.argv[5]) if capped else "")
-top = pts[-1]
+        # the least-squares slope over all rungs (the last few alone are noisy where fireflies
+        # dominate), from the top rung; time at the top rung's samples per second
+        fitted = [p for p in pts if p[2] > 0]
+        sn = slope([p[0] for p in fitted], [p[2] for p in fitted])
+        n_hit = top[0] * (target / top[2]) ** (1 / sn) if sn < 0 else float("inf")
+        t_hit = top[1] * n_hit / top[0]
+        how = "**extrapolated** from the top rung with the slope fitted over all rungs (%.2f)%s" % (
+            sn, ", top rung capped at %g s" % float(sys.argv[5]) if capped else "")
 fit = slope([p[0] for p in pts if p[2] > 0], [p[2] for p in pts if p[2] > 0])
 # cross-check: the spp at which the rung's own noise (no reference) falls to the target
 noise_n = top[0] * top[4] / target
@@ -131,6 +133,7 @@ for scene in "$root"/scenes/*.json; do
   "$lucent" converge "$scene" --spp-ladder "$ladder" --reference-spp "$ref_spp" \
     --csv "$work/full.csv" -q >/dev/null 2>"$work/log" ||
     { echo "bench-converge: $name failed: $(tail -1 "$work/log")" >&2; exit 1; }
+  if [[ -n ${BENCH_CONVERGE_KEEP:-} ]]; then mkdir -p "$BENCH_CONVERGE_KEEP" && cp "$work/full.csv" "$BENCH_CONVERGE_KEEP/$name.csv"; fi
   echo "| $name | $film | $(analyse "$work/full.csv" "$ref_spp" "$capped" "$max_seconds") |"
 done
 echo
