@@ -319,12 +319,17 @@ TEST_F(BvhTrace, RaysStartingOnBoxFaces) {
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<TraceRay> rays;
   for (int i = 0; i < 12000; ++i) {
+    // a child box of a random node (the boxes the kernel tests)
     const lc_bvh_node& nd =
         b.nodes[std::uniform_int_distribution<std::size_t>(0, b.nodes.size() - 1)(rng)];
+    int k = std::uniform_int_distribution<int>(0, LC_BVH_WIDTH - 1)(rng);
+    if (nd.child[k] == LC_INVALID) k = 0;  // slot 0 is always used
+    float lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) lo[a] = nd.bounds[2 * a][k], hi[a] = nd.bounds[2 * a + 1][k];
     int axis = i % 3;
     float o[3];
-    for (int a = 0; a < 3; ++a) o[a] = float(nd.bmin[a] + u(rng) * (nd.bmax[a] - nd.bmin[a]));
-    o[axis] = (i & 4) ? nd.bmax[axis] : nd.bmin[axis];
+    for (int a = 0; a < 3; ++a) o[a] = float(lo[a] + u(rng) * (hi[a] - lo[a]));
+    o[axis] = (i & 4) ? hi[axis] : lo[axis];
     D3 d = random_dir(rng);
     if (i & 8) {  // within the face plane
       if (axis == 0) d.x = 0;

@@ -1,13 +1,58 @@
-/* lucent kernel: scene description on the device and BVH2 traversal.
- * Node layout: shared/types.h (lc_bvh_node, 32 bytes, depth-first, children adjacent). Leaves
- * hold primitive references: a triangle index, or a sphere index with LC_PRIM_SPHERE_BIT set.
- * Traversal is ordered (nearer child first) with a stack of (node, entry distance) pairs, so a
- * popped node is dropped without touching its box once a closer hit is known. */
+/* lucent kernel: scene description on the device and wide-BVH traversal.
+ * Node layout: shared/types.h (lc_bvh_node: LC_BVH_WIDTH child boxes as structure of arrays,
+ * built by src/bvh/bvh_wide.cpp). Leaves hold primitive references: a triangle index, or a sphere
+ * index with LC_PRIM_SPHERE_BIT set.
+ * Traversal: one vector operation per slab plane tests all children of a node; the children hit
+ * are sorted by entry distance with a sorting network on (distance, lane) keys, the nearest is
+ * visited next and the others are pushed farthest first with one vector store, as (child, entry
+ * distance) pairs, so a popped node is dropped without touching its box once a closer hit is
+ * known. Ray quantities are lc_real (float, or double under LC_DOUBLE); boxes are loaded from
+ * the float node buffer and widened. */
 #ifndef LUCENT_BVH_TRAVERSE_CL
 #define LUCENT_BVH_TRAVERSE_CL
 
-/* Deep enough for any tree of src/bvh/bvh_build.cpp, which caps the depth at 64. */
-#define LC_BVH_STACK_SIZE 64
+/* At a node of depth k (root: 1) the stack holds at most (LC_BVH_WIDTH - 1) (k - 1) entries and a
+ * push writes LC_BVH_WIDTH slots from there; src/bvh keeps the depth within LC_BVH_MAX_DEPTH. */
+#define LC_BVH_STACK_SIZE ((LC_BVH_WIDTH - 1) * LC_BVH_MAX_DEPTH + 1)
+
+/* One lane per child. lc_bvh_rw: lc_real per child; lc_bvh_iw: int per child; lc_bvh_lw: long
+ * per child (stack entries). */
+#if LC_BVH_WIDTH == 4
+typedef int4 lc_bvh_iw;
+typedef uint4 lc_bvh_uw;
+typedef long4 lc_bvh_lw;
+#define lc_bvh_vloadw vload4
+#define lc_bvh_vstorew vstore4
+#define lc_bvh_sum(v) ((v).s0 + (v).s1 + (v).s2 + (v).s3)
+#define lc_bvh_as_iw as_int4
+#define lc_bvh_long(v) convert_long4(v)
+#ifdef LC_DOUBLE
+typedef double4 lc_bvh_rw;
+#define lc_bvh_rw_from_float(v) convert_double4(v)
+#define lc_bvh_float_down(v) convert_float4_rtn(v) /* never above v: culling stays safe */
+#define lc_bvh_int_mask(m) convert_int4(m)
+#else
+typedef float4 lc_bvh_rw;
+#define lc_bvh_rw_from_float(v) (v)
+#define lc_bvh_float_down(v) (v)
+#define lc_bvh_int_mask(m) (m)
+#endif
+/* Sorting network for 4 keys, descending: (0,1)(2,3), (0,2)(1,3), (1,2). */
+static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
+  lc_bvh_lw p = k.s1032, lo = min(k, p), hi = max(k, p);
+  k = (lc_bvh_lw)(hi.s0, lo.s1, hi.s2, lo.s3);
+  p = k.s2301;
+  lo = min(k, p);
+  hi = max(k, p);
+  k = (lc_bvh_lw)(hi.s0, hi.s1, lo.s2, lo.s3);
+  p = k.s0213;
+  lo = min(k, p);
+  hi = max(k, p);
+  return (lc_bvh_lw)(hi.s0, hi.s1, lo.s2, lo.s3);
+}
+#else
+#error "kernels/bvh/traverse.cl: LC_BVH_WIDTH must be 4"
+#endif
 
 typedef struct {
   __global const lc_params* params;
@@ -38,48 +83,22 @@ typedef struct {
    textures, texels}
 
 typedef struct {
-  float t;
-  lc_uint prim; /* primitive reference (LC_PRIM_SPHERE_BIT for spheres), LC_INVALID on a miss */
-  float b1, b2; /* triangle barycentrics of v1 and v2 */
+  lc_real t;
+  lc_uint prim;     /* primitive reference (LC_PRIM_SPHERE_BIT for spheres), LC_INVALID on a miss */
+  lc_real b1, b2;   /* triangle barycentrics of v1 and v2 */
 } lc_hit;
 
 /* 1 / d per component, +INFINITY where d is 0 (either sign) or so small that 1 / d overflows. */
-static inline float3 bvh_inv_dir(float3 d) {
-  float3 inv = 1.0f / d;
-  return select(inv, (float3)(INFINITY), isinf(inv));
+static inline lc_real3 bvh_inv_dir(lc_real3 d) {
+  lc_real3 inv = LC_REAL(1.0) / d;
+  return select(inv, (lc_real3)(INFINITY), isinf(inv));
 }
 
-/*
- * Slab test: the distance at which the ray enters the box within [tmin, tmax], or INFINITY on a
- * miss. With inv_d = +INFINITY on an axis the ray does not move along, (b - o) * inv_d is -inf or
- * +inf, or NaN (0 * inf) when the origin lies on that face plane. The selects below return t0 for
- * the near and t1 for the far distance whenever either is NaN, and the comparisons with enter and
- * exit keep the old value for a NaN: an origin on a face plane of a slab it does not move along
- * counts as inside that slab (boxes are closed), and no NaN decides anything.
- */
-static inline float bvh_box_entry(__global const lc_bvh_node* n, float3 o, float3 inv_d,
-                                  float tmin, float tmax) {
-  float3 t0 = (vload3(0, n->bmin) - o) * inv_d;
-  float3 t1 = (vload3(0, n->bmax) - o) * inv_d;
-  float3 tn = select(t0, t1, t1 < t0);
-  float3 tf = select(t1, t0, t0 > t1);
-  float enter = tmin, exit_ = tmax;
-  enter = tn.x > enter ? tn.x : enter;
-  enter = tn.y > enter ? tn.y : enter;
-  enter = tn.z > enter ? tn.z : enter;
-  exit_ = tf.x < exit_ ? tf.x : exit_;
-  exit_ = tf.y < exit_ ? tf.y : exit_;
-  exit_ = tf.z < exit_ ? tf.z : exit_;
-  /* conservative against rounding in t0, t1: widen the exit by 1 + 2 gamma(3) (pbrt-v4) */
-  exit_ *= 1.0000004f;
-  return enter <= exit_ ? enter : INFINITY;
-}
-
-static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tri_ray* tr, float3 o,
-                                     float3 d, float tmin, lc_hit* hit) {
+static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tri_ray* tr,
+                                     lc_real3 o, lc_real3 d, lc_real tmin, lc_hit* hit) {
   if (ref & LC_PRIM_SPHERE_BIT) {
     __global const lc_sphere* sp = &s->spheres[ref & ~LC_PRIM_SPHERE_BIT];
-    float t = sphere_intersect(vload3(0, sp->center), sp->radius, o, d, tmin, hit->t);
+    lc_real t = sphere_intersect(lc_load3r(sp->center), (lc_real)sp->radius, o, d, tmin, hit->t);
     if (t < hit->t) {
       hit->t = t;
       hit->prim = ref;
@@ -88,8 +107,8 @@ static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tr
     return 0;
   }
   __global const lc_triangle* tri = &s->triangles[ref];
-  float t, b1, b2;
-  if (triangle_intersect(tr, o, vload3(0, tri->v0), vload3(0, tri->v1), vload3(0, tri->v2), tmin,
+  lc_real t, b1, b2;
+  if (triangle_intersect(tr, o, lc_load3r(tri->v0), lc_load3r(tri->v1), lc_load3r(tri->v2), tmin,
                          hit->t, &t, &b1, &b2)) {
     hit->t = t;
     hit->prim = ref;
@@ -100,62 +119,98 @@ static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tr
   return 0;
 }
 
-/* Closest hit with t in (tmin, tmax). With any_hit set, returns at the first hit found (shadow
- * rays); hit then holds that hit, not necessarily the closest. */
-static inline int bvh_trace(const lc_scene* s, float3 o, float3 d, float tmin, float tmax,
-                            int any_hit, lc_hit* hit) {
+/*
+ * Closest hit with t in (tmin, tmax). With any_hit set, returns at the first hit found (shadow
+ * rays); hit then holds that hit, not necessarily the closest.
+ *
+ * Slab test per child, all children at once: for each axis the plane the ray meets first (min
+ * for a direction >= 0, else max; inv_d is +INFINITY for a zero direction, so min) gives the near
+ * distance (b - o) * inv_d, the other plane the far one. The entry is the largest of tmin and the
+ * near distances, the exit the smallest of the closest hit so far and the far distances, each
+ * taken with `x > acc ? x : acc`, which keeps acc when x is NaN: (b - o) * inv_d is NaN (0 * inf)
+ * only for an origin on a face plane of a slab the ray does not move along, and such an origin
+ * counts as inside the slab (boxes are closed); no NaN decides anything. An empty slot (min +inf,
+ * max -inf) gives near +inf and far -inf and is never entered. The exit is widened by
+ * 1 + 2 gamma(3) (pbrt-v4) against rounding in the distances.
+ */
+static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real tmin,
+                            lc_real tmax, int any_hit, lc_hit* hit) {
   hit->t = tmax;
   hit->prim = LC_INVALID;
-  hit->b1 = hit->b2 = 0.0f;
+  hit->b1 = hit->b2 = LC_REAL(0.0);
   if (s->params->num_nodes == 0) return 0;
   __global const lc_bvh_node* nodes = s->nodes;
-  float3 inv_d = bvh_inv_dir(d);
-  if (bvh_box_entry(&nodes[0], o, inv_d, tmin, tmax) == INFINITY) return 0;
+  lc_real3 inv_d = bvh_inv_dir(d);
+  /* rows of lc_bvh_node.bounds holding each axis's near plane; the far plane is the next row */
+  const int nx = inv_d.x >= LC_REAL(0.0) ? 0 : 1;
+  const int ny = inv_d.y >= LC_REAL(0.0) ? 2 : 3;
+  const int nz = inv_d.z >= LC_REAL(0.0) ? 4 : 5;
   lc_tri_ray tr = triangle_ray_setup(d);
-  lc_uint stack_node[LC_BVH_STACK_SIZE];
-  float stack_t[LC_BVH_STACK_SIZE];
+  /* pending children: entry distance (float bits, rounded down) << 32 | child reference */
+  long stack[LC_BVH_STACK_SIZE];
   int sp = 0;
-  lc_uint node = 0;
+  lc_uint ref = 0; /* the root node */
   for (;;) {
-    __global const lc_bvh_node* n = &nodes[node];
-    lc_uint count = n->count, first = n->left_first;
-    if (count > 0) {
+    if (!(ref & LC_BVH_LEAF_BIT)) {
+      __global const lc_bvh_node* n = &nodes[ref];
+      __global const float* b = &n->bounds[0][0];
+      lc_bvh_rw tnx = (lc_bvh_rw_from_float(lc_bvh_vloadw(nx, b)) - o.x) * inv_d.x;
+      lc_bvh_rw tfx = (lc_bvh_rw_from_float(lc_bvh_vloadw(nx ^ 1, b)) - o.x) * inv_d.x;
+      lc_bvh_rw tny = (lc_bvh_rw_from_float(lc_bvh_vloadw(ny, b)) - o.y) * inv_d.y;
+      lc_bvh_rw tfy = (lc_bvh_rw_from_float(lc_bvh_vloadw(ny ^ 1, b)) - o.y) * inv_d.y;
+      lc_bvh_rw tnz = (lc_bvh_rw_from_float(lc_bvh_vloadw(nz, b)) - o.z) * inv_d.z;
+      lc_bvh_rw tfz = (lc_bvh_rw_from_float(lc_bvh_vloadw(nz ^ 1, b)) - o.z) * inv_d.z;
+      lc_bvh_rw enter = (lc_bvh_rw)(tmin), exit_ = (lc_bvh_rw)(hit->t);
+      enter = select(enter, tnx, tnx > enter);
+      enter = select(enter, tny, tny > enter);
+      enter = select(enter, tnz, tnz > enter);
+      exit_ = select(exit_, tfx, tfx < exit_);
+      exit_ = select(exit_, tfy, tfy < exit_);
+      exit_ = select(exit_, tfz, tfz < exit_);
+      exit_ *= LC_REAL(1.0000004);
+      lc_bvh_rw t = select((lc_bvh_rw)(INFINITY), enter, enter <= exit_);
+      lc_bvh_iw hm = lc_bvh_int_mask(t < (lc_bvh_rw)(INFINITY)); /* -1: child entered */
+      int cnt = -lc_bvh_sum(hm);
+      if (cnt > 0) {
+        /* keys (entry distance, child), sorted farthest first, the children missed (LONG_MIN)
+         * last: stored whole, the first cnt - 1 become the stack's top (second nearest on top)
+         * and the nearest, at cnt - 1, is visited next. Signed order of the keys is the order of
+         * the distances for t >= 0. */
+        lc_bvh_lw key = (lc_bvh_long(lc_bvh_as_iw(lc_bvh_float_down(t))) << 32) |
+                        lc_bvh_long(lc_bvh_vloadw(0, n->child));
+        key = bvh_sort_desc(select((lc_bvh_lw)(LONG_MIN), key, lc_bvh_long(hm)));
+        lc_bvh_vstorew(key, 0, &stack[sp]);
+        ref = (lc_uint)stack[sp + cnt - 1];
+        sp += cnt - 1;
+        continue;
+      }
+    } else {
+      lc_uint first = ref & LC_BVH_LEAF_FIRST_MASK;
+      lc_uint count = ((ref & ~LC_BVH_LEAF_BIT) >> LC_BVH_LEAF_COUNT_SHIFT) + 1;
       for (lc_uint i = 0; i < count; ++i)
         if (bvh_intersect_prim(s, s->prim_refs[first + i], &tr, o, d, tmin, hit) && any_hit)
           return 1;
-    } else {
-      float tl = bvh_box_entry(&nodes[first], o, inv_d, tmin, hit->t);
-      float tr_ = bvh_box_entry(&nodes[first + 1], o, inv_d, tmin, hit->t);
-      lc_uint near_ = tl <= tr_ ? first : first + 1;
-      float t_near = fmin(tl, tr_), t_far = fmax(tl, tr_);
-      if (t_near != INFINITY) {
-        if (t_far != INFINITY && sp < LC_BVH_STACK_SIZE) {
-          stack_node[sp] = (near_ == first) ? first + 1 : first;
-          stack_t[sp] = t_far;
-          ++sp;
-        }
-        node = near_;
-        continue;
-      }
     }
-    /* pop the nearest pending node that may still hold a closer hit */
-    for (;;) {
+    /* pop the nearest pending child that may still hold a closer hit */
+    long e;
+    do {
       if (sp == 0) return hit->prim != LC_INVALID;
-      --sp;
-      if (stack_t[sp] < hit->t) break;
-    }
-    node = stack_node[sp];
+      e = stack[--sp];
+    } while (!(as_float((int)(e >> 32)) < hit->t));
+    ref = (lc_uint)e;
   }
 }
 
-static inline int scene_intersect(const lc_scene* s, lc_ray ray, float tmax, lc_hit* hit) {
-  return bvh_trace(s, ray.o, ray.d, 0.0f, tmax, 0, hit);
+static inline int scene_intersect(const lc_scene* s, lc_ray ray, lc_real tmax, lc_hit* hit) {
+  return bvh_trace(s, lc_real3_from_float3(ray.o), lc_real3_from_float3(ray.d), LC_REAL(0.0), tmax,
+                   0, hit);
 }
 
 /* 1 when something blocks the segment from ray.o to ray.o + dist * ray.d. */
-static inline int scene_occluded(const lc_scene* s, lc_ray ray, float dist) {
+static inline int scene_occluded(const lc_scene* s, lc_ray ray, lc_real dist) {
   lc_hit hit;
-  return bvh_trace(s, ray.o, ray.d, 0.0f, dist, 1, &hit);
+  return bvh_trace(s, lc_real3_from_float3(ray.o), lc_real3_from_float3(ray.d), LC_REAL(0.0), dist,
+                   1, &hit);
 }
 
 #endif

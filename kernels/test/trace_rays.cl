@@ -40,6 +40,6 @@ __kernel void lucent_trace_rays(__global const lc_params* params,
     hits[i] = (float4)(0.0f, as_float(occluded ? 0u : LC_INVALID), 0.0f, 0.0f);
   } else {
     scene_intersect(&s, ray, a.w, &hit);
-    hits[i] = (float4)(hit.t, as_float(hit.prim), hit.b1, hit.b2);
+    hits[i] = (float4)((float)hit.t, as_float(hit.prim), (float)hit.b1, (float)hit.b2);
   }
 }

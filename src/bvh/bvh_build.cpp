@@ -1,7 +1,7 @@
 // Binned SAH BVH builder (Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies",
 // 2007): 32 bins per axis over the centroid bounds, all three axes, multithreaded by handing
 // large subtrees to a small pool of std::threads. The tree is built into a scratch array and
-// flattened depth-first with adjacent children (lc_bvh_node, kernels/shared/types.h).
+// flattened depth-first with adjacent children (Node2, bvh.hpp); bvh_wide.cpp collapses it.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -26,7 +26,7 @@ namespace {
 constexpr int kBins = 32;
 constexpr std::size_t kSpawnSize = 2048;  // subtrees at least this large go to the shared queue
 constexpr std::size_t kParallelBinSize = 1u << 17;  // nodes this large bin on every thread
-constexpr unsigned kMaxDepth = 64;  // = LC_BVH_STACK_SIZE in kernels/bvh/traverse.cl
+constexpr unsigned kMaxDepth = LC_BVH_MAX_DEPTH;  // bounds the kernel's traversal stack
 
 // Four floats, one SIMD register where SSE2 is there (lane 3 is unused by the math below).
 #if defined(__SSE2__)
@@ -220,7 +220,7 @@ class Builder {
         max_leaf_(static_cast<std::size_t>(std::max(1, options.max_leaf_size))),
         threads_(threads),
         traversal_cost_(options.traversal_cost) {
-    nodes_.reset(new lc_bvh_node[std::max<std::size_t>(1, 2 * refs.size() - 1)]);
+    nodes_.reset(new Node2[std::max<std::size_t>(1, 2 * refs.size() - 1)]);
   }
 
   // Builds the tree over refs_, whose bounds and centroid bounds are given; returns the number
@@ -236,7 +236,7 @@ class Builder {
     return 1 + 2 * interior_.load();
   }
 
-  const lc_bvh_node* nodes() const { return nodes_.get(); }
+  const Node2* nodes() const { return nodes_.get(); }
   std::size_t max_depth() const { return max_depth_.load(); }
 
  private:
@@ -268,7 +268,7 @@ class Builder {
   }
 
   void make_leaf(const Task& t) {
-    lc_bvh_node& n = nodes_[t.node];
+    Node2& n = nodes_[t.node];
     n.left_first = static_cast<lc_uint>(t.begin);
     n.count = static_cast<lc_uint>(t.end - t.begin);
     std::size_t d = max_depth_.load(std::memory_order_relaxed);
@@ -331,7 +331,7 @@ class Builder {
     while (!stack.empty()) {
       Task t = stack.back();
       stack.pop_back();
-      lc_bvh_node& node = nodes_[t.node];
+      Node2& node = nodes_[t.node];
       t.box.get(node.bmin, node.bmax);
       std::size_t n = t.end - t.begin;
       if (n == 1) {
@@ -439,7 +439,7 @@ class Builder {
   std::size_t max_leaf_;
   unsigned threads_;
   float traversal_cost_;
-  std::unique_ptr<lc_bvh_node[]> nodes_;  // scratch tree (2n - 1 slots, not zeroed)
+  std::unique_ptr<Node2[]> nodes_;  // scratch tree (2n - 1 slots, not zeroed)
   std::atomic<std::size_t> interior_{0};
   std::atomic<std::size_t> max_depth_{0};
   std::mutex mutex_;
@@ -464,9 +464,9 @@ void parallel_for(std::size_t n, unsigned threads, F f) {
 
 }  // namespace
 
-double sah_cost(const std::vector<lc_bvh_node>& nodes) {
+double sah_cost(const std::vector<Node2>& nodes) {
   if (nodes.empty()) return 0;
-  auto area = [](const lc_bvh_node& n) {
+  auto area = [](const Node2& n) {
     double d[3];
     for (int a = 0; a < 3; ++a) d[a] = std::max(0.0, double(n.bmax[a]) - n.bmin[a]);
     return 2 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
@@ -478,10 +478,13 @@ double sah_cost(const std::vector<lc_bvh_node>& nodes) {
   return cost;
 }
 
-std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& triangles) {
+namespace {
+
+std::vector<lc_uint> reorder_refs(std::vector<lc_uint>& prim_refs,
+                                  std::vector<lc_triangle>& triangles) {
   std::vector<lc_uint> new_to_old;
   new_to_old.reserve(triangles.size());
-  for (lc_uint& ref : bvh.prim_refs) {
+  for (lc_uint& ref : prim_refs) {
     if (ref & LC_PRIM_SPHERE_BIT) continue;
     new_to_old.push_back(ref);
     ref = static_cast<lc_uint>(new_to_old.size() - 1);
@@ -494,10 +497,22 @@ std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& trian
   return new_to_old;
 }
 
-Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& spheres,
-          const BuildOptions& options) {
+}  // namespace
+
+std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& triangles) {
+  return reorder_refs(bvh.prim_refs, triangles);
+}
+
+std::vector<lc_uint> reorder_triangles(Bvh2& bvh, std::vector<lc_triangle>& triangles) {
+  return reorder_refs(bvh.prim_refs, triangles);
+}
+
+Bvh2 build_binary(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& spheres,
+                  const BuildOptions& options_in) {
   auto t0 = std::chrono::steady_clock::now();
-  Bvh out;
+  BuildOptions options = options_in;
+  options.max_leaf_size = std::min(std::max(options.max_leaf_size, 1), int(LC_BVH_LEAF_MAX));
+  Bvh2 out;
   const std::size_t nt = tris.size(), n = nt + spheres.size();
   out.stats.primitives = n;
   if (n == 0) return out;
@@ -547,7 +562,7 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
 
   Builder builder(refs, options, threads);
   std::size_t count = builder.run(box, cbox);
-  const lc_bvh_node* tmp = builder.nodes();
+  const Node2* tmp = builder.nodes();
 
   // flatten depth-first: a node's children are adjacent and its left subtree follows them. Node 1
   // is padding (an empty box, never referenced) so that every sibling pair starts at an even
@@ -556,7 +571,7 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
   const lc_uint first_pair = count > 1 ? 2 : 1;
   out.nodes.resize(count + (first_pair - 1));
   if (count > 1) {
-    lc_bvh_node& pad = out.nodes[1];
+    Node2& pad = out.nodes[1];
     for (int a = 0; a < 3; ++a) pad.bmin[a] = INFINITY, pad.bmax[a] = -INFINITY;
     pad.left_first = 0;
     pad.count = 0;
@@ -573,8 +588,8 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
   while (!stack.empty()) {
     Item it = stack.back();
     stack.pop_back();
-    const lc_bvh_node& s = tmp[it.src];
-    lc_bvh_node& d = out.nodes[it.dst];
+    const Node2& s = tmp[it.src];
+    Node2& d = out.nodes[it.dst];
     d = s;
     if (s.count == 0) {
       d.left_first = next;
@@ -595,6 +610,19 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
   st.mean_leaf_size = double(n) / double(st.leaves);
   st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   st.sah_cost = sah_cost(out.nodes);  // not part of the build time
+  st.binary_nodes = st.nodes;
+  st.binary_max_depth = st.max_depth;
+  return out;
+}
+
+Bvh build(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere>& spheres,
+          const BuildOptions& options) {
+  Bvh2 b = build_binary(triangles, spheres, options);
+  double binary_seconds = b.stats.seconds;
+  auto t0 = std::chrono::steady_clock::now();
+  Bvh out = collapse(b);
+  out.stats.seconds =
+      binary_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
 
