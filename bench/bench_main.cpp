@@ -46,6 +46,8 @@ struct Options {
   std::string only;         // run only the meshes whose name contains this
   bool embree = true;       // compare with Embree when built with it
   float traversal_cost = lucent::bvh::BuildOptions().traversal_cost;
+  int leaf_block = lucent::bvh::BuildOptions().leaf_block;
+  int max_leaf = lucent::bvh::BuildOptions().max_leaf_size;
   bool reorder = false;  // trace triangles stored in leaf order (bvh::reorder_triangles)
   std::string device;
 };
@@ -220,6 +222,8 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
     lucent::bvh::BuildOptions bo;
     bo.threads = opt.threads;
     bo.traversal_cost = opt.traversal_cost;
+    bo.leaf_block = opt.leaf_block;
+    bo.max_leaf_size = opt.max_leaf;
     bvh = lucent::bvh::build(tris, {}, bo);
     times.push_back(bvh.stats.seconds);
   }
@@ -325,6 +329,10 @@ int main(int argc, char** argv) {
       opt.embree = false;
     else if (a == "--reorder")
       opt.reorder = true;
+    else if (a == "--leaf-block")
+      opt.leaf_block = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--max-leaf")
+      opt.max_leaf = std::max(1, std::atoi(next().c_str()));
     else if (a == "--traversal-cost")
       opt.traversal_cost = float(std::atof(next().c_str()));
     else {

@@ -31,11 +31,13 @@ typedef double4 lc_bvh_rw;
 #define lc_bvh_rw_from_float(v) convert_double4(v)
 #define lc_bvh_float_down(v) convert_float4_rtn(v) /* never above v: culling stays safe */
 #define lc_bvh_int_mask(m) convert_int4(m)
+#define lc_bvh_r4(v) convert_double4(v)
 #else
 typedef float4 lc_bvh_rw;
 #define lc_bvh_rw_from_float(v) (v)
 #define lc_bvh_float_down(v) (v)
 #define lc_bvh_int_mask(m) (m)
+#define lc_bvh_r4(v) (v)
 #endif
 /* Sorting network for 4 keys, descending: (0,1)(2,3), (0,2)(1,3), (1,2). */
 static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
@@ -57,7 +59,7 @@ static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
 typedef struct {
   __global const lc_params* params;
   __global const lc_bvh_node* nodes;
-  __global const lc_uint* prim_refs;
+  __global const lc_bvh_leaf* leaves;
   __global const lc_triangle* triangles;
   __global const lc_triangle_attr* tri_attrs;
   __global const lc_sphere* spheres;
@@ -71,7 +73,7 @@ typedef struct {
 /* The scene's kernel arguments, in the order of src/render/device_scene.cpp (DeviceScene). */
 #define LC_SCENE_KERNEL_ARGS                                                                  \
   __global const lc_params *params, __global const lc_bvh_node *nodes,                        \
-      __global const lc_uint *prim_refs, __global const lc_triangle *triangles,               \
+      __global const lc_bvh_leaf *leaves, __global const lc_triangle *triangles,              \
       __global const lc_triangle_attr *tri_attrs, __global const lc_sphere *spheres,          \
       __global const lc_material *materials, __global const lc_light *lights,                 \
       __global const float *light_cdf, __global const lc_texture *textures,                   \
@@ -79,7 +81,7 @@ typedef struct {
 
 /* The lc_scene of a kernel declared with LC_SCENE_KERNEL_ARGS. */
 #define LC_SCENE_FROM_KERNEL_ARGS                                                             \
-  {params, nodes, prim_refs, triangles, tri_attrs, spheres, materials, lights, light_cdf,     \
+  {params, nodes, leaves, triangles, tri_attrs, spheres, materials, lights, light_cdf,     \
    textures, texels}
 
 typedef struct {
@@ -94,30 +96,91 @@ static inline lc_real3 bvh_inv_dir(lc_real3 d) {
   return select(inv, (lc_real3)(INFINITY), isinf(inv));
 }
 
-static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tri_ray* tr,
-                                     lc_real3 o, lc_real3 d, lc_real tmin, lc_hit* hit) {
-  if (ref & LC_PRIM_SPHERE_BIT) {
-    __global const lc_sphere* sp = &s->spheres[ref & ~LC_PRIM_SPHERE_BIT];
-    lc_real t = sphere_intersect(lc_load3r(sp->center), (lc_real)sp->radius, o, d, tmin, hit->t);
-    if (t < hit->t) {
-      hit->t = t;
-      hit->prim = ref;
-      return 1;
-    }
-    return 0;
+static inline lc_real bvh_lane(lc_real4 v, int k) {
+  return k == 0 ? v.s0 : (k == 1 ? v.s1 : (k == 2 ? v.s2 : v.s3));
+}
+
+/* lc_real4 comparison results as int4 and back */
+#ifdef LC_DOUBLE
+#define lc_bvh_m4(m) convert_int4(m)
+#define lc_bvh_rm4(m) convert_long4(m)
+#else
+#define lc_bvh_m4(m) (m)
+#define lc_bvh_rm4(m) (m)
+#endif
+#if defined(cl_khr_fp64) && !defined(LC_DOUBLE)
+#define LC_BVH_FP64_FALLBACK 1
+#endif
+
+/*
+ * The triangles of one leaf block, all four at once: the watertight test of geom/triangle.cl
+ * (Woop, Benthin and Wald 2013) lane by lane, with the same shear (r: triangle_ray_setup; okx,
+ * oky, okz: the origin's components along r->kx, r->ky, r->kz), the same operations in the same
+ * order without fused multiply-add, and the same fp64 recomputation of a triangle's edge
+ * functions when one of them rounds to 0, so each lane decides exactly as triangle_intersect
+ * would. Keeps the nearest hit with t in (tmin, hit->t); returns 1 when it found one.
+ */
+static inline int bvh_leaf_triangles(__global const lc_bvh_leaf* lf, int4 tri, const lc_tri_ray* r,
+                                     lc_real okx, lc_real oky, lc_real okz, lc_real tmin,
+                                     lc_hit* hit) {
+#pragma OPENCL FP_CONTRACT OFF
+  __global const float* v = &lf->v[0][0];
+  lc_real4 Az = lc_bvh_r4(vload4(r->kz, v)) - okz;
+  lc_real4 Bz = lc_bvh_r4(vload4(3 + r->kz, v)) - okz;
+  lc_real4 Cz = lc_bvh_r4(vload4(6 + r->kz, v)) - okz;
+  lc_real4 Ax = (lc_bvh_r4(vload4(r->kx, v)) - okx) - r->sx * Az;
+  lc_real4 Ay = (lc_bvh_r4(vload4(r->ky, v)) - oky) - r->sy * Az;
+  lc_real4 Bx = (lc_bvh_r4(vload4(3 + r->kx, v)) - okx) - r->sx * Bz;
+  lc_real4 By = (lc_bvh_r4(vload4(3 + r->ky, v)) - oky) - r->sy * Bz;
+  lc_real4 Cx = (lc_bvh_r4(vload4(6 + r->kx, v)) - okx) - r->sx * Cz;
+  lc_real4 Cy = (lc_bvh_r4(vload4(6 + r->ky, v)) - oky) - r->sy * Cz;
+  lc_real4 U = Cx * By - Cy * Bx;
+  lc_real4 V = Ax * Cy - Ay * Cx;
+  lc_real4 W = Bx * Ay - By * Ax;
+#ifdef LC_BVH_FP64_FALLBACK
+  int4 zero = tri & ((U == 0.0f) | (V == 0.0f) | (W == 0.0f));
+  if (any(zero)) {
+    double4 ax = convert_double4(Ax), ay = convert_double4(Ay), bx = convert_double4(Bx);
+    double4 by = convert_double4(By), cx = convert_double4(Cx), cy = convert_double4(Cy);
+    U = select(U, convert_float4(cx * by - cy * bx), zero);
+    V = select(V, convert_float4(ax * cy - ay * cx), zero);
+    W = select(W, convert_float4(bx * ay - by * ax), zero);
   }
-  __global const lc_triangle* tri = &s->triangles[ref];
-  lc_real t, b1, b2;
-  if (triangle_intersect(tr, o, lc_load3r(tri->v0), lc_load3r(tri->v1), lc_load3r(tri->v2), tmin,
-                         hit->t, &t, &b1, &b2)) {
+#endif
+  const lc_real z = LC_REAL(0.0);
+  int4 ok = tri & ~lc_bvh_m4(((U < z) | (V < z) | (W < z)) & ((U > z) | (V > z) | (W > z)));
+  lc_real4 det = U + V + W;
+  ok &= lc_bvh_m4(det != z);
+  if (!any(ok)) return 0;
+  lc_real4 T = U * (r->sz * Az) + V * (r->sz * Bz) + W * (r->sz * Cz);
+  lc_real4 inv = LC_REAL(1.0) / det;
+  lc_real4 t = T * inv;
+  ok &= lc_bvh_m4((t > tmin) & (t < hit->t));
+  if (!any(ok)) return 0;
+  lc_real4 tt = select((lc_real4)(INFINITY), t, lc_bvh_rm4(ok));
+  lc_real a = tt.s0 < tt.s1 ? tt.s0 : tt.s1, c = tt.s2 < tt.s3 ? tt.s2 : tt.s3;
+  lc_real m = a < c ? a : c;
+  int k = tt.s0 == m ? 0 : (tt.s1 == m ? 1 : (tt.s2 == m ? 2 : 3));
+  hit->t = m;
+  hit->prim = lf->prim[k];
+  hit->b1 = bvh_lane(V, k) * bvh_lane(inv, k);
+  hit->b2 = bvh_lane(W, k) * bvh_lane(inv, k);
+  return 1;
+}
+
+static inline int bvh_intersect_sphere(const lc_scene* s, lc_uint ref, lc_real3 o, lc_real3 d,
+                                       lc_real tmin, lc_hit* hit) {
+  __global const lc_sphere* sp = &s->spheres[ref & ~LC_PRIM_SPHERE_BIT];
+  lc_real t = sphere_intersect(lc_load3r(sp->center), (lc_real)sp->radius, o, d, tmin, hit->t);
+  if (t < hit->t) {
     hit->t = t;
     hit->prim = ref;
-    hit->b1 = b1;
-    hit->b2 = b2;
     return 1;
   }
   return 0;
 }
+
+static inline lc_real bvh_get(lc_real3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 
 /*
  * Closest hit with t in (tmin, tmax). With any_hit set, returns at the first hit found (shadow
@@ -146,6 +209,7 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
   const int ny = inv_d.y >= LC_REAL(0.0) ? 2 : 3;
   const int nz = inv_d.z >= LC_REAL(0.0) ? 4 : 5;
   lc_tri_ray tr = triangle_ray_setup(d);
+  const lc_real okx = bvh_get(o, tr.kx), oky = bvh_get(o, tr.ky), okz = bvh_get(o, tr.kz);
   /* pending children: entry distance (float bits, rounded down) << 32 | child reference */
   long stack[LC_BVH_STACK_SIZE];
   int sp = 0;
@@ -185,11 +249,21 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
         continue;
       }
     } else {
-      lc_uint first = ref & LC_BVH_LEAF_FIRST_MASK;
-      lc_uint count = ((ref & ~LC_BVH_LEAF_BIT) >> LC_BVH_LEAF_COUNT_SHIFT) + 1;
-      for (lc_uint i = 0; i < count; ++i)
-        if (bvh_intersect_prim(s, s->prim_refs[first + i], &tr, o, d, tmin, hit) && any_hit)
+      __global const lc_bvh_leaf* lf = &s->leaves[ref & LC_BVH_LEAF_FIRST_MASK];
+      __global const lc_bvh_leaf* end = lf + ((ref & ~LC_BVH_LEAF_BIT) >> LC_BVH_LEAF_COUNT_SHIFT) + 1;
+      for (; lf < end; ++lf) {
+        uint4 prim = vload4(0, lf->prim);
+        int4 sphere = (prim & LC_PRIM_SPHERE_BIT) != 0;
+        int4 tri = ~sphere;
+        int4 used_sphere = sphere & (prim != LC_INVALID);
+        if (any(tri) && bvh_leaf_triangles(lf, tri, &tr, okx, oky, okz, tmin, hit) && any_hit)
           return 1;
+        if (any(used_sphere))
+          for (int k = 0; k < 4; ++k)
+            if (lf->prim[k] != LC_INVALID && (lf->prim[k] & LC_PRIM_SPHERE_BIT) &&
+                bvh_intersect_sphere(s, lf->prim[k], o, d, tmin, hit) && any_hit)
+              return 1;
+      }
     }
     /* pop the nearest pending child that may still hold a closer hit */
     long e;

@@ -107,16 +107,16 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle_attr, uv) == 36, triangle_attr_uv);
  * bounds: the children's boxes, structure of arrays: row 0 min x, 1 max x, 2 min y, 3 max y,
  *   4 min z, 5 max z; column k is child k. The kernel loads row (0 or 1) + 2 axis whole, so the
  *   nearer plane of each axis is picked once per ray by the sign of its direction.
- * child: interior child: its node index; leaf: LC_BVH_LEAF_BIT | (count - 1) <<
- *   LC_BVH_LEAF_COUNT_SHIFT | first entry of the primitive reference array (count 1 to
- *   LC_BVH_LEAF_MAX); unused slot: LC_INVALID with an empty box (min +inf, max -inf), which no
- *   ray enters.
+ * child: interior child: its node index; leaf: LC_BVH_LEAF_BIT | (blocks - 1) <<
+ *   LC_BVH_LEAF_COUNT_SHIFT | index of its first lc_bvh_leaf block (a leaf of up to
+ *   LC_BVH_LEAF_MAX primitives fills 1 to 4 consecutive blocks); unused slot: LC_INVALID with an
+ *   empty box (min +inf, max -inf), which no ray enters.
  */
 #define LC_BVH_WIDTH 4
 #define LC_BVH_LEAF_BIT 0x80000000u
 #define LC_BVH_LEAF_COUNT_SHIFT 27
 #define LC_BVH_LEAF_MAX 16u                /* primitives per leaf, at most               */
-#define LC_BVH_LEAF_FIRST_MASK 0x07ffffffu /* first primitive reference of a leaf        */
+#define LC_BVH_LEAF_FIRST_MASK 0x07ffffffu /* first block of a leaf                      */
 #define LC_BVH_MAX_DEPTH 64 /* levels of the binary tree and so of the wide one, at most */
 
 typedef struct LC_ALIGN16 lc_bvh_node {
@@ -127,6 +127,19 @@ typedef struct LC_ALIGN16 lc_bvh_node {
 LC_STATIC_ASSERT(sizeof(lc_bvh_node) == 32 * LC_BVH_WIDTH, bvh_node_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, child) == 24 * LC_BVH_WIDTH, bvh_node_child);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, pad) == 28 * LC_BVH_WIDTH, bvh_node_pad);
+
+/* Leaf block: 4 primitives of a leaf (fewer in its last block), their triangles' vertices as
+ * structure of arrays so that one vector operation tests all four triangles.
+ * v: rows v0.x, v0.y, v0.z, v1.x, v1.y, v1.z, v2.x, v2.y, v2.z; column k is primitive k (zeros for
+ *   a sphere or an unused column).
+ * prim: primitive reference (triangle index, or sphere index | LC_PRIM_SPHERE_BIT), LC_INVALID for
+ *   an unused column. */
+typedef struct LC_ALIGN16 lc_bvh_leaf {
+  float v[9][4];   /* triangle vertices, one column per primitive */
+  lc_uint prim[4]; /* primitive references                        */
+} lc_bvh_leaf; /* total: 160 bytes */
+LC_STATIC_ASSERT(sizeof(lc_bvh_leaf) == 160, bvh_leaf_size);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_leaf, prim) == 144, bvh_leaf_prim);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Lights                                                                                     */

@@ -15,6 +15,9 @@ struct BuildOptions {
   /// SAH cost of one traversal step relative to one primitive intersection: larger values give
   /// larger leaves and fewer nodes.
   float traversal_cost = 1.0f;
+  /// Primitives the kernel tests together (lc_bvh_leaf holds 4): the SAH counts a leaf's
+  /// intersection cost in blocks of this many, so leaves fill blocks when that is no worse.
+  int leaf_block = 4;
 };
 
 struct BuildStats {
@@ -48,10 +51,13 @@ struct Bvh2 {
   BuildStats stats;
 };
 
-/// The tree the kernel walks: wide nodes (kernels/shared/types.h), depth-first.
+/// The tree the kernel walks: wide nodes and leaf blocks (kernels/shared/types.h), depth-first.
 struct Bvh {
   std::vector<lc_bvh_node> nodes;  ///< nodes[0] is the root; empty when there is no primitive
-  std::vector<lc_uint> prim_refs;  ///< triangle index, or sphere index | LC_PRIM_SPHERE_BIT
+  std::vector<lc_bvh_leaf> leaves; ///< leaf blocks, in the order the collapse meets the leaves
+  /// The binary tree's primitive references (triangle index, or sphere index |
+  /// LC_PRIM_SPHERE_BIT); each leaf's are consecutive here and in its blocks.
+  std::vector<lc_uint> prim_refs;
   float bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0};  ///< bounds of the scene (0 when empty)
   BuildStats stats;
 };
@@ -60,17 +66,19 @@ struct Bvh {
 Bvh2 build_binary(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere>& spheres,
                   const BuildOptions& options = {});
 
-/// Collapses a binary tree into wide nodes: each node takes the children of a binary node and
-/// opens its interior child of largest surface area until it has LC_BVH_WIDTH children or only
-/// leaves. Leaves and primitive references are kept as they are.
-Bvh collapse(const Bvh2& binary);
+/// Collapses a binary tree built over `triangles` (then spheres) into wide nodes: each node takes
+/// the children of a binary node and opens its interior child of largest surface area until it
+/// has LC_BVH_WIDTH children or only leaves. Each leaf becomes 1 to 4 consecutive leaf blocks
+/// holding the vertices of its triangles.
+Bvh collapse(const Bvh2& binary, const std::vector<lc_triangle>& triangles);
 
 /// build_binary, then collapse.
 Bvh build(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere>& spheres,
           const BuildOptions& options = {});
 
 /// Puts the triangles in the order in which the leaves reference them (neighbouring leaves then
-/// read neighbouring memory in the kernel) and rewrites bvh.prim_refs to match; spheres are left
+/// read neighbouring memory in the kernel) and rewrites bvh.prim_refs (and the leaf blocks'
+/// references) to match; spheres are left
 /// as they are. Returns, for each new triangle index, its old index: callers permute arrays kept
 /// parallel to the triangles with it and remap stored triangle indices (lights).
 std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& triangles);

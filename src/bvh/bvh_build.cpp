@@ -219,7 +219,8 @@ class Builder {
       : refs_(refs),
         max_leaf_(static_cast<std::size_t>(std::max(1, options.max_leaf_size))),
         threads_(threads),
-        traversal_cost_(options.traversal_cost) {
+        traversal_cost_(options.traversal_cost),
+        block_(static_cast<std::size_t>(std::max(1, options.leaf_block))) {
     nodes_.reset(new Node2[std::max<std::size_t>(1, 2 * refs.size() - 1)]);
   }
 
@@ -237,6 +238,9 @@ class Builder {
   }
 
   const Node2* nodes() const { return nodes_.get(); }
+
+  // intersection cost of n primitives: the blocks of block_ that a leaf of n fills
+  float blocks(std::size_t n) const { return float((n + block_ - 1) / block_); }
   std::size_t max_depth() const { return max_depth_.load(); }
 
  private:
@@ -374,7 +378,7 @@ class Builder {
             lacc.grow(bins.box[a][k - 1].lo, bins.box[a][k - 1].hi);
             lcnt += bins.count[a][k - 1];
             if (lcnt == 0 || right_count[k] == 0) continue;
-            float c = lacc.area() * float(lcnt) + right_area[k] * float(right_count[k]);
+            float c = lacc.area() * blocks(lcnt) + right_area[k] * blocks(right_count[k]);
             if (c < best) {
               best = c;
               best_axis = a;
@@ -384,7 +388,7 @@ class Builder {
         }
         float area = t.box.area();
         float split_cost = traversal_cost_ * area + best;  // both scaled by the node's area
-        float leaf_cost = float(n) * area;
+        float leaf_cost = blocks(n) * area;
         if (n <= max_leaf_ && (best_axis < 0 || leaf_cost <= split_cost)) {
           make_leaf(t);
           continue;
@@ -439,6 +443,7 @@ class Builder {
   std::size_t max_leaf_;
   unsigned threads_;
   float traversal_cost_;
+  std::size_t block_;
   std::unique_ptr<Node2[]> nodes_;  // scratch tree (2n - 1 slots, not zeroed)
   std::atomic<std::size_t> interior_{0};
   std::atomic<std::size_t> max_depth_{0};
@@ -500,7 +505,13 @@ std::vector<lc_uint> reorder_refs(std::vector<lc_uint>& prim_refs,
 }  // namespace
 
 std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& triangles) {
-  return reorder_refs(bvh.prim_refs, triangles);
+  std::vector<lc_uint> new_to_old = reorder_refs(bvh.prim_refs, triangles);
+  std::vector<lc_uint> old_to_new(new_to_old.size());
+  for (std::size_t i = 0; i < new_to_old.size(); ++i) old_to_new[new_to_old[i]] = lc_uint(i);
+  for (lc_bvh_leaf& l : bvh.leaves)
+    for (lc_uint& ref : l.prim)
+      if (!(ref & LC_PRIM_SPHERE_BIT)) ref = old_to_new[ref];  // LC_INVALID has the bit
+  return new_to_old;
 }
 
 std::vector<lc_uint> reorder_triangles(Bvh2& bvh, std::vector<lc_triangle>& triangles) {
@@ -620,7 +631,7 @@ Bvh build(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere
   Bvh2 b = build_binary(triangles, spheres, options);
   double binary_seconds = b.stats.seconds;
   auto t0 = std::chrono::steady_clock::now();
-  Bvh out = collapse(b);
+  Bvh out = collapse(b, triangles);
   out.stats.seconds =
       binary_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;

@@ -2,9 +2,11 @@
 // Each wide node starts from the two children of a binary node and repeatedly opens its interior
 // child of largest surface area (replacing it by that child's two children) until it holds
 // LC_BVH_WIDTH children or only leaves, as in Wald et al., "Getting Rid of Packets" (2008) and
-// Embree's BVH4/BVH8 builders. Leaves and the primitive reference array are kept as they are.
+// Embree's BVH4/BVH8 builders. A leaf's primitives (consecutive in prim_refs) go to consecutive
+// leaf blocks of 4, with their triangles' vertices in structure-of-arrays form.
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "bvh/bvh.hpp"
@@ -22,7 +24,7 @@ double area(const Node2& n) {
 
 }  // namespace
 
-Bvh collapse(const Bvh2& b) {
+Bvh collapse(const Bvh2& b, const std::vector<lc_triangle>& triangles) {
   Bvh out;
   out.prim_refs = b.prim_refs;
   out.stats = b.stats;
@@ -31,10 +33,38 @@ Bvh collapse(const Bvh2& b) {
   out.stats.nodes = 0;
   out.stats.max_depth = 0;
   if (b.nodes.empty()) return out;
+  // a leaf's blocks start at most at prim_refs.size() - 1 (one block per primitive at worst)
   if (b.prim_refs.size() > std::size_t(LC_BVH_LEAF_FIRST_MASK) + 1)
     throw Error("scene: " + std::to_string(b.prim_refs.size()) +
                 " primitives, more than the BVH can reference (" +
                 std::to_string(std::size_t(LC_BVH_LEAF_FIRST_MASK) + 1) + ")");
+  auto add_leaf = [&](const Node2& c) {
+    lc_uint first = static_cast<lc_uint>(out.leaves.size());
+    lc_uint blocks = (c.count + 3) / 4;
+    for (lc_uint k = 0; k < blocks; ++k) {
+      lc_bvh_leaf l{};
+      for (lc_uint j = 0; j < 4; ++j) {
+        lc_uint i = 4 * k + j;
+        if (i >= c.count) {
+          l.prim[j] = LC_INVALID;
+          continue;
+        }
+        lc_uint ref = b.prim_refs[c.left_first + i];
+        l.prim[j] = ref;
+        if (ref & LC_PRIM_SPHERE_BIT) continue;
+        if (ref >= triangles.size())
+          throw std::logic_error("bvh::collapse: the tree was not built over these triangles");
+        const lc_triangle& t = triangles[ref];
+        for (int a = 0; a < 3; ++a) {
+          l.v[a][j] = t.v0[a];
+          l.v[3 + a][j] = t.v1[a];
+          l.v[6 + a][j] = t.v2[a];
+        }
+      }
+      out.leaves.push_back(l);
+    }
+    return LC_BVH_LEAF_BIT | ((blocks - 1) << LC_BVH_LEAF_COUNT_SHIFT) | first;
+  };
   const Node2& root = b.nodes[0];
   for (int a = 0; a < 3; ++a) out.bmin[a] = root.bmin[a], out.bmax[a] = root.bmax[a];
 
@@ -43,6 +73,7 @@ Bvh collapse(const Bvh2& b) {
   };
   std::vector<Item> stack{{0, 0, 1}};
   out.nodes.reserve(b.nodes.size() / 2 + 1);
+  out.leaves.reserve(b.prim_refs.size() / 2 + 1);
   out.nodes.emplace_back();
   std::size_t leaves = 0, max_leaf = 0;
   while (!stack.empty()) {
@@ -94,7 +125,7 @@ Bvh collapse(const Bvh2& b) {
       }
       w.pad[k] = 0;
       if (c.count > 0) {
-        w.child[k] = LC_BVH_LEAF_BIT | ((c.count - 1) << LC_BVH_LEAF_COUNT_SHIFT) | c.left_first;
+        w.child[k] = add_leaf(c);
         ++leaves;
         max_leaf = std::max<std::size_t>(max_leaf, c.count);
       } else {

@@ -35,7 +35,7 @@ class DeviceTracer {
  private:
   const cl_util::Context& ctx_;
   cl::Kernel kernel_;
-  cl::Buffer params_, nodes_, refs_, tris_, spheres_;
+  cl::Buffer params_, nodes_, leaves_, tris_, spheres_;
   double kernel_seconds_ = 0;
 };
 
