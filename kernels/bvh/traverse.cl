@@ -124,16 +124,16 @@ static inline int bvh_leaf_triangles(__global const lc_bvh_leaf* lf, int4 tri, c
                                      lc_real okx, lc_real oky, lc_real okz, lc_real tmin,
                                      lc_hit* hit) {
 #pragma OPENCL FP_CONTRACT OFF
-  __global const float* v = &lf->v[0][0];
-  lc_real4 Az = lc_bvh_r4(vload4(r->kz, v)) - okz;
-  lc_real4 Bz = lc_bvh_r4(vload4(3 + r->kz, v)) - okz;
-  lc_real4 Cz = lc_bvh_r4(vload4(6 + r->kz, v)) - okz;
-  lc_real4 Ax = (lc_bvh_r4(vload4(r->kx, v)) - okx) - r->sx * Az;
-  lc_real4 Ay = (lc_bvh_r4(vload4(r->ky, v)) - oky) - r->sy * Az;
-  lc_real4 Bx = (lc_bvh_r4(vload4(3 + r->kx, v)) - okx) - r->sx * Bz;
-  lc_real4 By = (lc_bvh_r4(vload4(3 + r->ky, v)) - oky) - r->sy * Bz;
-  lc_real4 Cx = (lc_bvh_r4(vload4(6 + r->kx, v)) - okx) - r->sx * Cz;
-  lc_real4 Cy = (lc_bvh_r4(vload4(6 + r->ky, v)) - oky) - r->sy * Cz;
+  __global const float4* v = (__global const float4*)lf->v; /* one row per float4 */
+  lc_real4 Az = lc_bvh_r4(v[r->kz]) - okz;
+  lc_real4 Bz = lc_bvh_r4(v[3 + r->kz]) - okz;
+  lc_real4 Cz = lc_bvh_r4(v[6 + r->kz]) - okz;
+  lc_real4 Ax = (lc_bvh_r4(v[r->kx]) - okx) - r->sx * Az;
+  lc_real4 Ay = (lc_bvh_r4(v[r->ky]) - oky) - r->sy * Az;
+  lc_real4 Bx = (lc_bvh_r4(v[3 + r->kx]) - okx) - r->sx * Bz;
+  lc_real4 By = (lc_bvh_r4(v[3 + r->ky]) - oky) - r->sy * Bz;
+  lc_real4 Cx = (lc_bvh_r4(v[6 + r->kx]) - okx) - r->sx * Cz;
+  lc_real4 Cy = (lc_bvh_r4(v[6 + r->ky]) - oky) - r->sy * Cz;
   lc_real4 U = Cx * By - Cy * Bx;
   lc_real4 V = Ax * Cy - Ay * Cx;
   lc_real4 W = Bx * Ay - By * Ax;
@@ -217,13 +217,13 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
   for (;;) {
     if (!(ref & LC_BVH_LEAF_BIT)) {
       __global const lc_bvh_node* n = &nodes[ref];
-      __global const float* b = &n->bounds[0][0];
-      lc_bvh_rw tnx = (lc_bvh_rw_from_float(lc_bvh_vloadw(nx, b)) - o.x) * inv_d.x;
-      lc_bvh_rw tfx = (lc_bvh_rw_from_float(lc_bvh_vloadw(nx ^ 1, b)) - o.x) * inv_d.x;
-      lc_bvh_rw tny = (lc_bvh_rw_from_float(lc_bvh_vloadw(ny, b)) - o.y) * inv_d.y;
-      lc_bvh_rw tfy = (lc_bvh_rw_from_float(lc_bvh_vloadw(ny ^ 1, b)) - o.y) * inv_d.y;
-      lc_bvh_rw tnz = (lc_bvh_rw_from_float(lc_bvh_vloadw(nz, b)) - o.z) * inv_d.z;
-      lc_bvh_rw tfz = (lc_bvh_rw_from_float(lc_bvh_vloadw(nz ^ 1, b)) - o.z) * inv_d.z;
+      __global const float4* b = (__global const float4*)n->bounds; /* one row per float4 */
+      lc_bvh_rw tnx = (lc_bvh_rw_from_float(b[nx]) - o.x) * inv_d.x;
+      lc_bvh_rw tfx = (lc_bvh_rw_from_float(b[nx ^ 1]) - o.x) * inv_d.x;
+      lc_bvh_rw tny = (lc_bvh_rw_from_float(b[ny]) - o.y) * inv_d.y;
+      lc_bvh_rw tfy = (lc_bvh_rw_from_float(b[ny ^ 1]) - o.y) * inv_d.y;
+      lc_bvh_rw tnz = (lc_bvh_rw_from_float(b[nz]) - o.z) * inv_d.z;
+      lc_bvh_rw tfz = (lc_bvh_rw_from_float(b[nz ^ 1]) - o.z) * inv_d.z;
       lc_bvh_rw enter = (lc_bvh_rw)(tmin), exit_ = (lc_bvh_rw)(hit->t);
       enter = select(enter, tnx, tnx > enter);
       enter = select(enter, tny, tny > enter);
@@ -237,22 +237,26 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
       int cnt = -lc_bvh_sum(hm);
       if (cnt > 0) {
         /* keys (entry distance, child), sorted farthest first, the children missed (LONG_MIN)
-         * last: stored whole, the first cnt - 1 become the stack's top (second nearest on top)
-         * and the nearest, at cnt - 1, is visited next. Signed order of the keys is the order of
+         * last: stored whole, the first cnt - 1 become the stack's top (second nearest on top);
+         * the nearest (smallest key) is visited next. Signed order of the keys is the order of
          * the distances for t >= 0. */
         lc_bvh_lw key = (lc_bvh_long(lc_bvh_as_iw(lc_bvh_float_down(t))) << 32) |
-                        lc_bvh_long(lc_bvh_vloadw(0, n->child));
-        key = bvh_sort_desc(select((lc_bvh_lw)(LONG_MIN), key, lc_bvh_long(hm)));
+                        lc_bvh_long(*(__global const uint4*)n->child);
+        lc_bvh_lw lhm = lc_bvh_long(hm);
+        lc_bvh_lw near_ = select((lc_bvh_lw)(LONG_MAX), key, lhm);
+        near_ = min(near_, near_.s2301);
+        near_ = min(near_, near_.s1032);
+        key = bvh_sort_desc(select((lc_bvh_lw)(LONG_MIN), key, lhm));
         lc_bvh_vstorew(key, 0, &stack[sp]);
-        ref = (lc_uint)stack[sp + cnt - 1];
         sp += cnt - 1;
+        ref = (lc_uint)near_.s0;
         continue;
       }
     } else {
       __global const lc_bvh_leaf* lf = &s->leaves[ref & LC_BVH_LEAF_FIRST_MASK];
       __global const lc_bvh_leaf* end = lf + ((ref & ~LC_BVH_LEAF_BIT) >> LC_BVH_LEAF_COUNT_SHIFT) + 1;
       for (; lf < end; ++lf) {
-        uint4 prim = vload4(0, lf->prim);
+        uint4 prim = *(__global const uint4*)lf->prim;
         int4 sphere = (prim & LC_PRIM_SPHERE_BIT) != 0;
         int4 tri = ~sphere;
         int4 used_sphere = sphere & (prim != LC_INVALID);
