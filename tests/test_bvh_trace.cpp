@@ -24,6 +24,7 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "bvh/bvh.hpp"
@@ -174,8 +175,8 @@ class BvhTrace : public ::testing::Test {
 
   // Traces `rays` and judges every one against the brute force; returns the number checked.
   void compare(const Scene& s, const std::vector<TraceRay>& rays, bool any_hit = false,
-               const char* what = "") {
-    Bvh b = lucent::bvh::build(s.tris, s.spheres);
+               const char* what = "", const lucent::bvh::BuildOptions& options = {}) {
+    Bvh b = lucent::bvh::build(s.tris, s.spheres, options);
     auto hits = trace(s, b, rays, any_hit);
     std::size_t bad = 0, inexact = 0, hit = 0;
     for (std::size_t i = 0; i < rays.size(); ++i) {
@@ -336,9 +337,34 @@ TEST_F(BvhTrace, RaysStartingOnBoxFaces) {
       if (axis == 1) d.y = 0;
       if (axis == 2) d.z = 0;
     }
-    rays.push_back(make_ray(d3(o), d));
+    rays.push_back(make_ray(d3(o), d, (i & 16) ? float(0.05 + u(rng)) : INFINITY));
   }
   compare(s, rays, false, "box faces");
+  compare(s, rays, true, "box faces any-hit");
+}
+
+// Leaves of 1 to 16 primitives (1 to 4 leaf blocks), spheres and triangles sharing blocks, the
+// classic per-primitive SAH cost too: closest hits, any-hit and axis-parallel rays.
+TEST_F(BvhTrace, LeafSizesAndMixedBlocks) {
+  Scene s = soup(1200, 30, 0.07f);
+  add_spheres(s, 400, 31, 0.01f, 0.05f);
+  std::vector<TraceRay> axis;
+  std::mt19937 rng(32);
+  std::uniform_real_distribution<double> u(-0.2, 1.2);
+  for (int i = 0; i < 3000; ++i) {
+    D3 d{0, 0, 0};
+    (&d.x)[i % 3] = (i & 4) ? 1.0 : -1.0;
+    axis.push_back(make_ray({u(rng), u(rng), u(rng)}, d));
+  }
+  for (int leaf : {1, 8, 16}) {
+    lucent::bvh::BuildOptions o;
+    o.max_leaf_size = leaf;
+    o.leaf_block = leaf == 8 ? 1 : 4;
+    std::string what = "leaves of " + std::to_string(leaf);
+    compare(s, random_rays(6000, 33 + leaf), false, what.c_str(), o);
+    compare(s, random_rays(6000, 34 + leaf, true), true, (what + " any-hit").c_str(), o);
+    compare(s, axis, false, (what + " axis-parallel").c_str(), o);
+  }
 }
 
 // --- closed meshes: no ray passes through -------------------------------------------------------

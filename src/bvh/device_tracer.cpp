@@ -20,10 +20,12 @@ cl::Buffer upload(const cl_util::Context& ctx, const std::vector<T>& v) {
 }  // namespace
 
 DeviceTracer::DeviceTracer(const cl_util::Context& ctx, const std::vector<lc_triangle>& triangles,
-                           const std::vector<lc_sphere>& spheres, const Bvh& bvh)
+                           const std::vector<lc_sphere>& spheres, const Bvh& bvh,
+                           const std::string& build_options)
     : ctx_(ctx) {
-  cl::Program program = cl_util::build_program(
-      ctx, detail::assemble_kernel_source("test/trace_rays.cl"), "-cl-std=CL1.2");
+  cl::Program program =
+      cl_util::build_program(ctx, detail::assemble_kernel_source("test/trace_rays.cl"),
+                             "-cl-std=CL1.2" + (build_options.empty() ? "" : " " + build_options));
   try {
     kernel_ = cl::Kernel(program, "lucent_trace_rays");
     lc_params p{};
