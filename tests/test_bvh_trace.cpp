@@ -367,6 +367,23 @@ TEST_F(BvhTrace, LeafSizesAndMixedBlocks) {
   }
 }
 
+// No primitive: every ray misses. One primitive: the root's only child is a leaf.
+TEST_F(BvhTrace, EmptySceneAndSinglePrimitive) {
+  Scene empty;
+  Bvh b = lucent::bvh::build(empty.tris, empty.spheres);
+  auto rays = random_rays(1000, 40);
+  for (bool any : {false, true}) {
+    auto hits = trace(empty, b, rays, any);
+    std::size_t hit = 0;
+    for (auto& h : hits) hit += h.prim != LC_INVALID;
+    EXPECT_EQ(hit, 0u);
+  }
+  Scene one;
+  add_spheres(one, 1, 41, 0.45f, 0.5f, 0.45f, 0.1f);
+  compare(one, random_rays(3000, 42), false, "one sphere");
+  compare(one, random_rays(3000, 43, true), true, "one sphere any-hit");
+}
+
 // --- closed meshes: no ray passes through -------------------------------------------------------
 
 struct EdgeTarget {

@@ -15,13 +15,13 @@
  * push writes LC_BVH_WIDTH slots from there; src/bvh keeps the depth within LC_BVH_MAX_DEPTH. */
 #define LC_BVH_STACK_SIZE ((LC_BVH_WIDTH - 1) * LC_BVH_MAX_DEPTH + 1)
 
-/* One lane per child. lc_bvh_rw: lc_real per child; lc_bvh_iw: int per child; lc_bvh_lw: long
- * per child (stack entries). */
+/* One lane per child. lc_bvh_fw: float per child (a row of lc_bvh_node.bounds); lc_bvh_rw:
+ * lc_real per child; lc_bvh_iw, lc_bvh_uw, lc_bvh_lw: int, uint, long per child (stack entries). */
 #if LC_BVH_WIDTH == 4
+typedef float4 lc_bvh_fw;
 typedef int4 lc_bvh_iw;
 typedef uint4 lc_bvh_uw;
 typedef long4 lc_bvh_lw;
-#define lc_bvh_vloadw vload4
 #define lc_bvh_vstorew vstore4
 #define lc_bvh_sum(v) ((v).s0 + (v).s1 + (v).s2 + (v).s3)
 #define lc_bvh_as_iw as_int4
@@ -31,13 +31,11 @@ typedef double4 lc_bvh_rw;
 #define lc_bvh_rw_from_float(v) convert_double4(v)
 #define lc_bvh_float_down(v) convert_float4_rtn(v) /* never above v: culling stays safe */
 #define lc_bvh_int_mask(m) convert_int4(m)
-#define lc_bvh_r4(v) convert_double4(v)
 #else
 typedef float4 lc_bvh_rw;
 #define lc_bvh_rw_from_float(v) (v)
 #define lc_bvh_float_down(v) (v)
 #define lc_bvh_int_mask(m) (m)
-#define lc_bvh_r4(v) (v)
 #endif
 /* Sorting network for 4 keys, descending: (0,1)(2,3), (0,2)(1,3), (1,2). */
 static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
@@ -52,8 +50,64 @@ static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
   hi = max(k, p);
   return (lc_bvh_lw)(hi.s0, hi.s1, lo.s2, lo.s3);
 }
+static inline long bvh_min_key(lc_bvh_lw k) {
+  k = min(k, k.s2301);
+  k = min(k, k.s1032);
+  return k.s0;
+}
+#elif LC_BVH_WIDTH == 8
+typedef float8 lc_bvh_fw;
+typedef int8 lc_bvh_iw;
+typedef uint8 lc_bvh_uw;
+typedef long8 lc_bvh_lw;
+#define lc_bvh_vstorew vstore8
+#define lc_bvh_sum(v) ((v).s0 + (v).s1 + (v).s2 + (v).s3 + (v).s4 + (v).s5 + (v).s6 + (v).s7)
+#define lc_bvh_as_iw as_int8
+#define lc_bvh_long(v) convert_long8(v)
+#ifdef LC_DOUBLE
+typedef double8 lc_bvh_rw;
+#define lc_bvh_rw_from_float(v) convert_double8(v)
+#define lc_bvh_float_down(v) convert_float8_rtn(v) /* never above v: culling stays safe */
+#define lc_bvh_int_mask(m) convert_int8(m)
 #else
-#error "kernels/bvh/traverse.cl: LC_BVH_WIDTH must be 4"
+typedef float8 lc_bvh_rw;
+#define lc_bvh_rw_from_float(v) (v)
+#define lc_bvh_float_down(v) (v)
+#define lc_bvh_int_mask(m) (m)
+#endif
+/* Bitonic sorting network for 8 keys, descending: six layers, each lane taking the larger (H) or
+ * smaller (L) of itself and its partner. */
+#define LC_BVH_LAYER(sw, l0, l1, l2, l3, l4, l5, l6, l7)                                      \
+  p = k.sw;                                                                                 \
+  lo = min(k, p);                                                                           \
+  hi = max(k, p);                                                                           \
+  k = (lc_bvh_lw)(l0.s0, l1.s1, l2.s2, l3.s3, l4.s4, l5.s5, l6.s6, l7.s7);
+static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
+  lc_bvh_lw p, lo, hi;
+  LC_BVH_LAYER(s10325476, hi, lo, lo, hi, hi, lo, lo, hi)
+  LC_BVH_LAYER(s23016745, hi, hi, lo, lo, lo, lo, hi, hi)
+  LC_BVH_LAYER(s10325476, hi, lo, hi, lo, lo, hi, lo, hi)
+  LC_BVH_LAYER(s45670123, hi, hi, hi, hi, lo, lo, lo, lo)
+  LC_BVH_LAYER(s23016745, hi, hi, lo, lo, hi, hi, lo, lo)
+  LC_BVH_LAYER(s10325476, hi, lo, hi, lo, hi, lo, hi, lo)
+  return k;
+}
+#undef LC_BVH_LAYER
+static inline long bvh_min_key(lc_bvh_lw k) {
+  long4 h = min(k.lo, k.hi);
+  h = min(h, h.s2301);
+  h = min(h, h.s1032);
+  return h.s0;
+}
+#else
+#error "kernels/bvh/traverse.cl: LC_BVH_WIDTH must be 4 or 8"
+#endif
+
+/* leaf blocks: 4 lanes of lc_real */
+#ifdef LC_DOUBLE
+#define lc_bvh_r4(v) convert_double4(v)
+#else
+#define lc_bvh_r4(v) (v)
 #endif
 
 typedef struct {
@@ -217,7 +271,7 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
   for (;;) {
     if (!(ref & LC_BVH_LEAF_BIT)) {
       __global const lc_bvh_node* n = &nodes[ref];
-      __global const float4* b = (__global const float4*)n->bounds; /* one row per float4 */
+      __global const lc_bvh_fw* b = (__global const lc_bvh_fw*)n->bounds; /* rows */
       lc_bvh_rw tnx = (lc_bvh_rw_from_float(b[nx]) - o.x) * inv_d.x;
       lc_bvh_rw tfx = (lc_bvh_rw_from_float(b[nx ^ 1]) - o.x) * inv_d.x;
       lc_bvh_rw tny = (lc_bvh_rw_from_float(b[ny]) - o.y) * inv_d.y;
@@ -241,15 +295,13 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
          * the nearest (smallest key) is visited next. Signed order of the keys is the order of
          * the distances for t >= 0. */
         lc_bvh_lw key = (lc_bvh_long(lc_bvh_as_iw(lc_bvh_float_down(t))) << 32) |
-                        lc_bvh_long(*(__global const uint4*)n->child);
+                        lc_bvh_long(*(__global const lc_bvh_uw*)n->child);
         lc_bvh_lw lhm = lc_bvh_long(hm);
-        lc_bvh_lw near_ = select((lc_bvh_lw)(LONG_MAX), key, lhm);
-        near_ = min(near_, near_.s2301);
-        near_ = min(near_, near_.s1032);
+        long near_ = bvh_min_key(select((lc_bvh_lw)(LONG_MAX), key, lhm));
         key = bvh_sort_desc(select((lc_bvh_lw)(LONG_MIN), key, lhm));
         lc_bvh_vstorew(key, 0, &stack[sp]);
         sp += cnt - 1;
-        ref = (lc_uint)near_.s0;
+        ref = (lc_uint)near_;
         continue;
       }
     } else {

@@ -112,7 +112,7 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle_attr, uv) == 36, triangle_attr_uv);
  *   LC_BVH_LEAF_MAX primitives fills 1 to 4 consecutive blocks); unused slot: LC_INVALID with an
  *   empty box (min +inf, max -inf), which no ray enters.
  */
-#define LC_BVH_WIDTH 4
+#define LC_BVH_WIDTH 8
 #define LC_BVH_LEAF_BIT 0x80000000u
 #define LC_BVH_LEAF_COUNT_SHIFT 27
 #define LC_BVH_LEAF_MAX 16u                /* primitives per leaf, at most               */
@@ -123,7 +123,7 @@ typedef struct LC_ALIGN16 lc_bvh_node {
   float bounds[6][LC_BVH_WIDTH]; /* child boxes, rows min x, max x, min y, max y, min z, max z */
   lc_uint child[LC_BVH_WIDTH];   /* node index, leaf reference or LC_INVALID (see above)       */
   lc_uint pad[LC_BVH_WIDTH];     /* unused: keeps nodes on 64-byte boundaries                  */
-} lc_bvh_node; /* total: 128 bytes (LC_BVH_WIDTH 4) */
+} lc_bvh_node; /* total: 256 bytes (LC_BVH_WIDTH 8; 128 bytes with 4) */
 LC_STATIC_ASSERT(sizeof(lc_bvh_node) == 32 * LC_BVH_WIDTH, bvh_node_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, child) == 24 * LC_BVH_WIDTH, bvh_node_child);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, pad) == 28 * LC_BVH_WIDTH, bvh_node_pad);
