@@ -15,8 +15,9 @@ struct BuildOptions {
   /// SAH cost of one traversal step relative to one primitive intersection: larger values give
   /// larger leaves and fewer nodes.
   float traversal_cost = 1.0f;
-  /// Primitives the kernel tests together (lc_bvh_leaf holds 4): the SAH counts a leaf's
-  /// intersection cost in blocks of this many, so leaves fill blocks when that is no worse.
+  /// Triangles the kernel tests together (lc_bvh_leaf holds 4): the SAH counts a leaf's
+  /// intersection cost in blocks of this many triangles, plus one per sphere (spheres are tested
+  /// one by one), so leaves fill blocks when that is no worse.
   int leaf_block = 4;
 };
 

@@ -176,17 +176,20 @@ struct Bins {
   int n;
   BinBox box[3][kBins];
   lc_uint count[3][kBins];
+  lc_uint spheres[3][kBins];  // how many of count are spheres
   explicit Bins(int bins) : n(bins) {
     for (int a = 0; a < 3; ++a)
       for (int k = 0; k < n; ++k) {
         box[a][k] = {V4::splat(INFINITY), V4::splat(-INFINITY)};
         count[a][k] = 0;
+        spheres[a][k] = 0;
       }
   }
-  void grow(int a, int k, V4 lo, V4 hi) {
+  void grow(int a, int k, V4 lo, V4 hi, lc_uint sphere) {
     box[a][k].lo = vmin(box[a][k].lo, lo);
     box[a][k].hi = vmax(box[a][k].hi, hi);
     ++count[a][k];
+    spheres[a][k] += sphere;
   }
   void add(const Bins& o) {
     for (int a = 0; a < 3; ++a)
@@ -194,16 +197,20 @@ struct Bins {
         box[a][k].lo = vmin(box[a][k].lo, o.box[a][k].lo);
         box[a][k].hi = vmax(box[a][k].hi, o.box[a][k].hi);
         count[a][k] += o.count[a][k];
+        spheres[a][k] += o.spheres[a][k];
       }
   }
 };
 
-void bin_range(const PrimRef* refs, std::size_t n, const BinMap& map, Bins& bins) {
+// count_spheres: also count the spheres per bin (only needed when the scene has some)
+void bin_range(const PrimRef* refs, std::size_t n, const BinMap& map, Bins& bins,
+               bool count_spheres) {
   alignas(16) int k[4];
   for (std::size_t i = 0; i < n; ++i) {
     const PrimRef& p = refs[i];
     map(p.centroid2(), k);
-    for (int a = 0; a < 3; ++a) bins.grow(a, k[a], p.lo, p.hi);
+    lc_uint sphere = count_spheres ? p.id() >> 31 : 0;  // LC_PRIM_SPHERE_BIT
+    for (int a = 0; a < 3; ++a) bins.grow(a, k[a], p.lo, p.hi, sphere);
   }
 }
 
@@ -215,8 +222,10 @@ unsigned ceil_log2(std::size_t n) {
 
 class Builder {
  public:
-  Builder(std::vector<PrimRef>& refs, const BuildOptions& options, unsigned threads)
+  Builder(std::vector<PrimRef>& refs, const BuildOptions& options, unsigned threads,
+          bool has_spheres)
       : refs_(refs),
+        has_spheres_(has_spheres),
         max_leaf_(static_cast<std::size_t>(std::max(1, options.max_leaf_size))),
         threads_(threads),
         traversal_cost_(options.traversal_cost),
@@ -239,8 +248,11 @@ class Builder {
 
   const Node2* nodes() const { return nodes_.get(); }
 
-  // intersection cost of n primitives: the blocks of block_ that a leaf of n fills
-  float blocks(std::size_t n) const { return float((n + block_ - 1) / block_); }
+  // intersection cost of n primitives of which s spheres: the kernel tests the triangles by
+  // blocks of block_, the spheres one by one
+  float cost(std::size_t n, std::size_t s) const {
+    return float((n - s + block_ - 1) / block_ + s);
+  }
   std::size_t max_depth() const { return max_depth_.load(); }
 
  private:
@@ -289,7 +301,7 @@ class Builder {
       if (pending_ == 1) parts = threads_;  // the other workers are idle (near the root)
     }
     if (parts <= 1) {
-      bin_range(refs_.data() + t.begin, n, map, bins);
+      bin_range(refs_.data() + t.begin, n, map, bins, has_spheres_);
       return;
     }
     std::vector<Bins> partial(parts - 1, Bins(map.bins));
@@ -298,9 +310,10 @@ class Builder {
     for (unsigned p = 1; p < parts; ++p) {
       std::size_t b = std::min(n, p * step), e = std::min(n, (p + 1) * step);
       helpers.emplace_back(
-          [&, b, e, p] { bin_range(refs_.data() + t.begin + b, e - b, map, partial[p - 1]); });
+          [&, b, e, p] { bin_range(refs_.data() + t.begin + b, e - b, map, partial[p - 1], has_spheres_);
+          });
     }
-    bin_range(refs_.data() + t.begin, std::min(n, step), map, bins);
+    bin_range(refs_.data() + t.begin, std::min(n, step), map, bins, has_spheres_);
     for (auto& h : helpers) h.join();
     for (auto& p : partial) bins.add(p);
   }
@@ -359,26 +372,32 @@ class Builder {
         // sweep: right-to-left areas, then left-to-right with the SAH
         float best = INFINITY;
         int best_axis = -1, best_k = 0;
+        std::size_t node_spheres = 0;  // every primitive is in one bin of each axis
+        for (int k = 0; k < map.bins; ++k) node_spheres += bins.spheres[0][k];
         for (int a = 0; a < 3; ++a) {
           if (!map.usable(a)) continue;
           const int nb = map.bins;
           float right_area[kBins];
-          std::size_t right_count[kBins];
+          std::size_t right_count[kBins], right_spheres[kBins];
           Box acc;
-          std::size_t cnt = 0;
+          std::size_t cnt = 0, sph = 0;
           for (int k = nb - 1; k > 0; --k) {
             acc.grow(bins.box[a][k].lo, bins.box[a][k].hi);
             cnt += bins.count[a][k];
+            sph += bins.spheres[a][k];
             right_area[k] = acc.area();
             right_count[k] = cnt;
+            right_spheres[k] = sph;
           }
           Box lacc;
-          std::size_t lcnt = 0;
+          std::size_t lcnt = 0, lsph = 0;
           for (int k = 1; k < nb; ++k) {
             lacc.grow(bins.box[a][k - 1].lo, bins.box[a][k - 1].hi);
             lcnt += bins.count[a][k - 1];
+            lsph += bins.spheres[a][k - 1];
             if (lcnt == 0 || right_count[k] == 0) continue;
-            float c = lacc.area() * blocks(lcnt) + right_area[k] * blocks(right_count[k]);
+            float c = lacc.area() * cost(lcnt, lsph) +
+                      right_area[k] * cost(right_count[k], right_spheres[k]);
             if (c < best) {
               best = c;
               best_axis = a;
@@ -388,7 +407,7 @@ class Builder {
         }
         float area = t.box.area();
         float split_cost = traversal_cost_ * area + best;  // both scaled by the node's area
-        float leaf_cost = blocks(n) * area;
+        float leaf_cost = cost(n, node_spheres) * area;
         if (n <= max_leaf_ && (best_axis < 0 || leaf_cost <= split_cost)) {
           make_leaf(t);
           continue;
@@ -440,6 +459,7 @@ class Builder {
   }
 
   std::vector<PrimRef>& refs_;
+  bool has_spheres_;
   std::size_t max_leaf_;
   unsigned threads_;
   float traversal_cost_;
@@ -581,7 +601,7 @@ Bvh2 build_binary(const std::vector<lc_triangle>& tris, const std::vector<lc_sph
     cbox.grow(part_cbox[p]);
   }
 
-  Builder builder(refs, options, threads);
+  Builder builder(refs, options, threads, !spheres.empty());
   std::size_t count = builder.run(box, cbox);
   const Node2* tmp = builder.nodes();
 
