@@ -4,9 +4,9 @@
 // alternating with lucent's kernel round by round (best of --reps rounds each), and lucent's speed
 // is reported as a fraction of Embree's. Figures: BENCHMARKS.md.
 //
-// usage: lucent_bench [--runs N] [--reps N] [--width W] [--height H] [--device SELECTOR] [--threads N]
-//                     [--build-only] [--only NAME] [--no-embree] [--traversal-cost C]
-//                     [--reorder]
+// usage: lucent_bench [--runs N] [--reps N] [--width W] [--height H] [--device SELECTOR]
+//                     [--threads N] [--build-only] [--only NAME] [--no-embree]
+//                     [--traversal-cost C] [--max-leaf N] [--leaf-block N] [--reorder]
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
@@ -337,9 +337,9 @@ int main(int argc, char** argv) {
       opt.traversal_cost = float(std::atof(next().c_str()));
     else {
       std::fprintf(stderr,
-                   "usage: lucent_bench [--runs N] [--reps N] [--width W] [--height H] [--device S] "
-                   "[--threads N] [--build-only] [--only NAME] [--no-embree] "
-                   "[--traversal-cost C] [--reorder]\n");
+                   "usage: lucent_bench [--runs N] [--reps N] [--width W] [--height H] "
+                   "[--device S] [--threads N] [--build-only] [--only NAME] [--no-embree] "
+                   "[--traversal-cost C] [--max-leaf N] [--leaf-block N] [--reorder]\n");
       return 2;
     }
   }

@@ -1,7 +1,8 @@
-// Host-side invariants of the binary BVH builder (src/bvh/bvh_build.cpp), checked by an independent walk
-// of the flattened tree: every primitive referenced exactly once, each child box inside its
-// parent's, every primitive inside its leaf's box, leaf sizes within the limit, the depth-first
-// layout with adjacent children, the depth cap the kernel stack relies on, and the statistics.
+// Host-side invariants of the binary BVH builder (src/bvh/bvh_build.cpp), checked by an
+// independent walk of the flattened tree: every primitive referenced exactly once, each child box
+// inside its parent's, every primitive inside its leaf's box, leaf sizes within the limit, the
+// depth-first layout with adjacent children, the depth cap the kernel stack relies on, and the
+// statistics.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -110,7 +110,10 @@ class Checker {
     int used = 0;
     for (int k = 0; k < LC_BVH_WIDTH; ++k) {
       Box box;
-      for (int a = 0; a < 3; ++a) box.lo[a] = nd.bounds[2 * a][k], box.hi[a] = nd.bounds[2 * a + 1][k];
+      for (int a = 0; a < 3; ++a) {
+        box.lo[a] = nd.bounds[2 * a][k];
+        box.hi[a] = nd.bounds[2 * a + 1][k];
+      }
       lc_uint c = nd.child[k];
       if (c == LC_INVALID) {
         for (int a = 0; a < 3; ++a)

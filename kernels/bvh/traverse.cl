@@ -306,7 +306,8 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
       }
     } else {
       __global const lc_bvh_leaf* lf = &s->leaves[ref & LC_BVH_LEAF_FIRST_MASK];
-      __global const lc_bvh_leaf* end = lf + ((ref & ~LC_BVH_LEAF_BIT) >> LC_BVH_LEAF_COUNT_SHIFT) + 1;
+      __global const lc_bvh_leaf* end =
+          lf + ((ref & ~LC_BVH_LEAF_BIT) >> LC_BVH_LEAF_COUNT_SHIFT) + 1;
       for (; lf < end; ++lf) {
         uint4 prim = *(__global const uint4*)lf->prim;
         int4 sphere = (prim & LC_PRIM_SPHERE_BIT) != 0;

@@ -309,9 +309,9 @@ class Builder {
     std::size_t step = (n + parts - 1) / parts;
     for (unsigned p = 1; p < parts; ++p) {
       std::size_t b = std::min(n, p * step), e = std::min(n, (p + 1) * step);
-      helpers.emplace_back(
-          [&, b, e, p] { bin_range(refs_.data() + t.begin + b, e - b, map, partial[p - 1], has_spheres_);
-          });
+      helpers.emplace_back([&, b, e, p] {
+        bin_range(refs_.data() + t.begin + b, e - b, map, partial[p - 1], has_spheres_);
+      });
     }
     bin_range(refs_.data() + t.begin, std::min(n, step), map, bins, has_spheres_);
     for (auto& h : helpers) h.join();
