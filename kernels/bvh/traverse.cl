@@ -1,13 +1,14 @@
 /* lucent kernel: scene description on the device and wide-BVH traversal.
- * Node layout: shared/types.h (lc_bvh_node: LC_BVH_WIDTH child boxes as structure of arrays,
- * built by src/bvh/bvh_wide.cpp). Leaves hold primitive references: a triangle index, or a sphere
- * index with LC_PRIM_SPHERE_BIT set.
- * Traversal: one vector operation per slab plane tests all children of a node; the children hit
- * are sorted by entry distance with a sorting network on (distance, lane) keys, the nearest is
- * visited next and the others are pushed farthest first with one vector store, as (child, entry
- * distance) pairs, so a popped node is dropped without touching its box once a closer hit is
- * known. Ray quantities are lc_real (float, or double under LC_DOUBLE); boxes are loaded from
- * the float node buffer and widened. */
+ * Layout: shared/types.h (lc_bvh_node: LC_BVH_WIDTH child boxes as structure of arrays and child
+ * references; lc_bvh_leaf: blocks of 4 primitives with their triangles' vertices; built by
+ * src/bvh/bvh_wide.cpp). A primitive reference is a triangle index, or a sphere index with
+ * LC_PRIM_SPHERE_BIT set.
+ * Traversal: one vector operation per slab plane tests all children of a node; the children
+ * entered become (entry distance, child reference) keys, sorted by a sorting network, the nearest
+ * is visited next and the others are pushed farthest first with one vector store, so a popped
+ * child is dropped without touching its node once a closer hit is known. The triangles of a leaf
+ * block are tested at once. Ray quantities are lc_real (float, or double under LC_DOUBLE); boxes
+ * and vertices are loaded from the float buffers and widened. */
 #ifndef LUCENT_BVH_TRAVERSE_CL
 #define LUCENT_BVH_TRAVERSE_CL
 
