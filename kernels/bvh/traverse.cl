@@ -235,6 +235,15 @@ static inline int bvh_intersect_sphere(const lc_scene* s, lc_uint ref, lc_real3 
   return 0;
 }
 
+/* The primitive types to test: the feature defines of the megakernel (src/render/pack.cpp) name
+ * those a scene has; a kernel built without them tests both. */
+#if defined(LC_HAS_TRIANGLES) || !defined(LC_HAS_SPHERES)
+#define LC_BVH_TRIANGLES 1
+#endif
+#if defined(LC_HAS_SPHERES) || !defined(LC_HAS_TRIANGLES)
+#define LC_BVH_SPHERES 1
+#endif
+
 static inline lc_real bvh_get(lc_real3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 
 /*
@@ -312,15 +321,22 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
       for (; lf < end; ++lf) {
         uint4 prim = *(__global const uint4*)lf->prim;
         int4 sphere = (prim & LC_PRIM_SPHERE_BIT) != 0;
+#ifdef LC_BVH_TRIANGLES
         int4 tri = ~sphere;
-        int4 used_sphere = sphere & (prim != LC_INVALID);
         if (any(tri) && bvh_leaf_triangles(lf, tri, &tr, okx, oky, okz, tmin, hit) && any_hit)
           return 1;
-        if (any(used_sphere))
+#endif
+#ifdef LC_BVH_SPHERES
+        /* LC_INVALID (an unused column) has the sphere bit too */
+        int4 used_sphere = sphere & (prim != LC_INVALID);
+        if (any(used_sphere)) {
+          lc_uint refs[4] = {prim.s0, prim.s1, prim.s2, prim.s3};
           for (int k = 0; k < 4; ++k)
-            if (lf->prim[k] != LC_INVALID && (lf->prim[k] & LC_PRIM_SPHERE_BIT) &&
-                bvh_intersect_sphere(s, lf->prim[k], o, d, tmin, hit) && any_hit)
+            if (refs[k] != LC_INVALID && (refs[k] & LC_PRIM_SPHERE_BIT) &&
+                bvh_intersect_sphere(s, refs[k], o, d, tmin, hit) && any_hit)
               return 1;
+        }
+#endif
       }
     }
     /* pop the nearest pending child that may still hold a closer hit */
