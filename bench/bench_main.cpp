@@ -1,11 +1,12 @@
 // lucent_bench: BVH build speed and quality, and kernel traversal speed, on the Stanford bunny,
 // the dragon (../shared/assets/meshes, skipped when absent) and a generated 1M-triangle mesh.
-// When built with Embree 3 the same rays are traced through Embree (rtcIntersect1, 2 threads) and
-// lucent's speed is reported as a fraction of Embree's. Figures: BENCHMARKS.md.
+// When built with Embree 3 the same rays are traced through Embree (rtcIntersect1, 2 threads),
+// alternating with lucent's kernel round by round (best of --reps rounds each), and lucent's speed
+// is reported as a fraction of Embree's. Figures: BENCHMARKS.md.
 //
-// usage: lucent_bench [--runs N] [--width W] [--height H] [--device SELECTOR] [--threads N]
-//                     [--build-only] [--only NAME] [--no-embree] [--traversal-cost C]
-//                     [--reorder]
+// usage: lucent_bench [--runs N] [--reps N] [--width W] [--height H] [--device SELECTOR]
+//                     [--threads N] [--build-only] [--only NAME] [--no-embree]
+//                     [--traversal-cost C] [--max-leaf N] [--leaf-block N] [--reorder]
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
@@ -15,6 +16,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <random>
 #include <string>
 #include <thread>
@@ -37,12 +39,15 @@ using lucent::bvh::TraceRay;
 
 struct Options {
   int runs = 5;
+  int reps = 5;  // traversal timing rounds (lucent and Embree alternating), best of each
   int width = 640, height = 480;
   int threads = 0;          // BVH build threads, 0: all cores
   bool build_only = false;  // skip the traversal figures
   std::string only;         // run only the meshes whose name contains this
   bool embree = true;       // compare with Embree when built with it
   float traversal_cost = lucent::bvh::BuildOptions().traversal_cost;
+  int leaf_block = lucent::bvh::BuildOptions().leaf_block;
+  int max_leaf = lucent::bvh::BuildOptions().max_leaf_size;
   bool reorder = false;  // trace triangles stored in leaf order (bvh::reorder_triangles)
   std::string device;
 };
@@ -107,8 +112,8 @@ TraceRay make_ray(V3 o, V3 d) {
 }
 
 // A camera at 2.2 bounding radii looking at the centre of the mesh, 40 degrees vertical fov.
-std::vector<TraceRay> primary_rays(const lc_bvh_node& root, int w, int h) {
-  V3 lo = load(root.bmin), hi = load(root.bmax);
+std::vector<TraceRay> primary_rays(const lucent::bvh::Bvh& bvh, int w, int h) {
+  V3 lo = load(bvh.bmin), hi = load(bvh.bmax);
   V3 c = 0.5 * (lo + hi);
   double radius = 0.5 * std::sqrt(dot(hi - lo, hi - lo));
   V3 fwd = normalize(V3{-0.35, -0.3, -1});
@@ -217,6 +222,8 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
     lucent::bvh::BuildOptions bo;
     bo.threads = opt.threads;
     bo.traversal_cost = opt.traversal_cost;
+    bo.leaf_block = opt.leaf_block;
+    bo.max_leaf_size = opt.max_leaf;
     bvh = lucent::bvh::build(tris, {}, bo);
     times.push_back(bvh.stats.seconds);
   }
@@ -226,34 +233,47 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
   std::printf("build: median %.1f ms (best %.1f ms) over %d runs = %.2f Mtris/s\n", median * 1e3,
               times.front() * 1e3, opt.runs, tris.size() / median * 1e-6);
   std::printf(
-      "tree:  %zu nodes, %zu leaves, mean leaf %.2f, max leaf %zu, max depth %zu, "
-      "SAH cost %.2f\n",
-      s.nodes, s.leaves, s.mean_leaf_size, s.max_leaf_size, s.max_depth, s.sah_cost);
+      "tree:  binary %zu nodes, max depth %zu, SAH cost %.2f; %d-wide %zu nodes, max depth %zu; "
+      "%zu leaves, mean leaf %.2f, max leaf %zu\n",
+      s.binary_nodes, s.binary_max_depth, s.sah_cost, LC_BVH_WIDTH, s.nodes, s.max_depth,
+      s.leaves, s.mean_leaf_size, s.max_leaf_size);
   if (opt.build_only) return;
 
   std::vector<lc_triangle> stored = tris;
   if (opt.reorder) lucent::bvh::reorder_triangles(bvh, stored);
   lucent::bvh::DeviceTracer tracer(ctx, stored, {}, bvh);
-  const lc_bvh_node& root = bvh.nodes[0];
   double scale = 0;
-  for (int a = 0; a < 3; ++a) scale = std::max(scale, double(root.bmax[a] - root.bmin[a]));
-  auto primary = primary_rays(root, opt.width, opt.height);
+  for (int a = 0; a < 3; ++a) scale = std::max(scale, double(bvh.bmax[a] - bvh.bmin[a]));
+  auto primary = primary_rays(bvh, opt.width, opt.height);
   tracer.trace(primary);  // warm-up: PoCL compiles the work-group function on first launch
-  auto time_trace = [&](const std::vector<TraceRay>& rays, std::vector<TraceHit>& hits) {
-    double best = INFINITY;
-    for (int r = 0; r < 3; ++r) {
-      hits = tracer.trace(rays);
-      best = std::min(best, tracer.last_kernel_seconds());
-    }
-    return best;
-  };
-  std::vector<TraceHit> phits, dhits;
-  double tp = time_trace(primary, phits);
+  std::vector<TraceHit> phits = tracer.trace(primary), dhits;
   auto diffuse = diffuse_rays(primary, phits, stored, scale);
-  double td = time_trace(diffuse, dhits);
+  dhits = tracer.trace(diffuse);
   std::size_t ph = 0, dh = 0;
   for (auto& h : phits) ph += h.prim != LC_INVALID;
   for (auto& h : dhits) dh += h.prim != LC_INVALID;
+#ifdef LUCENT_BENCH_EMBREE
+  std::unique_ptr<Embree> em;
+  std::vector<TraceHit> eh;
+  if (opt.embree) {
+    em = std::make_unique<Embree>(tris);
+    em->trace(primary, eh);  // warm-up
+  }
+#endif
+  // lucent and Embree alternate, best time of each over opt.reps rounds: both see the same load
+  double tp = INFINITY, td = INFINITY, ep = INFINITY, ed = INFINITY;
+  for (int r = 0; r < opt.reps; ++r) {
+    tracer.trace(primary);
+    tp = std::min(tp, tracer.last_kernel_seconds());
+#ifdef LUCENT_BENCH_EMBREE
+    if (em) ep = std::min(ep, em->trace(primary, eh));
+#endif
+    tracer.trace(diffuse);
+    td = std::min(td, tracer.last_kernel_seconds());
+#ifdef LUCENT_BENCH_EMBREE
+    if (em) ed = std::min(ed, em->trace(diffuse, eh));
+#endif
+  }
   double mp = primary.size() / tp * 1e-6, md = diffuse.size() / td * 1e-6;
   std::printf(
       "lucent kernel: primary %zu rays (%.0f%% hit) %.2f Mrays/s; diffuse %zu rays "
@@ -261,21 +281,16 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
       primary.size(), 100.0 * ph / primary.size(), mp, diffuse.size(),
       100.0 * dh / std::max<std::size_t>(1, diffuse.size()), md);
 #ifdef LUCENT_BENCH_EMBREE
-  if (!opt.embree) return;
-  Embree em(tris);
-  std::vector<TraceHit> eh;
-  em.trace(primary, eh);  // warm-up
-  double ep = INFINITY, ed = INFINITY;
-  for (int r = 0; r < 3; ++r) ep = std::min(ep, em.trace(primary, eh));
+  if (!em) return;
+  em->trace(primary, eh);
   std::size_t agree = 0, total = eh.size();
   for (std::size_t i = 0; i < eh.size(); ++i)
     agree += (eh[i].prim == LC_INVALID) == (phits[i].prim == LC_INVALID);
-  for (int r = 0; r < 3; ++r) ed = std::min(ed, em.trace(diffuse, eh));
   double emp = primary.size() / ep * 1e-6, emd = diffuse.size() / ed * 1e-6;
   std::printf(
       "embree %d.%d.%d (rtcIntersect1, 2 threads, build %.1f ms): primary %.2f Mrays/s, "
       "diffuse %.2f Mrays/s; hit/miss agreement on primary rays %.4f%%\n",
-      RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, em.build_seconds * 1e3, emp, emd,
+      RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, em->build_seconds * 1e3, emp, emd,
       100.0 * agree / total);
   std::printf("lucent / embree: primary %.3f, diffuse %.3f\n", mp / emp, md / emd);
 #endif
@@ -296,6 +311,8 @@ int main(int argc, char** argv) {
     };
     if (a == "--runs")
       opt.runs = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--reps")
+      opt.reps = std::max(1, std::atoi(next().c_str()));
     else if (a == "--width")
       opt.width = std::max(1, std::atoi(next().c_str()));
     else if (a == "--height")
@@ -312,13 +329,17 @@ int main(int argc, char** argv) {
       opt.embree = false;
     else if (a == "--reorder")
       opt.reorder = true;
+    else if (a == "--leaf-block")
+      opt.leaf_block = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--max-leaf")
+      opt.max_leaf = std::max(1, std::atoi(next().c_str()));
     else if (a == "--traversal-cost")
       opt.traversal_cost = float(std::atof(next().c_str()));
     else {
       std::fprintf(stderr,
-                   "usage: lucent_bench [--runs N] [--width W] [--height H] [--device S] "
-                   "[--threads N] [--build-only] [--only NAME] [--no-embree] "
-                   "[--traversal-cost C] [--reorder]\n");
+                   "usage: lucent_bench [--runs N] [--reps N] [--width W] [--height H] "
+                   "[--device S] [--threads N] [--build-only] [--only NAME] [--no-embree] "
+                   "[--traversal-cost C] [--max-leaf N] [--leaf-block N] [--reorder]\n");
       return 2;
     }
   }

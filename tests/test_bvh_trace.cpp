@@ -24,6 +24,7 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "bvh/bvh.hpp"
@@ -174,8 +175,8 @@ class BvhTrace : public ::testing::Test {
 
   // Traces `rays` and judges every one against the brute force; returns the number checked.
   void compare(const Scene& s, const std::vector<TraceRay>& rays, bool any_hit = false,
-               const char* what = "") {
-    Bvh b = lucent::bvh::build(s.tris, s.spheres);
+               const char* what = "", const lucent::bvh::BuildOptions& options = {}) {
+    Bvh b = lucent::bvh::build(s.tris, s.spheres, options);
     auto hits = trace(s, b, rays, any_hit);
     std::size_t bad = 0, inexact = 0, hit = 0;
     for (std::size_t i = 0; i < rays.size(); ++i) {
@@ -319,21 +320,68 @@ TEST_F(BvhTrace, RaysStartingOnBoxFaces) {
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<TraceRay> rays;
   for (int i = 0; i < 12000; ++i) {
+    // a child box of a random node (the boxes the kernel tests)
     const lc_bvh_node& nd =
         b.nodes[std::uniform_int_distribution<std::size_t>(0, b.nodes.size() - 1)(rng)];
+    int k = std::uniform_int_distribution<int>(0, LC_BVH_WIDTH - 1)(rng);
+    if (nd.child[k] == LC_INVALID) k = 0;  // slot 0 is always used
+    float lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) lo[a] = nd.bounds[2 * a][k], hi[a] = nd.bounds[2 * a + 1][k];
     int axis = i % 3;
     float o[3];
-    for (int a = 0; a < 3; ++a) o[a] = float(nd.bmin[a] + u(rng) * (nd.bmax[a] - nd.bmin[a]));
-    o[axis] = (i & 4) ? nd.bmax[axis] : nd.bmin[axis];
+    for (int a = 0; a < 3; ++a) o[a] = float(lo[a] + u(rng) * (hi[a] - lo[a]));
+    o[axis] = (i & 4) ? hi[axis] : lo[axis];
     D3 d = random_dir(rng);
     if (i & 8) {  // within the face plane
       if (axis == 0) d.x = 0;
       if (axis == 1) d.y = 0;
       if (axis == 2) d.z = 0;
     }
-    rays.push_back(make_ray(d3(o), d));
+    rays.push_back(make_ray(d3(o), d, (i & 16) ? float(0.05 + u(rng)) : INFINITY));
   }
   compare(s, rays, false, "box faces");
+  compare(s, rays, true, "box faces any-hit");
+}
+
+// Leaves of 1 to 16 primitives (1 to 4 leaf blocks), spheres and triangles sharing blocks, the
+// classic per-primitive SAH cost too: closest hits, any-hit and axis-parallel rays.
+TEST_F(BvhTrace, LeafSizesAndMixedBlocks) {
+  Scene s = soup(1200, 30, 0.07f);
+  add_spheres(s, 400, 31, 0.01f, 0.05f);
+  std::vector<TraceRay> axis;
+  std::mt19937 rng(32);
+  std::uniform_real_distribution<double> u(-0.2, 1.2);
+  for (int i = 0; i < 3000; ++i) {
+    D3 d{0, 0, 0};
+    (&d.x)[i % 3] = (i & 4) ? 1.0 : -1.0;
+    axis.push_back(make_ray({u(rng), u(rng), u(rng)}, d));
+  }
+  for (int leaf : {1, 8, 16}) {
+    lucent::bvh::BuildOptions o;
+    o.max_leaf_size = leaf;
+    o.leaf_block = leaf == 8 ? 1 : 4;
+    std::string what = "leaves of " + std::to_string(leaf);
+    compare(s, random_rays(6000, 33 + leaf), false, what.c_str(), o);
+    compare(s, random_rays(6000, 34 + leaf, true), true, (what + " any-hit").c_str(), o);
+    compare(s, axis, false, (what + " axis-parallel").c_str(), o);
+  }
+}
+
+// No primitive: every ray misses. One primitive: the root's only child is a leaf.
+TEST_F(BvhTrace, EmptySceneAndSinglePrimitive) {
+  Scene empty;
+  Bvh b = lucent::bvh::build(empty.tris, empty.spheres);
+  auto rays = random_rays(1000, 40);
+  for (bool any : {false, true}) {
+    auto hits = trace(empty, b, rays, any);
+    std::size_t hit = 0;
+    for (auto& h : hits) hit += h.prim != LC_INVALID;
+    EXPECT_EQ(hit, 0u);
+  }
+  Scene one;
+  add_spheres(one, 1, 41, 0.45f, 0.5f, 0.45f, 0.1f);
+  compare(one, random_rays(3000, 42), false, "one sphere");
+  compare(one, random_rays(3000, 43, true), true, "one sphere any-hit");
 }
 
 // --- closed meshes: no ray passes through -------------------------------------------------------

@@ -1,18 +1,120 @@
-/* lucent kernel: scene description on the device and BVH2 traversal.
- * Node layout: shared/types.h (lc_bvh_node, 32 bytes, depth-first, children adjacent). Leaves
- * hold primitive references: a triangle index, or a sphere index with LC_PRIM_SPHERE_BIT set.
- * Traversal is ordered (nearer child first) with a stack of (node, entry distance) pairs, so a
- * popped node is dropped without touching its box once a closer hit is known. */
+/* lucent kernel: scene description on the device and wide-BVH traversal.
+ * Layout: shared/types.h (lc_bvh_node: LC_BVH_WIDTH child boxes as structure of arrays and child
+ * references; lc_bvh_leaf: blocks of 4 primitives with their triangles' vertices; built by
+ * src/bvh/bvh_wide.cpp). A primitive reference is a triangle index, or a sphere index with
+ * LC_PRIM_SPHERE_BIT set.
+ * Traversal: one vector operation per slab plane tests all children of a node; the children
+ * entered become (entry distance, child reference) keys, sorted by a sorting network, the nearest
+ * is visited next and the others are pushed farthest first with one vector store, so a popped
+ * child is dropped without touching its node once a closer hit is known. The triangles of a leaf
+ * block are tested at once. Ray quantities are lc_real (float, or double under LC_DOUBLE); boxes
+ * and vertices are loaded from the float buffers and widened. */
 #ifndef LUCENT_BVH_TRAVERSE_CL
 #define LUCENT_BVH_TRAVERSE_CL
 
-/* Deep enough for any tree of src/bvh/bvh_build.cpp, which caps the depth at 64. */
-#define LC_BVH_STACK_SIZE 64
+/* At a node of depth k (root: 1) the stack holds at most (LC_BVH_WIDTH - 1) (k - 1) entries and a
+ * push writes LC_BVH_WIDTH slots from there; src/bvh keeps the depth within LC_BVH_MAX_DEPTH. */
+#define LC_BVH_STACK_SIZE ((LC_BVH_WIDTH - 1) * LC_BVH_MAX_DEPTH + 1)
+
+/* One lane per child. lc_bvh_fw: float per child (a row of lc_bvh_node.bounds); lc_bvh_rw:
+ * lc_real per child; lc_bvh_iw, lc_bvh_uw, lc_bvh_lw: int, uint, long per child (stack entries). */
+#if LC_BVH_WIDTH == 4
+typedef float4 lc_bvh_fw;
+typedef int4 lc_bvh_iw;
+typedef uint4 lc_bvh_uw;
+typedef long4 lc_bvh_lw;
+#define lc_bvh_vstorew vstore4
+#define lc_bvh_sum(v) ((v).s0 + (v).s1 + (v).s2 + (v).s3)
+#define lc_bvh_as_iw as_int4
+#define lc_bvh_long(v) convert_long4(v)
+#ifdef LC_DOUBLE
+typedef double4 lc_bvh_rw;
+#define lc_bvh_rw_from_float(v) convert_double4(v)
+#define lc_bvh_float_down(v) convert_float4_rtn(v) /* never above v: culling stays safe */
+#define lc_bvh_int_mask(m) convert_int4(m)
+#else
+typedef float4 lc_bvh_rw;
+#define lc_bvh_rw_from_float(v) (v)
+#define lc_bvh_float_down(v) (v)
+#define lc_bvh_int_mask(m) (m)
+#endif
+/* Sorting network for 4 keys, descending: (0,1)(2,3), (0,2)(1,3), (1,2). */
+static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
+  lc_bvh_lw p = k.s1032, lo = min(k, p), hi = max(k, p);
+  k = (lc_bvh_lw)(hi.s0, lo.s1, hi.s2, lo.s3);
+  p = k.s2301;
+  lo = min(k, p);
+  hi = max(k, p);
+  k = (lc_bvh_lw)(hi.s0, hi.s1, lo.s2, lo.s3);
+  p = k.s0213;
+  lo = min(k, p);
+  hi = max(k, p);
+  return (lc_bvh_lw)(hi.s0, hi.s1, lo.s2, lo.s3);
+}
+static inline long bvh_min_key(lc_bvh_lw k) {
+  k = min(k, k.s2301);
+  k = min(k, k.s1032);
+  return k.s0;
+}
+#elif LC_BVH_WIDTH == 8
+typedef float8 lc_bvh_fw;
+typedef int8 lc_bvh_iw;
+typedef uint8 lc_bvh_uw;
+typedef long8 lc_bvh_lw;
+#define lc_bvh_vstorew vstore8
+#define lc_bvh_sum(v) ((v).s0 + (v).s1 + (v).s2 + (v).s3 + (v).s4 + (v).s5 + (v).s6 + (v).s7)
+#define lc_bvh_as_iw as_int8
+#define lc_bvh_long(v) convert_long8(v)
+#ifdef LC_DOUBLE
+typedef double8 lc_bvh_rw;
+#define lc_bvh_rw_from_float(v) convert_double8(v)
+#define lc_bvh_float_down(v) convert_float8_rtn(v) /* never above v: culling stays safe */
+#define lc_bvh_int_mask(m) convert_int8(m)
+#else
+typedef float8 lc_bvh_rw;
+#define lc_bvh_rw_from_float(v) (v)
+#define lc_bvh_float_down(v) (v)
+#define lc_bvh_int_mask(m) (m)
+#endif
+/* Bitonic sorting network for 8 keys, descending: six layers, each lane taking the larger (H) or
+ * smaller (L) of itself and its partner. */
+#define LC_BVH_LAYER(sw, l0, l1, l2, l3, l4, l5, l6, l7)                                      \
+  p = k.sw;                                                                                 \
+  lo = min(k, p);                                                                           \
+  hi = max(k, p);                                                                           \
+  k = (lc_bvh_lw)(l0.s0, l1.s1, l2.s2, l3.s3, l4.s4, l5.s5, l6.s6, l7.s7);
+static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
+  lc_bvh_lw p, lo, hi;
+  LC_BVH_LAYER(s10325476, hi, lo, lo, hi, hi, lo, lo, hi)
+  LC_BVH_LAYER(s23016745, hi, hi, lo, lo, lo, lo, hi, hi)
+  LC_BVH_LAYER(s10325476, hi, lo, hi, lo, lo, hi, lo, hi)
+  LC_BVH_LAYER(s45670123, hi, hi, hi, hi, lo, lo, lo, lo)
+  LC_BVH_LAYER(s23016745, hi, hi, lo, lo, hi, hi, lo, lo)
+  LC_BVH_LAYER(s10325476, hi, lo, hi, lo, hi, lo, hi, lo)
+  return k;
+}
+#undef LC_BVH_LAYER
+static inline long bvh_min_key(lc_bvh_lw k) {
+  long4 h = min(k.lo, k.hi);
+  h = min(h, h.s2301);
+  h = min(h, h.s1032);
+  return h.s0;
+}
+#else
+#error "kernels/bvh/traverse.cl: LC_BVH_WIDTH must be 4 or 8"
+#endif
+
+/* leaf blocks: 4 lanes of lc_real */
+#ifdef LC_DOUBLE
+#define lc_bvh_r4(v) convert_double4(v)
+#else
+#define lc_bvh_r4(v) (v)
+#endif
 
 typedef struct {
   __global const lc_params* params;
   __global const lc_bvh_node* nodes;
-  __global const lc_uint* prim_refs;
+  __global const lc_bvh_leaf* leaves;
   __global const lc_triangle* triangles;
   __global const lc_triangle_attr* tri_attrs;
   __global const lc_sphere* spheres;
@@ -26,7 +128,7 @@ typedef struct {
 /* The scene's kernel arguments, in the order of src/render/device_scene.cpp (DeviceScene). */
 #define LC_SCENE_KERNEL_ARGS                                                                  \
   __global const lc_params *params, __global const lc_bvh_node *nodes,                        \
-      __global const lc_uint *prim_refs, __global const lc_triangle *triangles,               \
+      __global const lc_bvh_leaf *leaves, __global const lc_triangle *triangles,              \
       __global const lc_triangle_attr *tri_attrs, __global const lc_sphere *spheres,          \
       __global const lc_material *materials, __global const lc_light *lights,                 \
       __global const float *light_cdf, __global const lc_texture *textures,                   \
@@ -34,13 +136,13 @@ typedef struct {
 
 /* The lc_scene of a kernel declared with LC_SCENE_KERNEL_ARGS. */
 #define LC_SCENE_FROM_KERNEL_ARGS                                                             \
-  {params, nodes, prim_refs, triangles, tri_attrs, spheres, materials, lights, light_cdf,     \
+  {params, nodes, leaves, triangles, tri_attrs, spheres, materials, lights, light_cdf,     \
    textures, texels}
 
 typedef struct {
   lc_real t;
-  lc_uint prim; /* primitive reference (LC_PRIM_SPHERE_BIT for spheres), LC_INVALID on a miss */
-  lc_real b1, b2; /* triangle barycentrics of v1 and v2 */
+  lc_uint prim;     /* primitive reference (LC_PRIM_SPHERE_BIT for spheres), LC_INVALID on a miss */
+  lc_real b1, b2;   /* triangle barycentrics of v1 and v2 */
 } lc_hit;
 
 /* 1 / d per component, +INFINITY where d is 0 (either sign) or so small that 1 / d overflows. */
@@ -49,109 +151,208 @@ static inline lc_real3 bvh_inv_dir(lc_real3 d) {
   return select(inv, (lc_real3)(INFINITY), isinf(inv));
 }
 
-/*
- * Slab test: the distance at which the ray enters the box within [tmin, tmax], or INFINITY on a
- * miss. With inv_d = +INFINITY on an axis the ray does not move along, (b - o) * inv_d is -inf or
- * +inf, or NaN (0 * inf) when the origin lies on that face plane. The selects below return t0 for
- * the near and t1 for the far distance whenever either is NaN, and the comparisons with enter and
- * exit keep the old value for a NaN: an origin on a face plane of a slab it does not move along
- * counts as inside that slab (boxes are closed), and no NaN decides anything.
- */
-static inline lc_real bvh_box_entry(__global const lc_bvh_node* n, lc_real3 o, lc_real3 inv_d,
-                                    lc_real tmin, lc_real tmax) {
-  lc_real3 t0 = (lc_real3_from_float3(vload3(0, n->bmin)) - o) * inv_d;
-  lc_real3 t1 = (lc_real3_from_float3(vload3(0, n->bmax)) - o) * inv_d;
-  lc_real3 tn = select(t0, t1, t1 < t0);
-  lc_real3 tf = select(t1, t0, t0 > t1);
-  lc_real enter = tmin, exit_ = tmax;
-  enter = tn.x > enter ? tn.x : enter;
-  enter = tn.y > enter ? tn.y : enter;
-  enter = tn.z > enter ? tn.z : enter;
-  exit_ = tf.x < exit_ ? tf.x : exit_;
-  exit_ = tf.y < exit_ ? tf.y : exit_;
-  exit_ = tf.z < exit_ ? tf.z : exit_;
-  /* conservative against rounding in t0, t1: widen the exit by 1 + 2 gamma(3) (pbrt-v4) */
-#ifdef LC_DOUBLE
-  exit_ *= 1.0000000000000007; /* the same in double */
-#else
-  exit_ *= 1.0000004f;
-#endif
-  return enter <= exit_ ? enter : INFINITY;
+static inline lc_real bvh_lane(lc_real4 v, int k) {
+  return k == 0 ? v.s0 : (k == 1 ? v.s1 : (k == 2 ? v.s2 : v.s3));
 }
 
-static inline int bvh_intersect_prim(const lc_scene* s, lc_uint ref, const lc_tri_ray* tr,
-                                     lc_real3 o, lc_real3 d, lc_real tmin, lc_hit* hit) {
-  if (ref & LC_PRIM_SPHERE_BIT) {
-    __global const lc_sphere* sp = &s->spheres[ref & ~LC_PRIM_SPHERE_BIT];
-    lc_real t = sphere_intersect(lc_real3_from_float3(vload3(0, sp->center)), sp->radius, o, d,
-                                 tmin, hit->t);
-    if (t < hit->t) {
-      hit->t = t;
-      hit->prim = ref;
-      return 1;
-    }
-    return 0;
+/* 1 + 2 gamma(3) of the precision: widens a box's exit distance against rounding (pbrt-v4) */
+#ifdef LC_DOUBLE
+#define LC_BVH_EXIT_WIDEN 1.0000000000000007
+#else
+#define LC_BVH_EXIT_WIDEN 1.0000004f
+#endif
+
+/* lc_real4 comparison results as int4 and back */
+#ifdef LC_DOUBLE
+#define lc_bvh_m4(m) convert_int4(m)
+#define lc_bvh_rm4(m) convert_long4(m)
+#else
+#define lc_bvh_m4(m) (m)
+#define lc_bvh_rm4(m) (m)
+#endif
+#if defined(cl_khr_fp64) && !defined(LC_DOUBLE)
+#define LC_BVH_FP64_FALLBACK 1
+#endif
+
+/*
+ * The triangles of one leaf block, all four at once: the watertight test of geom/triangle.cl
+ * (Woop, Benthin and Wald 2013) lane by lane, with the same shear (r: triangle_ray_setup; okx,
+ * oky, okz: the origin's components along r->kx, r->ky, r->kz), the same operations in the same
+ * order without fused multiply-add, and the same fp64 recomputation of a triangle's edge
+ * functions when one of them rounds to 0, so each lane decides exactly as triangle_intersect
+ * would. Keeps the nearest hit with t in (tmin, hit->t); returns 1 when it found one.
+ */
+static inline int bvh_leaf_triangles(__global const lc_bvh_leaf* lf, int4 tri, const lc_tri_ray* r,
+                                     lc_real okx, lc_real oky, lc_real okz, lc_real tmin,
+                                     lc_hit* hit) {
+#pragma OPENCL FP_CONTRACT OFF
+  __global const float4* v = (__global const float4*)lf->v; /* one row per float4 */
+  lc_real4 Az = lc_bvh_r4(v[r->kz]) - okz;
+  lc_real4 Bz = lc_bvh_r4(v[3 + r->kz]) - okz;
+  lc_real4 Cz = lc_bvh_r4(v[6 + r->kz]) - okz;
+  lc_real4 Ax = (lc_bvh_r4(v[r->kx]) - okx) - r->sx * Az;
+  lc_real4 Ay = (lc_bvh_r4(v[r->ky]) - oky) - r->sy * Az;
+  lc_real4 Bx = (lc_bvh_r4(v[3 + r->kx]) - okx) - r->sx * Bz;
+  lc_real4 By = (lc_bvh_r4(v[3 + r->ky]) - oky) - r->sy * Bz;
+  lc_real4 Cx = (lc_bvh_r4(v[6 + r->kx]) - okx) - r->sx * Cz;
+  lc_real4 Cy = (lc_bvh_r4(v[6 + r->ky]) - oky) - r->sy * Cz;
+  lc_real4 U = Cx * By - Cy * Bx;
+  lc_real4 V = Ax * Cy - Ay * Cx;
+  lc_real4 W = Bx * Ay - By * Ax;
+#ifdef LC_BVH_FP64_FALLBACK
+  int4 zero = tri & ((U == 0.0f) | (V == 0.0f) | (W == 0.0f));
+  if (any(zero)) {
+    double4 ax = convert_double4(Ax), ay = convert_double4(Ay), bx = convert_double4(Bx);
+    double4 by = convert_double4(By), cx = convert_double4(Cx), cy = convert_double4(Cy);
+    U = select(U, convert_float4(cx * by - cy * bx), zero);
+    V = select(V, convert_float4(ax * cy - ay * cx), zero);
+    W = select(W, convert_float4(bx * ay - by * ax), zero);
   }
-  __global const lc_triangle* tri = &s->triangles[ref];
-  lc_real t, b1, b2;
-  if (triangle_intersect(tr, o, lc_real3_from_float3(vload3(0, tri->v0)),
-                         lc_real3_from_float3(vload3(0, tri->v1)),
-                         lc_real3_from_float3(vload3(0, tri->v2)), tmin,
-                         hit->t, &t, &b1, &b2)) {
+#endif
+  const lc_real z = LC_REAL(0.0);
+  int4 ok = tri & ~lc_bvh_m4(((U < z) | (V < z) | (W < z)) & ((U > z) | (V > z) | (W > z)));
+  lc_real4 det = U + V + W;
+  ok &= lc_bvh_m4(det != z);
+  if (!any(ok)) return 0;
+  lc_real4 T = U * (r->sz * Az) + V * (r->sz * Bz) + W * (r->sz * Cz);
+  lc_real4 inv = LC_REAL(1.0) / det;
+  lc_real4 t = T * inv;
+  ok &= lc_bvh_m4((t > tmin) & (t < hit->t));
+  if (!any(ok)) return 0;
+  lc_real4 tt = select((lc_real4)(INFINITY), t, lc_bvh_rm4(ok));
+  lc_real a = tt.s0 < tt.s1 ? tt.s0 : tt.s1, c = tt.s2 < tt.s3 ? tt.s2 : tt.s3;
+  lc_real m = a < c ? a : c;
+  int k = tt.s0 == m ? 0 : (tt.s1 == m ? 1 : (tt.s2 == m ? 2 : 3));
+  hit->t = m;
+  hit->prim = lf->prim[k];
+  hit->b1 = bvh_lane(V, k) * bvh_lane(inv, k);
+  hit->b2 = bvh_lane(W, k) * bvh_lane(inv, k);
+  return 1;
+}
+
+static inline int bvh_intersect_sphere(const lc_scene* s, lc_uint ref, lc_real3 o, lc_real3 d,
+                                       lc_real tmin, lc_hit* hit) {
+  __global const lc_sphere* sp = &s->spheres[ref & ~LC_PRIM_SPHERE_BIT];
+  lc_real t = sphere_intersect(lc_load3r(sp->center), (lc_real)sp->radius, o, d, tmin, hit->t);
+  if (t < hit->t) {
     hit->t = t;
     hit->prim = ref;
-    hit->b1 = b1;
-    hit->b2 = b2;
     return 1;
   }
   return 0;
 }
 
-/* Closest hit with t in (tmin, tmax). With any_hit set, returns at the first hit found (shadow
- * rays); hit then holds that hit, not necessarily the closest. */
-static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real tmin, lc_real tmax,
-                            int any_hit, lc_hit* hit) {
+/* The primitive types to test: the feature defines of the megakernel (src/render/pack.cpp) name
+ * those a scene has; a kernel built without them tests both. */
+#if defined(LC_HAS_TRIANGLES) || !defined(LC_HAS_SPHERES)
+#define LC_BVH_TRIANGLES 1
+#endif
+#if defined(LC_HAS_SPHERES) || !defined(LC_HAS_TRIANGLES)
+#define LC_BVH_SPHERES 1
+#endif
+
+static inline lc_real bvh_get(lc_real3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+
+/*
+ * Closest hit with t in (tmin, tmax). With any_hit set, returns at the first hit found (shadow
+ * rays); hit then holds that hit, not necessarily the closest.
+ *
+ * Slab test per child, all children at once: for each axis the plane the ray meets first (min
+ * for a direction >= 0, else max; inv_d is +INFINITY for a zero direction, so min) gives the near
+ * distance (b - o) * inv_d, the other plane the far one. The entry is the largest of tmin and the
+ * near distances, the exit the smallest of the closest hit so far and the far distances, each
+ * taken with `x > acc ? x : acc`, which keeps acc when x is NaN: (b - o) * inv_d is NaN (0 * inf)
+ * only for an origin on a face plane of a slab the ray does not move along, and such an origin
+ * counts as inside the slab (boxes are closed); no NaN decides anything. An empty slot (min +inf,
+ * max -inf) gives near +inf and far -inf and is never entered. The exit is widened by
+ * 1 + 2 gamma(3) (pbrt-v4) against rounding in the distances.
+ */
+static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real tmin,
+                            lc_real tmax, int any_hit, lc_hit* hit) {
   hit->t = tmax;
   hit->prim = LC_INVALID;
   hit->b1 = hit->b2 = LC_REAL(0.0);
   if (s->params->num_nodes == 0) return 0;
   __global const lc_bvh_node* nodes = s->nodes;
   lc_real3 inv_d = bvh_inv_dir(d);
-  if (bvh_box_entry(&nodes[0], o, inv_d, tmin, tmax) == INFINITY) return 0;
+  /* rows of lc_bvh_node.bounds holding each axis's near plane; the far plane is the next row */
+  const int nx = inv_d.x >= LC_REAL(0.0) ? 0 : 1;
+  const int ny = inv_d.y >= LC_REAL(0.0) ? 2 : 3;
+  const int nz = inv_d.z >= LC_REAL(0.0) ? 4 : 5;
   lc_tri_ray tr = triangle_ray_setup(d);
-  lc_uint stack_node[LC_BVH_STACK_SIZE];
-  lc_real stack_t[LC_BVH_STACK_SIZE];
+  const lc_real okx = bvh_get(o, tr.kx), oky = bvh_get(o, tr.ky), okz = bvh_get(o, tr.kz);
+  /* pending children: entry distance (float bits, rounded down) << 32 | child reference */
+  long stack[LC_BVH_STACK_SIZE];
   int sp = 0;
-  lc_uint node = 0;
+  lc_uint ref = 0; /* the root node */
   for (;;) {
-    __global const lc_bvh_node* n = &nodes[node];
-    lc_uint count = n->count, first = n->left_first;
-    if (count > 0) {
-      for (lc_uint i = 0; i < count; ++i)
-        if (bvh_intersect_prim(s, s->prim_refs[first + i], &tr, o, d, tmin, hit) && any_hit)
-          return 1;
-    } else {
-      lc_real tl = bvh_box_entry(&nodes[first], o, inv_d, tmin, hit->t);
-      lc_real tr_ = bvh_box_entry(&nodes[first + 1], o, inv_d, tmin, hit->t);
-      lc_uint near_ = tl <= tr_ ? first : first + 1;
-      lc_real t_near = fmin(tl, tr_), t_far = fmax(tl, tr_);
-      if (t_near != INFINITY) {
-        if (t_far != INFINITY && sp < LC_BVH_STACK_SIZE) {
-          stack_node[sp] = (near_ == first) ? first + 1 : first;
-          stack_t[sp] = t_far;
-          ++sp;
-        }
-        node = near_;
+    if (!(ref & LC_BVH_LEAF_BIT)) {
+      __global const lc_bvh_node* n = &nodes[ref];
+      __global const lc_bvh_fw* b = (__global const lc_bvh_fw*)n->bounds; /* rows */
+      lc_bvh_rw tnx = (lc_bvh_rw_from_float(b[nx]) - o.x) * inv_d.x;
+      lc_bvh_rw tfx = (lc_bvh_rw_from_float(b[nx ^ 1]) - o.x) * inv_d.x;
+      lc_bvh_rw tny = (lc_bvh_rw_from_float(b[ny]) - o.y) * inv_d.y;
+      lc_bvh_rw tfy = (lc_bvh_rw_from_float(b[ny ^ 1]) - o.y) * inv_d.y;
+      lc_bvh_rw tnz = (lc_bvh_rw_from_float(b[nz]) - o.z) * inv_d.z;
+      lc_bvh_rw tfz = (lc_bvh_rw_from_float(b[nz ^ 1]) - o.z) * inv_d.z;
+      lc_bvh_rw enter = (lc_bvh_rw)(tmin), exit_ = (lc_bvh_rw)(hit->t);
+      enter = select(enter, tnx, tnx > enter);
+      enter = select(enter, tny, tny > enter);
+      enter = select(enter, tnz, tnz > enter);
+      exit_ = select(exit_, tfx, tfx < exit_);
+      exit_ = select(exit_, tfy, tfy < exit_);
+      exit_ = select(exit_, tfz, tfz < exit_);
+      exit_ *= LC_BVH_EXIT_WIDEN;
+      lc_bvh_rw t = select((lc_bvh_rw)(INFINITY), enter, enter <= exit_);
+      lc_bvh_iw hm = lc_bvh_int_mask(t < (lc_bvh_rw)(INFINITY)); /* -1: child entered */
+      int cnt = -lc_bvh_sum(hm);
+      if (cnt > 0) {
+        /* keys (entry distance, child), sorted farthest first, the children missed (LONG_MIN)
+         * last: stored whole, the first cnt - 1 become the stack's top (second nearest on top);
+         * the nearest (smallest key) is visited next. Signed order of the keys is the order of
+         * the distances for t >= 0. */
+        lc_bvh_lw key = (lc_bvh_long(lc_bvh_as_iw(lc_bvh_float_down(t))) << 32) |
+                        lc_bvh_long(*(__global const lc_bvh_uw*)n->child);
+        lc_bvh_lw lhm = lc_bvh_long(hm);
+        long near_ = bvh_min_key(select((lc_bvh_lw)(LONG_MAX), key, lhm));
+        key = bvh_sort_desc(select((lc_bvh_lw)(LONG_MIN), key, lhm));
+        lc_bvh_vstorew(key, 0, &stack[sp]);
+        sp += cnt - 1;
+        ref = (lc_uint)near_;
         continue;
       }
+    } else {
+      __global const lc_bvh_leaf* lf = &s->leaves[ref & LC_BVH_LEAF_FIRST_MASK];
+      __global const lc_bvh_leaf* end =
+          lf + ((ref & ~LC_BVH_LEAF_BIT) >> LC_BVH_LEAF_COUNT_SHIFT) + 1;
+      for (; lf < end; ++lf) {
+        uint4 prim = *(__global const uint4*)lf->prim;
+        int4 sphere = (prim & LC_PRIM_SPHERE_BIT) != 0;
+#ifdef LC_BVH_TRIANGLES
+        int4 tri = ~sphere;
+        if (any(tri) && bvh_leaf_triangles(lf, tri, &tr, okx, oky, okz, tmin, hit) && any_hit)
+          return 1;
+#endif
+#ifdef LC_BVH_SPHERES
+        /* LC_INVALID (an unused column) has the sphere bit too */
+        int4 used_sphere = sphere & (prim != LC_INVALID);
+        if (any(used_sphere)) {
+          lc_uint refs[4] = {prim.s0, prim.s1, prim.s2, prim.s3};
+          for (int k = 0; k < 4; ++k)
+            if (refs[k] != LC_INVALID && (refs[k] & LC_PRIM_SPHERE_BIT) &&
+                bvh_intersect_sphere(s, refs[k], o, d, tmin, hit) && any_hit)
+              return 1;
+        }
+#endif
+      }
     }
-    /* pop the nearest pending node that may still hold a closer hit */
-    for (;;) {
+    /* pop the nearest pending child that may still hold a closer hit */
+    long e;
+    do {
       if (sp == 0) return hit->prim != LC_INVALID;
-      --sp;
-      if (stack_t[sp] < hit->t) break;
-    }
-    node = stack_node[sp];
+      e = stack[--sp];
+    } while (!(as_float((int)(e >> 32)) < hit->t));
+    ref = (lc_uint)e;
   }
 }
 

@@ -99,20 +99,47 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle_attr, uv) == 36, triangle_attr_uv);
 /* Primitive references stored in BVH leaves: a triangle index, or a sphere index with this bit. */
 #define LC_PRIM_SPHERE_BIT 0x80000000u
 
-/* BVH2 node. nodes[0] is the root; nodes[1] is unused padding so that every sibling pair starts
- * at an even index and the two boxes of a traversal step share one 64-byte cache line; children
- * of an interior node are adjacent (left at an even index, right = left + 1). */
+/*
+ * Wide BVH node (LC_BVH_WIDTH children), built on the host by collapsing the binary SAH tree of
+ * src/bvh/bvh_build.cpp (src/bvh/bvh_wide.cpp) and walked by kernels/bvh/traverse.cl, which tests
+ * all children of a node with one vector operation per slab plane. nodes[0] is the root.
+ *
+ * bounds: the children's boxes, structure of arrays: row 0 min x, 1 max x, 2 min y, 3 max y,
+ *   4 min z, 5 max z; column k is child k. The kernel loads row (0 or 1) + 2 axis whole, so the
+ *   nearer plane of each axis is picked once per ray by the sign of its direction.
+ * child: interior child: its node index; leaf: LC_BVH_LEAF_BIT | (blocks - 1) <<
+ *   LC_BVH_LEAF_COUNT_SHIFT | index of its first lc_bvh_leaf block (a leaf of up to
+ *   LC_BVH_LEAF_MAX primitives fills 1 to 4 consecutive blocks); unused slot: LC_INVALID with an
+ *   empty box (min +inf, max -inf), which no ray enters.
+ */
+#define LC_BVH_WIDTH 8
+#define LC_BVH_LEAF_BIT 0x80000000u
+#define LC_BVH_LEAF_COUNT_SHIFT 27
+#define LC_BVH_LEAF_MAX 16u                /* primitives per leaf, at most               */
+#define LC_BVH_LEAF_FIRST_MASK 0x07ffffffu /* first block of a leaf                      */
+#define LC_BVH_MAX_DEPTH 64 /* levels of the binary tree and so of the wide one, at most */
+
 typedef struct LC_ALIGN16 lc_bvh_node {
-  float bmin[3];      /* bounds minimum                                                    */
-  lc_uint left_first; /* interior: index of the left child (right = left + 1); leaf: first
-                         entry in the primitive reference array                            */
-  float bmax[3];      /* bounds maximum                                                    */
-  lc_uint count;      /* 0 for an interior node, else the number of primitives in the leaf */
-} lc_bvh_node; /* total: 32 bytes */
-LC_STATIC_ASSERT(sizeof(lc_bvh_node) == 32, bvh_node_size);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, left_first) == 12, bvh_node_left_first);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, bmax) == 16, bvh_node_bmax);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, count) == 28, bvh_node_count);
+  float bounds[6][LC_BVH_WIDTH]; /* child boxes, rows min x, max x, min y, max y, min z, max z */
+  lc_uint child[LC_BVH_WIDTH];   /* node index, leaf reference or LC_INVALID (see above)       */
+  lc_uint pad[LC_BVH_WIDTH];     /* unused: keeps nodes on 64-byte boundaries                  */
+} lc_bvh_node; /* total: 256 bytes (LC_BVH_WIDTH 8; 128 bytes with 4) */
+LC_STATIC_ASSERT(sizeof(lc_bvh_node) == 32 * LC_BVH_WIDTH, bvh_node_size);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, child) == 24 * LC_BVH_WIDTH, bvh_node_child);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, pad) == 28 * LC_BVH_WIDTH, bvh_node_pad);
+
+/* Leaf block: 4 primitives of a leaf (fewer in its last block), their triangles' vertices as
+ * structure of arrays so that one vector operation tests all four triangles.
+ * v: rows v0.x, v0.y, v0.z, v1.x, v1.y, v1.z, v2.x, v2.y, v2.z; column k is primitive k (zeros for
+ *   a sphere or an unused column).
+ * prim: primitive reference (triangle index, or sphere index | LC_PRIM_SPHERE_BIT), LC_INVALID for
+ *   an unused column. */
+typedef struct LC_ALIGN16 lc_bvh_leaf {
+  float v[9][4];   /* triangle vertices, one column per primitive */
+  lc_uint prim[4]; /* primitive references                        */
+} lc_bvh_leaf; /* total: 160 bytes */
+LC_STATIC_ASSERT(sizeof(lc_bvh_leaf) == 160, bvh_leaf_size);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_leaf, prim) == 144, bvh_leaf_prim);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Lights                                                                                     */

@@ -76,7 +76,7 @@ __kernel void stability_spawn(__global const lc_sphere* spheres, lc_uint num_sph
   lc_scene s;
   s.params = 0;
   s.nodes = 0;
-  s.prim_refs = 0;
+  s.leaves = 0;
   s.triangles = triangles;
   s.tri_attrs = 0;
   s.spheres = spheres;

@@ -12,7 +12,7 @@
 
 __kernel void lucent_trace_rays(__global const lc_params* params,
                                 __global const lc_bvh_node* nodes,
-                                __global const lc_uint* prim_refs,
+                                __global const lc_bvh_leaf* leaves,
                                 __global const lc_triangle* triangles,
                                 __global const lc_sphere* spheres, __global const float4* rays,
                                 __global float4* hits, lc_uint count, lc_uint any_hit) {
@@ -21,7 +21,7 @@ __kernel void lucent_trace_rays(__global const lc_params* params,
   lc_scene s;
   s.params = params;
   s.nodes = nodes;
-  s.prim_refs = prim_refs;
+  s.leaves = leaves;
   s.triangles = triangles;
   s.tri_attrs = 0;
   s.spheres = spheres;

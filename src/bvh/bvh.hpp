@@ -1,5 +1,6 @@
 #pragma once
-// BVH over all primitives of a scene (triangles and spheres), flattened into lc_bvh_node.
+// BVH over all primitives of a scene (triangles and spheres): a binary SAH tree (build_binary),
+// collapsed into the wide nodes the kernel walks (lc_bvh_node, kernels/shared/types.h).
 #include <cstdint>
 #include <vector>
 
@@ -8,41 +9,83 @@
 namespace lucent::bvh {
 
 struct BuildOptions {
-  int max_leaf_size = 4;  ///< a leaf is forced to split above this many primitives
-  int threads = 0;        ///< 0: hardware concurrency
+  /// A leaf is forced to split above this many primitives (clamped to 1..LC_BVH_LEAF_MAX).
+  int max_leaf_size = 4;
+  int threads = 0;  ///< 0: hardware concurrency
   /// SAH cost of one traversal step relative to one primitive intersection: larger values give
   /// larger leaves and fewer nodes.
   float traversal_cost = 1.0f;
+  /// Triangles the kernel tests together (lc_bvh_leaf holds 4): the SAH counts a leaf's
+  /// intersection cost in blocks of this many triangles, plus one per sphere (spheres are tested
+  /// one by one), so leaves fill blocks when that is no worse.
+  int leaf_block = 4;
 };
 
 struct BuildStats {
-  double seconds = 0;
+  double seconds = 0;  ///< binary build and, for build(), the collapse
   std::size_t primitives = 0;
-  std::size_t nodes = 0;
+  std::size_t nodes = 0;  ///< nodes of this tree (wide nodes for build())
   std::size_t leaves = 0;
-  std::size_t max_depth = 0;
+  std::size_t max_depth = 0;  ///< of this tree (root: 1)
   std::size_t max_leaf_size = 0;
   double mean_leaf_size = 0;
-  double sah_cost = 0;  ///< traversal cost 1, intersection cost 1, relative to the root area
+  double sah_cost = 0;  ///< of the binary tree: traversal cost 1, intersection cost 1, / root area
+  std::size_t binary_nodes = 0;      ///< nodes of the binary tree it was collapsed from
+  std::size_t binary_max_depth = 0;  ///< depth of that binary tree
 };
 
-struct Bvh {
-  std::vector<lc_bvh_node> nodes;  ///< nodes[0] is the root; empty when there is no primitive
-  std::vector<lc_uint> prim_refs;  ///< triangle index, or sphere index | LC_PRIM_SPHERE_BIT
+/// Binary tree node, host only (the build's intermediate tree).
+struct Node2 {
+  float bmin[3];      ///< bounds minimum
+  lc_uint left_first; ///< interior: left child (right = left + 1); leaf: first prim_refs entry
+  float bmax[3];      ///< bounds maximum
+  lc_uint count;      ///< 0 for an interior node, else the number of primitives in the leaf
+};
+static_assert(sizeof(Node2) == 32, "Node2 should stay 32 bytes");
+
+/// Binary SAH tree. nodes[0] is the root; nodes[1] is an unused empty box when the root is not a
+/// leaf, so that every sibling pair starts at an even index; children of an interior node are
+/// adjacent and laid out depth-first.
+struct Bvh2 {
+  std::vector<Node2> nodes;       ///< empty when there is no primitive
+  std::vector<lc_uint> prim_refs; ///< triangle index, or sphere index | LC_PRIM_SPHERE_BIT
   BuildStats stats;
 };
 
-/// Builds the BVH over `triangles` then `spheres`.
+/// The tree the kernel walks: wide nodes and leaf blocks (kernels/shared/types.h), depth-first.
+struct Bvh {
+  std::vector<lc_bvh_node> nodes;  ///< nodes[0] is the root; empty when there is no primitive
+  std::vector<lc_bvh_leaf> leaves; ///< leaf blocks, in the order the collapse meets the leaves
+  /// The binary tree's primitive references (triangle index, or sphere index |
+  /// LC_PRIM_SPHERE_BIT); each leaf's are consecutive here and in its blocks.
+  std::vector<lc_uint> prim_refs;
+  float bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0};  ///< bounds of the scene (0 when empty)
+  BuildStats stats;
+};
+
+/// Builds the binary SAH tree over `triangles` then `spheres`.
+Bvh2 build_binary(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere>& spheres,
+                  const BuildOptions& options = {});
+
+/// Collapses a binary tree built over `triangles` (then spheres) into wide nodes: each node takes
+/// the children of a binary node and opens its interior child of largest surface area until it
+/// has LC_BVH_WIDTH children or only leaves. Each leaf becomes 1 to 4 consecutive leaf blocks
+/// holding the vertices of its triangles.
+Bvh collapse(const Bvh2& binary, const std::vector<lc_triangle>& triangles);
+
+/// build_binary, then collapse.
 Bvh build(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere>& spheres,
           const BuildOptions& options = {});
 
-/// Puts the triangles in the order in which the leaves reference them (neighbouring leaves then
-/// read neighbouring memory in the kernel) and rewrites bvh.prim_refs to match; spheres are left
+/// Puts the triangles in the order in which the leaves reference them (the leaf blocks' order for
+/// a Bvh, prim_refs' for a Bvh2) and rewrites the references (prim_refs and the blocks') to
+/// match, so that shading reads neighbouring memory for neighbouring leaves; spheres are left
 /// as they are. Returns, for each new triangle index, its old index: callers permute arrays kept
 /// parallel to the triangles with it and remap stored triangle indices (lights).
 std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& triangles);
+std::vector<lc_uint> reorder_triangles(Bvh2& bvh, std::vector<lc_triangle>& triangles);
 
-/// SAH cost of a built tree (same convention as BuildStats::sah_cost).
-double sah_cost(const std::vector<lc_bvh_node>& nodes);
+/// SAH cost of a binary tree (same convention as BuildStats::sah_cost).
+double sah_cost(const std::vector<Node2>& nodes);
 
 }  // namespace lucent::bvh

@@ -1,7 +1,7 @@
 // Binned SAH BVH builder (Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies",
 // 2007): 32 bins per axis over the centroid bounds, all three axes, multithreaded by handing
 // large subtrees to a small pool of std::threads. The tree is built into a scratch array and
-// flattened depth-first with adjacent children (lc_bvh_node, kernels/shared/types.h).
+// flattened depth-first with adjacent children (Node2, bvh.hpp); bvh_wide.cpp collapses it.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -26,7 +26,7 @@ namespace {
 constexpr int kBins = 32;
 constexpr std::size_t kSpawnSize = 2048;  // subtrees at least this large go to the shared queue
 constexpr std::size_t kParallelBinSize = 1u << 17;  // nodes this large bin on every thread
-constexpr unsigned kMaxDepth = 64;  // = LC_BVH_STACK_SIZE in kernels/bvh/traverse.cl
+constexpr unsigned kMaxDepth = LC_BVH_MAX_DEPTH;  // bounds the kernel's traversal stack
 
 // Four floats, one SIMD register where SSE2 is there (lane 3 is unused by the math below).
 #if defined(__SSE2__)
@@ -176,17 +176,20 @@ struct Bins {
   int n;
   BinBox box[3][kBins];
   lc_uint count[3][kBins];
+  lc_uint spheres[3][kBins];  // how many of count are spheres
   explicit Bins(int bins) : n(bins) {
     for (int a = 0; a < 3; ++a)
       for (int k = 0; k < n; ++k) {
         box[a][k] = {V4::splat(INFINITY), V4::splat(-INFINITY)};
         count[a][k] = 0;
+        spheres[a][k] = 0;
       }
   }
-  void grow(int a, int k, V4 lo, V4 hi) {
+  void grow(int a, int k, V4 lo, V4 hi, lc_uint sphere) {
     box[a][k].lo = vmin(box[a][k].lo, lo);
     box[a][k].hi = vmax(box[a][k].hi, hi);
     ++count[a][k];
+    spheres[a][k] += sphere;
   }
   void add(const Bins& o) {
     for (int a = 0; a < 3; ++a)
@@ -194,16 +197,20 @@ struct Bins {
         box[a][k].lo = vmin(box[a][k].lo, o.box[a][k].lo);
         box[a][k].hi = vmax(box[a][k].hi, o.box[a][k].hi);
         count[a][k] += o.count[a][k];
+        spheres[a][k] += o.spheres[a][k];
       }
   }
 };
 
-void bin_range(const PrimRef* refs, std::size_t n, const BinMap& map, Bins& bins) {
+// count_spheres: also count the spheres per bin (only needed when the scene has some)
+void bin_range(const PrimRef* refs, std::size_t n, const BinMap& map, Bins& bins,
+               bool count_spheres) {
   alignas(16) int k[4];
   for (std::size_t i = 0; i < n; ++i) {
     const PrimRef& p = refs[i];
     map(p.centroid2(), k);
-    for (int a = 0; a < 3; ++a) bins.grow(a, k[a], p.lo, p.hi);
+    lc_uint sphere = count_spheres ? p.id() >> 31 : 0;  // LC_PRIM_SPHERE_BIT
+    for (int a = 0; a < 3; ++a) bins.grow(a, k[a], p.lo, p.hi, sphere);
   }
 }
 
@@ -215,12 +222,15 @@ unsigned ceil_log2(std::size_t n) {
 
 class Builder {
  public:
-  Builder(std::vector<PrimRef>& refs, const BuildOptions& options, unsigned threads)
+  Builder(std::vector<PrimRef>& refs, const BuildOptions& options, unsigned threads,
+          bool has_spheres)
       : refs_(refs),
+        has_spheres_(has_spheres),
         max_leaf_(static_cast<std::size_t>(std::max(1, options.max_leaf_size))),
         threads_(threads),
-        traversal_cost_(options.traversal_cost) {
-    nodes_.reset(new lc_bvh_node[std::max<std::size_t>(1, 2 * refs.size() - 1)]);
+        traversal_cost_(options.traversal_cost),
+        block_(static_cast<std::size_t>(std::max(1, options.leaf_block))) {
+    nodes_.reset(new Node2[std::max<std::size_t>(1, 2 * refs.size() - 1)]);
   }
 
   // Builds the tree over refs_, whose bounds and centroid bounds are given; returns the number
@@ -236,7 +246,13 @@ class Builder {
     return 1 + 2 * interior_.load();
   }
 
-  const lc_bvh_node* nodes() const { return nodes_.get(); }
+  const Node2* nodes() const { return nodes_.get(); }
+
+  // intersection cost of n primitives of which s spheres: the kernel tests the triangles by
+  // blocks of block_, the spheres one by one
+  float cost(std::size_t n, std::size_t s) const {
+    return float((n - s + block_ - 1) / block_ + s);
+  }
   std::size_t max_depth() const { return max_depth_.load(); }
 
  private:
@@ -268,7 +284,7 @@ class Builder {
   }
 
   void make_leaf(const Task& t) {
-    lc_bvh_node& n = nodes_[t.node];
+    Node2& n = nodes_[t.node];
     n.left_first = static_cast<lc_uint>(t.begin);
     n.count = static_cast<lc_uint>(t.end - t.begin);
     std::size_t d = max_depth_.load(std::memory_order_relaxed);
@@ -285,7 +301,7 @@ class Builder {
       if (pending_ == 1) parts = threads_;  // the other workers are idle (near the root)
     }
     if (parts <= 1) {
-      bin_range(refs_.data() + t.begin, n, map, bins);
+      bin_range(refs_.data() + t.begin, n, map, bins, has_spheres_);
       return;
     }
     std::vector<Bins> partial(parts - 1, Bins(map.bins));
@@ -293,10 +309,11 @@ class Builder {
     std::size_t step = (n + parts - 1) / parts;
     for (unsigned p = 1; p < parts; ++p) {
       std::size_t b = std::min(n, p * step), e = std::min(n, (p + 1) * step);
-      helpers.emplace_back(
-          [&, b, e, p] { bin_range(refs_.data() + t.begin + b, e - b, map, partial[p - 1]); });
+      helpers.emplace_back([&, b, e, p] {
+        bin_range(refs_.data() + t.begin + b, e - b, map, partial[p - 1], has_spheres_);
+      });
     }
-    bin_range(refs_.data() + t.begin, std::min(n, step), map, bins);
+    bin_range(refs_.data() + t.begin, std::min(n, step), map, bins, has_spheres_);
     for (auto& h : helpers) h.join();
     for (auto& p : partial) bins.add(p);
   }
@@ -331,7 +348,7 @@ class Builder {
     while (!stack.empty()) {
       Task t = stack.back();
       stack.pop_back();
-      lc_bvh_node& node = nodes_[t.node];
+      Node2& node = nodes_[t.node];
       t.box.get(node.bmin, node.bmax);
       std::size_t n = t.end - t.begin;
       if (n == 1) {
@@ -355,26 +372,32 @@ class Builder {
         // sweep: right-to-left areas, then left-to-right with the SAH
         float best = INFINITY;
         int best_axis = -1, best_k = 0;
+        std::size_t node_spheres = 0;  // every primitive is in one bin of each axis
+        for (int k = 0; k < map.bins; ++k) node_spheres += bins.spheres[0][k];
         for (int a = 0; a < 3; ++a) {
           if (!map.usable(a)) continue;
           const int nb = map.bins;
           float right_area[kBins];
-          std::size_t right_count[kBins];
+          std::size_t right_count[kBins], right_spheres[kBins];
           Box acc;
-          std::size_t cnt = 0;
+          std::size_t cnt = 0, sph = 0;
           for (int k = nb - 1; k > 0; --k) {
             acc.grow(bins.box[a][k].lo, bins.box[a][k].hi);
             cnt += bins.count[a][k];
+            sph += bins.spheres[a][k];
             right_area[k] = acc.area();
             right_count[k] = cnt;
+            right_spheres[k] = sph;
           }
           Box lacc;
-          std::size_t lcnt = 0;
+          std::size_t lcnt = 0, lsph = 0;
           for (int k = 1; k < nb; ++k) {
             lacc.grow(bins.box[a][k - 1].lo, bins.box[a][k - 1].hi);
             lcnt += bins.count[a][k - 1];
+            lsph += bins.spheres[a][k - 1];
             if (lcnt == 0 || right_count[k] == 0) continue;
-            float c = lacc.area() * float(lcnt) + right_area[k] * float(right_count[k]);
+            float c = lacc.area() * cost(lcnt, lsph) +
+                      right_area[k] * cost(right_count[k], right_spheres[k]);
             if (c < best) {
               best = c;
               best_axis = a;
@@ -384,7 +407,7 @@ class Builder {
         }
         float area = t.box.area();
         float split_cost = traversal_cost_ * area + best;  // both scaled by the node's area
-        float leaf_cost = float(n) * area;
+        float leaf_cost = cost(n, node_spheres) * area;
         if (n <= max_leaf_ && (best_axis < 0 || leaf_cost <= split_cost)) {
           make_leaf(t);
           continue;
@@ -436,10 +459,12 @@ class Builder {
   }
 
   std::vector<PrimRef>& refs_;
+  bool has_spheres_;
   std::size_t max_leaf_;
   unsigned threads_;
   float traversal_cost_;
-  std::unique_ptr<lc_bvh_node[]> nodes_;  // scratch tree (2n - 1 slots, not zeroed)
+  std::size_t block_;
+  std::unique_ptr<Node2[]> nodes_;  // scratch tree (2n - 1 slots, not zeroed)
   std::atomic<std::size_t> interior_{0};
   std::atomic<std::size_t> max_depth_{0};
   std::mutex mutex_;
@@ -464,9 +489,9 @@ void parallel_for(std::size_t n, unsigned threads, F f) {
 
 }  // namespace
 
-double sah_cost(const std::vector<lc_bvh_node>& nodes) {
+double sah_cost(const std::vector<Node2>& nodes) {
   if (nodes.empty()) return 0;
-  auto area = [](const lc_bvh_node& n) {
+  auto area = [](const Node2& n) {
     double d[3];
     for (int a = 0; a < 3; ++a) d[a] = std::max(0.0, double(n.bmax[a]) - n.bmin[a]);
     return 2 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
@@ -478,10 +503,13 @@ double sah_cost(const std::vector<lc_bvh_node>& nodes) {
   return cost;
 }
 
-std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& triangles) {
+namespace {
+
+std::vector<lc_uint> reorder_refs(std::vector<lc_uint>& prim_refs,
+                                  std::vector<lc_triangle>& triangles) {
   std::vector<lc_uint> new_to_old;
   new_to_old.reserve(triangles.size());
-  for (lc_uint& ref : bvh.prim_refs) {
+  for (lc_uint& ref : prim_refs) {
     if (ref & LC_PRIM_SPHERE_BIT) continue;
     new_to_old.push_back(ref);
     ref = static_cast<lc_uint>(new_to_old.size() - 1);
@@ -494,10 +522,38 @@ std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& trian
   return new_to_old;
 }
 
-Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& spheres,
-          const BuildOptions& options) {
+}  // namespace
+
+std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& triangles) {
+  // the order of the leaf blocks (LC_INVALID has the sphere bit)
+  std::vector<lc_uint> refs;
+  refs.reserve(bvh.prim_refs.size());
+  for (const lc_bvh_leaf& l : bvh.leaves)
+    for (lc_uint ref : l.prim)
+      if (ref != LC_INVALID) refs.push_back(ref);
+  if (refs.size() != bvh.prim_refs.size())
+    throw std::logic_error("reorder_triangles: leaf blocks and prim_refs disagree");
+  std::vector<lc_uint> new_to_old = reorder_refs(refs, triangles);
+  std::vector<lc_uint> old_to_new(new_to_old.size());
+  for (std::size_t i = 0; i < new_to_old.size(); ++i) old_to_new[new_to_old[i]] = lc_uint(i);
+  for (lc_bvh_leaf& l : bvh.leaves)
+    for (lc_uint& ref : l.prim)
+      if (!(ref & LC_PRIM_SPHERE_BIT)) ref = old_to_new[ref];
+  for (lc_uint& ref : bvh.prim_refs)
+    if (!(ref & LC_PRIM_SPHERE_BIT)) ref = old_to_new[ref];
+  return new_to_old;
+}
+
+std::vector<lc_uint> reorder_triangles(Bvh2& bvh, std::vector<lc_triangle>& triangles) {
+  return reorder_refs(bvh.prim_refs, triangles);
+}
+
+Bvh2 build_binary(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& spheres,
+                  const BuildOptions& options_in) {
   auto t0 = std::chrono::steady_clock::now();
-  Bvh out;
+  BuildOptions options = options_in;
+  options.max_leaf_size = std::min(std::max(options.max_leaf_size, 1), int(LC_BVH_LEAF_MAX));
+  Bvh2 out;
   const std::size_t nt = tris.size(), n = nt + spheres.size();
   out.stats.primitives = n;
   if (n == 0) return out;
@@ -545,9 +601,9 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
     cbox.grow(part_cbox[p]);
   }
 
-  Builder builder(refs, options, threads);
+  Builder builder(refs, options, threads, !spheres.empty());
   std::size_t count = builder.run(box, cbox);
-  const lc_bvh_node* tmp = builder.nodes();
+  const Node2* tmp = builder.nodes();
 
   // flatten depth-first: a node's children are adjacent and its left subtree follows them. Node 1
   // is padding (an empty box, never referenced) so that every sibling pair starts at an even
@@ -556,7 +612,7 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
   const lc_uint first_pair = count > 1 ? 2 : 1;
   out.nodes.resize(count + (first_pair - 1));
   if (count > 1) {
-    lc_bvh_node& pad = out.nodes[1];
+    Node2& pad = out.nodes[1];
     for (int a = 0; a < 3; ++a) pad.bmin[a] = INFINITY, pad.bmax[a] = -INFINITY;
     pad.left_first = 0;
     pad.count = 0;
@@ -573,8 +629,8 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
   while (!stack.empty()) {
     Item it = stack.back();
     stack.pop_back();
-    const lc_bvh_node& s = tmp[it.src];
-    lc_bvh_node& d = out.nodes[it.dst];
+    const Node2& s = tmp[it.src];
+    Node2& d = out.nodes[it.dst];
     d = s;
     if (s.count == 0) {
       d.left_first = next;
@@ -595,6 +651,19 @@ Bvh build(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& sp
   st.mean_leaf_size = double(n) / double(st.leaves);
   st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   st.sah_cost = sah_cost(out.nodes);  // not part of the build time
+  st.binary_nodes = st.nodes;
+  st.binary_max_depth = st.max_depth;
+  return out;
+}
+
+Bvh build(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere>& spheres,
+          const BuildOptions& options) {
+  Bvh2 b = build_binary(triangles, spheres, options);
+  double binary_seconds = b.stats.seconds;
+  auto t0 = std::chrono::steady_clock::now();
+  Bvh out = collapse(b, triangles);
+  out.stats.seconds =
+      binary_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
 

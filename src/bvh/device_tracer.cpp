@@ -20,10 +20,12 @@ cl::Buffer upload(const cl_util::Context& ctx, const std::vector<T>& v) {
 }  // namespace
 
 DeviceTracer::DeviceTracer(const cl_util::Context& ctx, const std::vector<lc_triangle>& triangles,
-                           const std::vector<lc_sphere>& spheres, const Bvh& bvh)
+                           const std::vector<lc_sphere>& spheres, const Bvh& bvh,
+                           const std::string& build_options)
     : ctx_(ctx) {
-  cl::Program program = cl_util::build_program(
-      ctx, detail::assemble_kernel_source("test/trace_rays.cl"), "-cl-std=CL1.2");
+  cl::Program program =
+      cl_util::build_program(ctx, detail::assemble_kernel_source("test/trace_rays.cl"),
+                             "-cl-std=CL1.2" + (build_options.empty() ? "" : " " + build_options));
   try {
     kernel_ = cl::Kernel(program, "lucent_trace_rays");
     lc_params p{};
@@ -32,7 +34,7 @@ DeviceTracer::DeviceTracer(const cl_util::Context& ctx, const std::vector<lc_tri
     p.num_nodes = static_cast<lc_uint>(bvh.nodes.size());
     params_ = upload(ctx, std::vector<lc_params>{p});
     nodes_ = upload(ctx, bvh.nodes);
-    refs_ = upload(ctx, bvh.prim_refs);
+    leaves_ = upload(ctx, bvh.leaves);
     tris_ = upload(ctx, triangles);
     spheres_ = upload(ctx, spheres);
   } catch (const cl::Error& e) {
@@ -48,7 +50,7 @@ std::vector<TraceHit> DeviceTracer::trace(const std::vector<TraceRay>& rays, boo
                   rays.size() * sizeof(TraceRay), const_cast<TraceRay*>(rays.data()));
     cl::Buffer hb(ctx_.context, CL_MEM_WRITE_ONLY, hits.size() * sizeof(TraceHit));
     int a = 0;
-    for (cl::Buffer* b : {&params_, &nodes_, &refs_, &tris_, &spheres_, &rb, &hb})
+    for (cl::Buffer* b : {&params_, &nodes_, &leaves_, &tris_, &spheres_, &rb, &hb})
       kernel_.setArg(a++, *b);
     kernel_.setArg(a++, static_cast<cl_uint>(rays.size()));
     kernel_.setArg(a++, static_cast<cl_uint>(any_hit ? 1 : 0));

@@ -2,6 +2,7 @@
 // Traces batches of rays through the kernel traversal (kernels/test/trace_rays.cl) on one OpenCL
 // device: the tests compare it with a brute-force reference, the benchmark times it.
 #include <array>
+#include <string>
 #include <vector>
 
 #include "bvh/bvh.hpp"
@@ -24,9 +25,11 @@ struct TraceHit {
 
 class DeviceTracer {
  public:
-  /// Uploads the scene and builds the trace kernel. Throws lucent::Error.
+  /// Uploads the scene and builds the trace kernel, with `build_options` added to the OpenCL
+  /// build options (e.g. "-D LC_DOUBLE"). Throws lucent::Error.
   DeviceTracer(const cl_util::Context& ctx, const std::vector<lc_triangle>& triangles,
-               const std::vector<lc_sphere>& spheres, const Bvh& bvh);
+               const std::vector<lc_sphere>& spheres, const Bvh& bvh,
+               const std::string& build_options = "");
   /// Closest hits, or with any_hit only occlusion (prim != LC_INVALID when occluded).
   std::vector<TraceHit> trace(const std::vector<TraceRay>& rays, bool any_hit = false);
   /// Seconds the last trace() spent in the kernel alone (rays already on the device).
@@ -35,7 +38,7 @@ class DeviceTracer {
  private:
   const cl_util::Context& ctx_;
   cl::Kernel kernel_;
-  cl::Buffer params_, nodes_, refs_, tris_, spheres_;
+  cl::Buffer params_, nodes_, leaves_, tris_, spheres_;
   double kernel_seconds_ = 0;
 };
 

@@ -149,11 +149,12 @@ int run_info_command() {
   std::printf("\nBVH\n");
   std::printf("  build time          %.3f ms\n", s.seconds * 1e3);
   std::printf("  primitives          %zu\n", s.primitives);
-  std::printf("  nodes               %zu (%s)\n", s.nodes,
+  std::printf("  nodes               %zu binary, collapsed into %zu %d-wide (%s)\n",
+              s.binary_nodes, s.nodes, LC_BVH_WIDTH,
               format_bytes(double(packed.bvh.nodes.size()) * sizeof(lc_bvh_node)).c_str());
   std::printf("  leaves              %zu\n", s.leaves);
   std::printf("  leaf size           mean %.2f, max %zu\n", s.mean_leaf_size, s.max_leaf_size);
-  std::printf("  max depth           %zu\n", s.max_depth);
+  std::printf("  max depth           %zu binary, %zu wide\n", s.binary_max_depth, s.max_depth);
   std::printf("  SAH cost            %.3f\n", s.sah_cost);
 
   std::string defines = render_detail::feature_defines(scene, packed);

@@ -21,7 +21,7 @@ cl::Buffer make_buffer(const cl_util::Context& ctx, const std::vector<T>& v) {
 DeviceScene::DeviceScene(const cl_util::Context& ctx, const PackedScene& p)
     : params(make_buffer(ctx, std::vector<lc_params>{p.params})),
       nodes(make_buffer(ctx, p.bvh.nodes)),
-      prim_refs(make_buffer(ctx, p.bvh.prim_refs)),
+      leaves(make_buffer(ctx, p.bvh.leaves)),
       triangles(make_buffer(ctx, p.triangles)),
       tri_attrs(make_buffer(ctx, p.tri_attrs)),
       spheres(make_buffer(ctx, p.spheres)),
@@ -32,7 +32,7 @@ DeviceScene::DeviceScene(const cl_util::Context& ctx, const PackedScene& p)
       texels(make_buffer(ctx, p.texels)) {}
 
 int DeviceScene::set_args(cl::Kernel& kernel, int arg) const {
-  for (const cl::Buffer* b : {&params, &nodes, &prim_refs, &triangles, &tri_attrs, &spheres, &materials,
+  for (const cl::Buffer* b : {&params, &nodes, &leaves, &triangles, &tri_attrs, &spheres, &materials,
                               &lights, &light_cdf, &textures, &texels})
     kernel.setArg(arg++, *b);
   return arg;

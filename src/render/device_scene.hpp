@@ -1,6 +1,6 @@
 #pragma once
 // A packed scene's buffers on an OpenCL device, in the argument order of every kernel that takes
-// a scene: params, nodes, prim_refs, triangles, tri_attrs, spheres, materials, lights,
+// a scene: params, nodes, leaves, triangles, tri_attrs, spheres, materials, lights,
 // light_cdf, textures, texels (kernels/megakernel.cl, kernels/test/*_probe.cl).
 #include "cl/context.hpp"
 #include "render/pack.hpp"
@@ -9,7 +9,7 @@ namespace lucent::render_detail {
 
 struct DeviceScene {
   static constexpr int kArgCount = 11;
-  cl::Buffer params, nodes, prim_refs, triangles, tri_attrs, spheres, materials, lights, light_cdf,
+  cl::Buffer params, nodes, leaves, triangles, tri_attrs, spheres, materials, lights, light_cdf,
       textures, texels;
 
   /// Creates the buffers with their contents (copied at creation).

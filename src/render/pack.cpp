@@ -188,8 +188,8 @@ PackedScene pack_scene(const Scene& scene) {
   // Selection probabilities change only the variance, never the expected value.
   double radius = 1;
   if (!p.bvh.nodes.empty()) {
-    const lc_bvh_node& r = p.bvh.nodes[0];
-    glm::dvec3 d(r.bmax[0] - r.bmin[0], r.bmax[1] - r.bmin[1], r.bmax[2] - r.bmin[2]);
+    const float *lo = p.bvh.bmin, *hi = p.bvh.bmax;
+    glm::dvec3 d(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
     radius = std::max(1e-6, 0.5 * glm::length(d));
   }
   double view = glm::length(scene.camera.look_at - scene.camera.position);

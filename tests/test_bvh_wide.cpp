@@ -1,0 +1,343 @@
+// The collapse of the binary SAH tree into wide nodes and leaf blocks (src/bvh/bvh_wide.cpp),
+// checked by an independent walk of the result: every node reached once, every primitive in
+// exactly one leaf block column with its triangle's vertices, every child box containing its
+// whole subtree, unused slots empty, and node count, depth (the kernel's stack bound) and
+// statistics consistent. Traversal agreement with a brute force is in test_bvh_trace.cpp.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "bvh/bvh.hpp"
+#include "bvh/test_meshes.hpp"
+
+namespace {
+
+using lucent::bvh::BuildOptions;
+using lucent::bvh::Bvh;
+
+struct Box {
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  void grow(const Box& b) {
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], b.lo[a]), hi[a] = std::max(hi[a], b.hi[a]);
+  }
+};
+
+Box prim_box(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& spheres,
+             lc_uint ref) {
+  Box b;
+  if (ref & LC_PRIM_SPHERE_BIT) {
+    const lc_sphere& s = spheres[ref & ~LC_PRIM_SPHERE_BIT];
+    for (int a = 0; a < 3; ++a) b.lo[a] = s.center[a] - s.radius, b.hi[a] = s.center[a] + s.radius;
+    return b;
+  }
+  const lc_triangle& t = tris[ref];
+  for (int a = 0; a < 3; ++a) {
+    b.lo[a] = std::min({t.v0[a], t.v1[a], t.v2[a]});
+    b.hi[a] = std::max({t.v0[a], t.v1[a], t.v2[a]});
+  }
+  return b;
+}
+
+struct WideStats {
+  std::size_t nodes = 0, leaves = 0, depth = 0, used_slots = 0, mixed_blocks = 0;
+};
+
+class Checker {
+ public:
+  Checker(const Bvh& b, const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& spheres,
+          int max_leaf)
+      : b_(b), tris_(tris), spheres_(spheres), max_leaf_(max_leaf) {}
+
+  WideStats run() {
+    const std::size_t n = tris_.size() + spheres_.size();
+    WideStats st;
+    EXPECT_EQ(b_.stats.primitives, n);
+    if (n == 0) {
+      EXPECT_TRUE(b_.nodes.empty());
+      EXPECT_TRUE(b_.leaves.empty());
+      return st;
+    }
+    if (b_.nodes.empty()) {
+      ADD_FAILURE() << "no node for " << n << " primitives";
+      return st;
+    }
+    visited_.assign(b_.nodes.size(), 0);
+    block_used_.assign(b_.leaves.size(), 0);
+    seen_tri_.assign(tris_.size(), 0);
+    seen_sphere_.assign(spheres_.size(), 0);
+    Box all = node(0, 1, st);
+    for (std::size_t i = 0; i < visited_.size(); ++i)
+      EXPECT_EQ(visited_[i], 1) << "node " << i << " reached " << visited_[i] << " times";
+    for (std::size_t i = 0; i < block_used_.size(); ++i)
+      EXPECT_EQ(block_used_[i], 1) << "leaf block " << i << " used " << block_used_[i] << " times";
+    for (std::size_t i = 0; i < tris_.size(); ++i)
+      EXPECT_EQ(seen_tri_[i], 1) << "triangle " << i;
+    for (std::size_t i = 0; i < spheres_.size(); ++i)
+      EXPECT_EQ(seen_sphere_[i], 1) << "sphere " << i;
+    for (int a = 0; a < 3; ++a) {  // the scene bounds the Bvh reports
+      EXPECT_EQ(b_.bmin[a], all.lo[a]);
+      EXPECT_EQ(b_.bmax[a], all.hi[a]);
+    }
+    st.nodes = b_.nodes.size();
+    EXPECT_EQ(b_.stats.nodes, st.nodes);
+    EXPECT_EQ(b_.stats.leaves, st.leaves);
+    EXPECT_EQ(b_.stats.max_depth, st.depth);
+    // the kernel's stack (kernels/bvh/traverse.cl) holds (width - 1) (depth - 1) + width entries
+    EXPECT_LE(st.depth, std::size_t(LC_BVH_MAX_DEPTH));
+    EXPECT_LE(st.depth, b_.stats.binary_max_depth);
+    // a binary tree with L leaves has L - 1 interior nodes; each wide node absorbs at least one
+    // and, being full or holding only leaves, at most width - 1 of them
+    EXPECT_LE(st.nodes, std::max<std::size_t>(1, st.leaves - 1));
+    EXPECT_GE(st.nodes * (LC_BVH_WIDTH - 1) + 1, st.leaves);
+    return st;
+  }
+
+ private:
+  // Checks node `i` at depth `depth` and returns the bounds of its primitives.
+  Box node(lc_uint i, std::size_t depth, WideStats& st) {
+    Box out;
+    if (i >= b_.nodes.size()) {
+      ADD_FAILURE() << "node index " << i << " out of range";
+      return out;
+    }
+    if (visited_[i]++) return out;  // reported by run()
+    st.depth = std::max(st.depth, depth);
+    const lc_bvh_node& nd = b_.nodes[i];
+    int used = 0;
+    for (int k = 0; k < LC_BVH_WIDTH; ++k) {
+      Box box;
+      for (int a = 0; a < 3; ++a) {
+        box.lo[a] = nd.bounds[2 * a][k];
+        box.hi[a] = nd.bounds[2 * a + 1][k];
+      }
+      lc_uint c = nd.child[k];
+      if (c == LC_INVALID) {
+        for (int a = 0; a < 3; ++a)
+          EXPECT_TRUE(box.lo[a] == INFINITY && box.hi[a] == -INFINITY)
+              << "unused slot " << k << " of node " << i << " is not an empty box";
+        continue;
+      }
+      EXPECT_EQ(used, k) << "node " << i << ": used slots should come first";
+      ++used;
+      Box sub = (c & LC_BVH_LEAF_BIT) ? leaf(c, st) : node(c, depth + 1, st);
+      for (int a = 0; a < 3; ++a)
+        if (!(box.lo[a] <= sub.lo[a] && box.hi[a] >= sub.hi[a]))
+          ADD_FAILURE() << "child " << k << " of node " << i << " does not contain its subtree on "
+                        << "axis " << a;
+      out.grow(sub);
+    }
+    st.used_slots += used;
+    // the collapse stops short of LC_BVH_WIDTH children only when no child can be opened
+    if (used < LC_BVH_WIDTH) {
+      for (int k = 0; k < used; ++k) {
+        EXPECT_TRUE(nd.child[k] & LC_BVH_LEAF_BIT)
+            << "node " << i << " has " << used << " children, one of them interior";
+      }
+    }
+    EXPECT_GE(used, (i == 0 && b_.stats.leaves == 1) ? 1 : 2) << "node " << i;
+    return out;
+  }
+
+  Box leaf(lc_uint ref, WideStats& st) {
+    Box out;
+    ++st.leaves;
+    lc_uint first = ref & LC_BVH_LEAF_FIRST_MASK;
+    lc_uint blocks = ((ref & ~LC_BVH_LEAF_BIT) >> LC_BVH_LEAF_COUNT_SHIFT) + 1;
+    if (std::size_t(first) + blocks > b_.leaves.size()) {
+      ADD_FAILURE() << "leaf blocks " << first << " + " << blocks << " out of range";
+      return out;
+    }
+    lc_uint count = 0;
+    for (lc_uint k = 0; k < blocks; ++k) {
+      const lc_bvh_leaf& l = b_.leaves[first + k];
+      ++block_used_[first + k];
+      bool has_tri = false, has_sphere = false;
+      for (int j = 0; j < 4; ++j) {
+        lc_uint p = l.prim[j];
+        if (p == LC_INVALID) {
+          EXPECT_EQ(k, blocks - 1) << "only the last block of a leaf may have unused columns";
+          for (int r = 0; r < 9; ++r) EXPECT_EQ(l.v[r][j], 0.0f);
+          continue;
+        }
+        EXPECT_EQ(count, lc_uint(4 * k + j)) << "unused column before a used one";
+        ++count;
+        if (p & LC_PRIM_SPHERE_BIT) {
+          has_sphere = true;
+          lc_uint s = p & ~LC_PRIM_SPHERE_BIT;
+          if (s >= spheres_.size()) {
+            ADD_FAILURE() << "sphere " << s << " out of range";
+            continue;
+          }
+          ++seen_sphere_[s];
+          for (int r = 0; r < 9; ++r) EXPECT_EQ(l.v[r][j], 0.0f);
+        } else {
+          has_tri = true;
+          if (p >= tris_.size()) {
+            ADD_FAILURE() << "triangle " << p << " out of range";
+            continue;
+          }
+          ++seen_tri_[p];
+          const lc_triangle& t = tris_[p];
+          for (int a = 0; a < 3; ++a) {
+            EXPECT_EQ(l.v[a][j], t.v0[a]);
+            EXPECT_EQ(l.v[3 + a][j], t.v1[a]);
+            EXPECT_EQ(l.v[6 + a][j], t.v2[a]);
+          }
+        }
+        out.grow(prim_box(tris_, spheres_, p));
+      }
+      st.mixed_blocks += has_tri && has_sphere;
+    }
+    EXPECT_GE(count, 1u);
+    EXPECT_LE(count, lc_uint(max_leaf_));
+    EXPECT_EQ(blocks, (count + 3) / 4) << "a leaf fills as few blocks as it can";
+    return out;
+  }
+
+  const Bvh& b_;
+  const std::vector<lc_triangle>& tris_;
+  const std::vector<lc_sphere>& spheres_;
+  int max_leaf_;
+  std::vector<int> visited_, block_used_, seen_tri_, seen_sphere_;
+};
+
+WideStats build_and_check(const std::vector<lc_triangle>& tris,
+                          const std::vector<lc_sphere>& spheres, BuildOptions o = {}) {
+  Bvh b = lucent::bvh::build(tris, spheres, o);
+  return Checker(b, tris, spheres, o.max_leaf_size).run();
+}
+
+std::vector<lc_triangle> soup(int n, unsigned seed, float size) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0, 1), s(-size, size);
+  std::vector<lc_triangle> out;
+  for (int i = 0; i < n; ++i) {
+    lc_triangle t{};
+    float c[3] = {u(rng), u(rng), u(rng)};
+    for (int a = 0; a < 3; ++a) {
+      t.v0[a] = c[a] + s(rng);
+      t.v1[a] = c[a] + s(rng);
+      t.v2[a] = c[a] + s(rng);
+    }
+    out.push_back(t);
+  }
+  return out;
+}
+
+std::vector<lc_sphere> spheres(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0, 1), r(0.005f, 0.05f);
+  std::vector<lc_sphere> out;
+  for (int i = 0; i < n; ++i) {
+    lc_sphere s{};
+    s.center[0] = u(rng), s.center[1] = u(rng), s.center[2] = u(rng);
+    s.radius = r(rng);
+    out.push_back(s);
+  }
+  return out;
+}
+
+TEST(BvhWide, EmptyAndSinglePrimitive) {
+  build_and_check({}, {});
+  WideStats one = build_and_check(soup(1, 1, 0.1f), {});
+  EXPECT_EQ(one.nodes, 1u);  // a root whose only child is the leaf
+  EXPECT_EQ(one.leaves, 1u);
+  EXPECT_EQ(one.used_slots, 1u);
+  build_and_check({}, spheres(1, 2));
+  build_and_check(soup(3, 3, 0.1f), {});  // one leaf
+}
+
+TEST(BvhWide, SoupSpheresAndMixedBlocks) {
+  build_and_check(soup(5000, 4, 0.05f), {});
+  build_and_check({}, spheres(3000, 5));
+  // spheres and triangles around the same points end up in the same leaf blocks
+  WideStats mix = build_and_check(soup(2000, 6, 0.02f), spheres(2000, 6));
+  EXPECT_GT(mix.mixed_blocks, 0u) << "no block mixes spheres and triangles: the test is void";
+}
+
+TEST(BvhWide, ClosedMeshesFillTheNodes) {
+  auto torus = lucent::bvh::meshes::torus(300, 100, 1.0f, 0.3f, 0.2f).triangles();
+  WideStats st = build_and_check(torus, {});
+  // nodes are full but those just above the leaves (on average 3.1 of 4 or 4.4 of 8 children
+  // per node here)
+  EXPECT_GT(double(st.used_slots) / double(st.nodes), 0.5 * LC_BVH_WIDTH);
+  build_and_check(lucent::bvh::meshes::icosphere(5).triangles(), {});
+}
+
+TEST(BvhWide, LeafSizes) {
+  auto t = soup(3000, 7, 0.05f);
+  auto s = spheres(300, 8);
+  for (int leaf : {1, 2, 5, 8, 16}) {
+    BuildOptions o;
+    o.max_leaf_size = leaf;
+    build_and_check(t, s, o);
+    o.leaf_block = 1;
+    build_and_check(t, s, o);
+  }
+}
+
+// Degenerate inputs: equal centroids (median splits), zero-extent boxes, and exponentially
+// spaced primitives whose binary tree is as deep as the builder allows.
+TEST(BvhWide, DegenerateInputs) {
+  std::vector<lc_triangle> nested;
+  for (int i = 0; i < 1000; ++i) {
+    float s = 1.0f + i * 0.001f;
+    lc_triangle t{};
+    t.v0[0] = -s, t.v0[1] = -s, t.v1[0] = 2 * s, t.v1[1] = -s, t.v2[0] = -s, t.v2[1] = 2 * s;
+    nested.push_back(t);
+  }
+  build_and_check(nested, {});
+  std::vector<lc_triangle> points(100);
+  for (auto& p : points) p.v0[0] = p.v1[0] = p.v2[0] = 1;
+  build_and_check(points, {});
+  std::vector<lc_triangle> expo;
+  for (int k = -22; k <= 22; ++k)
+    for (int a = 0; a < 3; ++a) {
+      float x = std::pow(40.0f, float(k));
+      lc_triangle tr{};
+      tr.v0[a] = x, tr.v1[a] = x * 1.1f, tr.v2[a] = x;
+      tr.v1[(a + 1) % 3] = x * 0.1f, tr.v2[(a + 2) % 3] = x * 0.1f;
+      expo.push_back(tr);
+    }
+  for (int leaf : {1, 4}) {
+    BuildOptions o;
+    o.max_leaf_size = leaf;
+    build_and_check(expo, {}, o);
+  }
+}
+
+// reorder_triangles on the wide tree: the blocks' references follow the triangles, their
+// vertices stay those of the same triangles.
+TEST(BvhWide, ReorderTrianglesKeepsTheBlocksConsistent) {
+  auto t = soup(3000, 9, 0.05f);
+  auto s = spheres(500, 10);
+  Bvh b = lucent::bvh::build(t, s);
+  std::vector<lc_triangle> moved = t;
+  std::vector<lc_uint> new_to_old = lucent::bvh::reorder_triangles(b, moved);
+  ASSERT_EQ(new_to_old.size(), t.size());
+  Checker(b, moved, s, 4).run();
+  // leaf order: the blocks, walked in order, reference the triangles 0, 1, 2, ...
+  lc_uint next = 0;
+  for (const lc_bvh_leaf& l : b.leaves)
+    for (lc_uint p : l.prim)
+      if (!(p & LC_PRIM_SPHERE_BIT)) {
+        EXPECT_EQ(p, next++);
+      }
+}
+
+// The SAH counts leaf cost in blocks of leaf_block primitives: with blocks of 4 the leaves are
+// fuller than with the classic per-primitive cost, on the same triangles.
+TEST(BvhWide, BlockCostFillsLeaves) {
+  auto t = lucent::bvh::meshes::torus(200, 100, 1.0f, 0.3f, 0.2f).triangles();
+  BuildOptions classic;
+  classic.leaf_block = 1;
+  Bvh a = lucent::bvh::build(t, {}, classic), b = lucent::bvh::build(t, {});
+  EXPECT_GT(b.stats.mean_leaf_size, a.stats.mean_leaf_size + 0.5);
+  EXPECT_LT(b.leaves.size(), a.leaves.size());
+}
+
+}  // namespace
