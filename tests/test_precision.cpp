@@ -23,6 +23,7 @@
 #include "lucent/error.hpp"
 #include "lucent/reference.hpp"
 #include "render/pack.hpp"
+#include "stability_scene.hpp"
 #include "support.hpp"
 
 namespace {
@@ -328,7 +329,6 @@ TEST(PrecisionTranslateLight, FloatAt1e5FailsTheSameTest) {
   EXPECT_FALSE(cmp.passed) << cmp.summary();
 }
 
-
 // The scene of tests/test_stability_scene.cpp (floor, two spheres, a standing triangle, a rotated
 // box mesh of 12 triangles, a point light and a sphere lamp; objects 0.3-6 in size), translated
 // by 1e5 on every axis, renders ~3% too bright in float (BENCHMARKS.md, "Precision"). In double it
@@ -336,57 +336,14 @@ TEST(PrecisionTranslateLight, FloatAt1e5FailsTheSameTest) {
 // in both precisions, so every coordinate x becomes float(x + 1e5) - 1e5 (up to 0.004 off); the
 // reference is that rounded scene at the origin, where float arithmetic is exact enough (the
 // scale tests). Two-sample z-test (see the top); and float fails the same test (its 3%).
-std::string base_scene_json() {
-  std::string pos;
-  const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
-  for (int i = 0; i < 8; ++i) {
-    double x = (i & 1) ? 0.25 : -0.25, y = (i & 2) ? 0.5 : 0.0, z = (i & 4) ? 0.25 : -0.25;
-    char buf[128];
-    std::snprintf(buf, sizeof buf, "%s[%.17g, %.17g, %.17g]", i ? ", " : "", c * x + s * z, y,
-                  -s * x + c * z + 1.25);
-    pos += buf;
-  }
-  return R"({
-    "camera": {"position": [0, 1.2, 5], "look_at": [0, 0.4, 0], "fov": 38},
-    "film": {"width": 24, "height": 24},
-    "integrator": {"type": "path", "max_depth": 4},
-    "materials": {"floor": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
-                  "red": {"type": "diffuse", "albedo": [0.8, 0.25, 0.2]},
-                  "blue": {"type": "diffuse", "albedo": [0.2, 0.3, 0.8]},
-                  "green": {"type": "diffuse", "albedo": [0.3, 0.7, 0.3]},
-                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [6, 5, 4]}},
-    "shapes": [{"type": "triangles", "material": "floor",
-                "positions": [[-3,0,-3],[3,0,-3],[3,0,3],[-3,0,3]], "indices": [0,2,1, 0,3,2]},
-               {"type": "sphere", "center": [-0.8, 0.6, 0], "radius": 0.6, "material": "red"},
-               {"type": "sphere", "center": [0.9, 0.5, 0.4], "radius": 0.5, "material": "blue"},
-               {"type": "triangles", "material": "blue",
-                "positions": [[-2,0,-1.5],[2,0,-1.5],[0,2,-1.8]], "indices": [0,1,2]},
-               {"type": "triangles", "material": "green", "positions": [)" +
-         pos + R"(],
-                "indices": [0,2,3, 0,3,1, 4,5,7, 4,7,6, 0,1,5, 0,5,4, 2,6,7, 2,7,3,
-                            0,4,6, 0,6,2, 1,3,7, 1,7,5]},
-               {"type": "sphere", "center": [1.2, 2.2, 1.0], "radius": 0.3, "material": "lamp"}],
-    "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [30, 28, 25]}]
-  })";
-}
-
-// Every position p -> f(p) (camera position and look_at, vertices, sphere centres, lights).
-Scene moved(Scene scene, const std::function<dvec3(dvec3)>& f) {
-  scene.camera.position = f(scene.camera.position);
-  scene.camera.look_at = f(scene.camera.look_at);
-  for (auto& p : scene.positions) p = f(p);
-  for (auto& sp : scene.spheres) sp.center = f(sp.center);
-  for (auto& l : scene.lights) l.position = f(l.position);
-  return scene;
-}
-
 TEST(PrecisionTranslateScene, DoubleAt1e5MatchesTheStoredSceneAtOrigin) {
   REQUIRE_FP64();
   const double t = 1e5;
-  Scene base = scene_from(base_scene_json());
-  Scene far = moved(base, [&](dvec3 p) { return p + dvec3(t); });
+  Scene base = scene_from(lucent::test::stability_scene_json());
+  Scene far = lucent::test::map_positions(base, [&](dvec3 p) { return p + dvec3(t); });
   auto f32 = [&](double v) { return double(static_cast<float>(v + t)) - t; };
-  Scene stored = moved(base, [&](dvec3 p) { return dvec3(f32(p.x), f32(p.y), f32(p.z)); });
+  Scene stored = lucent::test::map_positions(
+      base, [&](dvec3 p) { return dvec3(f32(p.x), f32(p.y), f32(p.z)); });
   // the camera basis is computed in double from position and look_at: keep the view direction
   stored.camera.look_at = base.camera.look_at + (stored.camera.position - base.camera.position);
   RenderResult ref = render(stored, 256, 1, Precision::Float);

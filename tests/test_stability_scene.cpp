@@ -27,6 +27,7 @@
 #include "lucent/compare.hpp"
 #include "lucent/reference.hpp"
 #include "scene/loaders.hpp"
+#include "stability_scene.hpp"
 #include "support.hpp"
 
 namespace {
@@ -81,60 +82,12 @@ void expect_matches(const RenderResult& r, const std::function<double(int, int, 
   EXPECT_CLEAN(r);
 }
 
-// ------------------------------------------------------------------------------------------
-// The small test scene: a floor quad, two diffuse spheres, a standing triangle, a closed box mesh
-// (12 triangles, rotated), a point light and an emissive sphere (out of view), path integrator.
-
-std::string base_scene_json() {
-  // box: 0.5 x 0.5 x 0.5 standing on the floor at (0, 0, 1.25), rotated 30 degrees about y
-  std::string pos;
-  const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
-  for (int i = 0; i < 8; ++i) {
-    double x = (i & 1) ? 0.25 : -0.25, y = (i & 2) ? 0.5 : 0.0, z = (i & 4) ? 0.25 : -0.25;
-    char buf[128];
-    std::snprintf(buf, sizeof buf, "%s[%.17g, %.17g, %.17g]", i ? ", " : "", c * x + s * z, y,
-                  -s * x + c * z + 1.25);
-    pos += buf;
-  }
-  return R"({
-    "camera": {"position": [0, 1.2, 5], "look_at": [0, 0.4, 0], "fov": 38},
-    "film": {"width": 24, "height": 24},
-    "integrator": {"type": "path", "max_depth": 4},
-    "materials": {"floor": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
-                  "red": {"type": "diffuse", "albedo": [0.8, 0.25, 0.2]},
-                  "blue": {"type": "diffuse", "albedo": [0.2, 0.3, 0.8]},
-                  "green": {"type": "diffuse", "albedo": [0.3, 0.7, 0.3]},
-                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [6, 5, 4]}},
-    "shapes": [{"type": "triangles", "material": "floor",
-                "positions": [[-3,0,-3],[3,0,-3],[3,0,3],[-3,0,3]], "indices": [0,2,1, 0,3,2]},
-               {"type": "sphere", "center": [-0.8, 0.6, 0], "radius": 0.6, "material": "red"},
-               {"type": "sphere", "center": [0.9, 0.5, 0.4], "radius": 0.5, "material": "blue"},
-               {"type": "triangles", "material": "blue",
-                "positions": [[-2,0,-1.5],[2,0,-1.5],[0,2,-1.8]], "indices": [0,1,2]},
-               {"type": "triangles", "material": "green", "positions": [)" +
-         pos + R"(],
-                "indices": [0,2,3, 0,3,1, 4,5,7, 4,7,6, 0,1,5, 0,5,4, 2,6,7, 2,7,3,
-                            0,4,6, 0,6,2, 1,3,7, 1,7,5]},
-               {"type": "sphere", "center": [1.2, 2.2, 1.0], "radius": 0.3, "material": "lamp"}],
-    "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [30, 28, 25]}]
-  })";
-}
-
 // x -> s x + t for every position (camera, shapes, lights); radii scale by s and point
 // intensities by s^2, so that the image is unchanged (emitted radiance is scale-free).
 Scene transformed(Scene scene, double s, dvec3 t) {
-  auto f = [&](dvec3 p) { return s * p + t; };
-  scene.camera.position = f(scene.camera.position);
-  scene.camera.look_at = f(scene.camera.look_at);
-  for (auto& p : scene.positions) p = f(p);
-  for (auto& sp : scene.spheres) {
-    sp.center = f(sp.center);
-    sp.radius *= s;
-  }
-  for (auto& l : scene.lights) {
-    l.position = f(l.position);
-    l.intensity *= s * s;
-  }
+  scene = lucent::test::map_positions(scene, [&](dvec3 p) { return s * p + t; });
+  for (auto& sp : scene.spheres) sp.radius *= s;
+  for (auto& l : scene.lights) l.intensity *= s * s;
   return scene;
 }
 
@@ -150,9 +103,9 @@ std::string exp_name(double v) {
 class StabilityScale : public ::testing::TestWithParam<double> {};
 
 TEST_P(StabilityScale, SameImageAsUnitScene) {
-  static const RenderResult unit = render(scene_from(base_scene_json()), kSpp, 1);
+  static const RenderResult unit = render(scene_from(lucent::test::stability_scene_json()), kSpp, 1);
   const double s = GetParam();
-  RenderResult r = render(transformed(scene_from(base_scene_json()), s, dvec3(0)), kSpp, 2);
+  RenderResult r = render(transformed(scene_from(lucent::test::stability_scene_json()), s, dvec3(0)), kSpp, 2);
   EXPECT_SAME_IMAGE(r, unit, "A = scaled by " << s << ", B = unit scene");
 }
 
@@ -163,7 +116,7 @@ INSTANTIATE_TEST_SUITE_P(Scales, StabilityScale, ::testing::Values(1e-4, 1e-2, 1
 
 // Negative control: the comparison above sees a 5% change of the point light's intensity.
 TEST(StabilityScale, NegativeControlBrighterPointLight) {
-  Scene a = scene_from(base_scene_json());
+  Scene a = scene_from(lucent::test::stability_scene_json());
   Scene b = a;
   b.lights[0].intensity *= 1.05;
   CompareResult cmp = lucent::compare_images(render(a, kSpp, 1), render(b, kSpp, 2));
@@ -178,9 +131,9 @@ class StabilityTranslate : public ::testing::TestWithParam<double> {};
 TEST_P(StabilityTranslate, SameImageAsAtOrigin) {
   const double s = 20;
   static const RenderResult at_origin =
-      render(transformed(scene_from(base_scene_json()), s, dvec3(0)), kSpp, 1);
+      render(transformed(scene_from(lucent::test::stability_scene_json()), s, dvec3(0)), kSpp, 1);
   const double t = GetParam();
-  RenderResult r = render(transformed(scene_from(base_scene_json()), s, dvec3(t)), kSpp, 2);
+  RenderResult r = render(transformed(scene_from(lucent::test::stability_scene_json()), s, dvec3(t)), kSpp, 2);
   EXPECT_SAME_IMAGE(r, at_origin, "A = translated by " << t << ", B = at the origin");
 }
 
@@ -282,7 +235,7 @@ TEST(StabilityTranslateLight, SphereLightOverPlaneAt1e4) {
 using lucent::test::CaptureWarnings;
 
 TEST(StabilityInput, DegenerateAndNonFiniteTrianglesAreSkipped) {
-  Scene clean = scene_from(base_scene_json());
+  Scene clean = scene_from(lucent::test::stability_scene_json());
   Scene dirty = clean;
   const double nan = std::nan(""), inf = INFINITY;
   const int green = dirty.find_material("green"), lamp = dirty.find_material("lamp");
@@ -326,7 +279,7 @@ TEST(StabilityInput, DegenerateAndNonFiniteTrianglesAreSkipped) {
 // non-finite numbers) are never hit: no crash, no NaN, the image of the scene without them (same
 // seed: bit for bit). pack_scene gives no warning for them (it does for triangles).
 TEST(StabilityInput, NonFiniteSpheresAreNeverHit) {
-  Scene clean = scene_from(base_scene_json());
+  Scene clean = scene_from(lucent::test::stability_scene_json());
   Scene dirty = clean;
   lucent::Sphere sp;
   sp.center = dvec3(std::nan(""), 0, 0);
@@ -346,7 +299,7 @@ TEST(StabilityInput, NonFiniteSpheresAreNeverHit) {
 // be chosen for about half of the light samples, it must neither produce NaN nor change the
 // expected image: two-sample z-test against the scene without it (see the top).
 TEST(StabilityInput, EmitterDegenerateOnlyInFloat) {
-  Scene clean = scene_from(base_scene_json());
+  Scene clean = scene_from(lucent::test::stability_scene_json());
   Scene dirty = clean;
   lucent::Material hot;
   hot.name = "hot";
@@ -484,12 +437,12 @@ TEST(StabilityLight, TinyBrightSphereMatchesLargerSphere) {
 // The same tiny sphere in the full test scene (shadows, interreflection) matches a point light
 // of the same intensity, I = pi r^2 L.
 TEST(StabilityLight, TinyBrightSphereMatchesPointLight) {
-  Scene tiny = scene_from(base_scene_json());
+  Scene tiny = scene_from(lucent::test::stability_scene_json());
   const int lamp = tiny.find_material("lamp");
   const double r = 1e-4, scale = (0.3 / r) * (0.3 / r);
   tiny.materials[lamp].emission *= scale;
   tiny.spheres.back().radius = r;
-  Scene point = scene_from(base_scene_json());
+  Scene point = scene_from(lucent::test::stability_scene_json());
   lucent::Light l;
   l.type = lucent::LightType::Point;
   l.position = point.spheres.back().center;
