@@ -29,30 +29,8 @@ lc_triangle tri(float ax, float ay, float az, float bx, float by, float bz, floa
   return t;
 }
 
-std::vector<lc_triangle> random_soup(int n, unsigned seed, float size = 0.05f) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0, 1), s(-size, size);
-  std::vector<lc_triangle> out;
-  for (int i = 0; i < n; ++i) {
-    float x = u(rng), y = u(rng), z = u(rng);
-    out.push_back(tri(x + s(rng), y + s(rng), z + s(rng), x + s(rng), y + s(rng), z + s(rng),
-                      x + s(rng), y + s(rng), z + s(rng)));
-  }
-  return out;
-}
-
-std::vector<lc_sphere> random_spheres(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0, 1), r(0.005f, 0.05f);
-  std::vector<lc_sphere> out;
-  for (int i = 0; i < n; ++i) {
-    lc_sphere s{};
-    s.center[0] = u(rng), s.center[1] = u(rng), s.center[2] = u(rng);
-    s.radius = r(rng);
-    out.push_back(s);
-  }
-  return out;
-}
+using lucent::bvh::meshes::random_soup;
+using lucent::bvh::meshes::random_spheres;
 
 // The bounds of primitive `ref`, computed here.
 void prim_box(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& spheres,

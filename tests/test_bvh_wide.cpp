@@ -211,51 +211,24 @@ WideStats build_and_check(const std::vector<lc_triangle>& tris,
   return Checker(b, tris, spheres, o.max_leaf_size).run();
 }
 
-std::vector<lc_triangle> soup(int n, unsigned seed, float size) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0, 1), s(-size, size);
-  std::vector<lc_triangle> out;
-  for (int i = 0; i < n; ++i) {
-    lc_triangle t{};
-    float c[3] = {u(rng), u(rng), u(rng)};
-    for (int a = 0; a < 3; ++a) {
-      t.v0[a] = c[a] + s(rng);
-      t.v1[a] = c[a] + s(rng);
-      t.v2[a] = c[a] + s(rng);
-    }
-    out.push_back(t);
-  }
-  return out;
-}
-
-std::vector<lc_sphere> spheres(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0, 1), r(0.005f, 0.05f);
-  std::vector<lc_sphere> out;
-  for (int i = 0; i < n; ++i) {
-    lc_sphere s{};
-    s.center[0] = u(rng), s.center[1] = u(rng), s.center[2] = u(rng);
-    s.radius = r(rng);
-    out.push_back(s);
-  }
-  return out;
-}
+using lucent::bvh::meshes::random_soup;
+using lucent::bvh::meshes::random_spheres;
 
 TEST(BvhWide, EmptyAndSinglePrimitive) {
   build_and_check({}, {});
-  WideStats one = build_and_check(soup(1, 1, 0.1f), {});
+  WideStats one = build_and_check(random_soup(1, 1, 0.1f), {});
   EXPECT_EQ(one.nodes, 1u);  // a root whose only child is the leaf
   EXPECT_EQ(one.leaves, 1u);
   EXPECT_EQ(one.used_slots, 1u);
-  build_and_check({}, spheres(1, 2));
-  build_and_check(soup(3, 3, 0.1f), {});  // one leaf
+  build_and_check({}, random_spheres(1, 2));
+  build_and_check(random_soup(3, 3, 0.1f), {});  // one leaf
 }
 
 TEST(BvhWide, SoupSpheresAndMixedBlocks) {
-  build_and_check(soup(5000, 4, 0.05f), {});
-  build_and_check({}, spheres(3000, 5));
+  build_and_check(random_soup(5000, 4, 0.05f), {});
+  build_and_check({}, random_spheres(3000, 5));
   // spheres and triangles around the same points end up in the same leaf blocks
-  WideStats mix = build_and_check(soup(2000, 6, 0.02f), spheres(2000, 6));
+  WideStats mix = build_and_check(random_soup(2000, 6, 0.02f), random_spheres(2000, 6));
   EXPECT_GT(mix.mixed_blocks, 0u) << "no block mixes spheres and triangles: the test is void";
 }
 
@@ -269,8 +242,8 @@ TEST(BvhWide, ClosedMeshesFillTheNodes) {
 }
 
 TEST(BvhWide, LeafSizes) {
-  auto t = soup(3000, 7, 0.05f);
-  auto s = spheres(300, 8);
+  auto t = random_soup(3000, 7, 0.05f);
+  auto s = random_spheres(300, 8);
   for (int leaf : {1, 2, 5, 8, 16}) {
     BuildOptions o;
     o.max_leaf_size = leaf;
@@ -313,8 +286,8 @@ TEST(BvhWide, DegenerateInputs) {
 // reorder_triangles on the wide tree: the blocks' references follow the triangles, their
 // vertices stay those of the same triangles.
 TEST(BvhWide, ReorderTrianglesKeepsTheBlocksConsistent) {
-  auto t = soup(3000, 9, 0.05f);
-  auto s = spheres(500, 10);
+  auto t = random_soup(3000, 9, 0.05f);
+  auto s = random_spheres(500, 10);
   Bvh b = lucent::bvh::build(t, s);
   std::vector<lc_triangle> moved = t;
   std::vector<lc_uint> new_to_old = lucent::bvh::reorder_triangles(b, moved);

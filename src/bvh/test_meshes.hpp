@@ -1,9 +1,11 @@
 #pragma once
 // Generated meshes for the BVH tests and the benchmark: closed, shared-vertex triangle meshes
-// (every edge belongs to exactly two triangles), as lc_triangle arrays.
+// (every edge belongs to exactly two triangles), as lc_triangle arrays; and random triangle soups
+// and sphere sets.
 #include <array>
 #include <cmath>
 #include <map>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -106,6 +108,38 @@ inline IndexedMesh torus(int nu, int nv, float major = 1.0f, float minor = 0.3f,
       m.faces.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
     }
   return m;
+}
+
+/// n small triangles at uniform random points of the unit cube, vertices within +-size of them.
+inline std::vector<lc_triangle> random_soup(int n, unsigned seed, float size = 0.05f) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0, 1), s(-size, size);
+  std::vector<lc_triangle> out;
+  for (int i = 0; i < n; ++i) {
+    lc_triangle t{};
+    float c[3] = {u(rng), u(rng), u(rng)};
+    for (int a = 0; a < 3; ++a) {
+      t.v0[a] = c[a] + s(rng);
+      t.v1[a] = c[a] + s(rng);
+      t.v2[a] = c[a] + s(rng);
+    }
+    out.push_back(t);
+  }
+  return out;
+}
+
+/// n spheres of radius 0.005-0.05 at uniform random points of the unit cube.
+inline std::vector<lc_sphere> random_spheres(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0, 1), r(0.005f, 0.05f);
+  std::vector<lc_sphere> out;
+  for (int i = 0; i < n; ++i) {
+    lc_sphere s{};
+    s.center[0] = u(rng), s.center[1] = u(rng), s.center[2] = u(rng);
+    s.radius = r(rng);
+    out.push_back(s);
+  }
+  return out;
 }
 
 }  // namespace lucent::bvh::meshes
