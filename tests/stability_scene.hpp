@@ -1,5 +1,5 @@
-// The small scene of the stability and precision tests (tests/test_stability_scene.cpp,
-// tests/test_precision.cpp), and moving its positions.
+// The small scenes of the stability and precision tests (tests/test_stability_scene.cpp,
+// tests/test_precision.cpp), and moving their positions.
 #pragma once
 
 #include <cmath>
@@ -49,6 +49,27 @@ inline std::string stability_scene_json() {
                {"type": "sphere", "center": [1.2, 2.2, 1.0], "radius": 0.3, "material": "lamp"}],
     "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [30, 28, 25]}]
   })";
+}
+
+// A diffuse plane (z = t, 10 x 10) lit only by an emissive sphere (radius 0.5) centred at
+// t + (lamp_x, lamp_y, 2), seen from above by a 16 x 16 camera; every coordinate offset by t.
+inline std::string sphere_light_over_plane_json(double t, double lamp_x, double lamp_y) {
+  char buf[2048];
+  std::snprintf(buf, sizeof buf, R"({
+      "camera": {"position": [%.17g, %.17g, %.17g], "look_at": [%.17g, %.17g, %.17g],
+                 "up": [0, 0, 1], "fov": 40},
+      "film": {"width": 16, "height": 16},
+      "integrator": {"type": "path", "max_depth": 2},
+      "materials": {"plane": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
+                    "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [4, 4, 4]}},
+      "shapes": [{"type": "triangles", "material": "plane",
+                  "positions": [[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],
+                                [%.17g,%.17g,%.17g]], "indices": [0,1,2, 0,2,3]},
+                 {"type": "sphere", "center": [%.17g, %.17g, %.17g], "radius": 0.5,
+                  "material": "lamp"}]})",
+                t, t - 3, t + 1, t, t, t, t - 5, t - 5, t, t + 5, t - 5, t, t + 5, t + 5, t, t - 5,
+                t + 5, t, t + lamp_x, t + lamp_y, t + 2);
+  return buf;
 }
 
 // Every position p -> f(p): camera position and look_at, vertices, sphere centres, lights.

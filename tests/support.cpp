@@ -80,8 +80,12 @@ std::string shared_asset(const std::string& rel) {
   return fs::exists(p) ? p : std::string();
 }
 
+Scene scene_from(const std::string& json) {
+  return parse_scene(json, temp_dir() + "/scene.json");
+}
+
 RenderResult render_json(const std::string& json, int spp) {
-  Scene scene = parse_scene(json, temp_dir() + "/scene.json");
+  Scene scene = scene_from(json);
   RenderOptions opt;
   opt.spp = spp;
   return render(scene, opt);

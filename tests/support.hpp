@@ -30,6 +30,9 @@ std::string source_path(const std::string& rel);
 /// ../shared/assets/<rel> beside the project, or "" when ../shared is absent.
 std::string shared_asset(const std::string& rel);
 
+/// Parses a JSON scene held in memory (relative file names resolve against a temporary directory).
+Scene scene_from(const std::string& json);
+
 /// Renders a JSON scene held in memory with `spp` samples per pixel.
 RenderResult render_json(const std::string& json, int spp);
 

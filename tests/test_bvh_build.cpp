@@ -228,15 +228,7 @@ TEST(BvhBuild, ZeroExtentBoxes) {
 // splits peel off a few primitives per level: the tree stays valid and within the 64 levels of
 // the kernel's traversal stack (the builder falls back to median splits near that depth).
 TEST(BvhBuild, ExponentialSpacingStaysWithinTheKernelStack) {
-  std::vector<lc_triangle> t;
-  for (int k = -22; k <= 22; ++k)
-    for (int a = 0; a < 3; ++a) {
-      float x = std::pow(40.0f, float(k));
-      lc_triangle tr{};
-      tr.v0[a] = x, tr.v1[a] = x * 1.1f, tr.v2[a] = x;
-      tr.v1[(a + 1) % 3] = x * 0.1f, tr.v2[(a + 2) % 3] = x * 0.1f;
-      t.push_back(tr);
-    }
+  std::vector<lc_triangle> t = lucent::bvh::meshes::exponential_spacing();
   for (int leaf : {1, 4}) {
     BuildOptions o;
     o.max_leaf_size = leaf;

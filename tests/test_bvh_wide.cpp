@@ -267,15 +267,7 @@ TEST(BvhWide, DegenerateInputs) {
   std::vector<lc_triangle> points(100);
   for (auto& p : points) p.v0[0] = p.v1[0] = p.v2[0] = 1;
   build_and_check(points, {});
-  std::vector<lc_triangle> expo;
-  for (int k = -22; k <= 22; ++k)
-    for (int a = 0; a < 3; ++a) {
-      float x = std::pow(40.0f, float(k));
-      lc_triangle tr{};
-      tr.v0[a] = x, tr.v1[a] = x * 1.1f, tr.v2[a] = x;
-      tr.v1[(a + 1) % 3] = x * 0.1f, tr.v2[(a + 2) % 3] = x * 0.1f;
-      expo.push_back(tr);
-    }
+  std::vector<lc_triangle> expo = lucent::bvh::meshes::exponential_spacing();
   for (int leaf : {1, 4}) {
     BuildOptions o;
     o.max_leaf_size = leaf;

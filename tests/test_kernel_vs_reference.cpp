@@ -28,9 +28,7 @@ struct Both {
   CompareResult cmp;
 };
 
-Scene scene_from(const std::string& json) {
-  return lucent::parse_scene(json, lucent::test::temp_dir() + "/scene.json");
-}
+using lucent::test::scene_from;
 
 Both render_both(Scene scene, int spp, const CompareOptions& options = {}) {
   Both b;

@@ -34,9 +34,7 @@ using lucent::Precision;
 using lucent::RenderResult;
 using lucent::Scene;
 
-Scene scene_from(const std::string& json) {
-  return lucent::parse_scene(json, lucent::test::temp_dir() + "/scene.json");
-}
+using lucent::test::scene_from;
 
 bool device_has_fp64() {
   static const bool fp64 = lucent::select_device().fp64;
@@ -283,22 +281,7 @@ TEST(PrecisionDouble, WhittedMatchesReference) {
 // so the device buffers (float in both precisions) hold the same scene at every t and only the
 // arithmetic differs.
 Scene sphere_light_over_plane(double t) {
-  char buf[2048];
-  std::snprintf(buf, sizeof buf, R"({
-      "camera": {"position": [%.17g, %.17g, %.17g], "look_at": [%.17g, %.17g, %.17g],
-                 "up": [0, 0, 1], "fov": 40},
-      "film": {"width": 16, "height": 16},
-      "integrator": {"type": "path", "max_depth": 2},
-      "materials": {"plane": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
-                    "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [4, 4, 4]}},
-      "shapes": [{"type": "triangles", "material": "plane",
-                  "positions": [[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],
-                                [%.17g,%.17g,%.17g]], "indices": [0,1,2, 0,2,3]},
-                 {"type": "sphere", "center": [%.17g, %.17g, %.17g], "radius": 0.5,
-                  "material": "lamp"}]})",
-                t, t - 3, t + 1, t, t, t, t - 5, t - 5, t, t + 5, t - 5, t, t + 5, t + 5, t, t - 5,
-                t + 5, t, t + 0.25, t + 0.125, t + 2);
-  return scene_from(buf);
+  return scene_from(lucent::test::sphere_light_over_plane_json(t, 0.25, 0.125));
 }
 
 // In float the scene at 1e4 renders ~1% brighter than at the origin (the spawned origin leaves

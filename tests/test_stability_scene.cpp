@@ -37,9 +37,7 @@ using lucent::CompareResult;
 using lucent::RenderResult;
 using lucent::Scene;
 
-Scene scene_from(const std::string& json) {
-  return lucent::parse_scene(json, lucent::test::temp_dir() + "/scene.json");
-}
+using lucent::test::scene_from;
 
 RenderResult render(const Scene& scene, int spp, std::uint32_t seed) {
   Scene s = scene;
@@ -196,22 +194,7 @@ TEST(StabilityGrazing, DiffusePlaneAtGrazingView) {
 //   image mean within 2% of the untranslated one. (Before the fix in shadow_visible the shadow
 //   rays hit the light itself and the image was 20% too dark.)
 Scene sphere_light_over_plane(double t) {
-  char buf[2048];
-  std::snprintf(buf, sizeof buf, R"({
-      "camera": {"position": [%.17g, %.17g, %.17g], "look_at": [%.17g, %.17g, %.17g],
-                 "up": [0, 0, 1], "fov": 40},
-      "film": {"width": 16, "height": 16},
-      "integrator": {"type": "path", "max_depth": 2},
-      "materials": {"plane": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
-                    "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [4, 4, 4]}},
-      "shapes": [{"type": "triangles", "material": "plane",
-                  "positions": [[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],
-                                [%.17g,%.17g,%.17g]], "indices": [0,1,2, 0,2,3]},
-                 {"type": "sphere", "center": [%.17g, %.17g, %.17g], "radius": 0.5,
-                  "material": "lamp"}]})",
-                t, t - 3, t + 1, t, t, t, t - 5, t - 5, t, t + 5, t - 5, t, t + 5, t + 5, t, t - 5,
-                t + 5, t, t + 0.2, t + 0.1, t + 2);
-  return scene_from(buf);
+  return scene_from(lucent::test::sphere_light_over_plane_json(t, 0.2, 0.1));
 }
 
 TEST(StabilityTranslateLight, SphereLightOverPlaneAt1e3) {

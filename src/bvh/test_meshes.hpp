@@ -142,4 +142,19 @@ inline std::vector<lc_sphere> random_spheres(int n, unsigned seed) {
   return out;
 }
 
+/// 135 triangles at exponentially spaced positions 40^k, k = -22..22, along each axis in turn:
+/// binned SAH splits peel off a few primitives per level (a worst case for the tree's depth).
+inline std::vector<lc_triangle> exponential_spacing() {
+  std::vector<lc_triangle> out;
+  for (int k = -22; k <= 22; ++k)
+    for (int a = 0; a < 3; ++a) {
+      float x = std::pow(40.0f, float(k));
+      lc_triangle t{};
+      t.v0[a] = x, t.v1[a] = x * 1.1f, t.v2[a] = x;
+      t.v1[(a + 1) % 3] = x * 0.1f, t.v2[(a + 2) % 3] = x * 0.1f;
+      out.push_back(t);
+    }
+  return out;
+}
+
 }  // namespace lucent::bvh::meshes
