@@ -139,6 +139,17 @@ typedef struct {
   {params, nodes, leaves, triangles, tri_attrs, spheres, materials, lights, light_cdf,     \
    textures, texels}
 
+/* An lc_scene holding only the geometry (probe kernels that trace rays or intersect primitives);
+ * the shading buffers are null. */
+static inline lc_scene lc_scene_geometry(__global const lc_params* params,
+                                         __global const lc_bvh_node* nodes,
+                                         __global const lc_bvh_leaf* leaves,
+                                         __global const lc_triangle* triangles,
+                                         __global const lc_sphere* spheres) {
+  lc_scene s = {params, nodes, leaves, triangles, 0, spheres, 0, 0, 0, 0, 0};
+  return s;
+}
+
 typedef struct {
   lc_real t;
   lc_uint prim;     /* primitive reference (LC_PRIM_SPHERE_BIT for spheres), LC_INVALID on a miss */

@@ -73,18 +73,7 @@ __kernel void stability_spawn(__global const lc_sphere* spheres, lc_uint num_sph
   lc_uint i = (lc_uint)get_global_id(0);
   lc_uint prim = i % (num_spheres + num_triangles);
 #define U(k) lc_rng_uniform(i, 0u, (k), seed)
-  lc_scene s;
-  s.params = 0;
-  s.nodes = 0;
-  s.leaves = 0;
-  s.triangles = triangles;
-  s.tri_attrs = 0;
-  s.spheres = spheres;
-  s.materials = 0;
-  s.lights = 0;
-  s.light_cdf = 0;
-  s.textures = 0;
-  s.texels = 0;
+  lc_scene s = lc_scene_geometry(0, 0, 0, triangles, spheres);
 
   lc_ray ray;
   lc_hit hit;

@@ -18,18 +18,7 @@ __kernel void lucent_trace_rays(__global const lc_params* params,
                                 __global float4* hits, lc_uint count, lc_uint any_hit) {
   lc_uint i = (lc_uint)get_global_id(0);
   if (i >= count) return;
-  lc_scene s;
-  s.params = params;
-  s.nodes = nodes;
-  s.leaves = leaves;
-  s.triangles = triangles;
-  s.tri_attrs = 0;
-  s.spheres = spheres;
-  s.materials = 0;
-  s.lights = 0;
-  s.light_cdf = 0;
-  s.textures = 0;
-  s.texels = 0;
+  lc_scene s = lc_scene_geometry(params, nodes, leaves, triangles, spheres);
   float4 a = rays[2 * i], b = rays[2 * i + 1];
   lc_ray ray;
   ray.o = lc_real3_from_float3(a.xyz);

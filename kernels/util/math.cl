@@ -46,42 +46,43 @@ static inline lc_real3 lc_load3r(const __global float* p) {
   return (lc_real3)((lc_real)p[0], (lc_real)p[1], (lc_real)p[2]);
 }
 static inline float3 lc_load3c(__constant float* p) { return (float3)(p[0], p[1], p[2]); }
-static inline float lc_max3(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
-static inline lc_real lc_max3r(lc_real3 v) { return fmax(v.x, fmax(v.y, v.z)); }
 static inline float lc_luminance(float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 static inline int lc_isfinite3(float3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
-/* (cos 2 pi u, sin 2 pi u) for u in [0, 1). sinpi/cospi reduce their argument exactly and
- * cheaply (a multiple of pi), where cos(2 pi u) pays a general range reduction per call: on
- * PoCL that reduction alone cost ~150 instructions per cos or sin (callgrind). */
-static inline float2 lc_unit_circle(float u) {
-  float x = 2.0f * u;
-  return (float2)(cospi(x), sinpi(x));
-}
+/*
+ * Helpers needed both in float (shading) and in lc_real (geometry), written once: LC_MATH_HELPERS
+ * defines them for one scalar type T with the given name suffix. Under LC_DOUBLE the lc_real set
+ * is a second, double copy; otherwise its names are those of the float set.
+ *  - lc_max3: the largest component.
+ *  - lc_unit_circle: (cos 2 pi u, sin 2 pi u) for u in [0, 1). sinpi/cospi reduce their argument
+ *    exactly and cheaply (a multiple of pi), where cos(2 pi u) pays a general range reduction
+ *    per call: on PoCL that reduction alone cost ~150 instructions per cos or sin (callgrind).
+ *  - lc_onb: orthonormal basis t, b around unit n (Duff et al. 2017, "Building an Orthonormal
+ *    Basis, Revisited").
+ */
+#define LC_MATH_HELPERS(SUFFIX, T, T2, T3)                                                         \
+  static inline T lc_max3##SUFFIX(T3 v) { return fmax(v.x, fmax(v.y, v.z)); }                      \
+  static inline T2 lc_unit_circle##SUFFIX(T u) {                                                   \
+    T x = (T)2 * u;                                                                                \
+    return (T2)(cospi(x), sinpi(x));                                                               \
+  }                                                                                                \
+  static inline void lc_onb##SUFFIX(T3 n, T3* t, T3* b) {                                          \
+    T s = copysign((T)1, n.z);                                                                     \
+    T a = (T)-1 / (s + n.z);                                                                       \
+    T c = n.x * n.y * a;                                                                           \
+    *t = (T3)((T)1 + s * n.x * n.x * a, s * c, -s * n.x);                                          \
+    *b = (T3)(c, s + n.y * n.y * a, -n.y);                                                         \
+  }
 
-/* The same in lc_real. */
-static inline lc_real2 lc_unit_circler(lc_real u) {
-  lc_real x = LC_REAL(2.0) * u;
-  return (lc_real2)(cospi(x), sinpi(x));
-}
-
-/* Orthonormal basis around unit n (Duff et al. 2017, "Building an Orthonormal Basis, Revisited"). */
-static inline void lc_onb(float3 n, float3* t, float3* b) {
-  float s = copysign(1.0f, n.z);
-  float a = -1.0f / (s + n.z);
-  float c = n.x * n.y * a;
-  *t = (float3)(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
-  *b = (float3)(c, s + n.y * n.y * a, -n.y);
-}
-
-/* The same in lc_real (light sampling geometry). */
-static inline void lc_onbr(lc_real3 n, lc_real3* t, lc_real3* b) {
-  lc_real s = copysign(LC_REAL(1.0), n.z);
-  lc_real a = LC_REAL(-1.0) / (s + n.z);
-  lc_real c = n.x * n.y * a;
-  *t = (lc_real3)(LC_REAL(1.0) + s * n.x * n.x * a, s * c, -s * n.x);
-  *b = (lc_real3)(c, s + n.y * n.y * a, -n.y);
-}
+LC_MATH_HELPERS(, float, float2, float3)
+#ifdef LC_DOUBLE
+LC_MATH_HELPERS(r, double, double2, double3)
+#else
+#define lc_max3r lc_max3
+#define lc_unit_circler lc_unit_circle
+#define lc_onbr lc_onb
+#endif
+#undef LC_MATH_HELPERS
 
 /* One ulp further along the sign of n (nothing where n is 0). */
 static inline lc_real lc_nudge(lc_real x, lc_real n) {
