@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <regex>
 #include <set>
@@ -105,9 +106,10 @@ std::string find_bad_face(const std::string& path) {
 }
 
 // tinyobjloader reads a coordinate that is not a number ("v 1 abc 0") as 0 and a missing one as
-// 0 without a word: check the v, vn and vt lines ourselves and name the first bad one.
-std::string find_bad_vertex_line(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+// 0 without a word: check the v, vn and vt lines of the file's text ourselves and name the first
+// bad one.
+std::string find_bad_vertex_line(const std::string& path, const std::string& text) {
+  std::istringstream in(text);
   std::string line;
   for (long ln = 1; std::getline(in, line); ++ln) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -301,8 +303,11 @@ void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform
               int material_override) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw Error(path + ": cannot open OBJ file: is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open OBJ file: " + std::strerror(errno));
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw Error(path + ": cannot open OBJ file: " + std::strerror(errno));
+  // read once: tinyobjloader parses the text, find_bad_vertex_line checks it
+  const std::string text{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+  std::istringstream in(text);
   const bool use_mtl = material_override < 0;
   MtlReader reader(fs::path(path).parent_path(), use_mtl);
   tinyobj::attrib_t attrib;
@@ -312,7 +317,7 @@ void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform
   bool ok = tinyobj::LoadObj(&attrib, &shapes, &mats, &twarn, &terr, &in, &reader,
                              /*triangulate=*/true, /*default_vcols_fallback=*/false);
   if (!ok) throw_parse_error(path, terr);
-  if (std::string bad = find_bad_vertex_line(path); !bad.empty()) throw Error(bad);
+  if (std::string bad = find_bad_vertex_line(path, text); !bad.empty()) throw Error(bad);
 
   const long nv = static_cast<long>(attrib.vertices.size() / 3);
   const long nn = static_cast<long>(attrib.normals.size() / 3);
