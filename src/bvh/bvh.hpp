@@ -55,10 +55,9 @@ struct Bvh2 {
 /// The tree the kernel walks: wide nodes and leaf blocks (kernels/shared/types.h), depth-first.
 struct Bvh {
   std::vector<lc_bvh_node> nodes;  ///< nodes[0] is the root; empty when there is no primitive
-  std::vector<lc_bvh_leaf> leaves; ///< leaf blocks, in the order the collapse meets the leaves
-  /// The binary tree's primitive references (triangle index, or sphere index |
-  /// LC_PRIM_SPHERE_BIT); each leaf's are consecutive here and in its blocks.
-  std::vector<lc_uint> prim_refs;
+  /// Leaf blocks, in the order the collapse meets the leaves; they hold the primitive references
+  /// (triangle index, or sphere index | LC_PRIM_SPHERE_BIT).
+  std::vector<lc_bvh_leaf> leaves;
   float bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0};  ///< bounds of the scene (0 when empty)
   BuildStats stats;
 };
@@ -78,7 +77,7 @@ Bvh build(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere
           const BuildOptions& options = {});
 
 /// Puts the triangles in the order in which the leaves reference them (the leaf blocks' order for
-/// a Bvh, prim_refs' for a Bvh2) and rewrites the references (prim_refs and the blocks') to
+/// a Bvh, prim_refs' for a Bvh2) and rewrites the references (the blocks' or prim_refs) to
 /// match, so that shading reads neighbouring memory for neighbouring leaves; spheres are left
 /// as they are. Returns, for each new triangle index, its old index: callers permute arrays kept
 /// parallel to the triangles with it and remap stored triangle indices (lights).

@@ -527,20 +527,16 @@ std::vector<lc_uint> reorder_refs(std::vector<lc_uint>& prim_refs,
 std::vector<lc_uint> reorder_triangles(Bvh& bvh, std::vector<lc_triangle>& triangles) {
   // the order of the leaf blocks (LC_INVALID has the sphere bit)
   std::vector<lc_uint> refs;
-  refs.reserve(bvh.prim_refs.size());
+  refs.reserve(4 * bvh.leaves.size());
   for (const lc_bvh_leaf& l : bvh.leaves)
     for (lc_uint ref : l.prim)
       if (ref != LC_INVALID) refs.push_back(ref);
-  if (refs.size() != bvh.prim_refs.size())
-    throw std::logic_error("reorder_triangles: leaf blocks and prim_refs disagree");
   std::vector<lc_uint> new_to_old = reorder_refs(refs, triangles);
   std::vector<lc_uint> old_to_new(new_to_old.size());
   for (std::size_t i = 0; i < new_to_old.size(); ++i) old_to_new[new_to_old[i]] = lc_uint(i);
   for (lc_bvh_leaf& l : bvh.leaves)
     for (lc_uint& ref : l.prim)
       if (!(ref & LC_PRIM_SPHERE_BIT)) ref = old_to_new[ref];
-  for (lc_uint& ref : bvh.prim_refs)
-    if (!(ref & LC_PRIM_SPHERE_BIT)) ref = old_to_new[ref];
   return new_to_old;
 }
 

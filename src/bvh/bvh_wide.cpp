@@ -26,7 +26,6 @@ double area(const Node2& n) {
 
 Bvh collapse(const Bvh2& b, const std::vector<lc_triangle>& triangles) {
   Bvh out;
-  out.prim_refs = b.prim_refs;
   out.stats = b.stats;
   out.stats.binary_nodes = b.stats.nodes;
   out.stats.binary_max_depth = b.stats.max_depth;
@@ -139,7 +138,7 @@ Bvh collapse(const Bvh2& b, const std::vector<lc_triangle>& triangles) {
   out.stats.nodes = out.nodes.size();
   out.stats.leaves = leaves;
   out.stats.max_leaf_size = max_leaf;
-  out.stats.mean_leaf_size = leaves ? double(out.prim_refs.size()) / double(leaves) : 0;
+  out.stats.mean_leaf_size = leaves ? double(b.prim_refs.size()) / double(leaves) : 0;
   return out;
 }
 
