@@ -7,7 +7,13 @@
 
 #include <glm/glm.hpp>
 
+#include "lucent/registry.h"
+
 namespace lucent {
+
+// The type enums are generated from the registries (lucent/registry.h, kernels/shared/registry.h
+// in the source tree): one enumerator per entry, with the entry's value.
+#define LUCENT_REGISTRY_ENUMERATOR(ID, Name, value, ...) Name = value,
 
 struct Camera {
   glm::dvec3 position{0, 0, 5};
@@ -19,7 +25,7 @@ struct Camera {
   double focus_distance = 0;   ///< distance to the plane in focus (0: distance to look_at)
 };
 
-enum class FilterType { Box, Tent, Gaussian };
+enum class FilterType { LC_FILTER_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
 enum class Transfer { Srgb, Gamma, Linear };
 enum class ToneMap { Clamp, Reinhard, Aces };
 
@@ -38,7 +44,10 @@ struct Film {
   ToneMap tonemap = ToneMap::Clamp;
 };
 
-enum class IntegratorType { Path, Whitted, Direct, Albedo, Normal, Depth, Ao, Primitive };
+/// Integrators, then the AOVs (first-hit outputs), in one enum.
+enum class IntegratorType {
+  LC_INTEGRATOR_TYPES(LUCENT_REGISTRY_ENUMERATOR) LC_AOV_TYPES(LUCENT_REGISTRY_ENUMERATOR)
+};
 
 struct Integrator {
   IntegratorType type = IntegratorType::Path;
@@ -50,7 +59,7 @@ struct Integrator {
   bool mis = true;         ///< path: combine light and BSDF sampling (false: light sampling only)
 };
 
-enum class MaterialType { Diffuse, Mirror, Dielectric, Conductor, Plastic };
+enum class MaterialType { LC_MATERIAL_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
 
 struct Material {
   std::string name;
@@ -78,7 +87,9 @@ struct Triangle {
   int material = 0;
 };
 
-enum class LightType { Point, Environment, EnvironmentMap };
+/// Light types. A scene's `lights` hold Point, Environment and EnvironmentMap; Sphere and Triangle
+/// lights are the emissive shapes (materials with emission), made when the scene is packed.
+enum class LightType { LC_LIGHT_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
 
 /// Explicit lights. Emissive shapes are area lights without an entry here.
 struct Light {
