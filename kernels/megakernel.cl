@@ -1,25 +1,28 @@
 /* lucent: the megakernel. One work-item per pixel; each launch adds samples_per_pass samples per
  * pixel, starting at sample_offset, and writes their sum and sum of squares for the host to
- * accumulate. Features are switched on by defines chosen from the scene (LC_HAS_*, listed in
- * src/render/pack.cpp, feature_defines); a scene compiles only the code it uses. */
+ * accumulate. Features are switched on by defines chosen from the scene (LC_HAS_*: the feature
+ * column of shared/registry.h and src/render/features.cpp); a scene compiles only the code it
+ * uses. */
+/* clang-format off */
 #include "shared/types.h"
 #include "shared/rng.h"
 #include "util/math.cl"
-#include "geom/sphere.cl"
-#include "geom/triangle.cl"
-#include "bvh/traverse.cl"
+#include "scene/scene.cl"
+#include "sampler/sampler.cl"
 #include "geom/interaction.cl"
-#include "film/texture.cl"
+#include "bvh/traverse.cl"
+#include "texture/texture.cl"
 #include "film/filter.cl"
 #include "camera/camera.cl"
 #include "bsdf/fresnel.cl"
 #include "bsdf/microfacet.cl"
 #include "bsdf/bsdf.cl"
 #include "light/light.cl"
-#include "integrator/path.cl"
+#include "integrator/integrator.cl"
+/* clang-format on */
 
-__kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global float4* out_sum, __global float4* out_sumsq,
-                            __global lc_uint* counters) {
+__kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global float4* out_sum,
+                            __global float4* out_sumsq, __global lc_uint* counters) {
   lc_uint gid = (lc_uint)get_global_id(0);
   lc_uint width = params->width, height = params->height;
   if (gid >= width * height) return;
@@ -38,21 +41,7 @@ __kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global float4* out_sum, __gl
     lc_ray ray = camera_generate_ray(&params->camera, (float)px + 0.5f + off.x,
                                      (float)py + 0.5f + off.y, width, height,
                                      lc_rand(&rng, LC_DIM_LENS), lc_rand(&rng, LC_DIM_LENS + 1));
-    float3 L;
-    lc_uint integrator = params->integrator;
-    L = (float3)(0.0f);
-#ifdef LC_HAS_INTEGRATOR_PATH
-    if (integrator == LC_INTEGRATOR_PATH) L = integrator_path(&s, ray, &rng, &rays);
-#endif
-#ifdef LC_HAS_INTEGRATOR_WHITTED
-    if (integrator == LC_INTEGRATOR_WHITTED) L = integrator_whitted(&s, ray, &rays);
-#endif
-#ifdef LC_HAS_INTEGRATOR_DIRECT
-    if (integrator == LC_INTEGRATOR_DIRECT) L = integrator_direct(&s, ray, &rays);
-#endif
-#ifdef LC_HAS_INTEGRATOR_AOV
-    if (integrator >= LC_INTEGRATOR_ALBEDO) L = integrator_aov(&s, ray, &rng, &rays);
-#endif
+    float3 L = integrate(&s, ray, &rng, &rays);
     if (lc_isfinite3(L)) {
       sum += L;
       sumsq += L * L;

@@ -129,19 +129,19 @@ TEST(CliInfo, SceneAndBvhStatistics) {
   // the same numbers as the library's build of the same scene
   lucent::Scene s = lucent::load_scene(scene);
   lucent::render_detail::PackedScene packed = lucent::render_detail::pack_scene(s);
-  EXPECT_EQ(size_t(nodes), packed.bvh.stats.binary_nodes);
+  EXPECT_EQ(size_t(nodes), packed.bvh_stats.binary_nodes);
   // and the wide nodes the binary tree was collapsed into
   size_t wide = 0;
   int width = 0;
-  ASSERT_EQ(std::sscanf(m["BVH/nodes"].c_str(), "%*d binary, collapsed into %zu %d-wide", &wide,
-                        &width),
-            2)
+  ASSERT_EQ(
+      std::sscanf(m["BVH/nodes"].c_str(), "%*d binary, collapsed into %zu %d-wide", &wide, &width),
+      2)
       << m["BVH/nodes"];
-  EXPECT_EQ(wide, packed.bvh.stats.nodes);
+  EXPECT_EQ(wide, packed.bvh_stats.nodes);
   EXPECT_EQ(width, LC_BVH_WIDTH);
   EXPECT_GE(wide, 1u);
   EXPECT_LE(wide, size_t(nodes));
-  EXPECT_EQ(size_t(leaves), packed.bvh.stats.leaves);
+  EXPECT_EQ(size_t(leaves), packed.bvh_stats.leaves);
 
   // kernel: where sources come from and the feature defines of this scene
   std::string defines = lucent::render_detail::feature_defines(s, packed);

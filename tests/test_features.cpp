@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "render/features.hpp"
 #include "render/pack.hpp"
 #include "support.hpp"
 
@@ -31,7 +32,8 @@ bool has(const std::vector<std::string>& v, const std::string& f) {
 
 TEST(Features, DiffuseSpheresAndAPointLightCompileOnlyThat) {
   std::vector<std::string> f = features_of(kDiffuseScene);
-  std::vector<std::string> expected = {"LC_HAS_SPHERES", "LC_HAS_POINT_LIGHTS", "LC_HAS_INTEGRATOR_PATH"};
+  std::vector<std::string> expected = {"LC_HAS_SPHERES", "LC_HAS_DIFFUSE", "LC_HAS_POINT_LIGHTS",
+                                       "LC_HAS_FILTER_BOX", "LC_HAS_INTEGRATOR_PATH"};
   std::sort(f.begin(), f.end());
   std::sort(expected.begin(), expected.end());
   EXPECT_EQ(f, expected);
@@ -44,13 +46,15 @@ TEST(Features, DiffuseSpheresAndAPointLightCompileOnlyThat) {
 
 TEST(Features, EachUsedFeatureAppears) {
   std::string glass = kDiffuseScene;
-  glass.replace(glass.find(R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]})"),
-                std::string(R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]})").size(),
-                R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]}, "g": {"type": "dielectric", "ior": 1.5})");
+  glass.replace(
+      glass.find(R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]})"),
+      std::string(R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]})").size(),
+      R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]}, "g": {"type": "dielectric", "ior": 1.5})");
   // a glass material that is declared but used by no shape costs nothing
   EXPECT_FALSE(has(features_of(glass), "LC_HAS_DIELECTRIC"));
   std::string used = glass;
-  used.replace(used.find(R"("radius": 0.5, "material": "w")"), std::string(R"("radius": 0.5, "material": "w")").size(),
+  used.replace(used.find(R"("radius": 0.5, "material": "w")"),
+               std::string(R"("radius": 0.5, "material": "w")").size(),
                R"("radius": 0.5, "material": "g")");
   std::vector<std::string> f = features_of(used);
   EXPECT_TRUE(has(f, "LC_HAS_DIELECTRIC"));
@@ -66,12 +70,13 @@ TEST(Features, EachUsedFeatureAppears) {
                {"type": "sphere", "center": [0, 0, -2], "radius": 1, "material": "m"}],
     "lights": [{"type": "environment", "radiance": [0.1, 0.1, 0.1]}]})";
   f = features_of(rich);
-  for (const char* want : {"LC_HAS_TRIANGLES", "LC_HAS_SPHERES", "LC_HAS_SMOOTH_NORMALS", "LC_HAS_MIRROR",
-                           "LC_HAS_TRIANGLE_LIGHTS", "LC_HAS_ENV", "LC_HAS_THIN_LENS", "LC_HAS_FILTER_TENT",
-                           "LC_HAS_INTEGRATOR_WHITTED"})
+  for (const char* want : {"LC_HAS_TRIANGLES", "LC_HAS_SPHERES", "LC_HAS_SMOOTH_NORMALS",
+                           "LC_HAS_MIRROR", "LC_HAS_TRIANGLE_LIGHTS", "LC_HAS_ENV",
+                           "LC_HAS_THIN_LENS", "LC_HAS_FILTER_TENT", "LC_HAS_INTEGRATOR_WHITTED"})
     EXPECT_TRUE(has(f, want)) << want;
-  for (const char* not_want : {"LC_HAS_POINT_LIGHTS", "LC_HAS_SPHERE_LIGHTS", "LC_HAS_TEXTURES",
-                               "LC_HAS_FILTER_GAUSSIAN", "LC_HAS_INTEGRATOR_PATH", "LC_HAS_DIELECTRIC"})
+  for (const char* not_want :
+       {"LC_HAS_POINT_LIGHTS", "LC_HAS_SPHERE_LIGHTS", "LC_HAS_TEXTURES", "LC_HAS_FILTER_GAUSSIAN",
+        "LC_HAS_FILTER_BOX", "LC_HAS_INTEGRATOR_PATH", "LC_HAS_DIELECTRIC"})
     EXPECT_FALSE(has(f, not_want)) << not_want;
 }
 
@@ -87,7 +92,8 @@ TEST(Features, FullKernelHasEveryFeatureAndRendersTheSameImage) {
   // the same seed and the same arithmetic on the paths this scene takes: equal up to rounding
   double worst = 0;
   for (size_t i = 0; i < a.mean.rgb.size(); ++i)
-    worst = std::max(worst, std::abs(double(a.mean.rgb[i]) - b.mean.rgb[i]) / (1e-3 + std::abs(a.mean.rgb[i])));
+    worst = std::max(
+        worst, std::abs(double(a.mean.rgb[i]) - b.mean.rgb[i]) / (1e-3 + std::abs(a.mean.rgb[i])));
   EXPECT_LT(worst, 1e-4);
 }
 

@@ -8,6 +8,7 @@
 
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
+#include "scene/material_type.hpp"
 #include "shared/types.h"
 #include "support.hpp"
 
@@ -38,7 +39,8 @@ TEST(KernelBsdf, FresnelDielectricKnownValues) {
   for (double eta : {1.5, 1.0 / 1.5, 1.0, 1.333, 10.0})
     for (double c : {1.0, 0.9, 0.5, 0.2, 0.05, 1e-3, 0.0}) in.push_back({{float(c), float(eta)}});
   Probe& p = probe();
-  cl::Buffer bin(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, in.size() * sizeof(cl_float2), in.data());
+  cl::Buffer bin(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                 in.size() * sizeof(cl_float2), in.data());
   cl::Buffer bout(p.ctx.context, CL_MEM_WRITE_ONLY, in.size() * sizeof(cl_float2));
   cl::Kernel k(p.program, "probe_fresnel");
   k.setArg(0, bin);
@@ -63,24 +65,24 @@ TEST(KernelBsdf, FresnelDielectricKnownValues) {
   for (int i = 14; i < 20; ++i) EXPECT_NEAR(out[i].s[0], 0.0, 1e-6);
 }
 
-
 struct ChiSquareCase {
   const char* name;
   lc_material mat;
   double wo_theta;  // radians
 };
 
+// A material of the given type packed for the device as the renderer packs it.
 lc_material make(lc_uint type, float r, float g, float b, float spec, float rough, float ior) {
-  lc_material m{};
-  m.type = type;
-  m.albedo[0] = r;
-  m.albedo[1] = g;
-  m.albedo[2] = b;
-  m.specular[0] = m.specular[1] = m.specular[2] = spec;
+  lucent::Material m;
+  m.type = static_cast<lucent::MaterialType>(type);
+  m.albedo = {r, g, b};
+  m.specular = glm::dvec3(spec);
   m.roughness = rough;
   m.ior = ior;
-  m.albedo_tex = -1;
-  return m;
+  lc_material d{};
+  d.type = type;
+  lucent::scene_detail::material_type_def(m.type).pack(m, d.p);
+  return d;
 }
 
 // Samples N directions on the device, bins them over (cos theta, phi) and compares the counts
@@ -133,8 +135,10 @@ void chi_square(const ChiSquareCase& tc) {
           dirs.push_back({{float(r * std::cos(phi)), float(r * std::sin(phi)), float(z), 0.0f}});
           wos.push_back(wo);
         }
-  cl::Buffer bwo2(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, wos.size() * sizeof(cl_float4), wos.data());
-  cl::Buffer bwi2(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(cl_float4), dirs.data());
+  cl::Buffer bwo2(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                  wos.size() * sizeof(cl_float4), wos.data());
+  cl::Buffer bwi2(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                  dirs.size() * sizeof(cl_float4), dirs.data());
   cl::Buffer bout(p.ctx.context, CL_MEM_WRITE_ONLY, dirs.size() * sizeof(cl_float4));
   cl::Kernel ke(p.program, "probe_bsdf_eval");
   ke.setArg(0, bmat);
@@ -152,7 +156,8 @@ void chi_square(const ChiSquareCase& tc) {
     expected[i / (SUB * SUB)] += ev[i].s[3] * dA * N;
     integral += ev[i].s[3] * dA;
   }
-  EXPECT_NEAR(integral, double(produced) / N, 0.01) << tc.name << ": pdf integral vs sampling success";
+  EXPECT_NEAR(integral, double(produced) / N, 0.01)
+      << tc.name << ": pdf integral vs sampling success";
 
   lucent::test::PooledChi2 c = lucent::test::pooled_chi2(observed, expected);
   int dof = c.cells - 1;
@@ -166,8 +171,10 @@ void chi_square(const ChiSquareCase& tc) {
       some_wi.push_back({{wi[i].s[0], wi[i].s[1], wi[i].s[2], float(i)}});
       some_wo.push_back(wo);
     }
-  cl::Buffer b3(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, some_wi.size() * sizeof(cl_float4), some_wi.data());
-  cl::Buffer b4(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, some_wo.size() * sizeof(cl_float4), some_wo.data());
+  cl::Buffer b3(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                some_wi.size() * sizeof(cl_float4), some_wi.data());
+  cl::Buffer b4(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                some_wo.size() * sizeof(cl_float4), some_wo.data());
   cl::Buffer b5(p.ctx.context, CL_MEM_WRITE_ONLY, some_wi.size() * sizeof(cl_float4));
   ke.setArg(1, b4);
   ke.setArg(2, b3);
@@ -179,12 +186,15 @@ void chi_square(const ChiSquareCase& tc) {
     int idx = int(some_wi[i].s[3]);
     for (int c = 0; c < 3; ++c) {
       double want = fe[i].s[c] * some_wi[i].s[2] / fe[i].s[3];
-      ASSERT_NEAR(weight[idx].s[c], want, 1e-3 * std::max(1.0, want)) << tc.name << " sample " << idx;
+      ASSERT_NEAR(weight[idx].s[c], want, 1e-3 * std::max(1.0, want))
+          << tc.name << " sample " << idx;
     }
   }
 }
 
-TEST(KernelBsdf, ChiSquareDiffuse) { chi_square({"diffuse", make(LC_MAT_DIFFUSE, 0.5f, 0.6f, 0.7f, 0, 0, 1.5f), 0.7}); }
+TEST(KernelBsdf, ChiSquareDiffuse) {
+  chi_square({"diffuse", make(LC_MAT_DIFFUSE, 0.5f, 0.6f, 0.7f, 0, 0, 1.5f), 0.7});
+}
 TEST(KernelBsdf, ChiSquareConductorRough) {
   chi_square({"conductor 0.5", make(LC_MAT_CONDUCTOR, 0, 0, 0, 0.9f, 0.5f, 1.5f), 0.6});
 }

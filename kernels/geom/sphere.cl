@@ -31,4 +31,24 @@ static inline lc_real sphere_intersect(lc_real3 center, lc_real radius, lc_real3
   return INFINITY;
 }
 
+/* The surface at a hit on a sphere. */
+static inline void sphere_interaction(const lc_scene* s, lc_ray ray, const lc_hit* hit,
+                                      lc_interaction* it) {
+  __global const lc_sphere* sp = &s->spheres[hit->prim & ~LC_PRIM_SPHERE_BIT];
+  lc_real3 c = lc_load3r(sp->center);
+  lc_real3 p = ray.o + hit->t * ray.d;
+  lc_real3 n = normalize(p - c);
+  it->p = c + sp->radius * n; /* reproject onto the surface */
+  /* a few ulps of |c| + r: the representation limit (in lc_real) of this sphere's surface */
+  it->perr = (fabs(c) + sp->radius) * (LC_REAL(8.0) * LC_REAL_U);
+  it->ng = n;
+  float3 nf = lc_float3_from_real3(n);
+  it->ns = nf;
+  /* equirectangular uv: u along longitude around +y, v from the south to the north pole */
+  it->uv = (float2)(0.5f + atan2(nf.z, nf.x) * (0.5f * LC_INV_PI),
+                    0.5f + asin(clamp(nf.y, -1.0f, 1.0f)) * LC_INV_PI);
+  it->material = sp->material;
+  it->light = sp->light;
+}
+
 #endif

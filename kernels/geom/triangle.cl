@@ -17,7 +17,7 @@
 
 /* Per-ray constants of the watertight test. */
 typedef struct {
-  int kx, ky, kz; /* kz: the dominant axis of d; kx, ky: the others, swapped when d[kz] < 0 */
+  int kx, ky, kz;     /* kz: the dominant axis of d; kx, ky: the others, swapped when d[kz] < 0 */
   lc_real sx, sy, sz; /* shear: d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz] */
 } lc_tri_ray;
 
@@ -80,6 +80,48 @@ static inline int triangle_intersect(const lc_tri_ray* r, lc_real3 o, lc_real3 v
   *b1_out = V * inv;
   *b2_out = W * inv;
   return 1;
+}
+
+/* The surface at a hit on a triangle: barycentric position, interpolated normals and uvs where
+ * the triangle has them (LC_HAS_SMOOTH_NORMALS, LC_HAS_UVS). */
+static inline void triangle_interaction(const lc_scene* s, lc_ray ray, const lc_hit* hit,
+                                        lc_interaction* it) {
+  __global const lc_triangle* tri = &s->triangles[hit->prim];
+  lc_real3 v0 = lc_load3r(tri->v0), v1 = lc_load3r(tri->v1), v2 = lc_load3r(tri->v2);
+  lc_real b1 = hit->b1, b2 = hit->b2, b0 = LC_REAL(1.0) - b1 - b2;
+  it->p = b0 * v0 + b1 * v1 + b2 * v2;
+  /* gamma(7) bound of the barycentric interpolation (pbrt-v4, section 6.8), lc_real's gamma */
+  it->perr = (fabs(b0 * v0) + fabs(b1 * v1) + fabs(b2 * v2)) *
+             (LC_REAL(7.0) * LC_REAL_U * LC_REAL(1.0001));
+  lc_real3 ng = normalize(cross(v1 - v0, v2 - v0));
+  it->ng = ng;
+  float3 ngf = lc_float3_from_real3(ng);
+  it->ns = ngf;
+  float fb0 = (float)b0, fb1 = (float)b1, fb2 = (float)b2;
+  it->uv = (float2)(fb1, fb2);
+#if defined(LC_HAS_SMOOTH_NORMALS) || defined(LC_HAS_UVS)
+  if (tri->flags & (LC_TRI_HAS_NORMALS | LC_TRI_HAS_UVS)) {
+    __global const lc_triangle_attr* a = &s->tri_attrs[hit->prim];
+#ifdef LC_HAS_SMOOTH_NORMALS
+    if (tri->flags & LC_TRI_HAS_NORMALS) {
+      float3 ns = fb0 * lc_load3(a->n) + fb1 * lc_load3(a->n + 3) + fb2 * lc_load3(a->n + 6);
+      float len = length(ns);
+      if (len > 0.0f) {
+        ns /= len;
+        /* interpolated normals stay on the geometric side */
+        it->ns = dot(ns, ngf) < 0.0f ? -ns : ns;
+      }
+    }
+#endif
+#ifdef LC_HAS_UVS
+    if (tri->flags & LC_TRI_HAS_UVS)
+      it->uv = (float2)(fb0 * a->uv[0] + fb1 * a->uv[2] + fb2 * a->uv[4],
+                        fb0 * a->uv[1] + fb1 * a->uv[3] + fb2 * a->uv[5]);
+#endif
+  }
+#endif
+  it->material = tri->material;
+  it->light = tri->light;
 }
 
 #endif

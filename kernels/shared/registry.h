@@ -27,8 +27,9 @@
 #ifndef LUCENT_SHARED_REGISTRY_H
 #define LUCENT_SHARED_REGISTRY_H
 
-/* LC_ENABLED(LC_HAS_X) is 1 when the feature define LC_HAS_X is set (to 1, as -D LC_HAS_X does)
- * and 0 otherwise, so that generated dispatch code can test a feature in an expression
+/* LC_ENABLED(LC_HAS_X) is 1 when the feature define LC_HAS_X is set to 1 (as -D LC_HAS_X does;
+ * a define in a source file must say `#define LC_HAS_X 1`) and 0 otherwise, so that generated
+ * dispatch code can test a feature in an expression
  * (`if (LC_ENABLED(feature) && type == ...)`), which the compiler folds: a type that is not
  * enabled costs no code. (The Linux kernel's IS_ENABLED technique.) */
 #define LC_ARG_PLACEHOLDER_1 0,
@@ -45,44 +46,43 @@
 /* The kernel's BSDF is kernels/bsdf/<file>.cl, the reference's src/reference/bsdf/<file>.cpp,  */
 /* the scene-file parameters and their packing src/scene/materials/<file>.cpp.                 */
 /* ------------------------------------------------------------------------------------------ */
-#define LC_MATERIAL_TYPES(X)                                                                  \
-  X(DIFFUSE, Diffuse, 0, "diffuse", LC_HAS_DIFFUSE, diffuse,                                  \
-    LC_PARAMS(float albedo[3]; /* linear RGB */ lc_int albedo_tex; /* texture or -1 */))      \
-  X(MIRROR, Mirror, 1, "mirror", LC_HAS_MIRROR, mirror,                                       \
-    LC_PARAMS(float reflectance[3]; /* RGB reflectance */))                                  \
-  X(DIELECTRIC, Dielectric, 2, "dielectric", LC_HAS_DIELECTRIC, dielectric,                   \
-    LC_PARAMS(float tint[3]; /* transmission colour */ float ior;))                          \
-  X(CONDUCTOR, Conductor, 3, "conductor", LC_HAS_CONDUCTOR, conductor,                        \
-    LC_PARAMS(float f0[3]; /* Schlick F0 colour */ float roughness; /* GGX alpha */))        \
-  X(PLASTIC, Plastic, 4, "plastic", LC_HAS_PLASTIC, plastic,                                  \
-    LC_PARAMS(float albedo[3]; lc_int albedo_tex; float specular[3]; float ior;               \
-              float roughness;))
+#define LC_MATERIAL_TYPES(X)                                                             \
+  X(DIFFUSE, Diffuse, 0, "diffuse", LC_HAS_DIFFUSE, diffuse,                             \
+    LC_PARAMS(float albedo[3]; /* linear RGB */ lc_int albedo_tex; /* texture or -1 */)) \
+  X(MIRROR, Mirror, 1, "mirror", LC_HAS_MIRROR, mirror,                                  \
+    LC_PARAMS(float reflectance[3]; /* RGB reflectance */))                              \
+  X(DIELECTRIC, Dielectric, 2, "dielectric", LC_HAS_DIELECTRIC, dielectric,              \
+    LC_PARAMS(float tint[3]; /* transmission colour */ float ior;))                      \
+  X(CONDUCTOR, Conductor, 3, "conductor", LC_HAS_CONDUCTOR, conductor,                   \
+    LC_PARAMS(float f0[3]; /* Schlick F0 colour */ float roughness; /* GGX alpha */))    \
+  X(PLASTIC, Plastic, 4, "plastic", LC_HAS_PLASTIC, plastic,                             \
+    LC_PARAMS(float albedo[3]; lc_int albedo_tex; float specular[3]; float ior; float roughness;))
 
 /* ------------------------------------------------------------------------------------------ */
 /* Lights: X(ID, Name, value, name, feature, file, params)                                     */
 /* Point lights and environments come from the scene's "lights"; sphere and triangle lights   */
 /* are the emissive shapes (a material with "emission"). kernels/light/<file>.cl samples them. */
 /* ------------------------------------------------------------------------------------------ */
-#define LC_LIGHT_TYPES(X)                                                                     \
-  X(POINT, Point, 0, "point", LC_HAS_POINT_LIGHTS, point,                                     \
-    LC_PARAMS(float position[3]; float intensity[3]; /* W/sr */))                            \
-  X(SPHERE, Sphere, 1, "sphere", LC_HAS_SPHERE_LIGHTS, sphere,                                \
-    LC_PARAMS(lc_uint sphere; /* index into spheres */ float radiance[3];))                  \
-  X(TRIANGLE, Triangle, 2, "triangle", LC_HAS_TRIANGLE_LIGHTS, triangle,                      \
-    LC_PARAMS(lc_uint triangle; /* index into triangles */ float radiance[3]; float area;))   \
-  X(ENV, Environment, 3, "environment", LC_HAS_ENV, env,                                      \
-    LC_PARAMS(float radiance[3];))                                                           \
-  X(ENV_MAP, EnvironmentMap, 4, "environment_map", LC_HAS_ENV_MAP, env_map,                   \
-    LC_PARAMS(float scale[3]; lc_int texture; /* equirectangular image */                    \
-              lc_uint cdf; /* first of its width * height + 1 entries in light_cdf */))
+#define LC_LIGHT_TYPES(X)                                                                   \
+  X(POINT, Point, 0, "point", LC_HAS_POINT_LIGHTS, point,                                   \
+    LC_PARAMS(float position[3]; float intensity[3]; /* W/sr */))                           \
+  X(SPHERE, Sphere, 1, "sphere", LC_HAS_SPHERE_LIGHTS, sphere,                              \
+    LC_PARAMS(lc_uint sphere; /* index into spheres */ float radiance[3];))                 \
+  X(TRIANGLE, Triangle, 2, "triangle", LC_HAS_TRIANGLE_LIGHTS, triangle,                    \
+    LC_PARAMS(lc_uint triangle; /* index into triangles */ float radiance[3]; float area;)) \
+  X(ENV, Environment, 3, "environment", LC_HAS_ENV, env, LC_PARAMS(float radiance[3];))     \
+  X(ENV_MAP, EnvironmentMap, 4, "environment_map", LC_HAS_ENV_MAP, env_map,                 \
+    LC_PARAMS(float scale[3]; lc_int texture; /* equirectangular image */                   \
+              lc_uint cdf;                                                                  \
+              /* first of its width * height + 1 entries in light_cdf */))
 
 /* ------------------------------------------------------------------------------------------ */
 /* Shapes: X(ID, Name, value, name, feature, file)                                             */
 /* kernels/geom/<file>.cl: intersection and the surface at a hit. Mesh files and inline       */
 /* triangle lists both become triangles.                                                      */
 /* ------------------------------------------------------------------------------------------ */
-#define LC_SHAPE_TYPES(X)                                                                     \
-  X(SPHERE, Sphere, 0, "sphere", LC_HAS_SPHERES, sphere)                                      \
+#define LC_SHAPE_TYPES(X)                                \
+  X(SPHERE, Sphere, 0, "sphere", LC_HAS_SPHERES, sphere) \
   X(TRIANGLE, Triangle, 1, "triangles", LC_HAS_TRIANGLES, triangle)
 
 /* ------------------------------------------------------------------------------------------ */
@@ -90,28 +90,38 @@
 /* kernels/integrator/<file>.cl defines integrator_<file>(); the AOVs below share one kernel   */
 /* integrator (integrator/aov.cl) and follow the integrators in the same enum.                */
 /* ------------------------------------------------------------------------------------------ */
-#define LC_INTEGRATOR_TYPES(X)                                                                \
-  X(PATH, Path, 0, "path", LC_HAS_INTEGRATOR_PATH, path)                                      \
-  X(WHITTED, Whitted, 1, "whitted", LC_HAS_INTEGRATOR_WHITTED, whitted)                       \
+#define LC_INTEGRATOR_TYPES(X)                                          \
+  X(PATH, Path, 0, "path", LC_HAS_INTEGRATOR_PATH, path)                \
+  X(WHITTED, Whitted, 1, "whitted", LC_HAS_INTEGRATOR_WHITTED, whitted) \
   X(DIRECT, Direct, 2, "direct", LC_HAS_INTEGRATOR_DIRECT, direct)
 
 /* AOVs (arbitrary output variables of the first hit): X(ID, Name, value, name, feature, file);
  * their values continue the integrators'; integrator/aov.cl defines aov_<file>(). */
-#define LC_AOV_TYPES(X)                                                                       \
-  X(ALBEDO, Albedo, 3, "albedo", LC_HAS_INTEGRATOR_AOV, albedo)                               \
-  X(NORMAL, Normal, 4, "normal", LC_HAS_INTEGRATOR_AOV, normal)                               \
-  X(DEPTH, Depth, 5, "depth", LC_HAS_INTEGRATOR_AOV, depth)                                   \
-  X(AO, Ao, 6, "ao", LC_HAS_INTEGRATOR_AOV, ao)                                               \
+#define LC_AOV_TYPES(X)                                         \
+  X(ALBEDO, Albedo, 3, "albedo", LC_HAS_INTEGRATOR_AOV, albedo) \
+  X(NORMAL, Normal, 4, "normal", LC_HAS_INTEGRATOR_AOV, normal) \
+  X(DEPTH, Depth, 5, "depth", LC_HAS_INTEGRATOR_AOV, depth)     \
+  X(AO, Ao, 6, "ao", LC_HAS_INTEGRATOR_AOV, ao)                 \
   X(PRIMITIVE, Primitive, 7, "primitive", LC_HAS_INTEGRATOR_AOV, primitive)
 
 /* ------------------------------------------------------------------------------------------ */
 /* Pixel filters: X(ID, Name, value, name, feature, file, default radius in pixels)            */
 /* kernels/film/filter.cl defines filter_sample_<file>().                                      */
 /* ------------------------------------------------------------------------------------------ */
-#define LC_FILTER_TYPES(X)                                                                    \
-  X(BOX, Box, 0, "box", LC_HAS_FILTER_BOX, box, 0.5)                                          \
-  X(TENT, Tent, 1, "tent", LC_HAS_FILTER_TENT, tent, 1.5)                                     \
+#define LC_FILTER_TYPES(X)                                \
+  X(BOX, Box, 0, "box", LC_HAS_FILTER_BOX, box, 0.5)      \
+  X(TENT, Tent, 1, "tent", LC_HAS_FILTER_TENT, tent, 1.5) \
   X(GAUSSIAN, Gaussian, 2, "gaussian", LC_HAS_FILTER_GAUSSIAN, gaussian, 1.5)
+
+/* ------------------------------------------------------------------------------------------ */
+/* Other kernel features: X(feature, what). With the type lists' feature column they make every   */
+/* feature define (src/render/features.cpp decides which a scene uses).                         */
+/* ------------------------------------------------------------------------------------------ */
+#define LC_OTHER_FEATURES(X)                              \
+  X(LC_HAS_SMOOTH_NORMALS, "interpolated vertex normals") \
+  X(LC_HAS_UVS, "texture coordinates of triangles")       \
+  X(LC_HAS_TEXTURES, "textured materials")                \
+  X(LC_HAS_THIN_LENS, "thin-lens depth of field")
 
 /* ------------------------------------------------------------------------------------------ */
 /* Scene buffers: X(name, element type)                                                        */
@@ -119,16 +129,16 @@
 /* LC_SCENE_KERNEL_ARGS (scene/scene.cl), PackedScene and DeviceScene (src/render/). The      */
 /* launch parameters (lc_params) follow them as the last scene argument.                      */
 /* ------------------------------------------------------------------------------------------ */
-#define LC_SCENE_BUFFERS(X)                                                                   \
-  X(nodes, lc_bvh_node)           /* wide BVH nodes, nodes[0] the root        */              \
-  X(leaves, lc_bvh_leaf)          /* BVH leaf blocks                           */             \
-  X(triangles, lc_triangle)       /* triangle vertices, material, light        */             \
-  X(tri_attrs, lc_triangle_attr)  /* triangle normals and uvs                  */             \
-  X(spheres, lc_sphere)           /* spheres                                   */             \
-  X(materials, lc_material)       /* materials                                 */             \
-  X(lights, lc_light)             /* lights, in light-selection order          */             \
-  X(light_cdf, float)             /* light selection CDF, then env-map CDFs     */            \
-  X(textures, lc_texture)         /* texture headers                           */             \
-  X(texels, lc_float4)            /* every texture's texels, linear RGBA       */
+#define LC_SCENE_BUFFERS(X)                                                       \
+  X(nodes, lc_bvh_node)          /* wide BVH nodes, nodes[0] the root        */   \
+  X(leaves, lc_bvh_leaf)         /* BVH leaf blocks                           */  \
+  X(triangles, lc_triangle)      /* triangle vertices, material, light        */  \
+  X(tri_attrs, lc_triangle_attr) /* triangle normals and uvs                  */  \
+  X(spheres, lc_sphere)          /* spheres                                   */  \
+  X(materials, lc_material)      /* materials                                 */  \
+  X(lights, lc_light)            /* lights, in light-selection order          */  \
+  X(light_cdf, float)            /* light selection CDF, then env-map CDFs     */ \
+  X(textures, lc_texture)        /* texture headers                           */  \
+  X(texels, lc_float4)           /* every texture's texels, linear RGBA       */
 
 #endif /* LUCENT_SHARED_REGISTRY_H */

@@ -27,32 +27,103 @@ typedef std::int32_t lc_int;
 
 #define LC_INVALID 0xffffffffu
 
+#include "shared/registry.h"
+
+/* Four floats: float4 on the device, 16 aligned bytes on the host (texels). */
+#ifdef __OPENCL_C_VERSION__
+typedef float4 lc_float4;
+#else
+typedef struct LC_ALIGN16 {
+  float s[4];
+} lc_float4;
+#endif
+
+/* ------------------------------------------------------------------------------------------ */
+/* Registry enums and their checks                                                            */
+/* ------------------------------------------------------------------------------------------ */
+/* Device constants from shared/registry.h: LC_MAT_<ID>, LC_LIGHT_<ID>, LC_SHAPE_<ID>,
+ * LC_INTEGRATOR_<ID> (integrators, then AOVs), LC_FILTER_<ID>, and LC_<CONCEPT>_COUNT. */
+#define LC_ENUM_MAT(ID, Name, value, ...) LC_MAT_##ID = value,
+#define LC_ENUM_LIGHT(ID, Name, value, ...) LC_LIGHT_##ID = value,
+#define LC_ENUM_SHAPE(ID, Name, value, ...) LC_SHAPE_##ID = value,
+#define LC_ENUM_INTEGRATOR(ID, Name, value, ...) LC_INTEGRATOR_##ID = value,
+#define LC_ENUM_FILTER(ID, Name, value, ...) LC_FILTER_##ID = value,
+#define LC_ENUM_ONE(...) +1
+enum { LC_MATERIAL_TYPES(LC_ENUM_MAT) LC_MAT_COUNT = 0 LC_MATERIAL_TYPES(LC_ENUM_ONE) };
+enum { LC_LIGHT_TYPES(LC_ENUM_LIGHT) LC_LIGHT_COUNT = 0 LC_LIGHT_TYPES(LC_ENUM_ONE) };
+enum { LC_SHAPE_TYPES(LC_ENUM_SHAPE) LC_SHAPE_COUNT = 0 LC_SHAPE_TYPES(LC_ENUM_ONE) };
+enum {
+  LC_INTEGRATOR_TYPES(LC_ENUM_INTEGRATOR) LC_AOV_TYPES(LC_ENUM_INTEGRATOR)
+  /* the first AOV: integrator values from here on are AOVs (integrator/aov.cl) */
+  LC_INTEGRATOR_FIRST_AOV = 0 LC_INTEGRATOR_TYPES(LC_ENUM_ONE),
+  LC_INTEGRATOR_COUNT = 0 LC_INTEGRATOR_TYPES(LC_ENUM_ONE) LC_AOV_TYPES(LC_ENUM_ONE)
+};
+enum { LC_FILTER_TYPES(LC_ENUM_FILTER) LC_FILTER_COUNT = 0 LC_FILTER_TYPES(LC_ENUM_ONE) };
+
+/* Each list's values are 0, 1, ..., count - 1 in list order: a sum of count powers of two is
+ * 2^count - 1 only when they are exactly those (a repeated or missing value breaks it), and each
+ * entry's value is compared with its position. */
+#define LC_VALUE_BIT(ID, Name, value, ...) +(1u << (value))
+#define LC_POS_MAT(ID, ...) LC_MAT_POS_##ID,
+#define LC_POS_LIGHT(ID, ...) LC_LIGHT_POS_##ID,
+#define LC_POS_SHAPE(ID, ...) LC_SHAPE_POS_##ID,
+#define LC_POS_INTEGRATOR(ID, ...) LC_INTEGRATOR_POS_##ID,
+#define LC_POS_FILTER(ID, ...) LC_FILTER_POS_##ID,
+enum { LC_MATERIAL_TYPES(LC_POS_MAT) LC_MAT_POS_END_ };
+enum { LC_LIGHT_TYPES(LC_POS_LIGHT) LC_LIGHT_POS_END_ };
+enum { LC_SHAPE_TYPES(LC_POS_SHAPE) LC_SHAPE_POS_END_ };
+enum { LC_INTEGRATOR_TYPES(LC_POS_INTEGRATOR) LC_AOV_TYPES(LC_POS_INTEGRATOR) LC_INT_POS_END_ };
+enum { LC_FILTER_TYPES(LC_POS_FILTER) LC_FILTER_POS_END_ };
+#define LC_CHECK_MAT(ID, ...) \
+  LC_STATIC_ASSERT((int)LC_MAT_##ID == (int)LC_MAT_POS_##ID, mat_order_##ID);
+#define LC_CHECK_LIGHT(ID, ...) \
+  LC_STATIC_ASSERT((int)LC_LIGHT_##ID == (int)LC_LIGHT_POS_##ID, light_order_##ID);
+#define LC_CHECK_SHAPE(ID, ...) \
+  LC_STATIC_ASSERT((int)LC_SHAPE_##ID == (int)LC_SHAPE_POS_##ID, shape_order_##ID);
+#define LC_CHECK_INTEGRATOR(ID, ...) \
+  LC_STATIC_ASSERT((int)LC_INTEGRATOR_##ID == (int)LC_INTEGRATOR_POS_##ID, integrator_order_##ID);
+#define LC_CHECK_FILTER(ID, ...) \
+  LC_STATIC_ASSERT((int)LC_FILTER_##ID == (int)LC_FILTER_POS_##ID, filter_order_##ID);
+LC_MATERIAL_TYPES(LC_CHECK_MAT)
+LC_LIGHT_TYPES(LC_CHECK_LIGHT)
+LC_SHAPE_TYPES(LC_CHECK_SHAPE)
+LC_INTEGRATOR_TYPES(LC_CHECK_INTEGRATOR)
+LC_AOV_TYPES(LC_CHECK_INTEGRATOR)
+LC_FILTER_TYPES(LC_CHECK_FILTER)
+LC_STATIC_ASSERT((0u LC_MATERIAL_TYPES(LC_VALUE_BIT)) == (1u << LC_MAT_COUNT) - 1u,
+                 material_values);
+LC_STATIC_ASSERT((0u LC_LIGHT_TYPES(LC_VALUE_BIT)) == (1u << LC_LIGHT_COUNT) - 1u, light_values);
+LC_STATIC_ASSERT((0u LC_SHAPE_TYPES(LC_VALUE_BIT)) == (1u << LC_SHAPE_COUNT) - 1u, shape_values);
+LC_STATIC_ASSERT((0u LC_INTEGRATOR_TYPES(LC_VALUE_BIT) LC_AOV_TYPES(LC_VALUE_BIT)) ==
+                     (1u << LC_INTEGRATOR_COUNT) - 1u,
+                 integrator_values);
+LC_STATIC_ASSERT((0u LC_FILTER_TYPES(LC_VALUE_BIT)) == (1u << LC_FILTER_COUNT) - 1u, filter_values);
+
 /* ------------------------------------------------------------------------------------------ */
 /* Materials                                                                                  */
 /* ------------------------------------------------------------------------------------------ */
-#define LC_MAT_DIFFUSE 0u    /* Lambertian: albedo (or albedo_tex)                               */
-#define LC_MAT_MIRROR 1u     /* perfect specular reflection, RGB reflectance in specular          */
-#define LC_MAT_DIELECTRIC 2u /* Fresnel glass: ior, tint in specular                              */
-#define LC_MAT_CONDUCTOR 3u  /* GGX microfacet conductor: specular = F0 colour, roughness         */
-#define LC_MAT_PLASTIC 4u    /* GGX coating over a diffuse base: albedo, specular, roughness, ior */
+/* lc_<file>_params per material type (fields from the registry), and their union. A type's
+ * parameters must fit in 48 bytes: the union keeps lc_material at 64. */
+#define LC_MAT_PARAMS_STRUCT(ID, Name, value, name, feature, file, params) \
+  typedef struct {                                                         \
+    params                                                                 \
+  } lc_##file##_params;
+LC_MATERIAL_TYPES(LC_MAT_PARAMS_STRUCT)
+#define LC_MAT_PARAMS_MEMBER(ID, Name, value, name, feature, file, params) lc_##file##_params file;
+typedef union {
+  LC_MATERIAL_TYPES(LC_MAT_PARAMS_MEMBER)
+  float words[12];
+} lc_material_params;
+LC_STATIC_ASSERT(sizeof(lc_material_params) == 48, material_params_size);
 
 typedef struct LC_ALIGN16 lc_material {
-  float albedo[3];   /* diffuse colour, linear RGB                                   */
-  lc_int albedo_tex; /* texture index or -1                                          */
-  float emission[3]; /* emitted radiance, linear RGB (any material may emit)        */
-  lc_uint type;      /* LC_MAT_*                                                     */
-  float specular[3]; /* mirror reflectance / glass tint / glossy specular colour     */
-  float ior;         /* index of refraction (dielectric, plastic)                    */
-  float roughness;   /* GGX alpha (conductor, plastic)                               */
-  lc_uint flags;     /* reserved                                                     */
-  lc_uint pad0;
-  lc_uint pad1;
-} lc_material; /* total: 64 bytes */
+  float emission[3];    /* emitted radiance, linear RGB (any material may emit) */
+  lc_uint type;         /* LC_MAT_*                                             */
+  lc_material_params p; /* the type's parameters: p.<file> (shared/registry.h) */
+} lc_material;          /* total: 64 bytes */
 LC_STATIC_ASSERT(sizeof(lc_material) == 64, material_size);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_material, emission) == 16, material_emission);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_material, type) == 28, material_type);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_material, specular) == 32, material_specular);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_material, roughness) == 48, material_roughness);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_material, type) == 12, material_type);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_material, p) == 16, material_params);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Geometry                                                                                   */
@@ -80,7 +151,7 @@ typedef struct LC_ALIGN16 lc_triangle {
   lc_uint light; /* index into lights if emissive, LC_INVALID */
   float v2[3];
   lc_uint flags; /* LC_TRI_HAS_NORMALS | LC_TRI_HAS_UVS        */
-} lc_triangle; /* total: 48 bytes */
+} lc_triangle;   /* total: 48 bytes */
 LC_STATIC_ASSERT(sizeof(lc_triangle) == 48, triangle_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, v1) == 16, triangle_v1);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, v2) == 32, triangle_v2);
@@ -88,11 +159,11 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, flags) == 44, triangle_flags);
 
 /* Shading data of one triangle, read only at the closest hit. */
 typedef struct LC_ALIGN16 lc_triangle_attr {
-  float n[9];  /* vertex normals n0, n1, n2 (world space, unit)  */
-  float uv[6]; /* texture coordinates uv0, uv1, uv2              */
+  float n[9];           /* vertex normals n0, n1, n2 (world space, unit)  */
+  float uv[6];          /* texture coordinates uv0, uv1, uv2              */
   lc_uint source_index; /* index in the scene's triangle list (degenerate triangles are
                            dropped at packing, so it can differ from the packed index) */
-} lc_triangle_attr; /* total: 64 bytes */
+} lc_triangle_attr;     /* total: 64 bytes */
 LC_STATIC_ASSERT(sizeof(lc_triangle_attr) == 64, triangle_attr_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle_attr, uv) == 36, triangle_attr_uv);
 
@@ -123,7 +194,7 @@ typedef struct LC_ALIGN16 lc_bvh_node {
   float bounds[6][LC_BVH_WIDTH]; /* child boxes, rows min x, max x, min y, max y, min z, max z */
   lc_uint child[LC_BVH_WIDTH];   /* node index, leaf reference or LC_INVALID (see above)       */
   lc_uint pad[LC_BVH_WIDTH];     /* unused: keeps nodes on 64-byte boundaries                  */
-} lc_bvh_node; /* total: 256 bytes (LC_BVH_WIDTH 8; 128 bytes with 4) */
+} lc_bvh_node;                   /* total: 256 bytes (LC_BVH_WIDTH 8; 128 bytes with 4) */
 LC_STATIC_ASSERT(sizeof(lc_bvh_node) == 32 * LC_BVH_WIDTH, bvh_node_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, child) == 24 * LC_BVH_WIDTH, bvh_node_child);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, pad) == 28 * LC_BVH_WIDTH, bvh_node_pad);
@@ -137,32 +208,36 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_node, pad) == 28 * LC_BVH_WIDTH, bvh_node_pa
 typedef struct LC_ALIGN16 lc_bvh_leaf {
   float v[9][4];   /* triangle vertices, one column per primitive */
   lc_uint prim[4]; /* primitive references                        */
-} lc_bvh_leaf; /* total: 160 bytes */
+} lc_bvh_leaf;     /* total: 160 bytes */
 LC_STATIC_ASSERT(sizeof(lc_bvh_leaf) == 160, bvh_leaf_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_bvh_leaf, prim) == 144, bvh_leaf_prim);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Lights                                                                                     */
 /* ------------------------------------------------------------------------------------------ */
-#define LC_LIGHT_POINT 0u    /* position, intensity (W/sr)                              */
-#define LC_LIGHT_SPHERE 1u   /* emissive sphere: prim = sphere index                    */
-#define LC_LIGHT_TRIANGLE 2u /* emissive triangle: prim = triangle index                */
-#define LC_LIGHT_ENV 3u      /* constant environment: radiance in intensity             */
-#define LC_LIGHT_ENV_MAP 4u  /* equirectangular environment map: texture, scale        */
+/* lc_<file>_light_params per light type (fields from the registry), and their union. */
+#define LC_LIGHT_PARAMS_STRUCT(ID, Name, value, name, feature, file, params) \
+  typedef struct {                                                           \
+    params                                                                   \
+  } lc_##file##_light_params;
+LC_LIGHT_TYPES(LC_LIGHT_PARAMS_STRUCT)
+#define LC_LIGHT_PARAMS_MEMBER(ID, Name, value, name, feature, file, params) \
+  lc_##file##_light_params file;
+typedef union {
+  LC_LIGHT_TYPES(LC_LIGHT_PARAMS_MEMBER)
+  float words[8];
+} lc_light_params;
+LC_STATIC_ASSERT(sizeof(lc_light_params) == 32, light_params_size);
 
 typedef struct LC_ALIGN16 lc_light {
-  float position[3];  /* point light position                                        */
-  lc_uint type;       /* LC_LIGHT_*                                                  */
-  float intensity[3]; /* point: intensity; area/env: radiance (scale for maps)        */
-  lc_uint prim;       /* sphere or triangle index for area lights                     */
-  float pdf_select;   /* probability that light sampling picks this light (∝ power)   */
-  float area;         /* surface area for area lights                                 */
-  lc_int texture;     /* environment map texture or -1                               */
-  lc_uint pad0;
-} lc_light; /* total: 48 bytes */
+  lc_uint type;     /* LC_LIGHT_*                                               */
+  float pdf_select; /* probability that light sampling picks this light         */
+  lc_uint pad[2];
+  lc_light_params p; /* the type's parameters: p.<file> (shared/registry.h)      */
+} lc_light;          /* total: 48 bytes */
 LC_STATIC_ASSERT(sizeof(lc_light) == 48, light_size);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_light, intensity) == 16, light_intensity);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_light, pdf_select) == 32, light_pdf_select);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_light, pdf_select) == 4, light_pdf_select);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_light, p) == 16, light_params);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Textures: texels of every texture packed into one float4 buffer (linear RGBA).             */
@@ -171,7 +246,7 @@ typedef struct LC_ALIGN16 lc_texture {
   lc_uint offset; /* first texel in the texel buffer */
   lc_uint width;
   lc_uint height;
-  lc_uint flags;
+  lc_uint pad;
 } lc_texture; /* total: 16 bytes */
 LC_STATIC_ASSERT(sizeof(lc_texture) == 16, texture_size);
 
@@ -192,45 +267,32 @@ LC_STATIC_ASSERT(sizeof(lc_camera) == 64, camera_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_camera, right) == 16, camera_right);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_camera, forward) == 48, camera_forward);
 
-#define LC_INTEGRATOR_PATH 0u
-#define LC_INTEGRATOR_WHITTED 1u
-#define LC_INTEGRATOR_DIRECT 2u /* point lights only, no indirect: first renders */
-#define LC_INTEGRATOR_ALBEDO 3u
-#define LC_INTEGRATOR_NORMAL 4u
-#define LC_INTEGRATOR_DEPTH 5u
-#define LC_INTEGRATOR_AO 6u
-#define LC_INTEGRATOR_PRIMITIVE 7u /* scene-order primitive index + 1 of the first hit */
-
-#define LC_FILTER_BOX 0u
-#define LC_FILTER_TENT 1u
-#define LC_FILTER_GAUSSIAN 2u
-
 typedef struct LC_ALIGN16 lc_params {
   lc_camera camera;
   lc_uint width;
   lc_uint height;
-  lc_uint sample_offset;     /* index of the first sample of this pass             */
-  lc_uint samples_per_pass;  /* samples per pixel in this launch                   */
+  lc_uint sample_offset;    /* index of the first sample of this pass             */
+  lc_uint samples_per_pass; /* samples per pixel in this launch                   */
   lc_uint seed;
   lc_uint max_depth;
-  lc_uint rr_depth;          /* Russian roulette starts at this depth             */
-  lc_uint integrator;        /* LC_INTEGRATOR_*                                    */
+  lc_uint rr_depth;   /* Russian roulette starts at this depth             */
+  lc_uint integrator; /* LC_INTEGRATOR_* (integrators, then AOVs)           */
   lc_uint num_triangles;
   lc_uint num_spheres;
   lc_uint num_lights;
   lc_uint num_nodes;
-  float env_radiance[3];     /* constant environment radiance (0 when none)        */
-  lc_int env_light;          /* index of the environment light or -1              */
-  lc_uint filter;            /* LC_FILTER_*                                        */
-  float filter_radius;       /* in pixels                                          */
-  float ao_distance;         /* ambient occlusion ray length (INFINITY: unbounded) */
+  lc_int env_light;    /* index of the environment light or -1              */
+  lc_uint filter;      /* LC_FILTER_*                                        */
+  float filter_radius; /* in pixels                                          */
+  float ao_distance;   /* ambient occlusion ray length (INFINITY: unbounded) */
   lc_uint flags;
+  lc_uint pad[3];
 } lc_params; /* total: 144 bytes */
 LC_STATIC_ASSERT(sizeof(lc_params) == 144, params_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, width) == 64, params_width);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, num_triangles) == 96, params_num_triangles);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, env_radiance) == 112, params_env_radiance);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, filter) == 128, params_filter);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, env_light) == 112, params_env_light);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, filter) == 116, params_filter);
 
 /* lc_params.flags */
 #define LC_FLAG_NO_MIS 1u /* path: light sampling only for area lights (no BSDF-hit emission) */

@@ -1,19 +1,18 @@
 /* lucent test kernel: evaluates the device's Fresnel and BSDF code on inputs given by the host
  * (tests/test_kernel_bsdf.cpp). */
-#define LC_HAS_MIRROR
-#define LC_HAS_DIELECTRIC
-#define LC_HAS_CONDUCTOR
-#define LC_HAS_PLASTIC
+/* clang-format off */
+#include "generated/all_features.cl" /* every material type */
 #include "shared/types.h"
 #include "shared/rng.h"
 #include "util/math.cl"
-#include "geom/sphere.cl"
-#include "geom/triangle.cl"
+#include "scene/scene.cl"
+#include "geom/interaction.cl"
 #include "bvh/traverse.cl"
-#include "film/texture.cl"
+#include "texture/texture.cl"
 #include "bsdf/fresnel.cl"
 #include "bsdf/microfacet.cl"
 #include "bsdf/bsdf.cl"
+/* clang-format on */
 
 /* in: (cos_i, eta) pairs; out: (F, cos_t) pairs */
 __kernel void probe_fresnel(__global const float2* in, __global float2* out) {
@@ -29,9 +28,10 @@ __kernel void probe_bsdf_sample(__global const lc_material* mat, float4 wo_in, i
                                 __global float4* out_wi, __global float4* out_weight) {
   lc_uint i = (lc_uint)get_global_id(0);
   lc_bsdf b = bsdf_from_material_untextured(mat);
+  b.front = front;
   lc_bsdf_sample bs;
   float3 wo = normalize(wo_in.xyz);
-  int ok = bsdf_sample(&b, wo, front, lc_rng_uniform(0u, i, 0u, 7u), lc_rng_uniform(0u, i, 1u, 7u),
+  int ok = bsdf_sample(&b, wo, lc_rng_uniform(0u, i, 0u, 7u), lc_rng_uniform(0u, i, 1u, 7u),
                        lc_rng_uniform(0u, i, 2u, 7u), &bs);
   out_wi[i] = ok ? (float4)(bs.wi, bs.pdf) : (float4)(0.0f, 0.0f, 0.0f, -1.0f);
   out_weight[i] = ok ? (float4)(bs.weight, (float)bs.delta) : (float4)(0.0f);

@@ -20,15 +20,18 @@
  * sides (k = 1); case = side + 2 inside (side 0: reflection, 1: transmission).
  * example: the last failure as (p, case + 4 is_triangle) and (direction, t).
  */
-#define LC_HAS_SPHERES
-#define LC_HAS_TRIANGLES
+#define LC_HAS_SPHERES 1
+#define LC_HAS_TRIANGLES 1
+/* clang-format off */
+#define LC_HAS_SPHERES 1
+#define LC_HAS_TRIANGLES 1
 #include "shared/types.h"
 #include "shared/rng.h"
 #include "util/math.cl"
-#include "geom/sphere.cl"
-#include "geom/triangle.cl"
-#include "bvh/traverse.cl"
+#include "scene/scene.cl"
 #include "geom/interaction.cl"
+#include "bvh/traverse.cl"
+/* clang-format on */
 
 static inline float3 spawn_uniform_sphere(float u1, float u2) {
   float z = 1.0f - 2.0f * u1;

@@ -1,12 +1,11 @@
-/* lucent test kernel: the device's texture lookup (film/texture.cl) on textures packed by the host
- * (tests/test_texture_kernel.cpp): out[i] = texture_lookup(texture index[i], uv[i]). */
+/* lucent test kernel: the device's texture lookup (texture/texture.cl) on textures packed by the
+ * host (tests/test_texture_kernel.cpp): out[i] = texture_lookup(texture index[i], uv[i]). */
+/* clang-format off */
 #include "shared/types.h"
-#include "shared/rng.h"
 #include "util/math.cl"
-#include "geom/sphere.cl"
-#include "geom/triangle.cl"
-#include "bvh/traverse.cl"
-#include "film/texture.cl"
+#include "scene/scene.cl"
+#include "texture/texture.cl"
+/* clang-format on */
 
 __kernel void probe_texture_lookup(__global const lc_texture* textures,
                                    __global const float4* texels, __global const int* index,

@@ -4,14 +4,15 @@
  *   rays[2 i]     = (origin, tmax)      rays[2 i + 1] = (direction, unused)
  *   hits[i]       = (t, as_float(prim), b1, b2); prim = LC_INVALID on a miss. With any_hit set
  *                   only the occlusion answer is meaningful: prim != LC_INVALID when occluded. */
+/* clang-format off */
 #include "shared/types.h"
 #include "util/math.cl"
-#include "geom/sphere.cl"
-#include "geom/triangle.cl"
+#include "scene/scene.cl"
+#include "geom/interaction.cl"
 #include "bvh/traverse.cl"
+/* clang-format on */
 
-__kernel void lucent_trace_rays(__global const lc_params* params,
-                                __global const lc_bvh_node* nodes,
+__kernel void lucent_trace_rays(__global const lc_params* params, __global const lc_bvh_node* nodes,
                                 __global const lc_bvh_leaf* leaves,
                                 __global const lc_triangle* triangles,
                                 __global const lc_sphere* spheres, __global const float4* rays,

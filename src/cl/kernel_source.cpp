@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include "lucent/error.hpp"
+#include "render/features.hpp"
+#include "shared/registry.h"
 
 namespace lucent::detail {
 
@@ -44,9 +46,53 @@ void expand(const std::string& path, std::set<std::string>& seen, std::ostringst
   }
 }
 
+// The kernel files generated from the registries (kernels/shared/registry.h): the per-type file
+// lists that bsdf/bsdf.cl, light/light.cl, geom/interaction.cl and integrator/integrator.cl
+// include, and every feature define (for probe kernels that test every type).
+bool generated_kernel_file(const std::string& path, std::string& text) {
+  std::ostringstream out;
+  out << "/* generated from kernels/shared/registry.h by src/cl/kernel_source.cpp */\n";
+#define LUCENT_INCLUDE_TYPE(dir) \
+  [&](const char* file) { out << "#include \"" dir "/" << file << ".cl\"\n"; }
+  if (path == "generated/materials.cl") {
+    auto add = LUCENT_INCLUDE_TYPE("bsdf");
+#define X(ID, Name, value, name, feature, file, params) add(#file);
+    LC_MATERIAL_TYPES(X)
+#undef X
+  } else if (path == "generated/lights.cl") {
+    auto add = LUCENT_INCLUDE_TYPE("light");
+#define X(ID, Name, value, name, feature, file, params) add(#file);
+    LC_LIGHT_TYPES(X)
+#undef X
+  } else if (path == "generated/shapes.cl") {
+    auto add = LUCENT_INCLUDE_TYPE("geom");
+#define X(ID, Name, value, name, feature, file) add(#file);
+    LC_SHAPE_TYPES(X)
+#undef X
+  } else if (path == "generated/integrators.cl") {
+    auto add = LUCENT_INCLUDE_TYPE("integrator");
+#define X(ID, Name, value, name, feature, file) add(#file);
+    LC_INTEGRATOR_TYPES(X)
+#undef X
+  } else if (path == "generated/all_features.cl") {
+    for (const std::string& f : render_detail::all_features())
+      out << "#ifndef " << f << "\n#define " << f << " 1\n#endif\n";
+  } else {
+    return false;
+  }
+#undef LUCENT_INCLUDE_TYPE
+  text = out.str();
+  return true;
+}
+
 }  // namespace
 
 std::string read_kernel_file(const std::string& path) {
+  std::string generated;
+  if (path.rfind("generated/", 0) == 0) {
+    if (generated_kernel_file(path, generated)) return generated;
+    throw Error("kernels/" + path + ": no such generated kernel source");
+  }
   if (const char* dir = kernel_dir_override()) {
     std::string full = std::string(dir) + "/" + path;
     std::ifstream f(full, std::ios::binary);

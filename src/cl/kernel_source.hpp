@@ -4,13 +4,14 @@
 namespace lucent::detail {
 
 struct EmbeddedKernelFile {
-  const char* path;     ///< relative to kernels/, e.g. "bvh/traverse.cl"
+  const char* path;  ///< relative to kernels/, e.g. "bvh/traverse.cl"
   const char* content;
 };
 extern const EmbeddedKernelFile kEmbeddedKernelFiles[];
 extern const int kEmbeddedKernelFileCount;
 
-/// The text of kernels/<path>: from LUCENT_KERNEL_DIR when that is set (kernel development
+/// The text of kernels/<path>: generated/... files from the registries (whatever the source), else
+/// from LUCENT_KERNEL_DIR when that is set (kernel development
 /// without rebuilding), else from the copy embedded at build time. Throws lucent::Error.
 std::string read_kernel_file(const std::string& path);
 

@@ -1,17 +1,17 @@
 // `lucent info SCENE`: what the scene holds (shapes, materials, textures, lights), the BVH built
 // over it and the kernel feature defines it would be compiled with. Needs no OpenCL device.
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "bvh/bvh.hpp"
 #include "cl/kernel_source.hpp"
 #include "lucent/scene.hpp"
+#include "render/features.hpp"
 #include "render/pack.hpp"
 
 namespace lucent::cli {
@@ -45,24 +45,37 @@ std::string format_bytes(double b) {
 
 const char* material_name(MaterialType t) {
   switch (t) {
-    case MaterialType::Mirror: return "mirror";
-    case MaterialType::Dielectric: return "dielectric";
-    case MaterialType::Conductor: return "conductor";
-    case MaterialType::Plastic: return "plastic";
-    default: return "diffuse";
+    case MaterialType::Mirror:
+      return "mirror";
+    case MaterialType::Dielectric:
+      return "dielectric";
+    case MaterialType::Conductor:
+      return "conductor";
+    case MaterialType::Plastic:
+      return "plastic";
+    default:
+      return "diffuse";
   }
 }
 
 const char* integrator_name(IntegratorType t) {
   switch (t) {
-    case IntegratorType::Whitted: return "whitted";
-    case IntegratorType::Direct: return "direct";
-    case IntegratorType::Albedo: return "albedo";
-    case IntegratorType::Normal: return "normal";
-    case IntegratorType::Depth: return "depth";
-    case IntegratorType::Ao: return "ao";
-    case IntegratorType::Primitive: return "primitive";
-    default: return "path";
+    case IntegratorType::Whitted:
+      return "whitted";
+    case IntegratorType::Direct:
+      return "direct";
+    case IntegratorType::Albedo:
+      return "albedo";
+    case IntegratorType::Normal:
+      return "normal";
+    case IntegratorType::Depth:
+      return "depth";
+    case IntegratorType::Ao:
+      return "ao";
+    case IntegratorType::Primitive:
+      return "primitive";
+    default:
+      return "path";
   }
 }
 
@@ -145,13 +158,13 @@ int run_info_command() {
   std::printf("  environment         %zu\n", count[LC_LIGHT_ENV]);
   std::printf("  environment map     %zu\n", count[LC_LIGHT_ENV_MAP]);
 
-  const bvh::BuildStats& s = packed.bvh.stats;
+  const bvh::BuildStats& s = packed.bvh_stats;
   std::printf("\nBVH\n");
   std::printf("  build time          %.3f ms\n", s.seconds * 1e3);
   std::printf("  primitives          %zu\n", s.primitives);
-  std::printf("  nodes               %zu binary, collapsed into %zu %d-wide (%s)\n",
-              s.binary_nodes, s.nodes, LC_BVH_WIDTH,
-              format_bytes(double(packed.bvh.nodes.size()) * sizeof(lc_bvh_node)).c_str());
+  std::printf("  nodes               %zu binary, collapsed into %zu %d-wide (%s)\n", s.binary_nodes,
+              s.nodes, LC_BVH_WIDTH,
+              format_bytes(double(packed.nodes.size()) * sizeof(lc_bvh_node)).c_str());
   std::printf("  leaves              %zu\n", s.leaves);
   std::printf("  leaf size           mean %.2f, max %zu\n", s.mean_leaf_size, s.max_leaf_size);
   std::printf("  max depth           %zu binary, %zu wide\n", s.binary_max_depth, s.max_depth);
@@ -166,9 +179,9 @@ int run_info_command() {
   std::printf("\nkernel\n");
   std::printf("  sources             %s\n", detail::kernel_source_origin().c_str());
   std::printf("  feature defines     %s\n", defines.empty() ? "(none)" : defines.c_str());
-  std::printf("  precision           %s%s\n", precision_name(options.precision),
-              options.precision == Precision::Double ? " (rays and geometry in double; needs fp64)"
-                                                     : "");
+  std::printf(
+      "  precision           %s%s\n", precision_name(options.precision),
+      options.precision == Precision::Double ? " (rays and geometry in double; needs fp64)" : "");
   std::printf("  math                %s\n",
               options.fast_math ? "fast (-cl-fast-relaxed-math)" : "IEEE");
   std::printf("  build options       %s\n",

@@ -19,22 +19,18 @@ cl::Buffer make_buffer(const cl_util::Context& ctx, const std::vector<T>& v) {
 }  // namespace
 
 DeviceScene::DeviceScene(const cl_util::Context& ctx, const PackedScene& p)
-    : params(make_buffer(ctx, std::vector<lc_params>{p.params})),
-      nodes(make_buffer(ctx, p.bvh.nodes)),
-      leaves(make_buffer(ctx, p.bvh.leaves)),
-      triangles(make_buffer(ctx, p.triangles)),
-      tri_attrs(make_buffer(ctx, p.tri_attrs)),
-      spheres(make_buffer(ctx, p.spheres)),
-      materials(make_buffer(ctx, p.materials)),
-      lights(make_buffer(ctx, p.lights)),
-      light_cdf(make_buffer(ctx, p.light_cdf)),
-      textures(make_buffer(ctx, p.textures)),
-      texels(make_buffer(ctx, p.texels)) {}
+    :
+#define LUCENT_UPLOAD(name, type) name(make_buffer(ctx, p.name)),
+      LC_SCENE_BUFFERS(LUCENT_UPLOAD)
+#undef LUCENT_UPLOAD
+          params(make_buffer(ctx, std::vector<lc_params>{p.params})) {
+}
 
 int DeviceScene::set_args(cl::Kernel& kernel, int arg) const {
-  for (const cl::Buffer* b : {&params, &nodes, &leaves, &triangles, &tri_attrs, &spheres, &materials,
-                              &lights, &light_cdf, &textures, &texels})
-    kernel.setArg(arg++, *b);
+#define LUCENT_SET_ARG(name, type) kernel.setArg(arg++, name);
+  LC_SCENE_BUFFERS(LUCENT_SET_ARG)
+#undef LUCENT_SET_ARG
+  kernel.setArg(arg++, params);
   return arg;
 }
 

@@ -1,16 +1,20 @@
 #pragma once
 // A packed scene's buffers on an OpenCL device, in the argument order of every kernel that takes
-// a scene: params, nodes, leaves, triangles, tri_attrs, spheres, materials, lights,
-// light_cdf, textures, texels (kernels/megakernel.cl, kernels/test/*_probe.cl).
+// a scene (LC_SCENE_KERNEL_ARGS, kernels/scene/scene.cl): the buffers of LC_SCENE_BUFFERS
+// (kernels/shared/registry.h) in their order, then params.
 #include "cl/context.hpp"
 #include "render/pack.hpp"
 
 namespace lucent::render_detail {
 
 struct DeviceScene {
-  static constexpr int kArgCount = 11;
-  cl::Buffer params, nodes, leaves, triangles, tri_attrs, spheres, materials, lights, light_cdf,
-      textures, texels;
+#define LUCENT_COUNT_BUFFER(name, type) +1
+  static constexpr int kArgCount = 1 LC_SCENE_BUFFERS(LUCENT_COUNT_BUFFER);
+#undef LUCENT_COUNT_BUFFER
+#define LUCENT_DEVICE_BUFFER(name, type) cl::Buffer name;
+  LC_SCENE_BUFFERS(LUCENT_DEVICE_BUFFER)
+#undef LUCENT_DEVICE_BUFFER
+  cl::Buffer params;
 
   /// Creates the buffers with their contents (copied at creation).
   DeviceScene(const cl_util::Context& ctx, const PackedScene& packed);

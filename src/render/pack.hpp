@@ -1,28 +1,23 @@
 #pragma once
-// Scene -> device buffers: the float, 16-byte aligned layout of kernels/shared/types.h.
-#include <array>
+// Scene -> device buffers: the float, 16-byte aligned layout of kernels/shared/types.h, one
+// vector per entry of LC_SCENE_BUFFERS (kernels/shared/registry.h).
 #include <string>
 #include <vector>
 
 #include "bvh/bvh.hpp"
-#include "lucent/device.hpp"
-#include "lucent/render.hpp"
 #include "lucent/scene.hpp"
+#include "render/features.hpp"
 #include "shared/types.h"
 
 namespace lucent::render_detail {
 
 struct PackedScene {
   lc_params params{};
-  std::vector<lc_triangle> triangles;
-  std::vector<lc_triangle_attr> tri_attrs;
-  std::vector<lc_sphere> spheres;
-  std::vector<lc_material> materials;
-  std::vector<lc_light> lights;
-  std::vector<float> light_cdf;  ///< cumulative selection probabilities, last = 1
-  std::vector<lc_texture> textures;
-  std::vector<std::array<float, 4>> texels;
-  bvh::Bvh bvh;
+#define LUCENT_PACKED_BUFFER(name, type) std::vector<type> name;
+  LC_SCENE_BUFFERS(LUCENT_PACKED_BUFFER)
+#undef LUCENT_PACKED_BUFFER
+  bvh::BuildStats bvh_stats;
+  float bounds_min[3] = {0, 0, 0}, bounds_max[3] = {0, 0, 0};  ///< scene bounds (0 when empty)
   std::size_t skipped_triangles = 0;  ///< degenerate or non-finite, left out with a warning
 };
 
@@ -32,23 +27,10 @@ lc_camera pack_camera(const Camera& camera, int width, int height);
 /// Converts and validates the scene, builds the BVH and the light table.
 PackedScene pack_scene(const Scene& scene);
 
-/// The kernel features (LC_HAS_... defines) the scene uses.
-std::vector<std::string> scene_features(const Scene& scene, const PackedScene& packed);
-
-/// Every kernel feature: what --no-specialize compiles.
-const std::vector<std::string>& all_features();
-
-/// OpenCL build options (" -D LC_HAS_..." ...) for the scene's features, or for all of them.
-std::string feature_defines(const Scene& scene, const PackedScene& packed, bool specialize = true);
-
-/// The megakernel's full OpenCL build options for these render options: -cl-std, the feature
-/// defines, -D LC_DOUBLE with Precision::Double, -cl-fast-relaxed-math with fast_math. They are
-/// part of the program cache key, so each precision has its own cached binary.
-std::string build_options(const Scene& scene, const PackedScene& packed,
-                          const RenderOptions& options);
-
-/// Throws lucent::Error (one line naming the device) when `precision` needs what the device lacks:
-/// Precision::Double needs fp64 (cl_khr_fp64 / CL_DEVICE_DOUBLE_FP_CONFIG).
-void check_precision_support(const DeviceInfo& device, Precision precision);
+/// The light table (src/render/lights.cpp): the scene's point and environment lights after the
+/// area lights that pack_scene added for emissive shapes (`area_power`: their powers), each light's
+/// selection probability and the light_cdf buffer (selection CDF, then each environment map's
+/// texel CDF). Sets params.env_light.
+void pack_lights(const Scene& scene, PackedScene& packed, std::vector<double> area_power);
 
 }  // namespace lucent::render_detail

@@ -7,16 +7,16 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
 #include <initializer_list>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
-
-#include <glm/gtc/matrix_transform.hpp>
-#include <nlohmann/json.hpp>
 
 #include "lucent/error.hpp"
 #include "lucent/scene.hpp"
 #include "scene/loaders.hpp"
+#include "scene/material_type.hpp"
 
 namespace lucent {
 
@@ -31,15 +31,27 @@ int Scene::find_material(const std::string& name) const {
 
 namespace {
 
+/// Scene-file names of the material types, by value (kernels/shared/registry.h).
+#define LUCENT_MATERIAL_NAME(ID, Name, value, name, ...) name,
+const char* const kMaterialTypeNames[] = {LC_MATERIAL_TYPES(LUCENT_MATERIAL_NAME)};
+#undef LUCENT_MATERIAL_NAME
+
 std::string type_name(const json& j) {
   switch (j.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::boolean: return "a boolean";
-    case json::value_t::string: return "a string";
-    case json::value_t::array: return "an array";
-    case json::value_t::object: return "an object";
-    case json::value_t::discarded: return "invalid";
-    default: return "a number";
+    case json::value_t::null:
+      return "null";
+    case json::value_t::boolean:
+      return "a boolean";
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::array:
+      return "an array";
+    case json::value_t::object:
+      return "an object";
+    case json::value_t::discarded:
+      return "invalid";
+    default:
+      return "a number";
   }
 }
 
@@ -75,6 +87,11 @@ class Parser {
 
   void check_keys(const json& obj, const std::string& ptr,
                   std::initializer_list<const char*> allowed) const {
+    check_keys(obj, ptr, std::vector<const char*>(allowed));
+  }
+
+  void check_keys(const json& obj, const std::string& ptr,
+                  const std::vector<const char*>& allowed) const {
     check_object(obj, ptr);
     for (auto it = obj.begin(); it != obj.end(); ++it) {
       bool ok = false;
@@ -138,6 +155,18 @@ class Parser {
     for (const char* o : options) {
       if (s == o) return s;
       list += std::string(list.empty() ? "" : ", ") + o;
+    }
+    fail(ptr, "unknown value '" + s + "' (expected one of: " + list + ")");
+  }
+
+  /// A registry type by its scene-file name (names[i] is the name of value i).
+  template <typename Enum, size_t N>
+  Enum registry_choice(const json& j, const std::string& ptr, const char* const (&names)[N]) const {
+    std::string s = string(j, ptr);
+    std::string list;
+    for (size_t i = 0; i < N; ++i) {
+      if (s == names[i]) return static_cast<Enum>(i);
+      list += std::string(list.empty() ? "" : ", ") + names[i];
     }
     fail(ptr, "unknown value '" + s + "' (expected one of: " + list + ")");
   }
@@ -213,7 +242,8 @@ class Parser {
 
   void parse_film(const json& j, const std::string& p, Film& f) {
     check_keys(j, p, {"width", "height", "filter", "transfer", "gamma", "exposure", "tonemap"});
-    if (j.contains("width")) f.width = static_cast<int>(integer(j["width"], p + "/width", 1, 16384));
+    if (j.contains("width"))
+      f.width = static_cast<int>(integer(j["width"], p + "/width", 1, 16384));
     if (j.contains("height"))
       f.height = static_cast<int>(integer(j["height"], p + "/height", 1, 16384));
     if (j.contains("filter")) {
@@ -221,8 +251,8 @@ class Parser {
       std::string fp = p + "/filter";
       check_keys(fj, fp, {"type", "radius"});
       std::string t = choice(require(fj, fp, "type"), fp + "/type", {"box", "tent", "gaussian"});
-      f.filter.type = t == "box" ? FilterType::Box
-                                 : (t == "tent" ? FilterType::Tent : FilterType::Gaussian);
+      f.filter.type =
+          t == "box" ? FilterType::Box : (t == "tent" ? FilterType::Tent : FilterType::Gaussian);
       f.filter.radius = f.filter.type == FilterType::Box ? 0.5 : 1.5;
       if (fj.contains("radius")) {
         f.filter.radius = positive(fj["radius"], fp + "/radius");
@@ -231,21 +261,24 @@ class Parser {
     }
     if (j.contains("transfer")) {
       std::string t = choice(j["transfer"], p + "/transfer", {"srgb", "gamma", "linear"});
-      f.transfer = t == "srgb" ? Transfer::Srgb : (t == "gamma" ? Transfer::Gamma : Transfer::Linear);
+      f.transfer =
+          t == "srgb" ? Transfer::Srgb : (t == "gamma" ? Transfer::Gamma : Transfer::Linear);
     }
     if (j.contains("gamma")) f.gamma = positive(j["gamma"], p + "/gamma");
     if (j.contains("exposure")) f.exposure = number(j["exposure"], p + "/exposure");
     if (j.contains("tonemap")) {
       std::string t = choice(j["tonemap"], p + "/tonemap", {"clamp", "reinhard", "aces"});
-      f.tonemap = t == "clamp" ? ToneMap::Clamp : (t == "reinhard" ? ToneMap::Reinhard : ToneMap::Aces);
+      f.tonemap =
+          t == "clamp" ? ToneMap::Clamp : (t == "reinhard" ? ToneMap::Reinhard : ToneMap::Aces);
     }
   }
 
   void parse_integrator(const json& j, const std::string& p, Integrator& in) {
     check_keys(j, p, {"type", "max_depth", "rr_depth", "spp", "seed", "ao_distance", "mis"});
     if (j.contains("type")) {
-      std::string t = choice(j["type"], p + "/type",
-                             {"path", "whitted", "direct", "albedo", "normal", "depth", "ao", "primitive"});
+      std::string t =
+          choice(j["type"], p + "/type",
+                 {"path", "whitted", "direct", "albedo", "normal", "depth", "ao", "primitive"});
       in.type = parse_integrator_type(t);
     }
     if (j.contains("max_depth"))
@@ -256,7 +289,8 @@ class Parser {
     if (j.contains("seed"))
       in.seed = static_cast<std::uint32_t>(integer(j["seed"], p + "/seed", 0, 0xffffffffL));
     if (j.contains("mis")) {
-      if (!j["mis"].is_boolean()) fail(p + "/mis", "must be true or false, got " + type_name(j["mis"]));
+      if (!j["mis"].is_boolean())
+        fail(p + "/mis", "must be true or false, got " + type_name(j["mis"]));
       in.mis = j["mis"].get<bool>();
     }
     if (j.contains("ao_distance")) in.ao_distance = positive(j["ao_distance"], p + "/ao_distance");
@@ -287,54 +321,45 @@ class Parser {
     check_object(j, p);
     Material m;
     m.name = name;
-    std::string t = choice(require(j, p, "type"), p + "/type",
-                           {"diffuse", "mirror", "dielectric", "conductor", "plastic"});
-    if (t == "diffuse") {
-      check_keys(j, p, {"type", "albedo", "emission"});
-      m.type = MaterialType::Diffuse;
-    } else if (t == "mirror") {
-      check_keys(j, p, {"type", "reflectance", "emission"});
-      m.type = MaterialType::Mirror;
-      m.specular = glm::dvec3(1.0);
-      if (j.contains("reflectance")) m.specular = colour(j["reflectance"], p + "/reflectance");
-    } else if (t == "dielectric") {
-      check_keys(j, p, {"type", "ior", "tint", "emission"});
-      m.type = MaterialType::Dielectric;
-      m.specular = glm::dvec3(1.0);
-      if (j.contains("tint")) m.specular = colour(j["tint"], p + "/tint");
-    } else if (t == "conductor") {
-      check_keys(j, p, {"type", "specular", "roughness", "emission"});
-      m.type = MaterialType::Conductor;
-      m.specular = glm::dvec3(0.9);
-      if (j.contains("specular")) m.specular = colour(j["specular"], p + "/specular");
-    } else {
-      check_keys(j, p, {"type", "albedo", "specular", "roughness", "ior", "emission"});
-      m.type = MaterialType::Plastic;
-      m.specular = glm::dvec3(1.0);
-      if (j.contains("specular")) m.specular = colour(j["specular"], p + "/specular");
-    }
-    if (j.contains("albedo")) {
-      const json& a = j["albedo"];
-      if (a.is_object()) {
-        check_keys(a, p + "/albedo", {"texture"});
-        std::string file = string(require(a, p + "/albedo", "texture"), p + "/albedo/texture");
-        try {
-          m.albedo = glm::dvec3(1.0);
-          m.albedo_texture = scene_detail::load_texture(scene, resolve(file));
-        } catch (const Error& e) {
-          fail(p + "/albedo/texture", e.what());
+    m.type = registry_choice<MaterialType>(require(j, p, "type"), p + "/type", kMaterialTypeNames);
+    const scene_detail::MaterialTypeDef& def = scene_detail::material_type_def(m.type);
+    std::vector<const char*> keys = {"type", "emission"};
+    for (const scene_detail::MaterialParam& param : def.params) keys.push_back(param.key);
+    check_keys(j, p, keys);
+    for (const scene_detail::MaterialParam& param : def.params) {
+      std::string pp = p + "/" + param.key;
+      using Kind = scene_detail::MaterialParam::Kind;
+      if (param.colour) m.*param.colour = param.default_colour;
+      if (param.number) m.*param.number = param.default_number;
+      if (!j.contains(param.key)) continue;
+      const json& v = j[param.key];
+      switch (param.kind) {
+        case Kind::ColourOrTexture:
+          if (v.is_object()) {
+            check_keys(v, pp, {"texture"});
+            std::string file = string(require(v, pp, "texture"), pp + "/texture");
+            try {
+              m.*param.colour = glm::dvec3(1.0);
+              m.albedo_texture = scene_detail::load_texture(scene, resolve(file));
+            } catch (const Error& e) {
+              fail(pp + "/texture", e.what());
+            }
+            break;
+          }
+          [[fallthrough]];
+        case Kind::Colour:
+          m.*param.colour = colour(v, pp);
+          break;
+        case Kind::Positive:
+          m.*param.number = positive(v, pp);
+          break;
+        case Kind::UnitInterval: {
+          double x = number(v, pp);
+          if (x < 0 || x > 1) fail(pp, "must be in [0, 1], got " + format_number(x));
+          m.*param.number = x;
+          break;
         }
-      } else {
-        m.albedo = colour(a, p + "/albedo");
       }
-    }
-    if (j.contains("ior")) {
-      m.ior = positive(j["ior"], p + "/ior");
-    }
-    if (j.contains("roughness")) {
-      m.roughness = number(j["roughness"], p + "/roughness");
-      if (m.roughness < 0 || m.roughness > 1)
-        fail(p + "/roughness", "must be in [0, 1], got " + format_number(m.roughness));
     }
     if (j.contains("emission")) m.emission = colour(j["emission"], p + "/emission");
     return m;
@@ -385,7 +410,8 @@ class Parser {
           fail(mp, "the last row must be [0, 0, 0, 1] (affine transforms only)");
         if (std::abs(glm::determinant(s)) < 1e-300) fail(mp, "must be invertible");
       } else {
-        fail(sp + "/" + step.begin().key(), "unknown transform step (allowed: scale, rotate, translate, matrix)");
+        fail(sp + "/" + step.begin().key(),
+             "unknown transform step (allowed: scale, rotate, translate, matrix)");
       }
       m = s * m;  // steps apply in order
     }
@@ -424,7 +450,8 @@ class Parser {
     glm::dmat4 xf = j.contains("transform") ? parse_transform(j["transform"], p + "/transform")
                                             : glm::dmat4(1.0);
     const json& pos = require(j, p, "positions");
-    if (!pos.is_array() || pos.empty()) fail(p + "/positions", "must be a non-empty array of [x, y, z]");
+    if (!pos.is_array() || pos.empty())
+      fail(p + "/positions", "must be a non-empty array of [x, y, z]");
     const json& idx = require(j, p, "indices");
     if (!idx.is_array() || idx.size() % 3 != 0)
       fail(p + "/indices", "must be an array whose length is a multiple of 3");
@@ -592,7 +619,8 @@ Scene load_scene(const std::string& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw Error(path + ": is a directory, not a scene file");
   std::ifstream f(path, std::ios::binary);
-  if (!f) throw Error(path + ": cannot open scene file (" + std::string(std::strerror(errno)) + ")");
+  if (!f)
+    throw Error(path + ": cannot open scene file (" + std::string(std::strerror(errno)) + ")");
   std::ostringstream ss;
   ss << f.rdbuf();
   return parse_scene(ss.str(), path);

@@ -1,6 +1,6 @@
 /* lucent kernel: texture lookups, bilinear filtering with repeat wrapping. Texels are linear RGBA. */
-#ifndef LUCENT_FILM_TEXTURE_CL
-#define LUCENT_FILM_TEXTURE_CL
+#ifndef LUCENT_TEXTURE_TEXTURE_CL
+#define LUCENT_TEXTURE_TEXTURE_CL
 
 static inline float4 texture_texel(const lc_scene* s, __global const lc_texture* tex, int x, int y) {
   int w = (int)tex->width, h = (int)tex->height;

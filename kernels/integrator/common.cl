@@ -1,0 +1,103 @@
+/* lucent kernel: what several integrators share: MIS weights, the shading frame, shadow rays and
+ * point-light illumination. */
+#ifndef LUCENT_INTEGRATOR_COMMON_CL
+#define LUCENT_INTEGRATOR_COMMON_CL
+
+/* Power heuristic with beta = 2. */
+static inline float mis_power(float a, float b) {
+  if (isinf(a)) return 1.0f;
+  float a2 = a * a, b2 = b * b;
+  return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+/* Local shading frame around n. */
+typedef struct {
+  float3 t, b, n;
+} lc_frame;
+static inline lc_frame frame_from(float3 n) {
+  lc_frame f;
+  f.n = n;
+  lc_onb(n, &f.t, &f.b);
+  return f;
+}
+static inline float3 frame_to_local(const lc_frame* f, float3 v) {
+  return (float3)(dot(v, f->t), dot(v, f->b), dot(v, f->n));
+}
+static inline float3 frame_to_world(const lc_frame* f, float3 v) {
+  return v.x * f->t + v.y * f->b + v.z * f->n;
+}
+
+/* Unoccluded test from a spawned origin o towards a sampled light point (or direction) at
+ * distance dist from o. Light samples are taken from o itself, not from the surface point: the
+ * offset of o is large on huge spheres (it scales with their float precision), and a direction
+ * computed from the surface point would, seen from o, pass just inside a sphere light near its
+ * silhouette. */
+/* Relative shortening of shadow rays (see shadow_visible): float's 2e-4, and for double about
+ * 2e-4 times the ratio of the two epsilons (3.7e-13), rounded up. The sampled light point must
+ * then be computed in lc_real throughout (kernels/light/light.cl): a float barycentric sum or a
+ * float sin/cos pair puts it ~1e-7 off the light's surface, which this margin does not cover
+ * (the Cornell box's NEE was 15% too dark in double until they were lc_real). */
+#ifdef LC_DOUBLE
+#define LC_SHADOW_REL_MARGIN 1e-12
+#else
+#define LC_SHADOW_REL_MARGIN 2e-4f
+#endif
+
+static inline int shadow_visible(const lc_scene* s, lc_real3 o, lc_real3 wi, lc_real dist,
+                                 lc_uint* rays) {
+  lc_ray sr;
+  sr.o = o;
+  sr.d = wi;
+  ++*rays;
+  /* stop short of the light's own surface by its position error: relative to the distance, and
+   * a few ulps of the sampled point's coordinates (it is only known to those: at 1e4 from the
+   * origin a point on a sphere light 2 away is 1e-3 off, 2.5 times 2e-4 dist, and the shadow ray
+   * hit the light itself: 20% too dark, tests/test_stability_scene.cpp StabilityTranslateLight);
+   * both margins scale with lc_real's precision */
+  lc_real tmax = isinf(dist) ? (lc_real)INFINITY
+                             : dist * (LC_REAL(1.0) - LC_SHADOW_REL_MARGIN) -
+                                   LC_REAL(8.0) * LC_REAL_EPSILON * (lc_max3r(fabs(o)) + dist);
+  return !scene_occluded(s, sr, tmax);
+}
+
+/* Sum over point lights of f * cos * I / r^2 (direct and whitted integrators): f is the BSDF b,
+ * or when b is null the lambertian diffuse / pi (whitted's diffuse term). */
+static inline float3 point_lights_direct(const lc_scene* s, const lc_interaction* it,
+                                         const lc_bsdf* b, float3 diffuse, const lc_frame* fr,
+                                         float3 wo_l, lc_uint* rays) {
+  float3 sum = (float3)(0.0f);
+#ifdef LC_HAS_POINT_LIGHTS
+  __global const lc_params* P = s->params;
+  for (lc_uint i = 0; i < P->num_lights; ++i) {
+    __global const lc_light* L = &s->lights[i];
+    if (L->type != LC_LIGHT_POINT) continue;
+    /* irradiance from the surface point itself; the shadow ray leaves from the offset origin
+     * (a point light has no surface that the few-ulp parallel shift could graze) */
+    lc_real3 o = lc_spawn_origin(it->p, it->perr, it->ng);
+    lc_real3 to = lc_load3r(L->p.point.position) - it->p;
+    lc_real d2 = dot(to, to);
+    lc_real dist = sqrt(d2);
+    lc_real3 wi = to / dist;
+    if (dot(wi, it->ng) <= LC_REAL(0.0)) continue;
+    float3 wi_l = frame_to_local(fr, lc_float3_from_real3(wi));
+    if (wi_l.z <= 0.0f) continue;
+    float3 f;
+    if (!b) {
+      f = diffuse * LC_INV_PI;
+    } else {
+      float pdf;
+      f = bsdf_eval(b, wo_l, wi_l, &pdf);
+    }
+    if (lc_max3(f) <= 0.0f) continue;
+    lc_ray sr;
+    sr.o = o;
+    sr.d = wi;
+    ++*rays;
+    if (scene_occluded(s, sr, dist)) continue;
+    sum += f * lc_load3(L->p.point.intensity) * (wi_l.z / (float)d2);
+  }
+#endif
+  return sum;
+}
+
+#endif

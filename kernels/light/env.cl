@@ -1,0 +1,24 @@
+/* lucent kernel: the constant environment: the same radiance from every direction, sampled
+ * uniformly over the sphere. Parameters: lc_env_light_params. */
+#ifndef LUCENT_LIGHT_ENV_CL
+#define LUCENT_LIGHT_ENV_CL
+
+static inline int light_env_sample(const lc_scene* s, __global const lc_light* L, lc_real3 p,
+                                   float u1, float u2, lc_light_sample* ls) {
+  ls->wi = lc_real3_from_float3(sample_uniform_sphere(u1, u2));
+  ls->dist = INFINITY;
+  ls->L = lc_load3(L->p.env.radiance);
+  ls->pdf = L->pdf_select * (0.25f * LC_INV_PI);
+  return 1;
+}
+
+static inline float light_env_pdf(const lc_scene* s, __global const lc_light* L, lc_real3 p,
+                                  float3 d, lc_real dist, float cos_l) {
+  return L->pdf_select * (0.25f * LC_INV_PI);
+}
+
+static inline float3 light_env_emitted(const lc_scene* s, __global const lc_light* L, float3 d) {
+  return lc_load3(L->p.env.radiance);
+}
+
+#endif

@@ -1,0 +1,41 @@
+/* lucent kernel: emissive triangles, sampled uniformly by area (in lc_real), one-sided: they emit
+ * towards the side of (v1 - v0) x (v2 - v0). Parameters: lc_triangle_light_params (the triangle,
+ * its material's emitted radiance, its area). */
+#ifndef LUCENT_LIGHT_TRIANGLE_CL
+#define LUCENT_LIGHT_TRIANGLE_CL
+
+static inline int light_triangle_sample(const lc_scene* s, __global const lc_light* L, lc_real3 p,
+                                        float u1, float u2, lc_light_sample* ls) {
+  __global const lc_triangle* tri = &s->triangles[L->p.triangle.triangle];
+  lc_real3 v0 = lc_load3r(tri->v0), v1 = lc_load3r(tri->v1), v2 = lc_load3r(tri->v2);
+  /* barycentrics in lc_real: in float their sum is off 1 by an ulp, which puts q ~1e-7 |v| off
+   * the light's plane (covered by shadow_visible's float margin, not by its double one) */
+  lc_real su = sqrt((lc_real)u1);
+  lc_real b0 = LC_REAL(1.0) - su, b1 = u2 * su;
+  lc_real3 q = b0 * v0 + b1 * v1 + (LC_REAL(1.0) - b0 - b1) * v2;
+  lc_real3 nl = normalize(cross(v1 - v0, v2 - v0));
+  lc_real3 to = q - p;
+  lc_real d2 = dot(to, to);
+  lc_real dist = sqrt(d2);
+  if (!(dist > LC_REAL(0.0))) return 0;
+  ls->wi = to / dist;
+  lc_real cos_l = -dot(ls->wi, nl);
+  if (cos_l <= LC_REAL(0.0)) return 0; /* one-sided emitter seen from behind */
+  ls->dist = dist;
+  ls->L = lc_load3(L->p.triangle.radiance);
+  ls->pdf = L->pdf_select * d2 / (cos_l * L->p.triangle.area);
+  return 1;
+}
+
+static inline float light_triangle_pdf(const lc_scene* s, __global const lc_light* L, lc_real3 p,
+                                       float3 d, lc_real dist, float cos_l) {
+  if (cos_l > 0.0f) return L->pdf_select * dist * dist / (cos_l * L->p.triangle.area);
+  return 0.0f;
+}
+
+static inline float3 light_triangle_emitted(const lc_scene* s, __global const lc_light* L,
+                                            float3 d) {
+  return (float3)(0.0f);
+}
+
+#endif

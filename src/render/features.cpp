@@ -1,0 +1,114 @@
+#include "render/features.hpp"
+
+#include <algorithm>
+
+#include "lucent/error.hpp"
+#include "render/pack.hpp"
+
+namespace lucent::render_detail {
+
+const std::vector<std::string>& all_features() {
+  static const std::vector<std::string> all = [] {
+    std::vector<std::string> f;
+    auto add = [&f](const char* name) {
+      if (std::find(f.begin(), f.end(), name) == f.end()) f.push_back(name);
+    };
+#define LUCENT_TYPE_FEATURE(ID, Name, value, name, feature, ...) add(#feature);
+#define LUCENT_OTHER_FEATURE(feature, what) add(#feature);
+    LC_SHAPE_TYPES(LUCENT_TYPE_FEATURE)
+    LC_OTHER_FEATURES(LUCENT_OTHER_FEATURE)
+    LC_MATERIAL_TYPES(LUCENT_TYPE_FEATURE)
+    LC_LIGHT_TYPES(LUCENT_TYPE_FEATURE)
+    LC_FILTER_TYPES(LUCENT_TYPE_FEATURE)
+    LC_INTEGRATOR_TYPES(LUCENT_TYPE_FEATURE)
+    LC_AOV_TYPES(LUCENT_TYPE_FEATURE)
+#undef LUCENT_TYPE_FEATURE
+#undef LUCENT_OTHER_FEATURE
+    return f;
+  }();
+  return all;
+}
+
+std::vector<std::string> scene_features(const Scene& scene, const PackedScene& packed) {
+  // which type of each list the scene uses, by enum value
+  bool shape[LC_SHAPE_COUNT] = {}, material[LC_MAT_COUNT] = {}, light[LC_LIGHT_COUNT] = {};
+  bool filter[LC_FILTER_COUNT] = {}, integrator[LC_INTEGRATOR_COUNT] = {};
+  shape[LC_SHAPE_SPHERE] = !packed.spheres.empty();
+  shape[LC_SHAPE_TRIANGLE] = !packed.triangles.empty();
+  // materials some primitive uses (a declared but unused material costs nothing)
+  std::vector<char> used(scene.materials.size(), 0);
+  for (const lc_sphere& sp : packed.spheres) used[sp.material] = 1;
+  for (const lc_triangle& t : packed.triangles) used[t.material] = 1;
+  bool textured = false;
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    if (!used[i]) continue;
+    material[static_cast<int>(scene.materials[i].type)] = true;
+    textured = textured || scene.materials[i].albedo_texture >= 0;
+  }
+  for (const lc_light& l : packed.lights) light[l.type] = true;
+  filter[static_cast<int>(scene.film.filter.type)] = true;
+  integrator[static_cast<int>(scene.integrator.type)] = true;
+  bool smooth = false, uvs = false;
+  for (const lc_triangle& t : packed.triangles) {
+    smooth = smooth || (t.flags & LC_TRI_HAS_NORMALS);
+    uvs = uvs || (t.flags & LC_TRI_HAS_UVS);
+  }
+  const bool other[] = {smooth, uvs && textured, textured, scene.camera.aperture > 0};
+#define LUCENT_COUNT(feature, what) +1
+  static_assert(sizeof(other) / sizeof(other[0]) == 0 LC_OTHER_FEATURES(LUCENT_COUNT),
+                "one condition per LC_OTHER_FEATURES entry, in its order");
+#undef LUCENT_COUNT
+
+  // in the order of all_features()
+  std::vector<std::string> f;
+  auto add = [&f](bool on, const char* name) {
+    if (on && std::find(f.begin(), f.end(), name) == f.end()) f.push_back(name);
+  };
+  int k = 0;
+#define LUCENT_USED(list, ID, value, feature) add(list[value], #feature);
+#define LUCENT_SHAPE(ID, Name, value, name, feature, ...) LUCENT_USED(shape, ID, value, feature)
+#define LUCENT_OTHER(feature, what) add(other[k++], #feature);
+#define LUCENT_MAT(ID, Name, value, name, feature, ...) LUCENT_USED(material, ID, value, feature)
+#define LUCENT_LIGHT(ID, Name, value, name, feature, ...) LUCENT_USED(light, ID, value, feature)
+#define LUCENT_FILTER(ID, Name, value, name, feature, ...) LUCENT_USED(filter, ID, value, feature)
+#define LUCENT_INT(ID, Name, value, name, feature, ...) LUCENT_USED(integrator, ID, value, feature)
+  LC_SHAPE_TYPES(LUCENT_SHAPE)
+  LC_OTHER_FEATURES(LUCENT_OTHER)
+  LC_MATERIAL_TYPES(LUCENT_MAT)
+  LC_LIGHT_TYPES(LUCENT_LIGHT)
+  LC_FILTER_TYPES(LUCENT_FILTER)
+  LC_INTEGRATOR_TYPES(LUCENT_INT)
+  LC_AOV_TYPES(LUCENT_INT)
+#undef LUCENT_USED
+#undef LUCENT_SHAPE
+#undef LUCENT_OTHER
+#undef LUCENT_MAT
+#undef LUCENT_LIGHT
+#undef LUCENT_FILTER
+#undef LUCENT_INT
+  return f;
+}
+
+std::string feature_defines(const Scene& scene, const PackedScene& packed, bool specialize) {
+  std::string d;
+  for (const std::string& f : specialize ? scene_features(scene, packed) : all_features())
+    d += " -D " + f;
+  return d;
+}
+
+std::string build_options(const Scene& scene, const PackedScene& packed,
+                          const RenderOptions& options) {
+  std::string o = "-cl-std=CL1.2" + feature_defines(scene, packed, options.specialize);
+  if (options.precision == Precision::Double) o += " -D LC_DOUBLE";
+  if (options.fast_math) o += " -cl-fast-relaxed-math";
+  return o;
+}
+
+void check_precision_support(const DeviceInfo& device, Precision precision) {
+  if (precision == Precision::Double && !device.fp64)
+    throw Error("--precision double: device '" + device.name +
+                "' has no double-precision floating point (cl_khr_fp64); use --precision float "
+                "or pick another device with --device");
+}
+
+}  // namespace lucent::render_detail

@@ -1,0 +1,37 @@
+#pragma once
+// Kernel features: the LC_HAS_* defines a scene's megakernel is compiled with, and the build
+// options. Every feature comes from the registries (kernels/shared/registry.h): the feature column
+// of each type list and LC_OTHER_FEATURES.
+#include <string>
+#include <vector>
+
+#include "lucent/device.hpp"
+#include "lucent/render.hpp"
+#include "lucent/scene.hpp"
+
+namespace lucent::render_detail {
+
+struct PackedScene;
+
+/// Every kernel feature, once each, in registry order: what --no-specialize compiles.
+const std::vector<std::string>& all_features();
+
+/// The kernel features (LC_HAS_... defines) the scene uses: the types of its shapes, of the
+/// materials some shape uses, of its lights, filter and integrator, and the other features its
+/// data needs.
+std::vector<std::string> scene_features(const Scene& scene, const PackedScene& packed);
+
+/// OpenCL build options (" -D LC_HAS_..." ...) for the scene's features, or for all of them.
+std::string feature_defines(const Scene& scene, const PackedScene& packed, bool specialize = true);
+
+/// The megakernel's full OpenCL build options for these render options: -cl-std, the feature
+/// defines, -D LC_DOUBLE with Precision::Double, -cl-fast-relaxed-math with fast_math. They are
+/// part of the program cache key, so each precision has its own cached binary.
+std::string build_options(const Scene& scene, const PackedScene& packed,
+                          const RenderOptions& options);
+
+/// Throws lucent::Error (one line naming the device) when `precision` needs what the device lacks:
+/// Precision::Double needs fp64 (cl_khr_fp64 / CL_DEVICE_DOUBLE_FP_CONFIG).
+void check_precision_support(const DeviceInfo& device, Precision precision);
+
+}  // namespace lucent::render_detail

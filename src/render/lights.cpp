@@ -1,0 +1,108 @@
+// The light table: the scene's point and environment lights after the area lights of emissive
+// shapes, each light's selection probability (90% by power, 10% uniform) and the light_cdf buffer
+// (selection CDF, then every environment map's texel CDF). kernels/light/ samples from them.
+#include <algorithm>
+#include <cmath>
+
+#include "lucent/error.hpp"
+#include "render/pack.hpp"
+#include "scene/material_type.hpp"
+
+namespace lucent::render_detail {
+
+namespace {
+
+using scene_detail::put3;
+
+double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+/// The texel CDF of an environment map (luminance x sin(theta), n + 1 entries from 0 to 1),
+/// appended to `cdf`.
+void append_env_map_cdf(const Texture& t, std::vector<float>& cdf) {
+  std::vector<double> w(static_cast<size_t>(t.width) * t.height);
+  double total_w = 0;
+  for (int y = 0; y < t.height; ++y) {
+    double sin_t = std::sin(M_PI * (y + 0.5) / t.height);
+    for (int x = 0; x < t.width; ++x) {
+      const float* px = &t.rgba[(static_cast<size_t>(y) * t.width + x) * 4];
+      double lum = std::max(0.0, luminance({px[0], px[1], px[2]}));
+      w[static_cast<size_t>(y) * t.width + x] = lum * sin_t;
+      total_w += lum * sin_t;
+    }
+  }
+  double run = 0;
+  cdf.push_back(0.0f);
+  for (double v : w) {
+    run += total_w > 0 ? v / total_w : 1.0 / w.size();
+    cdf.push_back(static_cast<float>(run));
+  }
+  cdf.back() = 1.0f;
+}
+
+}  // namespace
+
+void pack_lights(const Scene& scene, PackedScene& p, std::vector<double> power) {
+  // Radius of the region that matters, for the power of environment lights: the scene's
+  // bounding radius, but no more than the camera's distance to what it looks at (a ground sphere
+  // of radius 1000 would otherwise make the sky outweigh every point light a thousandfold).
+  // Selection probabilities change only the variance, never the expected value.
+  double radius = 1;
+  if (!p.nodes.empty()) {
+    const float *lo = p.bounds_min, *hi = p.bounds_max;
+    glm::dvec3 d(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    radius = std::max(1e-6, 0.5 * glm::length(d));
+  }
+  double view = glm::length(scene.camera.look_at - scene.camera.position);
+  if (view > 0 && std::isfinite(view)) radius = std::min(radius, view);
+  for (const Light& l : scene.lights) {
+    lc_light d{};
+    d.type = static_cast<lc_uint>(l.type);
+    double pw = 0;
+    switch (l.type) {
+      case LightType::Point:
+        put3(d.p.point.position, l.position);
+        put3(d.p.point.intensity, l.intensity);
+        pw = luminance(l.intensity) * 4 * M_PI;
+        break;
+      case LightType::Environment:
+        put3(d.p.env.radiance, l.radiance);
+        break;
+      case LightType::EnvironmentMap:
+        put3(d.p.env_map.scale, l.radiance);
+        d.p.env_map.texture = l.texture;
+        d.p.env_map.cdf = LC_INVALID;  // below, after the selection CDF
+        break;
+      default:
+        throw Error(scene.path + ": a scene light cannot be of type " +
+                    std::to_string(static_cast<int>(l.type)) +
+                    " (area lights are emissive shapes)");
+    }
+    if (l.type == LightType::Environment || l.type == LightType::EnvironmentMap) {
+      pw = luminance(l.radiance) * M_PI * 4 * M_PI * radius * radius;
+      p.params.env_light = static_cast<lc_int>(p.lights.size());
+    }
+    p.lights.push_back(d);
+    power.push_back(std::max(0.0, pw));
+  }
+  double total = 0;
+  for (double w : power) total += w;
+  double acc = 0;
+  for (size_t i = 0; i < p.lights.size(); ++i) {
+    // 90% by power, 10% uniform: a defensive mixture, so that no light starves when one
+    // power estimate dwarfs the others (an environment behind a 1000-unit floor sphere)
+    double uniform = 1.0 / p.lights.size();
+    double pdf = total > 0 ? 0.9 * power[i] / total + 0.1 * uniform : uniform;
+    p.lights[i].pdf_select = static_cast<float>(pdf);
+    acc += pdf;
+    p.light_cdf.push_back(static_cast<float>(acc));
+  }
+  if (!p.light_cdf.empty()) p.light_cdf.back() = 1.0f;
+
+  for (lc_light& l : p.lights) {
+    if (l.type != LC_LIGHT_ENV_MAP) continue;
+    l.p.env_map.cdf = static_cast<lc_uint>(p.light_cdf.size());
+    append_env_map_cdf(scene.textures.at(static_cast<size_t>(l.p.env_map.texture)), p.light_cdf);
+  }
+}
+
+}  // namespace lucent::render_detail

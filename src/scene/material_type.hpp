@@ -1,0 +1,70 @@
+#pragma once
+// The host side of a material type: its parameters in scene files and how they become the
+// device's lc_<file>_params. Each entry of LC_MATERIAL_TYPES (kernels/shared/registry.h) has its
+// file src/scene/materials/<file>.cpp defining
+//   const MaterialTypeDef& material_type_<file>();
+// and material_type_def() dispatches on the registry. The parameter table is declarative, so the
+// JSON loader and the validation of scenes built in code read the same rules.
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "lucent/scene.hpp"
+#include "shared/types.h"
+
+namespace lucent::scene_detail {
+
+/// One parameter of a material type: its scene-file key, the lucent::Material field it sets, the
+/// values it accepts and its default.
+struct MaterialParam {
+  enum Kind {
+    Colour,           ///< RGB, every component >= 0
+    ColourOrTexture,  ///< Colour, or {"texture": file} (Material::albedo_texture)
+    Positive,         ///< a number > 0
+    UnitInterval,     ///< a number in [0, 1]
+  };
+  const char* key;
+  Kind kind;
+  glm::dvec3 Material::*colour = nullptr;  ///< Colour and ColourOrTexture
+  double Material::*number = nullptr;      ///< Positive and UnitInterval
+  glm::dvec3 default_colour{0.0};
+  double default_number = 0;
+
+  static MaterialParam colour_param(const char* key, glm::dvec3 Material::*field, glm::dvec3 def,
+                                    Kind kind = Colour) {
+    MaterialParam p{key, kind};
+    p.colour = field;
+    p.default_colour = def;
+    return p;
+  }
+  static MaterialParam number_param(const char* key, Kind kind, double Material::*field,
+                                    double def) {
+    MaterialParam p{key, kind};
+    p.number = field;
+    p.default_number = def;
+    return p;
+  }
+};
+
+struct MaterialTypeDef {
+  /// The scene-file parameters besides "type" and "emission" (which every type has).
+  std::vector<MaterialParam> params;
+  /// The device parameters (the union member of the type, shared/registry.h).
+  void (*pack)(const Material& m, lc_material_params& p);
+};
+
+#define LUCENT_DECLARE_MATERIAL_TYPE(ID, Name, value, name, feature, file, params) \
+  const MaterialTypeDef& material_type_##file();
+LC_MATERIAL_TYPES(LUCENT_DECLARE_MATERIAL_TYPE)
+#undef LUCENT_DECLARE_MATERIAL_TYPE
+
+/// The definition of a material type (from the registry).
+const MaterialTypeDef& material_type_def(MaterialType type);
+
+/// v as three floats (device parameters).
+inline void put3(float* dst, const glm::dvec3& v) {
+  dst[0] = static_cast<float>(v.x);
+  dst[1] = static_cast<float>(v.y);
+  dst[2] = static_cast<float>(v.z);
+}
+
+}  // namespace lucent::scene_detail
