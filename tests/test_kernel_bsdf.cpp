@@ -68,7 +68,9 @@ TEST(KernelBsdf, FresnelDielectricKnownValues) {
 struct ChiSquareCase {
   const char* name;
   lc_material mat;
-  double wo_theta;  // radians
+  double wo_theta;      // radians
+  bool sphere = false;  // the BSDF transmits: bin the whole sphere of directions, not z > 0
+  int front = 1;        // wo on the outside of the surface (0: inside; dielectrics)
 };
 
 // A material of the given type packed for the device as the renderer packs it.
@@ -88,10 +90,16 @@ lc_material make(lc_uint type, float r, float g, float b, float spec, float roug
 // Samples N directions on the device, bins them over (cos theta, phi) and compares the counts
 // with N times the integral of the device's pdf over each bin (numerical, 6x6 points per bin).
 // Bins with expected count < 5 are pooled. Fails when the p-value is below 1e-4 (Sidak for the
-// handful of cases at alpha ~ 1e-3). Also checks that each sample's weight equals f cos / pdf
-// from the evaluation code.
+// handful of cases at alpha ~ 1e-3). Also checks that each sample's weight equals f |cos| / pdf
+// from the evaluation code, and energy: the directional albedo estimated from the weights (their
+// mean over all N samples, failed ones counting 0) equals the integral of f |cos| from the
+// evaluation code (the same grid; 5 standard errors plus 1% for the quadrature), and no BSDF
+// creates energy: with the radiance scaling of refraction taken out (transmitted weights times
+// eta^2, eta = eta_t / eta_o, which radiance transport divides by), the albedo is at most 1
+// within 5 standard errors.
 void chi_square(const ChiSquareCase& tc) {
-  const int N = 400000, NT = 16, NP = 32;
+  const int N = 400000, NP = 32, NT = tc.sphere ? 32 : 16;
+  const double zlo = tc.sphere ? -1.0 : 0.0, zspan = 1.0 - zlo;
   Probe& p = probe();
   cl::Buffer bmat(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(lc_material),
                   const_cast<lc_material*>(&tc.mat));
@@ -101,7 +109,7 @@ void chi_square(const ChiSquareCase& tc) {
   cl::Kernel ks(p.program, "probe_bsdf_sample");
   ks.setArg(0, bmat);
   ks.setArg(1, wo);
-  ks.setArg(2, cl_int(1));
+  ks.setArg(2, cl_int(tc.front));
   ks.setArg(3, bwi);
   ks.setArg(4, bw);
   p.ctx.queue.enqueueNDRangeKernel(ks, cl::NullRange, cl::NDRange(N), cl::NullRange);
@@ -115,8 +123,8 @@ void chi_square(const ChiSquareCase& tc) {
     if (s.s[3] < 0) continue;
     ++produced;
     double z = std::clamp<double>(s.s[2], -1, 1);
-    if (z <= 0) continue;  // reflection only for these materials
-    int ti = std::min(NT - 1, int(z * NT));
+    if (z <= zlo) continue;  // reflection only unless the BSDF transmits
+    int ti = std::min(NT - 1, int((z - zlo) / zspan * NT));
     double phi = std::atan2(s.s[1], s.s[0]);
     if (phi < 0) phi += 2 * M_PI;
     int pi = std::min(NP - 1, int(phi / (2 * M_PI) * NP));
@@ -130,7 +138,8 @@ void chi_square(const ChiSquareCase& tc) {
     for (int pi = 0; pi < NP; ++pi)
       for (int a = 0; a < SUB; ++a)
         for (int b = 0; b < SUB; ++b) {
-          double z = (ti + (a + 0.5) / SUB) / NT, phi = (pi + (b + 0.5) / SUB) / NP * 2 * M_PI;
+          double z = zlo + zspan * (ti + (a + 0.5) / SUB) / NT;
+          double phi = (pi + (b + 0.5) / SUB) / NP * 2 * M_PI;
           double r = std::sqrt(std::max(0.0, 1 - z * z));
           dirs.push_back({{float(r * std::cos(phi)), float(r * std::sin(phi)), float(z), 0.0f}});
           wos.push_back(wo);
@@ -145,16 +154,18 @@ void chi_square(const ChiSquareCase& tc) {
   ke.setArg(1, bwo2);
   ke.setArg(2, bwi2);
   ke.setArg(3, bout);
+  ke.setArg(4, cl_int(tc.front));
   p.ctx.queue.enqueueNDRangeKernel(ke, cl::NullRange, cl::NDRange(dirs.size()), cl::NullRange);
   std::vector<cl_float4> ev(dirs.size());
   p.ctx.queue.enqueueReadBuffer(bout, CL_TRUE, 0, ev.size() * sizeof(cl_float4), ev.data());
   // solid angle of a sub-cell in (z, phi): dz dphi
-  const double dA = (1.0 / NT / SUB) * (2 * M_PI / NP / SUB);
+  const double dA = (zspan / NT / SUB) * (2 * M_PI / NP / SUB);
   std::vector<double> expected(NT * NP, 0.0);
-  double integral = 0;
+  double integral = 0, albedo_quadrature[3] = {0, 0, 0};
   for (size_t i = 0; i < ev.size(); ++i) {
     expected[i / (SUB * SUB)] += ev[i].s[3] * dA * N;
     integral += ev[i].s[3] * dA;
+    for (int c = 0; c < 3; ++c) albedo_quadrature[c] += ev[i].s[c] * std::abs(dirs[i].s[2]) * dA;
   }
   EXPECT_NEAR(integral, double(produced) / N, 0.01)
       << tc.name << ": pdf integral vs sampling success";
@@ -164,10 +175,34 @@ void chi_square(const ChiSquareCase& tc) {
   double pval = lucent::test::chi2_pvalue(c.chi2, dof);
   EXPECT_GT(pval, 1e-4) << tc.name << ": chi2 " << c.chi2 << " with " << dof << " dof";
 
-  // weights: f cos / pdf of the evaluation code at the sampled direction
+  // energy, for non-delta BSDFs (a delta BSDF has no pdf to integrate)
+  bool delta = false;
+  double ior = tc.mat.type == LC_MAT_ROUGH_DIELECTRIC ? tc.mat.p.rough_dielectric.ior : 1.0;
+  double eta = tc.front ? ior : 1 / ior;
+  double mean[3] = {0, 0, 0}, mean2[3] = {0, 0, 0}, energy[3] = {0, 0, 0}, energy2[3] = {0, 0, 0};
+  for (int i = 0; i < N; ++i) {
+    delta = delta || weight[i].s[3] > 0;
+    double scale = wi[i].s[2] < 0 ? eta * eta : 1;
+    for (int c = 0; c < 3; ++c) {
+      double w = weight[i].s[c];
+      mean[c] += w / N;
+      mean2[c] += w * w / N;
+      energy[c] += w * scale / N;
+      energy2[c] += w * scale * w * scale / N;
+    }
+  }
+  for (int c = 0; c < 3 && !delta; ++c) {
+    double se = std::sqrt(std::max(0.0, mean2[c] - mean[c] * mean[c]) / N);
+    EXPECT_NEAR(mean[c], albedo_quadrature[c], 5 * se + 0.01 * albedo_quadrature[c])
+        << tc.name << ": albedo from sampling weights vs quadrature of f |cos|, channel " << c;
+    double se_e = std::sqrt(std::max(0.0, energy2[c] - energy[c] * energy[c]) / N);
+    EXPECT_LE(energy[c], 1 + 5 * se_e) << tc.name << ": the BSDF reflects more than it receives";
+  }
+
+  // weights: f |cos| / pdf of the evaluation code at the sampled direction
   std::vector<cl_float4> some_wi, some_wo;
   for (int i = 0; i < N && some_wi.size() < 2000; ++i)
-    if (wi[i].s[3] > 0 && wi[i].s[2] > 1e-3) {
+    if (wi[i].s[3] > 0 && std::abs(wi[i].s[2]) > 1e-3) {
       some_wi.push_back({{wi[i].s[0], wi[i].s[1], wi[i].s[2], float(i)}});
       some_wo.push_back(wo);
     }
@@ -185,7 +220,7 @@ void chi_square(const ChiSquareCase& tc) {
   for (size_t i = 0; i < fe.size(); ++i) {
     int idx = int(some_wi[i].s[3]);
     for (int c = 0; c < 3; ++c) {
-      double want = fe[i].s[c] * some_wi[i].s[2] / fe[i].s[3];
+      double want = fe[i].s[c] * std::abs(some_wi[i].s[2]) / fe[i].s[3];
       ASSERT_NEAR(weight[idx].s[c], want, 1e-3 * std::max(1.0, want))
           << tc.name << " sample " << idx;
     }
@@ -203,6 +238,17 @@ TEST(KernelBsdf, ChiSquareConductorSmooth) {
 }
 TEST(KernelBsdf, ChiSquarePlastic) {
   chi_square({"plastic", make(LC_MAT_PLASTIC, 0.3f, 0.5f, 0.8f, 1.0f, 0.2f, 1.5f), 0.9});
+}
+// Rough dielectric: reflection and transmission over the whole sphere, from outside and inside
+// (where total internal reflection takes part), smooth-ish to rough.
+TEST(KernelBsdf, ChiSquareRoughDielectric) {
+  lc_uint t = LC_MAT_ROUGH_DIELECTRIC;
+  chi_square({"rough dielectric 0.3 outside", make(t, 0, 0, 0, 1.0f, 0.3f, 1.5f), 0.5, true, 1});
+  chi_square(
+      {"rough dielectric 0.6 outside grazing", make(t, 0, 0, 0, 0.8f, 0.6f, 1.5f), 1.3, true, 1});
+  chi_square({"rough dielectric 0.3 inside", make(t, 0, 0, 0, 1.0f, 0.3f, 1.5f), 0.5, true, 0});
+  chi_square({"rough dielectric 0.5 inside beyond critical", make(t, 0, 0, 0, 1.0f, 0.5f, 1.33f),
+              1.0, true, 0});
 }
 
 }  // namespace

@@ -60,6 +60,19 @@ static inline int shadow_visible(const lc_scene* s, lc_real3 o, lc_real3 wi, lc_
   return !scene_occluded(s, sr, tmax);
 }
 
+/* Unoccluded test of a light sample drawn from the origin o in front of the surface of `it`
+ * whose direction passes behind it (a transmitting BSDF): the shadow ray leaves from an origin
+ * behind the surface towards the sampled point (or along the direction, for environments). */
+static inline int shadow_visible_behind(const lc_scene* s, const lc_interaction* it, lc_real3 o,
+                                        const lc_light_sample* ls, lc_uint* rays) {
+  lc_real3 ob = lc_spawn_origin(it->p, it->perr, -it->ng);
+  if (isinf(ls->dist)) return shadow_visible(s, ob, ls->wi, ls->dist, rays);
+  lc_real3 to = (o + ls->dist * ls->wi) - ob;
+  lc_real dist = length(to);
+  if (!(dist > LC_REAL(0.0))) return 0;
+  return shadow_visible(s, ob, to / dist, dist, rays);
+}
+
 /* Sum over point lights of f * cos * I / r^2 (direct and whitted integrators): f is the BSDF b,
  * or when b is null the lambertian diffuse / pi (whitted's diffuse term). */
 static inline float3 point_lights_direct(const lc_scene* s, const lc_interaction* it,
@@ -72,15 +85,17 @@ static inline float3 point_lights_direct(const lc_scene* s, const lc_interaction
     __global const lc_light* L = &s->lights[i];
     if (L->type != LC_LIGHT_POINT) continue;
     /* irradiance from the surface point itself; the shadow ray leaves from the offset origin
-     * (a point light has no surface that the few-ulp parallel shift could graze) */
-    lc_real3 o = lc_spawn_origin(it->p, it->perr, it->ng);
+     * (a point light has no surface that the few-ulp parallel shift could graze), behind the
+     * surface for a light behind a transmitting BSDF */
     lc_real3 to = lc_load3r(L->p.point.position) - it->p;
     lc_real d2 = dot(to, to);
     lc_real dist = sqrt(d2);
     lc_real3 wi = to / dist;
-    if (dot(wi, it->ng) <= LC_REAL(0.0)) continue;
+    int behind = !(dot(wi, it->ng) > LC_REAL(0.0));
+    if (behind && !(b && (bsdf_lobes(b) & LC_BSDF_TRANSMISSION))) continue;
+    lc_real3 o = lc_spawn_origin(it->p, it->perr, behind ? -it->ng : it->ng);
     float3 wi_l = frame_to_local(fr, lc_float3_from_real3(wi));
-    if (wi_l.z <= 0.0f) continue;
+    if (behind ? wi_l.z >= 0.0f : wi_l.z <= 0.0f) continue;
     float3 f;
     if (!b) {
       f = diffuse * LC_INV_PI;
@@ -94,7 +109,7 @@ static inline float3 point_lights_direct(const lc_scene* s, const lc_interaction
     sr.d = wi;
     ++*rays;
     if (scene_occluded(s, sr, dist)) continue;
-    sum += f * lc_load3(L->p.point.intensity) * (wi_l.z / (float)d2);
+    sum += f * lc_load3(L->p.point.intensity) * (fabs(wi_l.z) / (float)d2);
   }
 #endif
   return sum;

@@ -40,20 +40,26 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
     if (wo_l.z <= 0.0f) break;
 
-    /* next-event estimation, from the origin that the shadow ray will use */
+    /* next-event estimation, from the origin that the shadow ray will use; a BSDF that transmits
+     * also takes light from behind the surface, with a shadow ray from an origin behind it */
     lc_real3 o = lc_spawn_origin(it.p, it.perr, it.ng);
-    if (!bsdf_is_delta(&b) && P->num_lights > 0) {
+    lc_uint lobes = bsdf_lobes(&b);
+    if (!(lobes & LC_BSDF_DELTA) && P->num_lights > 0) {
       lc_light_sample ls;
       if (light_sample(s, o, lc_rand(rng, dim + LC_DIM_LIGHT_SELECT),
                        lc_rand(rng, dim + LC_DIM_LIGHT_UV), lc_rand(rng, dim + LC_DIM_LIGHT_UV + 1),
                        &ls) &&
-          ls.pdf > 0.0f && dot(ls.wi, it.ng) > LC_REAL(0.0)) {
-        float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
-        float pdf_b;
-        float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf_b);
-        if (lc_max3(f) > 0.0f && shadow_visible(s, o, ls.wi, ls.dist, rays)) {
-          float w = (ls.delta || no_mis) ? 1.0f : mis_power(ls.pdf, pdf_b);
-          L += beta * f * ls.L * (wi_l.z * w / ls.pdf);
+          ls.pdf > 0.0f) {
+        int behind = !(dot(ls.wi, it.ng) > LC_REAL(0.0));
+        if (!behind || (lobes & LC_BSDF_TRANSMISSION)) {
+          float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
+          float pdf_b;
+          float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf_b);
+          if (lc_max3(f) > 0.0f && (behind ? shadow_visible_behind(s, &it, o, &ls, rays)
+                                           : shadow_visible(s, o, ls.wi, ls.dist, rays))) {
+            float w = (ls.delta || no_mis) ? 1.0f : mis_power(ls.pdf, pdf_b);
+            L += beta * f * ls.L * (fabs(wi_l.z) * w / ls.pdf);
+          }
         }
       }
     }
@@ -73,7 +79,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     prev_delta = bs.delta;
     prev_pdf = bs.pdf;
     ray.o = transmit ? lc_spawn_origin(it.p, it.perr, -it.ng) : o;
-    prev_p = ray.o; /* light pdfs for MIS are evaluated from where light sampling sampled */
+    prev_p = o; /* light pdfs for MIS are evaluated from where light sampling sampled */
     ray.d = wi;
     /* Russian roulette: survive with probability max(beta) while it is below 1, so the
      * throughput after the division never exceeds 1 (a cap such as min(0.95, max(beta)) makes

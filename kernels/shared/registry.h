@@ -46,17 +46,19 @@
 /* The kernel's BSDF is kernels/bsdf/<file>.cl, the reference's src/reference/bsdf/<file>.cpp,  */
 /* the scene-file parameters and their packing src/scene/materials/<file>.cpp.                 */
 /* ------------------------------------------------------------------------------------------ */
-#define LC_MATERIAL_TYPES(X)                                                             \
-  X(DIFFUSE, Diffuse, 0, "diffuse", LC_HAS_DIFFUSE, diffuse,                             \
-    LC_PARAMS(float albedo[3]; /* linear RGB */ lc_int albedo_tex; /* texture or -1 */)) \
-  X(MIRROR, Mirror, 1, "mirror", LC_HAS_MIRROR, mirror,                                  \
-    LC_PARAMS(float reflectance[3]; /* RGB reflectance */))                              \
-  X(DIELECTRIC, Dielectric, 2, "dielectric", LC_HAS_DIELECTRIC, dielectric,              \
-    LC_PARAMS(float tint[3]; /* transmission colour */ float ior;))                      \
-  X(CONDUCTOR, Conductor, 3, "conductor", LC_HAS_CONDUCTOR, conductor,                   \
-    LC_PARAMS(float f0[3]; /* Schlick F0 colour */ float roughness; /* GGX alpha */))    \
-  X(PLASTIC, Plastic, 4, "plastic", LC_HAS_PLASTIC, plastic,                             \
-    LC_PARAMS(float albedo[3]; lc_int albedo_tex; float specular[3]; float ior; float roughness;))
+#define LC_MATERIAL_TYPES(X)                                                                       \
+  X(DIFFUSE, Diffuse, 0, "diffuse", LC_HAS_DIFFUSE, diffuse,                                       \
+    LC_PARAMS(float albedo[3]; /* linear RGB */ lc_int albedo_tex; /* texture or -1 */))           \
+  X(MIRROR, Mirror, 1, "mirror", LC_HAS_MIRROR, mirror,                                            \
+    LC_PARAMS(float reflectance[3]; /* RGB reflectance */))                                        \
+  X(DIELECTRIC, Dielectric, 2, "dielectric", LC_HAS_DIELECTRIC, dielectric,                        \
+    LC_PARAMS(float tint[3]; /* transmission colour */ float ior;))                                \
+  X(CONDUCTOR, Conductor, 3, "conductor", LC_HAS_CONDUCTOR, conductor,                             \
+    LC_PARAMS(float f0[3]; /* Schlick F0 colour */ float roughness; /* GGX alpha */))              \
+  X(PLASTIC, Plastic, 4, "plastic", LC_HAS_PLASTIC, plastic,                                       \
+    LC_PARAMS(float albedo[3]; lc_int albedo_tex; float specular[3]; float ior; float roughness;)) \
+  X(ROUGH_DIELECTRIC, RoughDielectric, 5, "rough_dielectric", LC_HAS_ROUGH_DIELECTRIC,             \
+    rough_dielectric, LC_PARAMS(float tint[3]; float ior; float roughness;))
 
 /* ------------------------------------------------------------------------------------------ */
 /* Lights: X(ID, Name, value, name, feature, file, params)                                     */

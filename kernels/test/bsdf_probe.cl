@@ -37,11 +37,12 @@ __kernel void probe_bsdf_sample(__global const lc_material* mat, float4 wo_in, i
   out_weight[i] = ok ? (float4)(bs.weight, (float)bs.delta) : (float4)(0.0f);
 }
 
-/* Evaluates f and pdf for (wo, wi) pairs. */
+/* Evaluates f and pdf for (wo, wi) pairs, wo on the outside (front = 1) or inside. */
 __kernel void probe_bsdf_eval(__global const lc_material* mat, __global const float4* wo_in,
-                              __global const float4* wi_in, __global float4* out) {
+                              __global const float4* wi_in, __global float4* out, int front) {
   size_t i = get_global_id(0);
   lc_bsdf b = bsdf_from_material_untextured(mat);
+  b.front = front;
   float pdf;
   float3 f = bsdf_eval(&b, wo_in[i].xyz, wi_in[i].xyz, &pdf);
   out[i] = (float4)(f, pdf);
