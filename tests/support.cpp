@@ -1,7 +1,6 @@
 #include "support.hpp"
 
 #include <gtest/gtest.h>
-
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,7 +11,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "cl/program_cache.hpp"
 #include "lucent/compare.hpp"
+#include "lucent/session.hpp"
 #include "scene/loaders.hpp"
 
 namespace lucent::test {
@@ -45,6 +46,32 @@ TempRoot& temp_root() {
 }
 }  // namespace
 
+SessionOptions session_options() { return SessionOptions::from_environment(); }
+std::string device() { return session_options().device; }
+std::string kernel_dir() { return session_options().kernel_dir; }
+std::string cache_dir() {
+  std::string dir = session_options().cache_dir;
+  if (dir == "off") return "";
+  return dir.empty() ? cl_util::default_program_cache_dir() : dir;
+}
+
+RenderOptions render_options() {
+  SessionOptions env = session_options();
+  RenderOptions o;
+  o.device = env.device;
+  o.kernel_dir = env.kernel_dir;
+  o.cache_dir = env.cache_dir;
+  return o;
+}
+
+RenderResult render(const Scene& scene, RenderOptions options) {
+  SessionOptions env = session_options();
+  if (options.device.empty()) options.device = env.device;
+  if (options.kernel_dir.empty()) options.kernel_dir = env.kernel_dir;
+  if (options.cache_dir.empty()) options.cache_dir = env.cache_dir;
+  return lucent::render(scene, options);
+}
+
 std::string temp_dir() {
   static std::atomic<int> counter{0};
   std::string dir = temp_root().path + "/" + std::to_string(counter++);
@@ -73,22 +100,22 @@ void write_file(const std::string& path, const std::string& text) {
   f << text;
 }
 
-std::string source_path(const std::string& rel) { return std::string(LUCENT_SOURCE_DIR) + "/" + rel; }
+std::string source_path(const std::string& rel) {
+  return std::string(LUCENT_SOURCE_DIR) + "/" + rel;
+}
 
 std::string shared_asset(const std::string& rel) {
   std::string p = std::string(LUCENT_SHARED_DIR) + "/assets/" + rel;
   return fs::exists(p) ? p : std::string();
 }
 
-Scene scene_from(const std::string& json) {
-  return parse_scene(json, temp_dir() + "/scene.json");
-}
+Scene scene_from(const std::string& json) { return parse_scene(json, temp_dir() + "/scene.json"); }
 
 RenderResult render_json(const std::string& json, int spp) {
   Scene scene = scene_from(json);
   RenderOptions opt;
   opt.spp = spp;
-  return render(scene, opt);
+  return lucent::test::render(scene, opt);
 }
 
 int count_lines(const std::string& s) {

@@ -30,6 +30,22 @@ std::string source_path(const std::string& rel);
 /// ../shared/assets/<rel> beside the project, or "" when ../shared is absent.
 std::string shared_asset(const std::string& rel);
 
+/// The session defaults of the test programs, as the `lucent` command takes them: device, kernel
+/// directory and cache directory from LUCENT_DEVICE, LUCENT_KERNEL_DIR and LUCENT_CACHE_DIR (so
+/// that `LUCENT_DEVICE=... ctest` and planted-bug runs through LUCENT_KERNEL_DIR reach the tests).
+SessionOptions session_options();
+/// Their device selector and kernel directory alone.
+std::string device();
+std::string kernel_dir();
+/// The resolved kernel binary cache directory ("" when LUCENT_CACHE_DIR=off).
+std::string cache_dir();
+
+/// RenderOptions with the test defaults (device, kernel and cache directories).
+RenderOptions render_options();
+
+/// lucent::render with the test defaults filled in where `options` leaves them empty.
+RenderResult render(const Scene& scene, RenderOptions options = {});
+
 /// Parses a JSON scene held in memory (relative file names resolve against a temporary directory).
 Scene scene_from(const std::string& json);
 

@@ -252,9 +252,10 @@ TEST(Converge, KernelLadderAgainstKernelReference) {
   ASSERT_NE(ref_scene.integrator.seed, scene.integrator.seed);
   lucent::RenderOptions ro;
   ro.spp = 1024;
-  lucent::RenderResult reference = lucent::render(ref_scene, ro);
+  lucent::RenderResult reference = lucent::test::render(ref_scene, ro);
 
   lucent::ConvergeOptions opt;
+  opt.render = lucent::test::render_options();
   opt.spp_ladder = {4, 8, 16, 32, 64};
   for (const char* s : {"default", "max_depth=1", "max_depth=2"})
     opt.settings.push_back(lucent::parse_converge_setting(s));

@@ -85,7 +85,7 @@ TEST(Features, FullKernelHasEveryFeatureAndRendersTheSameImage) {
   lucent::RenderOptions spec, full;
   spec.spp = full.spp = 16;
   full.specialize = false;
-  lucent::RenderResult a = lucent::render(s, spec), b = lucent::render(s, full);
+  lucent::RenderResult a = lucent::test::render(s, spec), b = lucent::test::render(s, full);
   for (const std::string& f : lucent::render_detail::all_features())
     EXPECT_NE(b.build_options.find("-D " + f), std::string::npos) << f;
   EXPECT_LT(a.build_options.size(), b.build_options.size());

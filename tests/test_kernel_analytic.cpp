@@ -231,7 +231,7 @@ TEST(KernelAnalytic, SameSeedSameImageWhateverThePasses) {
   one_pass.spp = many_passes.spp = 24;
   one_pass.pass_seconds = 1e9;     // grows to all remaining samples after the first pass
   many_passes.pass_seconds = 1e-9; // one sample per pass
-  RenderResult a = lucent::render(scene, one_pass), b = lucent::render(scene, many_passes);
+  RenderResult a = lucent::test::render(scene, one_pass), b = lucent::test::render(scene, many_passes);
   ASSERT_EQ(a.spp, 24u);
   ASSERT_EQ(b.spp, 24u);
   double worst = 0;
@@ -239,7 +239,7 @@ TEST(KernelAnalytic, SameSeedSameImageWhateverThePasses) {
     worst = std::max(worst, double(std::abs(a.mean.rgb[i] - b.mean.rgb[i])) / (1e-3 + std::abs(a.mean.rgb[i])));
   EXPECT_LT(worst, 1e-5);  // only float summation order differs
   scene.integrator.seed = 8;
-  RenderResult c = lucent::render(scene, one_pass);
+  RenderResult c = lucent::test::render(scene, one_pass);
   double diff = 0;
   for (size_t i = 0; i < a.mean.rgb.size(); ++i) diff += std::abs(a.mean.rgb[i] - c.mean.rgb[i]);
   EXPECT_GT(diff, 1e-3);  // another seed, another image

@@ -15,9 +15,10 @@ namespace {
 
 
 struct Probe {
-  lucent::cl_util::Context ctx{""};
+  lucent::cl_util::Context ctx{lucent::test::device()};
   cl::Program program = lucent::cl_util::build_program_cached(
-      ctx, lucent::detail::assemble_kernel_source("test/light_probe.cl"), "-cl-std=CL1.2");
+      ctx, lucent::detail::assemble_kernel_source("test/light_probe.cl", lucent::test::kernel_dir()),
+      "-cl-std=CL1.2", lucent::test::cache_dir());
 };
 
 Probe& probe() {

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
-
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -11,6 +10,7 @@
 #include <vector>
 
 #include "cl/kernel_source.hpp"
+#include "lucent/session.hpp"
 #include "support.hpp"
 
 namespace {
@@ -106,7 +106,6 @@ struct KernelDirGuard {
 TEST(KernelSource, AssembledSourceHasLineMarkers) {
   KernelDirGuard guard;
   ::unsetenv("LUCENT_KERNEL_DIR");
-  EXPECT_EQ(lucent::detail::kernel_source_origin(), "embedded");
   std::string src = lucent::detail::assemble_kernel_source("megakernel.cl");
   EXPECT_EQ(src.rfind("#line 1 \"kernels/megakernel.cl\"\n", 0), 0u);
   EXPECT_NE(src.find("#line 1 \"kernels/shared/types.h\"\n"), std::string::npos);
@@ -147,15 +146,17 @@ TEST(KernelSource, KernelDirOverridesTheEmbeddedCopy) {
     EXPECT_NEAR(img.rgb[i + 2], 0.75f, 1e-6f);
   }
 
-  // the library reads the same directory
+  // the library reads a directory it is given, and only then: the environment is the CLI's
+  // default (SessionOptions::from_environment), not a setting the library consults
   KernelDirGuard guard;
   ::setenv("LUCENT_KERNEL_DIR", dir.c_str(), 1);
-  EXPECT_EQ(lucent::detail::kernel_source_origin(), dir);
-  EXPECT_NE(lucent::detail::read_kernel_file("megakernel.cl").find("0.25f, 0.5f, 0.75f"),
+  EXPECT_EQ(lucent::SessionOptions::from_environment().kernel_dir, dir);
+  EXPECT_NE(lucent::detail::read_kernel_file("megakernel.cl", dir).find("0.25f, 0.5f, 0.75f"),
             std::string::npos);
-  ::unsetenv("LUCENT_KERNEL_DIR");
   EXPECT_EQ(lucent::detail::read_kernel_file("megakernel.cl").find("0.25f, 0.5f, 0.75f"),
             std::string::npos);
+  ::unsetenv("LUCENT_KERNEL_DIR");
+  EXPECT_EQ(lucent::SessionOptions::from_environment().kernel_dir, "");
 }
 
 TEST(KernelSource, MissingFileInKernelDir) {
@@ -165,13 +166,13 @@ TEST(KernelSource, MissingFileInKernelDir) {
       render_plane("LUCENT_KERNEL_DIR='" + dir + "'", lucent::test::temp_dir() + "/o.pfm");
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(r.err, "lucent: error: " + dir +
-                       "/util/math.cl: cannot read kernel source (LUCENT_KERNEL_DIR is set)\n");
+                       "/util/math.cl: cannot read kernel source (kernel directory " + dir + ")\n");
 
   r = render_plane("LUCENT_KERNEL_DIR='" + dir + "/nowhere'", lucent::test::temp_dir() + "/o.pfm");
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(r.err, "lucent: error: " + dir +
-                       "/nowhere/megakernel.cl: cannot read kernel source (LUCENT_KERNEL_DIR is "
-                       "set)\n");
+                       "/nowhere/megakernel.cl: cannot read kernel source (kernel directory " +
+                       dir + "/nowhere)\n");
 }
 
 /// Inserts `bad` as line `line` (1-based) of kernels/<file> in `dir`; line 0 appends it.

@@ -34,7 +34,7 @@ Both render_both(Scene scene, int spp, const CompareOptions& options = {}) {
   Both b;
   lucent::RenderOptions ko;
   ko.spp = spp;
-  b.kernel = lucent::render(scene, ko);
+  b.kernel = lucent::test::render(scene, ko);
   scene.integrator.seed ^= 0x9e3779b9u;  // independent samples
   lucent::ReferenceOptions ro;
   ro.spp = spp;
@@ -432,7 +432,7 @@ TEST(KernelVsReference, DetectsAThreePercentAlbedoChange) {
                                   std::string(kPointLights) + ", " + kEnv));
   lucent::RenderOptions ko;
   ko.spp = 256;
-  RenderResult k = lucent::render(s, ko);
+  RenderResult k = lucent::test::render(s, ko);
   s.integrator.seed ^= 0x9e3779b9u;
   s.materials[s.find_material("floor")].albedo *= 0.97;
   lucent::ReferenceOptions ro;
@@ -464,7 +464,7 @@ TEST(KernelVsReference, PrimitiveIdDeterministic) {
        "indices": [0,2,1, 0,3,2, 4,5,6]}]})");
   lucent::RenderOptions ko;
   ko.spp = 1;
-  lucent::RenderResult k = lucent::render(s, ko);
+  lucent::RenderResult k = lucent::test::render(s, ko);
   lucent::ReferenceOptions ro;
   ro.spp = 1;
   lucent::RenderResult r = lucent::render_reference(s, ro);

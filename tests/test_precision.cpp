@@ -53,7 +53,7 @@ RenderResult render(const Scene& scene, int spp, std::uint32_t seed, Precision p
   o.spp = spp;
   o.specialize = false;
   o.precision = precision;
-  return lucent::render(s, o);
+  return lucent::test::render(s, o);
 }
 
 #define EXPECT_SAME_IMAGE(a, b, what)                           \

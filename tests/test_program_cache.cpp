@@ -18,21 +18,6 @@ using lucent::cl_util::ProgramBuildInfo;
 
 struct CacheDir {
   std::string dir = lucent::test::temp_dir() + "/cache";
-  std::string old;
-  bool had = false;
-  CacheDir() {
-    if (const char* e = std::getenv("LUCENT_CACHE_DIR")) {
-      had = true;
-      old = e;
-    }
-    setenv("LUCENT_CACHE_DIR", dir.c_str(), 1);
-  }
-  ~CacheDir() {
-    if (had)
-      setenv("LUCENT_CACHE_DIR", old.c_str(), 1);
-    else
-      unsetenv("LUCENT_CACHE_DIR");
-  }
 };
 
 // Runs the layout probe kernel: a built program that really works returns sizeof(lc_material).
@@ -48,19 +33,18 @@ unsigned run_probe(lucent::cl_util::Context& ctx, cl::Program& p) {
 
 TEST(ProgramCache, HitsMissesAndRebuildsCorruptEntries) {
   CacheDir cache;
-  EXPECT_EQ(lucent::cl_util::program_cache_dir(), cache.dir);
-  lucent::cl_util::Context ctx("");
+  lucent::cl_util::Context ctx{lucent::test::device()};
   std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
   ProgramBuildInfo a, b, c;
-  cl::Program p1 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &a);
+  cl::Program p1 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", cache.dir, &a);
   EXPECT_FALSE(a.cache_hit);
   ASSERT_TRUE(fs::exists(a.cache_file)) << a.cache_file;
-  cl::Program p2 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &b);
+  cl::Program p2 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", cache.dir, &b);
   EXPECT_TRUE(b.cache_hit);
   EXPECT_EQ(run_probe(ctx, p2), 64u);
 
   // other options, other entry
-  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2 -D LC_UNUSED", &c);
+  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2 -D LC_UNUSED", cache.dir, &c);
   EXPECT_FALSE(c.cache_hit);
   EXPECT_NE(c.cache_file, a.cache_file);
 
@@ -78,18 +62,18 @@ TEST(ProgramCache, HitsMissesAndRebuildsCorruptEntries) {
     f.write(&x, 1);
   }
   ProgramBuildInfo d;
-  cl::Program p3 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &d);
+  cl::Program p3 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", cache.dir, &d);
   EXPECT_FALSE(d.cache_hit);
   EXPECT_NE(d.note.find("checksum"), std::string::npos) << d.note;
   EXPECT_EQ(run_probe(ctx, p3), 64u);
   ProgramBuildInfo e;
-  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &e);
+  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", cache.dir, &e);
   EXPECT_TRUE(e.cache_hit) << "the rebuilt entry is written back";
 
   // truncate: detected
   fs::resize_file(a.cache_file, fs::file_size(a.cache_file) / 2);
   ProgramBuildInfo f;
-  cl::Program p4 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &f);
+  cl::Program p4 = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", cache.dir, &f);
   EXPECT_FALSE(f.cache_hit);
   EXPECT_FALSE(f.note.empty());
   EXPECT_EQ(run_probe(ctx, p4), 64u);
@@ -97,25 +81,22 @@ TEST(ProgramCache, HitsMissesAndRebuildsCorruptEntries) {
   // garbage file with the right name: bad header, rebuilt
   lucent::test::write_file(a.cache_file, "not a cache entry");
   ProgramBuildInfo g;
-  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &g);
+  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", cache.dir, &g);
   EXPECT_FALSE(g.cache_hit);
   EXPECT_NE(g.note.find("header"), std::string::npos) << g.note;
 
   // clear removes the entries
-  EXPECT_GE(lucent::cl_util::clear_program_cache(), 2);
+  EXPECT_GE(lucent::cl_util::clear_program_cache(cache.dir), 2);
   ProgramBuildInfo h;
-  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", &h);
+  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", cache.dir, &h);
   EXPECT_FALSE(h.cache_hit);
 }
 
 TEST(ProgramCache, CanBeDisabled) {
-  CacheDir cache;
-  setenv("LUCENT_CACHE_DIR", "off", 1);
-  EXPECT_EQ(lucent::cl_util::program_cache_dir(), "");
-  lucent::cl_util::Context ctx("");
+  lucent::cl_util::Context ctx{lucent::test::device()};
   ProgramBuildInfo a;
   cl::Program p = lucent::cl_util::build_program_cached(
-      ctx, lucent::detail::assemble_kernel_source("test/layout_probe.cl"), "-cl-std=CL1.2", &a);
+      ctx, lucent::detail::assemble_kernel_source("test/layout_probe.cl"), "-cl-std=CL1.2", "", &a);
   EXPECT_FALSE(a.cache_hit);
   EXPECT_TRUE(a.cache_file.empty());
   EXPECT_EQ(run_probe(ctx, p), 64u);

@@ -45,7 +45,7 @@ RenderResult render(const Scene& scene, int spp, std::uint32_t seed) {
   lucent::RenderOptions o;
   o.spp = spp;
   o.specialize = false;
-  return lucent::render(s, o);
+  return lucent::test::render(s, o);
 }
 
 bool all_finite(const RenderResult& r) {

@@ -15,14 +15,15 @@
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
 #include "shared/types.h"
+#include "support.hpp"
 
 namespace {
 
 struct SpawnProbe {
   explicit SpawnProbe(const std::string& options)
       : program(lucent::cl_util::build_program(
-            ctx, lucent::detail::assemble_kernel_source("test/stability_spawn.cl"), options)) {}
-  lucent::cl_util::Context ctx{""};
+            ctx, lucent::detail::assemble_kernel_source("test/stability_spawn.cl", lucent::test::kernel_dir()), options)) {}
+  lucent::cl_util::Context ctx{lucent::test::device()};
   cl::Program program;
 };
 
@@ -149,7 +150,7 @@ INSTANTIATE_TEST_SUITE_P(Magnitudes, StabilitySpawn, ::testing::Range(-8, 9),
 class StabilitySpawnDouble : public ::testing::TestWithParam<int> {};
 
 TEST_P(StabilitySpawnDouble, NoSelfIntersection) {
-  lucent::cl_util::Context ctx{""};
+  lucent::cl_util::Context ctx{lucent::test::device()};
   if (!ctx.device.info.fp64) GTEST_SKIP() << "the OpenCL device has no fp64";
   expect_no_self_intersection(GetParam(), 200000, true);
 }

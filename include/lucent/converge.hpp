@@ -29,7 +29,7 @@ namespace lucent {
 struct ConvergeSetting {
   std::string name = "default";
   bool fast_math = false;
-  int precision = -1;        ///< -1: the options'; else a Precision
+  int precision = -1;  ///< -1: the options'; else a Precision
   bool specialize = true;
   int mis = -1;              ///< -1: the scene's; 0 off; 1 on
   int max_depth = 0;         ///< 0: the scene's
@@ -87,11 +87,18 @@ struct ConvergeFit {
 /// Fits one setting's points (in ladder order). Needs at least two points for the slopes.
 ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points);
 
+class Renderer;
+
 struct ConvergeOptions {
   std::vector<ConvergeSetting> settings;  ///< empty: {default}
   std::vector<int> spp_ladder;            ///< samples per pixel of each rung
   std::vector<double> time_ladder;        ///< seconds per rung; used instead of spp_ladder if set
-  RenderOptions render;                   ///< device, cancel, pass_seconds (spp/time are set)
+  /// Device, kernel and cache directories, pass_seconds, cancel, on_progress (spp and time are
+  /// the ladder's; precision, fast math and specialisation the settings').
+  RenderOptions render;
+  /// The session to render with (its device, kernel and cache directories); null: a session
+  /// opened from `render`. Either way one session renders every rung of every setting.
+  Renderer* renderer = nullptr;
   /// Called after each rung (progress output).
   std::function<void(const ConvergePoint&)> on_point;
 };

@@ -22,8 +22,9 @@ struct DeviceInfo {
 std::vector<DeviceInfo> list_devices();
 
 /// Picks a device: `selector` is an index or a case-insensitive substring of the device name;
-/// empty means LUCENT_DEVICE if set, else the first GPU, else the first CPU device, else the
-/// first device. Throws lucent::Error when nothing matches.
-DeviceInfo select_device(const std::string& selector = "");
+/// empty means the first GPU, else the first CPU device, else the first device. (The CLI takes
+/// LUCENT_DEVICE as its default selector: SessionOptions::from_environment.) Throws lucent::Error
+/// when nothing matches; its message calls the selector `origin` ("--device 'x': ...").
+DeviceInfo select_device(const std::string& selector = "", const std::string& origin = "--device");
 
 }  // namespace lucent

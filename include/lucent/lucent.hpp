@@ -5,4 +5,5 @@
 #include "lucent/image.hpp"
 #include "lucent/render.hpp"
 #include "lucent/scene.hpp"
+#include "lucent/session.hpp"
 #include "lucent/version.hpp"

@@ -11,11 +11,12 @@
 namespace lucent {
 
 struct RenderProgress {
-  std::uint64_t samples_done = 0;   ///< per pixel
-  std::uint64_t samples_target = 0; ///< per pixel (0 when only a time limit is set)
-  double elapsed = 0;               ///< seconds
-  double time_limit = 0;            ///< seconds (0: none)
-  double samples_per_second = 0;    ///< camera samples (all pixels) per second
+  std::uint64_t samples_done = 0;    ///< per pixel, by this render call
+  std::uint64_t samples_target = 0;  ///< per pixel (0 when only a time limit is set)
+  std::uint64_t accumulated = 0;     ///< per pixel, in the accumulation (earlier calls included)
+  double elapsed = 0;                ///< seconds
+  double time_limit = 0;             ///< seconds (0: none)
+  double samples_per_second = 0;     ///< camera samples (all pixels) per second
 };
 
 /// Arithmetic of rays and geometry in the kernel (docs/rendering-model.md, "Precision"): float,
@@ -28,34 +29,43 @@ const char* precision_name(Precision p);
 /// Parses "float" or "double"; throws lucent::Error naming `what` (e.g. "--precision") otherwise.
 Precision parse_precision(const std::string& text, const std::string& what = "--precision");
 
+/// Receives warnings (one line each, without the "lucent: warning: " prefix).
+using WarningSink = std::function<void(const std::string&)>;
+
+/// Options of the one-shot render() (a session's options, SessionOptions, plus the sample budget).
 struct RenderOptions {
-  std::string device;             ///< selector, see select_device()
-  int spp = 0;                    ///< 0: the scene's integrator.spp
-  double time_limit = 0;          ///< seconds; 0: none
+  std::string device;                         ///< selector, see select_device()
+  std::string kernel_dir;                     ///< "" : embedded kernel sources (see SessionOptions)
+  std::string cache_dir;                      ///< "" : the default cache directory; "off": none
+  WarningSink on_warning;                     ///< null: stderr
+  int spp = 0;                                ///< 0: the scene's integrator.spp
+  double time_limit = 0;                      ///< seconds; 0: none
   const std::atomic<bool>* cancel = nullptr;  ///< set to stop after the current pass
   std::function<void(const RenderProgress&)> on_progress;
-  double pass_seconds = 0.25;     ///< target duration of one launch
-  bool fast_math = false;         ///< build with -cl-fast-relaxed-math (default: IEEE math)
-  bool specialize = true;         ///< compile only the features the scene uses (false: all)
+  double pass_seconds = 0.25;  ///< target duration of one launch
+  bool fast_math = false;      ///< build with -cl-fast-relaxed-math (default: IEEE math)
+  bool specialize = true;      ///< compile only the features the scene uses (false: all)
   Precision precision = Precision::Float;  ///< Double: build with -D LC_DOUBLE (needs fp64)
 };
 
 struct RenderResult {
-  Image mean;                      ///< per-pixel mean radiance
-  Image variance;                  ///< per-pixel sample variance (of one sample)
+  Image mean;                          ///< per-pixel mean radiance
+  Image variance;                      ///< per-pixel sample variance (of one sample)
   std::vector<std::uint32_t> samples;  ///< finite samples per pixel
-  std::uint64_t spp = 0;           ///< samples per pixel launched
-  std::uint64_t nonfinite = 0;     ///< NaN/Inf samples dropped and counted
-  std::uint64_t rays = 0;          ///< rays traced, shadow rays included
-  double seconds = 0;              ///< rendering time (kernel passes)
-  double build_seconds = 0;        ///< kernel source assembly and build (or cache load) time
-  bool program_cache_hit = false;  ///< the program came from lucent's binary cache
-  std::string build_options;       ///< OpenCL build options, feature defines included
+  std::uint64_t spp = 0;               ///< samples per pixel launched
+  std::uint64_t nonfinite = 0;         ///< NaN/Inf samples dropped and counted
+  std::uint64_t rays = 0;              ///< rays traced, shadow rays included
+  double seconds = 0;                  ///< rendering time (kernel passes)
+  double build_seconds = 0;            ///< kernel source assembly and build (or cache load) time
+  bool program_cache_hit = false;      ///< the program came from lucent's binary cache
+  std::string build_options;           ///< OpenCL build options, feature defines included
   bool cancelled = false;
   std::string device;
 };
 
-/// Renders `scene` with the OpenCL megakernel.
+/// Renders `scene` with the OpenCL megakernel: a one-shot lucent::Renderer session
+/// (lucent/session.hpp) that stops at options.spp samples per pixel (0: the scene's) or after
+/// options.time_limit seconds, whichever comes first.
 RenderResult render(const Scene& scene, const RenderOptions& options = {});
 
 }  // namespace lucent

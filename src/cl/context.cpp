@@ -86,16 +86,7 @@ std::vector<Device> enumerate_devices() {
   return out;
 }
 
-Device pick_device(const std::string& selector_in) {
-  std::string selector = selector_in;
-  std::string origin = "--device";
-  if (selector.empty()) {
-    const char* env = std::getenv("LUCENT_DEVICE");
-    if (env && *env) {
-      selector = env;
-      origin = "LUCENT_DEVICE";
-    }
-  }
+Device pick_device(const std::string& selector, const std::string& origin) {
   auto devices = enumerate_devices();
   if (selector.empty()) {
     for (auto& d : devices)
@@ -118,7 +109,8 @@ Device pick_device(const std::string& selector_in) {
   throw Error(origin + " '" + selector + "': no device name contains it (see `lucent devices`)");
 }
 
-Context::Context(const std::string& selector) : device(pick_device(selector)) {
+Context::Context(const std::string& selector, const std::string& origin)
+    : device(pick_device(selector, origin)) {
   try {
     context = cl::Context(device.device);
     queue = cl::CommandQueue(context, device.device);
@@ -127,7 +119,8 @@ Context::Context(const std::string& selector) : device(pick_device(selector)) {
   }
 }
 
-cl::Program build_program(const Context& ctx, const std::string& source, const std::string& options) {
+cl::Program build_program(const Context& ctx, const std::string& source,
+                          const std::string& options) {
   cl::Program program;
   try {
     program = cl::Program(ctx.context, source);
@@ -160,6 +153,8 @@ std::vector<DeviceInfo> list_devices() {
   return out;
 }
 
-DeviceInfo select_device(const std::string& selector) { return cl_util::pick_device(selector).info; }
+DeviceInfo select_device(const std::string& selector, const std::string& origin) {
+  return cl_util::pick_device(selector, origin).info;
+}
 
 }  // namespace lucent

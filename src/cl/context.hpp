@@ -16,20 +16,22 @@ struct Device {
 /// Every device of every platform, in `lucent devices` order. Throws lucent::Error.
 std::vector<Device> enumerate_devices();
 
-/// See lucent::select_device.
-Device pick_device(const std::string& selector);
+/// See lucent::select_device; "" picks the first GPU, else the first CPU device. Errors name
+/// `origin`, where the selector came from ("--device", "LUCENT_DEVICE", ...).
+Device pick_device(const std::string& selector, const std::string& origin = "--device");
 
 /// A context and an in-order queue on one device.
 struct Context {
   Device device;
   cl::Context context;
   cl::CommandQueue queue;
-  explicit Context(const std::string& selector);
+  explicit Context(const std::string& selector, const std::string& origin = "--device");
 };
 
 /// Builds `source` (already assembled, with #line markers) for the context's device. On a build
 /// failure throws lucent::Error holding the build log, whose lines name kernels/<file>:<line>,
 /// followed by "clBuildProgram: CL_BUILD_PROGRAM_FAILURE".
-cl::Program build_program(const Context& ctx, const std::string& source, const std::string& options);
+cl::Program build_program(const Context& ctx, const std::string& source,
+                          const std::string& options);
 
 }  // namespace lucent::cl_util

@@ -14,14 +14,10 @@ namespace lucent::detail {
 
 namespace {
 
-const char* kernel_dir_override() {
-  const char* dir = std::getenv("LUCENT_KERNEL_DIR");
-  return (dir && *dir) ? dir : nullptr;
-}
-
-void expand(const std::string& path, std::set<std::string>& seen, std::ostringstream& out) {
+void expand(const std::string& path, const std::string& kernel_dir, std::set<std::string>& seen,
+            std::ostringstream& out) {
   if (!seen.insert(path).second) return;  // each file once (all headers are guarded anyway)
-  std::istringstream in(read_kernel_file(path));
+  std::istringstream in(read_kernel_file(path, kernel_dir));
   out << "#line 1 \"kernels/" << path << "\"\n";
   std::string line;
   int number = 0;
@@ -38,7 +34,7 @@ void expand(const std::string& path, std::set<std::string>& seen, std::ostringst
       if (q1 == std::string::npos || q2 == std::string::npos)
         throw Error("kernels/" + path + ":" + std::to_string(number) +
                     ": only #include \"file\" is supported in kernel sources");
-      expand(line.substr(q1 + 1, q2 - q1 - 1), seen, out);
+      expand(line.substr(q1 + 1, q2 - q1 - 1), kernel_dir, seen, out);
       out << "#line " << number + 1 << " \"kernels/" << path << "\"\n";
       continue;
     }
@@ -87,16 +83,16 @@ bool generated_kernel_file(const std::string& path, std::string& text) {
 
 }  // namespace
 
-std::string read_kernel_file(const std::string& path) {
+std::string read_kernel_file(const std::string& path, const std::string& kernel_dir) {
   std::string generated;
   if (path.rfind("generated/", 0) == 0) {
     if (generated_kernel_file(path, generated)) return generated;
     throw Error("kernels/" + path + ": no such generated kernel source");
   }
-  if (const char* dir = kernel_dir_override()) {
-    std::string full = std::string(dir) + "/" + path;
+  if (!kernel_dir.empty()) {
+    std::string full = kernel_dir + "/" + path;
     std::ifstream f(full, std::ios::binary);
-    if (!f) throw Error(full + ": cannot read kernel source (LUCENT_KERNEL_DIR is set)");
+    if (!f) throw Error(full + ": cannot read kernel source (kernel directory " + kernel_dir + ")");
     std::ostringstream ss;
     ss << f.rdbuf();
     return ss.str();
@@ -106,16 +102,11 @@ std::string read_kernel_file(const std::string& path) {
   throw Error("kernels/" + path + ": no such embedded kernel source");
 }
 
-std::string assemble_kernel_source(const std::string& path) {
+std::string assemble_kernel_source(const std::string& path, const std::string& kernel_dir) {
   std::set<std::string> seen;
   std::ostringstream out;
-  expand(path, seen, out);
+  expand(path, kernel_dir, seen, out);
   return out.str();
-}
-
-std::string kernel_source_origin() {
-  const char* dir = kernel_dir_override();
-  return dir ? std::string(dir) : std::string("embedded");
 }
 
 }  // namespace lucent::detail

@@ -84,7 +84,8 @@ bool read_entry(const std::string& path, const std::string& key, std::vector<uns
   return true;
 }
 
-void write_entry(const std::string& path, const std::string& key, const std::vector<unsigned char>& binary) {
+void write_entry(const std::string& path, const std::string& key,
+                 const std::vector<unsigned char>& binary) {
   std::error_code ec;
   fs::create_directories(fs::path(path).parent_path(), ec);
   std::string tmp = path + ".tmp." + std::to_string(::getpid());
@@ -98,7 +99,8 @@ void write_entry(const std::string& path, const std::string& key, const std::vec
     f.write(key.data(), static_cast<std::streamsize>(key.size()));
     f.write(reinterpret_cast<const char*>(&bin_len), sizeof bin_len);
     f.write(reinterpret_cast<const char*>(&checksum), sizeof checksum);
-    f.write(reinterpret_cast<const char*>(binary.data()), static_cast<std::streamsize>(binary.size()));
+    f.write(reinterpret_cast<const char*>(binary.data()),
+            static_cast<std::streamsize>(binary.size()));
     if (!f) {
       fs::remove(tmp, ec);
       return;
@@ -110,9 +112,7 @@ void write_entry(const std::string& path, const std::string& key, const std::vec
 
 }  // namespace
 
-std::string program_cache_dir() {
-  const char* env = std::getenv("LUCENT_CACHE_DIR");
-  if (env && *env) return std::string(env) == "off" ? std::string() : std::string(env);
+std::string default_program_cache_dir() {
   const char* xdg = std::getenv("XDG_CACHE_HOME");
   if (xdg && *xdg) return std::string(xdg) + "/lucent";
   const char* home = std::getenv("HOME");
@@ -120,13 +120,14 @@ std::string program_cache_dir() {
   return "";
 }
 
-cl::Program build_program_cached(const Context& ctx, const std::string& source, const std::string& options,
+cl::Program build_program_cached(const Context& ctx, const std::string& source,
+                                 const std::string& options, const std::string& cache_dir,
                                  ProgramBuildInfo* info) {
   auto t0 = std::chrono::steady_clock::now();
   ProgramBuildInfo local;
   ProgramBuildInfo& bi = info ? *info : local;
   bi = ProgramBuildInfo{};
-  std::string dir = program_cache_dir();
+  const std::string& dir = cache_dir;
   std::string key = cache_key(ctx, source, options);
   auto finish = [&](cl::Program p) {
     bi.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -165,13 +166,13 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source, 
   return finish(p);
 }
 
-int clear_program_cache() {
-  std::string dir = program_cache_dir();
+int clear_program_cache(const std::string& dir) {
   if (dir.empty()) return 0;
   int n = 0;
   std::error_code ec;
   for (auto& e : fs::directory_iterator(dir, ec)) {
-    if (e.path().extension() == ".bin" || e.path().string().find(".bin.tmp.") != std::string::npos) {
+    if (e.path().extension() == ".bin" ||
+        e.path().string().find(".bin.tmp.") != std::string::npos) {
       fs::remove(e.path(), ec);
       if (!ec) ++n;
     }

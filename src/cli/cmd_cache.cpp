@@ -1,10 +1,10 @@
 // `lucent cache clear|dir`: the on-disk cache of built kernel programs (src/cl/program_cache.hpp).
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
 #include "cl/program_cache.hpp"
+#include "cli/commands.hpp"
 
 namespace lucent::cli {
 
@@ -15,20 +15,22 @@ std::string g_action;
 CLI::App* add_cache_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "cache", "Manage the kernel binary cache (LUCENT_CACHE_DIR, default ~/.cache/lucent)");
-  cmd->add_option("action", g_action, "clear: remove every cached program; dir: print the directory")
+  cmd->add_option("action", g_action,
+                  "clear: remove every cached program; dir: print the directory")
       ->required()
       ->check(CLI::IsMember({"clear", "dir"}));
   return cmd;
 }
 
 int run_cache_command() {
-  std::string dir = cl_util::program_cache_dir();
+  std::string dir = cache_dir_from_environment();
   if (g_action == "dir") {
     std::printf("%s\n", dir.empty() ? "(disabled)" : dir.c_str());
     return 0;
   }
-  int n = cl_util::clear_program_cache();
-  std::printf("removed %d cached program(s) from %s\n", n, dir.empty() ? "(disabled)" : dir.c_str());
+  int n = cl_util::clear_program_cache(dir);
+  std::printf("removed %d cached program(s) from %s\n", n,
+              dir.empty() ? "(disabled)" : dir.c_str());
   return 0;
 }
 

@@ -14,11 +14,13 @@
 #include <string>
 #include <vector>
 
+#include "cli/commands.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
 #include "lucent/reference.hpp"
+#include "lucent/session.hpp"
 
 namespace lucent::cli {
 
@@ -146,7 +148,6 @@ int run_converge_command() {
   opt.spp_ladder = a.time_ladder.empty()
                        ? (a.spp_ladder.empty() ? default_spp_ladder(a.max_spp) : a.spp_ladder)
                        : std::vector<int>{};
-  opt.render.device = a.device;
   opt.render.cancel = &g_stop;
 
   Scene scene = load_scene(a.scene);
@@ -154,6 +155,10 @@ int run_converge_command() {
   if (a.height > 0) scene.film.height = a.height;
 
   auto previous = std::signal(SIGINT, on_converge_sigint);
+  // one session renders the kernel reference and every rung (a different seed is only data)
+  Renderer renderer(session_options(a.device));
+  renderer.set_cancel_flag(&g_stop);
+  opt.renderer = &renderer;
   RenderResult reference;
   if (!a.reference.empty()) {
     reference = read_render(a.reference);
@@ -178,9 +183,9 @@ int run_converge_command() {
       ro.cancel = &g_stop;
       reference = render_reference(rs, ro);
     } else {
-      RenderOptions ro = opt.render;
-      ro.spp = spp;
-      reference = render(rs, ro);
+      renderer.set_scene(rs);
+      renderer.render(static_cast<std::uint64_t>(spp));
+      reference = renderer.result();
     }
     if (reference.cancelled || g_stop.load())
       throw Error("interrupted while rendering the reference");

@@ -11,6 +11,7 @@
 #include "bvh/bvh.hpp"
 #include "cl/kernel_source.hpp"
 #include "lucent/scene.hpp"
+#include "lucent/session.hpp"
 #include "render/features.hpp"
 #include "render/pack.hpp"
 
@@ -177,7 +178,8 @@ int run_info_command() {
   options.fast_math = args().fast_math;
   options.specialize = !args().no_specialize;
   std::printf("\nkernel\n");
-  std::printf("  sources             %s\n", detail::kernel_source_origin().c_str());
+  std::string kernel_dir = SessionOptions::from_environment().kernel_dir;
+  std::printf("  sources             %s\n", kernel_dir.empty() ? "embedded" : kernel_dir.c_str());
   std::printf("  feature defines     %s\n", defines.empty() ? "(none)" : defines.c_str());
   std::printf(
       "  precision           %s%s\n", precision_name(options.precision),

@@ -3,7 +3,9 @@
 #include <functional>
 #include <vector>
 
+#include "cl/program_cache.hpp"
 #include "lucent/error.hpp"
+#include "lucent/session.hpp"
 
 namespace lucent::cli {
 
@@ -19,6 +21,32 @@ IntegratorType parse_integrator(const std::string& n) {
   throw Error("--integrator " + n +
               ": unknown integrator (expected path, whitted, direct, albedo, normal, depth, ao, "
               "primitive)");
+}
+
+RenderOptions render_options_from_environment() {
+  SessionOptions s = SessionOptions::from_environment();
+  RenderOptions o;
+  o.device = s.device;
+  o.kernel_dir = s.kernel_dir;
+  o.cache_dir = s.cache_dir;
+  return o;
+}
+
+SessionOptions session_options(const std::string& device) {
+  SessionOptions s = SessionOptions::from_environment();
+  std::string origin = "LUCENT_DEVICE";
+  if (!device.empty()) {
+    s.device = device;
+    origin = "--device";
+  }
+  if (!s.device.empty()) select_device(s.device, origin);
+  return s;
+}
+
+std::string cache_dir_from_environment() {
+  std::string dir = SessionOptions::from_environment().cache_dir;
+  if (dir == "off") return "";
+  return dir.empty() ? cl_util::default_program_cache_dir() : dir;
 }
 
 // cmd_compare.cpp

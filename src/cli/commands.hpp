@@ -1,15 +1,29 @@
 #pragma once
 // Subcommands beyond render and devices live in their own files and register here.
+#include <CLI/CLI.hpp>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
+#include "lucent/render.hpp"
 #include "lucent/scene.hpp"
+#include "lucent/session.hpp"
 
 namespace lucent::cli {
 
 /// "path", "whitted", ... -> IntegratorType; throws lucent::Error on an unknown name.
 IntegratorType parse_integrator(const std::string& name);
+
+/// The command's defaults for a render: device, kernel directory and cache directory from
+/// LUCENT_DEVICE, LUCENT_KERNEL_DIR and LUCENT_CACHE_DIR
+/// (lucent::SessionOptions::from_environment).
+RenderOptions render_options_from_environment();
+
+/// Session options for a render: the environment's defaults, `device` (from --device) when not
+/// empty. Checks the device selector first, so that an unknown one is reported as the
+/// command's user gave it ("--device 'x': ..." or "LUCENT_DEVICE 'x': ...").
+SessionOptions session_options(const std::string& device);
+
+/// The kernel binary cache directory the command uses ("" when disabled: LUCENT_CACHE_DIR=off).
+std::string cache_dir_from_environment();
 
 /// Adds the extra subcommands (info, ...) to `app`.
 void register_extra_commands(CLI::App& app);

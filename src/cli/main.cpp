@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -11,10 +12,9 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "cli/commands.hpp"
 #include "lucent/compare.hpp"
@@ -79,12 +79,13 @@ void check_output_path(const std::string& out) {
 
 int cmd_devices() {
   auto devices = lucent::list_devices();
-  std::printf("%-3s %-28s %-40s %-5s %4s %10s  %-22s %s\n", "#", "platform", "device", "type", "CUs",
-              "memory", "OpenCL C", "fp64");
+  std::printf("%-3s %-28s %-40s %-5s %4s %10s  %-22s %s\n", "#", "platform", "device", "type",
+              "CUs", "memory", "OpenCL C", "fp64");
   for (const auto& d : devices)
     std::printf("%-3d %-28s %-40s %-5s %4u %10s  %-22s %s\n", d.index, d.platform.c_str(),
-                d.name.c_str(), d.type.c_str(), d.compute_units, format_bytes(d.global_memory).c_str(),
-                d.opencl_c_version.c_str(), d.fp64 ? "yes" : "no");
+                d.name.c_str(), d.type.c_str(), d.compute_units,
+                format_bytes(d.global_memory).c_str(), d.opencl_c_version.c_str(),
+                d.fp64 ? "yes" : "no");
   return 0;
 }
 
@@ -99,7 +100,7 @@ struct RenderArgs {
   double time_limit = 0;
   std::string integrator;
   bool quiet = false;
-  bool reference = false;  ///< the scalar reference integrator instead of the kernel
+  bool reference = false;         ///< the scalar reference integrator instead of the kernel
   std::vector<std::string> aovs;  ///< extra outputs: albedo, normal, depth, variance
   bool fast_math = false;
   std::string precision = "float";
@@ -112,8 +113,9 @@ std::string aov_path(const std::string& output, const std::string& name) {
   return (p.parent_path() / (p.stem().string() + "." + name + ".exr")).string();
 }
 
-/// Renders and writes the requested AOV images (linear EXR) after the main render.
-void write_aovs(const RenderArgs& a, const lucent::Scene& scene, const lucent::RenderOptions& opt,
+/// Renders and writes the requested AOV images (linear EXR) after the main render, on the same
+/// session: the BVH is reused, only the AOV kernel is built.
+void write_aovs(const RenderArgs& a, const lucent::Scene& scene, lucent::Renderer* renderer,
                 const lucent::RenderResult& main_result) {
   for (const std::string& name : a.aovs) {
     std::string path = aov_path(a.output, name);
@@ -122,11 +124,10 @@ void write_aovs(const RenderArgs& a, const lucent::Scene& scene, const lucent::R
     } else {
       lucent::Scene s = scene;
       s.integrator.type = lucent::cli::parse_integrator(name);
-      lucent::RenderOptions o = opt;
-      o.on_progress = nullptr;
-      o.spp = static_cast<int>(std::max<std::uint64_t>(1, main_result.spp));
-      o.time_limit = 0;
-      lucent::write_image(path, lucent::render(s, o).mean);
+      renderer->set_scene(s);
+      renderer->reset();
+      renderer->render(std::max<std::uint64_t>(1, main_result.spp));
+      lucent::write_image(path, renderer->result().mean);
     }
     if (!a.quiet) std::fprintf(stderr, "%s: %s AOV\n", path.c_str(), name.c_str());
   }
@@ -141,7 +142,6 @@ int cmd_render(const RenderArgs& a) {
   if (!a.integrator.empty()) scene.integrator.type = lucent::cli::parse_integrator(a.integrator);
 
   lucent::RenderOptions opt;
-  opt.device = a.device;
   opt.spp = a.spp;
   opt.time_limit = a.time_limit;
   opt.fast_math = a.fast_math;
@@ -170,6 +170,7 @@ int cmd_render(const RenderArgs& a) {
   }
   auto previous = std::signal(SIGINT, on_sigint);
   lucent::RenderResult r;
+  std::optional<lucent::Renderer> renderer;
   if (a.reference) {
     if (a.time_limit > 0) throw lucent::Error("--time is not supported with --reference");
     lucent::ReferenceOptions ro;
@@ -177,7 +178,17 @@ int cmd_render(const RenderArgs& a) {
     ro.cancel = &g_interrupted;
     r = lucent::render_reference(scene, ro);
   } else {
-    r = lucent::render(scene, opt);
+    lucent::SessionOptions so = lucent::cli::session_options(a.device);
+    so.precision = opt.precision;
+    so.fast_math = opt.fast_math;
+    so.specialize = opt.specialize;
+    renderer.emplace(so);
+    renderer->set_cancel_flag(&g_interrupted);
+    renderer->set_scene(scene);
+    std::uint64_t spp = a.spp > 0 ? static_cast<std::uint64_t>(a.spp)
+                                  : (a.time_limit > 0 ? 0 : scene.integrator.spp);
+    renderer->render(spp, a.time_limit, opt.on_progress);
+    r = renderer->result();
   }
   std::signal(SIGINT, previous);
   if (printed && tty) std::fprintf(stderr, "\n");
@@ -194,13 +205,16 @@ int cmd_render(const RenderArgs& a) {
     std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
                  static_cast<unsigned long long>(r.nonfinite));
   if (!a.quiet)
-    std::fprintf(stderr, "%s: %dx%d, %llu spp in %.2f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak host memory %.0f MiB) on %s\n",
-                 a.output.c_str(), scene.film.width, scene.film.height,
-                 static_cast<unsigned long long>(r.spp), r.seconds,
-                 r.seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / r.seconds * 1e-6 : 0,
-                 r.seconds > 0 ? double(r.rays) / r.seconds * 1e-6 : 0, r.build_seconds,
-                 peak_host_mib(), r.device.c_str());
-  if (!r.cancelled && !a.reference) write_aovs(a, scene, opt, r);
+    std::fprintf(
+        stderr,
+        "%s: %dx%d, %llu spp in %.2f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak host "
+        "memory %.0f MiB) on %s\n",
+        a.output.c_str(), scene.film.width, scene.film.height,
+        static_cast<unsigned long long>(r.spp), r.seconds,
+        r.seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / r.seconds * 1e-6 : 0,
+        r.seconds > 0 ? double(r.rays) / r.seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
+        r.device.c_str());
+  if (!r.cancelled && !a.reference) write_aovs(a, scene, &*renderer, r);
   if (r.cancelled) {
     std::fprintf(stderr, "lucent: interrupted: wrote %s with the %llu spp accumulated so far\n",
                  a.output.c_str(), static_cast<unsigned long long>(r.spp));
@@ -219,29 +233,39 @@ int main(int argc, char** argv) {
   RenderArgs ra;
   CLI::App* render = app.add_subcommand("render", "Render a JSON scene to an image");
   render->add_option("scene", ra.scene, "Scene file (JSON)")->required();
-  render->add_option("-o,--output", ra.output, "Output image: .png (8-bit sRGB), .pfm or .exr (linear)")
+  render
+      ->add_option("-o,--output", ra.output,
+                   "Output image: .png (8-bit sRGB), .pfm or .exr (linear)")
       ->required();
   render->add_option("--spp", ra.spp, "Samples per pixel (default: the scene's integrator.spp)")
       ->check(CLI::Range(1, 1 << 24));
   render->add_option("--time", ra.time_limit, "Stop after this many seconds of rendering")
       ->check(CLI::PositiveNumber);
-  render->add_option("--width", ra.width, "Image width (overrides the scene)")->check(CLI::Range(1, 16384));
-  render->add_option("--height", ra.height, "Image height (overrides the scene)")->check(CLI::Range(1, 16384));
-  render->add_option("--device", ra.device, "OpenCL device: index or name substring (env LUCENT_DEVICE)");
-  render->add_option("--seed", ra.seed, "Random seed (overrides the scene)")->check(CLI::Range(0LL, 0xffffffffLL));
-  render->add_option("--integrator", ra.integrator,
-                     "Override the integrator: path, whitted, direct, albedo, normal, depth, ao, primitive");
+  render->add_option("--width", ra.width, "Image width (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  render->add_option("--height", ra.height, "Image height (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  render->add_option("--device", ra.device,
+                     "OpenCL device: index or name substring (env LUCENT_DEVICE)");
+  render->add_option("--seed", ra.seed, "Random seed (overrides the scene)")
+      ->check(CLI::Range(0LL, 0xffffffffLL));
+  render->add_option(
+      "--integrator", ra.integrator,
+      "Override the integrator: path, whitted, direct, albedo, normal, depth, ao, primitive");
   render->add_flag("-q,--quiet", ra.quiet, "No progress line or summary");
-  render->add_flag("--fast-math", ra.fast_math,
-                   "Build the kernel with -cl-fast-relaxed-math (faster, not IEEE; see BENCHMARKS.md)");
-  render->add_option("--precision", ra.precision,
-                     "Ray and geometry arithmetic: float (default) or double (devices with fp64; "
-                     "slower, precise at extreme scales; see BENCHMARKS.md)")
+  render->add_flag(
+      "--fast-math", ra.fast_math,
+      "Build the kernel with -cl-fast-relaxed-math (faster, not IEEE; see BENCHMARKS.md)");
+  render
+      ->add_option("--precision", ra.precision,
+                   "Ray and geometry arithmetic: float (default) or double (devices with fp64; "
+                   "slower, precise at extreme scales; see BENCHMARKS.md)")
       ->check(CLI::IsMember({"float", "double"}));
   render->add_flag("--no-specialize", ra.no_specialize,
                    "Compile the full kernel instead of only the features the scene uses");
-  render->add_option("--aov", ra.aovs,
-                     "Also write AOV images <stem>.<name>.exr: albedo, normal, depth, variance")
+  render
+      ->add_option("--aov", ra.aovs,
+                   "Also write AOV images <stem>.<name>.exr: albedo, normal, depth, variance")
       ->delimiter(',')
       ->check(CLI::IsMember({"albedo", "normal", "depth", "variance"}));
   render->add_flag("--reference", ra.reference,

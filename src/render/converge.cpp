@@ -6,11 +6,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <sstream>
 
 #include "image/plot_svg.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
+#include "lucent/session.hpp"
 
 namespace lucent {
 
@@ -247,6 +249,23 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
   for (double t : options.time_ladder)
     if (!(t > 0)) throw Error("converge: time ladder values must be > 0 seconds");
 
+  // one session for the whole study: settings change only the scene's data or the build
+  // options, so the BVH is built once and each kernel variant once; the rungs of a setting
+  // accumulate progressively (a rung of N spp continues the previous rung's samples, which are
+  // those a fresh render of N spp would draw)
+  std::optional<Renderer> own;
+  Renderer* renderer = options.renderer;
+  if (!renderer) {
+    SessionOptions so;
+    so.device = options.render.device;
+    so.kernel_dir = options.render.kernel_dir;
+    so.cache_dir = options.render.cache_dir;
+    so.pass_seconds = options.render.pass_seconds;
+    so.on_warning = options.render.on_warning;
+    renderer = &own.emplace(so);
+  }
+  renderer->set_cancel_flag(options.render.cancel);
+
   ConvergeResult result;
   CompareOptions co;
   co.image_mean_test = false;
@@ -255,11 +274,22 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
     Scene s = scene;
     RenderOptions o = options.render;
     setting.apply(s, o);
+    renderer->set_build_options(o.precision, o.fast_math, o.specialize);
+    renderer->set_scene(s);
+    renderer->reset();
     std::vector<ConvergePoint> pts;
     for (std::size_t i = 0; i < rungs && !cancelled; ++i) {
-      o.spp = by_time ? 0 : options.spp_ladder[i];
-      o.time_limit = by_time ? options.time_ladder[i] : 0;
-      RenderResult r = render(s, o);
+      if (by_time) {
+        double t = options.time_ladder[i];
+        if (t <= renderer->result().seconds) renderer->reset();
+        renderer->render(0, t - renderer->result().seconds, options.render.on_progress);
+      } else {
+        std::uint64_t spp = static_cast<std::uint64_t>(options.spp_ladder[i]);
+        if (spp < renderer->spp()) renderer->reset();
+        if (spp > renderer->spp())
+          renderer->render(spp - renderer->spp(), 0, options.render.on_progress);
+      }
+      RenderResult r = renderer->result();
       if (r.cancelled) {
         cancelled = true;
         break;

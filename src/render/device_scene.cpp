@@ -1,6 +1,7 @@
 #include "render/device_scene.hpp"
 
 #include <algorithm>
+#include <cstring>
 
 namespace lucent::render_detail {
 
@@ -16,7 +17,31 @@ cl::Buffer make_buffer(const cl_util::Context& ctx, const std::vector<T>& v) {
                     const_cast<T*>(v.data()));
 }
 
+template <typename T>
+void update_buffer(const cl_util::Context& ctx, cl::Buffer& buffer, const std::vector<T>& old,
+                   const std::vector<T>& now, DeviceScene::Upload& up) {
+  if (old.size() == now.size() &&
+      (now.empty() || std::memcmp(old.data(), now.data(), now.size() * sizeof(T)) == 0))
+    return;
+  if (old.size() != now.size() || now.empty()) {
+    buffer = make_buffer(ctx, now);
+  } else {
+    ctx.queue.enqueueWriteBuffer(buffer, CL_TRUE, 0, now.size() * sizeof(T), now.data());
+  }
+  ++up.buffers;
+  up.bytes += now.size() * sizeof(T);
+}
+
 }  // namespace
+
+DeviceScene::Upload DeviceScene::update(const cl_util::Context& ctx, const PackedScene& previous,
+                                        const PackedScene& packed) {
+  Upload up;
+#define LUCENT_UPDATE(name, type) update_buffer(ctx, name, previous.name, packed.name, up);
+  LC_SCENE_BUFFERS(LUCENT_UPDATE)
+#undef LUCENT_UPDATE
+  return up;
+}
 
 DeviceScene::DeviceScene(const cl_util::Context& ctx, const PackedScene& p)
     :

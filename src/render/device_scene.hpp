@@ -19,6 +19,15 @@ struct DeviceScene {
   /// Creates the buffers with their contents (copied at creation).
   DeviceScene(const cl_util::Context& ctx, const PackedScene& packed);
 
+  struct Upload {
+    int buffers = 0;        ///< buffers written
+    std::size_t bytes = 0;  ///< bytes written
+  };
+  /// Brings the buffers from `previous` (what they hold) to `packed`: writes those whose contents
+  /// differ, recreating those whose size changed. The kernel arguments must be set again after.
+  Upload update(const cl_util::Context& ctx, const PackedScene& previous,
+                const PackedScene& packed);
+
   /// Sets kernel arguments first .. first + kArgCount - 1; returns the next argument index.
   int set_args(cl::Kernel& kernel, int first = 0) const;
 };

@@ -20,6 +20,23 @@ bool finite3(const glm::dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
+/// The primitives a BVH is built from are the same: triangle vertices, sphere centres and radii.
+bool same_geometry(const PackedScene& a, const PackedScene& b) {
+  if (a.triangles.size() != b.triangles.size() || a.spheres.size() != b.spheres.size())
+    return false;
+  for (size_t i = 0; i < a.triangles.size(); ++i) {
+    const lc_triangle &s = a.triangles[i], &t = b.triangles[i];
+    if (!std::equal(s.v0, s.v0 + 3, t.v0) || !std::equal(s.v1, s.v1 + 3, t.v1) ||
+        !std::equal(s.v2, s.v2 + 3, t.v2))
+      return false;
+  }
+  for (size_t i = 0; i < a.spheres.size(); ++i) {
+    const lc_sphere &s = a.spheres[i], &t = b.spheres[i];
+    if (!std::equal(s.center, s.center + 3, t.center) || s.radius != t.radius) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 lc_camera pack_camera(const Camera& c, int width, int height) {
@@ -46,7 +63,7 @@ lc_camera pack_camera(const Camera& c, int width, int height) {
   return cam;
 }
 
-PackedScene pack_scene(const Scene& scene) {
+PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bvh_reused) {
   PackedScene p;
   lc_params& P = p.params;
   P.camera = pack_camera(scene.camera, scene.film.width, scene.film.height);
@@ -143,12 +160,22 @@ PackedScene pack_scene(const Scene& scene) {
     scene_detail::warn(scene.path + ": skipped " + std::to_string(p.skipped_triangles) +
                        " degenerate or non-finite triangle(s)");
 
-  bvh::Bvh bvh = bvh::build(p.triangles, p.spheres);
-  p.nodes = std::move(bvh.nodes);
-  p.leaves = std::move(bvh.leaves);
-  p.bvh_stats = bvh.stats;
-  std::copy(bvh.bmin, bvh.bmin + 3, p.bounds_min);
-  std::copy(bvh.bmax, bvh.bmax + 3, p.bounds_max);
+  const bool reuse = previous && same_geometry(*previous, p);
+  if (bvh_reused) *bvh_reused = reuse;
+  if (reuse) {
+    p.nodes = previous->nodes;
+    p.leaves = previous->leaves;
+    p.bvh_stats = previous->bvh_stats;
+    std::copy(previous->bounds_min, previous->bounds_min + 3, p.bounds_min);
+    std::copy(previous->bounds_max, previous->bounds_max + 3, p.bounds_max);
+  } else {
+    bvh::Bvh bvh = bvh::build(p.triangles, p.spheres);
+    p.nodes = std::move(bvh.nodes);
+    p.leaves = std::move(bvh.leaves);
+    p.bvh_stats = bvh.stats;
+    std::copy(bvh.bmin, bvh.bmin + 3, p.bounds_min);
+    std::copy(bvh.bmax, bvh.bmax + 3, p.bounds_max);
+  }
 
   pack_lights(scene, p, std::move(power));
 

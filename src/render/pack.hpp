@@ -24,8 +24,11 @@ struct PackedScene {
 /// The camera basis (right, up, forward, with roll applied) as the kernel uses it.
 lc_camera pack_camera(const Camera& camera, int width, int height);
 
-/// Converts and validates the scene, builds the BVH and the light table.
-PackedScene pack_scene(const Scene& scene);
+/// Converts and validates the scene, builds the BVH and the light table. With `previous` (an
+/// earlier packing) whose geometry (triangle vertices, sphere centres and radii) is the same, its
+/// BVH is reused instead of built again; *bvh_reused says which happened.
+PackedScene pack_scene(const Scene& scene, const PackedScene* previous = nullptr,
+                       bool* bvh_reused = nullptr);
 
 /// The light table (src/render/lights.cpp): the scene's point and environment lights after the
 /// area lights that pack_scene added for emissive shapes (`area_power`: their powers), each light's

@@ -1,16 +1,30 @@
 #pragma once
 // Internal scene loading pieces: OBJ/MTL meshes and textures, called by the JSON loader.
-#include <string>
-
+#include <functional>
 #include <glm/glm.hpp>
+#include <string>
 
 #include "lucent/scene.hpp"
 
 namespace lucent::scene_detail {
 
-/// Warnings go through this hook (stderr by default) so tests can capture them.
+/// Warnings go to the calling thread's ScopedWarningSink if there is one, else to the
+/// process-wide hook (stderr by default; tests capture through it).
 void warn(const std::string& message);
 void set_warning_sink(void (*sink)(const std::string&));
+
+/// While alive, the calling thread's warnings go to `sink` (when it is not null): the sink of a
+/// load_scene call or of a render session.
+class ScopedWarningSink {
+ public:
+  explicit ScopedWarningSink(const std::function<void(const std::string&)>& sink);
+  ~ScopedWarningSink();
+  ScopedWarningSink(const ScopedWarningSink&) = delete;
+  ScopedWarningSink& operator=(const ScopedWarningSink&) = delete;
+
+ private:
+  const std::function<void(const std::string&)>* previous_;
+};
 
 /// Loads an OBJ file (and its MTL) into `scene`: positions, normals and UVs are transformed by
 /// `transform` (normals by its inverse transpose; a mirroring transform keeps faces' orientation)

@@ -5,11 +5,25 @@
 namespace lucent::scene_detail {
 
 namespace {
-void stderr_sink(const std::string& message) { std::fprintf(stderr, "lucent: warning: %s\n", message.c_str()); }
+void stderr_sink(const std::string& message) {
+  std::fprintf(stderr, "lucent: warning: %s\n", message.c_str());
+}
 void (*g_sink)(const std::string&) = stderr_sink;
+thread_local const std::function<void(const std::string&)>* t_sink = nullptr;
 }  // namespace
 
-void warn(const std::string& message) { g_sink(message); }
+void warn(const std::string& message) {
+  if (t_sink && *t_sink)
+    (*t_sink)(message);
+  else
+    g_sink(message);
+}
 void set_warning_sink(void (*sink)(const std::string&)) { g_sink = sink ? sink : stderr_sink; }
+
+ScopedWarningSink::ScopedWarningSink(const std::function<void(const std::string&)>& sink)
+    : previous_(t_sink) {
+  if (sink) t_sink = &sink;
+}
+ScopedWarningSink::~ScopedWarningSink() { t_sink = previous_; }
 
 }  // namespace lucent::scene_detail

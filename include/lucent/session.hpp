@@ -1,0 +1,129 @@
+#pragma once
+// A render session: one device (and its kernel builds) and one scene, rendered progressively.
+//
+//   lucent::Renderer renderer(lucent::SessionOptions::from_environment());
+//   renderer.set_scene(lucent::load_scene("scenes/default.json"));
+//   renderer.render(64);                        // adds 64 samples per pixel
+//   lucent::RenderResult r = renderer.result();
+//   scene.camera.position.x += 1;               // a new camera: no BVH or kernel rebuild
+//   renderer.set_scene(scene);
+//   renderer.render_for(2.0);                   // about two seconds of samples
+//
+// set_scene() packs the scene and builds what it needs, reusing what it can: the BVH when the
+// geometry is unchanged, the kernel when its build options are (they change with the types the
+// scene uses and the session's precision and math mode), the device buffers whose contents are
+// unchanged. stats() counts what was built. No OpenCL type appears in this header.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "lucent/device.hpp"
+#include "lucent/render.hpp"
+#include "lucent/scene.hpp"
+
+namespace lucent {
+
+/// How a session is set up. Every field has a built-in default; the environment is consulted
+/// only through from_environment().
+struct SessionOptions {
+  /// Device selector: an index from list_devices() or a case-insensitive substring of a device
+  /// name; "" picks the first GPU, else the first CPU device.
+  std::string device;
+  /// Kernel sources: "" uses the copy embedded in the library; a directory loads kernels/ files
+  /// from there instead (kernel development without rebuilding).
+  std::string kernel_dir;
+  /// Directory of the kernel binary cache; "" means $XDG_CACHE_HOME/lucent or ~/.cache/lucent,
+  /// "off" disables the cache.
+  std::string cache_dir;
+  Precision precision = Precision::Float;  ///< Double: rays and geometry in double (needs fp64)
+  bool fast_math = false;                  ///< -cl-fast-relaxed-math (default: IEEE math)
+  bool specialize = true;                  ///< compile only the features the scene uses
+  double pass_seconds = 0.25;              ///< target duration of one kernel launch
+  /// Warnings of scene packing (skipped triangles, ...); null: "lucent: warning: ..." on stderr.
+  WarningSink on_warning;
+
+  /// The defaults of the `lucent` command: device from LUCENT_DEVICE, kernel directory from
+  /// LUCENT_KERNEL_DIR, cache directory from LUCENT_CACHE_DIR (each when set and not empty).
+  static SessionOptions from_environment();
+};
+
+/// What a session has built and done, for tools that want to know what a change cost.
+struct SessionStats {
+  std::uint64_t scene_packs = 0;         ///< set_scene() calls that packed a scene
+  std::uint64_t bvh_builds = 0;          ///< BVH builds (not counted when the geometry was reused)
+  std::uint64_t kernel_compiles = 0;     ///< kernel programs compiled from source
+  std::uint64_t kernel_cache_loads = 0;  ///< programs loaded from the binary cache
+  std::uint64_t kernel_reuses = 0;       ///< set_scene() calls that kept the session's program
+  std::uint64_t buffer_uploads = 0;      ///< scene buffers written to the device
+  std::uint64_t bytes_uploaded = 0;
+  std::uint64_t passes = 0;  ///< kernel launches that rendered samples
+  double pack_seconds = 0;   ///< packing, BVH included
+  double bvh_seconds = 0;
+  double build_seconds = 0;   ///< kernel builds and cache loads
+  double render_seconds = 0;  ///< kernel passes
+};
+
+/// One device and one scene, rendered progressively. Not thread-safe, except cancel().
+class Renderer {
+ public:
+  /// Opens the device. Throws lucent::Error (no device, unknown selector, ...).
+  explicit Renderer(SessionOptions options = {});
+  ~Renderer();
+  Renderer(Renderer&&) noexcept;
+  Renderer& operator=(Renderer&&) noexcept;
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  const DeviceInfo& device() const;
+  const SessionOptions& options() const;
+  /// Changes the build settings (precision, fast math, specialisation) for the next render; the
+  /// device, kernel directory and cache directory stay those the session was opened with.
+  void set_build_options(Precision precision, bool fast_math, bool specialize);
+
+  /// Makes `scene` the session's scene (a copy is kept): packs it, builds or reuses the BVH and
+  /// the kernel, uploads the buffers that changed. The accumulated samples are kept when nothing
+  /// that changes the image changed (film display settings, the sample count), and dropped
+  /// otherwise. Throws lucent::Error for a scene it cannot render.
+  void set_scene(const Scene& scene);
+  /// The session's scene. Throws lucent::Error when none was set.
+  const Scene& scene() const;
+
+  /// Adds `spp` samples per pixel to the accumulation (fewer when cancelled). `on_progress` is
+  /// called after each pass. Returns the progress at the end.
+  RenderProgress render(std::uint64_t spp,
+                        const std::function<void(const RenderProgress&)>& on_progress = {});
+  /// Adds samples for about `seconds` (at least one pass).
+  RenderProgress render_for(double seconds,
+                            const std::function<void(const RenderProgress&)>& on_progress = {});
+  /// Adds `spp` samples per pixel or samples for `max_seconds`, whichever comes first (0: no
+  /// limit of that kind; not both 0).
+  RenderProgress render(std::uint64_t spp, double max_seconds,
+                        const std::function<void(const RenderProgress&)>& on_progress = {});
+  /// Drops the accumulation; the next sample index is `first_sample` (sample ranges: a render of
+  /// samples [A, B) is reset(A) then render(B - A)).
+  void reset(std::uint64_t first_sample = 0);
+
+  /// The accumulation so far: per-pixel mean, sample variance and sample count, with the spp,
+  /// rays, non-finite samples and render time. Cheap enough to call after every pass.
+  RenderResult result() const;
+  /// Samples per pixel accumulated so far.
+  std::uint64_t spp() const;
+  /// Index of the first sample of the accumulation (reset's argument).
+  std::uint64_t first_sample() const;
+
+  /// Stops a render in progress after its current pass (callable from another thread or a
+  /// signal handler through set_cancel_flag).
+  void cancel();
+  /// An external flag checked before each pass, as cancel() (e.g. set by a SIGINT handler).
+  void set_cancel_flag(const std::atomic<bool>* flag);
+
+  SessionStats stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lucent

@@ -1,0 +1,420 @@
+// The render session (lucent/session.hpp): one device, the kernel programs built for it (one per
+// set of build options), one packed scene on the device and the accumulation of its samples in
+// double on the host. lucent::render() (renderer.cpp) is a one-shot session.
+#include "lucent/session.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <optional>
+
+#include "cl/context.hpp"
+#include "cl/kernel_source.hpp"
+#include "cl/program_cache.hpp"
+#include "lucent/error.hpp"
+#include "render/device_scene.hpp"
+#include "render/features.hpp"
+#include "render/pack.hpp"
+#include "scene/loaders.hpp"
+
+namespace lucent {
+
+namespace {
+
+using clock_type = std::chrono::steady_clock;
+
+constexpr size_t kWorkGroupSize = 64;  // fixed: each new size costs PoCL a work-group compile
+
+double seconds_since(clock_type::time_point t) {
+  return std::chrono::duration<double>(clock_type::now() - t).count();
+}
+
+std::string env_or_empty(const char* name) {
+  const char* v = std::getenv(name);
+  return v ? std::string(v) : std::string();
+}
+
+/// The cache directory a session uses: "" disabled.
+std::string resolve_cache_dir(const std::string& dir) {
+  if (dir == "off") return "";
+  if (!dir.empty()) return dir;
+  return cl_util::default_program_cache_dir();
+}
+
+/// What a film of this size needs on the host: double sums, sums of squares and counts, the pass
+/// read-back and the result images.
+void check_film_memory(const Scene& scene, const cl_util::Context& ctx) {
+  const int width = scene.film.width, height = scene.film.height;
+  const size_t npix = static_cast<size_t>(width) * height;
+  const double host_bytes = double(npix) * (6 * sizeof(double) + sizeof(std::uint32_t) +
+                                            2 * sizeof(cl_float4) + 6 * sizeof(float));
+  const double host_memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
+  if (host_memory > 0 && host_bytes > 0.8 * host_memory)
+    throw Error(scene.path + ": a " + std::to_string(width) + "x" + std::to_string(height) +
+                " film needs " + std::to_string(static_cast<long long>(host_bytes / (1 << 20))) +
+                " MiB of host memory; this machine has " +
+                std::to_string(static_cast<long long>(host_memory / (1 << 20))) + " MiB");
+  const cl_ulong max_alloc = ctx.device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+  if (npix * sizeof(cl_float4) > max_alloc)
+    throw Error(scene.path + ": a " + std::to_string(width) + "x" + std::to_string(height) +
+                " film needs a " + std::to_string(npix * sizeof(cl_float4) >> 20) +
+                " MiB buffer; the device allows " + std::to_string(max_alloc >> 20) +
+                " MiB per buffer");
+}
+
+/// The launch parameters and every buffer of two packings are the same: they render the same
+/// image (with the same build options).
+bool same_render_data(const render_detail::PackedScene& a, const render_detail::PackedScene& b) {
+  if (std::memcmp(&a.params, &b.params, sizeof(lc_params)) != 0) return false;
+  bool same = true;
+#define LUCENT_SAME(name, type)                    \
+  same = same && a.name.size() == b.name.size() && \
+         (a.name.empty() ||                        \
+          std::memcmp(a.name.data(), b.name.data(), a.name.size() * sizeof(type)) == 0);
+  LC_SCENE_BUFFERS(LUCENT_SAME)
+#undef LUCENT_SAME
+  return same;
+}
+
+struct Program {
+  cl::Program program;
+  cl::Kernel kernel;
+  bool cache_hit = false;
+  double build_seconds = 0;
+};
+
+}  // namespace
+
+SessionOptions SessionOptions::from_environment() {
+  SessionOptions o;
+  o.device = env_or_empty("LUCENT_DEVICE");
+  o.kernel_dir = env_or_empty("LUCENT_KERNEL_DIR");
+  o.cache_dir = env_or_empty("LUCENT_CACHE_DIR");
+  return o;
+}
+
+struct Renderer::Impl {
+  SessionOptions options;
+  cl_util::Context ctx;
+  std::string cache_dir;
+
+  std::optional<Scene> scene;
+  render_detail::PackedScene packed;  // what the device buffers hold
+  std::optional<render_detail::DeviceScene> dev;
+  std::map<std::string, Program> programs;  // by build options
+  Program* program = nullptr;
+  std::string build_options;
+  size_t npix = 0;
+  cl::Buffer b_sum, b_sumsq, b_counters;
+
+  // the accumulation
+  std::vector<double> sum, sumsq;
+  std::vector<std::uint32_t> count;
+  std::uint64_t first = 0, done = 0, nonfinite = 0, rays = 0;
+  double render_seconds = 0;
+  bool last_cancelled = false;
+  std::uint32_t pass_spp = 1;  // samples per pixel of the next pass (tuned to pass_seconds)
+
+  std::atomic<bool> cancel_requested{false};
+  const std::atomic<bool>* cancel_flag = nullptr;
+  SessionStats stats;
+
+  explicit Impl(SessionOptions o)
+      : options(std::move(o)),
+        ctx(options.device, "device"),
+        cache_dir(resolve_cache_dir(options.cache_dir)) {}
+
+  bool cancelled() const { return cancel_requested.load() || (cancel_flag && cancel_flag->load()); }
+
+  void clear_accumulation(std::uint64_t first_sample) {
+    std::fill(sum.begin(), sum.end(), 0.0);
+    std::fill(sumsq.begin(), sumsq.end(), 0.0);
+    std::fill(count.begin(), count.end(), 0u);
+    first = first_sample;
+    done = nonfinite = rays = 0;
+    render_seconds = 0;
+    last_cancelled = false;
+  }
+
+  void set_args() {
+    int arg = dev->set_args(program->kernel);
+    program->kernel.setArg(arg++, b_sum);
+    program->kernel.setArg(arg++, b_sumsq);
+    program->kernel.setArg(arg++, b_counters);
+  }
+
+  size_t global_size() const {
+    return (npix + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
+  }
+
+  Program& get_program(const std::string& opts) {
+    auto it = programs.find(opts);
+    if (it != programs.end()) {
+      ++stats.kernel_reuses;
+      return it->second;
+    }
+    auto t0 = clock_type::now();
+    std::string source = detail::assemble_kernel_source("megakernel.cl", options.kernel_dir);
+    cl_util::ProgramBuildInfo info;
+    Program p;
+    p.program = cl_util::build_program_cached(ctx, source, opts, cache_dir, &info);
+    p.kernel = cl::Kernel(p.program, "lucent_render");
+    p.cache_hit = info.cache_hit;
+    if (!info.note.empty()) scene_detail::warn(info.note);
+    if (info.cache_hit)
+      ++stats.kernel_cache_loads;
+    else
+      ++stats.kernel_compiles;
+    p.build_seconds = seconds_since(t0);
+    stats.build_seconds += p.build_seconds;
+    return programs.emplace(opts, std::move(p)).first->second;
+  }
+
+  /// A launch without samples: some drivers (PoCL) compile the work-group function at the first
+  /// enqueue; it counts as build time, not render time.
+  void warm_up() {
+    auto t0 = clock_type::now();
+    lc_params P0 = packed.params;
+    P0.samples_per_pass = 0;
+    ctx.queue.enqueueWriteBuffer(dev->params, CL_FALSE, 0, sizeof(P0), &P0);
+    ctx.queue.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global_size()),
+                                   cl::NDRange(kWorkGroupSize));
+    ctx.queue.finish();
+    double s = seconds_since(t0);
+    program->build_seconds += s;
+    stats.build_seconds += s;
+  }
+
+  void set_scene(const Scene& s) {
+    scene_detail::ScopedWarningSink sink(options.on_warning);
+    check_film_memory(s, ctx);
+    auto t0 = clock_type::now();
+    bool bvh_reused = false;
+    render_detail::PackedScene next =
+        render_detail::pack_scene(s, dev ? &packed : nullptr, &bvh_reused);
+    ++stats.scene_packs;
+    if (!bvh_reused) {
+      ++stats.bvh_builds;
+      stats.bvh_seconds += next.bvh_stats.seconds;
+    }
+    stats.pack_seconds += seconds_since(t0);
+    RenderOptions ro;
+    ro.precision = options.precision;
+    ro.fast_math = options.fast_math;
+    ro.specialize = options.specialize;
+    render_detail::check_precision_support(ctx.device.info, options.precision);
+    std::string opts = render_detail::build_options(s, next, ro);
+
+    const bool keep = dev && opts == build_options && same_render_data(packed, next);
+    try {
+      Program* previous_program = program;
+      program = &get_program(opts);
+      bool new_program = program != previous_program;
+      if (!dev) {
+        dev.emplace(ctx, next);
+        ++stats.buffer_uploads;
+#define LUCENT_BYTES(name, type) stats.bytes_uploaded += next.name.size() * sizeof(type);
+        LC_SCENE_BUFFERS(LUCENT_BYTES)
+#undef LUCENT_BYTES
+      } else {
+        render_detail::DeviceScene::Upload up = dev->update(ctx, packed, next);
+        stats.buffer_uploads += up.buffers;
+        stats.bytes_uploaded += up.bytes;
+      }
+      size_t n = static_cast<size_t>(s.film.width) * s.film.height;
+      if (n != npix || !b_sum()) {
+        npix = n;
+        b_sum = cl::Buffer(ctx.context, CL_MEM_WRITE_ONLY, npix * sizeof(cl_float4));
+        b_sumsq = cl::Buffer(ctx.context, CL_MEM_WRITE_ONLY, npix * sizeof(cl_float4));
+        b_counters = cl::Buffer(ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
+      }
+      packed = std::move(next);
+      build_options = opts;
+      set_args();
+      if (new_program) warm_up();
+    } catch (const cl::Error& e) {
+      throw Error(cl_util::describe(e));
+    }
+    scene = s;
+    if (!keep) {
+      sum.assign(npix * 3, 0.0);
+      sumsq.assign(npix * 3, 0.0);
+      count.assign(npix, 0u);
+      clear_accumulation(first);
+      pass_spp = 1;
+    }
+  }
+
+  /// Adds samples until `target_spp` more (0: no limit) or `time_limit` seconds (0: none), at
+  /// least one pass unless cancelled with samples already accumulated.
+  RenderProgress run(std::uint64_t target_spp, double time_limit,
+                     const std::function<void(const RenderProgress&)>& on_progress) {
+    if (!scene) throw Error("render: the session has no scene (call set_scene first)");
+    cancel_requested = false;
+    last_cancelled = false;
+    std::vector<cl_float4> h_sum(npix), h_sumsq(npix);
+    std::uint64_t this_call = 0;
+    double call_seconds = 0;
+    auto t_start = clock_type::now();
+    RenderProgress pr;
+    try {
+      for (;;) {
+        if (target_spp > 0 && this_call >= target_spp) break;
+        if (time_limit > 0 && call_seconds >= time_limit && this_call > 0) break;
+        if (cancelled() && done > 0) {
+          last_cancelled = true;
+          break;
+        }
+        std::uint32_t n = pass_spp;
+        if (target_spp > 0)
+          n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, target_spp - this_call));
+        lc_params P = packed.params;
+        P.sample_offset = static_cast<lc_uint>(first + done);
+        P.samples_per_pass = n;
+        lc_uint zero[LC_COUNTER_COUNT] = {0, 0, 0, 0};
+        auto tp = clock_type::now();
+        cl::CommandQueue& q = ctx.queue;
+        q.enqueueWriteBuffer(dev->params, CL_FALSE, 0, sizeof(P), &P);
+        q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(zero), zero);
+        q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global_size()),
+                               cl::NDRange(kWorkGroupSize));
+        q.enqueueReadBuffer(b_sum, CL_FALSE, 0, npix * sizeof(cl_float4), h_sum.data());
+        q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, npix * sizeof(cl_float4), h_sumsq.data());
+        lc_uint counters[LC_COUNTER_COUNT];
+        q.enqueueReadBuffer(b_counters, CL_TRUE, 0, sizeof(counters), counters);
+        double pass_time = seconds_since(tp);
+        call_seconds += pass_time;
+        render_seconds += pass_time;
+        stats.render_seconds += pass_time;
+        ++stats.passes;
+        for (size_t i = 0; i < npix; ++i) {
+          for (int c = 0; c < 3; ++c) {
+            sum[i * 3 + c] += h_sum[i].s[c];
+            sumsq[i * 3 + c] += h_sumsq[i].s[c];
+          }
+          count[i] += static_cast<std::uint32_t>(h_sum[i].s[3]);
+        }
+        nonfinite += counters[LC_COUNTER_NONFINITE];
+        rays += counters[LC_COUNTER_RAYS];
+        done += n;
+        this_call += n;
+        // next pass: aim at pass_seconds per launch
+        double per_spp = pass_time / n;
+        double want = per_spp > 0 ? options.pass_seconds / per_spp : 2.0 * n;
+        pass_spp = static_cast<std::uint32_t>(std::clamp(want, 1.0, std::min(4.0 * n, 65536.0)));
+        if (time_limit > 0 && per_spp > 0) {
+          double left = time_limit - call_seconds;
+          pass_spp = static_cast<std::uint32_t>(std::clamp(left / per_spp, 1.0, double(pass_spp)));
+        }
+        pr.samples_done = this_call;
+        pr.samples_target = target_spp;
+        pr.accumulated = done;
+        pr.elapsed = seconds_since(t_start);
+        pr.time_limit = time_limit;
+        pr.samples_per_second = call_seconds > 0 ? double(this_call) * npix / call_seconds : 0;
+        if (on_progress) on_progress(pr);
+      }
+    } catch (const cl::Error& e) {
+      throw Error(cl_util::describe(e));
+    }
+    pr.samples_done = this_call;
+    pr.samples_target = target_spp;
+    pr.accumulated = done;
+    pr.elapsed = seconds_since(t_start);
+    pr.time_limit = time_limit;
+    pr.samples_per_second = call_seconds > 0 ? double(this_call) * npix / call_seconds : 0;
+    return pr;
+  }
+
+  RenderResult result() const {
+    if (!scene) throw Error("result: the session has no scene (call set_scene first)");
+    const int width = scene->film.width, height = scene->film.height;
+    RenderResult r;
+    r.mean = Image{width, height, std::vector<float>(npix * 3)};
+    r.variance = Image{width, height, std::vector<float>(npix * 3)};
+    r.samples = count;
+    for (size_t i = 0; i < npix; ++i) {
+      double n = count[i];
+      for (int c = 0; c < 3; ++c) {
+        double s = sum[i * 3 + c], s2 = sumsq[i * 3 + c];
+        double mean = n > 0 ? s / n : 0;
+        double var = n > 1 ? std::max(0.0, (s2 - s * mean) / (n - 1)) : 0;
+        r.mean.rgb[i * 3 + c] = static_cast<float>(mean);
+        r.variance.rgb[i * 3 + c] = static_cast<float>(var);
+      }
+    }
+    r.spp = done;
+    r.nonfinite = nonfinite;
+    r.rays = rays;
+    r.seconds = render_seconds;
+    r.build_seconds = program ? program->build_seconds : 0;
+    r.program_cache_hit = program && program->cache_hit;
+    r.build_options = build_options;
+    r.cancelled = last_cancelled;
+    r.device = ctx.device.info.name;
+    return r;
+  }
+};
+
+Renderer::Renderer(SessionOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+Renderer::~Renderer() = default;
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+
+const DeviceInfo& Renderer::device() const { return impl_->ctx.device.info; }
+const SessionOptions& Renderer::options() const { return impl_->options; }
+
+void Renderer::set_build_options(Precision precision, bool fast_math, bool specialize) {
+  impl_->options.precision = precision;
+  impl_->options.fast_math = fast_math;
+  impl_->options.specialize = specialize;
+  if (impl_->scene) impl_->set_scene(Scene(*impl_->scene));
+}
+
+void Renderer::set_scene(const Scene& scene) { impl_->set_scene(scene); }
+
+const Scene& Renderer::scene() const {
+  if (!impl_->scene) throw Error("the session has no scene (call set_scene first)");
+  return *impl_->scene;
+}
+
+RenderProgress Renderer::render(std::uint64_t spp,
+                                const std::function<void(const RenderProgress&)>& on_progress) {
+  if (spp == 0) throw Error("render: the number of samples per pixel must be positive");
+  return impl_->run(spp, 0, on_progress);
+}
+
+RenderProgress Renderer::render_for(double seconds,
+                                    const std::function<void(const RenderProgress&)>& on_progress) {
+  if (!(seconds > 0) || !std::isfinite(seconds))
+    throw Error("render_for: the time must be a positive number of seconds");
+  return impl_->run(0, seconds, on_progress);
+}
+
+RenderProgress Renderer::render(std::uint64_t spp, double max_seconds,
+                                const std::function<void(const RenderProgress&)>& on_progress) {
+  if (spp == 0 && !(max_seconds > 0))
+    throw Error("render: give a number of samples per pixel, a time limit or both");
+  if (!(max_seconds >= 0) || !std::isfinite(max_seconds))
+    throw Error("render: the time limit must be a non-negative number of seconds");
+  return impl_->run(spp, max_seconds, on_progress);
+}
+
+void Renderer::reset(std::uint64_t first_sample) {
+  if (first_sample > 0xffffffffull) throw Error("reset: the first sample index must be below 2^32");
+  impl_->clear_accumulation(first_sample);
+}
+
+RenderResult Renderer::result() const { return impl_->result(); }
+std::uint64_t Renderer::spp() const { return impl_->done; }
+std::uint64_t Renderer::first_sample() const { return impl_->first; }
+void Renderer::cancel() { impl_->cancel_requested = true; }
+void Renderer::set_cancel_flag(const std::atomic<bool>* flag) { impl_->cancel_flag = flag; }
+SessionStats Renderer::stats() const { return impl_->stats; }
+
+}  // namespace lucent

@@ -1,0 +1,273 @@
+// The render session (lucent::Renderer): what a change of the scene rebuilds, progressive
+// accumulation, sample ranges, cancellation, warnings, and every error of its API.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "lucent/session.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::Renderer;
+using lucent::RenderResult;
+using lucent::Scene;
+using lucent::SessionStats;
+
+const char* kScene = R"({
+  "camera": {"position": [0, 1, 5], "look_at": [0, 0.5, 0], "fov": 40},
+  "film": {"width": 16, "height": 12},
+  "integrator": {"type": "path", "max_depth": 4, "spp": 4},
+  "materials": {"w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]},
+                "g": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+  "shapes": [{"type": "sphere", "center": [0, 0.5, 0], "radius": 0.5, "material": "w"},
+             {"type": "triangles", "material": "g",
+              "positions": [[-5, 0, -5], [5, 0, -5], [5, 0, 5], [-5, 0, 5]],
+              "indices": [0, 2, 1, 0, 3, 2]}],
+  "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [20, 20, 20]}]})";
+
+Renderer session() {
+  lucent::SessionOptions o = lucent::test::session_options();
+  return Renderer(o);
+}
+
+bool same_image(const RenderResult& a, const RenderResult& b) {
+  return a.mean.rgb == b.mean.rgb && a.variance.rgb == b.variance.rgb && a.samples == b.samples;
+}
+
+/// The same samples summed in other passes: equal up to float summation order (each pass sums
+/// its samples in float on the device before the host adds the passes in double).
+void expect_same_samples(const RenderResult& a, const RenderResult& b) {
+  ASSERT_EQ(a.samples, b.samples);
+  ASSERT_EQ(a.mean.rgb.size(), b.mean.rgb.size());
+  double worst = 0;
+  for (size_t i = 0; i < a.mean.rgb.size(); ++i)
+    worst = std::max(
+        worst, double(std::abs(a.mean.rgb[i] - b.mean.rgb[i])) / (1e-3 + std::abs(a.mean.rgb[i])));
+  EXPECT_LT(worst, 1e-5);
+}
+
+uint64_t kernel_builds(const SessionStats& s) { return s.kernel_compiles + s.kernel_cache_loads; }
+
+// Moving the camera re-renders without rebuilding the BVH or the kernel; only the launch
+// parameters change, no scene buffer is uploaded.
+TEST(Session, CameraChangeRebuildsNothing) {
+  Renderer r = session();
+  Scene s = lucent::test::scene_from(kScene);
+  r.set_scene(s);
+  r.render(2);
+  RenderResult before = r.result();
+  SessionStats st = r.stats();
+  EXPECT_EQ(st.bvh_builds, 1u);
+  EXPECT_EQ(kernel_builds(st), 1u);
+  s.camera.position.x += 0.5;
+  r.set_scene(s);
+  EXPECT_EQ(r.spp(), 0u) << "a new camera drops the accumulation";
+  r.render(2);
+  SessionStats after = r.stats();
+  EXPECT_EQ(after.bvh_builds, 1u);
+  EXPECT_EQ(kernel_builds(after), 1u);
+  EXPECT_EQ(after.kernel_reuses, st.kernel_reuses + 1);
+  EXPECT_EQ(after.buffer_uploads, st.buffer_uploads) << "no scene buffer changed";
+  EXPECT_EQ(after.scene_packs, 2u);
+  EXPECT_FALSE(same_image(before, r.result()));
+}
+
+// A material's parameters are data: its buffer is uploaded again, nothing is rebuilt. A
+// material of a type the kernel was not built with needs a kernel build, still not a BVH.
+TEST(Session, MaterialChangesUploadDataOrBuildTheKernelButNeverTheBvh) {
+  Renderer r = session();
+  Scene s = lucent::test::scene_from(kScene);
+  r.set_scene(s);
+  SessionStats st = r.stats();
+  s.materials[0].albedo = {0.2, 0.9, 0.2};
+  r.set_scene(s);
+  SessionStats a = r.stats();
+  EXPECT_EQ(a.bvh_builds, 1u);
+  EXPECT_EQ(kernel_builds(a), kernel_builds(st));
+  EXPECT_EQ(a.buffer_uploads, st.buffer_uploads + 1) << "the materials buffer only";
+  r.render(1);
+  s.materials[0].type = lucent::MaterialType::Mirror;
+  s.materials[0].specular = glm::dvec3(0.9);
+  r.set_scene(s);
+  SessionStats b = r.stats();
+  EXPECT_EQ(b.bvh_builds, 1u);
+  EXPECT_EQ(kernel_builds(b), kernel_builds(st) + 1) << "a mirror kernel";
+  EXPECT_NE(r.result().build_options.find("LC_HAS_MIRROR"), std::string::npos);
+  // back to diffuse: the session kept the first program
+  s.materials[0].type = lucent::MaterialType::Diffuse;
+  r.set_scene(s);
+  EXPECT_EQ(kernel_builds(r.stats()), kernel_builds(st) + 1);
+}
+
+// Moving a primitive is a geometry change: the BVH is built again.
+TEST(Session, GeometryChangeRebuildsTheBvh) {
+  Renderer r = session();
+  Scene s = lucent::test::scene_from(kScene);
+  r.set_scene(s);
+  s.spheres[0].center.y += 0.25;
+  r.set_scene(s);
+  EXPECT_EQ(r.stats().bvh_builds, 2u);
+}
+
+// The film's display settings and the scene's sample count do not change the image: the
+// accumulation is kept. The seed does: it is dropped.
+TEST(Session, DisplaySettingsKeepTheAccumulation) {
+  Renderer r = session();
+  Scene s = lucent::test::scene_from(kScene);
+  r.set_scene(s);
+  r.render(3);
+  s.film.exposure = 2;
+  s.film.tonemap = lucent::ToneMap::Aces;
+  s.integrator.spp = 99;
+  r.set_scene(s);
+  EXPECT_EQ(r.spp(), 3u);
+  s.integrator.seed = 7;
+  r.set_scene(s);
+  EXPECT_EQ(r.spp(), 0u);
+}
+
+// Passes add up: 3 + 5 samples are the 8 samples of one render (the random numbers are a
+// function of the sample index; equal up to float summation order), and the one-shot
+// lucent::render with the same passes gives the same image bit for bit.
+TEST(Session, ProgressiveRendersAddUpExactly) {
+  Scene s = lucent::test::scene_from(kScene);
+  Renderer a = session();
+  a.set_scene(s);
+  a.render(3);
+  a.render(5);
+  Renderer b = session();
+  b.set_scene(s);
+  b.render(8);
+  EXPECT_EQ(a.spp(), 8u);
+  expect_same_samples(a.result(), b.result());
+  lucent::RenderOptions o;
+  o.spp = 8;
+  EXPECT_TRUE(same_image(b.result(), lucent::test::render(s, o)));
+}
+
+// reset(A) starts the accumulation at sample index A: samples [0, 4) then [4, 8) of two
+// sessions hold together what [0, 8) holds (sums of the two parts, weighted by their counts).
+TEST(Session, ResetStartsAtASampleIndex) {
+  Scene s = lucent::test::scene_from(kScene);
+  Renderer whole = session(), low = session(), high = session();
+  for (Renderer* r : {&whole, &low, &high}) r->set_scene(s);
+  whole.render(8);
+  low.render(4);
+  high.reset(4);
+  EXPECT_EQ(high.first_sample(), 4u);
+  high.render(4);
+  RenderResult w = whole.result(), l = low.result(), h = high.result();
+  EXPECT_FALSE(same_image(l, h)) << "different samples";
+  for (size_t i = 0; i < w.mean.rgb.size(); ++i) {
+    size_t p = i / 3;
+    double n_l = l.samples[p], n_h = h.samples[p];
+    double merged = (l.mean.rgb[i] * n_l + h.mean.rgb[i] * n_h) / (n_l + n_h);
+    EXPECT_NEAR(merged, w.mean.rgb[i], 1e-5 * (1 + std::abs(w.mean.rgb[i]))) << i;
+  }
+}
+
+TEST(Session, RenderForRendersAtLeastOnePass) {
+  Renderer r = session();
+  r.set_scene(lucent::test::scene_from(kScene));
+  lucent::RenderProgress p = r.render_for(0.05);
+  EXPECT_GT(p.samples_done, 0u);
+  EXPECT_EQ(p.accumulated, r.spp());
+  EXPECT_GT(r.result().seconds, 0);
+}
+
+// cancel() from another thread stops a long render after its current pass, with what it had.
+TEST(Session, CancelStopsAfterThePassInProgress) {
+  Renderer r = session();
+  Scene s = lucent::test::scene_from(kScene);
+  r.set_scene(s);
+  std::atomic<int> passes{0};
+  std::thread stopper;
+  lucent::RenderProgress p = r.render(1000000, [&](const lucent::RenderProgress&) {
+    if (++passes == 2) stopper = std::thread([&r] { r.cancel(); });
+  });
+  stopper.join();
+  EXPECT_LT(p.samples_done, 1000000u);
+  EXPECT_GT(r.spp(), 0u);
+  EXPECT_TRUE(r.result().cancelled);
+  // the next render starts uncancelled
+  r.render(1);
+  EXPECT_FALSE(r.result().cancelled);
+
+  std::atomic<bool> flag{true};
+  r.set_cancel_flag(&flag);
+  lucent::RenderProgress q = r.render(1000);
+  EXPECT_EQ(q.samples_done, 0u) << "a raised flag stops before the first pass";
+  EXPECT_TRUE(r.result().cancelled);
+}
+
+// Warnings of packing go to the session's sink, not to stderr.
+TEST(Session, WarningsGoToTheSessionsSink) {
+  std::vector<std::string> got;
+  lucent::SessionOptions o = lucent::test::session_options();
+  o.on_warning = [&](const std::string& m) { got.push_back(m); };
+  Renderer r(o);
+  Scene s = lucent::test::scene_from(kScene);
+  s.positions.push_back(s.positions[0]);  // a degenerate triangle: two equal vertices
+  lucent::Triangle t;
+  t.v[0] = 0;
+  t.v[1] = static_cast<int>(s.positions.size()) - 1;
+  t.v[2] = 1;
+  s.triangles.push_back(t);
+  r.set_scene(s);
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_NE(got[0].find("skipped 1 degenerate or non-finite triangle"), std::string::npos)
+      << got[0];
+}
+
+// The kernel cache directory is the session's: "off" compiles, a directory is filled and then
+// read by the next session.
+TEST(Session, CacheDirectoryIsAnOption) {
+  Scene s = lucent::test::scene_from(kScene);
+  lucent::SessionOptions o = lucent::test::session_options();
+  o.cache_dir = "off";
+  Renderer a(o);
+  a.set_scene(s);
+  EXPECT_EQ(a.stats().kernel_compiles, 1u);
+  o.cache_dir = lucent::test::temp_dir() + "/cache";
+  Renderer b(o), c(o);
+  b.set_scene(s);
+  EXPECT_EQ(b.stats().kernel_compiles, 1u);
+  c.set_scene(s);
+  EXPECT_EQ(c.stats().kernel_cache_loads, 1u);
+  EXPECT_EQ(c.stats().kernel_compiles, 0u);
+}
+
+TEST(Session, ErrorsAreLucentErrors) {
+  Renderer r = session();
+  EXPECT_THROW(r.render(1), lucent::Error) << "no scene yet";
+  EXPECT_THROW(r.result(), lucent::Error);
+  EXPECT_THROW(r.scene(), lucent::Error);
+  r.set_scene(lucent::test::scene_from(kScene));
+  EXPECT_THROW(r.render(0), lucent::Error);
+  EXPECT_THROW(r.render_for(0), lucent::Error);
+  EXPECT_THROW(r.render_for(std::nan("")), lucent::Error);
+  EXPECT_THROW(r.render(0, 0), lucent::Error);
+  EXPECT_THROW(r.render(1, -1), lucent::Error);
+  EXPECT_THROW(r.reset(1ull << 32), lucent::Error);
+  lucent::SessionOptions bad = lucent::test::session_options();
+  bad.device = "no such device at all";
+  EXPECT_THROW(Renderer{bad}, lucent::Error);
+  Scene huge = lucent::test::scene_from(kScene);
+  huge.film.width = huge.film.height = 1 << 20;
+  try {
+    r.set_scene(huge);
+    FAIL() << "a 2^20 x 2^20 film was accepted";
+  } catch (const lucent::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("film needs"), std::string::npos) << e.what();
+  }
+  // the session still renders its previous scene
+  r.render(1);
+  EXPECT_EQ(r.result().mean.width, 16);
+}
+
+}  // namespace
