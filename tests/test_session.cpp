@@ -242,6 +242,40 @@ TEST(Session, CacheDirectoryIsAnOption) {
   EXPECT_EQ(c.stats().kernel_compiles, 0u);
 }
 
+// Several devices share a render's passes (here two contexts on the same device, "0,0"): the
+// image is a one-device render's up to float summation order (the same samples, other passes),
+// every device takes part, and their shares add up to the spp.
+TEST(Session, SeveralDevicesShareTheSamples) {
+  Scene s = lucent::test::scene_from(kScene);
+  lucent::SessionOptions o = lucent::test::session_options();
+  std::string one = std::to_string(lucent::select_device(o.device).index);
+  o.device = one + "," + one;
+  o.pass_seconds = 1e-4;  // many small passes, so that both devices take some
+  Renderer both(o);
+  ASSERT_EQ(both.devices().size(), 2u);
+  both.set_scene(s);
+  lucent::RenderProgress p = both.render(24);
+  ASSERT_EQ(p.devices.size(), 2u);
+  EXPECT_EQ(p.devices[0].samples + p.devices[1].samples, 24u);
+  EXPECT_GT(p.devices[0].samples, 0u);
+  EXPECT_GT(p.devices[1].samples, 0u);
+  RenderResult r = both.result();
+  EXPECT_EQ(r.spp, 24u);
+  EXPECT_NE(r.device.find(" + "), std::string::npos) << r.device;
+  EXPECT_EQ(kernel_builds(both.stats()), 2u) << "one build (or cache load) per device";
+  Renderer single = session();
+  single.set_scene(s);
+  single.render(24);
+  expect_same_samples(r, single.result());
+
+  // a time budget and a cancel flag stop every device
+  lucent::RenderProgress q = both.render_for(0.05);
+  EXPECT_GT(q.samples_done, 0u);
+  std::atomic<bool> flag{true};
+  both.set_cancel_flag(&flag);
+  EXPECT_EQ(both.render(100).samples_done, 0u);
+}
+
 TEST(Session, ErrorsAreLucentErrors) {
   Renderer r = session();
   EXPECT_THROW(r.render(1), lucent::Error) << "no scene yet";
@@ -256,6 +290,10 @@ TEST(Session, ErrorsAreLucentErrors) {
   EXPECT_THROW(r.reset(1ull << 32), lucent::Error);
   lucent::SessionOptions bad = lucent::test::session_options();
   bad.device = "no such device at all";
+  EXPECT_THROW(Renderer{bad}, lucent::Error);
+  bad.device = "0,";
+  EXPECT_THROW(Renderer{bad}, lucent::Error);
+  bad.device = "0,no such device at all";
   EXPECT_THROW(Renderer{bad}, lucent::Error);
   Scene huge = lucent::test::scene_from(kScene);
   huge.film.width = huge.film.height = 1 << 20;

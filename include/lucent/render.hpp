@@ -4,11 +4,19 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "lucent/image.hpp"
 #include "lucent/scene.hpp"
 
 namespace lucent {
+
+/// One device's part of a render (several devices share a render's passes).
+struct DeviceShare {
+  std::string device;          ///< the device's name
+  std::uint64_t samples = 0;   ///< samples per pixel it rendered
+  double seconds = 0;          ///< time its passes took
+};
 
 struct RenderProgress {
   std::uint64_t samples_done = 0;    ///< per pixel, by this render call
@@ -17,6 +25,7 @@ struct RenderProgress {
   double elapsed = 0;                ///< seconds
   double time_limit = 0;             ///< seconds (0: none)
   double samples_per_second = 0;     ///< camera samples (all pixels) per second
+  std::vector<DeviceShare> devices;  ///< each device's part of this render call
 };
 
 /// Arithmetic of rays and geometry in the kernel (docs/rendering-model.md, "Precision"): float,
@@ -60,7 +69,8 @@ struct RenderResult {
   bool program_cache_hit = false;      ///< the program came from lucent's binary cache
   std::string build_options;           ///< OpenCL build options, feature defines included
   bool cancelled = false;
-  std::string device;
+  std::string device;                  ///< the device's name ("A + B" for several)
+  std::vector<DeviceShare> devices;    ///< each device's part of the accumulation
 };
 
 /// Renders `scene` with the OpenCL megakernel: a one-shot lucent::Renderer session

@@ -29,7 +29,10 @@ namespace lucent {
 /// only through from_environment().
 struct SessionOptions {
   /// Device selector: an index from list_devices() or a case-insensitive substring of a device
-  /// name; "" picks the first GPU, else the first CPU device.
+  /// name; "" picks the first GPU, else the first CPU device. Several devices: a comma-separated
+  /// list of selectors ("0,2", "nvidia,cpu"), or "all" for every device; they share each render's
+  /// passes (each device takes the next pass when it is done, its pass size tuned to its speed)
+  /// into one accumulation. A device listed twice opens two contexts on it.
   std::string device;
   /// Kernel sources: "" uses the copy embedded in the library; a directory loads kernels/ files
   /// from there instead (kernel development without rebuilding).
@@ -76,7 +79,9 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
+  /// The (first) device, and all of them.
   const DeviceInfo& device() const;
+  std::vector<DeviceInfo> devices() const;
   const SessionOptions& options() const;
   /// Changes the build settings (precision, fast math, specialisation) for the next render; the
   /// device, kernel directory and cache directory stay those the session was opened with.

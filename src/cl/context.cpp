@@ -157,4 +157,26 @@ DeviceInfo select_device(const std::string& selector, const std::string& origin)
   return cl_util::pick_device(selector, origin).info;
 }
 
+std::vector<DeviceInfo> select_devices(const std::string& selectors, const std::string& origin) {
+  if (selectors == "all") return list_devices();
+  std::vector<DeviceInfo> out;
+  if (selectors.find(',') == std::string::npos) {
+    out.push_back(select_device(selectors, origin));
+    return out;
+  }
+  std::string item;
+  for (size_t i = 0; i <= selectors.size(); ++i) {
+    if (i < selectors.size() && selectors[i] != ',') {
+      item += selectors[i];
+      continue;
+    }
+    size_t b = item.find_first_not_of(' '), e = item.find_last_not_of(' ');
+    if (b == std::string::npos)
+      throw Error(origin + " '" + selectors + "': an empty selector in the list");
+    out.push_back(select_device(item.substr(b, e - b + 1), origin));
+    item.clear();
+  }
+  return out;
+}
+
 }  // namespace lucent

@@ -39,7 +39,7 @@ SessionOptions session_options(const std::string& device) {
     s.device = device;
     origin = "--device";
   }
-  if (!s.device.empty()) select_device(s.device, origin);
+  if (!s.device.empty()) select_devices(s.device, origin);
   return s;
 }
 

@@ -41,6 +41,21 @@ std::string format_duration(double s) {
   return buf;
 }
 
+/// " [A 55%, B 45%]": each device's share of the samples, when several share a render.
+std::string device_shares(const std::vector<lucent::DeviceShare>& devices) {
+  if (devices.size() < 2) return "";
+  std::uint64_t total = 0;
+  for (const auto& d : devices) total += d.samples;
+  std::string out = " [";
+  for (size_t i = 0; i < devices.size(); ++i) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s%s %.0f%%", i ? ", " : "", devices[i].device.c_str(),
+                  total ? 100.0 * double(devices[i].samples) / double(total) : 0.0);
+    out += buf;
+  }
+  return out + "]";
+}
+
 std::string format_bytes(std::uint64_t b) {
   char buf[32];
   double g = double(b) / (1024.0 * 1024.0 * 1024.0);
@@ -160,10 +175,11 @@ int cmd_render(const RenderArgs& a) {
                                          : (p.time_limit > 0 ? p.elapsed / p.time_limit : 0);
       frac = std::min(1.0, frac);
       double eta = frac > 0 ? p.elapsed * (1 - frac) / frac : 0;
-      std::fprintf(stderr, "%s%5.1f%%  %llu spp  %.2f Msamples/s  elapsed %s  ETA %s%s",
+      std::fprintf(stderr, "%s%5.1f%%  %llu spp  %.2f Msamples/s  elapsed %s  ETA %s%s%s",
                    tty ? "\r" : "", 100 * frac, static_cast<unsigned long long>(p.samples_done),
                    p.samples_per_second * 1e-6, format_duration(p.elapsed).c_str(),
-                   format_duration(eta).c_str(), tty ? "   " : "\n");
+                   format_duration(eta).c_str(), device_shares(p.devices).c_str(),
+                   tty ? "   " : "\n");
       std::fflush(stderr);
       printed = true;
     };
@@ -171,6 +187,7 @@ int cmd_render(const RenderArgs& a) {
   auto previous = std::signal(SIGINT, on_sigint);
   lucent::RenderResult r;
   std::optional<lucent::Renderer> renderer;
+  double wall = 0;  // of the kernel render (several devices: their passes overlap)
   if (a.reference) {
     if (a.time_limit > 0) throw lucent::Error("--time is not supported with --reference");
     lucent::ReferenceOptions ro;
@@ -187,7 +204,9 @@ int cmd_render(const RenderArgs& a) {
     renderer->set_scene(scene);
     std::uint64_t spp = a.spp > 0 ? static_cast<std::uint64_t>(a.spp)
                                   : (a.time_limit > 0 ? 0 : scene.integrator.spp);
+    auto t0 = std::chrono::steady_clock::now();
     renderer->render(spp, a.time_limit, opt.on_progress);
+    wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     r = renderer->result();
   }
   std::signal(SIGINT, previous);
@@ -204,16 +223,18 @@ int cmd_render(const RenderArgs& a) {
   if (r.nonfinite > 0)
     std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
                  static_cast<unsigned long long>(r.nonfinite));
+  // one device: its pass time; several: the wall time of the render, when they overlapped
+  double seconds = r.devices.size() > 1 ? wall : r.seconds;
   if (!a.quiet)
     std::fprintf(
         stderr,
         "%s: %dx%d, %llu spp in %.2f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak host "
-        "memory %.0f MiB) on %s\n",
+        "memory %.0f MiB) on %s%s\n",
         a.output.c_str(), scene.film.width, scene.film.height,
-        static_cast<unsigned long long>(r.spp), r.seconds,
-        r.seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / r.seconds * 1e-6 : 0,
-        r.seconds > 0 ? double(r.rays) / r.seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
-        r.device.c_str());
+        static_cast<unsigned long long>(r.spp), seconds,
+        seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / seconds * 1e-6 : 0,
+        seconds > 0 ? double(r.rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
+        r.device.c_str(), device_shares(r.devices).c_str());
   if (!r.cancelled && !a.reference) write_aovs(a, scene, &*renderer, r);
   if (r.cancelled) {
     std::fprintf(stderr, "lucent: interrupted: wrote %s with the %llu spp accumulated so far\n",

@@ -10,8 +10,11 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <map>
+#include <mutex>
 #include <optional>
+#include <thread>
 
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
@@ -88,6 +91,55 @@ struct Program {
   double build_seconds = 0;
 };
 
+/// One device of a session: its context, the programs built for it, the scene's buffers on it,
+/// the pass output buffers, and its part of the work.
+struct Worker {
+  cl_util::Context ctx;
+  std::map<std::string, Program> programs;  // by build options
+  Program* program = nullptr;
+  std::optional<render_detail::DeviceScene> dev;
+  size_t npix = 0;
+  cl::Buffer b_sum, b_sumsq, b_counters;
+  std::vector<cl_float4> h_sum, h_sumsq;
+  std::uint32_t pass_spp = 1;  // samples per pixel of its next pass (tuned to pass_seconds)
+  DeviceShare share;           // of the accumulation
+  DeviceShare call;            // of the render call in progress
+
+  explicit Worker(const std::string& selector) : ctx(selector, "device") {
+    share.device = call.device = ctx.device.info.name;
+  }
+
+  size_t global_size() const {
+    return (npix + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
+  }
+
+  void set_args() {
+    int arg = dev->set_args(program->kernel);
+    program->kernel.setArg(arg++, b_sum);
+    program->kernel.setArg(arg++, b_sumsq);
+    program->kernel.setArg(arg++, b_counters);
+  }
+
+  /// Launches samples [first, first + n) of every pixel and reads back their sums.
+  void pass(const lc_params& params, std::uint64_t first, std::uint32_t n,
+            lc_uint counters[LC_COUNTER_COUNT]) {
+    lc_params P = params;
+    P.sample_offset = static_cast<lc_uint>(first);
+    P.samples_per_pass = n;
+    lc_uint zero[LC_COUNTER_COUNT] = {0, 0, 0, 0};
+    cl::CommandQueue& q = ctx.queue;
+    q.enqueueWriteBuffer(dev->params, CL_FALSE, 0, sizeof(P), &P);
+    q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(zero), zero);
+    q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global_size()),
+                           cl::NDRange(kWorkGroupSize));
+    h_sum.resize(npix);
+    h_sumsq.resize(npix);
+    q.enqueueReadBuffer(b_sum, CL_FALSE, 0, npix * sizeof(cl_float4), h_sum.data());
+    q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, npix * sizeof(cl_float4), h_sumsq.data());
+    q.enqueueReadBuffer(b_counters, CL_TRUE, 0, LC_COUNTER_COUNT * sizeof(lc_uint), counters);
+  }
+};
+
 }  // namespace
 
 SessionOptions SessionOptions::from_environment() {
@@ -100,17 +152,14 @@ SessionOptions SessionOptions::from_environment() {
 
 struct Renderer::Impl {
   SessionOptions options;
-  cl_util::Context ctx;
+  std::vector<std::unique_ptr<Worker>> workers;
+  std::vector<DeviceInfo> device_infos;
   std::string cache_dir;
 
   std::optional<Scene> scene;
   render_detail::PackedScene packed;  // what the device buffers hold
-  std::optional<render_detail::DeviceScene> dev;
-  std::map<std::string, Program> programs;  // by build options
-  Program* program = nullptr;
   std::string build_options;
   size_t npix = 0;
-  cl::Buffer b_sum, b_sumsq, b_counters;
 
   // the accumulation
   std::vector<double> sum, sumsq;
@@ -118,16 +167,18 @@ struct Renderer::Impl {
   std::uint64_t first = 0, done = 0, nonfinite = 0, rays = 0;
   double render_seconds = 0;
   bool last_cancelled = false;
-  std::uint32_t pass_spp = 1;  // samples per pixel of the next pass (tuned to pass_seconds)
 
   std::atomic<bool> cancel_requested{false};
   const std::atomic<bool>* cancel_flag = nullptr;
   SessionStats stats;
 
-  explicit Impl(SessionOptions o)
-      : options(std::move(o)),
-        ctx(options.device, "device"),
-        cache_dir(resolve_cache_dir(options.cache_dir)) {}
+  explicit Impl(SessionOptions o) : options(std::move(o)) {
+    for (const DeviceInfo& d : select_devices(options.device, "device")) {
+      workers.push_back(std::make_unique<Worker>(std::to_string(d.index)));
+      device_infos.push_back(workers.back()->ctx.device.info);
+    }
+    cache_dir = resolve_cache_dir(options.cache_dir);
+  }
 
   bool cancelled() const { return cancel_requested.load() || (cancel_flag && cancel_flag->load()); }
 
@@ -139,30 +190,20 @@ struct Renderer::Impl {
     done = nonfinite = rays = 0;
     render_seconds = 0;
     last_cancelled = false;
+    for (auto& w : workers) w->share.samples = 0, w->share.seconds = 0;
   }
 
-  void set_args() {
-    int arg = dev->set_args(program->kernel);
-    program->kernel.setArg(arg++, b_sum);
-    program->kernel.setArg(arg++, b_sumsq);
-    program->kernel.setArg(arg++, b_counters);
-  }
-
-  size_t global_size() const {
-    return (npix + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
-  }
-
-  Program& get_program(const std::string& opts) {
-    auto it = programs.find(opts);
-    if (it != programs.end()) {
+  /// The worker's program for these build options, built (or loaded from the cache) or reused.
+  Program& get_program(Worker& w, const std::string& opts, const std::string& source) {
+    auto it = w.programs.find(opts);
+    if (it != w.programs.end()) {
       ++stats.kernel_reuses;
       return it->second;
     }
     auto t0 = clock_type::now();
-    std::string source = detail::assemble_kernel_source("megakernel.cl", options.kernel_dir);
     cl_util::ProgramBuildInfo info;
     Program p;
-    p.program = cl_util::build_program_cached(ctx, source, opts, cache_dir, &info);
+    p.program = cl_util::build_program_cached(w.ctx, source, opts, cache_dir, &info);
     p.kernel = cl::Kernel(p.program, "lucent_render");
     p.cache_hit = info.cache_hit;
     if (!info.note.empty()) scene_detail::warn(info.note);
@@ -172,31 +213,34 @@ struct Renderer::Impl {
       ++stats.kernel_compiles;
     p.build_seconds = seconds_since(t0);
     stats.build_seconds += p.build_seconds;
-    return programs.emplace(opts, std::move(p)).first->second;
+    return w.programs.emplace(opts, std::move(p)).first->second;
   }
 
   /// A launch without samples: some drivers (PoCL) compile the work-group function at the first
   /// enqueue; it counts as build time, not render time.
-  void warm_up() {
+  void warm_up(Worker& w) {
     auto t0 = clock_type::now();
     lc_params P0 = packed.params;
     P0.samples_per_pass = 0;
-    ctx.queue.enqueueWriteBuffer(dev->params, CL_FALSE, 0, sizeof(P0), &P0);
-    ctx.queue.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global_size()),
-                                   cl::NDRange(kWorkGroupSize));
-    ctx.queue.finish();
+    w.ctx.queue.enqueueWriteBuffer(w.dev->params, CL_FALSE, 0, sizeof(P0), &P0);
+    w.ctx.queue.enqueueNDRangeKernel(w.program->kernel, cl::NullRange, cl::NDRange(w.global_size()),
+                                     cl::NDRange(kWorkGroupSize));
+    w.ctx.queue.finish();
     double s = seconds_since(t0);
-    program->build_seconds += s;
+    w.program->build_seconds += s;
     stats.build_seconds += s;
   }
 
   void set_scene(const Scene& s) {
     scene_detail::ScopedWarningSink sink(options.on_warning);
-    check_film_memory(s, ctx);
+    for (auto& w : workers) check_film_memory(s, w->ctx);
+    for (const DeviceInfo& d : device_infos)
+      render_detail::check_precision_support(d, options.precision);
     auto t0 = clock_type::now();
     bool bvh_reused = false;
+    const bool uploaded = workers.front()->dev.has_value();
     render_detail::PackedScene next =
-        render_detail::pack_scene(s, dev ? &packed : nullptr, &bvh_reused);
+        render_detail::pack_scene(s, uploaded ? &packed : nullptr, &bvh_reused);
     ++stats.scene_packs;
     if (!bvh_reused) {
       ++stats.bvh_builds;
@@ -207,128 +251,169 @@ struct Renderer::Impl {
     ro.precision = options.precision;
     ro.fast_math = options.fast_math;
     ro.specialize = options.specialize;
-    render_detail::check_precision_support(ctx.device.info, options.precision);
     std::string opts = render_detail::build_options(s, next, ro);
 
-    const bool keep = dev && opts == build_options && same_render_data(packed, next);
+    const bool keep = uploaded && opts == build_options && same_render_data(packed, next);
+    const size_t n = static_cast<size_t>(s.film.width) * s.film.height;
     try {
-      Program* previous_program = program;
-      program = &get_program(opts);
-      bool new_program = program != previous_program;
-      if (!dev) {
-        dev.emplace(ctx, next);
-        ++stats.buffer_uploads;
+      std::string source;
+      for (auto& wp : workers) {
+        Worker& w = *wp;
+        Program* previous_program = w.program;
+        if (!w.programs.count(opts) && source.empty())
+          source = detail::assemble_kernel_source("megakernel.cl", options.kernel_dir);
+        w.program = &get_program(w, opts, source);
+        if (!w.dev) {
+          w.dev.emplace(w.ctx, next);
+          ++stats.buffer_uploads;
 #define LUCENT_BYTES(name, type) stats.bytes_uploaded += next.name.size() * sizeof(type);
-        LC_SCENE_BUFFERS(LUCENT_BYTES)
+          LC_SCENE_BUFFERS(LUCENT_BYTES)
 #undef LUCENT_BYTES
-      } else {
-        render_detail::DeviceScene::Upload up = dev->update(ctx, packed, next);
-        stats.buffer_uploads += up.buffers;
-        stats.bytes_uploaded += up.bytes;
+        } else {
+          render_detail::DeviceScene::Upload up = w.dev->update(w.ctx, packed, next);
+          stats.buffer_uploads += up.buffers;
+          stats.bytes_uploaded += up.bytes;
+        }
+        if (n != w.npix || !w.b_sum()) {
+          w.npix = n;
+          w.b_sum = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
+          w.b_sumsq = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
+          w.b_counters =
+              cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
+        }
+        w.set_args();
+        if (w.program != previous_program) {
+          packed.params = next.params;  // the warm-up launch's parameters
+          warm_up(w);
+        }
       }
-      size_t n = static_cast<size_t>(s.film.width) * s.film.height;
-      if (n != npix || !b_sum()) {
-        npix = n;
-        b_sum = cl::Buffer(ctx.context, CL_MEM_WRITE_ONLY, npix * sizeof(cl_float4));
-        b_sumsq = cl::Buffer(ctx.context, CL_MEM_WRITE_ONLY, npix * sizeof(cl_float4));
-        b_counters = cl::Buffer(ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
-      }
-      packed = std::move(next);
-      build_options = opts;
-      set_args();
-      if (new_program) warm_up();
     } catch (const cl::Error& e) {
       throw Error(cl_util::describe(e));
     }
+    packed = std::move(next);
+    build_options = opts;
+    npix = n;
     scene = s;
     if (!keep) {
       sum.assign(npix * 3, 0.0);
       sumsq.assign(npix * 3, 0.0);
       count.assign(npix, 0u);
       clear_accumulation(first);
-      pass_spp = 1;
+      for (auto& w : workers) w->pass_spp = 1;
     }
   }
 
+  /// Adds one pass's sums to the accumulation.
+  void accumulate(const Worker& w, std::uint32_t n, const lc_uint counters[LC_COUNTER_COUNT]) {
+    for (size_t i = 0; i < npix; ++i) {
+      for (int c = 0; c < 3; ++c) {
+        sum[i * 3 + c] += w.h_sum[i].s[c];
+        sumsq[i * 3 + c] += w.h_sumsq[i].s[c];
+      }
+      count[i] += static_cast<std::uint32_t>(w.h_sum[i].s[3]);
+    }
+    nonfinite += counters[LC_COUNTER_NONFINITE];
+    rays += counters[LC_COUNTER_RAYS];
+    done += n;
+  }
+
+  /// The next pass size of a worker whose last pass of n spp took pass_time seconds: aim at
+  /// pass_seconds per launch, within the time left.
+  void tune(Worker& w, std::uint32_t n, double pass_time, double time_left) {
+    double per_spp = pass_time / n;
+    double want = per_spp > 0 ? options.pass_seconds / per_spp : 2.0 * n;
+    w.pass_spp = static_cast<std::uint32_t>(std::clamp(want, 1.0, std::min(4.0 * n, 65536.0)));
+    if (time_left < std::numeric_limits<double>::infinity() && per_spp > 0)
+      w.pass_spp =
+          static_cast<std::uint32_t>(std::clamp(time_left / per_spp, 1.0, double(w.pass_spp)));
+  }
+
   /// Adds samples until `target_spp` more (0: no limit) or `time_limit` seconds (0: none), at
-  /// least one pass unless cancelled with samples already accumulated.
+  /// least one pass unless cancelled with samples already accumulated. With several devices,
+  /// each takes the next range of sample indices when its pass is done.
   RenderProgress run(std::uint64_t target_spp, double time_limit,
                      const std::function<void(const RenderProgress&)>& on_progress) {
     if (!scene) throw Error("render: the session has no scene (call set_scene first)");
     cancel_requested = false;
     last_cancelled = false;
-    std::vector<cl_float4> h_sum(npix), h_sumsq(npix);
-    std::uint64_t this_call = 0;
-    double call_seconds = 0;
+    for (auto& w : workers) w->call.samples = 0, w->call.seconds = 0;
+    std::mutex m;  // guards the accumulation, the dispatch counters and the callback
+    std::uint64_t started = 0, finished = 0;  // samples per pixel of this call
+    const std::uint64_t start_index = first + done;
+    double call_seconds = 0;  // kernel time, summed over devices
     auto t_start = clock_type::now();
-    RenderProgress pr;
-    try {
-      for (;;) {
-        if (target_spp > 0 && this_call >= target_spp) break;
-        if (time_limit > 0 && call_seconds >= time_limit && this_call > 0) break;
-        if (cancelled() && done > 0) {
-          last_cancelled = true;
-          break;
-        }
-        std::uint32_t n = pass_spp;
-        if (target_spp > 0)
-          n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, target_spp - this_call));
-        lc_params P = packed.params;
-        P.sample_offset = static_cast<lc_uint>(first + done);
-        P.samples_per_pass = n;
-        lc_uint zero[LC_COUNTER_COUNT] = {0, 0, 0, 0};
-        auto tp = clock_type::now();
-        cl::CommandQueue& q = ctx.queue;
-        q.enqueueWriteBuffer(dev->params, CL_FALSE, 0, sizeof(P), &P);
-        q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(zero), zero);
-        q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global_size()),
-                               cl::NDRange(kWorkGroupSize));
-        q.enqueueReadBuffer(b_sum, CL_FALSE, 0, npix * sizeof(cl_float4), h_sum.data());
-        q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, npix * sizeof(cl_float4), h_sumsq.data());
-        lc_uint counters[LC_COUNTER_COUNT];
-        q.enqueueReadBuffer(b_counters, CL_TRUE, 0, sizeof(counters), counters);
-        double pass_time = seconds_since(tp);
-        call_seconds += pass_time;
-        render_seconds += pass_time;
-        stats.render_seconds += pass_time;
-        ++stats.passes;
-        for (size_t i = 0; i < npix; ++i) {
-          for (int c = 0; c < 3; ++c) {
-            sum[i * 3 + c] += h_sum[i].s[c];
-            sumsq[i * 3 + c] += h_sumsq[i].s[c];
+    auto progress = [&]() {
+      RenderProgress pr;
+      pr.samples_done = finished;
+      pr.samples_target = target_spp;
+      pr.accumulated = done;
+      pr.elapsed = seconds_since(t_start);
+      pr.time_limit = time_limit;
+      pr.samples_per_second = pr.elapsed > 0 ? double(finished) * npix / pr.elapsed : 0;
+      if (workers.size() == 1)
+        pr.samples_per_second = call_seconds > 0 ? double(finished) * npix / call_seconds : 0;
+      for (auto& w : workers) pr.devices.push_back(w->call);
+      return pr;
+    };
+    std::exception_ptr failure;
+    auto work = [&](Worker& w) {
+      try {
+        for (;;) {
+          std::uint64_t begin;
+          std::uint32_t n;
+          {
+            std::lock_guard<std::mutex> lock(m);
+            if (failure) return;
+            if (target_spp > 0 && started >= target_spp) return;
+            double elapsed = seconds_since(t_start);
+            if (time_limit > 0 && started > 0 && elapsed >= time_limit) return;
+            if (cancelled() && (done > 0 || started > 0)) {
+              last_cancelled = true;
+              return;
+            }
+            n = w.pass_spp;
+            if (target_spp > 0)
+              n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, target_spp - started));
+            begin = start_index + started;
+            started += n;
           }
-          count[i] += static_cast<std::uint32_t>(h_sum[i].s[3]);
+          lc_uint counters[LC_COUNTER_COUNT];
+          auto tp = clock_type::now();
+          w.pass(packed.params, begin, n, counters);
+          double pass_time = seconds_since(tp);
+          std::lock_guard<std::mutex> lock(m);
+          accumulate(w, n, counters);
+          finished += n;
+          call_seconds += pass_time;
+          render_seconds += pass_time;
+          stats.render_seconds += pass_time;
+          ++stats.passes;
+          w.call.samples += n;
+          w.call.seconds += pass_time;
+          w.share.samples += n;
+          w.share.seconds += pass_time;
+          double left = time_limit > 0 ? time_limit - seconds_since(t_start)
+                                       : std::numeric_limits<double>::infinity();
+          tune(w, n, pass_time, left);
+          if (on_progress) on_progress(progress());
         }
-        nonfinite += counters[LC_COUNTER_NONFINITE];
-        rays += counters[LC_COUNTER_RAYS];
-        done += n;
-        this_call += n;
-        // next pass: aim at pass_seconds per launch
-        double per_spp = pass_time / n;
-        double want = per_spp > 0 ? options.pass_seconds / per_spp : 2.0 * n;
-        pass_spp = static_cast<std::uint32_t>(std::clamp(want, 1.0, std::min(4.0 * n, 65536.0)));
-        if (time_limit > 0 && per_spp > 0) {
-          double left = time_limit - call_seconds;
-          pass_spp = static_cast<std::uint32_t>(std::clamp(left / per_spp, 1.0, double(pass_spp)));
-        }
-        pr.samples_done = this_call;
-        pr.samples_target = target_spp;
-        pr.accumulated = done;
-        pr.elapsed = seconds_since(t_start);
-        pr.time_limit = time_limit;
-        pr.samples_per_second = call_seconds > 0 ? double(this_call) * npix / call_seconds : 0;
-        if (on_progress) on_progress(pr);
+      } catch (const cl::Error& e) {
+        std::lock_guard<std::mutex> lock(m);
+        if (!failure) failure = std::make_exception_ptr(Error(cl_util::describe(e)));
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(m);
+        if (!failure) failure = std::current_exception();
       }
-    } catch (const cl::Error& e) {
-      throw Error(cl_util::describe(e));
+    };
+    if (workers.size() == 1) {
+      work(*workers.front());
+    } else {
+      std::vector<std::thread> threads;
+      for (auto& w : workers) threads.emplace_back(work, std::ref(*w));
+      for (auto& t : threads) t.join();
     }
-    pr.samples_done = this_call;
-    pr.samples_target = target_spp;
-    pr.accumulated = done;
-    pr.elapsed = seconds_since(t_start);
-    pr.time_limit = time_limit;
-    pr.samples_per_second = call_seconds > 0 ? double(this_call) * npix / call_seconds : 0;
-    return pr;
+    if (failure) std::rethrow_exception(failure);
+    return progress();
   }
 
   RenderResult result() const {
@@ -352,11 +437,16 @@ struct Renderer::Impl {
     r.nonfinite = nonfinite;
     r.rays = rays;
     r.seconds = render_seconds;
-    r.build_seconds = program ? program->build_seconds : 0;
-    r.program_cache_hit = program && program->cache_hit;
     r.build_options = build_options;
     r.cancelled = last_cancelled;
-    r.device = ctx.device.info.name;
+    for (const auto& w : workers) {
+      if (w->program) {
+        r.build_seconds = std::max(r.build_seconds, w->program->build_seconds);
+        r.program_cache_hit = w->program->cache_hit;
+      }
+      r.device += (r.device.empty() ? "" : " + ") + w->share.device;
+      r.devices.push_back(w->share);
+    }
     return r;
   }
 };
@@ -366,7 +456,8 @@ Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 
-const DeviceInfo& Renderer::device() const { return impl_->ctx.device.info; }
+const DeviceInfo& Renderer::device() const { return impl_->device_infos.front(); }
+std::vector<DeviceInfo> Renderer::devices() const { return impl_->device_infos; }
 const SessionOptions& Renderer::options() const { return impl_->options; }
 
 void Renderer::set_build_options(Precision precision, bool fast_math, bool specialize) {
