@@ -15,7 +15,9 @@
 #include <nlohmann/json.hpp>
 
 #include "lucent/error.hpp"
+#include "lucent/limits.hpp"
 #include "lucent/scene.hpp"
+#include "lucent/types.hpp"
 #include "scene/loaders.hpp"
 
 namespace lucent {
@@ -142,6 +144,14 @@ class Parser {
     fail(ptr, "unknown value '" + s + "' (expected one of: " + list + ")");
   }
 
+  /// A registry type by its name (lucent/types.hpp).
+  template <class E>
+  E type(const json& j, const std::string& ptr) const {
+    std::string s = string(j, ptr);
+    if (std::optional<E> v = find_type<E>(s)) return *v;
+    fail(ptr, "unknown value '" + s + "' (expected one of: " + type_names<E>() + ")");
+  }
+
   glm::dvec3 vec3(const json& j, const std::string& ptr) const {
     if (!j.is_array() || j.size() != 3)
       fail(ptr, "must be an array of 3 numbers, got " + type_name(j) + " " + show(j));
@@ -213,20 +223,20 @@ class Parser {
 
   void parse_film(const json& j, const std::string& p, Film& f) {
     check_keys(j, p, {"width", "height", "filter", "transfer", "gamma", "exposure", "tonemap"});
-    if (j.contains("width")) f.width = static_cast<int>(integer(j["width"], p + "/width", 1, 16384));
+    if (j.contains("width"))
+      f.width = static_cast<int>(integer(j["width"], p + "/width", 1, limits::kMaxImageSize));
     if (j.contains("height"))
-      f.height = static_cast<int>(integer(j["height"], p + "/height", 1, 16384));
+      f.height = static_cast<int>(integer(j["height"], p + "/height", 1, limits::kMaxImageSize));
     if (j.contains("filter")) {
       const json& fj = j["filter"];
       std::string fp = p + "/filter";
       check_keys(fj, fp, {"type", "radius"});
-      std::string t = choice(require(fj, fp, "type"), fp + "/type", {"box", "tent", "gaussian"});
-      f.filter.type = t == "box" ? FilterType::Box
-                                 : (t == "tent" ? FilterType::Tent : FilterType::Gaussian);
-      f.filter.radius = f.filter.type == FilterType::Box ? 0.5 : 1.5;
+      f.filter.type = type<FilterType>(require(fj, fp, "type"), fp + "/type");
+      f.filter.radius = default_filter_radius(f.filter.type);
       if (fj.contains("radius")) {
         f.filter.radius = positive(fj["radius"], fp + "/radius");
-        if (f.filter.radius > 8) fail(fp + "/radius", "must be <= 8 pixels");
+        if (f.filter.radius > limits::kMaxFilterRadius)
+          fail(fp + "/radius", "must be <= " + format_number(limits::kMaxFilterRadius) + " pixels");
       }
     }
     if (j.contains("transfer")) {
@@ -243,34 +253,21 @@ class Parser {
 
   void parse_integrator(const json& j, const std::string& p, Integrator& in) {
     check_keys(j, p, {"type", "max_depth", "rr_depth", "spp", "seed", "ao_distance", "mis"});
-    if (j.contains("type")) {
-      std::string t = choice(j["type"], p + "/type",
-                             {"path", "whitted", "direct", "albedo", "normal", "depth", "ao", "primitive"});
-      in.type = parse_integrator_type(t);
-    }
+    if (j.contains("type")) in.type = type<IntegratorType>(j["type"], p + "/type");
     if (j.contains("max_depth"))
-      in.max_depth = static_cast<int>(integer(j["max_depth"], p + "/max_depth", 1, 100000));
+      in.max_depth =
+          static_cast<int>(integer(j["max_depth"], p + "/max_depth", 1, limits::kMaxDepth));
     if (j.contains("rr_depth"))
-      in.rr_depth = static_cast<int>(integer(j["rr_depth"], p + "/rr_depth", 1, 100000));
-    if (j.contains("spp")) in.spp = static_cast<int>(integer(j["spp"], p + "/spp", 1, 1 << 24));
+      in.rr_depth = static_cast<int>(integer(j["rr_depth"], p + "/rr_depth", 1, limits::kMaxDepth));
+    if (j.contains("spp"))
+      in.spp = static_cast<int>(integer(j["spp"], p + "/spp", 1, limits::kMaxSpp));
     if (j.contains("seed"))
-      in.seed = static_cast<std::uint32_t>(integer(j["seed"], p + "/seed", 0, 0xffffffffL));
+      in.seed = static_cast<std::uint32_t>(integer(j["seed"], p + "/seed", 0, limits::kMaxSeed));
     if (j.contains("mis")) {
       if (!j["mis"].is_boolean()) fail(p + "/mis", "must be true or false, got " + type_name(j["mis"]));
       in.mis = j["mis"].get<bool>();
     }
     if (j.contains("ao_distance")) in.ao_distance = positive(j["ao_distance"], p + "/ao_distance");
-  }
-
-  static IntegratorType parse_integrator_type(const std::string& t) {
-    if (t == "whitted") return IntegratorType::Whitted;
-    if (t == "direct") return IntegratorType::Direct;
-    if (t == "albedo") return IntegratorType::Albedo;
-    if (t == "normal") return IntegratorType::Normal;
-    if (t == "depth") return IntegratorType::Depth;
-    if (t == "ao") return IntegratorType::Ao;
-    if (t == "primitive") return IntegratorType::Primitive;
-    return IntegratorType::Path;
   }
 
   void parse_materials(const json& j, const std::string& p, Scene& scene) {
@@ -287,31 +284,31 @@ class Parser {
     check_object(j, p);
     Material m;
     m.name = name;
-    std::string t = choice(require(j, p, "type"), p + "/type",
-                           {"diffuse", "mirror", "dielectric", "conductor", "plastic"});
-    if (t == "diffuse") {
-      check_keys(j, p, {"type", "albedo", "emission"});
-      m.type = MaterialType::Diffuse;
-    } else if (t == "mirror") {
-      check_keys(j, p, {"type", "reflectance", "emission"});
-      m.type = MaterialType::Mirror;
-      m.specular = glm::dvec3(1.0);
-      if (j.contains("reflectance")) m.specular = colour(j["reflectance"], p + "/reflectance");
-    } else if (t == "dielectric") {
-      check_keys(j, p, {"type", "ior", "tint", "emission"});
-      m.type = MaterialType::Dielectric;
-      m.specular = glm::dvec3(1.0);
-      if (j.contains("tint")) m.specular = colour(j["tint"], p + "/tint");
-    } else if (t == "conductor") {
-      check_keys(j, p, {"type", "specular", "roughness", "emission"});
-      m.type = MaterialType::Conductor;
-      m.specular = glm::dvec3(0.9);
-      if (j.contains("specular")) m.specular = colour(j["specular"], p + "/specular");
-    } else {
-      check_keys(j, p, {"type", "albedo", "specular", "roughness", "ior", "emission"});
-      m.type = MaterialType::Plastic;
-      m.specular = glm::dvec3(1.0);
-      if (j.contains("specular")) m.specular = colour(j["specular"], p + "/specular");
+    m.type = type<MaterialType>(require(j, p, "type"), p + "/type");
+    switch (m.type) {
+      case MaterialType::Diffuse:
+        check_keys(j, p, {"type", "albedo", "emission"});
+        break;
+      case MaterialType::Mirror:
+        check_keys(j, p, {"type", "reflectance", "emission"});
+        m.specular = glm::dvec3(1.0);
+        if (j.contains("reflectance")) m.specular = colour(j["reflectance"], p + "/reflectance");
+        break;
+      case MaterialType::Dielectric:
+        check_keys(j, p, {"type", "ior", "tint", "emission"});
+        m.specular = glm::dvec3(1.0);
+        if (j.contains("tint")) m.specular = colour(j["tint"], p + "/tint");
+        break;
+      case MaterialType::Conductor:
+        check_keys(j, p, {"type", "specular", "roughness", "emission"});
+        m.specular = glm::dvec3(0.9);
+        if (j.contains("specular")) m.specular = colour(j["specular"], p + "/specular");
+        break;
+      case MaterialType::Plastic:
+        check_keys(j, p, {"type", "albedo", "specular", "roughness", "ior", "emission"});
+        m.specular = glm::dvec3(1.0);
+        if (j.contains("specular")) m.specular = colour(j["specular"], p + "/specular");
+        break;
     }
     if (j.contains("albedo")) {
       const json& a = j["albedo"];
@@ -393,16 +390,37 @@ class Parser {
   }
 
   void parse_shape(const json& j, const std::string& p, Scene& scene) {
+    const std::size_t spheres = scene.spheres.size(), triangles = scene.triangles.size();
+    parse_shape_entry(j, p, scene);
+    ShapeEntry e;
+    if (scene.spheres.size() > spheres) {
+      e.first = spheres;
+      e.count = scene.spheres.size() - spheres;
+    } else {
+      e.type = ShapeType::Triangle;
+      e.first = triangles;
+      e.count = scene.triangles.size() - triangles;
+      if (j["type"] == "mesh") e.file = resolve(j["file"].get<std::string>());
+    }
+    scene.shapes.push_back(e);
+  }
+
+  void parse_shape_entry(const json& j, const std::string& p, Scene& scene) {
     check_object(j, p);
-    std::string t = choice(require(j, p, "type"), p + "/type", {"sphere", "mesh", "triangles"});
-    if (t == "sphere") {
+    // the registry's shape types, and "mesh": an OBJ file (its faces become triangles)
+    std::string name = string(require(j, p, "type"), p + "/type");
+    std::optional<ShapeType> t = find_type<ShapeType>(name);
+    if (!t && name != "mesh")
+      fail(p + "/type", "unknown value '" + name +
+                            "' (expected one of: " + type_names<ShapeType>() + ", mesh)");
+    if (t == ShapeType::Sphere) {
       check_keys(j, p, {"type", "center", "radius", "material"});
       Sphere s;
       s.center = vec3(require(j, p, "center"), p + "/center");
       s.radius = positive(require(j, p, "radius"), p + "/radius");
       s.material = material_ref(require(j, p, "material"), p + "/material", scene);
       scene.spheres.push_back(s);
-    } else if (t == "mesh") {
+    } else if (!t) {
       check_keys(j, p, {"type", "file", "material", "transform"});
       std::string file = resolve(string(require(j, p, "file"), p + "/file"));
       int mat = j.contains("material") ? material_ref(j["material"], p + "/material", scene) : -1;
@@ -483,17 +501,37 @@ class Parser {
     }
   }
 
+  /// A light type of the registry that a scene's "lights" may hold: not the emissive shapes.
+  LightType light_type(const json& j, const std::string& ptr) const {
+    std::string name = string(j, ptr);
+    std::optional<LightType> t = find_type<LightType>(name);
+    if (t && is_shape_light(*t))
+      fail(ptr, "'" + name + "' lights are emissive shapes, not entries of \"lights\": give a " +
+                    "shape a material with \"emission\"");
+    if (!t) {
+      std::string list;
+      for (const TypeEntry<LightType>& e : TypeList<LightType>::entries)
+        if (!is_shape_light(e.value)) list += std::string(list.empty() ? "" : ", ") + e.name;
+      fail(ptr, "unknown value '" + name + "' (expected one of: " + list + ")");
+    }
+    return *t;
+  }
+
   void parse_light(const json& j, const std::string& p, Scene& scene) {
     check_object(j, p);
-    std::string t = choice(require(j, p, "type"), p + "/type", {"point", "environment"});
     Light l;
-    if (t == "point") {
+    l.type = light_type(require(j, p, "type"), p + "/type");
+    if (l.type == LightType::Point) {
       check_keys(j, p, {"type", "position", "intensity"});
-      l.type = LightType::Point;
       l.position = vec3(require(j, p, "position"), p + "/position");
       l.intensity = colour(require(j, p, "intensity"), p + "/intensity");
     } else {
-      check_keys(j, p, {"type", "radiance", "file", "scale"});
+      if (l.type == LightType::EnvironmentMap) {
+        check_keys(j, p, {"type", "file", "scale"});
+        require(j, p, "file");
+      } else {
+        check_keys(j, p, {"type", "radiance", "file", "scale"});
+      }
       if (j.contains("file")) {
         if (j.contains("radiance")) fail(p + "/radiance", "give either radiance or file, not both");
         l.type = LightType::EnvironmentMap;
