@@ -117,7 +117,8 @@ std::string type_names(const char* separator = ", ") {
   return out;
 }
 
-/// The value named `name`; throws lucent::Error "unknown <what> '<name>' (expected one of: <names>)".
+/// The value named `name`; throws lucent::Error "unknown <what> '<name>' (expected one of:
+/// <names>)".
 template <class E>
 E parse_type(const std::string& name) {
   if (std::optional<E> v = find_type<E>(name)) return *v;
