@@ -14,26 +14,7 @@ namespace {
 using lucent::test::CommandResult;
 using lucent::test::run_cli;
 
-/// "key   value" lines of the report, keyed by section and key ("lights/point" -> "1").
-std::map<std::string, std::string> parse_report(const std::string& out) {
-  std::map<std::string, std::string> m;
-  std::istringstream in(out);
-  std::string section;
-  for (std::string line; std::getline(in, line);) {
-    if (line.empty()) continue;
-    bool indented = line[0] == ' ';
-    // key and value are separated by two or more spaces
-    size_t start = line.find_first_not_of(' ');
-    size_t gap = line.find("  ", start);
-    std::string key =
-        line.substr(start, gap == std::string::npos ? std::string::npos : gap - start);
-    std::string value;
-    if (gap != std::string::npos) value = line.substr(line.find_first_not_of(' ', gap));
-    if (!indented) section = key;
-    m[indented ? section + "/" + key : key] = value;
-  }
-  return m;
-}
+using lucent::test::parse_report;
 
 long long leading_int(const std::string& s) { return std::stoll(s); }
 
