@@ -52,7 +52,7 @@ void JsonReader::check_array(const json& j, const std::string& ptr) const {
 }
 
 void JsonReader::check_keys(const json& obj, const std::string& ptr,
-                            std::initializer_list<const char*> allowed) const {
+                            const std::vector<const char*>& allowed) const {
   check_object(obj, ptr);
   for (auto it = obj.begin(); it != obj.end(); ++it) {
     bool ok = false;

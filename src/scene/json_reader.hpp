@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "lucent/types.hpp"
 #include "scene/validate.hpp"
@@ -38,7 +39,7 @@ class JsonReader {
   void check_array(const json& j, const std::string& ptr) const;
   /// An object whose keys are all in `allowed`.
   void check_keys(const json& obj, const std::string& ptr,
-                  std::initializer_list<const char*> allowed) const;
+                  const std::vector<const char*>& allowed) const;
 
   /// A finite number (JSON has no NaN or Inf; the strings "nan", "inf", ... are named as such).
   double number(const json& j, const std::string& ptr) const;
