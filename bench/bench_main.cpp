@@ -23,8 +23,9 @@
 #include <vector>
 
 #include "bvh/bvh.hpp"
-#include "bvh/device_tracer.hpp"
-#include "bvh/test_meshes.hpp"
+#include "support/device_tracer.hpp"
+#include "support/reorder.hpp"
+#include "support/test_meshes.hpp"
 #include "cl/context.hpp"
 #include "lucent/error.hpp"
 
@@ -52,9 +53,6 @@ struct Options {
   std::string device;
 };
 
-double now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 bool load_obj(const std::string& path, std::vector<lc_triangle>& out) {
   std::ifstream probe(path);
@@ -156,6 +154,10 @@ std::vector<TraceRay> diffuse_rays(const std::vector<TraceRay>& primary,
 }
 
 #ifdef LUCENT_BENCH_EMBREE
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 struct Embree {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
@@ -261,7 +263,10 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
   }
 #endif
   // lucent and Embree alternate, best time of each over opt.reps rounds: both see the same load
-  double tp = INFINITY, td = INFINITY, ep = INFINITY, ed = INFINITY;
+  double tp = INFINITY, td = INFINITY;
+#ifdef LUCENT_BENCH_EMBREE
+  double ep = INFINITY, ed = INFINITY;
+#endif
   for (int r = 0; r < opt.reps; ++r) {
     tracer.trace(primary);
     tp = std::min(tp, tracer.last_kernel_seconds());

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "cl/program_cache.hpp"
@@ -225,6 +226,26 @@ void expect_matches(const RenderResult& r, const std::function<double(int, int, 
       }
   EXPECT_EQ(failures, 0) << "worst z " << worst << ", threshold " << zmax;
   EXPECT_EQ(r.nonfinite, 0u);
+}
+
+std::map<std::string, std::string> parse_report(const std::string& out) {
+  std::map<std::string, std::string> m;
+  std::istringstream in(out);
+  std::string section;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty()) continue;
+    bool indented = line[0] == ' ';
+    // key and value are separated by two or more spaces
+    size_t start = line.find_first_not_of(' ');
+    size_t gap = line.find("  ", start);
+    std::string key =
+        line.substr(start, gap == std::string::npos ? std::string::npos : gap - start);
+    std::string value;
+    if (gap != std::string::npos) value = line.substr(line.find_first_not_of(' ', gap));
+    if (!indented) section = key;
+    m[indented ? section + "/" + key : key] = value;
+  }
+  return m;
 }
 
 }  // namespace lucent::test

@@ -1,6 +1,7 @@
 #pragma once
 // Helpers shared by the tests: running the CLI, temporary files, rendering small scenes.
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,10 @@ Scene scene_from(const std::string& json);
 
 /// Renders a JSON scene held in memory with `spp` samples per pixel.
 RenderResult render_json(const std::string& json, int spp);
+
+/// The report of `lucent info`: "key   value" lines keyed by section and key ("lights/point" ->
+/// "1", "film" -> "40x30").
+std::map<std::string, std::string> parse_report(const std::string& out);
 
 /// Number of lines in `s` that are not empty.
 int count_lines(const std::string& s);

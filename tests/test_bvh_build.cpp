@@ -12,7 +12,8 @@
 #include <vector>
 
 #include "bvh/bvh.hpp"
-#include "bvh/test_meshes.hpp"
+#include "support/reorder.hpp"
+#include "support/test_meshes.hpp"
 
 namespace {
 

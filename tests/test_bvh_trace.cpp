@@ -28,8 +28,8 @@
 #include <vector>
 
 #include "bvh/bvh.hpp"
-#include "bvh/device_tracer.hpp"
-#include "bvh/test_meshes.hpp"
+#include "support/device_tracer.hpp"
+#include "support/test_meshes.hpp"
 #include "cl/context.hpp"
 
 namespace {

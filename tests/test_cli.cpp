@@ -1,8 +1,7 @@
 // The command-line front end: --version, --help, the render options, the progress line and
 // SIGINT (the image accumulated so far is written, exit status 130).
-#include <gtest/gtest.h>
-
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -112,6 +111,37 @@ TEST(Cli, HelpOnEachSubcommand) {
   for (const char* option : {"--output", "--spp", "--width", "--height", "--seed", "--device",
                              "--quiet", "--time", "--integrator", "LUCENT_DEVICE"})
     EXPECT_NE(h.out.find(option), std::string::npos) << option << " missing from:\n" << h.out;
+}
+
+// README.md's "Command line" documents every option of every subcommand, as --help lists them.
+TEST(Cli, ReadmeDocumentsEveryOption) {
+  std::string readme = read_all(lucent::test::source_path("README.md"));
+  size_t begin = readme.find("## Command line"), end = readme.find("\n## ", begin + 1);
+  ASSERT_NE(begin, std::string::npos);
+  std::string section = readme.substr(begin, end - begin);
+  std::vector<std::string> commands;
+  for (const std::string& line : lines_of(run_cli("--help").out))
+    if (line.rfind("  ", 0) == 0 && line.find_first_not_of(' ') == 2 && line[2] != '-')
+      commands.push_back(line.substr(2, line.find(' ', 2) - 2));
+  ASSERT_GE(commands.size(), 6u);
+  const std::regex option("(^|[ ,])(--?[a-z][a-z0-9-]*)");
+  int checked = 0;
+  for (const std::string& c : commands) {
+    EXPECT_NE(section.find("lucent " + c), std::string::npos) << c;
+    for (const std::string& line : lines_of(run_cli(c + " --help").out)) {
+      if (line.rfind("  -", 0) != 0) continue;  // option lines start with two spaces and a dash
+      std::string names = line.substr(0, line.find_first_of(" ", line.find_first_not_of(' ')));
+      for (std::sregex_iterator it(names.begin(), names.end(), option), stop; it != stop; ++it) {
+        std::string name = (*it)[2];
+        if (name == "-h" || name == "--help") continue;
+        ++checked;
+        // the name, not a longer option it begins (--reference in --reference-spp)
+        EXPECT_TRUE(std::regex_search(section, std::regex(name + "(?![a-z0-9-])")))
+            << "lucent " << c << " " << name << " is not in README.md's Command line";
+      }
+    }
+  }
+  EXPECT_GE(checked, 30);
 }
 
 TEST(Cli, WidthAndHeightSetTheImageSize) {

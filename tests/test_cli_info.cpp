@@ -14,26 +14,7 @@ namespace {
 using lucent::test::CommandResult;
 using lucent::test::run_cli;
 
-/// "key   value" lines of the report, keyed by section and key ("lights/point" -> "1").
-std::map<std::string, std::string> parse_report(const std::string& out) {
-  std::map<std::string, std::string> m;
-  std::istringstream in(out);
-  std::string section;
-  for (std::string line; std::getline(in, line);) {
-    if (line.empty()) continue;
-    bool indented = line[0] == ' ';
-    // key and value are separated by two or more spaces
-    size_t start = line.find_first_not_of(' ');
-    size_t gap = line.find("  ", start);
-    std::string key =
-        line.substr(start, gap == std::string::npos ? std::string::npos : gap - start);
-    std::string value;
-    if (gap != std::string::npos) value = line.substr(line.find_first_not_of(' ', gap));
-    if (!indented) section = key;
-    m[indented ? section + "/" + key : key] = value;
-  }
-  return m;
-}
+using lucent::test::parse_report;
 
 long long leading_int(const std::string& s) { return std::stoll(s); }
 
@@ -79,17 +60,23 @@ TEST(CliInfo, SceneAndBvhStatistics) {
   EXPECT_EQ(m["film"], "40x30");
   EXPECT_EQ(m["integrator"], "direct, max_depth 3, spp 9, seed 5");
 
-  EXPECT_EQ(m["shapes/spheres"], "3");
-  EXPECT_EQ(m["shapes/triangle lists"], "3");
-  EXPECT_EQ(m["shapes/meshes"], "0");
+  EXPECT_EQ(m["filter"], "box, radius 0.5");
+  // the shape list's entries by type, then the primitives they made
+  EXPECT_EQ(m["shapes"], "6");
+  EXPECT_EQ(m["shapes/sphere"], "3");
+  EXPECT_EQ(m["shapes/triangles"], "3");
+  EXPECT_EQ(m["shapes/mesh"], "0");
+  EXPECT_EQ(m["primitives/spheres"], "3");
   // 2 + 3 + 1 triangles; the last is degenerate (collinear corners) and left out of the BVH
-  EXPECT_EQ(m["shapes/triangles"], "6 (1 degenerate or non-finite, skipped)");
-  EXPECT_EQ(m["shapes/vertices"], "12 (normals 0, uvs 0)");
+  EXPECT_EQ(m["primitives/triangles"], "6 (1 degenerate or non-finite, skipped)");
+  EXPECT_EQ(m["primitives/vertices"], "12 (normals 0, uvs 0)");
 
   EXPECT_EQ(m["materials"], "5");
   EXPECT_EQ(m["materials/diffuse"], "3");
   EXPECT_EQ(m["materials/mirror"], "1");
   EXPECT_EQ(m["materials/dielectric"], "1");
+  EXPECT_EQ(m["materials/conductor"], "0");  // every registry type is listed
+  EXPECT_EQ(m["materials/plastic"], "0");
   EXPECT_EQ(m["materials/emissive"], "1");
 
   EXPECT_EQ(m["textures"], "1 (128 B on the device)");
@@ -99,10 +86,10 @@ TEST(CliInfo, SceneAndBvhStatistics) {
   // 2 point lights, the environment, the emissive sphere and 3 emissive triangles
   EXPECT_EQ(m["lights"], "7");
   EXPECT_EQ(m["lights/point"], "2");
-  EXPECT_EQ(m["lights/emissive spheres"], "1");
-  EXPECT_EQ(m["lights/emissive triangles"], "3");
+  EXPECT_EQ(m["lights/sphere"], "1");
+  EXPECT_EQ(m["lights/triangle"], "3");
   EXPECT_EQ(m["lights/environment"], "1");
-  EXPECT_EQ(m["lights/environment map"], "0");
+  EXPECT_EQ(m["lights/environment_map"], "0");
 
   // BVH: 3 spheres + 5 valid triangles. A binary BVH over n primitives in single-primitive or
   // larger leaves has 2 * leaves - 1 nodes, leaves * mean leaf size = n, and depth at least
@@ -160,8 +147,9 @@ TEST(CliInfo, EmptyScene) {
   CommandResult r = run_cli("info '" + scene + "'", "env -u LUCENT_KERNEL_DIR");
   ASSERT_EQ(r.status, 0) << r.err;
   std::map<std::string, std::string> m = parse_report(r.out);
-  EXPECT_EQ(m["shapes/spheres"], "0");
-  EXPECT_EQ(m["shapes/triangles"], "0");
+  EXPECT_EQ(m["shapes"], "0");
+  EXPECT_EQ(m["primitives/spheres"], "0");
+  EXPECT_EQ(m["primitives/triangles"], "0");
   EXPECT_EQ(m["lights"], "0");
   EXPECT_EQ(m["BVH/primitives"], "0");
   EXPECT_EQ(m["BVH/nodes"].substr(0, 2), "0 ");

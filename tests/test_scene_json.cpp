@@ -3,9 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <string>
-
 #include <glm/glm.hpp>
+#include <string>
 
 #include "support.hpp"
 
@@ -248,6 +247,45 @@ TEST(SceneJson, BadEnumValues) {
   // enumerations are case-sensitive
   EXPECT_STARTS_WITH(error_of(R"({"integrator": {"type": "Path"}})"),
                      "scene.json: /integrator/type: unknown value 'Path'");
+  // the lists are the registries' names (lucent/types.hpp); shapes add OBJ meshes, lights leave
+  // out the emissive shapes' types
+  EXPECT_EQ(error_of(R"({"shapes": [{"type": "cube"}]})"),
+            "scene.json: /shapes/0/type: unknown value 'cube' (expected one of: " +
+                lucent::type_names<lucent::ShapeType>() + ", mesh)");
+  EXPECT_EQ(error_of(R"({"lights": [{"type": "spot"}]})"),
+            "scene.json: /lights/0/type: unknown value 'spot' (expected one of: point, "
+            "environment, environment_map)");
+  EXPECT_EQ(error_of(R"({"integrator": {"type": "bdpt"}})"),
+            "scene.json: /integrator/type: unknown value 'bdpt' (expected one of: " +
+                lucent::type_names<lucent::IntegratorType>() + ")");
+}
+
+TEST(SceneJson, EnvironmentLights) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::write_image(dir + "/sky.pfm", lucent::Image{2, 1, std::vector<float>(6, 0.25f)});
+  // "environment" with "file" and "environment_map" are the same light
+  for (const char* type : {"environment", "environment_map"}) {
+    Scene s = lucent::parse_scene(std::string(R"({"lights": [{"type": ")") + type +
+                                      R"(", "file": ")" + dir + R"(/sky.pfm", "scale": 2}]})",
+                                  "scene.json");
+    ASSERT_EQ(s.lights.size(), 1u);
+    EXPECT_EQ(s.lights[0].type, lucent::LightType::EnvironmentMap);
+    EXPECT_EQ(s.lights[0].radiance, glm::dvec3(2.0));
+    ASSERT_EQ(s.textures.size(), 1u);
+    EXPECT_EQ(s.lights[0].texture, 0);
+  }
+  EXPECT_EQ(error_of(R"({"lights": [{"type": "environment_map", "scale": 2}]})"),
+            "scene.json: /lights/0: missing required field 'file'");
+  EXPECT_STARTS_WITH(
+      error_of(
+          R"({"lights": [{"type": "environment_map", "file": "x.pfm", "radiance": [1,1,1]}]})"),
+      "scene.json: /lights/0/radiance: unknown key (allowed: ");
+  EXPECT_EQ(error_of(R"({"lights": [{"type": "environment_map", "file": ")" + dir +
+                     R"(/sky.pfm", "scale": -1}]})"),
+            "scene.json: /lights/0/scale: must be >= 0, got -1");
+  EXPECT_EQ(error_of(R"({"lights": [{"type": "triangle"}]})"),
+            "scene.json: /lights/0/type: 'triangle' lights are emissive shapes, not entries of "
+            "\"lights\": give a shape a material with \"emission\"");
 }
 
 TEST(SceneJson, OutOfRangeIntegers) {

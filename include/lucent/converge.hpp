@@ -23,8 +23,9 @@ namespace lucent {
 ///   no-mis / mis       integrator.mis off / on
 ///   max_depth=N        integrator.max_depth (N >= 1)
 ///   rr_depth=N         integrator.rr_depth (N >= 1)
-///   filter=TYPE[:R]    film.filter: box, tent or gaussian, optional radius R in pixels (> 0)
-///   integrator=NAME    path, whitted, direct, ao, ...
+///   filter=TYPE[:R]    film.filter: a filter name (box, tent, gaussian: lucent/types.hpp),
+///                      optional radius R in pixels, in (0, limits::kMaxFilterRadius]
+///   integrator=NAME    an integrator or AOV name (path, whitted, ..., primitive)
 /// The setting's name is the text it was parsed from.
 struct ConvergeSetting {
   std::string name = "default";

@@ -1,6 +1,7 @@
 #pragma once
 // The scene description shared by the kernel renderer and the reference integrator. Everything is
 // in double precision and world space; the renderer converts to the device's float layout.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -100,6 +101,19 @@ struct Light {
   int texture = -1;                ///< environment map
 };
 
+/// Shape types: spheres, and triangles (inline triangle lists and OBJ meshes alike).
+enum class ShapeType { LC_SHAPE_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
+
+/// One entry of the scene's shape list, in the order given (the JSON "shapes" array, or
+/// SceneBuilder's add_sphere / add_mesh / add_obj calls): the primitives it made. Error messages
+/// name a shape by its index in this list ("/shapes/3/radius").
+struct ShapeEntry {
+  ShapeType type = ShapeType::Sphere;
+  std::string file;        ///< the OBJ file of a mesh; empty for a sphere or an inline triangle list
+  std::size_t first = 0;   ///< first sphere (Scene::spheres) or triangle (Scene::triangles)
+  std::size_t count = 0;   ///< number of spheres or triangles
+};
+
 struct Texture {
   std::string path;
   int width = 0;
@@ -120,6 +134,7 @@ struct Scene {
   std::vector<Triangle> triangles;
   std::vector<Light> lights;
   std::vector<Texture> textures;
+  std::vector<ShapeEntry> shapes;  ///< the shape list as given, for messages and statistics
 
   /// Index of the material named `name`, or -1.
   int find_material(const std::string& name) const;

@@ -19,8 +19,10 @@
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
+#include "lucent/limits.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/session.hpp"
+#include "lucent/types.hpp"
 
 namespace lucent::cli {
 
@@ -92,7 +94,7 @@ CLI::App* add_converge_command(CLI::App& app) {
   auto* ref_spp = cmd->add_option("--reference-spp", a.reference_spp,
                                   "Render the reference with this many spp (default: 16 x the "
                                   "largest rung, at least 256; 1024 with --time-ladder)")
-                      ->check(CLI::Range(1, 1 << 24));
+                      ->check(CLI::Range(1, limits::kMaxSpp));
   auto* ref_cpu = cmd->add_flag("--reference-cpu", a.reference_cpu,
                                 "Render the reference with the scalar reference integrator");
   ref->excludes(ref_spp)->excludes(ref_cpu);
@@ -100,23 +102,24 @@ CLI::App* add_converge_command(CLI::App& app) {
                   "Write the rendered reference to this .exr (reuse it with --reference)");
   cmd->add_option("--settings", a.settings,
                   "Comma-separated settings, knobs joined by +: default, fast-math, "
-                  "double, float, no-specialize, no-mis, mis, max_depth=N, rr_depth=N, "
-                  "filter=box|tent|gaussian[:R], integrator=NAME (default: default)")
+                  "double, float, no-specialize, no-mis, mis, max_depth=N, rr_depth=N, filter=" +
+                      type_names<FilterType>("|") + "[:R], integrator=" +
+                      type_names<IntegratorType>("|") + " (default: default)")
       ->delimiter(',');
   auto* spp = cmd->add_option("--spp-ladder", a.spp_ladder, "Samples per pixel of each rung")
                   ->delimiter(',')
-                  ->check(CLI::Range(1, 1 << 24));
+                  ->check(CLI::Range(1, limits::kMaxSpp));
   auto* time = cmd->add_option("--time-ladder", a.time_ladder, "Seconds of rendering per rung")
                    ->delimiter(',')
                    ->check(CLI::PositiveNumber);
   spp->excludes(time);
   cmd->add_option("--max-spp", a.max_spp,
                   "Default ladder: powers of two from 1 to this (default 64)")
-      ->check(CLI::Range(1, 1 << 20));
+      ->check(CLI::Range(1, limits::kMaxSpp / 16));  // the reference renders 16x the top rung
   cmd->add_option("--width", a.width, "Image width (overrides the scene)")
-      ->check(CLI::Range(1, 16384));
+      ->check(CLI::Range(1, limits::kMaxImageSize));
   cmd->add_option("--height", a.height, "Image height (overrides the scene)")
-      ->check(CLI::Range(1, 16384));
+      ->check(CLI::Range(1, limits::kMaxImageSize));
   cmd->add_option("--device", a.device, "OpenCL device: index or name substring");
   cmd->add_flag("-q,--quiet", a.quiet, "Print only the slopes");
   return cmd;

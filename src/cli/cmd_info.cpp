@@ -2,17 +2,18 @@
 // over it and the kernel feature defines it would be compiled with. Needs no OpenCL device.
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <fstream>
 #include <map>
-#include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
+
+#include <CLI/CLI.hpp>
 
 #include "bvh/bvh.hpp"
 #include "cl/kernel_source.hpp"
+#include "cli/commands.hpp"
 #include "lucent/scene.hpp"
 #include "lucent/session.hpp"
 #include "render/features.hpp"
+#include "lucent/types.hpp"
 #include "render/pack.hpp"
 
 namespace lucent::cli {
@@ -21,6 +22,7 @@ namespace {
 
 struct InfoArgs {
   std::string scene;
+  std::string integrator;
   std::string precision = "float";
   bool fast_math = false;
   bool no_specialize = false;
@@ -44,53 +46,13 @@ std::string format_bytes(double b) {
   return buf;
 }
 
-const char* material_name(MaterialType t) {
-  switch (t) {
-    case MaterialType::Mirror:
-      return "mirror";
-    case MaterialType::Dielectric:
-      return "dielectric";
-    case MaterialType::Conductor:
-      return "conductor";
-    case MaterialType::Plastic:
-      return "plastic";
-    default:
-      return "diffuse";
+/// Counts by registry entry, printed one line per entry (zeros included) under a section.
+template <class E>
+void print_counts(const std::map<E, std::size_t>& counts) {
+  for (const TypeEntry<E>& e : TypeList<E>::entries) {
+    auto it = counts.find(e.value);
+    std::printf("  %-19s %zu\n", e.name, it == counts.end() ? std::size_t(0) : it->second);
   }
-}
-
-const char* integrator_name(IntegratorType t) {
-  switch (t) {
-    case IntegratorType::Whitted:
-      return "whitted";
-    case IntegratorType::Direct:
-      return "direct";
-    case IntegratorType::Albedo:
-      return "albedo";
-    case IntegratorType::Normal:
-      return "normal";
-    case IntegratorType::Depth:
-      return "depth";
-    case IntegratorType::Ao:
-      return "ao";
-    case IntegratorType::Primitive:
-      return "primitive";
-    default:
-      return "path";
-  }
-}
-
-/// Shape entries of the scene file by type ("sphere", "triangles", "mesh"): the loaded Scene
-/// merges meshes and triangle lists into one triangle list. The file was validated already.
-std::map<std::string, int> shape_entries(const std::string& path) {
-  std::map<std::string, int> out;
-  std::ifstream f(path, std::ios::binary);
-  nlohmann::json root = nlohmann::json::parse(f, nullptr, false);
-  if (!root.is_object() || !root.contains("shapes") || !root["shapes"].is_array()) return out;
-  for (const auto& s : root["shapes"])
-    if (s.is_object() && s.contains("type") && s["type"].is_string())
-      ++out[s["type"].get<std::string>()];
-  return out;
 }
 
 }  // namespace
@@ -99,6 +61,9 @@ CLI::App* add_info_command(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("info", "Print scene statistics, its BVH and the kernel feature defines");
   cmd->add_option("scene", args().scene, "Scene file (JSON)")->required();
+  cmd->add_option("--integrator", args().integrator,
+                  "Show the scene with this integrator (as render --integrator): " +
+                      type_names<IntegratorType>());
   cmd->add_option("--precision", args().precision,
                   "Show the build options for this precision: float (default) or double")
       ->check(CLI::IsMember({"float", "double"}));
@@ -112,19 +77,26 @@ CLI::App* add_info_command(CLI::App& app) {
 int run_info_command() {
   const std::string& path = args().scene;
   Scene scene = load_scene(path);
+  if (!args().integrator.empty()) scene.integrator.type = parse_integrator(args().integrator);
   render_detail::PackedScene packed = render_detail::pack_scene(scene);
-  std::map<std::string, int> entries = shape_entries(path);
 
   std::printf("scene         %s\n", path.c_str());
   std::printf("film          %dx%d\n", scene.film.width, scene.film.height);
   std::printf("integrator    %s, max_depth %d, spp %d, seed %u\n",
-              integrator_name(scene.integrator.type), scene.integrator.max_depth,
-              scene.integrator.spp, static_cast<unsigned>(scene.integrator.seed));
+              type_name(scene.integrator.type), scene.integrator.max_depth, scene.integrator.spp,
+              static_cast<unsigned>(scene.integrator.seed));
+  std::printf("filter        %s, radius %g\n", type_name(scene.film.filter.type),
+              scene.film.filter.radius);
 
-  std::printf("\nshapes\n");
+  // the shape list as written: its entries by type (OBJ files apart), then the primitives
+  std::map<ShapeType, std::size_t> by_shape;
+  std::size_t meshes = 0;
+  for (const ShapeEntry& e : scene.shapes) ++(e.file.empty() ? by_shape[e.type] : meshes);
+  std::printf("\nshapes        %zu\n", scene.shapes.size());
+  print_counts(by_shape);
+  std::printf("  %-19s %zu\n", "mesh", meshes);
+  std::printf("\nprimitives\n");
   std::printf("  spheres             %zu\n", scene.spheres.size());
-  std::printf("  triangle lists      %d\n", entries["triangles"]);
-  std::printf("  meshes              %d\n", entries["mesh"]);
   std::printf("  triangles           %zu", scene.triangles.size());
   if (packed.skipped_triangles > 0)
     std::printf(" (%zu degenerate or non-finite, skipped)", packed.skipped_triangles);
@@ -132,14 +104,14 @@ int run_info_command() {
               scene.normals.size(), scene.uvs.size());
 
   std::printf("\nmaterials     %zu\n", scene.materials.size());
-  std::map<std::string, int> by_type;
-  int emissive = 0;
+  std::map<MaterialType, std::size_t> by_type;
+  std::size_t emissive = 0;
   for (const Material& m : scene.materials) {
-    ++by_type[material_name(m.type)];
+    ++by_type[m.type];
     if (m.emissive()) ++emissive;
   }
-  for (const auto& [name, n] : by_type) std::printf("  %-19s %d\n", name.c_str(), n);
-  std::printf("  %-19s %d\n", "emissive", emissive);
+  print_counts(by_type);
+  std::printf("  %-19s %zu\n", "emissive", emissive);
 
   double texel_bytes = 0;
   for (const Texture& t : scene.textures) texel_bytes += double(t.width) * t.height * 16;
@@ -149,15 +121,11 @@ int run_info_command() {
     std::printf("  %dx%d  %-10s  %s\n", t.width, t.height,
                 format_bytes(double(t.width) * t.height * 16).c_str(), t.path.c_str());
 
-  std::size_t count[5] = {0, 0, 0, 0, 0};
-  for (const lc_light& l : packed.lights)
-    if (l.type < 5) ++count[l.type];
+  // the packed lights: the scene's lights and one per emissive sphere or triangle
+  std::map<LightType, std::size_t> lights;
+  for (const lc_light& l : packed.lights) ++lights[static_cast<LightType>(l.type)];
   std::printf("\nlights        %zu\n", packed.lights.size());
-  std::printf("  point               %zu\n", count[LC_LIGHT_POINT]);
-  std::printf("  emissive spheres    %zu\n", count[LC_LIGHT_SPHERE]);
-  std::printf("  emissive triangles  %zu\n", count[LC_LIGHT_TRIANGLE]);
-  std::printf("  environment         %zu\n", count[LC_LIGHT_ENV]);
-  std::printf("  environment map     %zu\n", count[LC_LIGHT_ENV_MAP]);
+  print_counts(lights);
 
   const bvh::BuildStats& s = packed.bvh_stats;
   std::printf("\nBVH\n");

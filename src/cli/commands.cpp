@@ -6,21 +6,28 @@
 #include "cl/program_cache.hpp"
 #include "lucent/error.hpp"
 #include "lucent/session.hpp"
+#include "lucent/types.hpp"
 
 namespace lucent::cli {
 
 IntegratorType parse_integrator(const std::string& n) {
-  if (n == "path") return IntegratorType::Path;
-  if (n == "whitted") return IntegratorType::Whitted;
-  if (n == "direct") return IntegratorType::Direct;
-  if (n == "albedo") return IntegratorType::Albedo;
-  if (n == "normal") return IntegratorType::Normal;
-  if (n == "depth") return IntegratorType::Depth;
-  if (n == "ao") return IntegratorType::Ao;
-  if (n == "primitive") return IntegratorType::Primitive;
-  throw Error("--integrator " + n +
-              ": unknown integrator (expected path, whitted, direct, albedo, normal, depth, ao, "
-              "primitive)");
+  if (std::optional<IntegratorType> t = find_type<IntegratorType>(n)) return *t;
+  throw Error("--integrator " + n + ": unknown integrator (expected " +
+              type_names<IntegratorType>() + ")");
+}
+
+std::vector<std::string> aov_names() {
+  std::vector<std::string> out;
+  for (const TypeEntry<IntegratorType>& e : TypeList<IntegratorType>::entries)
+    if (is_aov(e.value)) out.push_back(e.name);
+  out.push_back("variance");
+  return out;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
 }
 
 RenderOptions render_options_from_environment() {

@@ -2,6 +2,7 @@
 // Subcommands beyond render and devices live in their own files and register here.
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 #include "lucent/render.hpp"
 #include "lucent/scene.hpp"
@@ -24,6 +25,11 @@ SessionOptions session_options(const std::string& device);
 
 /// The kernel binary cache directory the command uses ("" when disabled: LUCENT_CACHE_DIR=off).
 std::string cache_dir_from_environment();
+/// The names --aov accepts: the registry's AOVs (albedo, normal, ...), then "variance".
+std::vector<std::string> aov_names();
+
+/// "a, b, c".
+std::string joined(const std::vector<std::string>& names);
 
 /// Adds the extra subcommands (info, ...) to `app`.
 void register_extra_commands(CLI::App& app);

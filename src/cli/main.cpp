@@ -18,8 +18,10 @@
 
 #include "cli/commands.hpp"
 #include "lucent/compare.hpp"
+#include "lucent/limits.hpp"
 #include "lucent/lucent.hpp"
 #include "lucent/reference.hpp"
+#include "lucent/types.hpp"
 
 namespace {
 
@@ -259,20 +261,20 @@ int main(int argc, char** argv) {
                    "Output image: .png (8-bit sRGB), .pfm or .exr (linear)")
       ->required();
   render->add_option("--spp", ra.spp, "Samples per pixel (default: the scene's integrator.spp)")
-      ->check(CLI::Range(1, 1 << 24));
+      ->check(CLI::Range(1, lucent::limits::kMaxSpp));
   render->add_option("--time", ra.time_limit, "Stop after this many seconds of rendering")
       ->check(CLI::PositiveNumber);
   render->add_option("--width", ra.width, "Image width (overrides the scene)")
-      ->check(CLI::Range(1, 16384));
+      ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
   render->add_option("--height", ra.height, "Image height (overrides the scene)")
-      ->check(CLI::Range(1, 16384));
+      ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
   render->add_option("--device", ra.device,
-                     "OpenCL device: index or name substring (env LUCENT_DEVICE)");
+                     "OpenCL device: index or name substring, a comma-separated list of them or "
+                     "'all' to share the render (env LUCENT_DEVICE)");
   render->add_option("--seed", ra.seed, "Random seed (overrides the scene)")
-      ->check(CLI::Range(0LL, 0xffffffffLL));
-  render->add_option(
-      "--integrator", ra.integrator,
-      "Override the integrator: path, whitted, direct, albedo, normal, depth, ao, primitive");
+      ->check(CLI::Range(0LL, static_cast<long long>(lucent::limits::kMaxSeed)));
+  render->add_option("--integrator", ra.integrator,
+                     "Override the integrator: " + lucent::type_names<lucent::IntegratorType>());
   render->add_flag("-q,--quiet", ra.quiet, "No progress line or summary");
   render->add_flag(
       "--fast-math", ra.fast_math,
@@ -284,11 +286,11 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"float", "double"}));
   render->add_flag("--no-specialize", ra.no_specialize,
                    "Compile the full kernel instead of only the features the scene uses");
-  render
-      ->add_option("--aov", ra.aovs,
-                   "Also write AOV images <stem>.<name>.exr: albedo, normal, depth, variance")
+  render->add_option("--aov", ra.aovs,
+                     "Also write AOV images <stem>.<name>.exr: " +
+                         lucent::cli::joined(lucent::cli::aov_names()))
       ->delimiter(',')
-      ->check(CLI::IsMember({"albedo", "normal", "depth", "variance"}));
+      ->check(CLI::IsMember(lucent::cli::aov_names()));
   render->add_flag("--reference", ra.reference,
                    "Render with the scalar CPU reference integrator instead of the kernel");
 

@@ -13,6 +13,8 @@
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/session.hpp"
+#include "lucent/limits.hpp"
+#include "lucent/types.hpp"
 
 namespace lucent {
 
@@ -84,7 +86,7 @@ void ConvergeSetting::apply(Scene& scene, RenderOptions& options) const {
   if (integrator >= 0) scene.integrator.type = static_cast<IntegratorType>(integrator);
   if (filter >= 0) {
     FilterType t = static_cast<FilterType>(filter);
-    if (t != scene.film.filter.type) scene.film.filter.radius = t == FilterType::Box ? 0.5 : 1.5;
+    if (t != scene.film.filter.type) scene.film.filter.radius = default_filter_radius(t);
     scene.film.filter.type = t;
   }
   if (filter_radius > 0) scene.film.filter.radius = filter_radius;
@@ -128,9 +130,9 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
       no_value();
       s.mis = 1;
     } else if (key == "max_depth") {
-      s.max_depth = parse_positive_int(key, value, 1000);
+      s.max_depth = parse_positive_int(key, value, limits::kMaxDepth);
     } else if (key == "rr_depth") {
-      s.rr_depth = parse_positive_int(key, value, 1000);
+      s.rr_depth = parse_positive_int(key, value, limits::kMaxDepth);
     } else if (key == "filter") {
       std::string type = value, radius;
       std::size_t colon = value.find(':');
@@ -138,38 +140,30 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
         type = value.substr(0, colon);
         radius = value.substr(colon + 1);
       }
-      if (type == "box")
-        s.filter = static_cast<int>(FilterType::Box);
-      else if (type == "tent")
-        s.filter = static_cast<int>(FilterType::Tent);
-      else if (type == "gaussian")
-        s.filter = static_cast<int>(FilterType::Gaussian);
-      else
-        throw Error("setting " + knob + ": unknown filter '" + type +
-                    "' (expected box, tent or gaussian, optionally :RADIUS)");
+      std::optional<FilterType> t = find_type<FilterType>(type);
+      if (!t)
+        throw Error("setting " + knob + ": unknown filter '" + type + "' (expected " +
+                    type_names<FilterType>() + ", optionally :RADIUS)");
+      s.filter = static_cast<int>(*t);
       if (!radius.empty()) {
         char* end = nullptr;
         double r = std::strtod(radius.c_str(), &end);
-        if (*end != '\0' || !(r > 0) || r > 8)
-          throw Error("setting " + knob + ": filter radius must be a number in (0, 8] pixels");
+        if (*end != '\0' || !(r > 0) || r > limits::kMaxFilterRadius)
+          throw Error("setting " + knob + ": filter radius must be a number in (0, " +
+                      fmt("%g", limits::kMaxFilterRadius) + "] pixels");
         s.filter_radius = r;
       }
     } else if (key == "integrator") {
-      static const char* const names[] = {"path",   "whitted", "direct", "albedo",
-                                          "normal", "depth",   "ao"};
-      int found = -1;
-      for (int i = 0; i < 7; ++i)
-        if (value == names[i]) found = i;
-      if (found < 0)
-        throw Error("setting " + knob +
-                    ": unknown integrator (expected path, whitted, direct, albedo, normal, depth, "
-                    "ao)");
-      s.integrator = found;
+      std::optional<IntegratorType> t = find_type<IntegratorType>(value);
+      if (!t)
+        throw Error("setting " + knob + ": unknown integrator (expected " +
+                    type_names<IntegratorType>() + ")");
+      s.integrator = static_cast<int>(*t);
     } else {
       throw Error("setting '" + text + "': unknown knob '" + knob +
                   "' (expected default, fast-math, double, float, no-specialize, no-mis, mis, "
-                  "max_depth=N, rr_depth=N, filter=box|tent|gaussian[:R], integrator=NAME, "
-                  "joined by +)");
+                  "max_depth=N, rr_depth=N, filter=" + type_names<FilterType>("|") +
+                  "[:R], integrator=NAME, joined by +)");
     }
   }
   return s;

@@ -1,6 +1,10 @@
 #pragma once
 // Internal scene loading pieces: OBJ/MTL meshes and textures, called by the JSON loader.
 #include <functional>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
 #include <glm/glm.hpp>
 #include <string>
 
@@ -39,5 +43,12 @@ void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform
 /// linear) as a scene texture, reusing an already loaded one with the same path. Returns its
 /// index. Throws lucent::Error naming the file when it cannot be read.
 int load_texture(Scene& scene, const std::string& path);
+
+/// sRGB-encoded value in [0, 1] to linear.
+double srgb_to_linear(double c);
+
+/// `texels` texels of 8-bit sRGB data, `channels` (1 to 4: grey, grey + alpha, RGB, RGBA) bytes
+/// each, to linear RGBA floats (alpha kept linear) at `rgba`.
+void decode_srgb8(const std::uint8_t* data, std::size_t texels, int channels, float* rgba);
 
 }  // namespace lucent::scene_detail

@@ -22,10 +22,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-double srgb_to_linear(double c) {
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-}
-
 std::string lower_extension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -89,14 +85,9 @@ Texture decode(const std::string& path) {
     std::unique_ptr<stbi_uc, StbFree> data(stbi_load_from_file(f, &w, &h, &n, 4));
     std::fclose(f);
     if (!data) throw Error(path + ": cannot decode texture: " + stb_reason());
-    std::array<float, 256> lut;
-    for (int i = 0; i < 256; ++i) lut[i] = static_cast<float>(srgb_to_linear(i / 255.0));
     count = static_cast<size_t>(w) * h * 4;
     t.rgba.resize(count);
-    for (size_t i = 0; i < count; ++i) {
-      stbi_uc v = data.get()[i];
-      t.rgba[i] = i % 4 == 3 ? v / 255.0f : lut[v];
-    }
+    decode_srgb8(data.get(), count / 4, 4, t.rgba.data());
   }
   if (w <= 0 || h <= 0) throw Error(path + ": texture has no pixels");
   t.width = w;

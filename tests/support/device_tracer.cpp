@@ -1,4 +1,4 @@
-#include "bvh/device_tracer.hpp"
+#include "support/device_tracer.hpp"
 
 #include <chrono>
 

@@ -1,0 +1,19 @@
+#pragma once
+// The limits of a scene's settings, written once: the scene loader, the scene builder, the
+// command line (--width, --spp, ...) and `lucent converge` settings all check against these.
+#include <cstdint>
+
+namespace lucent::limits {
+
+/// Film width and height: 1 .. kMaxImageSize pixels.
+inline constexpr int kMaxImageSize = 16384;
+/// Samples per pixel: 1 .. kMaxSpp.
+inline constexpr int kMaxSpp = 1 << 24;
+/// Integrator max_depth and rr_depth: 1 .. kMaxDepth path segments.
+inline constexpr int kMaxDepth = 100000;
+/// Pixel filter radius: (0, kMaxFilterRadius] pixels.
+inline constexpr double kMaxFilterRadius = 8;
+/// Random seed: 0 .. kMaxSeed (32 bits).
+inline constexpr std::uint32_t kMaxSeed = 0xffffffffu;
+
+}  // namespace lucent::limits

@@ -1,0 +1,129 @@
+// The JSON reading helpers (json_reader.hpp).
+#include "scene/json_reader.hpp"
+
+#include <cstdint>
+
+namespace lucent::scene_detail {
+
+namespace fs = std::filesystem;
+
+std::string json_type_name(const json& j) {
+  switch (j.type()) {
+    case json::value_t::null:
+      return "null";
+    case json::value_t::boolean:
+      return "a boolean";
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::array:
+      return "an array";
+    case json::value_t::object:
+      return "an object";
+    case json::value_t::discarded:
+      return "invalid";
+    default:
+      return "a number";
+  }
+}
+
+namespace {
+
+/// The value as written, shortened for messages.
+std::string show(const json& j) {
+  std::string s = j.dump();
+  if (s.size() > 40) s = s.substr(0, 37) + "...";
+  return s;
+}
+
+}  // namespace
+
+const json& JsonReader::require(const json& obj, const std::string& ptr, const char* key) const {
+  auto it = obj.find(key);
+  if (it == obj.end()) fail(ptr, std::string("missing required field '") + key + "'");
+  return *it;
+}
+
+void JsonReader::check_object(const json& j, const std::string& ptr) const {
+  if (!j.is_object()) fail(ptr, "must be an object, got " + json_type_name(j));
+}
+
+void JsonReader::check_array(const json& j, const std::string& ptr) const {
+  if (!j.is_array()) fail(ptr, "must be an array, got " + json_type_name(j));
+}
+
+void JsonReader::check_keys(const json& obj, const std::string& ptr,
+                            const std::vector<const char*>& allowed) const {
+  check_object(obj, ptr);
+  for (auto it = obj.begin(); it != obj.end(); ++it) {
+    bool ok = false;
+    for (const char* a : allowed) ok = ok || it.key() == a;
+    if (!ok) {
+      std::string list;
+      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+      fail(ptr + "/" + it.key(), "unknown key (allowed: " + list + ")");
+    }
+  }
+}
+
+double JsonReader::number(const json& j, const std::string& ptr) const {
+  if (j.is_string()) {
+    // JSON has no NaN/Inf literals; strings are the usual way they sneak in
+    const std::string& s = j.get_ref<const std::string&>();
+    if (s == "nan" || s == "NaN" || s == "inf" || s == "Infinity" || s == "-inf" ||
+        s == "-Infinity")
+      fail(ptr, "must be a finite number, got " + s);
+  }
+  if (!j.is_number()) fail(ptr, "must be a number, got " + json_type_name(j) + " " + show(j));
+  return check_finite(at(ptr), j.get<double>());
+}
+
+long long JsonReader::integer(const json& j, const std::string& ptr, IntRange range) const {
+  if (!j.is_number_integer() && !j.is_number_unsigned())
+    fail(ptr, "must be an integer, got " + json_type_name(j) + " " + show(j));
+  // beyond the signed 64-bit range: reported as written, not wrapped around
+  if (j.is_number_unsigned() && j.get<std::uint64_t>() > static_cast<std::uint64_t>(range.hi))
+    fail_range(at(ptr), range, std::to_string(j.get<std::uint64_t>()));
+  long long v = j.get<long long>();
+  check_range(at(ptr), v, range);
+  return v;
+}
+
+bool JsonReader::boolean(const json& j, const std::string& ptr) const {
+  if (!j.is_boolean()) fail(ptr, "must be true or false, got " + json_type_name(j));
+  return j.get<bool>();
+}
+
+std::string JsonReader::string(const json& j, const std::string& ptr) const {
+  if (!j.is_string()) fail(ptr, "must be a string, got " + json_type_name(j) + " " + show(j));
+  return j.get<std::string>();
+}
+
+std::string JsonReader::choice(const json& j, const std::string& ptr,
+                               std::initializer_list<const char*> options) const {
+  std::string s = string(j, ptr);
+  std::string list;
+  for (const char* o : options) {
+    if (s == o) return s;
+    list += std::string(list.empty() ? "" : ", ") + o;
+  }
+  fail(ptr, "unknown value '" + s + "' (expected one of: " + list + ")");
+}
+
+glm::dvec3 JsonReader::vec3(const json& j, const std::string& ptr) const {
+  if (!j.is_array() || j.size() != 3)
+    fail(ptr, "must be an array of 3 numbers, got " + json_type_name(j) + " " + show(j));
+  return {number(j[0], ptr + "/0"), number(j[1], ptr + "/1"), number(j[2], ptr + "/2")};
+}
+
+glm::dvec2 JsonReader::vec2(const json& j, const std::string& ptr) const {
+  if (!j.is_array() || j.size() != 2) fail(ptr, "must be an array of 2 numbers");
+  return {number(j[0], ptr + "/0"), number(j[1], ptr + "/1")};
+}
+
+std::string JsonReader::resolve(const std::string& rel) const {
+  fs::path p(rel);
+  if (p.is_relative()) p = dir_ / p;
+  return p.lexically_normal().string();
+}
+
+}  // namespace lucent::scene_detail

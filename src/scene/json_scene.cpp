@@ -1,0 +1,114 @@
+// JSON scenes: the entry points (load_scene, parse_scene) and syntax errors. The sections are
+// read by json_settings.cpp, json_materials.cpp, json_shapes.cpp and json_lights.cpp into the
+// public structs, and built and checked by SceneBuilder, as a scene built in code is. Every
+// problem is reported as "<file>: <JSON pointer>: <what is wrong>" (or "<file>:<line>:<col>: ..."
+// for syntax errors).
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "lucent/error.hpp"
+#include "lucent/scene.hpp"
+#include "scene/json_sections.hpp"
+
+namespace lucent {
+
+using scene_detail::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Line and column (1-based) of the byte before `byte` (a 1-based count of bytes read).
+std::string line_col(const std::string& text, size_t byte) {
+  size_t line = 1, col = 1;
+  for (size_t i = 0; i + 1 < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return std::to_string(line) + ":" + std::to_string(col);
+}
+
+/// Finds where a parse stops for a reason json::parse reports without a place (a number literal
+/// out of double range, such as 1e999): a SAX pass that only records the error's byte count.
+struct ErrorLocator : nlohmann::json_sax<json> {
+  size_t byte = 0;
+  bool null() override { return true; }
+  bool boolean(bool) override { return true; }
+  bool number_integer(number_integer_t) override { return true; }
+  bool number_unsigned(number_unsigned_t) override { return true; }
+  bool number_float(number_float_t, const string_t&) override { return true; }
+  bool string(string_t&) override { return true; }
+  bool binary(binary_t&) override { return true; }
+  bool start_object(std::size_t) override { return true; }
+  bool key(string_t&) override { return true; }
+  bool end_object() override { return true; }
+  bool start_array(std::size_t) override { return true; }
+  bool end_array() override { return true; }
+  bool parse_error(std::size_t position, const std::string&,
+                   const nlohmann::detail::exception&) override {
+    byte = position;
+    return false;
+  }
+};
+
+/// The scene in `root`: its sections in a fixed order (materials before the shapes naming them).
+Scene build_scene(const json& root, const std::string& path) {
+  using namespace scene_detail;
+  JsonReader r(path, fs::path(path).parent_path());
+  SceneBuilder b(path);
+  r.check_keys(root, "", {"camera", "film", "integrator", "materials", "shapes", "lights"});
+  if (root.contains("camera")) parse_camera(r, root["camera"], b);
+  if (root.contains("film")) parse_film(r, root["film"], b);
+  if (root.contains("integrator")) parse_integrator(r, root["integrator"], b);
+  if (root.contains("materials")) parse_materials(r, root["materials"], b);
+  if (root.contains("shapes")) parse_shapes(r, root["shapes"], b);
+  if (root.contains("lights")) parse_lights(r, root["lights"], b);
+  return b.build();
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& path) {
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::parse_error& e) {
+    std::string what = e.what();
+    auto pos = what.find("syntax error");
+    if (pos != std::string::npos) what = what.substr(pos);
+    throw Error(path + ":" + line_col(text, e.byte) + ": invalid JSON: " + what);
+  } catch (const json::exception& e) {
+    // out_of_range 406, "number overflow parsing '1e999'", comes without a place: a SAX pass
+    // finds where the parser stopped, just after the literal, and we step back to its start.
+    ErrorLocator locator;
+    json::sax_parse(text, &locator);
+    size_t i = std::min(locator.byte, text.size());
+    while (i > 0 && std::strchr("0123456789+-.eE", text[i - 1]) && text[i - 1] != '\0') --i;
+    std::string literal = text.substr(i, std::min(locator.byte, text.size()) - i);
+    throw Error(path + ":" + line_col(text, i + 1) + ": " +
+                (e.id == 406 && !literal.empty()
+                     ? "number out of range (not a finite double): " + literal
+                     : std::string(e.what())));
+  }
+  return build_scene(root, path);
+}
+
+Scene load_scene(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw Error(path + ": is a directory, not a scene file");
+  std::ifstream f(path, std::ios::binary);
+  if (!f)
+    throw Error(path + ": cannot open scene file (" + std::string(std::strerror(errno)) + ")");
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  return parse_scene(ss.str(), path);
+}
+
+}  // namespace lucent

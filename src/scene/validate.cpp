@@ -1,0 +1,248 @@
+// The value checks of a scene (validate.hpp): one place for every check, shared by the JSON
+// loader and SceneBuilder.
+#include "scene/validate.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "lucent/error.hpp"
+#include "lucent/types.hpp"
+#include "scene/material_type.hpp"
+
+namespace lucent::scene_detail {
+
+void Reporter::fail(const std::string& what) const {
+  const std::string& ptr = pointer_.empty() ? std::string("/") : pointer_;
+  throw Error((file_.empty() ? "" : file_ + ": ") + ptr + ": " + what);
+}
+
+std::string format_number(double v) {
+  std::ostringstream ss;
+  ss << v;
+  return ss.str();
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void fail_range(const Reporter& at, IntRange range, const std::string& shown) {
+  at.fail("must be in [" + std::to_string(range.lo) + ", " + std::to_string(range.hi) + "], got " +
+          shown);
+}
+
+void check_range(const Reporter& at, long long v, IntRange range) {
+  if (v < range.lo || v > range.hi) fail_range(at, range, std::to_string(v));
+}
+
+double check_finite(const Reporter& at, double v) {
+  if (!std::isfinite(v)) at.fail("must be a finite number, got " + format_number(v));
+  return v;
+}
+
+void check_positive(const Reporter& at, double v) {
+  if (!(check_finite(at, v) > 0)) at.fail("must be > 0, got " + format_number(v));
+}
+
+void check_non_negative(const Reporter& at, double v) {
+  if (check_finite(at, v) < 0) at.fail("must be >= 0, got " + format_number(v));
+}
+
+void check_between(const Reporter& at, double v, double lo, double hi) {
+  if (check_finite(at, v) < lo || v > hi)
+    at.fail("must be in [" + format_number(lo) + ", " + format_number(hi) + "], got " +
+            format_number(v));
+}
+
+void check_point(const Reporter& at, const glm::dvec3& v) {
+  for (int i = 0; i < 3; ++i) check_finite(at.at(i), v[i]);
+}
+
+void check_colour(const Reporter& at, const glm::dvec3& c) {
+  for (int i = 0; i < 3; ++i) check_non_negative(at.at(i), c[i]);
+}
+
+void check_nonzero(const Reporter& at, const glm::dvec3& v) {
+  check_point(at, v);
+  if (glm::length(v) == 0) at.fail("must be a non-zero vector");
+}
+
+void check_scale(const Reporter& at, const glm::dvec3& s) {
+  if (s.x == s.y && s.y == s.z)
+    check_non_negative(at, s.x);
+  else
+    check_colour(at, s);
+}
+
+void check_affine(const Reporter& at, const glm::dmat4& m) {
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) check_finite(at.at(r).at(c), m[c][r]);  // glm: m[column][row]
+  if (m[0][3] != 0 || m[1][3] != 0 || m[2][3] != 0 || m[3][3] != 1)
+    at.fail("the last row must be [0, 0, 0, 1] (affine transforms only)");
+  if (std::abs(glm::determinant(m)) < 1e-300) at.fail("must be invertible");
+}
+
+void check_texture_index(const Reporter& at, int index, std::size_t textures, bool optional) {
+  if (optional && index == -1) return;
+  if (index < 0 || static_cast<std::size_t>(index) >= textures)
+    at.fail("must be the index of a texture of the scene (" + std::to_string(textures) +
+            (optional ? "), or -1, got " : "), got ") + std::to_string(index));
+}
+
+void check_light_type(const Reporter& at, LightType type) {
+  if (!find_entry(type)) at.fail("unknown light type " + std::to_string(static_cast<int>(type)));
+  if (is_shape_light(type))
+    at.fail(std::string("'") + type_name(type) +
+            "' lights are emissive shapes, not entries of \"lights\": give a shape a material "
+            "with \"emission\"");
+}
+
+std::string scene_light_names() {
+  std::string list;
+  for (const TypeEntry<LightType>& e : TypeList<LightType>::entries)
+    if (!is_shape_light(e.value)) list += std::string(list.empty() ? "" : ", ") + e.name;
+  return list;
+}
+
+namespace {
+
+bool finite(const glm::dvec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+/// A value of a registry enum that no entry has (an integer cast in code).
+template <class E>
+void check_type(const Reporter& at, E value) {
+  if (!find_entry(value))
+    at.fail(std::string("unknown ") + TypeList<E>::what + " " +
+            std::to_string(static_cast<int>(value)) + " (expected one of: " + type_names<E>() +
+            ")");
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+void validate_camera(const Camera& c, const Reporter& at) {
+  check_point(at.at("position"), c.position);
+  check_point(at.at("look_at"), c.look_at);
+  check_nonzero(at.at("up"), c.up);
+  if (!(check_finite(at.at("fov"), c.fov_degrees) > 0 && c.fov_degrees < 180))
+    at.at("fov").fail("must be in (0, 180) degrees, got " + format_number(c.fov_degrees));
+  check_finite(at.at("roll"), c.roll_degrees);
+  check_non_negative(at.at("aperture"), c.aperture);
+  check_non_negative(at.at("focus_distance"), c.focus_distance);
+  glm::dvec3 forward = c.look_at - c.position;
+  if (glm::length(forward) == 0) at.at("look_at").fail("must differ from the camera position");
+  if (glm::length(glm::cross(glm::normalize(forward), glm::normalize(c.up))) < 1e-9)
+    at.at("up").fail("must not be parallel to the viewing direction");
+}
+
+void validate_film(const Film& f, const Reporter& at) {
+  check_range(at.at("width"), f.width, rules::kImageSize);
+  check_range(at.at("height"), f.height, rules::kImageSize);
+  Reporter filter = at.at("filter");
+  check_type(filter.at("type"), f.filter.type);
+  check_positive(filter.at("radius"), f.filter.radius);
+  if (f.filter.radius > limits::kMaxFilterRadius)
+    filter.at("radius").fail("must be <= " + format_number(limits::kMaxFilterRadius) + " pixels");
+  if (f.transfer != Transfer::Srgb && f.transfer != Transfer::Gamma &&
+      f.transfer != Transfer::Linear)
+    at.at("transfer").fail("unknown transfer " + std::to_string(static_cast<int>(f.transfer)));
+  check_positive(at.at("gamma"), f.gamma);
+  check_finite(at.at("exposure"), f.exposure);
+  if (f.tonemap != ToneMap::Clamp && f.tonemap != ToneMap::Reinhard && f.tonemap != ToneMap::Aces)
+    at.at("tonemap").fail("unknown tone map " + std::to_string(static_cast<int>(f.tonemap)));
+}
+
+void validate_integrator(const Integrator& in, const Reporter& at) {
+  check_type(at.at("type"), in.type);
+  check_range(at.at("max_depth"), in.max_depth, rules::kDepth);
+  check_range(at.at("rr_depth"), in.rr_depth, rules::kDepth);
+  check_range(at.at("spp"), in.spp, rules::kSpp);
+  check_non_negative(at.at("ao_distance"), in.ao_distance);  // 0: unbounded
+}
+
+void validate_texture(const Texture& t, const Reporter& at) {
+  if (t.width < 1) at.at("width").fail("must be >= 1, got " + std::to_string(t.width));
+  if (t.height < 1) at.at("height").fail("must be >= 1, got " + std::to_string(t.height));
+  std::size_t want = std::size_t(4) * std::size_t(t.width) * std::size_t(t.height);
+  if (t.rgba.size() != want)
+    at.at("rgba").fail("must hold 4 x " + std::to_string(t.width) + " x " +
+                       std::to_string(t.height) + " = " + std::to_string(want) + " floats, got " +
+                       std::to_string(t.rgba.size()));
+  for (std::size_t i = 0; i < t.rgba.size(); ++i)  // the place is made only for a bad texel
+    if (!(std::isfinite(t.rgba[i]) && t.rgba[i] >= 0))
+      check_non_negative(at.at("rgba").at(i), t.rgba[i]);
+}
+
+void validate_material(const Material& m, std::size_t textures, const Reporter& at) {
+  if (m.name.empty()) at.fail("material names must not be empty");
+  check_type(at.at("type"), m.type);
+  check_colour(at.at("emission"), m.emission);
+  check_texture_index(at.at("albedo").at("texture"), m.albedo_texture, textures, true);
+  // the type's parameters, by its parameter table (src/scene/materials/<file>.cpp)
+  for (const MaterialParam& param : material_type_def(m.type).params) {
+    const Reporter p = at.at(param.key);
+    switch (param.kind) {
+      case MaterialParam::Colour:
+      case MaterialParam::ColourOrTexture:
+        check_colour(p, m.*param.colour);
+        break;
+      case MaterialParam::Positive:
+        check_positive(p, m.*param.number);
+        break;
+      case MaterialParam::UnitInterval:
+        check_between(p, m.*param.number, 0, 1);
+        break;
+    }
+  }
+}
+
+void validate_light(const Light& l, std::size_t textures, const Reporter& at) {
+  check_light_type(at.at("type"), l.type);
+  switch (l.type) {
+    case LightType::Point:
+      check_point(at.at("position"), l.position);
+      check_colour(at.at("intensity"), l.intensity);
+      break;
+    case LightType::Environment:
+      check_colour(at.at("radiance"), l.radiance);
+      break;
+    case LightType::EnvironmentMap:
+      check_texture_index(at.at("texture"), l.texture, textures, false);
+      check_scale(at.at("scale"), l.radiance);
+      break;
+    case LightType::Sphere:  // emissive shapes: refused by check_light_type
+    case LightType::Triangle:
+      break;
+  }
+}
+
+void validate_sphere(const SphereShape& s, const Reporter& at) {
+  check_point(at.at("center"), s.center);
+  check_positive(at.at("radius"), s.radius);
+}
+
+void validate_mesh(const MeshShape& m, const Reporter& at) {
+  const std::size_t n = m.positions.size();
+  if (n == 0) at.at("positions").fail("must be a non-empty array of [x, y, z]");
+  // (the places are made only for a bad element: meshes may be large)
+  for (std::size_t i = 0; i < n; ++i)
+    if (!finite(m.positions[i])) check_point(at.at("positions").at(i), m.positions[i]);
+  if (m.indices.size() % 3 != 0)
+    at.at("indices").fail("must be an array whose length is a multiple of 3");
+  for (std::size_t i = 0; i < m.indices.size(); ++i)
+    if (m.indices[i] < 0 || static_cast<std::size_t>(m.indices[i]) >= n)
+      check_range(at.at("indices").at(i), m.indices[i], rules::vertex_index(n));
+  if (!m.normals.empty() && m.normals.size() != n)
+    at.at("normals").fail("must have one entry per position (" + std::to_string(n) + ")");
+  for (std::size_t i = 0; i < m.normals.size(); ++i)
+    if (!finite(m.normals[i])) check_point(at.at("normals").at(i), m.normals[i]);
+  if (!m.uvs.empty() && m.uvs.size() != n)
+    at.at("uvs").fail("must have one entry per position (" + std::to_string(n) + ")");
+  for (std::size_t i = 0; i < m.uvs.size(); ++i)
+    if (!finite(glm::dvec3(m.uvs[i], 0)))
+      for (int c = 0; c < 2; ++c) check_finite(at.at("uvs").at(i).at(c), m.uvs[i][c]);
+  check_affine(at.at("transform"), m.transform);
+}
+
+}  // namespace lucent::scene_detail

@@ -1,0 +1,98 @@
+#pragma once
+// The value checks of a scene, written once and used by both ways of making one: the JSON loader
+// (src/scene/json_*.cpp) reads a file into the public structs and hands them to SceneBuilder,
+// whose add_* / set_* calls run the validators below. Every check names the place of the value as
+// a JSON pointer, so a scene built in code and the same scene written in JSON give the same
+// message ("scene.json: /materials/glass/ior: must be > 0, got -1").
+//
+// The JSON loader itself only checks what JSON can get wrong and code cannot: syntax, types,
+// unknown keys, missing fields, names of types and materials, integers that do not fit their
+// field (it checks those against the same ranges, before narrowing), and the steps of a JSON
+// transform.
+#include <cstddef>
+#include <glm/glm.hpp>
+#include <string>
+
+#include "lucent/limits.hpp"
+#include "lucent/registry.h"
+#include "lucent/scene.hpp"
+#include "lucent/scene_builder.hpp"
+
+namespace lucent::scene_detail {
+
+/// The place of a value: the scene's file (or a built scene's name) and the JSON pointer of the
+/// value in it. fail() throws lucent::Error "<file>: <pointer>: <what>" ("<pointer>: <what>" when
+/// the scene has no name).
+class Reporter {
+ public:
+  Reporter(std::string file, std::string pointer)
+      : file_(std::move(file)), pointer_(std::move(pointer)) {}
+  /// The member `key` of this object, or the element `index` of this array.
+  Reporter at(const std::string& key) const { return {file_, pointer_ + "/" + key}; }
+  Reporter at(std::size_t index) const { return at(std::to_string(index)); }
+  const std::string& file() const { return file_; }
+  const std::string& pointer() const { return pointer_; }
+  [[noreturn]] void fail(const std::string& what) const;
+
+ private:
+  std::string file_;
+  std::string pointer_;
+};
+
+/// A number as messages show it (6 significant digits; nan, inf).
+std::string format_number(double v);
+
+// ---------------------------------------------------------------------------------------------
+// Checks of one value. Each fails at `at` with a message saying what the value must be and what
+// it is; the vector checks name the component (".../albedo/1").
+
+/// An inclusive range of integers.
+struct IntRange {
+  long long lo, hi;
+};
+namespace rules {
+inline constexpr IntRange kImageSize{1, limits::kMaxImageSize};  ///< film width and height
+inline constexpr IntRange kSpp{1, limits::kMaxSpp};              ///< samples per pixel
+inline constexpr IntRange kDepth{1, limits::kMaxDepth};          ///< max_depth, rr_depth
+inline constexpr IntRange kSeed{0, limits::kMaxSeed};            ///< the 32-bit seed
+/// A vertex index of a mesh of n positions.
+inline IntRange vertex_index(std::size_t n) { return {0, static_cast<long long>(n) - 1}; }
+}  // namespace rules
+
+/// "must be in [lo, hi], got <shown>" (shown: the value as written, which may not fit a long).
+[[noreturn]] void fail_range(const Reporter& at, IntRange range, const std::string& shown);
+void check_range(const Reporter& at, long long v, IntRange range);
+double check_finite(const Reporter& at, double v);
+void check_positive(const Reporter& at, double v);                       ///< finite and > 0
+void check_non_negative(const Reporter& at, double v);                   ///< finite and >= 0
+void check_between(const Reporter& at, double v, double lo, double hi);  ///< finite, in [lo, hi]
+void check_point(const Reporter& at, const glm::dvec3& v);               ///< finite components
+void check_colour(const Reporter& at, const glm::dvec3& c);              ///< finite components >= 0
+void check_nonzero(const Reporter& at, const glm::dvec3& v);  ///< finite and not (0, 0, 0)
+/// A scale given as RGB or as one number (all components equal: the place has no component).
+void check_scale(const Reporter& at, const glm::dvec3& s);
+/// An affine, invertible 4x4 matrix of finite numbers; entries are named /row/column.
+void check_affine(const Reporter& at, const glm::dmat4& m);
+/// A texture index below `textures`, or -1 when `optional`.
+void check_texture_index(const Reporter& at, int index, std::size_t textures, bool optional);
+/// A light type a scene's "lights" may hold: the emissive shapes' types are refused.
+void check_light_type(const Reporter& at, LightType type);
+/// The light types a scene's "lights" may hold, "point, environment, ...".
+std::string scene_light_names();
+
+// ---------------------------------------------------------------------------------------------
+// Validators of one element of a scene, at its place ("/camera", "/materials/<name>",
+// "/shapes/<i>", "/lights/<i>", "/textures/<i>").
+
+void validate_camera(const Camera& camera, const Reporter& at);
+void validate_film(const Film& film, const Reporter& at);
+void validate_integrator(const Integrator& integrator, const Reporter& at);
+void validate_texture(const Texture& texture, const Reporter& at);
+/// The parameters every material has (name, type, emission, albedo texture), then its type's
+/// own, by the type's parameter table (scene/material_type.hpp).
+void validate_material(const Material& material, std::size_t textures, const Reporter& at);
+void validate_light(const Light& light, std::size_t textures, const Reporter& at);
+void validate_sphere(const SphereShape& sphere, const Reporter& at);
+void validate_mesh(const MeshShape& mesh, const Reporter& at);
+
+}  // namespace lucent::scene_detail
