@@ -261,6 +261,59 @@ TEST(ReferenceAnalytic, MirrorShowsEmitter) {
     }
 }
 
+// Russian roulette (docs/rendering-model.md, "Integrators"): once a path has rr_depth segments it
+// survives with probability q = max(beta) while q < 1, its throughput divided by q. The camera
+// sees the emitter of MirrorShowsEmitter through a mirror of reflectance rho with RR from the
+// first bounce: every sample is either rho Le / q (probability q) or 0, with q = min(1, max(rho)).
+// - max(rho) = 1: the path is never cut, every sample is rho Le exactly: the mean within 1e-6,
+//   the per-pixel sample variance 0 (a cap on the survival probability below 1, as the
+//   reference once had with 0.95, kills some of these paths: variance > 0).
+// - max(rho) = 0.8: the survival probability is 0.8: the per-pixel variance per channel is
+//   (rho Le / q)^2 q (1 - q); its mean over the 256 pixels (64 samples each) estimates that with
+//   a relative standard deviation of 1.2% (Bernoulli moments); 6% allowed. The means match
+//   rho Le (the default comparison).
+TEST(ReferenceAnalytic, RussianRouletteSurvivesWithMaxThroughput) {
+  auto scene = [](const char* rho) {
+    return std::string(R"({
+    "camera": {"position": [0, 0, 2], "look_at": [0, 0, 0], "fov": 30},
+    "film": {"width": 16, "height": 16},
+    "integrator": {"type": "path", "max_depth": 4, "rr_depth": 1},
+    "materials": {"mirror": {"type": "mirror", "reflectance": )") +
+           rho + R"(},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1, 2, 3]}},
+    "shapes": [
+      {"type": "triangles", "material": "mirror",
+       "positions": [[-5,-5,0],[5,-5,0],[5,5,0],[-5,5,0]], "indices": [0,1,2, 0,2,3]},
+      {"type": "triangles", "material": "lamp",
+       "positions": [[-5,-5,3],[5,-5,3],[5,5,3],[-5,5,3]], "indices": [0,2,1, 0,3,2]}]
+  })";
+  };
+  const glm::dvec3 Le(1, 2, 3);
+  {
+    const glm::dvec3 rho(1, 0.6, 0.3);
+    RenderResult r = render_ref(scene("[1, 0.6, 0.3]"), 16);
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x)
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_NEAR(r.mean.pixel(x, y)[c], rho[c] * Le[c], 1e-6) << x << "," << y;
+          EXPECT_LE(r.variance.pixel(x, y)[c], 1e-10) << x << "," << y;
+        }
+  }
+  {
+    const glm::dvec3 rho(0.8, 0.4, 0.2);
+    const double q = 0.8;
+    RenderResult r = render_ref(scene("[0.8, 0.4, 0.2]"), 64);
+    expect_matches(r, expected_image(r, [&](int, int) { return rho * Le; }));
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0;
+      for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) sum += r.variance.pixel(x, y)[c];
+      const double want = std::pow(rho[c] * Le[c] / q, 2) * q * (1 - q);
+      EXPECT_NEAR(sum / 256, want, 0.06 * want) << "channel " << c;
+    }
+  }
+}
+
 // The AOV integrators at known points: a plane z = 0 seen from straight above at height 5 gives
 // depth 5 / cos(angle off axis), normal (0, 0, 1), albedo; ambient occlusion of an open plane
 // is 1, and 0 on a miss. Tolerance 1e-6 (tiny filter).

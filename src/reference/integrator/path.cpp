@@ -70,8 +70,12 @@ dvec3 integrator_path(const Tracer& t, const Ray& camera_ray, const Sampler& rng
     prev_pdf = bs.pdf;
     prev_delta = bs.delta;
     ray = Tracer::spawn(s, bs.wi);
-    if (depth + 1 >= in.rr_depth) {
-      double q = std::min(0.95, max3(beta));
+    // Russian roulette once the path has rr_depth segments: while the largest component of the
+    // throughput is below 1 the path survives with that probability and the throughput is
+    // divided by it, so it never exceeds 1 (a cap such as min(0.95, max(beta)) lets beta grow
+    // like (albedo / 0.95)^n above albedo 0.95: unbiased, but of infinite variance).
+    double q = max3(beta);
+    if (depth + 1 >= in.rr_depth && q < 1) {
       if (rng.bounce(depth, LC_DIM_RR) >= q) break;
       beta /= q;
     }
