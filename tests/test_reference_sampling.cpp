@@ -141,13 +141,16 @@ lucent::Material material(lucent::MaterialType type, dvec3 albedo, double spec, 
   return m;
 }
 
-// Samples a BSDF at a tilted normal (world frame) and bins over the hemisphere around it; also
-// checks that each sample's weight equals eval / pdf at its direction and its pdf equals
-// Bsdf::pdf.
-void chi_square_bsdf(const char* name, const lucent::Material& m, double wo_theta) {
+// Samples a BSDF at a tilted normal (world frame) and bins over the hemisphere around it (the
+// whole sphere from z_lo = -1, for transmission; NT x NP cells, N samples); also checks that each
+// sample's weight equals eval / pdf at its direction and its pdf equals Bsdf::pdf. `front`: wo is
+// on the front side of the surface (dielectrics: eta = ior, else 1 / ior).
+void chi_square_bsdf(const char* name, const lucent::Material& m, double wo_theta,
+                     bool front = true, double z_lo = 0.0, int NT = 16, int NP = 32,
+                     int N = 1 << 18) {
   lucent::ref::ShadingPoint sp;
   sp.n = sp.ng = glm::normalize(dvec3(0.3, -0.5, 0.8));
-  sp.front = true;
+  sp.front = front;
   const std::unique_ptr<lucent::ref::Bsdf> bsdf = lucent::ref::make_bsdf(lucent::Scene{}, m, sp);
   const lucent::ref::Bsdf& b = *bsdf;
   Frame f = frame_of(sp.n);
@@ -171,7 +174,8 @@ void chi_square_bsdf(const char* name, const lucent::Material& m, double wo_thet
     return true;
   };
   auto pdf = [&](const dvec3& wi) { return b.pdf(wo, wi); };
-  chi_square(name, f, 0.0, 16, 32, sample, pdf, 0x5eed0001u + std::uint64_t(wo_theta * 1000));
+  chi_square(name, f, z_lo, NT, NP, sample, pdf, 0x5eed0001u + std::uint64_t(wo_theta * 1000),
+             nullptr, N);
 }
 
 using lucent::MaterialType;
@@ -190,6 +194,31 @@ TEST(ReferenceSampling, BsdfConductorSmooth) {
 
 TEST(ReferenceSampling, BsdfPlastic) {
   chi_square_bsdf("plastic", material(MaterialType::Plastic, dvec3(0.3, 0.5, 0.8), 1.0, 0.2), 0.9);
+}
+
+// Rough dielectric (GGX reflection and transmission, Walter et al. 2007): both hemispheres,
+// from outside (eta = 1.5) and inside (eta = 1 / 1.5; at 0.9 rad, beyond the critical angle of
+// 0.73 rad, most microfacets reflect everything), three roughnesses. 64 x 64 cells over the
+// sphere (2^19 samples) for the narrow lobes of roughness 0.1.
+lucent::Material rough_glass(double roughness) {
+  lucent::Material m;
+  m.type = MaterialType::RoughDielectric;
+  m.specular = dvec3(1.0, 0.8, 0.6);
+  m.ior = 1.5;
+  m.roughness = roughness;
+  return m;
+}
+
+TEST(ReferenceSampling, BsdfRoughDielectricOutside) {
+  chi_square_bsdf("rough dielectric 0.1 outside", rough_glass(0.1), 0.6, true, -1, 64, 64, 1 << 19);
+  chi_square_bsdf("rough dielectric 0.3 outside", rough_glass(0.3), 1.2, true, -1, 32, 32);
+  chi_square_bsdf("rough dielectric 0.7 outside", rough_glass(0.7), 0.3, true, -1, 32, 32);
+}
+
+TEST(ReferenceSampling, BsdfRoughDielectricInside) {
+  chi_square_bsdf("rough dielectric 0.1 inside", rough_glass(0.1), 0.5, false, -1, 64, 64, 1 << 19);
+  chi_square_bsdf("rough dielectric 0.3 inside", rough_glass(0.3), 0.9, false, -1, 32, 32);
+  chi_square_bsdf("rough dielectric 0.7 inside", rough_glass(0.7), 1.3, false, -1, 32, 32);
 }
 
 // ------------------------------------------------------------------------------------------

@@ -56,7 +56,9 @@
     LC_PARAMS(float f0[3]; /* Schlick F0 colour */ float roughness; /* GGX alpha */))        \
   X(PLASTIC, Plastic, 4, "plastic", LC_HAS_PLASTIC, plastic,                                  \
     LC_PARAMS(float albedo[3]; lc_int albedo_tex; float specular[3]; float ior;               \
-              float roughness;))
+              float roughness;))                                                             \
+  X(ROUGH_DIELECTRIC, RoughDielectric, 5, "rough_dielectric", LC_HAS_ROUGH_DIELECTRIC,        \
+    rough_dielectric, LC_PARAMS(float tint[3]; float ior; float roughness;))
 
 /* ------------------------------------------------------------------------------------------ */
 /* Lights: X(ID, Name, value, name, feature, file, params)                                     */
