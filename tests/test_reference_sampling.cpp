@@ -2,17 +2,19 @@
 // that mirror the device's (test_kernel_bsdf.cpp, test_kernel_light_sampling.cpp): BSDF sampling
 // against Bsdf::pdf, and next-event estimation's light sampling (uniform light choice, uniform
 // area points on spheres and triangles, uniform directions for the environment) against
-// env_light_pdf and area_light_pdf, the pdfs the reference uses for MIS.
+// Light::pdf, the pdfs the reference uses for MIS.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
-#include "reference/reference_internal.hpp"
+#include "reference/bsdf/bsdf.hpp"
+#include "reference/light/light.hpp"
 #include "support.hpp"
 
 namespace {
@@ -139,16 +141,19 @@ lucent::Material material(lucent::MaterialType type, dvec3 albedo, double spec, 
   return m;
 }
 
-// Samples a BSDF at a tilted normal (world frame) and bins over the hemisphere around it; also
-// checks that each sample's weight equals eval / pdf at its direction and its pdf equals
-// Bsdf::pdf.
-void chi_square_bsdf(const char* name, const lucent::Material& m, double wo_theta) {
-  lucent::ref::Bsdf b;
-  b.m = &m;
-  b.albedo = m.albedo;
-  b.n = b.ng = glm::normalize(dvec3(0.3, -0.5, 0.8));
-  b.front = true;
-  Frame f = frame_of(b.n);
+// Samples a BSDF at a tilted normal (world frame) and bins over the hemisphere around it (the
+// whole sphere from z_lo = -1, for transmission; NT x NP cells, N samples); also checks that each
+// sample's weight equals eval / pdf at its direction and its pdf equals Bsdf::pdf. `front`: wo is
+// on the front side of the surface (dielectrics: eta = ior, else 1 / ior).
+void chi_square_bsdf(const char* name, const lucent::Material& m, double wo_theta,
+                     bool front = true, double z_lo = 0.0, int NT = 16, int NP = 32,
+                     int N = 1 << 18) {
+  lucent::ref::ShadingPoint sp;
+  sp.n = sp.ng = glm::normalize(dvec3(0.3, -0.5, 0.8));
+  sp.front = front;
+  const std::unique_ptr<lucent::ref::Bsdf> bsdf = lucent::ref::make_bsdf(lucent::Scene{}, m, sp);
+  const lucent::ref::Bsdf& b = *bsdf;
+  Frame f = frame_of(sp.n);
   const double st = std::sin(wo_theta);
   const dvec3 wo = f.to_world(st * std::cos(0.4), st * std::sin(0.4), std::cos(wo_theta));
   int checked = 0;
@@ -169,7 +174,8 @@ void chi_square_bsdf(const char* name, const lucent::Material& m, double wo_thet
     return true;
   };
   auto pdf = [&](const dvec3& wi) { return b.pdf(wo, wi); };
-  chi_square(name, f, 0.0, 16, 32, sample, pdf, 0x5eed0001u + std::uint64_t(wo_theta * 1000));
+  chi_square(name, f, z_lo, NT, NP, sample, pdf, 0x5eed0001u + std::uint64_t(wo_theta * 1000),
+             nullptr, N);
 }
 
 using lucent::MaterialType;
@@ -190,6 +196,31 @@ TEST(ReferenceSampling, BsdfPlastic) {
   chi_square_bsdf("plastic", material(MaterialType::Plastic, dvec3(0.3, 0.5, 0.8), 1.0, 0.2), 0.9);
 }
 
+// Rough dielectric (GGX reflection and transmission, Walter et al. 2007): both hemispheres,
+// from outside (eta = 1.5) and inside (eta = 1 / 1.5; at 0.9 rad, beyond the critical angle of
+// 0.73 rad, most microfacets reflect everything), three roughnesses. 64 x 64 cells over the
+// sphere (2^19 samples) for the narrow lobes of roughness 0.1.
+lucent::Material rough_glass(double roughness) {
+  lucent::Material m;
+  m.type = MaterialType::RoughDielectric;
+  m.specular = dvec3(1.0, 0.8, 0.6);
+  m.ior = 1.5;
+  m.roughness = roughness;
+  return m;
+}
+
+TEST(ReferenceSampling, BsdfRoughDielectricOutside) {
+  chi_square_bsdf("rough dielectric 0.1 outside", rough_glass(0.1), 0.6, true, -1, 64, 64, 1 << 19);
+  chi_square_bsdf("rough dielectric 0.3 outside", rough_glass(0.3), 1.2, true, -1, 32, 32);
+  chi_square_bsdf("rough dielectric 0.7 outside", rough_glass(0.7), 0.3, true, -1, 32, 32);
+}
+
+TEST(ReferenceSampling, BsdfRoughDielectricInside) {
+  chi_square_bsdf("rough dielectric 0.1 inside", rough_glass(0.1), 0.5, false, -1, 64, 64, 1 << 19);
+  chi_square_bsdf("rough dielectric 0.3 inside", rough_glass(0.3), 0.9, false, -1, 32, 32);
+  chi_square_bsdf("rough dielectric 0.7 inside", rough_glass(0.7), 1.3, false, -1, 32, 32);
+}
+
 // ------------------------------------------------------------------------------------------
 // lights
 
@@ -198,7 +229,7 @@ void prim_hits(const lucent::ref::World& w, int prim, const dvec3& o, const dvec
                std::vector<std::pair<double, dvec3>>& hits) {
   hits.clear();
   const lucent::ref::Prim& p = w.prims[prim];
-  if (p.sphere) {
+  if (p.shape == lucent::ref::Shape::Sphere) {
     const lucent::Sphere& s = w.scene.spheres[p.index];
     dvec3 oc = o - s.center;
     double bh = glm::dot(oc, d), c = glm::dot(oc, oc) - s.radius * s.radius;
@@ -224,10 +255,11 @@ void prim_hits(const lucent::ref::World& w, int prim, const dvec3& o, const dvec
 
 // Samples next-event estimation's directions from the origin and bins them over the whole
 // sphere (48 x 96 cells; the lights sit near the equator). The density of a direction is the
-// sum over the light list of: env_light_pdf for the environment, and area_light_pdf at every
-// point where the ray meets an area light's primitive from its front side (the test's own ray
-// intersection). Point lights are delta: their samples count as unsuccessful. Also: a sample's
-// reported pdf equals that density (one light), or is at most it (several).
+// sum over the light list of: the environment's Light::pdf, and the area lights' Light::pdf
+// (Lights::pdf_hit) at every point where the ray meets an area light's primitive from its front
+// side (the test's own ray intersection). Point lights are delta: their samples count as
+// unsuccessful. Also: a sample's reported pdf equals that density (one light), or is at most it
+// (several).
 //
 // Expected counts: the environment and triangle terms are integrated over directions
 // (chi_square's quadrature). A sphere's term grows like 1 / cos_l towards its silhouette, an
@@ -239,23 +271,19 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
                        int N = 1 << 18) {
   lucent::Scene scene = lucent::parse_scene(json, lucent::test::temp_dir() + "/lights.json");
   lucent::ref::World world(scene);
-  int env = -1;
-  std::vector<lucent::ref::LightRef> lights = lucent::ref::light_list(world, env);
+  lucent::ref::Lights lights(world);
   ASSERT_FALSE(lights.empty());
+  auto is_sphere = [&](int prim) { return world.prims[prim].shape == lucent::ref::Shape::Sphere; };
   const dvec3 p(0.0);
   const int NT = 48, NP = 96;
   std::vector<std::pair<double, dvec3>> hits;
   auto pdf_terms = [&](const dvec3& wi, bool spheres) {
     double sum = 0;
-    for (const lucent::ref::LightRef& l : lights) {
-      if (l.kind == lucent::ref::LightRef::Env) sum += lucent::ref::env_light_pdf(lights.size());
-      if (l.kind != lucent::ref::LightRef::Area) continue;
-      int prim = world.area_lights[l.index].prim;
-      if (world.prims[prim].sphere && !spheres) continue;
+    if (lights.environment()) sum += lights.environment()->pdf(wi, lucent::ref::kInf, 0);
+    for (int prim = 0; prim < static_cast<int>(world.prims.size()); ++prim) {
+      if (!lights.area_light(prim) || (is_sphere(prim) && !spheres)) continue;
       prim_hits(world, prim, p, wi, hits);
-      for (auto& h : hits)
-        sum += lucent::ref::area_light_pdf(world, lights.size(), prim, h.first,
-                                           -glm::dot(h.second, wi));
+      for (auto& h : hits) sum += lights.pdf_hit(prim, wi, h.first, -glm::dot(h.second, wi));
     }
     return sum;
   };
@@ -263,10 +291,8 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
   auto pdf_no_spheres = [&](const dvec3& wi) { return pdf_terms(wi, false); };
   auto sphere_terms = [&](int N, std::vector<double>& expected) {
     const int M = 2048;
-    for (const lucent::ref::LightRef& l : lights) {
-      if (l.kind != lucent::ref::LightRef::Area) continue;
-      int prim = world.area_lights[l.index].prim;
-      if (!world.prims[prim].sphere) continue;
+    for (int prim = 0; prim < static_cast<int>(world.prims.size()); ++prim) {
+      if (!lights.area_light(prim) || !is_sphere(prim)) continue;
       const lucent::Sphere& sp = scene.spheres[world.prims[prim].index];
       const double dA = sp.radius * sp.radius * (2.0 / M) * (2 * kPi / M);
       for (int i = 0; i < M; ++i)
@@ -278,7 +304,7 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
           dvec3 wi = (y - p) / dist;
           double cos_l = -glm::dot(n, wi);
           if (cos_l <= 0) continue;
-          double pw = lucent::ref::area_light_pdf(world, lights.size(), prim, dist, cos_l);
+          double pw = lights.pdf_hit(prim, wi, dist, cos_l);
           int ti = std::min(NT - 1, int((std::clamp(wi.z, -1.0, 1.0) + 1) / 2 * NT));
           double ph = std::atan2(wi.y, wi.x);
           if (ph < 0) ph += 2 * kPi;
@@ -291,7 +317,7 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
   auto sample = [&](std::mt19937_64& rng, dvec3& w) {
     std::uniform_real_distribution<double> u(0.0, 1.0);
     double a = u(rng), b1 = u(rng), b2 = u(rng);
-    lucent::ref::LightSample s = lucent::ref::sample_light(world, lights, p, a, b1, b2);
+    lucent::ref::LightSample s = lights.sample(p, a, b1, b2);
     if (!s.valid || s.delta) return false;
     w = s.wi;
     if (checked < 4000) {

@@ -1,12 +1,15 @@
-// The rough dielectric BSDF rendered: white-furnace energy tests of the kernel. (Its sampling
-// against its pdf and its energy per direction: tests/test_kernel_bsdf.cpp,
-// KernelBsdf.ChiSquareRoughDielectric; the kernel against the reference:
-// tests/test_kernel_vs_reference.cpp.)
+// The rough dielectric BSDF rendered: white-furnace energy tests of the kernel, and the kernel
+// against the independent reference (src/reference/bsdf/rough_dielectric.cpp, which samples
+// microfacet normals from D instead of the visible normals). (Its sampling against its pdf and
+// its energy per direction: tests/test_kernel_bsdf.cpp, KernelBsdf.ChiSquareRoughDielectric, and
+// tests/test_reference_sampling.cpp.)
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
+#include "lucent/compare.hpp"
+#include "lucent/reference.hpp"
 #include "support.hpp"
 
 namespace {
@@ -38,7 +41,7 @@ TEST(RoughDielectric, NearlySmoothSphereInAWhiteFurnaceKeepsItsEnergy) {
 // from inside the glass at alpha 0.5 a third per interaction, and light inside meets the surface
 // several times: the sphere renders at about 0.31 where the environment is 0.5) but never creates
 // any: no pixel significantly above 0.5 (one-sided z at a Sidak-corrected 1e-3). How much it
-// loses is checked against the reference (KernelVsReference.PathRoughDielectric).
+// loses is checked against the reference (RoughDielectric.KernelMatchesReference).
 TEST(RoughDielectric, RoughSphereInAWhiteFurnaceGainsNoEnergy) {
   RenderResult r = lucent::test::render_json(furnace(0.5), 64);
   const int w = r.mean.width, h = r.mean.height;
@@ -54,6 +57,46 @@ TEST(RoughDielectric, RoughSphereInAWhiteFurnaceGainsNoEnergy) {
       }
   EXPECT_GT(sphere, w * h / 8) << "the sphere loses some energy";
   EXPECT_EQ(r.nonfinite, 0u);
+}
+
+// Rough glass of two roughnesses (one tinted) in front of and around a sphere light, a point
+// light and an environment, seen from outside and (through the large sphere) from inside; path
+// (light sampled through the surfaces from both sides, MIS), direct, whitted and the albedo AOV.
+// Kernel and reference with independent seeds, compared by lucent::compare_images' defaults
+// (per-pixel z-test, Sidak at family-wise 0.01, 99.5% of pixels, image-mean test; docs/compare.md).
+TEST(RoughDielectric, KernelMatchesReference) {
+  std::string json = R"({
+    "camera": {"position": [0, 1.0, 4], "look_at": [0, 0.6, 0], "fov": 42},
+    "film": {"width": 24, "height": 24},
+    "integrator": {"type": "path", "max_depth": 8, "seed": 3},
+    "materials": {"floor": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
+                  "frosted": {"type": "rough_dielectric", "ior": 1.5, "roughness": 0.1},
+                  "rough": {"type": "rough_dielectric", "ior": 1.33, "roughness": 0.45,
+                            "tint": [0.9, 0.7, 0.5]},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [8, 7, 6]}},
+    "shapes": [{"type": "triangles", "material": "floor",
+                "positions": [[-6,0,-6],[6,0,-6],[6,0,6],[-6,0,6]], "indices": [0,2,1, 0,3,2]},
+               {"type": "sphere", "center": [-0.6, 0.5, 0.3], "radius": 0.5, "material": "frosted"},
+               {"type": "sphere", "center": [0.7, 0.6, -0.2], "radius": 0.6, "material": "rough"},
+               {"type": "sphere", "center": [0.2, 0.9, -1.6], "radius": 0.25, "material": "lamp"}],
+    "lights": [{"type": "point", "position": [-2, 3, 2], "intensity": [6, 6, 6]},
+               {"type": "environment", "radiance": [0.2, 0.25, 0.3]}]})";
+  for (const char* integrator : {"path", "direct", "whitted", "albedo"}) {
+    lucent::Scene scene = lucent::test::scene_from(json);
+    scene.integrator.type = lucent::parse_type<lucent::IntegratorType>(integrator);
+    int spp = std::string(integrator) == "path" ? 256 : 16;
+    lucent::RenderOptions ko;
+    ko.spp = spp;
+    RenderResult kernel = lucent::test::render(scene, ko);
+    scene.integrator.seed ^= 0x9e3779b9u;  // independent samples
+    lucent::ReferenceOptions ro;
+    ro.spp = spp;
+    RenderResult reference = lucent::render_reference(scene, ro);
+    lucent::CompareResult c = lucent::compare_images(kernel, reference);
+    EXPECT_TRUE(c.passed) << integrator << ": A = kernel, B = reference\n" << c.summary();
+    EXPECT_EQ(kernel.nonfinite, 0u) << integrator;
+    EXPECT_EQ(reference.nonfinite, 0u) << integrator;
+  }
 }
 
 }  // namespace

@@ -1,0 +1,42 @@
+// The reference's camera: basis from position, look_at, up and roll; pinhole rays through the
+// film position; thin lens by a polar point of the aperture disk (the kernel uses another
+// mapping of the disk: the same distribution, different numbers).
+#include "reference/camera/camera.hpp"
+
+namespace lucent::ref {
+
+CameraModel::CameraModel(const Scene& scene) : filter_(scene.film.filter) {
+  const Camera& c = scene.camera;
+  pos_ = c.position;
+  fwd_ = glm::normalize(c.look_at - c.position);
+  dvec3 right = glm::normalize(glm::cross(fwd_, c.up));
+  dvec3 up = glm::cross(right, fwd_);
+  // roll: right and up turn counter-clockwise as seen looking along forward, i.e. right moves
+  // towards up
+  double r = c.roll_degrees * kPi / 180;
+  right_ = std::cos(r) * right + std::sin(r) * up;
+  up_ = -std::sin(r) * right + std::cos(r) * up;
+  width_ = scene.film.width;
+  height_ = scene.film.height;
+  tan_half_ = std::tan(c.fov_degrees * kPi / 360);
+  aspect_ = double(width_) / height_;
+  lens_ = c.aperture;
+  focus_ = c.focus_distance > 0 ? c.focus_distance : glm::length(c.look_at - c.position);
+}
+
+Ray CameraModel::ray(int x, int y, const Sampler& rng) const {
+  dvec2 off = filter_offset(filter_, rng);
+  double fx = x + 0.5 + off.x, fy = y + 0.5 + off.y;
+  double ndc_x = (2 * fx / width_ - 1) * tan_half_ * aspect_;
+  double ndc_y = (1 - 2 * fy / height_) * tan_half_;
+  Ray ray{pos_, glm::normalize(fwd_ + ndc_x * right_ + ndc_y * up_)};
+  if (lens_ > 0) {
+    dvec3 focus = pos_ + (focus_ / glm::dot(ray.d, fwd_)) * ray.d;
+    double lr = lens_ * std::sqrt(rng.get(LC_DIM_LENS)), phi = 2 * kPi * rng.get(LC_DIM_LENS + 1);
+    ray.o = pos_ + lr * std::cos(phi) * right_ + lr * std::sin(phi) * up_;
+    ray.d = glm::normalize(focus - ray.o);
+  }
+  return ray;
+}
+
+}  // namespace lucent::ref

@@ -1,0 +1,108 @@
+// The reference's light list and light-type dispatch (generated from LC_LIGHT_TYPES), and the
+// sampling shared by the environments (uniform directions) and by area lights (uniform points).
+#include <string>
+
+#include "lucent/error.hpp"
+#include "reference/light/light.hpp"
+
+namespace lucent::ref {
+
+namespace {
+
+std::unique_ptr<Light> make_light(LightType type, const World& world, int index, double nlights) {
+  switch (type) {
+#define LUCENT_REF_LIGHT_CASE(ID, Name, value, name, feature, file, ...) \
+  case LightType::Name:                                                  \
+    return make_light_##file(world, index, nlights);
+    LC_LIGHT_TYPES(LUCENT_REF_LIGHT_CASE)
+#undef LUCENT_REF_LIGHT_CASE
+  }
+  throw Error(world.scene.path + ": light " + std::to_string(index) + ": unknown type " +
+              std::to_string(static_cast<int>(type)));
+}
+
+}  // namespace
+
+Lights::Lights(const World& world) : prim_light_(world.prims.size(), -1) {
+  const Scene& scene = world.scene;
+  struct Entry {
+    LightType type;
+    int index;
+  };
+  std::vector<Entry> entries;
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    entries.push_back({scene.lights[i].type, static_cast<int>(i)});
+  for (size_t i = 0; i < world.prims.size(); ++i) {
+    const int prim = static_cast<int>(i);
+    if (!scene.materials[world.material(prim)].emissive()) continue;
+    prim_light_[prim] = static_cast<int>(entries.size());
+    entries.push_back({world.ops(prim).light, prim});
+  }
+  const double n = static_cast<double>(entries.size());
+  for (const Entry& e : entries) {
+    lights_.push_back(make_light(e.type, world, e.index, n));
+    if (lights_.back()->is_environment()) env_ = lights_.back().get();
+  }
+}
+
+LightSample Lights::sample(const dvec3& p, double u_select, double u1, double u2) const {
+  if (lights_.empty()) return LightSample{};
+  const double n = static_cast<double>(lights_.size());
+  int i = static_cast<int>(std::min(lights_.size() - 1, static_cast<size_t>(u_select * n)));
+  LightSample ls = lights_[i]->sample(p, u1, u2);
+  ls.light = i;
+  return ls;
+}
+
+// ------------------------------------------------------------------------------------------
+// environments: a uniform direction on the sphere
+
+LightSample EnvironmentLight::sample(const dvec3&, double u1, double u2) const {
+  LightSample ls;
+  ls.wi = uniform_sphere(u1, u2);
+  ls.pdf = pdf(ls.wi, kInf, 0);
+  ls.Le = radiance(ls.wi);
+  ls.valid = true;
+  return ls;
+}
+
+double EnvironmentLight::pdf(const dvec3&, double, double) const {
+  return 1 / (4 * kPi * nlights_);
+}
+
+// ------------------------------------------------------------------------------------------
+// area lights: a uniform point of the primitive's area
+
+AreaLight::AreaLight(const World& world, int prim, double nlights)
+    : world_(world),
+      prim_(prim),
+      nlights_(nlights),
+      area_(world.ops(prim).area(world.scene, world.prims[prim].index)),
+      emission_(world.scene.materials[world.material(prim)].emission) {}
+
+LightSample AreaLight::sample(const dvec3& p, double u1, double u2) const {
+  LightSample ls;
+  sample_point(u1, u2, ls.y, ls.ny);
+  ls.skip = prim_;
+  // The light's own primitive cannot hide a point of it that faces p (a sphere is convex), so it
+  // is left out of the shadow test: near its silhouette, the ray from the offset origin would
+  // otherwise graze it just before the sampled point.
+  ls.shadow_short = 1e-7;
+  ls.Le = emission_;
+  dvec3 to = ls.y - p;
+  ls.dist = glm::length(to);
+  if (ls.dist <= 0) return ls;
+  ls.wi = to / ls.dist;
+  double cos_l = -glm::dot(ls.ny, ls.wi);  // > 0: the point's front side faces p
+  if (cos_l <= 0) return ls;
+  ls.pdf = pdf(ls.wi, ls.dist, cos_l);
+  ls.valid = true;
+  return ls;
+}
+
+double AreaLight::pdf(const dvec3&, double dist, double cos_l) const {
+  if (cos_l <= 0) return 0;
+  return dist * dist / (cos_l * area_ * nlights_);
+}
+
+}  // namespace lucent::ref
