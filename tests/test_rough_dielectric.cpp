@@ -59,6 +59,23 @@ TEST(RoughDielectric, RoughSphereInAWhiteFurnaceGainsNoEnergy) {
   EXPECT_EQ(r.nonfinite, 0u);
 }
 
+// An ior of 1 is no interface: a rough sphere of it is invisible in front of an emitting wall
+// (the wall's radiance everywhere), as the smooth dielectric of ior 1 is, and as the reference
+// renders it.
+TEST(RoughDielectric, IorOneIsInvisible) {
+  RenderResult r = lucent::test::render_json(R"({
+    "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 30},
+    "film": {"width": 8, "height": 8},
+    "integrator": {"type": "path", "max_depth": 6},
+    "materials": {"glass": {"type": "rough_dielectric", "ior": 1, "roughness": 0.3},
+                  "wall": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.7, "material": "glass"},
+               {"type": "triangles", "material": "wall",
+                "positions": [[-9,-9,-3],[9,-9,-3],[9,9,-3],[-9,9,-3]], "indices": [0,1,2, 0,2,3]}]})",
+                                             4);
+  lucent::test::expect_matches(r, [](int, int, int) { return 0.5; });
+}
+
 // Rough glass of two roughnesses (one tinted) in front of and around a sphere light, a point
 // light and an environment, seen from outside and (through the large sphere) from inside; path
 // (light sampled through the surfaces from both sides, MIS), direct, whitted and the albedo AOV.

@@ -4,8 +4,9 @@
  * by visible normals (bsdf/microfacet.cl), then reflection with probability F(wo.h) and refraction
  * otherwise. Radiance transport: the transmitted term is divided by eta^2 and multiplied by tint,
  * as the smooth dielectric's refraction weight tint / eta^2. Two-sided: eta = ior from the outside,
- * 1 / ior from the inside. Parameters (lc_rough_dielectric_params): tint, ior, roughness (GGX
- * alpha, at least 1e-3). */
+ * 1 / ior from the inside. An ior of 1 is no interface: light passes straight through, weighted
+ * by tint (a delta BSDF; the generalized half vector of refraction does not exist there).
+ * Parameters (lc_rough_dielectric_params): tint, ior, roughness (GGX alpha, at least 1e-3). */
 #ifndef LUCENT_BSDF_ROUGH_DIELECTRIC_CL
 #define LUCENT_BSDF_ROUGH_DIELECTRIC_CL
 
@@ -23,7 +24,7 @@ static inline float bsdf_rough_dielectric_eta(const lc_bsdf* b) {
 static inline float3 bsdf_rough_dielectric_eval(const lc_bsdf* b, float3 wo, float3 wi,
                                                 float* pdf) {
   *pdf = 0.0f;
-  if (wo.z <= 0.0f || wi.z == 0.0f) return (float3)(0.0f);
+  if (wo.z <= 0.0f || wi.z == 0.0f || b->p.rough_dielectric.ior == 1.0f) return (float3)(0.0f);
   float alpha = bsdf_rough_dielectric_alpha(b), eta = bsdf_rough_dielectric_eta(b);
   int reflect = wi.z > 0.0f;
   /* the microfacet normal: the half vector, or the generalized one of refraction, facing +z */
@@ -57,6 +58,12 @@ static inline float3 bsdf_rough_dielectric_eval(const lc_bsdf* b, float3 wo, flo
 static inline int bsdf_rough_dielectric_sample(const lc_bsdf* b, float3 wo, float ul, float u1,
                                                float u2, lc_bsdf_sample* bs) {
   float eta = bsdf_rough_dielectric_eta(b);
+  if (eta == 1.0f) { /* no interface */
+    bs->wi = -wo;
+    bs->weight = lc_load3p(b->p.rough_dielectric.tint);
+    bs->delta = 1;
+    return 1;
+  }
   float3 h = ggx_sample_vndf(wo, bsdf_rough_dielectric_alpha(b), u1, u2);
   float oh = dot(wo, h);
   if (!(oh > 0.0f)) return 0;
