@@ -19,7 +19,10 @@
 // each other mode (and their largest per-pixel difference) are printed. Times are the process's
 // CPU seconds (all threads; a loaded machine disturbs them far less than wall time), --wall for
 // wall clock. Other options: --width --height --spp --reps --wave-local N --fast-math
-// --extra BUILD_OPTIONS. Build: cmake --build build --target lucent_proto.
+// --extra BUILD_OPTIONS. Build: cmake --build build --target lucent_proto (not part of the
+// default build). Written against the host code and kernels of commit f227b8a, before issue 10's
+// refactor (registries, one kernel file per type, the scene buffers' argument order): on later
+// commits wavefront.cl's includes and stage argument lists, and build_options here, need porting.
 #include <sys/resource.h>
 
 #include <algorithm>

@@ -1,6 +1,8 @@
 /* Prototypes for issue 11 (design exploration; not part of the renderer), run by
  * bench/prototypes/proto_main.cpp (lucent_proto); figures in BENCHMARKS.md, "Where the time goes".
- * kernels/ is on the include path: the prototypes call the renderer's own functions.
+ * kernels/ is on the include path: the prototypes call the renderer's own functions, those of
+ * commit f227b8a (before issue 10's refactor; later kernels need the includes and the stages'
+ * scene arguments ported).
  *
  * 1. Wavefront: the megakernel's path integrator (kernels/integrator/path.cl, integrator_path)
  *    split into stages over a structure-of-arrays path state (st: float rows S_*, su: uint rows
