@@ -10,8 +10,9 @@ Two jobs, both from one lucent JSON scene:
   bench_mitsuba.py render SCENE --size W H --spp N --max-depth D --threads T [--output X.exr]
       builds the same scene with Mitsuba's dict API and renders it with variant llvm_ad_rgb:
       one warm-up render (tracing, LLVM compilation or Dr.Jit's kernel cache), then one timed
-      render. Prints the timed render's wall time and Mpaths/s, Dr.Jit's kernel history
-      (compile and execution time) and the linear image mean.
+      render. Prints the timed render's wall time and Mpaths/s, its CPU time (user + system of
+      the process, every thread), Dr.Jit's kernel history (compile and execution time) and the
+      linear image mean.
 
 The subset of lucent's scene format translated (anything else is refused with a message):
 camera position/look_at/up/fov (vertical; no roll, no aperture); diffuse materials with an RGB
