@@ -133,12 +133,15 @@ typedef struct LC_ALIGN16 lc_sphere {
   float radius;
   lc_uint material; /* index into materials                     */
   lc_uint light;    /* index into lights if emissive, LC_INVALID */
+  lc_uint flags;    /* LC_SPHERE_TEXTURED                         */
   lc_uint pad0;
-  lc_uint pad1;
 } lc_sphere; /* total: 32 bytes */
 LC_STATIC_ASSERT(sizeof(lc_sphere) == 32, sphere_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_sphere, radius) == 12, sphere_radius);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_sphere, material) == 16, sphere_material);
+
+/* lc_sphere.flags: its material reads textures, so hits need texture coordinates */
+#define LC_SPHERE_TEXTURED 1u
 
 #define LC_TRI_HAS_NORMALS 1u
 #define LC_TRI_HAS_UVS 2u

@@ -107,6 +107,7 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     d.material = static_cast<lc_uint>(s.material);
     d.light = LC_INVALID;
     const Material& m = scene.materials[s.material];
+    d.flags = m.albedo_texture >= 0 ? LC_SPHERE_TEXTURED : 0u;
     if (m.emissive()) {
       lc_light l{};
       l.type = LC_LIGHT_SPHERE;
