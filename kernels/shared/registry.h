@@ -126,21 +126,22 @@
   X(LC_HAS_THIN_LENS, "thin-lens depth of field")
 
 /* ------------------------------------------------------------------------------------------ */
-/* Scene buffers: X(name, element type)                                                        */
+/* Scene buffers: X(name, element type, what)                                                  */
 /* The device arrays of a packed scene, in kernel-argument order: the fields of lc_scene and   */
 /* LC_SCENE_KERNEL_ARGS (scene/scene.cl), PackedScene and DeviceScene (src/render/). The      */
-/* launch parameters (lc_params) follow them as the last scene argument.                      */
+/* launch parameters (lc_params) follow them as the last scene argument. `what` names the     */
+/* buffer in messages (a scene too large for the device).                                     */
 /* ------------------------------------------------------------------------------------------ */
-#define LC_SCENE_BUFFERS(X)                                                       \
-  X(nodes, lc_bvh_node)          /* wide BVH nodes, nodes[0] the root        */   \
-  X(leaves, lc_bvh_leaf)         /* BVH leaf blocks                           */  \
-  X(triangles, lc_triangle)      /* triangle vertices, material, light        */  \
-  X(tri_attrs, lc_triangle_attr) /* triangle normals and uvs                  */  \
-  X(spheres, lc_sphere)          /* spheres                                   */  \
-  X(materials, lc_material)      /* materials                                 */  \
-  X(lights, lc_light)            /* lights, in light-selection order          */  \
-  X(light_cdf, float)            /* light selection CDF, then env-map CDFs     */ \
-  X(textures, lc_texture)        /* texture headers                           */  \
-  X(texels, lc_float4)           /* every texture's texels, linear RGBA       */
+#define LC_SCENE_BUFFERS(X)                                                  \
+  X(nodes, lc_bvh_node, "BVH nodes")                                         \
+  X(leaves, lc_bvh_leaf, "BVH leaf blocks")                                  \
+  X(triangles, lc_triangle, "triangles")                                     \
+  X(tri_attrs, lc_triangle_attr, "triangle normals and uvs")                 \
+  X(spheres, lc_sphere, "spheres")                                           \
+  X(materials, lc_material, "materials")                                     \
+  X(lights, lc_light, "lights")                                              \
+  X(light_cdf, float, "light selection and environment-map sampling tables") \
+  X(textures, lc_texture, "texture headers")                                 \
+  X(texels, lc_float4, "texture texels")
 
 #endif /* LUCENT_SHARED_REGISTRY_H */

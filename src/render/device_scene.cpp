@@ -37,7 +37,7 @@ void update_buffer(const cl_util::Context& ctx, cl::Buffer& buffer, const std::v
 DeviceScene::Upload DeviceScene::update(const cl_util::Context& ctx, const PackedScene& previous,
                                         const PackedScene& packed) {
   Upload up;
-#define LUCENT_UPDATE(name, type) update_buffer(ctx, name, previous.name, packed.name, up);
+#define LUCENT_UPDATE(name, type, ...) update_buffer(ctx, name, previous.name, packed.name, up);
   LC_SCENE_BUFFERS(LUCENT_UPDATE)
 #undef LUCENT_UPDATE
   return up;
@@ -45,14 +45,14 @@ DeviceScene::Upload DeviceScene::update(const cl_util::Context& ctx, const Packe
 
 DeviceScene::DeviceScene(const cl_util::Context& ctx, const PackedScene& p)
     :
-#define LUCENT_UPLOAD(name, type) name(make_buffer(ctx, p.name)),
+#define LUCENT_UPLOAD(name, type, ...) name(make_buffer(ctx, p.name)),
       LC_SCENE_BUFFERS(LUCENT_UPLOAD)
 #undef LUCENT_UPLOAD
           params(make_buffer(ctx, std::vector<lc_params>{p.params})) {
 }
 
 int DeviceScene::set_args(cl::Kernel& kernel, int arg) const {
-#define LUCENT_SET_ARG(name, type) kernel.setArg(arg++, name);
+#define LUCENT_SET_ARG(name, type, ...) kernel.setArg(arg++, name);
   LC_SCENE_BUFFERS(LUCENT_SET_ARG)
 #undef LUCENT_SET_ARG
   kernel.setArg(arg++, params);

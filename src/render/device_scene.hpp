@@ -8,10 +8,10 @@
 namespace lucent::render_detail {
 
 struct DeviceScene {
-#define LUCENT_COUNT_BUFFER(name, type) +1
+#define LUCENT_COUNT_BUFFER(name, type, ...) +1
   static constexpr int kArgCount = 1 LC_SCENE_BUFFERS(LUCENT_COUNT_BUFFER);
 #undef LUCENT_COUNT_BUFFER
-#define LUCENT_DEVICE_BUFFER(name, type) cl::Buffer name;
+#define LUCENT_DEVICE_BUFFER(name, type, ...) cl::Buffer name;
   LC_SCENE_BUFFERS(LUCENT_DEVICE_BUFFER)
 #undef LUCENT_DEVICE_BUFFER
   cl::Buffer params;

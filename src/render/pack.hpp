@@ -13,7 +13,7 @@ namespace lucent::render_detail {
 
 struct PackedScene {
   lc_params params{};
-#define LUCENT_PACKED_BUFFER(name, type) std::vector<type> name;
+#define LUCENT_PACKED_BUFFER(name, type, ...) std::vector<type> name;
   LC_SCENE_BUFFERS(LUCENT_PACKED_BUFFER)
 #undef LUCENT_PACKED_BUFFER
   bvh::BuildStats bvh_stats;

@@ -75,7 +75,7 @@ void check_film_memory(const Scene& scene, const cl_util::Context& ctx) {
 bool same_render_data(const render_detail::PackedScene& a, const render_detail::PackedScene& b) {
   if (std::memcmp(&a.params, &b.params, sizeof(lc_params)) != 0) return false;
   bool same = true;
-#define LUCENT_SAME(name, type)                    \
+#define LUCENT_SAME(name, type, ...)                    \
   same = same && a.name.size() == b.name.size() && \
          (a.name.empty() ||                        \
           std::memcmp(a.name.data(), b.name.data(), a.name.size() * sizeof(type)) == 0);
@@ -266,7 +266,7 @@ struct Renderer::Impl {
         if (!w.dev) {
           w.dev.emplace(w.ctx, next);
           ++stats.buffer_uploads;
-#define LUCENT_BYTES(name, type) stats.bytes_uploaded += next.name.size() * sizeof(type);
+#define LUCENT_BYTES(name, type, ...) stats.bytes_uploaded += next.name.size() * sizeof(type);
           LC_SCENE_BUFFERS(LUCENT_BYTES)
 #undef LUCENT_BYTES
         } else {
