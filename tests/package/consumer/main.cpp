@@ -1,8 +1,17 @@
-// A tiny program built against the installed lucent: parses a scene, renders it and checks that
-// the image is not black.
+// A small tool built against the installed lucent: a render session renders a scene, moves the
+// camera and renders again without rebuilding the BVH or the kernel (the session's counters say
+// so), and the one-shot lucent::render still works.
 #include <cstdio>
-
 #include <lucent/lucent.hpp>
+
+namespace {
+
+int fail(const char* what) {
+  std::fprintf(stderr, "consumer: %s\n", what);
+  return 1;
+}
+
+}  // namespace
 
 int main() {
   lucent::Scene scene = lucent::parse_scene(R"({
@@ -12,9 +21,34 @@ int main() {
     "materials": {"white": {"type": "diffuse", "albedo": [0.8, 0.8, 0.8]}},
     "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "white"}],
     "lights": [{"type": "point", "position": [0, 0, 4], "intensity": [10, 10, 10]}]
-  })", "consumer.json");
-  lucent::RenderResult r = lucent::render(scene);
-  const float* c = r.mean.pixel(8, 8);
-  std::printf("lucent %s: centre pixel %g %g %g\n", lucent::kVersion, c[0], c[1], c[2]);
-  return c[0] > 0 ? 0 : 1;
+  })",
+                                            "consumer.json");
+  try {
+    lucent::Renderer renderer(lucent::SessionOptions::from_environment());
+    renderer.set_scene(scene);
+    renderer.render(2);
+    lucent::RenderResult first = renderer.result();
+    scene.camera.position.x += 0.5;
+    renderer.set_scene(scene);
+    renderer.render(2);
+    lucent::RenderResult second = renderer.result();
+    lucent::SessionStats s = renderer.stats();
+    const float* c = first.mean.pixel(8, 8);
+    std::printf(
+        "lucent %s: centre pixel %g %g %g; after the camera move: %llu BVH build(s), %llu "
+        "kernel build(s), %llu kernel reuse(s)\n",
+        lucent::kVersion, c[0], c[1], c[2], static_cast<unsigned long long>(s.bvh_builds),
+        static_cast<unsigned long long>(s.kernel_compiles + s.kernel_cache_loads),
+        static_cast<unsigned long long>(s.kernel_reuses));
+    if (!(c[0] > 0)) return fail("the centre pixel is black");
+    if (second.spp != 2) return fail("the second render does not hold 2 spp");
+    if (second.mean.rgb == first.mean.rgb) return fail("moving the camera changed nothing");
+    if (s.bvh_builds != 1 || s.kernel_compiles + s.kernel_cache_loads != 1 || s.scene_packs != 2)
+      return fail("the camera move rebuilt the BVH or the kernel");
+    if (lucent::render(scene).mean.rgb != second.mean.rgb)
+      return fail("the one-shot render differs from the session's");
+  } catch (const lucent::Error& e) {
+    return fail(e.what());
+  }
+  return 0;
 }
