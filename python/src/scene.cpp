@@ -5,10 +5,13 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "common.hpp"
 #include "lucent/error.hpp"
+#include "render/features.hpp"
+#include "render/pack.hpp"
 #include "scene/loaders.hpp"
 
 PYBIND11_MAKE_OPAQUE(std::vector<lucent::Material>)
@@ -227,20 +230,75 @@ nlohmann::json to_json(py::handle o, const std::string& path, const std::string&
   return fail("cannot be written as JSON: " + py::repr(o).cast<std::string>());
 }
 
-/// Loads through `load` with the warnings sent to `on_warning` (warnings.warn when None).
+/// Runs `load` without the GIL, its warnings sent to `on_warning` (warnings.warn when None).
 template <class F>
-Scene with_warnings(py::object on_warning, F&& load) {
+auto with_warnings(py::object on_warning, F&& load) {
   check_callable(on_warning, "on_warning");
   auto errors = std::make_shared<CallbackErrors>();
   WarningSink sink = python_warning_sink(SharedObject(std::move(on_warning)), errors);
-  Scene scene;
+  std::optional<decltype(load())> out;
   {
     py::gil_scoped_release release;
     scene_detail::ScopedWarningSink scoped(sink);
-    scene = load();
+    out.emplace(load());
   }
   errors->rethrow();
-  return scene;
+  return std::move(*out);
+}
+
+/// What `lucent info` prints, as a dict: the packed scene's counts, its BVH and the kernel's
+/// feature defines and build options for these settings. Needs no device.
+py::dict scene_info(const Scene& scene, const std::string& precision, bool fast_math,
+                    bool specialize, py::object on_warning) {
+  RenderOptions options;
+  options.precision = parse_enum<Precision>(precision);
+  options.fast_math = fast_math;
+  options.specialize = specialize;
+  Scene copy = scene;
+  auto packed =
+      with_warnings(std::move(on_warning), [&] { return render_detail::pack_scene(copy); });
+  py::dict lights;
+  for (const auto& [type, name] : enum_names<LightType>().entries) lights[name] = 0;
+  for (const lc_light& l : packed.lights) {
+    py::str name(enum_name(static_cast<LightType>(l.type)));
+    lights[name] = lights[name].cast<int>() + 1;
+  }
+  const bvh::BuildStats& b = packed.bvh_stats;
+  py::dict bvh;
+  bvh["seconds"] = b.seconds;
+  bvh["primitives"] = b.primitives;
+  bvh["binary_nodes"] = b.binary_nodes;
+  bvh["nodes"] = b.nodes;
+  bvh["width"] = LC_BVH_WIDTH;
+  bvh["bytes"] = packed.nodes.size() * sizeof(lc_bvh_node);
+  bvh["leaves"] = b.leaves;
+  bvh["mean_leaf_size"] = b.mean_leaf_size;
+  bvh["max_leaf_size"] = b.max_leaf_size;
+  bvh["binary_max_depth"] = b.binary_max_depth;
+  bvh["max_depth"] = b.max_depth;
+  bvh["sah_cost"] = b.sah_cost;
+  double texel_bytes = 0;
+  for (const Texture& t : copy.textures) texel_bytes += double(t.width) * t.height * 16;
+  std::string defines = render_detail::feature_defines(copy, packed, specialize);
+  py::list define_list;
+  std::istringstream words(defines);
+  for (std::string w; words >> w;)
+    if (w != "-D") define_list.append(w);
+  py::dict d;
+  d["triangles"] = copy.triangles.size();
+  d["skipped_triangles"] = packed.skipped_triangles;
+  d["spheres"] = copy.spheres.size();
+  d["vertices"] = copy.positions.size();
+  d["materials"] = copy.materials.size();
+  d["textures"] = copy.textures.size();
+  d["texture_bytes"] = texel_bytes;
+  d["lights"] = lights;
+  d["bvh"] = bvh;
+  d["feature_defines"] = define_list;
+  d["precision"] = precision_name(options.precision);
+  d["fast_math"] = fast_math;
+  d["build_options"] = render_detail::build_options(copy, packed, options);
+  return d;
 }
 
 std::string scene_repr(const Scene& s) {
@@ -394,6 +452,12 @@ void bind_scene(py::module_& m) {
       py::arg("path"), py::arg("on_warning") = py::none(),
       "Loads a JSON scene. Warnings (a missing MTL file, ...) go to on_warning(message), or "
       "warnings.warn(message, LucentWarning) when None.");
+  m.def("scene_info", &scene_info, py::arg("scene"), py::kw_only(), py::arg("precision") = "float",
+        py::arg("fast_math") = false, py::arg("specialize") = true,
+        py::arg("on_warning") = py::none(),
+        "What `lucent info` prints, as a dict: counts (triangles, skipped_triangles, lights by "
+        "type, ...), the BVH's statistics, the kernel's feature defines and full build options "
+        "for these settings. Packs the scene and builds its BVH; needs no device.");
   m.def(
       "scene_from_dict",
       [](py::dict d, const std::filesystem::path& base_dir, const std::string& name,

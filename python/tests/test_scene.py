@@ -2,7 +2,9 @@
 writable, enums by their registry names, and every error of the scene API."""
 import json
 import math
+import os
 import re
+import subprocess
 
 import numpy as np
 import pytest
@@ -251,3 +253,34 @@ def test_bad_field_values():
         s.uvs = [[1, 2, 3]]
     with pytest.raises(ValueError, match=r"rgba: expected an array of shape \(H, W, 4\)"):
         lucent.Texture().rgba = np.zeros((2, 2, 3))
+
+
+def test_scene_info_matches_the_cli(tmp_path, small_dict):
+    small_dict["materials"]["lamp"] = {"type": "diffuse", "albedo": [0, 0, 0],
+                                       "emission": [1, 1, 1]}
+    small_dict["shapes"].append({"type": "sphere", "center": [1, 2, 0], "radius": 0.1,
+                                 "material": "lamp"})
+    scene = lucent.scene_from_dict(small_dict)
+    info = lucent.scene_info(scene)
+    assert (info["triangles"], info["spheres"], info["vertices"]) == (2, 2, 4)
+    assert info["lights"]["point"] == 1 and info["lights"]["sphere"] == 1
+    assert info["lights"]["triangle"] == 0 and info["skipped_triangles"] == 0
+    assert info["bvh"]["primitives"] == 4 and info["bvh"]["nodes"] >= 1
+    for define in ("LC_HAS_SPHERES", "LC_HAS_TRIANGLES", "LC_HAS_POINT_LIGHTS",
+                   "LC_HAS_SPHERE_LIGHTS", "LC_HAS_DIFFUSE", "LC_HAS_INTEGRATOR_PATH"):
+        assert define in info["feature_defines"], define
+    assert "LC_HAS_MIRROR" not in info["feature_defines"]
+    double = lucent.scene_info(scene, precision="double", fast_math=True, specialize=False)
+    assert "-D LC_DOUBLE" in double["build_options"]
+    assert "-cl-fast-relaxed-math" in double["build_options"]
+    assert "LC_HAS_MIRROR" in double["feature_defines"]
+    with pytest.raises(ValueError, match="unknown precision"):
+        lucent.scene_info(scene, precision="single")
+    cli = os.environ.get("LUCENT_CLI")
+    if cli:  # the same build options as `lucent info` prints
+        path = tmp_path / "s.json"
+        path.write_text(json.dumps(small_dict))
+        out = subprocess.run([cli, "info", str(path), "--precision", "double", "--fast-math",
+                              "--no-specialize"], check=True, capture_output=True, text=True)
+        line = next(x for x in out.stdout.splitlines() if "build options" in x)
+        assert line.split("build options", 1)[1].strip() == double["build_options"]
