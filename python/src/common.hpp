@@ -90,6 +90,9 @@ py::array_t<T> view(const std::vector<T>& data, std::vector<py::ssize_t> shape, 
   return py::array_t<T>(std::move(shape), data.data(), owner);
 }
 
+/// An (H, W, 3) float32 array that owns the image's pixels (moved into a capsule: no copy).
+py::array_t<float> image_array(Image&& image);
+
 /// A read-only NumPy array holding a copy of `n` rows of `cols` doubles starting at `first`.
 py::array_t<double> copy_rows(const double* first, std::size_t n, py::ssize_t cols);
 

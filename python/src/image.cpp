@@ -55,9 +55,7 @@ void bind_image(py::module_& m) {
           py::gil_scoped_release release;
           img = read_image(p);
         }
-        auto* owner = new std::vector<float>(std::move(img.rgb));
-        py::capsule capsule(owner, [](void* v) { delete static_cast<std::vector<float>*>(v); });
-        return py::array_t<float>({img.height, img.width, 3}, owner->data(), capsule);
+        return image_array(std::move(img));
       },
       py::arg("path"),
       "Reads .pfm, .exr (linear) or an 8-bit image (decoded to linear) as an (H, W, 3) float32 "

@@ -64,6 +64,12 @@ const EnumNames<Precision>& enum_names<Precision>() {
   return t;
 }
 
+py::array_t<float> image_array(Image&& image) {
+  auto* owner = new std::vector<float>(std::move(image.rgb));
+  py::capsule capsule(owner, [](void* v) { delete static_cast<std::vector<float>*>(v); });
+  return py::array_t<float>({image.height, image.width, 3}, owner->data(), capsule);
+}
+
 py::array_t<double> copy_rows(const double* first, std::size_t n, py::ssize_t cols) {
   py::array_t<double> a({static_cast<py::ssize_t>(n), cols});
   if (n > 0) std::copy(first, first + n * cols, a.mutable_data());

@@ -16,11 +16,12 @@ namespace lucent::python {
 namespace {
 
 // Every field of SessionStats, for attributes, as_dict() and repr().
-#define LUCENT_PY_SESSION_STATS(X)                                                              \
-  X(scene_packs)                                                                                \
-  X(bvh_builds)                                                                                 \
-  X(kernel_compiles) X(kernel_cache_loads) X(kernel_reuses) X(buffer_uploads) X(bytes_uploaded) \
-      X(passes) X(pack_seconds) X(bvh_seconds) X(build_seconds) X(render_seconds)
+#define LUCENT_PY_SESSION_STATS(X)                                                     \
+  X(scene_packs)                                                                       \
+  X(bvh_builds)                                                                        \
+  X(kernel_compiles)                                                                   \
+  X(kernel_cache_loads) X(kernel_reuses) X(buffer_uploads) X(bytes_uploaded) X(passes) \
+      X(pack_seconds) X(bvh_seconds) X(build_seconds) X(render_seconds)
 
 #define LUCENT_PY_PROGRESS(X) \
   X(samples_done) X(samples_target) X(accumulated) X(elapsed) X(time_limit) X(samples_per_second)
@@ -470,10 +471,7 @@ void bind_render(py::module_& m) {
       .def(
           "plot_image",
           [](const ConvergeResult& r, const std::string& title) {
-            Image img = convergence_image(r, title);
-            auto* owner = new std::vector<float>(std::move(img.rgb));
-            py::capsule capsule(owner, [](void* v) { delete static_cast<std::vector<float>*>(v); });
-            return py::array_t<float>({img.height, img.width, 3}, owner->data(), capsule);
+            return image_array(convergence_image(r, title));
           },
           py::arg("title") = "relMSE against render time",
           "The same plot as an (H, W, 3) linear float32 image (write_image it as a PNG).");
