@@ -8,6 +8,7 @@ packages=(
   pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers
   libglm-dev libtinyobjloader-dev libstb-dev libgtest-dev
   nlohmann-json3-dev libcli11-dev libtinyexr-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest
 )
 if [[ "${1:-}" == "--with-bench" ]]; then packages+=(libembree-dev); fi
 

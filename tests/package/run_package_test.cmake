@@ -21,3 +21,20 @@ execute_process(COMMAND ${WORK_DIR}/build/consumer WORKING_DIRECTORY ${WORK_DIR}
 if(rc)
   message(FATAL_ERROR "the consumer failed: ${rc}")
 endif()
+
+# the Python module, when it was built: installed where PYTHON_INSTALL_DIR says, imported from
+# there by the interpreter it was built for
+if(PYTHON_EXECUTABLE AND PYTHON_INSTALL_DIR)
+  set(module_dir ${WORK_DIR}/prefix/${PYTHON_INSTALL_DIR})
+  file(GLOB module ${module_dir}/lucent*.so)
+  if(NOT module)
+    message(FATAL_ERROR "the Python module is not installed in ${module_dir}")
+  endif()
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${module_dir}
+                          ${PYTHON_EXECUTABLE} ${SOURCE_DIR}/tests/package/check_python.py
+                          ${WORK_DIR}/prefix
+                  WORKING_DIRECTORY ${WORK_DIR} RESULT_VARIABLE rc)
+  if(rc)
+    message(FATAL_ERROR "importing the installed Python module failed: ${rc}")
+  endif()
+endif()

@@ -1,9 +1,19 @@
-// A tiny program built against the installed lucent: renders a scene parsed from JSON and the
-// same scene built in code, checks that both images are equal and not black, and that a wrong
-// value is reported as the JSON loader would.
+// A small tool built against the installed lucent: a render session renders a scene, moves the
+// camera and renders again without rebuilding the BVH or the kernel (the session's counters say
+// so), the one-shot lucent::render gives the same image, the same scene built in code gives the
+// same image, and a wrong value is reported as the JSON loader would.
 #include <cstdio>
 #include <lucent/lucent.hpp>
 #include <string>
+
+namespace {
+
+int fail(const char* what) {
+  std::fprintf(stderr, "consumer: %s\n", what);
+  return 1;
+}
+
+}  // namespace
 
 int main() {
   lucent::Scene scene = lucent::parse_scene(R"({
@@ -15,40 +25,63 @@ int main() {
     "lights": [{"type": "point", "position": [0, 0, 4], "intensity": [10, 10, 10]}]
   })",
                                             "consumer.json");
-  lucent::RenderResult r = lucent::render(scene);
-  const float* c = r.mean.pixel(8, 8);
-  std::printf("lucent %s: centre pixel %g %g %g\n", lucent::kVersion, c[0], c[1], c[2]);
-
-  lucent::SceneBuilder b("consumer.json");
-  lucent::Camera camera;
-  camera.position = {0, 0, 4};
-  camera.fov_degrees = 40;
-  b.set_camera(camera);
-  lucent::Film film;
-  film.width = film.height = 16;
-  b.set_film(film);
-  lucent::Integrator integrator;
-  integrator.type = lucent::parse_type<lucent::IntegratorType>("direct");
-  integrator.spp = 2;
-  b.set_integrator(integrator);
-  lucent::Material white;
-  white.name = "white";
-  white.albedo = {0.8, 0.8, 0.8};
-  b.add_material(white);
-  b.add_sphere({{0, 0, 0}, 1, "white"});
-  b.add_light(lucent::point_light({0, 0, 4}, {10, 10, 10}));
-  lucent::RenderResult built = lucent::render(b.build());
-  bool same = built.mean.rgb == r.mean.rgb;
-
-  std::string message;
   try {
-    lucent::SceneBuilder bad("consumer.json");
-    bad.add_sphere({{0, 0, 0}, 1, "white"});
+    lucent::Renderer renderer(lucent::SessionOptions::from_environment());
+    renderer.set_scene(scene);
+    renderer.render(2);
+    lucent::RenderResult first = renderer.result();
+    scene.camera.position.x += 0.5;
+    renderer.set_scene(scene);
+    renderer.render(2);
+    lucent::RenderResult second = renderer.result();
+    lucent::SessionStats s = renderer.stats();
+    const float* c = first.mean.pixel(8, 8);
+    std::printf(
+        "lucent %s: centre pixel %g %g %g; after the camera move: %llu BVH build(s), %llu "
+        "kernel build(s), %llu kernel reuse(s)\n",
+        lucent::kVersion, c[0], c[1], c[2], static_cast<unsigned long long>(s.bvh_builds),
+        static_cast<unsigned long long>(s.kernel_compiles + s.kernel_cache_loads),
+        static_cast<unsigned long long>(s.kernel_reuses));
+    if (!(c[0] > 0)) return fail("the centre pixel is black");
+    if (second.spp != 2) return fail("the second render does not hold 2 spp");
+    if (second.mean.rgb == first.mean.rgb) return fail("moving the camera changed nothing");
+    if (s.bvh_builds != 1 || s.kernel_compiles + s.kernel_cache_loads != 1 || s.scene_packs != 2)
+      return fail("the camera move rebuilt the BVH or the kernel");
+    if (lucent::render(scene).mean.rgb != second.mean.rgb)
+      return fail("the one-shot render differs from the session's");
+    lucent::SceneBuilder b("consumer.json");
+    lucent::Camera camera;
+    camera.position = {0, 0, 4};
+    camera.fov_degrees = 40;
+    b.set_camera(camera);
+    lucent::Film film;
+    film.width = film.height = 16;
+    b.set_film(film);
+    lucent::Integrator integrator;
+    integrator.type = lucent::parse_type<lucent::IntegratorType>("direct");
+    integrator.spp = 2;
+    b.set_integrator(integrator);
+    lucent::Material white;
+    white.name = "white";
+    white.albedo = {0.8, 0.8, 0.8};
+    b.add_material(white);
+    b.add_sphere({{0, 0, 0}, 1, "white"});
+    b.add_light(lucent::point_light({0, 0, 4}, {10, 10, 10}));
+    lucent::RenderResult built = lucent::render(b.build());
+    if (built.mean.rgb != first.mean.rgb)
+      return fail("the scene built in code renders differently");
+
+    std::string message;
+    try {
+      lucent::SceneBuilder bad("consumer.json");
+      bad.add_sphere({{0, 0, 0}, 1, "white"});
+    } catch (const lucent::Error& e) {
+      message = e.what();
+    }
+    if (message != "consumer.json: /shapes/0/material: unknown material 'white'")
+      return fail("the builder's error is not the loader's line");
   } catch (const lucent::Error& e) {
-    message = e.what();
+    return fail(e.what());
   }
-  bool named = message == "consumer.json: /shapes/0/material: unknown material 'white'";
-  std::printf("built in code: %s; error: %s\n", same ? "same image" : "DIFFERENT image",
-              message.c_str());
-  return c[0] > 0 && same && named ? 0 : 1;
+  return 0;
 }

@@ -1,0 +1,170 @@
+#pragma once
+// Shared pieces of the Python module: enum names from the registries, arrays that own or view
+// C++ vectors, images from arrays, and calling Python back from a render that released the GIL.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <atomic>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "lucent/image.hpp"
+#include "lucent/render.hpp"
+#include "lucent/scene.hpp"
+
+namespace py = pybind11;
+
+namespace lucent::python {
+
+// ------------------------------------------------------------------------------------------
+// Enums by name: the registries' scene-file names (kernels/shared/registry.h), so that Python
+// code reads and writes `material.type = "mirror"` as a scene file would.
+// ------------------------------------------------------------------------------------------
+
+template <class E>
+struct EnumNames {
+  const char* what;  ///< "material type", for messages
+  std::vector<std::pair<E, const char*>> entries;
+};
+
+template <class E>
+const EnumNames<E>& enum_names();
+template <>
+const EnumNames<MaterialType>& enum_names<MaterialType>();
+template <>
+const EnumNames<LightType>& enum_names<LightType>();
+template <>
+const EnumNames<IntegratorType>& enum_names<IntegratorType>();
+template <>
+const EnumNames<FilterType>& enum_names<FilterType>();
+template <>
+const EnumNames<Transfer>& enum_names<Transfer>();
+template <>
+const EnumNames<ToneMap>& enum_names<ToneMap>();
+template <>
+const EnumNames<Precision>& enum_names<Precision>();
+
+/// The registry name of `value`.
+template <class E>
+const char* enum_name(E value) {
+  for (const auto& [v, name] : enum_names<E>().entries)
+    if (v == value) return name;
+  return "?";
+}
+
+/// The value named `name`; ValueError naming the valid names otherwise.
+template <class E>
+E parse_enum(const std::string& name) {
+  const EnumNames<E>& t = enum_names<E>();
+  std::string valid;
+  for (const auto& [v, n] : t.entries) {
+    if (name == n) return v;
+    valid += (valid.empty() ? "" : ", ") + std::string(n);
+  }
+  throw py::value_error("unknown " + std::string(t.what) + " '" + name + "' (expected one of " +
+                        valid + ")");
+}
+
+/// The names, in registry order (module attributes such as lucent.MATERIAL_TYPES).
+template <class E>
+py::tuple enum_name_tuple() {
+  py::list out;
+  for (const auto& entry : enum_names<E>().entries) out.append(entry.second);
+  return py::tuple(out);
+}
+
+// ------------------------------------------------------------------------------------------
+// Arrays
+// ------------------------------------------------------------------------------------------
+
+/// A NumPy array over `data` (C order, `shape`), kept valid by `owner` (the Python object that
+/// holds the vector): no copy.
+template <class T>
+py::array_t<T> view(const std::vector<T>& data, std::vector<py::ssize_t> shape, py::handle owner) {
+  return py::array_t<T>(std::move(shape), data.data(), owner);
+}
+
+/// An (H, W, 3) float32 array that owns the image's pixels (moved into a capsule: no copy).
+py::array_t<float> image_array(Image&& image);
+
+/// A read-only NumPy array holding a copy of `n` rows of `cols` doubles starting at `first`.
+py::array_t<double> copy_rows(const double* first, std::size_t n, py::ssize_t cols);
+
+/// An (H, W, 3) float array (any real dtype, converted) as an Image; ValueError naming `what`
+/// when the shape is not (H, W, 3) with H, W >= 1.
+Image image_from_array(py::handle array, const char* what);
+
+/// The image of a RenderResult or of an (H, W, 3) array.
+RenderResult render_result_from(py::handle object, const char* what);
+
+// ------------------------------------------------------------------------------------------
+// Calling Python from C++ code that runs without the GIL
+// ------------------------------------------------------------------------------------------
+
+/// TypeError unless `f` is None or callable.
+inline void check_callable(const py::object& f, const char* what) {
+  if (!f.is_none() && !PyCallable_Check(f.ptr()))
+    throw py::type_error(std::string(what) + " must be callable or None, got " +
+                         py::repr(f).cast<std::string>());
+}
+
+/// A Python object that may be copied and destroyed without the GIL (the std::function objects
+/// of lucent's options are copied by the library, with the GIL released).
+class SharedObject {
+ public:
+  SharedObject() = default;
+  explicit SharedObject(py::object o);
+  py::object get() const { return object_ ? *object_ : py::none(); }
+  explicit operator bool() const { return object_ && !object_->is_none(); }
+
+ private:
+  std::shared_ptr<py::object> object_;
+};
+
+/// The first exception a callback raised while lucent ran without the GIL; rethrown by
+/// rethrow() once lucent returned (it never crosses the library).
+class CallbackErrors {
+ public:
+  bool failed() const { return static_cast<bool>(error_); }
+  /// Runs `f` (with the GIL held by the caller); keeps its exception. Returns false when `f`
+  /// threw or an earlier call did.
+  template <class F>
+  bool run(F&& f) {
+    if (error_) return false;
+    try {
+      f();
+      return true;
+    } catch (...) {
+      error_ = std::current_exception();
+      return false;
+    }
+  }
+  void rethrow() {
+    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+  }
+
+ private:
+  std::exception_ptr error_;
+};
+
+/// A warning sink that calls `callback(message)`, or warnings.warn(message, LucentWarning)
+/// when `callback` is None. Exceptions go to `errors`.
+WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackErrors> errors);
+
+/// Runs `work` on a worker thread with the GIL released while this thread checks Python's
+/// signals every 50 ms: on KeyboardInterrupt (or any exception of a signal handler) `cancel` is
+/// set, the work is awaited (it stops early on the flag) and the exception is raised.
+void run_interruptible(const std::function<void()>& work, std::atomic<bool>& cancel);
+
+/// Module parts.
+void bind_scene(py::module_& m);
+void bind_render(py::module_& m);
+void bind_image(py::module_& m);
+
+}  // namespace lucent::python

@@ -1,0 +1,154 @@
+// Images, comparison and convergence studies from Python: write_image / read_image, the EXR
+// with variances and counts (write_render_exr / read_render), compare() and converge().
+#include <cmath>
+
+#include "common.hpp"
+#include "lucent/compare.hpp"
+#include "lucent/error.hpp"
+
+namespace lucent::python {
+
+namespace {
+
+py::tuple triple(const double v[3]) { return py::make_tuple(v[0], v[1], v[2]); }
+
+/// The display settings of `film` (a Film or None: the defaults), each overridden when given.
+DisplaySettings display_settings(const Film* film, py::object transfer, py::object gamma,
+                                 py::object exposure, py::object tonemap) {
+  DisplaySettings d;
+  if (film) d = DisplaySettings{film->transfer, film->gamma, film->exposure, film->tonemap};
+  if (!transfer.is_none()) d.transfer = parse_enum<Transfer>(transfer.cast<std::string>());
+  if (!tonemap.is_none()) d.tonemap = parse_enum<ToneMap>(tonemap.cast<std::string>());
+  if (!gamma.is_none()) d.gamma = gamma.cast<double>();
+  if (!exposure.is_none()) d.exposure = exposure.cast<double>();
+  if (!(d.gamma > 0) || !std::isfinite(d.gamma))
+    throw py::value_error("gamma must be a finite number > 0, got " +
+                          py::repr(py::float_(d.gamma)).cast<std::string>());
+  if (!std::isfinite(d.exposure)) throw py::value_error("exposure must be finite");
+  return d;
+}
+
+}  // namespace
+
+void bind_image(py::module_& m) {
+  m.def(
+      "write_image",
+      [](const std::filesystem::path& path, py::handle image, const Film* film, py::object transfer,
+         py::object gamma, py::object exposure, py::object tonemap) {
+        DisplaySettings d = display_settings(film, transfer, gamma, exposure, tonemap);
+        RenderResult r = render_result_from(image, "image");
+        std::string p = path.string();
+        py::gil_scoped_release release;
+        write_image(p, r.mean, d);
+      },
+      py::arg("path"), py::arg("image"), py::kw_only(), py::arg("film") = nullptr,
+      py::arg("transfer") = py::none(), py::arg("gamma") = py::none(),
+      py::arg("exposure") = py::none(), py::arg("tonemap") = py::none(),
+      "Writes an (H, W, 3) array or a RenderResult's mean: .png (8-bit, display-encoded with "
+      "the film's settings, or the defaults, each overridable), .pfm or .exr (linear float).");
+  m.def(
+      "read_image",
+      [](const std::filesystem::path& path) {
+        Image img;
+        std::string p = path.string();
+        {
+          py::gil_scoped_release release;
+          img = read_image(p);
+        }
+        return image_array(std::move(img));
+      },
+      py::arg("path"),
+      "Reads .pfm, .exr (linear) or an 8-bit image (decoded to linear) as an (H, W, 3) float32 "
+      "array.");
+  m.def(
+      "write_render_exr",
+      [](const std::filesystem::path& path, py::handle result) {
+        RenderResult r = render_result_from(result, "result");
+        std::string p = path.string();
+        py::gil_scoped_release release;
+        write_render_exr(p, r);
+      },
+      py::arg("path"), py::arg("result"),
+      "Writes an OpenEXR with the mean (R, G, B) and, when the result has them, the variances "
+      "(var.R, var.G, var.B) and sample counts (n) that compare() uses.");
+  m.def(
+      "read_render",
+      [](const std::filesystem::path& path) {
+        std::string p = path.string();
+        py::gil_scoped_release release;
+        return read_render(p);
+      },
+      py::arg("path"),
+      "Reads an image as a RenderResult: an EXR with variances and counts, or any image "
+      "read_image() reads (variance and samples None).");
+
+  py::class_<CompareResult>(m, "CompareResult",
+                            "The per-pixel z-test of two images (docs/compare.md).")
+      .def_readonly("width", &CompareResult::width)
+      .def_readonly("height", &CompareResult::height)
+      .def_readonly("passed", &CompareResult::passed)
+      .def_readonly("statistical", &CompareResult::statistical)
+      .def_readonly("z_threshold", &CompareResult::z_threshold)
+      .def_readonly("tested", &CompareResult::tested)
+      .def_readonly("failed_channels", &CompareResult::failed_channels)
+      .def_readonly("failed_pixels", &CompareResult::failed_pixels)
+      .def_readonly("pass_fraction", &CompareResult::pass_fraction)
+      .def_readonly("required_fraction", &CompareResult::required_fraction)
+      .def_readonly("max_z", &CompareResult::max_z)
+      .def_readonly("max_z_x", &CompareResult::max_z_x)
+      .def_readonly("max_z_y", &CompareResult::max_z_y)
+      .def_readonly("max_z_channel", &CompareResult::max_z_channel)
+      .def_property_readonly("mean_a", [](const CompareResult& c) { return triple(c.mean_a); })
+      .def_property_readonly("mean_b", [](const CompareResult& c) { return triple(c.mean_b); })
+      .def_property_readonly("mean_z", [](const CompareResult& c) { return triple(c.mean_z); })
+      .def_readonly("mean_z_threshold", &CompareResult::mean_z_threshold)
+      .def_readonly("mean_test_passed", &CompareResult::mean_test_passed)
+      .def_readonly("rmse", &CompareResult::rmse)
+      .def_readonly("relmse", &CompareResult::relmse)
+      .def_readonly("max_abs_error", &CompareResult::max_abs_error)
+      .def_property_readonly(
+          "z",
+          [](py::object self) {
+            const CompareResult& c = self.cast<const CompareResult&>();
+            return view(c.z.rgb, {c.z.height, c.z.width, 3}, self);
+          },
+          "(H, W, 3) float32: signed z of each pixel-channel (a view)")
+      .def("summary", &CompareResult::summary, "The report `lucent compare` prints.")
+      .def("__bool__", [](const CompareResult& c) { return c.passed; })
+      .def("__repr__", [](const CompareResult& c) {
+        return std::string("<lucent.CompareResult ") + (c.passed ? "passed" : "FAILED") +
+               ", max |z| " + std::to_string(c.max_z) + ", RMSE " + std::to_string(c.rmse) + ">";
+      });
+
+  m.def(
+      "compare",
+      [](py::handle a, py::handle b, double alpha, double min_pass_fraction, double abs_epsilon,
+         double rel_epsilon, bool image_mean_test) {
+        if (!(alpha > 0 && alpha < 1))
+          throw py::value_error("alpha must be in (0, 1), got " + std::to_string(alpha));
+        if (!(min_pass_fraction >= 0 && min_pass_fraction <= 1))
+          throw py::value_error("min_pass_fraction must be in [0, 1], got " +
+                                std::to_string(min_pass_fraction));
+        if (!(abs_epsilon >= 0) || !(rel_epsilon >= 0) || !std::isfinite(abs_epsilon) ||
+            !std::isfinite(rel_epsilon))
+          throw py::value_error("abs_epsilon and rel_epsilon must be finite and >= 0");
+        RenderResult ra = render_result_from(a, "a"), rb = render_result_from(b, "b");
+        CompareOptions o;
+        o.alpha = alpha;
+        o.min_pass_fraction = min_pass_fraction;
+        o.abs_epsilon = abs_epsilon;
+        o.rel_epsilon = rel_epsilon;
+        o.image_mean_test = image_mean_test;
+        py::gil_scoped_release release;
+        return compare_images(ra, rb, o);
+      },
+      py::arg("a"), py::arg("b"), py::kw_only(), py::arg("alpha") = CompareOptions{}.alpha,
+      py::arg("min_pass_fraction") = CompareOptions{}.min_pass_fraction,
+      py::arg("abs_epsilon") = CompareOptions{}.abs_epsilon,
+      py::arg("rel_epsilon") = CompareOptions{}.rel_epsilon,
+      py::arg("image_mean_test") = CompareOptions{}.image_mean_test,
+      "Per-pixel z-test of two RenderResults (or (H, W, 3) arrays: no variance), as `lucent "
+      "compare`.");
+}
+
+}  // namespace lucent::python

@@ -1,0 +1,242 @@
+// The `lucent` Python module: errors, enum names, devices, the environment's defaults, and the
+// helpers shared by the other parts (scene.cpp, render.cpp, image.cpp).
+#include <chrono>
+#include <future>
+#include <thread>
+
+#include "cl/program_cache.hpp"
+#include "common.hpp"
+#include "lucent/device.hpp"
+#include "lucent/error.hpp"
+#include "lucent/session.hpp"
+#include "lucent/version.hpp"
+
+namespace lucent::python {
+
+#define LUCENT_PY_NAME(ID, Name, value, name, ...) {Enum::Name, name},
+
+template <>
+const EnumNames<MaterialType>& enum_names<MaterialType>() {
+  using Enum = MaterialType;
+  static const EnumNames<Enum> t{"material type", {LC_MATERIAL_TYPES(LUCENT_PY_NAME)}};
+  return t;
+}
+template <>
+const EnumNames<LightType>& enum_names<LightType>() {
+  using Enum = LightType;
+  static const EnumNames<Enum> t{"light type", {LC_LIGHT_TYPES(LUCENT_PY_NAME)}};
+  return t;
+}
+template <>
+const EnumNames<IntegratorType>& enum_names<IntegratorType>() {
+  using Enum = IntegratorType;
+  static const EnumNames<Enum> t{
+      "integrator", {LC_INTEGRATOR_TYPES(LUCENT_PY_NAME) LC_AOV_TYPES(LUCENT_PY_NAME)}};
+  return t;
+}
+template <>
+const EnumNames<FilterType>& enum_names<FilterType>() {
+  using Enum = FilterType;
+  static const EnumNames<Enum> t{"filter type", {LC_FILTER_TYPES(LUCENT_PY_NAME)}};
+  return t;
+}
+#undef LUCENT_PY_NAME
+
+// Not in the registries: the film's display settings (scene-file names) and the precision.
+template <>
+const EnumNames<Transfer>& enum_names<Transfer>() {
+  static const EnumNames<Transfer> t{
+      "transfer",
+      {{Transfer::Srgb, "srgb"}, {Transfer::Gamma, "gamma"}, {Transfer::Linear, "linear"}}};
+  return t;
+}
+template <>
+const EnumNames<ToneMap>& enum_names<ToneMap>() {
+  static const EnumNames<ToneMap> t{
+      "tone map",
+      {{ToneMap::Clamp, "clamp"}, {ToneMap::Reinhard, "reinhard"}, {ToneMap::Aces, "aces"}}};
+  return t;
+}
+template <>
+const EnumNames<Precision>& enum_names<Precision>() {
+  static const EnumNames<Precision> t{"precision",
+                                      {{Precision::Float, "float"}, {Precision::Double, "double"}}};
+  return t;
+}
+
+py::array_t<float> image_array(Image&& image) {
+  auto* owner = new std::vector<float>(std::move(image.rgb));
+  py::capsule capsule(owner, [](void* v) { delete static_cast<std::vector<float>*>(v); });
+  return py::array_t<float>({image.height, image.width, 3}, owner->data(), capsule);
+}
+
+py::array_t<double> copy_rows(const double* first, std::size_t n, py::ssize_t cols) {
+  py::array_t<double> a({static_cast<py::ssize_t>(n), cols});
+  if (n > 0) std::copy(first, first + n * cols, a.mutable_data());
+  a.attr("flags").attr("writeable") = false;
+  return a;
+}
+
+Image image_from_array(py::handle object, const char* what) {
+  auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(object);
+  if (!a) throw py::type_error(std::string(what) + ": expected an array of shape (H, W, 3)");
+  if (a.ndim() != 3 || a.shape(2) != 3 || a.shape(0) < 1 || a.shape(1) < 1) {
+    std::string shape;
+    for (py::ssize_t i = 0; i < a.ndim(); ++i)
+      shape += (i ? ", " : "") + std::to_string(a.shape(i));
+    throw py::value_error(std::string(what) + ": expected an array of shape (H, W, 3), got (" +
+                          shape + (a.ndim() == 1 ? ",)" : ")"));
+  }
+  Image img;
+  img.height = static_cast<int>(a.shape(0));
+  img.width = static_cast<int>(a.shape(1));
+  img.rgb.assign(a.data(), a.data() + a.size());
+  return img;
+}
+
+RenderResult render_result_from(py::handle object, const char* what) {
+  if (py::isinstance<RenderResult>(object)) return object.cast<RenderResult>();
+  RenderResult r;
+  r.mean = image_from_array(object, what);
+  return r;
+}
+
+SharedObject::SharedObject(py::object o)
+    : object_(new py::object(std::move(o)), [](py::object* p) {
+        py::gil_scoped_acquire gil;
+        delete p;
+      }) {}
+
+WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackErrors> errors) {
+  return [callback, errors](const std::string& message) {
+    py::gil_scoped_acquire gil;
+    errors->run([&] {
+      if (callback) {
+        callback.get()(message);
+      } else {
+        py::module_ lucent = py::module_::import("lucent");
+        py::module_::import("warnings").attr("warn")(message, lucent.attr("LucentWarning"), 2);
+      }
+    });
+  };
+}
+
+void run_interruptible(const std::function<void()>& work, std::atomic<bool>& cancel) {
+  std::exception_ptr interrupt;
+  std::exception_ptr failure;
+  {
+    py::gil_scoped_release release;
+    std::packaged_task<void()> task(work);
+    std::future<void> done = task.get_future();
+    std::thread worker(std::move(task));
+    while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+      if (interrupt) continue;
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) {
+        interrupt = std::make_exception_ptr(py::error_already_set());
+        cancel.store(true);
+      }
+    }
+    worker.join();
+    try {
+      done.get();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  if (interrupt) std::rethrow_exception(interrupt);
+  if (failure) std::rethrow_exception(failure);
+}
+
+namespace {
+
+/// The cache directory of a session whose cache_dir option is `dir` ("" when disabled).
+std::string resolved_cache_dir(const std::string& dir) {
+  std::string d = dir.empty() ? SessionOptions::from_environment().cache_dir : dir;
+  if (d == "off") return "";
+  return d.empty() ? cl_util::default_program_cache_dir() : d;
+}
+
+py::dict environment() {
+  SessionOptions o = SessionOptions::from_environment();
+  py::dict d;
+  d["device"] = o.device;
+  d["kernel_dir"] = o.kernel_dir;
+  d["cache_dir"] = o.cache_dir;
+  return d;
+}
+
+}  // namespace
+
+}  // namespace lucent::python
+
+PYBIND11_MODULE(lucent, m) {
+  using namespace lucent;
+  using namespace lucent::python;
+  m.doc() =
+      "lucent: a physically based OpenCL path tracer. Scenes (load_scene, scene_from_dict, "
+      "Scene), render sessions (Renderer), images (write_image, read_render, compare) and "
+      "convergence studies (converge). Every failure raises lucent.Error with lucent's one-line "
+      "message.";
+  m.attr("__version__") = kVersion;
+
+  static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
+  error.doc() =
+      "A failure reported by lucent: one line naming the file and the place, or the call.";
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const Error& e) {
+      error(e.what());
+    }
+  });
+  py::object warning = py::reinterpret_steal<py::object>(
+      PyErr_NewExceptionWithDoc("lucent.LucentWarning",
+                                "A warning of scene loading or packing (skipped triangles, a "
+                                "missing MTL file, ...).",
+                                PyExc_UserWarning, nullptr));
+  if (!warning) throw py::error_already_set();
+  m.attr("LucentWarning") = warning;
+
+  m.attr("MATERIAL_TYPES") = enum_name_tuple<MaterialType>();
+  m.attr("LIGHT_TYPES") = enum_name_tuple<LightType>();
+  m.attr("INTEGRATORS") = enum_name_tuple<IntegratorType>();
+  m.attr("FILTER_TYPES") = enum_name_tuple<FilterType>();
+  m.attr("TRANSFERS") = enum_name_tuple<Transfer>();
+  m.attr("TONEMAPS") = enum_name_tuple<ToneMap>();
+
+  py::class_<DeviceInfo>(m, "DeviceInfo", "An OpenCL device, as `lucent devices` lists it.")
+      .def_readonly("index", &DeviceInfo::index)
+      .def_readonly("platform", &DeviceInfo::platform)
+      .def_readonly("name", &DeviceInfo::name)
+      .def_readonly("type", &DeviceInfo::type)
+      .def_readonly("vendor", &DeviceInfo::vendor)
+      .def_readonly("driver_version", &DeviceInfo::driver_version)
+      .def_readonly("opencl_c_version", &DeviceInfo::opencl_c_version)
+      .def_readonly("compute_units", &DeviceInfo::compute_units)
+      .def_readonly("global_memory", &DeviceInfo::global_memory)
+      .def_readonly("fp64", &DeviceInfo::fp64)
+      .def("__repr__", [](const DeviceInfo& d) {
+        return "<lucent.DeviceInfo " + std::to_string(d.index) + ": " + d.name + " (" + d.type +
+               ", " + d.platform + ")>";
+      });
+  m.def("list_devices", &list_devices, "Every OpenCL device of every platform.");
+  m.def("select_device", &select_device, py::arg("selector") = "", py::arg("origin") = "device",
+        "The device a selector picks (an index or a case-insensitive substring of the name; \"\": "
+        "the first GPU, else the first CPU device).");
+  m.def("environment", &environment,
+        "The `lucent` command's session defaults from LUCENT_DEVICE, LUCENT_KERNEL_DIR and "
+        "LUCENT_CACHE_DIR, as keyword arguments for Renderer: Renderer(**lucent.environment()).");
+  m.def("cache_dir", &resolved_cache_dir, py::arg("cache_dir") = "",
+        "The kernel binary cache directory a session with this cache_dir uses (\"\": "
+        "LUCENT_CACHE_DIR, else the default), or \"\" when disabled (\"off\").");
+  m.def(
+      "clear_cache",
+      [](const std::string& dir) { return cl_util::clear_program_cache(resolved_cache_dir(dir)); },
+      py::arg("cache_dir") = "",
+      "Removes every cached kernel program from that directory; returns how many.");
+
+  bind_scene(m);
+  bind_render(m);
+  bind_image(m);
+}

@@ -1,0 +1,541 @@
+// Rendering from Python: the session (lucent.Renderer), its results as NumPy arrays without
+// copies, its statistics, and the reference integrator. Renders release the GIL; the progress
+// callback and Python's signal handlers run between passes, so Ctrl-C stops a render after the
+// current pass, keeps what it had accumulated and raises KeyboardInterrupt.
+#include <cmath>
+#include <optional>
+
+#include "common.hpp"
+#include "lucent/converge.hpp"
+#include "lucent/error.hpp"
+#include "lucent/reference.hpp"
+#include "lucent/session.hpp"
+
+namespace lucent::python {
+
+namespace {
+
+// Every field of SessionStats, for attributes, as_dict() and repr().
+#define LUCENT_PY_SESSION_STATS(X)                                                     \
+  X(scene_packs)                                                                       \
+  X(bvh_builds)                                                                        \
+  X(kernel_compiles)                                                                   \
+  X(kernel_cache_loads) X(kernel_reuses) X(buffer_uploads) X(bytes_uploaded) X(passes) \
+      X(pack_seconds) X(bvh_seconds) X(build_seconds) X(render_seconds)
+
+#define LUCENT_PY_PROGRESS(X) \
+  X(samples_done) X(samples_target) X(accumulated) X(elapsed) X(time_limit) X(samples_per_second)
+
+template <class T>
+std::string format_field(const T& v) {
+  if constexpr (std::is_floating_point_v<T>) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+    return buf;
+  } else {
+    return std::to_string(v);
+  }
+}
+
+// Several devices in one session (RenderResult::devices, RenderProgress::devices,
+// Renderer::devices()) are exposed when the library has them.
+template <class T, class = void>
+struct has_device_shares : std::false_type {};
+template <class T>
+struct has_device_shares<T, std::void_t<decltype(std::declval<T&>().devices)>> : std::true_type {};
+template <class T, class = void>
+struct has_devices_method : std::false_type {};
+template <class T>
+struct has_devices_method<T, std::void_t<decltype(std::declval<const T&>().devices())>>
+    : std::true_type {};
+
+/// `devices`: each device's part (a list of DeviceShare), when T has it.
+template <class T>
+void bind_device_shares(py::module_& m, py::class_<T>& c) {
+  if constexpr (has_device_shares<T>::value) {
+    using Share = typename decltype(std::declval<T&>().devices)::value_type;
+    if (!py::hasattr(m, "DeviceShare"))
+      py::class_<Share>(m, "DeviceShare", "One device's part of a render.")
+          .def_readonly("device", &Share::device)
+          .def_readonly("samples", &Share::samples)
+          .def_readonly("seconds", &Share::seconds)
+          .def("__repr__", [](const Share& d) {
+            return "<lucent.DeviceShare " + d.device + ": " + std::to_string(d.samples) + " spp>";
+          });
+    c.def_readonly("devices", &T::devices, "each device's part (several devices in a session)");
+  }
+}
+
+/// A session as Python holds it: the Renderer, the sink of its warnings, and a guard against
+/// two Python threads using it at once (only cancel() is thread-safe).
+class PyRenderer {
+ public:
+  PyRenderer(const std::string& device, const std::string& kernel_dir, const std::string& cache_dir,
+             const std::string& precision, bool fast_math, bool specialize, double pass_seconds,
+             py::object on_warning)
+      : warning_errors_(std::make_shared<CallbackErrors>()) {
+    check_callable(on_warning, "on_warning");
+    if (!(pass_seconds > 0) || !std::isfinite(pass_seconds))
+      throw py::value_error("pass_seconds must be a positive number of seconds, got " +
+                            format_field(pass_seconds));
+    SessionOptions o;
+    o.device = device;
+    o.kernel_dir = kernel_dir;
+    o.cache_dir = cache_dir;
+    o.precision = parse_enum<Precision>(precision);
+    o.fast_math = fast_math;
+    o.specialize = specialize;
+    o.pass_seconds = pass_seconds;
+    o.on_warning = python_warning_sink(SharedObject(std::move(on_warning)), warning_errors_);
+    py::gil_scoped_release release;
+    renderer_.emplace(std::move(o));
+    renderer_->set_cancel_flag(&stop_);
+  }
+
+  Renderer& get() {
+    if (!renderer_) throw Error("the renderer is closed");
+    return *renderer_;
+  }
+
+  /// Runs `f(renderer)` with the GIL released, one call at a time; then raises what a warning
+  /// callback raised.
+  template <class F>
+  auto call(F&& f) {
+    Busy busy(*this);
+    Renderer& r = get();
+    using Result = decltype(f(r));
+    if constexpr (std::is_void_v<Result>) {
+      {
+        py::gil_scoped_release release;
+        f(r);
+      }
+      warning_errors_->rethrow();
+    } else {
+      std::optional<Result> out;
+      {
+        py::gil_scoped_release release;
+        out.emplace(f(r));
+      }
+      warning_errors_->rethrow();
+      return std::move(*out);
+    }
+  }
+
+  /// Runs `f(renderer, stop)`, one call at a time, on a worker thread while this one runs
+  /// Python's signal handlers (run_interruptible): KeyboardInterrupt raises `stop`, the
+  /// session's cancel flag, and a render in progress ends after its current pass.
+  template <class F>
+  void call_interruptible(F&& f) {
+    Busy busy(*this);
+    Renderer& r = get();
+    stop_ = false;
+    run_interruptible([&] { f(r, stop_); }, stop_);
+    warning_errors_->rethrow();
+  }
+
+  /// A render call: `progress(p)` runs after each pass (on the rendering thread, with the GIL);
+  /// an exception it raises, or Ctrl-C, stops the render after the current pass and is raised
+  /// once the render returned. The accumulation keeps what was rendered.
+  RenderProgress render(std::uint64_t spp, double seconds, py::object progress) {
+    check_callable(progress, "progress");
+    CallbackErrors errors;
+    std::function<void(const RenderProgress&)> on_progress;
+    if (!progress.is_none())
+      on_progress = [&](const RenderProgress& p) {
+        py::gil_scoped_acquire gil;
+        if (!errors.run([&] { progress(p); })) stop_ = true;
+      };
+    RenderProgress out;
+    call_interruptible(
+        [&](Renderer& r, std::atomic<bool>&) { out = r.render(spp, seconds, on_progress); });
+    errors.rethrow();
+    return out;
+  }
+
+  void close() {
+    if (busy_) throw Error("the renderer is in use by another thread");
+    py::gil_scoped_release release;
+    renderer_.reset();
+  }
+
+ private:
+  /// Marks the session in use for a call; a second Python thread gets an error.
+  struct Busy {
+    explicit Busy(PyRenderer& r) : busy(r.busy_) {
+      if (busy.exchange(true))
+        throw Error(
+            "the renderer is in use by another thread (a session renders one call at a time)");
+    }
+    ~Busy() { busy = false; }
+    std::atomic<bool>& busy;
+  };
+
+  std::optional<Renderer> renderer_;
+  std::shared_ptr<CallbackErrors> warning_errors_;
+  std::atomic<bool> busy_{false};
+  std::atomic<bool> stop_{false};  ///< the session's cancel flag
+};
+
+/// Renderer.devices: every device of the session, when the library has several per session.
+template <class R>
+void bind_session_devices(py::class_<PyRenderer>& c) {
+  if constexpr (has_devices_method<R>::value)
+    c.def_property_readonly("devices",
+                            [](PyRenderer& r) { return static_cast<const R&>(r.get()).devices(); });
+}
+
+std::uint64_t checked_spp(long long spp, bool allow_zero) {
+  if (spp < 0 || (spp == 0 && !allow_zero))
+    throw py::value_error("spp must be " + std::string(allow_zero ? ">= 0" : "> 0") + ", got " +
+                          std::to_string(spp));
+  return static_cast<std::uint64_t>(spp);
+}
+
+double checked_seconds(double s, const char* what) {
+  if (!(s >= 0) || !std::isfinite(s))
+    throw py::value_error(std::string(what) + " must be a finite number >= 0, got " +
+                          format_field(s));
+  return s;
+}
+
+std::vector<ConvergeSetting> parse_settings(const std::vector<std::string>& names) {
+  std::vector<ConvergeSetting> out;
+  for (const std::string& n : names) {
+    for (const ConvergeSetting& s : out)
+      if (s.name == n) throw Error("settings: '" + n + "' is given twice");
+    try {
+      out.push_back(parse_converge_setting(n));
+    } catch (const Error& e) {
+      throw Error(std::string("settings: ") + e.what());
+    }
+  }
+  return out;
+}
+
+std::string result_repr(const RenderResult& r) {
+  return "<lucent.RenderResult " + std::to_string(r.mean.width) + "x" +
+         std::to_string(r.mean.height) + ", " + std::to_string(r.spp) + " spp, " +
+         format_field(r.seconds) + " s" + (r.cancelled ? ", cancelled" : "") + ", " + r.device +
+         ">";
+}
+
+}  // namespace
+
+void bind_render(py::module_& m) {
+  py::class_<RenderProgress> progress(m, "RenderProgress",
+                                      "Where a render call stands (after each pass).");
+  progress
+#define LUCENT_PY_FIELD(f) .def_readonly(#f, &RenderProgress::f)
+      LUCENT_PY_PROGRESS(LUCENT_PY_FIELD)
+#undef LUCENT_PY_FIELD
+          .def("__repr__", [](const RenderProgress& p) {
+            std::string s = "<lucent.RenderProgress";
+#define LUCENT_PY_FIELD(f) s += " " #f "=" + format_field(p.f);
+            LUCENT_PY_PROGRESS(LUCENT_PY_FIELD)
+#undef LUCENT_PY_FIELD
+            return s + ">";
+          });
+
+  bind_device_shares(m, progress);
+
+  py::class_<SessionStats>(m, "SessionStats",
+                           "What a session has built and done (lucent::SessionStats).")
+#define LUCENT_PY_FIELD(f) .def_readonly(#f, &SessionStats::f)
+      LUCENT_PY_SESSION_STATS(LUCENT_PY_FIELD)
+#undef LUCENT_PY_FIELD
+          .def("as_dict",
+               [](const SessionStats& s) {
+                 py::dict d;
+#define LUCENT_PY_FIELD(f) d[#f] = s.f;
+                 LUCENT_PY_SESSION_STATS(LUCENT_PY_FIELD)
+#undef LUCENT_PY_FIELD
+                 return d;
+               })
+          .def("__repr__", [](const SessionStats& s) {
+            std::string out = "<lucent.SessionStats";
+#define LUCENT_PY_FIELD(f) out += " " #f "=" + format_field(s.f);
+            LUCENT_PY_SESSION_STATS(LUCENT_PY_FIELD)
+#undef LUCENT_PY_FIELD
+            return out + ">";
+          });
+
+  py::class_<RenderResult> result(
+      m, "RenderResult",
+      "An accumulation: mean and variance (H, W, 3) float32 and samples (H, W) uint32 are NumPy "
+      "views of this object's memory (no copy); variance and samples are None for images that "
+      "carry none.");
+  bind_device_shares(m, result);
+  result
+      .def(
+          py::init([](py::handle mean, py::handle variance, py::handle samples, std::uint64_t spp) {
+            RenderResult r;
+            r.mean = image_from_array(mean, "mean");
+            if (!variance.is_none()) {
+              r.variance = image_from_array(variance, "variance");
+              if (r.variance.width != r.mean.width || r.variance.height != r.mean.height)
+                throw py::value_error("variance: its shape differs from the mean's");
+            }
+            if (!samples.is_none()) {
+              auto a =
+                  py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>::ensure(
+                      samples);
+              if (!a || a.ndim() != 2 || a.shape(0) != r.mean.height || a.shape(1) != r.mean.width)
+                throw py::value_error("samples: expected an array of shape (H, W) like the mean's");
+              r.samples.assign(a.data(), a.data() + a.size());
+            }
+            r.spp = spp;
+            return r;
+          }),
+          py::arg("mean"), py::arg("variance") = py::none(), py::arg("samples") = py::none(),
+          py::arg("spp") = 0)
+      .def_property_readonly("mean",
+                             [](py::object self) {
+                               const RenderResult& r = self.cast<const RenderResult&>();
+                               return view(r.mean.rgb, {r.mean.height, r.mean.width, 3}, self);
+                             })
+      .def_property_readonly(
+          "variance",
+          [](py::object self) -> py::object {
+            const RenderResult& r = self.cast<const RenderResult&>();
+            if (r.variance.rgb.empty()) return py::none();
+            return view(r.variance.rgb, {r.variance.height, r.variance.width, 3}, self);
+          })
+      .def_property_readonly("samples",
+                             [](py::object self) -> py::object {
+                               const RenderResult& r = self.cast<const RenderResult&>();
+                               if (r.samples.empty()) return py::none();
+                               return view(r.samples, {r.mean.height, r.mean.width}, self);
+                             })
+      .def_property_readonly("width", [](const RenderResult& r) { return r.mean.width; })
+      .def_property_readonly("height", [](const RenderResult& r) { return r.mean.height; })
+      .def_readonly("spp", &RenderResult::spp)
+      .def_readonly("nonfinite", &RenderResult::nonfinite)
+      .def_readonly("rays", &RenderResult::rays)
+      .def_readonly("seconds", &RenderResult::seconds)
+      .def_readonly("build_seconds", &RenderResult::build_seconds)
+      .def_readonly("program_cache_hit", &RenderResult::program_cache_hit)
+      .def_readonly("build_options", &RenderResult::build_options)
+      .def_readonly("cancelled", &RenderResult::cancelled)
+      .def_readonly("device", &RenderResult::device)
+      .def("__repr__", &result_repr);
+
+  py::class_<PyRenderer> renderer(
+      m, "Renderer",
+      "A render session: one device and one scene, rendered progressively. set_scene() packs "
+      "the scene and builds only what changed (a camera move rebuilds neither the BVH nor the "
+      "kernel: see stats). Environment variables are not read: pass **lucent.environment() for "
+      "the `lucent` command's defaults.");
+  bind_session_devices<Renderer>(renderer);
+  renderer
+      .def(py::init<const std::string&, const std::string&, const std::string&, const std::string&,
+                    bool, bool, double, py::object>(),
+           py::kw_only(), py::arg("device") = "", py::arg("kernel_dir") = "",
+           py::arg("cache_dir") = "", py::arg("precision") = "float", py::arg("fast_math") = false,
+           py::arg("specialize") = true, py::arg("pass_seconds") = 0.25,
+           py::arg("on_warning") = py::none(),
+           "device: an index from list_devices() or a name substring (\"\": the first GPU, else "
+           "the first CPU); kernel_dir: \"\" for the embedded kernels; cache_dir: \"\" for the "
+           "default, \"off\" for none; precision: \"float\" or \"double\"; on_warning(message): "
+           "warnings of scene packing (None: warnings.warn with LucentWarning).")
+      .def_property_readonly("device", [](PyRenderer& r) { return r.get().device(); })
+      .def_property_readonly("options",
+                             [](PyRenderer& r) {
+                               const SessionOptions& o = r.get().options();
+                               py::dict d;
+                               d["device"] = o.device;
+                               d["kernel_dir"] = o.kernel_dir;
+                               d["cache_dir"] = o.cache_dir;
+                               d["precision"] = precision_name(o.precision);
+                               d["fast_math"] = o.fast_math;
+                               d["specialize"] = o.specialize;
+                               d["pass_seconds"] = o.pass_seconds;
+                               return d;
+                             })
+      .def(
+          "set_build_options",
+          [](PyRenderer& r, const std::string& precision, bool fast_math, bool specialize) {
+            Precision p = parse_enum<Precision>(precision);
+            r.call([&](Renderer& rr) { rr.set_build_options(p, fast_math, specialize); });
+          },
+          py::kw_only(), py::arg("precision") = "float", py::arg("fast_math") = false,
+          py::arg("specialize") = true, "Build settings for the next set_scene/render.")
+      .def(
+          "set_scene",
+          [](PyRenderer& r, const Scene& scene) {
+            Scene copy = scene;  // Python threads may change `scene` while the GIL is released
+            r.call([&](Renderer& rr) { rr.set_scene(copy); });
+          },
+          py::arg("scene"),
+          "Makes a copy of `scene` the session's scene; keeps the BVH, the kernel and the "
+          "accumulation when it can (see Renderer).")
+      .def_property_readonly(
+          "scene", [](PyRenderer& r) { return Scene(r.get().scene()); },
+          "A copy of the session's scene.")
+      .def(
+          "render",
+          [](PyRenderer& r, long long spp, double seconds, py::object progress) {
+            return r.render(checked_spp(spp, true), checked_seconds(seconds, "seconds"),
+                            std::move(progress));
+          },
+          py::arg("spp"), py::arg("seconds") = 0.0, py::arg("progress") = py::none(),
+          "Adds `spp` samples per pixel, or samples for `seconds` when that comes first (0: no "
+          "limit of that kind). progress(RenderProgress) is called after each pass. Ctrl-C stops "
+          "after the current pass (the accumulation keeps it) and raises KeyboardInterrupt.")
+      .def(
+          "render_for",
+          [](PyRenderer& r, double seconds, py::object progress) {
+            if (!(seconds > 0) || !std::isfinite(seconds))
+              throw py::value_error("seconds must be a finite number > 0, got " +
+                                    format_field(seconds));
+            return r.render(0, seconds, std::move(progress));
+          },
+          py::arg("seconds"), py::arg("progress") = py::none(),
+          "Adds samples for about `seconds` (at least one pass).")
+      .def(
+          "reset",
+          [](PyRenderer& r, long long first_sample) {
+            if (first_sample < 0)
+              throw py::value_error("first_sample must be >= 0, got " +
+                                    std::to_string(first_sample));
+            r.call([&](Renderer& rr) { rr.reset(static_cast<std::uint64_t>(first_sample)); });
+          },
+          py::arg("first_sample") = 0,
+          "Drops the accumulation; the next sample index is first_sample.")
+      .def(
+          "result", [](PyRenderer& r) { return r.call([](Renderer& rr) { return rr.result(); }); },
+          "The accumulation so far (a RenderResult; its arrays are this call's own).")
+      .def_property_readonly("spp", [](PyRenderer& r) { return r.get().spp(); })
+      .def_property_readonly("first_sample", [](PyRenderer& r) { return r.get().first_sample(); })
+      .def_property_readonly("stats", [](PyRenderer& r) { return r.get().stats(); })
+      .def(
+          "cancel", [](PyRenderer& r) { r.get().cancel(); },
+          "Stops a render in progress (in another thread) after its current pass.")
+      .def("close", &PyRenderer::close, "Releases the device; the renderer can no longer be used.")
+      .def("__enter__", [](py::object self) { return self; })
+      .def("__exit__", [](PyRenderer& r, py::args) { r.close(); });
+
+  m.def(
+      "render_reference",
+      [](const Scene& scene, long long spp, int threads) {
+        if (threads < 0)
+          throw py::value_error("threads must be >= 0, got " + std::to_string(threads));
+        Scene copy = scene;
+        std::atomic<bool> cancel{false};
+        ReferenceOptions o;
+        if (checked_spp(spp, true) > static_cast<std::uint64_t>(1 << 30))
+          throw py::value_error("spp must be at most 2^30, got " + std::to_string(spp));
+        o.spp = static_cast<int>(spp);
+        o.threads = threads;
+        o.cancel = &cancel;
+        RenderResult out;
+        run_interruptible([&] { out = render_reference(copy, o); }, cancel);
+        return out;
+      },
+      py::arg("scene"), py::arg("spp") = 0, py::arg("threads") = 0,
+      "Renders with the scalar double-precision reference integrator (spp 0: the scene's; "
+      "threads 0: all cores). Ctrl-C stops it and raises KeyboardInterrupt.");
+
+  py::class_<ConvergePoint>(m, "ConvergePoint", "One rung of a convergence ladder.")
+      .def_readonly("setting", &ConvergePoint::setting)
+      .def_readonly("spp", &ConvergePoint::spp)
+      .def_readonly("seconds", &ConvergePoint::seconds)
+      .def_readonly("samples_per_second", &ConvergePoint::samples_per_second)
+      .def_readonly("rays_per_second", &ConvergePoint::rays_per_second)
+      .def_readonly("rmse", &ConvergePoint::rmse)
+      .def_readonly("relmse", &ConvergePoint::relmse)
+      .def_readonly("noise_relmse", &ConvergePoint::noise_relmse)
+      .def("__repr__", [](const ConvergePoint& p) {
+        return "<lucent.ConvergePoint " + p.setting + " " + std::to_string(p.spp) +
+               " spp, relMSE " + std::to_string(p.relmse) + ">";
+      });
+  py::class_<ConvergeFit>(m, "ConvergeFit", "The fitted error curve of one setting.")
+      .def_readonly("setting", &ConvergeFit::setting)
+      .def_readonly("points", &ConvergeFit::points)
+      .def_readonly("slope_time", &ConvergeFit::slope_time)
+      .def_readonly("slope_spp", &ConvergeFit::slope_spp)
+      .def_readonly("tail_slope_spp", &ConvergeFit::tail_slope_spp)
+      .def_readonly("excess_ratio", &ConvergeFit::excess_ratio)
+      .def_readonly("biased", &ConvergeFit::biased)
+      .def_readonly("bias_relmse", &ConvergeFit::bias_relmse)
+      .def_readonly("floor_seconds", &ConvergeFit::floor_seconds)
+      .def_readonly("verdict", &ConvergeFit::verdict)
+      .def("__repr__", [](const ConvergeFit& f) {
+        return "<lucent.ConvergeFit " + f.setting + ": " + f.verdict + ">";
+      });
+  py::class_<ConvergeResult>(m, "ConvergeResult", "Points (setting by setting) and fits.")
+      .def_readonly("points", &ConvergeResult::points)
+      .def_readonly("fits", &ConvergeResult::fits)
+      .def("csv", &convergence_csv, "setting,spp,seconds,samples_per_s,rmse,relmse,... rows")
+      .def("svg", &convergence_svg, py::arg("title") = "relMSE against render time",
+           "Log-log plot of relMSE against time, as SVG text.")
+      .def(
+          "plot_image",
+          [](const ConvergeResult& r, const std::string& title) {
+            return image_array(convergence_image(r, title));
+          },
+          py::arg("title") = "relMSE against render time",
+          "The same plot as an (H, W, 3) linear float32 image (write_image it as a PNG).");
+
+  m.def(
+      "converge",
+      [](const Scene& scene, py::handle reference, const std::vector<std::string>& settings,
+         std::optional<std::vector<int>> spp_ladder, std::optional<std::vector<double>> time_ladder,
+         py::object renderer, py::object on_point) {
+        check_callable(on_point, "on_point");
+        if (spp_ladder && time_ladder)
+          throw py::value_error("give spp_ladder or time_ladder, not both");
+        ConvergeOptions o;
+        o.settings = parse_settings(settings);
+        if (time_ladder)
+          o.time_ladder = *time_ladder;
+        else
+          o.spp_ladder = spp_ladder ? *spp_ladder : default_spp_ladder(64);
+        for (int s : o.spp_ladder)
+          if (s < 1)
+            throw py::value_error("spp_ladder values must be >= 1, got " + std::to_string(s));
+        for (double t : o.time_ladder)
+          if (!(t > 0) || !std::isfinite(t))
+            throw py::value_error("time_ladder values must be finite and > 0 seconds");
+        RenderResult ref = render_result_from(reference, "reference");
+        Scene copy = scene;
+        CallbackErrors errors;
+        std::atomic<bool>* stop = nullptr;
+        if (!on_point.is_none())
+          o.on_point = [&](const ConvergePoint& p) {
+            py::gil_scoped_acquire gil;
+            if (!errors.run([&] { on_point(p); })) *stop = true;
+          };
+        ConvergeResult out;
+        if (renderer.is_none()) {
+          auto warning_errors = std::make_shared<CallbackErrors>();
+          o.render.on_warning = python_warning_sink(SharedObject(py::none()), warning_errors);
+          std::atomic<bool> cancel{false};
+          stop = &cancel;
+          o.render.cancel = &cancel;
+          run_interruptible([&] { out = run_convergence(copy, ref, o); }, cancel);
+          warning_errors->rethrow();
+        } else {
+          // the session given renders every rung, with its own cancel flag
+          renderer.cast<PyRenderer&>().call_interruptible(
+              [&](Renderer& r, std::atomic<bool>& cancel) {
+                stop = &cancel;
+                o.render.cancel = &cancel;
+                o.renderer = &r;
+                out = run_convergence(copy, ref, o);
+              });
+        }
+        errors.rethrow();
+        return out;
+      },
+      py::arg("scene"), py::arg("reference"), py::kw_only(),
+      py::arg("settings") = std::vector<std::string>{"default"}, py::arg("spp_ladder") = py::none(),
+      py::arg("time_ladder") = py::none(), py::arg("renderer") = py::none(),
+      py::arg("on_point") = py::none(),
+      "Renders a ladder of spp (default 1, 2, 4, ..., 64) or seconds for each setting "
+      "(\"default\", \"fast-math\", \"max_depth=2+no-mis\", ...: see `lucent converge`) and "
+      "measures each rung's error against `reference` (a RenderResult or an array); returns a "
+      "ConvergeResult. renderer: a Renderer to render with (default: a new session with the "
+      "default options). Ctrl-C stops after the current pass and raises KeyboardInterrupt.");
+}
+
+}  // namespace lucent::python

@@ -1,0 +1,17 @@
+"""Runs lucent's pytest suite (the CTest entry python.pytest) with the interpreter CMake chose.
+
+Exits 77, which CTest reports as a skip, when that interpreter cannot import numpy or pytest.
+"""
+import importlib.util
+import sys
+
+missing = [m for m in ("numpy", "pytest") if importlib.util.find_spec(m) is None]
+if missing:
+    print(f"python.pytest skipped: {sys.executable} cannot import {' and '.join(missing)} "
+          "(Debian: apt-get install python3-numpy python3-pytest, or configure with "
+          "-DPython3_EXECUTABLE=<a python3 that has them>)")
+    sys.exit(77)
+
+import pytest  # noqa: E402
+
+sys.exit(pytest.main(["-q", "-p", "no:cacheprovider", *sys.argv[1:]]))

@@ -1,0 +1,194 @@
+"""Images, compare() and converge() from Python, with known answers and their error paths."""
+import numpy as np
+import pytest
+
+import lucent
+from conftest import session
+
+
+def constant(value, h=4, w=5):
+    return np.full((h, w, 3), value, np.float32)
+
+
+def test_write_and_read_linear_formats(tmp_path):
+    img = np.random.default_rng(1).random((6, 7, 3), dtype=np.float32) * 4
+    for ext in ("pfm", "exr"):
+        path = tmp_path / f"a.{ext}"
+        lucent.write_image(path, img)
+        back = lucent.read_image(path)
+        assert back.shape == (6, 7, 3) and back.dtype == np.float32
+        np.testing.assert_allclose(back, img, rtol=1e-6)
+
+
+def test_png_display_settings_known_answers(tmp_path):
+    path = tmp_path / "a.png"
+    # sRGB: 0.5 encodes to 188/255, which read_image decodes back to 0.5 (within 8-bit steps)
+    lucent.write_image(path, constant(0.5))
+    assert lucent.read_image(path) == pytest.approx(0.5, abs=4e-3)
+    # linear transfer: 0.5 -> 128/255, decoded as sRGB 128 -> 0.2158
+    lucent.write_image(path, constant(0.5), transfer="linear")
+    assert lucent.read_image(path) == pytest.approx(0.2158, abs=2e-3)
+    # one stop of exposure doubles 0.25 to 0.5
+    lucent.write_image(path, constant(0.25), transfer="linear", exposure=1)
+    assert lucent.read_image(path) == pytest.approx(0.2158, abs=2e-3)
+    # gamma 1 is linear; a film's settings apply, keywords override them
+    film = lucent.Film()
+    film.transfer = "gamma"
+    film.gamma = 1.0
+    lucent.write_image(path, constant(0.5), film=film)
+    assert lucent.read_image(path) == pytest.approx(0.2158, abs=2e-3)
+    lucent.write_image(path, constant(0.5), film=film, transfer="srgb")
+    assert lucent.read_image(path) == pytest.approx(0.5, abs=4e-3)
+    # clamp against Reinhard: 3.0 saturates, 3 / (1 + 3) = 0.75 does not
+    lucent.write_image(path, constant(3.0), transfer="linear")
+    assert lucent.read_image(path) == pytest.approx(1.0)
+    lucent.write_image(path, constant(3.0), transfer="linear", tonemap="reinhard")
+    assert lucent.read_image(path) == pytest.approx(0.5225, abs=3e-3)  # sRGB decode of 191
+
+
+def test_render_exr_keeps_variance_and_counts(tmp_path, small_scene):
+    with session() as r:
+        r.set_scene(small_scene)
+        r.render(4)
+        res = r.result()
+    path = tmp_path / "r.exr"
+    lucent.write_render_exr(path, res)
+    back = lucent.read_render(path)
+    np.testing.assert_array_equal(back.mean, res.mean)
+    np.testing.assert_array_equal(back.variance, res.variance)
+    np.testing.assert_array_equal(back.samples, res.samples)
+    lucent.write_image(tmp_path / "r.png", res)  # a result's mean
+    plain = lucent.read_render(tmp_path / "r.png")
+    assert plain.variance is None and plain.samples is None and plain.mean.shape == (12, 16, 3)
+
+
+def test_result_from_arrays():
+    r = lucent.RenderResult(constant(1.0), variance=constant(0.5), samples=np.full((4, 5), 3),
+                            spp=3)
+    assert r.spp == 3 and r.samples.dtype == np.uint32 and r.variance[0, 0, 0] == 0.5
+    with pytest.raises(ValueError, match="variance: its shape differs"):
+        lucent.RenderResult(constant(1.0), variance=constant(1.0, 2, 2))
+    with pytest.raises(ValueError, match=r"samples: expected an array of shape \(H, W\)"):
+        lucent.RenderResult(constant(1.0), samples=np.ones((5, 4)))
+
+
+def test_compare_kernel_against_the_reference(small_scene):
+    """The kernel and the independent reference integrator agree on the small scene (the
+    z-test of `lucent compare`), and a 30% albedo change is detected (negative control)."""
+    small_scene.integrator.seed = 3
+    with session() as r:
+        r.set_scene(small_scene)
+        r.render(64)
+        kernel = r.result()
+        ref = lucent.render_reference(small_scene, spp=64)
+        c = lucent.compare(kernel, ref)
+        assert isinstance(c, lucent.CompareResult) and c.passed and bool(c), c.summary()
+        assert c.statistical and c.tested == 16 * 12 * 3 and c.z.shape == (12, 16, 3)
+        assert np.abs(c.z).max() == pytest.approx(c.max_z, rel=1e-5)
+        assert len(c.mean_a) == 3 and "RMSE" in c.summary()
+        small_scene.materials[1].albedo = (0.35, 0.35, 0.35)
+        r.set_scene(small_scene)
+        r.render(64)
+        worse = lucent.compare(r.result(), ref)
+        assert not worse.passed and not worse.mean_test_passed
+
+
+def test_compare_arrays_without_variance():
+    a = constant(1.0)
+    c = lucent.compare(a, a)
+    assert c.passed and not c.statistical and c.rmse == 0
+    c = lucent.compare(a, constant(1.5))
+    assert not c.passed and c.max_abs_error == pytest.approx(0.5)
+    assert c.rmse == pytest.approx(0.5)
+
+
+def test_image_errors(tmp_path):
+    with pytest.raises(lucent.Error, match="unknown"):
+        lucent.write_image(tmp_path / "a.tiff", constant(1.0))
+    with pytest.raises(lucent.Error, match="nodir"):
+        lucent.write_image(tmp_path / "nodir" / "a.png", constant(1.0))
+    with pytest.raises(lucent.Error):
+        lucent.read_image(tmp_path / "none.exr")
+    with pytest.raises(lucent.Error):
+        lucent.read_render(tmp_path / "none.exr")
+    (tmp_path / "junk.exr").write_bytes(b"not an exr")
+    with pytest.raises(lucent.Error, match=r"junk\.exr"):
+        lucent.read_render(tmp_path / "junk.exr")
+    with pytest.raises(ValueError,
+                       match=r"image: expected an array of shape \(H, W, 3\), got \(4, 5\)"):
+        lucent.write_image(tmp_path / "a.png", np.zeros((4, 5)))
+    with pytest.raises(ValueError, match=r"got \(0, 5, 3\)"):
+        lucent.write_image(tmp_path / "a.png", np.zeros((0, 5, 3)))
+    with pytest.raises(TypeError):
+        lucent.write_image(tmp_path / "a.png", "pixels")
+    with pytest.raises(ValueError, match="unknown transfer 'log'"):
+        lucent.write_image(tmp_path / "a.png", constant(1.0), transfer="log")
+    with pytest.raises(ValueError, match="unknown tone map"):
+        lucent.write_image(tmp_path / "a.png", constant(1.0), tonemap="hable")
+    with pytest.raises(ValueError, match="gamma must be a finite number > 0"):
+        lucent.write_image(tmp_path / "a.png", constant(1.0), gamma=0)
+    with pytest.raises(TypeError):
+        lucent.write_image(tmp_path / "a.png", constant(1.0), film="srgb")
+    with pytest.raises(ValueError, match=r"b: expected an array of shape \(H, W, 3\)"):
+        lucent.compare(constant(1.0), np.zeros(3))
+    with pytest.raises(lucent.Error, match="size"):
+        lucent.compare(constant(1.0), constant(1.0, 2, 2))
+    for bad in ({"alpha": 0}, {"alpha": 1.5}, {"min_pass_fraction": 2}, {"abs_epsilon": -1}):
+        with pytest.raises(ValueError):
+            lucent.compare(constant(1.0), constant(1.0), **bad)
+
+
+def test_converge(small_scene):
+    reference = lucent.render_reference(small_scene, spp=64)
+    points = []
+    with session() as r:
+        res = lucent.converge(small_scene, reference, settings=["default", "max_depth=1"],
+                              spp_ladder=[1, 4, 16], renderer=r, on_point=points.append)
+        # one session: the BVH once for both settings and every rung
+        assert r.stats.bvh_builds == 1
+    assert [(p.setting, p.spp) for p in res.points] == [
+        ("default", 1), ("default", 4), ("default", 16),
+        ("max_depth=1", 1), ("max_depth=1", 4), ("max_depth=1", 16)]
+    assert [p.setting for p in points] == [p.setting for p in res.points]
+    default, direct_only = res.fits
+    assert default.points == 3 and default.slope_spp < -0.5 and not default.biased
+    # max_depth 1 sees emitters only: the lit scene renders black, far from the reference
+    assert direct_only.biased and res.points[-1].relmse > 10 * res.points[2].relmse
+    assert res.csv().startswith("setting,spp,seconds,samples_per_s,rmse,relmse")
+    assert res.csv().count("\n") == 7
+    assert res.svg("t").lstrip().startswith("<")
+    plot = res.plot_image("t")
+    assert plot.ndim == 3 and plot.shape[2] == 3
+
+
+def test_converge_by_time_and_errors(small_scene):
+    reference = lucent.render_reference(small_scene, spp=16)
+    with session() as r:
+        res = lucent.converge(small_scene, reference, time_ladder=[0.02, 0.05], renderer=r)
+        assert len(res.points) == 2 and res.points[1].seconds >= 0.05
+        with pytest.raises(lucent.Error, match="settings: .*max_depth"):
+            lucent.converge(small_scene, reference, settings=["max_depth=0"], renderer=r)
+        with pytest.raises(lucent.Error, match="given twice"):
+            lucent.converge(small_scene, reference, settings=["default", "default"], renderer=r)
+        with pytest.raises(ValueError, match="not both"):
+            lucent.converge(small_scene, reference, spp_ladder=[1], time_ladder=[1], renderer=r)
+        with pytest.raises(ValueError, match="spp_ladder values must be >= 1"):
+            lucent.converge(small_scene, reference, spp_ladder=[0], renderer=r)
+        with pytest.raises(ValueError, match="time_ladder values"):
+            lucent.converge(small_scene, reference, time_ladder=[-1], renderer=r)
+        with pytest.raises(lucent.Error, match="ladder is empty"):
+            lucent.converge(small_scene, reference, spp_ladder=[], renderer=r)
+        with pytest.raises(lucent.Error,
+                           match="the reference image is 5x4, the scene renders 16x12"):
+            lucent.converge(small_scene, constant(1.0), spp_ladder=[1], renderer=r)
+        with pytest.raises(TypeError, match="on_point must be callable"):
+            lucent.converge(small_scene, reference, on_point=1, renderer=r)
+
+        def stop(point):
+            raise RuntimeError("enough")
+        with pytest.raises(RuntimeError, match="enough"):
+            lucent.converge(small_scene, reference, spp_ladder=[1, 2, 4], renderer=r,
+                            on_point=stop)
+        # the session renders normally afterwards (its cancel flag is its own again)
+        r.set_scene(small_scene)
+        assert r.render(2).samples_done == 2

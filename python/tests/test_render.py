@@ -1,0 +1,346 @@
+"""The render session from Python: NumPy results without copies, progressive accumulation, what a
+change rebuilds (stats), AOVs, callbacks, the GIL, cancellation, and every error of the API."""
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import lucent
+from conftest import header_fields, session
+
+
+def kernel_builds(stats):
+    return stats.kernel_compiles + stats.kernel_cache_loads
+
+
+def test_result_arrays(renderer, small_scene):
+    renderer.set_scene(small_scene)
+    p = renderer.render(4)
+    assert isinstance(p, lucent.RenderProgress) and p.samples_done == 4 and p.accumulated == 4
+    r = renderer.result()
+    assert r.mean.shape == (12, 16, 3) and r.mean.dtype == np.float32
+    assert r.variance.shape == (12, 16, 3) and r.variance.dtype == np.float32
+    assert r.samples.shape == (12, 16) and r.samples.dtype == np.uint32
+    assert (r.samples == 4).all() and r.spp == 4 and renderer.spp == 4
+    assert r.rays > 0 and r.seconds > 0 and not r.cancelled and r.nonfinite == 0
+    assert "LC_HAS_SPHERES" in r.build_options and r.device == renderer.device.name
+    assert (r.width, r.height) == (16, 12)
+    # views of the result's own memory: no copy, kept alive by the arrays
+    assert np.shares_memory(r.mean, r.mean) and r.mean.base is not None
+    mean = r.mean
+    del r
+    assert np.isfinite(mean).all() and mean.max() > 0
+
+
+def test_progressive_renders_add_up(small_scene):
+    with session() as a, session() as b:
+        a.set_scene(small_scene)
+        b.set_scene(small_scene)
+        a.render(3)
+        a.render(5)
+        b.render(8)
+        ra, rb = a.result(), b.result()
+        assert (ra.samples == rb.samples).all() and ra.spp == 8
+        np.testing.assert_allclose(ra.mean, rb.mean, rtol=1e-5, atol=1e-6)
+
+
+def test_camera_change_rebuilds_neither_bvh_nor_kernel(renderer, small_scene):
+    renderer.set_scene(small_scene)
+    renderer.render(2)
+    before = renderer.result()
+    s0 = renderer.stats
+    assert (s0.bvh_builds, kernel_builds(s0), s0.scene_packs) == (1, 1, 1)
+    small_scene.camera.position.x += 0.5
+    renderer.set_scene(small_scene)
+    assert renderer.spp == 0, "a new camera drops the accumulation"
+    renderer.render(2)
+    s1 = renderer.stats
+    assert (s1.bvh_builds, kernel_builds(s1), s1.scene_packs) == (1, 1, 2)
+    assert s1.kernel_reuses == s0.kernel_reuses + 1
+    assert s1.buffer_uploads == s0.buffer_uploads, "no scene buffer changed"
+    assert not np.array_equal(before.mean, renderer.result().mean)
+    # a material's parameters: one buffer upload, nothing rebuilt
+    small_scene.materials[0].albedo = (0.2, 0.9, 0.2)
+    renderer.set_scene(small_scene)
+    s2 = renderer.stats
+    assert (s2.bvh_builds, kernel_builds(s2)) == (1, 1)
+    assert s2.buffer_uploads == s1.buffer_uploads + 1
+
+
+def test_stats_expose_every_field(renderer, small_scene):
+    renderer.set_scene(small_scene)
+    renderer.render(1)
+    st = renderer.stats
+    fields = header_fields("session.hpp", "SessionStats")
+    assert len(fields) >= 12
+    assert sorted(st.as_dict()) == sorted(fields)
+    for f in fields:
+        assert getattr(st, f) == st.as_dict()[f] and f in repr(st)
+    assert st.passes >= 1 and st.render_seconds > 0
+
+
+@pytest.mark.parametrize("header, struct, cls", [
+    ("render.hpp", "RenderResult", lucent.RenderResult),
+    ("render.hpp", "RenderProgress", lucent.RenderProgress),
+    ("compare.hpp", "CompareResult", lucent.CompareResult),
+    ("converge.hpp", "ConvergePoint", lucent.ConvergePoint),
+    ("converge.hpp", "ConvergeFit", lucent.ConvergeFit),
+    ("converge.hpp", "ConvergeResult", lucent.ConvergeResult),
+    ("device.hpp", "DeviceInfo", lucent.DeviceInfo),
+])
+def test_result_classes_expose_every_field(header, struct, cls):
+    fields = header_fields(header, struct)
+    assert fields
+    for f in fields:
+        assert hasattr(cls, f), f"{struct}.{f} is not exposed"
+
+
+def test_aov_renders_by_integrator_name(renderer, small_scene):
+    small_scene.integrator.type = "albedo"
+    renderer.set_scene(small_scene)
+    renderer.render(1)
+    r = renderer.result()
+    assert "LC_HAS_INTEGRATOR_AOV" in r.build_options
+    # the centre pixel sees the sphere: its albedo, exactly
+    np.testing.assert_allclose(r.mean[6, 8], [0.7, 0.6, 0.5], rtol=1e-6)
+    small_scene.integrator.type = "depth"
+    renderer.set_scene(small_scene)
+    renderer.render(1)
+    # distance from the camera (0, 1, 5) to the sphere's front, about 4.6
+    assert 4.0 < renderer.result().mean[6, 8, 0] < 5.0
+
+
+def test_render_for_reset_and_sample_ranges(renderer, small_scene):
+    renderer.set_scene(small_scene)
+    p = renderer.render_for(0.05)
+    assert p.samples_done > 0 and renderer.spp == p.accumulated
+    renderer.reset(4)
+    assert renderer.spp == 0 and renderer.first_sample == 4
+    renderer.render(4)
+    high = renderer.result()
+    renderer.reset()
+    renderer.render(4)
+    assert not np.array_equal(high.mean, renderer.result().mean), "other samples"
+    p = renderer.render(1000000, seconds=0.05)
+    assert 0 < p.samples_done < 1000000
+
+
+def test_progress_callback(renderer, small_scene):
+    renderer.set_scene(small_scene)
+    seen = []
+    renderer.render(16, progress=seen.append)
+    assert seen and all(isinstance(p, lucent.RenderProgress) for p in seen)
+    assert [p.accumulated for p in seen] == sorted(p.accumulated for p in seen)
+    assert seen[-1].samples_done == 16 and seen[-1].samples_target == 16
+
+
+def test_an_exception_in_the_progress_callback_stops_the_render(renderer, small_scene):
+    renderer.set_scene(small_scene)
+    calls = []
+
+    def stop(p):
+        calls.append(p)
+        raise ZeroDivisionError("stop here")
+    with pytest.raises(ZeroDivisionError, match="stop here"):
+        renderer.render(1000000, progress=stop)
+    assert len(calls) == 1, "stopped after the pass that raised"
+    r = renderer.result()
+    assert r.cancelled and 0 < r.spp < 1000000, "the accumulation keeps what was rendered"
+    renderer.render(1)
+    assert not renderer.result().cancelled
+
+
+def test_the_gil_is_released_while_rendering(renderer, small_scene):
+    renderer.set_scene(small_scene)
+    ticks = []
+    done = threading.Event()
+
+    def count():
+        while not done.is_set():
+            ticks.append(1)
+            time.sleep(0.001)
+    t = threading.Thread(target=count)
+    t.start()
+    try:
+        before = len(ticks)
+        renderer.render_for(0.3)
+        during = len(ticks) - before
+    finally:
+        done.set()
+        t.join()
+    assert during > 10, "another Python thread ran during the render"
+
+
+def test_cancel_from_another_thread(renderer, small_scene):
+    renderer.set_scene(small_scene)
+    timer = threading.Timer(0.2, renderer.cancel)
+    timer.start()
+    p = renderer.render(10 ** 9)
+    timer.join()
+    assert p.samples_done < 10 ** 9 and renderer.result().cancelled
+
+
+def test_one_call_at_a_time(renderer, small_scene):
+    renderer.set_scene(small_scene)
+    errors = []
+    started = threading.Event()
+
+    def other():
+        started.wait()
+        try:
+            renderer.render(1)
+        except lucent.Error as e:
+            errors.append(str(e))
+    t = threading.Thread(target=other)
+    t.start()
+
+    def progress(p):
+        started.set()
+        t.join(timeout=10)  # the other thread tries while this render is in progress
+    renderer.render(2, progress=progress)
+    t.join()
+    assert errors and "in use by another thread" in errors[0]
+
+
+def test_warnings_of_packing(small_scene):
+    small_scene.positions = np.vstack([small_scene.positions, small_scene.positions[:1]])
+    t = lucent.Triangle()
+    t.v = (0, 4, 1)  # vertices 0 and 4 are equal: degenerate
+    small_scene.triangles.append(t)
+    got = []
+    with session(on_warning=got.append) as r:
+        r.set_scene(small_scene)
+    assert len(got) == 1 and "skipped 1 degenerate or non-finite triangle" in got[0]
+    with session() as r, pytest.warns(lucent.LucentWarning, match="degenerate"):
+        r.set_scene(small_scene)
+
+
+def test_session_options_and_devices(small_scene):
+    devices = lucent.list_devices()
+    assert devices and all(isinstance(d, lucent.DeviceInfo) for d in devices)
+    assert lucent.select_device("0").name == devices[0].name
+    with session(device="0", fast_math=True, specialize=False) as r:
+        assert r.device.name == devices[0].name
+        assert r.options["fast_math"] and not r.options["specialize"]
+        r.set_scene(small_scene)
+        opts = r.result().build_options
+        assert "-cl-fast-relaxed-math" in opts and "LC_HAS_CONDUCTOR" in opts
+        r.set_build_options(precision="float")
+        r.set_scene(small_scene)
+        assert "-cl-fast-relaxed-math" not in r.result().build_options
+        assert r.scene.film.width == 16
+    assert set(lucent.environment()) == {"device", "kernel_dir", "cache_dir"}
+
+
+def test_kernel_cache_directory_is_an_option(tmp_path, small_scene):
+    with session(cache_dir=str(tmp_path)) as a:
+        a.set_scene(small_scene)
+        assert a.stats.kernel_compiles == 1
+    with session(cache_dir=str(tmp_path)) as b:
+        b.set_scene(small_scene)
+        assert (b.stats.kernel_cache_loads, b.stats.kernel_compiles) == (1, 0)
+    assert lucent.cache_dir(str(tmp_path)) == str(tmp_path)
+    assert lucent.cache_dir("off") == ""
+    assert lucent.clear_cache(str(tmp_path)) == 1
+
+
+# --- errors -------------------------------------------------------------------------------
+
+def test_session_errors(renderer, small_scene):
+    with pytest.raises(lucent.Error, match="no scene"):
+        renderer.render(1)
+    with pytest.raises(lucent.Error, match="no scene"):
+        renderer.result()
+    with pytest.raises(lucent.Error, match="no scene"):
+        renderer.scene
+    renderer.set_scene(small_scene)
+    with pytest.raises(ValueError, match="spp must be >= 0, got -1"):
+        renderer.render(-1)
+    with pytest.raises(lucent.Error, match="give a number of samples per pixel, a time limit"):
+        renderer.render(0)
+    with pytest.raises(TypeError):
+        renderer.render(1.5)
+    with pytest.raises(TypeError):
+        renderer.render("8")
+    with pytest.raises(ValueError, match="seconds must be a finite number >= 0"):
+        renderer.render(1, seconds=-1)
+    with pytest.raises(ValueError, match="seconds must be a finite number > 0"):
+        renderer.render_for(0)
+    with pytest.raises(ValueError, match="seconds must be a finite number > 0"):
+        renderer.render_for(float("nan"))
+    with pytest.raises(ValueError, match="first_sample must be >= 0"):
+        renderer.reset(-1)
+    with pytest.raises(lucent.Error, match="below 2\\^32"):
+        renderer.reset(2 ** 32)
+    with pytest.raises(TypeError):
+        renderer.set_scene({"film": {}})
+    with pytest.raises(TypeError):
+        renderer.render(1, 0, None, 3)
+    with pytest.raises(TypeError, match="progress must be callable or None, got 3"):
+        renderer.render(1, progress=3)
+    huge = small_scene.copy()
+    huge.film.width = huge.film.height = 1 << 20
+    with pytest.raises(lucent.Error, match="film needs") as e:
+        renderer.set_scene(huge)
+    assert "\n" not in str(e.value)
+    renderer.render(1)  # the session still renders its previous scene
+    assert renderer.result().width == 16
+    renderer.close()
+    with pytest.raises(lucent.Error, match="closed"):
+        renderer.render(1)
+
+
+def test_session_option_errors():
+    with pytest.raises(lucent.Error, match="no such device"):
+        session(device="no such device at all")
+    with pytest.raises(lucent.Error, match="no such device"):
+        lucent.select_device("no such device at all")
+    with pytest.raises(ValueError, match="unknown precision 'quad'"):
+        session(precision="quad")
+    with pytest.raises(ValueError, match="pass_seconds must be a positive number"):
+        session(pass_seconds=0)
+    with pytest.raises(TypeError):
+        session(fast_math="yes please", bogus=1)
+    with pytest.raises(TypeError):
+        lucent.Renderer("0")  # keyword arguments only
+    with pytest.raises(TypeError, match="on_warning must be callable"):
+        session(on_warning="stderr")
+    with session() as r, pytest.raises(ValueError, match="unknown precision"):
+        r.set_build_options(precision="half")
+
+
+def test_render_reference(small_scene):
+    r = lucent.render_reference(small_scene, spp=2, threads=1)
+    assert r.mean.shape == (12, 16, 3) and (r.samples == 2).all() and "reference" in r.device
+    with pytest.raises(ValueError, match="spp must be >= 0"):
+        lucent.render_reference(small_scene, spp=-2)
+    with pytest.raises(ValueError, match="threads must be >= 0"):
+        lucent.render_reference(small_scene, threads=-1)
+    small_scene.spheres[0].material = 7
+    with pytest.raises(lucent.Error):
+        lucent.render_reference(small_scene, spp=1)
+
+
+def test_python_render_equals_the_cli_render(tmp_path, small_dict):
+    """The binding adds nothing to the library's image: the `lucent` command and a session render
+    the same samples, and the arrays are in row-major (H, W) order like the CLI's EXR."""
+    import json
+    import os
+    import subprocess
+    cli = os.environ.get("LUCENT_CLI")
+    if not cli:
+        pytest.skip("LUCENT_CLI is not set (CTest sets it)")
+    path = tmp_path / "s.json"
+    small_dict["film"]["width"] = 20  # not square: a transposition would show
+    path.write_text(json.dumps(small_dict))
+    subprocess.run([cli, "render", str(path), "-o", str(tmp_path / "cli.exr"), "--spp", "8",
+                    "--quiet"], check=True)
+    with session() as r:
+        r.set_scene(lucent.load_scene(path))
+        r.render(8)
+        mine = r.result()
+    theirs = lucent.read_render(tmp_path / "cli.exr")
+    # equal up to the float summation order of passes (their split depends on timing)
+    np.testing.assert_allclose(mine.mean, theirs.mean, rtol=1e-5, atol=1e-6)
+    np.testing.assert_array_equal(mine.samples, theirs.samples)

@@ -1,0 +1,286 @@
+"""Scenes from Python: files and dicts through the one parser, every struct field readable and
+writable, enums by their registry names, and every error of the scene API."""
+import json
+import math
+import os
+import re
+import subprocess
+
+import numpy as np
+import pytest
+
+import lucent
+from conftest import SMALL, SOURCE_DIR, header_fields
+
+
+def test_dict_and_file_give_the_same_scene(tmp_path, small_scene):
+    path = tmp_path / "small.json"
+    path.write_text(json.dumps(SMALL))
+    from_file = lucent.load_scene(path)  # os.PathLike accepted
+    for s in (from_file, small_scene):
+        assert (s.film.width, s.film.height) == (16, 12)
+        assert s.camera.position == (0, 1, 5)
+        assert s.camera.fov_degrees == 40
+        assert sorted(m.name for m in s.materials) == ["g", "w"]
+        assert s.materials[s.find_material("w")].albedo == (0.7, 0.6, 0.5)
+        assert len(s.spheres) == 1 and len(s.triangles) == 2
+        assert s.positions.shape == (4, 3)
+        assert s.lights[0].type == "point" and s.lights[0].intensity == (20, 20, 20)
+    assert from_file.path == str(path)
+    assert small_scene.path.endswith("<dict>")
+
+
+def test_registry_names():
+    assert lucent.MATERIAL_TYPES[:3] == ("diffuse", "mirror", "dielectric")
+    assert "rough_dielectric" in lucent.MATERIAL_TYPES
+    assert lucent.INTEGRATORS == ("path", "whitted", "direct", "albedo", "normal", "depth", "ao",
+                                  "primitive")
+    assert lucent.FILTER_TYPES == ("box", "tent", "gaussian")
+    assert lucent.LIGHT_TYPES[0] == "point" and "environment_map" in lucent.LIGHT_TYPES
+    assert lucent.TRANSFERS == ("srgb", "gamma", "linear")
+    assert lucent.TONEMAPS == ("clamp", "reinhard", "aces")
+    # the registry header is the source of the names: every scene-file name of it is exposed
+    registry = (SOURCE_DIR / "kernels" / "shared" / "registry.h").read_text()
+    for name in re.findall(r'X\(\w+, \w+, \d+, "(\w+)"', registry):
+        assert name in (lucent.MATERIAL_TYPES + lucent.LIGHT_TYPES + lucent.INTEGRATORS +
+                        lucent.FILTER_TYPES + ("sphere", "triangles")), name
+
+
+@pytest.mark.parametrize("cls, header, struct", [
+    (lucent.Camera, "scene.hpp", "Camera"), (lucent.Filter, "scene.hpp", "Filter"),
+    (lucent.Film, "scene.hpp", "Film"), (lucent.Integrator, "scene.hpp", "Integrator"),
+    (lucent.Material, "scene.hpp", "Material"), (lucent.Sphere, "scene.hpp", "Sphere"),
+    (lucent.Triangle, "scene.hpp", "Triangle"), (lucent.Light, "scene.hpp", "Light"),
+    (lucent.Texture, "scene.hpp", "Texture"), (lucent.Scene, "scene.hpp", "Scene"),
+])
+def test_every_field_of_the_scene_structs_is_exposed(cls, header, struct):
+    fields = header_fields(header, struct)
+    assert fields, struct
+    for f in fields:
+        assert hasattr(cls(), f), f"{struct}.{f} is not exposed"
+
+
+def test_fields_are_writable_in_place(small_scene):
+    s = small_scene
+    s.camera.position.x += 1
+    s.camera.look_at = [0, 0, 0]
+    s.camera.up = np.array([0, 0, 1.0])
+    s.camera.aperture = 0.1
+    assert s.camera.position == (1, 1, 5) and s.camera.up == (0, 0, 1)
+    s.film.width = 8
+    s.film.filter.type = "gaussian"
+    s.film.filter.radius = 2
+    s.film.transfer = "linear"
+    s.film.tonemap = "aces"
+    s.integrator.type = "albedo"
+    s.integrator.seed = 7
+    s.materials[0].type = "rough_dielectric"
+    s.materials[0].roughness = 0.3
+    s.spheres[0].radius = 2
+    s.triangles[0].v = (0, 1, 2)
+    s.lights[0].position[1] = 10
+    assert (s.film.width, s.film.filter.type, s.film.filter.radius) == (8, "gaussian", 2)
+    assert (s.film.transfer, s.film.tonemap) == ("linear", "aces")
+    assert (s.integrator.type, s.integrator.seed) == ("albedo", 7)
+    assert (s.materials[0].type, s.materials[0].roughness) == ("rough_dielectric", 0.3)
+    assert s.spheres[0].radius == 2 and s.triangles[0].v == (0, 1, 2)
+    assert s.lights[0].position == (2, 10, 3)
+    assert list(s.camera.position) == [1, 1, 5] and np.asarray(s.camera.position).shape == (3,)
+
+
+def test_lists_grow_and_copies_are_independent(small_scene):
+    s = small_scene
+    copy = s.copy()
+    m = lucent.Material()
+    m.name = "lamp"
+    m.emission = (4, 4, 4)
+    s.materials.append(m)
+    s.spheres.append(lucent.Sphere((0, 2, 0), 0.25, material=2))
+    assert s.find_material("lamp") == 2 and s.materials[2].emissive
+    assert len(copy.materials) == 2 and len(copy.spheres) == 1
+    s.positions = s.positions + [0, 1, 0]
+    assert s.positions[0, 1] == 1 and copy.positions[0, 1] == 0
+    with pytest.raises(ValueError):
+        s.positions[0, 0] = 5  # a read-only copy: assign the attribute instead
+
+
+def test_scene_built_in_code_renders(renderer):
+    s = lucent.Scene()
+    s.film.width, s.film.height = 8, 8
+    s.camera.position = (0, 0, 4)
+    s.camera.look_at = (0, 0, 0)
+    m = lucent.Material()
+    m.albedo = (0.5, 0.25, 1.0)
+    s.materials.append(m)
+    s.spheres.append(lucent.Sphere((0, 0, 0), 1.5))
+    s.integrator.type = "albedo"
+    renderer.set_scene(s)
+    renderer.render(1)
+    # the albedo AOV of a sphere filling the centre is the material's albedo
+    assert renderer.result().mean[4, 4] == pytest.approx([0.5, 0.25, 1.0], rel=1e-6)
+
+
+def test_texture_from_an_array(small_scene):
+    t = lucent.Texture()
+    t.rgba = np.ones((2, 3, 4), np.float32) * [0.1, 0.2, 0.3, 1]
+    assert (t.width, t.height) == (3, 2) and t.rgba.shape == (2, 3, 4)
+    small_scene.textures.append(t)
+    small_scene.materials[0].albedo_texture = 0
+    assert small_scene.textures[0].rgba[1, 2, 1] == pytest.approx(0.2)
+
+
+def test_relative_files_are_relative_to_base_dir(tmp_path):
+    (tmp_path / "tri.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    d = {"shapes": [{"type": "mesh", "file": "tri.obj"}]}
+    s = lucent.scene_from_dict(d, base_dir=tmp_path)
+    assert len(s.triangles) == 1
+    with pytest.raises(lucent.Error, match=r"tri\.obj"):
+        lucent.scene_from_dict(d)  # "." holds no tri.obj
+
+
+def test_loader_warnings_go_to_the_callback_or_to_warnings(tmp_path):
+    (tmp_path / "m.obj").write_text("mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    d = {"shapes": [{"type": "mesh", "file": "m.obj"}]}
+    got = []
+    lucent.scene_from_dict(d, base_dir=tmp_path, on_warning=got.append)
+    assert len(got) == 1 and "missing.mtl" in got[0]
+    with pytest.warns(lucent.LucentWarning, match="missing.mtl"):
+        lucent.scene_from_dict(d, base_dir=tmp_path)
+
+    def fail(message):
+        raise KeyError("from the callback")
+    with pytest.raises(KeyError, match="from the callback"):
+        lucent.scene_from_dict(d, base_dir=tmp_path, on_warning=fail)
+
+
+# --- errors -------------------------------------------------------------------------------
+
+def one_line(e):
+    text = str(e.value)
+    assert "\n" not in text
+    return text
+
+
+def test_parser_errors_are_lucent_errors_with_the_json_path(small_dict):
+    assert issubclass(lucent.Error, RuntimeError)
+    small_dict["shapes"][0]["radius"] = -1
+    with pytest.raises(lucent.Error) as e:
+        lucent.scene_from_dict(small_dict)
+    assert one_line(e) == "./<dict>: /shapes/0/radius: must be > 0, got -1"
+    with pytest.raises(lucent.Error, match=r"^x/scene\.json: /camera/fvo: unknown key"):
+        lucent.scene_from_dict({"camera": {"fvo": 3}}, base_dir="x", name="scene.json")
+    with pytest.raises(lucent.Error, match="unknown material 'nope'"):
+        lucent.scene_from_dict({"shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1,
+                                           "material": "nope"}]})
+
+
+@pytest.mark.parametrize("value, message", [
+    (math.nan, "/camera/fov: must be a finite number, got nan"),
+    (math.inf, "/camera/fov: must be a finite number, got inf"),
+    (2 ** 70, "/camera/fov: integer out of range"),
+    (object(), "/camera/fov: cannot be written as JSON"),
+])
+def test_dict_values_json_cannot_hold(value, message):
+    with pytest.raises(lucent.Error, match=message.replace("(", r"\(")):
+        lucent.scene_from_dict({"camera": {"fov": value}})
+
+
+def test_dict_keys_must_be_strings():
+    with pytest.raises(lucent.Error, match="keys must be strings"):
+        lucent.scene_from_dict({"camera": {1: 2}})
+    with pytest.raises(TypeError):
+        lucent.scene_from_dict([1, 2])
+
+
+def test_numpy_values_in_dicts(small_dict):
+    small_dict["camera"]["position"] = np.array([0.0, 1, 5])
+    small_dict["film"]["width"] = np.int64(16)
+    assert lucent.scene_from_dict(small_dict).camera.position == (0, 1, 5)
+
+
+def test_load_scene_errors(tmp_path):
+    with pytest.raises(lucent.Error, match="cannot open scene file"):
+        lucent.load_scene(tmp_path / "none.json")
+    with pytest.raises(lucent.Error, match="is a directory"):
+        lucent.load_scene(tmp_path)
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"film": {"width": 0}}')
+    with pytest.raises(lucent.Error, match=r"bad\.json: /film/width"):
+        lucent.load_scene(bad)
+    with pytest.raises(TypeError):
+        lucent.load_scene(3)
+
+
+def test_bad_field_values():
+    m = lucent.Material()
+    with pytest.raises(ValueError,
+                       match=r"unknown material type 'gold' \(expected one of diffuse, "):
+        m.type = "gold"
+    with pytest.raises(ValueError, match="unknown integrator 'bdpt'"):
+        lucent.Integrator().type = "bdpt"
+    with pytest.raises(ValueError, match="unknown filter type"):
+        lucent.Filter().type = "lanczos"
+    with pytest.raises(ValueError, match="unknown transfer"):
+        lucent.Film().transfer = "pq"
+    with pytest.raises(ValueError, match="unknown tone map"):
+        lucent.Film().tonemap = "filmic"
+    with pytest.raises(ValueError, match="unknown light type"):
+        lucent.Light().type = "spot"
+    with pytest.raises(ValueError, match="expected a sequence of 3 numbers"):
+        m.albedo = (1, 2)
+    with pytest.raises(ValueError, match="expected a sequence of 3 numbers"):
+        m.albedo = "abc"
+    with pytest.raises(TypeError):
+        m.albedo = 0.5
+    with pytest.raises(TypeError):
+        m.albedo = ("a", "b", "c")
+    with pytest.raises(TypeError):
+        lucent.Film().width = "wide"
+    with pytest.raises(TypeError):
+        m.type = 3
+    with pytest.raises(ValueError, match="expected 3 indices"):
+        lucent.Triangle().v = (1, 2)
+    with pytest.raises(TypeError, match="expected 3 integer indices"):
+        lucent.Triangle().v = (1, 2, 3.5)
+    with pytest.raises(ValueError, match="expected a sequence of 3 numbers"):
+        lucent.Sphere((0, 0), 1)
+    with pytest.raises(IndexError):
+        lucent.Vec3((1, 2, 3))[3]
+    s = lucent.Scene()
+    with pytest.raises(ValueError, match=r"positions: expected an array of shape \(N, 3\)"):
+        s.positions = np.zeros((4, 2))
+    with pytest.raises(ValueError, match=r"uvs: expected an array of shape \(N, 2\)"):
+        s.uvs = [[1, 2, 3]]
+    with pytest.raises(ValueError, match=r"rgba: expected an array of shape \(H, W, 4\)"):
+        lucent.Texture().rgba = np.zeros((2, 2, 3))
+
+
+def test_scene_info_matches_the_cli(tmp_path, small_dict):
+    small_dict["materials"]["lamp"] = {"type": "diffuse", "albedo": [0, 0, 0],
+                                       "emission": [1, 1, 1]}
+    small_dict["shapes"].append({"type": "sphere", "center": [1, 2, 0], "radius": 0.1,
+                                 "material": "lamp"})
+    scene = lucent.scene_from_dict(small_dict)
+    info = lucent.scene_info(scene)
+    assert (info["triangles"], info["spheres"], info["vertices"]) == (2, 2, 4)
+    assert info["lights"]["point"] == 1 and info["lights"]["sphere"] == 1
+    assert info["lights"]["triangle"] == 0 and info["skipped_triangles"] == 0
+    assert info["bvh"]["primitives"] == 4 and info["bvh"]["nodes"] >= 1
+    for define in ("LC_HAS_SPHERES", "LC_HAS_TRIANGLES", "LC_HAS_POINT_LIGHTS",
+                   "LC_HAS_SPHERE_LIGHTS", "LC_HAS_DIFFUSE", "LC_HAS_INTEGRATOR_PATH"):
+        assert define in info["feature_defines"], define
+    assert "LC_HAS_MIRROR" not in info["feature_defines"]
+    double = lucent.scene_info(scene, precision="double", fast_math=True, specialize=False)
+    assert "-D LC_DOUBLE" in double["build_options"]
+    assert "-cl-fast-relaxed-math" in double["build_options"]
+    assert "LC_HAS_MIRROR" in double["feature_defines"]
+    with pytest.raises(ValueError, match="unknown precision"):
+        lucent.scene_info(scene, precision="single")
+    cli = os.environ.get("LUCENT_CLI")
+    if cli:  # the same build options as `lucent info` prints
+        path = tmp_path / "s.json"
+        path.write_text(json.dumps(small_dict))
+        out = subprocess.run([cli, "info", str(path), "--precision", "double", "--fast-math",
+                              "--no-specialize"], check=True, capture_output=True, text=True)
+        line = next(x for x in out.stdout.splitlines() if "build options" in x)
+        assert line.split("build options", 1)[1].strip() == double["build_options"]
