@@ -44,6 +44,8 @@ const EnumNames<IntegratorType>& enum_names<IntegratorType>();
 template <>
 const EnumNames<FilterType>& enum_names<FilterType>();
 template <>
+const EnumNames<ShapeType>& enum_names<ShapeType>();
+template <>
 const EnumNames<Transfer>& enum_names<Transfer>();
 template <>
 const EnumNames<ToneMap>& enum_names<ToneMap>();

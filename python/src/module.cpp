@@ -40,6 +40,12 @@ const EnumNames<FilterType>& enum_names<FilterType>() {
   static const EnumNames<Enum> t{"filter type", {LC_FILTER_TYPES(LUCENT_PY_NAME)}};
   return t;
 }
+template <>
+const EnumNames<ShapeType>& enum_names<ShapeType>() {
+  using Enum = ShapeType;
+  static const EnumNames<Enum> t{"shape type", {LC_SHAPE_TYPES(LUCENT_PY_NAME)}};
+  return t;
+}
 #undef LUCENT_PY_NAME
 
 // Not in the registries: the film's display settings (scene-file names) and the precision.

@@ -16,12 +16,13 @@ namespace lucent::python {
 namespace {
 
 // Every field of SessionStats, for attributes, as_dict() and repr().
-#define LUCENT_PY_SESSION_STATS(X)                                                     \
-  X(scene_packs)                                                                       \
-  X(bvh_builds)                                                                        \
-  X(kernel_compiles)                                                                   \
-  X(kernel_cache_loads) X(kernel_reuses) X(buffer_uploads) X(bytes_uploaded) X(passes) \
-      X(pack_seconds) X(bvh_seconds) X(build_seconds) X(render_seconds)
+#define LUCENT_PY_SESSION_STATS(X)                                                              \
+  X(scene_packs)                                                                                \
+  X(bvh_builds)                                                                                 \
+  X(kernel_compiles)                                                                            \
+  X(kernel_cache_loads)                                                                         \
+  X(kernel_reuses) X(buffer_uploads) X(bytes_uploaded) X(passes) X(pack_seconds) X(bvh_seconds) \
+      X(build_seconds) X(render_seconds)
 
 #define LUCENT_PY_PROGRESS(X) \
   X(samples_done) X(samples_target) X(accumulated) X(elapsed) X(time_limit) X(samples_per_second)

@@ -19,6 +19,7 @@ PYBIND11_MAKE_OPAQUE(std::vector<lucent::Sphere>)
 PYBIND11_MAKE_OPAQUE(std::vector<lucent::Triangle>)
 PYBIND11_MAKE_OPAQUE(std::vector<lucent::Light>)
 PYBIND11_MAKE_OPAQUE(std::vector<lucent::Texture>)
+PYBIND11_MAKE_OPAQUE(std::vector<lucent::ShapeEntry>)
 
 namespace lucent::python {
 
@@ -413,6 +414,17 @@ void bind_scene(py::module_& m) {
           },
           "(H, W, 4) float32, linear, row 0 at the top: a view (assign an array to resize)");
 
+  py::class_<ShapeEntry> shape_entry(
+      m, "ShapeEntry",
+      "One entry of the scene's shape list as given (for messages and statistics): type, the "
+      "OBJ file of a mesh, its first sphere or triangle and their count.");
+  shape_entry.def(py::init<>())
+      .def_readwrite("file", &ShapeEntry::file)
+      .def_readwrite("first", &ShapeEntry::first)
+      .def_readwrite("count", &ShapeEntry::count);
+  enum_property(shape_entry, "type", &ShapeEntry::type);
+
+  py::bind_vector<std::vector<ShapeEntry>>(m, "ShapeList");
   py::bind_vector<std::vector<Material>>(m, "MaterialList");
   py::bind_vector<std::vector<Sphere>>(m, "SphereList");
   py::bind_vector<std::vector<Triangle>>(m, "TriangleList");
@@ -433,6 +445,7 @@ void bind_scene(py::module_& m) {
       .def_readwrite("triangles", &Scene::triangles)
       .def_readwrite("lights", &Scene::lights)
       .def_readwrite("textures", &Scene::textures)
+      .def_readwrite("shapes", &Scene::shapes, "the shape list as given (ShapeEntry)")
       .def("find_material", &Scene::find_material, py::arg("name"),
            "Index of the material named `name`, or -1.")
       .def("copy", [](const Scene& s) { return Scene(s); })

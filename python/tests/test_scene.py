@@ -24,6 +24,8 @@ def test_dict_and_file_give_the_same_scene(tmp_path, small_scene):
         assert sorted(m.name for m in s.materials) == ["g", "w"]
         assert s.materials[s.find_material("w")].albedo == (0.7, 0.6, 0.5)
         assert len(s.spheres) == 1 and len(s.triangles) == 2
+        assert [(e.type, e.first, e.count) for e in s.shapes] == [("sphere", 0, 1),
+                                                                  ("triangles", 0, 2)]
         assert s.positions.shape == (4, 3)
         assert s.lights[0].type == "point" and s.lights[0].intensity == (20, 20, 20)
     assert from_file.path == str(path)
@@ -52,6 +54,7 @@ def test_registry_names():
     (lucent.Material, "scene.hpp", "Material"), (lucent.Sphere, "scene.hpp", "Sphere"),
     (lucent.Triangle, "scene.hpp", "Triangle"), (lucent.Light, "scene.hpp", "Light"),
     (lucent.Texture, "scene.hpp", "Texture"), (lucent.Scene, "scene.hpp", "Scene"),
+    (lucent.ShapeEntry, "scene.hpp", "ShapeEntry"),
 ])
 def test_every_field_of_the_scene_structs_is_exposed(cls, header, struct):
     fields = header_fields(header, struct)
