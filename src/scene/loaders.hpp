@@ -1,5 +1,6 @@
 #pragma once
 // Internal scene loading pieces: OBJ/MTL meshes and textures, called by the JSON loader.
+#include <cstddef>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -25,5 +26,9 @@ void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform
 /// linear) as a scene texture, reusing an already loaded one with the same path. Returns its
 /// index. Throws lucent::Error naming the file when it cannot be read.
 int load_texture(Scene& scene, const std::string& path);
+
+/// Decodes a texture file's bytes (`path` names it in messages): what load_texture does after
+/// reading the file. Throws lucent::Error naming `path`.
+Texture decode_texture(const unsigned char* data, std::size_t size, const std::string& path);
 
 }  // namespace lucent::scene_detail
