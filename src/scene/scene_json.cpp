@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cfloat>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -16,6 +17,7 @@
 
 #include "lucent/error.hpp"
 #include "lucent/scene.hpp"
+#include "scene/json_guard.hpp"
 #include "scene/loaders.hpp"
 
 namespace lucent {
@@ -98,6 +100,9 @@ class Parser {
     if (!j.is_number()) fail(ptr, "must be a number, got " + type_name(j) + " " + show(j));
     double v = j.get<double>();
     if (!std::isfinite(v)) fail(ptr, "must be a finite number, got " + format_number(v));
+    // the device stores floats: a larger value would become infinite there
+    if (std::abs(v) > FLT_MAX)
+      fail(ptr, "must fit in a float (magnitude at most 3.4e38), got " + format_number(v));
     return v;
   }
 
@@ -456,7 +461,10 @@ class Parser {
     int uvbase = static_cast<int>(scene.uvs.size());
     for (size_t i = 0; i < n; ++i) {
       glm::dvec3 v = vec3(pos[i], p + "/positions/" + std::to_string(i));
-      scene.positions.push_back(glm::dvec3(xf * glm::dvec4(v, 1.0)));
+      glm::dvec3 w = glm::dvec3(xf * glm::dvec4(v, 1.0));
+      if (!(std::abs(w.x) <= FLT_MAX && std::abs(w.y) <= FLT_MAX && std::abs(w.z) <= FLT_MAX))
+        fail(p + "/positions/" + std::to_string(i), "the transform takes it beyond float range");
+      scene.positions.push_back(w);
     }
     for (auto& nn : normals) {
       glm::dvec3 t = nxf * nn;
@@ -560,6 +568,7 @@ struct ErrorLocator : nlohmann::json_sax<json> {
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& path) {
+  scene_detail::check_json_structure(text, path);  // nesting depth, duplicate keys
   json root;
   try {
     root = json::parse(text);
@@ -589,13 +598,7 @@ Scene parse_scene(const std::string& text, const std::string& path) {
 }
 
 Scene load_scene(const std::string& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw Error(path + ": is a directory, not a scene file");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw Error(path + ": cannot open scene file (" + std::string(std::strerror(errno)) + ")");
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return parse_scene(ss.str(), path);
+  return parse_scene(scene_detail::read_scene_text(path), path);  // bounded; pipes allowed
 }
 
 }  // namespace lucent
