@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
+#include <regex>
+#include <sstream>
 
+#include "cl/kernel_source.hpp"
 #include "lucent/error.hpp"
 
 namespace lucent::cl_util {
@@ -28,6 +31,29 @@ std::string type_name(cl_device_type t) {
   if (t & CL_DEVICE_TYPE_CPU) return "CPU";
   if (t & CL_DEVICE_TYPE_ACCELERATOR) return "accelerator";
   return "other";
+}
+
+// "0 'name' (CPU), 1 'name' (GPU)": the devices an error about a selector lists.
+std::string device_list(const std::vector<Device>& devices) {
+  std::string out;
+  for (const Device& d : devices)
+    out += (out.empty() ? "" : ", ") + std::to_string(d.info.index) + " '" + d.info.name + "' (" +
+           d.info.type + ")";
+  return out;
+}
+
+// The first "kernels/<file>:<line>:<col>: error" of a build log, as "<file>:<line>:<col>" with
+// the kernel directory in use (LUCENT_KERNEL_DIR, or kernels/ for the embedded sources).
+std::string first_error_place(const std::string& log) {
+  static const std::regex place(R"(kernels/([^:\s]+:\d+(:\d+)?))");
+  std::istringstream in(log);
+  std::smatch m;
+  for (std::string line; std::getline(in, line);) {
+    if (line.find("error") == std::string::npos || !std::regex_search(line, m, place)) continue;
+    std::string origin = detail::kernel_source_origin();
+    return (origin == "embedded" ? std::string("kernels") : origin) + "/" + m[1].str();
+  }
+  return "";
 }
 
 const char kNoPlatform[] =
@@ -109,13 +135,17 @@ Device pick_device(const std::string& selector_in) {
   if (numeric) {
     long index = std::strtol(selector.c_str(), nullptr, 10);
     if (index >= 0 && index < static_cast<long>(devices.size())) return devices[index];
-    throw Error(origin + " " + selector + ": no device with this index (" +
-                std::to_string(devices.size()) + " device(s); see `lucent devices`)");
+    throw Error(origin + " " + selector +
+                ": no device with this index (available: " + device_list(devices) + ")");
   }
   std::string want = lower(selector);
+  if (trim(want).empty())
+    throw Error(origin + " '" + selector +
+                "': empty device selector (available: " + device_list(devices) + ")");
   for (auto& d : devices)
     if (lower(d.info.name).find(want) != std::string::npos) return d;
-  throw Error(origin + " '" + selector + "': no device name contains it (see `lucent devices`)");
+  throw Error(origin + " '" + selector +
+              "': no device name contains it (available: " + device_list(devices) + ")");
 }
 
 Context::Context(const std::string& selector) : device(pick_device(selector)) {
@@ -127,7 +157,8 @@ Context::Context(const std::string& selector) : device(pick_device(selector)) {
   }
 }
 
-cl::Program build_program(const Context& ctx, const std::string& source, const std::string& options) {
+cl::Program build_program(const Context& ctx, const std::string& source,
+                          const std::string& options) {
   cl::Program program;
   try {
     program = cl::Program(ctx.context, source);
@@ -142,10 +173,11 @@ cl::Program build_program(const Context& ctx, const std::string& source, const s
       log = trim(program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(ctx.device.device));
     } catch (const cl::Error&) {
     }
-    std::string msg;
-    if (!log.empty()) msg = "kernel build log:\n" + log + "\n";
-    msg += describe(e);
-    throw Error(msg);
+    std::string place = first_error_place(log);
+    std::string msg = (place.empty() ? std::string() : place + ": ") +
+                      "kernel build failed: " + describe(e) +
+                      (log.empty() ? "" : " (build log above)");
+    throw Error(msg, log.empty() ? std::string() : "kernel build log:\n" + log);
   }
   return program;
 }
@@ -160,6 +192,8 @@ std::vector<DeviceInfo> list_devices() {
   return out;
 }
 
-DeviceInfo select_device(const std::string& selector) { return cl_util::pick_device(selector).info; }
+DeviceInfo select_device(const std::string& selector) {
+  return cl_util::pick_device(selector).info;
+}
 
 }  // namespace lucent

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "core/file_io.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
@@ -68,9 +69,7 @@ std::string lower_extension(const std::string& path) {
 }
 
 void write_text(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary);
-  f << text;
-  if (!f) throw Error(path + ": cannot write");
+  io::write_file_atomic(path, text);  // checked to the last byte, never left half-written
 }
 
 }  // namespace
