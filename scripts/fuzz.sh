@@ -58,7 +58,7 @@ run_one() {
   case "$t" in
     scene) dict=scene.dict max_len=16384 ;;
     obj) dict=obj.dict max_len=16384 ;;
-    texture | render_image) dict=image.dict max_len=65536 ;;
+    texture | render_image) dict=image.dict max_len=16384 ;;
     *) echo "fuzz: unknown target '$t' (scene, obj, texture, render_image)" >&2; return 2 ;;
   esac
   mkdir -p "$work/corpus/$t" "$work/artifacts/$t"

@@ -6,7 +6,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -66,29 +65,11 @@ TEST(Env, UnusableCacheDirWarnsAndRenders) {
   }
 }
 
-struct CacheDirGuard {
-  std::string old;
-  bool had = false;
-  explicit CacheDirGuard(const std::string& dir) {
-    if (const char* e = std::getenv("LUCENT_CACHE_DIR")) {
-      had = true;
-      old = e;
-    }
-    ::setenv("LUCENT_CACHE_DIR", dir.c_str(), 1);
-  }
-  ~CacheDirGuard() {
-    if (had)
-      ::setenv("LUCENT_CACHE_DIR", old.c_str(), 1);
-    else
-      ::unsetenv("LUCENT_CACHE_DIR");
-  }
-};
-
 // An entry replaced by a FIFO (a read would block forever) or by a directory: rebuilt, with a
 // note naming the entry; the directory cannot be replaced, which is one warning.
 TEST(Env, CacheEntriesThatAreNotFilesAreRebuilt) {
   std::string dir = lucent::test::temp_dir() + "/cache";
-  CacheDirGuard guard(dir);
+  lucent::test::ScopedEnv guard("LUCENT_CACHE_DIR", dir.c_str());
   lucent::cl_util::Context ctx("");
   std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
   lucent::cl_util::ProgramBuildInfo a, b, c, d;

@@ -6,9 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 
 #include "fuzz_common.hpp"
@@ -21,17 +19,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string read_all(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 /// The error loading regression input `file` of `target` ("" when it loads and passes the fuzz
 /// targets' checks).
 std::string replay(const std::string& target, const fs::path& file) {
-  const std::string bytes = read_all(file);
+  const std::string bytes = lucent::test::read_file(file.string());
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   const std::string name = file.string();
   try {

@@ -13,9 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <regex>
-#include <sstream>
 #include <string>
 #include <thread>
 
@@ -30,12 +28,7 @@ using lucent::test::run_cli;
 
 std::string q(const std::string& s) { return "'" + s + "'"; }
 
-std::string read_all(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+using lucent::test::read_file;
 
 /// A small valid scene (albedo integrator: fast, deterministic) in `dir` named `name`.
 std::string scene_in(const std::string& dir, const std::string& name = "scene.json",
@@ -88,7 +81,7 @@ TEST(Outputs, FailedWriteIsAnErrorAndKeepsTheOldFile) {
                 "ulimit -f 1;");
     if (std::string(ext) == ".png" && r.status == 0) continue;  // compressed below the limit
     EXPECT_EQ(error_line(r), out + ": cannot write (File too large)") << ext;
-    EXPECT_EQ(read_all(out), "the previous image") << ext;
+    EXPECT_EQ(read_file(out), "the previous image") << ext;
     EXPECT_TRUE(others(dir, {"scene.json", "out.pfm", "out.exr", "out.png"}).empty())
         << ext << ": a temporary file was left";
   }
@@ -114,7 +107,7 @@ TEST(Outputs, FullDeviceIsAnErrorNamingThePath) {
     int raw = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(raw));
     EXPECT_EQ(WEXITSTATUS(raw), 1) << args;
-    EXPECT_EQ(read_all(dir + "/err"),
+    EXPECT_EQ(read_file(dir + "/err"),
               "lucent: error: standard output: cannot write (No space left on device)\n")
         << args;
   }
@@ -136,7 +129,7 @@ TEST(Outputs, WritesAreAtomicAndFollowSymlinks) {
   std::string plain = dir + "/plain.bin";
   lucent::io::write_file_atomic(plain, std::string("first"));
   lucent::io::write_file_atomic(plain, std::string("second, longer"));
-  EXPECT_EQ(read_all(plain), "second, longer");
+  EXPECT_EQ(read_file(plain), "second, longer");
   try {
     lucent::io::write_file_atomic(dir + "/missing/x.png", std::string("x"));
     ADD_FAILURE() << "no error";
@@ -151,7 +144,7 @@ TEST(Outputs, WritesAreAtomicAndFollowSymlinks) {
 TEST(Outputs, InputsOfTheRenderAreRefused) {
   std::string dir = lucent::test::temp_dir();
   std::string scene = scene_in(dir, "scene.exr");
-  const std::string before = read_all(scene);
+  const std::string before = read_file(scene);
   fs::create_symlink("scene.exr", dir + "/sym.exr");
   fs::create_hard_link(scene, dir + "/hard.exr");
   for (const std::string& out :
@@ -174,7 +167,7 @@ TEST(Outputs, InputsOfTheRenderAreRefused) {
   EXPECT_EQ(
       error_line(run_cli("render " + q(textured) + " -o " + q(dir + "/tex.pfm"))),
       dir + "/tex.pfm: is an input of this render (" + dir + "/tex.pfm); refusing to overwrite it");
-  EXPECT_EQ(read_all(scene), before);
+  EXPECT_EQ(read_file(scene), before);
   EXPECT_EQ(lucent::read_image(dir + "/tex.pfm").rgb, tex.rgb);
   // an AOV output that is a directory fails before rendering, the main output is not written
   fs::create_directories(dir + "/y.depth.exr");
@@ -290,9 +283,9 @@ void interrupt_render(int sig, const char* name, int status_expected) {
     return exited;
   };
   bool running = wait_for(90, [&] {
-    return reaped() || read_all(err_path).find("Msamples/s  elapsed") != std::string::npos;
+    return reaped() || read_file(err_path).find("Msamples/s  elapsed") != std::string::npos;
   });
-  ASSERT_TRUE(running && !exited) << "no progress line: " << read_all(err_path);
+  ASSERT_TRUE(running && !exited) << "no progress line: " << read_file(err_path);
   EXPECT_FALSE(fs::exists(out)) << "nothing under the output's name before the end";
   ASSERT_EQ(::kill(pid, sig), 0);
   if (!wait_for(60, reaped)) {
@@ -300,7 +293,7 @@ void interrupt_render(int sig, const char* name, int status_expected) {
     ::waitpid(pid, &status, 0);
     FAIL() << "lucent did not stop after " << name;
   }
-  std::string err = read_all(err_path);
+  std::string err = read_file(err_path);
   ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
   EXPECT_EQ(WEXITSTATUS(status), status_expected) << err;
   std::smatch m;

@@ -8,8 +8,6 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "core/file_io.hpp"
@@ -30,10 +28,7 @@ CommandResult piped(const std::string& feed, const std::string& args) {
                     q(dir + "/err");
   CommandResult r;
   r.status = std::system(cmd.c_str());
-  std::ifstream e(dir + "/err");
-  std::ostringstream ss;
-  ss << e.rdbuf();
-  r.err = ss.str();
+  r.err = lucent::test::read_file(dir + "/err");
   return r;
 }
 

@@ -32,6 +32,16 @@ bool starts_with(const unsigned char* d, std::size_t n, const char* magic, std::
   return n >= len && std::memcmp(d, magic, len) == 0;
 }
 
+// tinyexr's error text on one line (it ends its messages with newlines), freed.
+std::string exr_message(const char* err) {
+  std::string msg = err ? err : "unknown error";
+  if (err) FreeEXRErrorMessage(err);
+  for (char& c : msg)
+    if (c == '\n') c = ' ';
+  while (!msg.empty() && msg.back() == ' ') msg.pop_back();
+  return msg;
+}
+
 class Checker {
  public:
   Checker(const unsigned char* d, std::size_t n, const std::string& path, u64 max_pixels)
@@ -405,13 +415,8 @@ class Checker {
     InitEXRHeader(&header);
     const char* err = nullptr;
     if (ParseEXRHeaderFromMemory(&header, &version, d_, n_, &err) != TINYEXR_SUCCESS) {
-      std::string msg = err ? err : "unknown error";
-      if (err) FreeEXRErrorMessage(err);
       FreeEXRHeader(&header);
-      for (char& c : msg)
-        if (c == '\n') c = ' ';
-      while (!msg.empty() && msg.back() == ' ') msg.pop_back();
-      fail("cannot read OpenEXR header: " + msg);
+      fail("cannot read OpenEXR header: " + exr_message(err));
     }
     struct Free {
       EXRHeader* h;
@@ -554,10 +559,8 @@ std::string save_exr_to_memory(const std::string& path, const EXRImage& image,
   const char* err = nullptr;
   size_t n = SaveEXRImageToMemory(&image, &header, &memory, &err);
   if (n == 0 || !memory) {
-    std::string msg = err ? err : "unknown error";
-    if (err) FreeEXRErrorMessage(err);
     std::free(memory);
-    throw Error(path + ": cannot encode EXR: " + msg);
+    throw Error(path + ": cannot encode EXR: " + exr_message(err));
   }
   std::string out(reinterpret_cast<const char*>(memory), n);
   std::free(memory);
@@ -600,13 +603,8 @@ ExrChannels read_exr_channels(const unsigned char* data, std::size_t size, const
   image.num_channels = header.num_channels;
   const char* err = nullptr;
   if (LoadEXRImageFromMemory(&image, &header, data, size, &err) != TINYEXR_SUCCESS) {
-    std::string msg = err ? err : "unknown error";
-    if (err) FreeEXRErrorMessage(err);
     FreeEXRHeader(&header);
-    for (char& c : msg)
-      if (c == '\n') c = ' ';
-    while (!msg.empty() && msg.back() == ' ') msg.pop_back();
-    check.fail("cannot read OpenEXR pixels: " + msg);
+    check.fail("cannot read OpenEXR pixels: " + exr_message(err));
   }
   ExrChannels out;
   out.width = image.width;

@@ -528,20 +528,6 @@ class Parser {
   fs::path dir_;
 };
 
-/// Line and column (1-based) of the byte before `byte` (a 1-based count of bytes read).
-std::string line_col(const std::string& text, size_t byte) {
-  size_t line = 1, col = 1;
-  for (size_t i = 0; i + 1 < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      col = 1;
-    } else {
-      ++col;
-    }
-  }
-  return std::to_string(line) + ":" + std::to_string(col);
-}
-
 /// Finds where a parse stops for a reason json::parse reports without a place (a number literal
 /// out of double range, such as 1e999): a SAX pass that only records the error's byte count.
 struct ErrorLocator : nlohmann::json_sax<json> {
@@ -576,7 +562,9 @@ Scene parse_scene(const std::string& text, const std::string& path) {
     std::string what = e.what();
     auto pos = what.find("syntax error");
     if (pos != std::string::npos) what = what.substr(pos);
-    throw Error(path + ":" + line_col(text, e.byte) + ": invalid JSON: " + what);
+    // e.byte counts the bytes read, 1-based: the place is the byte before it
+    throw Error(path + ":" + scene_detail::line_col_at(text, e.byte > 0 ? e.byte - 1 : 0) +
+                ": invalid JSON: " + what);
   } catch (const json::exception& e) {
     // out_of_range 406, "number overflow parsing '1e999'", comes without a place: a SAX pass
     // finds where the parser stopped, just after the literal, and we step back to its start.
@@ -585,7 +573,7 @@ Scene parse_scene(const std::string& text, const std::string& path) {
     size_t i = std::min(locator.byte, text.size());
     while (i > 0 && std::strchr("0123456789+-.eE", text[i - 1]) && text[i - 1] != '\0') --i;
     std::string literal = text.substr(i, std::min(locator.byte, text.size()) - i);
-    throw Error(path + ":" + line_col(text, i + 1) + ": " +
+    throw Error(path + ":" + scene_detail::line_col_at(text, i) + ": " +
                 (e.id == 406 && !literal.empty()
                      ? "number out of range (not a finite double): " + literal
                      : std::string(e.what())));
