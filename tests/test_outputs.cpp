@@ -175,6 +175,7 @@ TEST(Outputs, InputsOfTheRenderAreRefused) {
       error_line(run_cli("render " + q(textured) + " -o " + q(dir + "/y.exr") + " --aov depth")),
       dir + "/y.depth.exr: is a directory");
   EXPECT_FALSE(fs::exists(dir + "/y.exr"));
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o ''")), "-o: the output path is empty");
 }
 
 // Spaces, quotes, a newline, a leading dash and bytes that are not UTF-8 in file names: renders

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
-#include <regex>
 #include <sstream>
 
 #include "cl/kernel_source.hpp"
@@ -45,13 +44,23 @@ std::string device_list(const std::vector<Device>& devices) {
 // The first "kernels/<file>:<line>:<col>: error" of a build log, as "<file>:<line>:<col>" with
 // the kernel directory in use (LUCENT_KERNEL_DIR, or kernels/ for the embedded sources).
 std::string first_error_place(const std::string& log) {
-  static const std::regex place(R"(kernels/([^:\s]+:\d+(:\d+)?))");
   std::istringstream in(log);
-  std::smatch m;
   for (std::string line; std::getline(in, line);) {
-    if (line.find("error") == std::string::npos || !std::regex_search(line, m, place)) continue;
-    std::string origin = detail::kernel_source_origin();
-    return (origin == "embedded" ? std::string("kernels") : origin) + "/" + m[1].str();
+    if (line.find("error") == std::string::npos) continue;
+    for (auto k = line.find("kernels/"); k != std::string::npos; k = line.find("kernels/", k + 1)) {
+      // kernels/<file>:<line>[:<col>]
+      size_t file_end = line.find(':', k + 8), e = file_end;
+      auto digits = [&](size_t at) {
+        size_t j = at;
+        while (j < line.size() && std::isdigit(static_cast<unsigned char>(line[j]))) ++j;
+        return j;
+      };
+      if (file_end == std::string::npos || (e = digits(file_end + 1)) == file_end + 1) continue;
+      if (e < line.size() && line[e] == ':' && digits(e + 1) > e + 1) e = digits(e + 1);
+      std::string origin = detail::kernel_source_origin();
+      return (origin == "embedded" ? std::string("kernels") : origin) + "/" +
+             line.substr(k + 8, e - k - 8);
+    }
   }
   return "";
 }

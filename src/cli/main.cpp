@@ -123,6 +123,7 @@ bool same_file(const std::string& a, const std::string& b) {
 void check_output_path(const std::string& out, const std::vector<std::string>& inputs,
                        const char* formats = ".png, .pfm or .exr") {
   namespace fs = std::filesystem;
+  if (out.empty()) throw lucent::Error("-o: the output path is empty");
   std::string ext = lower_extension(out);
   if (ext != ".png" && ext != ".pfm" && ext != ".exr")
     throw lucent::Error(out + ": unknown output format '" + ext + "' (use " + formats + ")");
