@@ -25,7 +25,8 @@ double max3(const glm::dvec3& c) { return std::max(c.x, std::max(c.y, c.z)); }
 fs::path texture_path(const std::string& mtl_path, const std::string& name) {
   fs::path p(name);
   if (!p.is_absolute()) p = fs::path(mtl_path).parent_path() / p;
-  if (!fs::exists(p) && name.find('\\') != std::string::npos) {  // Windows-style separators
+  std::error_code ec;  // names too long for the file system: no such file, no exception
+  if (!fs::exists(p, ec) && name.find('\\') != std::string::npos) {  // Windows-style separators
     std::string fixed = name;
     std::replace(fixed.begin(), fixed.end(), '\\', '/');
     return texture_path(mtl_path, fixed);
@@ -133,7 +134,8 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
 
   if (!t.diffuse_texname.empty() && m.type != MaterialType::Dielectric) {
     fs::path p = texture_path(mtl_path, t.diffuse_texname);
-    if (!fs::exists(p)) {
+    std::error_code ec;
+    if (!fs::exists(p, ec) && !ec) {
       warn(where + ": map_Kd texture '" + t.diffuse_texname + "' not found (" + p.string() +
            "); using Kd");
     } else {
@@ -162,7 +164,8 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
   for (const auto& [key, file] : unused) {
     if (file->empty()) continue;
     fs::path p = texture_path(mtl_path, *file);
-    if (!fs::exists(p) && warned_.insert(p.string()).second)
+    std::error_code ec;
+    if (!fs::exists(p, ec) && warned_.insert(p.string()).second)
       warn(where + ": " + key + " texture '" + *file + "' not found (" + p.string() +
            "); ignored (lucent does not use " + key + ")");
   }
