@@ -9,7 +9,8 @@
 # every run from scenes/ and assets/ by lucent_fuzz_seeds); crashes, leaks and UB reports land in
 # build-fuzz/fuzz/artifacts/TARGET/ and make the script fail. --if-available exits 0 with a
 # message when clang with libFuzzer is missing (CI); without it that is an error.
-# Needs the Debian packages clang and libclang-rt-14-dev (scripts/install-deps.sh --with-fuzz).
+# Needs the Debian packages clang and libclang-rt-14-dev (scripts/install-deps.sh --with-fuzz);
+# FUZZ_CC and FUZZ_CXX name other compilers (default clang, clang++).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -23,16 +24,18 @@ shift || true
 targets=("$@")
 if [[ ${#targets[@]} -eq 0 ]]; then targets=(scene obj texture render_image); fi
 jobs="${FUZZ_JOBS:-1}"
+cc="${FUZZ_CC:-clang}"
+cxx="${FUZZ_CXX:-clang++}"
 
 # clang with libFuzzer: compile and link a trivial target
 probe_dir="$(mktemp -d)"
 trap 'rm -rf "$probe_dir"' EXIT
 echo 'extern "C" int LLVMFuzzerTestOneInput(const unsigned char*, unsigned long) { return 0; }' \
   >"$probe_dir/probe.cpp"
-if ! command -v clang++ >/dev/null ||
-  ! clang++ -fsanitize=fuzzer,address,undefined "$probe_dir/probe.cpp" -o "$probe_dir/probe" \
+if ! command -v "$cxx" >/dev/null ||
+  ! "$cxx" -fsanitize=fuzzer,address,undefined "$probe_dir/probe.cpp" -o "$probe_dir/probe" \
     >/dev/null 2>&1; then
-  msg="fuzz: clang++ with libFuzzer not found (Debian packages clang and libclang-rt-14-dev)"
+  msg="fuzz: $cxx with libFuzzer not found (Debian packages clang and libclang-rt-14-dev)"
   if [[ $optional -eq 1 ]]; then
     echo "$msg: fuzzing skipped"
     exit 0
@@ -41,7 +44,7 @@ if ! command -v clang++ >/dev/null ||
   exit 1
 fi
 
-cmake -S . -B build-fuzz -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+cmake -S . -B build-fuzz -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLUCENT_FUZZ=ON -DLUCENT_BUILD_TESTS=OFF \
   -DLUCENT_BUILD_BENCH=OFF >/dev/null
 cmake --build build-fuzz --target lucent_fuzz_all -j"$(nproc)"
