@@ -6,10 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <glm/glm.hpp>
 #include <map>
 #include <string>
-
-#include <glm/glm.hpp>
 
 #include "fuzz_common.hpp"
 #include "image/image_probe.hpp"
@@ -20,7 +19,6 @@
 namespace {
 
 namespace fs = std::filesystem;
-
 
 /// The error loading regression input `file` of `target` ("" when it loads and passes the fuzz
 /// targets' checks).

@@ -176,6 +176,13 @@ TEST(Outputs, InputsOfTheRenderAreRefused) {
       dir + "/y.depth.exr: is a directory");
   EXPECT_FALSE(fs::exists(dir + "/y.exr"));
   EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o ''")), "-o: the output path is empty");
+  // compare's z map and converge's outputs are checked the same way
+  EXPECT_EQ(error_line(run_cli("compare " + q(dir + "/tex.pfm") + " " + q(dir + "/tex.pfm") +
+                               " --zmap " + q(dir + "/./tex.pfm"))),
+            dir + "/./tex.pfm: is an input of the comparison; refusing to overwrite it");
+  EXPECT_EQ(error_line(run_cli("converge " + q(textured) + " --csv " + q(textured))),
+            textured + ": is the scene file; refusing to overwrite it");
+  EXPECT_EQ(lucent::read_image(dir + "/tex.pfm").rgb, tex.rgb);
 }
 
 // Spaces, quotes, a newline, a leading dash and bytes that are not UTF-8 in file names: renders

@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/file_io.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
@@ -53,6 +54,9 @@ CLI::App* add_compare_command(CLI::App& app) {
 int run_compare_command() {
   CompareArgs& a = args();
   a.options.image_mean_test = !a.no_mean_test;
+  for (const std::string& in : {a.a, a.b})
+    if (!a.zmap.empty() && io::same_file(a.zmap, in))
+      throw Error(a.zmap + ": is an input of the comparison; refusing to overwrite it");
   RenderResult ra = read_render(a.a), rb = read_render(a.b);
   if (ra.mean.width != rb.mean.width || ra.mean.height != rb.mean.height)
     throw Error(a.b + ": size " + std::to_string(rb.mean.width) + "x" + std::to_string(rb.mean.height) +

@@ -51,7 +51,9 @@ extern "C" void on_converge_sigint(int) {
 }
 
 /// Fails before any rendering when `path` cannot be written.
-void check_writable(const std::string& path) {
+void check_writable(const std::string& path, const std::string& scene) {
+  if (io::same_file(path, scene))
+    throw Error(path + ": is the scene file; refusing to overwrite it");
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory");
   bool existed = std::filesystem::exists(path, ec);
@@ -121,14 +123,14 @@ CLI::App* add_converge_command(CLI::App& app) {
 
 int run_converge_command() {
   ConvergeArgs& a = args();
-  if (!a.csv.empty()) check_writable(a.csv);
+  if (!a.csv.empty()) check_writable(a.csv, a.scene);
   for (const std::string& plot : a.plots) {
     std::string ext = lower_extension(plot);
     if (ext != ".svg" && ext != ".png")
       throw Error(plot + ": unknown plot format '" + ext + "' (use .svg or .png)");
-    check_writable(plot);
+    check_writable(plot, a.scene);
   }
-  if (!a.save_reference.empty()) check_writable(a.save_reference);
+  if (!a.save_reference.empty()) check_writable(a.save_reference, a.scene);
 
   ConvergeOptions opt;
   std::set<std::string> seen;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "core/file_io.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/lucent.hpp"
 #include "lucent/reference.hpp"
@@ -106,17 +107,6 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-/// The same file (a hard or symbolic link to it included), or the same path once resolved.
-bool same_file(const std::string& a, const std::string& b) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec) && !ec;
-  fs::path ca = fs::weakly_canonical(a, ec);
-  if (ec) return false;
-  fs::path cb = fs::weakly_canonical(b, ec);
-  return !ec && ca == cb;
-}
-
 /// Fails early (before rendering) when `out` cannot be written: not an image format lucent
 /// writes, a directory, a directory that does not exist or cannot be written to (tested by
 /// creating a file there, as the final write does), a read-only file, or one of the inputs.
@@ -130,7 +120,7 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
   std::error_code ec;
   if (fs::is_directory(out, ec)) throw lucent::Error(out + ": is a directory");
   for (const std::string& in : inputs)
-    if (same_file(out, in))
+    if (lucent::io::same_file(out, in))
       throw lucent::Error(out + ": is an input of this render (" + in +
                           "); refusing to overwrite it");
   if (fs::exists(out, ec) && ::access(out.c_str(), W_OK) != 0)
@@ -461,8 +451,8 @@ int main(int argc, char** argv) {
     return 1;
   } catch (const std::exception& e) {
     // not a lucent::Error (a limit of the standard library): name what was being done
-    std::fprintf(stderr, "lucent: error: %s: %s\n",
-                 *render ? one_line(ra.scene).c_str() : "lucent", one_line(e.what()).c_str());
+    std::fprintf(stderr, "lucent: error: %s: %s\n", *render ? one_line(ra.scene).c_str() : "lucent",
+                 one_line(e.what()).c_str());
     return 1;
   }
   // what went to stdout (a table, a comparison) must have been written too

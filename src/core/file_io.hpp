@@ -38,6 +38,10 @@ inline void write_file_atomic(const std::string& path, const std::string& bytes)
 /// throws lucent::Error("<path>: cannot write (<reason>)") on failure. `path` names it.
 void write_all(int fd, const void* data, std::size_t size, const std::string& path);
 
+/// Whether `a` and `b` name the same file: the same file when both exist (symbolic and hard
+/// links included), else the same path once made canonical.
+bool same_file(const std::string& a, const std::string& b);
+
 /// "1.5 GiB", "256 MiB", "12 KiB", "7 bytes": a size for messages.
 std::string format_size(std::uint64_t bytes);
 
