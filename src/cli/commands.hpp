@@ -11,6 +11,12 @@ namespace lucent::cli {
 /// "path", "whitted", ... -> IntegratorType; throws lucent::Error on an unknown name.
 IntegratorType parse_integrator(const std::string& name);
 
+/// `lucent render` (cmd_render.cpp): registers the subcommand, runs it once parsed; the scene
+/// path given, for messages.
+CLI::App* add_render_command(CLI::App& app);
+int run_render_command();
+const std::string& render_scene();
+
 /// Adds the extra subcommands (info, ...) to `app`.
 void register_extra_commands(CLI::App& app);
 

@@ -49,6 +49,25 @@ struct Probe {
 Probe probe_image(const unsigned char* data, std::size_t size, const std::string& path,
                   std::uint64_t max_pixels);
 
+/// Where a PFM file's pixels are.
+struct PfmLayout {
+  std::uint64_t data_offset = 0;
+  int channels = 3;
+  bool big_endian = false;
+};
+
+/// probe_image for a PFM file, with the layout of its pixels.
+Probe probe_pfm(const unsigned char* data, std::size_t size, const std::string& path,
+                std::uint64_t max_pixels, PfmLayout& layout);
+
+/// probe_image for an OpenEXR file (checks its PIZ chunks too), with its header parsed by
+/// tinyexr into `header` (the caller frees it with FreeEXRHeader).
+Probe probe_exr(const unsigned char* data, std::size_t size, const std::string& path,
+                std::uint64_t max_pixels, EXRHeader& header);
+
+/// tinyexr's error text on one line (it ends its messages with newlines); frees `err`.
+std::string exr_message(const char* err);
+
 /// A decoded image with four channels (RGBA) or three (RGB); linear floats, row 0 at the top.
 /// 8-bit and 16-bit data are decoded from sRGB to linear (alpha stays linear).
 struct Decoded {
