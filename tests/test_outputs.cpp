@@ -242,6 +242,12 @@ TEST(Outputs, NonFiniteOptionsAreRefused) {
     EXPECT_EQ(r.status, 2) << opt << ": " << r.err;
     EXPECT_NE(error_line(r).find("must be a finite number"), std::string::npos) << r.err;
   }
+  // options the reference does not honour are refused before anything runs, not ignored
+  EXPECT_EQ(
+      error_line(run_cli("render " + q(scene) + " -o " + q(out) + " --reference --aov depth")),
+      "--aov is not supported with --reference");
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(out) + " --reference --time 2")),
+            "--time is not supported with --reference");
   CommandResult r = run_cli("converge " + q(scene) + " --time-ladder 1,nan");
   EXPECT_EQ(error_line(r), "--time-ladder nan: must be a finite number (see lucent --help)");
   EXPECT_FALSE(fs::exists(out));

@@ -172,6 +172,11 @@ std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_sp
 }
 
 int render_with(const RenderArgs& a) {
+  // options the reference does not honour: refused, rather than silently ignored
+  if (a.reference && a.time_limit > 0)
+    throw lucent::Error("--time is not supported with --reference");
+  if (a.reference && !a.aovs.empty())
+    throw lucent::Error("--aov is not supported with --reference");
   check_output_path(a.output, {a.scene});
   for (const std::string& name : a.aovs)
     check_output_path(aov_path(a.output, name), {a.scene, a.output});
@@ -226,7 +231,6 @@ int render_with(const RenderArgs& a) {
   }
   lucent::RenderResult r;
   if (a.reference) {
-    if (a.time_limit > 0) throw lucent::Error("--time is not supported with --reference");
     lucent::ReferenceOptions ro;
     ro.spp = a.spp;
     ro.cancel = &g_interrupted;
