@@ -71,13 +71,12 @@ std::string lower_extension(const std::string& path) {
 /// Fails early (before rendering) when `out` cannot be written: not an image format lucent
 /// writes, a directory, a directory that does not exist or cannot be written to (tested by
 /// creating a file there, as the final write does), a read-only file, or one of the inputs.
-void check_output_path(const std::string& out, const std::vector<std::string>& inputs,
-                       const char* formats = ".png, .pfm or .exr") {
+void check_output_path(const std::string& out, const std::vector<std::string>& inputs) {
   namespace fs = std::filesystem;
   if (out.empty()) throw lucent::Error("-o: the output path is empty");
   std::string ext = lower_extension(out);
   if (ext != ".png" && ext != ".pfm" && ext != ".exr")
-    throw lucent::Error(out + ": unknown output format '" + ext + "' (use " + formats + ")");
+    throw lucent::Error(out + ": unknown output format '" + ext + "' (use .png, .pfm or .exr)");
   std::error_code ec;
   if (fs::is_directory(out, ec)) throw lucent::Error(out + ": is a directory");
   for (const std::string& in : inputs)
@@ -90,11 +89,7 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
   std::string probe = (dir.empty() ? fs::path(".") : dir).string() + "/.lucent-write-test-" +
                       std::to_string(::getpid());
   int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) {
-    int err = errno;
-    // a file (not a directory) somewhere on the path reads better as the output's own problem
-    throw lucent::Error(out + ": cannot write output (" + std::strerror(err) + ")");
-  }
+  if (fd < 0) throw lucent::Error(out + ": cannot write output (" + std::strerror(errno) + ")");
   ::close(fd);
   ::unlink(probe.c_str());
 }
