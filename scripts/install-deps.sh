@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages lucent needs, and only those that are missing.
-# Usage: scripts/install-deps.sh [--with-bench]   (--with-bench adds Embree for the benchmark)
+# Usage: scripts/install-deps.sh [--with-bench] [--with-fuzz]
+#   --with-bench adds Embree for the benchmark; --with-fuzz adds clang and its libFuzzer and
+#   sanitizer runtimes for scripts/fuzz.sh (optional: the project builds and tests without them).
 set -euo pipefail
 
 packages=(
@@ -10,7 +12,13 @@ packages=(
   nlohmann-json3-dev libcli11-dev libtinyexr-dev
   pybind11-dev python3-dev python3-numpy python3-pytest
 )
-if [[ "${1:-}" == "--with-bench" ]]; then packages+=(libembree-dev); fi
+for arg in "$@"; do
+  case "$arg" in
+    --with-bench) packages+=(libembree-dev) ;;
+    --with-fuzz) packages+=(clang libclang-rt-14-dev) ;;
+    *) echo "install-deps: unknown option $arg (--with-bench, --with-fuzz)" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${packages[@]}"; do

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Second command of README (and what CI runs): install what is missing, build, run every test.
 # With LUCENT_SANITIZE=1 (CI sets it) the suite then runs again on an AddressSanitizer +
-# UndefinedBehaviorSanitizer build in build-asan/.
+# UndefinedBehaviorSanitizer build in build-asan/, and, when clang with libFuzzer is installed
+# (scripts/install-deps.sh --with-fuzz), each fuzz target runs for LUCENT_FUZZ_SECONDS (default
+# 30; 0 skips it) in build-fuzz/ (scripts/fuzz.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -22,4 +24,9 @@ if [[ "${LUCENT_SANITIZE:-0}" == "1" ]]; then
   # PoCL and the ICD loader keep allocations until exit: leak checking reports theirs, not ours
   (cd build-asan && ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
      ctest --output-on-failure -j"$jobs" --timeout 900)
+fi
+
+if [[ "${LUCENT_SANITIZE:-0}" == "1" && "${LUCENT_FUZZ_SECONDS:-30}" != "0" ]]; then
+  echo "test: fuzz smoke run (${LUCENT_FUZZ_SECONDS:-30} s per target)"
+  FUZZ_JOBS="$jobs" scripts/fuzz.sh --if-available "${LUCENT_FUZZ_SECONDS:-30}"
 fi

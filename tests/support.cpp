@@ -101,6 +101,26 @@ void write_file(const std::string& path, const std::string& text) {
   f << text;
 }
 
+std::string read_file(const std::string& path) { return read_all(path); }
+
+ScopedEnv::ScopedEnv(const char* name, const char* value) : name_(name) {
+  if (const char* old = std::getenv(name)) {
+    had_ = true;
+    old_ = old;
+  }
+  if (value)
+    ::setenv(name, value, 1);
+  else
+    ::unsetenv(name);
+}
+
+ScopedEnv::~ScopedEnv() {
+  if (had_)
+    ::setenv(name_.c_str(), old_.c_str(), 1);
+  else
+    ::unsetenv(name_.c_str());
+}
+
 std::string source_path(const std::string& rel) {
   return std::string(LUCENT_SOURCE_DIR) + "/" + rel;
 }

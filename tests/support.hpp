@@ -25,6 +25,22 @@ std::string temp_dir();
 /// Writes `text` to `path`.
 void write_file(const std::string& path, const std::string& text);
 
+/// The content of `path` ("" when it cannot be read).
+std::string read_file(const std::string& path);
+
+/// Sets an environment variable (or unsets it, for nullptr) while alive; restores it after.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value);
+  ~ScopedEnv();
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  std::string name_, old_;
+  bool had_ = false;
+};
+
 /// Path of a file under the source tree.
 std::string source_path(const std::string& rel);
 

@@ -1,20 +1,14 @@
-// The command-line front end: --version, --help, the render options, the progress line and
-// SIGINT (the image accumulated so far is written, exit status 130).
-#include <fcntl.h>
+// The command-line front end: --version, --help, the render options and the progress line
+// (interrupting a render: tests/test_outputs.cpp).
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <regex>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "support.hpp"
@@ -250,72 +244,6 @@ TEST(Cli, ProgressLineOnATerminal) {
       << text;
   EXPECT_NE(text.find("\n" + out + ": 64x16, "), std::string::npos) << text;
   EXPECT_EQ(text.find("lucent: error"), std::string::npos) << text;
-}
-
-// SIGINT while rendering: the image accumulated so far is written and the exit status is 130.
-// The signal is sent once the progress line shows the render loop is running (not after a fixed
-// delay), and --time bounds the render should the signal be lost.
-TEST(Cli, SigintWritesThePartialImage) {
-  std::string scene = plane_scene(0, 1 << 24);
-  std::string dir = lucent::test::temp_dir();
-  std::string out = dir + "/partial.pfm", err_path = dir + "/stderr";
-  pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    int fd = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    int null = ::open("/dev/null", O_RDWR);
-    if (fd < 0 || null < 0) ::_exit(126);
-    ::dup2(null, 0);
-    ::dup2(null, 1);
-    ::dup2(fd, 2);
-    ::signal(SIGINT, SIG_DFL);
-    ::execl(LUCENT_CLI_PATH, "lucent", "render", scene.c_str(), "-o", out.c_str(), "--time", "120",
-            "--width", "64", "--height", "48", static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  using clock = std::chrono::steady_clock;
-  auto wait_for = [&](double seconds, auto done) {
-    auto end = clock::now() + std::chrono::duration<double>(seconds);
-    while (clock::now() < end) {
-      if (done()) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    return false;
-  };
-  int status = 0;
-  bool exited = false;
-  auto reaped = [&] {
-    if (!exited && ::waitpid(pid, &status, WNOHANG) == pid) exited = true;
-    return exited;
-  };
-  bool running = wait_for(90, [&] {
-    return reaped() || read_all(err_path).find("Msamples/s  elapsed") != std::string::npos;
-  });
-  ASSERT_TRUE(running && !exited) << "no progress line: " << read_all(err_path);
-  ASSERT_EQ(::kill(pid, SIGINT), 0);
-  if (!wait_for(60, reaped)) {
-    ::kill(pid, SIGKILL);
-    ::waitpid(pid, &status, 0);
-    FAIL() << "lucent did not stop after SIGINT";
-  }
-  std::string err = read_all(err_path);
-  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
-  EXPECT_EQ(WEXITSTATUS(status), 130) << err;
-  std::smatch m;
-  ASSERT_TRUE(std::regex_search(err, m,
-                                std::regex("lucent: interrupted: wrote " + out +
-                                           " with the (\\d+) spp accumulated so far\n$")))
-      << err;
-  EXPECT_GE(std::stoll(m[1]), 1);
-  lucent::Image img = lucent::read_image(out);
-  ASSERT_EQ(img.width, 64);
-  ASSERT_EQ(img.height, 48);
-  double sum = 0;
-  for (float v : img.rgb) {
-    ASSERT_TRUE(std::isfinite(v));
-    sum += v;
-  }
-  EXPECT_GT(sum, 0) << "the partial image is black";
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "support.hpp"
 
@@ -183,19 +184,32 @@ TEST(CliErrors, NoOpenClPlatform) {
   EXPECT_EQ(run_cli("devices").status, 0);
 }
 
+// A selector that matches nothing lists the devices there are, in the one error line.
 TEST(CliErrors, NoMatchingDevice) {
   std::string scene = small_scene();
   std::string out = lucent::test::temp_dir() + "/o.png";
   std::string base = "render " + q(scene) + " -o " + q(out);
-  EXPECT_EQ(expect_one_error_line(run_cli(base + " --device no-such-device-xyz")),
-            "--device 'no-such-device-xyz': no device name contains it (see `lucent devices`)");
-  std::string msg = expect_one_error_line(run_cli(base + " --device 999"));
-  EXPECT_EQ(msg.rfind("--device 999: no device with this index (", 0), 0u) << msg;
-  EXPECT_EQ(
-      expect_one_error_line(run_cli(base, "LUCENT_DEVICE=no-such-device-xyz")),
-      "LUCENT_DEVICE 'no-such-device-xyz': no device name contains it (see `lucent devices`)");
-  msg = expect_one_error_line(run_cli(base, "LUCENT_DEVICE=999"));
-  EXPECT_EQ(msg.rfind("LUCENT_DEVICE 999: no device with this index (", 0), 0u) << msg;
+  std::vector<lucent::DeviceInfo> devices = lucent::list_devices();
+  ASSERT_FALSE(devices.empty());
+  std::string list = " (available: 0 '" + devices[0].name + "' (" + devices[0].type + ")";
+  struct Case {
+    std::string args, env, start;
+  } cases[] = {
+      {base + " --device no-such-device-xyz", "",
+       "--device 'no-such-device-xyz': no device name contains it"},
+      {base + " --device 999", "", "--device 999: no device with this index"},
+      {base, "LUCENT_DEVICE=no-such-device-xyz",
+       "LUCENT_DEVICE 'no-such-device-xyz': no device name contains it"},
+      {base, "LUCENT_DEVICE=999", "LUCENT_DEVICE 999: no device with this index"},
+      {base, "LUCENT_DEVICE=99999999999999999999999", "LUCENT_DEVICE 99999999999999999999999: no device with this index"},
+      {base, "LUCENT_DEVICE=' '", "LUCENT_DEVICE ' ': empty device selector"},
+      {base, "LUCENT_DEVICE=$(printf '\\377\\376')", "LUCENT_DEVICE '\\xff\\xfe': no device name contains it"},
+  };
+  for (const Case& c : cases) {
+    std::string msg = expect_one_error_line(run_cli(c.args, c.env));
+    EXPECT_EQ(msg.rfind(c.start + list, 0), 0u) << msg;
+    EXPECT_EQ(msg.back(), ')') << msg;
+  }
   EXPECT_FALSE(fs::exists(out));
 }
 

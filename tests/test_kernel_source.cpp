@@ -184,14 +184,21 @@ int inject(const std::string& dir, const std::string& file, int line, const std:
   return line;
 }
 
-void expect_build_failure(const CommandResult& r, const std::string& where) {
+// The build log comes first; the last line is the one error line, naming the file and line of
+// the first error (under LUCENT_KERNEL_DIR, the file there).
+void expect_build_failure(const CommandResult& r, const std::string& where, const std::string& file) {
   EXPECT_EQ(r.status, 1);
-  EXPECT_NE(r.err.find("lucent: error: kernel build log:\n"), std::string::npos) << r.err;
+  EXPECT_LT(r.err.find("kernel build log:\n"), r.err.find("lucent: error: ")) << r.err;
   EXPECT_NE(r.err.find(where), std::string::npos) << "no '" << where << "' in:\n" << r.err;
   std::vector<std::string> lines = lines_of(r.err);
   while (!lines.empty() && lines.back().empty()) lines.pop_back();
   ASSERT_FALSE(lines.empty());
-  EXPECT_EQ(lines.back(), "clBuildProgram: CL_BUILD_PROGRAM_FAILURE");
+  EXPECT_EQ(lines.back().rfind("lucent: error: " + file + ":", 0), 0u) << lines.back();
+  EXPECT_NE(lines.back().find(": kernel build failed: clBuildProgram: CL_BUILD_PROGRAM_FAILURE "
+                              "(build log above)"),
+            std::string::npos)
+      << lines.back();
+  EXPECT_EQ(r.err.find("lucent: error:"), r.err.rfind("lucent: error:")) << "one error line";
 }
 
 TEST(KernelSource, BuildFailureInTheMainFileNamesItsLine) {
@@ -204,7 +211,8 @@ TEST(KernelSource, BuildFailureInTheMainFileNamesItsLine) {
   int line = inject(dir, "megakernel.cl", at, "lucent_injected_error here;");
   CommandResult r =
       render_plane("LUCENT_KERNEL_DIR='" + dir + "'", lucent::test::temp_dir() + "/o.pfm");
-  expect_build_failure(r, "kernels/megakernel.cl:" + std::to_string(line) + ":");
+  expect_build_failure(r, "kernels/megakernel.cl:" + std::to_string(line) + ":",
+                       dir + "/megakernel.cl:" + std::to_string(line));
 }
 
 TEST(KernelSource, BuildFailureInAnIncludedFileNamesItsLine) {
@@ -212,7 +220,8 @@ TEST(KernelSource, BuildFailureInAnIncludedFileNamesItsLine) {
   int line = inject(dir, "util/math.cl", 0, "float lucent_injected_error(void) { return 1.0f +; }");
   CommandResult r =
       render_plane("LUCENT_KERNEL_DIR='" + dir + "'", lucent::test::temp_dir() + "/o.pfm");
-  expect_build_failure(r, "kernels/util/math.cl:" + std::to_string(line) + ":");
+  expect_build_failure(r, "kernels/util/math.cl:" + std::to_string(line) + ":",
+                       dir + "/util/math.cl:" + std::to_string(line));
 }
 
 }  // namespace

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
+#include <sstream>
 
+#include "cl/kernel_source.hpp"
 #include "lucent/error.hpp"
 
 namespace lucent::cl_util {
@@ -28,6 +30,37 @@ std::string type_name(cl_device_type t) {
   if (t & CL_DEVICE_TYPE_CPU) return "CPU";
   if (t & CL_DEVICE_TYPE_ACCELERATOR) return "accelerator";
   return "other";
+}
+
+// "0 'name' (CPU), 1 'name' (GPU)": the devices an error about a selector lists.
+std::string device_list(const std::vector<Device>& devices) {
+  std::string out;
+  for (const Device& d : devices)
+    out += (out.empty() ? "" : ", ") + std::to_string(d.info.index) + " '" + d.info.name + "' (" +
+           d.info.type + ")";
+  return out;
+}
+
+// The first "kernels/<file>:<line>:<col>: error" of a build log, as "kernels/<file>:<line>:<col>"
+// (the session names the kernel directory in use instead of kernels/ when there is one).
+std::string first_error_place(const std::string& log) {
+  std::istringstream in(log);
+  for (std::string line; std::getline(in, line);) {
+    if (line.find("error") == std::string::npos) continue;
+    for (auto k = line.find("kernels/"); k != std::string::npos; k = line.find("kernels/", k + 1)) {
+      // kernels/<file>:<line>[:<col>]
+      size_t file_end = line.find(':', k + 8), e = file_end;
+      auto digits = [&](size_t at) {
+        size_t j = at;
+        while (j < line.size() && std::isdigit(static_cast<unsigned char>(line[j]))) ++j;
+        return j;
+      };
+      if (file_end == std::string::npos || (e = digits(file_end + 1)) == file_end + 1) continue;
+      if (e < line.size() && line[e] == ':' && digits(e + 1) > e + 1) e = digits(e + 1);
+      return line.substr(k, e - k);
+    }
+  }
+  return "";
 }
 
 const char kNoPlatform[] =
@@ -100,13 +133,17 @@ Device pick_device(const std::string& selector, const std::string& origin) {
   if (numeric) {
     long index = std::strtol(selector.c_str(), nullptr, 10);
     if (index >= 0 && index < static_cast<long>(devices.size())) return devices[index];
-    throw Error(origin + " " + selector + ": no device with this index (" +
-                std::to_string(devices.size()) + " device(s); see `lucent devices`)");
+    throw Error(origin + " " + selector +
+                ": no device with this index (available: " + device_list(devices) + ")");
   }
   std::string want = lower(selector);
+  if (trim(want).empty())
+    throw Error(origin + " '" + selector +
+                "': empty device selector (available: " + device_list(devices) + ")");
   for (auto& d : devices)
     if (lower(d.info.name).find(want) != std::string::npos) return d;
-  throw Error(origin + " '" + selector + "': no device name contains it (see `lucent devices`)");
+  throw Error(origin + " '" + selector +
+              "': no device name contains it (available: " + device_list(devices) + ")");
 }
 
 Context::Context(const std::string& selector, const std::string& origin)
@@ -135,10 +172,11 @@ cl::Program build_program(const Context& ctx, const std::string& source,
       log = trim(program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(ctx.device.device));
     } catch (const cl::Error&) {
     }
-    std::string msg;
-    if (!log.empty()) msg = "kernel build log:\n" + log + "\n";
-    msg += describe(e);
-    throw Error(msg);
+    std::string place = first_error_place(log);
+    std::string msg = (place.empty() ? std::string() : place + ": ") +
+                      "kernel build failed: " + describe(e) +
+                      (log.empty() ? "" : " (build log above)");
+    throw Error(msg, log.empty() ? std::string() : "kernel build log:\n" + log);
   }
   return program;
 }

@@ -2,17 +2,22 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <mutex>
+#include <set>
 #include <sstream>
 #include <vector>
 
+#include "core/file_io.hpp"
 #include "lucent/error.hpp"
 #include "lucent/version.hpp"
+#include "scene/loaders.hpp"
 
 namespace lucent::cl_util {
 
@@ -47,36 +52,51 @@ std::string cache_key(const Context& ctx, const std::string& source, const std::
   return k.str();
 }
 
+// An entry: magic, key length, key, binary length, checksum, binary. Read with a bound and from
+// regular files only (an entry replaced by a FIFO or a device must not hang or flood a build).
 bool read_entry(const std::string& path, const std::string& key, std::vector<unsigned char>& binary,
                 std::string& why) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return false;  // a miss, not an error
-  std::string magic(sizeof kMagic - 1, '\0');
-  f.read(&magic[0], static_cast<std::streamsize>(magic.size()));
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(path, ec))) return false;  // a miss, not an error
+  std::string bytes;
+  try {
+    io::ReadSpec spec;
+    spec.what = "cache entry";
+    spec.max_bytes = (1ull << 31) + (2u << 20);
+    bytes = io::read_file(path, spec);
+  } catch (const Error& e) {
+    why = e.what();
+    return false;
+  }
+  const size_t magic_len = sizeof kMagic - 1;
   std::uint64_t key_len = 0, bin_len = 0, checksum = 0;
-  f.read(reinterpret_cast<char*>(&key_len), sizeof key_len);
-  if (!f || magic != kMagic || key_len > (1u << 20)) {
+  size_t at = magic_len + sizeof key_len;
+  if (bytes.size() < at || bytes.compare(0, magic_len, kMagic) != 0) {
     why = "bad header";
     return false;
   }
-  std::string stored_key(key_len, '\0');
-  f.read(&stored_key[0], static_cast<std::streamsize>(key_len));
-  f.read(reinterpret_cast<char*>(&bin_len), sizeof bin_len);
-  f.read(reinterpret_cast<char*>(&checksum), sizeof checksum);
-  if (!f || stored_key != key) {
+  std::memcpy(&key_len, bytes.data() + magic_len, sizeof key_len);
+  if (key_len > (1u << 20) || bytes.size() - at < key_len + 2 * sizeof(std::uint64_t)) {
+    why = "bad header";
+    return false;
+  }
+  if (bytes.compare(at, key_len, key) != 0 || key_len != key.size()) {
     why = "stale or colliding key";
     return false;
   }
+  at += key_len;
+  std::memcpy(&bin_len, bytes.data() + at, sizeof bin_len);
+  std::memcpy(&checksum, bytes.data() + at + sizeof bin_len, sizeof checksum);
+  at += 2 * sizeof(std::uint64_t);
   if (bin_len == 0 || bin_len > (1ull << 31)) {
     why = "bad binary size";
     return false;
   }
-  binary.resize(bin_len);
-  f.read(reinterpret_cast<char*>(binary.data()), static_cast<std::streamsize>(bin_len));
-  if (!f || f.peek() != std::char_traits<char>::eof()) {
+  if (bytes.size() - at != bin_len) {
     why = "truncated or oversized entry";
     return false;
   }
+  binary.assign(bytes.begin() + static_cast<std::ptrdiff_t>(at), bytes.end());
   if (fnv1a(binary.data(), binary.size()) != checksum) {
     why = "checksum mismatch";
     return false;
@@ -84,30 +104,31 @@ bool read_entry(const std::string& path, const std::string& key, std::vector<uns
   return true;
 }
 
+// Warns once per process and message: a cache that cannot be used only costs speed.
+void warn_once(const std::string& message) {
+  static std::mutex mutex;
+  static std::set<std::string> said;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (said.insert(message).second) scene_detail::warn(message);
+}
+
 void write_entry(const std::string& path, const std::string& key,
                  const std::vector<unsigned char>& binary) {
-  std::error_code ec;
-  fs::create_directories(fs::path(path).parent_path(), ec);
-  std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!f) return;  // an unwritable cache only costs speed
-    std::uint64_t key_len = key.size(), bin_len = binary.size();
-    std::uint64_t checksum = fnv1a(binary.data(), binary.size());
-    f.write(kMagic, sizeof kMagic - 1);
-    f.write(reinterpret_cast<const char*>(&key_len), sizeof key_len);
-    f.write(key.data(), static_cast<std::streamsize>(key.size()));
-    f.write(reinterpret_cast<const char*>(&bin_len), sizeof bin_len);
-    f.write(reinterpret_cast<const char*>(&checksum), sizeof checksum);
-    f.write(reinterpret_cast<const char*>(binary.data()),
-            static_cast<std::streamsize>(binary.size()));
-    if (!f) {
-      fs::remove(tmp, ec);
-      return;
-    }
+  std::uint64_t key_len = key.size(), bin_len = binary.size();
+  std::uint64_t checksum = fnv1a(binary.data(), binary.size());
+  std::string bytes(kMagic, sizeof kMagic - 1);
+  bytes.append(reinterpret_cast<const char*>(&key_len), sizeof key_len);
+  bytes += key;
+  bytes.append(reinterpret_cast<const char*>(&bin_len), sizeof bin_len);
+  bytes.append(reinterpret_cast<const char*>(&checksum), sizeof checksum);
+  bytes.append(reinterpret_cast<const char*>(binary.data()), binary.size());
+  try {
+    io::write_file_atomic(path, bytes);  // readers never see a half-written entry
+  } catch (const Error& e) {
+    warn_once(std::string(e.what()) +
+              "; the kernel cache is not updated (kernels are built "
+              "again next time)");
   }
-  fs::rename(tmp, path, ec);  // atomic: readers never see a half-written entry
-  if (ec) fs::remove(tmp, ec);
 }
 
 }  // namespace
@@ -120,6 +141,34 @@ std::string default_program_cache_dir() {
   return "";
 }
 
+namespace {
+
+// The cache directory if it can be used: a directory that exists or can be made and that this
+// process can write; otherwise "" after one warning (a cache that cannot be used only costs
+// speed).
+std::string usable_cache_dir(const std::string& dir) {
+  if (dir.empty()) return dir;
+  const std::string origin = "kernel cache";
+  std::error_code ec;
+  fs::file_status st = fs::status(dir, ec);
+  std::string why;
+  if (fs::exists(st)) {
+    if (!fs::is_directory(st))
+      why = "not a directory";
+    else if (::access(dir.c_str(), W_OK | X_OK) != 0)
+      why = std::strerror(errno);
+  } else if (!fs::create_directories(dir, ec) && ec) {
+    why = ec.message();
+  }
+  if (!why.empty()) {
+    warn_once(origin + " " + dir + ": " + why + "; kernels are built without the cache");
+    return "";
+  }
+  return dir;
+}
+
+}  // namespace
+
 cl::Program build_program_cached(const Context& ctx, const std::string& source,
                                  const std::string& options, const std::string& cache_dir,
                                  ProgramBuildInfo* info) {
@@ -127,7 +176,7 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
   ProgramBuildInfo local;
   ProgramBuildInfo& bi = info ? *info : local;
   bi = ProgramBuildInfo{};
-  const std::string& dir = cache_dir;
+  const std::string dir = usable_cache_dir(cache_dir);
   std::string key = cache_key(ctx, source, options);
   auto finish = [&](cl::Program p) {
     bi.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -149,7 +198,7 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
       }
     }
     if (!why.empty()) {
-      bi.note = bi.cache_file + ": " + why + "; rebuilt";
+      bi.note = (why.rfind(bi.cache_file, 0) == 0 ? why : bi.cache_file + ": " + why) + "; rebuilt";
       std::error_code ec;
       fs::remove(bi.cache_file, ec);
     }
@@ -171,8 +220,9 @@ int clear_program_cache(const std::string& dir) {
   int n = 0;
   std::error_code ec;
   for (auto& e : fs::directory_iterator(dir, ec)) {
-    if (e.path().extension() == ".bin" ||
-        e.path().string().find(".bin.tmp.") != std::string::npos) {
+    const std::string name = e.path().filename().string();
+    // entries, and the temporary files of writes that were interrupted
+    if (e.path().extension() == ".bin" || name.find(".bin.tmp") != std::string::npos) {
       fs::remove(e.path(), ec);
       if (!ec) ++n;
     }

@@ -1,10 +1,10 @@
 // `lucent compare A B`: the statistical comparison of two renders (docs/compare.md). Prints the
 // metrics and PASS or FAIL; exits 0 on PASS, 1 on FAIL or error.
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
+#include "core/file_io.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
@@ -53,11 +53,14 @@ CLI::App* add_compare_command(CLI::App& app) {
 int run_compare_command() {
   CompareArgs& a = args();
   a.options.image_mean_test = !a.no_mean_test;
+  for (const std::string& in : {a.a, a.b})
+    if (!a.zmap.empty() && io::same_file(a.zmap, in))
+      throw Error(a.zmap + ": is an input of the comparison; refusing to overwrite it");
   RenderResult ra = read_render(a.a), rb = read_render(a.b);
   if (ra.mean.width != rb.mean.width || ra.mean.height != rb.mean.height)
-    throw Error(a.b + ": size " + std::to_string(rb.mean.width) + "x" + std::to_string(rb.mean.height) +
-                " differs from " + a.a + " (" + std::to_string(ra.mean.width) + "x" +
-                std::to_string(ra.mean.height) + ")");
+    throw Error(a.b + ": size " + std::to_string(rb.mean.width) + "x" +
+                std::to_string(rb.mean.height) + " differs from " + a.a + " (" +
+                std::to_string(ra.mean.width) + "x" + std::to_string(ra.mean.height) + ")");
   CompareResult r = compare_images(ra, rb, a.options);
   if (!a.zmap.empty()) write_image(a.zmap, r.z);
   std::printf("A             %s%s\nB             %s%s\n", a.a.c_str(),

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "core/file_io.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
@@ -54,7 +55,9 @@ extern "C" void on_converge_sigint(int) {
 }
 
 /// Fails before any rendering when `path` cannot be written.
-void check_writable(const std::string& path) {
+void check_writable(const std::string& path, const std::string& scene) {
+  if (io::same_file(path, scene))
+    throw Error(path + ": is the scene file; refusing to overwrite it");
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory");
   bool existed = std::filesystem::exists(path, ec);
@@ -72,9 +75,7 @@ std::string lower_extension(const std::string& path) {
 }
 
 void write_text(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary);
-  f << text;
-  if (!f) throw Error(path + ": cannot write");
+  io::write_file_atomic(path, text);  // checked to the last byte, never left half-written
 }
 
 }  // namespace
@@ -103,8 +104,8 @@ CLI::App* add_converge_command(CLI::App& app) {
   cmd->add_option("--settings", a.settings,
                   "Comma-separated settings, knobs joined by +: default, fast-math, "
                   "double, float, no-specialize, no-mis, mis, max_depth=N, rr_depth=N, filter=" +
-                      type_names<FilterType>("|") + "[:R], integrator=" +
-                      type_names<IntegratorType>("|") + " (default: default)")
+                      type_names<FilterType>("|") +
+                      "[:R], integrator=" + type_names<IntegratorType>("|") + " (default: default)")
       ->delimiter(',');
   auto* spp = cmd->add_option("--spp-ladder", a.spp_ladder, "Samples per pixel of each rung")
                   ->delimiter(',')
@@ -127,14 +128,14 @@ CLI::App* add_converge_command(CLI::App& app) {
 
 int run_converge_command() {
   ConvergeArgs& a = args();
-  if (!a.csv.empty()) check_writable(a.csv);
+  if (!a.csv.empty()) check_writable(a.csv, a.scene);
   for (const std::string& plot : a.plots) {
     std::string ext = lower_extension(plot);
     if (ext != ".svg" && ext != ".png")
       throw Error(plot + ": unknown plot format '" + ext + "' (use .svg or .png)");
-    check_writable(plot);
+    check_writable(plot, a.scene);
   }
-  if (!a.save_reference.empty()) check_writable(a.save_reference);
+  if (!a.save_reference.empty()) check_writable(a.save_reference, a.scene);
 
   ConvergeOptions opt;
   std::set<std::string> seen;

@@ -5,15 +5,13 @@
 #include <map>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
 #include "bvh/bvh.hpp"
 #include "cl/kernel_source.hpp"
 #include "cli/commands.hpp"
 #include "lucent/scene.hpp"
 #include "lucent/session.hpp"
-#include "render/features.hpp"
 #include "lucent/types.hpp"
+#include "render/features.hpp"
 #include "render/pack.hpp"
 
 namespace lucent::cli {
@@ -82,8 +80,8 @@ int run_info_command() {
 
   std::printf("scene         %s\n", path.c_str());
   std::printf("film          %dx%d\n", scene.film.width, scene.film.height);
-  std::printf("integrator    %s, max_depth %d, spp %d, seed %u\n",
-              type_name(scene.integrator.type), scene.integrator.max_depth, scene.integrator.spp,
+  std::printf("integrator    %s, max_depth %d, spp %d, seed %u\n", type_name(scene.integrator.type),
+              scene.integrator.max_depth, scene.integrator.spp,
               static_cast<unsigned>(scene.integrator.seed));
   std::printf("filter        %s, radius %g\n", type_name(scene.film.filter.type),
               scene.film.filter.radius);

@@ -31,6 +31,12 @@ std::vector<std::string> aov_names();
 /// "a, b, c".
 std::string joined(const std::vector<std::string>& names);
 
+/// `lucent render` (cmd_render.cpp): registers the subcommand, runs it once parsed; the scene
+/// path given, for messages.
+CLI::App* add_render_command(CLI::App& app);
+int run_render_command();
+const std::string& render_scene();
+
 /// Adds the extra subcommands (info, ...) to `app`.
 void register_extra_commands(CLI::App& app);
 

@@ -43,12 +43,14 @@ void check_layers(const RenderResult& r, const char* which) {
   if (!r.variance.rgb.empty() && r.variance.rgb.size() != npix * 3)
     throw Error(std::string("compare: image ") + which + " has a variance layer of the wrong size");
   if (!r.samples.empty() && r.samples.size() != npix)
-    throw Error(std::string("compare: image ") + which + " has a sample-count layer of the wrong size");
+    throw Error(std::string("compare: image ") + which +
+                " has a sample-count layer of the wrong size");
 }
 
 }  // namespace
 
-CompareResult compare_images(const RenderResult& a, const RenderResult& b, const CompareOptions& o) {
+CompareResult compare_images(const RenderResult& a, const RenderResult& b,
+                             const CompareOptions& o) {
   if (a.mean.width != b.mean.width || a.mean.height != b.mean.height)
     throw Error("compare: image sizes differ: " + std::to_string(a.mean.width) + "x" +
                 std::to_string(a.mean.height) + " and " + std::to_string(b.mean.width) + "x" +
@@ -112,9 +114,11 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b, const
   for (int c = 0; c < 3; ++c) {
     r.mean_a[c] /= n;
     r.mean_b[c] /= n;
-    double eps = o.abs_epsilon + o.rel_epsilon * std::max(std::abs(r.mean_a[c]), std::abs(r.mean_b[c]));
+    double eps =
+        o.abs_epsilon + o.rel_epsilon * std::max(std::abs(r.mean_a[c]), std::abs(r.mean_b[c]));
     r.mean_z[c] = (r.mean_a[c] - r.mean_b[c]) / std::sqrt(sum_var[c] / (n * n) + eps * eps);
-    if (o.image_mean_test && !(std::abs(r.mean_z[c]) <= r.mean_z_threshold)) r.mean_test_passed = false;
+    if (o.image_mean_test && !(std::abs(r.mean_z[c]) <= r.mean_z_threshold))
+      r.mean_test_passed = false;
   }
   r.passed = r.pass_fraction >= o.min_pass_fraction && r.mean_test_passed;
   return r;
@@ -132,11 +136,11 @@ std::string CompareResult::summary() const {
   std::snprintf(buf, sizeof buf, "image-mean z  %.3f %.3f %.3f (threshold %.3f)%s\n", mean_z[0],
                 mean_z[1], mean_z[2], mean_z_threshold, mean_test_passed ? "" : "  FAIL");
   s += buf;
-  std::snprintf(buf, sizeof buf, "RMSE          %.6g\nrelMSE        %.6g\nmax abs error %.6g\n", rmse,
-                relmse, max_abs_error);
+  std::snprintf(buf, sizeof buf, "RMSE          %.6g\nrelMSE        %.6g\nmax abs error %.6g\n",
+                rmse, relmse, max_abs_error);
   s += buf;
-  std::snprintf(buf, sizeof buf, "max |z|       %.3f at (%d, %d) channel %c (threshold %.3f)\n", max_z,
-                max_z_x, max_z_y, "RGB"[max_z_channel], z_threshold);
+  std::snprintf(buf, sizeof buf, "max |z|       %.3f at (%d, %d) channel %c (threshold %.3f)\n",
+                max_z, max_z_x, max_z_y, "RGB"[max_z_channel], z_threshold);
   s += buf;
   std::snprintf(buf, sizeof buf, "failed        %zu of %zu pixel-channels, %zu pixels\n",
                 failed_channels, tested, failed_pixels);

@@ -1,18 +1,15 @@
-// Image output and input: PNG/JPG/BMP/TGA through stb, PFM by hand (a trivial format), EXR
-// through tinyexr.
-#include <algorithm>
-#include <cerrno>
-#include <cmath>
-#include <cstdio>
-#include <cstring>
-#include <fstream>
-#include <memory>
-#include <sstream>
-
-#include <stb/stb_image.h>
+// Image output and input. Outputs are encoded in memory (PNG through stb_image_write, PFM by
+// hand, EXR through tinyexr) and written through a temporary file renamed into place; inputs are
+// read with a bound and their headers checked before decoding (image/image_probe.cpp).
 #include <stb/stb_image_write.h>
 #include <tinyexr.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "core/file_io.hpp"
+#include "image/image_probe.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
 
@@ -25,7 +22,8 @@ std::string extension(const std::string& path) {
   auto slash = path.find_last_of('/');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
   std::string ext = path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
 
@@ -43,48 +41,18 @@ double tonemap(double v, ToneMap t) {
   }
 }
 
-std::string io_error(const std::string& path, const std::string& what) {
-  std::string msg = path + ": " + what;
-  if (errno) msg += " (" + std::string(std::strerror(errno)) + ")";
-  return msg;
-}
-
-void write_pfm(const std::string& path, const Image& img) {
-  errno = 0;
-  std::ofstream f(path, std::ios::binary);
-  if (!f) throw Error(io_error(path, "cannot open for writing"));
-  f << "PF\n" << img.width << " " << img.height << "\n-1.0\n";  // negative scale: little endian
-  // PFM stores rows bottom to top
+// PFM: a text header, then rows bottom to top, little-endian floats (negative scale)
+std::string encode_pfm(const Image& img) {
+  std::string out =
+      "PF\n" + std::to_string(img.width) + " " + std::to_string(img.height) + "\n-1.0\n";
+  const size_t row = sizeof(float) * 3 * static_cast<size_t>(img.width);
+  out.reserve(out.size() + row * static_cast<size_t>(img.height));
   for (int y = img.height - 1; y >= 0; --y)
-    f.write(reinterpret_cast<const char*>(img.pixel(0, y)),
-            static_cast<std::streamsize>(sizeof(float) * 3 * img.width));
-  if (!f) throw Error(io_error(path, "write failed"));
+    out.append(reinterpret_cast<const char*>(img.pixel(0, y)), row);
+  return out;
 }
 
-Image read_pfm(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw Error(path + ": cannot open image");
-  std::string magic;
-  int w = 0, h = 0;
-  double scale = 0;
-  f >> magic >> w >> h >> scale;
-  f.get();
-  if ((magic != "PF" && magic != "Pf") || w <= 0 || h <= 0 || scale == 0 || !f)
-    throw Error(path + ": not a valid PFM header");
-  if (scale > 0) throw Error(path + ": big-endian PFM is not supported");
-  int channels = magic == "PF" ? 3 : 1;
-  std::vector<float> raw(static_cast<size_t>(w) * h * channels);
-  f.read(reinterpret_cast<char*>(raw.data()), static_cast<std::streamsize>(raw.size() * sizeof(float)));
-  if (!f) throw Error(path + ": truncated PFM data");
-  Image img{w, h, std::vector<float>(static_cast<size_t>(w) * h * 3)};
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c)
-        img.pixel(x, h - 1 - y)[c] = raw[(static_cast<size_t>(y) * w + x) * channels + (channels == 3 ? c : 0)];
-  return img;
-}
-
-void write_exr(const std::string& path, const Image& img) {
+std::string encode_exr(const std::string& path, const Image& img) {
   // tinyexr wants planar channels in B, G, R order
   EXRHeader header;
   InitEXRHeader(&header);
@@ -105,43 +73,28 @@ void write_exr(const std::string& path, const Image& img) {
   std::vector<EXRChannelInfo> infos(3);
   const char* names[3] = {"B", "G", "R"};
   for (int c = 0; c < 3; ++c) {
+    std::memset(&infos[c], 0, sizeof(EXRChannelInfo));
     std::strncpy(infos[c].name, names[c], 255);
-    infos[c].name[255] = '\0';
   }
   header.channels = infos.data();
   std::vector<int> types(3, TINYEXR_PIXELTYPE_FLOAT);
   header.pixel_types = types.data();
   header.requested_pixel_types = types.data();
   header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
-  const char* err = nullptr;
-  errno = 0;
-  int rc = SaveEXRImageToFile(&image, &header, path.c_str(), &err);
-  if (rc != TINYEXR_SUCCESS) {
-    std::string msg = err ? err : "unknown error";
-    if (err) FreeEXRErrorMessage(err);
-    throw Error(path + ": cannot write EXR: " + msg);
-  }
+  return image_detail::save_exr_to_memory(path, image, header);
 }
 
-Image read_exr(const std::string& path) {
-  float* data = nullptr;
-  int w = 0, h = 0;
-  const char* err = nullptr;
-  int rc = LoadEXR(&data, &w, &h, path.c_str(), &err);
-  if (rc != TINYEXR_SUCCESS) {
-    std::string msg = err ? err : "unknown error";
-    if (err) FreeEXRErrorMessage(err);
-    throw Error(path + ": cannot read EXR: " + msg);
-  }
-  Image img{w, h, std::vector<float>(static_cast<size_t>(w) * h * 3)};
-  for (size_t i = 0; i < static_cast<size_t>(w) * h; ++i)
-    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = data[i * 4 + c];
-  std::free(data);
-  return img;
-}
-
-double srgb_to_linear(double v) {
-  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+std::string encode_png(const std::string& path, const Image& img, const DisplaySettings& display) {
+  std::vector<unsigned char> bytes(img.rgb.size());
+  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = encode_display(img.rgb[i], display);
+  std::string out;
+  auto append = [](void* context, void* data, int size) {
+    static_cast<std::string*>(context)->append(static_cast<const char*>(data),
+                                               static_cast<size_t>(size));
+  };
+  if (!stbi_write_png_to_func(append, &out, img.width, img.height, 3, bytes.data(), img.width * 3))
+    throw Error(path + ": cannot encode PNG");
+  return out;
 }
 
 }  // namespace
@@ -169,30 +122,24 @@ void write_image(const std::string& path, const Image& img, const DisplaySetting
       img.rgb.size() != static_cast<size_t>(img.width) * img.height * 3)
     throw Error(path + ": refusing to write an empty or inconsistent image");
   std::string ext = extension(path);
-  if (ext == "pfm") return write_pfm(path, img);
-  if (ext == "exr") return write_exr(path, img);
-  if (ext == "png") {
-    std::vector<unsigned char> bytes(img.rgb.size());
-    for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = encode_display(img.rgb[i], display);
-    errno = 0;
-    if (!stbi_write_png(path.c_str(), img.width, img.height, 3, bytes.data(), img.width * 3))
-      throw Error(io_error(path, "cannot write PNG"));
-    return;
-  }
-  throw Error(path + ": unknown output format '." + ext + "' (use .png, .pfm or .exr)");
+  std::string bytes;
+  if (ext == "pfm")
+    bytes = encode_pfm(img);
+  else if (ext == "exr")
+    bytes = encode_exr(path, img);
+  else if (ext == "png")
+    bytes = encode_png(path, img, display);
+  else
+    throw Error(path + ": unknown output format '." + ext + "' (use .png, .pfm or .exr)");
+  io::write_file_atomic(path, bytes);
 }
 
 Image read_image(const std::string& path) {
-  std::string ext = extension(path);
-  if (ext == "pfm") return read_pfm(path);
-  if (ext == "exr") return read_exr(path);
-  int w = 0, h = 0, n = 0;
-  unsigned char* data = stbi_load(path.c_str(), &w, &h, &n, 3);
-  if (!data) throw Error(path + ": cannot read image: " + std::string(stbi_failure_reason()));
-  Image img{w, h, std::vector<float>(static_cast<size_t>(w) * h * 3)};
-  for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] = static_cast<float>(srgb_to_linear(data[i] / 255.0));
-  stbi_image_free(data);
-  return img;
+  const std::string bytes = io::read_file(path, image_detail::image_read_spec());
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  image_detail::Decoded d =
+      image_detail::decode_image(data, bytes.size(), path, 3, image_detail::kMaxImagePixels);
+  return Image{d.width, d.height, std::move(d.pixels)};
 }
 
 }  // namespace lucent

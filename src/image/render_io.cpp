@@ -1,28 +1,21 @@
 // Renders with their statistics: an OpenEXR file with the mean (R, G, B), the per-pixel sample
 // variance (var.R, var.G, var.B) and the per-pixel finite-sample count (n), through tinyexr.
 // Format: docs/compare.md.
+#include <tinyexr.h>
+
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
 
-#include <tinyexr.h>
-
+#include "core/file_io.hpp"
+#include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
 
 namespace lucent {
-
-namespace {
-
-std::string exr_message(const char* err) {
-  std::string msg = err ? err : "unknown error";
-  if (err) FreeEXRErrorMessage(err);
-  return msg;
-}
-
-}  // namespace
 
 void write_render_exr(const std::string& path, const RenderResult& r) {
   const int w = r.mean.width, h = r.mean.height;
@@ -75,90 +68,59 @@ void write_render_exr(const std::string& path, const RenderResult& r) {
   header.pixel_types = types.data();
   header.requested_pixel_types = types.data();
   header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
-  const char* err = nullptr;
-  if (SaveEXRImageToFile(&image, &header, path.c_str(), &err) != TINYEXR_SUCCESS)
-    throw Error(path + ": cannot write EXR: " + exr_message(err));
+  io::write_file_atomic(path, image_detail::save_exr_to_memory(path, image, header));
 }
 
 RenderResult read_render(const std::string& path) {
+  const std::string bytes = io::read_file(path, image_detail::image_read_spec());
+  return image_detail::read_render_memory(reinterpret_cast<const unsigned char*>(bytes.data()),
+                                          bytes.size(), path);
+}
+
+namespace image_detail {
+
+RenderResult read_render_memory(const unsigned char* data, std::size_t size,
+                                const std::string& path) {
   RenderResult r;
-  auto ext_is_exr = [&]() {
-    auto dot = path.find_last_of('.');
-    if (dot == std::string::npos) return false;
-    std::string e = path.substr(dot + 1);
-    for (auto& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return e == "exr";
-  };
-  if (!ext_is_exr()) {
-    r.mean = read_image(path);
+  if (size < 4 || std::memcmp(data, "\x76\x2f\x31\x01", 4) != 0) {
+    Decoded d = decode_image(data, size, path, 3, kMaxImagePixels);
+    r.mean = Image{d.width, d.height, std::move(d.pixels)};
     return r;
   }
-  EXRVersion version;
-  if (ParseEXRVersionFromFile(&version, path.c_str()) != TINYEXR_SUCCESS)
-    throw Error(path + ": cannot read EXR: not an OpenEXR file or unreadable");
-  if (version.multipart || version.non_image || version.tiled) {
-    r.mean = read_image(path);  // not our layout: plain colour only
+  ExrChannels exr = read_exr_channels(data, size, path, kMaxImagePixels);
+  const int rgb[3] = {exr.find("R"), exr.find("G"), exr.find("B")};
+  if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) {
+    // not our layout (a luminance-only EXR, say): the general reader makes it grey or refuses
+    Decoded d = decode_image(data, size, path, 3, kMaxImagePixels);
+    r.mean = Image{d.width, d.height, std::move(d.pixels)};
     return r;
   }
-  EXRHeader header;
-  InitEXRHeader(&header);
-  const char* err = nullptr;
-  if (ParseEXRHeaderFromFile(&header, &version, path.c_str(), &err) != TINYEXR_SUCCESS)
-    throw Error(path + ": cannot read EXR header: " + exr_message(err));
-  for (int k = 0; k < header.num_channels; ++k)
-    if (header.pixel_types[k] == TINYEXR_PIXELTYPE_HALF)
-      header.requested_pixel_types[k] = TINYEXR_PIXELTYPE_FLOAT;
-  EXRImage image;
-  InitEXRImage(&image);
-  if (LoadEXRImageFromFile(&image, &header, path.c_str(), &err) != TINYEXR_SUCCESS) {
-    FreeEXRHeader(&header);
-    throw Error(path + ": cannot read EXR: " + exr_message(err));
-  }
-  auto find = [&](const char* name) {
-    for (int k = 0; k < header.num_channels; ++k)
-      if (std::strcmp(header.channels[k].name, name) == 0) return k;
-    return -1;
-  };
-  int rgb[3] = {find("R"), find("G"), find("B")};
-  int var[3] = {find("var.R"), find("var.G"), find("var.B")};
-  int cnt = find("n");
-  const int w = image.width, h = image.height;
+  const int w = exr.width, h = exr.height;
   const size_t n = static_cast<size_t>(w) * h;
-  bool ok = rgb[0] >= 0 && rgb[1] >= 0 && rgb[2] >= 0 && image.images != nullptr;
-  for (int c = 0; c < 3 && ok; ++c)
-    if (header.requested_pixel_types[rgb[c]] != TINYEXR_PIXELTYPE_FLOAT) ok = false;
-  if (ok) {
-    r.mean = Image{w, h, std::vector<float>(n * 3)};
-    for (int c = 0; c < 3; ++c) {
-      const float* src = reinterpret_cast<const float*>(image.images[rgb[c]]);
-      for (size_t i = 0; i < n; ++i) r.mean.rgb[i * 3 + c] = src[i];
-    }
-    bool stats = var[0] >= 0 && var[1] >= 0 && var[2] >= 0 && cnt >= 0;
-    for (int c = 0; c < 3 && stats; ++c)
-      if (header.requested_pixel_types[var[c]] != TINYEXR_PIXELTYPE_FLOAT) stats = false;
-    if (stats) {
-      r.variance = Image{w, h, std::vector<float>(n * 3)};
-      for (int c = 0; c < 3; ++c) {
-        const float* src = reinterpret_cast<const float*>(image.images[var[c]]);
-        for (size_t i = 0; i < n; ++i) r.variance.rgb[i * 3 + c] = src[i];
-      }
-      r.samples.resize(n);
-      int t = header.requested_pixel_types[cnt];
-      for (size_t i = 0; i < n; ++i) {
-        if (t == TINYEXR_PIXELTYPE_UINT)
-          r.samples[i] = reinterpret_cast<const unsigned int*>(image.images[cnt])[i];
-        else
-          r.samples[i] = static_cast<std::uint32_t>(reinterpret_cast<const float*>(image.images[cnt])[i]);
-      }
-      std::uint32_t most = 0;
-      for (auto s : r.samples) most = std::max(most, s);
-      r.spp = most;
-    }
+  r.mean = Image{w, h, std::vector<float>(n * 3)};
+  for (int c = 0; c < 3; ++c)
+    for (size_t i = 0; i < n; ++i) r.mean.rgb[i * 3 + c] = exr.planes[rgb[c]][i];
+  const int var[3] = {exr.find("var.R"), exr.find("var.G"), exr.find("var.B")};
+  const int cnt = exr.find("n");
+  if (var[0] < 0 || var[1] < 0 || var[2] < 0 || cnt < 0) return r;
+  r.variance = Image{w, h, std::vector<float>(n * 3)};
+  for (int c = 0; c < 3; ++c)
+    for (size_t i = 0; i < n; ++i) r.variance.rgb[i * 3 + c] = exr.planes[var[c]][i];
+  r.samples.resize(n);
+  std::uint32_t most = 0;
+  for (size_t i = 0; i < n; ++i) {
+    // a count is a non-negative integer: anything else (NaN, negative, huge) is a corrupt file
+    const float v = exr.planes[cnt][i];
+    if (!(v >= 0.0f && v < 4294967296.0f))
+      throw Error(path + ": channel n: pixel " + std::to_string(i % w) + ", " +
+                  std::to_string(i / w) + " has an invalid sample count " + std::to_string(v));
+    r.samples[i] = static_cast<std::uint32_t>(v);
+    most = std::max(most, r.samples[i]);
   }
-  FreeEXRImage(&image);
-  FreeEXRHeader(&header);
-  if (!ok) r.mean = read_image(path);  // e.g. a luminance-only EXR: let the general reader try
+  r.spp = most;
   return r;
 }
+
+}  // namespace image_detail
 
 }  // namespace lucent

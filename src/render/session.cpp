@@ -75,7 +75,7 @@ void check_film_memory(const Scene& scene, const cl_util::Context& ctx) {
 bool same_render_data(const render_detail::PackedScene& a, const render_detail::PackedScene& b) {
   if (std::memcmp(&a.params, &b.params, sizeof(lc_params)) != 0) return false;
   bool same = true;
-#define LUCENT_SAME(name, type, ...)                    \
+#define LUCENT_SAME(name, type, ...)               \
   same = same && a.name.size() == b.name.size() && \
          (a.name.empty() ||                        \
           std::memcmp(a.name.data(), b.name.data(), a.name.size() * sizeof(type)) == 0);
@@ -203,7 +203,15 @@ struct Renderer::Impl {
     auto t0 = clock_type::now();
     cl_util::ProgramBuildInfo info;
     Program p;
-    p.program = cl_util::build_program_cached(w.ctx, source, opts, cache_dir, &info);
+    try {
+      p.program = cl_util::build_program_cached(w.ctx, source, opts, cache_dir, &info);
+    } catch (const Error& e) {
+      // the place of a build error is "kernels/<file>:<line>": the file in the kernel directory
+      // in use when the sources came from one
+      const std::string what = e.what();
+      if (options.kernel_dir.empty() || what.rfind("kernels/", 0) != 0) throw;
+      throw Error(options.kernel_dir + what.substr(7), e.details());
+    }
     p.kernel = cl::Kernel(p.program, "lucent_render");
     p.cache_hit = info.cache_hit;
     if (!info.note.empty()) scene_detail::warn(info.note);

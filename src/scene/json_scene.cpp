@@ -12,6 +12,7 @@
 
 #include "lucent/error.hpp"
 #include "lucent/scene.hpp"
+#include "scene/json_guard.hpp"
 #include "scene/json_sections.hpp"
 
 namespace lucent {
@@ -20,20 +21,6 @@ using scene_detail::json;
 namespace fs = std::filesystem;
 
 namespace {
-
-/// Line and column (1-based) of the byte before `byte` (a 1-based count of bytes read).
-std::string line_col(const std::string& text, size_t byte) {
-  size_t line = 1, col = 1;
-  for (size_t i = 0; i + 1 < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      col = 1;
-    } else {
-      ++col;
-    }
-  }
-  return std::to_string(line) + ":" + std::to_string(col);
-}
 
 /// Finds where a parse stops for a reason json::parse reports without a place (a number literal
 /// out of double range, such as 1e999): a SAX pass that only records the error's byte count.
@@ -76,6 +63,7 @@ Scene build_scene(const json& root, const std::string& path) {
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& path) {
+  scene_detail::check_json_structure(text, path);  // nesting depth, duplicate keys
   json root;
   try {
     root = json::parse(text);
@@ -83,7 +71,9 @@ Scene parse_scene(const std::string& text, const std::string& path) {
     std::string what = e.what();
     auto pos = what.find("syntax error");
     if (pos != std::string::npos) what = what.substr(pos);
-    throw Error(path + ":" + line_col(text, e.byte) + ": invalid JSON: " + what);
+    // e.byte counts the bytes read, 1-based: the place is the byte before it
+    throw Error(path + ":" + scene_detail::line_col_at(text, e.byte > 0 ? e.byte - 1 : 0) +
+                ": invalid JSON: " + what);
   } catch (const json::exception& e) {
     // out_of_range 406, "number overflow parsing '1e999'", comes without a place: a SAX pass
     // finds where the parser stopped, just after the literal, and we step back to its start.
@@ -92,7 +82,7 @@ Scene parse_scene(const std::string& text, const std::string& path) {
     size_t i = std::min(locator.byte, text.size());
     while (i > 0 && std::strchr("0123456789+-.eE", text[i - 1]) && text[i - 1] != '\0') --i;
     std::string literal = text.substr(i, std::min(locator.byte, text.size()) - i);
-    throw Error(path + ":" + line_col(text, i + 1) + ": " +
+    throw Error(path + ":" + scene_detail::line_col_at(text, i) + ": " +
                 (e.id == 406 && !literal.empty()
                      ? "number out of range (not a finite double): " + literal
                      : std::string(e.what())));
@@ -101,14 +91,7 @@ Scene parse_scene(const std::string& text, const std::string& path) {
 }
 
 Scene load_scene(const std::string& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw Error(path + ": is a directory, not a scene file");
-  std::ifstream f(path, std::ios::binary);
-  if (!f)
-    throw Error(path + ": cannot open scene file (" + std::string(std::strerror(errno)) + ")");
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return parse_scene(ss.str(), path);
+  return parse_scene(scene_detail::read_scene_text(path), path);  // bounded; pipes allowed
 }
 
 }  // namespace lucent

@@ -1,8 +1,8 @@
 #pragma once
 // Internal scene loading pieces: OBJ/MTL meshes and textures, called by the JSON loader.
-#include <functional>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -44,8 +44,9 @@ void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform
 /// index. Throws lucent::Error naming the file when it cannot be read.
 int load_texture(Scene& scene, const std::string& path);
 
-/// sRGB-encoded value in [0, 1] to linear.
-double srgb_to_linear(double c);
+/// Decodes a texture file's bytes (`path` names it in messages): what load_texture does after
+/// reading the file. Throws lucent::Error naming `path`.
+Texture decode_texture(const unsigned char* data, std::size_t size, const std::string& path);
 
 /// `texels` texels of 8-bit sRGB data, `channels` (1 to 4: grey, grey + alpha, RGB, RGBA) bytes
 /// each, to linear RGBA floats (alpha kept linear) at `rgba`.

@@ -3,6 +3,8 @@
 // element's place, then adds it.
 #include "lucent/scene_builder.hpp"
 
+#include <cfloat>
+#include <cmath>
 #include <utility>
 
 #include "lucent/error.hpp"
@@ -111,8 +113,13 @@ void SceneBuilder::add_mesh(const MeshShape& mesh) {
   const int base = static_cast<int>(scene_.positions.size());
   const int nbase = static_cast<int>(scene_.normals.size());
   const int uvbase = static_cast<int>(scene_.uvs.size());
-  for (const glm::dvec3& v : mesh.positions)
-    scene_.positions.push_back(glm::dvec3(xf * glm::dvec4(v, 1.0)));
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+    const glm::dvec3 w = glm::dvec3(xf * glm::dvec4(mesh.positions[i], 1.0));
+    if (!(std::abs(w.x) <= FLT_MAX && std::abs(w.y) <= FLT_MAX && std::abs(w.z) <= FLT_MAX))
+      Reporter(scene_.path, p + "/positions/" + std::to_string(i))
+          .fail("the transform takes it beyond float range");
+    scene_.positions.push_back(w);
+  }
   for (const glm::dvec3& n : mesh.normals) {
     glm::dvec3 t = nxf * n;
     double len = glm::length(t);

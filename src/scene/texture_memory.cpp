@@ -1,7 +1,7 @@
 // Textures from memory (lucent/scene_builder.hpp) and the sRGB decoding that image files share.
-#include <array>
-#include <cmath>
+#include <algorithm>
 
+#include "image/image_probe.hpp"
 #include "lucent/error.hpp"
 #include "lucent/scene_builder.hpp"
 #include "scene/loaders.hpp"
@@ -10,19 +10,10 @@ namespace lucent {
 
 namespace scene_detail {
 
-double srgb_to_linear(double c) {
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-}
-
 void decode_srgb8(const std::uint8_t* data, std::size_t texels, int channels, float* rgba) {
-  static const std::array<float, 256> lut = [] {
-    std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i) t[i] = static_cast<float>(srgb_to_linear(i / 255.0));
-    return t;
-  }();
   for (std::size_t i = 0; i < texels; ++i, data += channels, rgba += 4) {
     bool grey = channels < 3;
-    for (int c = 0; c < 3; ++c) rgba[c] = lut[data[grey ? 0 : c]];
+    for (int c = 0; c < 3; ++c) rgba[c] = image_detail::srgb8_to_linear(data[grey ? 0 : c]);
     rgba[3] = channels == 2 || channels == 4 ? data[channels - 1] / 255.0f : 1.0f;  // linear
   }
 }

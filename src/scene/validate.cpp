@@ -2,6 +2,7 @@
 // loader and SceneBuilder.
 #include "scene/validate.hpp"
 
+#include <cfloat>
 #include <cmath>
 #include <sstream>
 
@@ -35,6 +36,9 @@ void check_range(const Reporter& at, long long v, IntRange range) {
 
 double check_finite(const Reporter& at, double v) {
   if (!std::isfinite(v)) at.fail("must be a finite number, got " + format_number(v));
+  // the device stores floats: a larger value would become infinite there
+  if (std::abs(v) > FLT_MAX)
+    at.fail("must fit in a float (magnitude at most 3.4e38), got " + format_number(v));
   return v;
 }
 
@@ -74,7 +78,9 @@ void check_scale(const Reporter& at, const glm::dvec3& s) {
 
 void check_affine(const Reporter& at, const glm::dmat4& m) {
   for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) check_finite(at.at(r).at(c), m[c][r]);  // glm: m[column][row]
+    for (int c = 0; c < 4; ++c)  // glm: m[column][row]; only the transformed points must be floats
+      if (!std::isfinite(m[c][r]))
+        at.at(r).at(c).fail("must be a finite number, got " + format_number(m[c][r]));
   if (m[0][3] != 0 || m[1][3] != 0 || m[2][3] != 0 || m[3][3] != 1)
     at.fail("the last row must be [0, 0, 0, 1] (affine transforms only)");
   if (std::abs(glm::determinant(m)) < 1e-300) at.fail("must be invertible");

@@ -1,0 +1,364 @@
+// `lucent render SCENE -o OUT`: renders a JSON scene with the kernel (or the reference) and writes
+// the image: outputs checked before rendering, written atomically, stop signals honoured
+// (SIGINT, SIGTERM, SIGHUP: what was rendered is written, exit 128 + the signal).
+#include <fcntl.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cli/commands.hpp"
+#include "core/file_io.hpp"
+#include "lucent/compare.hpp"
+#include "lucent/limits.hpp"
+#include "lucent/lucent.hpp"
+#include "lucent/reference.hpp"
+#include "lucent/types.hpp"
+
+namespace lucent::cli {
+
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+volatile std::sig_atomic_t g_signal = 0;
+
+// Ctrl-C (SIGINT), SIGTERM and SIGHUP: the render stops after the current pass, writes what it
+// has and exits with 128 + the signal. A second signal stops at once.
+extern "C" void on_stop_signal(int sig) {
+  g_signal = sig;
+  g_interrupted.store(true);
+  std::signal(sig, SIG_DFL);
+}
+
+const int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+const char* signal_name(int sig) {
+  return sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "SIGINT (Ctrl-C)";
+}
+
+std::string format_duration(double s) {
+  char buf[32];
+  if (s < 60) {
+    std::snprintf(buf, sizeof buf, "%.1fs", s);
+  } else {
+    int m = static_cast<int>(s / 60);
+    std::snprintf(buf, sizeof buf, "%dm%02ds", m, static_cast<int>(s - 60 * m));
+  }
+  return buf;
+}
+
+/// Peak resident memory of this process so far, in MiB (host side: scene, BVH, film, and the
+/// driver's own allocations; a GPU's device memory is not included).
+double peak_host_mib() {
+  struct rusage ru {};
+  if (getrusage(RUSAGE_SELF, &ru) != 0) return 0;
+  return double(ru.ru_maxrss) / 1024.0;  // Linux reports KiB
+}
+
+/// " [A 55%, B 45%]": each device's share of the samples, when several share a render.
+std::string device_shares(const std::vector<lucent::DeviceShare>& devices) {
+  if (devices.size() < 2) return "";
+  std::uint64_t total = 0;
+  for (const auto& d : devices) total += d.samples;
+  std::string out = " [";
+  for (size_t i = 0; i < devices.size(); ++i) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s%s %.0f%%", i ? ", " : "", devices[i].device.c_str(),
+                  total ? 100.0 * double(devices[i].samples) / double(total) : 0.0);
+    out += buf;
+  }
+  return out + "]";
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+/// Fails early (before rendering) when `out` cannot be written: not an image format lucent
+/// writes, a directory, a directory that does not exist or cannot be written to (tested by
+/// creating a file there, as the final write does), a read-only file, or one of the inputs.
+void check_output_path(const std::string& out, const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  if (out.empty()) throw lucent::Error("-o: the output path is empty");
+  std::string ext = lower_extension(out);
+  if (ext != ".png" && ext != ".pfm" && ext != ".exr")
+    throw lucent::Error(out + ": unknown output format '" + ext + "' (use .png, .pfm or .exr)");
+  std::error_code ec;
+  if (fs::is_directory(out, ec)) throw lucent::Error(out + ": is a directory");
+  for (const std::string& in : inputs)
+    if (lucent::io::same_file(out, in))
+      throw lucent::Error(out + ": is an input of this render (" + in +
+                          "); refusing to overwrite it");
+  if (fs::exists(out, ec) && ::access(out.c_str(), W_OK) != 0)
+    throw lucent::Error(out + ": cannot write output (" + std::strerror(errno) + ")");
+  fs::path dir = fs::path(out).parent_path();
+  std::string probe = (dir.empty() ? fs::path(".") : dir).string() + "/.lucent-write-test-" +
+                      std::to_string(::getpid());
+  int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) throw lucent::Error(out + ": cannot write output (" + std::strerror(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
+struct RenderArgs {
+  std::string scene;
+  std::string output;
+  int spp = 0;
+  int width = 0;
+  int height = 0;
+  std::string device;
+  long long seed = -1;
+  double time_limit = 0;
+  std::string integrator;
+  bool quiet = false;
+  bool reference = false;         ///< the scalar reference integrator instead of the kernel
+  std::vector<std::string> aovs;  ///< extra outputs: albedo, normal, depth, variance
+  bool fast_math = false;
+  std::string precision = "float";
+  bool no_specialize = false;
+};
+
+/// <output stem>.<name>.exr beside the main output.
+std::string aov_path(const std::string& output, const std::string& name) {
+  std::filesystem::path p(output);
+  return (p.parent_path() / (p.stem().string() + "." + name + ".exr")).string();
+}
+
+/// Renders and writes the requested AOV images (linear EXR) after the main render, on the same
+/// session (the BVH is reused, only the AOV kernel is built); stops when interrupted (the AOVs
+/// written so far stay).
+void write_aovs(const RenderArgs& a, const lucent::Scene& scene, lucent::Renderer* renderer,
+                const lucent::RenderResult& main_result) {
+  for (const std::string& name : a.aovs) {
+    if (g_interrupted.load()) return;
+    std::string path = aov_path(a.output, name);
+    if (name == "variance") {
+      lucent::write_image(path, main_result.variance);
+    } else {
+      lucent::Scene s = scene;
+      s.integrator.type = lucent::cli::parse_integrator(name);
+      renderer->set_scene(s);
+      renderer->reset();
+      renderer->render(std::max<std::uint64_t>(1, main_result.spp));
+      lucent::RenderResult aov = renderer->result();
+      if (aov.cancelled) return;  // a partial AOV is not worth a file
+      lucent::write_image(path, aov.mean);
+    }
+    if (!a.quiet) std::fprintf(stderr, "%s: %s AOV\n", path.c_str(), name.c_str());
+  }
+}
+
+/// How far an interrupted render got, for its last line.
+std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_spp,
+                          double time_limit) {
+  char buf[160];
+  if (!r.samples.empty() && r.spp > 0) {
+    size_t covered = 0;
+    for (std::uint32_t n : r.samples) covered += n > 0;
+    if (covered < r.samples.size()) {  // the reference renders row by row
+      std::snprintf(buf, sizeof buf, "%.1f%% of the pixels at %llu spp (the others are black)",
+                    100.0 * double(covered) / double(r.samples.size()),
+                    static_cast<unsigned long long>(r.spp));
+      return buf;
+    }
+  }
+  if (target_spp > 0)
+    std::snprintf(
+        buf, sizeof buf, "%llu of %llu spp (%.0f%%)", static_cast<unsigned long long>(r.spp),
+        static_cast<unsigned long long>(target_spp), 100.0 * double(r.spp) / double(target_spp));
+  else
+    std::snprintf(buf, sizeof buf, "%llu spp after %.1f of %g s",
+                  static_cast<unsigned long long>(r.spp), r.seconds, time_limit);
+  return buf;
+}
+
+int render_with(const RenderArgs& a) {
+  // options the reference does not honour: refused, rather than silently ignored
+  if (a.reference && a.time_limit > 0)
+    throw lucent::Error("--time is not supported with --reference");
+  if (a.reference && !a.aovs.empty())
+    throw lucent::Error("--aov is not supported with --reference");
+  check_output_path(a.output, {a.scene});
+  for (const std::string& name : a.aovs)
+    check_output_path(aov_path(a.output, name), {a.scene, a.output});
+  // from here on a stop signal lets the render end its pass and write what it has
+  for (int sig : kStopSignals) std::signal(sig, on_stop_signal);
+  std::signal(SIGPIPE, SIG_IGN);  // a closed stderr pipe must not cost the image
+  lucent::Scene scene = lucent::load_scene(a.scene);
+  {
+    // the images the scene reads are inputs too
+    std::vector<std::string> inputs{a.scene};
+    for (const lucent::Texture& t : scene.textures) inputs.push_back(t.path);
+    check_output_path(a.output, inputs);
+    for (const std::string& name : a.aovs) check_output_path(aov_path(a.output, name), inputs);
+  }
+  if (g_interrupted.load()) {
+    std::fprintf(stderr, "lucent: interrupted by %s before rendering: nothing written\n",
+                 signal_name(g_signal));
+    return 128 + g_signal;
+  }
+  if (a.width > 0) scene.film.width = a.width;
+  if (a.height > 0) scene.film.height = a.height;
+  if (a.seed >= 0) scene.integrator.seed = static_cast<std::uint32_t>(a.seed);
+  if (!a.integrator.empty()) scene.integrator.type = lucent::cli::parse_integrator(a.integrator);
+
+  lucent::RenderOptions opt;
+  opt.spp = a.spp;
+  opt.time_limit = a.time_limit;
+  opt.fast_math = a.fast_math;
+  opt.precision = lucent::parse_precision(a.precision);
+  opt.specialize = !a.no_specialize;
+  opt.cancel = &g_interrupted;
+  const bool tty = isatty(STDERR_FILENO);
+  double last_print = -10;
+  bool printed = false;
+  if (!a.quiet) {
+    opt.on_progress = [&](const lucent::RenderProgress& p) {
+      if (p.elapsed < 1.0) return;  // short renders stay silent
+      if (!tty && p.elapsed - last_print < 2.0) return;
+      last_print = p.elapsed;
+      double frac = p.samples_target > 0 ? double(p.samples_done) / double(p.samples_target)
+                                         : (p.time_limit > 0 ? p.elapsed / p.time_limit : 0);
+      frac = std::min(1.0, frac);
+      double eta = frac > 0 ? p.elapsed * (1 - frac) / frac : 0;
+      std::fprintf(stderr, "%s%5.1f%%  %llu spp  %.2f Msamples/s  elapsed %s  ETA %s%s%s",
+                   tty ? "\r" : "", 100 * frac, static_cast<unsigned long long>(p.samples_done),
+                   p.samples_per_second * 1e-6, format_duration(p.elapsed).c_str(),
+                   format_duration(eta).c_str(), device_shares(p.devices).c_str(),
+                   tty ? "   " : "\n");
+      std::fflush(stderr);
+      printed = true;
+    };
+  }
+  lucent::RenderResult r;
+  std::optional<lucent::Renderer> renderer;
+  double wall = 0;  // of the kernel render (several devices: their passes overlap)
+  if (a.reference) {
+    lucent::ReferenceOptions ro;
+    ro.spp = a.spp;
+    ro.cancel = &g_interrupted;
+    r = lucent::render_reference(scene, ro);
+  } else {
+    lucent::SessionOptions so = lucent::cli::session_options(a.device);
+    so.precision = opt.precision;
+    so.fast_math = opt.fast_math;
+    so.specialize = opt.specialize;
+    renderer.emplace(so);
+    renderer->set_cancel_flag(&g_interrupted);
+    renderer->set_scene(scene);
+    std::uint64_t spp = a.spp > 0 ? static_cast<std::uint64_t>(a.spp)
+                                  : (a.time_limit > 0 ? 0 : scene.integrator.spp);
+    auto t0 = std::chrono::steady_clock::now();
+    renderer->render(spp, a.time_limit, opt.on_progress);
+    wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r = renderer->result();
+  }
+  if (printed && tty) std::fprintf(stderr, "\n");
+
+  lucent::DisplaySettings display{scene.film.transfer, scene.film.gamma, scene.film.exposure,
+                                  scene.film.tonemap};
+  if (lower_extension(a.output) == ".exr")
+    lucent::write_render_exr(a.output, r);  // with var.R/G/B and n layers (docs/compare.md)
+  else
+    lucent::write_image(a.output, r.mean, display);
+  if (r.nonfinite > 0)
+    std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
+                 static_cast<unsigned long long>(r.nonfinite));
+  // one device: its pass time; several: the wall time of the render, when they overlapped
+  double seconds = r.devices.size() > 1 ? wall : r.seconds;
+  if (!a.quiet)
+    std::fprintf(
+        stderr,
+        "%s: %dx%d, %llu spp in %.2f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak host "
+        "memory %.0f MiB) on %s%s\n",
+        a.output.c_str(), scene.film.width, scene.film.height,
+        static_cast<unsigned long long>(r.spp), seconds,
+        seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / seconds * 1e-6 : 0,
+        seconds > 0 ? double(r.rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
+        r.device.c_str(), device_shares(r.devices).c_str());
+  if (!r.cancelled && !a.reference) write_aovs(a, scene, &*renderer, r);
+  if (r.cancelled || g_interrupted.load()) {
+    const int sig = g_signal ? static_cast<int>(g_signal) : SIGINT;
+    const std::uint64_t target = a.spp > 0
+                                     ? std::uint64_t(a.spp)
+                                     : (a.time_limit > 0 ? 0 : std::uint64_t(scene.integrator.spp));
+    std::fprintf(stderr, "lucent: interrupted by %s: wrote %s with %s%s\n", signal_name(sig),
+                 a.output.c_str(), progress_note(r, target, a.time_limit).c_str(),
+                 r.cancelled ? "" : " (the AOVs were not all written)");
+    return 128 + sig;
+  }
+  return 0;
+}
+
+RenderArgs& args() {
+  static RenderArgs a;
+  return a;
+}
+
+}  // namespace
+
+const std::string& render_scene() { return args().scene; }
+
+CLI::App* add_render_command(CLI::App& app) {
+  RenderArgs& ra = args();
+  CLI::App* render = app.add_subcommand("render", "Render a JSON scene to an image");
+  render->add_option("scene", ra.scene, "Scene file (JSON)")->required();
+  render
+      ->add_option("-o,--output", ra.output,
+                   "Output image: .png (8-bit sRGB), .pfm or .exr (linear)")
+      ->required();
+  render->add_option("--spp", ra.spp, "Samples per pixel (default: the scene's integrator.spp)")
+      ->check(CLI::Range(1, lucent::limits::kMaxSpp));
+  render->add_option("--time", ra.time_limit, "Stop after this many seconds of rendering")
+      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(0.0, 1e7));
+  render->add_option("--width", ra.width, "Image width (overrides the scene)")
+      ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
+  render->add_option("--height", ra.height, "Image height (overrides the scene)")
+      ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
+  render->add_option("--device", ra.device,
+                     "OpenCL device: index or name substring, a comma-separated list of them or "
+                     "'all' to share the render (env LUCENT_DEVICE)");
+  render->add_option("--seed", ra.seed, "Random seed (overrides the scene)")
+      ->check(CLI::Range(0LL, static_cast<long long>(lucent::limits::kMaxSeed)));
+  render->add_option("--integrator", ra.integrator,
+                     "Override the integrator: " + lucent::type_names<lucent::IntegratorType>());
+  render->add_flag("-q,--quiet", ra.quiet, "No progress line or summary");
+  render->add_flag(
+      "--fast-math", ra.fast_math,
+      "Build the kernel with -cl-fast-relaxed-math (faster, not IEEE; see BENCHMARKS.md)");
+  render
+      ->add_option("--precision", ra.precision,
+                   "Ray and geometry arithmetic: float (default) or double (devices with fp64; "
+                   "slower, precise at extreme scales; see BENCHMARKS.md)")
+      ->check(CLI::IsMember({"float", "double"}));
+  render->add_flag("--no-specialize", ra.no_specialize,
+                   "Compile the full kernel instead of only the features the scene uses");
+  render
+      ->add_option("--aov", ra.aovs,
+                   "Also write AOV images <stem>.<name>.exr: " +
+                       lucent::cli::joined(lucent::cli::aov_names()))
+      ->delimiter(',')
+      ->check(CLI::IsMember(lucent::cli::aov_names()));
+  render->add_flag("--reference", ra.reference,
+                   "Render with the scalar CPU reference integrator instead of the kernel");
+
+  return render;
+}
+
+int run_render_command() { return render_with(args()); }
+
+}  // namespace lucent::cli

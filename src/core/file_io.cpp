@@ -1,0 +1,182 @@
+#include "core/file_io.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "lucent/error.hpp"
+
+namespace lucent::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string reason(int err) { return std::strerror(err); }
+
+// Closes the descriptor on every path out of a function.
+struct Fd {
+  int fd = -1;
+  explicit Fd(int f) : fd(f) {}
+  ~Fd() {
+    if (fd >= 0) ::close(fd);
+  }
+  Fd(const Fd&) = delete;
+  Fd& operator=(const Fd&) = delete;
+};
+
+// "a texture", "an image", "an OBJ file", "an MTL file": the article for a kind of file.
+std::string a(const std::string& what) {
+  if (what.empty()) return "a file";
+  const char c = what[0];
+  bool vowel = std::strchr("aeiouAEIOU", c) != nullptr;
+  bool acronym = what.size() > 1 && std::isupper(static_cast<unsigned char>(what[1])) &&
+                 std::strchr("FHLMNRSX", c) != nullptr;  // em, ef, aitch, ...
+  return (vowel || acronym ? "an " : "a ") + what;
+}
+
+const char* kind_of(mode_t mode) {
+  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISFIFO(mode)) return "a pipe";
+  return "not a regular file";
+}
+
+}  // namespace
+
+std::string format_size(std::uint64_t b) {
+  char buf[48];
+  const double k = 1024.0;
+  if (b >= (1ull << 30))
+    std::snprintf(buf, sizeof buf, "%.1f GiB", double(b) / (k * k * k));
+  else if (b >= (1ull << 20))
+    std::snprintf(buf, sizeof buf, "%.1f MiB", double(b) / (k * k));
+  else if (b >= (1ull << 10))
+    std::snprintf(buf, sizeof buf, "%.1f KiB", double(b) / k);
+  else
+    std::snprintf(buf, sizeof buf, "%llu bytes", static_cast<unsigned long long>(b));
+  return buf;
+}
+
+std::string read_file(const std::string& path, const ReadSpec& spec) {
+  const std::string what = spec.what;
+  // O_NONBLOCK: opening a FIFO nobody writes to returns at once (a read then sees end of file)
+  Fd f(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY));
+  if (f.fd < 0) throw Error(path + ": cannot open " + what + " (" + reason(errno) + ")");
+  struct stat st {};
+  if (::fstat(f.fd, &st) != 0)
+    throw Error(path + ": cannot open " + what + " (" + reason(errno) + ")");
+  if (S_ISDIR(st.st_mode)) throw Error(path + ": is a directory, not " + a(what));
+  const bool regular = S_ISREG(st.st_mode);
+  const bool pipe = S_ISFIFO(st.st_mode);
+  if (!regular && !(pipe && spec.allow_pipe))
+    throw Error(path + ": is " + kind_of(st.st_mode) + ", not " + a(what) +
+                " (only regular files are read)");
+  const std::uint64_t limit = spec.max_bytes;
+  if (regular && static_cast<std::uint64_t>(st.st_size) > limit)
+    throw Error(path + ": " + format_size(static_cast<std::uint64_t>(st.st_size)) +
+                " is more than the " + format_size(limit) + " " + a(what) + " may have");
+  // the descriptor stays non-blocking: a pipe is waited for with poll() below, with a bound
+
+  std::string out;
+  if (regular) out.reserve(static_cast<size_t>(st.st_size));
+  char buf[1 << 16];
+  for (;;) {
+    ssize_t n = ::read(f.fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && errno == EAGAIN && pipe) {
+      struct pollfd p {
+        f.fd, POLLIN, 0
+      };
+      int r = ::poll(&p, 1, spec.stream_idle_seconds * 1000);
+      if (r < 0 && errno == EINTR) continue;
+      if (r == 0)
+        throw Error(path + ": no data for " + std::to_string(spec.stream_idle_seconds) +
+                    " s after " + format_size(out.size()) + " (a pipe that never ends?)");
+      continue;
+    }
+    if (n < 0) throw Error(path + ": cannot read " + what + " (" + reason(errno) + ")");
+    if (n == 0) break;
+    if (spec.text) {
+      if (const void* z = std::memchr(buf, '\0', static_cast<size_t>(n))) {
+        size_t at = out.size() + static_cast<size_t>(static_cast<const char*>(z) - buf);
+        throw Error(path + ": byte " + std::to_string(at + 1) + " is a NUL byte: not a text " +
+                    what);
+      }
+    }
+    if (out.size() + static_cast<size_t>(n) > limit)
+      throw Error(path + ": more than the " + format_size(limit) + " " + a(what) + " may have" +
+                  (regular ? " (the file grew while being read)" : " (a stream that never ends?)"));
+    out.append(buf, static_cast<size_t>(n));
+  }
+  return out;
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec) && !ec;
+  fs::path ca = fs::weakly_canonical(a, ec);
+  if (ec) return false;
+  fs::path cb = fs::weakly_canonical(b, ec);
+  return !ec && ca == cb;
+}
+
+void write_all(int fd, const void* data, std::size_t size, const std::string& path) {
+  const char* p = static_cast<const char*>(data);
+  while (size > 0) {
+    ssize_t n = ::write(fd, p, size);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw Error(path + ": cannot write (" + reason(errno) + ")");
+    if (n == 0) throw Error(path + ": cannot write (the device accepts no more data)");
+    p += n;
+    size -= static_cast<std::size_t>(n);
+  }
+}
+
+void write_file_atomic(const std::string& path, const void* data, std::size_t size) {
+  // write where a symbolic link points: replacing the link itself would surprise
+  fs::path target(path);
+  std::error_code ec;
+  if (fs::is_symlink(target, ec)) {
+    fs::path resolved = fs::weakly_canonical(target, ec);
+    if (!ec) target = resolved;
+  }
+  const std::string name = target.filename().string();
+  if (name.empty() || name == "." || name == "..")
+    throw Error(path + ": cannot write (not a file name)");
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  static std::atomic<unsigned> counter{0};
+  const std::string tmp =
+      (dir / ("." + name + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++)))
+          .string();
+  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) throw Error(path + ": cannot write (" + reason(errno) + ")");
+  auto fail = [&](int err) {
+    if (fd >= 0) ::close(fd);
+    ::unlink(tmp.c_str());
+    throw Error(path + ": cannot write (" + reason(err) + ")");
+  };
+  try {
+    write_all(fd, data, size, path);
+  } catch (const Error&) {
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    throw;
+  }
+  // a full disk or an I/O error may only show when the data reaches the device
+  if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) fail(errno);
+  int rc = ::close(fd);
+  fd = -1;
+  if (rc != 0 && errno != EINTR) fail(errno);
+  if (::rename(tmp.c_str(), target.c_str()) != 0) fail(errno);
+}
+
+}  // namespace lucent::io

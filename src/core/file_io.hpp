@@ -1,0 +1,48 @@
+#pragma once
+// Reading input files with a bound, and writing outputs so that a file under its final name is
+// always complete. Every failure throws lucent::Error naming the path.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace lucent::io {
+
+/// What a file being read is, for messages and limits.
+struct ReadSpec {
+  const char* what = "file";           ///< "scene file", "OBJ file", "texture", ... (for messages)
+  std::uint64_t max_bytes = 1u << 30;  ///< larger files (or longer streams) are refused
+  /// Pipes (a FIFO, `<(command)`, /dev/stdin) are read up to max_bytes, waiting at most
+  /// `stream_idle_seconds` for each chunk; otherwise only regular files are accepted. Devices
+  /// and sockets are always refused.
+  bool allow_pipe = false;
+  int stream_idle_seconds = 10;
+  /// Text formats: a NUL byte (a binary file, /dev/zero) stops the read with an error.
+  bool text = false;
+};
+
+/// The whole content of `path`. Never blocks on a FIFO without a writer, never reads more than
+/// spec.max_bytes (+1) bytes, refuses directories and devices. Throws lucent::Error
+/// ("<path>: cannot open <what> (<reason>)", "<path>: is a directory, not a <what>", ...).
+std::string read_file(const std::string& path, const ReadSpec& spec);
+
+/// Writes `size` bytes to `path` through a temporary file in the same directory that is renamed
+/// into place once every byte is written and flushed: a crash, a kill or a full disk never
+/// leaves a truncated file under `path` (an existing file stays as it was). A symbolic link is
+/// followed (its target is replaced). Throws lucent::Error("<path>: cannot write (<reason>)").
+void write_file_atomic(const std::string& path, const void* data, std::size_t size);
+inline void write_file_atomic(const std::string& path, const std::string& bytes) {
+  write_file_atomic(path, bytes.data(), bytes.size());
+}
+
+/// Writes all `size` bytes to the open descriptor `fd` (retrying short writes and EINTR);
+/// throws lucent::Error("<path>: cannot write (<reason>)") on failure. `path` names it.
+void write_all(int fd, const void* data, std::size_t size, const std::string& path);
+
+/// Whether `a` and `b` name the same file: the same file when both exist (symbolic and hard
+/// links included), else the same path once made canonical.
+bool same_file(const std::string& a, const std::string& b);
+
+/// "1.5 GiB", "256 MiB", "12 KiB", "7 bytes": a size for messages.
+std::string format_size(std::uint64_t bytes);
+
+}  // namespace lucent::io

@@ -1,0 +1,217 @@
+// Image decoding, after the header checks of image_probe.cpp: PNG, JPEG, BMP, TGA and Radiance
+// HDR through stb_image, PFM by hand, OpenEXR through tinyexr (every channel, widened to float);
+// and EXR encoding in memory.
+#include <stb/stb_image.h>
+#include <tinyexr.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+
+#include "image/image_probe.hpp"
+#include "lucent/error.hpp"
+
+namespace lucent::image_detail {
+
+namespace {
+
+// Throws lucent::Error("<path>: <what>").
+struct Fail {
+  const std::string& path;
+  [[noreturn]] void operator()(const std::string& what) const { throw Error(path + ": " + what); }
+};
+
+std::string stb_reason() {
+  const char* r = stbi_failure_reason();
+  return r ? r : "unknown error";
+}
+
+struct StbFree {
+  void operator()(void* p) const { stbi_image_free(p); }
+};
+
+}  // namespace
+
+io::ReadSpec image_read_spec(const char* what) {
+  io::ReadSpec spec;
+  spec.what = what;
+  spec.max_bytes = kMaxImageFileBytes;
+  return spec;
+}
+
+std::string save_exr_to_memory(const std::string& path, const EXRImage& image,
+                               const EXRHeader& header) {
+  unsigned char* memory = nullptr;
+  const char* err = nullptr;
+  size_t n = SaveEXRImageToMemory(&image, &header, &memory, &err);
+  if (n == 0 || !memory) {
+    std::free(memory);
+    throw Error(path + ": cannot encode EXR: " + exr_message(err));
+  }
+  std::string out(reinterpret_cast<const char*>(memory), n);
+  std::free(memory);
+  return out;
+}
+
+double srgb_to_linear(double c) {
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+float srgb8_to_linear(std::uint8_t v) {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) t[i] = static_cast<float>(srgb_to_linear(i / 255.0));
+    return t;
+  }();
+  return table[v];
+}
+
+int ExrChannels::find(const char* name) const {
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+ExrChannels read_exr_channels(const unsigned char* data, std::size_t size, const std::string& path,
+                              std::uint64_t max_pixels) {
+  const Fail fail{path};
+  EXRHeader header;
+  probe_exr(data, size, path, max_pixels, header);
+  for (int c = 0; c < header.num_channels; ++c)
+    if (header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF)
+      header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
+  // defence in depth: tinyexr's decoders have read a few kilobytes past a chunk; whatever they
+  // still read past the file's end is zeros, never another object's memory
+  std::vector<unsigned char> padded(size + (64u << 10), 0);
+  std::memcpy(padded.data(), data, size);
+  data = padded.data();
+  EXRImage image;
+  InitEXRImage(&image);
+  // tinyexr frees a half-decoded scanline image on failure with FreeEXRImage, which frees only
+  // num_channels channel buffers: still 0 there unless set beforehand (found by fuzzing)
+  image.num_channels = header.num_channels;
+  const char* err = nullptr;
+  if (LoadEXRImageFromMemory(&image, &header, data, size, &err) != TINYEXR_SUCCESS) {
+    FreeEXRHeader(&header);
+    fail("cannot read OpenEXR pixels: " + exr_message(err));
+  }
+  ExrChannels out;
+  out.width = image.width;
+  out.height = image.height;
+  const size_t n = static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
+  for (int c = 0; c < header.num_channels; ++c) {
+    out.names.push_back(header.channels[c].name);
+    out.planes.emplace_back(n, 0.0f);
+  }
+  auto copy = [&](int c, const unsigned char* src, size_t from, size_t to) {
+    if (header.requested_pixel_types[c] == TINYEXR_PIXELTYPE_UINT)
+      out.planes[c][to] = static_cast<float>(reinterpret_cast<const unsigned int*>(src)[from]);
+    else
+      out.planes[c][to] = reinterpret_cast<const float*>(src)[from];
+  };
+  if (header.tiled) {
+    for (int t = 0; t < image.num_tiles; ++t) {
+      const EXRTile& tile = image.tiles[t];
+      if (tile.level_x != 0 || tile.level_y != 0) continue;  // the full-resolution level only
+      for (int j = 0; j < tile.height; ++j)
+        for (int i = 0; i < tile.width; ++i) {
+          const long x = long(tile.offset_x) * header.tile_size_x + i;
+          const long y = long(tile.offset_y) * header.tile_size_y + j;
+          if (x < 0 || y < 0 || x >= image.width || y >= image.height) continue;
+          for (int c = 0; c < header.num_channels; ++c)
+            copy(c, tile.images[c], size_t(j) * header.tile_size_x + i,
+                 size_t(y) * image.width + x);
+        }
+    }
+  } else if (image.images) {
+    for (int c = 0; c < header.num_channels; ++c)
+      for (size_t i = 0; i < n; ++i) copy(c, image.images[c], i, i);
+  }
+  FreeEXRImage(&image);
+  FreeEXRHeader(&header);
+  return out;
+}
+
+Decoded decode_image(const unsigned char* data, std::size_t size, const std::string& path,
+                     int channels, std::uint64_t max_pixels) {
+  const Fail fail{path};
+  Probe p = probe_image(data, size, path, max_pixels);
+  Decoded out;
+  out.format = p.format;
+  out.channels = channels;
+  auto allocate = [&](int w, int h) {
+    out.width = w;
+    out.height = h;
+    out.pixels.assign(static_cast<size_t>(w) * h * channels, 1.0f);
+  };
+  if (p.format == Format::Pfm) {
+    PfmLayout layout;
+    probe_pfm(data, size, path, max_pixels, layout);
+    if (layout.big_endian) fail("big-endian PFM files are not supported");
+    const std::uint64_t offset = layout.data_offset;
+    const int ch = layout.channels;
+    allocate(p.width, p.height);
+    const unsigned char* src = data + offset;
+    for (int y = 0; y < p.height; ++y)  // PFM rows run bottom to top
+      for (int x = 0; x < p.width; ++x)
+        for (int c = 0; c < 3; ++c) {
+          float v;
+          const size_t i = (static_cast<size_t>(y) * p.width + x) * ch + (ch == 3 ? c : 0);
+          std::memcpy(&v, src + 4 * i, 4);
+          out.pixels[(static_cast<size_t>(p.height - 1 - y) * p.width + x) * channels + c] = v;
+        }
+    return out;
+  }
+  if (p.format == Format::Exr) {
+    ExrChannels exr = read_exr_channels(data, size, path, max_pixels);
+    int src[3] = {exr.find("R"), exr.find("G"), exr.find("B")};
+    if (src[0] < 0 || src[1] < 0 || src[2] < 0) {
+      // a single channel (Y, or anything else) is grey
+      int grey = exr.find("Y");
+      if (grey < 0 && exr.names.size() == 1) grey = 0;
+      if (grey < 0) fail("OpenEXR file has no R, G, B or Y channels");
+      src[0] = src[1] = src[2] = grey;
+    }
+    allocate(exr.width, exr.height);
+    const size_t n = static_cast<size_t>(exr.width) * exr.height;
+    for (size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) out.pixels[i * channels + c] = exr.planes[src[c]][i];
+    return out;
+  }
+
+  stbi_set_flip_vertically_on_load(0);  // a global setting: rows must come top first
+  const int len = static_cast<int>(std::min<std::size_t>(size, 0x7fffffff));
+  int w = 0, h = 0, n = 0;
+  if (p.format == Format::Hdr) {
+    std::unique_ptr<float, StbFree> px(stbi_loadf_from_memory(data, len, &w, &h, &n, channels));
+    if (!px) fail("cannot decode Radiance HDR: " + stb_reason());
+    allocate(w, h);
+    std::copy(px.get(), px.get() + out.pixels.size(), out.pixels.begin());
+  } else if (p.sixteen_bit) {
+    std::unique_ptr<stbi_us, StbFree> px(stbi_load_16_from_memory(data, len, &w, &h, &n, channels));
+    if (!px) fail("cannot decode PNG: " + stb_reason());
+    allocate(w, h);
+    for (size_t i = 0; i < out.pixels.size(); ++i) {
+      double v = px.get()[i] / 65535.0;
+      out.pixels[i] = static_cast<float>(i % channels == 3 ? v : srgb_to_linear(v));
+    }
+  } else {
+    std::unique_ptr<stbi_uc, StbFree> px(stbi_load_from_memory(data, len, &w, &h, &n, channels));
+    if (!px) fail(std::string("cannot decode ") + format_name(p.format) + ": " + stb_reason());
+    allocate(w, h);
+    for (size_t i = 0; i < out.pixels.size(); ++i) {
+      stbi_uc v = px.get()[i];
+      out.pixels[i] = i % channels == 3 ? v / 255.0f : srgb8_to_linear(v);
+    }
+  }
+  if (w != p.width || h != p.height)
+    fail(std::string(format_name(p.format)) + " decoded to " + std::to_string(w) + "x" +
+         std::to_string(h) + " pixels, its header claims " + std::to_string(p.width) + "x" +
+         std::to_string(p.height));
+  return out;
+}
+
+}  // namespace lucent::image_detail

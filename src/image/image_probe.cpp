@@ -1,0 +1,546 @@
+// Image headers checked before any pixel is allocated: the format from the magic bytes, the size
+// the header claims against the pixel limit and against what the file can hold (decoding:
+// image_decode.cpp).
+#include "image/image_probe.hpp"
+
+#include <tinyexr.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+
+#include "core/file_io.hpp"
+#include "lucent/error.hpp"
+
+namespace lucent::image_detail {
+
+namespace {
+
+using u64 = std::uint64_t;
+
+// Reads of fixed-size fields; callers check the length first.
+u64 be16(const unsigned char* p) { return (u64(p[0]) << 8) | p[1]; }
+u64 be32(const unsigned char* p) { return (be16(p) << 16) | be16(p + 2); }
+u64 le16(const unsigned char* p) { return (u64(p[1]) << 8) | p[0]; }
+u64 le32(const unsigned char* p) { return (le16(p + 2) << 16) | le16(p); }
+
+bool starts_with(const unsigned char* d, std::size_t n, const char* magic, std::size_t len) {
+  return n >= len && std::memcmp(d, magic, len) == 0;
+}
+
+class Checker {
+ public:
+  Checker(const unsigned char* d, std::size_t n, const std::string& path, u64 max_pixels)
+      : d_(d), n_(n), path_(path), max_pixels_(max_pixels) {}
+
+  [[noreturn]] void fail(const std::string& what) const { throw Error(path_ + ": " + what); }
+
+  /// Checks the claimed size against the pixel limit (before anything else is computed).
+  void size(Probe& p, u64 w, u64 h) const {
+    const char* fmt = format_name(p.format);
+    if (w == 0 || h == 0)
+      fail(std::string(fmt) + " header claims an empty image (" + std::to_string(w) + "x" +
+           std::to_string(h) + ")");
+    if (w > (1u << 30) || h > (1u << 30) || w * h > max_pixels_)
+      fail(std::string(fmt) + " header claims " + std::to_string(w) + "x" + std::to_string(h) +
+           " pixels, more than the limit of " + std::to_string(max_pixels_) +
+           " pixels (corrupt, or too large)");
+    p.width = static_cast<int>(w);
+    p.height = static_cast<int>(h);
+  }
+
+  /// The file holds `have` bytes where the header needs at least `need`.
+  void need(const Probe& p, u64 need, u64 have, const char* what) const {
+    if (have < need)
+      fail(std::string(format_name(p.format)) + " file is truncated: its " +
+           std::to_string(p.width) + "x" + std::to_string(p.height) + " header needs " +
+           std::to_string(need) + " bytes of " + what + ", the file has " + std::to_string(have));
+  }
+
+  /// A compressed stream of `have` bytes cannot expand to more than `ratio` times its size.
+  void ratio(const Probe& p, u64 raw, u64 have, u64 ratio, const char* what) const {
+    const u64 slack = 1u << 20;
+    if (raw > slack && raw / ratio > have)
+      fail(std::string(format_name(p.format)) + " header claims " + std::to_string(p.width) + "x" +
+           std::to_string(p.height) + " pixels (" + std::to_string(raw) + " bytes), more than " +
+           std::to_string(have) + " bytes of " + what + " can hold (truncated or corrupt)");
+  }
+
+  Probe png() const {
+    Probe p{Format::Png};
+    if (n_ < 33 || be32(d_ + 8) != 13 || std::memcmp(d_ + 12, "IHDR", 4) != 0)
+      fail("PNG file has no IHDR header (truncated or corrupt)");
+    const unsigned char* h = d_ + 16;
+    const u64 depth = h[8], type = h[9];
+    int channels = 0;
+    switch (type) {
+      case 0:
+        channels = 1;
+        break;
+      case 2:
+        channels = 3;
+        break;
+      case 3:
+        channels = 1;
+        break;
+      case 4:
+        channels = 2;
+        break;
+      case 6:
+        channels = 4;
+        break;
+      default:
+        fail("PNG header has an invalid colour type " + std::to_string(type));
+    }
+    if (depth != 1 && depth != 2 && depth != 4 && depth != 8 && depth != 16)
+      fail("PNG header has an invalid bit depth " + std::to_string(depth));
+    size(p, be32(h), be32(h + 4));
+    p.sixteen_bit = depth == 16;
+    // walk the chunks: every one must lie inside the file; sum the compressed image data
+    u64 idat = 0, pos = 8;
+    bool end = false;
+    while (pos + 12 <= n_) {
+      const u64 len = be32(d_ + pos);
+      if (len > n_ - pos - 12)
+        fail("PNG file is truncated: the chunk at byte " + std::to_string(pos) + " needs " +
+             std::to_string(len) + " bytes, the file has " + std::to_string(n_ - pos - 12));
+      if (std::memcmp(d_ + pos + 4, "IDAT", 4) == 0) idat += len;
+      if (std::memcmp(d_ + pos + 4, "IEND", 4) == 0) {
+        end = true;
+        break;
+      }
+      pos += 12 + len;
+    }
+    if (!end) fail("PNG file is truncated: no IEND chunk");
+    const u64 row = (u64(p.width) * channels * depth + 7) / 8 + 1;
+    ratio(p, row * u64(p.height), idat, 1032, "deflate data");  // deflate expands at most 1032x
+    return p;
+  }
+
+  Probe jpeg() const {
+    Probe p{Format::Jpeg};
+    u64 pos = 2;
+    bool frame = false, scan = false;
+    while (true) {
+      if (pos >= n_) break;
+      if (d_[pos] != 0xFF) {
+        if (!scan) fail("JPEG file is corrupt: no marker at byte " + std::to_string(pos));
+        ++pos;  // entropy-coded data
+        continue;
+      }
+      while (pos < n_ && d_[pos] == 0xFF) ++pos;  // fill bytes
+      if (pos >= n_) break;
+      const unsigned m = d_[pos++];
+      if (m == 0x00 || (m >= 0xD0 && m <= 0xD7) || m == 0x01) continue;  // stuffing, RSTn, TEM
+      if (m == 0xD9) {
+        if (!frame || !scan) fail("JPEG file has no image data before its end marker");
+        const u64 px = u64(p.width) * u64(p.height);
+        // at least one bit per 8x8 block for the DC coefficients: 512 pixels per byte at best
+        if (px > (1u << 20) && px / 1024 > n_)
+          fail("JPEG header claims " + std::to_string(p.width) + "x" + std::to_string(p.height) +
+               " pixels, more than " + std::to_string(n_) + " bytes can hold (corrupt)");
+        return p;
+      }
+      if (pos + 2 > n_) break;
+      const u64 len = be16(d_ + pos);
+      if (len < 2 || pos + len > n_) break;
+      const bool sof = (m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC);
+      if (sof) {
+        if (len < 8) fail("JPEG frame header is too short");
+        if (!frame) size(p, be16(d_ + pos + 5), be16(d_ + pos + 3));
+        frame = true;
+      }
+      if (m == 0xDA) {
+        if (!frame) fail("JPEG file has image data before its frame header");
+        scan = true;
+      }
+      if (m == 0xC4) huffman_tables(pos + 2, len - 2);
+      pos += len;
+    }
+    fail("JPEG file is truncated: no end-of-image marker");
+  }
+
+  // A DHT segment's tables, read as stb_image reads them (on past the segment if its length
+  // lies): more than 256 codes in one table overflow stb_image's arrays (found by fuzzing).
+  void huffman_tables(u64 pos, u64 left) const {
+    auto get8 = [&]() -> unsigned { return pos < n_ ? d_[pos++] : (++pos, 0u); };
+    while (left > 0 && left < (1u << 16)) {
+      const unsigned q = get8();
+      if ((q >> 4) > 1 || (q & 15) > 3) return;  // stb_image refuses the table itself
+      u64 codes = 0;
+      for (int i = 0; i < 16; ++i) codes += get8();
+      if (codes > 256)
+        fail("JPEG Huffman table at byte " + std::to_string(pos - 17) + " has " +
+             std::to_string(codes) + " codes, more than 256 (corrupt)");
+      pos += codes;
+      if (17 + codes > left) return;
+      left -= 17 + codes;
+    }
+  }
+
+  Probe bmp() const {
+    Probe p{Format::Bmp};
+    if (n_ < 26) fail("BMP file is truncated: no complete header");
+    const u64 offset = le32(d_ + 10), hsz = le32(d_ + 14);
+    u64 w, h, bpp, compression = 0;
+    if (hsz == 12) {
+      w = le16(d_ + 18);
+      h = le16(d_ + 20);
+      bpp = le16(d_ + 24);
+    } else if (hsz == 40 || hsz == 56 || hsz == 108 || hsz == 124) {
+      if (n_ < 34) fail("BMP file is truncated: no complete header");
+      const std::int32_t sw = static_cast<std::int32_t>(le32(d_ + 18));
+      const std::int32_t sh = static_cast<std::int32_t>(le32(d_ + 22));
+      if (sw <= 0) fail("BMP header has an invalid width " + std::to_string(sw));
+      w = static_cast<u64>(sw);
+      h = sh < 0 ? u64(-static_cast<std::int64_t>(sh)) : u64(sh);  // negative: top-down rows
+      bpp = le16(d_ + 28);
+      compression = le32(d_ + 30);
+    } else {
+      fail("BMP header has an unsupported size " + std::to_string(hsz));
+    }
+    if (bpp != 1 && bpp != 4 && bpp != 8 && bpp != 16 && bpp != 24 && bpp != 32)
+      fail("BMP header has an unsupported bit count " + std::to_string(bpp));
+    if (compression != 0 && compression != 3)
+      fail("BMP compression " + std::to_string(compression) +
+           " is not supported (uncompressed and bit-field BMPs are)");
+    size(p, w, h);
+    const u64 stride = (w * bpp + 31) / 32 * 4;
+    const u64 start = std::max<u64>(offset, 14 + hsz);
+    need(p, start + stride * h, n_, "header and pixel rows");
+    return p;
+  }
+
+  // Radiance RGBE, as stb_image reads it: a header ending in an empty line, "-Y h +X w", then
+  // scanlines either flat (4 bytes a pixel) or run-length encoded per component. The encoded
+  // stream is walked here: stb_image reads zeros past the end of its input, and a zero-length
+  // run then never advances (an endless loop on a truncated or corrupt file).
+  Probe hdr() const {
+    Probe p{Format::Hdr};
+    u64 pos = 0;
+    auto line = [&]() {
+      u64 e = pos;
+      while (e < n_ && d_[e] != '\n') ++e;
+      if (e >= n_) fail("Radiance HDR header is truncated");
+      std::string s(reinterpret_cast<const char*>(d_ + pos), e - pos);
+      pos = e + 1;
+      return s;
+    };
+    line();  // "#?RADIANCE"
+    bool rgbe = false;
+    for (std::string s; !(s = line()).empty();)
+      if (s == "FORMAT=32-bit_rle_rgbe") rgbe = true;
+    if (!rgbe) fail("Radiance HDR file is not in the 32-bit_rle_rgbe format");
+    const std::string res = line();
+    long long hv = 0, wv = 0;
+    const char* b = res.c_str();
+    const char* e = b + res.size();
+    auto number = [&](const char*& q, long long& v) {
+      while (q < e && (*q == ' ' || *q == '+')) ++q;  // as strtol reads it
+      auto r = std::from_chars(q, e, v);
+      if (r.ec != std::errc()) fail("Radiance HDR resolution line '" + res + "' is not -Y h +X w");
+      q = r.ptr;
+    };
+    if (res.compare(0, 3, "-Y ") != 0)
+      fail("Radiance HDR resolution line '" + res + "' is not -Y h +X w");
+    const char* q = b + 3;
+    number(q, hv);
+    while (q < e && *q == ' ') ++q;
+    if (e - q < 3 || std::strncmp(q, "+X ", 3) != 0)
+      fail("Radiance HDR resolution line '" + res + "' is not -Y h +X w");
+    q += 3;
+    number(q, wv);
+    if (hv <= 0 || wv <= 0)
+      fail("Radiance HDR header claims an empty image (" + std::to_string(wv) + "x" +
+           std::to_string(hv) + ")");
+    size(p, u64(wv), u64(hv));
+    const u64 w = u64(wv), h = u64(hv);
+    if (w < 8 || w >= 32768) {
+      need(p, pos + 4 * w * h, n_, "header and pixels");
+      return p;
+    }
+    for (u64 y = 0; y < h; ++y) {
+      if (pos + 4 > n_) need(p, pos + 4, n_, "header and scanlines");
+      if (d_[pos] != 2 || d_[pos + 1] != 2 || (d_[pos + 2] & 0x80)) {
+        // not run-length encoded: stb_image reads the whole image flat from here on (its first
+        // pixel included), whatever scanline this is
+        need(p, pos + 4 * w * h, n_, "header and pixels");
+        return p;
+      }
+      const u64 len = (u64(d_[pos + 2]) << 8) | d_[pos + 3];
+      if (len != w)
+        fail("Radiance HDR scanline " + std::to_string(y) + " has length " + std::to_string(len) +
+             ", the header says " + std::to_string(w));
+      pos += 4;
+      for (int k = 0; k < 4; ++k) {
+        for (u64 i = 0; i < w;) {
+          if (pos >= n_) need(p, pos + 1, n_, "run-length data");
+          u64 count = d_[pos++];
+          u64 bytes = 1;
+          if (count > 128) {
+            count -= 128;
+          } else {
+            bytes = count;
+          }
+          if (count == 0 || count > w - i)
+            fail("Radiance HDR scanline " + std::to_string(y) + " has a bad run length at byte " +
+                 std::to_string(pos - 1) + " (corrupt)");
+          if (pos + bytes > n_) need(p, pos + bytes, n_, "run-length data");
+          pos += bytes;
+          i += count;
+        }
+      }
+    }
+    return p;
+  }
+
+  Probe pfm(u64* data_offset = nullptr, int* channels = nullptr, bool* big_endian = nullptr) const {
+    Probe p{Format::Pfm};
+    u64 pos = 2;
+    auto space = [&](u64 at) { return at < n_ && std::strchr(" \t\r\n", d_[at]) && d_[at]; };
+    auto field = [&](const char* what) {
+      if (!space(pos)) fail(std::string("PFM header: no ") + what);
+      while (space(pos)) ++pos;
+      u64 s = pos;
+      while (pos < n_ && !space(pos)) ++pos;
+      if (s == pos) fail(std::string("PFM header: no ") + what);
+      return std::string(reinterpret_cast<const char*>(d_ + s), pos - s);
+    };
+    auto integer = [&](const char* what) {
+      std::string s = field(what);
+      long long v = 0;
+      auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+      if (r.ec != std::errc() || r.ptr != s.data() + s.size() || v <= 0)
+        fail(std::string("PFM header: ") + what + " '" + s + "' is not a positive integer");
+      return u64(v);
+    };
+    const u64 w = integer("width"), h = integer("height");
+    std::string sc = field("scale");
+    double scale = 0;
+    auto r = std::from_chars(sc.data(), sc.data() + sc.size(), scale);
+    if (r.ec != std::errc() || r.ptr != sc.data() + sc.size() || !std::isfinite(scale) ||
+        scale == 0)
+      fail("PFM header: scale '" + sc + "' is not a finite non-zero number");
+    if (!space(pos)) fail("PFM header: no pixel data");
+    ++pos;  // exactly one whitespace byte before the data
+    size(p, w, h);
+    const int ch = d_[1] == 'F' ? 3 : 1;
+    need(p, pos + w * h * ch * 4, n_, "header and pixels");
+    if (data_offset) *data_offset = pos;
+    if (channels) *channels = ch;
+    if (big_endian) *big_endian = scale > 0;
+    return p;
+  }
+
+  Probe tga() const {
+    Probe p{Format::Tga};
+    const char* unknown =
+        "unknown image format (lucent reads PNG, JPEG, BMP, TGA, Radiance HDR, PFM and OpenEXR)";
+    if (n_ < 18) fail(unknown);
+    const unsigned idlen = d_[0], cmap = d_[1], type = d_[2];
+    const u64 cmap_len = le16(d_ + 5), cmap_bits = d_[7], bpp = d_[16];
+    const u64 w = le16(d_ + 12), h = le16(d_ + 14);
+    auto bits_ok = [](u64 b) { return b == 8 || b == 15 || b == 16 || b == 24 || b == 32; };
+    bool ok = cmap <= 1 && w > 0 && h > 0 && bits_ok(bpp);
+    if (cmap == 1)
+      ok = ok && (type == 1 || type == 9) && bits_ok(cmap_bits) && (bpp == 8 || bpp == 16);
+    else
+      ok = ok && (type == 2 || type == 3 || type == 10 || type == 11);
+    if (!ok) fail(unknown);
+    size(p, w, h);
+    const u64 px_bytes = (bpp + 7) / 8;
+    u64 pos = 18 + idlen + (cmap == 1 ? cmap_len * ((cmap_bits + 7) / 8) : 0);
+    const u64 total = w * h;
+    if (type < 8) {
+      need(p, pos + total * px_bytes, n_, "header and pixels");
+      return p;
+    }
+    for (u64 px = 0; px < total;) {
+      if (pos >= n_) need(p, pos + 1, n_, "run-length data");
+      const unsigned hdr = d_[pos++];
+      const u64 count = (hdr & 0x7F) + 1;
+      pos += (hdr & 0x80) ? px_bytes : count * px_bytes;
+      if (pos > n_) need(p, pos, n_, "run-length data");
+      px += count;
+    }
+    return p;
+  }
+
+  Probe probe() const {
+    static const char kPng[] = "\x89PNG\r\n\x1a\n";
+    if (starts_with(d_, n_, kPng, 8)) return png();
+    if (starts_with(d_, n_, "\xFF\xD8\xFF", 3)) return jpeg();
+    if (starts_with(d_, n_, "BM", 2)) return bmp();
+    if (starts_with(d_, n_, "#?RADIANCE\n", 11) || starts_with(d_, n_, "#?RGBE\n", 7)) return hdr();
+    if (n_ >= 3 && d_[0] == 'P' && (d_[1] == 'F' || d_[1] == 'f') &&
+        std::strchr(" \t\r\n", d_[2]) && d_[2])
+      return pfm();
+    if (starts_with(d_, n_, "\x76\x2f\x31\x01", 4)) return exr(nullptr);
+    if (n_ == 0) fail("empty image file");
+    const char* other = starts_with(d_, n_, "GIF8", 4)               ? "GIF"
+                        : starts_with(d_, n_, "8BPS", 4)             ? "PSD"
+                        : starts_with(d_, n_, "\x53\x80\xF6\x34", 4) ? "Softimage PIC"
+                        : (n_ >= 2 && d_[0] == 'P' && d_[1] >= '1' && d_[1] <= '7') ? "PNM"
+                                                                                    : nullptr;
+    if (other)
+      fail(std::string(other) +
+           " images are not supported (lucent reads PNG, JPEG, BMP, TGA, Radiance HDR, PFM and "
+           "OpenEXR)");
+    return tga();
+  }
+
+  // The header through tinyexr (`header` filled when given; the caller frees it).
+  Probe exr(EXRHeader* out) const {
+    Probe p{Format::Exr};
+    EXRVersion version;
+    if (ParseEXRVersionFromMemory(&version, d_, n_) != TINYEXR_SUCCESS)
+      fail("OpenEXR file has an invalid version field");
+    if (version.multipart || version.non_image)
+      fail("multi-part and deep OpenEXR files are not supported");
+    EXRHeader header;
+    InitEXRHeader(&header);
+    const char* err = nullptr;
+    if (ParseEXRHeaderFromMemory(&header, &version, d_, n_, &err) != TINYEXR_SUCCESS) {
+      FreeEXRHeader(&header);
+      fail("cannot read OpenEXR header: " + exr_message(err));
+    }
+    struct Free {
+      EXRHeader* h;
+      bool keep;
+      ~Free() {
+        if (!keep) FreeEXRHeader(h);
+      }
+    } guard{&header, false};
+    const EXRBox2i& dw = header.data_window;
+    const std::int64_t w = std::int64_t(dw.max_x) - dw.min_x + 1;
+    const std::int64_t h = std::int64_t(dw.max_y) - dw.min_y + 1;
+    if (w <= 0 || h <= 0)
+      fail("OpenEXR header claims an empty data window (" + std::to_string(w) + "x" +
+           std::to_string(h) + ")");
+    size(p, u64(w), u64(h));
+    if (header.num_channels <= 0) fail("OpenEXR header has no channels");
+    u64 bytes_per_pixel = 0;
+    for (int c = 0; c < header.num_channels; ++c)
+      bytes_per_pixel += header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF ? 2 : 4;
+    u64 chunks;
+    if (header.tiled) {
+      if (header.tile_size_x <= 0 || header.tile_size_y <= 0)
+        fail("OpenEXR header has an invalid tile size");
+      chunks = ((u64(w) + header.tile_size_x - 1) / header.tile_size_x) *
+               ((u64(h) + header.tile_size_y - 1) / header.tile_size_y);
+    } else {
+      int lines = 1;
+      switch (header.compression_type) {
+        case TINYEXR_COMPRESSIONTYPE_ZIP:
+          lines = 16;
+          break;
+        case TINYEXR_COMPRESSIONTYPE_PIZ:
+          lines = 32;
+          break;
+        default:
+          lines = 1;
+      }
+      chunks = (u64(h) + lines - 1) / lines;
+    }
+    // the offset table follows the magic number, the version and the header
+    need(p, 8 + u64(header.header_len) + 8 * chunks, n_, "header and offset table");
+    if (header.compression_type == TINYEXR_COMPRESSIONTYPE_PIZ) {
+      if (header.tiled) fail("tiled PIZ-compressed OpenEXR files are not supported");
+      piz_chunks(header, u64(w), chunks, bytes_per_pixel);
+    }
+    // zlib expands at most 1032x; PIZ's Huffman runs a few hundred times
+    ratio(p, u64(w) * u64(h) * bytes_per_pixel, n_, 2048, "file");
+    if (out) {
+      *out = header;
+      guard.keep = true;
+    }
+    return p;
+  }
+
+  // tinyexr 1.0.1 reads a PIZ chunk's bitmap, its Huffman length and the Huffman header
+  // without checking them against the chunk's size (a heap over-read found by fuzzing): each
+  // scanline chunk is checked here as tinyexr will read it.
+  void piz_chunks(const EXRHeader& header, u64 width, u64 chunks, u64 bytes_per_pixel) const {
+    const u64 table = u64(header.header_len) + 8;
+    auto i32 = [&](u64 at) { return static_cast<std::int32_t>(le32(d_ + at)); };
+    for (u64 c = 0; c < chunks; ++c) {
+      u64 offset = le32(d_ + table + 8 * c) | (u64(le32(d_ + table + 8 * c + 4)) << 32);
+      if (offset > n_ || n_ - offset < 8) continue;  // tinyexr refuses these itself
+      const std::int64_t line = i32(offset), len = i32(offset + 4);
+      if (len <= 0 || u64(len) > n_ - offset - 8) continue;
+      const std::int64_t end =
+          std::min<std::int64_t>(line + 32, std::int64_t(header.data_window.max_y) + 1);
+      if (end <= line) continue;
+      if (u64(len) == width * u64(end - line) * bytes_per_pixel) continue;  // stored raw
+      const u64 at = offset + 8;
+      auto bad = [&](const std::string& why) {
+        fail("OpenEXR PIZ chunk at byte " + std::to_string(offset) + " is corrupt: " + why);
+      };
+      if (len < 4) bad("shorter than its bitmap bounds");
+      const u64 lo = le16(d_ + at), hi = le16(d_ + at + 2);
+      const u64 bitmap = lo <= hi ? hi - lo + 1 : 0;
+      if (4 + bitmap + 4 > u64(len)) bad("its bitmap runs past its end");
+      const std::int64_t huffman = i32(at + 4 + bitmap);
+      if (huffman < 20 || 4 + bitmap + 4 + u64(huffman) > u64(len))
+        bad("its Huffman data size " + std::to_string(huffman) + " does not fit");
+    }
+  }
+
+  const unsigned char* d_;
+  std::size_t n_;
+  const std::string& path_;
+  u64 max_pixels_;
+};
+
+}  // namespace
+
+std::string exr_message(const char* err) {
+  std::string msg = err ? err : "unknown error";
+  if (err) FreeEXRErrorMessage(err);
+  for (char& c : msg)
+    if (c == '\n') c = ' ';
+  while (!msg.empty() && msg.back() == ' ') msg.pop_back();
+  return msg;
+}
+
+const char* format_name(Format f) {
+  switch (f) {
+    case Format::Png:
+      return "PNG";
+    case Format::Jpeg:
+      return "JPEG";
+    case Format::Bmp:
+      return "BMP";
+    case Format::Tga:
+      return "TGA";
+    case Format::Hdr:
+      return "Radiance HDR";
+    case Format::Pfm:
+      return "PFM";
+    case Format::Exr:
+      return "OpenEXR";
+  }
+  return "image";
+}
+
+Probe probe_image(const unsigned char* data, std::size_t size, const std::string& path,
+                  std::uint64_t max_pixels) {
+  return Checker(data, size, path, max_pixels).probe();
+}
+
+Probe probe_pfm(const unsigned char* data, std::size_t size, const std::string& path,
+                std::uint64_t max_pixels, PfmLayout& layout) {
+  return Checker(data, size, path, max_pixels)
+      .pfm(&layout.data_offset, &layout.channels, &layout.big_endian);
+}
+
+Probe probe_exr(const unsigned char* data, std::size_t size, const std::string& path,
+                std::uint64_t max_pixels, EXRHeader& header) {
+  Checker check(data, size, path, max_pixels);
+  if (!starts_with(data, size, "\x76\x2f\x31\x01", 4)) check.fail("not an OpenEXR file");
+  return check.exr(&header);
+}
+
+}  // namespace lucent::image_detail

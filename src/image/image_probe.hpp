@@ -1,0 +1,112 @@
+#pragma once
+// Image files as they enter lucent (textures, environment maps, images given to compare and
+// converge): the format from the file's magic bytes, the size its header claims, checked against
+// a pixel limit and against what the file's length can hold, and the decoders that take the
+// file's bytes. Nothing is allocated for pixels before the header has passed the checks.
+#include <tinyexr.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/file_io.hpp"
+#include "lucent/image.hpp"
+#include "lucent/render.hpp"
+
+namespace lucent::image_detail {
+
+enum class Format { Png, Jpeg, Bmp, Tga, Hdr, Pfm, Exr };
+
+const char* format_name(Format f);
+
+#ifndef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
+/// Upper bound on width * height of any image lucent reads (the largest film, 16384 x 16384).
+constexpr std::uint64_t kMaxImagePixels = 16384ull * 16384ull;
+/// Upper bound on a texture's or environment map's width * height (8192 x 8192, or 16384 x 4096:
+/// 1 GiB as linear RGBA float, the form textures take).
+constexpr std::uint64_t kMaxTexturePixels = 8192ull * 8192ull;
+#else
+// fuzzing: valid images this large take seconds to decode and would only slow the search down
+constexpr std::uint64_t kMaxImagePixels = 1ull << 22;
+constexpr std::uint64_t kMaxTexturePixels = 1ull << 22;
+#endif
+/// Upper bound on an image file's size.
+constexpr std::uint64_t kMaxImageFileBytes = 4ull << 30;
+
+struct Probe {
+  Format format = Format::Png;
+  int width = 0;
+  int height = 0;
+  bool sixteen_bit = false;  ///< a 16-bit PNG
+};
+
+/// Identifies the format of `data` (PNG, JPEG, BMP, TGA, Radiance HDR, PFM, OpenEXR; anything
+/// else is refused), reads the size its header claims and checks it: at least one pixel, at most
+/// `max_pixels`, and no more than the file's length can hold (uncompressed formats need every
+/// byte; run-length streams are walked without decoding; deflate and JPEG streams have a
+/// bounded compression ratio). Throws lucent::Error("<path>: ...") on the first problem.
+Probe probe_image(const unsigned char* data, std::size_t size, const std::string& path,
+                  std::uint64_t max_pixels);
+
+/// Where a PFM file's pixels are.
+struct PfmLayout {
+  std::uint64_t data_offset = 0;
+  int channels = 3;
+  bool big_endian = false;
+};
+
+/// probe_image for a PFM file, with the layout of its pixels.
+Probe probe_pfm(const unsigned char* data, std::size_t size, const std::string& path,
+                std::uint64_t max_pixels, PfmLayout& layout);
+
+/// probe_image for an OpenEXR file (checks its PIZ chunks too), with its header parsed by
+/// tinyexr into `header` (the caller frees it with FreeEXRHeader).
+Probe probe_exr(const unsigned char* data, std::size_t size, const std::string& path,
+                std::uint64_t max_pixels, EXRHeader& header);
+
+/// tinyexr's error text on one line (it ends its messages with newlines); frees `err`.
+std::string exr_message(const char* err);
+
+/// A decoded image with four channels (RGBA) or three (RGB); linear floats, row 0 at the top.
+/// 8-bit and 16-bit data are decoded from sRGB to linear (alpha stays linear).
+struct Decoded {
+  Format format = Format::Png;
+  int width = 0, height = 0, channels = 0;
+  std::vector<float> pixels;
+};
+
+/// Decodes image bytes that probe_image accepted (it is called again first).
+Decoded decode_image(const unsigned char* data, std::size_t size, const std::string& path,
+                     int channels, std::uint64_t max_pixels);
+
+/// An OpenEXR file's channels, each converted to float (HALF widened, UINT converted).
+struct ExrChannels {
+  int width = 0, height = 0;
+  std::vector<std::string> names;
+  std::vector<std::vector<float>> planes;  ///< one per name, width * height, row 0 at the top
+  int find(const char* name) const;        ///< index of a channel, or -1
+};
+
+/// Reads every channel of a scanline or tiled single-part OpenEXR held in memory.
+ExrChannels read_exr_channels(const unsigned char* data, std::size_t size, const std::string& path,
+                              std::uint64_t max_pixels);
+
+/// How image files are read: regular files of at most kMaxImageFileBytes.
+io::ReadSpec image_read_spec(const char* what = "image");
+
+/// Encodes `image` as OpenEXR in memory; throws lucent::Error("<path>: cannot encode EXR: ...").
+std::string save_exr_to_memory(const std::string& path, const EXRImage& image,
+                               const EXRHeader& header);
+
+/// read_render() on a file's bytes: an EXR with lucent's layers (mean, var.R/G/B, n), or any
+/// image decode_image reads (variance and samples left empty).
+RenderResult read_render_memory(const unsigned char* data, std::size_t size,
+                                const std::string& path);
+
+/// sRGB-encoded value in [0, 1] to linear.
+double srgb_to_linear(double c);
+/// An 8-bit sRGB value to linear (a table of srgb_to_linear).
+float srgb8_to_linear(std::uint8_t v);
+
+}  // namespace lucent::image_detail

@@ -1,0 +1,172 @@
+#include "scene/json_guard.hpp"
+
+#include <cstddef>
+#include <iterator>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "core/file_io.hpp"
+#include "lucent/error.hpp"
+
+namespace lucent::scene_detail {
+
+namespace {
+
+using nlohmann::json;
+
+// An iterator over the text that remembers the last character the parser read, so that the
+// SAX callbacks below know where they are (nlohmann's SAX interface gives no position).
+struct TrackingIterator {
+  using iterator_category = std::input_iterator_tag;
+  using value_type = char;
+  using difference_type = std::ptrdiff_t;
+  using pointer = const char*;
+  using reference = const char&;
+
+  const char* p = nullptr;
+  const char** last = nullptr;
+
+  reference operator*() const {
+    *last = p;
+    return *p;
+  }
+  TrackingIterator& operator++() {
+    ++p;
+    return *this;
+  }
+  TrackingIterator operator++(int) {
+    TrackingIterator t = *this;
+    ++p;
+    return t;
+  }
+  bool operator==(const TrackingIterator& o) const { return p == o.p; }
+  bool operator!=(const TrackingIterator& o) const { return p != o.p; }
+};
+
+class StructureCheck : public nlohmann::json_sax<json> {
+ public:
+  StructureCheck(const std::string& text, const std::string& path, const char** last)
+      : text_(text), path_(path), last_(last) {}
+
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t&) override { return value(); }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override { return open(true); }
+  bool start_array(std::size_t) override { return open(false); }
+  bool end_object() override { return close(); }
+  bool end_array() override { return close(); }
+
+  bool key(string_t& k) override {
+    Frame& f = frames_.back();
+    const std::size_t at = key_start();
+    auto [it, fresh] = f.keys.emplace(k, at);
+    f.key = k;
+    if (!fresh) {
+      const bool material = frames_.size() == 2 && frames_[0].key == "materials";
+      fail(at, pointer(),
+           std::string(material ? "duplicate material name '" + k + "'" : "duplicate key") +
+               " (first at " + line_col_at(text_, it->second) + ")");
+    }
+    return true;
+  }
+
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;  // syntax errors: the parser reports them with their place
+  }
+
+ private:
+  struct Frame {
+    bool object = false;
+    long index = -1;                          ///< arrays: the current element
+    std::string key;                          ///< objects: the current key
+    std::map<std::string, std::size_t> keys;  ///< objects: each key and where it first appears
+  };
+
+  std::size_t here() const { return static_cast<std::size_t>(*last_ - text_.data()); }
+
+  // The key's opening quote: the last character read is its closing quote.
+  std::size_t key_start() const {
+    std::size_t i = here();
+    while (i > 0) {
+      --i;
+      if (text_[i] != '"') continue;
+      std::size_t slashes = 0;
+      while (i > slashes && text_[i - 1 - slashes] == '\\') ++slashes;
+      if (slashes % 2 == 0) return i;
+    }
+    return here();
+  }
+
+  std::string pointer() const {
+    std::string p;
+    for (const Frame& f : frames_) p += "/" + (f.object ? f.key : std::to_string(f.index));
+    return p.empty() ? "/" : p;
+  }
+
+  [[noreturn]] void fail(std::size_t at, const std::string& ptr, const std::string& what) const {
+    throw Error(path_ + ":" + line_col_at(text_, at) + ": " + ptr + ": " + what);
+  }
+
+  bool value() {
+    if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
+    return true;
+  }
+
+  bool open(bool object) {
+    value();
+    if (static_cast<int>(frames_.size()) >= kMaxJsonDepth)
+      fail(here(), pointer(),
+           "nested deeper than " + std::to_string(kMaxJsonDepth) +
+               " levels (a scene needs 6: is this a scene file?)");
+    frames_.push_back(Frame{object, -1, {}, {}});
+    return true;
+  }
+
+  bool close() {
+    frames_.pop_back();
+    return true;
+  }
+
+  const std::string& text_;
+  const std::string& path_;
+  const char** last_;
+  std::vector<Frame> frames_;
+};
+
+}  // namespace
+
+std::string line_col_at(const std::string& text, std::size_t offset) {
+  std::size_t line = 1, col = 1;
+  for (std::size_t i = 0; i < offset && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return std::to_string(line) + ":" + std::to_string(col);
+}
+
+std::string read_scene_text(const std::string& path) {
+  io::ReadSpec spec;
+  spec.what = "scene file";
+  spec.max_bytes = kMaxSceneBytes;
+  spec.allow_pipe = true;
+  spec.text = true;
+  return io::read_file(path, spec);
+}
+
+void check_json_structure(const std::string& text, const std::string& path) {
+  const char* last = text.data();
+  StructureCheck check(text, path, &last);
+  TrackingIterator first{text.data(), &last}, end{text.data() + text.size(), &last};
+  json::sax_parse(first, end, &check);
+}
+
+}  // namespace lucent::scene_detail

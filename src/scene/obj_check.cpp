@@ -1,0 +1,264 @@
+// The text of OBJ and MTL files, checked before tinyobjloader parses it. tinyobjloader reads a
+// coordinate that is not a number ("v 1 abc 0", "v nan 0 0") as 0 without a word, lets 1e39
+// overflow to infinity in its floats, and reports out-of-range indices only as a warning at the
+// last line: every number and index is checked here, and the first bad one named with its line.
+#include <cfloat>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <regex>
+#include <sstream>
+#include <string_view>
+
+#include "lucent/error.hpp"
+#include "scene/obj_internal.hpp"
+
+namespace lucent::scene_detail::obj {
+
+namespace {
+
+bool space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+// Splits `text` into lines as tinyobjloader does ("\n", "\r\n" or a lone "\r" ends one) and
+// calls f(line, number) for each.
+template <typename F>
+void for_each_line(const std::string& text, F&& f) {
+  std::size_t start = 0;
+  long number = 1;
+  while (start < text.size()) {
+    std::size_t end = text.find_first_of("\r\n", start);
+    if (end == std::string::npos) end = text.size();
+    f(std::string_view(text.data() + start, end - start), number++);
+    if (end < text.size() && text[end] == '\r' && end + 1 < text.size() && text[end + 1] == '\n')
+      ++end;
+    start = end + 1;
+  }
+}
+
+// The next whitespace-separated token of `rest` (empty at the end of the line or at a comment).
+std::string_view token(std::string_view& rest) {
+  std::size_t i = 0;
+  while (i < rest.size() && space(rest[i])) ++i;
+  std::size_t j = i;
+  while (j < rest.size() && !space(rest[j])) ++j;
+  std::string_view t = rest.substr(i, j - i);
+  rest.remove_prefix(j);
+  if (!t.empty() && t[0] == '#') {
+    rest = {};
+    return {};
+  }
+  return t;
+}
+
+std::string str(std::string_view s) {
+  std::string out(s.substr(0, 40));
+  if (s.size() > 40) out += "...";
+  return out;
+}
+
+class LineError {
+ public:
+  LineError(const std::string& path, long line) : path_(path), line_(line) {}
+  [[noreturn]] void operator()(const std::string& what) const {
+    throw Error(path_ + ":" + std::to_string(line_) + ": " + what);
+  }
+
+ private:
+  const std::string& path_;
+  long line_;
+};
+
+// A number as tinyobjloader stores it (a float): finite and within float range. Underflow to 0
+// is fine.
+double number(std::string_view tok, const LineError& fail, const char* what) {
+  std::string_view t = tok;
+  if (!t.empty() && t[0] == '+') t.remove_prefix(1);
+  double v = 0;
+  auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (ec == std::errc::result_out_of_range && ptr == t.data() + t.size()) {
+    v = std::strtod(std::string(t).c_str(), nullptr);  // tells overflow from underflow
+    if (std::abs(v) <= 1.0) return 0.0;
+    fail(std::string(what) + " line: '" + str(tok) + "' is out of range");
+  }
+  if (ec != std::errc() || ptr != t.data() + t.size())
+    fail(std::string(what) + " line: '" + str(tok) + "' is not a number");
+  if (!std::isfinite(v))
+    fail(std::string(what) + " line: '" + str(tok) + "' is not a finite number");
+  if (std::abs(v) > FLT_MAX)
+    fail(std::string(what) + " line: '" + str(tok) + "' is out of range for a float");
+  return v;
+}
+
+const char* const kKinds[3] = {"vertex", "texture coordinate", "normal"};
+
+}  // namespace
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    size_t b = line.find_first_not_of(" \t\r."), e = line.find_last_not_of(" \t\r");
+    if (b == std::string::npos) continue;  // tinyobjloader's stray "." lines
+    out.push_back(line.substr(b, e - b + 1));
+  }
+  return out;
+}
+
+TextCounts check_obj_text(const std::string& path, const std::string& text) {
+  std::int64_t count[3] = {0, 0, 0};  // v, vt, vn defined so far
+  // the largest positive index of each kind and its line: checked against the final counts
+  std::int64_t wanted[3] = {0, 0, 0};
+  long wanted_line[3] = {0, 0, 0};
+  TextCounts out;
+  for_each_line(text, [&](std::string_view rest, long ln) {
+    const LineError fail(path, ln);
+    std::string_view tag = token(rest);
+    if (tag.empty()) return;
+    int need = 0;
+    const char* what = nullptr;
+    if (tag == "v") {
+      need = 3, what = "vertex", ++count[0];
+    } else if (tag == "vt") {
+      need = 1, what = "texture coordinate", ++count[1];
+    } else if (tag == "vn") {
+      need = 3, what = "normal", ++count[2];
+    }
+    if (what) {
+      int n = 0;
+      for (std::string_view t; !(t = token(rest)).empty(); ++n) number(t, fail, what);
+      if (n < need)
+        fail(std::string(what) + " line has " + std::to_string(n) + " number" +
+             (n == 1 ? "" : "s") + ", needs " + std::to_string(need));
+      return;
+    }
+    const char* element = tag == "f"   ? "face"
+                          : tag == "l" ? "line element"
+                          : tag == "p" ? "point element"
+                                       : nullptr;
+    if (!element) return;
+    int corners = 0;
+    for (std::string_view t; !(t = token(rest)).empty(); ++corners) {
+      // v, v/vt, v//vn or v/vt/vn
+      std::string_view parts[3];
+      int np = 0;
+      for (std::size_t start = 0;;) {
+        std::size_t slash = t.find('/', start);
+        if (np == 3) fail(std::string(element) + ": '" + str(t) + "' has more than 3 indices");
+        parts[np++] = t.substr(start, slash == std::string_view::npos ? slash : slash - start);
+        if (slash == std::string_view::npos) break;
+        start = slash + 1;
+      }
+      for (int k = 0; k < np; ++k) {
+        if (parts[k].empty()) {
+          if (k == 0) fail(std::string(element) + ": '" + str(t) + "' has no vertex index");
+          continue;  // "1//3": no texture coordinate
+        }
+        std::int64_t idx = 0;
+        std::string_view p = parts[k];
+        if (p[0] == '+') p.remove_prefix(1);
+        auto [ptr, ec] = std::from_chars(p.data(), p.data() + p.size(), idx);
+        if (ec == std::errc::result_out_of_range)
+          fail(std::string(element) + ": " + kKinds[k] + " index " + str(parts[k]) +
+               " is out of range");
+        if (ec != std::errc() || ptr != p.data() + p.size())
+          fail(std::string(element) + ": " + kKinds[k] + " index '" + str(parts[k]) +
+               "' is not an integer");
+        if (idx == 0)
+          fail(std::string(element) + ": " + kKinds[k] + " index 0 (OBJ indices start at 1)");
+        if (idx < 0) {
+          if (count[k] + idx + 1 < 1)
+            fail(std::string(element) + ": " + kKinds[k] + " index " + std::to_string(idx) +
+                 " is out of range (" + std::to_string(count[k]) + " defined so far)");
+        } else if (idx > count[k] && idx > wanted[k]) {
+          wanted[k] = idx;  // may be defined further down: checked at the end
+          wanted_line[k] = ln;
+        }
+      }
+    }
+    if (tag != "f") return;
+    if (corners > kMaxFaceVertices)
+      fail("face has " + std::to_string(corners) + " corners, more than the " +
+           std::to_string(kMaxFaceVertices) + " lucent triangulates");
+    if (corners >= 3) out.triangles += corners - 2;
+    if (static_cast<std::uint64_t>(out.triangles) > kMaxTriangles)
+      fail("more than " + std::to_string(kMaxTriangles) + " triangles in one OBJ file");
+  });
+  for (int k = 0; k < 3; ++k)
+    if (wanted[k] > count[k])
+      LineError(path, wanted_line[k])(
+          std::string(kKinds[k]) + " index " + std::to_string(wanted[k]) +
+          " is out of range (the file defines " + std::to_string(count[k]) + ")");
+  out.vertices = count[0];
+  out.texcoords = count[1];
+  out.normals = count[2];
+  return out;
+}
+
+void check_mtl_text(const std::string& path, const std::string& text) {
+  for_each_line(text, [&](std::string_view rest, long ln) {
+    const LineError fail(path, ln);
+    std::string_view tag = token(rest);
+    if (tag.empty()) return;
+    static const char* const colours[] = {"Ka", "Kd", "Ks", "Ke", "Kt", "Tf"};
+    static const char* const scalars[] = {"Ns", "Ni", "d",   "Tr",    "Pr",    "Pm",
+                                          "Ps", "Pc", "Pcr", "aniso", "anisor"};
+    std::string name(tag);
+    bool colour = false, scalar = false;
+    for (const char* c : colours) colour = colour || tag == c;
+    for (const char* s : scalars) scalar = scalar || tag == s;
+    if (colour) {
+      std::string_view probe = rest;
+      std::string_view first = token(probe);
+      if (first == "spectral" || first == "xyz") return;  // forms tinyobjloader does not read
+      int n = 0;
+      for (std::string_view t; !(t = token(rest)).empty(); ++n) {
+        double v = number(t, fail, name.c_str());
+        if (v < 0) fail(name + " line: '" + str(t) + "' is negative");
+      }
+      if (n != 3)
+        fail(name + " line has " + std::to_string(n) + " number" + (n == 1 ? "" : "s") +
+             ", needs 3");
+    } else if (scalar) {
+      std::string_view t = token(rest);
+      if (t.empty()) fail(name + " line has no number");
+      number(t, fail, name.c_str());
+    } else if (tag == "illum") {
+      std::string_view t = token(rest);
+      int v = -1;
+      auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+      if (ec != std::errc() || ptr != t.data() + t.size() || v < 0 || v > 10)
+        fail("illum line: '" + str(t) + "' is not an illumination model (0 to 10)");
+    }
+  });
+}
+
+long line_of_statement(const std::string& text, const char* tag, std::int64_t n) {
+  long found = 0;
+  std::int64_t seen = 0;
+  for_each_line(text, [&](std::string_view rest, long ln) {
+    if (found == 0 && token(rest) == tag && seen++ == n) found = ln;
+  });
+  return found;
+}
+
+[[noreturn]] void throw_parse_error(const std::string& path, const std::string& err) {
+  std::vector<std::string> lines = lines_of(err);
+  std::string first = lines.empty() ? "cannot parse the file" : lines.front();
+  std::smatch m;
+  static const std::regex line_re(R"(line:? (\d+))");
+  if (std::regex_search(first, m, line_re)) {
+    std::string what = first;
+    if (first.find("Failed parse `f'") != std::string::npos)
+      what = "malformed face: an index is 0 or not a number";
+    else if (first.find("Failed parse `l'") != std::string::npos)
+      what = "malformed line element: an index is 0 or not a number";
+    else if (first.find("Failed parse `p'") != std::string::npos)
+      what = "malformed point element: an index is 0 or not a number";
+    throw Error(path + ":" + m[1].str() + ": " + what);
+  }
+  throw Error(path + ": " + first);
+}
+
+}  // namespace lucent::scene_detail::obj

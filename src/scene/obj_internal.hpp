@@ -1,0 +1,99 @@
+#pragma once
+// Pieces of the OBJ/MTL loader (scene/obj.cpp assembles triangles): the checks of the files'
+// text (obj_check.cpp) and the MTL libraries and their mapping to lucent materials
+// (obj_mtl.cpp).
+#include <tiny_obj_loader.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "lucent/scene.hpp"
+
+namespace lucent::scene_detail::obj {
+
+/// Largest OBJ file read (tinyobjloader holds the text and its arrays at once).
+constexpr std::uint64_t kMaxObjBytes = 1ull << 30;
+/// Largest MTL file read.
+constexpr std::uint64_t kMaxMtlBytes = 64ull << 20;
+/// Most triangles one OBJ file may produce (67 million: several GiB of scene and BVH).
+constexpr std::uint64_t kMaxTriangles = 1ull << 26;
+/// Most corners of one polygon: tinyobjloader's ear clipping takes cubic time in it.
+constexpr int kMaxFaceVertices = 1024;
+
+/// What the check of an OBJ file's text counted.
+struct TextCounts {
+  std::int64_t vertices = 0, normals = 0, texcoords = 0, triangles = 0;
+};
+
+/// Checks an OBJ file's text before tinyobjloader sees it: every number of a v, vn and vt line
+/// (present, a number, finite, within float range), every index of an f, l and p element (an
+/// integer, not 0, within the vertices, texture coordinates and normals the file defines, the
+/// negative ones relative to those defined so far), polygons of at most kMaxFaceVertices corners
+/// and at most kMaxTriangles triangles. Throws lucent::Error("<path>:<line>: ...").
+TextCounts check_obj_text(const std::string& path, const std::string& text);
+
+/// Checks the numbers of an MTL file's statements that carry them (Ka, Kd, Ks, Ke, Tf, Ns, Ni,
+/// d, Tr, illum, ...): finite, within float range, colours not negative. Throws
+/// lucent::Error("<path>:<line>: ...").
+void check_mtl_text(const std::string& path, const std::string& text);
+
+/// Line (1-based) of the `n`-th (0-based) statement `tag` of `text`, or 0.
+long line_of_statement(const std::string& text, const char* tag, std::int64_t n);
+
+/// Turns tinyobjloader's error text into one lucent::Error naming the file and line.
+[[noreturn]] void throw_parse_error(const std::string& path, const std::string& err);
+
+/// The non-empty lines of `text`, trimmed (tinyobjloader's warnings and errors).
+std::vector<std::string> lines_of(const std::string& text);
+
+/// Reads the libraries named by `mtllib` (relative to the OBJ's directory) with a bound and
+/// checks their text, and remembers which file each material came from, since texture paths are
+/// relative to it. Missing or unreadable libraries are recorded (the caller warns); a malformed
+/// one is recorded as `error` (the caller throws). When disabled (a material override) nothing
+/// is read.
+class MtlReader : public tinyobj::MaterialReader {
+ public:
+  MtlReader(std::filesystem::path dir, bool enabled) : dir_(std::move(dir)), enabled_(enabled) {}
+
+  bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
+                  std::map<std::string, int>* map, std::string* warn, std::string* err) override;
+
+  std::vector<std::string> missing;     ///< libraries that do not exist
+  std::vector<std::string> unreadable;  ///< libraries that exist but cannot be read (messages)
+  std::vector<std::string> origin;      ///< the library of each material, by index
+  std::vector<std::string> warnings;    ///< the libraries' own warnings, prefixed with their path
+  std::string error;                    ///< the first malformed library's error
+
+ private:
+  std::filesystem::path dir_;
+  bool enabled_;
+};
+
+/// Creates scene materials from MTL materials on first use (docs/obj-mtl.md).
+class MaterialMapper {
+ public:
+  MaterialMapper(Scene& scene, const std::string& obj_path,
+                 const std::vector<tinyobj::material_t>& mats,
+                 const std::vector<std::string>& origin);
+
+  /// The scene material of MTL material `id` (created on first use), or the default one.
+  int get(int id);
+  int default_material();
+
+ private:
+  int convert(const tinyobj::material_t& t, const std::string& mtl_path);
+
+  Scene& scene_;
+  const std::vector<tinyobj::material_t>& mats_;
+  const std::vector<std::string>& origin_;
+  std::vector<int> index_;
+  std::string obj_name_;
+  int default_ = -1;
+  std::set<std::string> warned_;
+};
+
+}  // namespace lucent::scene_detail::obj

@@ -1,0 +1,177 @@
+// MTL libraries: read with a bound, their numbers checked (obj_check.cpp), and their materials
+// mapped to lucent materials as docs/obj-mtl.md describes.
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <sstream>
+
+#include "core/file_io.hpp"
+#include "lucent/error.hpp"
+#include "scene/loaders.hpp"
+#include "scene/obj_internal.hpp"
+
+namespace lucent::scene_detail::obj {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kDefaultMaterial = "obj:default";
+
+glm::dvec3 rgb(const tinyobj::real_t* c) { return {c[0], c[1], c[2]}; }
+double max3(const glm::dvec3& c) { return std::max(c.x, std::max(c.y, c.z)); }
+
+// A texture named in an MTL file, relative to that file's directory.
+fs::path texture_path(const std::string& mtl_path, const std::string& name) {
+  fs::path p(name);
+  if (!p.is_absolute()) p = fs::path(mtl_path).parent_path() / p;
+  std::error_code ec;  // names too long for the file system: no such file, no exception
+  if (!fs::exists(p, ec) && name.find('\\') != std::string::npos) {  // Windows-style separators
+    std::string fixed = name;
+    std::replace(fixed.begin(), fixed.end(), '\\', '/');
+    return texture_path(mtl_path, fixed);
+  }
+  return p;
+}
+
+}  // namespace
+
+bool MtlReader::operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
+                           std::map<std::string, int>* map, std::string*, std::string*) {
+  if (!enabled_) return true;
+  fs::path p = fs::path(name).is_absolute() ? fs::path(name) : dir_ / name;
+  std::string text;
+  try {
+    io::ReadSpec spec;
+    spec.what = "MTL file";
+    spec.max_bytes = kMaxMtlBytes;
+    spec.text = true;
+    text = io::read_file(p.string(), spec);
+  } catch (const Error& e) {
+    std::error_code ec;
+    if (!fs::exists(p, ec))
+      missing.push_back(p.string());
+    else
+      unreadable.push_back(e.what());
+    return false;
+  }
+  try {
+    check_mtl_text(p.string(), text);
+  } catch (const Error& e) {
+    if (error.empty()) error = e.what();
+    return false;
+  }
+  std::istringstream in(text);
+  size_t before = materials->size();
+  std::string mtl_warn, mtl_err;
+  tinyobj::LoadMtl(map, materials, &in, &mtl_warn, &mtl_err);
+  for (size_t i = before; i < materials->size(); ++i) origin.push_back(p.string());
+  for (const std::string& w : lines_of(mtl_warn + mtl_err))
+    warnings.push_back(p.string() + ": " + w);
+  return true;
+}
+
+MaterialMapper::MaterialMapper(Scene& scene, const std::string& obj_path,
+                               const std::vector<tinyobj::material_t>& mats,
+                               const std::vector<std::string>& origin)
+    : scene_(scene), mats_(mats), origin_(origin), index_(mats.size(), -1) {
+  obj_name_ = fs::path(obj_path).filename().string();
+}
+
+int MaterialMapper::get(int id) {
+  if (id < 0 || id >= static_cast<int>(mats_.size())) return default_material();
+  if (index_[id] < 0) index_[id] = convert(mats_[id], origin_[id]);
+  return index_[id];
+}
+
+int MaterialMapper::default_material() {
+  if (default_ < 0) {
+    default_ = scene_.find_material(kDefaultMaterial);
+    if (default_ < 0) {
+      Material m;
+      m.name = kDefaultMaterial;
+      m.type = MaterialType::Diffuse;
+      m.albedo = glm::dvec3(0.8);
+      scene_.materials.push_back(m);
+      default_ = static_cast<int>(scene_.materials.size() - 1);
+    }
+  }
+  return default_;
+}
+
+int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl_path) {
+  std::string name = obj_name_ + ":" + t.name;
+  int existing = scene_.find_material(name);
+  if (existing >= 0) return existing;  // the same OBJ loaded again
+
+  Material m;
+  m.name = name;
+  glm::dvec3 kd = rgb(t.diffuse), ks = rgb(t.specular);
+  m.albedo = kd;
+  m.emission = glm::max(rgb(t.emission), glm::dvec3(0.0));
+  double ior = t.ior > 1 ? t.ior : 1.5;
+  bool has_ks = max3(ks) > 0;
+  int illum = t.illum;
+  std::string where = mtl_path + ": material '" + t.name + "'";
+
+  if (illum == 4 || illum == 6 || illum == 7 || illum == 9 || t.dissolve < 1) {
+    m.type = MaterialType::Dielectric;
+    m.ior = ior;
+    m.specular = glm::dvec3(1.0);
+  } else if ((illum == 3 || illum == 5) && has_ks && max3(kd) <= 0.01 &&
+             t.diffuse_texname.empty()) {
+    m.type = MaterialType::Mirror;
+    m.specular = ks;
+  } else if (illum >= 2 && has_ks) {
+    m.type = MaterialType::Plastic;
+    m.specular = ks;
+    m.ior = ior;
+    m.roughness =
+        std::clamp(std::sqrt(2.0 / (std::max(0.0, double(t.shininess)) + 2.0)), 1e-3, 1.0);
+  } else {
+    m.type = MaterialType::Diffuse;
+  }
+
+  if (!t.diffuse_texname.empty() && m.type != MaterialType::Dielectric) {
+    fs::path p = texture_path(mtl_path, t.diffuse_texname);
+    std::error_code ec;
+    if (!fs::exists(p, ec) && !ec) {
+      warn(where + ": map_Kd texture '" + t.diffuse_texname + "' not found (" + p.string() +
+           "); using Kd");
+    } else {
+      try {
+        m.albedo_texture = load_texture(scene_, p.string());
+        m.albedo = glm::dvec3(1.0);
+      } catch (const Error& e) {
+        warn(std::string(e.what()) + " (map_Kd of " + where + "); using Kd");
+      }
+    }
+  }
+  // maps lucent does not use: only a missing file is worth a word
+  const std::pair<const char*, const std::string*> unused[] = {
+      {"map_Ka", &t.ambient_texname},
+      {"map_Ks", &t.specular_texname},
+      {"map_Ns", &t.specular_highlight_texname},
+      {"map_bump", &t.bump_texname},
+      {"disp", &t.displacement_texname},
+      {"map_d", &t.alpha_texname},
+      {"refl", &t.reflection_texname},
+      {"map_Ke", &t.emissive_texname},
+      {"norm", &t.normal_texname},
+      {"map_Pr", &t.roughness_texname},
+      {"map_Pm", &t.metallic_texname},
+      {"map_Ps", &t.sheen_texname}};
+  for (const auto& [key, file] : unused) {
+    if (file->empty()) continue;
+    fs::path p = texture_path(mtl_path, *file);
+    std::error_code ec;
+    if (!fs::exists(p, ec) && warned_.insert(p.string()).second)
+      warn(where + ": " + key + " texture '" + *file + "' not found (" + p.string() +
+           "); ignored (lucent does not use " + key + ")");
+  }
+
+  scene_.materials.push_back(m);
+  return static_cast<int>(scene_.materials.size() - 1);
+}
+
+}  // namespace lucent::scene_detail::obj

@@ -1,0 +1,53 @@
+#pragma once
+// Shared by the fuzz targets: inputs that carry several files, a private directory to write them
+// to, and the checks every loaded scene must pass.
+//
+// A bundle is the main file's bytes, then any number of parts, each introduced by a line
+// "@@ NAME" (the "\n@@ " marker, a name of at most 32 characters from [A-Za-z0-9._-] not
+// starting with a dot, a newline); parts with other names are dropped. The loaders see the main
+// file and the parts as files of one directory, so that a scene's meshes and textures, and an
+// OBJ file's MTL libraries and textures, come from the same input.
+#include <cfloat>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "lucent/scene.hpp"
+
+namespace lucent::fuzz {
+
+struct Bundle {
+  std::string main;
+  std::vector<std::pair<std::string, std::string>> parts;
+};
+
+Bundle parse_bundle(const std::uint8_t* data, std::size_t size);
+
+/// Serialises a bundle (the seed generator writes them).
+std::string make_bundle(const std::string& main,
+                        const std::vector<std::pair<std::string, std::string>>& parts);
+
+/// A directory private to this process (on /dev/shm when it exists), emptied of the files the
+/// previous input wrote; writes `main_name` and the parts into it. Returns the directory.
+std::string write_bundle(const Bundle& b, const std::string& main_name);
+
+/// Scene loading warnings are dropped (they are not what the fuzzer looks at).
+void silence_warnings();
+
+/// Traps (a crash libFuzzer reports) unless `ok`: a loader accepted something it must refuse.
+inline void check(bool ok, const char* what) {
+  if (!ok) {
+    std::fprintf(stderr, "fuzz invariant violated: %s\n", what);
+    std::abort();
+  }
+}
+
+/// What a loaded scene must satisfy: every index in range, every number finite and within float
+/// range where the device stores floats, every texture consistent.
+void check_scene(const Scene& s);
+
+}  // namespace lucent::fuzz

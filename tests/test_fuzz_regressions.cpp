@@ -1,0 +1,96 @@
+// Inputs the fuzzers (tests/fuzz, scripts/fuzz.sh) found crashing, leaking or reading out of
+// bounds, kept in tests/fuzz/regressions/<target>/ and replayed through the release loaders: each
+// must be refused with one line that names the file and says what is wrong, or load (the fuzz
+// build replays them too, under AddressSanitizer and LeakSanitizer, as seeds).
+// docs/reliability.md describes each finding.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <glm/glm.hpp>
+#include <map>
+#include <string>
+
+#include "fuzz_common.hpp"
+#include "image/image_probe.hpp"
+#include "lucent/error.hpp"
+#include "scene/loaders.hpp"
+#include "support.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The error loading regression input `file` of `target` ("" when it loads and passes the fuzz
+/// targets' checks).
+std::string replay(const std::string& target, const fs::path& file) {
+  const std::string bytes = lucent::test::read_file(file.string());
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  const std::string name = file.string();
+  try {
+    if (target == "texture") {
+      lucent::scene_detail::decode_texture(data, bytes.size(), name);
+    } else if (target == "render_image") {
+      lucent::image_detail::read_render_memory(data, bytes.size(), name);
+    } else if (target == "scene") {
+      lucent::fuzz::Bundle b = lucent::fuzz::parse_bundle(data, bytes.size());
+      std::string dir = lucent::fuzz::write_bundle(b, "scene.json");
+      lucent::fuzz::check_scene(lucent::load_scene(dir + "/scene.json"));
+    } else if (target == "obj") {
+      lucent::fuzz::Bundle b = lucent::fuzz::parse_bundle(data, bytes.size());
+      std::string dir = lucent::fuzz::write_bundle(b, "m.obj");
+      lucent::Scene scene;
+      lucent::scene_detail::load_obj(scene, dir + "/m.obj", glm::dmat4(1.0), -1);
+      lucent::fuzz::check_scene(scene);
+    }
+  } catch (const lucent::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// What each input must be refused with (part of the message after the file name); "" for the
+// inputs that must load (and pass the fuzz targets' checks).
+const std::map<std::string, std::string> kExpected = {
+    {"jpeg-dht-overflow.jpg",
+     ": JPEG Huffman table at byte 414 has 905 codes, more than 256 (corrupt)"},
+    {"exr-piz-overread.exr",
+     ": OpenEXR PIZ chunk at byte 329 is corrupt: its bitmap runs past its end"},
+    {"exr-piz-overread-2.exr",
+     ": OpenEXR PIZ chunk at byte 329 is corrupt: its bitmap runs past its end"},
+    {"exr-leak.exr", ": cannot read OpenEXR pixels:"},
+    {"exr-offset-table-overread.exr",
+     ": OpenEXR file is truncated: its 5x2088 header needs 841 bytes of header and offset table, "
+     "the file has 840"},
+    {"exr-leak-env.bundle", "/img.exr: cannot read OpenEXR pixels:"},
+    // a map_Kd name longer than the file system allows: std::filesystem::exists threw
+    {"long-texture-name.bundle", ""},
+};
+
+TEST(FuzzRegressions, EveryFoundInputIsRefusedWithOneLineOrLoads) {
+  const fs::path root = lucent::test::source_path("tests/fuzz/regressions");
+  int n = 0;
+  for (const char* target : {"texture", "render_image", "scene", "obj"}) {
+    if (!fs::is_directory(root / target)) continue;
+    for (const auto& e : fs::directory_iterator(root / target)) {
+      const std::string name = e.path().filename().string();
+      lucent::test::CaptureWarnings warnings;
+      const std::string err = replay(target, e.path());
+      ++n;
+      auto it = kExpected.find(name);
+      ASSERT_NE(it, kExpected.end()) << name << ": no expected message for it: " << err;
+      if (it->second.empty()) {
+        EXPECT_EQ(err, "") << name;
+        continue;
+      }
+      ASSERT_FALSE(err.empty()) << name << " loaded";
+      EXPECT_EQ(err.find('\n'), std::string::npos) << name << ": " << err;
+      EXPECT_NE(err.find(it->second), std::string::npos) << name << ": " << err;
+      if (std::string(target) != "scene") {
+        EXPECT_EQ(err.rfind(e.path().string() + ": ", 0), 0u) << name << ": " << err;
+      }
+    }
+  }
+  EXPECT_EQ(n, static_cast<int>(kExpected.size()));
+}
+
+}  // namespace

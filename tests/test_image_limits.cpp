@@ -1,0 +1,269 @@
+// Image files that lie (src/image/image_probe.cpp): a header claiming more pixels than the limit
+// or than the file can hold is refused with one line before anything is allocated; truncated
+// files are refused instead of decoded with zeros; the corrupt Radiance HDR that hung stb_image
+// is refused; formats lucent does not read are named. Images of one pixel, one row and one column
+// decode exactly, and an environment map of one pixel or one row lights a scene like the constant
+// sky it is.
+#include <gtest/gtest.h>
+#include <stb/stb_image_write.h>
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "image/image_probe.hpp"
+#include "lucent/compare.hpp"
+#include "lucent/error.hpp"
+#include "scene/loaders.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::scene_detail::decode_texture;
+
+std::string le16(unsigned v) { return {char(v & 0xFF), char(v >> 8)}; }
+std::string le32(std::uint32_t v) { return le16(v & 0xFFFF) + le16(v >> 16); }
+std::string be16(unsigned v) { return {char(v >> 8), char(v & 0xFF)}; }
+std::string be32(std::uint32_t v) { return be16(v >> 16) + be16(v & 0xFFFF); }
+
+/// The error decoding `bytes` as a texture named "t", without the "t: " prefix ("" if none).
+std::string texture_error(const std::string& bytes) {
+  try {
+    decode_texture(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), "t");
+  } catch (const lucent::Error& e) {
+    std::string m = e.what();
+    return m.rfind("t: ", 0) == 0 ? m.substr(3) : m;
+  }
+  return "";
+}
+
+lucent::Texture texture(const std::string& bytes) {
+  return decode_texture(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), "t");
+}
+
+void append(void* ctx, void* data, int size) {
+  static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size);
+}
+
+std::string png(int w, int h, const std::vector<unsigned char>& rgb) {
+  std::string out;
+  stbi_write_png_to_func(append, &out, w, h, 3, rgb.data(), w * 3);
+  return out;
+}
+
+std::string bmp(int w, int h, const std::vector<unsigned char>& rgb) {
+  std::string out;
+  stbi_write_bmp_to_func(append, &out, w, h, 3, rgb.data());
+  return out;
+}
+
+std::string tga(int w, int h, const std::vector<unsigned char>& rgb, bool rle) {
+  std::string out;
+  stbi_write_tga_with_rle = rle ? 1 : 0;
+  stbi_write_tga_to_func(append, &out, w, h, 3, rgb.data());
+  return out;
+}
+
+std::string hdr_header(int w, int h) {
+  return "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " +
+         std::to_string(w) + "\n";
+}
+
+std::string pfm(int w, int h, std::size_t floats) {
+  return "PF\n" + std::to_string(w) + " " + std::to_string(h) + "\n-1.0\n" +
+         std::string(4 * floats, '\0');
+}
+
+TEST(ImageLimits, LyingSizesAreRefusedBeforeAllocating) {
+  auto t0 = std::chrono::steady_clock::now();
+  // 65535 x 65535 claimed by a tiny file, in every format that states a size
+  std::string ihdr = be32(65535) + be32(65535) + std::string("\x08\x02\x00\x00\x00", 5);
+  std::string lying_png = std::string("\x89PNG\r\n\x1a\n", 8) + be32(13) + "IHDR" + ihdr + be32(0);
+  EXPECT_EQ(texture_error(lying_png),
+            "PNG header claims 65535x65535 pixels, more than the limit of 67108864 pixels "
+            "(corrupt, or too large)");
+  std::string lying_bmp = "BM" + le32(54) + le32(0) + le32(54) + le32(40) + le32(65535) +
+                          le32(65535) + le16(1) + le16(24) + std::string(24, '\0');
+  EXPECT_EQ(texture_error(lying_bmp),
+            "BMP header claims 65535x65535 pixels, more than the limit of 67108864 pixels "
+            "(corrupt, or too large)");
+  EXPECT_EQ(texture_error(hdr_header(65535, 65535) + "\x02\x02\xff\xff"),
+            "Radiance HDR header claims 65535x65535 pixels, more than the limit of 67108864 "
+            "pixels (corrupt, or too large)");
+  EXPECT_EQ(texture_error(pfm(65535, 65535, 3)),
+            "PFM header claims 65535x65535 pixels, more than the limit of 67108864 pixels "
+            "(corrupt, or too large)");
+  std::string tga_header =
+      std::string("\0\0\2", 3) + std::string(9, '\0') + le16(65535) + le16(65535) + "\x18\x00";
+  EXPECT_EQ(texture_error(tga_header + "abc"),
+            "TGA header claims 65535x65535 pixels, more than the limit of 67108864 pixels "
+            "(corrupt, or too large)");
+  std::string jpeg = std::string("\xFF\xD8\xFF\xC0", 4) + be16(11) + "\x08" + be16(65535) +
+                     be16(65535) + "\x01\x01\x11\x00" + "\xFF\xD9";
+  EXPECT_EQ(texture_error(jpeg),
+            "JPEG header claims 65535x65535 pixels, more than the limit of 67108864 pixels "
+            "(corrupt, or too large)");
+  // within the limit, but more than the file can hold
+  std::string ihdr2 = be32(8000) + be32(8000) + std::string("\x08\x02\x00\x00\x00", 5);
+  std::string small_png = std::string("\x89PNG\r\n\x1a\n", 8) + be32(13) + "IHDR" + ihdr2 +
+                          be32(0) + be32(10) + "IDAT" + std::string(10, 'x') + be32(0) + be32(0) +
+                          "IEND" + be32(0);
+  EXPECT_EQ(texture_error(small_png),
+            "PNG header claims 8000x8000 pixels (192008000 bytes), more than 10 bytes of deflate "
+            "data can hold (truncated or corrupt)");
+  EXPECT_EQ(texture_error(pfm(4000, 4000, 3)),
+            "PFM file is truncated: its 4000x4000 header needs 192000018 bytes of header and "
+            "pixels, the file has 30");
+  // every refusal above took no time and no memory worth measuring
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+}
+
+TEST(ImageLimits, TruncatedFilesAreRefused) {
+  std::vector<unsigned char> px(16 * 8 * 3);
+  for (size_t i = 0; i < px.size(); ++i) px[i] = static_cast<unsigned char>(i * 7);
+  std::string b = bmp(16, 8, px);
+  ASSERT_EQ(texture_error(b), "");
+  // stb_image decodes a truncated BMP with black rows: the campaign's "accepted silently"
+  EXPECT_EQ(texture_error(b.substr(0, b.size() - 100)),
+            "BMP file is truncated: its 16x8 header needs 438 bytes of header and pixel rows, the "
+            "file has 338");
+  std::string t = tga(16, 8, px, false);
+  ASSERT_EQ(texture_error(t), "");
+  EXPECT_NE(texture_error(t.substr(0, t.size() - 40)).find("TGA file is truncated"),
+            std::string::npos);
+  std::string tr = tga(16, 8, px, true);
+  ASSERT_EQ(texture_error(tr), "");
+  EXPECT_NE(texture_error(tr.substr(0, tr.size() / 2)).find("TGA file is truncated"),
+            std::string::npos);
+  std::string p = png(16, 8, px);
+  ASSERT_EQ(texture_error(p), "");
+  EXPECT_EQ(texture_error(p.substr(0, p.size() - 12)), "PNG file is truncated: no IEND chunk");
+  std::string f = pfm(3, 2, 18);
+  ASSERT_EQ(texture_error(f), "");
+  EXPECT_EQ(texture_error(f.substr(0, f.size() - 1)),
+            "PFM file is truncated: its 3x2 header needs 84 bytes of header and pixels, the file "
+            "has 83");
+  std::string jpg;
+  stbi_write_jpg_to_func(append, &jpg, 16, 8, 3, px.data(), 90);
+  ASSERT_EQ(texture_error(jpg), "");
+  EXPECT_EQ(texture_error(jpg.substr(0, jpg.size() - 20)),
+            "JPEG file is truncated: no end-of-image marker");
+}
+
+// stb_image loops forever on a run-length scanline whose run is 0, which is what it reads past
+// the end of a truncated file: the corrupt environment map that hung lucent.
+TEST(ImageLimits, CorruptRadianceHdrIsRefusedNotLoopedOn) {
+  std::vector<float> rgb(16 * 2 * 3, 0.5f);
+  std::string good;
+  stbi_write_hdr_to_func(append, &good, 16, 2, 3, rgb.data());
+  ASSERT_EQ(texture_error(good), "");
+  auto t0 = std::chrono::steady_clock::now();
+  EXPECT_NE(texture_error(good.substr(0, good.size() - 5)).find("Radiance HDR file is truncated"),
+            std::string::npos);
+  std::string zero_run =
+      hdr_header(16, 1) + std::string("\x02\x02\x00\x10", 4) + std::string(64, '\0');
+  EXPECT_EQ(texture_error(zero_run),
+            "Radiance HDR scanline 0 has a bad run length at byte 50 (corrupt)");
+  std::string long_run = hdr_header(16, 1) + std::string("\x02\x02\x00\x10", 4) + "\xff\x01";
+  EXPECT_EQ(texture_error(long_run),
+            "Radiance HDR scanline 0 has a bad run length at byte 50 (corrupt)");
+  EXPECT_EQ(texture_error(hdr_header(16, 1) + std::string("\x02\x02\x00\x11", 4)),
+            "Radiance HDR scanline 0 has length 17, the header says 16");
+  EXPECT_EQ(texture_error("#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 1 +X 1\n1234"),
+            "Radiance HDR file is not in the 32-bit_rle_rgbe format");
+  EXPECT_EQ(texture_error("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n+Y 1 +X 1\n1234"),
+            "Radiance HDR resolution line '+Y 1 +X 1' is not -Y h +X w");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+}
+
+TEST(ImageLimits, UnsupportedAndUnknownFormatsAreNamed) {
+  EXPECT_EQ(texture_error("GIF89a\x01\x00\x01\x00"),
+            "GIF images are not supported (lucent reads PNG, JPEG, BMP, TGA, Radiance HDR, PFM "
+            "and OpenEXR)");
+  EXPECT_EQ(texture_error("P6\n1 1\n255\nabc"),
+            "PNM images are not supported (lucent reads PNG, JPEG, BMP, TGA, Radiance HDR, PFM "
+            "and OpenEXR)");
+  EXPECT_EQ(texture_error("this is not an image at all"),
+            "unknown image format (lucent reads PNG, JPEG, BMP, TGA, Radiance HDR, PFM and "
+            "OpenEXR)");
+  EXPECT_EQ(texture_error(""), "empty image file");
+  // a BMP with run-length compression, which stb_image does not read
+  std::string rle_bmp = "BM" + le32(70) + le32(0) + le32(54) + le32(40) + le32(2) + le32(2) +
+                        le16(1) + le16(8) + le32(1) + std::string(20, '\0') + std::string(16, '\0');
+  EXPECT_EQ(texture_error(rle_bmp),
+            "BMP compression 1 is not supported (uncompressed and bit-field BMPs are)");
+}
+
+// One pixel, one row, one column: every format decodes them exactly (no resampling path divides
+// by width - 1 or height - 1).
+TEST(ImageLimits, OnePixelRowAndColumnImagesDecode) {
+  struct Size {
+    int w, h;
+  } sizes[] = {{1, 1}, {5, 1}, {1, 5}};
+  for (Size s : sizes) {
+    std::vector<unsigned char> px(static_cast<size_t>(s.w) * s.h * 3);
+    for (size_t i = 0; i < px.size(); ++i) px[i] = static_cast<unsigned char>(40 + 30 * i);
+    for (const std::string& bytes :
+         {png(s.w, s.h, px), bmp(s.w, s.h, px), tga(s.w, s.h, px, true)}) {
+      lucent::Texture t = texture(bytes);
+      ASSERT_EQ(t.width, s.w);
+      ASSERT_EQ(t.height, s.h);
+      for (size_t i = 0; i < px.size(); ++i)
+        EXPECT_NEAR(t.rgba[i / 3 * 4 + i % 3], lucent::image_detail::srgb_to_linear(px[i] / 255.0),
+                    1e-6);
+    }
+    std::vector<float> f(px.begin(), px.end());
+    for (float& v : f) v /= 64.0f;  // exact in RGBE: multiples of 1/64 below 4
+    std::string hdr;
+    stbi_write_hdr_to_func(append, &hdr, s.w, s.h, 3, f.data());
+    lucent::Image img{s.w, s.h, f};
+    std::string dir = lucent::test::temp_dir();
+    lucent::write_image(dir + "/i.pfm", img);
+    lucent::write_image(dir + "/i.exr", img);
+    for (const std::string& path : {dir + "/i.pfm", dir + "/i.exr"}) {
+      lucent::Image back = lucent::read_image(path);
+      EXPECT_EQ(back.rgb, f) << path;
+    }
+    lucent::Texture t = texture(hdr);
+    ASSERT_EQ(t.width, s.w);
+    ASSERT_EQ(t.height, s.h);
+    for (size_t i = 0; i < f.size(); ++i) EXPECT_NEAR(t.rgba[i / 3 * 4 + i % 3], f[i], f[i] / 64);
+  }
+}
+
+// An environment map of one pixel, or of one row of equal pixels, is a constant sky: a diffuse
+// sphere under it renders like under {"radiance": ...} (z-test of lucent compare). A valid
+// one-pixel map hung the renderer in the bad-input campaign.
+TEST(ImageLimits, OnePixelAndOneRowEnvironmentMapsAreConstantSkies) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::write_image(dir + "/one.pfm", lucent::Image{1, 1, {0.6f, 0.5f, 0.4f}});
+  lucent::Image row{7, 1, {}};
+  for (int i = 0; i < 7; ++i) row.rgb.insert(row.rgb.end(), {0.6f, 0.5f, 0.4f});
+  lucent::write_image(dir + "/row.pfm", row);
+  auto scene = [&](const std::string& light) {
+    return R"({"camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 40},
+      "film": {"width": 12, "height": 12}, "integrator": {"type": "path", "max_depth": 3},
+      "materials": {"m": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]}},
+      "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+      "lights": [)" +
+           light + "]}";
+  };
+  auto t0 = std::chrono::steady_clock::now();
+  lucent::RenderResult constant = lucent::test::render_json(
+      scene(R"({"type": "environment", "radiance": [0.6, 0.5, 0.4]})"), 64);
+  for (const char* map : {"one.pfm", "row.pfm"}) {
+    lucent::Scene s = lucent::parse_scene(
+        scene(std::string(R"({"type": "environment", "file": ")") + map + "\"}"),
+        dir + "/scene.json");
+    lucent::RenderOptions opt;
+    opt.spp = 64;
+    lucent::RenderResult r = lucent::render(s, opt);
+    EXPECT_EQ(r.nonfinite, 0u) << map;
+    lucent::CompareResult c = lucent::compare_images(r, constant);
+    EXPECT_TRUE(c.passed) << map << "\n" << c.summary();
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 20.0);
+}
+
+}  // namespace

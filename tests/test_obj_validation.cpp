@@ -1,0 +1,155 @@
+// Values entering through OBJ and MTL files (src/scene/obj_check.cpp): tinyobjloader read NaN and
+// Inf coordinates as 0, let 1e39 overflow its floats, and took absurd indices with a warning;
+// each is now an error naming the file and line. Also: forward references still load, files that
+// are not regular files are refused, huge polygons are refused before the triangulator's cubic
+// time, a transform that takes a vertex beyond float range is an error.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <chrono>
+#include <filesystem>
+#include <glm/gtc/matrix_transform.hpp>
+#include <string>
+
+#include "lucent/error.hpp"
+#include "scene/loaders.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::Scene;
+
+/// Loads `text` as an OBJ (and `mtl` as m.mtl beside it); returns the error, "" when it loads.
+std::string obj_error(const std::string& text, const std::string& mtl = "",
+                      const glm::dmat4& xf = glm::dmat4(1.0), Scene* out = nullptr) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/m.obj", text);
+  if (!mtl.empty()) lucent::test::write_file(dir + "/m.mtl", mtl);
+  Scene scene;
+  try {
+    lucent::scene_detail::load_obj(scene, dir + "/m.obj", xf, -1);
+  } catch (const lucent::Error& e) {
+    std::string m = e.what();
+    auto at = m.find("m.obj");
+    return at == std::string::npos ? m : m.substr(at);
+  }
+  if (out) *out = scene;
+  return "";
+}
+
+const std::string kTri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+
+TEST(ObjValidation, NonFiniteAndHugeCoordinatesAreErrors) {
+  EXPECT_EQ(obj_error("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+            "m.obj:1: vertex line: 'nan' is not a finite number");
+  EXPECT_EQ(obj_error(kTri + "v 0 -inf 0\nf 1 2 3\n"),
+            "m.obj:4: vertex line: '-inf' is not a finite number");
+  EXPECT_EQ(obj_error(kTri + "vn 0 Infinity 0\nf 1 2 3\n"),
+            "m.obj:4: normal line: 'Infinity' is not a finite number");
+  EXPECT_EQ(obj_error(kTri + "vt NAN 0\nf 1 2 3\n"),
+            "m.obj:4: texture coordinate line: 'NAN' is not a finite number");
+  EXPECT_EQ(obj_error(kTri + "v 1e39 0 0\nf 1 2 3\n"),
+            "m.obj:4: vertex line: '1e39' is out of range for a float");
+  EXPECT_EQ(obj_error(kTri + "v 1e999 0 0\nf 1 2 3\n"),
+            "m.obj:4: vertex line: '1e999' is out of range");
+  // underflow is zero, not an error
+  Scene s;
+  ASSERT_EQ(obj_error("v 1e-999 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "", glm::dmat4(1.0), &s), "");
+  EXPECT_EQ(s.positions[0].x, 0.0);
+}
+
+TEST(ObjValidation, AbsurdIndicesAreErrors) {
+  EXPECT_EQ(obj_error(kTri + "f 1 2 99999999999999999999999\n"),
+            "m.obj:4: face: vertex index 99999999999999999999999 is out of range");
+  EXPECT_EQ(obj_error(kTri + "f 1 2 2147483648\n"),
+            "m.obj:4: vertex index 2147483648 is out of range (the file defines 3)");
+  EXPECT_EQ(obj_error(kTri + "f 1 2 -2147483649\n"),
+            "m.obj:4: face: vertex index -2147483649 is out of range (3 defined so far)");
+  EXPECT_EQ(obj_error(kTri + "f 1 2 0\n"),
+            "m.obj:4: face: vertex index 0 (OBJ indices start at 1)");
+  EXPECT_EQ(obj_error(kTri + "f 1/1 2/1 3/1\n"),
+            "m.obj:4: texture coordinate index 1 is out of range (the file defines 0)");
+  EXPECT_EQ(obj_error(kTri + "f 1//-1 2//-1 3//-1\n"),
+            "m.obj:4: face: normal index -1 is out of range (0 defined so far)");
+  EXPECT_EQ(obj_error(kTri + "f 1/2/3/4 2 3\n"),
+            "m.obj:4: face: '1/2/3/4' has more than 3 indices");
+  EXPECT_EQ(obj_error(kTri + "l 1 7\n"),
+            "m.obj:4: vertex index 7 is out of range (the file defines 3)");
+  EXPECT_EQ(obj_error(kTri + "p 1.5\n"),
+            "m.obj:4: point element: vertex index '1.5' is not an integer");
+  // a face may name vertices defined further down (tinyobjloader accepts it): still loads
+  Scene s;
+  EXPECT_EQ(obj_error("v 0 0 0\nf 1 2 3\nv 1 0 0\nv 0 1 0\n", "", glm::dmat4(1.0), &s), "");
+  EXPECT_EQ(s.triangles.size(), 1u);
+}
+
+TEST(ObjValidation, HugePolygonsAreRefusedQuickly) {
+  std::string text;
+  for (int i = 0; i < 1100; ++i)
+    text += "v " + std::to_string(i % 7) + " " + std::to_string(i % 3) + " 0\n";
+  std::string face = "f";
+  for (int i = 1; i <= 1100; ++i) face += " " + std::to_string(i);
+  auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(obj_error(text + face + "\n"),
+            "m.obj:1101: face has 1100 corners, more than the 1024 lucent triangulates");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
+}
+
+TEST(ObjValidation, MtlNumbersAreChecked) {
+  const std::string obj = "mtllib m.mtl\n" + kTri + "usemtl a\nf 1 2 3\n";
+  struct Case {
+    std::string line, error;
+  } cases[] = {
+      {"Kd nan 0.5 0.5", "m.mtl:2: Kd line: 'nan' is not a finite number"},
+      {"Ks 1 1e39 1", "m.mtl:2: Ks line: '1e39' is out of range for a float"},
+      {"Ke -1 0 0", "m.mtl:2: Ke line: '-1' is negative"},
+      {"Kd 0.5", "m.mtl:2: Kd line has 1 number, needs 3"},
+      {"Ns inf", "m.mtl:2: Ns line: 'inf' is not a finite number"},
+      {"Ni", "m.mtl:2: Ni line has no number"},
+      {"illum 99", "m.mtl:2: illum line: '99' is not an illumination model (0 to 10)"},
+  };
+  for (const Case& c : cases) {
+    std::string err = obj_error(obj, "newmtl a\n" + c.line + "\n");
+    EXPECT_NE(err.find(c.error), std::string::npos) << c.line << ": " << err;
+    EXPECT_EQ(err.find('\n'), std::string::npos) << err;
+  }
+  // forms tinyobjloader does not read are left alone; valid libraries load
+  EXPECT_EQ(obj_error(obj, "newmtl a\nKd spectral x.rfl\nKd 0.5 0.5 0.5\nNs 10\nillum 2\n"), "");
+}
+
+TEST(ObjValidation, TransformBeyondFloatRangeIsAnError) {
+  glm::dmat4 xf = glm::scale(glm::dmat4(1.0), glm::dvec3(1e30));
+  EXPECT_EQ(obj_error("v 0 0 0\nv 1e9 0 0\nv 0 1 0\nf 1 2 3\n", "", xf),
+            "m.obj:2: vertex 2 is (1e+39, 0, 0) after the transform, beyond the range of a float");
+}
+
+TEST(ObjValidation, FilesThatAreNotRegularAreRefused) {
+  std::string dir = lucent::test::temp_dir();
+  Scene scene;
+  for (const std::string& path : {std::string("/dev/zero"), dir}) {
+    try {
+      lucent::scene_detail::load_obj(scene, path, glm::dmat4(1.0), -1);
+      ADD_FAILURE() << path;
+    } catch (const lucent::Error& e) {
+      EXPECT_EQ(std::string(e.what()), path == dir
+                                           ? dir + ": is a directory, not an OBJ file"
+                                           : "/dev/zero: is a device, not an OBJ file (only "
+                                             "regular files are read)");
+    }
+  }
+  // a NUL byte: a binary file, not an OBJ
+  EXPECT_EQ(obj_error(kTri + std::string("f 1 2 3\0\n", 8)),
+            "m.obj: byte 32 is a NUL byte: not a text OBJ file");
+  // an MTL library that is a directory or a device: a warning, the default material
+  lucent::test::CaptureWarnings warnings;
+  std::string d2 = lucent::test::temp_dir();
+  std::filesystem::create_directories(d2 + "/m.mtl");
+  lucent::test::write_file(d2 + "/m.obj", "mtllib m.mtl\nmtllib /dev/zero\n" + kTri + "f 1 2 3\n");
+  lucent::scene_detail::load_obj(scene, d2 + "/m.obj", glm::dmat4(1.0), -1);
+  EXPECT_EQ(
+      warnings.count("m.mtl: is a directory, not an MTL file; faces use the default material"), 1)
+      << warnings.dump();
+  EXPECT_EQ(warnings.count("/dev/zero: is a device, not an MTL file"), 1) << warnings.dump();
+}
+
+}  // namespace

@@ -1,0 +1,336 @@
+// Outputs that never lie: a failed write (a file size limit, a full device) is an error naming
+// the path and leaves no file, nor a truncated one, under the requested name (an older file
+// stays); outputs are checked before rendering (an input of the render, a directory, an AOV that
+// cannot be written); SIGINT and SIGTERM write what was rendered and say how far it got; odd
+// characters in paths work, and in messages stay on one line.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <thread>
+
+#include "core/file_io.hpp"
+#include "support.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using lucent::test::CommandResult;
+using lucent::test::run_cli;
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+using lucent::test::read_file;
+
+/// A small valid scene (albedo integrator: fast, deterministic) in `dir` named `name`.
+std::string scene_in(const std::string& dir, const std::string& name = "scene.json",
+                     const std::string& extra_material = "") {
+  std::string path = dir + "/" + name;
+  lucent::test::write_file(path, R"({
+    "film": {"width": 32, "height": 24},
+    "integrator": {"type": "albedo", "spp": 1},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.25, 0.75]})" +
+                                     extra_material + R"(},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]
+  })");
+  return path;
+}
+
+/// The error line's message, checking the one-line contract.
+std::string error_line(const CommandResult& r) {
+  EXPECT_NE(r.status, 0);
+  EXPECT_LT(r.status, 128) << "killed by a signal";
+  EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("lucent: error: ", 0), 0u) << r.err;
+  std::string msg = r.err.substr(std::min(r.err.size(), sizeof("lucent: error: ") - 1));
+  while (!msg.empty() && msg.back() == '\n') msg.pop_back();
+  return msg;
+}
+
+/// Names in `dir` other than `keep` (left-over temporary files, say).
+std::vector<std::string> others(const std::string& dir, std::vector<std::string> keep) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    std::string n = e.path().filename().string();
+    if (std::find(keep.begin(), keep.end(), n) == keep.end()) out.push_back(n);
+  }
+  return out;
+}
+
+// A file size limit makes the write fail half-way (EFBIG, as a full disk gives ENOSPC): one error
+// line naming the output, no success line, no temporary file left, and an older file under the
+// name is untouched.
+TEST(Outputs, FailedWriteIsAnErrorAndKeepsTheOldFile) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  for (const char* ext : {".pfm", ".exr", ".png"}) {
+    std::string out = dir + "/out" + ext;
+    lucent::test::write_file(out, "the previous image");
+    // 512 or 1024 bytes (the shell's unit): the header of every format fits, the pixels do not.
+    // The CPU reference renders: PoCL itself would fail to write its kernel cache.
+    CommandResult r =
+        run_cli("render " + q(scene) + " -o " + q(out) + " --width 256 --height 256 --reference",
+                "ulimit -f 1;");
+    if (std::string(ext) == ".png" && r.status == 0) continue;  // compressed below the limit
+    EXPECT_EQ(error_line(r), out + ": cannot write (File too large)") << ext;
+    EXPECT_EQ(read_file(out), "the previous image") << ext;
+    EXPECT_TRUE(others(dir, {"scene.json", "out.pfm", "out.exr", "out.png"}).empty())
+        << ext << ": a temporary file was left";
+  }
+}
+
+// /dev/full: every write fails with ENOSPC.
+TEST(Outputs, FullDeviceIsAnErrorNamingThePath) {
+  int fd = ::open("/dev/full", O_WRONLY);
+  if (fd < 0) GTEST_SKIP() << "no /dev/full";
+  std::string data(1 << 16, 'x');
+  try {
+    lucent::io::write_all(fd, data.data(), data.size(), "/some/image.png");
+    ADD_FAILURE() << "no error writing to /dev/full";
+  } catch (const lucent::Error& e) {
+    EXPECT_STREQ(e.what(), "/some/image.png: cannot write (No space left on device)");
+  }
+  ::close(fd);
+  // what the CLI prints to standard output is checked too
+  std::string dir = lucent::test::temp_dir();
+  for (const std::string& args : {std::string("devices"), std::string("cache dir")}) {
+    std::string cmd =
+        std::string("'") + LUCENT_CLI_PATH + "' " + args + " >/dev/full 2>" + q(dir + "/err");
+    int raw = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(raw));
+    EXPECT_EQ(WEXITSTATUS(raw), 1) << args;
+    EXPECT_EQ(read_file(dir + "/err"),
+              "lucent: error: standard output: cannot write (No space left on device)\n")
+        << args;
+  }
+}
+
+TEST(Outputs, WritesAreAtomicAndFollowSymlinks) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  fs::create_directories(dir + "/real");
+  lucent::test::write_file(dir + "/real/img.pfm", "old");
+  fs::create_symlink("real/img.pfm", dir + "/link.pfm");
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(dir + "/link.pfm") + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(dir + "/link.pfm")) << "the link was replaced";
+  lucent::Image img = lucent::read_image(dir + "/real/img.pfm");
+  EXPECT_EQ(img.width, 32);
+  EXPECT_TRUE(others(dir + "/real", {"img.pfm"}).empty());
+  // the library's writer: replaced whole, mode from the umask like any new file
+  std::string plain = dir + "/plain.bin";
+  lucent::io::write_file_atomic(plain, std::string("first"));
+  lucent::io::write_file_atomic(plain, std::string("second, longer"));
+  EXPECT_EQ(read_file(plain), "second, longer");
+  try {
+    lucent::io::write_file_atomic(dir + "/missing/x.png", std::string("x"));
+    ADD_FAILURE() << "no error";
+  } catch (const lucent::Error& e) {
+    EXPECT_STREQ(e.what(),
+                 (dir + "/missing/x.png: cannot write (No such file or directory)").c_str());
+  }
+}
+
+// Inputs are never overwritten: the scene file (named like an image, through a symbolic or a hard
+// link), a texture the scene reads, and AOV outputs are checked too, all before rendering.
+TEST(Outputs, InputsOfTheRenderAreRefused) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir, "scene.exr");
+  const std::string before = read_file(scene);
+  fs::create_symlink("scene.exr", dir + "/sym.exr");
+  fs::create_hard_link(scene, dir + "/hard.exr");
+  for (const std::string& out :
+       {scene, dir + "/sym.exr", dir + "/hard.exr", dir + "/./scene.exr"}) {
+    EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(out))),
+              out + ": is an input of this render (" + scene + "); refusing to overwrite it");
+  }
+  // an AOV path that is the scene: <stem>.albedo.exr
+  std::string aov_scene = scene_in(dir, "x.albedo.exr");
+  EXPECT_EQ(
+      error_line(run_cli("render " + q(aov_scene) + " -o " + q(dir + "/x.exr") + " --aov albedo")),
+      dir + "/x.albedo.exr: is an input of this render (" + aov_scene +
+          "); refusing to overwrite it");
+  EXPECT_FALSE(fs::exists(dir + "/x.exr"));
+  // a texture of the scene
+  lucent::Image tex{2, 2, std::vector<float>(12, 0.5f)};
+  lucent::write_image(dir + "/tex.pfm", tex);
+  std::string textured = scene_in(
+      dir, "textured.json", R"(, "t": {"type": "diffuse", "albedo": {"texture": "tex.pfm"}})");
+  EXPECT_EQ(
+      error_line(run_cli("render " + q(textured) + " -o " + q(dir + "/tex.pfm"))),
+      dir + "/tex.pfm: is an input of this render (" + dir + "/tex.pfm); refusing to overwrite it");
+  EXPECT_EQ(read_file(scene), before);
+  EXPECT_EQ(lucent::read_image(dir + "/tex.pfm").rgb, tex.rgb);
+  // an AOV output that is a directory fails before rendering, the main output is not written
+  fs::create_directories(dir + "/y.depth.exr");
+  EXPECT_EQ(
+      error_line(run_cli("render " + q(textured) + " -o " + q(dir + "/y.exr") + " --aov depth")),
+      dir + "/y.depth.exr: is a directory");
+  EXPECT_FALSE(fs::exists(dir + "/y.exr"));
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o ''")), "-o: the output path is empty");
+  // compare's z map and converge's outputs are checked the same way
+  EXPECT_EQ(error_line(run_cli("compare " + q(dir + "/tex.pfm") + " " + q(dir + "/tex.pfm") +
+                               " --zmap " + q(dir + "/./tex.pfm"))),
+            dir + "/./tex.pfm: is an input of the comparison; refusing to overwrite it");
+  EXPECT_EQ(error_line(run_cli("converge " + q(textured) + " --csv " + q(textured))),
+            textured + ": is the scene file; refusing to overwrite it");
+  EXPECT_EQ(lucent::read_image(dir + "/tex.pfm").rgb, tex.rgb);
+}
+
+// Spaces, quotes, a newline, a leading dash and bytes that are not UTF-8 in file names: renders
+// work, and a message that names such a file stays one line (control bytes and invalid UTF-8
+// shown escaped).
+TEST(Outputs, OddCharactersInPaths) {
+  std::string base = lucent::test::temp_dir();
+  for (const std::string& name :
+       {std::string("with space"), std::string("quote'\"s"), std::string("new\nline"),
+        std::string("-dash"), std::string("latin1-\xe9t\xe9")}) {
+    std::string dir = base + "/" + name;
+    fs::create_directories(dir);
+    std::string scene = scene_in(dir, name + ".json");
+    std::string out = dir + "/" + name + ".png";
+    // the shell quoting of run_cli: single quotes, with ' written as '\''
+    auto sh = [](const std::string& s) {
+      std::string r = "'";
+      for (char c : s) r += c == '\'' ? std::string("'\\''") : std::string(1, c);
+      return r + "'";
+    };
+    CommandResult r = run_cli("render " + sh(scene) + " -o " + sh(out) + " --quiet");
+    EXPECT_EQ(r.status, 0) << name << ": " << r.err;
+    EXPECT_EQ(lucent::read_image(out).width, 32) << name;
+    // an error naming the file: one line
+    r = run_cli("render " + sh(dir + "/missing " + name + ".json") + " -o " + sh(out));
+    std::string msg = error_line(r);
+    EXPECT_NE(msg.find("cannot open scene file (No such file or directory)"), std::string::npos)
+        << msg;
+  }
+  // a name starting with '-' given as an option is named, with the way out
+  CommandResult r = run_cli("render -scene.json -o out.png");
+  EXPECT_NE(error_line(r).find("unknown option -scene.json (a file whose name starts with '-' can "
+                               "be given as ./-scene.json)"),
+            std::string::npos)
+      << r.err;
+}
+
+// NaN, infinite and absurd numbers on the command line are refused before anything runs (a NaN
+// --time never ended a render: every comparison with NaN is false).
+TEST(Outputs, NonFiniteOptionsAreRefused) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  std::string out = dir + "/o.png";
+  for (const char* opt : {"--time nan", "--time inf", "--time -nan", "--time 1e400", "--time NaN",
+                          "--time 1e9", "--time 0"}) {
+    CommandResult r = run_cli("render " + q(scene) + " -o " + q(out) + " " + opt);
+    std::string msg = error_line(r);
+    EXPECT_EQ(r.status, 2) << opt << ": " << msg;
+  }
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(out) + " --time nan")),
+            "--time nan: must be a finite number (see lucent --help)");
+  lucent::Image img{2, 2, std::vector<float>(12, 0.5f)};
+  lucent::write_image(dir + "/a.pfm", img);
+  for (const char* opt :
+       {"--alpha nan", "--min-pass nan", "--abs-epsilon inf", "--rel-epsilon nan"}) {
+    CommandResult r = run_cli("compare " + q(dir + "/a.pfm") + " " + q(dir + "/a.pfm") + " " + opt);
+    EXPECT_EQ(r.status, 2) << opt << ": " << r.err;
+    EXPECT_NE(error_line(r).find("must be a finite number"), std::string::npos) << r.err;
+  }
+  // options the reference does not honour are refused before anything runs, not ignored
+  EXPECT_EQ(
+      error_line(run_cli("render " + q(scene) + " -o " + q(out) + " --reference --aov depth")),
+      "--aov is not supported with --reference");
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(out) + " --reference --time 2")),
+            "--time is not supported with --reference");
+  CommandResult r = run_cli("converge " + q(scene) + " --time-ladder 1,nan");
+  EXPECT_EQ(error_line(r), "--time-ladder nan: must be a finite number (see lucent --help)");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// SIGINT and SIGTERM while rendering: the image rendered so far is written, the last line says
+// how far the render got, the exit status is 128 + the signal. The signal is sent once the
+// progress line shows the render loop is running, and --time bounds the render should it be lost.
+void interrupt_render(int sig, const char* name, int status_expected) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  lucent::test::write_file(scene, R"({
+    "film": {"width": 64, "height": 48},
+    "integrator": {"type": "path", "spp": 16777216},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
+  })");
+  std::string out = dir + "/partial.pfm", err_path = dir + "/stderr";
+  pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    int fd = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int null = ::open("/dev/null", O_RDWR);
+    if (fd < 0 || null < 0) ::_exit(126);
+    ::dup2(null, 0);
+    ::dup2(null, 1);
+    ::dup2(fd, 2);
+    ::signal(sig, SIG_DFL);
+    ::execl(LUCENT_CLI_PATH, "lucent", "render", scene.c_str(), "-o", out.c_str(), "--time", "120",
+            static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  using clock = std::chrono::steady_clock;
+  auto wait_for = [&](double seconds, auto done) {
+    auto end = clock::now() + std::chrono::duration<double>(seconds);
+    while (clock::now() < end) {
+      if (done()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  };
+  int status = 0;
+  bool exited = false;
+  auto reaped = [&] {
+    if (!exited && ::waitpid(pid, &status, WNOHANG) == pid) exited = true;
+    return exited;
+  };
+  bool running = wait_for(90, [&] {
+    return reaped() || read_file(err_path).find("Msamples/s  elapsed") != std::string::npos;
+  });
+  ASSERT_TRUE(running && !exited) << "no progress line: " << read_file(err_path);
+  EXPECT_FALSE(fs::exists(out)) << "nothing under the output's name before the end";
+  ASSERT_EQ(::kill(pid, sig), 0);
+  if (!wait_for(60, reaped)) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    FAIL() << "lucent did not stop after " << name;
+  }
+  std::string err = read_file(err_path);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
+  EXPECT_EQ(WEXITSTATUS(status), status_expected) << err;
+  std::smatch m;
+  ASSERT_TRUE(
+      std::regex_search(err, m,
+                        std::regex(std::string("lucent: interrupted by ") + name + ": wrote " +
+                                   out + " with (\\d+) spp after [0-9.]+ of 120 s\n$")))
+      << err;
+  EXPECT_GE(std::stoll(m[1]), 1);
+  lucent::Image img = lucent::read_image(out);
+  ASSERT_EQ(img.width, 64);
+  ASSERT_EQ(img.height, 48);
+  double sum = 0;
+  for (float v : img.rgb) {
+    ASSERT_TRUE(std::isfinite(v));
+    sum += v;
+  }
+  EXPECT_GT(sum, 0) << "the partial image is black";
+  EXPECT_TRUE(others(dir, {"scene.json", "partial.pfm", "stderr"}).empty());
+}
+
+TEST(Outputs, SigintWritesThePartialImage) { interrupt_render(SIGINT, "SIGINT \\(Ctrl-C\\)", 130); }
+
+TEST(Outputs, SigtermWritesThePartialImage) { interrupt_render(SIGTERM, "SIGTERM", 143); }
+
+}  // namespace

@@ -1,0 +1,170 @@
+// What a scene file must be before it is parsed (src/scene/json_guard.cpp): bounded (a pipe or a
+// device that never ends is refused, not read forever), nested at most 64 deep, free of duplicate
+// keys (two materials of one name, two radii in one sphere); and every number must fit the
+// floats the device stores.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <string>
+
+#include "core/file_io.hpp"
+#include "lucent/error.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::test::CommandResult;
+using lucent::test::run_cli;
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+/// Runs `feed | lucent ARGS` (run_cli reads standard input from /dev/null).
+CommandResult piped(const std::string& feed, const std::string& args) {
+  std::string dir = lucent::test::temp_dir();
+  std::string cmd = feed + " | '" + LUCENT_CLI_PATH + "' " + args + " >" + q(dir + "/out") + " 2>" +
+                    q(dir + "/err");
+  CommandResult r;
+  r.status = std::system(cmd.c_str());
+  r.err = lucent::test::read_file(dir + "/err");
+  return r;
+}
+
+/// The message of the error parsing `json` (as <dir>/scene.json), or "" when it parses.
+std::string parse_error(const std::string& json) {
+  try {
+    lucent::test::scene_from(json);
+  } catch (const lucent::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string after_path(const std::string& msg) {
+  auto at = msg.find("scene.json");
+  return at == std::string::npos ? msg : msg.substr(at + 10);
+}
+
+TEST(SceneGuard, DeepNestingIsRefusedQuickly) {
+  // 10^5 levels crashed the loader (stack overflow in recursive code)
+  for (const char* open : {"[", "{\"a\":"}) {
+    std::string json = "{\"camera\": ";
+    for (int i = 0; i < 100000; ++i) json += open;
+    auto t0 = std::chrono::steady_clock::now();
+    std::string msg = parse_error(json);
+    double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_LT(s, 2.0);
+    EXPECT_NE(msg.find("nested deeper than 64 levels"), std::string::npos) << msg.substr(0, 300);
+    EXPECT_NE(msg.find("scene.json:1:"), std::string::npos) << msg.substr(0, 300);
+  }
+  // 63 levels of arrays are only a schema error
+  std::string ok = "{\"camera\": {\"position\": ";
+  for (int i = 0; i < 61; ++i) ok += "[";
+  for (int i = 0; i < 61; ++i) ok += "]";
+  EXPECT_EQ(parse_error(ok + "}}").find("nested"), std::string::npos);
+}
+
+TEST(SceneGuard, DuplicateKeysNameBothPlaces) {
+  EXPECT_EQ(after_path(parse_error(R"({"materials": {
+  "white": {"type": "diffuse"},
+  "white": {"type": "mirror"}}})")),
+            ":3:3: /materials/white: duplicate material name 'white' (first at 2:3)");
+  EXPECT_EQ(after_path(parse_error(R"({"film": {"width": 8, "width": 9}})")),
+            ":1:23: /film/width: duplicate key (first at 1:11)");
+  EXPECT_EQ(
+      after_path(parse_error(
+          R"({"shapes": [{"type": "sphere"}, {"type": "sphere", "radius": 1, "radius": 2}]})")),
+      ":1:65: /shapes/1/radius: duplicate key (first at 1:52)");
+  // escaped quotes inside a key do not confuse the place
+  EXPECT_EQ(after_path(parse_error(R"({"a\"b": 1, "a\"b": 2})")),
+            ":1:13: /a\"b: duplicate key (first at 1:2)");
+  // the same key in two different objects is fine
+  EXPECT_EQ(parse_error(R"({"film": {"width": 8}, "camera": {"fov": 30}})"), "");
+}
+
+TEST(SceneGuard, NumbersBeyondFloatRangeNameTheirPointer) {
+  // finite in JSON (a double), infinite in the device's floats: the camera basis became inf/NaN
+  EXPECT_EQ(after_path(parse_error(R"({"camera": {"position": [1e39, 0, 0]}})")),
+            ": /camera/position/0: must fit in a float (magnitude at most 3.4e38), got 1e+39");
+  EXPECT_EQ(after_path(parse_error(R"({"camera": {"fov": -4e38}})")),
+            ": /camera/fov: must fit in a float (magnitude at most 3.4e38), got -4e+38");
+  EXPECT_EQ(
+      after_path(parse_error(R"({"materials": {"m": {"type": "diffuse",
+    "emission": [1, 1e300, 1]}}})")),
+      ": /materials/m/emission/1: must fit in a float (magnitude at most 3.4e38), got 1e+300");
+  EXPECT_EQ(parse_error(R"({"camera": {"position": [3.4e38, 0, 0], "look_at": [0, 0, 0]}})"), "");
+  // inline triangles that a transform takes beyond float range
+  EXPECT_EQ(after_path(parse_error(R"({"materials": {"m": {"type": "diffuse"}},
+    "shapes": [{"type": "triangles", "positions": [[1, 0, 0], [0, 0, 0], [0, 1, 0]],
+                "indices": [0, 1, 2], "material": "m",
+                "transform": [{"scale": 1e30}, {"scale": 1e30}]}]})")),
+            ": /shapes/0/positions/0: the transform takes it beyond float range");
+}
+
+TEST(SceneGuard, StreamsAndDevicesAreBounded) {
+  std::string dir = lucent::test::temp_dir();
+  std::string out = dir + "/o.png";
+  // a device: refused without reading
+  auto r = run_cli("render /dev/zero -o " + q(out));
+  EXPECT_EQ(
+      r.err,
+      "lucent: error: /dev/zero: is a device, not a scene file (only regular files are read)\n");
+  // an endless pipe of NUL bytes: stopped at the first one
+  r = piped("head -c 100000000 /dev/zero", "render /dev/stdin -o " + q(out));
+  EXPECT_EQ(r.err, "lucent: error: /dev/stdin: byte 1 is a NUL byte: not a text scene file\n");
+  // an endless pipe of text: stopped at the limit (256 MiB)
+  auto t0 = std::chrono::steady_clock::now();
+  r = piped("yes", "render /dev/stdin -o " + q(out));
+  double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.err,
+            "lucent: error: /dev/stdin: more than the 256.0 MiB a scene file may have (a "
+            "stream that never ends?)\n");
+  EXPECT_LT(s, 20);
+  // a pipe that ends is a scene like any other
+  std::string scene = dir + "/s.json";
+  lucent::test::write_file(
+      scene, R"({"film": {"width": 4, "height": 4}, "integrator": {"type": "albedo", "spp": 1}})");
+  r = piped("cat " + q(scene), "render /dev/stdin -o " + q(out) + " --quiet");
+  EXPECT_EQ(r.status, 0) << r.err;
+  // a FIFO nobody writes to: read as empty at once, not waited for
+  std::string fifo = dir + "/fifo.json";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  r = run_cli("render " + q(fifo) + " -o " + q(out));
+  EXPECT_NE(r.err.find(fifo + ":1:1: invalid JSON"), std::string::npos) << r.err;
+}
+
+// A writer that holds a pipe open and sends nothing: the read gives up after the idle time.
+TEST(SceneGuard, SilentPipeTimesOut) {
+  std::string fifo = lucent::test::temp_dir() + "/silent";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  int keep = ::open(fifo.c_str(), O_RDWR | O_NONBLOCK);  // a writer that never writes
+  ASSERT_GE(keep, 0);
+  lucent::io::ReadSpec spec;
+  spec.what = "scene file";
+  spec.allow_pipe = true;
+  spec.stream_idle_seconds = 1;
+  auto t0 = std::chrono::steady_clock::now();
+  try {
+    lucent::io::read_file(fifo, spec);
+    ADD_FAILURE() << "no error";
+  } catch (const lucent::Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              fifo + ": no data for 1 s after 0 bytes (a pipe that never ends?)");
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5);
+  ::close(keep);
+  // and referenced files must be regular files
+  spec.allow_pipe = false;
+  spec.what = "texture";
+  try {
+    lucent::io::read_file(fifo, spec);
+    ADD_FAILURE() << "no error";
+  } catch (const lucent::Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              fifo + ": is a pipe, not a texture (only regular files are read)");
+  }
+}
+
+}  // namespace
