@@ -5,7 +5,9 @@
 // kernel source; the file name is a 64-bit hash of the key and the file repeats the key, so a
 // hash collision, a truncated or corrupt file, or a stale entry (another driver or lucent
 // version) is detected and rebuilt. Directory: LUCENT_CACHE_DIR, else $XDG_CACHE_HOME/lucent,
-// else ~/.cache/lucent. LUCENT_CACHE_DIR=off disables the cache.
+// else ~/.cache/lucent. LUCENT_CACHE_DIR=off disables the cache. A miss is built under an
+// exclusive lock on <entry>.lock, so that processes missing the same entry at once (a parallel
+// test run on cold caches) compile it once and the others read it.
 #include <string>
 
 #include "cl/context.hpp"
