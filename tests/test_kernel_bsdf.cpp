@@ -8,6 +8,7 @@
 
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
+#include "cl/program_cache.hpp"
 #include "shared/types.h"
 #include "support.hpp"
 
@@ -15,7 +16,7 @@ namespace {
 
 struct Probe {
   lucent::cl_util::Context ctx{""};
-  cl::Program program = lucent::cl_util::build_program(
+  cl::Program program = lucent::cl_util::build_program_cached(
       ctx, lucent::detail::assemble_kernel_source("test/bsdf_probe.cl"), "-cl-std=CL1.2");
 };
 

@@ -14,13 +14,14 @@
 
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
+#include "cl/program_cache.hpp"
 #include "shared/types.h"
 
 namespace {
 
 struct SpawnProbe {
   explicit SpawnProbe(const std::string& options)
-      : program(lucent::cl_util::build_program(
+      : program(lucent::cl_util::build_program_cached(
             ctx, lucent::detail::assemble_kernel_source("test/stability_spawn.cl"), options)) {}
   lucent::cl_util::Context ctx{""};
   cl::Program program;
