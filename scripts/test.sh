@@ -20,9 +20,17 @@ export LUCENT_CACHE_DIR="$PWD/build/lucent-cache"
 # one PoCL worker per test process: ctest runs $jobs of them at a time
 export POCL_MAX_PTHREAD_COUNT="${POCL_MAX_PTHREAD_COUNT:-1}"
 
+# every stage reports its wall and CPU time (CPU time depends little on what else the machine runs)
+timed() {
+  local label="$1" TIMEFORMAT
+  shift
+  TIMEFORMAT="test: $label: %0R s wall, %0U + %0S s CPU"
+  time "$@"
+}
+
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
-cmake --build build -j"$jobs"
-(cd build && ctest --output-on-failure -j"$jobs")
+timed "release build" cmake --build build -j"$jobs"
+timed "release tests" ctest --test-dir build --output-on-failure -j"$jobs"
 
 if [[ "${LUCENT_SANITIZE:-0}" == "1" ]]; then
   echo "test: sanitizer build (ASan + UBSan)"
@@ -30,8 +38,8 @@ if [[ "${LUCENT_SANITIZE:-0}" == "1" ]]; then
   cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLUCENT_SANITIZE=ON \
     -DLUCENT_BUILD_BENCH=OFF "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" \
     "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
-  cmake --build build-asan -j"$jobs"
+  timed "sanitizer build" cmake --build build-asan -j"$jobs"
   # PoCL and the ICD loader keep allocations until exit: leak checking reports theirs, not ours
-  (cd build-asan && ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
-     ctest --output-on-failure -j"$jobs")
+  ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
+    timed "sanitizer tests" ctest --test-dir build-asan --output-on-failure -j"$jobs"
 fi
