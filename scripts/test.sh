@@ -4,26 +4,46 @@
 # UndefinedBehaviorSanitizer build in build-asan/, and, when clang with libFuzzer is installed
 # (scripts/install-deps.sh --with-fuzz), each fuzz target runs for LUCENT_FUZZ_SECONDS (default
 # 30; 0 skips it) in build-fuzz/ (scripts/fuzz.sh).
+#
+# Sized for a slow, shared machine (docs/testing.md): as many builds and tests at a time as there
+# are CPUs this process may really use (scripts/cpus.sh: the affinity mask and the cgroup CPU
+# quota, not the host's CPU count), and one PoCL worker thread per test process, so that N test
+# processes keep N CPUs busy instead of starting N x (host CPUs) threads.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-jobs="$(nproc)"
+jobs="${LUCENT_TEST_JOBS:-$(scripts/cpus.sh)}"
+echo "test: $jobs job(s) at a time (scripts/cpus.sh; LUCENT_TEST_JOBS overrides)"
 
-# private caches, so runs do not depend on what a user's caches hold
+# private caches, so runs do not depend on what a user's caches hold; the sanitizer stage uses
+# the same ones (same kernels, same device: every program is already built)
 export POCL_CACHE_DIR="$PWD/build/pocl-cache"
 export LUCENT_CACHE_DIR="$PWD/build/lucent-cache"
+# one PoCL worker per test process: ctest runs $jobs of them at a time
+export POCL_MAX_PTHREAD_COUNT="${POCL_MAX_PTHREAD_COUNT:-1}"
+
+# every stage reports its wall and CPU time (CPU time depends little on what else the machine runs)
+timed() {
+  local label="$1" TIMEFORMAT
+  shift
+  TIMEFORMAT="test: $label: %0R s wall, %0U + %0S s CPU"
+  time "$@"
+}
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
-cmake --build build -j"$jobs"
-(cd build && ctest --output-on-failure -j"$jobs" --timeout 600)
+timed "release build" cmake --build build -j"$jobs"
+timed "release tests" ctest --test-dir build --output-on-failure -j"$jobs"
 
 if [[ "${LUCENT_SANITIZE:-0}" == "1" ]]; then
   echo "test: sanitizer build (ASan + UBSan)"
-  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLUCENT_SANITIZE=ON -DLUCENT_BUILD_BENCH=OFF
-  cmake --build build-asan -j"$jobs"
+  # -O1 -g1: half the compile time of RelWithDebInfo's -O2 -g, with file:line in every report
+  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLUCENT_SANITIZE=ON \
+    -DLUCENT_BUILD_BENCH=OFF "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" \
+    "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
+  timed "sanitizer build" cmake --build build-asan -j"$jobs"
   # PoCL and the ICD loader keep allocations until exit: leak checking reports theirs, not ours
-  (cd build-asan && ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
-     ctest --output-on-failure -j"$jobs" --timeout 900)
+  ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
+    timed "sanitizer tests" ctest --test-dir build-asan --output-on-failure -j"$jobs"
 fi
 
 if [[ "${LUCENT_SANITIZE:-0}" == "1" && "${LUCENT_FUZZ_SECONDS:-30}" != "0" ]]; then

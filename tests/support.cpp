@@ -132,10 +132,11 @@ std::string shared_asset(const std::string& rel) {
 
 Scene scene_from(const std::string& json) { return parse_scene(json, temp_dir() + "/scene.json"); }
 
-RenderResult render_json(const std::string& json, int spp) {
+RenderResult render_json(const std::string& json, int spp, bool specialize) {
   Scene scene = scene_from(json);
   RenderOptions opt;
   opt.spp = spp;
+  opt.specialize = specialize;
   return lucent::test::render(scene, opt);
 }
 

@@ -66,8 +66,10 @@ RenderResult render(const Scene& scene, RenderOptions options = {});
 /// Parses a JSON scene held in memory (relative file names resolve against a temporary directory).
 Scene scene_from(const std::string& json);
 
-/// Renders a JSON scene held in memory with `spp` samples per pixel.
-RenderResult render_json(const std::string& json, int spp);
+/// Renders a JSON scene held in memory with `spp` samples per pixel. `specialize` false compiles
+/// every kernel feature (RenderOptions::specialize): the one program that the stability,
+/// precision and known-answer tests share, built once per cache instead of once per scene.
+RenderResult render_json(const std::string& json, int spp, bool specialize = true);
 
 /// The report of `lucent info`: "key   value" lines keyed by section and key ("lights/point" ->
 /// "1", "film" -> "40x30").

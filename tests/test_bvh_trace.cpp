@@ -28,9 +28,10 @@
 #include <vector>
 
 #include "bvh/bvh.hpp"
-#include "support/device_tracer.hpp"
-#include "support/test_meshes.hpp"
 #include "cl/context.hpp"
+#include "support/device_tracer.hpp"
+#include "support.hpp"
+#include "support/test_meshes.hpp"
 
 namespace {
 
@@ -164,12 +165,12 @@ Verdict judge(const Scene& s, const TraceRay& r, const TraceHit& k, bool any_hit
 
 class BvhTrace : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { ctx_ = std::make_unique<lucent::cl_util::Context>(""); }
+  static void SetUpTestSuite() { ctx_ = std::make_unique<lucent::cl_util::Context>(lucent::test::device()); }
   static void TearDownTestSuite() { ctx_.reset(); }
 
   std::vector<TraceHit> trace(const Scene& s, const Bvh& b, const std::vector<TraceRay>& rays,
                               bool any_hit = false) {
-    lucent::bvh::DeviceTracer tracer(*ctx_, s.tris, s.spheres, b);
+    lucent::bvh::DeviceTracer tracer(*ctx_, s.tris, s.spheres, b, "", lucent::test::cache_dir());
     return tracer.trace(rays, any_hit);
   }
 

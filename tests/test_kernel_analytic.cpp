@@ -3,6 +3,11 @@
 // which must stay below the Sidak-corrected two-sided threshold for alpha = 1e-3 over all pixel
 // channels (about 5 for the 1-4k values tested here; the threshold is computed, not guessed).
 // The standard error gets a floor of 1e-4 relative (float rounding, see expect_matches).
+//
+// Every render compiles all kernel features (RenderOptions::specialize = false): these tests check
+// the integrator's arithmetic, which specialisation does not change (Features.* checks that it
+// does not), and they share the one full program with the stability and precision tests instead
+// of building a program per scene (about 2 s of CPU each on a cold cache).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,6 +21,10 @@ using lucent::RenderResult;
 
 using lucent::test::expect_matches;
 using lucent::test::sidak_z;
+
+RenderResult render_full(const std::string& json, int spp) {
+  return lucent::test::render_json(json, spp, /*specialize=*/false);
+}
 
 // The camera model of docs/rendering-model.md, for computing expected pixel values: the point
 // where the ray through film position (fx, fy) meets the plane z = 0.
@@ -81,7 +90,7 @@ TEST(KernelAnalytic, PathPointLightOverPlane) {
     "materials": {"plane": {"type": "diffuse", "albedo": [0.7, 0.5, 0.3]}},
     "shapes": [)") + kPlane + R"(],
     "lights": [{"type": "point", "position": [0.5, 0.3, 1.5], "intensity": [20, 20, 20]}]})";
-  RenderResult r = lucent::test::render_json(scene, 32);
+  RenderResult r = render_full(scene, 32);
   const double pos[3] = {1, -2, 4}, look[3] = {0, 0, 0}, up[3] = {0, 0, 1};
   PinholeToPlane cam(pos, look, up, 30, 24, 24);
   const double albedo[3] = {0.7, 0.5, 0.3};
@@ -108,7 +117,7 @@ void sphere_irradiance_case(double R, double Le, bool mis) {
                   "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [%g, %g, %g]}},
     "shapes": [%s, {"type": "sphere", "center": [0.2, 0.1, 2], "radius": %g, "material": "lamp"}]})",
                 mis ? "true" : "false", Le, Le, Le, kPlane, R);
-  RenderResult r = lucent::test::render_json(buf, 64);
+  RenderResult r = render_full(buf, 64);
   const double pos[3] = {0, -3, 1}, look[3] = {0, 0, 0}, up[3] = {0, 0, 1};
   PinholeToPlane cam(pos, look, up, 12, 16, 16);
   expect_matches(r, [&](int x, int y, int) {
@@ -136,7 +145,7 @@ TEST(KernelAnalytic, MirrorShowsKnownEmitter) {
     "shapes": [)") + kPlane + R"(,
       {"type": "triangles", "material": "lamp",
        "positions": [[-20, 8, -5], [20, 8, -5], [20, 8, 30], [-20, 8, 30]], "indices": [0, 1, 2, 0, 2, 3]}]})";
-  RenderResult r = lucent::test::render_json(scene, 4);
+  RenderResult r = render_full(scene, 4);
   const double expected[3] = {0.9 * 2, 0.5 * 3, 0.2 * 4};
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 8; ++x)
@@ -146,13 +155,14 @@ TEST(KernelAnalytic, MirrorShowsKnownEmitter) {
 // White furnace: an albedo-1 diffuse sphere in a constant environment renders the environment's
 // value everywhere (unbounded depth, Russian roulette keeps it unbiased).
 TEST(KernelAnalytic, WhiteFurnace) {
-  RenderResult r = lucent::test::render_json(R"({
+  RenderResult r = render_full(R"({
     "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 40},
     "film": {"width": 16, "height": 16},
     "integrator": {"type": "path", "max_depth": 1000, "rr_depth": 3},
     "materials": {"white": {"type": "diffuse", "albedo": [1, 1, 1]}},
     "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "white"}],
-    "lights": [{"type": "environment", "radiance": [0.5, 0.5, 0.5]}]})", 64);
+    "lights": [{"type": "environment", "radiance": [0.5, 0.5, 0.5]}]})",
+                               64);
   expect_matches(r, [](int, int, int) { return 0.5; });
 }
 
@@ -160,7 +170,7 @@ TEST(KernelAnalytic, WhiteFurnace) {
 // renders Le / (1 - rho) at unbounded depth.
 TEST(KernelAnalytic, ClosedBoxRendersLeOverOneMinusRho) {
   // cube [-1,1]^3, faces wound so that the front (normal) side faces the inside
-  RenderResult r = lucent::test::render_json(R"({
+  RenderResult r = render_full(R"({
     "camera": {"position": [0.2, -0.3, 0.1], "look_at": [0, 1, 0.3], "up": [0, 0, 1], "fov": 90},
     "film": {"width": 16, "height": 16},
     "integrator": {"type": "path", "max_depth": 100000, "rr_depth": 4},
@@ -168,7 +178,7 @@ TEST(KernelAnalytic, ClosedBoxRendersLeOverOneMinusRho) {
     "shapes": [{"type": "triangles", "material": "m",
       "positions": [[-1,-1,-1],[1,-1,-1],[1,1,-1],[-1,1,-1],[-1,-1,1],[1,-1,1],[1,1,1],[-1,1,1]],
       "indices": [0,1,2, 0,2,3,  4,6,5, 4,7,6,  0,4,5, 0,5,1,  3,2,6, 3,6,7,  0,3,7, 0,7,4,  1,5,6, 1,6,2]}]})",
-                                              64);
+                               64);
   const double Le[3] = {0.25, 0.3, 0.1}, rho[3] = {0.5, 0.25, 0.75};
   expect_matches(r, [&](int, int, int c) { return Le[c] / (1 - rho[c]); });
 }
@@ -193,8 +203,8 @@ TEST(KernelAnalytic, MisOnAndOffConvergeToTheSameMean) {
         {"type": "triangles", "material": "panel",
          "positions": [[-2, 1, 3], [0, 1, 3], [0, 2, 3], [-2, 2, 3]], "indices": [0, 2, 1, 0, 3, 2]}]})";
   };
-  RenderResult a = lucent::test::render_json(scene(true), 256);
-  RenderResult b = lucent::test::render_json(scene(false), 256);
+  RenderResult a = render_full(scene(true), 256);
+  RenderResult b = render_full(scene(false), 256);
   const int w = a.mean.width, h = a.mean.height;
   const double zmax = sidak_z(1e-3, w * h * 3);
   int failures = 0;
@@ -229,6 +239,7 @@ TEST(KernelAnalytic, SameSeedSameImageWhateverThePasses) {
   lucent::Scene scene = lucent::parse_scene(json, "seed.json");
   lucent::RenderOptions one_pass, many_passes;
   one_pass.spp = many_passes.spp = 24;
+  one_pass.specialize = many_passes.specialize = false;
   one_pass.pass_seconds = 1e9;     // grows to all remaining samples after the first pass
   many_passes.pass_seconds = 1e-9; // one sample per pass
   RenderResult a = lucent::test::render(scene, one_pass), b = lucent::test::render(scene, many_passes);
@@ -277,10 +288,10 @@ TEST(KernelAnalytic, EnvironmentMapOverPlane) {
   const double A[3] = {0.6, 0.3, 0.3}, albedo[3] = {0.5, 0.8, 0.25};
   for (bool mis : {true, false}) {
     SCOPED_TRACE(mis ? "with MIS" : "light sampling only");
-    expect_matches(lucent::test::render_json(env_map_scene(mis, false), 512),
+    expect_matches(render_full(env_map_scene(mis, false), 512),
                    [&](int, int, int c) { return albedo[c] * A[c]; });
   }
-  RenderResult sky = lucent::test::render_json(env_map_scene(true, true), 4);
+  RenderResult sky = render_full(env_map_scene(true, true), 4);
   for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(sky.mean.pixel(5, 7)[c], float(A[c]));
 }
 

@@ -8,6 +8,7 @@
 
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
+#include "cl/program_cache.hpp"
 #include "scene/material_type.hpp"
 #include "shared/types.h"
 #include "support.hpp"
@@ -16,9 +17,9 @@ namespace {
 
 struct Probe {
   lucent::cl_util::Context ctx{lucent::test::device()};
-  cl::Program program = lucent::cl_util::build_program(
+  cl::Program program = lucent::cl_util::build_program_cached(
       ctx, lucent::detail::assemble_kernel_source("test/bsdf_probe.cl", lucent::test::kernel_dir()),
-      "-cl-std=CL1.2");
+      "-cl-std=CL1.2", lucent::test::cache_dir());
 };
 
 Probe& probe() {

@@ -1,4 +1,6 @@
-// End-to-end renders through the megakernel checked against closed-form answers.
+// End-to-end renders through the megakernel checked against closed-form answers. Every render
+// compiles all kernel features (specialize = false), sharing one program with the other
+// known-answer, stability and precision tests (see test_kernel_analytic.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -27,7 +29,7 @@ TEST(RenderAnalytic, DiffusePlaneUnderPointLight) {
     "lights": [{"type": "point", "position": [0.7, 0.4, 2.0], "intensity": [50, 50, 50]}]
   })";
   const int spp = 64;
-  lucent::RenderResult r = lucent::test::render_json(scene, spp);
+  lucent::RenderResult r = lucent::test::render_json(scene, spp, false);
   const double t = std::tan(10.0 * M_PI / 180.0);  // tan(fov / 2)
   auto radiance = [&](double fx, double fy) {      // film position in pixels
     // the camera ray through (fx, fy) meets z = 0 at 5 * ndc * tan(fov/2)
@@ -66,7 +68,7 @@ TEST(RenderAnalytic, SphereFacingPointLight) {
     "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
     "lights": [{"type": "point", "position": [0, 0, 10], "intensity": [81, 81, 81]}]
   })";
-  lucent::RenderResult r = lucent::test::render_json(scene, 16);
+  lucent::RenderResult r = lucent::test::render_json(scene, 16, false);
   const float* c = r.mean.pixel(4, 4);
   const double E = 81.0 / 81.0;  // I cos / r^2 with r = 9
   EXPECT_NEAR(c[0], 0.5 / M_PI * E, 1e-3 * 0.5 / M_PI * E * 10);
@@ -90,7 +92,7 @@ TEST(RenderAnalytic, ShadowRaysAreBoundedByTheLightDistance) {
     ],
     "lights": [{"type": "point", "position": [0, 0, 1], "intensity": [1, 1, 1]}]
   })";
-  lucent::RenderResult r = lucent::test::render_json(scene2, 4);
+  lucent::RenderResult r = lucent::test::render_json(scene2, 4, false);
   const float* c = r.mean.pixel(4, 4);
   // the pixel sees (about) the origin: E = 1 * 1 / 1, L = 1/pi
   EXPECT_NEAR(c[0], 1.0 / M_PI, 0.02 / M_PI);

@@ -14,6 +14,7 @@
 
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
+#include "cl/program_cache.hpp"
 #include "shared/types.h"
 #include "support.hpp"
 
@@ -21,8 +22,11 @@ namespace {
 
 struct SpawnProbe {
   explicit SpawnProbe(const std::string& options)
-      : program(lucent::cl_util::build_program(
-            ctx, lucent::detail::assemble_kernel_source("test/stability_spawn.cl", lucent::test::kernel_dir()), options)) {}
+      : program(lucent::cl_util::build_program_cached(
+            ctx,
+            lucent::detail::assemble_kernel_source("test/stability_spawn.cl",
+                                                   lucent::test::kernel_dir()),
+            options, lucent::test::cache_dir())) {}
   lucent::cl_util::Context ctx{lucent::test::device()};
   cl::Program program;
 };

@@ -1,5 +1,7 @@
 #include "cl/program_cache.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -9,9 +11,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "core/file_io.hpp"
@@ -131,6 +135,38 @@ void write_entry(const std::string& path, const std::string& key,
   }
 }
 
+/// An exclusive flock on `path` held while alive: processes that miss the same entry at the same
+/// time build it once (the others wait, then read what the first wrote) instead of each compiling
+/// it. Waits at most `max_wait` seconds (a holder stuck in a driver must not stall every other
+/// process), then builds without the lock; any failure to lock only costs a redundant build.
+class BuildLock {
+ public:
+  BuildLock(const std::string& path, double max_wait) {
+    std::error_code ec;
+    fs::create_directories(fs::path(path).parent_path(), ec);
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) return;
+    auto t0 = std::chrono::steady_clock::now();
+    while (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      if (errno != EWOULDBLOCK ||
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > max_wait) {
+        ::close(fd_);
+        fd_ = -1;
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  ~BuildLock() {
+    if (fd_ >= 0) ::close(fd_);  // releases the lock
+  }
+  BuildLock(const BuildLock&) = delete;
+  BuildLock& operator=(const BuildLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
 }  // namespace
 
 std::string default_program_cache_dir() {
@@ -182,21 +218,30 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
     bi.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return p;
   };
+  std::unique_ptr<BuildLock> lock;
   if (!dir.empty()) {
     bi.cache_file = dir + "/" + hex(fnv1a(key.data(), key.size())) + ".bin";
-    std::vector<unsigned char> binary;
     std::string why;
-    if (read_entry(bi.cache_file, key, binary, why)) {
+    auto load = [&](cl::Program& p) {
+      std::vector<unsigned char> binary;
+      why.clear();
+      if (!read_entry(bi.cache_file, key, binary, why)) return false;
       try {
         cl::Program::Binaries bins{binary};
-        cl::Program p(ctx.context, {ctx.device.device}, bins);
+        p = cl::Program(ctx.context, {ctx.device.device}, bins);
         p.build({ctx.device.device}, options.c_str());
         bi.cache_hit = true;
-        return finish(p);
+        return true;
       } catch (const cl::Error&) {
         why = "the driver rejected the binary";
+        return false;
       }
-    }
+    };
+    cl::Program p;
+    if (load(p)) return finish(p);
+    // a miss: wait for another process that may be building this entry, then look again
+    lock = std::make_unique<BuildLock>(bi.cache_file + ".lock", 600);
+    if (load(p)) return finish(p);
     if (!why.empty()) {
       bi.note = (why.rfind(bi.cache_file, 0) == 0 ? why : bi.cache_file + ": " + why) + "; rebuilt";
       std::error_code ec;
@@ -221,6 +266,10 @@ int clear_program_cache(const std::string& dir) {
   std::error_code ec;
   for (auto& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
+    if (e.path().extension() == ".lock") {
+      fs::remove(e.path(), ec);  // build locks: not entries, not counted
+      continue;
+    }
     // entries, and the temporary files of writes that were interrupted
     if (e.path().extension() == ".bin" || name.find(".bin.tmp") != std::string::npos) {
       fs::remove(e.path(), ec);

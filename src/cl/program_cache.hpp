@@ -6,6 +6,8 @@
 // hash collision, a truncated or corrupt file, or a stale entry (another driver or lucent
 // version) is detected and rebuilt. The directory is the caller's (SessionOptions::cache_dir;
 // the CLI's default is LUCENT_CACHE_DIR, "off" disabling it); "" disables the cache.
+// A miss is built under an exclusive lock on <entry>.lock, so that processes missing the same
+// entry at once (a parallel test run on cold caches) compile it once and the others read it.
 #include <string>
 
 #include "cl/context.hpp"

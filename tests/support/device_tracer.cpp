@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "cl/kernel_source.hpp"
+#include "cl/program_cache.hpp"
 #include "lucent/error.hpp"
 
 namespace lucent::bvh {
@@ -21,11 +22,11 @@ cl::Buffer upload(const cl_util::Context& ctx, const std::vector<T>& v) {
 
 DeviceTracer::DeviceTracer(const cl_util::Context& ctx, const std::vector<lc_triangle>& triangles,
                            const std::vector<lc_sphere>& spheres, const Bvh& bvh,
-                           const std::string& build_options)
+                           const std::string& build_options, const std::string& cache_dir)
     : ctx_(ctx) {
-  cl::Program program =
-      cl_util::build_program(ctx, detail::assemble_kernel_source("test/trace_rays.cl"),
-                             "-cl-std=CL1.2" + (build_options.empty() ? "" : " " + build_options));
+  cl::Program program = cl_util::build_program_cached(
+      ctx, detail::assemble_kernel_source("test/trace_rays.cl"),
+      "-cl-std=CL1.2" + (build_options.empty() ? "" : " " + build_options), cache_dir);
   try {
     kernel_ = cl::Kernel(program, "lucent_trace_rays");
     lc_params p{};

@@ -26,10 +26,11 @@ struct TraceHit {
 class DeviceTracer {
  public:
   /// Uploads the scene and builds the trace kernel, with `build_options` added to the OpenCL
-  /// build options (e.g. "-D LC_DOUBLE"). Throws lucent::Error.
+  /// build options (e.g. "-D LC_DOUBLE"), through the program cache in `cache_dir` ("" none).
+  /// Throws lucent::Error.
   DeviceTracer(const cl_util::Context& ctx, const std::vector<lc_triangle>& triangles,
                const std::vector<lc_sphere>& spheres, const Bvh& bvh,
-               const std::string& build_options = "");
+               const std::string& build_options = "", const std::string& cache_dir = "");
   /// Closest hits, or with any_hit only occlusion (prim != LC_INVALID when occluded).
   std::vector<TraceHit> trace(const std::vector<TraceRay>& rays, bool any_hit = false);
   /// Seconds the last trace() spent in the kernel alone (rays already on the device).

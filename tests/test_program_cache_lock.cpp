@@ -1,0 +1,58 @@
+// The program cache builds an entry once when several builders miss it at the same time (a
+// parallel test run on cold caches, several renders started together): the first takes the
+// entry's lock and builds, the others wait for it and read what it wrote. flock locks belong to
+// open file descriptions, so two threads of one process exclude each other as two processes do.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cl/kernel_source.hpp"
+#include "cl/program_cache.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::cl_util::ProgramBuildInfo;
+
+TEST(ProgramCacheLock, SimultaneousMissesBuildOnce) {
+  const std::string dir = lucent::test::temp_dir() + "/cache";
+  const std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
+  // an option of its own: no other test's entry can be there already
+  const std::string options = "-cl-std=CL1.2 -D LC_PROGRAM_CACHE_LOCK_TEST";
+
+  constexpr int kBuilders = 3;
+  std::vector<std::unique_ptr<lucent::cl_util::Context>> contexts;
+  for (int i = 0; i < kBuilders; ++i)
+    contexts.push_back(std::make_unique<lucent::cl_util::Context>(""));
+  std::vector<ProgramBuildInfo> info(kBuilders);
+  std::vector<std::string> errors(kBuilders);
+  std::atomic<int> ready{0};
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kBuilders; ++i)
+    threads.emplace_back([&, i] {
+      ++ready;
+      while (ready.load() < kBuilders) std::this_thread::yield();  // all miss at once
+      try {
+        lucent::cl_util::build_program_cached(*contexts[i], src, options, dir, &info[i]);
+      } catch (const std::exception& e) {
+        errors[i] = e.what();
+      }
+    });
+  for (auto& t : threads) t.join();
+
+  int built = 0;
+  for (int i = 0; i < kBuilders; ++i) {
+    EXPECT_EQ(errors[i], "") << "builder " << i;
+    EXPECT_EQ(info[i].cache_file, info[0].cache_file);
+    if (!info[i].cache_hit) ++built;
+  }
+  EXPECT_EQ(built, 1) << "each builder that missed compiled the program itself";
+  EXPECT_TRUE(std::filesystem::exists(info[0].cache_file));
+}
+
+}  // namespace
