@@ -66,6 +66,18 @@ static inline void whitted_bsdf_none(lc_whitted_bsdf* w) {
   w->diffuse = w->reflect = w->transmit = w->transmit_wi = (float3)(0.0f);
 }
 
+/* Whitted's classic weights of a dielectric interface of relative index eta (eta_t / eta_i, wo
+ * on the incident side): reflection F, refraction (1 - F) tint (no 1 / eta^2). */
+static inline void whitted_dielectric(float3 wo, float eta, float3 tint, lc_whitted_bsdf* w) {
+  float ct;
+  float F = fresnel_dielectric(wo.z, eta, &ct);
+  w->reflect = (float3)(F);
+  if (F < 1.0f) {
+    w->transmit = tint * (1.0f - F);
+    w->transmit_wi = (float3)(-wo.x / eta, -wo.y / eta, -ct);
+  }
+}
+
 /* bsdf/<file>.cl for every material type */
 #include "generated/materials.cl"
 

@@ -42,14 +42,7 @@ static inline lc_uint bsdf_dielectric_lobes(const lc_bsdf* b) {
 
 /* reflection F, refraction (1 - F) tint (no 1 / eta^2: Whitted's classic weights) */
 static inline void bsdf_dielectric_whitted(const lc_bsdf* b, float3 wo, lc_whitted_bsdf* w) {
-  float eta = bsdf_dielectric_eta(b);
-  float ct;
-  float F = fresnel_dielectric(wo.z, eta, &ct);
-  w->reflect = (float3)(F);
-  if (F < 1.0f) {
-    w->transmit = lc_load3p(b->p.dielectric.tint) * (1.0f - F);
-    w->transmit_wi = (float3)(-wo.x / eta, -wo.y / eta, -ct);
-  }
+  whitted_dielectric(wo, bsdf_dielectric_eta(b), lc_load3p(b->p.dielectric.tint), w);
 }
 
 #endif

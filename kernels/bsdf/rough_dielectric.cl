@@ -90,14 +90,7 @@ static inline lc_uint bsdf_rough_dielectric_lobes(const lc_bsdf* b) { return LC_
 
 /* as the smooth dielectric: reflection F, refraction (1 - F) tint about the shading normal */
 static inline void bsdf_rough_dielectric_whitted(const lc_bsdf* b, float3 wo, lc_whitted_bsdf* w) {
-  float eta = bsdf_rough_dielectric_eta(b);
-  float ct;
-  float F = fresnel_dielectric(wo.z, eta, &ct);
-  w->reflect = (float3)(F);
-  if (F < 1.0f) {
-    w->transmit = lc_load3p(b->p.rough_dielectric.tint) * (1.0f - F);
-    w->transmit_wi = (float3)(-wo.x / eta, -wo.y / eta, -ct);
-  }
+  whitted_dielectric(wo, bsdf_rough_dielectric_eta(b), lc_load3p(b->p.rough_dielectric.tint), w);
 }
 
 #endif

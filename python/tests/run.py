@@ -1,4 +1,4 @@
-"""Runs lucent's pytest suite (the CTest entry python.pytest) with the interpreter CMake chose.
+"""Runs lucent's pytest suite (the CTest entries python.pytest.<file>) with the interpreter CMake chose.
 
 Exits 77, which CTest reports as a skip, when that interpreter cannot import numpy or pytest.
 """
@@ -7,7 +7,7 @@ import sys
 
 missing = [m for m in ("numpy", "pytest") if importlib.util.find_spec(m) is None]
 if missing:
-    print(f"python.pytest skipped: {sys.executable} cannot import {' and '.join(missing)} "
+    print(f"python tests skipped: {sys.executable} cannot import {' and '.join(missing)} "
           "(Debian: apt-get install python3-numpy python3-pytest, or configure with "
           "-DPython3_EXECUTABLE=<a python3 that has them>)")
     sys.exit(77)
