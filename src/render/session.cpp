@@ -364,12 +364,30 @@ struct Renderer::Impl {
       return pr;
     };
     std::exception_ptr failure;
-    auto work = [&](Worker& w) {
+    // Claims the next range of sample indices for `w` (n = 0: none left); under the lock.
+    auto claim = [&](Worker& w, std::uint64_t& begin, std::uint32_t& n) {
+      n = w.pass_spp;
+      if (target_spp > 0)
+        n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, target_spp - started));
+      begin = start_index + started;
+      started += n;
+    };
+    // With several devices each takes its first pass before any takes a second: a device whose
+    // thread starts late still gets its share (the others do not drain a short render first).
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> first_pass(workers.size(), {0, 0});
+    if (workers.size() > 1 && !cancelled())
+      for (size_t i = 0; i < workers.size(); ++i)
+        if (target_spp == 0 || started < target_spp)
+          claim(*workers[i], first_pass[i].first, first_pass[i].second);
+    auto work = [&](Worker& w, size_t index) {
       try {
-        for (;;) {
+        for (bool first = true;; first = false) {
           std::uint64_t begin;
           std::uint32_t n;
-          {
+          if (first && first_pass[index].second > 0) {
+            begin = first_pass[index].first;
+            n = first_pass[index].second;
+          } else {
             std::lock_guard<std::mutex> lock(m);
             if (failure) return;
             if (target_spp > 0 && started >= target_spp) return;
@@ -379,11 +397,7 @@ struct Renderer::Impl {
               last_cancelled = true;
               return;
             }
-            n = w.pass_spp;
-            if (target_spp > 0)
-              n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, target_spp - started));
-            begin = start_index + started;
-            started += n;
+            claim(w, begin, n);
           }
           lc_uint counters[LC_COUNTER_COUNT];
           auto tp = clock_type::now();
@@ -414,10 +428,11 @@ struct Renderer::Impl {
       }
     };
     if (workers.size() == 1) {
-      work(*workers.front());
+      work(*workers.front(), 0);
     } else {
       std::vector<std::thread> threads;
-      for (auto& w : workers) threads.emplace_back(work, std::ref(*w));
+      for (size_t i = 0; i < workers.size(); ++i)
+        threads.emplace_back(work, std::ref(*workers[i]), i);
       for (auto& t : threads) t.join();
     }
     if (failure) std::rethrow_exception(failure);
