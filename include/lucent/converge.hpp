@@ -30,7 +30,7 @@ namespace lucent {
 ///   clamp=X            integrator.clamp (X >= 0; 0: off)
 ///   adaptive           each rung an adaptive render (Renderer::render_adaptive) whose samples
 ///                      average the rung's spp; rungs below the pilot are skipped
-///   min-spp=N          adaptive: the pilot's samples per pixel (default 32)
+///   min-spp=N          adaptive: the pilot's samples per pixel (default 64)
 ///   target-error=E     one adaptive render to relMSE E (E > 0), whatever the ladder
 /// The setting's name is the text it was parsed from.
 struct ConvergeSetting {

@@ -76,7 +76,7 @@ struct SessionStats {
 struct AdaptiveOptions {
   double target_error = 0;        ///< relMSE to reach (> 0); 0: use budget_spp
   double budget_spp = 0;          ///< instead of a target: the mean samples per pixel
-  std::uint32_t min_spp = 32;     ///< per pixel: the pilot (even, >= 4; half in each half)
+  std::uint32_t min_spp = 64;     ///< per pixel: the pilot (even, >= 4; half in each half)
   std::uint32_t max_spp = 16384;  ///< per pixel, at most
   double max_seconds = 0;         ///< stop after this much time (0: no limit)
 };

@@ -23,7 +23,7 @@ void add_sampling_options(CLI::App* cmd, SamplingArgs& a, bool adaptive) {
                   "with --spp as the most samples per pixel and --time as a time limit")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--min-spp", a.min_spp,
-                  "Adaptive sampling: samples per pixel of the pilot, everywhere (default 32)")
+                  "Adaptive sampling: samples per pixel of the pilot, everywhere (default 64)")
       ->check(CLI::Range(4, limits::kMaxSpp));
 }
 

@@ -49,7 +49,7 @@ SamplePlan plan_samples(const std::vector<double>& v, int width, int height, dou
       const std::uint32_t n =
           want >= max_n ? max_n : std::max(min_n, static_cast<std::uint32_t>(std::max(0.0, want)));
       plan.counts[i] = n;
-      predicted += v[i] / n;
+      predicted += shape[i] * shape[i] / n;  // the smoothed variance: see plan_samples' doc
       total += n;
     }
     plan.predicted = npix ? predicted / double(npix) : 0;

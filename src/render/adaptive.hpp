@@ -48,7 +48,8 @@ struct SamplePlan {
 /// allocation that minimises sum v / n for a given sum n), where v is first raised to the mean
 /// of its 3 x 3 neighbourhood (a pixel whose pilot saw little of a noisy neighbourhood still gets
 /// samples), clamped to [min_n, max_n]. With target > 0 the counts are the smallest such that
-/// the predicted relMSE of the half's image, mean of v / n, is at most target (max_n everywhere
+/// the predicted relMSE of the half's image, mean of that raised v over n (v itself would
+/// under-predict: the pixels whose pilot under-estimated v get fewer samples), is at most target (max_n everywhere
 /// when even that does not reach it); otherwise the largest such that the mean count is at most
 /// budget. Raising `target` or lowering `budget` never raises a count.
 SamplePlan plan_samples(const std::vector<double>& v, int width, int height, double target,
