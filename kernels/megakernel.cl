@@ -1,8 +1,8 @@
-/* lucent: the megakernel. One work-item per pixel; each launch adds samples_per_pass samples per
- * pixel, starting at sample_offset, and writes their sum and sum of squares for the host to
- * accumulate. Features are switched on by defines chosen from the scene (LC_HAS_*: the feature
- * column of shared/registry.h and src/render/features.cpp); a scene compiles only the code it
- * uses. */
+/* lucent: the megakernel. One work-item per pixel (or per entry of an adaptive pass's work list);
+ * each launch adds samples_per_pass samples per pixel, starting at sample_offset (or the entry's
+ * samples), and writes their sum and sum of squares for the host to accumulate. Features are
+ * switched on by defines chosen from the scene (LC_HAS_*: the feature column of shared/registry.h
+ * and src/render/features.cpp); a scene compiles only the code it uses. */
 /* clang-format off */
 #include "shared/types.h"
 #include "shared/rng.h"
@@ -21,26 +21,49 @@
 #include "integrator/integrator.cl"
 /* clang-format on */
 
-__kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global float4* out_sum,
-                            __global float4* out_sumsq, __global lc_uint* counters) {
+/* The work list of an adaptive pass (params->work_items > 0): entry i = (pixel, first sample,
+ * number of samples, stream) for work-item i, whose sums go to out_sum[i], out_sumsq[i]; stream
+ * s draws with the seed lc_stream_seed(seed, s) (shared/rng.h). Without a work list, work-item i
+ * is pixel i and renders samples [sample_offset, sample_offset + samples_per_pass) with the seed.
+ * Either way a sample's random numbers depend only on its pixel, index and seed. */
+__kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global const uint4* work,
+                            __global float4* out_sum, __global float4* out_sumsq,
+                            __global lc_uint* counters) {
   lc_uint gid = (lc_uint)get_global_id(0);
   lc_uint width = params->width, height = params->height;
-  if (gid >= width * height) return;
+  lc_rng rng;
+  rng.sampler = params->sampler;
+  lc_uint first, count;
+  if (params->work_items > 0u) {
+    if (gid >= params->work_items) return;
+    uint4 e = work[gid];
+    rng.pixel = e.x;
+    first = e.y;
+    count = e.z;
+    rng.seed = lc_stream_seed(params->seed, e.w);
+  } else {
+    if (gid >= width * height) return;
+    rng.pixel = gid;
+    first = params->sample_offset;
+    count = params->samples_per_pass;
+    rng.seed = params->seed;
+  }
   lc_scene s = LC_SCENE_FROM_KERNEL_ARGS;
 
-  lc_uint px = gid % width, py = gid / width;
+  lc_uint px = rng.pixel % width, py = rng.pixel / width;
   float3 sum = (float3)(0.0f), sumsq = (float3)(0.0f);
   lc_uint accepted = 0, nonfinite = 0, rays = 0;
-  for (lc_uint k = 0; k < params->samples_per_pass; ++k) {
-    lc_rng rng;
-    rng.pixel = gid;
-    rng.sample = params->sample_offset + k;
-    rng.seed = params->seed;
-    float2 off = filter_sample(params->filter, params->filter_radius, lc_rand(&rng, LC_DIM_FILTER),
-                               lc_rand(&rng, LC_DIM_FILTER + 1));
+  for (lc_uint k = 0; k < count; ++k) {
+    rng.sample = first + k;
+    float2 uf = lc_rand2(&rng, LC_DIM_FILTER);
+    float2 off = filter_sample(params->filter, params->filter_radius, uf.x, uf.y);
+#ifdef LC_HAS_THIN_LENS
+    float2 ul = lc_rand2(&rng, LC_DIM_LENS);
+#else
+    float2 ul = (float2)(0.0f);
+#endif
     lc_ray ray = camera_generate_ray(&params->camera, (float)px + 0.5f + off.x,
-                                     (float)py + 0.5f + off.y, width, height,
-                                     lc_rand(&rng, LC_DIM_LENS), lc_rand(&rng, LC_DIM_LENS + 1));
+                                     (float)py + 0.5f + off.y, width, height, ul.x, ul.y);
     float3 L = integrate(&s, ray, &rng, &rays);
     if (lc_isfinite3(L)) {
       sum += L;

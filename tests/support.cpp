@@ -130,7 +130,15 @@ std::string shared_asset(const std::string& rel) {
   return fs::exists(p) ? p : std::string();
 }
 
-Scene scene_from(const std::string& json) { return parse_scene(json, temp_dir() + "/scene.json"); }
+Scene with_independent_samples(Scene scene) {
+  scene.integrator.sampler = SamplerType::Independent;
+  return scene;
+}
+
+Scene scene_from(const std::string& json) {
+  Scene scene = parse_scene(json, temp_dir() + "/scene.json");
+  return json.find("\"sampler\"") != std::string::npos ? scene : with_independent_samples(scene);
+}
 
 RenderResult render_json(const std::string& json, int spp, bool specialize) {
   Scene scene = scene_from(json);

@@ -63,7 +63,14 @@ RenderOptions render_options();
 /// lucent::render with the test defaults filled in where `options` leaves them empty.
 RenderResult render(const Scene& scene, RenderOptions options = {});
 
-/// Parses a JSON scene held in memory (relative file names resolve against a temporary directory).
+/// The sampler of the statistical tests: `scene` with integrator.sampler = independent, so that
+/// a pixel's sample variance / n is the variance of its mean, as the z-tests assume (Sobol
+/// samples are stratified: that estimate is then no longer the variance of the mean).
+Scene with_independent_samples(Scene scene);
+
+/// Parses a JSON scene held in memory (relative file names resolve against a temporary directory),
+/// with the independent sampler unless the JSON names one ("sampler" in "integrator"): tests of
+/// the Sobol sampler name it.
 Scene scene_from(const std::string& json);
 
 /// Renders a JSON scene held in memory with `spp` samples per pixel. `specialize` false compiles

@@ -28,7 +28,7 @@ const char* kScene = R"({
 })";
 
 RenderResult render_ref(std::uint32_t seed, int spp = 32) {
-  lucent::Scene scene = lucent::parse_scene(kScene, lucent::test::temp_dir() + "/scene.json");
+  lucent::Scene scene = lucent::test::scene_from(kScene);
   scene.integrator.seed = seed;
   lucent::ReferenceOptions o;
   o.spp = spp;

@@ -32,8 +32,9 @@ bool has(const std::vector<std::string>& v, const std::string& f) {
 
 TEST(Features, DiffuseSpheresAndAPointLightCompileOnlyThat) {
   std::vector<std::string> f = features_of(kDiffuseScene);
-  std::vector<std::string> expected = {"LC_HAS_SPHERES", "LC_HAS_DIFFUSE", "LC_HAS_POINT_LIGHTS",
-                                       "LC_HAS_FILTER_BOX", "LC_HAS_INTEGRATOR_PATH"};
+  std::vector<std::string> expected = {"LC_HAS_SPHERES",         "LC_HAS_DIFFUSE",
+                                       "LC_HAS_POINT_LIGHTS",    "LC_HAS_FILTER_BOX",
+                                       "LC_HAS_INTEGRATOR_PATH", "LC_HAS_SAMPLER_SOBOL"};
   std::sort(f.begin(), f.end());
   std::sort(expected.begin(), expected.end());
   EXPECT_EQ(f, expected);

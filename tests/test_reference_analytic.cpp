@@ -20,7 +20,7 @@ namespace {
 using lucent::RenderResult;
 
 RenderResult render_ref(const std::string& json, int spp) {
-  lucent::Scene scene = lucent::parse_scene(json, lucent::test::temp_dir() + "/scene.json");
+  lucent::Scene scene = lucent::test::scene_from(json);
   lucent::ReferenceOptions o;
   o.spp = spp;
   return lucent::render_reference(scene, o);
@@ -232,7 +232,10 @@ TEST(ReferenceAnalytic, GlassSlabAtNormalIncidence) {
       {"type": "triangles", "material": "lamp",
        "positions": [[-5,-5,-1],[5,-5,-1],[5,5,-1],[-5,5,-1]], "indices": [0,1,2, 0,2,3]}]
   })";
-  RenderResult r = render_ref(scene, 256);
+  // each sample is Le or 0 (transmitted or not), p = 0.92: 1024 spp so that the variance the
+  // z-test estimates from a pixel's samples is close to p (1 - p) (at 256 spp a pixel that drew
+  // 3 sd too many transmissions gets a z near 5 from its smaller estimated variance)
+  RenderResult r = render_ref(scene, 1024);
   const double F = 0.04, k = (1 - F) / (1 + F);
   expect_matches(r, expected_image(r, [&](int, int) { return k * glm::dvec3(1, 2, 4); }));
 }

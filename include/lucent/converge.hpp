@@ -26,6 +26,12 @@ namespace lucent {
 ///   filter=TYPE[:R]    film.filter: a filter name (box, tent, gaussian: lucent/types.hpp),
 ///                      optional radius R in pixels, in (0, limits::kMaxFilterRadius]
 ///   integrator=NAME    an integrator or AOV name (path, whitted, ..., primitive)
+///   sampler=NAME       integrator.sampler: sobol or independent
+///   clamp=X            integrator.clamp (X >= 0; 0: off)
+///   adaptive           each rung an adaptive render (Renderer::render_adaptive) whose samples
+///                      average the rung's spp; rungs below the pilot are skipped
+///   min-spp=N          adaptive: the pilot's samples per pixel (default 64)
+///   target-error=E     one adaptive render to relMSE E (E > 0), whatever the ladder
 /// The setting's name is the text it was parsed from.
 struct ConvergeSetting {
   std::string name = "default";
@@ -38,6 +44,11 @@ struct ConvergeSetting {
   int filter = -1;           ///< -1: the scene's; else a FilterType
   double filter_radius = 0;  ///< 0: the scene's (or the filter's default when the type changes)
   int integrator = -1;       ///< -1: the scene's; else an IntegratorType
+  int sampler = -1;          ///< -1: the scene's; else a SamplerType
+  double clamp = -1;         ///< < 0: the scene's; else integrator.clamp
+  bool adaptive = false;     ///< rungs are adaptive renders of the rung's mean spp
+  int min_spp = 0;           ///< adaptive: the pilot (0: AdaptiveOptions' default)
+  double target_error = 0;   ///< > 0: one adaptive render to this relMSE
 
   /// Applies the setting to a copy of the scene and of the options.
   void apply(Scene& scene, RenderOptions& options) const;
@@ -60,6 +71,11 @@ struct ConvergePoint {
   /// The expected relMSE of an unbiased setting; 0 when the render has fewer than 2 samples per
   /// pixel (no variance estimate).
   double noise_relmse = 0;
+  /// The reference's own share of noise_relmse: mean over pixel-channels of var_R / n_R /
+  /// (R^2 + 0.01) (0 without its variance); its expected contribution to relmse.
+  double reference_noise_relmse = 0;
+  /// Adaptive renders: the relMSE the render's own variances predict (RenderResult).
+  double estimated_relmse = 0;
 };
 
 /// The error curve of one setting, fitted on log-log axes.
@@ -121,8 +137,14 @@ std::uint32_t reference_seed(std::uint32_t scene_seed);
 /// Powers of two from 1 to max_spp (max_spp included when it is not a power of two).
 std::vector<int> default_spp_ladder(int max_spp);
 
-/// CSV: setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s; one row a point.
+/// CSV: setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s,
+/// reference_noise_relmse,estimated_relmse; one row a point.
 std::string convergence_csv(const ConvergeResult& result);
+
+/// The render time at which one setting's points (in ladder order) reach relMSE `error`,
+/// interpolated linearly on log-log axes between the rungs around the first crossing; the first
+/// rung's time when it is already below; infinity when no rung reaches it.
+double time_to_relmse(const std::vector<ConvergePoint>& points, double error);
 
 /// SVG: relMSE against render time on log-log axes, one path (with point markers) per setting,
 /// axis labels, decade ticks and a legend.

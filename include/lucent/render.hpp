@@ -55,13 +55,18 @@ struct RenderOptions {
   bool fast_math = false;      ///< build with -cl-fast-relaxed-math (default: IEEE math)
   bool specialize = true;      ///< compile only the features the scene uses (false: all)
   Precision precision = Precision::Float;  ///< Double: build with -D LC_DOUBLE (needs fp64)
+  /// > 0: render adaptively until the image's estimated relMSE is at most this
+  /// (Renderer::render_adaptive), with at least min_spp and at most `spp` samples per pixel (0:
+  /// AdaptiveOptions' defaults) and the time limit.
+  double target_error = 0;
+  int min_spp = 0;  ///< adaptive: the pilot per pixel; 0: AdaptiveOptions' default
 };
 
 struct RenderResult {
   Image mean;                          ///< per-pixel mean radiance
   Image variance;                      ///< per-pixel sample variance (of one sample)
   std::vector<std::uint32_t> samples;  ///< finite samples per pixel
-  std::uint64_t spp = 0;               ///< samples per pixel launched
+  std::uint64_t spp = 0;               ///< samples per pixel launched (adaptive: the mean)
   std::uint64_t nonfinite = 0;         ///< NaN/Inf samples dropped and counted
   std::uint64_t rays = 0;              ///< rays traced, shadow rays included
   double seconds = 0;                  ///< rendering time (kernel passes)
@@ -71,11 +76,15 @@ struct RenderResult {
   bool cancelled = false;
   std::string device;                  ///< the device's name ("A + B" for several)
   std::vector<DeviceShare> devices;    ///< each device's part of the accumulation
+  /// Adaptive renders: the relMSE that the image's own per-pixel variances predict (mean over
+  /// pixel-channels of var / n / (mean^2 + 0.01)), and the target; 0 for uniform renders.
+  double estimated_relmse = 0;
+  double target_error = 0;
 };
 
 /// Renders `scene` with the OpenCL megakernel: a one-shot lucent::Renderer session
 /// (lucent/session.hpp) that stops at options.spp samples per pixel (0: the scene's) or after
-/// options.time_limit seconds, whichever comes first.
+/// options.time_limit seconds, whichever comes first; with options.target_error, adaptively.
 RenderResult render(const Scene& scene, const RenderOptions& options = {});
 
 }  // namespace lucent

@@ -50,6 +50,10 @@ enum class IntegratorType {
   LC_INTEGRATOR_TYPES(LUCENT_REGISTRY_ENUMERATOR) LC_AOV_TYPES(LUCENT_REGISTRY_ENUMERATOR)
 };
 
+/// The random numbers of the camera samples (kernels/shared/rng.h): Owen-scrambled Sobol, or
+/// independent numbers (what per-pixel z-tests such as lucent compare assume).
+enum class SamplerType { LC_SAMPLER_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
+
 struct Integrator {
   IntegratorType type = IntegratorType::Path;
   int max_depth = 8;
@@ -58,6 +62,10 @@ struct Integrator {
   std::uint32_t seed = 0;
   double ao_distance = 0;  ///< ambient occlusion ray length; 0: unbounded
   bool mis = true;         ///< path: combine light and BSDF sampling (false: light sampling only)
+  SamplerType sampler = SamplerType::Sobol;
+  /// path: the largest component a contribution after a scattering may have; larger ones are
+  /// scaled down to it (docs/rendering-model.md, "Clamping"). 0: off. Biased when it binds.
+  double clamp = 0;
 };
 
 enum class MaterialType { LC_MATERIAL_TYPES(LUCENT_REGISTRY_ENUMERATOR) };

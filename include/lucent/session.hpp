@@ -68,6 +68,19 @@ struct SessionStats {
   double render_seconds = 0;  ///< kernel passes
 };
 
+/// An adaptive render (Renderer::render_adaptive; docs/rendering-model.md, "Adaptive sampling"):
+/// a pilot of min_spp samples in every pixel, then more samples where the pixel's error is high,
+/// planned so that the image's estimated relMSE (as lucent compare defines it) reaches
+/// target_error, or so that the samples average budget_spp per pixel. Unbiased: the samples are
+/// kept in two independent halves, each planned from the other's pilot (src/render/adaptive.hpp).
+struct AdaptiveOptions {
+  double target_error = 0;        ///< relMSE to reach (> 0); 0: use budget_spp
+  double budget_spp = 0;          ///< instead of a target: the mean samples per pixel
+  std::uint32_t min_spp = 64;     ///< per pixel: the pilot (even, >= 4; half in each half)
+  std::uint32_t max_spp = 16384;  ///< per pixel, at most
+  double max_seconds = 0;         ///< stop after this much time (0: no limit)
+};
+
 /// One device and one scene, rendered progressively. Not thread-safe, except cancel().
 class Renderer {
  public:
@@ -106,8 +119,18 @@ class Renderer {
   /// limit of that kind; not both 0).
   RenderProgress render(std::uint64_t spp, double max_seconds,
                         const std::function<void(const RenderProgress&)>& on_progress = {});
-  /// Drops the accumulation; the next sample index is `first_sample` (sample ranges: a render of
-  /// samples [A, B) is reset(A) then render(B - A)).
+  /// Renders adaptively (AdaptiveOptions): a pilot, then the samples planned from it, until the
+  /// plan is done, the time limit or a cancel. A further call continues the same render with
+  /// another target or budget (a plan never takes samples away), so a series of rising budgets
+  /// is progressive; calling it on a uniform accumulation that has samples, or render() on an
+  /// adaptive one, throws lucent::Error: reset() first. result() gives the average of the halves,
+  /// with per-pixel counts and a variance such that var / n is the variance of the pixel's mean;
+  /// RenderResult::spp is the mean count.
+  RenderProgress render_adaptive(
+      const AdaptiveOptions& options,
+      const std::function<void(const RenderProgress&)>& on_progress = {});
+  /// Drops the accumulation (uniform or adaptive); the next sample index is `first_sample`
+  /// (sample ranges: a render of samples [A, B) is reset(A) then render(B - A)).
   void reset(std::uint64_t first_sample = 0);
 
   /// The accumulation so far: per-pixel mean, sample variance and sample count, with the spp,

@@ -1,9 +1,9 @@
 #pragma once
-// The names of lucent's types (materials, lights, shapes, integrators and AOVs, pixel filters),
-// generated from the registries (lucent/registry.h; kernels/shared/registry.h in the source tree):
-// the name of each enum value, the lookup of a name, the list of valid names. Every name table of
-// the library, the scene loader and the command line comes from here, so that a type added to a
-// registry is known everywhere at once.
+// The names of lucent's types (materials, lights, shapes, integrators and AOVs, pixel filters,
+// samplers), generated from the registries (lucent/registry.h; kernels/shared/registry.h in the
+// source tree): the name of each enum value, the lookup of a name, the list of valid names. Every
+// name table of the library, the scene loader and the command line comes from here, so that a
+// type added to a registry is known everywhere at once.
 //
 //   lucent::type_name(lucent::IntegratorType::Ao)            -> "ao"
 //   lucent::find_type<lucent::MaterialType>("mirror")        -> MaterialType::Mirror (optional)
@@ -40,6 +40,7 @@ struct TypeList;
 #define LUCENT_SHAPE_ENTRY(...) LUCENT_TYPE_ENTRY(ShapeType, __VA_ARGS__)
 #define LUCENT_INTEGRATOR_ENTRY(...) LUCENT_TYPE_ENTRY(IntegratorType, __VA_ARGS__)
 #define LUCENT_FILTER_ENTRY(...) LUCENT_TYPE_ENTRY(FilterType, __VA_ARGS__)
+#define LUCENT_SAMPLER_ENTRY(...) LUCENT_TYPE_ENTRY(SamplerType, __VA_ARGS__)
 
 template <>
 struct TypeList<MaterialType> {
@@ -68,12 +69,18 @@ struct TypeList<FilterType> {
   static constexpr const char* what = "filter";
   static constexpr TypeEntry<FilterType> entries[] = {LC_FILTER_TYPES(LUCENT_FILTER_ENTRY)};
 };
+template <>
+struct TypeList<SamplerType> {
+  static constexpr const char* what = "sampler";
+  static constexpr TypeEntry<SamplerType> entries[] = {LC_SAMPLER_TYPES(LUCENT_SAMPLER_ENTRY)};
+};
 
 #undef LUCENT_MATERIAL_ENTRY
 #undef LUCENT_LIGHT_ENTRY
 #undef LUCENT_SHAPE_ENTRY
 #undef LUCENT_INTEGRATOR_ENTRY
 #undef LUCENT_FILTER_ENTRY
+#undef LUCENT_SAMPLER_ENTRY
 #undef LUCENT_TYPE_ENTRY
 
 /// The registry entry of `value`, or nullptr for a value no entry has (a cast integer).

@@ -40,9 +40,8 @@ static inline float3 aov_albedo(const lc_scene* s, lc_ray ray, const lc_rng* rng
 static inline float3 aov_ao(const lc_scene* s, lc_ray ray, const lc_rng* rng, const lc_hit* hit,
                             const lc_interaction* it, lc_uint* rays) {
   lc_frame fr = frame_from(it->ns);
-  float3 wi = frame_to_world(
-      &fr, sample_cosine_hemisphere(lc_rand(rng, LC_DIM_BOUNCE + LC_DIM_BSDF_UV),
-                                    lc_rand(rng, LC_DIM_BOUNCE + LC_DIM_BSDF_UV + 1)));
+  float2 u = lc_rand2(rng, LC_DIM_BOUNCE + LC_DIM_BSDF_UV);
+  float3 wi = frame_to_world(&fr, sample_cosine_hemisphere(u.x, u.y));
   lc_real3 wir = lc_real3_from_float3(wi);
   if (dot(wir, it->ng) <= LC_REAL(0.0)) return (float3)(0.0f);
   lc_ray sr;

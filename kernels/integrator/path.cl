@@ -1,8 +1,22 @@
 /* lucent kernel: the path tracer (docs/rendering-model.md): next-event estimation with multiple
- * importance sampling (power heuristic), Russian roulette. One call computes the radiance of one
- * camera sample; random numbers come from lc_rand with the dimension layout of shared/rng.h. */
+ * importance sampling (power heuristic), Russian roulette, optional clamping. One call computes
+ * the radiance of one camera sample; random numbers come from lc_rand4 with the dimension layout
+ * of shared/rng.h. */
 #ifndef LUCENT_INTEGRATOR_PATH_CL
 #define LUCENT_INTEGRATOR_PATH_CL
+
+/* integrator.clamp (docs/rendering-model.md, "Clamping"): a contribution of the path after at
+ * least one scattering (next-event estimation, or an emitter or the environment reached by a
+ * BSDF-sampled ray) whose largest component exceeds `bound` is scaled to have that largest
+ * component; bound 0 is off. Emitters and the environment seen by the camera ray are never
+ * clamped. A non-finite contribution stays non-finite (it is counted, not hidden). */
+static inline float3 path_clamp(float3 c, float bound) {
+#ifdef LC_HAS_CLAMP
+  float m = lc_max3(c);
+  if (bound > 0.0f && m > bound) c *= bound / m;
+#endif
+  return c;
+}
 
 static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng* rng,
                                      lc_uint* rays) {
@@ -18,7 +32,8 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     if (!scene_intersect(s, ray, INFINITY, &hit)) {
       float pdf_l;
       float3 Le = env_radiance(s, lc_float3_from_real3(ray.d), &pdf_l);
-      L += beta * Le * (prev_delta ? 1.0f : (no_mis ? 0.0f : mis_power(prev_pdf, pdf_l)));
+      float3 c = beta * Le * (prev_delta ? 1.0f : (no_mis ? 0.0f : mis_power(prev_pdf, pdf_l)));
+      L += depth > 0 ? path_clamp(c, P->clamp) : c;
       break;
     }
     lc_interaction it = interaction_from_hit(s, ray, &hit);
@@ -31,10 +46,13 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
             light_pdf(s, it.light, prev_p, lc_float3_from_real3(ray.d), hit.t, dot(-ray.d, it.ng));
         w = no_mis ? 0.0f : mis_power(prev_pdf, pdf_l);
       }
-      L += beta * Le * w;
+      L += depth > 0 ? path_clamp(beta * Le * w, P->clamp) : beta * Le * w;
     }
     if (depth + 2 > P->max_depth) break;
     lc_uint dim = LC_DIM_BOUNCE + depth * LC_DIMS_PER_BOUNCE;
+    /* light point, light selection, lobe; BSDF direction, Russian roulette */
+    float4 u_light = lc_rand4(rng, dim + LC_DIM_LIGHT_UV);
+    float4 u_bsdf = lc_rand4(rng, dim + LC_DIM_BSDF_UV);
     lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
     lc_frame fr = frame_from(it.ns);
     float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
@@ -46,10 +64,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     lc_uint lobes = bsdf_lobes(&b);
     if (!(lobes & LC_BSDF_DELTA) && P->num_lights > 0) {
       lc_light_sample ls;
-      if (light_sample(s, o, lc_rand(rng, dim + LC_DIM_LIGHT_SELECT),
-                       lc_rand(rng, dim + LC_DIM_LIGHT_UV), lc_rand(rng, dim + LC_DIM_LIGHT_UV + 1),
-                       &ls) &&
-          ls.pdf > 0.0f) {
+      if (light_sample(s, o, u_light.z, u_light.x, u_light.y, &ls) && ls.pdf > 0.0f) {
         int behind = !(dot(ls.wi, it.ng) > LC_REAL(0.0));
         if (!behind || (lobes & LC_BSDF_TRANSMISSION)) {
           float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
@@ -58,7 +73,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
           if (lc_max3(f) > 0.0f && (behind ? shadow_visible_behind(s, &it, o, &ls, rays)
                                            : shadow_visible(s, o, ls.wi, ls.dist, rays))) {
             float w = (ls.delta || no_mis) ? 1.0f : mis_power(ls.pdf, pdf_b);
-            L += beta * f * ls.L * (fabs(wi_l.z) * w / ls.pdf);
+            L += path_clamp(beta * f * ls.L * (fabs(wi_l.z) * w / ls.pdf), P->clamp);
           }
         }
       }
@@ -66,10 +81,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
 
     /* continue the path */
     lc_bsdf_sample bs;
-    if (!bsdf_sample(&b, wo_l, lc_rand(rng, dim + LC_DIM_BSDF_LOBE),
-                     lc_rand(rng, dim + LC_DIM_BSDF_UV), lc_rand(rng, dim + LC_DIM_BSDF_UV + 1),
-                     &bs))
-      break;
+    if (!bsdf_sample(&b, wo_l, u_light.w, u_bsdf.x, u_bsdf.y, &bs)) break;
     lc_real3 wi = normalize(lc_real3_from_float3(frame_to_world(&fr, bs.wi)));
     int transmit = bs.wi.z < 0.0f;
     lc_real side = dot(wi, it.ng);
@@ -86,7 +98,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
      * beta grow like (albedo / 0.95)^n on albedos above 0.95: unbiased, infinite variance) */
     float q = lc_max3(beta);
     if (depth + 2 > P->rr_depth && q < 1.0f) {
-      if (lc_rand(rng, dim + LC_DIM_RR) >= q) break;
+      if (u_bsdf.z >= q) break;
       beta /= q;
     }
   }

@@ -1,13 +1,13 @@
 /*
  * lucent: the type registries. Every concept that has several types (materials, lights, shapes,
- * integrators, AOVs, filters) and the list of scene buffers is named here once, in plain C, and
- * expanded wherever a type is named: device enums and parameter structs (shared/types.h), the
- * kernel's dispatch (bsdf/bsdf.cl, light/light.cl, geom/interaction.cl, integrator/integrator.cl,
- * film/filter.cl) and per-type file list (src/cl/kernel_source.cpp), the public C++ enums
- * (include/lucent/scene.hpp), scene-file names, feature defines (src/render/features.cpp),
- * `lucent info`, the CLI and `lucent converge`, and the reference integrator's dispatch.
- * docs/adding-a-type.md says how to add an entry. Compiled as OpenCL C and as C++; installed as
- * <lucent/registry.h> because the public enums are generated from it.
+ * integrators, AOVs, filters, samplers) and the list of scene buffers is named here once, in plain
+ * C, and expanded wherever a type is named: device enums and parameter structs (shared/types.h),
+ * the kernel's dispatch (bsdf/bsdf.cl, light/light.cl, geom/interaction.cl,
+ * integrator/integrator.cl, film/filter.cl) and per-type file list (src/cl/kernel_source.cpp), the
+ * public C++ enums (include/lucent/scene.hpp), scene-file names, feature defines
+ * (src/render/features.cpp), `lucent info`, the CLI and `lucent converge`, and the reference
+ * integrator's dispatch. docs/adding-a-type.md says how to add an entry. Compiled as OpenCL C and
+ * as C++; installed as <lucent/registry.h> because the public enums are generated from it.
  *
  * Every list is an X-macro: LC_MATERIAL_TYPES(X) expands X(...) once per entry, in order. The
  * columns common to the type lists are
@@ -116,6 +116,16 @@
   X(GAUSSIAN, Gaussian, 2, "gaussian", LC_HAS_FILTER_GAUSSIAN, gaussian, 1.5)
 
 /* ------------------------------------------------------------------------------------------ */
+/* Samplers: X(ID, Name, value, name, feature, file)                                           */
+/* The random numbers of a camera sample (shared/rng.h: lc_<file>_pair): Owen-scrambled Sobol */
+/* (the default) or independent numbers (what the statistical tests assume). The kernel       */
+/* (sampler/sampler.cl) and the reference (src/reference/sampler.hpp) draw the same numbers.  */
+/* ------------------------------------------------------------------------------------------ */
+#define LC_SAMPLER_TYPES(X)                                \
+  X(SOBOL, Sobol, 0, "sobol", LC_HAS_SAMPLER_SOBOL, sobol) \
+  X(INDEPENDENT, Independent, 1, "independent", LC_HAS_SAMPLER_INDEPENDENT, independent)
+
+/* ------------------------------------------------------------------------------------------ */
 /* Other kernel features: X(feature, what). With the type lists' feature column they make every   */
 /* feature define (src/render/features.cpp decides which a scene uses).                         */
 /* ------------------------------------------------------------------------------------------ */
@@ -123,7 +133,8 @@
   X(LC_HAS_SMOOTH_NORMALS, "interpolated vertex normals") \
   X(LC_HAS_UVS, "texture coordinates of triangles")       \
   X(LC_HAS_TEXTURES, "textured materials")                \
-  X(LC_HAS_THIN_LENS, "thin-lens depth of field")
+  X(LC_HAS_THIN_LENS, "thin-lens depth of field")         \
+  X(LC_HAS_CLAMP, "clamped path contributions (integrator.clamp)")
 
 /* ------------------------------------------------------------------------------------------ */
 /* Scene buffers: X(name, element type, what)                                                  */

@@ -1,12 +1,36 @@
 /*
- * lucent: counter-based random numbers, shared by the kernel and the host reference integrator.
+ * lucent: the random numbers of a camera sample, shared by the kernel (sampler/sampler.cl) and
+ * the host reference integrator (src/reference/sampler.hpp), in plain C.
  *
- * Every random number is a pure function of (pixel, sample index, dimension, seed): the same seed
- * gives the same image whatever the device, work-group size or number of progressive passes.
- * The hash is pcg4d (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020).
+ * Every number is a pure function of (sampler, pixel, sample index, dimension, seed): the same
+ * seed gives the same image whatever the device, work-group size, number of progressive passes
+ * or devices, and pixel p's k-th sample always draws the same numbers (adaptive sampling gives
+ * pixels different sample ranges). Numbers are floats in [0, 1) with 24 random bits.
  *
- * Dimension layout, shared by both integrators (see docs or integrator code):
- *   0,1 pixel filter   2,3 lens   then LC_DIMS_PER_BOUNCE numbers per bounce starting at 4.
+ * Dimension layout, shared by both integrators. Dimensions come in aligned pairs (2k, 2k + 1),
+ * and every 2D quantity is one pair, so that a low-discrepancy sampler stratifies it in 2D:
+ *   0,1  pixel filter offset       2,3  lens point
+ *   then LC_DIMS_PER_BOUNCE = 8 per bounce, from LC_DIM_BOUNCE + 8 * depth:
+ *   +0,+1 point on the light   +2 light selection, +3 BSDF lobe   +4,+5 BSDF direction
+ *   +6 Russian roulette, +7 unused
+ * Groups of four (4k .. 4k + 3) are what one call of lc_independent_quad gives; lc_*_pair give
+ * one pair. The reference's filters draw extra pairs from dimension 0x40000000 on.
+ *
+ * Samplers (shared/registry.h, LC_SAMPLER_TYPES):
+ *  - independent: pcg4d (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020) of
+ *    (pixel, sample, dimension / 4, seed); its four output words are the numbers of the four
+ *    dimensions of the group (one hash per four numbers).
+ *  - sobol: Owen-scrambled Sobol as in Burley, "Practical Hash-based Owen Scrambling" (JCGT
+ *    2020), padded by pairs: every pair of dimensions is its own shuffled and scrambled copy of
+ *    the first two Sobol dimensions (a (0,2)-sequence). For pair g of pixel p a pcg4d of
+ *    (p, g, seed) gives three keys: the sample index is shuffled by a nested uniform scramble
+ *    keyed by the first (the first 2^k samples of any pixel map to an aligned block of 2^k Sobol
+ *    points), and each of the two coordinates is Owen-scrambled (nested uniform scrambling by a
+ *    hash) keyed by the second and third. So the first 2^k samples of every pair of every pixel
+ *    form a (0,k,2)-net (every elementary box of area 2^-k holds one point), each point is
+ *    uniform on [0,1)^2, and pairs and pixels are decorrelated by their independent keys. The
+ *    per-digit hash is Vegdahl's improved Laine-Karras permutation ("Building a Better LK Hash",
+ *    2021), applied to bit-reversed values.
  */
 #ifndef LUCENT_SHARED_RNG_H
 #define LUCENT_SHARED_RNG_H
@@ -20,18 +44,16 @@
 #define LC_DIM_BOUNCE 4u
 #define LC_DIMS_PER_BOUNCE 8u
 /* offsets inside one bounce */
-#define LC_DIM_LIGHT_SELECT 0u /* choose a light                 */
-#define LC_DIM_LIGHT_UV 1u     /* 2 numbers: point on the light  */
-#define LC_DIM_BSDF_LOBE 3u    /* choose a lobe (glass, plastic) */
-#define LC_DIM_BSDF_UV 4u      /* 2 numbers: BSDF direction      */
-#define LC_DIM_RR 6u           /* Russian roulette               */
+#define LC_DIM_LIGHT_UV 0u     /* pair: point on the light                            */
+#define LC_DIM_LIGHT_SELECT 2u /* pair with the lobe: choose a light                  */
+#define LC_DIM_BSDF_LOBE 3u    /* choose a lobe (glass, plastic)                      */
+#define LC_DIM_BSDF_UV 4u      /* pair: BSDF direction                                */
+#define LC_DIM_RR 6u           /* pair with an unused number: Russian roulette        */
 
-/* pcg4d: hashes four 32-bit words into four; returns the first. */
-LC_RNG_FN lc_uint lc_hash4(lc_uint x, lc_uint y, lc_uint z, lc_uint w) {
-  x = x * 1664525u + 1013904223u;
-  y = y * 1664525u + 1013904223u;
-  z = z * 1664525u + 1013904223u;
-  w = w * 1664525u + 1013904223u;
+/* pcg4d: hashes four 32-bit words into four, in place. */
+LC_RNG_FN void lc_pcg4d(lc_uint v[4]) {
+  lc_uint x = v[0] * 1664525u + 1013904223u, y = v[1] * 1664525u + 1013904223u;
+  lc_uint z = v[2] * 1664525u + 1013904223u, w = v[3] * 1664525u + 1013904223u;
   x += y * w;
   y += z * x;
   z += x * y;
@@ -44,12 +66,105 @@ LC_RNG_FN lc_uint lc_hash4(lc_uint x, lc_uint y, lc_uint z, lc_uint w) {
   y += z * x;
   z += x * y;
   w += y * z;
-  return x ^ w;
+  v[0] = x;
+  v[1] = y;
+  v[2] = z;
+  v[3] = w;
 }
 
-/* Uniform float in [0, 1) with 24 random bits; the same bits on host and device. */
+/* The float in [0, 1) of a 32-bit word's top 24 bits: the same bits on host and device. */
+LC_RNG_FN float lc_u01(lc_uint x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+
+/* ---- independent sampler ------------------------------------------------------------------ */
+
+/* The words of dimensions 4 group .. 4 group + 3. */
+LC_RNG_FN void lc_independent_quad(lc_uint pixel, lc_uint sample, lc_uint group, lc_uint seed,
+                                   lc_uint out[4]) {
+  out[0] = pixel;
+  out[1] = sample;
+  out[2] = group;
+  out[3] = seed;
+  lc_pcg4d(out);
+}
+
+/* The words of dimensions 2 pair and 2 pair + 1. */
+LC_RNG_FN void lc_independent_pair(lc_uint pixel, lc_uint sample, lc_uint pair, lc_uint seed,
+                                   lc_uint out[2]) {
+  lc_uint q[4];
+  lc_independent_quad(pixel, sample, pair >> 1, seed, q);
+  out[0] = q[(pair & 1u) * 2u];
+  out[1] = q[(pair & 1u) * 2u + 1u];
+}
+
+/* One number of the independent sampler (the chi-square probes' random numbers too). */
 LC_RNG_FN float lc_rng_uniform(lc_uint pixel, lc_uint sample, lc_uint dim, lc_uint seed) {
-  return (float)(lc_hash4(pixel, sample, dim, seed) >> 8) * (1.0f / 16777216.0f);
+  lc_uint q[4];
+  lc_independent_quad(pixel, sample, dim >> 2, seed, q);
+  return lc_u01(q[dim & 3u]);
+}
+
+/* ---- Owen-scrambled Sobol ----------------------------------------------------------------- */
+
+LC_RNG_FN lc_uint lc_reverse_bits(lc_uint x) {
+  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+  return (x >> 16) | (x << 16);
+}
+
+/* A random bijection of 32-bit words in which bit k of the result depends only on bits 0..k of x
+ * (each step is an add, a multiplication by an odd number or x ^= x * even): applied to
+ * bit-reversed digits it flips each digit by a hash of the digits before it, a nested uniform
+ * (Owen) scramble. Vegdahl's constants. */
+LC_RNG_FN lc_uint lc_owen_hash(lc_uint x, lc_uint seed) {
+  x ^= x * 0x3d20adeau;
+  x += seed;
+  x *= (seed >> 16) | 1u;
+  x ^= x * 0x05526c56u;
+  x ^= x * 0x53a22864u;
+  return x;
+}
+
+/* The second Sobol dimension of index i with its digits bit-reversed (bit j = digit j + 1 after
+ * the point). Its generator matrix is Pascal's triangle mod 2: digit j is the parity of the bits
+ * k of i with C(k, j) odd, i.e. (Lucas) with j a subset of k, a superset sum done in five
+ * steps. The first dimension, reversed, is i itself. */
+LC_RNG_FN lc_uint lc_sobol1_reversed(lc_uint i) {
+  i ^= (i >> 1) & 0x55555555u;
+  i ^= (i >> 2) & 0x33333333u;
+  i ^= (i >> 4) & 0x0f0f0f0fu;
+  i ^= (i >> 8) & 0x00ff00ffu;
+  i ^= (i >> 16) & 0x0000ffffu;
+  return i;
+}
+
+/* The words of dimensions 2 pair and 2 pair + 1 of sample `sample` of pixel `pixel`. */
+LC_RNG_FN void lc_sobol_pair(lc_uint pixel, lc_uint sample, lc_uint pair, lc_uint seed,
+                             lc_uint out[2]) {
+  lc_uint key[4];
+  key[0] = pixel;
+  key[1] = pair;
+  key[2] = seed;
+  key[3] = 0x50b01u; /* keys differ from the independent sampler's words */
+  lc_pcg4d(key);
+  /* shuffled index: nested uniform scramble of the sample index (on its reversed bits) */
+  lc_uint i = lc_reverse_bits(lc_owen_hash(lc_reverse_bits(sample), key[0]));
+  out[0] = lc_reverse_bits(lc_owen_hash(i, key[1]));
+  out[1] = lc_reverse_bits(lc_owen_hash(lc_sobol1_reversed(i), key[2]));
+}
+
+/* The stream seed of half `stream` of an adaptive render (session.cpp): stream 0 is the seed
+ * itself, so that its samples are those of a uniform render; stream 1 is independent of it. */
+LC_RNG_FN lc_uint lc_stream_seed(lc_uint seed, lc_uint stream) {
+  if (stream == 0u) return seed;
+  lc_uint k[4];
+  k[0] = seed;
+  k[1] = stream;
+  k[2] = 0x5eedu;
+  k[3] = 0xada97u;
+  lc_pcg4d(k);
+  return k[0];
 }
 
 #endif /* LUCENT_SHARED_RNG_H */

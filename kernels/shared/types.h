@@ -42,12 +42,14 @@ typedef struct LC_ALIGN16 {
 /* Registry enums and their checks                                                            */
 /* ------------------------------------------------------------------------------------------ */
 /* Device constants from shared/registry.h: LC_MAT_<ID>, LC_LIGHT_<ID>, LC_SHAPE_<ID>,
- * LC_INTEGRATOR_<ID> (integrators, then AOVs), LC_FILTER_<ID>, and LC_<CONCEPT>_COUNT. */
+ * LC_INTEGRATOR_<ID> (integrators, then AOVs), LC_FILTER_<ID>, LC_SAMPLER_<ID>, and
+ * LC_<CONCEPT>_COUNT. */
 #define LC_ENUM_MAT(ID, Name, value, ...) LC_MAT_##ID = value,
 #define LC_ENUM_LIGHT(ID, Name, value, ...) LC_LIGHT_##ID = value,
 #define LC_ENUM_SHAPE(ID, Name, value, ...) LC_SHAPE_##ID = value,
 #define LC_ENUM_INTEGRATOR(ID, Name, value, ...) LC_INTEGRATOR_##ID = value,
 #define LC_ENUM_FILTER(ID, Name, value, ...) LC_FILTER_##ID = value,
+#define LC_ENUM_SAMPLER(ID, Name, value, ...) LC_SAMPLER_##ID = value,
 #define LC_ENUM_ONE(...) +1
 enum { LC_MATERIAL_TYPES(LC_ENUM_MAT) LC_MAT_COUNT = 0 LC_MATERIAL_TYPES(LC_ENUM_ONE) };
 enum { LC_LIGHT_TYPES(LC_ENUM_LIGHT) LC_LIGHT_COUNT = 0 LC_LIGHT_TYPES(LC_ENUM_ONE) };
@@ -59,6 +61,7 @@ enum {
   LC_INTEGRATOR_COUNT = 0 LC_INTEGRATOR_TYPES(LC_ENUM_ONE) LC_AOV_TYPES(LC_ENUM_ONE)
 };
 enum { LC_FILTER_TYPES(LC_ENUM_FILTER) LC_FILTER_COUNT = 0 LC_FILTER_TYPES(LC_ENUM_ONE) };
+enum { LC_SAMPLER_TYPES(LC_ENUM_SAMPLER) LC_SAMPLER_COUNT = 0 LC_SAMPLER_TYPES(LC_ENUM_ONE) };
 
 /* Each list's values are 0, 1, ..., count - 1 in list order: a sum of count powers of two is
  * 2^count - 1 only when they are exactly those (a repeated or missing value breaks it), and each
@@ -69,11 +72,13 @@ enum { LC_FILTER_TYPES(LC_ENUM_FILTER) LC_FILTER_COUNT = 0 LC_FILTER_TYPES(LC_EN
 #define LC_POS_SHAPE(ID, ...) LC_SHAPE_POS_##ID,
 #define LC_POS_INTEGRATOR(ID, ...) LC_INTEGRATOR_POS_##ID,
 #define LC_POS_FILTER(ID, ...) LC_FILTER_POS_##ID,
+#define LC_POS_SAMPLER(ID, ...) LC_SAMPLER_POS_##ID,
 enum { LC_MATERIAL_TYPES(LC_POS_MAT) LC_MAT_POS_END_ };
 enum { LC_LIGHT_TYPES(LC_POS_LIGHT) LC_LIGHT_POS_END_ };
 enum { LC_SHAPE_TYPES(LC_POS_SHAPE) LC_SHAPE_POS_END_ };
 enum { LC_INTEGRATOR_TYPES(LC_POS_INTEGRATOR) LC_AOV_TYPES(LC_POS_INTEGRATOR) LC_INT_POS_END_ };
 enum { LC_FILTER_TYPES(LC_POS_FILTER) LC_FILTER_POS_END_ };
+enum { LC_SAMPLER_TYPES(LC_POS_SAMPLER) LC_SAMPLER_POS_END_ };
 #define LC_CHECK_MAT(ID, ...) \
   LC_STATIC_ASSERT((int)LC_MAT_##ID == (int)LC_MAT_POS_##ID, mat_order_##ID);
 #define LC_CHECK_LIGHT(ID, ...) \
@@ -90,6 +95,9 @@ LC_SHAPE_TYPES(LC_CHECK_SHAPE)
 LC_INTEGRATOR_TYPES(LC_CHECK_INTEGRATOR)
 LC_AOV_TYPES(LC_CHECK_INTEGRATOR)
 LC_FILTER_TYPES(LC_CHECK_FILTER)
+#define LC_CHECK_SAMPLER(ID, ...) \
+  LC_STATIC_ASSERT((int)LC_SAMPLER_##ID == (int)LC_SAMPLER_POS_##ID, sampler_order_##ID);
+LC_SAMPLER_TYPES(LC_CHECK_SAMPLER)
 LC_STATIC_ASSERT((0u LC_MATERIAL_TYPES(LC_VALUE_BIT)) == (1u << LC_MAT_COUNT) - 1u,
                  material_values);
 LC_STATIC_ASSERT((0u LC_LIGHT_TYPES(LC_VALUE_BIT)) == (1u << LC_LIGHT_COUNT) - 1u, light_values);
@@ -98,6 +106,8 @@ LC_STATIC_ASSERT((0u LC_INTEGRATOR_TYPES(LC_VALUE_BIT) LC_AOV_TYPES(LC_VALUE_BIT
                      (1u << LC_INTEGRATOR_COUNT) - 1u,
                  integrator_values);
 LC_STATIC_ASSERT((0u LC_FILTER_TYPES(LC_VALUE_BIT)) == (1u << LC_FILTER_COUNT) - 1u, filter_values);
+LC_STATIC_ASSERT((0u LC_SAMPLER_TYPES(LC_VALUE_BIT)) == (1u << LC_SAMPLER_COUNT) - 1u,
+                 sampler_values);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Materials                                                                                  */
@@ -289,13 +299,16 @@ typedef struct LC_ALIGN16 lc_params {
   float filter_radius; /* in pixels                                          */
   float ao_distance;   /* ambient occlusion ray length (INFINITY: unbounded) */
   lc_uint flags;
-  lc_uint pad[3];
-} lc_params; /* total: 144 bytes */
+  lc_uint sampler;    /* LC_SAMPLER_*                                       */
+  float clamp;        /* path: bound of a scattered contribution (0: off)   */
+  lc_uint work_items; /* 0: every pixel; else the length of the work list  */
+} lc_params;          /* total: 144 bytes */
 LC_STATIC_ASSERT(sizeof(lc_params) == 144, params_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, width) == 64, params_width);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, num_triangles) == 96, params_num_triangles);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, env_light) == 112, params_env_light);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, filter) == 116, params_filter);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, sampler) == 132, params_sampler);
 
 /* lc_params.flags */
 #define LC_FLAG_NO_MIS 1u /* path: light sampling only for area lights (no BSDF-hit emission) */

@@ -46,6 +46,8 @@ const EnumNames<FilterType>& enum_names<FilterType>();
 template <>
 const EnumNames<ShapeType>& enum_names<ShapeType>();
 template <>
+const EnumNames<SamplerType>& enum_names<SamplerType>();
+template <>
 const EnumNames<Transfer>& enum_names<Transfer>();
 template <>
 const EnumNames<ToneMap>& enum_names<ToneMap>();

@@ -46,6 +46,12 @@ const EnumNames<ShapeType>& enum_names<ShapeType>() {
   static const EnumNames<Enum> t{"shape type", {LC_SHAPE_TYPES(LUCENT_PY_NAME)}};
   return t;
 }
+template <>
+const EnumNames<SamplerType>& enum_names<SamplerType>() {
+  using Enum = SamplerType;
+  static const EnumNames<Enum> t{"sampler", {LC_SAMPLER_TYPES(LUCENT_PY_NAME)}};
+  return t;
+}
 #undef LUCENT_PY_NAME
 
 // Not in the registries: the film's display settings (scene-file names) and the precision.
@@ -208,6 +214,7 @@ PYBIND11_MODULE(lucent, m) {
   m.attr("LIGHT_TYPES") = enum_name_tuple<LightType>();
   m.attr("INTEGRATORS") = enum_name_tuple<IntegratorType>();
   m.attr("FILTER_TYPES") = enum_name_tuple<FilterType>();
+  m.attr("SAMPLERS") = enum_name_tuple<SamplerType>();
   m.attr("TRANSFERS") = enum_name_tuple<Transfer>();
   m.attr("TONEMAPS") = enum_name_tuple<ToneMap>();
 

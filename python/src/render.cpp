@@ -21,8 +21,9 @@ namespace {
   X(bvh_builds)                                                                                 \
   X(kernel_compiles)                                                                            \
   X(kernel_cache_loads)                                                                         \
-  X(kernel_reuses) X(buffer_uploads) X(bytes_uploaded) X(passes) X(pack_seconds) X(bvh_seconds) \
-      X(build_seconds) X(render_seconds)
+  X(kernel_reuses)                                                                              \
+  X(buffer_uploads) X(bytes_uploaded) X(passes) X(pack_seconds) X(bvh_seconds) X(build_seconds) \
+      X(render_seconds)
 
 #define LUCENT_PY_PROGRESS(X) \
   X(samples_done) X(samples_target) X(accumulated) X(elapsed) X(time_limit) X(samples_per_second)
@@ -138,17 +139,32 @@ class PyRenderer {
   /// an exception it raises, or Ctrl-C, stops the render after the current pass and is raised
   /// once the render returned. The accumulation keeps what was rendered.
   RenderProgress render(std::uint64_t spp, double seconds, py::object progress) {
+    return run_with_progress(std::move(progress), [&](Renderer& r, const ProgressFn& on_progress) {
+      return r.render(spp, seconds, on_progress);
+    });
+  }
+
+  RenderProgress render_adaptive(const AdaptiveOptions& options, py::object progress) {
+    return run_with_progress(std::move(progress), [&](Renderer& r, const ProgressFn& on_progress) {
+      return r.render_adaptive(options, on_progress);
+    });
+  }
+
+  using ProgressFn = std::function<void(const RenderProgress&)>;
+  /// Runs `f(renderer, on_progress)` interruptibly, with `progress` (a callable or None) called
+  /// under the GIL after each pass.
+  template <class F>
+  RenderProgress run_with_progress(py::object progress, F&& f) {
     check_callable(progress, "progress");
     CallbackErrors errors;
-    std::function<void(const RenderProgress&)> on_progress;
+    ProgressFn on_progress;
     if (!progress.is_none())
       on_progress = [&](const RenderProgress& p) {
         py::gil_scoped_acquire gil;
         if (!errors.run([&] { progress(p); })) stop_ = true;
       };
     RenderProgress out;
-    call_interruptible(
-        [&](Renderer& r, std::atomic<bool>&) { out = r.render(spp, seconds, on_progress); });
+    call_interruptible([&](Renderer& r, std::atomic<bool>&) { out = f(r, on_progress); });
     errors.rethrow();
     return out;
   }
@@ -311,6 +327,10 @@ void bind_render(py::module_& m) {
       .def_property_readonly("height", [](const RenderResult& r) { return r.mean.height; })
       .def_readonly("spp", &RenderResult::spp)
       .def_readonly("nonfinite", &RenderResult::nonfinite)
+      .def_readonly("estimated_relmse", &RenderResult::estimated_relmse,
+                    "an adaptive render's estimate of its relMSE (0: not adaptive)")
+      .def_readonly("target_error", &RenderResult::target_error,
+                    "the relMSE an adaptive render aimed at (0: not adaptive)")
       .def_readonly("rays", &RenderResult::rays)
       .def_readonly("seconds", &RenderResult::seconds)
       .def_readonly("build_seconds", &RenderResult::build_seconds)
@@ -383,6 +403,30 @@ void bind_render(py::module_& m) {
           "limit of that kind). progress(RenderProgress) is called after each pass. Ctrl-C stops "
           "after the current pass (the accumulation keeps it) and raises KeyboardInterrupt.")
       .def(
+          "render_adaptive",
+          [](PyRenderer& r, double target_error, double budget_spp, long long min_spp,
+             long long max_spp, double max_seconds, py::object progress) {
+            AdaptiveOptions o;
+            o.target_error = checked_seconds(target_error, "target_error");
+            o.budget_spp = checked_seconds(budget_spp, "budget_spp");
+            if (!(o.target_error > 0) && !(o.budget_spp > 0))
+              throw py::value_error("render_adaptive: give target_error > 0 or budget_spp > 0");
+            o.min_spp = static_cast<std::uint32_t>(std::min<std::uint64_t>(
+                checked_spp(min_spp, false), std::numeric_limits<std::uint32_t>::max()));
+            o.max_spp = static_cast<std::uint32_t>(std::min<std::uint64_t>(
+                checked_spp(max_spp, false), std::numeric_limits<std::uint32_t>::max()));
+            o.max_seconds = checked_seconds(max_seconds, "max_seconds");
+            return r.render_adaptive(o, std::move(progress));
+          },
+          py::arg("target_error") = 0.0, py::arg("budget_spp") = 0.0, py::arg("min_spp") = 64,
+          py::arg("max_spp") = 16384, py::arg("max_seconds") = 0.0,
+          py::arg("progress") = py::none(),
+          "Adaptive sampling (the CLI's --target-error): a pilot of min_spp samples per pixel, "
+          "then more where the error is high, until the estimated relMSE is at most target_error "
+          "(or the samples average budget_spp per pixel), at most max_spp per pixel, within "
+          "max_seconds (0: no limit). Unbiased; result().estimated_relmse says what it reached. "
+          "Ends the uniform accumulation: call reset() before a uniform render.")
+      .def(
           "render_for",
           [](PyRenderer& r, double seconds, py::object progress) {
             if (!(seconds > 0) || !std::isfinite(seconds))
@@ -445,6 +489,8 @@ void bind_render(py::module_& m) {
       .def_readonly("rmse", &ConvergePoint::rmse)
       .def_readonly("relmse", &ConvergePoint::relmse)
       .def_readonly("noise_relmse", &ConvergePoint::noise_relmse)
+      .def_readonly("reference_noise_relmse", &ConvergePoint::reference_noise_relmse)
+      .def_readonly("estimated_relmse", &ConvergePoint::estimated_relmse)
       .def("__repr__", [](const ConvergePoint& p) {
         return "<lucent.ConvergePoint " + p.setting + " " + std::to_string(p.spp) +
                " spp, relMSE " + std::to_string(p.relmse) + ">";

@@ -349,8 +349,11 @@ void bind_scene(py::module_& m) {
       .def_readwrite("spp", &Integrator::spp)
       .def_readwrite("seed", &Integrator::seed)
       .def_readwrite("ao_distance", &Integrator::ao_distance)
-      .def_readwrite("mis", &Integrator::mis);
+      .def_readwrite("mis", &Integrator::mis)
+      .def_readwrite("clamp", &Integrator::clamp,
+                     "the largest sample contribution (0: off); biased, lower variance");
   enum_property(integrator, "type", &Integrator::type);
+  enum_property(integrator, "sampler", &Integrator::sampler);
 
   py::class_<Material> material(m, "Material", "type: MATERIAL_TYPES; README, \"materials\".");
   material.def(py::init<>())

@@ -344,3 +344,37 @@ def test_python_render_equals_the_cli_render(tmp_path, small_dict):
     # equal up to the float summation order of passes (their split depends on timing)
     np.testing.assert_allclose(mine.mean, theirs.mean, rtol=1e-5, atol=1e-6)
     np.testing.assert_array_equal(mine.samples, theirs.samples)
+
+
+def test_samplers_clamp_and_adaptive(renderer, small_scene):
+    """The sampling knobs of the CLI (--sampler, --clamp, --target-error) from Python."""
+    images = {}
+    for name in lucent.SAMPLERS:
+        small_scene.integrator.sampler = name
+        renderer.set_scene(small_scene)
+        renderer.render(4)
+        images[name] = renderer.result().mean.copy()
+    assert not np.array_equal(images["sobol"], images["independent"]), "other random numbers"
+    with pytest.raises(ValueError):
+        small_scene.integrator.sampler = "halton"
+
+    # clamping only removes energy: never brighter than the unclamped render of the same samples
+    small_scene.integrator.sampler = "independent"
+    small_scene.integrator.clamp = 0.05
+    renderer.set_scene(small_scene)
+    renderer.render(4)
+    clamped = renderer.result().mean
+    assert clamped.mean() < images["independent"].mean()
+    assert (clamped <= images["independent"] + 1e-6).all()
+
+    small_scene.integrator.clamp = 0
+    renderer.set_scene(small_scene)
+    renderer.reset()
+    renderer.render_adaptive(target_error=0.05, min_spp=8, max_spp=256)
+    r = renderer.result()
+    assert 0 < r.estimated_relmse <= 0.05 and r.target_error == 0.05
+    assert r.samples.min() >= 8 and r.samples.max() <= 256
+    with pytest.raises(ValueError):
+        renderer.render_adaptive()  # neither a target nor a budget
+    with pytest.raises(ValueError):
+        renderer.render_adaptive(target_error=float("nan"))

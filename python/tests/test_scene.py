@@ -38,6 +38,7 @@ def test_registry_names():
     assert lucent.INTEGRATORS == ("path", "whitted", "direct", "albedo", "normal", "depth", "ao",
                                   "primitive")
     assert lucent.FILTER_TYPES == ("box", "tent", "gaussian")
+    assert lucent.SAMPLERS == ("sobol", "independent")
     assert lucent.LIGHT_TYPES[0] == "point" and "environment_map" in lucent.LIGHT_TYPES
     assert lucent.TRANSFERS == ("srgb", "gamma", "linear")
     assert lucent.TONEMAPS == ("clamp", "reinhard", "aces")
@@ -45,7 +46,7 @@ def test_registry_names():
     registry = (SOURCE_DIR / "kernels" / "shared" / "registry.h").read_text()
     for name in re.findall(r'X\(\w+, \w+, \d+, "(\w+)"', registry):
         assert name in (lucent.MATERIAL_TYPES + lucent.LIGHT_TYPES + lucent.INTEGRATORS +
-                        lucent.FILTER_TYPES + ("sphere", "triangles")), name
+                        lucent.FILTER_TYPES + lucent.SAMPLERS + ("sphere", "triangles")), name
 
 
 @pytest.mark.parametrize("cls, header, struct", [

@@ -2,6 +2,7 @@
 // and several speed/accuracy settings; prints the table and the fitted slopes, writes a CSV and an
 // SVG plot (lucent/converge.hpp).
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
@@ -10,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -105,7 +107,9 @@ CLI::App* add_converge_command(CLI::App& app) {
                   "Comma-separated settings, knobs joined by +: default, fast-math, "
                   "double, float, no-specialize, no-mis, mis, max_depth=N, rr_depth=N, filter=" +
                       type_names<FilterType>("|") +
-                      "[:R], integrator=" + type_names<IntegratorType>("|") + " (default: default)")
+                      "[:R], integrator=" + type_names<IntegratorType>("|") +
+                      ", sampler=" + type_names<SamplerType>("|") +
+                      ", clamp=X, adaptive, min-spp=N, target-error=E (default: default)")
       ->delimiter(',');
   auto* spp = cmd->add_option("--spp-ladder", a.spp_ladder, "Samples per pixel of each rung")
                   ->delimiter(',')
@@ -124,6 +128,29 @@ CLI::App* add_converge_command(CLI::App& app) {
   cmd->add_option("--device", a.device, "OpenCL device: index or name substring");
   cmd->add_flag("-q,--quiet", a.quiet, "Print only the slopes");
   return cmd;
+}
+
+/// What a setting buys: the time each setting takes to reach the largest of the settings' last
+/// errors (an error every setting reaches), against the first setting's.
+void print_time_to_common_error(const ConvergeResult& result) {
+  if (result.fits.size() < 2) return;
+  double common = 0;
+  std::map<std::string, std::vector<ConvergePoint>> by_setting;
+  for (const ConvergePoint& p : result.points) by_setting[p.setting].push_back(p);
+  for (const ConvergeFit& f : result.fits) {
+    const auto& pts = by_setting[f.setting];
+    if (!pts.empty()) common = std::max(common, pts.back().relmse);
+  }
+  if (!(common > 0)) return;
+  std::printf("\ntime to relMSE %.3g (reached by every setting; interpolated on log-log axes):\n",
+              common);
+  double first = 0;
+  for (const ConvergeFit& f : result.fits) {
+    const double t = time_to_relmse(by_setting[f.setting], common);
+    if (first == 0) first = t;
+    std::printf("  %-22s %9.3f s  (x%.2f of %s)\n", f.setting.c_str(), t,
+                first > 0 ? t / first : 0.0, result.fits.front().setting.c_str());
+  }
 }
 
 int run_converge_command() {
@@ -177,6 +204,8 @@ int run_converge_command() {
                                   : (opt.time_ladder.empty() ? std::max(256, 16 * largest) : 1024);
     Scene rs = scene;
     rs.integrator.seed = reference_seed(scene.integrator.seed);  // independent of the ladder
+    // independent samples: the reference's own noise is what its variances say
+    rs.integrator.sampler = SamplerType::Independent;
     if (!a.quiet)
       std::fprintf(stderr, "reference: %d spp with the %s (seed %u)...\n", spp,
                    a.reference_cpu ? "reference integrator" : "kernel",
@@ -218,6 +247,8 @@ int run_converge_command() {
   for (const ConvergeFit& f : result.fits)
     std::printf("  %-22s %6.2f  (against spp %5.2f, last 3 rungs %5.2f)  %s\n", f.setting.c_str(),
                 f.slope_time, f.slope_spp, f.tail_slope_spp, f.verdict.c_str());
+
+  print_time_to_common_error(result);
 
   if (!a.csv.empty()) write_text(a.csv, convergence_csv(result));
   const std::string title = std::filesystem::path(a.scene).filename().string() + ", " +

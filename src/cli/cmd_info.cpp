@@ -24,6 +24,7 @@ struct InfoArgs {
   std::string precision = "float";
   bool fast_math = false;
   bool no_specialize = false;
+  SamplingArgs sampling;
 };
 
 InfoArgs& args() {
@@ -69,6 +70,7 @@ CLI::App* add_info_command(CLI::App& app) {
                 "Show the build options with -cl-fast-relaxed-math");
   cmd->add_flag("--no-specialize", args().no_specialize,
                 "Show the build options of the full kernel");
+  add_sampling_options(cmd, args().sampling, false);
   return cmd;
 }
 
@@ -76,6 +78,7 @@ int run_info_command() {
   const std::string& path = args().scene;
   Scene scene = load_scene(path);
   if (!args().integrator.empty()) scene.integrator.type = parse_integrator(args().integrator);
+  apply_sampling_options(args().sampling, scene);
   render_detail::PackedScene packed = render_detail::pack_scene(scene);
 
   std::printf("scene         %s\n", path.c_str());
@@ -85,6 +88,11 @@ int run_info_command() {
               static_cast<unsigned>(scene.integrator.seed));
   std::printf("filter        %s, radius %g\n", type_name(scene.film.filter.type),
               scene.film.filter.radius);
+  std::printf("sampler       %s\n", type_name(scene.integrator.sampler));
+  if (scene.integrator.clamp > 0)
+    std::printf("clamp         %g\n", scene.integrator.clamp);
+  else
+    std::printf("clamp         off\n");
 
   // the shape list as written: its entries by type (OBJ files apart), then the primitives
   std::map<ShapeType, std::size_t> by_shape;

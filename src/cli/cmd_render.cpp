@@ -129,6 +129,7 @@ struct RenderArgs {
   bool fast_math = false;
   std::string precision = "float";
   bool no_specialize = false;
+  lucent::cli::SamplingArgs sampling;  ///< --sampler, --clamp, --target-error, --min-spp
 };
 
 /// <output stem>.<name>.exr beside the main output.
@@ -191,6 +192,8 @@ int render_with(const RenderArgs& a) {
     throw lucent::Error("--time is not supported with --reference");
   if (a.reference && !a.aovs.empty())
     throw lucent::Error("--aov is not supported with --reference");
+  if (a.reference && a.sampling.target_error > 0)
+    throw lucent::Error("--target-error is not supported with --reference");
   check_output_path(a.output, {a.scene});
   for (const std::string& name : a.aovs)
     check_output_path(aov_path(a.output, name), {a.scene, a.output});
@@ -214,6 +217,7 @@ int render_with(const RenderArgs& a) {
   if (a.height > 0) scene.film.height = a.height;
   if (a.seed >= 0) scene.integrator.seed = static_cast<std::uint32_t>(a.seed);
   if (!a.integrator.empty()) scene.integrator.type = lucent::cli::parse_integrator(a.integrator);
+  lucent::cli::apply_sampling_options(a.sampling, scene);
 
   lucent::RenderOptions opt;
   opt.spp = a.spp;
@@ -262,7 +266,11 @@ int render_with(const RenderArgs& a) {
     std::uint64_t spp = a.spp > 0 ? static_cast<std::uint64_t>(a.spp)
                                   : (a.time_limit > 0 ? 0 : scene.integrator.spp);
     auto t0 = std::chrono::steady_clock::now();
-    renderer->render(spp, a.time_limit, opt.on_progress);
+    if (a.sampling.target_error > 0)
+      renderer->render_adaptive(lucent::cli::adaptive_options(a.sampling, a.spp, a.time_limit),
+                                opt.on_progress);
+    else
+      renderer->render(spp, a.time_limit, opt.on_progress);
     wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     r = renderer->result();
   }
@@ -289,6 +297,10 @@ int render_with(const RenderArgs& a) {
         seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / seconds * 1e-6 : 0,
         seconds > 0 ? double(r.rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
         r.device.c_str(), device_shares(r.devices).c_str());
+  if (!a.quiet && r.target_error > 0)
+    std::fprintf(stderr, "%s: adaptive: %llu spp on average, estimated relMSE %.3g (target %.3g)\n",
+                 a.output.c_str(), static_cast<unsigned long long>(r.spp), r.estimated_relmse,
+                 r.target_error);
   if (!r.cancelled && !a.reference) write_aovs(a, scene, &*renderer, r);
   if (r.cancelled || g_interrupted.load()) {
     const int sig = g_signal ? static_cast<int>(g_signal) : SIGINT;
@@ -320,7 +332,10 @@ CLI::App* add_render_command(CLI::App& app) {
       ->add_option("-o,--output", ra.output,
                    "Output image: .png (8-bit sRGB), .pfm or .exr (linear)")
       ->required();
-  render->add_option("--spp", ra.spp, "Samples per pixel (default: the scene's integrator.spp)")
+  render
+      ->add_option("--spp", ra.spp,
+                   "Samples per pixel (default: the scene's integrator.spp; with --target-error "
+                   "the most per pixel, default 16384)")
       ->check(CLI::Range(1, lucent::limits::kMaxSpp));
   render->add_option("--time", ra.time_limit, "Stop after this many seconds of rendering")
       ->check(CLI::PositiveNumber)
@@ -355,6 +370,7 @@ CLI::App* add_render_command(CLI::App& app) {
       ->check(CLI::IsMember(lucent::cli::aov_names()));
   render->add_flag("--reference", ra.reference,
                    "Render with the scalar CPU reference integrator instead of the kernel");
+  lucent::cli::add_sampling_options(render, ra.sampling, true);
 
   return render;
 }

@@ -37,6 +37,20 @@ CLI::App* add_render_command(CLI::App& app);
 int run_render_command();
 const std::string& render_scene();
 
+/// The sampling options of `render` (and --sampler, --clamp of `info`): src/cli/sampling.cpp.
+struct SamplingArgs {
+  std::string sampler;      ///< "" : the scene's integrator.sampler
+  double clamp = -1;        ///< < 0: the scene's integrator.clamp
+  double target_error = 0;  ///< > 0: adaptive sampling to this relMSE
+  int min_spp = 0;          ///< adaptive: the pilot (0: the default)
+};
+/// Adds --sampler and --clamp (and, with `adaptive`, --target-error and --min-spp) to `cmd`.
+void add_sampling_options(CLI::App* cmd, SamplingArgs& args, bool adaptive);
+/// Applies --sampler and --clamp to the scene.
+void apply_sampling_options(const SamplingArgs& args, Scene& scene);
+/// The adaptive render of --target-error: --min-spp, --spp as the maximum, --time.
+AdaptiveOptions adaptive_options(const SamplingArgs& args, int max_spp, double time_limit);
+
 /// Adds the extra subcommands (info, ...) to `app`.
 void register_extra_commands(CLI::App& app);
 

@@ -43,7 +43,7 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
         const size_t i = static_cast<size_t>(y) * W + x;
         for (int k = 0; k < spp; ++k) {
           ref::Sampler rng{static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k),
-                           scene.integrator.seed};
+                           scene.integrator.seed, scene.integrator.sampler};
           glm::dvec3 v = ref::radiance(tracer, camera.ray(x, y, rng), rng);
           if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
             ++my_nonfinite;

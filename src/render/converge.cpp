@@ -6,14 +6,15 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <optional>
 #include <sstream>
 
 #include "image/plot_svg.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
-#include "lucent/session.hpp"
 #include "lucent/limits.hpp"
+#include "lucent/session.hpp"
 #include "lucent/types.hpp"
 
 namespace lucent {
@@ -46,6 +47,16 @@ double log_log_slope(const std::vector<double>& x, const std::vector<double>& y)
   return (n * sxy - sx * sy) / den;
 }
 
+/// A finite number >= lo (> lo when `strict`).
+double parse_number(const std::string& knob, const std::string& value, double lo, bool strict) {
+  char* end = nullptr;
+  double v = std::strtod(value.c_str(), &end);
+  if (value.empty() || *end != '\0' || !std::isfinite(v) || (strict ? !(v > lo) : !(v >= lo)))
+    throw Error("setting " + knob + ": expected a number " + (strict ? ">" : ">=") + " " +
+                std::to_string(static_cast<int>(lo)));
+  return v;
+}
+
 std::string fmt(const char* f, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, f, v);
@@ -74,6 +85,20 @@ double noise_relmse(const RenderResult& a, const RenderResult& ref) {
   return sum / (3.0 * double(npix));
 }
 
+/// The reference's own expected share of a relMSE against it: mean of var_R / n_R / (R^2 + 0.01).
+double reference_noise(const RenderResult& ref) {
+  const std::size_t npix = static_cast<std::size_t>(ref.mean.width) * ref.mean.height;
+  if (npix == 0 || ref.variance.rgb.size() != npix * 3 || ref.samples.size() != npix) return 0;
+  double sum = 0;
+  for (std::size_t i = 0; i < npix; ++i)
+    for (int c = 0; c < 3; ++c) {
+      if (ref.samples[i] < 2) continue;
+      double r = ref.mean.rgb[i * 3 + c];
+      sum += ref.variance.rgb[i * 3 + c] / double(ref.samples[i]) / (r * r + 0.01);
+    }
+  return sum / (3.0 * double(npix));
+}
+
 }  // namespace
 
 void ConvergeSetting::apply(Scene& scene, RenderOptions& options) const {
@@ -90,6 +115,8 @@ void ConvergeSetting::apply(Scene& scene, RenderOptions& options) const {
     scene.film.filter.type = t;
   }
   if (filter_radius > 0) scene.film.filter.radius = filter_radius;
+  if (sampler >= 0) scene.integrator.sampler = static_cast<SamplerType>(sampler);
+  if (clamp >= 0) scene.integrator.clamp = clamp;
 }
 
 ConvergeSetting parse_converge_setting(const std::string& text) {
@@ -153,6 +180,22 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
                       fmt("%g", limits::kMaxFilterRadius) + "] pixels");
         s.filter_radius = r;
       }
+    } else if (key == "sampler") {
+      std::optional<SamplerType> t = find_type<SamplerType>(value);
+      if (!t)
+        throw Error("setting " + knob + ": unknown sampler (expected " + type_names<SamplerType>() +
+                    ")");
+      s.sampler = static_cast<int>(*t);
+    } else if (key == "clamp") {
+      s.clamp = parse_number(knob, value, 0, false);
+    } else if (key == "adaptive") {
+      no_value();
+      s.adaptive = true;
+    } else if (key == "min_spp") {
+      s.min_spp = parse_positive_int(key, value, limits::kMaxSpp);
+      if (s.min_spp < 4) throw Error("setting " + knob + ": the pilot needs at least 4 spp");
+    } else if (key == "target_error") {
+      s.target_error = parse_number(knob, value, 0, true);
     } else if (key == "integrator") {
       std::optional<IntegratorType> t = find_type<IntegratorType>(value);
       if (!t)
@@ -162,10 +205,16 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
     } else {
       throw Error("setting '" + text + "': unknown knob '" + knob +
                   "' (expected default, fast-math, double, float, no-specialize, no-mis, mis, "
-                  "max_depth=N, rr_depth=N, filter=" + type_names<FilterType>("|") +
-                  "[:R], integrator=NAME, joined by +)");
+                  "max_depth=N, rr_depth=N, filter=" +
+                  type_names<FilterType>("|") +
+                  "[:R], integrator=NAME, sampler=" + type_names<SamplerType>("|") +
+                  ", clamp=X, adaptive, min-spp=N, target-error=E, joined by +)");
     }
   }
+  if (s.adaptive && s.target_error > 0)
+    throw Error("setting '" + text + "': adaptive and target-error exclude each other");
+  if (s.min_spp > 0 && !s.adaptive && !(s.target_error > 0))
+    throw Error("setting '" + text + "': min-spp needs adaptive or target-error");
   return s;
 }
 
@@ -264,16 +313,32 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
   CompareOptions co;
   co.image_mean_test = false;
   bool cancelled = false;
+  const double ref_noise = reference_noise(reference);
   for (const ConvergeSetting& setting : settings) {
     Scene s = scene;
     RenderOptions o = options.render;
     setting.apply(s, o);
+    const bool adaptive = setting.adaptive || setting.target_error > 0;
+    if (adaptive && by_time)
+      throw Error("converge: setting " + setting.name + " is adaptive: use an spp ladder");
     renderer->set_build_options(o.precision, o.fast_math, o.specialize);
     renderer->set_scene(s);
     renderer->reset();
+    AdaptiveOptions ao;
+    if (setting.min_spp > 0) ao.min_spp = static_cast<std::uint32_t>(setting.min_spp);
     std::vector<ConvergePoint> pts;
-    for (std::size_t i = 0; i < rungs && !cancelled; ++i) {
-      if (by_time) {
+    // a target-error setting is one render, whatever the ladder
+    const std::size_t setting_rungs = setting.target_error > 0 ? 1 : rungs;
+    for (std::size_t i = 0; i < setting_rungs && !cancelled; ++i) {
+      if (setting.target_error > 0) {
+        ao.target_error = setting.target_error;
+        renderer->render_adaptive(ao, options.render.on_progress);
+      } else if (setting.adaptive) {
+        // the rungs' budgets rise: each continues the previous rung's render
+        if (options.spp_ladder[i] < static_cast<int>(ao.min_spp)) continue;
+        ao.budget_spp = options.spp_ladder[i];
+        renderer->render_adaptive(ao, options.render.on_progress);
+      } else if (by_time) {
         double t = options.time_ladder[i];
         if (t <= renderer->result().seconds) renderer->reset();
         renderer->render(0, t - renderer->result().seconds, options.render.on_progress);
@@ -299,6 +364,8 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
       p.rmse = c.rmse;
       p.relmse = c.relmse;
       p.noise_relmse = noise_relmse(r, reference);
+      p.reference_noise_relmse = ref_noise;
+      p.estimated_relmse = r.estimated_relmse;
       if (options.on_point) options.on_point(p);
       pts.push_back(p);
     }
@@ -312,7 +379,9 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
 }
 
 std::string convergence_csv(const ConvergeResult& result) {
-  std::string out = "setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s\n";
+  std::string out =
+      "setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s,"
+      "reference_noise_relmse,estimated_relmse\n";
   char buf[256];
   for (const ConvergePoint& p : result.points) {
     std::string name = p.setting;
@@ -321,12 +390,27 @@ std::string convergence_csv(const ConvergeResult& result) {
       for (char c : name) q += c == '"' ? std::string("\"\"") : std::string(1, c);
       name = q + "\"";
     }
-    std::snprintf(buf, sizeof buf, ",%llu,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n",
+    std::snprintf(buf, sizeof buf, ",%llu,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n",
                   static_cast<unsigned long long>(p.spp), p.seconds, p.samples_per_second, p.rmse,
-                  p.relmse, p.noise_relmse, p.rays_per_second);
+                  p.relmse, p.noise_relmse, p.rays_per_second, p.reference_noise_relmse,
+                  p.estimated_relmse);
     out += name + buf;
   }
   return out;
+}
+
+double time_to_relmse(const std::vector<ConvergePoint>& points, double error) {
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const ConvergePoint& b = points[i];
+    if (!(b.relmse <= error)) continue;
+    if (i == 0) return b.seconds;
+    const ConvergePoint& a = points[i - 1];
+    if (!(a.relmse > 0 && b.relmse > 0 && a.seconds > 0 && b.seconds > 0) || a.relmse == b.relmse)
+      return b.seconds;
+    const double f = std::log(error / a.relmse) / std::log(b.relmse / a.relmse);
+    return std::exp(std::log(a.seconds) + f * std::log(b.seconds / a.seconds));
+  }
+  return std::numeric_limits<double>::infinity();
 }
 
 namespace {

@@ -20,6 +20,7 @@ const std::vector<std::string>& all_features() {
     LC_MATERIAL_TYPES(LUCENT_TYPE_FEATURE)
     LC_LIGHT_TYPES(LUCENT_TYPE_FEATURE)
     LC_FILTER_TYPES(LUCENT_TYPE_FEATURE)
+    LC_SAMPLER_TYPES(LUCENT_TYPE_FEATURE)
     LC_INTEGRATOR_TYPES(LUCENT_TYPE_FEATURE)
     LC_AOV_TYPES(LUCENT_TYPE_FEATURE)
 #undef LUCENT_TYPE_FEATURE
@@ -33,6 +34,7 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
   // which type of each list the scene uses, by enum value
   bool shape[LC_SHAPE_COUNT] = {}, material[LC_MAT_COUNT] = {}, light[LC_LIGHT_COUNT] = {};
   bool filter[LC_FILTER_COUNT] = {}, integrator[LC_INTEGRATOR_COUNT] = {};
+  bool sampler[LC_SAMPLER_COUNT] = {};
   shape[LC_SHAPE_SPHERE] = !packed.spheres.empty();
   shape[LC_SHAPE_TRIANGLE] = !packed.triangles.empty();
   // materials some primitive uses (a declared but unused material costs nothing)
@@ -48,12 +50,14 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
   for (const lc_light& l : packed.lights) light[l.type] = true;
   filter[static_cast<int>(scene.film.filter.type)] = true;
   integrator[static_cast<int>(scene.integrator.type)] = true;
+  sampler[static_cast<int>(scene.integrator.sampler)] = true;
   bool smooth = false, uvs = false;
   for (const lc_triangle& t : packed.triangles) {
     smooth = smooth || (t.flags & LC_TRI_HAS_NORMALS);
     uvs = uvs || (t.flags & LC_TRI_HAS_UVS);
   }
-  const bool other[] = {smooth, uvs && textured, textured, scene.camera.aperture > 0};
+  const bool clamped = scene.integrator.clamp > 0 && scene.integrator.type == IntegratorType::Path;
+  const bool other[] = {smooth, uvs && textured, textured, scene.camera.aperture > 0, clamped};
 #define LUCENT_COUNT(feature, what) +1
   static_assert(sizeof(other) / sizeof(other[0]) == 0 LC_OTHER_FEATURES(LUCENT_COUNT),
                 "one condition per LC_OTHER_FEATURES entry, in its order");
@@ -71,12 +75,14 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
 #define LUCENT_MAT(ID, Name, value, name, feature, ...) LUCENT_USED(material, ID, value, feature)
 #define LUCENT_LIGHT(ID, Name, value, name, feature, ...) LUCENT_USED(light, ID, value, feature)
 #define LUCENT_FILTER(ID, Name, value, name, feature, ...) LUCENT_USED(filter, ID, value, feature)
+#define LUCENT_SAMPLER(ID, Name, value, name, feature, ...) LUCENT_USED(sampler, ID, value, feature)
 #define LUCENT_INT(ID, Name, value, name, feature, ...) LUCENT_USED(integrator, ID, value, feature)
   LC_SHAPE_TYPES(LUCENT_SHAPE)
   LC_OTHER_FEATURES(LUCENT_OTHER)
   LC_MATERIAL_TYPES(LUCENT_MAT)
   LC_LIGHT_TYPES(LUCENT_LIGHT)
   LC_FILTER_TYPES(LUCENT_FILTER)
+  LC_SAMPLER_TYPES(LUCENT_SAMPLER)
   LC_INTEGRATOR_TYPES(LUCENT_INT)
   LC_AOV_TYPES(LUCENT_INT)
 #undef LUCENT_USED
@@ -85,6 +91,7 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
 #undef LUCENT_MAT
 #undef LUCENT_LIGHT
 #undef LUCENT_FILTER
+#undef LUCENT_SAMPLER
 #undef LUCENT_INT
   return f;
 }

@@ -1,6 +1,7 @@
 #include "render/pack.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -77,6 +78,11 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   P.filter_radius = static_cast<float>(scene.film.filter.radius);
   P.env_light = -1;
   P.flags = scene.integrator.mis ? 0u : LC_FLAG_NO_MIS;
+  P.sampler = static_cast<lc_uint>(scene.integrator.sampler);
+  // a positive clamp stays positive in float (0 is off)
+  P.clamp = scene.integrator.clamp > 0
+                ? std::max(static_cast<float>(scene.integrator.clamp), FLT_MIN)
+                : 0.0f;
   P.ao_distance = scene.integrator.ao_distance > 0
                       ? static_cast<float>(scene.integrator.ao_distance)
                       : INFINITY;

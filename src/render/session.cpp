@@ -20,6 +20,7 @@
 #include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
 #include "lucent/error.hpp"
+#include "render/adaptive.hpp"
 #include "render/device_scene.hpp"
 #include "render/features.hpp"
 #include "render/pack.hpp"
@@ -99,7 +100,7 @@ struct Worker {
   Program* program = nullptr;
   std::optional<render_detail::DeviceScene> dev;
   size_t npix = 0;
-  cl::Buffer b_sum, b_sumsq, b_counters;
+  cl::Buffer b_work, b_sum, b_sumsq, b_counters;  // work list: npix entries at most
   std::vector<cl_float4> h_sum, h_sumsq;
   std::uint32_t pass_spp = 1;  // samples per pixel of its next pass (tuned to pass_seconds)
   DeviceShare share;           // of the accumulation
@@ -115,6 +116,7 @@ struct Worker {
 
   void set_args() {
     int arg = dev->set_args(program->kernel);
+    program->kernel.setArg(arg++, b_work);
     program->kernel.setArg(arg++, b_sum);
     program->kernel.setArg(arg++, b_sumsq);
     program->kernel.setArg(arg++, b_counters);
@@ -126,16 +128,34 @@ struct Worker {
     lc_params P = params;
     P.sample_offset = static_cast<lc_uint>(first);
     P.samples_per_pass = n;
+    P.work_items = 0;
+    launch(P, npix, nullptr, counters);
+  }
+
+  /// Launches the work list `entries` (pixel, first sample, samples, stream; at most npix) and
+  /// reads back their sums, entry by entry.
+  void pass_list(const lc_params& params, const std::vector<cl_uint4>& entries,
+                 lc_uint counters[LC_COUNTER_COUNT]) {
+    lc_params P = params;
+    P.work_items = static_cast<lc_uint>(entries.size());
+    launch(P, entries.size(), &entries, counters);
+  }
+
+  void launch(const lc_params& P, size_t items, const std::vector<cl_uint4>* entries,
+              lc_uint counters[LC_COUNTER_COUNT]) {
     lc_uint zero[LC_COUNTER_COUNT] = {0, 0, 0, 0};
     cl::CommandQueue& q = ctx.queue;
     q.enqueueWriteBuffer(dev->params, CL_FALSE, 0, sizeof(P), &P);
     q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(zero), zero);
-    q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global_size()),
+    if (entries)
+      q.enqueueWriteBuffer(b_work, CL_FALSE, 0, items * sizeof(cl_uint4), entries->data());
+    const size_t global = (items + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
+    q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global),
                            cl::NDRange(kWorkGroupSize));
-    h_sum.resize(npix);
-    h_sumsq.resize(npix);
-    q.enqueueReadBuffer(b_sum, CL_FALSE, 0, npix * sizeof(cl_float4), h_sum.data());
-    q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, npix * sizeof(cl_float4), h_sumsq.data());
+    h_sum.resize(items);
+    h_sumsq.resize(items);
+    q.enqueueReadBuffer(b_sum, CL_FALSE, 0, items * sizeof(cl_float4), h_sum.data());
+    q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, items * sizeof(cl_float4), h_sumsq.data());
     q.enqueueReadBuffer(b_counters, CL_TRUE, 0, LC_COUNTER_COUNT * sizeof(lc_uint), counters);
   }
 };
@@ -191,6 +211,7 @@ struct Renderer::Impl {
     render_seconds = 0;
     last_cancelled = false;
     for (auto& w : workers) w->share.samples = 0, w->share.seconds = 0;
+    clear_adaptive();
   }
 
   /// The worker's program for these build options, built (or loaded from the cache) or reused.
@@ -284,6 +305,7 @@ struct Renderer::Impl {
         }
         if (n != w.npix || !w.b_sum()) {
           w.npix = n;
+          w.b_work = cl::Buffer(w.ctx.context, CL_MEM_READ_ONLY, n * sizeof(cl_uint4));
           w.b_sum = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
           w.b_sumsq = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
           w.b_counters =
@@ -312,7 +334,7 @@ struct Renderer::Impl {
   }
 
   /// Adds one pass's sums to the accumulation.
-  void accumulate(const Worker& w, std::uint32_t n, const lc_uint counters[LC_COUNTER_COUNT]) {
+  void accumulate(const Worker& w, std::uint32_t n) {
     for (size_t i = 0; i < npix; ++i) {
       for (int c = 0; c < 3; ++c) {
         sum[i * 3 + c] += w.h_sum[i].s[c];
@@ -320,110 +342,105 @@ struct Renderer::Impl {
       }
       count[i] += static_cast<std::uint32_t>(w.h_sum[i].s[3]);
     }
-    nonfinite += counters[LC_COUNTER_NONFINITE];
-    rays += counters[LC_COUNTER_RAYS];
     done += n;
   }
 
-  /// The next pass size of a worker whose last pass of n spp took pass_time seconds: aim at
-  /// pass_seconds per launch, within the time left.
-  void tune(Worker& w, std::uint32_t n, double pass_time, double time_left) {
-    double per_spp = pass_time / n;
-    double want = per_spp > 0 ? options.pass_seconds / per_spp : 2.0 * n;
-    w.pass_spp = static_cast<std::uint32_t>(std::clamp(want, 1.0, std::min(4.0 * n, 65536.0)));
+  /// The next pass size of a worker whose last pass of `spp` samples per pixel (or their
+  /// equivalent in a work list's samples) took pass_time seconds: aim at pass_seconds per
+  /// launch, within the time left.
+  void tune(Worker& w, double spp, double pass_time, double time_left) {
+    double per_spp = pass_time / spp;
+    double want = per_spp > 0 ? options.pass_seconds / per_spp : 2.0 * spp;
+    w.pass_spp = static_cast<std::uint32_t>(
+        std::clamp(want, 1.0, std::min(4.0 * std::max(1.0, spp), 65536.0)));
     if (time_left < std::numeric_limits<double>::infinity() && per_spp > 0)
       w.pass_spp =
           static_cast<std::uint32_t>(std::clamp(time_left / per_spp, 1.0, double(w.pass_spp)));
   }
 
-  /// Adds samples until `target_spp` more (0: no limit) or `time_limit` seconds (0: none), at
-  /// least one pass unless cancelled with samples already accumulated. With several devices,
-  /// each takes the next range of sample indices when its pass is done.
-  RenderProgress run(std::uint64_t target_spp, double time_limit,
-                     const std::function<void(const RenderProgress&)>& on_progress) {
-    if (!scene) throw Error("render: the session has no scene (call set_scene first)");
+  /// One launch: samples [begin, begin + n) of every pixel, or a slice of a work list.
+  struct Job {
+    std::uint64_t begin = 0;
+    std::uint32_t n = 0;
+    std::vector<cl_uint4> entries;  // a work list instead (n: 0)
+    double spp = 0;                 // its samples per pixel, or their equivalent, for tuning
+  };
+
+  /// Launches jobs on every device until `next` has none (or the time limit, a cancel or an
+  /// error), with the accumulation and the call's statistics guarded by one lock. `next(w, job)`
+  /// (under the lock) fills the worker's next job or returns false; `finish(w, job, counters)`
+  /// (under the lock) takes its results. At least one job runs unless cancelled with samples
+  /// already accumulated.
+  struct CallState {
+    std::mutex m;
+    clock_type::time_point t_start = clock_type::now();
+    double call_seconds = 0;  // kernel time, summed over devices
+    bool started = false;     // a job of this call was launched
+  };
+  /// The start of a render call: no cancel pending, the call's shares at zero.
+  void begin_call() {
     cancel_requested = false;
     last_cancelled = false;
     for (auto& w : workers) w->call.samples = 0, w->call.seconds = 0;
-    std::mutex m;  // guards the accumulation, the dispatch counters and the callback
-    std::uint64_t started = 0, finished = 0;  // samples per pixel of this call
-    const std::uint64_t start_index = first + done;
-    double call_seconds = 0;  // kernel time, summed over devices
-    auto t_start = clock_type::now();
-    auto progress = [&]() {
-      RenderProgress pr;
-      pr.samples_done = finished;
-      pr.samples_target = target_spp;
-      pr.accumulated = done;
-      pr.elapsed = seconds_since(t_start);
-      pr.time_limit = time_limit;
-      pr.samples_per_second = pr.elapsed > 0 ? double(finished) * npix / pr.elapsed : 0;
-      if (workers.size() == 1)
-        pr.samples_per_second = call_seconds > 0 ? double(finished) * npix / call_seconds : 0;
-      for (auto& w : workers) pr.devices.push_back(w->call);
-      return pr;
-    };
+  }
+  void dispatch(CallState& cs, double time_limit, bool have_samples,
+                const std::function<bool(Worker&, Job&)>& next,
+                const std::function<void(Worker&, const Job&)>& finish,
+                const std::function<void()>& on_pass) {
+    bool& started = cs.started;
     std::exception_ptr failure;
-    // Claims the next range of sample indices for `w` (n = 0: none left); under the lock.
-    auto claim = [&](Worker& w, std::uint64_t& begin, std::uint32_t& n) {
-      n = w.pass_spp;
-      if (target_spp > 0)
-        n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, target_spp - started));
-      begin = start_index + started;
-      started += n;
-    };
-    // With several devices each takes its first pass before any takes a second: a device whose
+    // With several devices each takes its first job before any takes a second: a device whose
     // thread starts late still gets its share (the others do not drain a short render first).
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> first_pass(workers.size(), {0, 0});
+    std::vector<Job> first_job(workers.size());
+    std::vector<char> has_first(workers.size(), 0);
     if (workers.size() > 1 && !cancelled())
       for (size_t i = 0; i < workers.size(); ++i)
-        if (target_spp == 0 || started < target_spp)
-          claim(*workers[i], first_pass[i].first, first_pass[i].second);
+        if (next(*workers[i], first_job[i])) has_first[i] = 1, started = true;
     auto work = [&](Worker& w, size_t index) {
       try {
         for (bool first = true;; first = false) {
-          std::uint64_t begin;
-          std::uint32_t n;
-          if (first && first_pass[index].second > 0) {
-            begin = first_pass[index].first;
-            n = first_pass[index].second;
+          Job job;
+          if (first && has_first[index]) {
+            job = std::move(first_job[index]);
           } else {
-            std::lock_guard<std::mutex> lock(m);
+            std::lock_guard<std::mutex> lock(cs.m);
             if (failure) return;
-            if (target_spp > 0 && started >= target_spp) return;
-            double elapsed = seconds_since(t_start);
-            if (time_limit > 0 && started > 0 && elapsed >= time_limit) return;
-            if (cancelled() && (done > 0 || started > 0)) {
+            double elapsed = seconds_since(cs.t_start);
+            if (time_limit > 0 && started && elapsed >= time_limit) return;
+            if (cancelled() && (have_samples || started)) {
               last_cancelled = true;
               return;
             }
-            claim(w, begin, n);
+            if (!next(w, job)) return;
+            started = true;
           }
           lc_uint counters[LC_COUNTER_COUNT];
           auto tp = clock_type::now();
-          w.pass(packed.params, begin, n, counters);
+          if (job.entries.empty())
+            w.pass(packed.params, job.begin, job.n, counters);
+          else
+            w.pass_list(packed.params, job.entries, counters);
           double pass_time = seconds_since(tp);
-          std::lock_guard<std::mutex> lock(m);
-          accumulate(w, n, counters);
-          finished += n;
-          call_seconds += pass_time;
+          std::lock_guard<std::mutex> lock(cs.m);
+          finish(w, job);
+          nonfinite += counters[LC_COUNTER_NONFINITE];
+          rays += counters[LC_COUNTER_RAYS];
+          cs.call_seconds += pass_time;
           render_seconds += pass_time;
           stats.render_seconds += pass_time;
           ++stats.passes;
-          w.call.samples += n;
           w.call.seconds += pass_time;
-          w.share.samples += n;
           w.share.seconds += pass_time;
-          double left = time_limit > 0 ? time_limit - seconds_since(t_start)
+          double left = time_limit > 0 ? time_limit - seconds_since(cs.t_start)
                                        : std::numeric_limits<double>::infinity();
-          tune(w, n, pass_time, left);
-          if (on_progress) on_progress(progress());
+          tune(w, job.spp, pass_time, left);
+          if (on_pass) on_pass();
         }
       } catch (const cl::Error& e) {
-        std::lock_guard<std::mutex> lock(m);
+        std::lock_guard<std::mutex> lock(cs.m);
         if (!failure) failure = std::make_exception_ptr(Error(cl_util::describe(e)));
       } catch (...) {
-        std::lock_guard<std::mutex> lock(m);
+        std::lock_guard<std::mutex> lock(cs.m);
         if (!failure) failure = std::current_exception();
       }
     };
@@ -436,6 +453,216 @@ struct Renderer::Impl {
       for (auto& t : threads) t.join();
     }
     if (failure) std::rethrow_exception(failure);
+  }
+
+  RenderProgress make_progress(const CallState& cs, std::uint64_t finished, std::uint64_t target,
+                               double time_limit) const {
+    RenderProgress pr;
+    pr.samples_done = finished;
+    pr.samples_target = target;
+    pr.accumulated = done;
+    pr.elapsed = seconds_since(cs.t_start);
+    pr.time_limit = time_limit;
+    pr.samples_per_second = pr.elapsed > 0 ? double(finished) * npix / pr.elapsed : 0;
+    if (workers.size() == 1)
+      pr.samples_per_second = cs.call_seconds > 0 ? double(finished) * npix / cs.call_seconds : 0;
+    for (auto& w : workers) pr.devices.push_back(w->call);
+    return pr;
+  }
+
+  /// Adds samples until `target_spp` more (0: no limit) or `time_limit` seconds (0: none), at
+  /// least one pass unless cancelled with samples already accumulated. With several devices,
+  /// each takes the next range of sample indices when its pass is done.
+  RenderProgress run(std::uint64_t target_spp, double time_limit,
+                     const std::function<void(const RenderProgress&)>& on_progress) {
+    if (!scene) throw Error("render: the session has no scene (call set_scene first)");
+    if (adaptive)
+      throw Error("render: the accumulation is an adaptive render's (call reset() first)");
+    begin_call();
+    CallState cs;
+    std::uint64_t started = 0, finished = 0;  // samples per pixel of this call
+    const std::uint64_t start_index = first + done;
+    auto next = [&](Worker& w, Job& job) {
+      if (target_spp > 0 && started >= target_spp) return false;
+      job.n = w.pass_spp;
+      if (target_spp > 0)
+        job.n = static_cast<std::uint32_t>(std::min<std::uint64_t>(job.n, target_spp - started));
+      job.begin = start_index + started;
+      job.spp = job.n;
+      started += job.n;
+      return true;
+    };
+    auto finish = [&](Worker& w, const Job& job) {
+      accumulate(w, job.n);
+      finished += job.n;
+      w.call.samples += job.n;
+      w.share.samples += job.n;
+    };
+    auto on_pass = [&] {
+      if (on_progress) on_progress(make_progress(cs, finished, target_spp, time_limit));
+    };
+    dispatch(cs, time_limit, done > 0, next, finish, on_pass);
+    return make_progress(cs, finished, target_spp, time_limit);
+  }
+
+  // ---- adaptive renders (render_adaptive; the arithmetic is in render/adaptive.cpp) ----------
+
+  /// One half of an adaptive render: stream `h` (seed lc_stream_seed(seed, h)), its per-pixel
+  /// sums, the samples launched (sample indices first .. first + launched - 1) and planned, and
+  /// the relative variance of its pilot, which plans the other half.
+  struct Half {
+    std::vector<double> sum, sumsq;
+    std::vector<std::uint32_t> count, launched, plan;
+    std::vector<double> pilot_v;
+  };
+  bool adaptive = false;
+  std::uint32_t pilot = 0;  // per pixel and half
+  Half halves[2];
+  double adaptive_target = 0;
+
+  void clear_adaptive() {
+    adaptive = false;
+    pilot = 0;
+    adaptive_target = 0;
+    for (Half& h : halves) h = Half{};
+  }
+
+  /// Renders every (half, pixel) up to its plan, in rounds: each round gives every entry still
+  /// short of its plan up to `cap` samples, cap spreading one pass per device over the entries.
+  /// Returns false when stopped by the time limit or a cancel.
+  bool render_plans(CallState& cs, double time_limit, std::uint64_t& launched_total,
+                    std::uint64_t call_start, std::uint64_t planned_total,
+                    const std::function<void(const RenderProgress&)>& on_progress) {
+    for (;;) {
+      std::vector<cl_uint4> list;
+      double pass_samples = 0;
+      for (auto& w : workers) pass_samples += double(w->pass_spp) * double(npix);
+      size_t active = 0;
+      for (const Half& h : halves)
+        for (size_t i = 0; i < npix; ++i) active += h.launched[i] < h.plan[i];
+      if (active == 0) return true;
+      const std::uint32_t cap = static_cast<std::uint32_t>(
+          std::clamp(std::ceil(pass_samples / double(active)), 1.0, 65536.0));
+      list.reserve(active);
+      for (lc_uint hi = 0; hi < 2; ++hi) {
+        const Half& h = halves[hi];
+        for (size_t i = 0; i < npix; ++i)
+          if (h.launched[i] < h.plan[i]) {
+            cl_uint4 e;
+            e.s[0] = static_cast<cl_uint>(i);
+            e.s[1] = static_cast<cl_uint>(first + h.launched[i]);
+            e.s[2] = std::min(h.plan[i] - h.launched[i], cap);
+            e.s[3] = hi;
+            list.push_back(e);
+          }
+      }
+      size_t pos = 0;
+      auto next = [&](Worker& w, Job& job) {
+        if (pos >= list.size()) return false;
+        // about one pass of this device's size, at most npix entries
+        const double want = double(w.pass_spp) * double(npix);
+        double samples = 0;
+        size_t end = pos;
+        while (end < list.size() && end - pos < npix && samples < want) samples += list[end++].s[2];
+        job.entries.assign(list.begin() + pos, list.begin() + end);
+        job.spp = samples / double(npix);
+        pos = end;
+        return true;
+      };
+      auto finish = [&](Worker& w, const Job& job) {
+        std::uint64_t samples = 0;
+        for (size_t k = 0; k < job.entries.size(); ++k) {
+          const cl_uint4& e = job.entries[k];
+          Half& h = halves[e.s[3]];
+          const size_t i = e.s[0];
+          for (int c = 0; c < 3; ++c) {
+            h.sum[i * 3 + c] += w.h_sum[k].s[c];
+            h.sumsq[i * 3 + c] += w.h_sumsq[k].s[c];
+          }
+          h.count[i] += static_cast<std::uint32_t>(w.h_sum[k].s[3]);
+          h.launched[i] += e.s[2];
+          samples += e.s[2];
+        }
+        launched_total += samples;
+        done = (launched_total + npix / 2) / npix;
+        w.call.samples += samples / npix;
+        w.share.samples += samples / npix;
+      };
+      auto on_pass = [&] {
+        if (on_progress)
+          on_progress(make_progress(cs, (launched_total - call_start) / npix,
+                                    (planned_total - call_start) / npix, time_limit));
+      };
+      dispatch(cs, time_limit, true, next, finish, on_pass);
+      if (pos < list.size() || last_cancelled) return false;  // stopped by the clock or a cancel
+    }
+  }
+
+  RenderProgress run_adaptive(const AdaptiveOptions& o,
+                              const std::function<void(const RenderProgress&)>& on_progress) {
+    if (!scene) throw Error("render_adaptive: the session has no scene (call set_scene first)");
+    if (!(o.target_error > 0) == !(o.budget_spp > 0) || !std::isfinite(o.target_error) ||
+        !std::isfinite(o.budget_spp))
+      throw Error("render_adaptive: give either a target error or a budget, a positive number");
+    if (o.min_spp < 4 || o.max_spp < o.min_spp)
+      throw Error("render_adaptive: expected 4 <= min_spp <= max_spp, got " +
+                  std::to_string(o.min_spp) + " and " + std::to_string(o.max_spp));
+    if (!(o.max_seconds >= 0) || !std::isfinite(o.max_seconds))
+      throw Error("render_adaptive: the time limit must be a non-negative number of seconds");
+    const std::uint32_t m = (o.min_spp + 1) / 2;
+    if (!adaptive) {
+      if (done > 0)
+        throw Error(
+            "render_adaptive: the accumulation holds a uniform render's samples (call reset() "
+            "first)");
+      adaptive = true;
+      pilot = m;
+      for (Half& h : halves) {
+        h.sum.assign(npix * 3, 0.0);
+        h.sumsq.assign(npix * 3, 0.0);
+        h.count.assign(npix, 0u);
+        h.launched.assign(npix, 0u);
+        h.plan.assign(npix, m);
+        h.pilot_v.clear();
+      }
+    } else if (pilot != m) {
+      throw Error("render_adaptive: min_spp " + std::to_string(o.min_spp) +
+                  " differs from the adaptive render in progress (call reset() first)");
+    }
+    auto planned = [&] {
+      std::uint64_t t = 0;
+      for (const Half& h : halves)
+        for (std::uint32_t n : h.plan) t += n;
+      return t;
+    };
+    begin_call();
+    CallState cs;
+    std::uint64_t launched_total = 0;
+    for (const Half& h : halves)
+      for (std::uint32_t n : h.launched) launched_total += n;
+    const std::uint64_t call_start = launched_total;
+    auto progress = [&] {
+      return make_progress(cs, (launched_total - call_start) / npix,
+                           (planned() - call_start) / npix, o.max_seconds);
+    };
+    const double time_limit = o.max_seconds;
+    // the pilot: `pilot` samples in every pixel of both halves
+    if (!render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress))
+      return progress();
+    for (Half& h : halves)
+      if (h.pilot_v.empty()) h.pilot_v = render_detail::relative_variance(h.sum, h.sumsq, h.count);
+    // each half planned from the other's pilot alone: its mean stays unbiased (adaptive.hpp); a
+    // half's predicted relMSE 2 E makes the average of the two halves' E
+    const std::uint32_t max_half = std::max(m, o.max_spp / 2);
+    for (int hi = 0; hi < 2; ++hi) {
+      render_detail::SamplePlan p =
+          render_detail::plan_samples(halves[1 - hi].pilot_v, scene->film.width, scene->film.height,
+                                      2 * o.target_error, o.budget_spp / 2, m, max_half);
+      for (size_t i = 0; i < npix; ++i)
+        halves[hi].plan[i] = std::max(halves[hi].plan[i], p.counts[i]);
+    }
+    adaptive_target = o.target_error;
+    render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress);
     return progress();
   }
 
@@ -446,14 +673,32 @@ struct Renderer::Impl {
     r.mean = Image{width, height, std::vector<float>(npix * 3)};
     r.variance = Image{width, height, std::vector<float>(npix * 3)};
     r.samples = count;
-    for (size_t i = 0; i < npix; ++i) {
-      double n = count[i];
-      for (int c = 0; c < 3; ++c) {
-        double s = sum[i * 3 + c], s2 = sumsq[i * 3 + c];
-        double mean = n > 0 ? s / n : 0;
-        double var = n > 1 ? std::max(0.0, (s2 - s * mean) / (n - 1)) : 0;
-        r.mean.rgb[i * 3 + c] = static_cast<float>(mean);
-        r.variance.rgb[i * 3 + c] = static_cast<float>(var);
+    if (adaptive) {
+      // the average of the halves (render/adaptive.hpp), and the relMSE its variances predict
+      double predicted = 0;
+      for (size_t i = 0; i < npix; ++i) {
+        const Half &a = halves[0], &b = halves[1];
+        render_detail::combine_halves(&a.sum[i * 3], &a.sumsq[i * 3], a.count[i], &b.sum[i * 3],
+                                      &b.sumsq[i * 3], b.count[i], &r.mean.rgb[i * 3],
+                                      &r.variance.rgb[i * 3], &r.samples[i]);
+        for (int c = 0; c < 3; ++c) {
+          const double m = r.mean.rgb[i * 3 + c];
+          if (r.samples[i] > 0)
+            predicted += r.variance.rgb[i * 3 + c] / r.samples[i] / (m * m + 0.01);
+        }
+      }
+      r.estimated_relmse = npix ? predicted / (3.0 * double(npix)) : 0;
+      r.target_error = adaptive_target;
+    } else {
+      for (size_t i = 0; i < npix; ++i) {
+        double n = count[i];
+        for (int c = 0; c < 3; ++c) {
+          double s = sum[i * 3 + c], s2 = sumsq[i * 3 + c];
+          double mean = n > 0 ? s / n : 0;
+          double var = n > 1 ? std::max(0.0, (s2 - s * mean) / (n - 1)) : 0;
+          r.mean.rgb[i * 3 + c] = static_cast<float>(mean);
+          r.variance.rgb[i * 3 + c] = static_cast<float>(var);
+        }
       }
     }
     r.spp = done;
@@ -508,6 +753,11 @@ RenderProgress Renderer::render_for(double seconds,
   if (!(seconds > 0) || !std::isfinite(seconds))
     throw Error("render_for: the time must be a positive number of seconds");
   return impl_->run(0, seconds, on_progress);
+}
+
+RenderProgress Renderer::render_adaptive(
+    const AdaptiveOptions& options, const std::function<void(const RenderProgress&)>& on_progress) {
+  return impl_->run_adaptive(options, on_progress);
 }
 
 RenderProgress Renderer::render(std::uint64_t spp, double max_seconds,

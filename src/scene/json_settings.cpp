@@ -50,7 +50,9 @@ void parse_film(const JsonReader& r, const json& j, SceneBuilder& b) {
 
 void parse_integrator(const JsonReader& r, const json& j, SceneBuilder& b) {
   const std::string p = "/integrator";
-  r.check_keys(j, p, {"type", "max_depth", "rr_depth", "spp", "seed", "ao_distance", "mis"});
+  r.check_keys(
+      j, p,
+      {"type", "max_depth", "rr_depth", "spp", "seed", "ao_distance", "mis", "sampler", "clamp"});
   Integrator in = b.scene().integrator;
   if (j.contains("type")) in.type = r.type<IntegratorType>(j["type"], p + "/type");
   if (j.contains("max_depth"))
@@ -62,6 +64,8 @@ void parse_integrator(const JsonReader& r, const json& j, SceneBuilder& b) {
     in.seed = static_cast<std::uint32_t>(r.integer(j["seed"], p + "/seed", rules::kSeed));
   if (j.contains("mis")) in.mis = r.boolean(j["mis"], p + "/mis");
   if (j.contains("ao_distance")) in.ao_distance = r.number(j["ao_distance"], p + "/ao_distance");
+  if (j.contains("sampler")) in.sampler = r.type<SamplerType>(j["sampler"], p + "/sampler");
+  if (j.contains("clamp")) in.clamp = r.number(j["clamp"], p + "/clamp");
   b.set_integrator(in);
 }
 

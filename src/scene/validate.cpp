@@ -165,6 +165,8 @@ void validate_integrator(const Integrator& in, const Reporter& at) {
   check_range(at.at("rr_depth"), in.rr_depth, rules::kDepth);
   check_range(at.at("spp"), in.spp, rules::kSpp);
   check_non_negative(at.at("ao_distance"), in.ao_distance);  // 0: unbounded
+  check_type(at.at("sampler"), in.sampler);
+  check_non_negative(at.at("clamp"), in.clamp);  // 0: off
 }
 
 void validate_texture(const Texture& t, const Reporter& at) {

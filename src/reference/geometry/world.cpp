@@ -154,6 +154,9 @@ Surface World::surface(const Ray& ray, const Hit& hit) const {
     s.ng = -s.ng;
     s.ns = -s.ns;
   }
+  // an interpolated normal facing away from the viewer (wo below the shading hemisphere, near a
+  // silhouette of a coarse mesh): the geometric normal instead (docs/rendering-model.md)
+  if (glm::dot(ray.d, s.ns) >= 0) s.ns = s.ng;
   return s;
 }
 

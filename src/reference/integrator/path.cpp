@@ -1,6 +1,9 @@
 // path: unidirectional path tracing with next-event estimation at every non-delta vertex, one
 // light chosen uniformly, and multiple importance sampling (power heuristic) between light and
-// BSDF sampling. Expected value: the rendering equation truncated at max_depth segments.
+// BSDF sampling. Expected value: the rendering equation truncated at max_depth segments (with
+// integrator.clamp, the expectation of the clamped estimator: docs/rendering-model.md).
+#include <algorithm>
+#include <cfloat>
 #include <cmath>
 
 #include "reference/integrator/integrator.hpp"
@@ -32,10 +35,19 @@ dvec3 next_event(const Tracer& t, const Surface& s, const Bsdf& b, const dvec3& 
   return f * ls.Le * power_heuristic(ls.pdf, b.pdf(wo, ls.wi)) / ls.pdf;
 }
 
+/// integrator.clamp: a contribution after a scattering whose largest component exceeds `bound`
+/// (> 0) is scaled down to it; non-finite ones stay non-finite.
+dvec3 clamped(const dvec3& c, double bound) {
+  double m = std::max({c.x, c.y, c.z});
+  return bound > 0 && m > bound ? c * (bound / m) : c;
+}
+
 }  // namespace
 
 dvec3 integrator_path(const Tracer& t, const Ray& camera_ray, const Sampler& rng) {
   const Integrator& in = t.scene.integrator;
+  // the kernel clamps against the bound rounded to float (render/pack.cpp)
+  const double bound = in.clamp > 0 ? std::max<double>(static_cast<float>(in.clamp), FLT_MIN) : 0;
   const Light* env = t.lights.environment();
   Ray ray = camera_ray;
   dvec3 L(0.0), beta(1.0);
@@ -46,7 +58,8 @@ dvec3 integrator_path(const Tracer& t, const Ray& camera_ray, const Sampler& rng
     if (!t.trace(ray, hit)) {
       double w = 1;
       if (!prev_delta && env) w = power_heuristic(prev_pdf, env->pdf(ray.d, kInf, 0));
-      L += beta * t.escaped(ray.d) * w;
+      dvec3 c = beta * t.escaped(ray.d) * w;
+      L += depth > 0 ? clamped(c, bound) : c;
       break;
     }
     Surface s = t.surface(ray, hit);
@@ -56,12 +69,12 @@ dvec3 integrator_path(const Tracer& t, const Ray& camera_ray, const Sampler& rng
       if (!prev_delta)
         w = power_heuristic(prev_pdf,
                             t.lights.pdf_hit(s.prim, ray.d, hit.t, glm::dot(s.ng, -ray.d)));
-      L += beta * Le * w;
+      L += depth > 0 ? clamped(beta * Le * w, bound) : beta * Le * w;
     }
     if (depth + 1 >= in.max_depth) break;
     dvec3 wo = -ray.d;
     std::unique_ptr<Bsdf> b = t.bsdf(s);
-    if (!b->is_delta()) L += beta * next_event(t, s, *b, wo, rng, depth);
+    if (!b->is_delta()) L += clamped(beta * next_event(t, s, *b, wo, rng, depth), bound);
     BsdfSample bs =
         b->sample(wo, rng.bounce(depth, LC_DIM_BSDF_LOBE), rng.bounce(depth, LC_DIM_BSDF_UV),
                   rng.bounce(depth, LC_DIM_BSDF_UV + 1));

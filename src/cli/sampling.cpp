@@ -1,0 +1,53 @@
+// The sampling options of the command line: the sampler, clamping, adaptive sampling.
+#include <optional>
+#include <string>
+
+#include "cli/commands.hpp"
+#include "lucent/error.hpp"
+#include "lucent/limits.hpp"
+#include "lucent/types.hpp"
+
+namespace lucent::cli {
+
+void add_sampling_options(CLI::App* cmd, SamplingArgs& a, bool adaptive) {
+  cmd->add_option("--sampler", a.sampler,
+                  "Random numbers: " + type_names<SamplerType>() +
+                      " (overrides integrator.sampler; default sobol)");
+  cmd->add_option("--clamp", a.clamp,
+                  "Largest contribution of a path vertex after a scattering (overrides "
+                  "integrator.clamp; 0: off; biased when it binds)")
+      ->check(CLI::NonNegativeNumber);
+  if (!adaptive) return;
+  cmd->add_option("--target-error", a.target_error,
+                  "Adaptive sampling: render until the image's estimated relMSE is at most this, "
+                  "with --spp as the most samples per pixel and --time as a time limit")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--min-spp", a.min_spp,
+                  "Adaptive sampling: samples per pixel of the pilot, everywhere (default 64)")
+      ->check(CLI::Range(4, limits::kMaxSpp));
+}
+
+void apply_sampling_options(const SamplingArgs& a, Scene& scene) {
+  if (!a.sampler.empty()) {
+    std::optional<SamplerType> t = find_type<SamplerType>(a.sampler);
+    if (!t)
+      throw Error("--sampler " + a.sampler + ": unknown sampler (expected " +
+                  type_names<SamplerType>() + ")");
+    scene.integrator.sampler = *t;
+  }
+  if (a.clamp >= 0) scene.integrator.clamp = a.clamp;
+}
+
+AdaptiveOptions adaptive_options(const SamplingArgs& a, int max_spp, double time_limit) {
+  AdaptiveOptions o;
+  o.target_error = a.target_error;
+  if (a.min_spp > 0) o.min_spp = static_cast<std::uint32_t>(a.min_spp);
+  if (max_spp > 0) o.max_spp = static_cast<std::uint32_t>(max_spp);
+  if (o.max_spp < o.min_spp)
+    throw Error("--spp " + std::to_string(o.max_spp) + " is below the adaptive pilot (--min-spp " +
+                std::to_string(o.min_spp) + ")");
+  o.max_seconds = time_limit;
+  return o;
+}
+
+}  // namespace lucent::cli

@@ -1,0 +1,119 @@
+// Adaptive sampling: planning the halves' sample counts and combining them (adaptive.hpp).
+#include "render/adaptive.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lucent::render_detail {
+
+std::vector<double> relative_variance(const std::vector<double>& sum,
+                                      const std::vector<double>& sumsq,
+                                      const std::vector<std::uint32_t>& count) {
+  std::vector<double> v(count.size(), 0.0);
+  for (std::size_t i = 0; i < count.size(); ++i) {
+    const double n = count[i];
+    if (n < 2) continue;
+    double r = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double s = sum[i * 3 + c], mean = s / n;
+      const double var = std::max(0.0, (sumsq[i * 3 + c] - s * mean) / (n - 1));
+      r += var / (mean * mean + 0.01);
+    }
+    v[i] = r / 3;
+  }
+  return v;
+}
+
+SamplePlan plan_samples(const std::vector<double>& v, int width, int height, double target,
+                        double budget, std::uint32_t min_n, std::uint32_t max_n) {
+  const std::size_t npix = static_cast<std::size_t>(width) * height;
+  max_n = std::max(max_n, min_n);
+  // the shape: sqrt of the larger of the pixel's variance and its 3 x 3 neighbourhood's mean
+  std::vector<double> shape(npix, 0.0);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      double s = 0;
+      int k = 0;
+      for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy)
+        for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx, ++k)
+          s += v[static_cast<std::size_t>(yy) * width + xx];
+      const std::size_t i = static_cast<std::size_t>(y) * width + x;
+      shape[i] = std::sqrt(std::max(v[i], s / k));
+    }
+  SamplePlan plan;
+  plan.counts.assign(npix, min_n);
+  auto fill = [&](double lambda) {
+    double predicted = 0, total = 0;
+    for (std::size_t i = 0; i < npix; ++i) {
+      const double want = std::ceil(lambda * shape[i]);
+      const std::uint32_t n =
+          want >= max_n ? max_n : std::max(min_n, static_cast<std::uint32_t>(std::max(0.0, want)));
+      plan.counts[i] = n;
+      predicted += shape[i] * shape[i] / n;  // the smoothed variance: see plan_samples' doc
+      total += n;
+    }
+    plan.predicted = npix ? predicted / double(npix) : 0;
+    plan.mean = npix ? total / double(npix) : 0;
+  };
+  // reaching the goal is monotone in lambda: bisect on log(lambda) between "every count at
+  // min_n" and "every count at max_n"
+  auto reached = [&](double lambda) {
+    fill(lambda);
+    return target > 0 ? plan.predicted <= target : plan.mean <= budget;
+  };
+  double lo = 0, hi = 0;  // lambdas; 0 gives min_n everywhere
+  double smallest = 0;
+  for (double s : shape)
+    if (s > 0 && (smallest == 0 || s < smallest)) smallest = s;
+  if (smallest == 0) {  // no variance anywhere: nothing to adapt to
+    fill(0);
+    return plan;
+  }
+  hi = double(max_n) / smallest * 2;  // every count at max_n
+  if (target > 0) {
+    if (reached(0)) return plan;    // the pilot-sized plan already predicts the target
+    if (!reached(hi)) return plan;  // unreachable: every count at max_n
+    lo = 1e-30 * hi;                // not reached there (counts at min_n)
+    for (int it = 0; it < 200 && hi / lo > 1 + 1e-9; ++it) {
+      const double mid = std::sqrt(lo * hi);
+      (reached(mid) ? hi : lo) = mid;
+    }
+    fill(hi);  // the smallest lambda found that reaches it
+  } else {
+    if (!reached(0)) return plan;  // even min_n everywhere is over the budget
+    if (reached(hi)) return plan;  // max_n everywhere fits
+    lo = 1e-30 * hi;
+    for (int it = 0; it < 200 && hi / lo > 1 + 1e-9; ++it) {
+      const double mid = std::sqrt(lo * hi);
+      (reached(mid) ? lo : hi) = mid;
+    }
+    fill(lo);  // the largest lambda found within the budget
+  }
+  return plan;
+}
+
+void combine_halves(const double* sum_a, const double* sumsq_a, std::uint32_t n_a,
+                    const double* sum_b, const double* sumsq_b, std::uint32_t n_b, float mean[3],
+                    float var[3], std::uint32_t* n) {
+  *n = n_a + n_b;
+  for (int c = 0; c < 3; ++c) {
+    const double ma = n_a ? sum_a[c] / n_a : 0, mb = n_b ? sum_b[c] / n_b : 0;
+    double m = n_a && n_b ? 0.5 * (ma + mb) : (n_a ? ma : mb);
+    // pooled variance of one sample: squared deviations from each half's own mean
+    double ss = 0;
+    if (n_a) ss += std::max(0.0, sumsq_a[c] - sum_a[c] * ma);
+    if (n_b) ss += std::max(0.0, sumsq_b[c] - sum_b[c] * mb);
+    const int groups = (n_a > 0) + (n_b > 0);
+    const double dof = double(*n) - groups;
+    const double s2 = dof > 0 ? ss / dof : 0;
+    double v = 0;
+    if (n_a && n_b)
+      v = double(*n) * s2 * (1.0 / n_a + 1.0 / n_b) / 4;
+    else
+      v = s2;
+    mean[c] = static_cast<float>(m);
+    var[c] = static_cast<float>(v);
+  }
+}
+
+}  // namespace lucent::render_detail

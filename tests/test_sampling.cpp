@@ -1,0 +1,372 @@
+// The samplers (kernels/shared/rng.h), adaptive sampling (Renderer::render_adaptive,
+// render/adaptive.hpp) and clamping (integrator.clamp).
+//
+// Which sampler each test uses: the z-tests (kernel against reference, against analytic values,
+// adaptive against uniform) use the independent sampler, whose per-pixel sample variance / n is
+// the variance of the pixel's mean; the Sobol tests check the sampler's own properties (nets,
+// direction numbers), that the kernel and the reference draw the same numbers, and that its
+// error is lower, measured across seeds (each seed an independent scramble, so the spread of a
+// pixel over seeds is the variance of its Sobol estimate, whatever the stratification).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "lucent/compare.hpp"
+#include "lucent/reference.hpp"
+#include "lucent/session.hpp"
+#include "render/adaptive.hpp"
+#include "shared/rng.h"
+#include "support.hpp"
+
+namespace {
+
+using lucent::RenderResult;
+using lucent::SamplerType;
+using lucent::Scene;
+
+// ---- the Sobol sampler's numbers ------------------------------------------------------------
+
+// The second Sobol dimension from its direction numbers (Joe and Kuo: polynomial x + 1, m_k =
+// 2 m_{k-1} xor m_{k-1}, m_1 = 1), against the Pascal-matrix form of rng.h.
+TEST(SobolSampler, SecondDimensionMatchesDirectionNumbers) {
+  std::uint32_t v[32];
+  std::uint32_t m = 1;
+  for (int k = 1; k <= 32; ++k) {
+    if (k > 1) m = (m << 1) ^ m;
+    v[k - 1] = m << (32 - k);  // m_k / 2^k as a 32-bit fraction
+  }
+  for (std::uint32_t i = 0; i < (1u << 16); ++i) {
+    std::uint32_t x = 0;
+    for (int b = 0; b < 32; ++b)
+      if (i >> b & 1u) x ^= v[b];
+    ASSERT_EQ(lc_reverse_bits(lc_sobol1_reversed(i)), x) << "index " << i;
+  }
+}
+
+// The first 2^k samples of a pixel's pair form a (0,k,2)-net: every elementary box of area 2^-k
+// (2^a by 2^(k-a) cells) holds exactly one point; and every point is a different one as k grows
+// (the first 2^k samples of 2^(k+1) are the first net).
+TEST(SobolSampler, EveryPairOfEveryPixelIsANet) {
+  for (std::uint32_t pixel : {0u, 7u, 123456u})
+    for (std::uint32_t pair : {0u, 1u, 2u, 9u, 1000u})
+      for (std::uint32_t seed : {0u, 42u})
+        for (int k = 1; k <= 10; ++k) {
+          const std::uint32_t n = 1u << k;
+          std::vector<std::uint32_t> x(n), y(n);
+          for (std::uint32_t s = 0; s < n; ++s) {
+            lc_uint w[2];
+            lc_sobol_pair(pixel, s, pair, seed, w);
+            x[s] = w[0];
+            y[s] = w[1];
+          }
+          for (int a = 0; a <= k; ++a) {
+            std::vector<int> cells(n, 0);
+            for (std::uint32_t s = 0; s < n; ++s) {
+              const std::uint32_t cx = a ? x[s] >> (32 - a) : 0,
+                                  cy = a < k ? y[s] >> (32 - (k - a)) : 0;
+              ++cells[(cx << (k - a)) | cy];
+            }
+            ASSERT_EQ(*std::max_element(cells.begin(), cells.end()), 1)
+                << "pixel " << pixel << " pair " << pair << " seed " << seed << " 2^" << a
+                << " x 2^" << (k - a) << " boxes";
+          }
+        }
+}
+
+// Each number is uniform over pixels (the scrambles are random): the mean of one dimension of
+// sample 0 over 2^16 pixels is 1/2 within 5 standard deviations (1 / sqrt(12 * 2^16)), and pairs
+// and pixels are uncorrelated.
+TEST(SobolSampler, UniformAndUncorrelatedOverPixels) {
+  const int N = 1 << 16;
+  for (std::uint32_t sample : {0u, 1u, 5u}) {
+    double s0 = 0, s1 = 0, s01 = 0, sp = 0;
+    for (int p = 0; p < N; ++p) {
+      lc_uint a[2], b[2];
+      lc_sobol_pair(static_cast<lc_uint>(p), sample, 3, 0, a);
+      lc_sobol_pair(static_cast<lc_uint>(p), sample, 4, 0, b);
+      const double u = lc_u01(a[0]) - 0.5, v = lc_u01(a[1]) - 0.5, w = lc_u01(b[0]) - 0.5;
+      s0 += u;
+      s1 += v;
+      s01 += u * v;
+      sp += u * w;
+    }
+    const double sd = 1 / std::sqrt(12.0 * N), sd_prod = 1 / (12.0 * std::sqrt(double(N)));
+    EXPECT_LT(std::abs(s0 / N), 5 * sd);
+    EXPECT_LT(std::abs(s1 / N), 5 * sd);
+    EXPECT_LT(std::abs(s01 / N), 5 * sd_prod) << "the two numbers of a pair";
+    EXPECT_LT(std::abs(sp / N), 5 * sd_prod) << "two pairs";
+  }
+}
+
+// ---- kernel and reference draw the same numbers ------------------------------------------------
+
+const char* kLampScene = R"({
+  "camera": {"position": [0, 1.5, 4], "look_at": [0, 0.3, 0], "fov": 40},
+  "film": {"width": 32, "height": 32, "filter": {"type": "tent", "radius": 1}},
+  "integrator": {"type": "path", "max_depth": 2, "sampler": "SAMPLER"},
+  "materials": {"floor": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]},
+                "ball": {"type": "diffuse", "albedo": [0.8, 0.3, 0.2]},
+                "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [8, 7, 6]}},
+  "shapes": [{"type": "triangles", "material": "floor",
+              "positions": [[-5,0,-5],[5,0,-5],[5,0,5],[-5,0,5]], "indices": [0,2,1, 0,3,2]},
+             {"type": "sphere", "center": [0.3, 0.5, 0], "radius": 0.5, "material": "ball"},
+             {"type": "sphere", "center": [-0.8, 1.6, 0.6], "radius": 0.35, "material": "lamp"}]
+})";
+
+/// The same with a quad lamp (sampled uniformly by area in both the kernel and the reference,
+/// where the sphere lamp is sampled by its cone in the kernel and by area in the reference) and
+/// the box filter (the reference's tent filter draws extra numbers).
+const char* kQuadLampScene = R"({
+  "camera": {"position": [0, 1.5, 4], "look_at": [0, 0.3, 0], "fov": 40},
+  "film": {"width": 32, "height": 32},
+  "integrator": {"type": "path", "max_depth": 2, "sampler": "SAMPLER"},
+  "materials": {"floor": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]},
+                "ball": {"type": "diffuse", "albedo": [0.8, 0.3, 0.2]},
+                "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [8, 7, 6]}},
+  "shapes": [{"type": "triangles", "material": "floor",
+              "positions": [[-5,0,-5],[5,0,-5],[5,0,5],[-5,0,5]], "indices": [0,2,1, 0,3,2]},
+             {"type": "sphere", "center": [0.3, 0.5, 0], "radius": 0.5, "material": "ball"},
+             {"type": "triangles", "material": "lamp",
+              "positions": [[-1.2,2,0.2],[-0.4,2,0.2],[-0.4,2,1],[-1.2,2,1]], "indices": [0,1,2, 0,2,3]}]
+})";
+
+Scene scene_with(const char* json_text, SamplerType sampler) {
+  std::string json = json_text;
+  json.replace(json.find("SAMPLER"), 7, sampler == SamplerType::Sobol ? "sobol" : "independent");
+  return lucent::test::scene_from(json);
+}
+
+Scene lamp_scene(SamplerType sampler) {
+  std::string json = kLampScene;
+  json.replace(json.find("SAMPLER"), 7, sampler == SamplerType::Sobol ? "sobol" : "independent");
+  return lucent::test::scene_from(json);
+}
+
+/// Whether pixel i of a and b agree within 1e-3 relative (+ 1e-4 absolute) in every channel.
+bool pixel_equal(const RenderResult& a, const RenderResult& b, size_t i) {
+  bool ok = true;
+  for (int c = 0; c < 3; ++c) {
+    const double x = a.mean.rgb[i * 3 + c], y = b.mean.rgb[i * 3 + c];
+    ok = ok && std::abs(x - y) <= 1e-3 * std::abs(y) + 1e-4;
+  }
+  return ok;
+}
+
+// With the same seed the kernel and the reference trace the same camera rays and sample the same
+// light points and directions, so at 1 spp (where every pixel is one noisy sample) their images
+// agree pixel for pixel up to float rounding; with another seed they do not (the control).
+TEST(SobolSampler, KernelAndReferenceDrawTheSameNumbers) {
+  for (SamplerType t : {SamplerType::Sobol, SamplerType::Independent}) {
+    SCOPED_TRACE(lucent::type_name(t));
+    Scene s = scene_with(kQuadLampScene, t);
+    lucent::RenderOptions ko;
+    ko.spp = 1;
+    RenderResult k = lucent::test::render(s, ko);
+    Scene other = s;
+    other.integrator.seed = 1;
+    RenderResult k_other = lucent::test::render(other, ko);
+    lucent::ReferenceOptions ro;
+    ro.spp = 1;
+    RenderResult ref = lucent::render_reference(s, ro);
+    RenderResult ref_other = lucent::render_reference(other, ro);
+    // the pixels whose value depends on the random numbers (the seeds give different values)
+    size_t noisy = 0, same = 0, same_control = 0;
+    for (size_t i = 0; i < k.samples.size(); ++i) {
+      if (pixel_equal(k, k_other, i)) continue;
+      ++noisy;
+      same += pixel_equal(k, ref, i);
+      same_control += pixel_equal(k, ref_other, i);
+    }
+    ASSERT_GT(noisy, k.samples.size() / 2);
+    EXPECT_GT(double(same) / noisy, 0.95) << same << " of " << noisy;
+    EXPECT_LT(double(same_control) / noisy, 0.05) << same_control << " of " << noisy;
+  }
+}
+
+// ---- the Sobol sampler's error ---------------------------------------------------------------
+
+/// Mean over pixel-channels of the variance of the pixel over `seeds` renders, relative as relMSE
+/// weighs errors (divided by mean^2 + 0.01).
+double spread_over_seeds(Scene s, int spp, int seeds) {
+  const size_t n = static_cast<size_t>(s.film.width) * s.film.height * 3;
+  std::vector<double> sum(n, 0.0), sumsq(n, 0.0);
+  lucent::RenderOptions o;
+  o.spp = spp;
+  for (int k = 0; k < seeds; ++k) {
+    s.integrator.seed = 1000u + static_cast<std::uint32_t>(k);
+    RenderResult r = lucent::test::render(s, o);
+    for (size_t i = 0; i < n; ++i) {
+      sum[i] += r.mean.rgb[i];
+      sumsq[i] += double(r.mean.rgb[i]) * r.mean.rgb[i];
+    }
+  }
+  double total = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double m = sum[i] / seeds, v = (sumsq[i] - sum[i] * m) / (seeds - 1);
+    total += std::max(0.0, v) / (m * m + 0.01);
+  }
+  return total / double(n);
+}
+
+// Direct and one-bounce light from a sphere lamp: at 64 spp the Sobol sampler's relative variance
+// is below half the independent sampler's (measured: about a fifth). 12 seeds: the ratio of two
+// means over 3072 pixel-channels of 11-degree-of-freedom variances is known to a few percent.
+TEST(SobolSampler, LowerErrorThanIndependentSamples) {
+  const double sobol = spread_over_seeds(lamp_scene(SamplerType::Sobol), 64, 12);
+  const double indep = spread_over_seeds(lamp_scene(SamplerType::Independent), 64, 12);
+  RecordProperty("ratio", std::to_string(sobol / indep));
+  EXPECT_LT(sobol, 0.5 * indep) << "sobol " << sobol << ", independent " << indep;
+  EXPECT_GT(sobol, 0.0);
+}
+
+// ---- adaptive sampling -----------------------------------------------------------------------
+
+TEST(AdaptivePlan, CountsFollowTheSquareRootOfTheVarianceAndMeetTheTarget) {
+  const int W = 8, H = 8;
+  std::vector<double> v(W * H, 0.01);
+  for (int x = 0; x < W; ++x) v[3 * W + x] = 1.0;  // a noisy row
+  auto p = lucent::render_detail::plan_samples(v, W, H, 1e-3, 0, 4, 1u << 20);
+  EXPECT_LE(p.predicted, 1e-3);
+  // the prediction is conservative: the variances raised to their 3 x 3 means, so at least v / n
+  double check = 0;
+  for (int i = 0; i < W * H; ++i) check += v[i] / p.counts[i];
+  EXPECT_LE(check / (W * H), p.predicted);
+  // far from the noisy row (and its 3 x 3 neighbourhood) counts are ~sqrt(100) = 10 times fewer
+  const double ratio = double(p.counts[3 * W + 4]) / p.counts[7 * W + 4];
+  EXPECT_NEAR(ratio, 10.0, 0.5);
+  // a lower target never takes samples away; a budget is met
+  auto q = lucent::render_detail::plan_samples(v, W, H, 5e-4, 0, 4, 1u << 20);
+  for (int i = 0; i < W * H; ++i) EXPECT_GE(q.counts[i], p.counts[i]);
+  auto b = lucent::render_detail::plan_samples(v, W, H, 0, 100, 4, 1u << 20);
+  EXPECT_LE(b.mean, 100);
+  EXPECT_GT(b.mean, 95);
+}
+
+TEST(AdaptivePlan, CombinedVarianceIsThatOfTheAverageOfTheHalves) {
+  // half A: 2 samples {1, 3}; half B: 4 samples {2, 2, 4, 4}
+  const double sa[3] = {4, 4, 4}, qa[3] = {10, 10, 10}, sb[3] = {12, 12, 12}, qb[3] = {40, 40, 40};
+  float mean[3], var[3];
+  std::uint32_t n;
+  lucent::render_detail::combine_halves(sa, qa, 2, sb, qb, 4, mean, var, &n);
+  EXPECT_EQ(n, 6u);
+  EXPECT_FLOAT_EQ(mean[0], 2.5f);  // (2 + 3) / 2, not the pooled 16 / 6
+  // pooled s^2 = (2 + 4) / (6 - 2) = 1.5; var(mean) = s^2 (1/2 + 1/4) / 4; var = n var(mean)
+  EXPECT_FLOAT_EQ(var[0] / 6, static_cast<float>(1.5 * (0.5 + 0.25) / 4));
+}
+
+/// The plastic-and-lamp scene of the adaptive tests: a noisy glossy highlight and soft shadows
+/// beside flat, quickly converged floor.
+Scene adaptive_scene() {
+  Scene s = lamp_scene(SamplerType::Independent);
+  s.film.width = 24;
+  s.film.height = 24;
+  return s;
+}
+
+// --target-error E: the relMSE of the result against a reference (the reference's own expected
+// share subtracted) is within a factor 2 of E, and so is the render's own estimate (the plan
+// comes from the default pilot, 32 samples per half, whose variances are noisy: measured 1.05 E;
+// with 8 per half, 1.9 E). The
+// reference has 20 times the adaptive render's mean spp, so its own share is about 1/20 of E.
+TEST(Adaptive, TargetErrorIsMet) {
+  const double E = 5e-4;
+  Scene s = adaptive_scene();
+  lucent::Renderer r(lucent::test::session_options());
+  r.set_scene(s);
+  lucent::AdaptiveOptions ao;
+  ao.target_error = E;
+  r.render_adaptive(ao);
+  RenderResult a = r.result();
+  ASSERT_GT(a.spp, 0u);
+  EXPECT_EQ(a.target_error, E);
+  RecordProperty("estimated_over_target", std::to_string(a.estimated_relmse / E));
+  EXPECT_LE(a.estimated_relmse, 2 * E);
+
+  Scene rs = s;
+  rs.integrator.seed = 0x51ed5eedu;
+  lucent::RenderOptions ro;
+  ro.spp = static_cast<int>(20 * a.spp);
+  RenderResult ref = lucent::test::render(rs, ro);
+  lucent::CompareResult c = lucent::compare_images(a, ref);
+  double ref_noise = 0;
+  const size_t npix = ref.samples.size();
+  for (size_t i = 0; i < npix; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const double m = ref.mean.rgb[i * 3 + k];
+      ref_noise += ref.variance.rgb[i * 3 + k] / ref.samples[i] / (m * m + 0.01);
+    }
+  ref_noise /= 3.0 * double(npix);
+  const double achieved = c.relmse - ref_noise;
+  RecordProperty("achieved_over_target", std::to_string(achieved / E));
+  EXPECT_LT(achieved, 2 * E) << "relMSE " << c.relmse << " - reference noise " << ref_noise
+                             << ", mean spp " << a.spp;
+  EXPECT_GT(achieved, E / 2) << "relMSE " << c.relmse << " - reference noise " << ref_noise
+                             << ": stopped far beyond the target (wasted samples)";
+  // and it adapted: the counts range over more than a factor 2
+  const auto [lo, hi] = std::minmax_element(a.samples.begin(), a.samples.end());
+  EXPECT_GT(*hi, 3 * *lo);
+}
+
+// Unbiased: an adaptive render (independent halves) against a uniform render of about the same
+// spp and another seed, by lucent compare's z-test (per pixel-channel at family-wise alpha 0.01,
+// and the image means). The control: the same test catches a 2% change in the lamp.
+TEST(Adaptive, MeanIsUnbiased) {
+  Scene s = adaptive_scene();
+  lucent::Renderer r(lucent::test::session_options());
+  r.set_scene(s);
+  lucent::AdaptiveOptions ao;
+  ao.budget_spp = 256;
+  r.render_adaptive(ao);
+  RenderResult a = r.result();
+  EXPECT_NEAR(double(a.spp), 256, 16);
+
+  Scene u = s;
+  u.integrator.seed = 0xabcdefu;
+  lucent::RenderOptions o;
+  o.spp = 256;
+  RenderResult uniform = lucent::test::render(u, o);
+  lucent::CompareResult c = lucent::compare_images(a, uniform);
+  EXPECT_TRUE(c.passed) << c.summary();
+
+  for (auto& m : u.materials)
+    if (m.emissive()) m.emission *= 1.02;
+  RenderResult brighter = lucent::test::render(u, o);
+  EXPECT_FALSE(lucent::compare_images(a, brighter).passed) << "the test has no power";
+}
+
+// ---- clamping --------------------------------------------------------------------------------
+
+// integrator.clamp: the kernel and the reference compute the same clamped estimator (z-test), its
+// mean is lower than the unclamped one by far more than the noise (the bias that converge
+// shows), and its variance lower.
+// The quad lamp: a clamped estimator's mean depends on how each contribution was sampled, and
+// the kernel and the reference sample a quad lamp the same way (not a sphere lamp).
+TEST(Clamp, KernelMatchesReferenceAndTheBiasIsVisible) {
+  Scene s = scene_with(kQuadLampScene, SamplerType::Independent);
+  s.integrator.clamp = 0.1;
+  lucent::RenderOptions o;
+  o.spp = 128;
+  RenderResult k = lucent::test::render(s, o);
+  Scene rs = s;
+  rs.integrator.seed ^= 0x9e3779b9u;
+  lucent::ReferenceOptions ro;
+  ro.spp = 128;
+  RenderResult ref = lucent::render_reference(rs, ro);
+  lucent::CompareResult c = lucent::compare_images(k, ref);
+  EXPECT_TRUE(c.passed) << "A = kernel, B = reference, both clamped\n" << c.summary();
+
+  Scene free = s;
+  free.integrator.clamp = 0;
+  RenderResult unclamped = lucent::test::render(free, o);
+  lucent::CompareResult b = lucent::compare_images(k, unclamped);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_LT(b.mean_z[ch], -5) << "channel " << ch;
+  double vk = 0, vu = 0;
+  for (size_t i = 0; i < k.variance.rgb.size(); ++i)
+    vk += k.variance.rgb[i], vu += unclamped.variance.rgb[i];
+  EXPECT_LT(vk, 0.8 * vu);
+}
+
+}  // namespace
