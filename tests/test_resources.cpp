@@ -223,6 +223,16 @@ TEST(Resources, SessionRefusesBeforeAllocatingAndRecovers) {
               std::string::npos)
         << msg;
   }
+  // a 100000 x 100000 film given through the library (the JSON loader's range check is not on
+  // this path): refused by the host estimate, at once
+  Scene huge = s;
+  huge.film.width = huge.film.height = 100000;
+  std::string msg = error_of([&] { r.set_scene(huge); });
+  EXPECT_EQ(msg.rfind("t.json: rendering needs about ", 0), 0u) << msg;
+  EXPECT_NE(msg.find("the largest part is the accumulation and result images of the "
+                     "100000x100000 film (745.1 GiB): reduce the film size"),
+            std::string::npos)
+      << msg;
   // the limits back to the device's: the same session renders the scene
   r.set_scene(s);
   r.render(1);
