@@ -1,9 +1,11 @@
 #include "render/resources.hpp"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 
 #include "bvh/bvh.hpp"
 #include "lucent/error.hpp"
@@ -64,19 +66,61 @@ std::string format_bytes(std::uint64_t bytes) {
   return buf;
 }
 
-std::uint64_t physical_memory() {
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-  if (pages <= 0 || page <= 0) return 0;
-  return std::uint64_t(pages) * std::uint64_t(page);
+namespace {
+
+/// A cgroup memory limit file's value (0: none, "max" or unreadable).
+std::uint64_t read_limit(const std::string& path) {
+  std::ifstream f(path);
+  unsigned long long v = 0;
+  if (!(f >> v) || v >= (1ull << 62)) return 0;
+  return v;
 }
 
-std::uint64_t host_memory_limit() { return physical_memory() / 5 * 4; }
+/// The memory limit of this process's cgroup (v2, then v1), 0 when none.
+std::uint64_t cgroup_limit() {
+  std::ifstream f("/proc/self/cgroup");
+  std::string line;
+  while (std::getline(f, line)) {
+    const auto colon = line.find(':'), second = line.find(':', colon + 1);
+    if (colon == std::string::npos || second == std::string::npos) continue;
+    const std::string controllers = line.substr(colon + 1, second - colon - 1);
+    std::string path = line.substr(second + 1);
+    if (path == "/") path.clear();
+    std::uint64_t v = 0;
+    if (line.rfind("0::", 0) == 0)
+      v = read_limit("/sys/fs/cgroup" + path + "/memory.max");
+    else if (("," + controllers + ",").find(",memory,") != std::string::npos)
+      v = read_limit("/sys/fs/cgroup/memory" + path + "/memory.limit_in_bytes");
+    if (v > 0) return v;
+  }
+  return 0;
+}
+
+}  // namespace
+
+HostMemory host_memory() {
+  HostMemory m;
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  if (pages > 0 && page > 0) m = {std::uint64_t(pages) * std::uint64_t(page), "physical memory"};
+  auto lower = [&](std::uint64_t v, const char* what) {
+    if (v > 0 && (m.bytes == 0 || v < m.bytes)) m = {v, what};
+  };
+  struct rlimit rl;
+  if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY)
+    lower(rl.rlim_cur, "the address-space limit (ulimit -v)");
+  lower(cgroup_limit(), "the cgroup's memory limit");
+  return m;
+}
+
+std::uint64_t host_memory_limit() { return host_memory().bytes / 5 * 4; }
 
 DeviceLimits DeviceLimits::of(const cl_util::Device& device) {
   DeviceLimits d;
   d.max_alloc = device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
   d.global_mem = device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
-  d.host_mem = host_memory_limit();
+  const HostMemory host = host_memory();
+  d.host_mem = host.bytes / 5 * 4;
+  d.host_what = host.what;
   d.host_unified = (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
   d.device = device.info.name;
   if (g_override) {
@@ -151,16 +195,16 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
 }
 
 void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
-                       std::uint64_t host_limit) {
+                       std::uint64_t host_limit, const std::string& limit_what) {
   if (host_limit == 0) return;
   const std::vector<MemoryPart> parts = estimate_host_memory(scene, devices);
   const std::uint64_t need = total(parts);
   if (need <= host_limit) return;
   const MemoryPart& big = largest(parts);
   throw Error(scene_name(scene) + ": rendering needs about " + format_bytes(need) +
-              " of host memory, more than the limit of " + format_bytes(host_limit) +
-              " (80% of physical memory); the largest part is " + big.what + " (" +
-              format_bytes(big.bytes) + "): reduce " + big.reduce);
+              " of host memory, more than the limit of " + format_bytes(host_limit) + " (80% of " +
+              limit_what + "); the largest part is " + big.what + " (" + format_bytes(big.bytes) +
+              "): reduce " + big.reduce);
 }
 
 std::vector<MemoryPart> film_device_buffers(int width, int height) {

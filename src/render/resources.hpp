@@ -18,8 +18,9 @@ struct DeviceLimits {
   std::uint64_t max_alloc = 0;   ///< CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest buffer
   std::uint64_t global_mem = 0;  ///< CL_DEVICE_GLOBAL_MEM_SIZE: all buffers together
   std::uint64_t host_mem = 0;    ///< what lucent allows itself on the host (host_memory_limit)
-  bool host_unified = false;     ///< the device's buffers live in host memory (a CPU device)
-  std::string device;            ///< the device's name, for messages
+  std::string host_what = "physical memory";  ///< what host_mem is 80% of, for messages
+  bool host_unified = false;  ///< the device's buffers live in host memory (a CPU device)
+  std::string device;         ///< the device's name, for messages
 
   /// The limits of an OpenCL device, with host_mem = host_memory_limit(), each lowered to the
   /// override's where it sets one (ScopedLimitOverride).
@@ -37,9 +38,15 @@ class ScopedLimitOverride {
   ScopedLimitOverride& operator=(const ScopedLimitOverride&) = delete;
 };
 
-/// Physical memory of this machine in bytes (0 when unknown).
-std::uint64_t physical_memory();
-/// The host limit: 80% of physical memory (0 when unknown).
+/// The memory this process may use: the smallest of physical memory, the address-space limit
+/// (RLIMIT_AS, `ulimit -v`) and the cgroup's memory limit (v2 memory.max, v1
+/// memory.limit_in_bytes), with which of them it is ("physical memory", ...). 0 when unknown.
+struct HostMemory {
+  std::uint64_t bytes = 0;
+  std::string what;
+};
+HostMemory host_memory();
+/// The host limit: 80% of host_memory() (0 when unknown).
 std::uint64_t host_memory_limit();
 
 /// One part of an estimate: what it is, its size, and what to reduce when it is too large.
@@ -57,9 +64,9 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                                              const std::vector<DeviceLimits>& devices);
 
 /// Throws lucent::Error when the estimate exceeds `host_limit` (0: no check), naming the largest
-/// part and the limit.
+/// part and the limit (80% of `limit_what`).
 void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
-                       std::uint64_t host_limit);
+                       std::uint64_t host_limit, const std::string& limit_what = "physical memory");
 
 /// The film buffers of a device: the pass's sums and sums of squares (float4 per pixel).
 std::vector<MemoryPart> film_device_buffers(int width, int height);

@@ -221,7 +221,7 @@ struct Renderer::Impl {
     scene_detail::ScopedWarningSink sink(options.on_warning);
     std::vector<render_detail::DeviceLimits> limits;
     for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
-    render_detail::check_host_memory(s, limits, limits.front().host_mem);
+    render_detail::check_host_memory(s, limits, limits.front().host_mem, limits.front().host_what);
     for (const DeviceInfo& d : device_infos)
       render_detail::check_precision_support(d, options.precision);
     auto t0 = clock_type::now();
