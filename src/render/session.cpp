@@ -245,12 +245,14 @@ struct Renderer::Impl {
     const size_t n = static_cast<size_t>(s.film.width) * s.film.height;
     for (const render_detail::DeviceLimits& l : limits)
       render_detail::check_device_memory(s, next, l);
-    std::string device;  // the one being set up, for messages
+    std::string device;  // the one being set up, and what it does, for messages
+    render_detail::ClStage stage = render_detail::ClStage::Upload;
     try {
       std::string source;
       for (auto& wp : workers) {
         Worker& w = *wp;
         device = w.ctx.device.info.name;
+        stage = render_detail::ClStage::Upload;
         Program* previous_program = w.program;
         if (!w.programs.count(opts) && source.empty())
           source = detail::assemble_kernel_source("megakernel.cl", options.kernel_dir);
@@ -276,11 +278,12 @@ struct Renderer::Impl {
         w.set_args();
         if (w.program != previous_program) {
           packed.params = next.params;  // the warm-up launch's parameters
+          stage = render_detail::ClStage::Pass;
           warm_up(w);
         }
       }
     } catch (const cl::Error& e) {
-      throw Error(render_detail::resource_error(e, render_detail::ClStage::Upload, s.path, device));
+      throw Error(render_detail::resource_error(e, stage, s.path, device));
     }
     packed = std::move(next);
     build_options = opts;
