@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -315,6 +316,57 @@ TEST(Resources, AddressSpaceLimitBoundsTheHost) {
             std::string::npos)
       << r.err;
   EXPECT_FALSE(lucent::test::read_file(dir + "/o.png").size() > 0);
+}
+
+// Each texture is bounded (8192 x 8192), and so are all of them together: as they load, the
+// scene's textures as linear RGBA float must stay within the host limit. 40 names of one 1024 x
+// 1024 run-length TGA (128 KiB, 16 MiB decoded) under `ulimit -v` 256 MiB: the 13th is refused.
+TEST(Resources, TexturesTogetherAreBounded) {
+  if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer cannot run under ulimit -v";
+  std::string dir = lucent::test::temp_dir();
+  const int w = 1024, h = 1024;
+  std::string tga = {0,
+                     0,
+                     10,
+                     0,
+                     0,
+                     0,
+                     0,
+                     0,
+                     0,
+                     0,
+                     0,
+                     0,
+                     char(w & 255),
+                     char(w >> 8),
+                     char(h & 255),
+                     char(h >> 8),
+                     24,
+                     0x20};
+  for (int i = 0; i < w * h / 128; ++i) tga += std::string("\xff\x28\x50\x78", 4);
+  std::string materials;
+  for (int i = 0; i < 40; ++i) {
+    std::string name = "t" + std::to_string(i) + ".tga";
+    lucent::test::write_file(dir + "/" + name, tga);
+    char key[8];
+    std::snprintf(key, sizeof key, "m%02d", i);
+    materials += std::string(i ? "," : "") + "\"" + key +
+                 "\": {\"type\": \"diffuse\", \"albedo\": {\"texture\": \"" + name + "\"}}";
+  }
+  lucent::test::write_file(dir + "/s.json", R"({"film": {"width": 4, "height": 4},
+    "materials": {)" + materials + R"(},
+    "shapes": [{"type": "sphere", "center": [0, 0, -3], "radius": 1, "material": "m00"}]})");
+  auto r = lucent::test::run_cli("render " + q(dir + "/s.json") + " -o " + q(dir + "/o.png"),
+                                 ulimit_v("262144"));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("/materials/m12/albedo/texture: " + dir +
+                       "/t12.tga: with this 1024x1024 texture (16.0 MiB) the scene's 13 textures "
+                       "need 208.0 MiB, more than the limit of 204.8 MiB (80% of the "
+                       "address-space limit (ulimit -v)): reduce the textures' resolution or "
+                       "number"),
+            std::string::npos)
+      << r.err;
 }
 
 // The issue's list: each ends in one line and a non-zero exit, within seconds and 4 GiB.

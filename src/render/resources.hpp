@@ -7,17 +7,21 @@
 #include <vector>
 
 #include "cl/context.hpp"
+#include "core/host_memory.hpp"
 #include "lucent/scene.hpp"
 #include "render/pack.hpp"
 
 namespace lucent::render_detail {
+
+using sys::format_bytes;
+using sys::host_memory_limit;
 
 /// The limits a scene is checked against. Tests shrink them to exercise the checks without
 /// allocating; 0 means "no limit known".
 struct DeviceLimits {
   std::uint64_t max_alloc = 0;   ///< CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest buffer
   std::uint64_t global_mem = 0;  ///< CL_DEVICE_GLOBAL_MEM_SIZE: all buffers together
-  std::uint64_t host_mem = 0;    ///< what lucent allows itself on the host (host_memory_limit)
+  std::uint64_t host_mem = 0;    ///< what lucent allows itself on the host (sys::host_memory_limit)
   std::string host_what = "physical memory";  ///< what host_mem is 80% of, for messages
   bool host_unified = false;  ///< the device's buffers live in host memory (a CPU device)
   std::string device;         ///< the device's name, for messages
@@ -37,17 +41,6 @@ class ScopedLimitOverride {
   ScopedLimitOverride(const ScopedLimitOverride&) = delete;
   ScopedLimitOverride& operator=(const ScopedLimitOverride&) = delete;
 };
-
-/// The memory this process may use: the smallest of physical memory, the address-space limit
-/// (RLIMIT_AS, `ulimit -v`) and the cgroup's memory limit (v2 memory.max, v1
-/// memory.limit_in_bytes), with which of them it is ("physical memory", ...). 0 when unknown.
-struct HostMemory {
-  std::uint64_t bytes = 0;
-  std::string what;
-};
-HostMemory host_memory();
-/// The host limit: 80% of host_memory() (0 when unknown).
-std::uint64_t host_memory_limit();
 
 /// One part of an estimate: what it is, its size, and what to reduce when it is too large.
 struct MemoryPart {
@@ -88,8 +81,5 @@ enum class ClStage {
 /// other errors keep cl_util::describe's text.
 std::string resource_error(const cl::Error& e, ClStage stage, const std::string& scene_path,
                            const std::string& device);
-
-/// Bytes as "12.3 GiB", "512.0 MiB", "96.0 KiB", "100 bytes".
-std::string format_bytes(std::uint64_t bytes);
 
 }  // namespace lucent::render_detail
