@@ -64,6 +64,9 @@ const std::map<std::string, std::string> kExpected = {
     {"exr-leak-env.bundle", "/img.exr: cannot read OpenEXR pixels:"},
     // a map_Kd name longer than the file system allows: std::filesystem::exists threw
     {"long-texture-name.bundle", ""},
+    // a vw (skin weight) line whose joint 112147483648 tinyobjloader converted to int: undefined
+    // behaviour; its vertex '0f' is refused first
+    {"vw-joint-int-overflow.bundle", "/m.obj:8: skin weight line: '0f' is not a number"},
 };
 
 TEST(FuzzRegressions, EveryFoundInputIsRefusedWithOneLineOrLoads) {
@@ -85,7 +88,8 @@ TEST(FuzzRegressions, EveryFoundInputIsRefusedWithOneLineOrLoads) {
       ASSERT_FALSE(err.empty()) << name << " loaded";
       EXPECT_EQ(err.find('\n'), std::string::npos) << name << ": " << err;
       EXPECT_NE(err.find(it->second), std::string::npos) << name << ": " << err;
-      if (std::string(target) != "scene") {
+      // a bundle's files are written out under their own names (scene.json, m.obj, ...)
+      if (std::string(target) != "scene" && std::string(target) != "obj") {
         EXPECT_EQ(err.rfind(e.path().string() + ": ", 0), 0u) << name << ": " << err;
       }
     }
