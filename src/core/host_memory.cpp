@@ -54,7 +54,7 @@ HostMemory host_memory() {
   return m;
 }
 
-std::uint64_t host_memory_limit() { return host_memory().bytes / 5 * 4; }
+std::uint64_t host_memory_limit() { return host_memory().limit(); }
 
 std::string format_bytes(std::uint64_t bytes) {
   char buf[64];

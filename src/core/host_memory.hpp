@@ -12,6 +12,8 @@ namespace lucent::sys {
 struct HostMemory {
   std::uint64_t bytes = 0;
   std::string what;
+  /// What lucent allows itself: 80% of it.
+  std::uint64_t limit() const { return bytes / 5 * 4; }
 };
 HostMemory host_memory();
 

@@ -8,8 +8,8 @@
 
 namespace lucent::render_detail {
 
-using sys::HostMemory;
 using sys::host_memory;
+using sys::HostMemory;
 
 namespace {
 
@@ -56,7 +56,7 @@ DeviceLimits DeviceLimits::of(const cl_util::Device& device) {
   d.max_alloc = device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
   d.global_mem = device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
   const HostMemory host = host_memory();
-  d.host_mem = host.bytes / 5 * 4;
+  d.host_mem = host.limit();
   d.host_what = host.what;
   d.host_unified = (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
   d.device = device.info.name;

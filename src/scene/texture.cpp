@@ -53,7 +53,7 @@ int load_texture(Scene& scene, const std::string& path) {
   for (const Texture& t : scene.textures) loaded += std::uint64_t(t.width) * t.height * texel;
   const std::uint64_t adds = std::uint64_t(p.width) * std::uint64_t(p.height) * texel;
   const sys::HostMemory host = sys::host_memory();
-  const std::uint64_t limit = host.bytes / 5 * 4;
+  const std::uint64_t limit = host.limit();
   if (limit > 0 && loaded + adds > limit)
     throw Error(path + ": with this " + std::to_string(p.width) + "x" + std::to_string(p.height) +
                 " texture (" + sys::format_bytes(adds) + ") the scene's " +
