@@ -58,12 +58,25 @@ const std::map<std::string, std::string> kExpected = {
     {"exr-piz-overread-2.exr",
      ": OpenEXR PIZ chunk at byte 329 is corrupt: its bitmap runs past its end"},
     {"exr-leak.exr", ": cannot read OpenEXR pixels:"},
+    // not found by fuzzing: progressive JPEGs (jpegtran -progressive of the seeds' RGB and grey
+    // images), whose scans read DC or AC tables only, must pass the scan check above
+    {"jpeg-progressive-rgb.jpg", ""},
+    {"jpeg-progressive-grey.jpg", ""},
+    // a scan reading an AC table no DHT defined: stb_image read past its maxcode array
+    {"jpeg-undefined-huffman-table.jpg",
+     ": JPEG scan at byte 593 uses Huffman table AC1, which no DHT segment before it defines "
+     "(corrupt)"},
+    // stb_image's bit reader shifted by 32 (code_bits negative): ubsan.supp, a decoding error
+    {"jpeg-negative-code-bits.jpg", ": cannot decode JPEG: unknown marker"},
     {"exr-offset-table-overread.exr",
      ": OpenEXR file is truncated: its 5x2088 header needs 841 bytes of header and offset table, "
      "the file has 840"},
     {"exr-leak-env.bundle", "/img.exr: cannot read OpenEXR pixels:"},
     // a map_Kd name longer than the file system allows: std::filesystem::exists threw
     {"long-texture-name.bundle", ""},
+    // a vw (skin weight) line whose joint 112147483648 tinyobjloader converted to int: undefined
+    // behaviour; its vertex '0f' is refused first
+    {"vw-joint-int-overflow.bundle", "/m.obj:8: skin weight line: '0f' is not a number"},
 };
 
 TEST(FuzzRegressions, EveryFoundInputIsRefusedWithOneLineOrLoads) {
@@ -85,7 +98,8 @@ TEST(FuzzRegressions, EveryFoundInputIsRefusedWithOneLineOrLoads) {
       ASSERT_FALSE(err.empty()) << name << " loaded";
       EXPECT_EQ(err.find('\n'), std::string::npos) << name << ": " << err;
       EXPECT_NE(err.find(it->second), std::string::npos) << name << ": " << err;
-      if (std::string(target) != "scene") {
+      // a bundle's files are written out under their own names (scene.json, m.obj, ...)
+      if (std::string(target) != "scene" && std::string(target) != "obj") {
         EXPECT_EQ(err.rfind(e.path().string() + ": ", 0), 0u) << name << ": " << err;
       }
     }

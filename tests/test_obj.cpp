@@ -10,12 +10,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <glm/gtc/matrix_transform.hpp>
 #include <map>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <glm/gtc/matrix_transform.hpp>
 
 #include "lucent/error.hpp"
 #include "scene/loaders.hpp"
@@ -56,8 +55,7 @@ std::array<std::array<double, 3>, 3> corners(const Scene& s, const Triangle& t) 
 }
 
 // tinyobjloader reads numbers as float: compare colours to single precision
-#define EXPECT_COLOUR(a, ...) \
-  EXPECT_NEAR(glm::length((a) - glm::dvec3(__VA_ARGS__)), 0.0, 1e-6) << #a
+#define EXPECT_COLOUR(a, ...) EXPECT_NEAR(glm::length((a)-glm::dvec3(__VA_ARGS__)), 0.0, 1e-6) << #a
 
 const Material& material_named(const Scene& s, const std::string& name) {
   int i = s.find_material(name);
@@ -343,6 +341,11 @@ TEST(Obj, MalformedFilesAreErrorsNamingFileAndLine) {
       {"vnword.obj", "vn 0 1 0x\n", "'0x' is not a number"},
       {"vtword.obj", "vt u 0\n", "texture coordinate line: 'u' is not"},
       {"vhuge.obj", "v 1e999 0 0\n", "out of range"},
+      // tinyobjloader's skin weights: it converts joints to int unchecked (found by fuzz_obj)
+      {"vwjoint.obj", "vw 1 112147483648 0.5\n",
+       "skin weight line: joint '112147483648' is out of range (0 to 2147483647)"},
+      {"vwnegative.obj", "vw 1 -1 0.5\n", "skin weight line: joint '-1' is out of range"},
+      {"vwweight.obj", "vw 1 0 1e39\n", "skin weight line: '1e39' is out of range for a float"},
   };
   for (const Case& c : cases) {
     std::string path = write(dir, c.name, head + "f 1 2 3\n" + c.face);  // the face: line 7
@@ -357,6 +360,15 @@ TEST(Obj, MalformedFilesAreErrorsNamingFileAndLine) {
   EXPECT_NE(err.find(missing), std::string::npos) << err;
   err = load_error(dir);
   EXPECT_NE(err.find(dir + ": "), std::string::npos) << "a directory: " << err;
+}
+
+// Skin weights within range load as before (lucent ignores them).
+TEST(Obj, SkinWeightsInRangeLoad) {
+  std::string dir = lucent::test::temp_dir();
+  std::string path = write(dir, "vw.obj",
+                           "v 0 0 0\nv 1 0 0\nv 1 1 0\nvw 0 0 0.25 1 0.75\nvw 1 2147483647 1\n"
+                           "f 1 2 3\n");
+  EXPECT_EQ(load_error(path), "");
 }
 
 TEST(Obj, TransformMovesPositionsAndNormalsByTheInverseTranspose) {

@@ -281,7 +281,7 @@ def test_session_errors(renderer, small_scene):
         renderer.render(1, progress=3)
     huge = small_scene.copy()
     huge.film.width = huge.film.height = 1 << 20
-    with pytest.raises(lucent.Error, match="film needs") as e:
+    with pytest.raises(lucent.Error, match="1048576x1048576 film") as e:
         renderer.set_scene(huge)
     assert "\n" not in str(e.value)
     renderer.render(1)  # the session still renders its previous scene

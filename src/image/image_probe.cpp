@@ -122,7 +122,8 @@ class Checker {
   Probe jpeg() const {
     Probe p{Format::Jpeg};
     u64 pos = 2;
-    bool frame = false, scan = false;
+    bool frame = false, scan = false, progressive = false;
+    unsigned tables = 0;  // Huffman tables defined so far: bit 4 * class + id
     while (true) {
       if (pos >= n_) break;
       if (d_[pos] != 0xFF) {
@@ -151,33 +152,63 @@ class Checker {
         if (len < 8) fail("JPEG frame header is too short");
         if (!frame) size(p, be16(d_ + pos + 5), be16(d_ + pos + 3));
         frame = true;
+        progressive = progressive || m == 0xC2;
       }
       if (m == 0xDA) {
         if (!frame) fail("JPEG file has image data before its frame header");
+        scan_tables(pos - 2, pos + 2, len - 2, progressive, tables);
         scan = true;
       }
-      if (m == 0xC4) huffman_tables(pos + 2, len - 2);
+      if (m == 0xC4) tables |= huffman_tables(pos + 2, len - 2);
       pos += len;
     }
     fail("JPEG file is truncated: no end-of-image marker");
   }
 
+  // A scan header (SOS at byte `at`, its segment from `pos`): every Huffman table its decoding
+  // reads must have been defined by a DHT segment before it. stb_image keeps its tables in
+  // memory it does not clear, and a table no DHT defined sends its decoder past its arrays
+  // (found by fuzzing). A baseline scan reads its components' DC and AC tables; a progressive
+  // scan the DC tables for a first DC scan (Ss = 0, Ah = 0), the AC tables for an AC scan.
+  void scan_tables(u64 at, u64 pos, u64 left, bool progressive, unsigned tables) const {
+    if (left < 1) return;
+    const unsigned count = d_[pos];
+    if (left < 1 + 2 * u64(count) + 3) return;  // stb_image refuses the header itself
+    const unsigned ss = d_[pos + 1 + 2 * count], ah = d_[pos + 3 + 2 * count] >> 4;
+    const bool dc = !progressive || (ss == 0 && ah == 0), ac = !progressive || ss > 0;
+    for (unsigned k = 0; k < count; ++k) {
+      const unsigned sel = d_[pos + 2 + 2 * k], td = sel >> 4, ta = sel & 15;
+      if (td > 3 || ta > 3) return;  // stb_image refuses the header itself
+      for (unsigned cls = 0; cls < 2; ++cls) {
+        const unsigned id = cls == 0 ? td : ta;
+        if ((cls == 0 ? dc : ac) && !(tables & (1u << (4 * cls + id))))
+          fail("JPEG scan at byte " + std::to_string(at) + " uses Huffman table " +
+               (cls == 0 ? "DC" : "AC") + std::to_string(id) +
+               ", which no DHT segment before it defines (corrupt)");
+      }
+    }
+  }
+
   // A DHT segment's tables, read as stb_image reads them (on past the segment if its length
   // lies): more than 256 codes in one table overflow stb_image's arrays (found by fuzzing).
-  void huffman_tables(u64 pos, u64 left) const {
+  // Returns the tables it defines (bit 4 * class + id).
+  unsigned huffman_tables(u64 pos, u64 left) const {
+    unsigned defined = 0;
     auto get8 = [&]() -> unsigned { return pos < n_ ? d_[pos++] : (++pos, 0u); };
     while (left > 0 && left < (1u << 16)) {
       const unsigned q = get8();
-      if ((q >> 4) > 1 || (q & 15) > 3) return;  // stb_image refuses the table itself
+      if ((q >> 4) > 1 || (q & 15) > 3) return defined;  // stb_image refuses the table itself
       u64 codes = 0;
       for (int i = 0; i < 16; ++i) codes += get8();
       if (codes > 256)
         fail("JPEG Huffman table at byte " + std::to_string(pos - 17) + " has " +
              std::to_string(codes) + " codes, more than 256 (corrupt)");
       pos += codes;
-      if (17 + codes > left) return;
+      defined |= 1u << (4 * (q >> 4) + (q & 15));
+      if (17 + codes > left) return defined;
       left -= 17 + codes;
     }
+    return defined;
   }
 
   Probe bmp() const {

@@ -3,8 +3,6 @@
 // double on the host. lucent::render() (renderer.cpp) is a one-shot session.
 #include "lucent/session.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -24,6 +22,7 @@
 #include "render/device_scene.hpp"
 #include "render/features.hpp"
 #include "render/pack.hpp"
+#include "render/resources.hpp"
 #include "scene/loaders.hpp"
 
 namespace lucent {
@@ -48,27 +47,6 @@ std::string resolve_cache_dir(const std::string& dir) {
   if (dir == "off") return "";
   if (!dir.empty()) return dir;
   return cl_util::default_program_cache_dir();
-}
-
-/// What a film of this size needs on the host: double sums, sums of squares and counts, the pass
-/// read-back and the result images.
-void check_film_memory(const Scene& scene, const cl_util::Context& ctx) {
-  const int width = scene.film.width, height = scene.film.height;
-  const size_t npix = static_cast<size_t>(width) * height;
-  const double host_bytes = double(npix) * (6 * sizeof(double) + sizeof(std::uint32_t) +
-                                            2 * sizeof(cl_float4) + 6 * sizeof(float));
-  const double host_memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
-  if (host_memory > 0 && host_bytes > 0.8 * host_memory)
-    throw Error(scene.path + ": a " + std::to_string(width) + "x" + std::to_string(height) +
-                " film needs " + std::to_string(static_cast<long long>(host_bytes / (1 << 20))) +
-                " MiB of host memory; this machine has " +
-                std::to_string(static_cast<long long>(host_memory / (1 << 20))) + " MiB");
-  const cl_ulong max_alloc = ctx.device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
-  if (npix * sizeof(cl_float4) > max_alloc)
-    throw Error(scene.path + ": a " + std::to_string(width) + "x" + std::to_string(height) +
-                " film needs a " + std::to_string(npix * sizeof(cl_float4) >> 20) +
-                " MiB buffer; the device allows " + std::to_string(max_alloc >> 20) +
-                " MiB per buffer");
 }
 
 /// The launch parameters and every buffer of two packings are the same: they render the same
@@ -262,7 +240,9 @@ struct Renderer::Impl {
 
   void set_scene(const Scene& s) {
     scene_detail::ScopedWarningSink sink(options.on_warning);
-    for (auto& w : workers) check_film_memory(s, w->ctx);
+    std::vector<render_detail::DeviceLimits> limits;
+    for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
+    render_detail::check_host_memory(s, limits, limits.front().host_mem, limits.front().host_what);
     for (const DeviceInfo& d : device_infos)
       render_detail::check_precision_support(d, options.precision);
     auto t0 = clock_type::now();
@@ -284,10 +264,16 @@ struct Renderer::Impl {
 
     const bool keep = uploaded && opts == build_options && same_render_data(packed, next);
     const size_t n = static_cast<size_t>(s.film.width) * s.film.height;
+    for (const render_detail::DeviceLimits& l : limits)
+      render_detail::check_device_memory(s, next, l);
+    std::string device;  // the one being set up, and what it does, for messages
+    render_detail::ClStage stage = render_detail::ClStage::Upload;
     try {
       std::string source;
       for (auto& wp : workers) {
         Worker& w = *wp;
+        device = w.ctx.device.info.name;
+        stage = render_detail::ClStage::Upload;
         Program* previous_program = w.program;
         if (!w.programs.count(opts) && source.empty())
           source = detail::assemble_kernel_source("megakernel.cl", options.kernel_dir);
@@ -314,11 +300,12 @@ struct Renderer::Impl {
         w.set_args();
         if (w.program != previous_program) {
           packed.params = next.params;  // the warm-up launch's parameters
+          stage = render_detail::ClStage::Pass;
           warm_up(w);
         }
       }
     } catch (const cl::Error& e) {
-      throw Error(cl_util::describe(e));
+      throw Error(render_detail::resource_error(e, stage, s.path, device));
     }
     packed = std::move(next);
     build_options = opts;
@@ -438,7 +425,9 @@ struct Renderer::Impl {
         }
       } catch (const cl::Error& e) {
         std::lock_guard<std::mutex> lock(cs.m);
-        if (!failure) failure = std::make_exception_ptr(Error(cl_util::describe(e)));
+        if (!failure)
+          failure = std::make_exception_ptr(Error(render_detail::resource_error(
+              e, render_detail::ClStage::Pass, scene->path, w.ctx.device.info.name)));
       } catch (...) {
         std::lock_guard<std::mutex> lock(cs.m);
         if (!failure) failure = std::current_exception();

@@ -4,6 +4,7 @@
 // last line: every number and index is checked here, and the first bad one named with its line.
 #include <cfloat>
 #include <charconv>
+#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -124,6 +125,18 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
       need = 1, what = "texture coordinate", ++count[1];
     } else if (tag == "vn") {
       need = 3, what = "normal", ++count[2];
+    }
+    if (tag == "vw") {
+      // tinyobjloader's skin weights (vw vertex joint weight joint weight ...), unused by lucent
+      // but parsed: it converts each joint to int unchecked (1e11 is undefined behaviour)
+      int n = 0;
+      for (std::string_view t; !(t = token(rest)).empty(); ++n) {
+        const double v = number(t, fail, "skin weight");
+        if (n % 2 == 1 && !(v >= 0 && v <= INT_MAX))
+          fail("skin weight line: joint '" + str(t) + "' is out of range (0 to " +
+               std::to_string(INT_MAX) + ")");
+      }
+      return;
     }
     if (what) {
       int n = 0;

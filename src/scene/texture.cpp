@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "core/file_io.hpp"
+#include "core/host_memory.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/error.hpp"
 #include "scene/loaders.hpp"
@@ -42,8 +43,25 @@ int load_texture(Scene& scene, const std::string& path) {
   for (size_t i = 0; i < scene.textures.size(); ++i)
     if (texture_key(scene.textures[i].path) == key) return static_cast<int>(i);
   const std::string bytes = io::read_file(path, image_detail::image_read_spec("texture"));
-  scene.textures.push_back(
-      decode_texture(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), path));
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  // the scene's textures together, as linear RGBA float, within the host limit: each is bounded,
+  // not their number (a few kilobytes of compressed PNG can claim a gigabyte)
+  const image_detail::Probe p =
+      image_detail::probe_image(data, bytes.size(), path, image_detail::kMaxTexturePixels);
+  const std::uint64_t texel = 4 * sizeof(float);
+  std::uint64_t loaded = 0;
+  for (const Texture& t : scene.textures) loaded += std::uint64_t(t.width) * t.height * texel;
+  const std::uint64_t adds = std::uint64_t(p.width) * std::uint64_t(p.height) * texel;
+  const sys::HostMemory host = sys::host_memory();
+  const std::uint64_t limit = host.limit();
+  if (limit > 0 && loaded + adds > limit)
+    throw Error(path + ": with this " + std::to_string(p.width) + "x" + std::to_string(p.height) +
+                " texture (" + sys::format_bytes(adds) + ") the scene's " +
+                std::to_string(scene.textures.size() + 1) + " textures need " +
+                sys::format_bytes(loaded + adds) + ", more than the limit of " +
+                sys::format_bytes(limit) + " (80% of " + host.what +
+                "): reduce the textures' resolution or number");
+  scene.textures.push_back(decode_texture(data, bytes.size(), path));
   return static_cast<int>(scene.textures.size() - 1);
 }
 

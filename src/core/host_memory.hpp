@@ -1,0 +1,26 @@
+#pragma once
+// The memory this process may use on the host, for the checks that refuse what would exhaust it
+// (the scene's textures as they load, the render's estimate in render/resources.cpp).
+#include <cstdint>
+#include <string>
+
+namespace lucent::sys {
+
+/// The smallest of physical memory, the address-space limit (RLIMIT_AS, `ulimit -v`) and the
+/// cgroup's memory limit (v2 memory.max, v1 memory.limit_in_bytes), with which of them it is
+/// ("physical memory", ...). bytes is 0 when none is known.
+struct HostMemory {
+  std::uint64_t bytes = 0;
+  std::string what;
+  /// What lucent allows itself: 80% of it.
+  std::uint64_t limit() const { return bytes / 5 * 4; }
+};
+HostMemory host_memory();
+
+/// What lucent allows itself: 80% of host_memory() (0 when unknown).
+std::uint64_t host_memory_limit();
+
+/// Bytes as "12.3 GiB", "512.0 MiB", "96.0 KiB", "100 bytes".
+std::string format_bytes(std::uint64_t bytes);
+
+}  // namespace lucent::sys

@@ -1,0 +1,204 @@
+#include "render/resources.hpp"
+
+#include <algorithm>
+
+#include "bvh/bvh.hpp"
+#include "core/host_memory.hpp"
+#include "lucent/error.hpp"
+
+namespace lucent::render_detail {
+
+using sys::host_memory;
+using sys::HostMemory;
+
+namespace {
+
+const DeviceLimits* g_override = nullptr;
+
+std::uint64_t lowered(std::uint64_t real, std::uint64_t override) {
+  if (override == 0) return real;
+  return real == 0 ? override : std::min(real, override);
+}
+
+std::string scene_name(const Scene& scene) { return scene.path.empty() ? "scene" : scene.path; }
+
+std::string film_size(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+/// What to reduce when a scene buffer is too large, by its LC_SCENE_BUFFERS name.
+std::string reduce_buffer(const std::string& name) {
+  if (name == "nodes" || name == "leaves") return "the number of triangles and spheres";
+  if (name == "triangles" || name == "tri_attrs") return "the number of triangles";
+  if (name == "spheres") return "the number of spheres";
+  if (name == "materials") return "the number of materials";
+  if (name == "lights") return "the number of lights (every emissive triangle is one)";
+  if (name == "light_cdf") return "the environment map's resolution";
+  return "the textures' resolution";  // textures, texels
+}
+
+const MemoryPart& largest(const std::vector<MemoryPart>& parts) {
+  return *std::max_element(
+      parts.begin(), parts.end(),
+      [](const MemoryPart& a, const MemoryPart& b) { return a.bytes < b.bytes; });
+}
+
+std::uint64_t total(const std::vector<MemoryPart>& parts) {
+  std::uint64_t t = 0;
+  for (const MemoryPart& p : parts) t += p.bytes;
+  return t;
+}
+
+}  // namespace
+
+DeviceLimits DeviceLimits::of(const cl_util::Device& device) {
+  DeviceLimits d;
+  d.max_alloc = device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+  d.global_mem = device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+  const HostMemory host = host_memory();
+  d.host_mem = host.limit();
+  d.host_what = host.what;
+  d.host_unified = (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+  d.device = device.info.name;
+  if (g_override) {
+    d.max_alloc = lowered(d.max_alloc, g_override->max_alloc);
+    d.global_mem = lowered(d.global_mem, g_override->global_mem);
+    d.host_mem = lowered(d.host_mem, g_override->host_mem);
+  }
+  return d;
+}
+
+ScopedLimitOverride::ScopedLimitOverride(const DeviceLimits& limits) {
+  delete g_override;
+  g_override = new DeviceLimits(limits);
+}
+
+ScopedLimitOverride::~ScopedLimitOverride() {
+  delete g_override;
+  g_override = nullptr;
+}
+
+std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
+                                             const std::vector<DeviceLimits>& devices) {
+  const std::uint64_t npix = std::uint64_t(scene.film.width) * std::uint64_t(scene.film.height);
+  const std::string film = film_size(scene.film.width, scene.film.height);
+  std::vector<MemoryPart> parts;
+  // session.cpp: double sums and sums of squares (3 + 3) and a sample count per pixel; the
+  // result's mean and variance (3 + 3 floats) and sample counts
+  parts.push_back({"the accumulation and result images of the " + film + " film",
+                   npix * (6 * sizeof(double) + sizeof(std::uint32_t) + 6 * sizeof(float) +
+                           sizeof(std::uint32_t)),
+                   "the film size"});
+  // the packed scene (pack.cpp): a triangle and its attributes, a sphere, a texel as float4, and
+  // an environment map's sampling table (a float per texel)
+  const std::uint64_t ntri = scene.triangles.size(), nsph = scene.spheres.size();
+  const std::uint64_t tri_bytes = ntri * (sizeof(lc_triangle) + sizeof(lc_triangle_attr));
+  const std::uint64_t sph_bytes = nsph * sizeof(lc_sphere);
+  std::uint64_t tex_bytes = 0;
+  for (const Texture& t : scene.textures)
+    tex_bytes += std::uint64_t(t.width) * std::uint64_t(t.height) * sizeof(lc_float4);
+  for (const Light& l : scene.lights)
+    if (l.type == LightType::EnvironmentMap && l.texture >= 0 &&
+        size_t(l.texture) < scene.textures.size()) {
+      const Texture& t = scene.textures[size_t(l.texture)];
+      tex_bytes += (std::uint64_t(t.width) * std::uint64_t(t.height) + 1) * sizeof(float);
+    }
+  // the BVH: the build's primitive references (32 bytes), binary nodes (at most 2 per primitive)
+  // and primitive indices; then the wide tree's leaf blocks (about one per 2 primitives) and
+  // nodes (about one per 4)
+  const std::uint64_t nprim = ntri + nsph;
+  const std::uint64_t bvh_tree =
+      (nprim / 2 + 1) * sizeof(lc_bvh_leaf) + (nprim / 4 + 1) * sizeof(lc_bvh_node);
+  const std::uint64_t bvh_bytes =
+      nprim * (32 + 2 * sizeof(bvh::Node2) + sizeof(lc_uint)) + bvh_tree;
+  parts.push_back(
+      {"the " + std::to_string(ntri) + " triangles", tri_bytes, "the number of triangles"});
+  parts.push_back({"the " + std::to_string(nsph) + " spheres", sph_bytes, "the number of spheres"});
+  parts.push_back({"the texels of the " + std::to_string(scene.textures.size()) + " textures",
+                   tex_bytes, "the textures' resolution"});
+  parts.push_back({"the BVH of " + std::to_string(nprim) + " primitives", bvh_bytes,
+                   "the number of triangles and spheres"});
+  const std::uint64_t scene_buffers = tri_bytes + sph_bytes + tex_bytes + bvh_tree;
+  for (const DeviceLimits& d : devices) {
+    // the pass read-back (session.cpp: h_sum, h_sumsq)
+    std::uint64_t bytes = 2 * npix * sizeof(cl_float4);
+    // a CPU device's buffers are host memory: the scene's and the film's
+    if (d.host_unified) bytes += scene_buffers + 2 * npix * sizeof(cl_float4);
+    parts.push_back({"the buffers of device '" + d.device + "' for the " + film + " film" +
+                         (d.host_unified ? " and the scene (host memory)" : ""),
+                     bytes, d.host_unified ? "the film size or the scene" : "the film size"});
+  }
+  return parts;
+}
+
+void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
+                       std::uint64_t host_limit, const std::string& limit_what) {
+  if (host_limit == 0) return;
+  const std::vector<MemoryPart> parts = estimate_host_memory(scene, devices);
+  const std::uint64_t need = total(parts);
+  if (need <= host_limit) return;
+  const MemoryPart& big = largest(parts);
+  throw Error(scene_name(scene) + ": rendering needs about " + format_bytes(need) +
+              " of host memory, more than the limit of " + format_bytes(host_limit) + " (80% of " +
+              limit_what + "); the largest part is " + big.what + " (" + format_bytes(big.bytes) +
+              "): reduce " + big.reduce);
+}
+
+std::vector<MemoryPart> film_device_buffers(int width, int height) {
+  const std::uint64_t npix = std::uint64_t(width) * std::uint64_t(height);
+  const std::string film = film_size(width, height);
+  return {{"film sample sums (" + film + ")", npix * sizeof(cl_float4), "the film size"},
+          {"film sums of squares (" + film + ")", npix * sizeof(cl_float4), "the film size"}};
+}
+
+void check_device_memory(const Scene& scene, const PackedScene& packed,
+                         const DeviceLimits& limits) {
+  std::vector<MemoryPart> parts;
+  // OpenCL forbids empty buffers: an empty one keeps one element (device_scene.cpp)
+#define LUCENT_BUFFER_PART(name, type, what)                                            \
+  parts.push_back({what, std::max<std::uint64_t>(packed.name.size(), 1) * sizeof(type), \
+                   reduce_buffer(#name)});
+  LC_SCENE_BUFFERS(LUCENT_BUFFER_PART)
+#undef LUCENT_BUFFER_PART
+  for (MemoryPart& p : film_device_buffers(scene.film.width, scene.film.height))
+    parts.push_back(std::move(p));
+  const std::string device = "device '" + limits.device + "'";
+  // the largest buffer is the one to reduce first
+  const MemoryPart& big = largest(parts);
+  if (limits.max_alloc > 0 && big.bytes > limits.max_alloc)
+    throw Error(scene_name(scene) + ": the " + big.what + " need a buffer of " +
+                format_bytes(big.bytes) + ", more than the " + format_bytes(limits.max_alloc) +
+                " " + device + " allows per buffer (CL_DEVICE_MAX_MEM_ALLOC_SIZE): reduce " +
+                big.reduce);
+  const std::uint64_t need = total(parts) + sizeof(lc_params) + LC_COUNTER_COUNT * sizeof(lc_uint);
+  if (limits.global_mem > 0 && need > limits.global_mem)
+    throw Error(scene_name(scene) + ": the scene and film buffers need " + format_bytes(need) +
+                " on " + device + ", more than its " + format_bytes(limits.global_mem) +
+                " of global memory (CL_DEVICE_GLOBAL_MEM_SIZE); the largest is the " + big.what +
+                " (" + format_bytes(big.bytes) + "): reduce " + big.reduce);
+}
+
+std::string resource_error(const cl::Error& e, ClStage stage, const std::string& scene_path,
+                           const std::string& device) {
+  const cl_int code = e.err();
+  if (code != CL_OUT_OF_RESOURCES && code != CL_MEM_OBJECT_ALLOCATION_FAILURE &&
+      code != CL_OUT_OF_HOST_MEMORY)
+    return cl_util::describe(e);
+  const std::string call = e.what() ? e.what() : "OpenCL";
+  std::string doing, reduce;
+  if (stage == ClStage::Upload) {
+    doing = "creating the scene and film buffers";
+    reduce = "the film size, the textures' resolution or the number of triangles";
+  } else if (call.find("clEnqueueRead") != std::string::npos) {
+    doing = "reading a pass back";
+    reduce = "the film size";
+  } else {
+    doing = "running a pass";
+    reduce = "the film size, max_depth or the samples per pass (a shorter pass time)";
+  }
+  return (scene_path.empty() ? std::string("scene") : scene_path) + ": device '" + device +
+         "' ran out of " + (code == CL_OUT_OF_HOST_MEMORY ? "host memory" : "memory or resources") +
+         " " + doing + " (" + call + ": " + cl_util::error_name(code) + "): reduce " + reduce;
+}
+
+}  // namespace lucent::render_detail

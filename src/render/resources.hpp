@@ -1,0 +1,85 @@
+#pragma once
+// Bounded resources: what a scene asks of the host and of each device, checked before anything
+// large is allocated, and OpenCL's out-of-resources errors turned into a message saying what to
+// reduce. Every refusal is one line naming the scene, the culprit and the limit.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cl/context.hpp"
+#include "core/host_memory.hpp"
+#include "lucent/scene.hpp"
+#include "render/pack.hpp"
+
+namespace lucent::render_detail {
+
+using sys::format_bytes;
+using sys::host_memory_limit;
+
+/// The limits a scene is checked against. Tests shrink them to exercise the checks without
+/// allocating; 0 means "no limit known".
+struct DeviceLimits {
+  std::uint64_t max_alloc = 0;   ///< CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest buffer
+  std::uint64_t global_mem = 0;  ///< CL_DEVICE_GLOBAL_MEM_SIZE: all buffers together
+  std::uint64_t host_mem = 0;    ///< what lucent allows itself on the host (sys::host_memory_limit)
+  std::string host_what = "physical memory";  ///< what host_mem is 80% of, for messages
+  bool host_unified = false;  ///< the device's buffers live in host memory (a CPU device)
+  std::string device;         ///< the device's name, for messages
+
+  /// The limits of an OpenCL device, with host_mem = host_memory_limit(), each lowered to the
+  /// override's where it sets one (ScopedLimitOverride).
+  static DeviceLimits of(const cl_util::Device& device);
+};
+
+/// For tests: while alive, DeviceLimits::of lowers every limit to the override's non-zero ones,
+/// so that a session refuses a small scene as it would a huge one, without allocating. Not
+/// thread-safe; one at a time.
+class ScopedLimitOverride {
+ public:
+  explicit ScopedLimitOverride(const DeviceLimits& limits);
+  ~ScopedLimitOverride();
+  ScopedLimitOverride(const ScopedLimitOverride&) = delete;
+  ScopedLimitOverride& operator=(const ScopedLimitOverride&) = delete;
+};
+
+/// One part of an estimate: what it is, its size, and what to reduce when it is too large.
+struct MemoryPart {
+  std::string what;  ///< "film accumulation (16384x16384)", "texture texels", ...
+  std::uint64_t bytes = 0;
+  std::string reduce;  ///< "the film size", ...
+};
+
+/// What rendering `scene` will allocate on the host, estimated before packing: the film's
+/// accumulation and result images, the packed triangles, spheres and texels, the BVH (its build
+/// and the tree), and per device the pass read-back (and, for devices whose memory is the host's,
+/// their buffers). `devices` lists the limits of each device of the session.
+std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
+                                             const std::vector<DeviceLimits>& devices);
+
+/// Throws lucent::Error when the estimate exceeds `host_limit` (0: no check), naming the largest
+/// part and the limit (80% of `limit_what`).
+void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
+                       std::uint64_t host_limit, const std::string& limit_what = "physical memory");
+
+/// The film buffers of a device: the pass's sums and sums of squares (float4 per pixel).
+std::vector<MemoryPart> film_device_buffers(int width, int height);
+
+/// Before upload: every scene buffer of `packed` (by its LC_SCENE_BUFFERS description) and film
+/// buffer must fit in one allocation of the device, and all of them in its global memory.
+/// Throws lucent::Error naming the buffer (the largest over the limit), its size, the device and
+/// its limit.
+void check_device_memory(const Scene& scene, const PackedScene& packed, const DeviceLimits& limits);
+
+/// What a session is doing when OpenCL fails, for the advice of resource_error.
+enum class ClStage {
+  Upload,  ///< set_scene: creating and writing buffers (and the warm-up launch)
+  Pass     ///< a pass: its launch, or its read-back when the failing call is a clEnqueueRead*
+};
+
+/// A cl::Error thrown while `stage` on `device`, as one line: CL_OUT_OF_RESOURCES,
+/// CL_MEM_OBJECT_ALLOCATION_FAILURE and CL_OUT_OF_HOST_MEMORY say what ran out and what to reduce;
+/// other errors keep cl_util::describe's text.
+std::string resource_error(const cl::Error& e, ClStage stage, const std::string& scene_path,
+                           const std::string& device);
+
+}  // namespace lucent::render_detail

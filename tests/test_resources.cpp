@@ -1,0 +1,441 @@
+// Bounded resources (src/render/resources.cpp): the host estimate made before packing, the device
+// checks made before upload, OpenCL's out-of-resources errors, and the issue's list of requests
+// that must end in one line and a non-zero exit within seconds and bounded memory. The limits are
+// shrunk (DeviceLimits, ScopedLimitOverride) so that small scenes stand for huge ones.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "lucent/error.hpp"
+#include "lucent/session.hpp"
+#include "render/pack.hpp"
+#include "render/resources.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::Scene;
+using lucent::render_detail::ClStage;
+using lucent::render_detail::DeviceLimits;
+using lucent::render_detail::MemoryPart;
+using lucent::render_detail::ScopedLimitOverride;
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+// AddressSanitizer reserves terabytes of address space for its shadow memory: a CLI built with it
+// cannot start under `ulimit -v`, so the sanitizer build runs these cases without it.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
+/// A shell prefix limiting the address space to `kib` KiB ("" under AddressSanitizer).
+std::string ulimit_v(const std::string& kib) {
+  return kAddressSanitizer ? "" : "ulimit -v " + kib + ";";
+}
+
+/// A grid of n x n quads (2 n^2 triangles) and a sphere, with an n x n film.
+std::string grid_scene(int n, int film) {
+  std::string pos, idx;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x)
+      pos += std::string(pos.empty() ? "" : ",") + "[" + std::to_string(x) + ",0," +
+             std::to_string(y) + "]";
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      int a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
+      idx += std::string(idx.empty() ? "" : ",") + std::to_string(a) + "," + std::to_string(c) +
+             "," + std::to_string(b) + "," + std::to_string(b) + "," + std::to_string(c) + "," +
+             std::to_string(d);
+    }
+  return R"({"camera": {"position": [0, 5, -5], "look_at": [0, 0, 0]},
+    "film": {"width": )" +
+         std::to_string(film) + R"(, "height": )" + std::to_string(film) + R"(},
+    "integrator": {"type": "albedo", "spp": 1},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "triangles", "material": "m", "positions": [)" +
+         pos + "], \"indices\": [" + idx + R"(]},
+               {"type": "sphere", "center": [0, 1, 0], "radius": 0.5, "material": "m"}]})";
+}
+
+/// A w x h PFM texture (grey) in a fresh directory, and a 4x4 scene with a sphere using it.
+std::string textured_scene_file(int w, int h, int film) {
+  std::string dir = lucent::test::temp_dir();
+  std::string pfm = "PF\n" + std::to_string(w) + " " + std::to_string(h) + "\n-1.0\n";
+  std::vector<float> px(size_t(w) * h * 3, 0.5f);
+  pfm.append(reinterpret_cast<const char*>(px.data()), px.size() * sizeof(float));
+  lucent::test::write_file(dir + "/t.pfm", pfm);
+  lucent::test::write_file(dir + "/s.json",
+                           R"({"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0]},
+          "film": {"width": )" +
+                               std::to_string(film) + R"(, "height": )" + std::to_string(film) +
+                               R"(},
+          "integrator": {"type": "albedo", "spp": 1},
+          "materials": {"m": {"type": "diffuse", "albedo": {"texture": "t.pfm"}}},
+          "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]})");
+  return dir + "/s.json";
+}
+
+std::uint64_t part(const std::vector<MemoryPart>& parts, const std::string& prefix) {
+  for (const MemoryPart& p : parts)
+    if (p.what.rfind(prefix, 0) == 0) return p.bytes;
+  ADD_FAILURE() << "no part '" << prefix << "'";
+  return 0;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const lucent::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The estimate made before packing covers what packing then allocates, within a small factor.
+TEST(Resources, HostEstimateCoversThePackedScene) {
+  Scene s = lucent::test::scene_from(grid_scene(40, 32));
+  s.textures.push_back({"t.png", 64, 32, std::vector<float>(64 * 32 * 4, 0.5f)});
+  auto packed = lucent::render_detail::pack_scene(s);
+  DeviceLimits gpu;
+  gpu.device = "gpu";
+  DeviceLimits cpu = gpu;
+  cpu.device = "cpu";
+  cpu.host_unified = true;
+  auto parts = lucent::render_detail::estimate_host_memory(s, {gpu, cpu});
+
+  const std::uint64_t tris = packed.triangles.size() * sizeof(lc_triangle) +
+                             packed.tri_attrs.size() * sizeof(lc_triangle_attr);
+  EXPECT_EQ(part(parts, "the 3200 triangles"), tris);
+  EXPECT_EQ(part(parts, "the 1 spheres"), sizeof(lc_sphere));
+  EXPECT_GE(part(parts, "the texels of the 1 textures"), 64u * 32 * sizeof(lc_float4));
+  // the BVH part (build and tree) holds the tree the kernel gets, and not 10 times more
+  const std::uint64_t tree =
+      packed.nodes.size() * sizeof(lc_bvh_node) + packed.leaves.size() * sizeof(lc_bvh_leaf);
+  const std::uint64_t bvh = part(parts, "the BVH of 3201 primitives");
+  EXPECT_GE(bvh, tree);
+  EXPECT_LE(bvh, 10 * tree);
+  // the film: double sums and squares, counts, result images; per device the pass read-back,
+  // and for a CPU device its buffers too (the scene's and the film's)
+  EXPECT_EQ(part(parts, "the accumulation and result images of the 32x32 film"), 32u * 32 * 80);
+  const std::uint64_t gpu_part = part(parts, "the buffers of device 'gpu'");
+  EXPECT_EQ(gpu_part, 32u * 32 * 32);
+  EXPECT_GE(part(parts, "the buffers of device 'cpu'"), gpu_part + 32u * 32 * 32 + tris + tree);
+}
+
+// Over the host limit: one line naming the total, the limit, the largest part and what to reduce.
+TEST(Resources, HostLimitNamesTheCulprit) {
+  Scene s = lucent::test::scene_from(grid_scene(2, 4));
+  s.path = "big.json";
+  s.film.width = s.film.height = 16384;  // numbers only: nothing is allocated
+  DeviceLimits d;
+  d.device = "dev";
+  std::string msg =
+      error_of([&] { lucent::render_detail::check_host_memory(s, {d}, std::uint64_t(16) << 30); });
+  EXPECT_EQ(msg,
+            "big.json: rendering needs about 28.0 GiB of host memory, more than the limit of "
+            "16.0 GiB (80% of physical memory); the largest part is the accumulation and result "
+            "images of the 16384x16384 film (20.0 GiB): reduce the film size");
+  // a texture whose size is all the scene asks (its pixels are not needed for the estimate)
+  s.film.width = s.film.height = 4;
+  s.textures.push_back({"huge.exr", 16384, 16384, {}});
+  msg = error_of([&] { lucent::render_detail::check_host_memory(s, {d}, std::uint64_t(1) << 30); });
+  EXPECT_NE(msg.find("more than the limit of 1.0 GiB"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("the largest part is the texels of the 1 textures (4.0 GiB): reduce the "
+                     "textures' resolution"),
+            std::string::npos)
+      << msg;
+  // within the limit: nothing to say; 0: no limit known
+  EXPECT_EQ(
+      error_of([&] { lucent::render_detail::check_host_memory(s, {d}, std::uint64_t(8) << 30); }),
+      "");
+  EXPECT_EQ(error_of([&] { lucent::render_detail::check_host_memory(s, {d}, 0); }), "");
+}
+
+// Before upload, per device: each buffer against the largest allocation, by its registry
+// description, and all of them against global memory.
+TEST(Resources, DeviceLimitsNameTheBuffer) {
+  Scene s = lucent::test::scene_from(grid_scene(10, 16));
+  s.path = "s.json";
+  auto packed = lucent::render_detail::pack_scene(s);
+  DeviceLimits d;
+  d.device = "Tiny GPU";
+  d.max_alloc = 4096;
+  // 200 triangles: the largest buffer, named by its registry description, is refused
+  std::string largest;
+  std::size_t largest_bytes = 0;
+#define LUCENT_LARGEST(name, type, what)                 \
+  if (packed.name.size() * sizeof(type) > largest_bytes) \
+    largest_bytes = packed.name.size() * sizeof(type), largest = what;
+  LC_SCENE_BUFFERS(LUCENT_LARGEST)
+#undef LUCENT_LARGEST
+  ASSERT_GT(largest_bytes, 8192u);
+  std::string msg = error_of([&] { lucent::render_detail::check_device_memory(s, packed, d); });
+  EXPECT_EQ(msg.rfind("s.json: the " + largest + " need a buffer of ", 0), 0u) << msg;
+  EXPECT_NE(msg.find(", more than the 4.0 KiB device 'Tiny GPU' allows per buffer "
+                     "(CL_DEVICE_MAX_MEM_ALLOC_SIZE): reduce the number of triangles"),
+            std::string::npos)
+      << msg;
+  // the film's buffers are checked too: 16 bytes per pixel
+  d.max_alloc = 1 << 20;
+  s.film.width = s.film.height = 512;
+  EXPECT_EQ(error_of([&] { lucent::render_detail::check_device_memory(s, packed, d); }),
+            "s.json: the film sample sums (512x512) need a buffer of 4.0 MiB, more than the 1.0 "
+            "MiB device 'Tiny GPU' allows per buffer (CL_DEVICE_MAX_MEM_ALLOC_SIZE): reduce the "
+            "film size");
+  // every buffer fits, not all of them
+  d.max_alloc = 0;
+  d.global_mem = 6 << 20;
+  msg = error_of([&] { lucent::render_detail::check_device_memory(s, packed, d); });
+  EXPECT_EQ(msg.rfind("s.json: the scene and film buffers need 8.0 MiB on device 'Tiny GPU', more "
+                      "than its 6.0 MiB of global memory (CL_DEVICE_GLOBAL_MEM_SIZE); the largest "
+                      "is the film sample sums (512x512) (4.0 MiB): reduce the film size",
+                      0),
+            0u)
+      << msg;
+  d.global_mem = 9 << 20;
+  EXPECT_EQ(error_of([&] { lucent::render_detail::check_device_memory(s, packed, d); }), "");
+}
+
+// A session applies both checks before it allocates, and stays usable after a refusal.
+TEST(Resources, SessionRefusesBeforeAllocatingAndRecovers) {
+  Scene s = lucent::load_scene(textured_scene_file(64, 64, 32));  // 64 KiB of texels
+  s.path = "t.json";
+  lucent::Renderer r(lucent::test::session_options());
+  {
+    DeviceLimits lim;
+    lim.host_mem = 64 << 10;
+    ScopedLimitOverride o(lim);
+    std::string msg = error_of([&] { r.set_scene(s); });
+    EXPECT_NE(msg.find("t.json: rendering needs about "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("more than the limit of 64.0 KiB"), std::string::npos) << msg;
+  }
+  {
+    DeviceLimits lim;
+    lim.max_alloc = 32 << 10;
+    ScopedLimitOverride o(lim);
+    std::string msg = error_of([&] { r.set_scene(s); });
+    EXPECT_NE(msg.find("t.json: the texture texels need a buffer of 64.0 KiB, more than the 32.0 "
+                       "KiB device '"),
+              std::string::npos)
+        << msg;
+    EXPECT_NE(msg.find("reduce the textures' resolution"), std::string::npos) << msg;
+  }
+  {
+    DeviceLimits lim;
+    lim.global_mem = 64 << 10;
+    ScopedLimitOverride o(lim);
+    std::string msg = error_of([&] { r.set_scene(s); });
+    EXPECT_NE(msg.find("more than its 64.0 KiB of global memory (CL_DEVICE_GLOBAL_MEM_SIZE); "
+                       "the largest is the texture texels (64.0 KiB)"),
+              std::string::npos)
+        << msg;
+  }
+  // a 100000 x 100000 film given through the library (the JSON loader's range check is not on
+  // this path): refused by the host estimate, at once
+  Scene huge = s;
+  huge.film.width = huge.film.height = 100000;
+  std::string msg = error_of([&] { r.set_scene(huge); });
+  EXPECT_EQ(msg.rfind("t.json: rendering needs about ", 0), 0u) << msg;
+  EXPECT_NE(msg.find("the largest part is the accumulation and result images of the "
+                     "100000x100000 film (745.1 GiB): reduce the film size"),
+            std::string::npos)
+      << msg;
+  // the limits back to the device's: the same session renders the scene
+  r.set_scene(s);
+  r.render(1);
+  auto res = r.result();
+  EXPECT_EQ(res.spp, 1u);
+  EXPECT_NEAR(res.mean.rgb[(16 * 32 + 16) * 3], 0.5, 1e-3);  // albedo of the texture
+}
+
+// OpenCL's resource errors say what ran out, where and what to reduce; others are unchanged.
+TEST(Resources, OutOfResourcesSaysWhatToReduce) {
+  using lucent::render_detail::resource_error;
+  EXPECT_EQ(resource_error(cl::Error(CL_MEM_OBJECT_ALLOCATION_FAILURE, "clCreateBuffer"),
+                           ClStage::Upload, "s.json", "GPU"),
+            "s.json: device 'GPU' ran out of memory or resources creating the scene and film "
+            "buffers (clCreateBuffer: CL_MEM_OBJECT_ALLOCATION_FAILURE): reduce the film size, "
+            "the textures' resolution or the number of triangles");
+  EXPECT_EQ(resource_error(cl::Error(CL_OUT_OF_RESOURCES, "clEnqueueNDRangeKernel"), ClStage::Pass,
+                           "s.json", "GPU"),
+            "s.json: device 'GPU' ran out of memory or resources running a pass "
+            "(clEnqueueNDRangeKernel: CL_OUT_OF_RESOURCES): reduce the film size, max_depth or "
+            "the samples per pass (a shorter pass time)");
+  EXPECT_EQ(resource_error(cl::Error(CL_OUT_OF_HOST_MEMORY, "clEnqueueReadBuffer"), ClStage::Pass,
+                           "", "CPU"),
+            "scene: device 'CPU' ran out of host memory reading a pass back "
+            "(clEnqueueReadBuffer: CL_OUT_OF_HOST_MEMORY): reduce the film size");
+  EXPECT_EQ(
+      resource_error(cl::Error(CL_INVALID_VALUE, "clSetKernelArg"), ClStage::Pass, "s.json", "GPU"),
+      "clSetKernelArg: CL_INVALID_VALUE");
+}
+
+/// Runs the CLI with at most 4 GiB of address space (but under AddressSanitizer); the time it
+/// took.
+lucent::test::CommandResult bounded_cli(const std::string& args, double* seconds) {
+  auto t0 = std::chrono::steady_clock::now();
+  auto r = lucent::test::run_cli(args, ulimit_v("4194304"));
+  *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+void expect_one_line_refusal(const std::string& args, const std::string& expected) {
+  double seconds = 0;
+  auto r = bounded_cli(args, &seconds);
+  EXPECT_NE(r.status, 0) << args;
+  EXPECT_LT(seconds, 10) << args;
+  EXPECT_EQ(lucent::test::count_lines(r.err), 1) << args << "\n" << r.err;
+  EXPECT_NE(r.err.find(expected), std::string::npos) << args << "\n" << r.err;
+}
+
+// The host limit is 80% of the smallest of physical memory, the address-space limit and the
+// cgroup's: under `ulimit -v` 2 GiB an 8192x8192 film is refused by the estimate (it made PoCL
+// abort on an assertion when its buffer allocation failed, or ended in a bare 'out of memory').
+TEST(Resources, AddressSpaceLimitBoundsTheHost) {
+  if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer cannot run under ulimit -v";
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/s.json", grid_scene(2, 4));
+  auto t0 = std::chrono::steady_clock::now();
+  auto r = lucent::test::run_cli("render " + q(dir + "/s.json") + " -o " + q(dir + "/o.png") +
+                                     " --width 8192 --height 8192 --integrator albedo",
+                                 ulimit_v("2097152"));
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_LT(seconds, 10);
+  EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("of host memory, more than the limit of 1.6 GiB (80% of the address-space "
+                       "limit (ulimit -v)); the largest part is the accumulation and result "
+                       "images of the 8192x8192 film (5.0 GiB): reduce the film size"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(lucent::test::read_file(dir + "/o.png").size() > 0);
+}
+
+// Each texture is bounded (8192 x 8192), and so are all of them together: as they load, the
+// scene's textures as linear RGBA float must stay within the host limit. 40 names of one 1024 x
+// 1024 run-length TGA (128 KiB, 16 MiB decoded) under `ulimit -v` 256 MiB: the 13th is refused.
+TEST(Resources, TexturesTogetherAreBounded) {
+  if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer cannot run under ulimit -v";
+  std::string dir = lucent::test::temp_dir();
+  const int w = 1024, h = 1024;
+  std::string tga = {0,
+                     0,
+                     10,
+                     0,
+                     0,
+                     0,
+                     0,
+                     0,
+                     0,
+                     0,
+                     0,
+                     0,
+                     char(w & 255),
+                     char(w >> 8),
+                     char(h & 255),
+                     char(h >> 8),
+                     24,
+                     0x20};
+  for (int i = 0; i < w * h / 128; ++i) tga += std::string("\xff\x28\x50\x78", 4);
+  std::string materials;
+  for (int i = 0; i < 40; ++i) {
+    std::string name = "t" + std::to_string(i) + ".tga";
+    lucent::test::write_file(dir + "/" + name, tga);
+    char key[8];
+    std::snprintf(key, sizeof key, "m%02d", i);
+    materials += std::string(i ? "," : "") + "\"" + key +
+                 "\": {\"type\": \"diffuse\", \"albedo\": {\"texture\": \"" + name + "\"}}";
+  }
+  lucent::test::write_file(dir + "/s.json", R"({"film": {"width": 4, "height": 4},
+    "materials": {)" + materials + R"(},
+    "shapes": [{"type": "sphere", "center": [0, 0, -3], "radius": 1, "material": "m00"}]})");
+  auto r = lucent::test::run_cli("render " + q(dir + "/s.json") + " -o " + q(dir + "/o.png"),
+                                 ulimit_v("262144"));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("/materials/m12/albedo/texture: " + dir +
+                       "/t12.tga: with this 1024x1024 texture (16.0 MiB) the scene's 13 textures "
+                       "need 208.0 MiB, more than the limit of 204.8 MiB (80% of the "
+                       "address-space limit (ulimit -v)): reduce the textures' resolution or "
+                       "number"),
+            std::string::npos)
+      << r.err;
+}
+
+// The issue's list: each ends in one line and a non-zero exit, within seconds and 4 GiB.
+TEST(Resources, IssueCasesEndInOneLine) {
+  std::string dir = lucent::test::temp_dir();
+  std::string out = q(dir + "/o.png");
+  auto scene = [&](const std::string& name, const std::string& json) {
+    lucent::test::write_file(dir + "/" + name, json);
+    return q(dir + "/" + name);
+  };
+  std::string small = scene("small.json", grid_scene(2, 4));
+
+  // a 100000 x 100000 film, on the command line and in the scene
+  expect_one_line_refusal("render " + small + " -o " + out + " --width 100000 --height 100000",
+                          "--width: Value 100000 not in range 1 to 16384");
+  expect_one_line_refusal(
+      "render " + scene("film.json", R"({"film": {"width": 100000, "height": 100000}})") + " -o " +
+          out,
+      "/film/width: must be in [1, 16384], got 100000");
+  // the largest film allowed needs 28 GiB of host memory: refused here by the estimate before
+  // anything is allocated (on a machine with 35 GiB or more it would be rendered)
+  if (lucent::render_detail::host_memory_limit() < (std::uint64_t(28) << 30))
+    expect_one_line_refusal(
+        "render " + small + " -o " + out + " --width 16384 --height 16384 --integrator albedo",
+        "the largest part is the accumulation and result images of the 16384x16384 film");
+
+  // a texture whose header claims 65535 x 65535, as a material's texture and an environment map
+  std::string png = std::string("\x89PNG\r\n\x1a\n", 8);
+  auto be32 = [](std::uint32_t v) {
+    return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+  };
+  png += be32(13) + "IHDR" + be32(65535) + be32(65535) + std::string("\x08\x02\x00\x00\x00", 5) +
+         be32(0);
+  lucent::test::write_file(dir + "/huge.png", png);
+  expect_one_line_refusal(
+      "render " +
+          scene("tex.json",
+                R"({"materials": {"m": {"type": "diffuse", "albedo": {"texture": "huge.png"}}},
+                    "shapes": [{"type": "sphere", "center": [0, 0, -3], "radius": 1,
+                                "material": "m"}]})") +
+          " -o " + out,
+      "PNG header claims 65535x65535 pixels, more than the limit of 67108864 pixels");
+  expect_one_line_refusal(
+      "render " +
+          scene("env.json", R"({"lights": [{"type": "environment_map", "file": "huge.png"}]})") +
+          " -o " + out,
+      "PNG header claims 65535x65535 pixels");
+
+  // JSON nested 10^5 deep
+  std::string deep = "{\"camera\": ";
+  for (int i = 0; i < 100000; ++i) deep += "[";
+  expect_one_line_refusal("render " + scene("deep.json", deep) + " -o " + out,
+                          "nested deeper than 64 levels");
+
+  // 10^9 spp: option, scene integer, scene number
+  expect_one_line_refusal("render " + small + " -o " + out + " --spp 1000000000",
+                          "--spp: Value 1000000000 not in range 1 to 16777216");
+  expect_one_line_refusal(
+      "render " + scene("spp.json", R"({"integrator": {"spp": 1000000000}})") + " -o " + out,
+      "/integrator/spp: must be in [1, 16777216], got 1000000000");
+  expect_one_line_refusal(
+      "render " + scene("spp2.json", R"({"integrator": {"spp": 1e9}})") + " -o " + out,
+      "/integrator/spp: must be an integer");
+
+  // max_depth 10^9
+  expect_one_line_refusal("render " +
+                              scene("depth.json", R"({"integrator": {"max_depth": 1000000000}})") +
+                              " -o " + out,
+                          "/integrator/max_depth: must be in [1, 100000], got 1000000000");
+}
+
+}  // namespace
