@@ -269,6 +269,41 @@ TEST(Parts, SigtermedPartRecordsItsRangeAndMerges) {
   EXPECT_EQ(*std::min_element(merged.acc.count.begin(), merged.acc.count.end()), k + 5);
 }
 
+// scripts/slurm: submit.sh submits the array of render-part.sbatch tasks and the merge.sbatch
+// that depends on them; here tests/slurm/sbatch stands in for Slurm and runs them in order.
+TEST(Parts, SlurmArrayScriptsRenderAndMerge) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  const std::string out = dir + "/merged.exr", log = dir + "/jobs.log";
+  const std::string cmd = "PATH=" + q(lucent::test::source_path("tests/slurm")) +
+                          ":\"$PATH\" LUCENT=" + q(LUCENT_CLI_PATH) + " FAKE_SBATCH_LOG=" + q(log) +
+                          " bash " + q(lucent::test::source_path("scripts/slurm/submit.sh")) + " " +
+                          q(scene) + " 8 3 " + q(dir + "/parts") + " " + q(out) + " -q >" +
+                          q(dir + "/submit.out") + " 2>" + q(dir + "/submit.err");
+  int raw = std::system(cmd.c_str());
+  const std::string err = lucent::test::read_file(dir + "/submit.err");
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << err;
+  EXPECT_NE(lucent::test::read_file(dir + "/submit.out").find("(3 tasks), merge job"),
+            std::string::npos);
+  // three tasks of [0, 2), [2, 5), [5, 8), then the merge, all successful
+  const std::string jobs = lucent::test::read_file(log);
+  EXPECT_EQ(lucent::test::count_lines(jobs), 4) << jobs;
+  size_t ok = 0;
+  for (size_t at = jobs.find(": exit 0\n"); at != std::string::npos;
+       at = jobs.find(": exit 0\n", at + 1))
+    ++ok;
+  EXPECT_EQ(ok, 4u) << jobs;
+  EXPECT_EQ(lucent::read_part_info(dir + "/parts/part-0001.exr").samples,
+            (std::vector<lucent::SampleRange>{{2, 5}}));
+  EXPECT_NE(err.find("samples [0, 8)"), std::string::npos) << err;
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:8 -o " + q(dir + "/one.exr")).status,
+            0);
+  lucent::RenderPart merged = lucent::read_render_part(out);
+  EXPECT_EQ(merged.info.samples, (std::vector<lucent::SampleRange>{{0, 8}}));
+  EXPECT_LT(max_relative_difference(merged.acc, lucent::read_render_part(dir + "/one.exr").acc),
+            1e-5);
+}
+
 #ifdef LUCENT_MPI_PATH
 /// mpirun with the settings a test needs: root allowed (containers), no CMA single copy (ptrace
 /// is often restricted in containers), oversubscription of the 2-core machine.
