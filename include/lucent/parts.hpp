@@ -81,9 +81,9 @@ struct MergeReport {
 };
 
 /// Adds parts one at a time, each checked against the first (film, seed, integrator, scene hash)
-/// and against the ranges already added (no overlap). Adding in ascending sample order makes the
-/// sums independent of how the samples were split into parts' passes only up to double rounding;
-/// merge_render_parts sorts its inputs so.
+/// and against the ranges already added (no overlap). Double addition is not associative: the sum
+/// depends on the order of the parts, so merge_render_parts adds them in ascending order of their
+/// first sample (as lucent-mpi adds its ranks), whatever order they are given in.
 class PartMerger {
  public:
   /// Throws lucent::Error (one line naming `name` and, for an overlap or a mismatch, the part it

@@ -4,6 +4,7 @@
 #include "lucent/parts.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cinttypes>
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <map>
 
 #include "core/file_io.hpp"
 #include "image/image_probe.hpp"
