@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian packages lucent needs, and only those that are missing.
-# Usage: scripts/install-deps.sh [--with-bench] [--with-fuzz]
+# Usage: scripts/install-deps.sh [--with-bench] [--with-fuzz] [--with-mpi]
 #   --with-bench adds Embree for the benchmark; --with-fuzz adds clang and its libFuzzer and
-#   sanitizer runtimes for scripts/fuzz.sh (optional: the project builds and tests without them).
+#   sanitizer runtimes for scripts/fuzz.sh; --with-mpi adds OpenMPI for lucent-mpi (optional: the
+#   project builds and tests without them).
 set -euo pipefail
 
 packages=(
@@ -16,7 +17,8 @@ for arg in "$@"; do
   case "$arg" in
     --with-bench) packages+=(libembree-dev) ;;
     --with-fuzz) packages+=(clang libclang-rt-14-dev) ;;
-    *) echo "install-deps: unknown option $arg (--with-bench, --with-fuzz)" >&2; exit 2 ;;
+    --with-mpi) packages+=(libopenmpi-dev openmpi-bin) ;;
+    *) echo "install-deps: unknown option $arg (--with-bench, --with-fuzz, --with-mpi)" >&2; exit 2 ;;
   esac
 done
 

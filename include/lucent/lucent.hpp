@@ -4,6 +4,7 @@
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
 #include "lucent/limits.hpp"
+#include "lucent/parts.hpp"
 #include "lucent/render.hpp"
 #include "lucent/scene.hpp"
 #include "lucent/session.hpp"

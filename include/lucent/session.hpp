@@ -19,6 +19,7 @@
 #include <memory>
 #include <string>
 
+#include "lucent/accumulation.hpp"
 #include "lucent/device.hpp"
 #include "lucent/render.hpp"
 #include "lucent/scene.hpp"
@@ -140,6 +141,13 @@ class Renderer {
   std::uint64_t spp() const;
   /// Index of the first sample of the accumulation (reset's argument).
   std::uint64_t first_sample() const;
+  /// The raw accumulation (double sums, sums of squares, counts) of the samples
+  /// [first_sample(), first_sample() + spp()), for sample-range renders (lucent/parts.hpp).
+  Accumulation accumulation() const;
+  /// A 64-bit hash of everything the image depends on: the packed scene (camera, film size and
+  /// filter, seed, integrator settings, geometry, materials, lights, textures) and the kernel's
+  /// build options. Renders of equal hashes give the same samples for the same sample indices.
+  std::uint64_t image_hash() const;
 
   /// Stops a render in progress after its current pass (callable from another thread or a
   /// signal handler through set_cancel_flag).

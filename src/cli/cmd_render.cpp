@@ -23,6 +23,7 @@
 #include "lucent/compare.hpp"
 #include "lucent/limits.hpp"
 #include "lucent/lucent.hpp"
+#include "lucent/parts.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/types.hpp"
 
@@ -130,6 +131,7 @@ struct RenderArgs {
   std::string precision = "float";
   bool no_specialize = false;
   lucent::cli::SamplingArgs sampling;  ///< --sampler, --clamp, --target-error, --min-spp
+  std::string samples;  ///< "A:B": a part file of sample indices [A, B) (lucent/parts.hpp)
 };
 
 /// <output stem>.<name>.exr beside the main output.
@@ -194,6 +196,15 @@ int render_with(const RenderArgs& a) {
     throw lucent::Error("--aov is not supported with --reference");
   if (a.reference && a.sampling.target_error > 0)
     throw lucent::Error("--target-error is not supported with --reference");
+  std::optional<lucent::SampleRange> range;  // --samples: a part for `lucent merge`
+  if (!a.samples.empty()) {
+    range = lucent::parse_sample_range(a.samples);
+    if (a.spp > 0) throw lucent::Error("--samples and --spp cannot be combined");
+    if (a.reference || !a.aovs.empty() || a.sampling.target_error > 0)
+      throw lucent::Error("--samples is not supported with --reference, --aov or --target-error");
+    if (lower_extension(a.output) != ".exr")
+      throw lucent::Error(a.output + ": --samples writes a part file: use an .exr output");
+  }
   check_output_path(a.output, {a.scene});
   for (const std::string& name : a.aovs)
     check_output_path(aov_path(a.output, name), {a.scene, a.output});
@@ -265,6 +276,10 @@ int render_with(const RenderArgs& a) {
     renderer->set_scene(scene);
     std::uint64_t spp = a.spp > 0 ? static_cast<std::uint64_t>(a.spp)
                                   : (a.time_limit > 0 ? 0 : scene.integrator.spp);
+    if (range) {
+      renderer->reset(range->begin);
+      spp = range->end - range->begin;
+    }
     auto t0 = std::chrono::steady_clock::now();
     if (a.sampling.target_error > 0)
       renderer->render_adaptive(lucent::cli::adaptive_options(a.sampling, a.spp, a.time_limit),
@@ -278,7 +293,9 @@ int render_with(const RenderArgs& a) {
 
   lucent::DisplaySettings display{scene.film.transfer, scene.film.gamma, scene.film.exposure,
                                   scene.film.tonemap};
-  if (lower_extension(a.output) == ".exr")
+  if (range)
+    lucent::write_render_part(a.output, lucent::make_part(*renderer, *range, a.scene));
+  else if (lower_extension(a.output) == ".exr")
     lucent::write_render_exr(a.output, r);  // with var.R/G/B and n layers (docs/compare.md)
   else
     lucent::write_image(a.output, r.mean, display);
@@ -304,12 +321,17 @@ int render_with(const RenderArgs& a) {
   if (!r.cancelled && !a.reference) write_aovs(a, scene, &*renderer, r);
   if (r.cancelled || g_interrupted.load()) {
     const int sig = g_signal ? static_cast<int>(g_signal) : SIGINT;
-    const std::uint64_t target = a.spp > 0
-                                     ? std::uint64_t(a.spp)
+    std::uint64_t target = a.spp > 0 ? std::uint64_t(a.spp)
                                      : (a.time_limit > 0 ? 0 : std::uint64_t(scene.integrator.spp));
+    if (range) target = range->end - range->begin;
     std::fprintf(stderr, "lucent: interrupted by %s: wrote %s with %s%s\n", signal_name(sig),
                  a.output.c_str(), progress_note(r, target, a.time_limit).c_str(),
                  r.cancelled ? "" : " (the AOVs were not all written)");
+    if (range)
+      std::fprintf(stderr, "lucent: %s holds samples [%llu, %llu) of %s\n", a.output.c_str(),
+                   static_cast<unsigned long long>(range->begin),
+                   static_cast<unsigned long long>(range->begin + r.spp),
+                   lucent::range_text(*range).c_str());
     return 128 + sig;
   }
   return 0;
@@ -368,6 +390,9 @@ CLI::App* add_render_command(CLI::App& app) {
                        lucent::cli::joined(lucent::cli::aov_names()))
       ->delimiter(',')
       ->check(CLI::IsMember(lucent::cli::aov_names()));
+  render->add_option("--samples", ra.samples,
+                     "Render only the sample indices [A, B) (A:B) and write their raw "
+                     "accumulation to an .exr part file for `lucent merge`");
   render->add_flag("--reference", ra.reference,
                    "Render with the scalar CPU reference integrator instead of the kernel");
   lucent::cli::add_sampling_options(render, ra.sampling, true);

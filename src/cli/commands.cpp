@@ -68,12 +68,16 @@ int run_cache_command();
 // cmd_converge.cpp
 CLI::App* add_converge_command(CLI::App& app);
 int run_converge_command();
+// cmd_merge.cpp
+CLI::App* add_merge_command(CLI::App& app);
+int run_merge_command();
 
 void register_extra_commands(CLI::App& app) {
   add_compare_command(app);
   add_info_command(app);
   add_cache_command(app);
   add_converge_command(app);
+  add_merge_command(app);
 }
 
 int run_extra_commands(CLI::App& app) {
@@ -81,6 +85,7 @@ int run_extra_commands(CLI::App& app) {
   if (app.got_subcommand("info")) return run_info_command();
   if (app.got_subcommand("cache")) return run_cache_command();
   if (app.got_subcommand("converge")) return run_converge_command();
+  if (app.got_subcommand("merge")) return run_merge_command();
   return 0;
 }
 

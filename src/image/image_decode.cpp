@@ -75,6 +75,17 @@ int ExrChannels::find(const char* name) const {
   return -1;
 }
 
+std::map<std::string, std::string> exr_string_attributes(const EXRHeader& header) {
+  std::map<std::string, std::string> out;
+  for (int a = 0; a < header.num_custom_attributes; ++a) {
+    const EXRAttribute& attr = header.custom_attributes[a];
+    if (std::strcmp(attr.type, "string") == 0 && attr.size >= 0 && attr.value)
+      out[attr.name] =
+          std::string(reinterpret_cast<const char*>(attr.value), static_cast<size_t>(attr.size));
+  }
+  return out;
+}
+
 ExrChannels read_exr_channels(const unsigned char* data, std::size_t size, const std::string& path,
                               std::uint64_t max_pixels) {
   const Fail fail{path};
@@ -105,12 +116,18 @@ ExrChannels read_exr_channels(const unsigned char* data, std::size_t size, const
   for (int c = 0; c < header.num_channels; ++c) {
     out.names.push_back(header.channels[c].name);
     out.planes.emplace_back(n, 0.0f);
+    out.uint_planes.emplace_back(header.requested_pixel_types[c] == TINYEXR_PIXELTYPE_UINT ? n : 0,
+                                 0u);
   }
+  out.attributes = exr_string_attributes(header);
   auto copy = [&](int c, const unsigned char* src, size_t from, size_t to) {
-    if (header.requested_pixel_types[c] == TINYEXR_PIXELTYPE_UINT)
-      out.planes[c][to] = static_cast<float>(reinterpret_cast<const unsigned int*>(src)[from]);
-    else
+    if (header.requested_pixel_types[c] == TINYEXR_PIXELTYPE_UINT) {
+      const unsigned int v = reinterpret_cast<const unsigned int*>(src)[from];
+      out.uint_planes[c][to] = v;
+      out.planes[c][to] = static_cast<float>(v);
+    } else {
       out.planes[c][to] = reinterpret_cast<const float*>(src)[from];
+    }
   };
   if (header.tiled) {
     for (int t = 0; t < image.num_tiles; ++t) {

@@ -7,7 +7,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/file_io.hpp"
@@ -85,8 +87,14 @@ struct ExrChannels {
   int width = 0, height = 0;
   std::vector<std::string> names;
   std::vector<std::vector<float>> planes;  ///< one per name, width * height, row 0 at the top
-  int find(const char* name) const;        ///< index of a channel, or -1
+  /// The exact values of UINT channels (empty for the others), as `planes`
+  std::vector<std::vector<std::uint32_t>> uint_planes;
+  std::map<std::string, std::string> attributes;  ///< the header's attributes of type string
+  int find(const char* name) const;               ///< index of a channel, or -1
 };
+
+/// The header's custom attributes of type string, by name.
+std::map<std::string, std::string> exr_string_attributes(const EXRHeader& header);
 
 /// Reads every channel of a scanline or tiled single-part OpenEXR held in memory.
 ExrChannels read_exr_channels(const unsigned char* data, std::size_t size, const std::string& path,
@@ -98,6 +106,16 @@ io::ReadSpec image_read_spec(const char* what = "image");
 /// Encodes `image` as OpenEXR in memory; throws lucent::Error("<path>: cannot encode EXR: ...").
 std::string save_exr_to_memory(const std::string& path, const EXRImage& image,
                                const EXRHeader& header);
+
+/// What a render EXR may carry beyond write_render_exr's layers: UINT channels (name, width *
+/// height values) and string attributes (name, value).
+struct ExrExtras {
+  std::vector<std::pair<std::string, const std::uint32_t*>> uint_channels;
+  std::vector<std::pair<std::string, std::string>> attributes;
+};
+
+/// write_render_exr() with extra channels and attributes.
+void write_render_exr(const std::string& path, const RenderResult& r, const ExrExtras& extras);
 
 /// read_render() on a file's bytes: an EXR with lucent's layers (mean, var.R/G/B, n), or any
 /// image decode_image reads (variance and samples left empty).

@@ -18,11 +18,17 @@
 namespace lucent {
 
 void write_render_exr(const std::string& path, const RenderResult& r) {
+  image_detail::write_render_exr(path, r, {});
+}
+
+namespace image_detail {
+
+void write_render_exr(const std::string& path, const RenderResult& r, const ExrExtras& extras) {
   const int w = r.mean.width, h = r.mean.height;
   const size_t n = static_cast<size_t>(w) * h;
   if (r.mean.rgb.size() != n * 3) throw Error(path + ": cannot write EXR: inconsistent image");
   const bool stats = r.variance.rgb.size() == n * 3 && r.samples.size() == n;
-  // channels in the sorted order OpenEXR wants: B G R n var.B var.G var.R
+  // the mean (B G R), then the statistics (n var.B var.G var.R) and the extras, sorted below
   std::vector<std::string> names = {"B", "G", "R"};
   std::vector<std::vector<float>> planes;
   for (int c = 2; c >= 0; --c) {
@@ -38,22 +44,44 @@ void write_render_exr(const std::string& path, const RenderResult& r) {
       for (size_t i = 0; i < n; ++i) planes.back()[i] = r.variance.rgb[i * 3 + c];
     }
   }
-  const int nch = static_cast<int>(names.size());
+  struct Channel {
+    std::string name;
+    unsigned char* data;
+    int type;
+  };
+  std::vector<Channel> channels;
+  for (size_t k = 0, p = 0; k < names.size(); ++k) {
+    if (names[k] == "n")
+      channels.push_back(
+          {names[k], reinterpret_cast<unsigned char*>(counts.data()), TINYEXR_PIXELTYPE_UINT});
+    else
+      channels.push_back({names[k], reinterpret_cast<unsigned char*>(planes[p++].data()),
+                          TINYEXR_PIXELTYPE_FLOAT});
+  }
+  for (const auto& [name, data] : extras.uint_channels)
+    channels.push_back({name, reinterpret_cast<unsigned char*>(const_cast<std::uint32_t*>(data)),
+                        TINYEXR_PIXELTYPE_UINT});
+  // OpenEXR wants the channels sorted by name
+  std::sort(channels.begin(), channels.end(),
+            [](const Channel& a, const Channel& b) { return a.name < b.name; });
+  const int nch = static_cast<int>(channels.size());
   std::vector<unsigned char*> ptrs;
   std::vector<int> types;
-  for (int k = 0, p = 0; k < nch; ++k) {
-    if (names[k] == "n") {
-      ptrs.push_back(reinterpret_cast<unsigned char*>(counts.data()));
-      types.push_back(TINYEXR_PIXELTYPE_UINT);
-    } else {
-      ptrs.push_back(reinterpret_cast<unsigned char*>(planes[p++].data()));
-      types.push_back(TINYEXR_PIXELTYPE_FLOAT);
-    }
-  }
   std::vector<EXRChannelInfo> infos(nch);
   for (int k = 0; k < nch; ++k) {
+    ptrs.push_back(channels[k].data);
+    types.push_back(channels[k].type);
     std::memset(&infos[k], 0, sizeof(EXRChannelInfo));
-    std::strncpy(infos[k].name, names[k].c_str(), 255);
+    std::strncpy(infos[k].name, channels[k].name.c_str(), 255);
+  }
+  std::vector<EXRAttribute> attributes(extras.attributes.size());
+  for (size_t k = 0; k < attributes.size(); ++k) {
+    std::memset(&attributes[k], 0, sizeof(EXRAttribute));
+    std::strncpy(attributes[k].name, extras.attributes[k].first.c_str(), 255);
+    std::strncpy(attributes[k].type, "string", 255);
+    attributes[k].value =
+        reinterpret_cast<unsigned char*>(const_cast<char*>(extras.attributes[k].second.data()));
+    attributes[k].size = static_cast<int>(extras.attributes[k].second.size());
   }
   EXRHeader header;
   InitEXRHeader(&header);
@@ -68,8 +96,12 @@ void write_render_exr(const std::string& path, const RenderResult& r) {
   header.pixel_types = types.data();
   header.requested_pixel_types = types.data();
   header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
-  io::write_file_atomic(path, image_detail::save_exr_to_memory(path, image, header));
+  header.num_custom_attributes = static_cast<int>(attributes.size());
+  header.custom_attributes = attributes.empty() ? nullptr : attributes.data();
+  io::write_file_atomic(path, save_exr_to_memory(path, image, header));
 }
+
+}  // namespace image_detail
 
 RenderResult read_render(const std::string& path) {
   const std::string bytes = io::read_file(path, image_detail::image_read_spec());

@@ -764,6 +764,46 @@ void Renderer::reset(std::uint64_t first_sample) {
 }
 
 RenderResult Renderer::result() const { return impl_->result(); }
+
+Accumulation Renderer::accumulation() const {
+  const Impl& m = *impl_;
+  if (!m.scene) throw Error("accumulation: the session has no scene (call set_scene first)");
+  Accumulation a;
+  a.width = m.scene->film.width;
+  a.height = m.scene->film.height;
+  a.sum = m.sum;
+  a.sumsq = m.sumsq;
+  a.count = m.count;
+  a.first_sample = m.first;
+  a.spp = m.done;
+  a.nonfinite = m.nonfinite;
+  a.rays = m.rays;
+  a.seconds = m.render_seconds;
+  return a;
+}
+
+std::uint64_t Renderer::image_hash() const {
+  const Impl& m = *impl_;
+  if (!m.scene) throw Error("image_hash: the session has no scene (call set_scene first)");
+  std::uint64_t h = 14695981039346656037ull;  // FNV-1a, 64 bits
+  auto add = [&h](const void* data, size_t size) {
+    const unsigned char* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < size; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  };
+  lc_params P = m.packed.params;  // the per-pass fields are not part of the image
+  P.sample_offset = P.samples_per_pass = 0;
+  add(&P, sizeof P);
+#define LUCENT_HASH(name, type, ...)                    \
+  {                                                     \
+    const std::uint64_t n = m.packed.name.size();       \
+    add(&n, sizeof n);                                  \
+    if (n) add(m.packed.name.data(), n * sizeof(type)); \
+  }
+  LC_SCENE_BUFFERS(LUCENT_HASH)
+#undef LUCENT_HASH
+  add(m.build_options.data(), m.build_options.size());
+  return h;
+}
 std::uint64_t Renderer::spp() const { return impl_->done; }
 std::uint64_t Renderer::first_sample() const { return impl_->first; }
 void Renderer::cancel() { impl_->cancel_requested = true; }

@@ -1,0 +1,25 @@
+# lucent-mpi (src/mpi/): one render split over MPI ranks. LUCENT_MPI: AUTO (default) builds it
+# when an MPI implementation is found (Debian: libopenmpi-dev openmpi-bin), ON requires one, OFF
+# skips it.
+set(LUCENT_MPI AUTO CACHE STRING "Build lucent-mpi: AUTO (when MPI is found), ON or OFF")
+set_property(CACHE LUCENT_MPI PROPERTY STRINGS AUTO ON OFF)
+if(NOT LUCENT_MPI STREQUAL "OFF")
+  if(LUCENT_MPI STREQUAL "ON")
+    find_package(MPI REQUIRED COMPONENTS C)
+  else()
+    find_package(MPI QUIET COMPONENTS C)
+  endif()
+  if(MPI_C_FOUND)
+    add_executable(lucent_mpi ${CMAKE_CURRENT_SOURCE_DIR}/src/mpi/lucent_mpi.cpp)
+    set_target_properties(lucent_mpi PROPERTIES OUTPUT_NAME lucent-mpi)
+    target_compile_options(lucent_mpi PRIVATE -Wall -Wextra)
+    # the C API only: no deprecated C++ bindings (their symbols are in another library)
+    target_compile_definitions(lucent_mpi PRIVATE OMPI_SKIP_MPICXX=1 MPICH_SKIP_MPICXX=1)
+    target_link_libraries(lucent_mpi PRIVATE lucent CLI11::CLI11 MPI::MPI_C)
+    install(TARGETS lucent_mpi RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+    message(STATUS "lucent-mpi: building against MPI ${MPI_C_VERSION} (${MPIEXEC_EXECUTABLE})")
+  else()
+    message(STATUS "lucent-mpi: no MPI found, not built (Debian: apt-get install libopenmpi-dev "
+                   "openmpi-bin; -DLUCENT_MPI=OFF to skip the search)")
+  endif()
+endif()

@@ -1,0 +1,116 @@
+#pragma once
+// Sample-range renders ("parts") and their exact merge: `lucent render --samples A:B`, `lucent
+// merge`, Slurm array jobs and the MPI renderer. A part holds the raw accumulation of some sample
+// indices of one scene (double sums, sums of squares, counts) with what identifies the image
+// (scene hash, seed, film, integrator). Parts of disjoint ranges of the same image add up to the
+// accumulation of their union; merging adds them in ascending sample order, so a merge does not
+// depend on the order its inputs are given in. File format: docs/parts.md.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "lucent/accumulation.hpp"
+#include "lucent/image.hpp"
+#include "lucent/render.hpp"
+
+namespace lucent {
+
+class Renderer;
+
+/// Sample indices [begin, end).
+struct SampleRange {
+  std::uint64_t begin = 0;
+  std::uint64_t end = 0;
+  bool operator==(const SampleRange& o) const { return begin == o.begin && end == o.end; }
+};
+
+/// "[0, 16)"; a list: "[0, 16), [32, 48)" ("none" when empty).
+std::string range_text(const SampleRange& r);
+std::string ranges_text(const std::vector<SampleRange>& rs);
+
+/// Parses "A:B" (0 <= A < B <= 2^32, B - A <= limits::kMaxSpp); throws lucent::Error naming
+/// `what` (e.g. "--samples") otherwise.
+SampleRange parse_sample_range(const std::string& text, const std::string& what = "--samples");
+
+/// What identifies a part's image and where its samples come from (a part file's header).
+struct PartInfo {
+  int width = 0, height = 0;
+  std::uint64_t scene_hash = 0;  ///< Renderer::image_hash()
+  std::uint32_t seed = 0;
+  std::string integrator;              ///< its name ("path", ...)
+  std::string version;                 ///< lucent's version that rendered it
+  std::string scene;                   ///< the scene file (informative)
+  std::vector<SampleRange> samples;    ///< rendered: sorted, disjoint
+  std::vector<SampleRange> requested;  ///< asked for: sorted, disjoint, covers `samples`
+  DisplaySettings display;             ///< the film's display settings (for 8-bit outputs)
+  std::uint64_t nonfinite = 0, rays = 0;
+  double seconds = 0;  ///< kernel time, summed over the parts merged
+};
+
+/// A part: its header and its accumulation (acc.first_sample and acc.spp are unused: the
+/// ranges are in info.samples).
+struct RenderPart {
+  PartInfo info;
+  Accumulation acc;
+};
+
+/// The part a session holds after reset(range.begin) and render(range.end - range.begin),
+/// possibly cut short: samples [first_sample, first_sample + spp) of `requested`. `scene_path`
+/// is recorded for information.
+RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
+                     const std::string& scene_path);
+
+/// The part's mean, variance and counts as a RenderResult (as Renderer::result() computes them).
+RenderResult part_result(const RenderPart& part);
+
+/// Writes a part file (an OpenEXR: the render's R, G, B, var.*, n layers, which `lucent compare`
+/// reads, plus the raw double sums and the header as attributes; docs/parts.md), atomically.
+void write_render_part(const std::string& path, const RenderPart& part);
+/// Reads a part file; throws lucent::Error naming the file and what is wrong.
+RenderPart read_render_part(const std::string& path);
+/// Reads only a part file's header.
+PartInfo read_part_info(const std::string& path);
+
+/// The result of a merge.
+struct MergeReport {
+  RenderPart merged;                       ///< the sum; info.samples: the union of the ranges
+  std::vector<SampleRange> missing;        ///< gaps in [0, the highest end requested)
+  std::uint32_t min_spp = 0, max_spp = 0;  ///< finite samples per pixel, over the pixels
+  double mean_spp = 0;
+  std::vector<std::string> order;  ///< the inputs in the order they were added
+};
+
+/// Adds parts one at a time, each checked against the first (film, seed, integrator, scene hash)
+/// and against the ranges already added (no overlap). Double addition is not associative: the sum
+/// depends on the order of the parts, so merge_render_parts adds them in ascending order of their
+/// first sample (as lucent-mpi adds its ranks), whatever order they are given in.
+class PartMerger {
+ public:
+  /// Throws lucent::Error (one line naming `name` and, for an overlap or a mismatch, the part it
+  /// conflicts with).
+  void check(const std::string& name, const PartInfo& info);
+  /// check(), then records the header alone (to check a set of parts before reading their
+  /// pixels); finish() is for a merger fed with add().
+  void add_header(const std::string& name, const PartInfo& info);
+  /// check(), then adds the part.
+  void add(const std::string& name, const RenderPart& part);
+  bool empty() const { return names_.empty(); }
+  /// The merged part and its coverage.
+  MergeReport finish();
+
+ private:
+  std::vector<std::string> names_;
+  std::vector<PartInfo> infos_;
+  RenderPart total_;
+};
+
+/// Reads the headers of `paths`, checks them (same film, seed, integrator and scene hash; no
+/// overlapping ranges), then reads and adds the parts in ascending order of their first sample
+/// (one part in memory at a time besides the sum).
+MergeReport merge_render_parts(const std::vector<std::string>& paths);
+
+/// Writes a merged part in the format of `path`'s extension: .exr (a part file, which can be
+/// merged again), .png (8-bit, the parts' display settings), .pfm (the mean). Atomic.
+void write_merged(const std::string& path, const RenderPart& part);
+
+}  // namespace lucent

@@ -1,0 +1,72 @@
+// `lucent merge PART... -o OUT`: adds the part files of sample-range renders (`lucent render
+// --samples A:B`) into one image, exactly (lucent/parts.hpp, docs/parts.md). Checks that the parts
+// come from the same scene, seed and film and that their ranges do not overlap, says which ranges
+// are missing and the effective samples per pixel, and writes OUT atomically.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "core/file_io.hpp"
+#include "lucent/error.hpp"
+#include "lucent/parts.hpp"
+
+namespace lucent::cli {
+
+namespace {
+
+struct MergeArgs {
+  std::vector<std::string> parts;
+  std::string output;
+  bool complete = false;
+  bool quiet = false;
+};
+
+MergeArgs& args() {
+  static MergeArgs a;
+  return a;
+}
+
+}  // namespace
+
+CLI::App* add_merge_command(CLI::App& app) {
+  MergeArgs& a = args();
+  CLI::App* cmd = app.add_subcommand(
+      "merge", "Merge the part files of sample-range renders (render --samples A:B) exactly");
+  cmd->add_option("parts", a.parts, "Part files (.exr written by render --samples)")->required();
+  cmd->add_option("-o,--output", a.output,
+                  "Merged image: .exr (a part file, mergeable again), .png or .pfm")
+      ->required();
+  cmd->add_flag("--complete", a.complete,
+                "Fail (and write nothing) when sample ranges are missing");
+  cmd->add_flag("-q,--quiet", a.quiet, "Print only warnings and errors");
+  return cmd;
+}
+
+int run_merge_command() {
+  MergeArgs& a = args();
+  for (const std::string& in : a.parts)
+    if (io::same_file(a.output, in))
+      throw Error(a.output + ": is an input of the merge; refusing to overwrite it");
+  MergeReport r = merge_render_parts(a.parts);
+  const PartInfo& info = r.merged.info;
+  if (!r.missing.empty()) {
+    if (a.complete)
+      throw Error("merge: samples " + ranges_text(r.missing) + " are missing (--complete)");
+    std::fprintf(stderr, "lucent: warning: samples %s are missing: the image has fewer samples\n",
+                 ranges_text(r.missing).c_str());
+  }
+  write_merged(a.output, r.merged);
+  if (!a.quiet) {
+    std::fprintf(stderr, "%s: %dx%d, %zu part(s), samples %s\n", a.output.c_str(), info.width,
+                 info.height, r.order.size(), ranges_text(info.samples).c_str());
+    std::fprintf(stderr, "effective samples per pixel (finite): min %u, mean %.2f, max %u\n",
+                 r.min_spp, r.mean_spp, r.max_spp);
+    if (info.nonfinite > 0)
+      std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
+                   static_cast<unsigned long long>(info.nonfinite));
+  }
+  return 0;
+}
+
+}  // namespace lucent::cli

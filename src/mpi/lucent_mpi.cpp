@@ -1,0 +1,245 @@
+// `mpirun -np K lucent-mpi SCENE -o OUT`: one render split over MPI ranks. Rank r renders the
+// sample indices [N r / K, N (r + 1) / K) of the N samples per pixel, then rank 0 receives the
+// ranks' raw accumulations in rank order (ascending sample ranges), adds them with
+// lucent::PartMerger (the code of `lucent merge`, so the image is the merge of the ranks' parts)
+// and writes OUT atomically. A rank that fails prints one line naming it and ends the job with
+// MPI_Abort: nothing is written. SIGINT, SIGTERM and SIGHUP stop every rank after its current
+// pass; what they rendered is merged and written (an .exr records the ranges it holds).
+#include <mpi.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "lucent/limits.hpp"
+#include "lucent/lucent.hpp"
+#include "lucent/parts.hpp"
+#include "lucent/types.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+volatile std::sig_atomic_t g_signal = 0;
+
+extern "C" void on_stop_signal(int sig) {
+  g_signal = sig;
+  g_stop.store(true);
+}
+
+int g_rank = 0, g_size = 1;
+
+/// One line naming the rank, then the whole job ends: no rank writes anything after this.
+[[noreturn]] void fail(const std::string& what) {
+  char host[256] = "?";
+  gethostname(host, sizeof host - 1);
+  std::fprintf(stderr, "lucent-mpi: error: rank %d of %d (%s): %s\n", g_rank, g_size, host,
+               what.c_str());
+  std::fflush(stderr);
+  MPI_Abort(MPI_COMM_WORLD, 1);
+  std::_Exit(1);  // not reached
+}
+
+struct Args {
+  std::string scene, output, device, precision = "float";
+  int spp = 0, width = 0, height = 0;
+  long long seed = -1;
+  double time_limit = 0;
+  bool fast_math = false, quiet = false;
+};
+
+// What travels from a rank to rank 0 besides its sums: the part's header.
+struct Header {
+  std::uint64_t width, height, hash, seed, begin, end, req_begin, req_end, nonfinite, rays;
+  double seconds;
+  char integrator[32];
+};
+
+void send_part(const lucent::RenderPart& p) {
+  Header h{};
+  h.width = p.info.width;
+  h.height = p.info.height;
+  h.hash = p.info.scene_hash;
+  h.seed = p.info.seed;
+  if (!p.info.samples.empty()) h.begin = p.info.samples[0].begin, h.end = p.info.samples[0].end;
+  h.req_begin = p.info.requested[0].begin;
+  h.req_end = p.info.requested[0].end;
+  h.nonfinite = p.info.nonfinite;
+  h.rays = p.info.rays;
+  h.seconds = p.info.seconds;
+  std::strncpy(h.integrator, p.info.integrator.c_str(), sizeof h.integrator - 1);
+  MPI_Send(&h, sizeof h, MPI_BYTE, 0, 0, MPI_COMM_WORLD);
+  MPI_Send(p.acc.sum.data(), static_cast<int>(p.acc.sum.size()), MPI_DOUBLE, 0, 1, MPI_COMM_WORLD);
+  MPI_Send(p.acc.sumsq.data(), static_cast<int>(p.acc.sumsq.size()), MPI_DOUBLE, 0, 2,
+           MPI_COMM_WORLD);
+  MPI_Send(p.acc.count.data(), static_cast<int>(p.acc.count.size()), MPI_UINT32_T, 0, 3,
+           MPI_COMM_WORLD);
+}
+
+/// Rank `from`'s part; the header fields that are not sent (display, version, scene) are
+/// rank 0's.
+lucent::RenderPart receive_part(int from, const lucent::PartInfo& mine) {
+  Header h{};
+  MPI_Recv(&h, sizeof h, MPI_BYTE, from, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  if (h.width != std::uint64_t(mine.width) || h.height != std::uint64_t(mine.height))
+    fail("rank " + std::to_string(from) + " rendered a " + std::to_string(h.width) + "x" +
+         std::to_string(h.height) + " film, rank 0 " + std::to_string(mine.width) + "x" +
+         std::to_string(mine.height));
+  lucent::RenderPart p;
+  p.info = mine;
+  p.info.scene_hash = h.hash;
+  p.info.seed = static_cast<std::uint32_t>(h.seed);
+  p.info.samples.clear();
+  if (h.end > h.begin) p.info.samples.push_back({h.begin, h.end});
+  p.info.requested = {{h.req_begin, h.req_end}};
+  p.info.nonfinite = h.nonfinite;
+  p.info.rays = h.rays;
+  p.info.seconds = h.seconds;
+  h.integrator[sizeof h.integrator - 1] = 0;
+  p.info.integrator = h.integrator;
+  const size_t npix = static_cast<size_t>(mine.width) * mine.height;
+  p.acc.width = mine.width;
+  p.acc.height = mine.height;
+  p.acc.sum.resize(npix * 3);
+  p.acc.sumsq.resize(npix * 3);
+  p.acc.count.resize(npix);
+  MPI_Recv(p.acc.sum.data(), static_cast<int>(npix * 3), MPI_DOUBLE, from, 1, MPI_COMM_WORLD,
+           MPI_STATUS_IGNORE);
+  MPI_Recv(p.acc.sumsq.data(), static_cast<int>(npix * 3), MPI_DOUBLE, from, 2, MPI_COMM_WORLD,
+           MPI_STATUS_IGNORE);
+  MPI_Recv(p.acc.count.data(), static_cast<int>(npix), MPI_UINT32_T, from, 3, MPI_COMM_WORLD,
+           MPI_STATUS_IGNORE);
+  return p;
+}
+
+/// Fails before rendering when OUT cannot be written (format, directory).
+void check_output(const std::string& out, const std::string& scene) {
+  namespace fs = std::filesystem;
+  std::string ext = fs::path(out).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".exr" && ext != ".png" && ext != ".pfm")
+    throw lucent::Error(out + ": unknown output format '" + ext + "' (use .exr, .png or .pfm)");
+  std::error_code ec;
+  if (fs::equivalent(out, scene, ec)) throw lucent::Error(out + ": is the scene file");
+  fs::path dir = fs::path(out).parent_path();
+  if (dir.empty()) dir = ".";
+  if (!fs::is_directory(dir, ec) || ::access(dir.c_str(), W_OK) != 0)
+    throw lucent::Error(out + ": cannot write output (directory " + dir.string() +
+                        " missing or not writable)");
+}
+
+int run(const Args& a) {
+  const bool root = g_rank == 0;
+  if (root) check_output(a.output, a.scene);
+  lucent::Scene scene = lucent::load_scene(a.scene);
+  if (a.width > 0) scene.film.width = a.width;
+  if (a.height > 0) scene.film.height = a.height;
+  if (a.seed >= 0) scene.integrator.seed = static_cast<std::uint32_t>(a.seed);
+  const std::uint64_t n = a.spp > 0 ? std::uint64_t(a.spp) : scene.integrator.spp;
+  if (n < std::uint64_t(g_size))
+    throw lucent::Error(std::to_string(g_size) + " ranks for " + std::to_string(n) +
+                        " samples per pixel: use at most one rank per sample");
+  const lucent::SampleRange range{n * g_rank / g_size, n * (g_rank + 1) / g_size};
+
+  lucent::SessionOptions so = lucent::SessionOptions::from_environment();
+  if (!a.device.empty()) so.device = a.device;
+  so.precision = lucent::parse_precision(a.precision);
+  so.fast_math = a.fast_math;
+  lucent::Renderer renderer(so);
+  renderer.set_cancel_flag(&g_stop);
+  renderer.set_scene(scene);
+  renderer.reset(range.begin);
+  const bool tty = isatty(STDERR_FILENO);
+  double last = -10;
+  auto progress = [&](const lucent::RenderProgress& p) {
+    if (!root || a.quiet || p.elapsed < 1.0 || (!tty && p.elapsed - last < 2.0)) return;
+    last = p.elapsed;
+    std::fprintf(stderr, "%srank 0 of %d: %5.1f%%  %llu of %llu spp  %.2f Msamples/s%s",
+                 tty ? "\r" : "", g_size, 100.0 * double(p.samples_done) / double(p.samples_target),
+                 static_cast<unsigned long long>(p.samples_done),
+                 static_cast<unsigned long long>(p.samples_target), p.samples_per_second * 1e-6,
+                 tty ? "   " : "\n");
+  };
+  renderer.render(range.end - range.begin, a.time_limit, progress);
+  if (root && !a.quiet && last > 0 && tty) std::fprintf(stderr, "\n");
+  lucent::RenderPart part = lucent::make_part(renderer, range, a.scene);
+
+  if (!root) {
+    send_part(part);
+    return 0;
+  }
+  lucent::PartMerger merger;
+  merger.add("rank 0", part);
+  for (int r = 1; r < g_size; ++r) {
+    lucent::RenderPart p = receive_part(r, part.info);
+    try {
+      merger.add("rank " + std::to_string(r), p);
+    } catch (const lucent::Error& e) {
+      fail(e.what());
+    }
+  }
+  lucent::MergeReport m = merger.finish();
+  lucent::write_merged(a.output, m.merged);
+  if (!a.quiet)
+    std::fprintf(stderr, "%s: %dx%d, samples %s from %d ranks (%.2f s of kernel time in all)\n",
+                 a.output.c_str(), m.merged.info.width, m.merged.info.height,
+                 lucent::ranges_text(m.merged.info.samples).c_str(), g_size, m.merged.info.seconds);
+  if (g_stop.load()) {
+    std::fprintf(stderr, "lucent-mpi: interrupted: %s holds samples %s of [0, %llu)\n",
+                 a.output.c_str(), lucent::ranges_text(m.merged.info.samples).c_str(),
+                 static_cast<unsigned long long>(n));
+    return 128 + (g_signal ? int(g_signal) : SIGINT);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &g_size);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, on_stop_signal);
+
+  Args a;
+  CLI::App app{
+      "lucent-mpi: one render split over MPI ranks (mpirun -np K lucent-mpi SCENE -o OUT)"};
+  app.add_option("scene", a.scene, "Scene file (JSON)")->required();
+  app.add_option("-o,--output", a.output, "Output: .exr (a part file), .png or .pfm")->required();
+  app.add_option("--spp", a.spp, "Samples per pixel in all (default: the scene's)")
+      ->check(CLI::Range(1, lucent::limits::kMaxSpp));
+  app.add_option("--time", a.time_limit, "Each rank stops after this many seconds")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--width", a.width, "Image width")
+      ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
+  app.add_option("--height", a.height, "Image height")
+      ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
+  app.add_option("--seed", a.seed, "Random seed")
+      ->check(CLI::Range(0LL, static_cast<long long>(lucent::limits::kMaxSeed)));
+  app.add_option("--device", a.device, "OpenCL device(s) of every rank (env LUCENT_DEVICE)");
+  app.add_option("--precision", a.precision, "float or double")
+      ->check(CLI::IsMember({"float", "double"}));
+  app.add_flag("--fast-math", a.fast_math, "Build the kernel with -cl-fast-relaxed-math");
+  app.add_flag("-q,--quiet", a.quiet, "No progress line or summary");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int status = 0;
+    if (g_rank == 0) status = app.exit(e);
+    MPI_Finalize();
+    return status ? status : (e.get_exit_code() ? 2 : 0);
+  }
+  int status = 0;
+  try {
+    status = run(a);
+  } catch (const std::exception& e) {
+    fail(e.what());
+  }
+  MPI_Finalize();
+  return status;
+}

@@ -1,0 +1,516 @@
+// Sample-range renders ("parts") and their exact merge (lucent/parts.hpp). A part file is a render
+// EXR (R, G, B, var.*, n: `lucent compare` reads it) with the raw double sums stored bit for bit
+// as pairs of UINT channels and the header as string attributes. Format: docs/parts.md.
+#include "lucent/parts.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <map>
+
+#include "core/file_io.hpp"
+#include "image/image_probe.hpp"
+#include "lucent/error.hpp"
+#include "lucent/limits.hpp"
+#include "lucent/session.hpp"
+#include "lucent/types.hpp"
+#include "lucent/version.hpp"
+
+namespace lucent {
+
+namespace {
+
+constexpr const char* kFormat = "lucent-part 1";
+constexpr const char* kPlanes[2] = {"sum", "sumsq"};
+constexpr const char* kRgb[3] = {"R", "G", "B"};
+
+const char* transfer_name(Transfer t) {
+  return t == Transfer::Srgb ? "srgb" : t == Transfer::Gamma ? "gamma" : "linear";
+}
+const char* tonemap_name(ToneMap t) {
+  return t == ToneMap::Clamp ? "clamp" : t == ToneMap::Reinhard ? "reinhard" : "aces";
+}
+
+/// Parses a whole unsigned decimal number of at most `max`; throws naming the attribute.
+std::uint64_t parse_u64(const std::string& path, const std::string& what, const std::string& s,
+                        std::uint64_t max = std::numeric_limits<std::uint64_t>::max()) {
+  errno = 0;
+  char* end = nullptr;
+  const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
+  if (s.empty() || s[0] < '0' || s[0] > '9' || *end != '\0' || errno == ERANGE || v > max)
+    throw Error(path + ": attribute " + what + ": invalid number '" + s + "'");
+  return v;
+}
+
+double parse_double(const std::string& path, const std::string& what, const std::string& s) {
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || *end != '\0' || !std::isfinite(v))
+    throw Error(path + ": attribute " + what + ": invalid number '" + s + "'");
+  return v;
+}
+
+std::string ranges_attribute(const std::vector<SampleRange>& rs) {
+  std::string out;
+  for (const SampleRange& r : rs)
+    out += (out.empty() ? "" : ",") + std::to_string(r.begin) + ":" + std::to_string(r.end);
+  return out;
+}
+
+/// "A:B,C:D": sorted, disjoint, non-empty ranges below 2^32.
+std::vector<SampleRange> parse_ranges(const std::string& path, const std::string& what,
+                                      const std::string& s) {
+  std::vector<SampleRange> out;
+  size_t at = 0;
+  while (at < s.size()) {
+    size_t comma = s.find(',', at);
+    if (comma == std::string::npos) comma = s.size();
+    const std::string item = s.substr(at, comma - at);
+    const size_t colon = item.find(':');
+    if (colon == std::string::npos)
+      throw Error(path + ": attribute " + what + ": '" + item + "' is not a range A:B");
+    SampleRange r{parse_u64(path, what, item.substr(0, colon), 1ull << 32),
+                  parse_u64(path, what, item.substr(colon + 1), 1ull << 32)};
+    if (r.end <= r.begin || (!out.empty() && r.begin < out.back().end))
+      throw Error(path + ": attribute " + what + ": ranges must be non-empty, sorted and disjoint");
+    out.push_back(r);
+    at = comma + 1;
+  }
+  return out;
+}
+
+std::uint64_t total(const std::vector<SampleRange>& rs) {
+  std::uint64_t n = 0;
+  for (const SampleRange& r : rs) n += r.end - r.begin;
+  return n;
+}
+
+/// Sorted union of two sorted disjoint lists (adjacent ranges joined).
+std::vector<SampleRange> unite(std::vector<SampleRange> a, const std::vector<SampleRange>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  std::sort(a.begin(), a.end(),
+            [](const SampleRange& x, const SampleRange& y) { return x.begin < y.begin; });
+  std::vector<SampleRange> out;
+  for (const SampleRange& r : a) {
+    if (!out.empty() && r.begin <= out.back().end)
+      out.back().end = std::max(out.back().end, r.end);
+    else
+      out.push_back(r);
+  }
+  return out;
+}
+
+/// The first overlap between two sorted disjoint lists, if any.
+bool overlap(const std::vector<SampleRange>& a, const std::vector<SampleRange>& b,
+             SampleRange* first_a, SampleRange* first_b) {
+  for (const SampleRange& x : a)
+    for (const SampleRange& y : b)
+      if (x.begin < y.end && y.begin < x.end) {
+        *first_a = x;
+        *first_b = y;
+        return true;
+      }
+  return false;
+}
+
+std::string hex64(std::uint64_t v) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016" PRIx64, v);
+  return buf;
+}
+
+PartInfo info_from_attributes(const std::string& path,
+                              const std::map<std::string, std::string>& attrs, int width,
+                              int height) {
+  auto get = [&](const std::string& key) -> const std::string& {
+    auto it = attrs.find("lucent." + key);
+    if (it == attrs.end())
+      throw Error(path + ": not a lucent part file (no lucent." + key +
+                  " attribute; render parts with `lucent render --samples A:B`)");
+    return it->second;
+  };
+  if (get("format") != kFormat)
+    throw Error(path + ": unsupported part format '" + get("format") + "' (expected '" + kFormat +
+                "')");
+  PartInfo info;
+  info.width = width;
+  info.height = height;
+  const std::string film = std::to_string(width) + "x" + std::to_string(height);
+  if (get("film") != film)
+    throw Error(path + ": attribute lucent.film '" + get("film") + "' differs from the image's " +
+                film);
+  const std::string& h = get("hash");
+  if (h.size() != 16 || h.find_first_not_of("0123456789abcdef") != std::string::npos)
+    throw Error(path + ": attribute lucent.hash: invalid hash '" + h + "'");
+  info.scene_hash = std::strtoull(h.c_str(), nullptr, 16);
+  info.seed = static_cast<std::uint32_t>(parse_u64(path, "lucent.seed", get("seed"), 0xffffffffu));
+  info.integrator = get("integrator");
+  info.version = get("version");
+  info.scene = get("scene");
+  info.samples = parse_ranges(path, "lucent.samples", get("samples"));
+  info.requested = parse_ranges(path, "lucent.requested", get("requested"));
+  if (info.requested.empty()) throw Error(path + ": attribute lucent.requested: no sample range");
+  if (unite(info.requested, info.samples) != info.requested)
+    throw Error(path + ": attribute lucent.samples: " + ranges_text(info.samples) +
+                " lies outside the requested " + ranges_text(info.requested));
+  info.nonfinite = parse_u64(path, "lucent.nonfinite", get("nonfinite"));
+  info.rays = parse_u64(path, "lucent.rays", get("rays"));
+  info.seconds = parse_double(path, "lucent.seconds", get("seconds"));
+  // display: transfer,gamma,exposure,tonemap
+  const std::string& d = get("display");
+  char transfer[16] = {0}, tonemap[16] = {0};
+  double gamma = 0, exposure = 0;
+  if (std::sscanf(d.c_str(), "%15[a-z],%lf,%lf,%15[a-z]", transfer, &gamma, &exposure, tonemap) !=
+          4 ||
+      !std::isfinite(gamma) || !(gamma > 0) || !std::isfinite(exposure))
+    throw Error(path + ": attribute lucent.display: invalid '" + d + "'");
+  const std::string t = transfer, m = tonemap;
+  if (t != "srgb" && t != "gamma" && t != "linear")
+    throw Error(path + ": attribute lucent.display: unknown transfer '" + t + "'");
+  if (m != "clamp" && m != "reinhard" && m != "aces")
+    throw Error(path + ": attribute lucent.display: unknown tone map '" + m + "'");
+  info.display.transfer =
+      t == "srgb" ? Transfer::Srgb : (t == "gamma" ? Transfer::Gamma : Transfer::Linear);
+  info.display.gamma = gamma;
+  info.display.exposure = exposure;
+  info.display.tonemap =
+      m == "clamp" ? ToneMap::Clamp : (m == "reinhard" ? ToneMap::Reinhard : ToneMap::Aces);
+  return info;
+}
+
+std::string channel_name(int plane, int c, bool high) {
+  return std::string(kPlanes[plane]) + "." + kRgb[c] + (high ? ".hi" : ".lo");
+}
+
+}  // namespace
+
+std::string range_text(const SampleRange& r) {
+  return "[" + std::to_string(r.begin) + ", " + std::to_string(r.end) + ")";
+}
+
+std::string ranges_text(const std::vector<SampleRange>& rs) {
+  if (rs.empty()) return "none";
+  std::string out;
+  for (const SampleRange& r : rs) out += (out.empty() ? "" : ", ") + range_text(r);
+  return out;
+}
+
+SampleRange parse_sample_range(const std::string& text, const std::string& what) {
+  const size_t colon = text.find(':');
+  auto number = [&](const std::string& s, std::uint64_t* v) {
+    if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos || s.size() > 11)
+      return false;
+    *v = std::stoull(s);
+    return true;
+  };
+  SampleRange r;
+  if (colon == std::string::npos || !number(text.substr(0, colon), &r.begin) ||
+      !number(text.substr(colon + 1), &r.end))
+    throw Error(what + " '" + text + "': expected A:B, the sample indices [A, B)");
+  if (r.end <= r.begin || r.end > (1ull << 32))
+    throw Error(what + " '" + text + "': need 0 <= A < B <= 4294967296");
+  if (r.end - r.begin > static_cast<std::uint64_t>(limits::kMaxSpp))
+    throw Error(what + " '" + text + "': at most " + std::to_string(limits::kMaxSpp) +
+                " samples per part");
+  return r;
+}
+
+RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
+                     const std::string& scene_path) {
+  RenderPart p;
+  p.acc = renderer.accumulation();
+  const Scene& scene = renderer.scene();
+  PartInfo& info = p.info;
+  info.width = p.acc.width;
+  info.height = p.acc.height;
+  info.scene_hash = renderer.image_hash();
+  info.seed = scene.integrator.seed;
+  info.integrator = type_name(scene.integrator.type);
+  info.version = kVersion;
+  info.scene = scene_path;
+  if (p.acc.spp > 0) info.samples = {{p.acc.first_sample, p.acc.first_sample + p.acc.spp}};
+  info.requested = {requested};
+  if (unite(info.requested, info.samples) != info.requested)
+    throw Error("make_part: the session's samples " + ranges_text(info.samples) +
+                " lie outside the requested " + range_text(requested));
+  info.display = DisplaySettings{scene.film.transfer, scene.film.gamma, scene.film.exposure,
+                                 scene.film.tonemap};
+  info.nonfinite = p.acc.nonfinite;
+  info.rays = p.acc.rays;
+  info.seconds = p.acc.seconds;
+  return p;
+}
+
+RenderResult part_result(const RenderPart& part) {
+  const Accumulation& a = part.acc;
+  const size_t npix = static_cast<size_t>(a.width) * a.height;
+  RenderResult r;
+  r.mean = Image{a.width, a.height, std::vector<float>(npix * 3)};
+  r.variance = Image{a.width, a.height, std::vector<float>(npix * 3)};
+  r.samples = a.count;
+  for (size_t i = 0; i < npix; ++i) {
+    const double n = a.count[i];
+    for (int c = 0; c < 3; ++c) {
+      const double s = a.sum[i * 3 + c], s2 = a.sumsq[i * 3 + c];
+      const double mean = n > 0 ? s / n : 0;
+      r.mean.rgb[i * 3 + c] = static_cast<float>(mean);
+      r.variance.rgb[i * 3 + c] =
+          static_cast<float>(n > 1 ? std::max(0.0, (s2 - s * mean) / (n - 1)) : 0);
+    }
+  }
+  r.spp = total(part.info.samples);
+  r.nonfinite = part.info.nonfinite;
+  r.rays = part.info.rays;
+  r.seconds = part.info.seconds;
+  return r;
+}
+
+void write_render_part(const std::string& path, const RenderPart& part) {
+  const PartInfo& info = part.info;
+  const Accumulation& a = part.acc;
+  const size_t npix = static_cast<size_t>(a.width) * a.height;
+  if (a.width != info.width || a.height != info.height || a.sum.size() != npix * 3 ||
+      a.sumsq.size() != npix * 3 || a.count.size() != npix)
+    throw Error(path + ": cannot write part: inconsistent accumulation");
+  // each double as two UINT channels: its high and low 32 bits (EXR has no 64-bit pixel type)
+  std::vector<std::vector<std::uint32_t>> words;
+  image_detail::ExrExtras extras;
+  for (int plane = 0; plane < 2; ++plane) {
+    const std::vector<double>& src = plane == 0 ? a.sum : a.sumsq;
+    for (int c = 0; c < 3; ++c) {
+      std::vector<std::uint32_t> hi(npix), lo(npix);
+      for (size_t i = 0; i < npix; ++i) {
+        std::uint64_t bits;
+        std::memcpy(&bits, &src[i * 3 + c], sizeof bits);
+        hi[i] = static_cast<std::uint32_t>(bits >> 32);
+        lo[i] = static_cast<std::uint32_t>(bits);
+      }
+      words.push_back(std::move(hi));
+      words.push_back(std::move(lo));
+    }
+  }
+  for (int plane = 0, k = 0; plane < 2; ++plane)
+    for (int c = 0; c < 3; ++c)
+      for (bool high : {true, false})
+        extras.uint_channels.emplace_back(channel_name(plane, c, high), words[k++].data());
+  char gamma[64], exposure[64], seconds[64];
+  std::snprintf(gamma, sizeof gamma, "%.17g", info.display.gamma);
+  std::snprintf(exposure, sizeof exposure, "%.17g", info.display.exposure);
+  std::snprintf(seconds, sizeof seconds, "%.6f", info.seconds);
+  extras.attributes = {
+      {"lucent.format", kFormat},
+      {"lucent.film", std::to_string(info.width) + "x" + std::to_string(info.height)},
+      {"lucent.hash", hex64(info.scene_hash)},
+      {"lucent.seed", std::to_string(info.seed)},
+      {"lucent.integrator", info.integrator},
+      {"lucent.version", info.version},
+      {"lucent.scene", info.scene},
+      {"lucent.samples", ranges_attribute(info.samples)},
+      {"lucent.requested", ranges_attribute(info.requested)},
+      {"lucent.nonfinite", std::to_string(info.nonfinite)},
+      {"lucent.rays", std::to_string(info.rays)},
+      {"lucent.seconds", seconds},
+      {"lucent.display", std::string(transfer_name(info.display.transfer)) + "," + gamma + "," +
+                             exposure + "," + tonemap_name(info.display.tonemap)},
+  };
+  image_detail::write_render_exr(path, part_result(part), extras);
+}
+
+PartInfo read_part_info(const std::string& path) {
+  const std::string bytes = io::read_file(path, image_detail::image_read_spec("part file"));
+  EXRHeader header;
+  image_detail::Probe probe =
+      image_detail::probe_exr(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(),
+                              path, image_detail::kMaxImagePixels, header);
+  const std::map<std::string, std::string> attrs = image_detail::exr_string_attributes(header);
+  FreeEXRHeader(&header);
+  return info_from_attributes(path, attrs, probe.width, probe.height);
+}
+
+RenderPart read_render_part(const std::string& path) {
+  const std::string bytes = io::read_file(path, image_detail::image_read_spec("part file"));
+  if (bytes.size() < 4 || std::memcmp(bytes.data(), "\x76\x2f\x31\x01", 4) != 0)
+    throw Error(path + ": not a lucent part file (not an OpenEXR file)");
+  image_detail::ExrChannels exr =
+      image_detail::read_exr_channels(reinterpret_cast<const unsigned char*>(bytes.data()),
+                                      bytes.size(), path, image_detail::kMaxImagePixels);
+  RenderPart p;
+  p.info = info_from_attributes(path, exr.attributes, exr.width, exr.height);
+  const size_t npix = static_cast<size_t>(exr.width) * exr.height;
+  Accumulation& a = p.acc;
+  a.width = exr.width;
+  a.height = exr.height;
+  a.sum.resize(npix * 3);
+  a.sumsq.resize(npix * 3);
+  auto uint_channel = [&](const std::string& name) -> const std::vector<std::uint32_t>& {
+    const int k = exr.find(name.c_str());
+    if (k < 0 || exr.uint_planes[k].size() != npix)
+      throw Error(path + ": part file has no UINT channel " + name);
+    return exr.uint_planes[k];
+  };
+  for (int plane = 0; plane < 2; ++plane) {
+    std::vector<double>& dst = plane == 0 ? a.sum : a.sumsq;
+    for (int c = 0; c < 3; ++c) {
+      const std::vector<std::uint32_t>& hi = uint_channel(channel_name(plane, c, true));
+      const std::vector<std::uint32_t>& lo = uint_channel(channel_name(plane, c, false));
+      for (size_t i = 0; i < npix; ++i) {
+        const std::uint64_t bits = (std::uint64_t(hi[i]) << 32) | lo[i];
+        std::memcpy(&dst[i * 3 + c], &bits, sizeof(double));
+        if (!std::isfinite(dst[i * 3 + c]) || (plane == 1 && dst[i * 3 + c] < 0))
+          throw Error(path + ": channel " + channel_name(plane, c, true) + ": pixel " +
+                      std::to_string(i % a.width) + ", " + std::to_string(i / a.width) +
+                      " holds an invalid sum");
+      }
+    }
+  }
+  a.count = uint_channel("n");
+  const std::uint64_t spp = total(p.info.samples);
+  for (size_t i = 0; i < npix; ++i)
+    if (a.count[i] > spp)
+      throw Error(path + ": channel n: pixel " + std::to_string(i % a.width) + ", " +
+                  std::to_string(i / a.width) + " counts " + std::to_string(a.count[i]) +
+                  " samples, more than the part's " + std::to_string(spp));
+  a.spp = spp;
+  a.nonfinite = p.info.nonfinite;
+  a.rays = p.info.rays;
+  a.seconds = p.info.seconds;
+  return p;
+}
+
+void PartMerger::check(const std::string& name, const PartInfo& info) {
+  if (names_.empty()) return;
+  const PartInfo& first = infos_.front();
+  const std::string& fname = names_.front();
+  if (info.width != first.width || info.height != first.height)
+    throw Error(name + ": film " + std::to_string(info.width) + "x" + std::to_string(info.height) +
+                " differs from " + fname + "'s " + std::to_string(first.width) + "x" +
+                std::to_string(first.height));
+  if (info.seed != first.seed)
+    throw Error(name + ": seed " + std::to_string(info.seed) + " differs from " + fname + "'s " +
+                std::to_string(first.seed));
+  if (info.integrator != first.integrator)
+    throw Error(name + ": integrator " + info.integrator + " differs from " + fname + "'s " +
+                first.integrator);
+  if (info.scene_hash != first.scene_hash)
+    throw Error(name + ": scene hash " + hex64(info.scene_hash) + " differs from " + fname + "'s " +
+                hex64(first.scene_hash) +
+                " (another scene, camera, film, integrator setting or build option)");
+  for (size_t k = 0; k < infos_.size(); ++k) {
+    SampleRange a, b;
+    if (overlap(info.samples, infos_[k].samples, &a, &b))
+      throw Error(name + ": samples " + range_text(a) + " overlap " + names_[k] + "'s " +
+                  range_text(b));
+  }
+}
+
+void PartMerger::add_header(const std::string& name, const PartInfo& info) {
+  check(name, info);
+  names_.push_back(name);
+  infos_.push_back(info);
+}
+
+void PartMerger::add(const std::string& name, const RenderPart& part) {
+  check(name, part.info);
+  const Accumulation& a = part.acc;
+  const size_t npix = static_cast<size_t>(a.width) * a.height;
+  if (a.sum.size() != npix * 3 || a.sumsq.size() != npix * 3 || a.count.size() != npix ||
+      a.width != part.info.width || a.height != part.info.height)
+    throw Error(name + ": inconsistent part (film and accumulation sizes differ)");
+  if (names_.empty()) {
+    total_ = part;
+  } else {
+    Accumulation& t = total_.acc;
+    for (size_t i = 0; i < npix; ++i)
+      if (std::uint64_t(t.count[i]) + a.count[i] > 0xffffffffull)
+        throw Error(name + ": pixel " + std::to_string(i % a.width) + ", " +
+                    std::to_string(i / a.width) + ": more than 2^32 samples in all");
+    for (size_t i = 0; i < npix * 3; ++i) {
+      t.sum[i] += a.sum[i];
+      t.sumsq[i] += a.sumsq[i];
+    }
+    for (size_t i = 0; i < npix; ++i) t.count[i] += a.count[i];
+    PartInfo& ti = total_.info;
+    ti.samples = unite(ti.samples, part.info.samples);
+    ti.requested = unite(ti.requested, part.info.requested);
+    ti.nonfinite += part.info.nonfinite;
+    ti.rays += part.info.rays;
+    ti.seconds += part.info.seconds;
+    t.spp = total(ti.samples);
+    t.nonfinite = ti.nonfinite;
+    t.rays = ti.rays;
+    t.seconds = ti.seconds;
+  }
+  names_.push_back(name);
+  infos_.push_back(part.info);
+}
+
+MergeReport PartMerger::finish() {
+  if (names_.empty()) throw Error("merge: no parts");
+  MergeReport r;
+  r.merged = total_;
+  r.order = names_;
+  // missing: [0, the highest end requested) less what was rendered
+  const std::uint64_t end =
+      r.merged.info.requested.empty() ? 0 : r.merged.info.requested.back().end;
+  std::uint64_t at = 0;
+  for (const SampleRange& s : r.merged.info.samples) {
+    if (s.begin > at) r.missing.push_back({at, s.begin});
+    at = s.end;
+  }
+  if (at < end) r.missing.push_back({at, end});
+  const std::vector<std::uint32_t>& count = r.merged.acc.count;
+  if (!count.empty()) {
+    r.min_spp = *std::min_element(count.begin(), count.end());
+    r.max_spp = *std::max_element(count.begin(), count.end());
+    double sum = 0;
+    for (std::uint32_t n : count) sum += n;
+    r.mean_spp = sum / double(count.size());
+  }
+  return r;
+}
+
+MergeReport merge_render_parts(const std::vector<std::string>& paths) {
+  if (paths.empty()) throw Error("merge: no part files given");
+  struct Entry {
+    std::string path;
+    PartInfo info;
+  };
+  std::vector<Entry> entries;
+  PartMerger headers;  // every header is checked before any pixel is read
+  for (const std::string& p : paths) {
+    for (const Entry& e : entries)
+      if (io::same_file(e.path, p)) throw Error(p + ": given twice (as " + e.path + ")");
+    entries.push_back(Entry{p, read_part_info(p)});
+    headers.add_header(p, entries.back().info);
+  }
+  std::stable_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    const std::uint64_t ka =
+        a.info.samples.empty() ? a.info.requested.front().begin : a.info.samples.front().begin;
+    const std::uint64_t kb =
+        b.info.samples.empty() ? b.info.requested.front().begin : b.info.samples.front().begin;
+    return ka < kb;
+  });
+  PartMerger merger;
+  for (const Entry& e : entries) merger.add(e.path, read_render_part(e.path));
+  return merger.finish();
+}
+
+void write_merged(const std::string& path, const RenderPart& part) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".exr")
+    write_render_part(path, part);
+  else if (ext == ".png" || ext == ".pfm")
+    write_image(path, part_result(part).mean, part.info.display);
+  else
+    throw Error(path + ": unknown output format '" + ext + "' (use .exr, .png or .pfm)");
+}
+
+}  // namespace lucent

@@ -1,0 +1,370 @@
+// Sample-range renders and their merge (lucent/parts.hpp, docs/parts.md): parts of [0, N) merge
+// into the accumulation of one N-spp render; the part file keeps the double sums bit for bit;
+// overlapping or mismatched parts are refused with one line; a part cut short by SIGTERM records
+// the range it completed and merges; mpirun -np 2 lucent-mpi renders the one-process image.
+//
+// Equality: the kernel sums each pass's samples in float and the session adds the pass sums in
+// double. Rendered with one sample per pass (pass_seconds tiny), a split render adds the same
+// floats in another order, so the sums agree to double rounding (relative 1e-12). Through the
+// command line the pass sizes (1, 4, 16, ... spp, tuned to the device's speed) differ between a
+// part and the whole, so the float pass sums round differently: relative 1e-5 on the sums, while
+// a one-sample shift of the range (the error this guards against) changes them by the noise,
+// ~10% (checked below, so the tolerance can fail).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <string>
+
+#include "lucent/compare.hpp"
+#include "lucent/parts.hpp"
+#include "support.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using lucent::test::CommandResult;
+using lucent::test::run_cli;
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+/// A diffuse sphere and a plane under a point light and a sky: every pixel noisy, 12x10.
+std::string noisy_scene(const std::string& dir, int seed = 3, int width = 12) {
+  std::string path = dir + "/scene.json";
+  lucent::test::write_file(path, R"({
+    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
+    "film": {"width": )" + std::to_string(width) +
+                                     R"(, "height": 10},
+    "integrator": {"type": "path", "spp": 8, "seed": )" +
+                                     std::to_string(seed) + R"(},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.25, 0.5, 0.75]}},
+    "shapes": [{"type": "triangles", "material": "m",
+                "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]], "indices": [0,1,2, 0,2,3]},
+               {"type": "sphere", "center": [0.3, 0.2, 0.5], "radius": 0.5, "material": "m"}],
+    "lights": [{"type": "point", "position": [0.7, 0.4, 2.0], "intensity": [20, 20, 20]},
+               {"type": "environment", "radiance": [0.3, 0.3, 0.3]}]
+  })");
+  return path;
+}
+
+/// Largest relative difference between two accumulations' sums (and sums of squares); the
+/// counts must be equal.
+double max_relative_difference(const lucent::Accumulation& a, const lucent::Accumulation& b) {
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  EXPECT_EQ(a.count, b.count);
+  double worst = 0;
+  for (int plane = 0; plane < 2; ++plane) {
+    const std::vector<double>& x = plane ? a.sumsq : a.sum;
+    const std::vector<double>& y = plane ? b.sumsq : b.sum;
+    EXPECT_EQ(x.size(), y.size());
+    for (size_t i = 0; i < x.size() && i < y.size(); ++i) {
+      const double scale = std::max(std::abs(x[i]), std::abs(y[i]));
+      if (scale > 0) worst = std::max(worst, std::abs(x[i] - y[i]) / scale);
+    }
+  }
+  return worst;
+}
+
+bool bit_equal(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+/// The only line of stderr, which must start with "lucent: error: ".
+std::string error_line(const CommandResult& r) {
+  EXPECT_NE(r.status, 0);
+  const std::string prefix = "lucent: error: ";
+  EXPECT_EQ(r.err.rfind(prefix, 0), 0u) << r.err;
+  EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+  std::string line = r.err.substr(0, r.err.find('\n'));
+  return line.size() > prefix.size() ? line.substr(prefix.size()) : line;
+}
+
+lucent::RenderPart render_range(lucent::Renderer& renderer, std::uint64_t begin,
+                                std::uint64_t end) {
+  renderer.reset(begin);
+  renderer.render(end - begin);
+  return lucent::make_part(renderer, {begin, end}, "scene.json");
+}
+
+TEST(Parts, MergedRangesEqualOneRenderToDoubleRounding) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::SessionOptions so = lucent::test::session_options();
+  so.pass_seconds = 1e-9;  // one sample per pass: the float pass sums are single samples
+  lucent::Renderer renderer(so);
+  renderer.set_scene(lucent::load_scene(noisy_scene(dir)));
+  lucent::RenderPart whole = render_range(renderer, 0, 8);
+  EXPECT_EQ(renderer.stats().passes, 8u);
+  lucent::RenderPart a = render_range(renderer, 0, 3), b = render_range(renderer, 3, 8);
+  EXPECT_EQ(a.info.scene_hash, whole.info.scene_hash);
+  lucent::write_render_part(dir + "/a.exr", a);
+  lucent::write_render_part(dir + "/b.exr", b);
+
+  // the file keeps every double bit for bit
+  lucent::RenderPart back = lucent::read_render_part(dir + "/b.exr");
+  EXPECT_TRUE(bit_equal(back.acc.sum, b.acc.sum));
+  EXPECT_TRUE(bit_equal(back.acc.sumsq, b.acc.sumsq));
+  EXPECT_EQ(back.acc.count, b.acc.count);
+  EXPECT_EQ(back.info.samples, (std::vector<lucent::SampleRange>{{3, 8}}));
+
+  lucent::MergeReport m = lucent::merge_render_parts({dir + "/b.exr", dir + "/a.exr"});
+  EXPECT_EQ(m.order, (std::vector<std::string>{dir + "/a.exr", dir + "/b.exr"}));
+  EXPECT_EQ(m.merged.info.samples, (std::vector<lucent::SampleRange>{{0, 8}}));
+  EXPECT_TRUE(m.missing.empty());
+  EXPECT_EQ(m.min_spp, 8u);
+  EXPECT_EQ(m.max_spp, 8u);
+  EXPECT_LT(max_relative_difference(m.merged.acc, whole.acc), 1e-12);
+  // the order the files are given in does not matter: the merge adds in sample order
+  lucent::MergeReport m2 = lucent::merge_render_parts({dir + "/a.exr", dir + "/b.exr"});
+  EXPECT_TRUE(bit_equal(m2.merged.acc.sum, m.merged.acc.sum));
+  // a shifted range is a different image: the comparison can fail
+  lucent::RenderPart shifted = render_range(renderer, 1, 9);
+  EXPECT_GT(max_relative_difference(shifted.acc, whole.acc), 1e-3);
+}
+
+TEST(Parts, CommandLinePartsMergeIntoTheSingleRender) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  for (const char* range : {"0:3", "3:8", "0:8", "1:9"}) {
+    std::string name = std::string(range).replace(1, 1, "-");
+    CommandResult r = run_cli("render " + q(scene) + " --samples " + range + " -q -o " +
+                              q(dir + "/p" + name + ".exr"));
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  CommandResult r = run_cli("render " + q(scene) + " -q --spp 8 -o " + q(dir + "/single.exr"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run_cli("merge " + q(dir + "/p3-8.exr") + " " + q(dir + "/p0-3.exr") + " -o " +
+              q(dir + "/merged.exr"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("samples [0, 8)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("min 8, mean 8.00, max 8"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+
+  lucent::RenderPart merged = lucent::read_render_part(dir + "/merged.exr");
+  lucent::RenderPart whole = lucent::read_render_part(dir + "/p0-8.exr");
+  lucent::RenderPart shifted = lucent::read_render_part(dir + "/p1-9.exr");
+  EXPECT_EQ(merged.info.scene_hash, whole.info.scene_hash);
+  EXPECT_EQ(merged.info.seed, 3u);
+  EXPECT_EQ(merged.info.integrator, "path");
+  EXPECT_LT(max_relative_difference(merged.acc, whole.acc), 1e-5);
+  EXPECT_GT(max_relative_difference(shifted.acc, whole.acc), 1e-3);
+  // against a plain render of 8 spp: the same mean, variance and counts
+  lucent::RenderResult single = lucent::read_render(dir + "/single.exr");
+  lucent::RenderResult mine = lucent::read_render(dir + "/merged.exr");
+  ASSERT_EQ(single.mean.rgb.size(), mine.mean.rgb.size());
+  EXPECT_EQ(single.samples, mine.samples);
+  for (size_t i = 0; i < single.mean.rgb.size(); ++i) {
+    EXPECT_NEAR(mine.mean.rgb[i], single.mean.rgb[i], 1e-5 * std::abs(single.mean.rgb[i]) + 1e-7);
+    EXPECT_NEAR(mine.variance.rgb[i], single.variance.rgb[i],
+                1e-4 * std::abs(single.variance.rgb[i]) + 1e-7);
+  }
+  // .pfm and .png outputs: the mean
+  r = run_cli("merge -q " + q(dir + "/p0-3.exr") + " " + q(dir + "/p3-8.exr") + " -o " +
+              q(dir + "/merged.pfm"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(lucent::read_image(dir + "/merged.pfm").rgb, mine.mean.rgb);
+}
+
+TEST(Parts, OverlapsAndMismatchesAreOneLineErrors) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  std::string other_dir = dir + "/other";
+  fs::create_directories(other_dir);
+  std::string other = noisy_scene(other_dir, 3, 14);
+  auto part = [&](const std::string& s, const std::string& range, const std::string& out,
+                  const std::string& extra = "") {
+    CommandResult r = run_cli("render " + q(s) + " -q --samples " + range + " " + extra + " -o " +
+                              q(dir + "/" + out));
+    EXPECT_EQ(r.status, 0) << r.err;
+    return q(dir + "/" + out);
+  };
+  std::string a = part(scene, "0:4", "a.exr"), b = part(scene, "2:6", "b.exr");
+  std::string c = part(scene, "4:6", "c.exr", "--seed 9");
+  std::string d = part(other, "4:6", "d.exr");
+  std::string e = part(scene, "4:6", "e.exr", "--integrator direct");
+  std::string f = part(scene, "6:8", "f.exr", "--fast-math");
+  const std::string out = dir + "/out.exr";
+  EXPECT_EQ(error_line(run_cli("merge " + a + " " + b + " -o " + q(out))),
+            dir + "/b.exr: samples [2, 6) overlap " + dir + "/a.exr's [0, 4)");
+  EXPECT_EQ(error_line(run_cli("merge " + a + " " + c + " -o " + q(out))),
+            dir + "/c.exr: seed 9 differs from " + dir + "/a.exr's 3");
+  EXPECT_EQ(error_line(run_cli("merge " + a + " " + d + " -o " + q(out))),
+            dir + "/d.exr: film 14x10 differs from " + dir + "/a.exr's 12x10");
+  EXPECT_EQ(error_line(run_cli("merge " + a + " " + e + " -o " + q(out))),
+            dir + "/e.exr: integrator direct differs from " + dir + "/a.exr's path");
+  EXPECT_NE(error_line(run_cli("merge " + a + " " + f + " -o " + q(out)))
+                .find(dir + "/f.exr: scene hash "),
+            std::string::npos);
+  EXPECT_EQ(error_line(run_cli("merge " + a + " " + a + " -o " + q(out))),
+            dir + "/a.exr: given twice (as " + dir + "/a.exr)");
+  // a render EXR that is not a part
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --spp 2 -o " + q(dir + "/plain.exr")).status, 0);
+  EXPECT_EQ(error_line(run_cli("merge " + a + " " + q(dir + "/plain.exr") + " -o " + q(out))),
+            dir + "/plain.exr: not a lucent part file (no lucent.format attribute; render parts " +
+                "with `lucent render --samples A:B`)");
+  EXPECT_EQ(error_line(run_cli("merge " + a + " -o " + a)),
+            dir + "/a.exr: is an input of the merge; refusing to overwrite it");
+  EXPECT_FALSE(fs::exists(out));
+  // bad ranges and combinations
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " --samples 5:5 -o " + q(out))),
+            "--samples '5:5': need 0 <= A < B <= 4294967296");
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " --samples 3 -o " + q(out))),
+            "--samples '3': expected A:B, the sample indices [A, B)");
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " --samples 0:4 -o " + q(dir + "/x.png"))),
+            dir + "/x.png: --samples writes a part file: use an .exr output");
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " --samples 0:4 --spp 4 -o " + q(out))),
+            "--samples and --spp cannot be combined");
+  // missing ranges: a warning naming them, or an error with --complete (nothing written)
+  std::string g = part(scene, "6:8", "g.exr");
+  EXPECT_EQ(error_line(run_cli("merge --complete " + a + " " + g + " -o " + q(out))),
+            "merge: samples [4, 6) are missing (--complete)");
+  EXPECT_FALSE(fs::exists(out));
+  CommandResult r = run_cli("merge " + a + " " + g + " -o " + q(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("lucent: warning: samples [4, 6) are missing"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("min 6, mean 6.00, max 6"), std::string::npos) << r.err;
+}
+
+// A part stopped by SIGTERM (Slurm's signal at a job's time limit) keeps the samples it finished,
+// says which, and merges with a part of the range it left.
+TEST(Parts, SigtermedPartRecordsItsRangeAndMerges) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  std::string part = dir + "/long.exr", err = dir + "/long.err";
+  // started in the background; SIGTERM once the progress line shows the render loop running
+  std::string script = "'" + std::string(LUCENT_CLI_PATH) + "' render " + q(scene) +
+                       " --samples 0:16000000 -o " + q(part) + " 2>" + q(err) +
+                       " </dev/null & pid=$!; for i in $(seq 600); do grep -q Msamples/s " +
+                       q(err) + " && break; sleep 0.1; done; kill -TERM $pid; wait $pid";
+  int raw = std::system(("bash -c " + q(script)).c_str());
+  ASSERT_TRUE(WIFEXITED(raw));
+  std::string text = lucent::test::read_file(err);
+  ASSERT_EQ(WEXITSTATUS(raw), 143) << text;
+  lucent::PartInfo info = lucent::read_part_info(part);
+  ASSERT_EQ(info.samples.size(), 1u) << text;
+  const std::uint64_t k = info.samples[0].end;
+  EXPECT_EQ(info.samples[0].begin, 0u);
+  EXPECT_GT(k, 0u);
+  EXPECT_LT(k, 16000000u);
+  EXPECT_EQ(info.requested, (std::vector<lucent::SampleRange>{{0, 16000000}}));
+  EXPECT_NE(text.find("lucent: " + part + " holds samples [0, " + std::to_string(k) +
+                      ") of [0, 16000000)"),
+            std::string::npos)
+      << text;
+  // the rest of the range, in part: the merge says what is still missing
+  std::string rest = dir + "/rest.exr", out = dir + "/merged.exr";
+  const std::string range = std::to_string(k) + ":" + std::to_string(k + 5);
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples " + range + " -o " + q(rest)).status, 0);
+  CommandResult r = run_cli("merge " + q(part) + " " + q(rest) + " -o " + q(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(
+      r.err.find("lucent: warning: samples [" + std::to_string(k + 5) + ", 16000000) are missing"),
+      std::string::npos)
+      << r.err;
+  lucent::RenderPart merged = lucent::read_render_part(out);
+  EXPECT_EQ(merged.info.samples, (std::vector<lucent::SampleRange>{{0, k + 5}}));
+  EXPECT_EQ(*std::min_element(merged.acc.count.begin(), merged.acc.count.end()), k + 5);
+}
+
+// scripts/slurm: submit.sh submits the array of render-part.sbatch tasks and the merge.sbatch
+// that depends on them; here tests/slurm/sbatch stands in for Slurm and runs them in order.
+TEST(Parts, SlurmArrayScriptsRenderAndMerge) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  const std::string out = dir + "/merged.exr", log = dir + "/jobs.log";
+  const std::string cmd = "PATH=" + q(lucent::test::source_path("tests/slurm")) +
+                          ":\"$PATH\" LUCENT=" + q(LUCENT_CLI_PATH) + " FAKE_SBATCH_LOG=" + q(log) +
+                          " bash " + q(lucent::test::source_path("scripts/slurm/submit.sh")) + " " +
+                          q(scene) + " 8 3 " + q(dir + "/parts") + " " + q(out) + " -q >" +
+                          q(dir + "/submit.out") + " 2>" + q(dir + "/submit.err");
+  int raw = std::system(cmd.c_str());
+  const std::string err = lucent::test::read_file(dir + "/submit.err");
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << err;
+  EXPECT_NE(lucent::test::read_file(dir + "/submit.out").find("(3 tasks), merge job"),
+            std::string::npos);
+  // three tasks of [0, 2), [2, 5), [5, 8), then the merge, all successful
+  const std::string jobs = lucent::test::read_file(log);
+  EXPECT_EQ(lucent::test::count_lines(jobs), 4) << jobs;
+  size_t ok = 0;
+  for (size_t at = jobs.find(": exit 0\n"); at != std::string::npos;
+       at = jobs.find(": exit 0\n", at + 1))
+    ++ok;
+  EXPECT_EQ(ok, 4u) << jobs;
+  EXPECT_EQ(lucent::read_part_info(dir + "/parts/part-0001.exr").samples,
+            (std::vector<lucent::SampleRange>{{2, 5}}));
+  EXPECT_NE(err.find("samples [0, 8)"), std::string::npos) << err;
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:8 -o " + q(dir + "/one.exr")).status,
+            0);
+  lucent::RenderPart merged = lucent::read_render_part(out);
+  EXPECT_EQ(merged.info.samples, (std::vector<lucent::SampleRange>{{0, 8}}));
+  EXPECT_LT(max_relative_difference(merged.acc, lucent::read_render_part(dir + "/one.exr").acc),
+            1e-5);
+}
+
+#ifdef LUCENT_MPI_PATH
+/// mpirun with the settings a test needs: root allowed (containers), no CMA single copy (ptrace
+/// is often restricted in containers), oversubscription of the 2-core machine.
+std::string mpirun(const std::string& args) {
+  return std::string(
+             "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+             "OMPI_MCA_btl_vader_single_copy_mechanism=none '") +
+         LUCENT_MPIEXEC + "' --oversubscribe " + args;
+}
+
+bool have_mpirun() { return fs::exists(LUCENT_MPIEXEC); }
+
+CommandResult run_shell(const std::string& cmd, const std::string& dir) {
+  int raw =
+      std::system((cmd + " </dev/null >" + q(dir + "/out") + " 2>" + q(dir + "/err")).c_str());
+  CommandResult r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+  r.out = lucent::test::read_file(dir + "/out");
+  r.err = lucent::test::read_file(dir + "/err");
+  return r;
+}
+
+TEST(Parts, MpiTwoRanksRenderTheOneProcessImage) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  CommandResult r = run_shell(mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) +
+                                     " --spp 8 -o " + q(dir + "/mpi.exr")),
+                              dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("samples [0, 8) from 2 ranks"), std::string::npos) << r.err;
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:8 -o " + q(dir + "/one.exr")).status,
+            0);
+  lucent::RenderPart mpi = lucent::read_render_part(dir + "/mpi.exr");
+  lucent::RenderPart one = lucent::read_render_part(dir + "/one.exr");
+  EXPECT_EQ(mpi.info.scene_hash, one.info.scene_hash);
+  EXPECT_EQ(mpi.info.samples, (std::vector<lucent::SampleRange>{{0, 8}}));
+  EXPECT_LT(max_relative_difference(mpi.acc, one.acc), 1e-5);
+}
+
+TEST(Parts, MpiFailingRankEndsTheJobWithoutOutput) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  const std::string out = dir + "/mpi.exr";
+  const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " -o " + q(out);
+  // rank 1 asks for a device this machine does not have
+  CommandResult r =
+      run_shell(mpirun("-np 1 " + prog + " : -np 1 -x LUCENT_DEVICE=no-such-device " + prog), dir);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("lucent-mpi: error: rank 1 of 2 ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no-such-device"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& entry : fs::directory_iterator(dir))
+    EXPECT_EQ(entry.path().filename().string().find("mpi.exr"), std::string::npos)
+        << "a temporary output was left: " << entry.path();
+}
+#else
+TEST(Parts, MpiTwoRanksRenderTheOneProcessImage) {
+  GTEST_SKIP() << "lucent-mpi is not built (no MPI found; see LUCENT_MPI)";
+}
+#endif
+
+}  // namespace
