@@ -3,7 +3,7 @@
 # With LUCENT_SANITIZE=1 (CI sets it) the suite then runs again on an AddressSanitizer +
 # UndefinedBehaviorSanitizer build in build-asan/, and, when clang with libFuzzer is installed
 # (scripts/install-deps.sh --with-fuzz), each fuzz target runs for LUCENT_FUZZ_SECONDS (default
-# 30; 0 skips it) in build-fuzz/ (scripts/fuzz.sh).
+# 20; 0 skips it) in build-fuzz/ (scripts/fuzz.sh).
 #
 # Sized for a slow, shared machine (docs/testing.md): as many builds and tests at a time as there
 # are CPUs this process may really use (scripts/cpus.sh: the affinity mask and the cgroup CPU
@@ -46,7 +46,8 @@ if [[ "${LUCENT_SANITIZE:-0}" == "1" ]]; then
     timed "sanitizer tests" ctest --test-dir build-asan --output-on-failure -j"$jobs"
 fi
 
-if [[ "${LUCENT_SANITIZE:-0}" == "1" && "${LUCENT_FUZZ_SECONDS:-30}" != "0" ]]; then
-  echo "test: fuzz smoke run (${LUCENT_FUZZ_SECONDS:-30} s per target)"
-  FUZZ_JOBS="$jobs" scripts/fuzz.sh --if-available "${LUCENT_FUZZ_SECONDS:-30}"
+if [[ "${LUCENT_SANITIZE:-0}" == "1" && "${LUCENT_FUZZ_SECONDS:-20}" != "0" ]]; then
+  echo "test: fuzz smoke run (${LUCENT_FUZZ_SECONDS:-20} s per target)"
+  export FUZZ_JOBS="$jobs"
+  timed "fuzz smoke run" scripts/fuzz.sh --if-available "${LUCENT_FUZZ_SECONDS:-20}"
 fi
