@@ -171,6 +171,24 @@ TEST(Session, ResetStartsAtASampleIndex) {
   }
 }
 
+// Sample indices are 32-bit in the sampler: a render that would go past 2^32 is refused (its
+// samples would repeat those of index 0 on), one that ends there is rendered, and a render by
+// time stops there.
+TEST(Session, SampleIndicesStopAt2To32) {
+  Renderer r = session();
+  r.set_scene(lucent::test::scene_from(kScene));
+  const std::uint64_t end = std::uint64_t(1) << 32;
+  r.reset(end - 4);
+  EXPECT_THROW(r.render(5), lucent::Error);
+  EXPECT_EQ(r.spp(), 0u) << "nothing rendered";
+  r.render(3);
+  EXPECT_EQ(r.spp(), 3u);
+  lucent::RenderProgress p = r.render_for(5.0);
+  EXPECT_EQ(p.samples_done, 1u) << "stops at 2^32";
+  EXPECT_EQ(r.spp(), 4u);
+  EXPECT_THROW(r.render(1), lucent::Error);
+}
+
 TEST(Session, RenderForRendersAtLeastOnePass) {
   Renderer r = session();
   r.set_scene(lucent::test::scene_from(kScene));

@@ -471,9 +471,17 @@ struct Renderer::Impl {
     CallState cs;
     std::uint64_t started = 0, finished = 0;  // samples per pixel of this call
     const std::uint64_t start_index = first + done;
+    // the sampler takes 32-bit sample indices: past 2^32 samples would repeat
+    const std::uint64_t index_end = std::uint64_t(1) << 32;
+    if (start_index >= index_end || (target_spp > 0 && target_spp > index_end - start_index))
+      throw Error("render: sample indices [" + std::to_string(start_index) + ", " +
+                  std::to_string(start_index + (target_spp > 0 ? target_spp : 1)) +
+                  ") go past 2^32, the sampler's range (samples would repeat)");
     auto next = [&](Worker& w, Job& job) {
       if (target_spp > 0 && started >= target_spp) return false;
-      job.n = w.pass_spp;
+      if (start_index + started >= index_end) return false;  // a time-limited render stops there
+      job.n = static_cast<std::uint32_t>(
+          std::min<std::uint64_t>(w.pass_spp, index_end - start_index - started));
       if (target_spp > 0)
         job.n = static_cast<std::uint32_t>(std::min<std::uint64_t>(job.n, target_spp - started));
       job.begin = start_index + started;
