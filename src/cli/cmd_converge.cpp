@@ -70,12 +70,6 @@ void check_writable(const std::string& path, const std::string& scene) {
   if (!existed) std::filesystem::remove(path, ec);
 }
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 void write_text(const std::string& path, const std::string& text) {
   io::write_file_atomic(path, text);  // checked to the last byte, never left half-written
 }
@@ -158,7 +152,7 @@ int run_converge_command() {
   ConvergeArgs& a = args();
   if (!a.csv.empty()) check_writable(a.csv, a.scene);
   for (const std::string& plot : a.plots) {
-    std::string ext = lower_extension(plot);
+    std::string ext = io::lower_extension(plot);
     if (ext != ".svg" && ext != ".png")
       throw Error(plot + ": unknown plot format '" + ext + "' (use .svg or .png)");
     check_writable(plot, a.scene);
@@ -256,7 +250,7 @@ int run_converge_command() {
                             std::to_string(scene.film.width) + "x" +
                             std::to_string(scene.film.height) + ": relMSE against render time";
   for (const std::string& plot : a.plots) {
-    if (lower_extension(plot) == ".png")
+    if (io::lower_extension(plot) == ".png")
       write_image(plot, convergence_image(result, title));
     else
       write_text(plot, convergence_svg(result, title));

@@ -82,38 +82,6 @@ std::string device_shares(const std::vector<lucent::DeviceShare>& devices) {
   return out + "]";
 }
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
-/// Fails early (before rendering) when `out` cannot be written: not an image format lucent
-/// writes, a directory, a directory that does not exist or cannot be written to (tested by
-/// creating a file there, as the final write does), a read-only file, or one of the inputs.
-void check_output_path(const std::string& out, const std::vector<std::string>& inputs) {
-  namespace fs = std::filesystem;
-  if (out.empty()) throw lucent::Error("-o: the output path is empty");
-  std::string ext = lower_extension(out);
-  if (ext != ".png" && ext != ".pfm" && ext != ".exr")
-    throw lucent::Error(out + ": unknown output format '" + ext + "' (use .png, .pfm or .exr)");
-  std::error_code ec;
-  if (fs::is_directory(out, ec)) throw lucent::Error(out + ": is a directory");
-  for (const std::string& in : inputs)
-    if (lucent::io::same_file(out, in))
-      throw lucent::Error(out + ": is an input of this render (" + in +
-                          "); refusing to overwrite it");
-  if (fs::exists(out, ec) && ::access(out.c_str(), W_OK) != 0)
-    throw lucent::Error(out + ": cannot write output (" + std::strerror(errno) + ")");
-  fs::path dir = fs::path(out).parent_path();
-  std::string probe = (dir.empty() ? fs::path(".") : dir).string() + "/.lucent-write-test-" +
-                      std::to_string(::getpid());
-  int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) throw lucent::Error(out + ": cannot write output (" + std::strerror(errno) + ")");
-  ::close(fd);
-  ::unlink(probe.c_str());
-}
-
 struct RenderArgs {
   std::string scene;
   std::string output;
@@ -202,12 +170,12 @@ int render_with(const RenderArgs& a) {
     if (a.spp > 0) throw lucent::Error("--samples and --spp cannot be combined");
     if (a.reference || !a.aovs.empty() || a.sampling.target_error > 0)
       throw lucent::Error("--samples is not supported with --reference, --aov or --target-error");
-    if (lower_extension(a.output) != ".exr")
+    if (lucent::io::lower_extension(a.output) != ".exr")
       throw lucent::Error(a.output + ": --samples writes a part file: use an .exr output");
   }
-  check_output_path(a.output, {a.scene});
+  lucent::io::check_output_path(a.output, {a.scene});
   for (const std::string& name : a.aovs)
-    check_output_path(aov_path(a.output, name), {a.scene, a.output});
+    lucent::io::check_output_path(aov_path(a.output, name), {a.scene, a.output});
   // from here on a stop signal lets the render end its pass and write what it has
   for (int sig : kStopSignals) std::signal(sig, on_stop_signal);
   std::signal(SIGPIPE, SIG_IGN);  // a closed stderr pipe must not cost the image
@@ -216,8 +184,9 @@ int render_with(const RenderArgs& a) {
     // the images the scene reads are inputs too
     std::vector<std::string> inputs{a.scene};
     for (const lucent::Texture& t : scene.textures) inputs.push_back(t.path);
-    check_output_path(a.output, inputs);
-    for (const std::string& name : a.aovs) check_output_path(aov_path(a.output, name), inputs);
+    lucent::io::check_output_path(a.output, inputs);
+    for (const std::string& name : a.aovs)
+      lucent::io::check_output_path(aov_path(a.output, name), inputs);
   }
   if (g_interrupted.load()) {
     std::fprintf(stderr, "lucent: interrupted by %s before rendering: nothing written\n",
@@ -295,7 +264,7 @@ int render_with(const RenderArgs& a) {
                                   scene.film.tonemap};
   if (range)
     lucent::write_render_part(a.output, lucent::make_part(*renderer, *range, a.scene));
-  else if (lower_extension(a.output) == ".exr")
+  else if (lucent::io::lower_extension(a.output) == ".exr")
     lucent::write_render_exr(a.output, r);  // with var.R/G/B and n layers (docs/compare.md)
   else
     lucent::write_image(a.output, r.mean, display);

@@ -120,6 +120,33 @@ std::string read_file(const std::string& path, const ReadSpec& spec) {
   return out;
 }
 
+std::string lower_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+void check_output_path(const std::string& out, const std::vector<std::string>& inputs) {
+  if (out.empty()) throw Error("-o: the output path is empty");
+  std::string ext = lower_extension(out);
+  if (ext != ".png" && ext != ".pfm" && ext != ".exr")
+    throw Error(out + ": unknown output format '" + ext + "' (use .png, .pfm or .exr)");
+  std::error_code ec;
+  if (fs::is_directory(out, ec)) throw Error(out + ": is a directory");
+  for (const std::string& in : inputs)
+    if (same_file(out, in))
+      throw Error(out + ": is an input of this render (" + in + "); refusing to overwrite it");
+  if (fs::exists(out, ec) && ::access(out.c_str(), W_OK) != 0)
+    throw Error(out + ": cannot write output (" + std::strerror(errno) + ")");
+  fs::path dir = fs::path(out).parent_path();
+  std::string probe = (dir.empty() ? fs::path(".") : dir).string() + "/.lucent-write-test-" +
+                      std::to_string(::getpid());
+  int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) throw Error(out + ": cannot write output (" + std::strerror(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
 bool same_file(const std::string& a, const std::string& b) {
   std::error_code ec;
   if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec) && !ec;

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace lucent::io {
 
@@ -41,6 +42,15 @@ void write_all(int fd, const void* data, std::size_t size, const std::string& pa
 /// Whether `a` and `b` name the same file: the same file when both exist (symbolic and hard
 /// links included), else the same path once made canonical.
 bool same_file(const std::string& a, const std::string& b);
+
+/// The extension of `path` with its dot, lower-cased: ".exr", ".png", "" when none.
+std::string lower_extension(const std::string& path);
+
+/// Fails early (before rendering) when `out` cannot be written as an image: not a format lucent
+/// writes (.png, .pfm, .exr), a directory, a directory that does not exist or cannot be written
+/// to (tested by creating a file there, as the final write does), a read-only file, or one of
+/// `inputs` ("<out>: is an input of this render (<input>); refusing to overwrite it").
+void check_output_path(const std::string& out, const std::vector<std::string>& inputs);
 
 /// "1.5 GiB", "256 MiB", "12 KiB", "7 bytes": a size for messages.
 std::string format_size(std::uint64_t bytes);

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/file_io.hpp"
 #include "lucent/limits.hpp"
 #include "lucent/lucent.hpp"
 #include "lucent/parts.hpp"
@@ -117,25 +118,9 @@ lucent::RenderPart receive_part(int from, const lucent::PartInfo& mine) {
   return p;
 }
 
-/// Fails before rendering when OUT cannot be written (format, directory).
-void check_output(const std::string& out, const std::string& scene) {
-  namespace fs = std::filesystem;
-  std::string ext = fs::path(out).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".exr" && ext != ".png" && ext != ".pfm")
-    throw lucent::Error(out + ": unknown output format '" + ext + "' (use .exr, .png or .pfm)");
-  std::error_code ec;
-  if (fs::equivalent(out, scene, ec)) throw lucent::Error(out + ": is the scene file");
-  fs::path dir = fs::path(out).parent_path();
-  if (dir.empty()) dir = ".";
-  if (!fs::is_directory(dir, ec) || ::access(dir.c_str(), W_OK) != 0)
-    throw lucent::Error(out + ": cannot write output (directory " + dir.string() +
-                        " missing or not writable)");
-}
-
 int run(const Args& a) {
   const bool root = g_rank == 0;
-  if (root) check_output(a.output, a.scene);
+  if (root) lucent::io::check_output_path(a.output, {a.scene});
   lucent::Scene scene = lucent::load_scene(a.scene);
   if (a.width > 0) scene.film.width = a.width;
   if (a.height > 0) scene.film.height = a.height;

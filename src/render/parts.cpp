@@ -503,8 +503,7 @@ MergeReport merge_render_parts(const std::vector<std::string>& paths) {
 }
 
 void write_merged(const std::string& path, const RenderPart& part) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = io::lower_extension(path);
   if (ext == ".exr")
     write_render_part(path, part);
   else if (ext == ".png" || ext == ".pfm")
