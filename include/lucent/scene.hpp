@@ -66,6 +66,10 @@ struct Integrator {
   /// path: the largest component a contribution after a scattering may have; larger ones are
   /// scaled down to it (docs/rendering-model.md, "Clamping"). 0: off. Biased when it binds.
   double clamp = 0;
+  /// path: caustic paths (light, one or more delta scatterings, one non-delta vertex seen by the
+  /// camera) come from light tracing instead of the camera path (docs/rendering-model.md,
+  /// "Caustics by light tracing"). Pinhole cameras only.
+  bool caustics = false;
 };
 
 enum class MaterialType { LC_MATERIAL_TYPES(LUCENT_REGISTRY_ENUMERATOR) };

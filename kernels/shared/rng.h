@@ -49,6 +49,11 @@
 #define LC_DIM_BSDF_LOBE 3u    /* choose a lobe (glass, plastic)                      */
 #define LC_DIM_BSDF_UV 4u      /* pair: BSDF direction                                */
 #define LC_DIM_RR 6u           /* pair with an unused number: Russian roulette        */
+/* The light path of a camera sample (integrator.caustics, docs/rendering-model.md): from
+ * LC_DIM_LIGHT_PATH, +0,+1 point on the light, +2 light selection, +4,+5 emitted direction; then
+ * 8 per scattering vertex i = 1, 2, ... from LC_DIM_LIGHT_PATH + 8 i with the offsets above
+ * (+3 lobe, +4,+5 BSDF direction, +6 Russian roulette). */
+#define LC_DIM_LIGHT_PATH 0x20000000u
 
 /* pcg4d: hashes four 32-bit words into four, in place. */
 LC_RNG_FN void lc_pcg4d(lc_uint v[4]) {

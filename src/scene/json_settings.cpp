@@ -50,9 +50,9 @@ void parse_film(const JsonReader& r, const json& j, SceneBuilder& b) {
 
 void parse_integrator(const JsonReader& r, const json& j, SceneBuilder& b) {
   const std::string p = "/integrator";
-  r.check_keys(
-      j, p,
-      {"type", "max_depth", "rr_depth", "spp", "seed", "ao_distance", "mis", "sampler", "clamp"});
+  r.check_keys(j, p,
+               {"type", "max_depth", "rr_depth", "spp", "seed", "ao_distance", "mis", "sampler",
+                "clamp", "caustics"});
   Integrator in = b.scene().integrator;
   if (j.contains("type")) in.type = r.type<IntegratorType>(j["type"], p + "/type");
   if (j.contains("max_depth"))
@@ -66,6 +66,7 @@ void parse_integrator(const JsonReader& r, const json& j, SceneBuilder& b) {
   if (j.contains("ao_distance")) in.ao_distance = r.number(j["ao_distance"], p + "/ao_distance");
   if (j.contains("sampler")) in.sampler = r.type<SamplerType>(j["sampler"], p + "/sampler");
   if (j.contains("clamp")) in.clamp = r.number(j["clamp"], p + "/clamp");
+  if (j.contains("caustics")) in.caustics = r.boolean(j["caustics"], p + "/caustics");
   b.set_integrator(in);
 }
 
