@@ -1,17 +1,21 @@
 // The reference integrator's render loop: rows shared out to threads, every camera sample of a
 // pixel taken in order, Welford's running mean and variance per pixel, non-finite samples counted
 // and left out. The integrators are in integrator/, the camera in camera/, the scene's geometry,
-// lights and BSDFs in geometry/, light/ and bsdf/.
+// lights and BSDFs in geometry/, light/ and bsdf/. With integrator.caustics (path integrator),
+// each row's camera samples are followed by their light paths (integrator/light_tracer.cpp), whose
+// contributions each thread sums, with their squares, in its own buffers.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <thread>
 
 #include "lucent/error.hpp"
 #include "lucent/reference.hpp"
 #include "reference/camera/camera.hpp"
 #include "reference/integrator/integrator.hpp"
+#include "reference/integrator/light_tracer.hpp"
 
 namespace lucent {
 
@@ -23,17 +27,33 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
   auto t0 = std::chrono::steady_clock::now();
   const ref::Tracer tracer(scene);
   const ref::CameraModel camera(scene);
+  const bool caustics = scene.integrator.caustics && scene.integrator.type == IntegratorType::Path;
+  std::unique_ptr<ref::LightTracer> light_tracer;
+  if (caustics) light_tracer = std::make_unique<ref::LightTracer>(tracer, camera);
 
   const size_t npix = static_cast<size_t>(W) * H;
   std::vector<double> mean(npix * 3, 0.0), m2(npix * 3, 0.0);
   std::vector<std::uint32_t> count(npix, 0);
   std::atomic<int> next_row{0};
-  std::atomic<std::uint64_t> nonfinite{0}, rays{0};
+  std::atomic<std::uint64_t> nonfinite{0}, rays{0}, light_paths{0};
   std::atomic<bool> cancelled{false};
+  int threads = options.threads > 0
+                    ? options.threads
+                    : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  threads = std::min(threads, H);
+  // per thread: the sum and the sum of squares of the light paths' contributions per pixel and
+  // channel (a light path gives a pixel at most one contribution c_jp)
+  std::vector<std::vector<double>> light_sum(caustics ? threads : 0),
+      light_sq(caustics ? threads : 0);
 
-  auto worker = [&]() {
+  auto worker = [&](int thread) {
     ref::reset_ray_count();
-    std::uint64_t my_nonfinite = 0;
+    std::uint64_t my_nonfinite = 0, my_paths = 0;
+    std::vector<ref::Splat> splats;
+    if (caustics) {
+      light_sum[thread].assign(npix * 3, 0.0);
+      light_sq[thread].assign(npix * 3, 0.0);
+    }
     for (int y; (y = next_row.fetch_add(1)) < H;) {
       if (options.cancel && options.cancel->load()) {
         cancelled = true;
@@ -58,27 +78,61 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
           }
         }
       }
+      if (!caustics) continue;
+      // the row's light paths: one per camera sample, with that sample's random numbers
+      for (int x = 0; x < W; ++x)
+        for (int k = 0; k < spp; ++k) {
+          ref::Sampler rng{static_cast<std::uint32_t>(static_cast<size_t>(y) * W + x),
+                           static_cast<std::uint32_t>(k), scene.integrator.seed,
+                           scene.integrator.sampler};
+          splats.clear();
+          light_tracer->trace(rng, splats);
+          ++my_paths;
+          for (const ref::Splat& sp : splats) {
+            if (!ref::finite(sp.c)) {
+              ++my_nonfinite;
+              continue;
+            }
+            for (int c = 0; c < 3; ++c) {
+              light_sum[thread][sp.pixel * 3 + c] += sp.c[c];
+              light_sq[thread][sp.pixel * 3 + c] += sp.c[c] * sp.c[c];
+            }
+          }
+        }
     }
     rays += ref::ray_count();
     nonfinite += my_nonfinite;
+    light_paths += my_paths;
   };
-  int threads = options.threads > 0
-                    ? options.threads
-                    : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  threads = std::min(threads, H);
   std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker, t);
+  worker(0);
   for (auto& t : pool) t.join();
+
+  // light tracing: pixel value = camera mean + sum_c / N; the variance of one camera sample gets
+  // n times the light paths' variance of their mean, (sum c^2 / N - (sum c / N)^2) / (N - 1), so
+  // that variance / n stays the variance of the pixel's mean. N counts the light paths traced
+  // (all N = W H spp unless cancelled); pixels without camera samples stay empty.
+  const double N = static_cast<double>(light_paths);
+  for (size_t t = 1; t < light_sum.size(); ++t)
+    for (size_t j = 0; j < npix * 3; ++j) {
+      light_sum[0][j] += light_sum[t][j];
+      light_sq[0][j] += light_sq[t][j];
+    }
 
   RenderResult r;
   r.mean = Image{W, H, std::vector<float>(npix * 3)};
   r.variance = Image{W, H, std::vector<float>(npix * 3)};
   for (size_t i = 0; i < npix; ++i)
     for (int c = 0; c < 3; ++c) {
-      r.mean.rgb[i * 3 + c] = static_cast<float>(mean[i * 3 + c]);
-      r.variance.rgb[i * 3 + c] =
-          static_cast<float>(count[i] > 1 ? m2[i * 3 + c] / (count[i] - 1) : 0.0);
+      double m = mean[i * 3 + c], var = count[i] > 1 ? m2[i * 3 + c] / (count[i] - 1) : 0.0;
+      if (caustics && N > 0 && count[i] > 0) {
+        const double lm = light_sum[0][i * 3 + c] / N;
+        m += lm;
+        if (N > 1) var += count[i] * std::max(0.0, light_sq[0][i * 3 + c] / N - lm * lm) / (N - 1);
+      }
+      r.mean.rgb[i * 3 + c] = static_cast<float>(m);
+      r.variance.rgb[i * 3 + c] = static_cast<float>(var);
     }
   r.samples = std::move(count);
   r.spp = static_cast<std::uint64_t>(spp);

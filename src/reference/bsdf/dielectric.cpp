@@ -31,6 +31,7 @@ class Dielectric final : public Bsdf {
     } else {  // refract with probability 1 - F: weight tint / eta^2
       s.wi = refract(wo, n_, co, eta_);
       s.weight = tint_ / (eta_ * eta_);
+      s.eta = eta_;
     }
     return s;
   }

@@ -39,4 +39,18 @@ Ray CameraModel::ray(int x, int y, const Sampler& rng) const {
   return ray;
 }
 
+bool CameraModel::project(const dvec3& x, dvec2& film, double& cos_c) const {
+  dvec3 v = x - pos_;
+  double len = glm::length(v);
+  if (!(len > 0)) return false;
+  cos_c = glm::dot(v, fwd_) / len;
+  if (!(cos_c > 0)) return false;
+  // the pinhole direction is normalize(fwd + ndc_x right + ndc_y up): scale v to fwd . v = 1
+  double ndc_x = glm::dot(v, right_) / glm::dot(v, fwd_);
+  double ndc_y = glm::dot(v, up_) / glm::dot(v, fwd_);
+  film.x = (ndc_x / (tan_half_ * aspect_) + 1) * width_ / 2;
+  film.y = (1 - ndc_y / tan_half_) * height_ / 2;
+  return true;
+}
+
 }  // namespace lucent::ref

@@ -8,12 +8,27 @@ namespace lucent::ref {
 
 /// Offset of a sample from its pixel's centre, in pixels, drawn from the film's filter.
 dvec2 filter_offset(const Filter& filter, const Sampler& rng);
+/// The normalized density (per pixel^2) with which filter_offset draws `offset`: what light
+/// tracing weighs a film position by, for each pixel whose centre is within the filter's radius.
+double filter_density(const Filter& filter, dvec2 offset);
 
 class CameraModel {
  public:
   explicit CameraModel(const Scene& scene);
   /// The ray of one camera sample of pixel (x, y), (0, 0) the top-left one.
   Ray ray(int x, int y, const Sampler& rng) const;
+
+  /// Light tracing: the film position (fx, fy), in pixels, of the pinhole ray through world
+  /// point x, and cos_c = forward . (x - position) / |x - position|; false when x is not in
+  /// front of the camera (cos_c <= 0).
+  bool project(const dvec3& x, dvec2& film, double& cos_c) const;
+  const dvec3& position() const { return pos_; }
+  /// s = 2 tan(fov / 2) / H: the side of a pixel on the plane at distance 1.
+  double pixel_pitch() const { return 2 * tan_half_ / height_; }
+  bool thin_lens() const { return lens_ > 0; }
+  const Filter& filter() const { return filter_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
 
  private:
   Filter filter_;

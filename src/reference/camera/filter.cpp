@@ -34,7 +34,38 @@ dvec2 filter_gaussian(double r, const Sampler& rng) {
   return dvec2(0.0);  // (0.011)^64: never
 }
 
+/// The densities of the three filters (docs/rendering-model.md, "Camera and film"), each written
+/// next to its sampling above.
+double density_box(double r, dvec2 o) {
+  return std::abs(o.x) <= r && std::abs(o.y) <= r ? 1 / (4 * r * r) : 0;
+}
+
+double density_tent(double r, dvec2 o) {
+  auto d = [r](double t) { return std::abs(t) <= r ? (r - std::abs(t)) / (r * r) : 0.0; };
+  return d(o.x) * d(o.y);
+}
+
+/// exp(-rho^2 / (2 sigma^2)) on the disk rho <= r, over its integral there,
+/// 2 pi sigma^2 (1 - exp(-r^2 / (2 sigma^2))).
+double density_gaussian(double r, dvec2 o) {
+  double sigma = r / 3, rho2 = glm::dot(o, o);
+  if (rho2 > r * r) return 0;
+  double k = 1 / (2 * sigma * sigma);
+  return std::exp(-rho2 * k) / (2 * kPi * sigma * sigma * (1 - std::exp(-r * r * k)));
+}
+
 }  // namespace
+
+double filter_density(const Filter& filter, dvec2 offset) {
+  switch (filter.type) {
+#define LUCENT_REF_FILTER_DENSITY(ID, Name, value, name, feature, file, ...) \
+  case FilterType::Name:                                                     \
+    return density_##file(filter.radius, offset);
+    LC_FILTER_TYPES(LUCENT_REF_FILTER_DENSITY)
+#undef LUCENT_REF_FILTER_DENSITY
+  }
+  return 0;
+}
 
 dvec2 filter_offset(const Filter& filter, const Sampler& rng) {
   switch (filter.type) {

@@ -14,9 +14,9 @@ thread_local std::uint64_t t_rays = 0;
 std::uint64_t ray_count() { return t_rays; }
 void reset_ray_count() { t_rays = 0; }
 
-bool Tracer::trace(const Ray& r, Hit& h) const {
+bool Tracer::trace(const Ray& r, Hit& h, int skip) const {
   ++t_rays;
-  return world.intersect(r, kInf, h);
+  return world.intersect(r, kInf, h, skip);
 }
 
 bool Tracer::blocked(const Ray& r, double tmax, int skip) const {

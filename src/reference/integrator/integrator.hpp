@@ -24,7 +24,8 @@ class Tracer {
   World world;
   Lights lights;
 
-  bool trace(const Ray& r, Hit& h) const;
+  /// Closest hit, ignoring primitive `skip` (if >= 0).
+  bool trace(const Ray& r, Hit& h, int skip = -1) const;
   bool blocked(const Ray& r, double tmax, int skip = -1) const;
   Surface surface(const Ray& r, const Hit& h) const { return world.surface(r, h); }
 

@@ -1,7 +1,8 @@
 // path: unidirectional path tracing with next-event estimation at every non-delta vertex, one
 // light chosen uniformly, and multiple importance sampling (power heuristic) between light and
 // BSDF sampling. Expected value: the rendering equation truncated at max_depth segments (with
-// integrator.clamp, the expectation of the clamped estimator: docs/rendering-model.md).
+// integrator.clamp, the expectation of the clamped estimator: docs/rendering-model.md). With
+// integrator.caustics, without the caustic paths E X S+ L that the light tracer renders.
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -53,6 +54,10 @@ dvec3 integrator_path(const Tracer& t, const Ray& camera_ray, const Sampler& rng
   dvec3 L(0.0), beta(1.0);
   double prev_pdf = 0;     // BSDF pdf of the previous direction
   bool prev_delta = true;  // camera rays and delta bounces: no MIS on what they hit
+  // integrator.caustics: the lobe sampled at the first hit was not delta and every one since was
+  // delta, so an emitter found now (segment >= 3) closes a caustic path E X S+ L, which the
+  // light tracer renders (integrator/light_tracer.cpp)
+  bool caustic = false;
   for (int depth = 0;; ++depth) {
     Hit hit;
     if (!t.trace(ray, hit)) {
@@ -64,7 +69,7 @@ dvec3 integrator_path(const Tracer& t, const Ray& camera_ray, const Sampler& rng
     }
     Surface s = t.surface(ray, hit);
     dvec3 Le = t.emitted(s);
-    if (max3(Le) > 0) {
+    if (max3(Le) > 0 && !(caustic && depth >= 2)) {
       double w = 1;
       if (!prev_delta)
         w = power_heuristic(prev_pdf,
@@ -82,6 +87,7 @@ dvec3 integrator_path(const Tracer& t, const Ray& camera_ray, const Sampler& rng
     beta *= bs.weight;
     prev_pdf = bs.pdf;
     prev_delta = bs.delta;
+    caustic = depth == 0 ? in.caustics && !bs.delta : caustic && bs.delta;
     ray = Tracer::spawn(s, bs.wi);
     // Russian roulette once the path has rr_depth segments: while the largest component of the
     // throughput is below 1 the path survives with that probability and the throughput is

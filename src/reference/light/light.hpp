@@ -30,6 +30,15 @@ struct LightSample {
   bool valid = false;       ///< false when the sampled point does not face the shading point
 };
 
+/// Light leaving a light, drawn by Light::emit (light tracing, integrator.caustics).
+struct LightEmission {
+  dvec3 y{0.0};     ///< the point y0 the light leaves from
+  dvec3 d{0.0};     ///< unit direction of the emitted ray
+  dvec3 beta{0.0};  ///< Le |cos| / (p_select p_A p_w); point lights I / (p_select p_w)
+  int skip = -1;    ///< primitive the emitted ray ignores: the area light's own
+  bool valid = false;
+};
+
 class Light {
  public:
   virtual ~Light() = default;
@@ -44,6 +53,10 @@ class Light {
   virtual double pdf(const dvec3& wi, double dist, double cos_l) const = 0;
   /// Environments: radiance arriving from direction -d (escaping along d); others: 0.
   virtual dvec3 radiance(const dvec3&) const { return dvec3(0.0); }
+  /// A point and a direction of light leaving the light (docs/rendering-model.md, "Caustics by
+  /// light tracing"), from two pairs of numbers; beta includes the selection probability (1 /
+  /// size). Environments are no light-tracing source: invalid.
+  virtual LightEmission emit(double, double, double, double) const { return LightEmission{}; }
 };
 
 /// Environments, sampled uniformly over the sphere whatever their radiance; env.cpp and
@@ -67,6 +80,9 @@ class AreaLight : public Light {
   AreaLight(const World& world, int prim, double nlights);
   LightSample sample(const dvec3& p, double u1, double u2) const override;
   double pdf(const dvec3& wi, double dist, double cos_l) const override;
+  /// A uniform point of the area (sample_point) and a cosine-distributed direction about its
+  /// front normal: beta = Le cos / (1 / size * 1 / area * cos / pi) = Le pi area size.
+  LightEmission emit(double u1, double u2, double u3, double u4) const override;
 
  protected:
   const World& world_;
@@ -90,6 +106,9 @@ class Lights {
 
   /// Chooses a light uniformly with u_select, then a direction from p towards it.
   LightSample sample(const dvec3& p, double u_select, double u1, double u2) const;
+  /// Light tracing: chooses a light uniformly with u_select, then light leaving it (beta
+  /// includes the selection probability 1 / size).
+  LightEmission emit(double u_select, double u1, double u2, double u3, double u4) const;
   /// The environment, or null.
   const Light* environment() const { return env_; }
   /// The area light of primitive `prim`, or null.

@@ -1,5 +1,6 @@
 // The reference's light list and light-type dispatch (generated from LC_LIGHT_TYPES), and the
-// sampling shared by the environments (uniform directions) and by area lights (uniform points).
+// sampling shared by the environments (uniform directions) and by area lights (uniform points;
+// light tracing: a uniform point and a cosine direction about its front normal).
 #include <string>
 
 #include "lucent/error.hpp"
@@ -54,6 +55,13 @@ LightSample Lights::sample(const dvec3& p, double u_select, double u1, double u2
   return ls;
 }
 
+LightEmission Lights::emit(double u_select, double u1, double u2, double u3, double u4) const {
+  if (lights_.empty()) return LightEmission{};
+  const double n = static_cast<double>(lights_.size());
+  int i = static_cast<int>(std::min(lights_.size() - 1, static_cast<size_t>(u_select * n)));
+  return lights_[i]->emit(u1, u2, u3, u4);
+}
+
 // ------------------------------------------------------------------------------------------
 // environments: a uniform direction on the sphere
 
@@ -98,6 +106,20 @@ LightSample AreaLight::sample(const dvec3& p, double u1, double u2) const {
   ls.pdf = pdf(ls.wi, ls.dist, cos_l);
   ls.valid = true;
   return ls;
+}
+
+LightEmission AreaLight::emit(double u1, double u2, double u3, double u4) const {
+  LightEmission e;
+  dvec3 ny;
+  sample_point(u1, u2, e.y, ny);
+  e.d = cosine_direction(ny, u3, u4);
+  const double cos0 = glm::dot(e.d, ny);
+  if (!(cos0 > 0)) return e;
+  // Le cos0 / (p_select p_A p_w) with p_select = 1 / n, p_A = 1 / area, p_w = cos0 / pi
+  e.beta = emission_ * cos0 / ((1 / nlights_) * (1 / area_) * (cos0 / kPi));
+  e.skip = prim_;  // the emitted ray leaves the primitive's front side: a sphere is convex
+  e.valid = true;
+  return e;
 }
 
 double AreaLight::pdf(const dvec3&, double dist, double cos_l) const {

@@ -29,6 +29,16 @@ class PointLight final : public Light {
 
   double pdf(const dvec3&, double, double) const override { return 0; }
 
+  /// Light tracing: a uniform direction, beta = I / (p_select p_w) = I 4 pi size.
+  LightEmission emit(double, double, double u3, double u4) const override {
+    LightEmission e;
+    e.y = position_;
+    e.d = uniform_sphere(u3, u4);
+    e.beta = intensity_ / ((1 / nlights_) * (1 / (4 * kPi)));
+    e.valid = true;
+    return e;
+  }
+
  private:
   dvec3 position_, intensity_;
   double nlights_;

@@ -1,0 +1,39 @@
+#pragma once
+// Caustics by light tracing (integrator.caustics, docs/rendering-model.md, "Caustics by light
+// tracing"): one light path per camera sample, traced from a light through delta scatterings
+// (mirror, smooth glass) and connected to the pinhole camera at its first non-delta vertex.
+// The path integrator leaves out the same paths (path.cpp), so that the two estimators split path
+// space and their sum estimates the path integrator's image, plus point lights' caustics.
+#include <vector>
+
+#include "reference/camera/camera.hpp"
+#include "reference/integrator/integrator.hpp"
+
+namespace lucent::ref {
+
+/// A light path's contribution c_p to pixel p (index y * W + x).
+struct Splat {
+  int pixel;
+  dvec3 c;
+};
+
+class LightTracer {
+ public:
+  /// Throws lucent::Error for a thin-lens camera, which light tracing cannot reach.
+  LightTracer(const Tracer& tracer, const CameraModel& camera);
+
+  /// The light path of one camera sample (rng: its pixel, sample index and seed; the path draws
+  /// from LC_DIM_LIGHT_PATH on): appends its contributions to `out`, at most one per pixel (a
+  /// path ends at its first non-delta vertex, the only one it connects). Contributions are not
+  /// divided by the number of light paths N; non-finite ones are appended as they are.
+  void trace(const Sampler& rng, std::vector<Splat>& out) const;
+
+ private:
+  const Tracer& t_;
+  const CameraModel& camera_;
+
+  /// Connects vertex `hit` of light ray `ray` (throughput beta arriving there) to the camera.
+  void connect(const Ray& ray, const Hit& hit, const dvec3& beta, std::vector<Splat>& out) const;
+};
+
+}  // namespace lucent::ref

@@ -1,0 +1,299 @@
+// Caustics by light tracing in the reference integrator (integrator.caustics,
+// docs/rendering-model.md, "Caustics by light tracing"), against closed-form answers and against
+// the path integrator alone. Statistical checks: lucent::compare_images (per pixel-channel
+// z = (A - B) / sqrt(var_A / n_A + var_B / n_B + eps^2), Sidak-corrected at family-wise
+// alpha = 0.01, |z| < ~4.5 for 32x24 pixels; 99.5% of the pixels must pass, and the image means
+// per channel must agree, |z| < 2.93), plus, where stated, a z-test of a region's mean.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include "lucent/compare.hpp"
+#include "lucent/error.hpp"
+#include "lucent/reference.hpp"
+#include "support.hpp"
+
+namespace {
+
+using glm::dvec3;
+using lucent::RenderResult;
+
+RenderResult render_ref(const std::string& json, int spp) {
+  lucent::Scene scene = lucent::test::scene_from(json);  // independent sampler
+  lucent::ReferenceOptions o;
+  o.spp = spp;
+  return lucent::render_reference(scene, o);
+}
+
+// A point light of intensity I at (lx, ly, lz) between a diffuse floor z = 0 of albedo a and a
+// mirror ceiling z = 2 (reflectance 1, x, y within +-3, facing down). The camera looks straight
+// down from (0, 0, 1.9), fov 60, at the floor x, y within about +-1.46, +-1.1 (it sees no
+// ceiling). With max_depth 3 the path integrator renders direct light only (its BSDF rays reach
+// the ceiling, never the point light); light tracing adds the light reflected by the ceiling,
+// which is the light of the mirror image (lx, ly, 4 - lz):
+//   L(p) = a / pi * I * (cos1 / d1^2 + cos2 / d2^2).
+// About 5% of the light paths reach the floor that the camera sees through the ceiling, so a
+// render of n samples per pixel has about n / 20 light-path hits per pixel.
+constexpr double kAlbedo = 0.5, kI = 4, kLx = 0.3, kLy = 0.2, kLz = 1.2, kCeiling = 2;
+constexpr int kW = 32, kH = 24;
+const double kTanHalf = std::tan(30 * M_PI / 180);  // fov 60
+const dvec3 kCamera(0, 0, 1.9);
+
+std::string mirror_scene(bool caustics, const std::string& filter) {
+  return std::string(R"({
+    "camera": {"position": [0, 0, 1.9], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 60},
+    "film": {"width": 32, "height": 24, "filter": )") +
+         filter + R"(},
+    "integrator": {"type": "path", "max_depth": 3, "caustics": )" +
+         (caustics ? "true" : "false") + R"(},
+    "materials": {"floor": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
+                  "mirror": {"type": "mirror", "reflectance": [1, 1, 1]}},
+    "shapes": [{"type": "triangles", "material": "floor",
+                "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]],
+                "indices": [0,1,2, 0,2,3]},
+               {"type": "triangles", "material": "mirror",
+                "positions": [[-3,-3,2],[3,-3,2],[3,3,2],[-3,3,2]],
+                "indices": [0,2,1, 0,3,2]}],
+    "lights": [{"type": "point", "position": [0.3, 0.2, 1.2], "intensity": [4, 4, 4]}]
+  })";
+}
+
+/// The floor point that film position (fx, fy) sees, from the model's camera basis (here
+/// forward -z, right +x, up +y).
+glm::dvec2 floor_point(double fx, double fy) {
+  const dvec3 fwd(0, 0, -1), right = glm::normalize(glm::cross(fwd, dvec3(0, 1, 0)));
+  const dvec3 up = glm::cross(right, fwd);
+  double nx = (2 * fx / kW - 1) * kTanHalf * kW / kH, ny = (1 - 2 * fy / kH) * kTanHalf;
+  dvec3 d = fwd + nx * right + ny * up;
+  dvec3 p = kCamera + (kCamera.z / -d.z) * d;  // z = 0
+  return glm::dvec2(p.x, p.y);
+}
+
+/// The floor's radiance at p: direct light, plus the mirror image's when `mirror`. Checks that
+/// the ceiling really reflects there: the ray from p to the image crosses z = 2 inside it.
+double floor_radiance(glm::dvec2 p, bool mirror) {
+  auto term = [&](double lz) {
+    double dx = kLx - p.x, dy = kLy - p.y, d2 = dx * dx + dy * dy + lz * lz;
+    return lz / std::sqrt(d2) / d2;
+  };
+  double e = term(kLz);
+  if (mirror) {
+    const double iz = 2 * kCeiling - kLz;  // the mirror image of the light
+    const double t = kCeiling / iz;
+    const glm::dvec2 q = p + t * (glm::dvec2(kLx, kLy) - p);
+    EXPECT_TRUE(std::abs(q.x) < 3 && std::abs(q.y) < 3) << p.x << " " << p.y;
+    e += term(iz);
+  }
+  return kAlbedo / M_PI * kI * e;
+}
+
+/// Expected image: each pixel the mean of the floor's radiance over the film positions that its
+/// filter draws, by a midpoint rule over [-r, r]^2 weighted by the filter's (unnormalized)
+/// shape `w`, normalized here.
+RenderResult expected_image(const RenderResult& like, bool mirror, double r,
+                            const std::function<double(double, double)>& w) {
+  RenderResult e;
+  e.mean = like.mean;
+  const int n = 24;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      double sum = 0, wsum = 0;
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          double ox = r * (2 * (i + 0.5) / n - 1), oy = r * (2 * (j + 0.5) / n - 1);
+          double wi = w(ox, oy);
+          if (wi <= 0) continue;
+          sum += wi * floor_radiance(floor_point(x + 0.5 + ox, y + 0.5 + oy), mirror);
+          wsum += wi;
+        }
+      for (int c = 0; c < 3; ++c) e.mean.pixel(x, y)[c] = static_cast<float>(sum / wsum);
+    }
+  return e;
+}
+
+double box_shape(double, double) { return 1; }
+
+// Caustics on, box filter: the floor shows the light and its mirror image (a caustic of a point
+// light, which only light tracing finds). Default comparison (see the top of the file); 2048
+// samples per pixel, about 100 light-path hits per pixel.
+TEST(ReferenceCaustics, PointLightMirrorImage) {
+  RenderResult r = render_ref(mirror_scene(true, R"({"type": "box"})"), 2048);
+  lucent::CompareResult c = lucent::compare_images(r, expected_image(r, true, 0.5, box_shape));
+  EXPECT_TRUE(c.passed) << c.summary();
+  EXPECT_EQ(r.nonfinite, 0u);
+}
+
+// Caustics off: the path integrator cannot reach a point light through a mirror, so the floor
+// shows the direct light only; the same render does not match the image with the mirror term,
+// so the test above tests something.
+TEST(ReferenceCaustics, PointLightMirrorImageAbsentWithoutCaustics) {
+  RenderResult r = render_ref(mirror_scene(false, R"({"type": "box"})"), 64);
+  lucent::CompareResult direct =
+      lucent::compare_images(r, expected_image(r, false, 0.5, box_shape));
+  EXPECT_TRUE(direct.passed) << direct.summary();
+  lucent::CompareResult with_mirror =
+      lucent::compare_images(r, expected_image(r, true, 0.5, box_shape));
+  EXPECT_FALSE(with_mirror.passed) << with_mirror.summary();
+}
+
+// The light tracer spreads a connection over every pixel whose filter reaches it, weighted by the
+// filter's normalized density: tent (radius 1) and gaussian (radius 1.5, sigma 0.5, truncated)
+// against the expected image built from their shapes alone. Default comparison.
+TEST(ReferenceCaustics, PointLightMirrorImageFilters) {
+  {
+    SCOPED_TRACE("tent");
+    RenderResult r = render_ref(mirror_scene(true, R"({"type": "tent", "radius": 1})"), 1024);
+    auto tent = [](double x, double y) { return (1 - std::abs(x)) * (1 - std::abs(y)); };
+    lucent::CompareResult c = lucent::compare_images(r, expected_image(r, true, 1, tent));
+    EXPECT_TRUE(c.passed) << c.summary();
+  }
+  {
+    SCOPED_TRACE("gaussian");
+    RenderResult r = render_ref(mirror_scene(true, R"({"type": "gaussian", "radius": 1.5})"), 1024);
+    auto gauss = [](double x, double y) {
+      double r2 = x * x + y * y;
+      return r2 <= 1.5 * 1.5 ? std::exp(-r2 / (2 * 0.5 * 0.5)) : 0.0;
+    };
+    lucent::CompareResult c = lucent::compare_images(r, expected_image(r, true, 1.5, gauss));
+    EXPECT_TRUE(c.passed) << c.summary();
+  }
+}
+
+// A thin-lens camera cannot be reached by light tracing: refused with an error naming the
+// setting.
+TEST(ReferenceCaustics, ThinLensRefused) {
+  std::string scene = mirror_scene(true, R"({"type": "box"})");
+  scene.replace(scene.find(R"("fov": 60)"), 9, R"("fov": 60, "aperture": 0.1)");
+  try {
+    render_ref(scene, 1);
+    FAIL() << "a thin-lens camera with caustics rendered";
+  } catch (const lucent::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("caustics"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("aperture"), std::string::npos) << e.what();
+  }
+}
+
+/// Mean over the pixels x0 <= x < x1, y0 <= y < y1 of channel 1, and the variance of that mean
+/// (the pixels' variance / n summed, over the count squared).
+struct RegionMean {
+  double mean = 0, var = 0;
+};
+RegionMean region_mean(const RenderResult& r, int x0, int x1, int y0, int y1) {
+  RegionMean m;
+  double k = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const size_t i = static_cast<size_t>(y) * r.mean.width + x;
+      m.mean += r.mean.pixel(x, y)[1];
+      m.var += r.variance.pixel(x, y)[1] / r.samples[i];
+      ++k;
+    }
+  m.mean /= k;
+  m.var /= k * k;
+  return m;
+}
+
+/// Caustics on (light tracing the caustic paths, the path integrator the rest) and off (the path
+/// integrator alone, finding the caustics by BSDF sampling through the glass) estimate the same
+/// image. `scene(caustics, max_depth)` is rendered with both at 256 samples per pixel: the means
+/// of the 8x8 pixels at the centre (where the caustic is) agree, |z| < 4 with
+/// z = (A - B) / sqrt(var_A + var_B) of the region means; the whole images pass the default
+/// comparison. The caustic must matter: the region is more than twice as bright as with
+/// max_depth 2 (direct light only).
+void expect_caustics_match_path_tracing(const std::function<std::string(bool, int)>& scene) {
+  RenderResult on = render_ref(scene(true, 6), 256);
+  RenderResult off = render_ref(scene(false, 6), 256);
+  RenderResult direct = render_ref(scene(false, 2), 16);
+  EXPECT_EQ(on.nonfinite, 0u);
+  RegionMean a = region_mean(on, 12, 20, 8, 16), b = region_mean(off, 12, 20, 8, 16),
+             d = region_mean(direct, 12, 20, 8, 16);
+  const double z = (a.mean - b.mean) / std::sqrt(a.var + b.var);
+  EXPECT_LT(std::abs(z), 4) << "caustics on " << a.mean << " +- " << std::sqrt(a.var) << ", off "
+                            << b.mean << " +- " << std::sqrt(b.var);
+  EXPECT_GT(a.mean, 2 * d.mean) << "direct light only: " << d.mean;
+  lucent::CompareResult c = lucent::compare_images(on, off);
+  EXPECT_TRUE(c.passed) << c.summary();
+}
+
+/// A glass ball (radius 0.5 at (0, 0, 1)) on a diffuse floor, seen from above at 45 degrees (the
+/// image centre is the floor under the ball, beside the ball's image), with `more` shapes (a
+/// lamp), and the floor's vertex normals `floor_normals` (JSON, or "" for none).
+std::string glass_ball_scene(bool caustics, int max_depth, const std::string& more,
+                             const std::string& floor_normals = "") {
+  return std::string(R"({
+    "camera": {"position": [0, -4, 4], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 12},
+    "film": {"width": 32, "height": 24},
+    "integrator": {"type": "path", "max_depth": )") +
+         std::to_string(max_depth) + R"(, "caustics": )" + (caustics ? "true" : "false") + R"(},
+    "materials": {"floor": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]},
+                  "glass": {"type": "dielectric", "ior": 1.5},
+                  "mirror": {"type": "mirror", "reflectance": [0.9, 0.9, 0.9]},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [20, 20, 20]}},
+    "shapes": [{"type": "triangles", "material": "floor",
+                "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]],)" +
+         (floor_normals.empty() ? "" : R"("normals": )" + floor_normals + ",") + R"(
+                "indices": [0,1,2, 0,2,3]},
+               {"type": "sphere", "center": [0, 0, 1], "radius": 0.5, "material": "glass"},
+               )" +
+         more + R"(]
+  })";
+}
+
+// A render cancelled before it starts keeps nothing and says so: no light paths traced (N = 0
+// divides nothing), every pixel empty.
+TEST(ReferenceCaustics, CancelledBeforeStart) {
+  lucent::Scene scene = lucent::test::scene_from(mirror_scene(true, R"({"type": "box"})"));
+  std::atomic<bool> cancel{true};
+  lucent::ReferenceOptions o;
+  o.spp = 4;
+  o.cancel = &cancel;
+  RenderResult r = lucent::render_reference(scene, o);
+  EXPECT_TRUE(r.cancelled);
+  EXPECT_EQ(r.nonfinite, 0u);
+  for (size_t i = 0; i < r.samples.size(); ++i) {
+    EXPECT_EQ(r.samples[i], 0u);
+    EXPECT_EQ(r.mean.rgb[i * 3], 0.0f);
+  }
+}
+
+// A small lamp over the ball: the ball focuses its light into a caustic on the floor below.
+TEST(ReferenceCaustics, GlassBallCausticMatchesPathTracing) {
+  expect_caustics_match_path_tracing([](bool caustics, int max_depth) {
+    return glass_ball_scene(
+        caustics, max_depth,
+        R"({"type": "sphere", "center": [0, 0, 3], "radius": 0.25, "material": "lamp"})");
+  });
+}
+
+// A lamp inside the ball: its light leaves the glass through one refraction, so the light
+// tracer's adjoint weight (without the radiance weight's 1 / eta^2 = 2.25 here) is tested; every
+// light on the floor is a caustic (shadow rays do not cross the glass).
+TEST(ReferenceCaustics, LampInsideGlassMatchesPathTracing) {
+  expect_caustics_match_path_tracing([](bool caustics, int max_depth) {
+    return glass_ball_scene(
+        caustics, max_depth,
+        R"({"type": "sphere", "center": [0, 0, 1.1], "radius": 0.15, "material": "lamp"})");
+  });
+}
+
+// Shading normals: the floor's vertex normals tilt by up to 17 degrees (the connection's
+// |wl.ns| |wc.ng| / |wl.ng| and the camera's shading frame), and a mirror wall beside the ball
+// whose vertex normals tilt by up to 11 degrees reflects the lamp onto the floor (the adjoint
+// weight's shading-normal correction).
+TEST(ReferenceCaustics, ShadingNormalsMatchPathTracing) {
+  expect_caustics_match_path_tracing([](bool caustics, int max_depth) {
+    return glass_ball_scene(
+        caustics, max_depth,
+        R"({"type": "sphere", "center": [0, 0, 3], "radius": 0.25, "material": "lamp"},
+           {"type": "triangles", "material": "mirror",
+            "positions": [[-1.2,-2,0],[-1.2,2,0],[-1.2,2,2.5],[-1.2,-2,2.5]],
+            "normals": [[1,0.2,0],[1,-0.1,0.1],[1,0,-0.2],[1,0.1,0.15]],
+            "indices": [0,2,1, 0,3,2]})",
+        "[[0.3,0.1,1],[-0.2,0.3,1],[0.1,-0.3,1],[-0.3,-0.1,1]]");
+  });
+}
+
+}  // namespace
