@@ -25,10 +25,13 @@
  * number of samples, stream) for work-item i, whose sums go to out_sum[i], out_sumsq[i]; stream
  * s draws with the seed lc_stream_seed(seed, s) (shared/rng.h). Without a work list, work-item i
  * is pixel i and renders samples [sample_offset, sample_offset + samples_per_pass) with the seed.
- * Either way a sample's random numbers depend only on its pixel, index and seed. */
+ * Either way a sample's random numbers depend only on its pixel, index and seed. With
+ * integrator.caustics each camera sample also traces a light path that adds to light_sum and
+ * light_sumsq, any pixel's (integrator/caustics.cl; uniform passes only). */
 __kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global const uint4* work,
                             __global float4* out_sum, __global float4* out_sumsq,
-                            __global lc_uint* counters) {
+                            __global lc_uint* counters, __global float4* light_sum,
+                            __global float4* light_sumsq) {
   lc_uint gid = (lc_uint)get_global_id(0);
   lc_uint width = params->width, height = params->height;
   lc_rng rng;
@@ -65,6 +68,10 @@ __kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global const uint4* work,
     lc_ray ray = camera_generate_ray(&params->camera, (float)px + 0.5f + off.x,
                                      (float)py + 0.5f + off.y, width, height, ul.x, ul.y);
     float3 L = integrate(&s, ray, &rng, &rays);
+#ifdef LC_HAS_CAUSTICS
+    if ((params->flags & LC_FLAG_CAUSTICS) && params->work_items == 0u)
+      nonfinite += caustics_light_path(&s, &rng, light_sum, light_sumsq, &rays);
+#endif
     if (lc_isfinite3(L)) {
       sum += L;
       sumsq += L * L;

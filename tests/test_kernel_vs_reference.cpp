@@ -253,6 +253,43 @@ TEST(KernelVsReference, PathDielectric) {
   EXPECT_AGREE(b);
 }
 
+// Caustics by light tracing (integrator.caustics, docs/rendering-model.md): a glass sphere and
+// a mirror sphere under area lights (a sphere lamp, a triangle panel) and a point light (whose
+// caustics only light tracing finds), a plastic sphere (a non-delta lobe that light paths end
+// on), with a tent filter that splats over 3x3 pixels.
+TEST(KernelVsReference, PathCaustics) {
+  Both b = render_both(
+      scene_from(scene_json(R"({"type": "path", "max_depth": 6, "caustics": true})",
+                            std::string(kDiffuseMats) + ", " + kLamps +
+                                R"(, "glass": {"type": "dielectric", "ior": 1.5, "tint": [1, 0.9, 0.8]},
+                                   "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]},
+                                   "plastic": {"type": "plastic", "albedo": [0.3, 0.6, 0.3], "roughness": 0.2})",
+                            std::string(kLampShapes) +
+                                R"(, {"type": "sphere", "center": [0.1, 0.5, 1.3], "radius": 0.5, "material": "glass"},
+                                   {"type": "sphere", "center": [-1.0, 0.4, 0.6], "radius": 0.4, "material": "mirror"},
+                                   {"type": "sphere", "center": [1.3, 0.35, 0.2], "radius": 0.35, "material": "plastic"})",
+                            kPointLights, "",
+                            R"({"width": 32, "height": 32, "filter": {"type": "tent", "radius": 1}})")),
+      256);
+  EXPECT_AGREE(b);
+}
+
+// Lights inside glass: one refraction between light and floor, where the adjoint weight of a
+// light path (no 1 / eta^2) differs from the radiance weight (through a whole sphere the two
+// factors cancel). A sphere lamp inside one glass sphere, a point light inside another.
+TEST(KernelVsReference, PathCausticsLightsInsideGlass) {
+  Both b = render_both(
+      scene_from(scene_json(R"({"type": "path", "max_depth": 5, "caustics": true})",
+                            std::string(kDiffuseMats) + ", " + kLamps +
+                                R"(, "glass": {"type": "dielectric", "ior": 1.5})",
+                            R"({"type": "sphere", "center": [-0.8, 0.9, 0.5], "radius": 0.6, "material": "glass"},
+                               {"type": "sphere", "center": [-0.8, 0.9, 0.5], "radius": 0.15, "material": "lamp"},
+                               {"type": "sphere", "center": [0.9, 0.7, 0.2], "radius": 0.5, "material": "glass"})",
+                            R"({"type": "point", "position": [0.9, 0.7, 0.2], "intensity": [3, 3, 3]})")),
+      256);
+  EXPECT_AGREE(b);
+}
+
 TEST(KernelVsReference, PathConductor) {
   Both b = render_both(
       scene_from(scene_json(

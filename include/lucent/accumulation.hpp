@@ -14,11 +14,15 @@ struct Accumulation {
   std::vector<double> sum;           ///< width * height * 3 (RGB), row 0 at the top
   std::vector<double> sumsq;         ///< the same layout: sums of squared samples
   std::vector<std::uint32_t> count;  ///< finite samples per pixel
-  std::uint64_t first_sample = 0;    ///< index of the first sample accumulated
-  std::uint64_t spp = 0;             ///< samples per pixel launched: [first_sample, +spp)
-  std::uint64_t nonfinite = 0;       ///< NaN/Inf samples dropped and counted
-  std::uint64_t rays = 0;            ///< rays traced
-  double seconds = 0;                ///< kernel time
+  /// integrator.caustics: the light paths' per-pixel sums of contributions and of their squares
+  /// (same layout; empty without caustics) and their number (docs/rendering-model.md)
+  std::vector<double> light_sum, light_sumsq;
+  std::uint64_t light_paths = 0;
+  std::uint64_t first_sample = 0;  ///< index of the first sample accumulated
+  std::uint64_t spp = 0;           ///< samples per pixel launched: [first_sample, +spp)
+  std::uint64_t nonfinite = 0;     ///< NaN/Inf samples dropped and counted
+  std::uint64_t rays = 0;          ///< rays traced
+  double seconds = 0;              ///< kernel time
 };
 
 }  // namespace lucent

@@ -36,6 +36,7 @@ typedef struct {
   float3 weight; /* f |cos| / pdf, or the delta weight */
   float pdf;     /* solid-angle pdf, 0 for delta */
   int delta;
+  float eta; /* refraction: eta_t / eta_o (weight has its 1 / eta^2); 1 otherwise */
 } lc_bsdf_sample;
 
 /* What the Whitted integrator (integrator/whitted.cl) takes of a BSDF: a lambertian part lit by
@@ -57,9 +58,6 @@ static inline void lc_store3p(float* p, float3 v) {
   p[2] = v.z;
 }
 
-static inline float3 sample_cosine_hemisphere(float u1, float u2) {
-  return (float3)(sqrt(u1) * lc_unit_circle(u2), sqrt(fmax(0.0f, 1.0f - u1)));
-}
 
 static inline void whitted_bsdf_none(lc_whitted_bsdf* w) {
   w->diffuse_lobe = 0;
@@ -129,6 +127,7 @@ static inline int bsdf_sample(const lc_bsdf* b, float3 wo, float ul, float u1, f
                               lc_bsdf_sample* bs) {
   bs->delta = 0;
   bs->pdf = 0.0f;
+  bs->eta = 1.0f;
   if (wo.z <= 0.0f) return 0;
   LC_MATERIAL_TYPES(LC_BSDF_SAMPLE)
   return 0;

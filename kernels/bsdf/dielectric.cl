@@ -28,6 +28,7 @@ static inline int bsdf_dielectric_sample(const lc_bsdf* b, float3 wo, float ul, 
   } else {
     bs->wi = (float3)(-wo.x / eta, -wo.y / eta, -cos_t);
     bs->weight = lc_load3p(b->p.dielectric.tint) / (eta * eta);
+    bs->eta = eta;
   }
   return 1;
 }

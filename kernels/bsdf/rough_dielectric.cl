@@ -75,6 +75,7 @@ static inline int bsdf_rough_dielectric_sample(const lc_bsdf* b, float3 wo, floa
   } else {
     bs->wi = normalize((oh / eta - cos_t) * h - wo / eta);
     if (bs->wi.z >= 0.0f) return 0;
+    bs->eta = eta;
   }
   float3 f = bsdf_rough_dielectric_eval(b, wo, bs->wi, &bs->pdf);
   if (!(bs->pdf > 0.0f)) return 0;

@@ -43,4 +43,19 @@ static inline lc_ray camera_generate_ray(__global const lc_camera* cam, float fx
   return ray;
 }
 
+/* The pinhole's film position (fx, fy) of point p (the inverse of camera_generate_ray without a
+ * lens) and the cosine between forward and the direction to p; 0 when p is not in front. */
+static inline int camera_project(__global const lc_camera* cam, lc_real3 p, lc_uint width,
+                                 lc_uint height, float* fx, float* fy, float* cos_c) {
+  lc_real3 d = p - lc_load3r(cam->position);
+  lc_real z = dot(d, lc_load3r(cam->forward));
+  if (!(z > LC_REAL(0.0))) return 0;
+  lc_real ndc_x = dot(d, lc_load3r(cam->right)) / (z * cam->tan_half_fov * cam->aspect);
+  lc_real ndc_y = dot(d, lc_load3r(cam->up)) / (z * cam->tan_half_fov);
+  *fx = (float)((ndc_x + LC_REAL(1.0)) * (LC_REAL(0.5) * (lc_real)width));
+  *fy = (float)((LC_REAL(1.0) - ndc_y) * (LC_REAL(0.5) * (lc_real)height));
+  *cos_c = (float)(z / length(d));
+  return 1;
+}
+
 #endif

@@ -32,6 +32,22 @@ static inline float2 filter_sample_gaussian(float radius, float u1, float u2) {
   return r * lc_unit_circle(u2);
 }
 
+/* The normalized densities of the offsets drawn above (light tracing splats with them,
+ * integrator/caustics.cl): filter_density_<file>(radius, dx, dy). */
+static inline float filter_density_box(float r, float dx, float dy) {
+  return (fabs(dx) <= r && fabs(dy) <= r) ? 1.0f / (4.0f * r * r) : 0.0f;
+}
+static inline float filter_density_tent1(float t, float r) { return fmax(0.0f, r - fabs(t)) / (r * r); }
+static inline float filter_density_tent(float r, float dx, float dy) {
+  return filter_density_tent1(dx, r) * filter_density_tent1(dy, r);
+}
+static inline float filter_density_gaussian(float r, float dx, float dy) {
+  float sigma = r / 3.0f, rho2 = dx * dx + dy * dy;
+  if (rho2 > r * r) return 0.0f;
+  const float tail = 0.98889100346175773f;
+  return exp(-rho2 / (2.0f * sigma * sigma)) / (2.0f * LC_PI * sigma * sigma * tail);
+}
+
 #define LC_FILTER_SAMPLE(ID, Name, value, name, feature, file, radius_default) \
   if (LC_ENABLED(feature) && type == LC_FILTER_##ID) return filter_sample_##file(radius, u1, u2);
 /* Offset from the pixel centre, in pixels. */
@@ -40,5 +56,14 @@ static inline float2 filter_sample(lc_uint type, float radius, float u1, float u
   return (float2)(0.0f);
 }
 #undef LC_FILTER_SAMPLE
+
+#define LC_FILTER_DENSITY(ID, Name, value, name, feature, file, radius_default) \
+  if (LC_ENABLED(feature) && type == LC_FILTER_##ID) return filter_density_##file(radius, dx, dy);
+/* Density of the offset (dx, dy) from the pixel centre, in pixels^-2. */
+static inline float filter_density(lc_uint type, float radius, float dx, float dy) {
+  LC_FILTER_TYPES(LC_FILTER_DENSITY)
+  return 0.0f;
+}
+#undef LC_FILTER_DENSITY
 
 #endif

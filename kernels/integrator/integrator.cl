@@ -12,6 +12,9 @@
 #include "generated/integrators.cl"
 #include "integrator/aov.cl"
 /* clang-format on */
+#ifdef LC_HAS_CAUSTICS
+#include "integrator/caustics.cl"
+#endif
 
 #define LC_INTEGRATOR_CALL(ID, Name, value, name, feature, file) \
   if (LC_ENABLED(feature) && integrator == LC_INTEGRATOR_##ID)   \

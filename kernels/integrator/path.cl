@@ -25,6 +25,12 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
   float prev_pdf = 0.0f;
   int prev_delta = 1; /* the camera ray: emitters count fully */
   lc_real3 prev_p = ray.o;
+#ifdef LC_HAS_CAUSTICS
+  /* integrator.caustics: emitters that the path reaches as E X S+ L (a non-delta lobe at the
+   * first hit, delta lobes since) are left to the light paths (integrator/caustics.cl) */
+  const int caustics = (P->flags & LC_FLAG_CAUSTICS) != 0;
+  int caustic = 0;
+#endif
   for (lc_uint depth = 0;; ++depth) {
     lc_hit hit;
     ++*rays;
@@ -38,7 +44,11 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     }
     lc_interaction it = interaction_from_hit(s, ray, &hit);
     __global const lc_material* m = &s->materials[it.material];
-    if (it.front && it.light != LC_INVALID) {
+    int emits = it.front && it.light != LC_INVALID;
+#ifdef LC_HAS_CAUSTICS
+    if (caustics && caustic && depth >= 2u) emits = 0;
+#endif
+    if (emits) {
       float3 Le = lc_load3(m->emission);
       float w = 1.0f;
       if (!prev_delta) {
@@ -88,6 +98,9 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     if (transmit ? side >= LC_REAL(0.0) : side <= LC_REAL(0.0)) break; /* shading normal leak */
     beta *= bs.weight;
     if (!(lc_max3(beta) > 0.0f)) break;
+#ifdef LC_HAS_CAUSTICS
+    caustic = depth == 0 ? !bs.delta : (caustic && bs.delta);
+#endif
     prev_delta = bs.delta;
     prev_pdf = bs.pdf;
     ray.o = transmit ? lc_spawn_origin(it.p, it.perr, -it.ng) : o;

@@ -21,4 +21,9 @@ static inline float3 light_env_emitted(const lc_scene* s, __global const lc_ligh
   return lc_load3(L->p.env.radiance);
 }
 
+/* environments start no light paths: their caustics stay with the camera path */
+static inline int light_env_emit(const lc_scene* s, __global const lc_light* L, float4 u,
+                                lc_ray* ray, float3* beta) {
+  return 0;
+}
 #endif

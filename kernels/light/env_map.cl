@@ -58,4 +58,9 @@ static inline float3 light_env_map_emitted(const lc_scene* s, __global const lc_
   return env_map_radiance(s, L, d, &texel);
 }
 
+/* environments start no light paths: their caustics stay with the camera path */
+static inline int light_env_map_emit(const lc_scene* s, __global const lc_light* L, float4 u,
+                                lc_ray* ray, float3* beta) {
+  return 0;
+}
 #endif

@@ -12,6 +12,11 @@
  *   float3 light_<file>_emitted(const lc_scene* s, __global const lc_light* L, float3 d)
  *            radiance of a ray escaping the scene in direction d (environments; 0 for others,
  *            whose emission is their material's)
+ *   int    light_<file>_emit(const lc_scene* s, __global const lc_light* L, float4 u,
+ *                            lc_ray* ray, float3* beta)
+ *            light tracing (integrator/caustics.cl): a ray leaving the light and its weight
+ *            Le |cos| / (p_A p_w), or I / p_w for point lights (selection not included); 0 for
+ *            lights that start no light paths (environments)
  * Every type's file is included (generated/lights.cl); the dispatch compiles a type's branch
  * only when its feature define is set. */
 #ifndef LUCENT_LIGHT_LIGHT_CL
@@ -95,5 +100,21 @@ static inline int light_sample(const lc_scene* s, lc_real3 p, float us, float u1
   return 0;
 }
 #undef LC_LIGHT_SAMPLE
+
+#define LC_LIGHT_EMIT(ID, Name, value, name, feature, file, params) \
+  if (LC_ENABLED(feature) && L->type == LC_LIGHT_##ID) ok = light_##file##_emit(s, L, u, ray, beta);
+/* Chooses a light with us (the next-event selection) and starts a light path on it with u: the
+ * ray and its weight, the selection probability included. */
+static inline int light_emit(const lc_scene* s, float us, float4 u, lc_ray* ray, float3* beta) {
+  __global const lc_params* P = s->params;
+  if (P->num_lights == 0) return 0;
+  __global const lc_light* L = &s->lights[lc_cdf_search(s->light_cdf, P->num_lights, us)];
+  int ok = 0;
+  LC_LIGHT_TYPES(LC_LIGHT_EMIT)
+  if (!ok || !(L->pdf_select > 0.0f)) return 0;
+  *beta /= L->pdf_select;
+  return 1;
+}
+#undef LC_LIGHT_EMIT
 
 #endif

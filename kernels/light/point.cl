@@ -25,4 +25,12 @@ static inline float3 light_point_emitted(const lc_scene* s, __global const lc_li
   return (float3)(0.0f);
 }
 
+/* uniform directions: weight I / (1 / 4 pi) */
+static inline int light_point_emit(const lc_scene* s, __global const lc_light* L, float4 u,
+                                   lc_ray* ray, float3* beta) {
+  ray->o = lc_load3r(L->p.point.position);
+  ray->d = lc_real3_from_float3(sample_uniform_sphere(u.x, u.y));
+  *beta = lc_load3(L->p.point.intensity) * (4.0f * LC_PI);
+  return 1;
+}
 #endif

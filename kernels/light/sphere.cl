@@ -61,4 +61,21 @@ static inline float3 light_sphere_emitted(const lc_scene* s, __global const lc_l
   return (float3)(0.0f);
 }
 
+/* a uniform point of the sphere, a cosine-distributed direction about its outward normal:
+ * weight Le cos / (1 / area * cos / pi) = Le pi area */
+static inline int light_sphere_emit(const lc_scene* s, __global const lc_light* L, float4 u,
+                                    lc_ray* ray, float3* beta) {
+  __global const lc_sphere* sp = &s->spheres[L->p.sphere.sphere];
+  lc_real3 c = lc_load3r(sp->center);
+  lc_real r = sp->radius;
+  lc_real3 n = normalize(lc_real3_from_float3(sample_uniform_sphere(u.x, u.y)));
+  lc_real3 perr = (fabs(c) + r) * (LC_REAL(8.0) * LC_REAL_U); /* as sphere_interaction */
+  lc_real3 t, b;
+  lc_onbr(n, &t, &b);
+  float3 d = sample_cosine_hemisphere(u.z, u.w);
+  ray->o = lc_spawn_origin(c + r * n, perr, n);
+  ray->d = normalize((lc_real)d.x * t + (lc_real)d.y * b + (lc_real)d.z * n);
+  *beta = lc_load3(L->p.sphere.radiance) * (float)(LC_PI * 4.0f * LC_PI * r * r);
+  return 1;
+}
 #endif

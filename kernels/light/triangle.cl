@@ -38,4 +38,24 @@ static inline float3 light_triangle_emitted(const lc_scene* s, __global const lc
   return (float3)(0.0f);
 }
 
+/* a uniform point, a cosine-distributed direction on the front side: weight Le pi area */
+static inline int light_triangle_emit(const lc_scene* s, __global const lc_light* L, float4 u,
+                                      lc_ray* ray, float3* beta) {
+  __global const lc_triangle* tri = &s->triangles[L->p.triangle.triangle];
+  lc_real3 v0 = lc_load3r(tri->v0), v1 = lc_load3r(tri->v1), v2 = lc_load3r(tri->v2);
+  lc_real su = sqrt((lc_real)u.x);
+  lc_real b0 = LC_REAL(1.0) - su, b1 = u.y * su, b2 = LC_REAL(1.0) - b0 - b1;
+  lc_real3 q = b0 * v0 + b1 * v1 + b2 * v2;
+  /* as triangle_interaction */
+  lc_real3 perr =
+      (fabs(b0 * v0) + fabs(b1 * v1) + fabs(b2 * v2)) * (LC_REAL(7.0) * LC_REAL_U * LC_REAL(1.0001));
+  lc_real3 nl = normalize(cross(v1 - v0, v2 - v0));
+  lc_real3 t, b;
+  lc_onbr(nl, &t, &b);
+  float3 d = sample_cosine_hemisphere(u.z, u.w);
+  ray->o = lc_spawn_origin(q, perr, nl);
+  ray->d = normalize((lc_real)d.x * t + (lc_real)d.y * b + (lc_real)d.z * nl);
+  *beta = lc_load3(L->p.triangle.radiance) * (LC_PI * L->p.triangle.area);
+  return 1;
+}
 #endif

@@ -134,7 +134,8 @@
   X(LC_HAS_UVS, "texture coordinates of triangles")       \
   X(LC_HAS_TEXTURES, "textured materials")                \
   X(LC_HAS_THIN_LENS, "thin-lens depth of field")         \
-  X(LC_HAS_CLAMP, "clamped path contributions (integrator.clamp)")
+  X(LC_HAS_CLAMP, "clamped path contributions (integrator.clamp)")       \
+  X(LC_HAS_CAUSTICS, "caustics by light tracing (integrator.caustics)")
 
 /* ------------------------------------------------------------------------------------------ */
 /* Scene buffers: X(name, element type, what)                                                  */

@@ -311,7 +311,8 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, filter) == 116, params_filter);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, sampler) == 132, params_sampler);
 
 /* lc_params.flags */
-#define LC_FLAG_NO_MIS 1u /* path: light sampling only for area lights (no BSDF-hit emission) */
+#define LC_FLAG_NO_MIS 1u   /* path: light sampling only for area lights (no BSDF-hit emission) */
+#define LC_FLAG_CAUSTICS 2u /* path: caustic paths by light tracing (integrator/caustics.cl)     */
 
 /* Counters accumulated by one launch (atomics on the device). */
 #define LC_COUNTER_NONFINITE 0 /* samples whose radiance was NaN or Inf (not added to the film) */

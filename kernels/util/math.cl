@@ -114,4 +114,9 @@ static inline lc_real3 lc_spawn_origin(lc_real3 p, lc_real3 perr, lc_real3 n) {
   return (lc_real3)(lc_nudge(o.x, n.x), lc_nudge(o.y, n.y), lc_nudge(o.z, n.z));
 }
 
+/* A cosine-distributed direction about +z (BSDFs, and lights emitting light paths). */
+static inline float3 sample_cosine_hemisphere(float u1, float u2) {
+  return (float3)(sqrt(u1) * lc_unit_circle(u2), sqrt(fmax(0.0f, 1.0f - u1)));
+}
+
 #endif

@@ -351,7 +351,9 @@ void bind_scene(py::module_& m) {
       .def_readwrite("ao_distance", &Integrator::ao_distance)
       .def_readwrite("mis", &Integrator::mis)
       .def_readwrite("clamp", &Integrator::clamp,
-                     "the largest sample contribution (0: off); biased, lower variance");
+                     "the largest sample contribution (0: off); biased, lower variance")
+      .def_readwrite("caustics", &Integrator::caustics,
+                     "path: caustic paths by light tracing (pinhole cameras, uniform renders)");
   enum_property(integrator, "type", &Integrator::type);
   enum_property(integrator, "sampler", &Integrator::sampler);
 

@@ -104,7 +104,8 @@ CLI::App* add_converge_command(CLI::App& app) {
                       type_names<FilterType>("|") +
                       "[:R], integrator=" + type_names<IntegratorType>("|") +
                       ", sampler=" + type_names<SamplerType>("|") +
-                      ", clamp=X, adaptive, min-spp=N, target-error=E (default: default)")
+                      ", clamp=X, caustics, no-caustics, adaptive, min-spp=N, target-error=E (default: "
+                      "default)")
       ->delimiter(',');
   auto* spp = cmd->add_option("--spp-ladder", a.spp_ladder, "Samples per pixel of each rung")
                   ->delimiter(',')

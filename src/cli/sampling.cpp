@@ -17,6 +17,11 @@ void add_sampling_options(CLI::App* cmd, SamplingArgs& a, bool adaptive) {
                   "Largest contribution of a path vertex after a scattering (overrides "
                   "integrator.clamp; 0: off; biased when it binds)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag_callback(
+      "--caustics", [&a] { a.caustics = 1; },
+      "Caustic paths by light tracing (integrator.caustics; path integrator, pinhole camera)");
+  cmd->add_flag_callback(
+      "--no-caustics", [&a] { a.caustics = 0; }, "Caustic paths by the camera path alone");
   if (!adaptive) return;
   cmd->add_option("--target-error", a.target_error,
                   "Adaptive sampling: render until the image's estimated relMSE is at most this, "
@@ -36,6 +41,7 @@ void apply_sampling_options(const SamplingArgs& a, Scene& scene) {
     scene.integrator.sampler = *t;
   }
   if (a.clamp >= 0) scene.integrator.clamp = a.clamp;
+  if (a.caustics >= 0) scene.integrator.caustics = a.caustics == 1;
 }
 
 AdaptiveOptions adaptive_options(const SamplingArgs& a, int max_spp, double time_limit) {

@@ -117,6 +117,7 @@ void ConvergeSetting::apply(Scene& scene, RenderOptions& options) const {
   if (filter_radius > 0) scene.film.filter.radius = filter_radius;
   if (sampler >= 0) scene.integrator.sampler = static_cast<SamplerType>(sampler);
   if (clamp >= 0) scene.integrator.clamp = clamp;
+  if (caustics >= 0) scene.integrator.caustics = caustics == 1;
 }
 
 ConvergeSetting parse_converge_setting(const std::string& text) {
@@ -188,6 +189,9 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
       s.sampler = static_cast<int>(*t);
     } else if (key == "clamp") {
       s.clamp = parse_number(knob, value, 0, false);
+    } else if (key == "caustics" || key == "no_caustics") {
+      no_value();
+      s.caustics = key == "caustics" ? 1 : 0;
     } else if (key == "adaptive") {
       no_value();
       s.adaptive = true;
@@ -208,7 +212,8 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
                   "max_depth=N, rr_depth=N, filter=" +
                   type_names<FilterType>("|") +
                   "[:R], integrator=NAME, sampler=" + type_names<SamplerType>("|") +
-                  ", clamp=X, adaptive, min-spp=N, target-error=E, joined by +)");
+                  ", clamp=X, caustics, no-caustics, adaptive, min-spp=N, target-error=E, "
+                  "joined by +)");
     }
   }
   if (s.adaptive && s.target_error > 0)

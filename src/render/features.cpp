@@ -57,7 +57,9 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
     uvs = uvs || (t.flags & LC_TRI_HAS_UVS);
   }
   const bool clamped = scene.integrator.clamp > 0 && scene.integrator.type == IntegratorType::Path;
-  const bool other[] = {smooth, uvs && textured, textured, scene.camera.aperture > 0, clamped};
+  const bool caustics = scene.integrator.caustics && scene.integrator.type == IntegratorType::Path;
+  const bool other[] = {smooth,  uvs && textured, textured, scene.camera.aperture > 0,
+                        clamped, caustics};
 #define LUCENT_COUNT(feature, what) +1
   static_assert(sizeof(other) / sizeof(other[0]) == 0 LC_OTHER_FEATURES(LUCENT_COUNT),
                 "one condition per LC_OTHER_FEATURES entry, in its order");

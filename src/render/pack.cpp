@@ -77,7 +77,10 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   P.filter = static_cast<lc_uint>(scene.film.filter.type);
   P.filter_radius = static_cast<float>(scene.film.filter.radius);
   P.env_light = -1;
-  P.flags = scene.integrator.mis ? 0u : LC_FLAG_NO_MIS;
+  P.flags =
+      (scene.integrator.mis ? 0u : LC_FLAG_NO_MIS) |
+      (scene.integrator.caustics && scene.integrator.type == IntegratorType::Path ? LC_FLAG_CAUSTICS
+                                                                                  : 0u);
   P.sampler = static_cast<lc_uint>(scene.integrator.sampler);
   // a positive clamp stays positive in float (0 is off)
   P.clamp = scene.integrator.clamp > 0

@@ -279,6 +279,10 @@ void write_render_part(const std::string& path, const RenderPart& part) {
   if (a.width != info.width || a.height != info.height || a.sum.size() != npix * 3 ||
       a.sumsq.size() != npix * 3 || a.count.size() != npix)
     throw Error(path + ": cannot write part: inconsistent accumulation");
+  if (a.light_paths > 0)
+    throw Error(path +
+                ": cannot write part: part files do not hold light-traced caustics "
+                "(integrator.caustics); render the scene without --samples A:B");
   // each double as two UINT channels: its high and low 32 bits (EXR has no 64-bit pixel type)
   std::vector<std::vector<std::uint32_t>> words;
   image_detail::ExrExtras extras;

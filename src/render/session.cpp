@@ -79,7 +79,8 @@ struct Worker {
   std::optional<render_detail::DeviceScene> dev;
   size_t npix = 0;
   cl::Buffer b_work, b_sum, b_sumsq, b_counters;  // work list: npix entries at most
-  std::vector<cl_float4> h_sum, h_sumsq;
+  cl::Buffer b_light, b_lightsq;                  // caustics: the light paths' splats
+  std::vector<cl_float4> h_sum, h_sumsq, h_light, h_lightsq;
   std::uint32_t pass_spp = 1;  // samples per pixel of its next pass (tuned to pass_seconds)
   DeviceShare share;           // of the accumulation
   DeviceShare call;            // of the render call in progress
@@ -98,6 +99,8 @@ struct Worker {
     program->kernel.setArg(arg++, b_sum);
     program->kernel.setArg(arg++, b_sumsq);
     program->kernel.setArg(arg++, b_counters);
+    program->kernel.setArg(arg++, b_light);
+    program->kernel.setArg(arg++, b_lightsq);
   }
 
   /// Launches samples [first, first + n) of every pixel and reads back their sums.
@@ -127,6 +130,12 @@ struct Worker {
     q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(zero), zero);
     if (entries)
       q.enqueueWriteBuffer(b_work, CL_FALSE, 0, items * sizeof(cl_uint4), entries->data());
+    const bool light = (P.flags & LC_FLAG_CAUSTICS) && !entries;
+    if (light) {
+      const cl_float4 z = {{0, 0, 0, 0}};
+      q.enqueueFillBuffer(b_light, z, 0, npix * sizeof(cl_float4));
+      q.enqueueFillBuffer(b_lightsq, z, 0, npix * sizeof(cl_float4));
+    }
     const size_t global = (items + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
     q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global),
                            cl::NDRange(kWorkGroupSize));
@@ -134,6 +143,12 @@ struct Worker {
     h_sumsq.resize(items);
     q.enqueueReadBuffer(b_sum, CL_FALSE, 0, items * sizeof(cl_float4), h_sum.data());
     q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, items * sizeof(cl_float4), h_sumsq.data());
+    if (light) {
+      h_light.resize(npix);
+      h_lightsq.resize(npix);
+      q.enqueueReadBuffer(b_light, CL_FALSE, 0, npix * sizeof(cl_float4), h_light.data());
+      q.enqueueReadBuffer(b_lightsq, CL_FALSE, 0, npix * sizeof(cl_float4), h_lightsq.data());
+    }
     q.enqueueReadBuffer(b_counters, CL_TRUE, 0, LC_COUNTER_COUNT * sizeof(lc_uint), counters);
   }
 };
@@ -163,6 +178,10 @@ struct Renderer::Impl {
   std::vector<double> sum, sumsq;
   std::vector<std::uint32_t> count;
   std::uint64_t first = 0, done = 0, nonfinite = 0, rays = 0;
+  // caustics (docs/rendering-model.md): the light paths' sums of contributions and of their
+  // squares per pixel, and the number of light paths
+  std::vector<double> light_sum, light_sumsq;
+  std::uint64_t light_paths = 0;
   double render_seconds = 0;
   bool last_cancelled = false;
 
@@ -184,6 +203,9 @@ struct Renderer::Impl {
     std::fill(sum.begin(), sum.end(), 0.0);
     std::fill(sumsq.begin(), sumsq.end(), 0.0);
     std::fill(count.begin(), count.end(), 0u);
+    std::fill(light_sum.begin(), light_sum.end(), 0.0);
+    std::fill(light_sumsq.begin(), light_sumsq.end(), 0.0);
+    light_paths = 0;
     first = first_sample;
     done = nonfinite = rays = 0;
     render_seconds = 0;
@@ -240,6 +262,10 @@ struct Renderer::Impl {
 
   void set_scene(const Scene& s) {
     scene_detail::ScopedWarningSink sink(options.on_warning);
+    if (s.integrator.caustics && s.integrator.type == IntegratorType::Path && s.camera.aperture > 0)
+      throw Error(s.path +
+                  ": integrator.caustics: light tracing needs a pinhole camera (camera.aperture "
+                  "0); render this scene without caustics");
     std::vector<render_detail::DeviceLimits> limits;
     for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
     render_detail::check_host_memory(s, limits, limits.front().host_mem, limits.front().host_what);
@@ -296,6 +322,8 @@ struct Renderer::Impl {
           w.b_sumsq = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
           w.b_counters =
               cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
+          w.b_light = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, n * sizeof(cl_float4));
+          w.b_lightsq = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, n * sizeof(cl_float4));
         }
         w.set_args();
         if (w.program != previous_program) {
@@ -315,6 +343,9 @@ struct Renderer::Impl {
       sum.assign(npix * 3, 0.0);
       sumsq.assign(npix * 3, 0.0);
       count.assign(npix, 0u);
+      const bool caustics = packed.params.flags & LC_FLAG_CAUSTICS;
+      light_sum.assign(caustics ? npix * 3 : 0, 0.0);
+      light_sumsq.assign(caustics ? npix * 3 : 0, 0.0);
       clear_accumulation(first);
       for (auto& w : workers) w->pass_spp = 1;
     }
@@ -328,6 +359,14 @@ struct Renderer::Impl {
         sumsq[i * 3 + c] += w.h_sumsq[i].s[c];
       }
       count[i] += static_cast<std::uint32_t>(w.h_sum[i].s[3]);
+    }
+    if (!light_sum.empty()) {
+      for (size_t i = 0; i < npix; ++i)
+        for (int c = 0; c < 3; ++c) {
+          light_sum[i * 3 + c] += w.h_light[i].s[c];
+          light_sumsq[i * 3 + c] += w.h_lightsq[i].s[c];
+        }
+      light_paths += std::uint64_t(n) * npix;
     }
     done += n;
   }
@@ -598,6 +637,10 @@ struct Renderer::Impl {
   RenderProgress run_adaptive(const AdaptiveOptions& o,
                               const std::function<void(const RenderProgress&)>& on_progress) {
     if (!scene) throw Error("render_adaptive: the session has no scene (call set_scene first)");
+    if (packed.params.flags & LC_FLAG_CAUSTICS)
+      throw Error(scene->path +
+                  ": integrator.caustics: adaptive sampling cannot render light-traced caustics "
+                  "(its per-pixel sample counts differ); render them uniformly");
     if (!(o.target_error > 0) == !(o.budget_spp > 0) || !std::isfinite(o.target_error) ||
         !std::isfinite(o.budget_spp))
       throw Error("render_adaptive: give either a target error or a budget, a positive number");
@@ -693,6 +736,13 @@ struct Renderer::Impl {
           double s = sum[i * 3 + c], s2 = sumsq[i * 3 + c];
           double mean = n > 0 ? s / n : 0;
           double var = n > 1 ? std::max(0.0, (s2 - s * mean) / (n - 1)) : 0;
+          if (light_paths > 1) {
+            // the light paths' mean, and its variance in units of one camera sample
+            const double N = double(light_paths), lm = light_sum[i * 3 + c] / N;
+            const double lvar = std::max(0.0, light_sumsq[i * 3 + c] / N - lm * lm) / (N - 1);
+            mean += lm;
+            var += n * lvar;
+          }
           r.mean.rgb[i * 3 + c] = static_cast<float>(mean);
           r.variance.rgb[i * 3 + c] = static_cast<float>(var);
         }
@@ -782,6 +832,9 @@ Accumulation Renderer::accumulation() const {
   a.sum = m.sum;
   a.sumsq = m.sumsq;
   a.count = m.count;
+  a.light_sum = m.light_sum;
+  a.light_sumsq = m.light_sumsq;
+  a.light_paths = m.light_paths;
   a.first_sample = m.first;
   a.spp = m.done;
   a.nonfinite = m.nonfinite;

@@ -1,0 +1,158 @@
+/* lucent kernel: caustics by light tracing (integrator.caustics; docs/rendering-model.md,
+ * "Caustics by light tracing"). Each camera sample also traces one light path: from a light,
+ * through one or more delta scatterings, to the first non-delta vertex, which is connected to
+ * the pinhole and splatted with the pixel filter's density into the film's light sums
+ * (atomically: any work-item may reach any pixel). The path integrator leaves out the same paths
+ * (integrator/path.cl), so the two split path space. The host divides the light sums by the
+ * number of light paths, W * H * spp. */
+#ifndef LUCENT_INTEGRATOR_CAUSTICS_CL
+#define LUCENT_INTEGRATOR_CAUSTICS_CL
+
+/* *p += v for a float in global memory (OpenCL 1.2 has integer atomics only) */
+static inline void lc_atomic_add_float(volatile __global float* p, float v) {
+  union {
+    unsigned int u;
+    float f;
+  } old, sum;
+  do {
+    old.f = *p;
+    sum.f = old.f + v;
+  } while (atomic_cmpxchg((volatile __global unsigned int*)p, old.u, sum.u) != old.u);
+}
+
+/* Adds contribution c (before the filter) at film position (fx, fy) to every pixel whose filter
+ * reaches it, and its square to the sums of squares. */
+static inline void caustics_splat(const lc_scene* s, float fx, float fy, float3 c,
+                                  __global float4* light_sum, __global float4* light_sumsq) {
+  __global const lc_params* P = s->params;
+  const float r = P->filter_radius;
+  const int W = (int)P->width, H = (int)P->height;
+  if (!(fx > -r - 1.0f && fx < (float)W + r + 1.0f && fy > -r - 1.0f && fy < (float)H + r + 1.0f))
+    return;
+  /* pixels whose centre (x + 0.5) lies within r of fx */
+  int x0 = max(0, (int)ceil(fx - r - 0.5f)), x1 = min(W - 1, (int)floor(fx + r - 0.5f));
+  int y0 = max(0, (int)ceil(fy - r - 0.5f)), y1 = min(H - 1, (int)floor(fy + r - 0.5f));
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      float w = filter_density(P->filter, r, fx - ((float)x + 0.5f), fy - ((float)y + 0.5f));
+      if (!(w > 0.0f)) continue;
+      float3 v = c * w;
+      volatile __global float* a = (volatile __global float*)&light_sum[y * W + x];
+      volatile __global float* b = (volatile __global float*)&light_sumsq[y * W + x];
+      lc_atomic_add_float(a + 0, v.x);
+      lc_atomic_add_float(a + 1, v.y);
+      lc_atomic_add_float(a + 2, v.z);
+      lc_atomic_add_float(b + 0, v.x * v.x);
+      lc_atomic_add_float(b + 1, v.y * v.y);
+      lc_atomic_add_float(b + 2, v.z * v.z);
+    }
+}
+
+/* Connects the light path's vertex x at `hit` (reached by ray with weight beta) to the camera. The
+ * BSDF there is seen as a camera ray hitting the point would see it (its normals facing the
+ * camera, the geometric one where the interpolated one faces away), so that the contribution is
+ * exactly the one the path integrator leaves out. Returns 0 when the contribution is not finite
+ * (it is then counted, not splatted). */
+static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_hit* hit, lc_real3 x,
+                                   float3 beta, __global float4* light_sum,
+                                   __global float4* light_sumsq, lc_uint* rays) {
+  __global const lc_params* P = s->params;
+  __global const lc_camera* cam = &P->camera;
+  float fx, fy, cos_c;
+  if (!camera_project(cam, x, P->width, P->height, &fx, &fy, &cos_c)) return 1;
+  const float r = P->filter_radius;
+  if (!(fx > -r && fx < (float)P->width + r && fy > -r && fy < (float)P->height + r)) return 1;
+  lc_real3 cpos = lc_load3r(cam->position);
+  lc_real3 toc = cpos - x;
+  lc_real dist = length(toc);
+  if (!(dist > LC_REAL(0.0))) return 1;
+  lc_real3 wc = toc / dist;
+  /* the interaction of the camera ray through this point */
+  lc_ray cray;
+  cray.o = cpos;
+  cray.d = -wc;
+  lc_hit ch = *hit;
+  ch.t = dist;
+  lc_interaction it = interaction_from_hit(s, cray, &ch);
+  __global const lc_material* m = &s->materials[it.material];
+  lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
+  lc_frame fr = frame_from(it.ns);
+  float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(wc));
+  if (wo_l.z <= 0.0f) return 1;
+  lc_real3 wl = -ray.d; /* towards the arriving light */
+  float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(wl));
+  lc_real side = dot(wl, it.ng);
+  if (wi_l.z < 0.0f ? side >= LC_REAL(0.0) : side <= LC_REAL(0.0)) return 1; /* as path.cl */
+  float pdf;
+  float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf);
+  if (!(lc_max3(f) > 0.0f)) return 1;
+  lc_real3 o = lc_spawn_origin(it.p, it.perr, it.ng); /* ng faces the camera */
+  lc_real3 to = cpos - o;
+  lc_real od = length(to);
+  if (!(od > LC_REAL(0.0)) || !shadow_visible(s, o, to / od, od, rays)) return 1;
+  /* |wl.ns| |wc.ng| / |wl.ng|, and the pinhole's importance 1 / (s^2 cos^3) over r^2 */
+  float cos_x = fabs(wi_l.z) * (float)dot(wc, it.ng) / (float)fabs(side);
+  float pitch = 2.0f * cam->tan_half_fov / (float)P->height;
+  float3 c = beta * f *
+             (cos_x / ((float)(dist * dist) * pitch * pitch * cos_c * cos_c * cos_c));
+  if (!lc_isfinite3(c)) return 0;
+  caustics_splat(s, fx, fy, c, light_sum, light_sumsq);
+  return 1;
+}
+
+/* The light path of the camera sample rng (random numbers from LC_DIM_LIGHT_PATH). Returns the
+ * number of non-finite contributions it dropped. */
+static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
+                                          __global float4* light_sum,
+                                          __global float4* light_sumsq, lc_uint* rays) {
+  __global const lc_params* P = s->params;
+  if (P->max_depth < 3u) return 0; /* a caustic path has at least 3 segments */
+  float4 ue = lc_rand4(rng, LC_DIM_LIGHT_PATH);
+  float4 ud = lc_rand4(rng, LC_DIM_LIGHT_PATH + 4u);
+  lc_ray ray;
+  float3 beta;
+  if (!light_emit(s, ue.z, (float4)(ue.x, ue.y, ud.x, ud.y), &ray, &beta)) return 0;
+  const float beta0 = lc_max3(beta);
+  lc_uint nonfinite = 0;
+  /* scattering vertices 1 .. max_depth - 1: the camera path's segment limit */
+  for (lc_uint i = 1; i < P->max_depth; ++i) {
+    lc_hit hit;
+    ++*rays;
+    if (!scene_intersect(s, ray, INFINITY, &hit)) break;
+    lc_interaction it = interaction_from_hit(s, ray, &hit);
+    __global const lc_material* m = &s->materials[it.material];
+    lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
+    if (i >= 2u && !(bsdf_lobes(&b) & LC_BSDF_DELTA))
+      nonfinite += !caustics_connect(s, ray, &hit, it.p, beta, light_sum, light_sumsq, rays);
+    /* continue through a delta lobe only */
+    lc_uint dim = LC_DIM_LIGHT_PATH + 8u * i;
+    float4 ua = lc_rand4(rng, dim);
+    float4 ub = lc_rand4(rng, dim + 4u);
+    lc_frame fr = frame_from(it.ns);
+    float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
+    if (wo_l.z <= 0.0f) break;
+    lc_bsdf_sample bs;
+    if (!bsdf_sample(&b, wo_l, ua.w, ub.x, ub.y, &bs) || !bs.delta) break;
+    lc_real3 wi = normalize(lc_real3_from_float3(frame_to_world(&fr, bs.wi)));
+    int transmit = bs.wi.z < 0.0f;
+    lc_real side = dot(wi, it.ng);
+    if (transmit ? side >= LC_REAL(0.0) : side <= LC_REAL(0.0)) break;
+    /* the adjoint weight: power, not radiance, crosses a refraction (no 1 / eta^2), and the
+     * shading-normal correction |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) */
+    float wo_ng = (float)dot(-ray.d, it.ng);
+    float corr = wo_l.z * (float)fabs(side) / (wo_ng * fabs(bs.wi.z));
+    beta *= bs.weight * (bs.eta * bs.eta * corr);
+    if (!(lc_max3(beta) > 0.0f)) break;
+    ray.o = lc_spawn_origin(it.p, it.perr, transmit ? -it.ng : it.ng);
+    ray.d = wi;
+    /* Russian roulette on the throughput relative to the emitted weight, as path.cl does */
+    float q = lc_max3(beta) / beta0;
+    if (i + 2u > P->rr_depth && q < 1.0f) {
+      if (ub.z >= q) break;
+      beta /= q;
+    }
+  }
+  return nonfinite;
+}
+
+#endif
