@@ -77,6 +77,9 @@ const std::map<std::string, std::string> kExpected = {
     // a vw (skin weight) line whose joint 112147483648 tinyobjloader converted to int: undefined
     // behaviour; its vertex '0f' is refused first
     {"vw-joint-int-overflow.bundle", "/m.obj:8: skin weight line: '0f' is not a number"},
+    // a tag line ('t') whose number 3e2147483648... overflowed tinyobjloader's int exponent:
+    // undefined behaviour (src/scene/obj_check.cpp, check_exponent)
+    {"tinyobj-exponent-overflow.bundle", "/m.obj:1: '3e2147483648"},
 };
 
 TEST(FuzzRegressions, EveryFoundInputIsRefusedWithOneLineOrLoads) {

@@ -58,6 +58,22 @@ TEST(ObjValidation, NonFiniteAndHugeCoordinatesAreErrors) {
   EXPECT_EQ(s.positions[0].x, 0.0);
 }
 
+// tinyobjloader reads a number's exponent into an int, overflowing on ten digits (undefined
+// behaviour, found by fuzz_obj on a tag line): every number it parses is checked first.
+TEST(ObjValidation, ExponentsOfTenDigitsAreErrors) {
+  EXPECT_EQ(obj_error(kTri + "v 1e-2147483648 0 0\nf 1 2 3\n"),
+            "m.obj:4: '1e-2147483648': the exponent is out of range");
+  EXPECT_EQ(obj_error(kTri + "t crease 0/1/0 2.5e+002147483649\nf 1 2 3\n"),
+            "m.obj:4: '2.5e+002147483649': the exponent is out of range");
+  const std::string obj = "mtllib m.mtl\n" + kTri + "usemtl a\nf 1 2 3\n";
+  EXPECT_NE(obj_error(obj, "newmtl a\nmap_Kd -bm 1E-99999999999 t.png\n")
+                .find("m.mtl:2: '1E-99999999999': the exponent is out of range"),
+            std::string::npos);
+  // nine digits are parsed (as 0 here); names are not numbers
+  EXPECT_EQ(obj_error("v 1e-999999999 0 0\nv 1 0 0\nv 0 1 0\nt a 0/0/1 e1234567890\nf 1 2 3\n"),
+            "");
+}
+
 TEST(ObjValidation, AbsurdIndicesAreErrors) {
   EXPECT_EQ(obj_error(kTri + "f 1 2 99999999999999999999999\n"),
             "m.obj:4: face: vertex index 99999999999999999999999 is out of range");

@@ -2,6 +2,7 @@
 // coordinate that is not a number ("v 1 abc 0", "v nan 0 0") as 0 without a word, lets 1e39
 // overflow to infinity in its floats, and reports out-of-range indices only as a warning at the
 // last line: every number and index is checked here, and the first bad one named with its line.
+#include <cctype>
 #include <cfloat>
 #include <charconv>
 #include <climits>
@@ -72,7 +73,27 @@ class LineError {
 
 // A number as tinyobjloader stores it (a float): finite and within float range. Underflow to 0
 // is fine.
+// tinyobjloader's number parser (tryParseDouble) reads a decimal exponent into an int and guards
+// against overflow one digit too late: "1e-2147483648" is undefined behaviour (found by
+// fuzz_obj). It runs on every number of v, vt, vn, vw and t lines and of MTL files (texture
+// options too), so every token of those lines that reads as a number with an exponent of ten or
+// more significant digits is refused (no float has such an exponent).
+void check_exponent(std::string_view tok, const LineError& fail) {
+  std::size_t i = 0;
+  if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
+  while (i < tok.size() && (std::isdigit(static_cast<unsigned char>(tok[i])) || tok[i] == '.')) ++i;
+  if (i == 0 || i >= tok.size() || (tok[i] != 'e' && tok[i] != 'E')) return;
+  ++i;
+  if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
+  while (i < tok.size() && tok[i] == '0') ++i;
+  std::size_t digits = 0;
+  while (i + digits < tok.size() && std::isdigit(static_cast<unsigned char>(tok[i + digits])))
+    ++digits;
+  if (digits >= 10) fail("'" + str(tok) + "': the exponent is out of range");
+}
+
 double number(std::string_view tok, const LineError& fail, const char* what) {
+  check_exponent(tok, fail);
   std::string_view t = tok;
   if (!t.empty() && t[0] == '+') t.remove_prefix(1);
   double v = 0;
@@ -125,6 +146,10 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
       need = 1, what = "texture coordinate", ++count[1];
     } else if (tag == "vn") {
       need = 3, what = "normal", ++count[2];
+    }
+    if (tag == "t") {  // tinyobjloader's tags: ints, reals and strings, unused by lucent
+      for (std::string_view t; !(t = token(rest)).empty();) check_exponent(t, fail);
+      return;
     }
     if (tag == "vw") {
       // tinyobjloader's skin weights (vw vertex joint weight joint weight ...), unused by lucent
@@ -214,6 +239,8 @@ void check_mtl_text(const std::string& path, const std::string& text) {
     const LineError fail(path, ln);
     std::string_view tag = token(rest);
     if (tag.empty()) return;
+    if (tag != "newmtl")
+      for (std::string_view probe = rest, t; !(t = token(probe)).empty();) check_exponent(t, fail);
     static const char* const colours[] = {"Ka", "Kd", "Ks", "Ke", "Kt", "Tf"};
     static const char* const scalars[] = {"Ns", "Ni", "d",   "Tr",    "Pr",    "Pm",
                                           "Ps", "Pc", "Pcr", "aniso", "anisor"};
