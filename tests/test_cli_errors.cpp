@@ -1,7 +1,6 @@
 // Error paths of the CLI: each gives exactly one line on stderr starting with "lucent: error:",
 // nothing on stdout and a non-zero exit status (never a crash, a hang or an uncaught exception).
 #include <gtest/gtest.h>
-
 #include <sys/stat.h>
 
 #include <filesystem>
@@ -201,9 +200,11 @@ TEST(CliErrors, NoMatchingDevice) {
       {base, "LUCENT_DEVICE=no-such-device-xyz",
        "LUCENT_DEVICE 'no-such-device-xyz': no device name contains it"},
       {base, "LUCENT_DEVICE=999", "LUCENT_DEVICE 999: no device with this index"},
-      {base, "LUCENT_DEVICE=99999999999999999999999", "LUCENT_DEVICE 99999999999999999999999: no device with this index"},
+      {base, "LUCENT_DEVICE=99999999999999999999999",
+       "LUCENT_DEVICE 99999999999999999999999: no device with this index"},
       {base, "LUCENT_DEVICE=' '", "LUCENT_DEVICE ' ': empty device selector"},
-      {base, "LUCENT_DEVICE=$(printf '\\377\\376')", "LUCENT_DEVICE '\\xff\\xfe': no device name contains it"},
+      {base, "LUCENT_DEVICE=$(printf '\\377\\376')",
+       "LUCENT_DEVICE '\\xff\\xfe': no device name contains it"},
   };
   for (const Case& c : cases) {
     std::string msg = expect_one_error_line(run_cli(c.args, c.env));
@@ -211,6 +212,45 @@ TEST(CliErrors, NoMatchingDevice) {
     EXPECT_EQ(msg.back(), ')') << msg;
   }
   EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
+
+namespace {
+
+// Light-traced caustics (integrator.caustics) cannot be split into part files or rendered
+// adaptively, nor seen through a thin lens: each is refused with one line before rendering, and
+// no output is written.
+TEST(CliErrors, CausticsRefusalsAreOneLine) {
+  std::string scene = small_scene();
+  std::string dir = scene.substr(0, scene.rfind('/'));
+  lucent::test::write_file(dir + "/path.json", R"({
+    "film": {"width": 8, "height": 8},
+    "integrator": {"type": "path", "spp": 4, "caustics": true},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+    "lights": [{"type": "point", "position": [0, 3, 3], "intensity": [5, 5, 5]}]
+  })");
+  const std::string in = q(dir + "/path.json");
+  struct Case {
+    std::string args, needle;
+  } cases[] = {
+      {"render " + in + " --samples 0:4 -o " + q(dir + "/part.exr"), "part files"},
+      {"render " + in + " --target-error 0.01 -o " + q(dir + "/a.exr"), "adaptive sampling"},
+      {"render " + q(scene) + " --integrator path --caustics --samples 0:4 -o " +
+           q(dir + "/part2.exr"),
+       "part files"},
+  };
+  for (const Case& c : cases) {
+    std::string msg = expect_one_error_line(run_cli(c.args));
+    EXPECT_NE(msg.find("integrator.caustics"), std::string::npos) << c.args << ": " << msg;
+    EXPECT_NE(msg.find(c.needle), std::string::npos) << c.args << ": " << msg;
+  }
+  for (const char* f : {"/part.exr", "/a.exr", "/part2.exr"})
+    EXPECT_FALSE(fs::exists(dir + f)) << f;
+  // the same scene renders with caustics in one process
+  CommandResult ok = run_cli("render " + in + " -q -o " + q(dir + "/ok.exr"));
+  EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
 }  // namespace

@@ -54,6 +54,11 @@ struct RenderPart {
   Accumulation acc;
 };
 
+/// Throws lucent::Error (naming `scene_path`) when the scene renders something part files cannot
+/// hold: light-traced caustics (integrator.caustics with the path integrator), whose splats are
+/// not per-pixel samples. Called by make_part, and by front ends before they render.
+void check_part_scene(const Scene& scene, const std::string& scene_path);
+
 /// The part a session holds after reset(range.begin) and render(range.end - range.begin),
 /// possibly cut short: samples [first_sample, first_sample + spp) of `requested`. `scene_path`
 /// is recorded for information.

@@ -198,6 +198,7 @@ int render_with(const RenderArgs& a) {
   if (a.seed >= 0) scene.integrator.seed = static_cast<std::uint32_t>(a.seed);
   if (!a.integrator.empty()) scene.integrator.type = lucent::cli::parse_integrator(a.integrator);
   lucent::cli::apply_sampling_options(a.sampling, scene);
+  if (range) lucent::check_part_scene(scene, a.scene);
 
   lucent::RenderOptions opt;
   opt.spp = a.spp;

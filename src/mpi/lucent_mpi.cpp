@@ -125,6 +125,7 @@ int run(const Args& a) {
   if (a.width > 0) scene.film.width = a.width;
   if (a.height > 0) scene.film.height = a.height;
   if (a.seed >= 0) scene.integrator.seed = static_cast<std::uint32_t>(a.seed);
+  lucent::check_part_scene(scene, a.scene);
   const std::uint64_t n = a.spp > 0 ? std::uint64_t(a.spp) : scene.integrator.spp;
   if (n < std::uint64_t(g_size))
     throw lucent::Error(std::to_string(g_size) + " ranks for " + std::to_string(n) +

@@ -222,8 +222,16 @@ SampleRange parse_sample_range(const std::string& text, const std::string& what)
   return r;
 }
 
+void check_part_scene(const Scene& scene, const std::string& scene_path) {
+  if (scene.integrator.caustics && scene.integrator.type == IntegratorType::Path)
+    throw Error(scene_path +
+                ": integrator.caustics: part files and MPI ranks cannot hold light-traced "
+                "caustics yet; render this scene in one process, or without caustics");
+}
+
 RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
                      const std::string& scene_path) {
+  check_part_scene(renderer.scene(), scene_path);
   RenderPart p;
   p.acc = renderer.accumulation();
   const Scene& scene = renderer.scene();
