@@ -378,3 +378,24 @@ def test_samplers_clamp_and_adaptive(renderer, small_scene):
         renderer.render_adaptive()  # neither a target nor a budget
     with pytest.raises(ValueError):
         renderer.render_adaptive(target_error=float("nan"))
+
+
+def test_caustics_from_python(renderer, small_dict):
+    """integrator.caustics: a point light's caustic through a mirror appears only with it, and
+    what light tracing cannot do is refused with lucent.Error."""
+    small_dict["materials"]["mirror"] = {"type": "mirror"}
+    small_dict["shapes"].append({"type": "sphere", "center": [-1.5, 1, 0], "radius": 1,
+                                 "material": "mirror"})
+    small_dict["integrator"] = {"type": "path", "max_depth": 4, "sampler": "independent"}
+    means = {}
+    for caustics in (False, True):
+        scene = lucent.scene_from_dict(small_dict)
+        scene.integrator.caustics = caustics
+        renderer.set_scene(scene)
+        renderer.reset()
+        renderer.render(16)
+        means[caustics] = renderer.result().mean.mean()
+    # the mirror sends the point light's light onto the floor: light tracing adds it
+    assert means[True] > means[False] * 1.01
+    with pytest.raises(lucent.Error, match="integrator.caustics"):
+        renderer.render_adaptive(target_error=0.05, min_spp=8, max_spp=64)
