@@ -1,9 +1,9 @@
 /* lucent kernel: caustics by light tracing (integrator.caustics; docs/rendering-model.md,
  * "Caustics by light tracing"). Each camera sample also traces one light path: from a light,
- * through one or more delta scatterings, to the first non-delta vertex, which is connected to
- * the pinhole and splatted with the pixel filter's density into the film's light sums
- * (atomically: any work-item may reach any pixel). The path integrator leaves out the same paths
- * (integrator/path.cl), so the two split path space. The host divides the light sums by the
+ * through one or more delta scatterings, then through non-delta ones; each non-delta vertex is
+ * connected to the pinhole and splatted with the pixel filter's density into the film's light
+ * sums (atomically: any work-item may reach any pixel). The path integrator leaves out the same
+ * paths, E N+ S+ L (integrator/path.cl), so the two split path space. The host divides the light sums by the
  * number of light paths, W * H * spp. */
 #ifndef LUCENT_INTEGRATOR_CAUSTICS_CL
 #define LUCENT_INTEGRATOR_CAUSTICS_CL
@@ -114,6 +114,7 @@ static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
   if (!light_emit(s, ue.z, (float4)(ue.x, ue.y, ud.x, ud.y), &ray, &beta)) return 0;
   const float beta0 = lc_max3(beta);
   lc_uint nonfinite = 0;
+  int state = 0; /* the lobes sampled so far: 0 none, 1 S+, 2 S+ N+ */
   /* scattering vertices 1 .. max_depth - 1: the camera path's segment limit */
   for (lc_uint i = 1; i < P->max_depth; ++i) {
     lc_hit hit;
@@ -122,9 +123,9 @@ static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
     lc_interaction it = interaction_from_hit(s, ray, &hit);
     __global const lc_material* m = &s->materials[it.material];
     lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
-    if (i >= 2u && !(bsdf_lobes(&b) & LC_BSDF_DELTA))
+    if (state != 0 && !(bsdf_lobes(&b) & LC_BSDF_DELTA))
       nonfinite += !caustics_connect(s, ray, &hit, it.p, beta, light_sum, light_sumsq, rays);
-    /* continue through a delta lobe only */
+    /* continue while the lobes read S+ N* */
     lc_uint dim = LC_DIM_LIGHT_PATH + 8u * i;
     float4 ua = lc_rand4(rng, dim);
     float4 ub = lc_rand4(rng, dim + 4u);
@@ -132,13 +133,16 @@ static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
     float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
     if (wo_l.z <= 0.0f) break;
     lc_bsdf_sample bs;
-    if (!bsdf_sample(&b, wo_l, ua.w, ub.x, ub.y, &bs) || !bs.delta) break;
+    if (!bsdf_sample(&b, wo_l, ua.w, ub.x, ub.y, &bs)) break;
+    if (bs.delta ? state == 2 : state == 0) break;
+    state = bs.delta ? 1 : 2;
     lc_real3 wi = normalize(lc_real3_from_float3(frame_to_world(&fr, bs.wi)));
     int transmit = bs.wi.z < 0.0f;
     lc_real side = dot(wi, it.ng);
     if (transmit ? side >= LC_REAL(0.0) : side <= LC_REAL(0.0)) break;
-    /* the adjoint weight: power, not radiance, crosses a refraction (no 1 / eta^2), and the
-     * shading-normal correction |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) */
+    /* the adjoint weight: power, not radiance, crosses a refraction (no 1 / eta^2; lucent's
+     * other BSDFs are symmetric), and the shading-normal correction
+     * |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) */
     float wo_ng = (float)dot(-ray.d, it.ng);
     float corr = wo_l.z * (float)fabs(side) / (wo_ng * fabs(bs.wi.z));
     beta *= bs.weight * (bs.eta * bs.eta * corr);
