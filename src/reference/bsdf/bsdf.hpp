@@ -24,8 +24,9 @@ struct BsdfSample {
   dvec3 wi{0.0};
   dvec3 weight{0.0};  ///< f |cos| / pdf (or the specular weight)
   double pdf = 0;     ///< solid-angle pdf; meaningless when delta
-  /// Delta refraction: eta = n_transmitted / n_incident, whose 1 / eta^2 the weight holds
-  /// (radiance transport); light tracing, which carries power, multiplies it back. 1 otherwise.
+  /// Refraction (delta or rough): eta = n_transmitted / n_incident, whose 1 / eta^2 the weight
+  /// holds (radiance transport); light tracing, which carries power, multiplies it back. 1
+  /// otherwise.
   double eta = 1;
   bool delta = false;
   bool valid = false;

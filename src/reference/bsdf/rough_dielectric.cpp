@@ -85,7 +85,9 @@ class RoughDielectric final : public Bsdf {
       wi = refract(wo, h, oh, eta_);
       if (glm::dot(wi, n_) >= 0) return BsdfSample{};
     }
-    return sampled(wo, wi);
+    BsdfSample s = sampled(wo, wi);
+    if (glm::dot(wi, n_) < 0) s.eta = eta_;  // refracted: f holds 1 / eta^2 (light tracing)
+    return s;
   }
 
   dvec3 albedo() const override { return tint_; }

@@ -1,7 +1,8 @@
 // Caustics by light tracing, written from docs/rendering-model.md ("Caustics by light tracing"):
-// a light chosen uniformly (Lights::emit), a point and direction from it (Light::emit), delta
-// scatterings with the adjoint weight, a connection to the camera at the first non-delta vertex
-// y_i (i >= 2), Russian roulette on the product of the adjoint weights.
+// a light chosen uniformly (Lights::emit), a point and direction from it (Light::emit),
+// scatterings with the adjoint weight while their lobes read S+ N*, a connection to the camera
+// at every vertex y_i with a non-delta BSDF that the path reaches with i >= 2 (paths E N+ S+ L),
+// Russian roulette on the product of the adjoint weights.
 #include "reference/integrator/light_tracer.hpp"
 
 #include <cmath>
@@ -39,27 +40,32 @@ void LightTracer::trace(const Sampler& rng, std::vector<Splat>& out) const {
   dvec3 weight(1.0);  // product of the adjoint weights: beta = e.beta * weight
   Ray ray{e.y, e.d};
   int skip = e.skip;
+  // The lobes sampled at y_1 .. y_{i-1} read S+ N* at every vertex the path reaches with i >= 2
+  // (it ends where they would not); `diffused`: the N* part is not empty.
+  bool diffused = false;
   for (int i = 1; i <= max_vertices; ++i) {
     Hit hit;
     if (!t_.trace(ray, hit, skip)) return;
     skip = -1;
     Surface s = t_.surface(ray, hit);
     std::unique_ptr<Bsdf> b = t_.bsdf(s);
-    // The reference's BSDFs are wholly delta or not: a non-delta one is the path's only
-    // connection (after at least one delta vertex) and its end, whatever lobe it would sample.
-    if (!b->is_delta()) {
-      if (i >= 2) connect(ray, hit, e.beta * weight, out);
-      return;
-    }
+    // The reference's BSDFs are wholly delta or not: a non-delta one is the non-delta part that
+    // the connection evaluates, and samples non-delta lobes only.
+    if (i >= 2 && !b->is_delta()) connect(ray, hit, e.beta * weight, out);
     if (i == max_vertices) return;
     const dvec3 wo = -ray.d;  // towards the arriving light
     BsdfSample bs =
         b->sample(wo, light_dim(rng, i, LC_DIM_BSDF_LOBE), light_dim(rng, i, LC_DIM_BSDF_UV),
                   light_dim(rng, i, LC_DIM_BSDF_UV + 1));
     if (!bs.valid) return;
-    // The adjoint weight: the radiance weight without the 1 / eta^2 of refraction (power is not
-    // compressed into a narrower cone as radiance is), times the shading-normal correction
-    // |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) (Veach's thesis, 5.3).
+    // S+ N* goes on: a non-delta lobe at y_1 (no delta before it) or a delta lobe after a
+    // non-delta one ends the path
+    if (bs.delta ? diffused : i == 1) return;
+    diffused = !bs.delta || diffused;
+    // The adjoint weight, for every lobe: the radiance weight without the 1 / eta^2 of
+    // refraction (power is not compressed into a narrower cone as radiance is; bs.eta, delta or
+    // rough), times the shading-normal correction |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) (Veach's
+    // thesis, 5.3). The other BSDFs are symmetric: their weights are f |wi.ns| / pdf.
     const double corr = std::abs(glm::dot(wo, s.ns)) * std::abs(glm::dot(bs.wi, s.ng)) /
                         (std::abs(glm::dot(wo, s.ng)) * std::abs(glm::dot(bs.wi, s.ns)));
     weight *= bs.weight * (bs.eta * bs.eta) * corr;

@@ -1,7 +1,8 @@
 #pragma once
 // Caustics by light tracing (integrator.caustics, docs/rendering-model.md, "Caustics by light
-// tracing"): one light path per camera sample, traced from a light through delta scatterings
-// (mirror, smooth glass) and connected to the pinhole camera at its first non-delta vertex.
+// tracing"): one light path per camera sample, traced from a light through one or more delta
+// scatterings (mirror, smooth glass), then any non-delta ones, and connected to the pinhole camera
+// at every non-delta vertex after the delta ones (the paths E N+ S+ L).
 // The path integrator leaves out the same paths (path.cpp), so that the two estimators split path
 // space and their sum estimates the path integrator's image, plus point lights' caustics.
 #include <vector>
@@ -23,9 +24,10 @@ class LightTracer {
   LightTracer(const Tracer& tracer, const CameraModel& camera);
 
   /// The light path of one camera sample (rng: its pixel, sample index and seed; the path draws
-  /// from LC_DIM_LIGHT_PATH on): appends its contributions to `out`, at most one per pixel (a
-  /// path ends at its first non-delta vertex, the only one it connects). Contributions are not
-  /// divided by the number of light paths N; non-finite ones are appended as they are.
+  /// from LC_DIM_LIGHT_PATH on): appends its contributions to `out`, one per connection and
+  /// pixel (a path may connect at several vertices, and two of them may reach one pixel).
+  /// Contributions are not divided by the number of light paths N; non-finite ones are appended
+  /// as they are.
   void trace(const Sampler& rng, std::vector<Splat>& out) const;
 
  private:
