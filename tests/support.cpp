@@ -277,4 +277,32 @@ std::map<std::string, std::string> parse_report(const std::string& out) {
   return m;
 }
 
+std::string bounced_caustic_scene(bool caustics, int max_depth, const std::string& light,
+                                  const std::string& more, const std::string& camera) {
+  return R"({
+    "camera": )" +
+         camera + R"(,
+    "film": {"width": 16, "height": 12},
+    "integrator": {"type": "path", "max_depth": )" +
+         std::to_string(max_depth) + R"(, "caustics": )" + (caustics ? "true" : "false") + R"(},
+    "materials": {"white": {"type": "diffuse", "albedo": [0.8, 0.8, 0.8]},
+                  "black": {"type": "diffuse", "albedo": [0, 0, 0]},
+                  "mirror": {"type": "mirror", "reflectance": [1, 1, 1]},
+                  "frosted": {"type": "rough_dielectric", "ior": 1.5, "roughness": 0.3},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [4, 4, 4]}},
+    "shapes": [{"type": "triangles", "material": "white",
+                "positions": [[-6,-6,0],[6,-6,0],[6,6,0],[-6,6,0]],
+                "indices": [0,1,2, 0,2,3]},
+               {"type": "triangles", "material": "white",
+                "positions": [[-1.5,-1.5,1.9],[1.5,-1.5,1.9],[1.5,1.5,1.9],[-1.5,1.5,1.9]],
+                "indices": [0,2,1, 0,3,2]},
+               {"type": "triangles", "material": "black",
+                "positions": [[-1.5,-1.5,1.95],[1.5,-1.5,1.95],[1.5,1.5,1.95],[-1.5,1.5,1.95]],
+                "indices": [0,1,2, 0,2,3]},
+               {"type": "triangles", "material": "mirror",
+                "positions": [[-3,-3,3.2],[3,-3,3.2],[3,3,3.2],[-3,3,3.2]],
+                "indices": [0,2,1, 0,3,2]})" +
+         more + light + "}";
+}
+
 }  // namespace lucent::test

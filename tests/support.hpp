@@ -124,4 +124,18 @@ class CaptureWarnings {
 /// error). Also: no non-finite sample. Reports the first failing pixels with ADD_FAILURE.
 void expect_matches(const RenderResult& r, const std::function<double(int, int, int)>& expected);
 
+// E N N S+ L: the light that a caustic sends on to another diffuse surface. A light at
+// (0, 0, 2.5) under a mirror ceiling z = 3.2 (x, y within +-3, facing down); a black square
+// z = 1.95 (x, y within +-1.5) shades the diffuse floor z = 0 (x, y within +-6) from it, so the
+// floor is lit only by the mirror, in a ring outside the square's shadow. Just under the black
+// square, a diffuse "wall" z = 1.9 of the same size faces the floor: the light and its mirror
+// image are above it, so its only light is the floor's, i.e. light that came off the mirror.
+// The camera at (0, 0, 0.5) looks straight up and sees nothing but the wall.
+// `light` closes the shapes (a sphere lamp, then "]", or "]" and a point light); `more` adds
+// shapes (before `light`), `camera` replaces the camera.
+std::string bounced_caustic_scene(
+    bool caustics, int max_depth, const std::string& light, const std::string& more = "",
+    const std::string& camera =
+        R"({"position": [0, 0, 0.5], "look_at": [0, 0, 1.9], "up": [0, 1, 0], "fov": 60})");
+
 }  // namespace lucent::test

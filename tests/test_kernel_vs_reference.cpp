@@ -294,28 +294,11 @@ TEST(KernelVsReference, PathCausticsLightsInsideGlass) {
 // mirror ceiling, a floor that the mirror lights and that a black square shades from the light,
 // and a white panel just under the square, facing the floor, which is all the camera sees: its
 // light comes only light -> mirror -> floor -> panel, which only light tracing finds (the scene of
-// test_reference_caustics.cpp's PointLightBouncedCaustic).
+// tests/support.hpp's bounced_caustic_scene, as in test_reference_caustics.cpp).
 TEST(KernelVsReference, PathCausticsBouncedOffTheFloor) {
-  Both b = render_both(scene_from(R"({
-    "camera": {"position": [0, 0, 0.5], "look_at": [0, 0, 1.9], "up": [0, 1, 0], "fov": 60},
-    "film": {"width": 16, "height": 12},
-    "integrator": {"type": "path", "max_depth": 4, "caustics": true},
-    "materials": {"white": {"type": "diffuse", "albedo": [0.8, 0.8, 0.8]},
-                  "black": {"type": "diffuse", "albedo": [0, 0, 0]},
-                  "mirror": {"type": "mirror", "reflectance": [1, 1, 1]}},
-    "shapes": [{"type": "triangles", "material": "white",
-                "positions": [[-6,-6,0],[6,-6,0],[6,6,0],[-6,6,0]], "indices": [0,1,2, 0,2,3]},
-               {"type": "triangles", "material": "white",
-                "positions": [[-1.5,-1.5,1.9],[1.5,-1.5,1.9],[1.5,1.5,1.9],[-1.5,1.5,1.9]],
-                "indices": [0,2,1, 0,3,2]},
-               {"type": "triangles", "material": "black",
-                "positions": [[-1.5,-1.5,1.95],[1.5,-1.5,1.95],[1.5,1.5,1.95],[-1.5,1.5,1.95]],
-                "indices": [0,1,2, 0,2,3]},
-               {"type": "triangles", "material": "mirror",
-                "positions": [[-3,-3,3.2],[3,-3,3.2],[3,3,3.2],[-3,3,3.2]],
-                "indices": [0,2,1, 0,3,2]}],
-    "lights": [{"type": "point", "position": [0, 0, 2.5], "intensity": [4, 4, 4]}]
-  })"),
+  Both b = render_both(
+      scene_from(lucent::test::bounced_caustic_scene(
+          true, 4, R"(], "lights": [{"type": "point", "position": [0, 0, 2.5], "intensity": [4, 4, 4]}])")),
                        1024);
   EXPECT_AGREE(b);
   double mean = 0;

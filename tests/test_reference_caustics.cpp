@@ -297,44 +297,7 @@ TEST(ReferenceCaustics, ShadingNormalsMatchPathTracing) {
   });
 }
 
-// E N N S+ L: the light that a caustic sends on to another diffuse surface. A light at
-// (0, 0, 2.5) under a mirror ceiling z = 3.2 (x, y within +-3, facing down); a black square
-// z = 1.95 (x, y within +-1.5) shades the diffuse floor z = 0 (x, y within +-6) from it, so the
-// floor is lit only by the mirror, in a ring outside the square's shadow. Just under the black
-// square, a diffuse "wall" z = 1.9 of the same size faces the floor: the light and its mirror
-// image are above it, so its only light is the floor's, i.e. light that came off the mirror.
-// The camera at (0, 0, 0.5) looks straight up and sees nothing but the wall.
-// `light` closes the shapes (a sphere lamp, then "]", or "]" and a point light); `more` adds
-// shapes (before `light`), `camera` replaces the camera.
-std::string bounced_caustic_scene(
-    bool caustics, int max_depth, const std::string& light, const std::string& more = "",
-    const std::string& camera =
-        R"({"position": [0, 0, 0.5], "look_at": [0, 0, 1.9], "up": [0, 1, 0], "fov": 60})") {
-  return R"({
-    "camera": )" +
-         camera + R"(,
-    "film": {"width": 16, "height": 12},
-    "integrator": {"type": "path", "max_depth": )" +
-         std::to_string(max_depth) + R"(, "caustics": )" + (caustics ? "true" : "false") + R"(},
-    "materials": {"white": {"type": "diffuse", "albedo": [0.8, 0.8, 0.8]},
-                  "black": {"type": "diffuse", "albedo": [0, 0, 0]},
-                  "mirror": {"type": "mirror", "reflectance": [1, 1, 1]},
-                  "frosted": {"type": "rough_dielectric", "ior": 1.5, "roughness": 0.3},
-                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [4, 4, 4]}},
-    "shapes": [{"type": "triangles", "material": "white",
-                "positions": [[-6,-6,0],[6,-6,0],[6,6,0],[-6,6,0]],
-                "indices": [0,1,2, 0,2,3]},
-               {"type": "triangles", "material": "white",
-                "positions": [[-1.5,-1.5,1.9],[1.5,-1.5,1.9],[1.5,1.5,1.9],[-1.5,1.5,1.9]],
-                "indices": [0,2,1, 0,3,2]},
-               {"type": "triangles", "material": "black",
-                "positions": [[-1.5,-1.5,1.95],[1.5,-1.5,1.95],[1.5,1.5,1.95],[-1.5,1.5,1.95]],
-                "indices": [0,1,2, 0,2,3]},
-               {"type": "triangles", "material": "mirror",
-                "positions": [[-3,-3,3.2],[3,-3,3.2],[3,3,3.2],[-3,3,3.2]],
-                "indices": [0,2,1, 0,3,2]})" +
-         more + light + "}";
-}
+using lucent::test::bounced_caustic_scene;
 
 // A point light: the wall is lit only through E N N S L (max_depth 4: camera, wall, floor,
 // mirror, light), which path tracing cannot find with a point light: with caustics off the wall
