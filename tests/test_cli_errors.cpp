@@ -227,8 +227,9 @@ TEST(CliErrors, CausticsRefusalsAreOneLine) {
   lucent::test::write_file(dir + "/path.json", R"({
     "film": {"width": 8, "height": 8},
     "integrator": {"type": "path", "spp": 4, "caustics": true},
-    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
-    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}, "mirror": {"type": "mirror"}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"},
+               {"type": "sphere", "center": [2, 0, 0], "radius": 0.5, "material": "mirror"}],
     "lights": [{"type": "point", "position": [0, 3, 3], "intensity": [5, 5, 5]}]
   })");
   const std::string in = q(dir + "/path.json");

@@ -99,3 +99,30 @@ TEST(Features, FullKernelHasEveryFeatureAndRendersTheSameImage) {
 }
 
 }  // namespace
+
+namespace {
+
+// integrator.caustics compiles the light paths only where a caustic path exists: a surface that
+// scatters by a delta lobe (a mirror, smooth glass, a rough dielectric of ior 1), used by a shape.
+TEST(Features, CausticsOnlyWithADeltaSurface) {
+  auto scene = [](const std::string& material) {
+    std::string j = kDiffuseScene;
+    auto replace = [&j](const std::string& from, const std::string& to) {
+      j.replace(j.find(from), from.size(), to);
+    };
+    replace(R"("max_depth": 4)", R"("max_depth": 4, "caustics": true)");
+    replace(R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]})",
+            R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]}, "x": )" + material);
+    replace(R"("radius": 0.5, "material": "w")", R"("radius": 0.5, "material": "x")");
+    return j;
+  };
+  EXPECT_FALSE(has(features_of(scene(R"({"type": "diffuse"})")), "LC_HAS_CAUSTICS"));
+  EXPECT_FALSE(
+      has(features_of(scene(R"({"type": "rough_dielectric", "ior": 1.5})")), "LC_HAS_CAUSTICS"));
+  EXPECT_TRUE(has(features_of(scene(R"({"type": "mirror"})")), "LC_HAS_CAUSTICS"));
+  EXPECT_TRUE(has(features_of(scene(R"({"type": "dielectric", "ior": 1.5})")), "LC_HAS_CAUSTICS"));
+  EXPECT_TRUE(
+      has(features_of(scene(R"({"type": "rough_dielectric", "ior": 1})")), "LC_HAS_CAUSTICS"));
+}
+
+}  // namespace

@@ -57,7 +57,7 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
     uvs = uvs || (t.flags & LC_TRI_HAS_UVS);
   }
   const bool clamped = scene.integrator.clamp > 0 && scene.integrator.type == IntegratorType::Path;
-  const bool caustics = scene.integrator.caustics && scene.integrator.type == IntegratorType::Path;
+  const bool caustics = (packed.params.flags & LC_FLAG_CAUSTICS) != 0;  // pack_scene decides
   const bool other[] = {smooth,  uvs && textured, textured, scene.camera.aperture > 0,
                         clamped, caustics};
 #define LUCENT_COUNT(feature, what) +1

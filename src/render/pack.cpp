@@ -169,6 +169,19 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   if (p.skipped_triangles > 0)
     scene_detail::warn(scene.path + ": skipped " + std::to_string(p.skipped_triangles) +
                        " degenerate or non-finite triangle(s)");
+  // integrator.caustics: no surface that can scatter by a delta lobe (a mirror, smooth glass, a
+  // rough dielectric of ior 1), no caustic path: the kernel is built and run without light paths
+  if (P.flags & LC_FLAG_CAUSTICS) {
+    auto delta = [&scene](lc_uint mi) {
+      const Material& m = scene.materials[mi];
+      return m.type == MaterialType::Mirror || m.type == MaterialType::Dielectric ||
+             (m.type == MaterialType::RoughDielectric && static_cast<float>(m.ior) == 1.0f);
+    };
+    bool any = false;
+    for (const lc_sphere& sp : p.spheres) any = any || delta(sp.material);
+    for (const lc_triangle& t : p.triangles) any = any || delta(t.material);
+    if (!any) P.flags &= ~LC_FLAG_CAUSTICS;
+  }
 
   const bool reuse = previous && same_geometry(*previous, p);
   if (bvh_reused) *bvh_reused = reuse;
