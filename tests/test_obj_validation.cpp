@@ -69,6 +69,11 @@ TEST(ObjValidation, ExponentsOfTenDigitsAreErrors) {
   EXPECT_NE(obj_error(obj, "newmtl a\nmap_Kd -bm 1E-99999999999 t.png\n")
                 .find("m.mtl:2: '1E-99999999999': the exponent is out of range"),
             std::string::npos);
+  // tinyobjloader reads on past a '#' inside a line: so do the checks
+  EXPECT_EQ(obj_error(kTri + "vw 1 0 # 1e39\nf 1 2 3\n"),
+            "m.obj:4: skin weight line: '#' is not a number");
+  EXPECT_EQ(obj_error(kTri + "v 1 2 3 # 1e-2147483648\nf 1 2 3\n"),
+            "m.obj:4: '1e-2147483648': the exponent is out of range");
   // nine digits are parsed (as 0 here); names are not numbers
   EXPECT_EQ(obj_error("v 1e-999999999 0 0\nv 1 0 0\nv 0 1 0\nt a 0/0/1 e1234567890\nf 1 2 3\n"),
             "");

@@ -53,6 +53,19 @@ std::string_view token(std::string_view& rest) {
   return t;
 }
 
+// The next whitespace-separated token of `rest`, '#' included: tinyobjloader treats '#' as a
+// comment only at the start of a line, and parses the numbers after a '#' further on ("vw 0 0 #
+// 1e39" converts 1e39 to int, found by fuzz_obj), so its number checks see every token.
+std::string_view raw_token(std::string_view& rest) {
+  std::size_t i = 0;
+  while (i < rest.size() && space(rest[i])) ++i;
+  std::size_t j = i;
+  while (j < rest.size() && !space(rest[j])) ++j;
+  std::string_view t = rest.substr(i, j - i);
+  rest.remove_prefix(j);
+  return t;
+}
+
 std::string str(std::string_view s) {
   std::string out(s.substr(0, 40));
   if (s.size() > 40) out += "...";
@@ -148,14 +161,14 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
       need = 3, what = "normal", ++count[2];
     }
     if (tag == "t") {  // tinyobjloader's tags: ints, reals and strings, unused by lucent
-      for (std::string_view t; !(t = token(rest)).empty();) check_exponent(t, fail);
+      for (std::string_view t; !(t = raw_token(rest)).empty();) check_exponent(t, fail);
       return;
     }
     if (tag == "vw") {
       // tinyobjloader's skin weights (vw vertex joint weight joint weight ...), unused by lucent
       // but parsed: it converts each joint to int unchecked (1e11 is undefined behaviour)
       int n = 0;
-      for (std::string_view t; !(t = token(rest)).empty(); ++n) {
+      for (std::string_view t; !(t = raw_token(rest)).empty(); ++n) {
         const double v = number(t, fail, "skin weight");
         if (n % 2 == 1 && !(v >= 0 && v <= INT_MAX))
           fail("skin weight line: joint '" + str(t) + "' is out of range (0 to " +
@@ -164,6 +177,9 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
       return;
     }
     if (what) {
+      // tinyobjloader reads up to six numbers (a vertex colour), past a '#' too
+      for (std::string_view probe = rest, t; !(t = raw_token(probe)).empty();)
+        check_exponent(t, fail);
       int n = 0;
       for (std::string_view t; !(t = token(rest)).empty(); ++n) number(t, fail, what);
       if (n < need)
@@ -240,7 +256,8 @@ void check_mtl_text(const std::string& path, const std::string& text) {
     std::string_view tag = token(rest);
     if (tag.empty()) return;
     if (tag != "newmtl")
-      for (std::string_view probe = rest, t; !(t = token(probe)).empty();) check_exponent(t, fail);
+      for (std::string_view probe = rest, t; !(t = raw_token(probe)).empty();)
+        check_exponent(t, fail);
     static const char* const colours[] = {"Ka", "Kd", "Ks", "Ke", "Kt", "Tf"};
     static const char* const scalars[] = {"Ns", "Ni", "d",   "Tr",    "Pr",    "Pm",
                                           "Ps", "Pc", "Pcr", "aniso", "anisor"};
