@@ -430,6 +430,7 @@ class Checker {
       fail("OpenEXR file has an invalid version field");
     if (version.multipart || version.non_image)
       fail("multi-part and deep OpenEXR files are not supported");
+    exr_attribute_sizes();
     EXRHeader header;
     InitEXRHeader(&header);
     const char* err = nullptr;
@@ -488,6 +489,37 @@ class Checker {
       guard.keep = true;
     }
     return p;
+  }
+
+  // tinyexr 1.0.1 reads the value of two header attributes without checking its size: "tiles"
+  // as 9 bytes (a 1-byte one is a heap over-read, found by fuzz_texture) and "compression" as 1.
+  // The header's attributes (name, type, int32 size, value; a null byte ends the list) are
+  // walked first and those two must have their sizes; a header that ends early is left to
+  // tinyexr's own error.
+  void exr_attribute_sizes() const {
+    std::size_t pos = 8;  // magic number and version
+    auto cstring = [&](std::string* out) {
+      const void* end = pos < n_ ? std::memchr(d_ + pos, 0, n_ - pos) : nullptr;
+      if (!end) return false;
+      const std::size_t len = static_cast<const unsigned char*>(end) - (d_ + pos);
+      out->assign(reinterpret_cast<const char*>(d_ + pos), len);
+      pos += len + 1;
+      return true;
+    };
+    while (pos < n_ && d_[pos] != 0) {
+      std::string name, type;
+      if (!cstring(&name) || !cstring(&type) || pos + 4 > n_) return;
+      const std::uint32_t size = std::uint32_t(d_[pos]) | std::uint32_t(d_[pos + 1]) << 8 |
+                                 std::uint32_t(d_[pos + 2]) << 16 |
+                                 std::uint32_t(d_[pos + 3]) << 24;
+      pos += 4;
+      const std::size_t want = name == "tiles" ? 9 : (name == "compression" ? 1 : 0);
+      if (want && size != want)
+        fail("OpenEXR header attribute '" + name + "' has " + std::to_string(size) +
+             " bytes, not " + std::to_string(want));
+      if (size > n_ - pos) return;
+      pos += size;
+    }
   }
 
   // tinyexr 1.0.1 reads a PIZ chunk's bitmap, its Huffman length and the Huffman header
