@@ -38,21 +38,6 @@ void for_each_line(const std::string& text, F&& f) {
   }
 }
 
-// The next whitespace-separated token of `rest` (empty at the end of the line or at a comment).
-std::string_view token(std::string_view& rest) {
-  std::size_t i = 0;
-  while (i < rest.size() && space(rest[i])) ++i;
-  std::size_t j = i;
-  while (j < rest.size() && !space(rest[j])) ++j;
-  std::string_view t = rest.substr(i, j - i);
-  rest.remove_prefix(j);
-  if (!t.empty() && t[0] == '#') {
-    rest = {};
-    return {};
-  }
-  return t;
-}
-
 // The next whitespace-separated token of `rest`, '#' included: tinyobjloader treats '#' as a
 // comment only at the start of a line, and parses the numbers after a '#' further on ("vw 0 0 #
 // 1e39" converts 1e39 to int, found by fuzz_obj), so its number checks see every token.
@@ -63,6 +48,16 @@ std::string_view raw_token(std::string_view& rest) {
   while (j < rest.size() && !space(rest[j])) ++j;
   std::string_view t = rest.substr(i, j - i);
   rest.remove_prefix(j);
+  return t;
+}
+
+// The next whitespace-separated token of `rest` (empty at the end of the line or at a comment).
+std::string_view token(std::string_view& rest) {
+  std::string_view t = raw_token(rest);
+  if (!t.empty() && t[0] == '#') {
+    rest = {};
+    return {};
+  }
   return t;
 }
 
