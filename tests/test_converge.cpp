@@ -296,11 +296,11 @@ TEST(Converge, KernelLadderAgainstKernelReference) {
   ASSERT_EQ(lines.size(), 16u);
   EXPECT_EQ(lines[0],
             "setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s,"
-            "reference_noise_relmse,estimated_relmse");
+            "reference_noise_relmse,estimated_relmse,halves_relmse");
   const char* names[] = {"default", "max_depth=1", "max_depth=2"};
   for (size_t i = 1; i < lines.size(); ++i) {
     std::vector<std::string> f = split(lines[i], ',');
-    ASSERT_EQ(f.size(), 10u) << lines[i];
+    ASSERT_EQ(f.size(), 11u) << lines[i];
     EXPECT_EQ(f[0], names[(i - 1) / 5]);
     EXPECT_EQ(std::stoi(f[1]), opt.spp_ladder[(i - 1) % 5]);
     EXPECT_GE(std::stod(f[2]), 0.0);
@@ -397,7 +397,7 @@ TEST(Converge, CommandTimeLadderAndCpuReference) {
   ASSERT_EQ(csv.size(), 3u);
   for (size_t i = 1; i < csv.size(); ++i) {
     std::vector<std::string> f = split(csv[i], ',');
-    ASSERT_EQ(f.size(), 10u);
+    ASSERT_EQ(f.size(), 11u);
     EXPECT_EQ(f[0], "default");
     EXPECT_GE(std::stoi(f[1]), 1);
   }

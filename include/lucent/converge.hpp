@@ -78,6 +78,8 @@ struct ConvergePoint {
   double reference_noise_relmse = 0;
   /// Adaptive renders: the relMSE the render's own variances predict (RenderResult).
   double estimated_relmse = 0;
+  /// Adaptive renders: the a-posteriori relMSE from the halves' difference (RenderResult).
+  double halves_relmse = 0;
 };
 
 /// The error curve of one setting, fitted on log-log axes.
@@ -140,7 +142,7 @@ std::uint32_t reference_seed(std::uint32_t scene_seed);
 std::vector<int> default_spp_ladder(int max_spp);
 
 /// CSV: setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s,
-/// reference_noise_relmse,estimated_relmse; one row a point.
+/// reference_noise_relmse,estimated_relmse,halves_relmse; one row a point.
 std::string convergence_csv(const ConvergeResult& result);
 
 /// The render time at which one setting's points (in ladder order) reach relMSE `error`,

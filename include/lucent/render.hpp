@@ -77,9 +77,19 @@ struct RenderResult {
   std::string device;                  ///< the device's name ("A + B" for several)
   std::vector<DeviceShare> devices;    ///< each device's part of the accumulation
   /// Adaptive renders: the relMSE that the image's own per-pixel variances predict (mean over
-  /// pixel-channels of var / n / (mean^2 + 0.01)), and the target; 0 for uniform renders.
+  /// pixel-channels of var / n / (mean^2 + 0.01)), each half's share scaled by its model_gain
+  /// when the render had a target, and the target; 0 for uniform renders.
   double estimated_relmse = 0;
   double target_error = 0;
+  /// Adaptive renders: the a-posteriori relMSE from the difference of the two halves (mean over
+  /// pixel-channels of (A - B)^2 / 4 / (mean^2 + 0.01)), an unbiased estimate of the error
+  /// variance for any sampler, Sobol included (noisy on small films); 0 for uniform renders.
+  double halves_relmse = 0;
+  /// Adaptive renders with a target: the calibration's gains of halves A and B (measured error of
+  /// a pilot over the v / n model's; ~1 with independent samples, < 1 with Sobol), and the
+  /// relMSE the calibrated plans predicted; 0 otherwise.
+  double model_gain_a = 0, model_gain_b = 0;
+  double planned_relmse = 0;
 };
 
 /// Renders `scene` with the OpenCL megakernel: a one-shot lucent::Renderer session

@@ -329,6 +329,14 @@ void bind_render(py::module_& m) {
       .def_readonly("nonfinite", &RenderResult::nonfinite)
       .def_readonly("estimated_relmse", &RenderResult::estimated_relmse,
                     "an adaptive render's estimate of its relMSE (0: not adaptive)")
+      .def_readonly("halves_relmse", &RenderResult::halves_relmse,
+                    "an adaptive render's relMSE from its halves' difference (0: not adaptive)")
+      .def_readonly("model_gain_a", &RenderResult::model_gain_a,
+                    "a target render's calibration gain of half A's error model (0: none)")
+      .def_readonly("model_gain_b", &RenderResult::model_gain_b,
+                    "a target render's calibration gain of half B's error model (0: none)")
+      .def_readonly("planned_relmse", &RenderResult::planned_relmse,
+                    "the relMSE a target render's calibrated plans predicted (0: none)")
       .def_readonly("target_error", &RenderResult::target_error,
                     "the relMSE an adaptive render aimed at (0: not adaptive)")
       .def_readonly("rays", &RenderResult::rays)
@@ -491,6 +499,7 @@ void bind_render(py::module_& m) {
       .def_readonly("noise_relmse", &ConvergePoint::noise_relmse)
       .def_readonly("reference_noise_relmse", &ConvergePoint::reference_noise_relmse)
       .def_readonly("estimated_relmse", &ConvergePoint::estimated_relmse)
+      .def_readonly("halves_relmse", &ConvergePoint::halves_relmse)
       .def("__repr__", [](const ConvergePoint& p) {
         return "<lucent.ConvergePoint " + p.setting + " " + std::to_string(p.spp) +
                " spp, relMSE " + std::to_string(p.relmse) + ">";

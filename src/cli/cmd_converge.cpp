@@ -83,7 +83,7 @@ CLI::App* add_converge_command(CLI::App& app) {
   cmd->add_option("scene", a.scene, "Scene file (JSON)")->required();
   cmd->add_option("--csv", a.csv,
                   "Write setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s,"
-                  "reference_noise_relmse,estimated_relmse");
+                  "reference_noise_relmse,estimated_relmse,halves_relmse");
   cmd->add_option("--plot", a.plots,
                   "Write a plot of relMSE against time (log-log): .svg, or .png (raster); may be "
                   "given more than once");

@@ -285,9 +285,11 @@ int render_with(const RenderArgs& a) {
         seconds > 0 ? double(r.rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
         r.device.c_str(), device_shares(r.devices).c_str());
   if (!a.quiet && r.target_error > 0)
-    std::fprintf(stderr, "%s: adaptive: %llu spp on average, estimated relMSE %.3g (target %.3g)\n",
+    std::fprintf(stderr,
+                 "%s: adaptive: %llu spp on average, estimated relMSE %.3g (target %.3g; model "
+                 "gains %.3g, %.3g), from the halves' difference %.3g\n",
                  a.output.c_str(), static_cast<unsigned long long>(r.spp), r.estimated_relmse,
-                 r.target_error);
+                 r.target_error, r.model_gain_a, r.model_gain_b, r.halves_relmse);
   if (!r.cancelled && !a.reference) write_aovs(a, scene, &*renderer, r);
   if (r.cancelled || g_interrupted.load()) {
     const int sig = g_signal ? static_cast<int>(g_signal) : SIGINT;

@@ -25,7 +25,7 @@ std::vector<double> relative_variance(const std::vector<double>& sum,
 }
 
 SamplePlan plan_samples(const std::vector<double>& v, int width, int height, double target,
-                        double budget, std::uint32_t min_n, std::uint32_t max_n) {
+                        double budget, std::uint32_t min_n, std::uint32_t max_n, double gain) {
   const std::size_t npix = static_cast<std::size_t>(width) * height;
   max_n = std::max(max_n, min_n);
   // the shape: sqrt of the larger of the pixel's variance and its 3 x 3 neighbourhood's mean
@@ -52,7 +52,7 @@ SamplePlan plan_samples(const std::vector<double>& v, int width, int height, dou
       predicted += shape[i] * shape[i] / n;  // the smoothed variance: see plan_samples' doc
       total += n;
     }
-    plan.predicted = npix ? predicted / double(npix) : 0;
+    plan.predicted = npix ? gain * predicted / double(npix) : 0;
     plan.mean = npix ? total / double(npix) : 0;
   };
   // reaching the goal is monotone in lambda: bisect on log(lambda) between "every count at
@@ -90,6 +90,73 @@ SamplePlan plan_samples(const std::vector<double>& v, int width, int height, dou
     fill(lo);  // the largest lambda found within the budget
   }
   return plan;
+}
+
+Calibration calibrate_model(const std::vector<double>& o_sum, const std::vector<double>& o_sumsq,
+                            const std::vector<std::uint32_t>& o_count,
+                            const std::vector<double>& c_sum, const std::vector<double>& c_sumsq,
+                            const std::vector<std::uint32_t>& c_count, double lo, double hi) {
+  Calibration cal;
+  for (std::size_t i = 0; i < c_count.size() && i < o_count.size(); ++i) {
+    const double no = o_count[i], nc = c_count[i];
+    if (no < 2 || nc < 2) continue;
+    ++cal.pixels;
+    for (int c = 0; c < 3; ++c) {
+      const std::size_t k = i * 3 + c;
+      const double mo = o_sum[k] / no, mc = c_sum[k] / nc, value = 0.5 * (mo + mc);
+      const double w = 1 / (value * value + 0.01);
+      // one sample's variance pooled over O and C (squared deviations from each one's own mean)
+      const double ss =
+          std::max(0.0, o_sumsq[k] - o_sum[k] * mo) + std::max(0.0, c_sumsq[k] - c_sum[k] * mc);
+      const double s2 = ss / (no + nc - 2);
+      cal.measured += w * (mo - mc) * (mo - mc) / 2;
+      cal.modelled += w * s2 * (1 / no + 1 / nc) / 2;
+    }
+  }
+  if (cal.modelled > 0)
+    cal.gain = std::clamp(cal.measured / cal.modelled, lo, hi);
+  else
+    cal.gain = cal.measured > 0 ? hi : 1;  // no variance seen: nothing to scale
+  return cal;
+}
+
+HalfPlans plan_halves(const Pilot& a, const Pilot& b, const Pilot& c, int width, int height,
+                      double target, double budget, std::uint32_t min_n, std::uint32_t max_n) {
+  HalfPlans out;
+  const Pilot* other[2] = {&b, &a};
+  for (int h = 0; h < 2; ++h) {
+    const Pilot& o = *other[h];
+    if (target > 0)
+      out.calib[h] = calibrate_model(o.sum, o.sumsq, o.count, c.sum, c.sumsq, c.count);
+    out.plan[h] =
+        plan_samples(o.v, width, height, 2 * target, budget / 2, min_n, max_n, out.calib[h].gain);
+  }
+  return out;
+}
+
+int calibration_stride(int width, int height, std::size_t min_pixels) {
+  for (int s = 4; s > 1; --s) {
+    const std::size_t n =
+        static_cast<std::size_t>((width + s - 1 - s / 2) / s) * ((height + s - 1 - s / 2) / s);
+    if (n >= min_pixels) return s;
+  }
+  return 1;
+}
+
+double halves_relmse(const std::vector<double>& sum_a, const std::vector<std::uint32_t>& n_a,
+                     const std::vector<double>& sum_b, const std::vector<std::uint32_t>& n_b) {
+  double total = 0;
+  std::size_t pixels = 0;
+  for (std::size_t i = 0; i < n_a.size() && i < n_b.size(); ++i) {
+    if (n_a[i] == 0 || n_b[i] == 0) continue;
+    ++pixels;
+    for (int c = 0; c < 3; ++c) {
+      const double a = sum_a[i * 3 + c] / n_a[i], b = sum_b[i * 3 + c] / n_b[i];
+      const double value = 0.5 * (a + b);
+      total += (a - b) * (a - b) / 4 / (value * value + 0.01);
+    }
+  }
+  return pixels ? total / (3.0 * double(pixels)) : 0;
 }
 
 void combine_halves(const double* sum_a, const double* sumsq_a, std::uint32_t n_a,

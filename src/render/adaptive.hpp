@@ -23,6 +23,13 @@
 // plan by the clock: the counts then depend on how long the passes took, which depends on the
 // samples only through the cost of tracing them; a render that completes its plan has none of
 // this. Non-finite samples are left out and counted, as in every render.)
+//
+// With a target error, the plan's scale comes from the model "relMSE of a pixel = v / n", which
+// holds for independent samples but over-predicts for Owen-scrambled Sobol samples (their error
+// falls faster). A third stream C (lc_stream_seed(seed, 2)) renders the same pilot on a sparse
+// subset of pixels; C's samples are never averaged into the image. Half A's model is scaled by a
+// gain measured from B's pilot and C (calibrate_model), B's from A's pilot and C: the argument
+// above is unchanged, since A's counts still read nothing of A's samples.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -49,11 +56,75 @@ struct SamplePlan {
 /// of its 3 x 3 neighbourhood (a pixel whose pilot saw little of a noisy neighbourhood still gets
 /// samples), clamped to [min_n, max_n]. With target > 0 the counts are the smallest such that
 /// the predicted relMSE of the half's image, mean of that raised v over n (v itself would
-/// under-predict: the pixels whose pilot under-estimated v get fewer samples), is at most target (max_n everywhere
-/// when even that does not reach it); otherwise the largest such that the mean count is at most
-/// budget. Raising `target` or lowering `budget` never raises a count.
+/// under-predict: the pixels whose pilot under-estimated v get fewer samples), is at most target
+/// (max_n everywhere when even that does not reach it); otherwise the largest such that the mean
+/// count is at most budget. Raising `target` or lowering `budget` never raises a count. `gain`
+/// scales the model (calibrate_model): the predicted relMSE is gain times the mean of the raised v
+/// over n (gain 1: independent samples); it plays no part in a budget's plan.
 SamplePlan plan_samples(const std::vector<double>& v, int width, int height, double target,
-                        double budget, std::uint32_t min_n, std::uint32_t max_n);
+                        double budget, std::uint32_t min_n, std::uint32_t max_n, double gain = 1);
+
+/// The calibration of the plan's error model "relMSE of a pixel = v / n" (exact for independent
+/// samples; Owen-scrambled Sobol samples do better, by a factor that depends on the scene and on
+/// n). A third stream C (lc_stream_seed(seed, 2)) renders a pilot on a sparse subset of the
+/// pixels; at each pixel p of the subset, the pilot mean O_p of the other half (the one whose
+/// pilot plans this half) and C's mean C_p are independent estimates of the same value, so
+/// E[(O_p - C_p)^2] / 2 is the variance of one pilot's mean, whatever the sampler. Summed over
+/// the subset's pixel-channels with relMSE's weights 1 / (value^2 + 0.01) (the value (O_p +
+/// C_p) / 2) this is `measured`; `modelled` is the same sum of the model's variance of that
+/// pilot mean, s^2 (1/n_O + 1/n_C) / 2 (= s^2 / m for equal counts), with s^2 the variance of one
+/// sample pooled over O and C. gain = measured / modelled, clamped to [lo, hi]: ~1 for
+/// independent samples, below 1 for Sobol. It reads O and C only, never the half it plans, so
+/// that half's counts stay independent of its samples (the argument above).
+///
+/// The gain is measured at the pilot's m samples; Sobol's error falls faster than 1 / n, so at
+/// the larger counts of a plan the calibrated model still over-predicts (conservative).
+struct Calibration {
+  double gain = 1;
+  double measured = 0, modelled = 0;  ///< the sums above
+  std::size_t pixels = 0;             ///< pixels of the subset with >= 2 samples in O and C
+};
+Calibration calibrate_model(const std::vector<double>& o_sum, const std::vector<double>& o_sumsq,
+                            const std::vector<std::uint32_t>& o_count,
+                            const std::vector<double>& c_sum, const std::vector<double>& c_sumsq,
+                            const std::vector<std::uint32_t>& c_count, double lo = 1.0 / 64,
+                            double hi = 4);
+
+/// What the plans read of a finished pilot: per-pixel relative variances v (relative_variance;
+/// empty for C) and the sums, sums of squares (3 channels) and counts on the calibration pixels.
+struct Pilot {
+  std::vector<double> v;
+  std::vector<double> sum, sumsq;
+  std::vector<std::uint32_t> count;
+};
+
+/// Both halves' plans: half h's plan (h = 0: A, 1: B) from the other half's pilot and, with a
+/// target, C's: calib[h] = calibrate_model(other, c) and plan[h] = plan_samples(other.v, ...,
+/// 2 target, budget / 2, min_n, max_n, calib[h].gain) (a half at 2 E makes the average of the
+/// two E). Nothing of half h's pilot reaches plan[h] or calib[h]. With a budget, calib stays at
+/// gain 1 and c is not read.
+struct HalfPlans {
+  SamplePlan plan[2];
+  Calibration calib[2];
+};
+HalfPlans plan_halves(const Pilot& a, const Pilot& b, const Pilot& c, int width, int height,
+                      double target, double budget, std::uint32_t min_n, std::uint32_t max_n);
+
+/// The pixels of stream C's pilot: every `stride`-th pixel of every `stride`-th row (offset
+/// stride / 2), stride the largest in 1..4 that keeps at least `min_pixels` of them (1: the
+/// whole film). Returns the stride.
+int calibration_stride(int width, int height, std::size_t min_pixels = 4096);
+
+/// The a-posteriori relMSE of the average of the halves: the mean over pixel-channels of
+/// (A_p - B_p)^2 / 4 / (value^2 + 0.01), value (A_p + B_p) / 2, over the pixels where both halves
+/// have samples. E[(A_p - B_p)^2] / 4 is the variance of (A_p + B_p) / 2 for any sampler, counts
+/// planned or not: given all of A's stream, B's count is fixed (it reads A's pilot only) and B's
+/// samples are independent of A's, so E[B_p | A's stream] = mu_p; hence E[A_p B_p] = mu_p^2, the
+/// halves are uncorrelated, and E[(A_p - B_p)^2] = Var A_p + Var B_p = 4 Var((A_p + B_p) / 2).
+/// Noisy per pixel (one degree of freedom), fine over an image. Reported, never read by a
+/// decision.
+double halves_relmse(const std::vector<double>& sum_a, const std::vector<std::uint32_t>& n_a,
+                     const std::vector<double>& sum_b, const std::vector<std::uint32_t>& n_b);
 
 /// One pixel of an adaptive render from its two halves' sums (3 channels), sums of squares and
 /// counts: mean = (mean_A + mean_B) / 2 (one half's mean alone when the other has no sample),

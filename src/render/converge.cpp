@@ -371,6 +371,7 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
       p.noise_relmse = noise_relmse(r, reference);
       p.reference_noise_relmse = ref_noise;
       p.estimated_relmse = r.estimated_relmse;
+      p.halves_relmse = r.halves_relmse;
       if (options.on_point) options.on_point(p);
       pts.push_back(p);
     }
@@ -386,7 +387,7 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
 std::string convergence_csv(const ConvergeResult& result) {
   std::string out =
       "setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s,"
-      "reference_noise_relmse,estimated_relmse\n";
+      "reference_noise_relmse,estimated_relmse,halves_relmse\n";
   char buf[256];
   for (const ConvergePoint& p : result.points) {
     std::string name = p.setting;
@@ -395,10 +396,10 @@ std::string convergence_csv(const ConvergeResult& result) {
       for (char c : name) q += c == '"' ? std::string("\"\"") : std::string(1, c);
       name = q + "\"";
     }
-    std::snprintf(buf, sizeof buf, ",%llu,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n",
+    std::snprintf(buf, sizeof buf, ",%llu,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n",
                   static_cast<unsigned long long>(p.spp), p.seconds, p.samples_per_second, p.rmse,
                   p.relmse, p.noise_relmse, p.rays_per_second, p.reference_noise_relmse,
-                  p.estimated_relmse);
+                  p.estimated_relmse, p.halves_relmse);
     out += name + buf;
   }
   return out;

@@ -545,15 +545,24 @@ struct Renderer::Impl {
 
   /// One half of an adaptive render: stream `h` (seed lc_stream_seed(seed, h)), its per-pixel
   /// sums, the samples launched (sample indices first .. first + launched - 1) and planned, and
-  /// the relative variance of its pilot, which plans the other half.
+  /// what the plans read of its pilot (render_detail::Pilot: the relative variances, which plan
+  /// the other half, and the sums on calib_pixels, which calibrate the other half's plan).
   struct Half {
     std::vector<double> sum, sumsq;
     std::vector<std::uint32_t> count, launched, plan;
-    std::vector<double> pilot_v;
+    render_detail::Pilot pilot;
+    bool piloted = false;
   };
   bool adaptive = false;
   std::uint32_t pilot = 0;  // per pixel and half
-  Half halves[2];
+  /// A and B, then C: stream 2, the calibration's pilot (render_detail::calibrate_model) on
+  /// calib_pixels only, never averaged into the image; its vectors stay empty until a render with
+  /// a target needs it (a budget's plan has no use for the model's scale).
+  Half halves[3];
+  std::vector<std::size_t> calib_pixels;
+  bool calibrated = false;              // calib holds a target render's calibration
+  render_detail::Calibration calib[2];  // calib[h]: the gain of half h's plan
+  double planned_relmse[2] = {0, 0};    // the calibrated plans' predictions (target renders)
   double adaptive_target = 0;
 
   void clear_adaptive() {
@@ -561,6 +570,24 @@ struct Renderer::Impl {
     pilot = 0;
     adaptive_target = 0;
     for (Half& h : halves) h = Half{};
+    calib_pixels.clear();
+    calibrated = false;
+    calib[0] = calib[1] = render_detail::Calibration{};
+    planned_relmse[0] = planned_relmse[1] = 0;
+  }
+
+  /// The sums (3 channels) and counts of `h` on the calibration pixels, in their order.
+  void calibration_sums(const Half& h, render_detail::Pilot& p) const {
+    p.sum.clear();
+    p.sumsq.clear();
+    p.count.clear();
+    for (std::size_t i : calib_pixels) {
+      for (int c = 0; c < 3; ++c) {
+        p.sum.push_back(h.sum[i * 3 + c]);
+        p.sumsq.push_back(h.sumsq[i * 3 + c]);
+      }
+      p.count.push_back(h.count[i]);
+    }
   }
 
   /// Renders every (half, pixel) up to its plan, in rounds: each round gives every entry still
@@ -575,14 +602,14 @@ struct Renderer::Impl {
       for (auto& w : workers) pass_samples += double(w->pass_spp) * double(npix);
       size_t active = 0;
       for (const Half& h : halves)
-        for (size_t i = 0; i < npix; ++i) active += h.launched[i] < h.plan[i];
+        for (size_t i = 0; i < h.plan.size(); ++i) active += h.launched[i] < h.plan[i];
       if (active == 0) return true;
       const std::uint32_t cap = static_cast<std::uint32_t>(
           std::clamp(std::ceil(pass_samples / double(active)), 1.0, 65536.0));
       list.reserve(active);
-      for (lc_uint hi = 0; hi < 2; ++hi) {
+      for (lc_uint hi = 0; hi < 3; ++hi) {
         const Half& h = halves[hi];
-        for (size_t i = 0; i < npix; ++i)
+        for (size_t i = 0; i < h.plan.size(); ++i)
           if (h.launched[i] < h.plan[i]) {
             cl_uint4 e;
             e.s[0] = static_cast<cl_uint>(i);
@@ -657,14 +684,21 @@ struct Renderer::Impl {
             "first)");
       adaptive = true;
       pilot = m;
-      for (Half& h : halves) {
+      for (int hi = 0; hi < 2; ++hi) {
+        Half& h = halves[hi];
         h.sum.assign(npix * 3, 0.0);
         h.sumsq.assign(npix * 3, 0.0);
         h.count.assign(npix, 0u);
         h.launched.assign(npix, 0u);
         h.plan.assign(npix, m);
-        h.pilot_v.clear();
+        h.pilot = render_detail::Pilot{};
+        h.piloted = false;
       }
+      const int width = scene->film.width, height = scene->film.height;
+      const int stride = render_detail::calibration_stride(width, height);
+      for (int y = stride / 2; y < height; y += stride)
+        for (int x = stride / 2; x < width; x += stride)
+          calib_pixels.push_back(static_cast<std::size_t>(y) * width + x);
     } else if (pilot != m) {
       throw Error("render_adaptive: min_spp " + std::to_string(o.min_spp) +
                   " differs from the adaptive render in progress (call reset() first)");
@@ -686,21 +720,43 @@ struct Renderer::Impl {
                            (planned() - call_start) / npix, o.max_seconds);
     };
     const double time_limit = o.max_seconds;
-    // the pilot: `pilot` samples in every pixel of both halves
+    Half& calib_half = halves[2];
+    if (o.target_error > 0 && calib_half.plan.empty()) {
+      // the calibration's pilot: `pilot` samples of stream C in each calibration pixel
+      calib_half.sum.assign(npix * 3, 0.0);
+      calib_half.sumsq.assign(npix * 3, 0.0);
+      calib_half.count.assign(npix, 0u);
+      calib_half.launched.assign(npix, 0u);
+      calib_half.plan.assign(npix, 0u);
+      for (std::size_t i : calib_pixels) calib_half.plan[i] = m;
+    }
+    // the pilot: `pilot` samples in every pixel of both halves (and C's, above)
     if (!render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress))
       return progress();
-    for (Half& h : halves)
-      if (h.pilot_v.empty()) h.pilot_v = render_detail::relative_variance(h.sum, h.sumsq, h.count);
-    // each half planned from the other's pilot alone: its mean stays unbiased (adaptive.hpp); a
-    // half's predicted relMSE 2 E makes the average of the two halves' E
-    const std::uint32_t max_half = std::max(m, o.max_spp / 2);
     for (int hi = 0; hi < 2; ++hi) {
-      render_detail::SamplePlan p =
-          render_detail::plan_samples(halves[1 - hi].pilot_v, scene->film.width, scene->film.height,
-                                      2 * o.target_error, o.budget_spp / 2, m, max_half);
-      for (size_t i = 0; i < npix; ++i)
-        halves[hi].plan[i] = std::max(halves[hi].plan[i], p.counts[i]);
+      Half& h = halves[hi];
+      if (h.piloted) continue;  // its samples are no longer only the pilot's
+      h.pilot.v = render_detail::relative_variance(h.sum, h.sumsq, h.count);
+      calibration_sums(h, h.pilot);
+      h.piloted = true;
     }
+    render_detail::Pilot c;
+    if (o.target_error > 0) calibration_sums(calib_half, c);  // C holds its pilot only
+    // each half planned (and, with a target, calibrated) from the other's pilot and C alone: its
+    // mean stays unbiased (adaptive.hpp)
+    const std::uint32_t max_half = std::max(m, o.max_spp / 2);
+    const render_detail::HalfPlans plans =
+        render_detail::plan_halves(halves[0].pilot, halves[1].pilot, c, scene->film.width,
+                                   scene->film.height, o.target_error, o.budget_spp, m, max_half);
+    for (int hi = 0; hi < 2; ++hi) {
+      for (size_t i = 0; i < npix; ++i)
+        halves[hi].plan[i] = std::max(halves[hi].plan[i], plans.plan[hi].counts[i]);
+      if (o.target_error > 0) {
+        calib[hi] = plans.calib[hi];
+        planned_relmse[hi] = plans.plan[hi].predicted;
+      }
+    }
+    calibrated = calibrated || o.target_error > 0;
     adaptive_target = o.target_error;
     render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress);
     return progress();
@@ -714,21 +770,34 @@ struct Renderer::Impl {
     r.variance = Image{width, height, std::vector<float>(npix * 3)};
     r.samples = count;
     if (adaptive) {
-      // the average of the halves (render/adaptive.hpp), and the relMSE its variances predict
+      // the average of the halves (render/adaptive.hpp), the relMSE its variances predict with
+      // each half's model scaled by its calibration's gain (1 without one), and the halves'
+      // a-posteriori estimate
+      const Half &a = halves[0], &b = halves[1];
+      const double ga = calibrated ? calib[0].gain : 1, gb = calibrated ? calib[1].gain : 1;
       double predicted = 0;
       for (size_t i = 0; i < npix; ++i) {
-        const Half &a = halves[0], &b = halves[1];
         render_detail::combine_halves(&a.sum[i * 3], &a.sumsq[i * 3], a.count[i], &b.sum[i * 3],
                                       &b.sumsq[i * 3], b.count[i], &r.mean.rgb[i * 3],
                                       &r.variance.rgb[i * 3], &r.samples[i]);
+        if (r.samples[i] == 0) continue;
+        // var / n is s^2 (1/n_A + 1/n_B) / 4; the calibrated model's is s^2 (g_A/n_A + g_B/n_B) / 4
+        const double na = a.count[i], nb = b.count[i];
+        const double gain =
+            na > 0 && nb > 0 ? (ga / na + gb / nb) / (1 / na + 1 / nb) : (na > 0 ? ga : gb);
         for (int c = 0; c < 3; ++c) {
           const double m = r.mean.rgb[i * 3 + c];
-          if (r.samples[i] > 0)
-            predicted += r.variance.rgb[i * 3 + c] / r.samples[i] / (m * m + 0.01);
+          predicted += gain * r.variance.rgb[i * 3 + c] / r.samples[i] / (m * m + 0.01);
         }
       }
       r.estimated_relmse = npix ? predicted / (3.0 * double(npix)) : 0;
+      r.halves_relmse = render_detail::halves_relmse(a.sum, a.count, b.sum, b.count);
       r.target_error = adaptive_target;
+      if (calibrated) {
+        r.model_gain_a = calib[0].gain;
+        r.model_gain_b = calib[1].gain;
+        r.planned_relmse = (planned_relmse[0] + planned_relmse[1]) / 4;
+      }
     } else {
       for (size_t i = 0; i < npix; ++i) {
         double n = count[i];
