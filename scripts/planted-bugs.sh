@@ -5,7 +5,7 @@
 #
 #   scripts/planted-bugs.sh [--build DIR] [--jobs N] [--work DIR] [BUG...]
 #
-# BUG: baseline (the unmodified copy: every test must pass), 1 ... 5 (default: all of them).
+# BUG: baseline (the unmodified copy: every test must pass), 1 ... 7 (default: all of them).
 # Results: WORK/<bug>.failed (one failing test per line) and WORK/<bug>.log (ctest's output).
 # Each run starts from cold caches: about 2-3 minutes on two quiet cores.
 set -euo pipefail
@@ -21,7 +21,7 @@ while [[ $# -gt 0 && "$1" == --* ]]; do
 done
 [[ -n "$jobs" ]] || jobs="$(scripts/cpus.sh)"
 bugs=("$@")
-[[ ${#bugs[@]} -gt 0 ]] || bugs=(baseline 1 2 3 4 5)
+[[ ${#bugs[@]} -gt 0 ]] || bugs=(baseline 1 2 3 4 5 6 7)
 build="$(cd "$build" && pwd)"
 mkdir -p "$work"
 
@@ -39,6 +39,10 @@ plant() {
        from='static inline lc_real3 lc_spawn_origin(lc_real3 p, lc_real3 perr, lc_real3 n) {'
        to="$from return p + 1e-4f * n;" ;;
     5) file=integrator/path.cl from='beta /= q;' to='' ;;
+    6) file=integrator/caustics.cl from='beta *= bs.weight * (bs.eta * bs.eta * corr);'
+       to='beta *= bs.weight * corr;' ;;
+    7) file=shared/rng.h from='out[1] = lc_reverse_bits(lc_owen_hash(lc_sobol1_reversed(i), key[2]));'
+       to='out[1] = lc_reverse_bits(lc_owen_hash(lc_sobol1_reversed(i), key[1]));' ;;
     *) echo "planted-bugs: unknown bug $1" >&2; return 1 ;;
   esac
   python3 - "$2/$file" "$from" "$to" <<'EOF'

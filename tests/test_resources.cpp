@@ -126,7 +126,15 @@ TEST(Resources, HostEstimateCoversThePackedScene) {
   EXPECT_EQ(part(parts, "the accumulation and result images of the 32x32 film"), 32u * 32 * 80);
   const std::uint64_t gpu_part = part(parts, "the buffers of device 'gpu'");
   EXPECT_EQ(gpu_part, 32u * 32 * 32);
-  EXPECT_GE(part(parts, "the buffers of device 'cpu'"), gpu_part + 32u * 32 * 32 + tris + tree);
+  EXPECT_EQ(part(parts, "the buffers of device 'cpu'"), gpu_part + 32u * 32 * 48);
+  EXPECT_GE(part(parts, "the scene's buffers on device 'cpu'"), tris + tree);
+  for (const MemoryPart& p : parts) EXPECT_EQ(p.what.find("caustics"), std::string::npos);
+  // caustics: the light sums in doubles, and two more float4 read-back buffers per device
+  s.integrator.type = lucent::IntegratorType::Path;
+  s.integrator.caustics = true;
+  parts = lucent::render_detail::estimate_host_memory(s, {gpu, cpu});
+  EXPECT_EQ(part(parts, "the caustics light sums of the 32x32 film"), 32u * 32 * 48);
+  EXPECT_EQ(part(parts, "the buffers of device 'gpu'"), 32u * 32 * 64);
 }
 
 // Over the host limit: one line naming the total, the limit, the largest part and what to reduce.
@@ -193,14 +201,21 @@ TEST(Resources, DeviceLimitsNameTheBuffer) {
   d.max_alloc = 0;
   d.global_mem = 6 << 20;
   msg = error_of([&] { lucent::render_detail::check_device_memory(s, packed, d); });
-  EXPECT_EQ(msg.rfind("s.json: the scene and film buffers need 8.0 MiB on device 'Tiny GPU', more "
-                      "than its 6.0 MiB of global memory (CL_DEVICE_GLOBAL_MEM_SIZE); the largest "
-                      "is the film sample sums (512x512) (4.0 MiB): reduce the film size",
+  // sums, sums of squares and the work list: 3 x 4 MiB
+  EXPECT_EQ(msg.rfind("s.json: the scene and film buffers need 12.0 MiB on device 'Tiny GPU', "
+                      "more than its 6.0 MiB of global memory (CL_DEVICE_GLOBAL_MEM_SIZE); the "
+                      "largest is the film sample sums (512x512) (4.0 MiB): reduce the film size",
                       0),
             0u)
       << msg;
-  d.global_mem = 9 << 20;
+  d.global_mem = 13 << 20;
   EXPECT_EQ(error_of([&] { lucent::render_detail::check_device_memory(s, packed, d); }), "");
+  // with caustics the light paths' sums and sums of squares take two more film buffers
+  packed.params.flags |= LC_FLAG_CAUSTICS;
+  msg = error_of([&] { lucent::render_detail::check_device_memory(s, packed, d); });
+  EXPECT_EQ(msg.rfind("s.json: the scene and film buffers need 20.0 MiB on device 'Tiny GPU'", 0),
+            0u)
+      << msg;
 }
 
 // A session applies both checks before it allocates, and stays usable after a refusal.

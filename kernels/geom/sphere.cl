@@ -31,6 +31,13 @@ static inline lc_real sphere_intersect(lc_real3 center, lc_real radius, lc_real3
   return INFINITY;
 }
 
+/* The bound on the absolute error of a point of the sphere (centre c, radius r), per component:
+ * a few ulps of |c| + r, the representation limit (in lc_real) of its surface. Shared by hits
+ * (sphere_interaction) and emitted points (light/sphere.cl). */
+static inline lc_real3 sphere_point_error(lc_real3 c, lc_real r) {
+  return (fabs(c) + r) * (LC_REAL(8.0) * LC_REAL_U);
+}
+
 /* The surface at a hit on a sphere. */
 static inline void sphere_interaction(const lc_scene* s, lc_ray ray, const lc_hit* hit,
                                       lc_interaction* it) {
@@ -39,8 +46,7 @@ static inline void sphere_interaction(const lc_scene* s, lc_ray ray, const lc_hi
   lc_real3 p = ray.o + hit->t * ray.d;
   lc_real3 n = normalize(p - c);
   it->p = c + sp->radius * n; /* reproject onto the surface */
-  /* a few ulps of |c| + r: the representation limit (in lc_real) of this sphere's surface */
-  it->perr = (fabs(c) + sp->radius) * (LC_REAL(8.0) * LC_REAL_U);
+  it->perr = sphere_point_error(c, sp->radius);
   it->ng = n;
   float3 nf = lc_float3_from_real3(n);
   it->ns = nf;

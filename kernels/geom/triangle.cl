@@ -82,6 +82,15 @@ static inline int triangle_intersect(const lc_tri_ray* r, lc_real3 o, lc_real3 v
   return 1;
 }
 
+/* The bound on the absolute error of the point b0 v0 + b1 v1 + b2 v2, per component: gamma(7) of
+ * the barycentric interpolation (pbrt-v4, section 6.8), lc_real's gamma. Shared by hits
+ * (triangle_interaction) and emitted points (light/triangle.cl). */
+static inline lc_real3 triangle_point_error(lc_real b0, lc_real b1, lc_real b2, lc_real3 v0,
+                                            lc_real3 v1, lc_real3 v2) {
+  return (fabs(b0 * v0) + fabs(b1 * v1) + fabs(b2 * v2)) *
+         (LC_REAL(7.0) * LC_REAL_U * LC_REAL(1.0001));
+}
+
 /* The surface at a hit on a triangle: barycentric position, interpolated normals and uvs where
  * the triangle has them (LC_HAS_SMOOTH_NORMALS, LC_HAS_UVS). */
 static inline void triangle_interaction(const lc_scene* s, lc_ray ray, const lc_hit* hit,
@@ -90,9 +99,7 @@ static inline void triangle_interaction(const lc_scene* s, lc_ray ray, const lc_
   lc_real3 v0 = lc_load3r(tri->v0), v1 = lc_load3r(tri->v1), v2 = lc_load3r(tri->v2);
   lc_real b1 = hit->b1, b2 = hit->b2, b0 = LC_REAL(1.0) - b1 - b2;
   it->p = b0 * v0 + b1 * v1 + b2 * v2;
-  /* gamma(7) bound of the barycentric interpolation (pbrt-v4, section 6.8), lc_real's gamma */
-  it->perr = (fabs(b0 * v0) + fabs(b1 * v1) + fabs(b2 * v2)) *
-             (LC_REAL(7.0) * LC_REAL_U * LC_REAL(1.0001));
+  it->perr = triangle_point_error(b0, b1, b2, v0, v1, v2);
   lc_real3 ng = normalize(cross(v1 - v0, v2 - v0));
   it->ng = ng;
   float3 ngf = lc_float3_from_real3(ng);

@@ -27,9 +27,8 @@ static inline void caustics_splat(const lc_scene* s, float fx, float fy, float3 
   __global const lc_params* P = s->params;
   const float r = P->filter_radius;
   const int W = (int)P->width, H = (int)P->height;
-  if (!(fx > -r - 1.0f && fx < (float)W + r + 1.0f && fy > -r - 1.0f && fy < (float)H + r + 1.0f))
-    return;
-  /* pixels whose centre (x + 0.5) lies within r of fx */
+  /* caustics_connect has checked that (fx, fy) lies within r of the film (so the casts to int
+   * below are in range); the pixels whose centre (x + 0.5) lies within r of fx: */
   int x0 = max(0, (int)ceil(fx - r - 0.5f)), x1 = min(W - 1, (int)floor(fx + r - 0.5f));
   int y0 = max(0, (int)ceil(fy - r - 0.5f)), y1 = min(H - 1, (int)floor(fy + r - 0.5f));
   for (int y = y0; y <= y1; ++y)

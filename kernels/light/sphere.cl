@@ -69,7 +69,7 @@ static inline int light_sphere_emit(const lc_scene* s, __global const lc_light* 
   lc_real3 c = lc_load3r(sp->center);
   lc_real r = sp->radius;
   lc_real3 n = normalize(lc_real3_from_float3(sample_uniform_sphere(u.x, u.y)));
-  lc_real3 perr = (fabs(c) + r) * (LC_REAL(8.0) * LC_REAL_U); /* as sphere_interaction */
+  lc_real3 perr = sphere_point_error(c, r);
   lc_real3 t, b;
   lc_onbr(n, &t, &b);
   float3 d = sample_cosine_hemisphere(u.z, u.w);

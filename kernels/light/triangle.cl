@@ -46,9 +46,7 @@ static inline int light_triangle_emit(const lc_scene* s, __global const lc_light
   lc_real su = sqrt((lc_real)u.x);
   lc_real b0 = LC_REAL(1.0) - su, b1 = u.y * su, b2 = LC_REAL(1.0) - b0 - b1;
   lc_real3 q = b0 * v0 + b1 * v1 + b2 * v2;
-  /* as triangle_interaction */
-  lc_real3 perr =
-      (fabs(b0 * v0) + fabs(b1 * v1) + fabs(b2 * v2)) * (LC_REAL(7.0) * LC_REAL_U * LC_REAL(1.0001));
+  lc_real3 perr = triangle_point_error(b0, b1, b2, v0, v1, v2);
   lc_real3 nl = normalize(cross(v1 - v0, v2 - v0));
   lc_real3 t, b;
   lc_onbr(nl, &t, &b);

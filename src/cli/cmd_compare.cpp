@@ -20,7 +20,7 @@ struct CompareArgs {
   std::string zmap;
 };
 
-CompareArgs& args() {
+CompareArgs& compare_args() {
   static CompareArgs a;
   return a;
 }
@@ -28,7 +28,7 @@ CompareArgs& args() {
 }  // namespace
 
 CLI::App* add_compare_command(CLI::App& app) {
-  CompareArgs& a = args();
+  CompareArgs& a = compare_args();
   CLI::App* cmd = app.add_subcommand(
       "compare", "Compare two renders statistically (z-test per pixel; EXR with var.*/n layers)");
   cmd->add_option("a", a.a, "First image (.exr with variance layers, or any image)")->required();
@@ -51,7 +51,7 @@ CLI::App* add_compare_command(CLI::App& app) {
 }
 
 int run_compare_command() {
-  CompareArgs& a = args();
+  CompareArgs& a = compare_args();
   a.options.image_mean_test = !a.no_mean_test;
   for (const std::string& in : {a.a, a.b})
     if (!a.zmap.empty() && io::same_file(a.zmap, in))

@@ -45,7 +45,7 @@ struct ConvergeArgs {
   bool quiet = false;
 };
 
-ConvergeArgs& args() {
+ConvergeArgs& converge_args() {
   static ConvergeArgs a;
   return a;
 }
@@ -77,7 +77,7 @@ void write_text(const std::string& path, const std::string& text) {
 }  // namespace
 
 CLI::App* add_converge_command(CLI::App& app) {
-  ConvergeArgs& a = args();
+  ConvergeArgs& a = converge_args();
   CLI::App* cmd = app.add_subcommand(
       "converge", "Error against a reference for a ladder of spp or time budgets and settings");
   cmd->add_option("scene", a.scene, "Scene file (JSON)")->required();
@@ -98,14 +98,14 @@ CLI::App* add_converge_command(CLI::App& app) {
   ref->excludes(ref_spp)->excludes(ref_cpu);
   cmd->add_option("--save-reference", a.save_reference,
                   "Write the rendered reference to this .exr (reuse it with --reference)");
-  cmd->add_option("--settings", a.settings,
-                  "Comma-separated settings, knobs joined by +: default, fast-math, "
-                  "double, float, no-specialize, no-mis, mis, max_depth=N, rr_depth=N, filter=" +
-                      type_names<FilterType>("|") +
-                      "[:R], integrator=" + type_names<IntegratorType>("|") +
-                      ", sampler=" + type_names<SamplerType>("|") +
-                      ", clamp=X, caustics, no-caustics, adaptive, min-spp=N, target-error=E (default: "
-                      "default)")
+  cmd->add_option(
+         "--settings", a.settings,
+         "Comma-separated settings, knobs joined by +: default, fast-math, "
+         "double, float, no-specialize, no-mis, mis, max_depth=N, rr_depth=N, filter=" +
+             type_names<FilterType>("|") + "[:R], integrator=" + type_names<IntegratorType>("|") +
+             ", sampler=" + type_names<SamplerType>("|") +
+             ", clamp=X, caustics, no-caustics, adaptive, min-spp=N, target-error=E (default: "
+             "default)")
       ->delimiter(',');
   auto* spp = cmd->add_option("--spp-ladder", a.spp_ladder, "Samples per pixel of each rung")
                   ->delimiter(',')
@@ -150,7 +150,7 @@ void print_time_to_common_error(const ConvergeResult& result) {
 }
 
 int run_converge_command() {
-  ConvergeArgs& a = args();
+  ConvergeArgs& a = converge_args();
   if (!a.csv.empty()) check_writable(a.csv, a.scene);
   for (const std::string& plot : a.plots) {
     std::string ext = io::lower_extension(plot);

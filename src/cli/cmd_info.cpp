@@ -27,7 +27,7 @@ struct InfoArgs {
   SamplingArgs sampling;
 };
 
-InfoArgs& args() {
+InfoArgs& info_args() {
   static InfoArgs a;
   return a;
 }
@@ -59,26 +59,27 @@ void print_counts(const std::map<E, std::size_t>& counts) {
 CLI::App* add_info_command(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("info", "Print scene statistics, its BVH and the kernel feature defines");
-  cmd->add_option("scene", args().scene, "Scene file (JSON)")->required();
-  cmd->add_option("--integrator", args().integrator,
+  cmd->add_option("scene", info_args().scene, "Scene file (JSON)")->required();
+  cmd->add_option("--integrator", info_args().integrator,
                   "Show the scene with this integrator (as render --integrator): " +
                       type_names<IntegratorType>());
-  cmd->add_option("--precision", args().precision,
+  cmd->add_option("--precision", info_args().precision,
                   "Show the build options for this precision: float (default) or double")
       ->check(CLI::IsMember({"float", "double"}));
-  cmd->add_flag("--fast-math", args().fast_math,
+  cmd->add_flag("--fast-math", info_args().fast_math,
                 "Show the build options with -cl-fast-relaxed-math");
-  cmd->add_flag("--no-specialize", args().no_specialize,
+  cmd->add_flag("--no-specialize", info_args().no_specialize,
                 "Show the build options of the full kernel");
-  add_sampling_options(cmd, args().sampling, false);
+  add_sampling_options(cmd, info_args().sampling, false);
   return cmd;
 }
 
 int run_info_command() {
-  const std::string& path = args().scene;
+  const std::string& path = info_args().scene;
   Scene scene = load_scene(path);
-  if (!args().integrator.empty()) scene.integrator.type = parse_integrator(args().integrator);
-  apply_sampling_options(args().sampling, scene);
+  if (!info_args().integrator.empty())
+    scene.integrator.type = parse_integrator(info_args().integrator);
+  apply_sampling_options(info_args().sampling, scene);
   render_detail::PackedScene packed = render_detail::pack_scene(scene);
 
   std::printf("scene         %s\n", path.c_str());
@@ -148,9 +149,9 @@ int run_info_command() {
   std::string defines = render_detail::feature_defines(scene, packed);
   if (!defines.empty() && defines[0] == ' ') defines.erase(0, 1);
   RenderOptions options;
-  options.precision = parse_precision(args().precision);
-  options.fast_math = args().fast_math;
-  options.specialize = !args().no_specialize;
+  options.precision = parse_precision(info_args().precision);
+  options.fast_math = info_args().fast_math;
+  options.specialize = !info_args().no_specialize;
   std::printf("\nkernel\n");
   std::string kernel_dir = SessionOptions::from_environment().kernel_dir;
   std::printf("  sources             %s\n", kernel_dir.empty() ? "embedded" : kernel_dir.c_str());

@@ -22,7 +22,7 @@ struct MergeArgs {
   bool quiet = false;
 };
 
-MergeArgs& args() {
+MergeArgs& merge_args() {
   static MergeArgs a;
   return a;
 }
@@ -30,7 +30,7 @@ MergeArgs& args() {
 }  // namespace
 
 CLI::App* add_merge_command(CLI::App& app) {
-  MergeArgs& a = args();
+  MergeArgs& a = merge_args();
   CLI::App* cmd = app.add_subcommand(
       "merge", "Merge the part files of sample-range renders (render --samples A:B) exactly");
   cmd->add_option("parts", a.parts, "Part files (.exr written by render --samples)")->required();
@@ -44,7 +44,7 @@ CLI::App* add_merge_command(CLI::App& app) {
 }
 
 int run_merge_command() {
-  MergeArgs& a = args();
+  MergeArgs& a = merge_args();
   for (const std::string& in : a.parts)
     if (io::same_file(a.output, in))
       throw Error(a.output + ": is an input of the merge; refusing to overwrite it");

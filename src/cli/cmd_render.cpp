@@ -309,17 +309,17 @@ int render_with(const RenderArgs& a) {
   return 0;
 }
 
-RenderArgs& args() {
+RenderArgs& render_args() {
   static RenderArgs a;
   return a;
 }
 
 }  // namespace
 
-const std::string& render_scene() { return args().scene; }
+const std::string& render_scene() { return render_args().scene; }
 
 CLI::App* add_render_command(CLI::App& app) {
-  RenderArgs& ra = args();
+  RenderArgs& ra = render_args();
   CLI::App* render = app.add_subcommand("render", "Render a JSON scene to an image");
   render->add_option("scene", ra.scene, "Scene file (JSON)")->required();
   render
@@ -372,6 +372,6 @@ CLI::App* add_render_command(CLI::App& app) {
   return render;
 }
 
-int run_render_command() { return render_with(args()); }
+int run_render_command() { return render_with(render_args()); }
 
 }  // namespace lucent::cli

@@ -89,6 +89,12 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                    npix * (6 * sizeof(double) + sizeof(std::uint32_t) + 6 * sizeof(float) +
                            sizeof(std::uint32_t)),
                    "the film size"});
+  // caustics: the light paths' sums and sums of squares (3 + 3 doubles per pixel); an upper
+  // bound (pack_scene drops caustics from a scene without a delta surface)
+  const bool caustics = scene.integrator.caustics && scene.integrator.type == IntegratorType::Path;
+  if (caustics)
+    parts.push_back({"the caustics light sums of the " + film + " film", npix * 6 * sizeof(double),
+                     "the film size, or render without caustics"});
   // the packed scene (pack.cpp): a triangle and its attributes, a sphere, a texel as float4, and
   // an environment map's sampling table (a float per texel)
   const std::uint64_t ntri = scene.triangles.size(), nsph = scene.spheres.size();
@@ -120,13 +126,17 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                    "the number of triangles and spheres"});
   const std::uint64_t scene_buffers = tri_bytes + sph_bytes + tex_bytes + bvh_tree;
   for (const DeviceLimits& d : devices) {
-    // the pass read-back (session.cpp: h_sum, h_sumsq)
-    std::uint64_t bytes = 2 * npix * sizeof(cl_float4);
-    // a CPU device's buffers are host memory: the scene's and the film's
-    if (d.host_unified) bytes += scene_buffers + 2 * npix * sizeof(cl_float4);
+    // the pass read-back (session.cpp: h_sum, h_sumsq, and h_light, h_lightsq with caustics)
+    const std::uint64_t film_bufs = (caustics ? 4 : 2) * npix * sizeof(cl_float4);
+    std::uint64_t bytes = film_bufs;
+    // a CPU device's buffers are host memory: the film's (and the work list), and the scene's
+    if (d.host_unified) bytes += film_bufs + npix * sizeof(cl_uint4);
     parts.push_back({"the buffers of device '" + d.device + "' for the " + film + " film" +
-                         (d.host_unified ? " and the scene (host memory)" : ""),
-                     bytes, d.host_unified ? "the film size or the scene" : "the film size"});
+                         (d.host_unified ? " (host memory)" : ""),
+                     bytes, "the film size"});
+    if (d.host_unified)
+      parts.push_back({"the scene's buffers on device '" + d.device + "' (host memory)",
+                       scene_buffers, "the number of triangles or the textures' resolution"});
   }
   return parts;
 }
@@ -144,11 +154,21 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
               "): reduce " + big.reduce);
 }
 
-std::vector<MemoryPart> film_device_buffers(int width, int height) {
+std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics) {
   const std::uint64_t npix = std::uint64_t(width) * std::uint64_t(height);
   const std::string film = film_size(width, height);
-  return {{"film sample sums (" + film + ")", npix * sizeof(cl_float4), "the film size"},
-          {"film sums of squares (" + film + ")", npix * sizeof(cl_float4), "the film size"}};
+  // session.cpp's Worker: the work list, the pass sums, and the light paths' sums (one element
+  // each without caustics)
+  std::vector<MemoryPart> parts = {
+      {"film sample sums (" + film + ")", npix * sizeof(cl_float4), "the film size"},
+      {"film sums of squares (" + film + ")", npix * sizeof(cl_float4), "the film size"},
+      {"film work list (" + film + ")", npix * sizeof(cl_uint4), "the film size"}};
+  const std::uint64_t nl = caustics ? npix : 1;
+  parts.push_back({"caustics light sums (" + film + ")", nl * sizeof(cl_float4),
+                   caustics ? "the film size, or render without caustics" : "the film size"});
+  parts.push_back({"caustics light sums of squares (" + film + ")", nl * sizeof(cl_float4),
+                   caustics ? "the film size, or render without caustics" : "the film size"});
+  return parts;
 }
 
 void check_device_memory(const Scene& scene, const PackedScene& packed,
@@ -160,7 +180,8 @@ void check_device_memory(const Scene& scene, const PackedScene& packed,
                    reduce_buffer(#name)});
   LC_SCENE_BUFFERS(LUCENT_BUFFER_PART)
 #undef LUCENT_BUFFER_PART
-  for (MemoryPart& p : film_device_buffers(scene.film.width, scene.film.height))
+  for (MemoryPart& p : film_device_buffers(scene.film.width, scene.film.height,
+                                           (packed.params.flags & LC_FLAG_CAUSTICS) != 0))
     parts.push_back(std::move(p));
   const std::string device = "device '" + limits.device + "'";
   // the largest buffer is the one to reduce first

@@ -61,8 +61,10 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
 void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
                        std::uint64_t host_limit, const std::string& limit_what = "physical memory");
 
-/// The film buffers of a device: the pass's sums and sums of squares (float4 per pixel).
-std::vector<MemoryPart> film_device_buffers(int width, int height);
+/// The film buffers of a device: the pass's sums and sums of squares (float4 per pixel), the
+/// work list (uint4 per pixel), and the light paths' sums and sums of squares (float4 per pixel
+/// with `caustics`, one element without).
+std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics);
 
 /// Before upload: every scene buffer of `packed` (by its LC_SCENE_BUFFERS description) and film
 /// buffer must fit in one allocation of the device, and all of them in its global memory.

@@ -79,7 +79,8 @@ struct Worker {
   std::optional<render_detail::DeviceScene> dev;
   size_t npix = 0;
   cl::Buffer b_work, b_sum, b_sumsq, b_counters;  // work list: npix entries at most
-  cl::Buffer b_light, b_lightsq;                  // caustics: the light paths' splats
+  cl::Buffer b_light, b_lightsq;  // caustics: the light paths' splats (one element without)
+  bool light_buffers = false;     // b_light and b_lightsq hold npix elements
   std::vector<cl_float4> h_sum, h_sumsq, h_light, h_lightsq;
   std::uint32_t pass_spp = 1;  // samples per pixel of its next pass (tuned to pass_seconds)
   DeviceShare share;           // of the accumulation
@@ -315,15 +316,23 @@ struct Renderer::Impl {
           stats.buffer_uploads += up.buffers;
           stats.bytes_uploaded += up.bytes;
         }
-        if (n != w.npix || !w.b_sum()) {
+        // the light sums take a film's worth of memory only when the kernel traces light paths
+        const bool light = next.params.flags & LC_FLAG_CAUSTICS;
+        if (n != w.npix || !w.b_sum() || light != w.light_buffers) {
           w.npix = n;
           w.b_work = cl::Buffer(w.ctx.context, CL_MEM_READ_ONLY, n * sizeof(cl_uint4));
           w.b_sum = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
           w.b_sumsq = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
           w.b_counters =
               cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
-          w.b_light = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, n * sizeof(cl_float4));
-          w.b_lightsq = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, n * sizeof(cl_float4));
+          const size_t nl = light ? n : 1;
+          w.b_light = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
+          w.b_lightsq = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
+          w.light_buffers = light;
+          if (!light) {
+            std::vector<cl_float4>().swap(w.h_light);
+            std::vector<cl_float4>().swap(w.h_lightsq);
+          }
         }
         w.set_args();
         if (w.program != previous_program) {
