@@ -31,10 +31,10 @@ plant() {
   case "$1" in
     baseline) return 0 ;;
     1) file=bsdf/fresnel.cl from='return 0.5f * (rs * rs + rp * rp);' to='return rs * rs;' ;;
-    2) file=integrator/path.cl from='L += beta * f * ls.L * (wi_l.z * w / ls.pdf);'
-       to='L += beta * f * ls.L * (w / ls.pdf);' ;;
-    3) file=light/light.cl from='ls->pdf = L->pdf_select * d2 / (cos_l * L->area);'
-       to='ls->pdf = L->pdf_select * d2 / L->area;' ;;
+    2) file=integrator/path.cl from='beta * f * ls.L * (fabs(wi_l.z) * w / ls.pdf)'
+       to='beta * f * ls.L * (w / ls.pdf)' ;;
+    3) file=light/triangle.cl from='ls->pdf = L->pdf_select * d2 / (cos_l * L->p.triangle.area);'
+       to='ls->pdf = L->pdf_select * d2 / L->p.triangle.area;' ;;
     4) file=util/math.cl
        from='static inline lc_real3 lc_spawn_origin(lc_real3 p, lc_real3 perr, lc_real3 n) {'
        to="$from return p + 1e-4f * n;" ;;
