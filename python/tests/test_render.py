@@ -374,6 +374,11 @@ def test_samplers_clamp_and_adaptive(renderer, small_scene):
     r = renderer.result()
     assert 0 < r.estimated_relmse <= 0.05 and r.target_error == 0.05
     assert r.samples.min() >= 8 and r.samples.max() <= 256
+    # the calibration and the halves' estimate come through: gains within their clamp, the plan
+    # at the target, and an a-posteriori estimate from the two halves' difference
+    assert 1 / 64 <= r.model_gain_a <= 4 and 1 / 64 <= r.model_gain_b <= 4
+    assert 0 < r.planned_relmse <= 0.05
+    assert r.halves_relmse > 0
     with pytest.raises(ValueError):
         renderer.render_adaptive()  # neither a target nor a budget
     with pytest.raises(ValueError):
