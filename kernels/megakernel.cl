@@ -27,7 +27,9 @@
  * is pixel i and renders samples [sample_offset, sample_offset + samples_per_pass) with the seed.
  * Either way a sample's random numbers depend only on its pixel, index and seed. With
  * integrator.caustics each camera sample also traces a light path that adds to light_sum and
- * light_sumsq, any pixel's (integrator/caustics.cl; uniform passes only). */
+ * light_sumsq, any pixel's (integrator/caustics.cl): a uniform pass's to elements [0, W H), a
+ * work list's stream s < 2 to elements [s W H, (s + 1) W H) (the adaptive halves' separate light
+ * estimates); stream 2, the calibration's, traces none. */
 __kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global const uint4* work,
                             __global float4* out_sum, __global float4* out_sumsq,
                             __global lc_uint* counters, __global float4* light_sum,
@@ -37,6 +39,10 @@ __kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global const uint4* work,
   lc_rng rng;
   rng.sampler = params->sampler;
   lc_uint first, count;
+#ifdef LC_HAS_CAUSTICS
+  lc_uint light_base = 0u; /* the light sums' first element for this work-item's stream */
+  int trace_light = 1;
+#endif
   if (params->work_items > 0u) {
     if (gid >= params->work_items) return;
     uint4 e = work[gid];
@@ -44,6 +50,10 @@ __kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global const uint4* work,
     first = e.y;
     count = e.z;
     rng.seed = lc_stream_seed(params->seed, e.w);
+#ifdef LC_HAS_CAUSTICS
+    trace_light = e.w < 2u;
+    light_base = trace_light ? e.w * width * height : 0u;
+#endif
   } else {
     if (gid >= width * height) return;
     rng.pixel = gid;
@@ -69,8 +79,9 @@ __kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global const uint4* work,
                                      (float)py + 0.5f + off.y, width, height, ul.x, ul.y);
     float3 L = integrate(&s, ray, &rng, &rays);
 #ifdef LC_HAS_CAUSTICS
-    if ((params->flags & LC_FLAG_CAUSTICS) && params->work_items == 0u)
-      nonfinite += caustics_light_path(&s, &rng, light_sum, light_sumsq, &rays);
+    if ((params->flags & LC_FLAG_CAUSTICS) && trace_light)
+      nonfinite += caustics_light_path(&s, &rng, light_sum + light_base,
+                                       light_sumsq + light_base, &rays);
 #endif
     if (lc_isfinite3(L)) {
       sum += L;

@@ -337,6 +337,59 @@ TEST(AdaptivePlan, GainScalesThePrediction) {
             lucent::render_detail::plan_samples(v, W, H, 0, 50, 4, 1u << 20, 1).counts);
 }
 
+// Caustics' light term (adaptive.hpp): the prediction adds light_w / (sum of the counts), exactly;
+// a light term only raises counts (the target is met with more samples); with no camera variance
+// at all the counts are even and the target is met by the light term's total alone. The
+// prediction stays monotone: a lower target never lowers a count.
+TEST(AdaptivePlan, LightTermAddsToThePrediction) {
+  using lucent::render_detail::plan_samples;
+  const int W = 8, H = 8;
+  std::vector<double> v(W * H, 0.01);
+  for (int x = 0; x < W; ++x) v[3 * W + x] = 1.0;
+  auto camera = plan_samples(v, W, H, 1e-3, 0, 4, 1u << 20, 1);
+  auto light = plan_samples(v, W, H, 1e-3, 0, 4, 1u << 20, 1, 50.0);
+  double total = 0;
+  for (std::uint32_t n : light.counts) total += n;
+  EXPECT_DOUBLE_EQ(light.light, 50.0 / total);
+  EXPECT_LE(light.predicted, 1e-3);
+  EXPECT_GT(light.predicted, light.light);
+  EXPECT_GT(light.mean, camera.mean);
+  for (size_t i = 0; i < v.size(); ++i) EXPECT_GE(light.counts[i], camera.counts[i]) << i;
+  auto lower = plan_samples(v, W, H, 5e-4, 0, 4, 1u << 20, 1, 50.0);
+  for (size_t i = 0; i < v.size(); ++i) EXPECT_GE(lower.counts[i], light.counts[i]) << i;
+  // light only: even counts, the smallest total with 50 / total <= 1e-3, i.e. 50000 / 64 each
+  auto only = plan_samples(std::vector<double>(W * H, 0.0), W, H, 1e-3, 0, 4, 1u << 20, 1, 50.0);
+  EXPECT_EQ(*std::min_element(only.counts.begin(), only.counts.end()),
+            *std::max_element(only.counts.begin(), only.counts.end()));
+  EXPECT_EQ(only.counts[0], 782u);  // ceil(50000 / 64)
+  EXPECT_LE(only.predicted, 1e-3);
+  // unreachable with max_n: every count at max_n, the prediction over the target
+  auto capped = plan_samples(v, W, H, 1e-3, 0, 4, 64, 1, 50.0);
+  for (std::uint32_t n : capped.counts) EXPECT_EQ(n, 64u);
+  EXPECT_GT(capped.predicted, 1e-3);
+}
+
+// add_light_halves: the light part is the average of the halves' light means (sum / paths), its
+// variance that of the average, (s_A^2 / N_A + s_B^2 / N_B) / 4 with s^2 the unbiased variance
+// of one path, added to var times n; one half's alone when the other traced no path.
+TEST(AdaptivePlan, LightHalvesCombine) {
+  // half A: 4 paths splatting 1, 3, 0, 0 in channel 0; half B: 2 paths, 2 and 0
+  const double la[3] = {4, 0, 0}, qa[3] = {10, 0, 0}, lb[3] = {2, 0, 0}, qb[3] = {4, 0, 0};
+  float mean[3] = {1, 1, 1}, var[3] = {0.5f, 0.5f, 0.5f};
+  double lv[3];
+  lucent::render_detail::add_light_halves(la, qa, 4, lb, qb, 2, 8, mean, var, lv);
+  // A: mean 1, s^2 = (10 - 16 / 4) / 3 = 2; B: mean 1, s^2 = (4 - 4 / 2) / 1 = 2
+  EXPECT_FLOAT_EQ(mean[0], 2.0f);
+  EXPECT_DOUBLE_EQ(lv[0], (2.0 / 4 + 2.0 / 2) / 4);
+  EXPECT_FLOAT_EQ(var[0], 0.5f + 8 * float((2.0 / 4 + 2.0 / 2) / 4));
+  EXPECT_FLOAT_EQ(mean[1], 1.0f);
+  EXPECT_DOUBLE_EQ(lv[1], 0.0);
+  float m2[3] = {0, 0, 0}, v2[3] = {0, 0, 0};
+  lucent::render_detail::add_light_halves(la, qa, 4, lb, qb, 0, 8, m2, v2, lv);
+  EXPECT_FLOAT_EQ(m2[0], 1.0f);
+  EXPECT_DOUBLE_EQ(lv[0], 2.0 / 4);
+}
+
 // Half A's plan and gain read nothing of half A's pilot (what keeps its mean unbiased,
 // adaptive.hpp): changing A's variances and calibration sums leaves them as they were, while
 // half B's plan and gain change (the control: B's do read A's pilot), and so do both gains when

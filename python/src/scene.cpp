@@ -353,7 +353,7 @@ void bind_scene(py::module_& m) {
       .def_readwrite("clamp", &Integrator::clamp,
                      "the largest sample contribution (0: off); biased, lower variance")
       .def_readwrite("caustics", &Integrator::caustics,
-                     "path: caustic paths by light tracing (pinhole cameras, uniform renders)");
+                     "path: caustic paths by light tracing (pinhole cameras)");
   enum_property(integrator, "type", &Integrator::type);
   enum_property(integrator, "sampler", &Integrator::sampler);
 

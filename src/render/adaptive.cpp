@@ -8,7 +8,8 @@ namespace lucent::render_detail {
 
 std::vector<double> relative_variance(const std::vector<double>& sum,
                                       const std::vector<double>& sumsq,
-                                      const std::vector<std::uint32_t>& count) {
+                                      const std::vector<std::uint32_t>& count,
+                                      const std::vector<double>* offset) {
   std::vector<double> v(count.size(), 0.0);
   for (std::size_t i = 0; i < count.size(); ++i) {
     const double n = count[i];
@@ -17,15 +18,54 @@ std::vector<double> relative_variance(const std::vector<double>& sum,
     for (int c = 0; c < 3; ++c) {
       const double s = sum[i * 3 + c], mean = s / n;
       const double var = std::max(0.0, (sumsq[i * 3 + c] - s * mean) / (n - 1));
-      r += var / (mean * mean + 0.01);
+      const double value = mean + (offset ? (*offset)[i * 3 + c] : 0.0);
+      r += var / (value * value + 0.01);
     }
     v[i] = r / 3;
   }
   return v;
 }
 
+std::vector<double> light_means(const std::vector<double>& light_sum, std::uint64_t paths,
+                                int width, int height) {
+  std::vector<double> m(light_sum.size(), 0.0);
+  if (paths == 0 || light_sum.size() != static_cast<std::size_t>(width) * height * 3) return m;
+  const double N = double(paths);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      double s[3] = {0, 0, 0};
+      int k = 0;
+      for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy)
+        for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx, ++k)
+          for (int c = 0; c < 3; ++c) s[c] += light_sum[(std::size_t(yy) * width + xx) * 3 + c];
+      for (int c = 0; c < 3; ++c) m[(std::size_t(y) * width + x) * 3 + c] = s[c] / (k * N);
+    }
+  return m;
+}
+
+double light_relative_variance(const std::vector<double>& light_sum,
+                               const std::vector<double>& light_sumsq, std::uint64_t paths,
+                               const std::vector<double>& sum,
+                               const std::vector<std::uint32_t>& count,
+                               const std::vector<double>& light_mean) {
+  const std::size_t npix = count.size();
+  if (paths < 2 || npix == 0 || light_sum.size() < npix * 3 || light_mean.size() < npix * 3)
+    return 0;
+  const double N = double(paths);
+  double total = 0;
+  for (std::size_t i = 0; i < npix; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const std::size_t k = i * 3 + c;
+      const double s2 = std::max(0.0, (light_sumsq[k] - light_sum[k] * light_sum[k] / N) / (N - 1));
+      const double value = light_mean[k] + (count[i] ? sum[k] / count[i] : 0.0);
+      total += s2 / (value * value + 0.01);
+    }
+  return total / (3.0 * double(npix));
+}
+
 SamplePlan plan_samples(const std::vector<double>& v, int width, int height, double target,
-                        double budget, std::uint32_t min_n, std::uint32_t max_n, double gain) {
+                        double budget, std::uint32_t min_n, std::uint32_t max_n, double gain,
+                        double light_w) {
   const std::size_t npix = static_cast<std::size_t>(width) * height;
   max_n = std::max(max_n, min_n);
   // the shape: sqrt of the larger of the pixel's variance and its 3 x 3 neighbourhood's mean
@@ -40,19 +80,28 @@ SamplePlan plan_samples(const std::vector<double>& v, int width, int height, dou
       const std::size_t i = static_cast<std::size_t>(y) * width + x;
       shape[i] = std::sqrt(std::max(v[i], s / k));
     }
+  double smallest = 0;
+  for (double s : shape)
+    if (s > 0 && (smallest == 0 || s < smallest)) smallest = s;
+  // the allocation's shape: the camera term's, or an even one when only the light term (which
+  // reads the total count alone) has variance
+  const bool light_only = smallest == 0 && light_w > 0;
+  std::vector<double> alloc = light_only ? std::vector<double>(npix, 1.0) : shape;
+  if (light_only) smallest = 1;
   SamplePlan plan;
   plan.counts.assign(npix, min_n);
   auto fill = [&](double lambda) {
     double predicted = 0, total = 0;
     for (std::size_t i = 0; i < npix; ++i) {
-      const double want = std::ceil(lambda * shape[i]);
+      const double want = std::ceil(lambda * alloc[i]);
       const std::uint32_t n =
           want >= max_n ? max_n : std::max(min_n, static_cast<std::uint32_t>(std::max(0.0, want)));
       plan.counts[i] = n;
       predicted += shape[i] * shape[i] / n;  // the smoothed variance: see plan_samples' doc
       total += n;
     }
-    plan.predicted = npix ? gain * predicted / double(npix) : 0;
+    plan.light = total > 0 ? light_w / total : 0;
+    plan.predicted = npix ? gain * predicted / double(npix) + plan.light : 0;
     plan.mean = npix ? total / double(npix) : 0;
   };
   // reaching the goal is monotone in lambda: bisect on log(lambda) between "every count at
@@ -62,10 +111,7 @@ SamplePlan plan_samples(const std::vector<double>& v, int width, int height, dou
     return target > 0 ? plan.predicted <= target : plan.mean <= budget;
   };
   double lo = 0, hi = 0;  // lambdas; 0 gives min_n everywhere
-  double smallest = 0;
-  for (double s : shape)
-    if (s > 0 && (smallest == 0 || s < smallest)) smallest = s;
-  if (smallest == 0) {  // no variance anywhere: nothing to adapt to
+  if (smallest == 0) {    // no variance anywhere: nothing to adapt to
     fill(0);
     return plan;
   }
@@ -128,8 +174,8 @@ HalfPlans plan_halves(const Pilot& a, const Pilot& b, const Pilot& c, int width,
     const Pilot& o = *other[h];
     if (target > 0)
       out.calib[h] = calibrate_model(o.sum, o.sumsq, o.count, c.sum, c.sumsq, c.count);
-    out.plan[h] =
-        plan_samples(o.v, width, height, 2 * target, budget / 2, min_n, max_n, out.calib[h].gain);
+    out.plan[h] = plan_samples(o.v, width, height, 2 * target, budget / 2, min_n, max_n,
+                               out.calib[h].gain, o.light_w);
   }
   return out;
 }
@@ -180,6 +226,30 @@ void combine_halves(const double* sum_a, const double* sumsq_a, std::uint32_t n_
       v = s2;
     mean[c] = static_cast<float>(m);
     var[c] = static_cast<float>(v);
+  }
+}
+
+void add_light_halves(const double* lsum_a, const double* lsumsq_a, std::uint64_t paths_a,
+                      const double* lsum_b, const double* lsumsq_b, std::uint64_t paths_b,
+                      std::uint32_t n, float mean[3], float var[3], double light_var[3]) {
+  for (int c = 0; c < 3; ++c) {
+    double m[2] = {0, 0}, v[2] = {0, 0};
+    const double* ls[2] = {lsum_a, lsum_b};
+    const double* lq[2] = {lsumsq_a, lsumsq_b};
+    const std::uint64_t np[2] = {paths_a, paths_b};
+    for (int h = 0; h < 2; ++h) {
+      if (np[h] == 0) continue;
+      const double N = double(np[h]);
+      m[h] = ls[h][c] / N;
+      // the variance of the half's light estimate: one path's variance over N
+      v[h] = N > 1 ? std::max(0.0, (lq[h][c] - ls[h][c] * m[h]) / (N - 1)) / N : 0;
+    }
+    const bool both = paths_a > 0 && paths_b > 0;
+    const double lm = both ? 0.5 * (m[0] + m[1]) : m[0] + m[1];
+    const double lv = both ? (v[0] + v[1]) / 4 : v[0] + v[1];
+    light_var[c] = lv;
+    mean[c] = static_cast<float>(double(mean[c]) + lm);
+    var[c] = static_cast<float>(double(var[c]) + double(n) * lv);
   }
 }
 

@@ -30,6 +30,33 @@
 // subset of pixels; C's samples are never averaged into the image. Half A's model is scaled by a
 // gain measured from B's pilot and C (calibrate_model), B's from A's pilot and C: the argument
 // above is unchanged, since A's counts still read nothing of A's samples.
+//
+// Light-traced caustics (integrator.caustics; docs/rendering-model.md): every camera sample of a
+// half also traces one light path (its numbers from LC_DIM_LIGHT_PATH on, of the half's stream),
+// which splats into that half's own light sums L_h (any pixel's); C's samples trace none. Half
+// h's estimate of pixel p is then its camera mean plus L_h(p) / N_h, N_h the light paths it
+// traced = the samples it launched (a non-finite camera sample's light path still counts), and
+// the image is the average of the halves as before (add_light_halves). Unbiased by the same
+// argument: N_h and which (pixel, index) pairs trace light paths are functions of half h's plan,
+// which reads only the other half's pilot (camera samples and light paths) and C's, all of other
+// streams; so given N_h, L_h(p) / N_h averages N_h light paths each of whose expectation is the
+// light-traced part of p, and E[L_h(p) / N_h] is that part whatever N_h is. The light sums are
+// per half on purpose: one image-wide light estimate over both halves' N_A + N_B paths would
+// divide by a count planned from the pilots' light paths that it also averages (a pilot whose
+// light paths happened to be noisy would plan more paths and dilute its own bright splats), which
+// is biased. Per half, the planning half's pilot light paths plan only the other half. Within a
+// half the light paths' numbers (pairs from LC_DIM_LIGHT_PATH on) are independent of its camera
+// samples' for both samplers (independent: a hash of the dimension group; Sobol: each pair has
+// its own scramble keys, hashed from the pair's index): unbiasedness does not need it, but the
+// variance of a half's estimate is then the sum of its camera and light terms.
+//
+// The plan's model with caustics: relMSE of half h = g * mean_p(v_p / n_p) + w / N_h, with w
+// the mean over pixels of the per-light-path relative variance from the other half's pilot
+// (light_relative_variance) and N_h the sum of the plan's counts. Both terms fall as the counts
+// rise, so the bisection stays monotone; the light term reads only the total, so the counts keep
+// their shape sqrt(v) (an even shape when only the light term has variance). The gain scales the
+// camera term only (C traces no light paths). The relative variances weigh errors by the pilot's
+// whole pixel value, camera mean plus light mean.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -39,14 +66,38 @@ namespace lucent::render_detail {
 /// The relative variance of one sample of each pixel, as relMSE weighs errors (docs/compare.md):
 /// (1/3) sum over channels of s^2 / (mean^2 + 0.01), from per-pixel sums, sums of squares (3
 /// channels each) and sample counts; 0 for a pixel with fewer than 2 samples.
+/// With `offset` (3 per pixel: the light-traced part's mean) the value weighing the errors is
+/// the sample mean plus the offset.
 std::vector<double> relative_variance(const std::vector<double>& sum,
                                       const std::vector<double>& sumsq,
-                                      const std::vector<std::uint32_t>& count);
+                                      const std::vector<std::uint32_t>& count,
+                                      const std::vector<double>* offset = nullptr);
+
+/// The light paths' mean of each pixel-channel (width x height pixels), smoothed: the mean of
+/// light_sum / paths over the pixel's 3 x 3 neighbourhood (0 without paths). It only weighs
+/// errors (the value in relMSE's 1 / (value^2 + 0.01)): a pilot's light mean in one pixel rests
+/// on a few splats, and that noise, correlated with the splats' variance, makes the mean of
+/// s^2 / value^2 low (measured on the mirror scene of test_kernel_caustics.cpp: 0.63 times the
+/// converged value from a 32-spp pilot, unsmoothed).
+std::vector<double> light_means(const std::vector<double>& light_sum, std::uint64_t paths,
+                                int width, int height);
+
+/// The mean over pixels of the relative variance of one light path's contribution to the pixel:
+/// (1/3) sum over channels of s_l^2 / (value^2 + 0.01), s_l^2 the variance over the `paths`
+/// light paths of their splats to the pixel (light_sum, light_sumsq), value the pixel's light
+/// mean `light_mean` (light_means) plus its camera mean (sum / count). A light estimate over N
+/// paths then has the mean relative variance w / N. 0 with fewer than 2 paths.
+double light_relative_variance(const std::vector<double>& light_sum,
+                               const std::vector<double>& light_sumsq, std::uint64_t paths,
+                               const std::vector<double>& sum,
+                               const std::vector<std::uint32_t>& count,
+                               const std::vector<double>& light_mean);
 
 /// A plan of per-pixel sample counts for one half.
 struct SamplePlan {
   std::vector<std::uint32_t> counts;  ///< samples of each pixel, in [min_n, max_n]
-  double predicted = 0;  ///< mean over pixels of v / count: the half's predicted relMSE
+  double predicted = 0;  ///< gain * mean over pixels of v / count + light: predicted relMSE
+  double light = 0;      ///< the light term light_w / (sum of counts)
   double mean = 0;       ///< mean count per pixel
 };
 
@@ -60,9 +111,12 @@ struct SamplePlan {
 /// (max_n everywhere when even that does not reach it); otherwise the largest such that the mean
 /// count is at most budget. Raising `target` or lowering `budget` never raises a count. `gain`
 /// scales the model (calibrate_model): the predicted relMSE is gain times the mean of the raised v
-/// over n (gain 1: independent samples); it plays no part in a budget's plan.
+/// over n (gain 1: independent samples); it plays no part in a budget's plan. `light_w` > 0
+/// (caustics: light_relative_variance of the other half's pilot) adds light_w / (sum of the
+/// counts) to the predicted relMSE, one light path per camera sample.
 SamplePlan plan_samples(const std::vector<double>& v, int width, int height, double target,
-                        double budget, std::uint32_t min_n, std::uint32_t max_n, double gain = 1);
+                        double budget, std::uint32_t min_n, std::uint32_t max_n, double gain = 1,
+                        double light_w = 0);
 
 /// The calibration of the plan's error model "relMSE of a pixel = v / n" (exact for independent
 /// samples; Owen-scrambled Sobol samples do better, by a factor that depends on the scene and on
@@ -94,13 +148,15 @@ Calibration calibrate_model(const std::vector<double>& o_sum, const std::vector<
 /// empty for C) and the sums, sums of squares (3 channels) and counts on the calibration pixels.
 struct Pilot {
   std::vector<double> v;
+  double light_w = 0;  ///< caustics: light_relative_variance of the pilot's light paths
   std::vector<double> sum, sumsq;
   std::vector<std::uint32_t> count;
 };
 
 /// Both halves' plans: half h's plan (h = 0: A, 1: B) from the other half's pilot and, with a
 /// target, C's: calib[h] = calibrate_model(other, c) and plan[h] = plan_samples(other.v, ...,
-/// 2 target, budget / 2, min_n, max_n, calib[h].gain) (a half at 2 E makes the average of the
+/// 2 target, budget / 2, min_n, max_n, calib[h].gain, other.light_w) (a half at 2 E makes the
+/// average of the
 /// two E). Nothing of half h's pilot reaches plan[h] or calib[h]. With a budget, calib stays at
 /// gain 1 and c is not read.
 struct HalfPlans {
@@ -133,5 +189,15 @@ double halves_relmse(const std::vector<double>& sum_a, const std::vector<std::ui
 void combine_halves(const double* sum_a, const double* sumsq_a, std::uint32_t n_a,
                     const double* sum_b, const double* sumsq_b, std::uint32_t n_b, float mean[3],
                     float var[3], std::uint32_t* n);
+
+/// Adds the light-traced part (caustics) to a pixel combined by combine_halves (n samples): each
+/// half's light estimate is its light sum over its paths_h light paths, with variance s_l^2 /
+/// paths_h (s_l^2: one path's variance, from the sums of squares); the pixel's light part is
+/// their average (one half's alone when the other traced none), added to mean, and its variance
+/// light_var (that of the average) is added to var as n * light_var, var / n staying the
+/// variance of the pixel's mean.
+void add_light_halves(const double* lsum_a, const double* lsumsq_a, std::uint64_t paths_a,
+                      const double* lsum_b, const double* lsumsq_b, std::uint64_t paths_b,
+                      std::uint32_t n, float mean[3], float var[3], double light_var[3]);
 
 }  // namespace lucent::render_detail

@@ -126,8 +126,9 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                    "the number of triangles and spheres"});
   const std::uint64_t scene_buffers = tri_bytes + sph_bytes + tex_bytes + bvh_tree;
   for (const DeviceLimits& d : devices) {
-    // the pass read-back (session.cpp: h_sum, h_sumsq, and h_light, h_lightsq with caustics)
-    const std::uint64_t film_bufs = (caustics ? 4 : 2) * npix * sizeof(cl_float4);
+    // the pass read-back (session.cpp: h_sum, h_sumsq, and with caustics h_light, h_lightsq:
+    // two films each, an adaptive work list's halves A and B)
+    const std::uint64_t film_bufs = (caustics ? 6 : 2) * npix * sizeof(cl_float4);
     std::uint64_t bytes = film_bufs;
     // a CPU device's buffers are host memory: the film's (and the work list), and the scene's
     if (d.host_unified) bytes += film_bufs + npix * sizeof(cl_uint4);
@@ -163,7 +164,7 @@ std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics
       {"film sample sums (" + film + ")", npix * sizeof(cl_float4), "the film size"},
       {"film sums of squares (" + film + ")", npix * sizeof(cl_float4), "the film size"},
       {"film work list (" + film + ")", npix * sizeof(cl_uint4), "the film size"}};
-  const std::uint64_t nl = caustics ? npix : 1;
+  const std::uint64_t nl = caustics ? 2 * npix : 1;  // an adaptive work list's halves A and B
   parts.push_back({"caustics light sums (" + film + ")", nl * sizeof(cl_float4),
                    caustics ? "the film size, or render without caustics" : "the film size"});
   parts.push_back({"caustics light sums of squares (" + film + ")", nl * sizeof(cl_float4),

@@ -79,8 +79,10 @@ struct Worker {
   std::optional<render_detail::DeviceScene> dev;
   size_t npix = 0;
   cl::Buffer b_work, b_sum, b_sumsq, b_counters;  // work list: npix entries at most
-  cl::Buffer b_light, b_lightsq;  // caustics: the light paths' splats (one element without)
-  bool light_buffers = false;     // b_light and b_lightsq hold npix elements
+  // caustics: the light paths' splats (one element without): elements [0, npix) a uniform
+  // pass's, [h npix, (h + 1) npix) a work list's half h's (megakernel.cl)
+  cl::Buffer b_light, b_lightsq;
+  bool light_buffers = false;  // b_light and b_lightsq hold 2 npix elements
   std::vector<cl_float4> h_sum, h_sumsq, h_light, h_lightsq;
   std::uint32_t pass_spp = 1;  // samples per pixel of its next pass (tuned to pass_seconds)
   DeviceShare share;           // of the accumulation
@@ -131,11 +133,12 @@ struct Worker {
     q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(zero), zero);
     if (entries)
       q.enqueueWriteBuffer(b_work, CL_FALSE, 0, items * sizeof(cl_uint4), entries->data());
-    const bool light = (P.flags & LC_FLAG_CAUSTICS) && !entries;
+    const bool light = P.flags & LC_FLAG_CAUSTICS;
+    const size_t nl = entries ? 2 * npix : npix;  // a work list's: halves A and B
     if (light) {
       const cl_float4 z = {{0, 0, 0, 0}};
-      q.enqueueFillBuffer(b_light, z, 0, npix * sizeof(cl_float4));
-      q.enqueueFillBuffer(b_lightsq, z, 0, npix * sizeof(cl_float4));
+      q.enqueueFillBuffer(b_light, z, 0, nl * sizeof(cl_float4));
+      q.enqueueFillBuffer(b_lightsq, z, 0, nl * sizeof(cl_float4));
     }
     const size_t global = (items + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
     q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global),
@@ -145,10 +148,10 @@ struct Worker {
     q.enqueueReadBuffer(b_sum, CL_FALSE, 0, items * sizeof(cl_float4), h_sum.data());
     q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, items * sizeof(cl_float4), h_sumsq.data());
     if (light) {
-      h_light.resize(npix);
-      h_lightsq.resize(npix);
-      q.enqueueReadBuffer(b_light, CL_FALSE, 0, npix * sizeof(cl_float4), h_light.data());
-      q.enqueueReadBuffer(b_lightsq, CL_FALSE, 0, npix * sizeof(cl_float4), h_lightsq.data());
+      h_light.resize(nl);
+      h_lightsq.resize(nl);
+      q.enqueueReadBuffer(b_light, CL_FALSE, 0, nl * sizeof(cl_float4), h_light.data());
+      q.enqueueReadBuffer(b_lightsq, CL_FALSE, 0, nl * sizeof(cl_float4), h_lightsq.data());
     }
     q.enqueueReadBuffer(b_counters, CL_TRUE, 0, LC_COUNTER_COUNT * sizeof(lc_uint), counters);
   }
@@ -325,7 +328,7 @@ struct Renderer::Impl {
           w.b_sumsq = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
           w.b_counters =
               cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
-          const size_t nl = light ? n : 1;
+          const size_t nl = light ? 2 * n : 1;  // uniform passes use the first n
           w.b_light = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
           w.b_lightsq = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
           w.light_buffers = light;
@@ -559,6 +562,9 @@ struct Renderer::Impl {
   struct Half {
     std::vector<double> sum, sumsq;
     std::vector<std::uint32_t> count, launched, plan;
+    // caustics (A and B only): the half's light paths' splat sums and their number
+    std::vector<double> light_sum, light_sumsq;
+    std::uint64_t light_paths = 0;
     render_detail::Pilot pilot;
     bool piloted = false;
   };
@@ -653,7 +659,17 @@ struct Renderer::Impl {
           }
           h.count[i] += static_cast<std::uint32_t>(w.h_sum[k].s[3]);
           h.launched[i] += e.s[2];
+          if (!h.light_sum.empty()) h.light_paths += e.s[2];  // one per camera sample
           samples += e.s[2];
+        }
+        for (int hi = 0; hi < 2; ++hi) {  // the halves' light splats, anywhere on the film
+          Half& h = halves[hi];
+          if (h.light_sum.empty()) continue;
+          for (size_t i = 0; i < npix; ++i)
+            for (int c = 0; c < 3; ++c) {
+              h.light_sum[i * 3 + c] += w.h_light[hi * npix + i].s[c];
+              h.light_sumsq[i * 3 + c] += w.h_lightsq[hi * npix + i].s[c];
+            }
         }
         launched_total += samples;
         done = (launched_total + npix / 2) / npix;
@@ -673,10 +689,6 @@ struct Renderer::Impl {
   RenderProgress run_adaptive(const AdaptiveOptions& o,
                               const std::function<void(const RenderProgress&)>& on_progress) {
     if (!scene) throw Error("render_adaptive: the session has no scene (call set_scene first)");
-    if (packed.params.flags & LC_FLAG_CAUSTICS)
-      throw Error(scene->path +
-                  ": integrator.caustics: adaptive sampling cannot render light-traced caustics "
-                  "(its per-pixel sample counts differ); render them uniformly");
     if (!(o.target_error > 0) == !(o.budget_spp > 0) || !std::isfinite(o.target_error) ||
         !std::isfinite(o.budget_spp))
       throw Error("render_adaptive: give either a target error or a budget, a positive number");
@@ -702,6 +714,10 @@ struct Renderer::Impl {
         h.plan.assign(npix, m);
         h.pilot = render_detail::Pilot{};
         h.piloted = false;
+        const bool caustics = packed.params.flags & LC_FLAG_CAUSTICS;
+        h.light_sum.assign(caustics ? npix * 3 : 0, 0.0);
+        h.light_sumsq.assign(caustics ? npix * 3 : 0, 0.0);
+        h.light_paths = 0;
       }
       const int width = scene->film.width, height = scene->film.height;
       const int stride = render_detail::calibration_stride(width, height);
@@ -745,7 +761,15 @@ struct Renderer::Impl {
     for (int hi = 0; hi < 2; ++hi) {
       Half& h = halves[hi];
       if (h.piloted) continue;  // its samples are no longer only the pilot's
-      h.pilot.v = render_detail::relative_variance(h.sum, h.sumsq, h.count);
+      if (h.light_sum.empty()) {
+        h.pilot.v = render_detail::relative_variance(h.sum, h.sumsq, h.count);
+      } else {  // errors weighed by the whole pixel, camera and light means
+        const std::vector<double> lm = render_detail::light_means(
+            h.light_sum, h.light_paths, scene->film.width, scene->film.height);
+        h.pilot.v = render_detail::relative_variance(h.sum, h.sumsq, h.count, &lm);
+        h.pilot.light_w = render_detail::light_relative_variance(h.light_sum, h.light_sumsq,
+                                                                 h.light_paths, h.sum, h.count, lm);
+      }
       calibration_sums(h, h.pilot);
       h.piloted = true;
     }
@@ -784,11 +808,20 @@ struct Renderer::Impl {
       // a-posteriori estimate
       const Half &a = halves[0], &b = halves[1];
       const double ga = calibrated ? calib[0].gain : 1, gb = calibrated ? calib[1].gain : 1;
+      const bool caustics = !a.light_sum.empty();
       double predicted = 0;
       for (size_t i = 0; i < npix; ++i) {
         render_detail::combine_halves(&a.sum[i * 3], &a.sumsq[i * 3], a.count[i], &b.sum[i * 3],
                                       &b.sumsq[i * 3], b.count[i], &r.mean.rgb[i * 3],
                                       &r.variance.rgb[i * 3], &r.samples[i]);
+        double light_var[3] = {0, 0, 0};  // of the light part (caustics), not scaled by gains
+        const double camera_var[3] = {r.variance.rgb[i * 3], r.variance.rgb[i * 3 + 1],
+                                      r.variance.rgb[i * 3 + 2]};
+        if (caustics)
+          render_detail::add_light_halves(&a.light_sum[i * 3], &a.light_sumsq[i * 3], a.light_paths,
+                                          &b.light_sum[i * 3], &b.light_sumsq[i * 3], b.light_paths,
+                                          r.samples[i], &r.mean.rgb[i * 3], &r.variance.rgb[i * 3],
+                                          light_var);
         if (r.samples[i] == 0) continue;
         // var / n is s^2 (1/n_A + 1/n_B) / 4; the calibrated model's is s^2 (g_A/n_A + g_B/n_B) / 4
         const double na = a.count[i], nb = b.count[i];
@@ -796,11 +829,20 @@ struct Renderer::Impl {
             na > 0 && nb > 0 ? (ga / na + gb / nb) / (1 / na + 1 / nb) : (na > 0 ? ga : gb);
         for (int c = 0; c < 3; ++c) {
           const double m = r.mean.rgb[i * 3 + c];
-          predicted += gain * r.variance.rgb[i * 3 + c] / r.samples[i] / (m * m + 0.01);
+          predicted += (gain * camera_var[c] / r.samples[i] + light_var[c]) / (m * m + 0.01);
         }
       }
       r.estimated_relmse = npix ? predicted / (3.0 * double(npix)) : 0;
-      r.halves_relmse = render_detail::halves_relmse(a.sum, a.count, b.sum, b.count);
+      if (caustics) {  // each half's whole estimate: its camera mean plus its light part
+        std::vector<double> sa = a.sum, sb = b.sum;
+        for (size_t k = 0; k < sa.size(); ++k) {
+          if (a.light_paths) sa[k] += a.count[k / 3] * a.light_sum[k] / double(a.light_paths);
+          if (b.light_paths) sb[k] += b.count[k / 3] * b.light_sum[k] / double(b.light_paths);
+        }
+        r.halves_relmse = render_detail::halves_relmse(sa, a.count, sb, b.count);
+      } else {
+        r.halves_relmse = render_detail::halves_relmse(a.sum, a.count, b.sum, b.count);
+      }
       r.target_error = adaptive_target;
       if (calibrated) {
         r.model_gain_a = calib[0].gain;
