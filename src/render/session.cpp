@@ -81,8 +81,11 @@ struct Worker {
   cl::Buffer b_work, b_sum, b_sumsq, b_counters;  // work list: npix entries at most
   // caustics: the light paths' splats (one element without): elements [0, npix) a uniform
   // pass's, [h npix, (h + 1) npix) a work list's half h's (megakernel.cl)
+  // caustics: the light paths' splats; npix elements for uniform passes, 2 npix once an adaptive
+  // render needs them (its work lists' halves A and B), one element without caustics
   cl::Buffer b_light, b_lightsq;
-  bool light_buffers = false;  // b_light and b_lightsq hold 2 npix elements
+  bool light_buffers = false;
+  size_t light_elems = 0;
   std::vector<cl_float4> h_sum, h_sumsq, h_light, h_lightsq;
   std::uint32_t pass_spp = 1;  // samples per pixel of its next pass (tuned to pass_seconds)
   DeviceShare share;           // of the accumulation
@@ -94,6 +97,15 @@ struct Worker {
 
   size_t global_size() const {
     return (npix + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
+  }
+
+  /// Makes the light buffers hold at least `elems` elements (an adaptive render's two films).
+  void ensure_light(size_t elems) {
+    if (light_elems >= elems) return;
+    b_light = cl::Buffer(ctx.context, CL_MEM_READ_WRITE, elems * sizeof(cl_float4));
+    b_lightsq = cl::Buffer(ctx.context, CL_MEM_READ_WRITE, elems * sizeof(cl_float4));
+    light_elems = elems;
+    set_args();
   }
 
   void set_args() {
@@ -328,10 +340,11 @@ struct Renderer::Impl {
           w.b_sumsq = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
           w.b_counters =
               cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
-          const size_t nl = light ? 2 * n : 1;  // uniform passes use the first n
+          const size_t nl = light ? n : 1;  // an adaptive render doubles it (ensure_light)
           w.b_light = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
           w.b_lightsq = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
           w.light_buffers = light;
+          w.light_elems = nl;
           if (!light) {
             std::vector<cl_float4>().swap(w.h_light);
             std::vector<cl_float4>().swap(w.h_lightsq);
@@ -724,7 +737,16 @@ struct Renderer::Impl {
       for (int y = stride / 2; y < height; y += stride)
         for (int x = stride / 2; x < width; x += stride)
           calib_pixels.push_back(static_cast<std::size_t>(y) * width + x);
-    } else if (pilot != m) {
+    }
+    if (packed.params.flags & LC_FLAG_CAUSTICS) {
+      try {
+        for (auto& w : workers) w->ensure_light(2 * npix);  // halves A and B
+      } catch (const cl::Error& e) {
+        throw Error(render_detail::resource_error(e, render_detail::ClStage::Upload, scene->path,
+                                                  workers.front()->ctx.device.info.name));
+      }
+    }
+    if (adaptive && pilot != m) {
       throw Error("render_adaptive: min_spp " + std::to_string(o.min_spp) +
                   " differs from the adaptive render in progress (call reset() first)");
     }
