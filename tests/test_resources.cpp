@@ -456,3 +456,39 @@ TEST(Resources, IssueCasesEndInOneLine) {
 }
 
 }  // namespace
+
+// An adaptive render keeps three halves, two pilots and the plans on the host, about four times a
+// uniform render's accumulation: a host limit that a uniform render fits under refuses the
+// adaptive one in one line naming that part, before it allocates, and the session still renders
+// uniformly afterwards.
+TEST(Resources, AdaptiveRenderChecksItsHostMemory) {
+  Scene s = lucent::test::scene_from(grid_scene(4, 4));
+  s.path = "a.json";
+  s.film.width = s.film.height = 256;
+  lucent::Renderer r(lucent::test::session_options());
+  DeviceLimits cpu;  // PoCL's CPU device: its buffers are host memory
+  cpu.device = r.device().name;
+  cpu.host_unified = true;
+  std::vector<DeviceLimits> devices = {cpu};
+  std::uint64_t uniform = 0;
+  for (const auto& p : lucent::render_detail::estimate_host_memory(s, devices)) uniform += p.bytes;
+  const std::uint64_t extra = lucent::render_detail::adaptive_host_bytes(256u * 256, false);
+  ASSERT_GT(extra, uniform / 2);
+  DeviceLimits lim;
+  lim.host_mem = uniform + extra / 2;
+  ScopedLimitOverride o(lim);
+  r.set_scene(s);
+  lucent::AdaptiveOptions ao;
+  ao.target_error = 1e-2;
+  std::string msg = error_of([&] { r.render_adaptive(ao); });
+  EXPECT_EQ(msg.rfind("a.json: rendering needs about ", 0), 0u) << msg;
+  EXPECT_NE(msg.find("the largest part is the halves, pilots and plans of adaptive sampling for "
+                     "the 256x256 film"),
+            std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("reduce the film size, or render a fixed number of samples"),
+            std::string::npos)
+      << msg;
+  r.render(1);  // the uniform render was never refused
+  EXPECT_EQ(r.result().spp, 1u);
+}

@@ -142,10 +142,10 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
   return parts;
 }
 
-void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
-                       std::uint64_t host_limit, const std::string& limit_what) {
-  if (host_limit == 0) return;
-  const std::vector<MemoryPart> parts = estimate_host_memory(scene, devices);
+namespace {
+
+void check_host_parts(const Scene& scene, const std::vector<MemoryPart>& parts,
+                      std::uint64_t host_limit, const std::string& limit_what) {
   const std::uint64_t need = total(parts);
   if (need <= host_limit) return;
   const MemoryPart& big = largest(parts);
@@ -153,6 +153,37 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
               " of host memory, more than the limit of " + format_bytes(host_limit) + " (80% of " +
               limit_what + "); the largest part is " + big.what + " (" + format_bytes(big.bytes) +
               "): reduce " + big.reduce);
+}
+
+}  // namespace
+
+void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
+                       std::uint64_t host_limit, const std::string& limit_what) {
+  if (host_limit == 0) return;
+  check_host_parts(scene, estimate_host_memory(scene, devices), host_limit, limit_what);
+}
+
+std::uint64_t adaptive_host_bytes(std::uint64_t npix, bool caustics) {
+  // a half: 3 + 3 doubles and 3 uint32; a pilot: 7 doubles and a uint32; the planner's
+  // temporaries: about 4 doubles
+  const std::uint64_t half = 6 * sizeof(double) + 3 * sizeof(std::uint32_t);
+  const std::uint64_t pilot = 7 * sizeof(double) + sizeof(std::uint32_t);
+  std::uint64_t per_pixel = 3 * half + 2 * pilot + 4 * sizeof(double);
+  if (caustics) per_pixel += 2 * 6 * sizeof(double);
+  return npix * per_pixel;
+}
+
+void check_adaptive_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
+                                bool caustics, std::uint64_t host_limit,
+                                const std::string& limit_what) {
+  if (host_limit == 0) return;
+  std::vector<MemoryPart> parts = estimate_host_memory(scene, devices);
+  const std::uint64_t npix = std::uint64_t(scene.film.width) * std::uint64_t(scene.film.height);
+  parts.push_back({"the halves, pilots and plans of adaptive sampling for the " +
+                       film_size(scene.film.width, scene.film.height) + " film",
+                   adaptive_host_bytes(npix, caustics),
+                   "the film size, or render a fixed number of samples (no --target-error)"});
+  check_host_parts(scene, parts, host_limit, limit_what);
 }
 
 std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics) {

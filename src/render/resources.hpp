@@ -61,6 +61,16 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
 void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
                        std::uint64_t host_limit, const std::string& limit_what = "physical memory");
 
+/// An adaptive render's host memory beyond a uniform render's (session.cpp run_adaptive): the
+/// halves A, B and C (sums and sums of squares, counts, launched samples, plans), A's and B's
+/// pilots, the planner's per-pixel temporaries, and with caustics A's and B's light sums.
+std::uint64_t adaptive_host_bytes(std::uint64_t npix, bool caustics);
+
+/// check_host_memory with an adaptive render's memory added (adaptive_host_bytes).
+void check_adaptive_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
+                                bool caustics, std::uint64_t host_limit,
+                                const std::string& limit_what = "physical memory");
+
 /// The film buffers of a device: the pass's sums and sums of squares (float4 per pixel), the
 /// work list (uint4 per pixel), and the light paths' sums and sums of squares (float4 per pixel
 /// with `caustics`, one element without).

@@ -716,6 +716,11 @@ struct Renderer::Impl {
         throw Error(
             "render_adaptive: the accumulation holds a uniform render's samples (call reset() "
             "first)");
+      std::vector<render_detail::DeviceLimits> limits;
+      for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
+      render_detail::check_adaptive_host_memory(*scene, limits,
+                                                (packed.params.flags & LC_FLAG_CAUSTICS) != 0,
+                                                limits.front().host_mem, limits.front().host_what);
       adaptive = true;
       pilot = m;
       for (int hi = 0; hi < 2; ++hi) {
