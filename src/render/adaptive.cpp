@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "render/sample_stats.hpp"
+
 namespace lucent::render_detail {
 
 std::vector<double> relative_variance(const std::vector<double>& sum,
@@ -16,8 +18,8 @@ std::vector<double> relative_variance(const std::vector<double>& sum,
     if (n < 2) continue;
     double r = 0;
     for (int c = 0; c < 3; ++c) {
-      const double s = sum[i * 3 + c], mean = s / n;
-      const double var = std::max(0.0, (sumsq[i * 3 + c] - s * mean) / (n - 1));
+      const double mean = sum[i * 3 + c] / n;
+      const double var = sample_variance(sum[i * 3 + c], sumsq[i * 3 + c], n);
       const double value = mean + (offset ? (*offset)[i * 3 + c] : 0.0);
       r += var / (value * value + 0.01);
     }
@@ -56,7 +58,7 @@ double light_relative_variance(const std::vector<double>& light_sum,
   for (std::size_t i = 0; i < npix; ++i)
     for (int c = 0; c < 3; ++c) {
       const std::size_t k = i * 3 + c;
-      const double s2 = std::max(0.0, (light_sumsq[k] - light_sum[k] * light_sum[k] / N) / (N - 1));
+      const double s2 = sample_variance(light_sum[k], light_sumsq[k], N);
       const double value = light_mean[k] + (count[i] ? sum[k] / count[i] : 0.0);
       total += s2 / (value * value + 0.01);
     }
@@ -151,10 +153,8 @@ Calibration calibrate_model(const std::vector<double>& o_sum, const std::vector<
       const std::size_t k = i * 3 + c;
       const double mo = o_sum[k] / no, mc = c_sum[k] / nc, value = 0.5 * (mo + mc);
       const double w = 1 / (value * value + 0.01);
-      // one sample's variance pooled over O and C (squared deviations from each one's own mean)
-      const double ss =
-          std::max(0.0, o_sumsq[k] - o_sum[k] * mo) + std::max(0.0, c_sumsq[k] - c_sum[k] * mc);
-      const double s2 = ss / (no + nc - 2);
+      // one sample's variance pooled over O and C
+      const double s2 = pooled_variance(o_sum[k], o_sumsq[k], no, c_sum[k], c_sumsq[k], nc);
       cal.measured += w * (mo - mc) * (mo - mc) / 2;
       cal.modelled += w * s2 * (1 / no + 1 / nc) / 2;
     }
@@ -212,13 +212,7 @@ void combine_halves(const double* sum_a, const double* sumsq_a, std::uint32_t n_
   for (int c = 0; c < 3; ++c) {
     const double ma = n_a ? sum_a[c] / n_a : 0, mb = n_b ? sum_b[c] / n_b : 0;
     double m = n_a && n_b ? 0.5 * (ma + mb) : (n_a ? ma : mb);
-    // pooled variance of one sample: squared deviations from each half's own mean
-    double ss = 0;
-    if (n_a) ss += std::max(0.0, sumsq_a[c] - sum_a[c] * ma);
-    if (n_b) ss += std::max(0.0, sumsq_b[c] - sum_b[c] * mb);
-    const int groups = (n_a > 0) + (n_b > 0);
-    const double dof = double(*n) - groups;
-    const double s2 = dof > 0 ? ss / dof : 0;
+    const double s2 = pooled_variance(sum_a[c], sumsq_a[c], n_a, sum_b[c], sumsq_b[c], n_b);
     double v = 0;
     if (n_a && n_b)
       v = double(*n) * s2 * (1.0 / n_a + 1.0 / n_b) / 4;
@@ -242,7 +236,7 @@ void add_light_halves(const double* lsum_a, const double* lsumsq_a, std::uint64_
       const double N = double(np[h]);
       m[h] = ls[h][c] / N;
       // the variance of the half's light estimate: one path's variance over N
-      v[h] = N > 1 ? std::max(0.0, (lq[h][c] - ls[h][c] * m[h]) / (N - 1)) / N : 0;
+      v[h] = sample_variance(ls[h][c], lq[h][c], N) / N;
     }
     const bool both = paths_a > 0 && paths_b > 0;
     const double lm = both ? 0.5 * (m[0] + m[1]) : m[0] + m[1];

@@ -22,6 +22,7 @@
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
 #include "lucent/version.hpp"
+#include "render/sample_stats.hpp"
 
 namespace lucent {
 
@@ -269,8 +270,7 @@ RenderResult part_result(const RenderPart& part) {
       const double s = a.sum[i * 3 + c], s2 = a.sumsq[i * 3 + c];
       const double mean = n > 0 ? s / n : 0;
       r.mean.rgb[i * 3 + c] = static_cast<float>(mean);
-      r.variance.rgb[i * 3 + c] =
-          static_cast<float>(n > 1 ? std::max(0.0, (s2 - s * mean) / (n - 1)) : 0);
+      r.variance.rgb[i * 3 + c] = static_cast<float>(render_detail::sample_variance(s, s2, n));
     }
   }
   r.spp = total(part.info.samples);

@@ -23,6 +23,7 @@
 #include "render/features.hpp"
 #include "render/pack.hpp"
 #include "render/resources.hpp"
+#include "render/sample_stats.hpp"
 #include "scene/loaders.hpp"
 
 namespace lucent {
@@ -79,10 +80,9 @@ struct Worker {
   std::optional<render_detail::DeviceScene> dev;
   size_t npix = 0;
   cl::Buffer b_work, b_sum, b_sumsq, b_counters;  // work list: npix entries at most
-  // caustics: the light paths' splats (one element without): elements [0, npix) a uniform
-  // pass's, [h npix, (h + 1) npix) a work list's half h's (megakernel.cl)
-  // caustics: the light paths' splats; npix elements for uniform passes, 2 npix once an adaptive
-  // render needs them (its work lists' halves A and B), one element without caustics
+  // caustics: the light paths' splats, one element without caustics; elements [0, npix) a uniform
+  // pass's, [h npix, (h + 1) npix) a work list's half h's (megakernel.cl): npix elements until an
+  // adaptive render needs 2 npix (ensure_light)
   cl::Buffer b_light, b_lightsq;
   bool light_buffers = false;
   size_t light_elems = 0;
@@ -882,11 +882,12 @@ struct Renderer::Impl {
         for (int c = 0; c < 3; ++c) {
           double s = sum[i * 3 + c], s2 = sumsq[i * 3 + c];
           double mean = n > 0 ? s / n : 0;
-          double var = n > 1 ? std::max(0.0, (s2 - s * mean) / (n - 1)) : 0;
+          double var = render_detail::sample_variance(s, s2, n);
           if (light_paths > 1) {
             // the light paths' mean, and its variance in units of one camera sample
             const double N = double(light_paths), lm = light_sum[i * 3 + c] / N;
-            const double lvar = std::max(0.0, light_sumsq[i * 3 + c] / N - lm * lm) / (N - 1);
+            const double lvar =
+                render_detail::sample_variance(light_sum[i * 3 + c], light_sumsq[i * 3 + c], N) / N;
             mean += lm;
             var += n * lvar;
           }
