@@ -8,20 +8,54 @@
 
 namespace lucent::render_detail {
 
+std::vector<double> neighbour_values(const std::vector<double>& mean,
+                                     const std::vector<std::uint32_t>& present, int width,
+                                     int height, const std::vector<double>* add) {
+  const std::size_t npix = static_cast<std::size_t>(width) * height;
+  std::vector<double> v(npix * 3, 0.0);
+  if (mean.size() < npix * 3 || present.size() < npix) return v;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * width + x;
+      double s[3] = {0, 0, 0};
+      int k = 0;
+      for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy)
+        for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx) {
+          const std::size_t j = static_cast<std::size_t>(yy) * width + xx;
+          if (j == i || present[j] == 0) continue;
+          ++k;
+          for (int c = 0; c < 3; ++c) s[c] += mean[j * 3 + c];
+        }
+      for (int c = 0; c < 3; ++c) {
+        const double own = mean[i * 3 + c];
+        v[i * 3 + c] = (k ? std::min(own, s[c] / k) : own) + (add ? (*add)[i * 3 + c] : 0.0);
+      }
+    }
+  return v;
+}
+
+std::vector<double> sample_means(const std::vector<double>& sum,
+                                 const std::vector<std::uint32_t>& count) {
+  std::vector<double> m(count.size() * 3, 0.0);
+  for (std::size_t i = 0; i < count.size(); ++i)
+    if (count[i] > 0)
+      for (int c = 0; c < 3; ++c) m[i * 3 + c] = sum[i * 3 + c] / count[i];
+  return m;
+}
+
 std::vector<double> relative_variance(const std::vector<double>& sum,
                                       const std::vector<double>& sumsq,
                                       const std::vector<std::uint32_t>& count,
-                                      const std::vector<double>* offset) {
+                                      const std::vector<double>* value) {
   std::vector<double> v(count.size(), 0.0);
   for (std::size_t i = 0; i < count.size(); ++i) {
     const double n = count[i];
     if (n < 2) continue;
     double r = 0;
     for (int c = 0; c < 3; ++c) {
-      const double mean = sum[i * 3 + c] / n;
       const double var = sample_variance(sum[i * 3 + c], sumsq[i * 3 + c], n);
-      const double value = mean + (offset ? (*offset)[i * 3 + c] : 0.0);
-      r += var / (value * value + 0.01);
+      const double val = value ? (*value)[i * 3 + c] : sum[i * 3 + c] / n;
+      r += var / (val * val + 0.01);
     }
     v[i] = r / 3;
   }
@@ -47,21 +81,15 @@ std::vector<double> light_means(const std::vector<double>& light_sum, std::uint6
 
 double light_relative_variance(const std::vector<double>& light_sum,
                                const std::vector<double>& light_sumsq, std::uint64_t paths,
-                               const std::vector<double>& sum,
-                               const std::vector<std::uint32_t>& count,
-                               const std::vector<double>& light_mean) {
-  const std::size_t npix = count.size();
-  if (paths < 2 || npix == 0 || light_sum.size() < npix * 3 || light_mean.size() < npix * 3)
-    return 0;
+                               const std::vector<double>& value) {
+  const std::size_t npix = value.size() / 3;
+  if (paths < 2 || npix == 0 || light_sum.size() < npix * 3) return 0;
   const double N = double(paths);
   double total = 0;
-  for (std::size_t i = 0; i < npix; ++i)
-    for (int c = 0; c < 3; ++c) {
-      const std::size_t k = i * 3 + c;
-      const double s2 = sample_variance(light_sum[k], light_sumsq[k], N);
-      const double value = light_mean[k] + (count[i] ? sum[k] / count[i] : 0.0);
-      total += s2 / (value * value + 0.01);
-    }
+  for (std::size_t k = 0; k < npix * 3; ++k) {
+    const double s2 = sample_variance(light_sum[k], light_sumsq[k], N);
+    total += s2 / (value[k] * value[k] + 0.01);
+  }
   return total / (3.0 * double(npix));
 }
 
@@ -190,7 +218,8 @@ int calibration_stride(int width, int height, std::size_t min_pixels) {
 }
 
 double halves_relmse(const std::vector<double>& sum_a, const std::vector<std::uint32_t>& n_a,
-                     const std::vector<double>& sum_b, const std::vector<std::uint32_t>& n_b) {
+                     const std::vector<double>& sum_b, const std::vector<std::uint32_t>& n_b,
+                     const std::vector<double>* value) {
   double total = 0;
   std::size_t pixels = 0;
   for (std::size_t i = 0; i < n_a.size() && i < n_b.size(); ++i) {
@@ -198,8 +227,8 @@ double halves_relmse(const std::vector<double>& sum_a, const std::vector<std::ui
     ++pixels;
     for (int c = 0; c < 3; ++c) {
       const double a = sum_a[i * 3 + c] / n_a[i], b = sum_b[i * 3 + c] / n_b[i];
-      const double value = 0.5 * (a + b);
-      total += (a - b) * (a - b) / 4 / (value * value + 0.01);
+      const double val = value ? (*value)[i * 3 + c] : 0.5 * (a + b);
+      total += (a - b) * (a - b) / 4 / (val * val + 0.01);
     }
   }
   return pixels ? total / (3.0 * double(pixels)) : 0;

@@ -56,22 +56,42 @@
 // rise, so the bisection stays monotone; the light term reads only the total, so the counts keep
 // their shape sqrt(v) (an even shape when only the light term has variance). The gain scales the
 // camera term only (C traces no light paths). The relative variances weigh errors by the pilot's
-// whole pixel value, camera mean plus light mean.
+// whole pixel value, camera part (neighbour_values) plus light mean.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 namespace lucent::render_detail {
 
+/// The value that weighs a pixel's errors in the error model (relMSE's 1 / (value^2 + 0.01)):
+/// per channel, the smaller of the pixel's own sample mean and the mean of its 8 neighbours'
+/// (mean, 3 per pixel; a neighbour counts when present[i] > 0; the own mean alone when none is
+/// present, as on a 1 x 1 film), plus add (3 per pixel) when given. The own mean alone is
+/// correlated with the pixel's sample variance (a pixel whose samples drew a rare bright path has
+/// both a large variance and a large mean), so s^2 / (mean^2 + 0.01) under-estimates the relative
+/// variance exactly where it is large; the neighbours' mean alone over-weighs a dark pixel beside
+/// a bright one (a 48 x 48 lamp scene stopped at 4.4 E with it). The smaller of the two keeps
+/// the neighbours' value where the pixel drew a rare bright sample, and the dark side of an edge
+/// its own; it can only over-weigh (conservative). Measured on scenes/course.json (128 x 128,
+/// 155 spp, caustics, 4 renders): the variances weighed by each pixel's own mean predicted
+/// 0.42-0.65 of the relMSE that the same variances weighed by the reference predict; weighed by
+/// this value, 0.95-1.41.
+std::vector<double> neighbour_values(const std::vector<double>& mean,
+                                     const std::vector<std::uint32_t>& present, int width,
+                                     int height, const std::vector<double>* add = nullptr);
+
+/// The sample means (3 per pixel) of per-pixel sums and counts (0 without samples).
+std::vector<double> sample_means(const std::vector<double>& sum,
+                                 const std::vector<std::uint32_t>& count);
+
 /// The relative variance of one sample of each pixel, as relMSE weighs errors (docs/compare.md):
-/// (1/3) sum over channels of s^2 / (mean^2 + 0.01), from per-pixel sums, sums of squares (3
-/// channels each) and sample counts; 0 for a pixel with fewer than 2 samples.
-/// With `offset` (3 per pixel: the light-traced part's mean) the value weighing the errors is
-/// the sample mean plus the offset.
+/// (1/3) sum over channels of s^2 / (value^2 + 0.01), from per-pixel sums, sums of squares (3
+/// channels each) and sample counts; 0 for a pixel with fewer than 2 samples. `value` (3 per
+/// pixel; neighbour_values) weighs the errors; without it, the pixel's sample mean.
 std::vector<double> relative_variance(const std::vector<double>& sum,
                                       const std::vector<double>& sumsq,
                                       const std::vector<std::uint32_t>& count,
-                                      const std::vector<double>* offset = nullptr);
+                                      const std::vector<double>* value = nullptr);
 
 /// The light paths' mean of each pixel-channel (width x height pixels), smoothed: the mean of
 /// light_sum / paths over the pixel's 3 x 3 neighbourhood (0 without paths). It only weighs
@@ -84,14 +104,13 @@ std::vector<double> light_means(const std::vector<double>& light_sum, std::uint6
 
 /// The mean over pixels of the relative variance of one light path's contribution to the pixel:
 /// (1/3) sum over channels of s_l^2 / (value^2 + 0.01), s_l^2 the variance over the `paths`
-/// light paths of their splats to the pixel (light_sum, light_sumsq), value the pixel's light
-/// mean `light_mean` (light_means) plus its camera mean (sum / count). A light estimate over N
-/// paths then has the mean relative variance w / N. 0 with fewer than 2 paths.
+/// light paths of their splats to the pixel (light_sum, light_sumsq), value the pixel's whole
+/// value (3 per pixel: the camera part from the neighbours, neighbour_values, plus the light
+/// mean, light_means). A light estimate over N paths then has the mean relative variance w / N.
+/// 0 with fewer than 2 paths.
 double light_relative_variance(const std::vector<double>& light_sum,
                                const std::vector<double>& light_sumsq, std::uint64_t paths,
-                               const std::vector<double>& sum,
-                               const std::vector<std::uint32_t>& count,
-                               const std::vector<double>& light_mean);
+                               const std::vector<double>& value);
 
 /// A plan of per-pixel sample counts for one half.
 struct SamplePlan {
@@ -179,8 +198,11 @@ int calibration_stride(int width, int height, std::size_t min_pixels = 4096);
 /// halves are uncorrelated, and E[(A_p - B_p)^2] = Var A_p + Var B_p = 4 Var((A_p + B_p) / 2).
 /// Noisy per pixel (one degree of freedom), fine over an image. Reported, never read by a
 /// decision.
+/// `value` (3 per pixel; neighbour_values of the average) weighs the errors in place of
+/// (A_p + B_p) / 2, which is correlated with (A_p - B_p)^2 (neighbour_values).
 double halves_relmse(const std::vector<double>& sum_a, const std::vector<std::uint32_t>& n_a,
-                     const std::vector<double>& sum_b, const std::vector<std::uint32_t>& n_b);
+                     const std::vector<double>& sum_b, const std::vector<std::uint32_t>& n_b,
+                     const std::vector<double>* value = nullptr);
 
 /// One pixel of an adaptive render from its two halves' sums (3 channels), sums of squares and
 /// counts: mean = (mean_A + mean_B) / 2 (one half's mean alone when the other has no sample),

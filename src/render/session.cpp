@@ -788,14 +788,22 @@ struct Renderer::Impl {
     for (int hi = 0; hi < 2; ++hi) {
       Half& h = halves[hi];
       if (h.piloted) continue;  // its samples are no longer only the pilot's
+      // errors weighed by the pixel's value from its neighbours (neighbour_values), and with
+      // caustics by the whole pixel, camera and light means
+      const int width = scene->film.width, height = scene->film.height;
+      const std::vector<double> means = render_detail::sample_means(h.sum, h.count);
       if (h.light_sum.empty()) {
-        h.pilot.v = render_detail::relative_variance(h.sum, h.sumsq, h.count);
-      } else {  // errors weighed by the whole pixel, camera and light means
-        const std::vector<double> lm = render_detail::light_means(
-            h.light_sum, h.light_paths, scene->film.width, scene->film.height);
-        h.pilot.v = render_detail::relative_variance(h.sum, h.sumsq, h.count, &lm);
+        const std::vector<double> value =
+            render_detail::neighbour_values(means, h.count, width, height);
+        h.pilot.v = render_detail::relative_variance(h.sum, h.sumsq, h.count, &value);
+      } else {
+        const std::vector<double> lm =
+            render_detail::light_means(h.light_sum, h.light_paths, width, height);
+        const std::vector<double> value =
+            render_detail::neighbour_values(means, h.count, width, height, &lm);
+        h.pilot.v = render_detail::relative_variance(h.sum, h.sumsq, h.count, &value);
         h.pilot.light_w = render_detail::light_relative_variance(h.light_sum, h.light_sumsq,
-                                                                 h.light_paths, h.sum, h.count, lm);
+                                                                 h.light_paths, value);
       }
       calibration_sums(h, h.pilot);
       h.piloted = true;
@@ -836,7 +844,7 @@ struct Renderer::Impl {
       const Half &a = halves[0], &b = halves[1];
       const double ga = calibrated ? calib[0].gain : 1, gb = calibrated ? calib[1].gain : 1;
       const bool caustics = !a.light_sum.empty();
-      double predicted = 0;
+      std::vector<double> mean_var(npix * 3, 0.0);  // the variance of each pixel's mean
       for (size_t i = 0; i < npix; ++i) {
         render_detail::combine_halves(&a.sum[i * 3], &a.sumsq[i * 3], a.count[i], &b.sum[i * 3],
                                       &b.sumsq[i * 3], b.count[i], &r.mean.rgb[i * 3],
@@ -854,11 +862,14 @@ struct Renderer::Impl {
         const double na = a.count[i], nb = b.count[i];
         const double gain =
             na > 0 && nb > 0 ? (ga / na + gb / nb) / (1 / na + 1 / nb) : (na > 0 ? ga : gb);
-        for (int c = 0; c < 3; ++c) {
-          const double m = r.mean.rgb[i * 3 + c];
-          predicted += (gain * camera_var[c] / r.samples[i] + light_var[c]) / (m * m + 0.01);
-        }
+        for (int c = 0; c < 3; ++c)
+          mean_var[i * 3 + c] = gain * camera_var[c] / r.samples[i] + light_var[c];
       }
+      // errors weighed by each pixel's value from its neighbours (render/adaptive.hpp)
+      const std::vector<double> value = render_detail::neighbour_values(
+          std::vector<double>(r.mean.rgb.begin(), r.mean.rgb.end()), r.samples, width, height);
+      double predicted = 0;
+      for (size_t k = 0; k < npix * 3; ++k) predicted += mean_var[k] / (value[k] * value[k] + 0.01);
       r.estimated_relmse = npix ? predicted / (3.0 * double(npix)) : 0;
       if (caustics) {  // each half's whole estimate: its camera mean plus its light part
         std::vector<double> sa = a.sum, sb = b.sum;
@@ -866,9 +877,9 @@ struct Renderer::Impl {
           if (a.light_paths) sa[k] += a.count[k / 3] * a.light_sum[k] / double(a.light_paths);
           if (b.light_paths) sb[k] += b.count[k / 3] * b.light_sum[k] / double(b.light_paths);
         }
-        r.halves_relmse = render_detail::halves_relmse(sa, a.count, sb, b.count);
+        r.halves_relmse = render_detail::halves_relmse(sa, a.count, sb, b.count, &value);
       } else {
-        r.halves_relmse = render_detail::halves_relmse(a.sum, a.count, b.sum, b.count);
+        r.halves_relmse = render_detail::halves_relmse(a.sum, a.count, b.sum, b.count, &value);
       }
       r.target_error = adaptive_target;
       if (calibrated) {
