@@ -16,6 +16,7 @@
 #include <regex>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "core/file_io.hpp"
 #include "support.hpp"
@@ -250,6 +251,19 @@ TEST(Outputs, NonFiniteOptionsAreRefused) {
             "--time is not supported with --reference");
   CommandResult r = run_cli("converge " + q(scene) + " --time-ladder 1,nan");
   EXPECT_EQ(error_line(r), "--time-ladder nan: must be a finite number (see lucent --help)");
+  // out-of-range reals in one short line (CLI11's own checks wrote out a range up to 1.8e308)
+  const std::pair<const char*, const char*> bad[] = {
+      {"--target-error -1", "--target-error: must be a positive number, got -1"},
+      {"--target-error 0", "--target-error: must be a positive number, got 0"},
+      {"--target-error x", "--target-error: must be a number, got x"},
+      {"--clamp -0.5", "--clamp: must be 0 or more, got -0.5"},
+      {"--time -3", "--time: must be a positive number, got -3"}};
+  for (const auto& [opt, want] : bad)
+    EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(out) + " " + opt)),
+              std::string(want) + " (see lucent --help)");
+  EXPECT_EQ(error_line(run_cli("compare " + q(dir + "/a.pfm") + " " + q(dir + "/a.pfm") +
+                               " --abs-epsilon -1")),
+            "--abs-epsilon: must be 0 or more, got -1 (see lucent --help)");
   EXPECT_FALSE(fs::exists(out));
 }
 

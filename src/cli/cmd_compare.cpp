@@ -40,10 +40,10 @@ CLI::App* add_compare_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--abs-epsilon", a.options.abs_epsilon,
                   "Absolute error allowed where variances are zero (default 1e-5)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(lucent::cli::non_negative_real());
   cmd->add_option("--rel-epsilon", a.options.rel_epsilon,
                   "Relative error allowed where variances are zero (default 1e-4)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(lucent::cli::non_negative_real());
   cmd->add_flag("--no-mean-test", a.no_mean_test, "Skip the test of the image means");
   cmd->add_option("--zmap", a.zmap,
                   "Write the per-pixel z values (signed, per channel) to this .exr or .pfm file");

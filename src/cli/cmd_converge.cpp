@@ -112,7 +112,7 @@ CLI::App* add_converge_command(CLI::App& app) {
                   ->check(CLI::Range(1, limits::kMaxSpp));
   auto* time = cmd->add_option("--time-ladder", a.time_ladder, "Seconds of rendering per rung")
                    ->delimiter(',')
-                   ->check(CLI::PositiveNumber);
+                   ->check(lucent::cli::positive_real());
   spp->excludes(time);
   cmd->add_option("--max-spp", a.max_spp,
                   "Default ladder: powers of two from 1 to this (default 64)")

@@ -332,7 +332,7 @@ CLI::App* add_render_command(CLI::App& app) {
                    "the most per pixel, default 16384)")
       ->check(CLI::Range(1, lucent::limits::kMaxSpp));
   render->add_option("--time", ra.time_limit, "Stop after this many seconds of rendering")
-      ->check(CLI::PositiveNumber)
+      ->check(lucent::cli::positive_real())
       ->check(CLI::Range(0.0, 1e7));
   render->add_option("--width", ra.width, "Image width (overrides the scene)")
       ->check(CLI::Range(1, lucent::limits::kMaxImageSize));

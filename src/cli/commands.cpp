@@ -24,6 +24,23 @@ std::vector<std::string> aov_names() {
   return out;
 }
 
+namespace {
+CLI::Validator real_check(bool strict) {
+  return CLI::Validator(
+      [strict](std::string& text) -> std::string {
+        double v = 0;
+        if (!CLI::detail::lexical_cast(text, v)) return "must be a number, got " + text;
+        if (strict ? v > 0 : v >= 0) return "";
+        return std::string(strict ? "must be a positive number" : "must be 0 or more") + ", got " +
+               text;
+      },
+      strict ? "POSITIVE" : "NONNEGATIVE");
+}
+}  // namespace
+
+CLI::Validator positive_real() { return real_check(true); }
+CLI::Validator non_negative_real() { return real_check(false); }
+
 std::string joined(const std::vector<std::string>& names) {
   std::string out;
   for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;

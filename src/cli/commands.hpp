@@ -28,6 +28,12 @@ std::string cache_dir_from_environment();
 /// The names --aov accepts: the registry's AOVs (albedo, normal, ...), then "variance".
 std::vector<std::string> aov_names();
 
+/// Checks for a real option, with one-line messages ("must be a positive number, got -1"):
+/// CLI::PositiveNumber and NonNegativeNumber report a range up to 1.8e308 written out in full.
+/// (NaN and infinities are refused before these run: main.cpp's non_finite_option.)
+CLI::Validator positive_real();
+CLI::Validator non_negative_real();
+
 /// "a, b, c".
 std::string joined(const std::vector<std::string>& names);
 

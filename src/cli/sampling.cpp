@@ -16,7 +16,7 @@ void add_sampling_options(CLI::App* cmd, SamplingArgs& a, bool adaptive) {
   cmd->add_option("--clamp", a.clamp,
                   "Largest contribution of a path vertex after a scattering (overrides "
                   "integrator.clamp; 0: off; biased when it binds)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_real());
   cmd->add_flag_callback(
       "--caustics", [&a] { a.caustics = 1; },
       "Caustic paths by light tracing (integrator.caustics; path integrator, pinhole camera)");
@@ -26,7 +26,7 @@ void add_sampling_options(CLI::App* cmd, SamplingArgs& a, bool adaptive) {
   cmd->add_option("--target-error", a.target_error,
                   "Adaptive sampling: render until the image's estimated relMSE is at most this, "
                   "with --spp as the most samples per pixel and --time as a time limit")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_real());
   cmd->add_option("--min-spp", a.min_spp,
                   "Adaptive sampling: samples per pixel of the pilot, everywhere (default 64)")
       ->check(CLI::Range(4, limits::kMaxSpp));
