@@ -164,11 +164,12 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
 }
 
 std::uint64_t adaptive_host_bytes(std::uint64_t npix, bool caustics) {
-  // a half: 3 + 3 doubles and 3 uint32; a pilot: 7 doubles and a uint32; the planner's
-  // temporaries: about 4 doubles
+  // a half: 3 + 3 doubles and 3 uint32; a pilot: 7 doubles and a uint32; the temporaries of
+  // the pilots' relative variances (sample means, light means, neighbour values) and of the
+  // result (variances of the means, neighbour values, the image's means): about 12 doubles
   const std::uint64_t half = 6 * sizeof(double) + 3 * sizeof(std::uint32_t);
   const std::uint64_t pilot = 7 * sizeof(double) + sizeof(std::uint32_t);
-  std::uint64_t per_pixel = 3 * half + 2 * pilot + 4 * sizeof(double);
+  std::uint64_t per_pixel = 3 * half + 2 * pilot + 12 * sizeof(double);
   if (caustics) per_pixel += 2 * 6 * sizeof(double);
   return npix * per_pixel;
 }
