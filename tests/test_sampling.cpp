@@ -448,6 +448,23 @@ TEST(AdaptivePlan, HalvesRelmseIsTheVarianceOfTheAverage) {
   EXPECT_NEAR(halves_relmse(sa, na, sb, nb), expected, 0.03 * expected);
 }
 
+// The warning of a render whose halves say it missed its target: none within 1.5 times the
+// target, nor without a target or when cancelled; otherwise one line with the ratio.
+TEST(AdaptivePlan, TargetShortfallIsReportedAbove1Point5TimesTheTarget) {
+  RenderResult r;
+  EXPECT_EQ(lucent::target_shortfall(r), "");
+  r.target_error = 1e-3;
+  r.halves_relmse = 1.4e-3;
+  EXPECT_EQ(lucent::target_shortfall(r), "");
+  r.halves_relmse = 2.2e-3;
+  EXPECT_EQ(lucent::target_shortfall(r),
+            "the halves' difference estimates relMSE 0.0022, 2.2 times the target 0.001: the "
+            "plan from the pilot fell short (rare bright paths the pilot missed, or the --spp "
+            "cap); raise --min-spp or lower --target-error");
+  r.cancelled = true;
+  EXPECT_EQ(lucent::target_shortfall(r), "");
+}
+
 // The weighing value: analytic on a 3 x 3 film of grey pixels (1, the same in the 3 channels
 // but for the blue channel's + 20) with a firefly at the centre (10): the centre gets its 8
 // neighbours' mean, 1; a corner keeps its own 1 (below its neighbours' (1 + 1 + 10) / 3). A pixel

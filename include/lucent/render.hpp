@@ -13,9 +13,9 @@ namespace lucent {
 
 /// One device's part of a render (several devices share a render's passes).
 struct DeviceShare {
-  std::string device;          ///< the device's name
-  std::uint64_t samples = 0;   ///< samples per pixel it rendered
-  double seconds = 0;          ///< time its passes took
+  std::string device;         ///< the device's name
+  std::uint64_t samples = 0;  ///< samples per pixel it rendered
+  double seconds = 0;         ///< time its passes took
 };
 
 struct RenderProgress {
@@ -74,16 +74,17 @@ struct RenderResult {
   bool program_cache_hit = false;      ///< the program came from lucent's binary cache
   std::string build_options;           ///< OpenCL build options, feature defines included
   bool cancelled = false;
-  std::string device;                  ///< the device's name ("A + B" for several)
-  std::vector<DeviceShare> devices;    ///< each device's part of the accumulation
+  std::string device;                ///< the device's name ("A + B" for several)
+  std::vector<DeviceShare> devices;  ///< each device's part of the accumulation
   /// Adaptive renders: the relMSE that the image's own per-pixel variances predict (mean over
-  /// pixel-channels of var / n / (mean^2 + 0.01)), each half's share scaled by its model_gain
-  /// when the render had a target, and the target; 0 for uniform renders.
+  /// pixel-channels of var / n / (value^2 + 0.01), value the smaller of the pixel's mean and its
+  /// neighbours'), each half's share scaled by its model_gain when the render had a target, and
+  /// the target; 0 for uniform renders.
   double estimated_relmse = 0;
   double target_error = 0;
   /// Adaptive renders: the a-posteriori relMSE from the difference of the two halves (mean over
-  /// pixel-channels of (A - B)^2 / 4 / (mean^2 + 0.01)), an unbiased estimate of the error
-  /// variance for any sampler, Sobol included (noisy on small films); 0 for uniform renders.
+  /// pixel-channels of (A - B)^2 / 4 / (value^2 + 0.01), value as above), an estimate of the
+  /// error variance for any sampler, Sobol included (noisy on small films); 0 for uniform renders.
   double halves_relmse = 0;
   /// Adaptive renders with a target: the calibration's gains of halves A and B (measured error of
   /// a pilot over the v / n model's; ~1 with independent samples, < 1 with Sobol), and the
@@ -91,6 +92,13 @@ struct RenderResult {
   double model_gain_a = 0, model_gain_b = 0;
   double planned_relmse = 0;
 };
+
+/// A render with a target error whose halves' estimate (halves_relmse) is above 1.5 times the
+/// target: one line saying so and what to do ("" otherwise, and for renders without a target).
+/// The plan is made from a pilot, and a pilot that misses a scene's rare bright paths
+/// under-predicts (docs/rendering-model.md "Adaptive sampling"); the halves see what the whole
+/// render drew. Not a failure: the image is unbiased, only noisier than asked.
+std::string target_shortfall(const RenderResult& result);
 
 /// Renders `scene` with the OpenCL megakernel: a one-shot lucent::Renderer session
 /// (lucent/session.hpp) that stops at options.spp samples per pixel (0: the scene's) or after

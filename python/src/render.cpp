@@ -16,14 +16,14 @@ namespace lucent::python {
 namespace {
 
 // Every field of SessionStats, for attributes, as_dict() and repr().
-#define LUCENT_PY_SESSION_STATS(X)                                                              \
-  X(scene_packs)                                                                                \
-  X(bvh_builds)                                                                                 \
-  X(kernel_compiles)                                                                            \
-  X(kernel_cache_loads)                                                                         \
-  X(kernel_reuses)                                                                              \
-  X(buffer_uploads) X(bytes_uploaded) X(passes) X(pack_seconds) X(bvh_seconds) X(build_seconds) \
-      X(render_seconds)
+#define LUCENT_PY_SESSION_STATS(X) \
+  X(scene_packs)                   \
+  X(bvh_builds)                    \
+  X(kernel_compiles)               \
+  X(kernel_cache_loads)            \
+  X(kernel_reuses)                 \
+  X(buffer_uploads)                \
+  X(bytes_uploaded) X(passes) X(pack_seconds) X(bvh_seconds) X(build_seconds) X(render_seconds)
 
 #define LUCENT_PY_PROGRESS(X) \
   X(samples_done) X(samples_target) X(accumulated) X(elapsed) X(time_limit) X(samples_per_second)
@@ -339,6 +339,9 @@ void bind_render(py::module_& m) {
                     "the relMSE a target render's calibrated plans predicted (0: none)")
       .def_readonly("target_error", &RenderResult::target_error,
                     "the relMSE an adaptive render aimed at (0: not adaptive)")
+      .def_property_readonly("target_shortfall", &lucent::target_shortfall,
+                             "a target render's warning when its halves' relMSE is above 1.5 "
+                             "times the target ('' otherwise)")
       .def_readonly("rays", &RenderResult::rays)
       .def_readonly("seconds", &RenderResult::seconds)
       .def_readonly("build_seconds", &RenderResult::build_seconds)

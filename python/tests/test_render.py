@@ -379,6 +379,8 @@ def test_samplers_clamp_and_adaptive(renderer, small_scene):
     assert 1 / 64 <= r.model_gain_a <= 4 and 1 / 64 <= r.model_gain_b <= 4
     assert 0 < r.planned_relmse <= 0.05
     assert r.halves_relmse > 0
+    # the shortfall warning says so exactly when the halves are above 1.5 times the target
+    assert (r.target_shortfall != "") == (r.halves_relmse > 1.5 * 0.05)
     with pytest.raises(ValueError):
         renderer.render_adaptive()  # neither a target nor a budget
     with pytest.raises(ValueError):

@@ -290,6 +290,8 @@ int render_with(const RenderArgs& a) {
                  "gains %.3g, %.3g), from the halves' difference %.3g\n",
                  a.output.c_str(), static_cast<unsigned long long>(r.spp), r.estimated_relmse,
                  r.target_error, r.model_gain_a, r.model_gain_b, r.halves_relmse);
+  if (std::string s = lucent::target_shortfall(r); !s.empty())
+    std::fprintf(stderr, "lucent: warning: %s: %s\n", a.output.c_str(), s.c_str());
   if (!r.cancelled && !a.reference) write_aovs(a, scene, &*renderer, r);
   if (r.cancelled || g_interrupted.load()) {
     const int sig = g_signal ? static_cast<int>(g_signal) : SIGINT;

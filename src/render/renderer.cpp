@@ -1,8 +1,21 @@
 // lucent::render(): a one-shot render session (src/render/session.cpp).
+#include <cstdio>
+
 #include "lucent/render.hpp"
 #include "lucent/session.hpp"
 
 namespace lucent {
+
+std::string target_shortfall(const RenderResult& r) {
+  if (!(r.target_error > 0) || r.cancelled || !(r.halves_relmse > 1.5 * r.target_error)) return "";
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "the halves' difference estimates relMSE %.3g, %.1f times the target %.3g: the "
+                "plan from the pilot fell short (rare bright paths the pilot missed, or the --spp "
+                "cap); raise --min-spp or lower --target-error",
+                r.halves_relmse, r.halves_relmse / r.target_error, r.target_error);
+  return line;
+}
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   SessionOptions so;
