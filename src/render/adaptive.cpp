@@ -93,23 +93,66 @@ double light_relative_variance(const std::vector<double>& light_sum,
   return total / (3.0 * double(npix));
 }
 
-SamplePlan plan_samples(const std::vector<double>& v, int width, int height, double target,
-                        double budget, std::uint32_t min_n, std::uint32_t max_n, double gain,
-                        double light_w) {
+std::vector<double> raised_variance(const std::vector<double>& v, int width, int height,
+                                    int radius) {
   const std::size_t npix = static_cast<std::size_t>(width) * height;
-  max_n = std::max(max_n, min_n);
-  // the shape: sqrt of the larger of the pixel's variance and its 3 x 3 neighbourhood's mean
-  std::vector<double> shape(npix, 0.0);
-  for (int y = 0; y < height; ++y)
+  std::vector<double> r(npix, 0.0);
+  if (v.size() < npix) return r;
+  // column sums over the window's rows, then a sliding sum along the row
+  std::vector<double> col(width);
+  std::vector<int> rows(width);
+  for (int y = 0; y < height; ++y) {
+    const int y0 = std::max(0, y - radius), y1 = std::min(height - 1, y + radius);
     for (int x = 0; x < width; ++x) {
       double s = 0;
-      int k = 0;
-      for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy)
-        for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx, ++k)
-          s += v[static_cast<std::size_t>(yy) * width + xx];
-      const std::size_t i = static_cast<std::size_t>(y) * width + x;
-      shape[i] = std::sqrt(std::max(v[i], s / k));
+      for (int yy = y0; yy <= y1; ++yy) s += v[static_cast<std::size_t>(yy) * width + x];
+      col[x] = s;
     }
+    for (int x = 0; x < width; ++x) {
+      const int x0 = std::max(0, x - radius), x1 = std::min(width - 1, x + radius);
+      double s = 0;
+      for (int xx = x0; xx <= x1; ++xx) s += col[xx];
+      const double k = double(x1 - x0 + 1) * double(y1 - y0 + 1);
+      const std::size_t i = static_cast<std::size_t>(y) * width + x;
+      r[i] = std::max(v[i], s / k);
+    }
+  }
+  return r;
+}
+
+int choose_radius(const Pilot& o, const Pilot& c, int width, int height, double* under) {
+  const int radii[] = {1, 2, 3, 5};
+  if (under) *under = 0;
+  const std::size_t n = c.pixels.size();
+  if (o.value.size() < n * 3 || c.count.size() < n || c.sum.size() < n * 3 || n == 0) return 1;
+  // C's relative variances, weighed by o's neighbour values at C's pixels
+  const std::vector<double> vc = relative_variance(c.sum, c.sumsq, c.count, &o.value);
+  double u = 0;
+  for (int R : radii) {
+    const std::vector<double> r = raised_variance(o.v, width, height, R);
+    double num = 0, den = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::size_t i = c.pixels[j];
+      if (i >= r.size() || !(r[i] > 0) || c.count[j] < 2) continue;
+      const double s = std::sqrt(r[i]);
+      num += vc[j] / s;
+      den += s;
+    }
+    u = den > 0 ? num / den : 0;
+    if (under) *under = u;
+    if (u <= 1.1) return R;
+  }
+  return radii[3];
+}
+
+SamplePlan plan_samples(const std::vector<double>& v, int width, int height, double target,
+                        double budget, std::uint32_t min_n, std::uint32_t max_n, double gain,
+                        double light_w, int radius) {
+  const std::size_t npix = static_cast<std::size_t>(width) * height;
+  max_n = std::max(max_n, min_n);
+  // the shape: sqrt of the larger of the pixel's variance and its neighbourhood's mean
+  std::vector<double> shape = raised_variance(v, width, height, radius);
+  for (double& x : shape) x = std::sqrt(x);
   double smallest = 0;
   for (double s : shape)
     if (s > 0 && (smallest == 0 || s < smallest)) smallest = s;
@@ -200,10 +243,12 @@ HalfPlans plan_halves(const Pilot& a, const Pilot& b, const Pilot& c, int width,
   const Pilot* other[2] = {&b, &a};
   for (int h = 0; h < 2; ++h) {
     const Pilot& o = *other[h];
-    if (target > 0)
+    if (target > 0) {
       out.calib[h] = calibrate_model(o.sum, o.sumsq, o.count, c.sum, c.sumsq, c.count);
+      out.radius[h] = choose_radius(o, c, width, height, &out.under[h]);
+    }
     out.plan[h] = plan_samples(o.v, width, height, 2 * target, budget / 2, min_n, max_n,
-                               out.calib[h].gain, o.light_w);
+                               out.calib[h].gain, o.light_w, out.radius[h]);
   }
   return out;
 }

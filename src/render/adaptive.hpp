@@ -123,8 +123,8 @@ struct SamplePlan {
 /// Plans the per-pixel sample counts of one half from the relative variances v of the other
 /// half's pilot (width x height pixels): counts proportional to the square root of v (the
 /// allocation that minimises sum v / n for a given sum n), where v is first raised to the mean
-/// of its 3 x 3 neighbourhood (a pixel whose pilot saw little of a noisy neighbourhood still gets
-/// samples), clamped to [min_n, max_n]. With target > 0 the counts are the smallest such that
+/// of its neighbourhood, 3 x 3 for radius 1 (a pixel whose pilot saw little of a noisy
+/// neighbourhood still gets samples), clamped to [min_n, max_n]. With target > 0 the counts are the smallest such that
 /// the predicted relMSE of the half's image, mean of that raised v over n (v itself would
 /// under-predict: the pixels whose pilot under-estimated v get fewer samples), is at most target
 /// (max_n everywhere when even that does not reach it); otherwise the largest such that the mean
@@ -133,9 +133,15 @@ struct SamplePlan {
 /// over n (gain 1: independent samples); it plays no part in a budget's plan. `light_w` > 0
 /// (caustics: light_relative_variance of the other half's pilot) adds light_w / (sum of the
 /// counts) to the predicted relMSE, one light path per camera sample.
+/// `radius` (choose_radius) sizes the neighbourhood whose mean raises v: (2 radius + 1)^2.
 SamplePlan plan_samples(const std::vector<double>& v, int width, int height, double target,
                         double budget, std::uint32_t min_n, std::uint32_t max_n, double gain = 1,
-                        double light_w = 0);
+                        double light_w = 0, int radius = 1);
+
+/// v raised to the mean of its (2 radius + 1)^2 neighbourhood (clipped at the film's edges):
+/// max(v_p, mean over the window of v).
+std::vector<double> raised_variance(const std::vector<double>& v, int width, int height,
+                                    int radius);
 
 /// The calibration of the plan's error model "relMSE of a pixel = v / n" (exact for independent
 /// samples; Owen-scrambled Sobol samples do better, by a factor that depends on the scene and on
@@ -170,7 +176,22 @@ struct Pilot {
   double light_w = 0;  ///< caustics: light_relative_variance of the pilot's light paths
   std::vector<double> sum, sumsq;
   std::vector<std::uint32_t> count;
+  std::vector<double> value;        ///< neighbour_values on the calibration pixels (not for C)
+  std::vector<std::size_t> pixels;  ///< the calibration pixels (indices into the film)
 };
+
+/// The neighbourhood of plan_samples' raise for the half planned from pilot `o`, checked
+/// against C, which is independent of o: at C's pixels, U_R = sum of v_C / sqrt(r_R) over the
+/// sum of sqrt(r_R), with r_R = raised_variance(o.v, R) (the plan's variances; its counts go as
+/// sqrt(r_R)) and v_C C's relative variances weighed by o's neighbour values (independent of
+/// C's samples, so that v_C is an unbiased estimate of each pixel's relative variance). U_R is
+/// the ratio of the error that the counts sqrt(r_R) would reach on C's estimate to what the
+/// plan predicts: about 1 or below when o's per-pixel variances hold, above 1 when o's pilot
+/// missed paths that C's drew elsewhere (rare bright paths: a pilot catches them in a few pixels
+/// and misses them in the others). Returns the smallest R of 1, 2, 3, 5 with U_R <= 1.1, else 5
+/// (1 when o has no values or C no pixels); `under` receives U of the radius returned. It reads
+/// o and C only, never the planned half.
+int choose_radius(const Pilot& o, const Pilot& c, int width, int height, double* under = nullptr);
 
 /// Both halves' plans: half h's plan (h = 0: A, 1: B) from the other half's pilot and, with a
 /// target, C's: calib[h] = calibrate_model(other, c) and plan[h] = plan_samples(other.v, ...,
@@ -181,6 +202,8 @@ struct Pilot {
 struct HalfPlans {
   SamplePlan plan[2];
   Calibration calib[2];
+  int radius[2] = {1, 1};    ///< choose_radius (with a target; 1 for a budget)
+  double under[2] = {0, 0};  ///< its U
 };
 HalfPlans plan_halves(const Pilot& a, const Pilot& b, const Pilot& c, int width, int height,
                       double target, double budget, std::uint32_t min_n, std::uint32_t max_n);

@@ -605,14 +605,19 @@ struct Renderer::Impl {
   }
 
   /// The sums (3 channels) and counts of `h` on the calibration pixels, in their order.
-  void calibration_sums(const Half& h, render_detail::Pilot& p) const {
+  /// With `value` (3 per pixel: a half's neighbour_values), its values there too.
+  void calibration_sums(const Half& h, render_detail::Pilot& p,
+                        const std::vector<double>* value = nullptr) const {
     p.sum.clear();
     p.sumsq.clear();
     p.count.clear();
+    p.value.clear();
+    p.pixels = calib_pixels;
     for (std::size_t i : calib_pixels) {
       for (int c = 0; c < 3; ++c) {
         p.sum.push_back(h.sum[i * 3 + c]);
         p.sumsq.push_back(h.sumsq[i * 3 + c]);
+        if (value) p.value.push_back((*value)[i * 3 + c]);
       }
       p.count.push_back(h.count[i]);
     }
@@ -792,20 +797,17 @@ struct Renderer::Impl {
       // caustics by the whole pixel, camera and light means
       const int width = scene->film.width, height = scene->film.height;
       const std::vector<double> means = render_detail::sample_means(h.sum, h.count);
-      if (h.light_sum.empty()) {
-        const std::vector<double> value =
-            render_detail::neighbour_values(means, h.count, width, height);
-        h.pilot.v = render_detail::relative_variance(h.sum, h.sumsq, h.count, &value);
-      } else {
-        const std::vector<double> lm =
-            render_detail::light_means(h.light_sum, h.light_paths, width, height);
-        const std::vector<double> value =
-            render_detail::neighbour_values(means, h.count, width, height, &lm);
-        h.pilot.v = render_detail::relative_variance(h.sum, h.sumsq, h.count, &value);
+      const bool light = !h.light_sum.empty();
+      const std::vector<double> lm =
+          light ? render_detail::light_means(h.light_sum, h.light_paths, width, height)
+                : std::vector<double>();
+      const std::vector<double> value =
+          render_detail::neighbour_values(means, h.count, width, height, light ? &lm : nullptr);
+      h.pilot.v = render_detail::relative_variance(h.sum, h.sumsq, h.count, &value);
+      if (light)
         h.pilot.light_w = render_detail::light_relative_variance(h.light_sum, h.light_sumsq,
                                                                  h.light_paths, value);
-      }
-      calibration_sums(h, h.pilot);
+      calibration_sums(h, h.pilot, &value);
       h.piloted = true;
     }
     render_detail::Pilot c;
