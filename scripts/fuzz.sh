@@ -12,7 +12,9 @@
 # Needs the Debian packages clang and libclang-rt-14-dev (scripts/install-deps.sh --with-fuzz);
 # FUZZ_CC and FUZZ_CXX name other compilers (default clang, clang++); FUZZ_FLAGS the optimisation
 # and debug flags (default "-O1 -g1": half the build time of -O2 -g, for CI's smoke run; long
-# campaigns may prefer -O2).
+# campaigns may prefer -O2); FUZZ_DECODER_CMP=OFF compiles the third-party decoders without
+# comparison tracing (tests/fuzz/CMakeLists.txt: about 3x the executions per second of
+# fuzz_render_image, whose time goes to stb_image's JPEG decoder; default ON).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -49,7 +51,8 @@ fi
 flags="${FUZZ_FLAGS:--O1 -g1} -DNDEBUG"
 cmake -S . -B build-fuzz -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLUCENT_FUZZ=ON -DLUCENT_BUILD_TESTS=OFF \
-  -DLUCENT_BUILD_BENCH=OFF "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$flags" \
+  -DLUCENT_BUILD_BENCH=OFF -DLUCENT_FUZZ_DECODER_CMP="${FUZZ_DECODER_CMP:-ON}" \
+  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$flags" \
   "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$flags" >/dev/null
 cmake --build build-fuzz --target lucent_fuzz_all -j"$(nproc)"
 
