@@ -58,6 +58,8 @@ const std::map<std::string, std::string> kExpected = {
     {"exr-piz-overread-2.exr",
      ": OpenEXR PIZ chunk at byte 329 is corrupt: its bitmap runs past its end"},
     {"exr-leak.exr", ": cannot read OpenEXR pixels:"},
+    {"exr-piz-negative-bits.exr",
+     ": OpenEXR PIZ chunk at byte 329 is corrupt: its Huffman bit count -2147483648 is negative"},
     // not found by fuzzing: progressive JPEGs (jpegtran -progressive of the seeds' RGB and grey
     // images), whose scans read DC or AC tables only, must pass the scan check above
     {"jpeg-progressive-rgb.jpg", ""},

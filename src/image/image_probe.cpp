@@ -548,6 +548,10 @@ class Checker {
       const std::int64_t huffman = i32(at + 4 + bitmap);
       if (huffman < 20 || 4 + bitmap + 4 + u64(huffman) > u64(len))
         bad("its Huffman data size " + std::to_string(huffman) + " does not fit");
+      // the Huffman header: im, iM, table length, bit count (int32), reserved; tinyexr computes
+      // (8 - bits) & 7 on a negative count (signed overflow at INT_MIN, found by fuzzing)
+      const std::int64_t bits = i32(at + 4 + bitmap + 4 + 12);
+      if (bits < 0) bad("its Huffman bit count " + std::to_string(bits) + " is negative");
     }
   }
 
