@@ -257,13 +257,17 @@ TEST(Outputs, NonFiniteOptionsAreRefused) {
       {"--target-error 0", "--target-error: must be a positive number, got 0"},
       {"--target-error x", "--target-error: must be a number, got x"},
       {"--clamp -0.5", "--clamp: must be 0 or more, got -0.5"},
-      {"--time -3", "--time: must be a positive number, got -3"}};
+      {"--time -3", "--time: must be a positive number, got -3"},
+      {"--time 1e8", "--time: must be in [0, 1e+07], got 1e8"}};
   for (const auto& [opt, want] : bad)
     EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(out) + " " + opt)),
               std::string(want) + " (see lucent --help)");
   EXPECT_EQ(error_line(run_cli("compare " + q(dir + "/a.pfm") + " " + q(dir + "/a.pfm") +
                                " --abs-epsilon -1")),
             "--abs-epsilon: must be 0 or more, got -1 (see lucent --help)");
+  EXPECT_EQ(
+      error_line(run_cli("compare " + q(dir + "/a.pfm") + " " + q(dir + "/a.pfm") + " --alpha 0")),
+      "--alpha: must be in [1e-12, 0.5], got 0 (see lucent --help)");
   EXPECT_FALSE(fs::exists(out));
 }
 

@@ -34,10 +34,10 @@ CLI::App* add_compare_command(CLI::App& app) {
   cmd->add_option("a", a.a, "First image (.exr with variance layers, or any image)")->required();
   cmd->add_option("b", a.b, "Second image, the reference for relMSE")->required();
   cmd->add_option("--alpha", a.options.alpha, "Family-wise significance level (default 0.01)")
-      ->check(CLI::Range(1e-12, 0.5));
+      ->check(lucent::cli::real_range(1e-12, 0.5));
   cmd->add_option("--min-pass", a.options.min_pass_fraction,
                   "Fraction of pixels that must pass (default 0.995)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(lucent::cli::real_range(0.0, 1.0));
   cmd->add_option("--abs-epsilon", a.options.abs_epsilon,
                   "Absolute error allowed where variances are zero (default 1e-5)")
       ->check(lucent::cli::non_negative_real());

@@ -335,7 +335,7 @@ CLI::App* add_render_command(CLI::App& app) {
       ->check(CLI::Range(1, lucent::limits::kMaxSpp));
   render->add_option("--time", ra.time_limit, "Stop after this many seconds of rendering")
       ->check(lucent::cli::positive_real())
-      ->check(CLI::Range(0.0, 1e7));
+      ->check(lucent::cli::real_range(0.0, 1e7));
   render->add_option("--width", ra.width, "Image width (overrides the scene)")
       ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
   render->add_option("--height", ra.height, "Image height (overrides the scene)")

@@ -1,5 +1,6 @@
 #include "cli/commands.hpp"
 
+#include <cstdio>
 #include <functional>
 #include <vector>
 
@@ -37,6 +38,19 @@ CLI::Validator real_check(bool strict) {
       strict ? "POSITIVE" : "NONNEGATIVE");
 }
 }  // namespace
+
+CLI::Validator real_range(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& text) -> std::string {
+        double v = 0;
+        if (!CLI::detail::lexical_cast(text, v)) return "must be a number, got " + text;
+        if (v >= lo && v <= hi) return "";
+        char range[96];
+        std::snprintf(range, sizeof range, "must be in [%g, %g], got ", lo, hi);
+        return range + text;
+      },
+      "REAL");
+}
 
 CLI::Validator positive_real() { return real_check(true); }
 CLI::Validator non_negative_real() { return real_check(false); }

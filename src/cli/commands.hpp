@@ -33,6 +33,8 @@ std::vector<std::string> aov_names();
 /// (NaN and infinities are refused before these run: main.cpp's non_finite_option.)
 CLI::Validator positive_real();
 CLI::Validator non_negative_real();
+/// lo <= value <= hi, as "must be in [1e-12, 0.5], got 0" (CLI::Range prints "%f": 0.000000).
+CLI::Validator real_range(double lo, double hi);
 
 /// "a, b, c".
 std::string joined(const std::vector<std::string>& names);
