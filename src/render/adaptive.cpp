@@ -98,9 +98,8 @@ std::vector<double> raised_variance(const std::vector<double>& v, int width, int
   const std::size_t npix = static_cast<std::size_t>(width) * height;
   std::vector<double> r(npix, 0.0);
   if (v.size() < npix) return r;
-  // column sums over the window's rows, then a sliding sum along the row
+  // per row: each column's sum over the window's rows, then those sums over the window's columns
   std::vector<double> col(width);
-  std::vector<int> rows(width);
   for (int y = 0; y < height; ++y) {
     const int y0 = std::max(0, y - radius), y1 = std::min(height - 1, y + radius);
     for (int x = 0; x < width; ++x) {

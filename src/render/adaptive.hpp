@@ -120,20 +120,20 @@ struct SamplePlan {
   double mean = 0;       ///< mean count per pixel
 };
 
-/// Plans the per-pixel sample counts of one half from the relative variances v of the other
-/// half's pilot (width x height pixels): counts proportional to the square root of v (the
-/// allocation that minimises sum v / n for a given sum n), where v is first raised to the mean
-/// of its neighbourhood, 3 x 3 for radius 1 (a pixel whose pilot saw little of a noisy
-/// neighbourhood still gets samples), clamped to [min_n, max_n]. With target > 0 the counts are the smallest such that
+/// Plans the per-pixel sample counts of one half from the relative variances v of the other half's
+/// pilot (width x height pixels): counts proportional to the square root of v (the allocation that
+/// minimises sum v / n for a given sum n), where v is first raised to the mean of its
+/// neighbourhood, 3 x 3 for radius 1 (a pixel whose pilot saw little of a noisy neighbourhood still
+/// gets samples), clamped to [min_n, max_n]. With target > 0 the counts are the smallest such that
 /// the predicted relMSE of the half's image, mean of that raised v over n (v itself would
 /// under-predict: the pixels whose pilot under-estimated v get fewer samples), is at most target
 /// (max_n everywhere when even that does not reach it); otherwise the largest such that the mean
 /// count is at most budget. Raising `target` or lowering `budget` never raises a count. `gain`
 /// scales the model (calibrate_model): the predicted relMSE is gain times the mean of the raised v
 /// over n (gain 1: independent samples); it plays no part in a budget's plan. `light_w` > 0
-/// (caustics: light_relative_variance of the other half's pilot) adds light_w / (sum of the
-/// counts) to the predicted relMSE, one light path per camera sample.
-/// `radius` (choose_radius) sizes the neighbourhood whose mean raises v: (2 radius + 1)^2.
+/// (caustics: light_relative_variance of the other half's pilot) adds light_w / (sum of the counts)
+/// to the predicted relMSE, one light path per camera sample. `radius` (choose_radius) sizes the
+/// neighbourhood whose mean raises v: (2 radius + 1)^2.
 SamplePlan plan_samples(const std::vector<double>& v, int width, int height, double target,
                         double budget, std::uint32_t min_n, std::uint32_t max_n, double gain = 1,
                         double light_w = 0, int radius = 1);
@@ -195,10 +195,10 @@ int choose_radius(const Pilot& o, const Pilot& c, int width, int height, double*
 
 /// Both halves' plans: half h's plan (h = 0: A, 1: B) from the other half's pilot and, with a
 /// target, C's: calib[h] = calibrate_model(other, c) and plan[h] = plan_samples(other.v, ...,
-/// 2 target, budget / 2, min_n, max_n, calib[h].gain, other.light_w) (a half at 2 E makes the
-/// average of the
-/// two E). Nothing of half h's pilot reaches plan[h] or calib[h]. With a budget, calib stays at
-/// gain 1 and c is not read.
+/// 2 target, budget / 2, min_n, max_n, calib[h].gain, other.light_w, radius[h]) (a half at 2 E
+/// makes the average of the two E), radius[h] = choose_radius(other, c). Nothing of half h's
+/// pilot reaches plan[h], calib[h] or radius[h]. With a budget, calib stays at gain 1, the radius
+/// at 1, and c is not read.
 struct HalfPlans {
   SamplePlan plan[2];
   Calibration calib[2];
