@@ -2,6 +2,8 @@
 
 #include <cstdio>
 #include <functional>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "cl/program_cache.hpp"
@@ -26,34 +28,32 @@ std::vector<std::string> aov_names() {
 }
 
 namespace {
-CLI::Validator real_check(bool strict) {
+/// A real option's check: "" when ok(value), else "<what>, got <text>" ("must be a number, got
+/// <text>" when it is not one).
+CLI::Validator real_check(std::function<bool(double)> ok, std::string what, std::string name) {
   return CLI::Validator(
-      [strict](std::string& text) -> std::string {
+      [ok = std::move(ok), what = std::move(what)](std::string& text) -> std::string {
         double v = 0;
         if (!CLI::detail::lexical_cast(text, v)) return "must be a number, got " + text;
-        if (strict ? v > 0 : v >= 0) return "";
-        return std::string(strict ? "must be a positive number" : "must be 0 or more") + ", got " +
-               text;
+        return ok(v) ? "" : what + ", got " + text;
       },
-      strict ? "POSITIVE" : "NONNEGATIVE");
+      std::move(name));
 }
 }  // namespace
 
 CLI::Validator real_range(double lo, double hi) {
-  return CLI::Validator(
-      [lo, hi](std::string& text) -> std::string {
-        double v = 0;
-        if (!CLI::detail::lexical_cast(text, v)) return "must be a number, got " + text;
-        if (v >= lo && v <= hi) return "";
-        char range[96];
-        std::snprintf(range, sizeof range, "must be in [%g, %g], got ", lo, hi);
-        return range + text;
-      },
-      "REAL");
+  char what[96];
+  std::snprintf(what, sizeof what, "must be in [%g, %g]", lo, hi);
+  return real_check([lo, hi](double v) { return v >= lo && v <= hi; }, what, "REAL");
 }
 
-CLI::Validator positive_real() { return real_check(true); }
-CLI::Validator non_negative_real() { return real_check(false); }
+CLI::Validator positive_real() {
+  return real_check([](double v) { return v > 0; }, "must be a positive number", "POSITIVE");
+}
+
+CLI::Validator non_negative_real() {
+  return real_check([](double v) { return v >= 0; }, "must be 0 or more", "NONNEGATIVE");
+}
 
 std::string joined(const std::vector<std::string>& names) {
   std::string out;
