@@ -220,7 +220,7 @@ namespace {
 
 // Light-traced caustics (integrator.caustics) cannot be split into part files, nor seen through a
 // thin lens: each is refused with one line before rendering, and no output is written. (They
-// render adaptively: Adaptive.CausticsMeanIsUnbiased in test_sampling.cpp.)
+// render adaptively: KernelCaustics.AdaptiveIsUnbiased in test_kernel_caustics.cpp.)
 TEST(CliErrors, CausticsRefusalsAreOneLine) {
   std::string scene = small_scene();
   std::string dir = scene.substr(0, scene.rfind('/'));
