@@ -521,9 +521,9 @@ TEST(AdaptivePlan, TargetShortfallIsReportedAbove1Point5TimesTheTarget) {
   EXPECT_EQ(lucent::target_shortfall(r), "");
   r.halves_relmse = 2.2e-3;
   EXPECT_EQ(lucent::target_shortfall(r),
-            "the halves' difference estimates relMSE 0.0022, 2.2 times the target 0.001: the "
-            "plan from the pilot fell short (rare bright paths the pilot missed, or the --spp "
-            "cap); raise --min-spp or lower --target-error");
+            "the halves' difference estimates relMSE 0.0022, 2.2 times the target 0.001 (rare "
+            "bright samples that no pilot foresees, or the --spp cap): lower --target-error or "
+            "raise --spp; integrator.clamp trades such samples for bias");
   r.cancelled = true;
   EXPECT_EQ(lucent::target_shortfall(r), "");
 }

@@ -68,7 +68,7 @@ struct Integrator {
   double clamp = 0;
   /// path: caustic paths (light, one or more delta scatterings, one non-delta vertex seen by the
   /// camera) come from light tracing instead of the camera path (docs/rendering-model.md,
-  /// "Caustics by light tracing"). Pinhole cameras only.
+  /// "Caustics by light tracing"). Pinhole and thin-lens cameras.
   bool caustics = false;
 };
 

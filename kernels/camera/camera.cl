@@ -58,4 +58,37 @@ static inline int camera_project(__global const lc_camera* cam, lc_real3 p, lc_u
   return 1;
 }
 
+/* Light tracing's connection to the camera: the point *o of the lens that the connection to p
+ * starts from (the lens point (lu, lv) mapped as camera_generate_ray maps it; the pinhole's
+ * position without a lens), the film position (fx, fy) of the camera rays from *o that reach p
+ * (through the point of the focal plane on the line from *o through p) and the cosine between
+ * forward and p - *o; 0 when p is not in front of *o. */
+static inline int camera_project_lens(__global const lc_camera* cam, lc_real3 p, float lu, float lv,
+                                      lc_uint width, lc_uint height, float* fx, float* fy,
+                                      float* cos_c, lc_real3* o) {
+  *o = lc_load3r(cam->position);
+#ifdef LC_HAS_THIN_LENS
+  if (cam->lens_radius > 0.0f) {
+    lc_real3 right = lc_load3r(cam->right), up = lc_load3r(cam->up);
+    lc_real3 fwd = lc_load3r(cam->forward);
+    float2 lens = cam->lens_radius * sample_concentric_disk(lu, lv);
+    lc_real3 c = *o;
+    *o = c + (lc_real)lens.x * right + (lc_real)lens.y * up;
+    lc_real3 d = p - *o;
+    lc_real z = dot(d, fwd);
+    if (!(z > LC_REAL(0.0))) return 0;
+    /* the focal plane's point on the ray, seen from the lens centre at depth focus_distance */
+    lc_real3 f = *o + d * ((lc_real)cam->focus_distance / z) - c;
+    lc_real fz = (lc_real)cam->focus_distance;
+    lc_real ndc_x = dot(f, right) / (fz * cam->tan_half_fov * cam->aspect);
+    lc_real ndc_y = dot(f, up) / (fz * cam->tan_half_fov);
+    *fx = (float)((ndc_x + LC_REAL(1.0)) * (LC_REAL(0.5) * (lc_real)width));
+    *fy = (float)((LC_REAL(1.0) - ndc_y) * (LC_REAL(0.5) * (lc_real)height));
+    *cos_c = (float)(z / length(d));
+    return 1;
+  }
+#endif
+  return camera_project(cam, p, width, height, fx, fy, cos_c);
+}
+
 #endif

@@ -1,10 +1,10 @@
 /* lucent kernel: caustics by light tracing (integrator.caustics; docs/rendering-model.md,
  * "Caustics by light tracing"). Each camera sample also traces one light path: from a light,
  * through one or more delta scatterings, then through non-delta ones; each non-delta vertex is
- * connected to the pinhole and splatted with the pixel filter's density into the film's light
- * sums (atomically: any work-item may reach any pixel). The path integrator leaves out the same
- * paths, E N+ S+ L (integrator/path.cl), so the two split path space. The host divides the light sums by the
- * number of light paths, W * H * spp. */
+ * connected to the camera (the pinhole, or a point of a thin lens) and splatted with the pixel
+ * filter's density into the film's light sums (atomically: any work-item may reach any pixel). The
+ * path integrator leaves out the same paths, E N+ S+ L (integrator/path.cl), so the two split path
+ * space. The host divides the light sums by the number of light paths, W * H * spp. */
 #ifndef LUCENT_INTEGRATOR_CAUSTICS_CL
 #define LUCENT_INTEGRATOR_CAUSTICS_CL
 
@@ -47,21 +47,22 @@ static inline void caustics_splat(const lc_scene* s, float fx, float fy, float3 
     }
 }
 
-/* Connects the light path's vertex x at `hit` (reached by ray with weight beta) to the camera. The
- * BSDF there is seen as a camera ray hitting the point would see it (its normals facing the
- * camera, the geometric one where the interpolated one faces away), so that the contribution is
- * exactly the one the path integrator leaves out. Returns 0 when the contribution is not finite
- * (it is then counted, not splatted). */
+/* Connects the light path's vertex x at `hit` (reached by ray with weight beta) to the camera:
+ * to the pinhole, or to the point (lu, lv) of a thin lens. The BSDF there is seen as a camera ray
+ * hitting the point would see it (its normals facing the camera, the geometric one where the
+ * interpolated one faces away), so that the contribution is exactly the one the path integrator
+ * leaves out. Returns 0 when the contribution is not finite (it is then counted, not
+ * splatted). */
 static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_hit* hit, lc_real3 x,
-                                   float3 beta, __global float4* light_sum,
+                                   float lu, float lv, float3 beta, __global float4* light_sum,
                                    __global float4* light_sumsq, lc_uint* rays) {
   __global const lc_params* P = s->params;
   __global const lc_camera* cam = &P->camera;
   float fx, fy, cos_c;
-  if (!camera_project(cam, x, P->width, P->height, &fx, &fy, &cos_c)) return 1;
+  lc_real3 cpos; /* the pinhole, or the lens point */
+  if (!camera_project_lens(cam, x, lu, lv, P->width, P->height, &fx, &fy, &cos_c, &cpos)) return 1;
   const float r = P->filter_radius;
   if (!(fx > -r && fx < (float)P->width + r && fy > -r && fy < (float)P->height + r)) return 1;
-  lc_real3 cpos = lc_load3r(cam->position);
   lc_real3 toc = cpos - x;
   lc_real dist = length(toc);
   if (!(dist > LC_REAL(0.0))) return 1;
@@ -89,11 +90,12 @@ static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_hit* 
   lc_real3 to = cpos - o;
   lc_real od = length(to);
   if (!(od > LC_REAL(0.0)) || !shadow_visible(s, o, to / od, od, rays)) return 1;
-  /* |wl.ns| |wc.ng| / |wl.ng|, and the pinhole's importance 1 / (s^2 cos^3) over r^2 */
+  /* |wl.ns| |wc.ng| / |wl.ng|, and the importance 1 / (s^2 cos^3) over r^2, for a pinhole and
+   * for a thin lens alike (with r and cos from the lens point: the lens point's density
+   * 1 / area cancels the importance's 1 / area) */
   float cos_x = fabs(wi_l.z) * (float)dot(wc, it.ng) / (float)fabs(side);
   float pitch = 2.0f * cam->tan_half_fov / (float)P->height;
-  float3 c = beta * f *
-             (cos_x / ((float)(dist * dist) * pitch * pitch * cos_c * cos_c * cos_c));
+  float3 c = beta * f * (cos_x / ((float)(dist * dist) * pitch * pitch * cos_c * cos_c * cos_c));
   if (!lc_isfinite3(c)) return 0;
   caustics_splat(s, fx, fy, c, light_sum, light_sumsq);
   return 1;
@@ -102,8 +104,8 @@ static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_hit* 
 /* The light path of the camera sample rng (random numbers from LC_DIM_LIGHT_PATH). Returns the
  * number of non-finite contributions it dropped. */
 static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
-                                          __global float4* light_sum,
-                                          __global float4* light_sumsq, lc_uint* rays) {
+                                          __global float4* light_sum, __global float4* light_sumsq,
+                                          lc_uint* rays) {
   __global const lc_params* P = s->params;
   if (P->max_depth < 3u) return 0; /* a caustic path has at least 3 segments */
   float4 ue = lc_rand4(rng, LC_DIM_LIGHT_PATH);
@@ -122,12 +124,13 @@ static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
     lc_interaction it = interaction_from_hit(s, ray, &hit);
     __global const lc_material* m = &s->materials[it.material];
     lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
-    if (state != 0 && !(bsdf_lobes(&b) & LC_BSDF_DELTA))
-      nonfinite += !caustics_connect(s, ray, &hit, it.p, beta, light_sum, light_sumsq, rays);
-    /* continue while the lobes read S+ N* */
     lc_uint dim = LC_DIM_LIGHT_PATH + 8u * i;
     float4 ua = lc_rand4(rng, dim);
     float4 ub = lc_rand4(rng, dim + 4u);
+    if (state != 0 && !(bsdf_lobes(&b) & LC_BSDF_DELTA))
+      nonfinite +=
+          !caustics_connect(s, ray, &hit, it.p, ua.x, ua.y, beta, light_sum, light_sumsq, rays);
+    /* continue while the lobes read S+ N* */
     lc_frame fr = frame_from(it.ns);
     float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
     if (wo_l.z <= 0.0f) break;

@@ -52,7 +52,8 @@
 /* The light path of a camera sample (integrator.caustics, docs/rendering-model.md): from
  * LC_DIM_LIGHT_PATH, +0,+1 point on the light, +2 light selection, +4,+5 emitted direction; then
  * 8 per scattering vertex i = 1, 2, ... from LC_DIM_LIGHT_PATH + 8 i with the offsets above
- * (+3 lobe, +4,+5 BSDF direction, +6 Russian roulette). */
+ * (+0,+1 the lens point of the vertex's connection to a thin-lens camera, +3 lobe, +4,+5 BSDF
+ * direction, +6 Russian roulette). */
 #define LC_DIM_LIGHT_PATH 0x20000000u
 
 /* pcg4d: hashes four 32-bit words into four, in place. */

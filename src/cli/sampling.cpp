@@ -19,7 +19,7 @@ void add_sampling_options(CLI::App* cmd, SamplingArgs& a, bool adaptive) {
       ->check(non_negative_real());
   cmd->add_flag_callback(
       "--caustics", [&a] { a.caustics = 1; },
-      "Caustic paths by light tracing (integrator.caustics; path integrator, pinhole camera)");
+      "Caustic paths by light tracing (integrator.caustics; path integrator)");
   cmd->add_flag_callback(
       "--no-caustics", [&a] { a.caustics = 0; }, "Caustic paths by the camera path alone");
   if (!adaptive) return;

@@ -16,9 +16,9 @@ std::string target_shortfall(const RenderResult& r) {
   if (!(r.target_error > 0) || r.cancelled || !(r.halves_relmse > limit)) return "";
   char line[320];
   std::snprintf(line, sizeof line,
-                "the halves' difference estimates relMSE %.3g, %.1f times the target %.3g: the "
-                "plan from the pilot fell short (rare bright paths the pilot missed, or the --spp "
-                "cap); raise --min-spp or lower --target-error",
+                "the halves' difference estimates relMSE %.3g, %.1f times the target %.3g (rare "
+                "bright samples that no pilot foresees, or the --spp cap): lower --target-error or "
+                "raise --spp; integrator.clamp trades such samples for bias",
                 r.halves_relmse, r.halves_relmse / r.target_error, r.target_error);
   return line;
 }

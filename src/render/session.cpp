@@ -278,10 +278,6 @@ struct Renderer::Impl {
 
   void set_scene(const Scene& s) {
     scene_detail::ScopedWarningSink sink(options.on_warning);
-    if (s.integrator.caustics && s.integrator.type == IntegratorType::Path && s.camera.aperture > 0)
-      throw Error(s.path +
-                  ": integrator.caustics: light tracing needs a pinhole camera (camera.aperture "
-                  "0); render this scene without caustics");
     std::vector<render_detail::DeviceLimits> limits;
     for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
     render_detail::check_host_memory(s, limits, limits.front().host_mem, limits.front().host_what);

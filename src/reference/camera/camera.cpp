@@ -32,11 +32,32 @@ Ray CameraModel::ray(int x, int y, const Sampler& rng) const {
   Ray ray{pos_, glm::normalize(fwd_ + ndc_x * right_ + ndc_y * up_)};
   if (lens_ > 0) {
     dvec3 focus = pos_ + (focus_ / glm::dot(ray.d, fwd_)) * ray.d;
-    double lr = lens_ * std::sqrt(rng.get(LC_DIM_LENS)), phi = 2 * kPi * rng.get(LC_DIM_LENS + 1);
-    ray.o = pos_ + lr * std::cos(phi) * right_ + lr * std::sin(phi) * up_;
+    ray.o = lens_point(rng.get(LC_DIM_LENS), rng.get(LC_DIM_LENS + 1));
     ray.d = glm::normalize(focus - ray.o);
   }
   return ray;
+}
+
+dvec3 CameraModel::lens_point(double u1, double u2) const {
+  double lr = lens_ * std::sqrt(u1), phi = 2 * kPi * u2;
+  return pos_ + lr * std::cos(phi) * right_ + lr * std::sin(phi) * up_;
+}
+
+bool CameraModel::project_lens(const dvec3& x, double u1, double u2, dvec2& film, double& cos_c,
+                               dvec3& origin) const {
+  if (lens_ <= 0) {
+    origin = pos_;
+    return project(x, film, cos_c);
+  }
+  origin = lens_point(u1, u2);
+  dvec3 v = x - origin;
+  double len = glm::length(v), depth = glm::dot(v, fwd_);
+  if (!(len > 0) || !(depth > 0)) return false;
+  cos_c = depth / len;
+  // ray() aims every lens point of film position u at the focal plane's point that the pinhole
+  // ray of u crosses: the film position is the pinhole's of that point
+  double unused;
+  return project(origin + (focus_ / depth) * v, film, unused);
 }
 
 bool CameraModel::project(const dvec3& x, dvec2& film, double& cos_c) const {

@@ -22,6 +22,12 @@ class CameraModel {
   /// point x, and cos_c = forward . (x - position) / |x - position|; false when x is not in
   /// front of the camera (cos_c <= 0).
   bool project(const dvec3& x, dvec2& film, double& cos_c) const;
+  /// Light tracing with a thin lens: the lens point `origin` drawn from (u1, u2) as ray() draws
+  /// it (the position for a pinhole), the film position of the camera rays from it that reach
+  /// x (they cross the focal plane where the line from origin through x does), and cos_c =
+  /// forward . (x - origin) / |x - origin|; false when x is not in front of origin.
+  bool project_lens(const dvec3& x, double u1, double u2, dvec2& film, double& cos_c,
+                    dvec3& origin) const;
   const dvec3& position() const { return pos_; }
   /// s = 2 tan(fov / 2) / H: the side of a pixel on the plane at distance 1.
   double pixel_pitch() const { return 2 * tan_half_ / height_; }
@@ -34,6 +40,7 @@ class CameraModel {
   Filter filter_;
   dvec3 pos_, right_, up_, fwd_;
   double tan_half_ = 0, aspect_ = 1, lens_ = 0, focus_ = 0;
+  dvec3 lens_point(double u1, double u2) const;  ///< polar map of the aperture disk
   int width_ = 1, height_ = 1;
 };
 

@@ -7,14 +7,13 @@
 
 #include <cmath>
 
-#include "lucent/error.hpp"
-
 namespace lucent::ref {
 
 namespace {
 
 /// Number `offset` of light-path vertex i (0: the emission: +0,+1 point, +2 selection, +4,+5
-/// direction; i >= 1: +3 lobe, +4,+5 BSDF direction, +6 Russian roulette).
+/// direction; i >= 1: +0,+1 the lens point of its connection, +3 lobe, +4,+5 BSDF direction, +6
+/// Russian roulette).
 double light_dim(const Sampler& rng, int i, std::uint32_t offset) {
   return rng.get(LC_DIM_LIGHT_PATH + LC_DIMS_PER_BOUNCE * static_cast<std::uint32_t>(i) + offset);
 }
@@ -22,12 +21,7 @@ double light_dim(const Sampler& rng, int i, std::uint32_t offset) {
 }  // namespace
 
 LightTracer::LightTracer(const Tracer& tracer, const CameraModel& camera)
-    : t_(tracer), camera_(camera) {
-  if (camera.thin_lens())
-    throw Error(tracer.scene.path +
-                ": integrator.caustics needs a pinhole camera: light tracing cannot reach a "
-                "thin-lens camera (camera.aperture > 0)");
-}
+    : t_(tracer), camera_(camera) {}
 
 void LightTracer::trace(const Sampler& rng, std::vector<Splat>& out) const {
   const Integrator& in = t_.scene.integrator;
@@ -51,7 +45,8 @@ void LightTracer::trace(const Sampler& rng, std::vector<Splat>& out) const {
     std::unique_ptr<Bsdf> b = t_.bsdf(s);
     // The reference's BSDFs are wholly delta or not: a non-delta one is the non-delta part that
     // the connection evaluates, and samples non-delta lobes only.
-    if (i >= 2 && !b->is_delta()) connect(ray, hit, e.beta * weight, out);
+    if (i >= 2 && !b->is_delta())
+      connect(ray, hit, e.beta * weight, light_dim(rng, i, 0), light_dim(rng, i, 1), out);
     if (i == max_vertices) return;
     const dvec3 wo = -ray.d;  // towards the arriving light
     BsdfSample bs =
@@ -80,33 +75,37 @@ void LightTracer::trace(const Sampler& rng, std::vector<Splat>& out) const {
   }
 }
 
-void LightTracer::connect(const Ray& ray, const Hit& hit, const dvec3& beta,
-                          std::vector<Splat>& out) const {
+void LightTracer::connect(const Ray& ray, const Hit& hit, const dvec3& beta, double lens_u,
+                          double lens_v, std::vector<Splat>& out) const {
   const Surface sl = t_.surface(ray, hit);  // oriented towards the light ray
   const dvec3 x = sl.p;
   dvec2 film;
   double cos_c;
-  if (!camera_.project(x, film, cos_c)) return;
+  dvec3 eye;  // the pinhole, or the point of the thin lens
+  if (!camera_.project_lens(x, lens_u, lens_v, film, cos_c, eye)) return;
   const Filter& filter = camera_.filter();
   const int W = camera_.width(), H = camera_.height();
   const double fr = filter.radius;
   // no pixel's filter reaches film (this also keeps the pixel range below in int's range)
   if (!(film.x > -fr - 1 && film.x < W + fr + 1 && film.y > -fr - 1 && film.y < H + fr + 1)) return;
-  const dvec3 to_cam = camera_.position() - x;
+  const dvec3 to_cam = eye - x;
   const double r = glm::length(to_cam);
   const dvec3 wc = to_cam / r, wl = -ray.d;
   // the surface as the camera ray through x would build it: normals facing the camera, the
   // geometric one where the interpolated one faces away
   Hit hc = hit;
   hc.t = r;
-  const Surface sc = t_.surface(Ray{camera_.position(), -wc}, hc);
+  const Surface sc = t_.surface(Ray{eye, -wc}, hc);
   std::unique_ptr<Bsdf> b = t_.bsdf(sc);
   const dvec3 f = b->eval(wc, wl);        // f(wo = wc, wi = wl) |wl.ns|; 0 below the surface
   if (finite(f) && max3(f) <= 0) return;  // non-finite ones go on, to be counted
   const Ray shadow = Tracer::spawn(sc, wc);
-  if (t_.blocked(shadow, glm::length(camera_.position() - shadow.o))) return;
+  if (t_.blocked(shadow, glm::length(eye - shadow.o))) return;
   // film density: du = dw / (s^2 cos^3) and dw = dA |wc.ng| / r^2; the light path's density of
-  // arrival per area carries |wl.ng|, which f's |wl.ns| replaces
+  // arrival per area carries |wl.ng|, which f's |wl.ns| replaces. With a thin lens, r and cos_c
+  // are the lens point's: for a fixed lens point the film position is a function of the
+  // direction to x with the same density (a shift by the lens offset over the focus distance),
+  // and the uniform lens point's density 1 / area cancels the 1 / area of the lens' importance.
   const double s = camera_.pixel_pitch();
   const dvec3 c = beta * f * std::abs(glm::dot(wc, sc.ng)) /
                   (std::abs(glm::dot(wl, sc.ng)) * r * r * s * s * cos_c * cos_c * cos_c);

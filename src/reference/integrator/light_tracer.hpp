@@ -1,10 +1,11 @@
 #pragma once
 // Caustics by light tracing (integrator.caustics, docs/rendering-model.md, "Caustics by light
 // tracing"): one light path per camera sample, traced from a light through one or more delta
-// scatterings (mirror, smooth glass), then any non-delta ones, and connected to the pinhole camera
-// at every non-delta vertex after the delta ones (the paths E N+ S+ L).
-// The path integrator leaves out the same paths (path.cpp), so that the two estimators split path
-// space and their sum estimates the path integrator's image, plus point lights' caustics.
+// scatterings (mirror, smooth glass), then any non-delta ones, and connected to the camera (its
+// pinhole or a point of its thin lens) at every non-delta vertex after the delta ones (the paths E
+// N+ S+ L). The path integrator leaves out the same paths (path.cpp), so that the two estimators
+// split path space and their sum estimates the path integrator's image, plus point lights'
+// caustics.
 #include <vector>
 
 #include "reference/camera/camera.hpp"
@@ -20,7 +21,6 @@ struct Splat {
 
 class LightTracer {
  public:
-  /// Throws lucent::Error for a thin-lens camera, which light tracing cannot reach.
   LightTracer(const Tracer& tracer, const CameraModel& camera);
 
   /// The light path of one camera sample (rng: its pixel, sample index and seed; the path draws
@@ -34,8 +34,10 @@ class LightTracer {
   const Tracer& t_;
   const CameraModel& camera_;
 
-  /// Connects vertex `hit` of light ray `ray` (throughput beta arriving there) to the camera.
-  void connect(const Ray& ray, const Hit& hit, const dvec3& beta, std::vector<Splat>& out) const;
+  /// Connects vertex `hit` of light ray `ray` (throughput beta arriving there) to the camera:
+  /// to its pinhole, or to the point (lens_u, lens_v) of its thin lens (CameraModel::project_lens).
+  void connect(const Ray& ray, const Hit& hit, const dvec3& beta, double lens_u, double lens_v,
+               std::vector<Splat>& out) const;
 };
 
 }  // namespace lucent::ref
