@@ -5,6 +5,8 @@
 #
 #   scripts/bench-mitsuba.sh [BUILD_DIR] [SPP] [PAIRS] [SIZE]     (defaults: build, 64, 3, 256)
 #   BENCH_MITSUBA_SCENES="cornell-box default dragon-box"          (scenes/NAME.json, the default)
+#   BENCH_LUCENT_SAMPLER=independent    lucent's sampler, as Mitsuba's (default: lucent's own, sobol,
+#                                       which costs 11-19% more per path; BENCHMARKS.md)
 #
 # Each scene is rendered SIZE x SIZE with a box filter (radius 0.5), SPP samples per pixel, its own
 # max_depth (cornell-box and dragon-box 8, default 6), Russian roulette at each renderer's default,
@@ -117,7 +119,7 @@ run_lucent() {  # $1 lucent scene json [$2 extra option]; CPU seconds of the pro
 
 echo "Machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores;" \
   "load average at start: $(cut -d' ' -f1-3 /proc/loadavg)."
-echo "lucent $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo '?'); ${size}x$size, $spp spp," \
+echo "lucent $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo '?') (sampler: ${BENCH_LUCENT_SAMPLER:-scene default}); ${size}x$size, $spp spp," \
   "box filter, $threads threads; $pairs alternating pairs per scene."
 for name in $scenes; do
   scene=$root/scenes/$name.json
@@ -137,7 +139,7 @@ EOF
   fi
   max_depth=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1])).get("integrator", {}).get("max_depth", 5))' "$scene")
   python3 "$helper" lucent-scene "$scene" "$work/$name.json" --size "$size" "$size" --spp "$spp" \
-    --max-depth "$max_depth"
+    --max-depth "$max_depth" ${BENCH_LUCENT_SAMPLER:+--sampler "$BENCH_LUCENT_SAMPLER"}
   run_lucent "$work/$name.json"  # warm-up: builds the kernel into the (new) caches
   first_build=$luc_build
   run_lucent "$work/$name.json" "--spp 1"  # the fixed CPU cost of a run, for lucent's CPU time

@@ -275,6 +275,8 @@ def write_lucent_scene(args):
     integ = scene.setdefault("integrator", {})
     integ["spp"] = args.spp
     integ["max_depth"] = args.max_depth
+    if args.sampler:
+        integ["sampler"] = args.sampler
     for sh in scene.get("shapes", []):
         if "file" in sh:
             sh["file"] = os.path.normpath(os.path.join(scene_dir, sh["file"]))
@@ -446,6 +448,9 @@ def main():
         p.add_argument("--size", type=int, nargs=2, default=[256, 256], metavar=("W", "H"))
         p.add_argument("--spp", type=int, default=64)
         p.add_argument("--max-depth", type=int, required=True)
+        if name == "lucent-scene":
+            p.add_argument("--sampler", choices=["sobol", "independent"],
+                           help="lucent's sampler (default: the scene's; Mitsuba's is independent)")
         if name == "render":
             p.add_argument("--threads", type=int, default=2)
             p.add_argument("--variant", default="llvm_ad_rgb")
