@@ -256,20 +256,24 @@ TEST(KernelVsReference, PathDielectric) {
 // Caustics by light tracing (integrator.caustics, docs/rendering-model.md): a glass sphere and
 // a mirror sphere under area lights (a sphere lamp, a triangle panel) and a point light (whose
 // caustics only light tracing finds), a plastic sphere (a non-delta lobe that light paths end
-// on), with a tent filter that splats over 3x3 pixels.
-TEST(KernelVsReference, PathCaustics) {
-  Both b = render_both(
-      scene_from(scene_json(R"({"type": "path", "max_depth": 6, "caustics": true})",
-                            std::string(kDiffuseMats) + ", " + kLamps +
-                                R"(, "glass": {"type": "dielectric", "ior": 1.5, "tint": [1, 0.9, 0.8]},
+// on), seen by `camera` (empty: the default pinhole) on the 32 x 32 `film`.
+Scene caustics_scene(const std::string& camera, const std::string& film) {
+  return scene_from(scene_json(R"({"type": "path", "max_depth": 6, "caustics": true})",
+                               std::string(kDiffuseMats) + ", " + kLamps +
+                                   R"(, "glass": {"type": "dielectric", "ior": 1.5, "tint": [1, 0.9, 0.8]},
                                    "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]},
                                    "plastic": {"type": "plastic", "albedo": [0.3, 0.6, 0.3], "roughness": 0.2})",
-                            std::string(kLampShapes) +
-                                R"(, {"type": "sphere", "center": [0.1, 0.5, 1.3], "radius": 0.5, "material": "glass"},
+                               std::string(kLampShapes) +
+                                   R"(, {"type": "sphere", "center": [0.1, 0.5, 1.3], "radius": 0.5, "material": "glass"},
                                    {"type": "sphere", "center": [-1.0, 0.4, 0.6], "radius": 0.4, "material": "mirror"},
                                    {"type": "sphere", "center": [1.3, 0.35, 0.2], "radius": 0.35, "material": "plastic"})",
-                            kPointLights, "",
-                            R"({"width": 32, "height": 32, "filter": {"type": "tent", "radius": 1}})")),
+                               kPointLights, camera, film));
+}
+
+// With a tent filter that splats over 3x3 pixels.
+TEST(KernelVsReference, PathCaustics) {
+  Both b = render_both(
+      caustics_scene("", R"({"width": 32, "height": 32, "filter": {"type": "tent", "radius": 1}})"),
       256);
   EXPECT_AGREE(b);
 }
@@ -281,18 +285,9 @@ TEST(KernelVsReference, PathCaustics) {
 // 576 pixels), whose closed form is where the lens mapping is checked.
 TEST(KernelVsReference, PathCausticsThinLens) {
   Both b = render_both(
-      scene_from(scene_json(R"({"type": "path", "max_depth": 6, "caustics": true})",
-                            std::string(kDiffuseMats) + ", " + kLamps +
-                                R"(, "glass": {"type": "dielectric", "ior": 1.5, "tint": [1, 0.9, 0.8]},
-                                   "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]},
-                                   "plastic": {"type": "plastic", "albedo": [0.3, 0.6, 0.3], "roughness": 0.2})",
-                            std::string(kLampShapes) +
-                                R"(, {"type": "sphere", "center": [0.1, 0.5, 1.3], "radius": 0.5, "material": "glass"},
-                                   {"type": "sphere", "center": [-1.0, 0.4, 0.6], "radius": 0.4, "material": "mirror"},
-                                   {"type": "sphere", "center": [1.3, 0.35, 0.2], "radius": 0.35, "material": "plastic"})",
-                            kPointLights,
-                            R"({"position": [0, 1.2, 5], "look_at": [0, 0.4, 0], "fov": 38, "aperture": 0.25, "focus_distance": 3})",
-                            R"({"width": 32, "height": 32, "filter": {"type": "gaussian", "radius": 1.5}})")),
+      caustics_scene(
+          R"({"position": [0, 1.2, 5], "look_at": [0, 0.4, 0], "fov": 38, "aperture": 0.25, "focus_distance": 3})",
+          R"({"width": 32, "height": 32, "filter": {"type": "gaussian", "radius": 1.5}})"),
       256);
   EXPECT_AGREE(b);
 }
