@@ -70,20 +70,18 @@ static inline int camera_project_lens(__global const lc_camera* cam, lc_real3 p,
 #ifdef LC_HAS_THIN_LENS
   if (cam->lens_radius > 0.0f) {
     lc_real3 right = lc_load3r(cam->right), up = lc_load3r(cam->up);
-    lc_real3 fwd = lc_load3r(cam->forward);
     float2 lens = cam->lens_radius * sample_concentric_disk(lu, lv);
-    lc_real3 c = *o;
-    *o = c + (lc_real)lens.x * right + (lc_real)lens.y * up;
+    *o += (lc_real)lens.x * right + (lc_real)lens.y * up;
     lc_real3 d = p - *o;
-    lc_real z = dot(d, fwd);
+    lc_real z = dot(d, lc_load3r(cam->forward));
     if (!(z > LC_REAL(0.0))) return 0;
-    /* the focal plane's point on the ray, seen from the lens centre at depth focus_distance */
-    lc_real3 f = *o + d * ((lc_real)cam->focus_distance / z) - c;
-    lc_real fz = (lc_real)cam->focus_distance;
-    lc_real ndc_x = dot(f, right) / (fz * cam->tan_half_fov * cam->aspect);
-    lc_real ndc_y = dot(f, up) / (fz * cam->tan_half_fov);
-    *fx = (float)((ndc_x + LC_REAL(1.0)) * (LC_REAL(0.5) * (lc_real)width));
-    *fy = (float)((LC_REAL(1.0) - ndc_y) * (LC_REAL(0.5) * (lc_real)height));
+    /* camera_generate_ray aims every lens point of a film position at the focal plane's point
+     * that the film position's pinhole ray crosses: the film position is the pinhole's of the
+     * focal plane's point on the line from *o through p */
+    float unused;
+    if (!camera_project(cam, *o + d * ((lc_real)cam->focus_distance / z), width, height, fx, fy,
+                        &unused))
+      return 0;
     *cos_c = (float)(z / length(d));
     return 1;
   }

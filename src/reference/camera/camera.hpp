@@ -31,7 +31,6 @@ class CameraModel {
   const dvec3& position() const { return pos_; }
   /// s = 2 tan(fov / 2) / H: the side of a pixel on the plane at distance 1.
   double pixel_pitch() const { return 2 * tan_half_ / height_; }
-  bool thin_lens() const { return lens_ > 0; }
   const Filter& filter() const { return filter_; }
   int width() const { return width_; }
   int height() const { return height_; }
