@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "cl/context.hpp"
+#include "cl/kernel_source.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/session.hpp"
@@ -178,6 +180,59 @@ TEST(SobolSampler, KernelAndReferenceDrawTheSameNumbers) {
     ASSERT_GT(noisy, k.samples.size() / 2);
     EXPECT_GT(double(same) / noisy, 0.95) << same << " of " << noisy;
     EXPECT_LT(double(same_control) / noisy, 0.05) << same_control << " of " << noisy;
+  }
+}
+
+// The megakernel's lc_rand8 (the Sobol sampler's four pairs computed in vector lanes) and lc_rand2,
+// through a probe kernel, against rng.h's scalar lc_sobol_pair and lc_independent_quad: equal bit
+// for bit on random and extreme pixels, samples, dimensions and seeds.
+TEST(SobolSampler, KernelVectorNumbersEqualTheScalarOnes) {
+  lucent::cl_util::Context ctx{lucent::test::device()};
+  cl::Program program = lucent::cl_util::build_program(
+      ctx, lucent::detail::assemble_kernel_source("test/rng_probe.cl", lucent::test::kernel_dir()),
+      "-cl-std=CL1.2 -D LC_HAS_SAMPLER_SOBOL -D LC_HAS_SAMPLER_INDEPENDENT");
+  std::vector<cl_uint4> query;
+  std::mt19937 gen(7);
+  for (int i = 0; i < 4096; ++i) {
+    const cl_uint dim = (i % 16 == 0) ? 0xfffffff8u - 4u * (i % 5) : 4u * (gen() % 64u);
+    query.push_back({{static_cast<cl_uint>(gen()), static_cast<cl_uint>(i % 3 == 0 ? i : gen()),
+                      i % 7 == 0 ? LC_DIM_LIGHT_PATH + 8u * (i % 9) : dim,
+                      static_cast<cl_uint>(i % 2 ? gen() : 0u)}});
+  }
+  query.push_back({{0u, 0u, 0u, 0u}});
+  query.push_back({{0xffffffffu, 0xffffffffu, 0xfffffffcu, 0xffffffffu}});
+  for (SamplerType t : {SamplerType::Sobol, SamplerType::Independent}) {
+    SCOPED_TRACE(lucent::type_name(t));
+    cl::Buffer b_query(ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                       query.size() * sizeof(cl_uint4), query.data());
+    cl::Buffer b_out(ctx.context, CL_MEM_WRITE_ONLY, query.size() * 10 * sizeof(float));
+    cl::Kernel k(program, "probe_rng");
+    k.setArg(0, b_query);
+    k.setArg(1, static_cast<cl_uint>(t == SamplerType::Sobol ? LC_SAMPLER_SOBOL
+                                                             : LC_SAMPLER_INDEPENDENT));
+    k.setArg(2, b_out);
+    ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(query.size()), cl::NullRange);
+    std::vector<float> out(query.size() * 10);
+    ctx.queue.enqueueReadBuffer(b_out, CL_TRUE, 0, out.size() * sizeof(float), out.data());
+    size_t wrong = 0;
+    for (size_t i = 0; i < query.size(); ++i) {
+      const cl_uint4& q = query[i];
+      lc_uint w[8];
+      for (lc_uint g = 0; g < (t == SamplerType::Sobol ? 4u : 2u); ++g) {
+        if (t == SamplerType::Sobol)
+          lc_sobol_pair(q.s[0], q.s[1], (q.s[2] >> 1) + g, q.s[3], w + 2 * g);
+        else
+          lc_independent_quad(q.s[0], q.s[1], (q.s[2] >> 2) + g, q.s[3], w + 4 * g);
+      }
+      for (int d = 0; d < 10; ++d) {
+        const float expected = lc_u01(w[d < 8 ? d : d - 8]);
+        if (out[10 * i + d] != expected && wrong++ < 5)
+          ADD_FAILURE() << "pixel " << q.s[0] << " sample " << q.s[1] << " dimension "
+                        << q.s[2] + (d < 8 ? d : d - 8) << " seed " << q.s[3] << ": kernel "
+                        << out[10 * i + d] << ", rng.h " << expected;
+      }
+    }
+    EXPECT_EQ(wrong, 0u);
   }
 }
 

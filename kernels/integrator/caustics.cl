@@ -108,8 +108,8 @@ static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
                                           lc_uint* rays) {
   __global const lc_params* P = s->params;
   if (P->max_depth < 3u) return 0; /* a caustic path has at least 3 segments */
-  float4 ue = lc_rand4(rng, LC_DIM_LIGHT_PATH);
-  float4 ud = lc_rand4(rng, LC_DIM_LIGHT_PATH + 4u);
+  float8 u0 = lc_rand8(rng, LC_DIM_LIGHT_PATH);
+  float4 ue = u0.lo, ud = u0.hi;
   lc_ray ray;
   float3 beta;
   if (!light_emit(s, ue.z, (float4)(ue.x, ue.y, ud.x, ud.y), &ray, &beta)) return 0;
@@ -125,8 +125,8 @@ static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
     __global const lc_material* m = &s->materials[it.material];
     lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
     lc_uint dim = LC_DIM_LIGHT_PATH + 8u * i;
-    float4 ua = lc_rand4(rng, dim);
-    float4 ub = lc_rand4(rng, dim + 4u);
+    float8 uv = lc_rand8(rng, dim);
+    float4 ua = uv.lo, ub = uv.hi;
     if (state != 0 && !(bsdf_lobes(&b) & LC_BSDF_DELTA))
       nonfinite +=
           !caustics_connect(s, ray, &hit, it.p, ua.x, ua.y, beta, light_sum, light_sumsq, rays);

@@ -1,6 +1,6 @@
 /* lucent kernel: the path tracer (docs/rendering-model.md): next-event estimation with multiple
  * importance sampling (power heuristic), Russian roulette, optional clamping. One call computes
- * the radiance of one camera sample; random numbers come from lc_rand4 with the dimension layout
+ * the radiance of one camera sample; random numbers come from lc_rand8 with the dimension layout
  * of shared/rng.h. */
 #ifndef LUCENT_INTEGRATOR_PATH_CL
 #define LUCENT_INTEGRATOR_PATH_CL
@@ -62,8 +62,8 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     if (depth + 2 > P->max_depth) break;
     lc_uint dim = LC_DIM_BOUNCE + depth * LC_DIMS_PER_BOUNCE;
     /* light point, light selection, lobe; BSDF direction, Russian roulette */
-    float4 u_light = lc_rand4(rng, dim + LC_DIM_LIGHT_UV);
-    float4 u_bsdf = lc_rand4(rng, dim + LC_DIM_BSDF_UV);
+    float8 u = lc_rand8(rng, dim);
+    float4 u_light = u.lo, u_bsdf = u.hi;
     lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
     lc_frame fr = frame_from(it.ns);
     float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));

@@ -56,22 +56,30 @@
  * direction, +6 Russian roulette). */
 #define LC_DIM_LIGHT_PATH 0x20000000u
 
-/* pcg4d: hashes four 32-bit words into four, in place. */
+/* pcg4d: hashes the four 32-bit words x, y, z, w into four, in place. A statement macro, so that
+ * the kernel can hash several keys at once in vector lanes (sampler/sampler.cl); lc_pcg4d is the
+ * scalar function. */
+#define LC_PCG4D(x, y, z, w)      \
+  x = x * 1664525u + 1013904223u; \
+  y = y * 1664525u + 1013904223u; \
+  z = z * 1664525u + 1013904223u; \
+  w = w * 1664525u + 1013904223u; \
+  x += y * w;                     \
+  y += z * x;                     \
+  z += x * y;                     \
+  w += y * z;                     \
+  x ^= x >> 16u;                  \
+  y ^= y >> 16u;                  \
+  z ^= z >> 16u;                  \
+  w ^= w >> 16u;                  \
+  x += y * w;                     \
+  y += z * x;                     \
+  z += x * y;                     \
+  w += y * z;
+
 LC_RNG_FN void lc_pcg4d(lc_uint v[4]) {
-  lc_uint x = v[0] * 1664525u + 1013904223u, y = v[1] * 1664525u + 1013904223u;
-  lc_uint z = v[2] * 1664525u + 1013904223u, w = v[3] * 1664525u + 1013904223u;
-  x += y * w;
-  y += z * x;
-  z += x * y;
-  w += y * z;
-  x ^= x >> 16u;
-  y ^= y >> 16u;
-  z ^= z >> 16u;
-  w ^= w >> 16u;
-  x += y * w;
-  y += z * x;
-  z += x * y;
-  w += y * z;
+  lc_uint x = v[0], y = v[1], z = v[2], w = v[3];
+  LC_PCG4D(x, y, z, w)
   v[0] = x;
   v[1] = y;
   v[2] = z;
@@ -111,24 +119,31 @@ LC_RNG_FN float lc_rng_uniform(lc_uint pixel, lc_uint sample, lc_uint dim, lc_ui
 
 /* ---- Owen-scrambled Sobol ----------------------------------------------------------------- */
 
+/* The Sobol sampler's word operations are statement macros on x in place (scalars here, vectors
+ * of words in the kernel's lc_sobol_pairs4), each with its scalar function. */
+#define LC_REVERSE_BITS(x)                                 \
+  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1); \
+  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2); \
+  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4); \
+  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8); \
+  x = (x >> 16) | (x << 16);
 LC_RNG_FN lc_uint lc_reverse_bits(lc_uint x) {
-  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
-  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
-  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
-  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
-  return (x >> 16) | (x << 16);
+  LC_REVERSE_BITS(x)
+  return x;
 }
 
 /* A random bijection of 32-bit words in which bit k of the result depends only on bits 0..k of x
  * (each step is an add, a multiplication by an odd number or x ^= x * even): applied to
  * bit-reversed digits it flips each digit by a hash of the digits before it, a nested uniform
  * (Owen) scramble. Vegdahl's constants. */
-LC_RNG_FN lc_uint lc_owen_hash(lc_uint x, lc_uint seed) {
-  x ^= x * 0x3d20adeau;
-  x += seed;
-  x *= (seed >> 16) | 1u;
-  x ^= x * 0x05526c56u;
+#define LC_OWEN_HASH(x, seed) \
+  x ^= x * 0x3d20adeau;       \
+  x += seed;                  \
+  x *= (seed >> 16) | 1u;     \
+  x ^= x * 0x05526c56u;       \
   x ^= x * 0x53a22864u;
+LC_RNG_FN lc_uint lc_owen_hash(lc_uint x, lc_uint seed) {
+  LC_OWEN_HASH(x, seed)
   return x;
 }
 
@@ -136,12 +151,14 @@ LC_RNG_FN lc_uint lc_owen_hash(lc_uint x, lc_uint seed) {
  * the point). Its generator matrix is Pascal's triangle mod 2: digit j is the parity of the bits
  * k of i with C(k, j) odd, i.e. (Lucas) with j a subset of k, a superset sum done in five
  * steps. The first dimension, reversed, is i itself. */
-LC_RNG_FN lc_uint lc_sobol1_reversed(lc_uint i) {
-  i ^= (i >> 1) & 0x55555555u;
-  i ^= (i >> 2) & 0x33333333u;
-  i ^= (i >> 4) & 0x0f0f0f0fu;
-  i ^= (i >> 8) & 0x00ff00ffu;
+#define LC_SOBOL1_REVERSED(i)  \
+  i ^= (i >> 1) & 0x55555555u; \
+  i ^= (i >> 2) & 0x33333333u; \
+  i ^= (i >> 4) & 0x0f0f0f0fu; \
+  i ^= (i >> 8) & 0x00ff00ffu; \
   i ^= (i >> 16) & 0x0000ffffu;
+LC_RNG_FN lc_uint lc_sobol1_reversed(lc_uint i) {
+  LC_SOBOL1_REVERSED(i)
   return i;
 }
 
