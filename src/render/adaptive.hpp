@@ -156,8 +156,11 @@ std::vector<double> raised_variance(const std::vector<double>& v, int width, int
 /// independent samples, below 1 for Sobol. It reads O and C only, never the half it plans, so
 /// that half's counts stay independent of its samples (the argument above).
 ///
-/// The gain is measured at the pilot's m samples; Sobol's error falls faster than 1 / n, so at
-/// the larger counts of a plan the calibrated model still over-predicts (conservative).
+/// The gain is measured at the pilot's m samples. Where Sobol's error keeps falling faster than
+/// 1 / n (default, textured, the Cornell box), the calibrated model over-predicts at the larger
+/// counts of a plan (conservative). Where rare high-dimensional paths carry the variance (course),
+/// the gain at the pilot (0.44-0.64) is about 1 at the plan's counts, so there it under-predicts
+/// (docs/rendering-model.md).
 struct Calibration {
   double gain = 1;
   double measured = 0, modelled = 0;  ///< the sums above
