@@ -41,8 +41,8 @@ plant() {
     5) file=integrator/path.cl from='beta /= q;' to='' ;;
     6) file=integrator/caustics.cl from='beta *= bs.weight * (bs.eta * bs.eta * corr);'
        to='beta *= bs.weight * corr;' ;;
-    7) file=shared/rng.h from='out[1] = lc_reverse_bits(lc_owen_hash(lc_sobol1_reversed(i), key[2]));'
-       to='out[1] = lc_reverse_bits(lc_owen_hash(lc_sobol1_reversed(i), key[1]));' ;;
+    7) file=sampler/sampler.cl from='uint8 k = (uint8)(y.s0, z.s0, y.s1, z.s1, y.s2, z.s2, y.s3, z.s3);'
+       to='uint8 k = (uint8)(y.s0, y.s0, y.s1, y.s1, y.s2, y.s2, y.s3, y.s3);' ;;
     *) echo "planted-bugs: unknown bug $1" >&2; return 1 ;;
   esac
   python3 - "$2/$file" "$from" "$to" <<'EOF'
