@@ -24,10 +24,13 @@ static inline float2 lc_rand2(const lc_rng* r, lc_uint dim) {
 }
 #undef LC_SAMPLER_PAIR
 
-#ifdef LC_HAS_SAMPLER_SOBOL
-/* lc_sobol_pair of pairs pair .. pair + 3, bit for bit, with rng.h's word operations on vectors
- * (lane k: pair + k): the four keys, shuffles and eight scrambles take the instructions of one,
- * their chains of multiplications overlapped. */
+/* Each sampler's lc_<file>_pairs4 (the registry's file name, as its lc_<file>_pair in
+ * shared/rng.h): the words of pairs pair .. pair + 3 (pair even), bit for bit those of its pair
+ * function, computed together. */
+
+/* Sobol: lc_sobol_pair with rng.h's word operations on vectors (lane k: pair + k): the four keys,
+ * shuffles and eight scrambles take the instructions of one, their chains of multiplications
+ * overlapped. */
 static inline uint8 lc_sobol_pairs4(lc_uint pixel, lc_uint sample, lc_uint pair, lc_uint seed) {
   uint4 x = (uint4)(pixel), y = (uint4)(pair) + (uint4)(0u, 1u, 2u, 3u);
   uint4 z = (uint4)(seed), w = (uint4)(0x50b01u);
@@ -43,24 +46,26 @@ static inline uint8 lc_sobol_pairs4(lc_uint pixel, lc_uint sample, lc_uint pair,
   LC_REVERSE_BITS(v)
   return v;
 }
-#endif
+
+/* Independent: two quads, scalar (in uint2 lanes they measured 2% slower). */
+static inline uint8 lc_independent_pairs4(lc_uint pixel, lc_uint sample, lc_uint pair,
+                                          lc_uint seed) {
+  lc_uint a[4], c[4];
+  lc_independent_quad(pixel, sample, pair >> 1, seed, a);
+  lc_independent_quad(pixel, sample, (pair >> 1) + 1u, seed, c);
+  return (uint8)(a[0], a[1], a[2], a[3], c[0], c[1], c[2], c[3]);
+}
 
 /* Numbers dim .. dim + 7 (dim a multiple of 4): one bounce's, or a light path vertex's. */
+#define LC_SAMPLER_PAIRS4(ID, Name, value, name, feature, file) \
+  if (LC_ENABLED(feature) && r->sampler == LC_SAMPLER_##ID)     \
+    q = lc_##file##_pairs4(r->pixel, r->sample, dim >> 1, r->seed);
 static inline float8 lc_rand8(const lc_rng* r, lc_uint dim) {
   uint8 q = (uint8)(0u);
-#ifdef LC_HAS_SAMPLER_SOBOL
-  if (r->sampler == LC_SAMPLER_SOBOL) q = lc_sobol_pairs4(r->pixel, r->sample, dim >> 1, r->seed);
-#endif
-#ifdef LC_HAS_SAMPLER_INDEPENDENT
-  if (r->sampler == LC_SAMPLER_INDEPENDENT) {
-    lc_uint a[4], c[4];
-    lc_independent_quad(r->pixel, r->sample, dim >> 2, r->seed, a);
-    lc_independent_quad(r->pixel, r->sample, (dim >> 2) + 1u, r->seed, c);
-    q = (uint8)(a[0], a[1], a[2], a[3], c[0], c[1], c[2], c[3]);
-  }
-#endif
+  LC_SAMPLER_TYPES(LC_SAMPLER_PAIRS4)
   return convert_float8(q >> 8u) * (1.0f / 16777216.0f); /* lc_u01 */
 }
+#undef LC_SAMPLER_PAIRS4
 
 static inline float lc_rand(const lc_rng* r, lc_uint dim) {
   float2 u = lc_rand2(r, dim & ~1u);

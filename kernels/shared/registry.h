@@ -117,7 +117,8 @@
 
 /* ------------------------------------------------------------------------------------------ */
 /* Samplers: X(ID, Name, value, name, feature, file)                                           */
-/* The random numbers of a camera sample (shared/rng.h: lc_<file>_pair): Owen-scrambled Sobol */
+/* The random numbers of a camera sample (shared/rng.h: lc_<file>_pair; the kernel's four     */
+/* pairs at once: lc_<file>_pairs4 in sampler/sampler.cl): Owen-scrambled Sobol               */
 /* (the default) or independent numbers (what the statistical tests assume). The kernel       */
 /* (sampler/sampler.cl) and the reference (src/reference/sampler.hpp) draw the same numbers.  */
 /* ------------------------------------------------------------------------------------------ */
