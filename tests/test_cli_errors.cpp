@@ -219,8 +219,8 @@ TEST(CliErrors, NoMatchingDevice) {
 namespace {
 
 // Light-traced caustics (integrator.caustics) cannot be split into part files: refused with one
-// line before rendering, and no output is written. (They
-// render adaptively: KernelCaustics.AdaptiveIsUnbiased in test_kernel_caustics.cpp.)
+// line before rendering, and no output is written. (They render adaptively:
+// KernelCaustics.AdaptiveIsUnbiased in test_kernel_caustics.cpp.)
 TEST(CliErrors, CausticsRefusalsAreOneLine) {
   std::string scene = small_scene();
   std::string dir = scene.substr(0, scene.rfind('/'));

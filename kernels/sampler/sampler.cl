@@ -4,8 +4,8 @@
  * lc_rand2 and lc_rand8 give the numbers of an aligned pair, or of eight dimensions from a
  * multiple of 4 (one bounce's), at once; each is bit for bit what lc_rand gives for its
  * dimensions, and what the reference (src/reference/sampler.hpp) draws. lc_rand8 computes the
- * Sobol sampler's four pairs as vector operations (one lane per pair): 6-9% faster renders than
- * four calls of the scalar pair (BENCHMARKS.md, "Where the time goes"). */
+ * Sobol sampler's four pairs as vector operations (one lane per pair): 4.5-7% faster renders
+ * than four calls of the scalar pair (BENCHMARKS.md, "Where the time goes"). */
 #ifndef LUCENT_SAMPLER_SAMPLER_CL
 #define LUCENT_SAMPLER_SAMPLER_CL
 

@@ -28,7 +28,6 @@ class CameraModel {
   /// forward . (x - origin) / |x - origin|; false when x is not in front of origin.
   bool project_lens(const dvec3& x, double u1, double u2, dvec2& film, double& cos_c,
                     dvec3& origin) const;
-  const dvec3& position() const { return pos_; }
   /// s = 2 tan(fov / 2) / H: the side of a pixel on the plane at distance 1.
   double pixel_pitch() const { return 2 * tan_half_ / height_; }
   const Filter& filter() const { return filter_; }
