@@ -4,7 +4,7 @@
 #ifndef LUCENT_SCENE_SCENE_CL
 #define LUCENT_SCENE_SCENE_CL
 
-#define LC_SCENE_FIELD(name, type, ...) __global const type* name;
+#define LC_SCENE_FIELD(name, type, what) __global const type* name;
 typedef struct {
   LC_SCENE_BUFFERS(LC_SCENE_FIELD)
   __global const lc_params* params;
@@ -12,11 +12,11 @@ typedef struct {
 #undef LC_SCENE_FIELD
 
 /* The scene's kernel arguments: every scene buffer, then params. */
-#define LC_SCENE_ARG(name, type, ...) __global const type *name,
+#define LC_SCENE_ARG(name, type, what) __global const type *name,
 #define LC_SCENE_KERNEL_ARGS LC_SCENE_BUFFERS(LC_SCENE_ARG) __global const lc_params* params
 
 /* The lc_scene of a kernel declared with LC_SCENE_KERNEL_ARGS. */
-#define LC_SCENE_ARG_NAME(name, type, ...) name,
+#define LC_SCENE_ARG_NAME(name, type, what) name,
 #define LC_SCENE_FROM_KERNEL_ARGS \
   { LC_SCENE_BUFFERS(LC_SCENE_ARG_NAME) params }
 

@@ -31,15 +31,22 @@
  * a define in a source file must say `#define LC_HAS_X 1`) and 0 otherwise, so that generated
  * dispatch code can test a feature in an expression
  * (`if (LC_ENABLED(feature) && type == ...)`), which the compiler folds: a type that is not
- * enabled costs no code. (The Linux kernel's IS_ENABLED technique.) */
-#define LC_ARG_PLACEHOLDER_1 0,
+ * enabled costs no code. The feature's expansion is pasted onto LC_ON_: a set feature gives
+ * LC_ON_1, which is 1; one that is not set stays a name, LC_ON_LC_HAS_X, which
+ * generated/features_off.cl (written by src/cl/kernel_source.cpp from every feature column and
+ * LC_OTHER_FEATURES) defines as 0. Kernel code only: the kernel is OpenCL C 1.2, which has no
+ * variadic macros (NVIDIA's compiler refuses them), so the Linux kernel's IS_ENABLED technique,
+ * which needs one, is not used. */
+#define LC_ON_1 1
 #define LC_ENABLED(feature) LC_ENABLED_1(feature)
-#define LC_ENABLED_1(value) LC_ENABLED_2(LC_ARG_PLACEHOLDER_##value)
-#define LC_ENABLED_2(arg_or_junk) LC_ENABLED_3(arg_or_junk 1, 0)
-#define LC_ENABLED_3(ignored, value, ...) value
+#define LC_ENABLED_1(value) LC_ON_##value
+#ifdef __OPENCL_C_VERSION__
+#include "generated/features_off.cl"
+#endif
 
-/* The fields of a parameter struct, written inside one registry entry. */
-#define LC_PARAMS(...) __VA_ARGS__
+/* The fields of a parameter struct, written inside one registry entry: declarations ending in
+ * `;`, one name per declaration (no commas: the fields are one macro argument). */
+#define LC_PARAMS(fields) fields
 
 /* ------------------------------------------------------------------------------------------ */
 /* Materials: X(ID, Name, value, name, feature, file, params)                                  */

@@ -44,69 +44,75 @@ typedef struct LC_ALIGN16 {
 /* Device constants from shared/registry.h: LC_MAT_<ID>, LC_LIGHT_<ID>, LC_SHAPE_<ID>,
  * LC_INTEGRATOR_<ID> (integrators, then AOVs), LC_FILTER_<ID>, LC_SAMPLER_<ID>, and
  * LC_<CONCEPT>_COUNT. */
-#define LC_ENUM_MAT(ID, Name, value, ...) LC_MAT_##ID = value,
-#define LC_ENUM_LIGHT(ID, Name, value, ...) LC_LIGHT_##ID = value,
-#define LC_ENUM_SHAPE(ID, Name, value, ...) LC_SHAPE_##ID = value,
-#define LC_ENUM_INTEGRATOR(ID, Name, value, ...) LC_INTEGRATOR_##ID = value,
-#define LC_ENUM_FILTER(ID, Name, value, ...) LC_FILTER_##ID = value,
-#define LC_ENUM_SAMPLER(ID, Name, value, ...) LC_SAMPLER_##ID = value,
-#define LC_ENUM_ONE(...) +1
-enum { LC_MATERIAL_TYPES(LC_ENUM_MAT) LC_MAT_COUNT = 0 LC_MATERIAL_TYPES(LC_ENUM_ONE) };
-enum { LC_LIGHT_TYPES(LC_ENUM_LIGHT) LC_LIGHT_COUNT = 0 LC_LIGHT_TYPES(LC_ENUM_ONE) };
-enum { LC_SHAPE_TYPES(LC_ENUM_SHAPE) LC_SHAPE_COUNT = 0 LC_SHAPE_TYPES(LC_ENUM_ONE) };
+/* Every X macro below names all of its list's columns: the kernel is OpenCL C 1.2, which has no
+ * variadic macros (NVIDIA's compiler refuses them; tests/test_kernel_source.cpp checks). Seven
+ * columns: materials and lights (params), filters (radius); six: the other lists. */
+#define LC_ENUM_MAT(ID, Name, value, name, feature, file, params) LC_MAT_##ID = value,
+#define LC_ENUM_LIGHT(ID, Name, value, name, feature, file, params) LC_LIGHT_##ID = value,
+#define LC_ENUM_SHAPE(ID, Name, value, name, feature, file) LC_SHAPE_##ID = value,
+#define LC_ENUM_INTEGRATOR(ID, Name, value, name, feature, file) LC_INTEGRATOR_##ID = value,
+#define LC_ENUM_FILTER(ID, Name, value, name, feature, file, radius) LC_FILTER_##ID = value,
+#define LC_ENUM_SAMPLER(ID, Name, value, name, feature, file) LC_SAMPLER_##ID = value,
+#define LC_ONE_6(ID, Name, value, name, feature, file) +1
+#define LC_ONE_7(ID, Name, value, name, feature, file, extra) +1
+enum { LC_MATERIAL_TYPES(LC_ENUM_MAT) LC_MAT_COUNT = 0 LC_MATERIAL_TYPES(LC_ONE_7) };
+enum { LC_LIGHT_TYPES(LC_ENUM_LIGHT) LC_LIGHT_COUNT = 0 LC_LIGHT_TYPES(LC_ONE_7) };
+enum { LC_SHAPE_TYPES(LC_ENUM_SHAPE) LC_SHAPE_COUNT = 0 LC_SHAPE_TYPES(LC_ONE_6) };
 enum {
   LC_INTEGRATOR_TYPES(LC_ENUM_INTEGRATOR) LC_AOV_TYPES(LC_ENUM_INTEGRATOR)
   /* the first AOV: integrator values from here on are AOVs (integrator/aov.cl) */
-  LC_INTEGRATOR_FIRST_AOV = 0 LC_INTEGRATOR_TYPES(LC_ENUM_ONE),
-  LC_INTEGRATOR_COUNT = 0 LC_INTEGRATOR_TYPES(LC_ENUM_ONE) LC_AOV_TYPES(LC_ENUM_ONE)
+  LC_INTEGRATOR_FIRST_AOV = 0 LC_INTEGRATOR_TYPES(LC_ONE_6),
+  LC_INTEGRATOR_COUNT = 0 LC_INTEGRATOR_TYPES(LC_ONE_6) LC_AOV_TYPES(LC_ONE_6)
 };
-enum { LC_FILTER_TYPES(LC_ENUM_FILTER) LC_FILTER_COUNT = 0 LC_FILTER_TYPES(LC_ENUM_ONE) };
-enum { LC_SAMPLER_TYPES(LC_ENUM_SAMPLER) LC_SAMPLER_COUNT = 0 LC_SAMPLER_TYPES(LC_ENUM_ONE) };
+enum { LC_FILTER_TYPES(LC_ENUM_FILTER) LC_FILTER_COUNT = 0 LC_FILTER_TYPES(LC_ONE_7) };
+enum { LC_SAMPLER_TYPES(LC_ENUM_SAMPLER) LC_SAMPLER_COUNT = 0 LC_SAMPLER_TYPES(LC_ONE_6) };
 
 /* Each list's values are 0, 1, ..., count - 1 in list order: a sum of count powers of two is
  * 2^count - 1 only when they are exactly those (a repeated or missing value breaks it), and each
  * entry's value is compared with its position. */
-#define LC_VALUE_BIT(ID, Name, value, ...) +(1u << (value))
-#define LC_POS_MAT(ID, ...) LC_MAT_POS_##ID,
-#define LC_POS_LIGHT(ID, ...) LC_LIGHT_POS_##ID,
-#define LC_POS_SHAPE(ID, ...) LC_SHAPE_POS_##ID,
-#define LC_POS_INTEGRATOR(ID, ...) LC_INTEGRATOR_POS_##ID,
-#define LC_POS_FILTER(ID, ...) LC_FILTER_POS_##ID,
-#define LC_POS_SAMPLER(ID, ...) LC_SAMPLER_POS_##ID,
+#define LC_VALUE_BIT_6(ID, Name, value, name, feature, file) +(1u << (value))
+#define LC_VALUE_BIT_7(ID, Name, value, name, feature, file, extra) +(1u << (value))
+#define LC_POS_MAT(ID, Name, value, name, feature, file, params) LC_MAT_POS_##ID,
+#define LC_POS_LIGHT(ID, Name, value, name, feature, file, params) LC_LIGHT_POS_##ID,
+#define LC_POS_SHAPE(ID, Name, value, name, feature, file) LC_SHAPE_POS_##ID,
+#define LC_POS_INTEGRATOR(ID, Name, value, name, feature, file) LC_INTEGRATOR_POS_##ID,
+#define LC_POS_FILTER(ID, Name, value, name, feature, file, radius) LC_FILTER_POS_##ID,
+#define LC_POS_SAMPLER(ID, Name, value, name, feature, file) LC_SAMPLER_POS_##ID,
 enum { LC_MATERIAL_TYPES(LC_POS_MAT) LC_MAT_POS_END_ };
 enum { LC_LIGHT_TYPES(LC_POS_LIGHT) LC_LIGHT_POS_END_ };
 enum { LC_SHAPE_TYPES(LC_POS_SHAPE) LC_SHAPE_POS_END_ };
 enum { LC_INTEGRATOR_TYPES(LC_POS_INTEGRATOR) LC_AOV_TYPES(LC_POS_INTEGRATOR) LC_INT_POS_END_ };
 enum { LC_FILTER_TYPES(LC_POS_FILTER) LC_FILTER_POS_END_ };
 enum { LC_SAMPLER_TYPES(LC_POS_SAMPLER) LC_SAMPLER_POS_END_ };
-#define LC_CHECK_MAT(ID, ...) \
+#define LC_CHECK_MAT(ID, Name, value, name, feature, file, params) \
   LC_STATIC_ASSERT((int)LC_MAT_##ID == (int)LC_MAT_POS_##ID, mat_order_##ID);
-#define LC_CHECK_LIGHT(ID, ...) \
+#define LC_CHECK_LIGHT(ID, Name, value, name, feature, file, params) \
   LC_STATIC_ASSERT((int)LC_LIGHT_##ID == (int)LC_LIGHT_POS_##ID, light_order_##ID);
-#define LC_CHECK_SHAPE(ID, ...) \
+#define LC_CHECK_SHAPE(ID, Name, value, name, feature, file) \
   LC_STATIC_ASSERT((int)LC_SHAPE_##ID == (int)LC_SHAPE_POS_##ID, shape_order_##ID);
-#define LC_CHECK_INTEGRATOR(ID, ...) \
+#define LC_CHECK_INTEGRATOR(ID, Name, value, name, feature, file) \
   LC_STATIC_ASSERT((int)LC_INTEGRATOR_##ID == (int)LC_INTEGRATOR_POS_##ID, integrator_order_##ID);
-#define LC_CHECK_FILTER(ID, ...) \
+#define LC_CHECK_FILTER(ID, Name, value, name, feature, file, radius) \
   LC_STATIC_ASSERT((int)LC_FILTER_##ID == (int)LC_FILTER_POS_##ID, filter_order_##ID);
+#define LC_CHECK_SAMPLER(ID, Name, value, name, feature, file) \
+  LC_STATIC_ASSERT((int)LC_SAMPLER_##ID == (int)LC_SAMPLER_POS_##ID, sampler_order_##ID);
 LC_MATERIAL_TYPES(LC_CHECK_MAT)
 LC_LIGHT_TYPES(LC_CHECK_LIGHT)
 LC_SHAPE_TYPES(LC_CHECK_SHAPE)
 LC_INTEGRATOR_TYPES(LC_CHECK_INTEGRATOR)
 LC_AOV_TYPES(LC_CHECK_INTEGRATOR)
 LC_FILTER_TYPES(LC_CHECK_FILTER)
-#define LC_CHECK_SAMPLER(ID, ...) \
-  LC_STATIC_ASSERT((int)LC_SAMPLER_##ID == (int)LC_SAMPLER_POS_##ID, sampler_order_##ID);
 LC_SAMPLER_TYPES(LC_CHECK_SAMPLER)
-LC_STATIC_ASSERT((0u LC_MATERIAL_TYPES(LC_VALUE_BIT)) == (1u << LC_MAT_COUNT) - 1u,
+LC_STATIC_ASSERT((0u LC_MATERIAL_TYPES(LC_VALUE_BIT_7)) == (1u << LC_MAT_COUNT) - 1u,
                  material_values);
-LC_STATIC_ASSERT((0u LC_LIGHT_TYPES(LC_VALUE_BIT)) == (1u << LC_LIGHT_COUNT) - 1u, light_values);
-LC_STATIC_ASSERT((0u LC_SHAPE_TYPES(LC_VALUE_BIT)) == (1u << LC_SHAPE_COUNT) - 1u, shape_values);
-LC_STATIC_ASSERT((0u LC_INTEGRATOR_TYPES(LC_VALUE_BIT) LC_AOV_TYPES(LC_VALUE_BIT)) ==
+LC_STATIC_ASSERT((0u LC_LIGHT_TYPES(LC_VALUE_BIT_7)) == (1u << LC_LIGHT_COUNT) - 1u, light_values);
+LC_STATIC_ASSERT((0u LC_SHAPE_TYPES(LC_VALUE_BIT_6)) == (1u << LC_SHAPE_COUNT) - 1u, shape_values);
+LC_STATIC_ASSERT((0u LC_INTEGRATOR_TYPES(LC_VALUE_BIT_6) LC_AOV_TYPES(LC_VALUE_BIT_6)) ==
                      (1u << LC_INTEGRATOR_COUNT) - 1u,
                  integrator_values);
-LC_STATIC_ASSERT((0u LC_FILTER_TYPES(LC_VALUE_BIT)) == (1u << LC_FILTER_COUNT) - 1u, filter_values);
-LC_STATIC_ASSERT((0u LC_SAMPLER_TYPES(LC_VALUE_BIT)) == (1u << LC_SAMPLER_COUNT) - 1u,
+LC_STATIC_ASSERT((0u LC_FILTER_TYPES(LC_VALUE_BIT_7)) == (1u << LC_FILTER_COUNT) - 1u,
+                 filter_values);
+LC_STATIC_ASSERT((0u LC_SAMPLER_TYPES(LC_VALUE_BIT_6)) == (1u << LC_SAMPLER_COUNT) - 1u,
                  sampler_values);
 
 /* ------------------------------------------------------------------------------------------ */
@@ -312,7 +318,7 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, sampler) == 132, params_sampler);
 
 /* lc_params.flags */
 #define LC_FLAG_NO_MIS 1u   /* path: light sampling only for area lights (no BSDF-hit emission) */
-#define LC_FLAG_CAUSTICS 2u /* path: caustic paths by light tracing (integrator/caustics.cl)     */
+#define LC_FLAG_CAUSTICS 2u /* path: caustic paths by light tracing (integrator/caustics.cl) */
 
 /* Counters accumulated by one launch (atomics on the device). */
 #define LC_COUNTER_NONFINITE 0 /* samples whose radiance was NaN or Inf (not added to the film) */

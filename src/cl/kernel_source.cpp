@@ -44,7 +44,8 @@ void expand(const std::string& path, const std::string& kernel_dir, std::set<std
 
 // The kernel files generated from the registries (kernels/shared/registry.h): the per-type file
 // lists that bsdf/bsdf.cl, light/light.cl, geom/interaction.cl and integrator/integrator.cl
-// include, and every feature define (for probe kernels that test every type).
+// include, LC_ENABLED's 0 for every feature (shared/registry.h), and every feature define (for
+// probe kernels that test every type).
 bool generated_kernel_file(const std::string& path, std::string& text) {
   std::ostringstream out;
   out << "/* generated from kernels/shared/registry.h by src/cl/kernel_source.cpp */\n";
@@ -70,6 +71,10 @@ bool generated_kernel_file(const std::string& path, std::string& text) {
 #define X(ID, Name, value, name, feature, file) add(#file);
     LC_INTEGRATOR_TYPES(X)
 #undef X
+  } else if (path == "generated/features_off.cl") {
+    // LC_ENABLED's value for a feature that is not defined (shared/registry.h)
+    for (const std::string& f : render_detail::all_features())
+      out << "#define LC_ON_" << f << " 0\n";
   } else if (path == "generated/all_features.cl") {
     for (const std::string& f : render_detail::all_features())
       out << "#ifndef " << f << "\n#define " << f << " 1\n#endif\n";
