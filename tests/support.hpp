@@ -15,6 +15,14 @@ struct CommandResult {
   std::string err;  ///< stderr
 };
 
+// AddressSanitizer reserves terabytes of address space for its shadow memory: a CLI built with it
+// cannot start under `ulimit -v`, so the sanitizer build runs such cases without it.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
 /// Runs the lucent CLI with `args` (a shell-quoted string) and optional extra environment
 /// assignments placed before the command (e.g. "LUCENT_DEVICE=foo").
 CommandResult run_cli(const std::string& args, const std::string& env = "");

@@ -178,6 +178,17 @@ TEST(CliErrors, NoOpenClPlatform) {
   msg = expect_one_error_line(r);
   EXPECT_EQ(msg.rfind("no OpenCL platform found", 0), 0u) << msg;
   EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(msg.find("ulimit"), std::string::npos) << msg;
+
+  // under an address-space limit the message names it: NVIDIA's driver does not load under one
+  // of a few GiB, and "install a driver" alone would mislead (AddressSanitizer cannot run so)
+  if (!lucent::test::kAddressSanitizer) {
+    msg = expect_one_error_line(run_cli("devices", "ulimit -v 3145728; " + env));
+    EXPECT_EQ(msg.rfind("no OpenCL platform found", 0), 0u) << msg;
+    EXPECT_NE(msg.find("or raise the address-space limit (ulimit -v, now 3 GiB)"),
+              std::string::npos)
+        << msg;
+  }
 
   // and the same command without the override finds a device: the override is what hid it
   EXPECT_EQ(run_cli("devices").status, 0);

@@ -9,8 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
 #include "lucent/session.hpp"
+#include "render/features.hpp"
 #include "support.hpp"
 
 namespace {
@@ -186,7 +188,8 @@ int inject(const std::string& dir, const std::string& file, int line, const std:
 
 // The build log comes first; the last line is the one error line, naming the file and line of
 // the first error (under LUCENT_KERNEL_DIR, the file there).
-void expect_build_failure(const CommandResult& r, const std::string& where, const std::string& file) {
+void expect_build_failure(const CommandResult& r, const std::string& where,
+                          const std::string& file) {
   EXPECT_EQ(r.status, 1);
   EXPECT_LT(r.err.find("kernel build log:\n"), r.err.find("lucent: error: ")) << r.err;
   EXPECT_NE(r.err.find(where), std::string::npos) << "no '" << where << "' in:\n" << r.err;
@@ -225,3 +228,108 @@ TEST(KernelSource, BuildFailureInAnIncludedFileNamesItsLine) {
 }
 
 }  // namespace
+
+// Portability: the kernel is OpenCL C 1.2, compiled by whatever compiler the device's driver has.
+// PoCL's recent clang accepts variadic macros as an extension; NVIDIA's OpenCL compiler refuses
+// them ("variadic macros not supported in OpenCL"), which once broke every kernel there. Every
+// kernel file (all of them are embedded) must define its macros with named parameters only.
+TEST(KernelSource, NoVariadicMacrosInKernelSources) {
+  int files = 0;
+  for (int i = 0; i < lucent::detail::kEmbeddedKernelFileCount; ++i) {
+    const auto& f = lucent::detail::kEmbeddedKernelFiles[i];
+    ++files;
+    std::vector<std::string> lines = lines_of(f.content);
+    for (size_t n = 0; n < lines.size(); ++n) {
+      const std::string& l = lines[n];
+      std::string::size_type d = l.find_first_not_of(" \t");
+      bool define = d != std::string::npos && l.compare(d, 1, "#") == 0 &&
+                    l.find("define", d) != std::string::npos;
+      std::string::size_type open = l.find('(');
+      std::string::size_type close = open == std::string::npos ? open : l.find(')', open);
+      bool variadic_params = define && close != std::string::npos &&
+                             l.substr(open, close - open).find("...") != std::string::npos;
+      EXPECT_FALSE(variadic_params || l.find("__VA_ARGS__") != std::string::npos)
+          << "kernels/" << f.path << ":" << n + 1 << ": variadic macro: " << l;
+    }
+  }
+  EXPECT_GT(files, 30);
+}
+
+// The same kernels through a second OpenCL C front end, when clang is installed (CI installs it
+// for the fuzz stage): OpenCL C 1.2 with -pedantic, every warning an error. This catches clang
+// extensions that PoCL accepts and stricter drivers may not (a variadic macro fails it too).
+TEST(KernelSource, KernelsAreStrictOpenCL12ForClang) {
+  if (std::system("command -v clang >/dev/null 2>&1") != 0) GTEST_SKIP() << "clang is absent";
+  KernelDirGuard guard;
+  ::unsetenv("LUCENT_KERNEL_DIR");
+  std::string all;  // the megakernel with every feature, as --no-specialize builds it
+  for (const std::string& f : lucent::render_detail::all_features()) all += "#define " + f + " 1\n";
+  struct Case {
+    std::string name, prefix, path;
+  };
+  // every feature, every feature in double precision, and none (the #else branches)
+  std::vector<Case> cases = {{"megakernel", all, "megakernel.cl"},
+                             {"megakernel-double", all + "#define LC_DOUBLE 1\n", "megakernel.cl"},
+                             {"megakernel-no-features", "", "megakernel.cl"}};
+  for (int i = 0; i < lucent::detail::kEmbeddedKernelFileCount; ++i) {
+    std::string p = lucent::detail::kEmbeddedKernelFiles[i].path;
+    if (p.rfind("test/", 0) == 0) cases.push_back({p, "", p});
+  }
+  ASSERT_GT(cases.size(), 5u);
+  std::string dir = lucent::test::temp_dir();
+  for (const Case& c : cases) {
+    std::string file = dir + "/k.cl", log = dir + "/clang.log";
+    lucent::test::write_file(file, c.prefix + lucent::detail::assemble_kernel_source(c.path));
+    std::string cmd =
+        "clang -x cl -cl-std=CL1.2 -fsyntax-only -pedantic -Werror -Xclang "
+        "-finclude-default-header '" +
+        file + "' >'" + log + "' 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << c.name << ":\n" << lucent::test::read_file(log);
+  }
+}
+
+// NVIDIA's OpenCL compiler ignores #line in its diagnostics' places: "<kernel>:3417:1: error: ..."
+// gives the physical line of the assembled source. lucent maps such places back through the
+// #line markers, so the error line names kernels/<file>:<line> on every driver. (Checked against
+// NVIDIA's real log of an injected error: BENCHMARKS.md, "GPU".)
+TEST(KernelSource, PhysicalLinePlacesMapThroughLineMarkers) {
+  KernelDirGuard guard;
+  ::unsetenv("LUCENT_KERNEL_DIR");
+  std::string src = lucent::detail::assemble_kernel_source("megakernel.cl");
+  std::vector<std::string> phys = lines_of(src);
+  std::vector<std::string> mk = lines_of(lucent::detail::read_kernel_file("megakernel.cl"));
+  std::vector<std::string> math = lines_of(lucent::detail::read_kernel_file("util/math.cl"));
+  auto index_of = [](const std::vector<std::string>& v, const std::string& what) {
+    for (size_t i = 0; i < v.size(); ++i)
+      if (v[i].find(what) != std::string::npos) return static_cast<long>(i) + 1;
+    return 0L;
+  };
+  long k_phys = index_of(phys, "__kernel void lucent_render"),
+       k_file = index_of(mk, "__kernel void lucent_render");
+  ASSERT_GT(k_phys, k_file);  // the includes come before it
+  ASSERT_GT(k_file, 0);
+  EXPECT_EQ(lucent::cl_util::source_place(src, k_phys),
+            "kernels/megakernel.cl:" + std::to_string(k_file));
+  // a line of an included file (its last line: the physical line before the next marker)
+  long m_first = index_of(phys, "#line 1 \"kernels/util/math.cl\"") + 1;
+  ASSERT_GT(m_first, 1);
+  long m_last = m_first + static_cast<long>(math.size()) - 1;
+  EXPECT_EQ(phys[m_last - 1], math.back());
+  EXPECT_EQ(lucent::cl_util::source_place(src, m_last),
+            "kernels/util/math.cl:" + std::to_string(math.size()));
+  EXPECT_EQ(lucent::cl_util::source_place(src, static_cast<long>(phys.size()) + 5), "");
+  EXPECT_EQ(lucent::cl_util::source_place(src, 0), "");
+
+  std::string log =
+      "1 error generated.\n<kernel>:" + std::to_string(k_phys) +
+      ":15: error: unknown type name 'x'\nx here;\n^\n<kernel>:" + std::to_string(m_last) +
+      ":3: note: expanded from macro 'Y'\n" +
+      "kernels/bvh/traverse.cl:12:1: warning: left as it is";
+  std::string mapped = lucent::cl_util::map_source_places(log, src);
+  EXPECT_EQ(mapped, "1 error generated.\nkernels/megakernel.cl:" + std::to_string(k_file) +
+                        ":15: error: unknown type name 'x'\nx here;\n^\nkernels/util/math.cl:" +
+                        std::to_string(math.size()) + ":3: note: expanded from macro 'Y'\n" +
+                        "kernels/bvh/traverse.cl:12:1: warning: left as it is");
+  EXPECT_EQ(lucent::cl_util::first_error_place(mapped),
+            "kernels/megakernel.cl:" + std::to_string(k_file) + ":15");
+}

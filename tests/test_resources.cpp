@@ -27,13 +27,7 @@ using lucent::render_detail::ScopedLimitOverride;
 
 std::string q(const std::string& s) { return "'" + s + "'"; }
 
-// AddressSanitizer reserves terabytes of address space for its shadow memory: a CLI built with it
-// cannot start under `ulimit -v`, so the sanitizer build runs these cases without it.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
+using lucent::test::kAddressSanitizer;
 
 /// A shell prefix limiting the address space to `kib` KiB ("" under AddressSanitizer).
 std::string ulimit_v(const std::string& kib) {

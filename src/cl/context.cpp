@@ -1,5 +1,7 @@
 #include "cl/context.hpp"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
@@ -41,8 +43,54 @@ std::string device_list(const std::vector<Device>& devices) {
   return out;
 }
 
-// The first "kernels/<file>:<line>:<col>: error" of a build log, as "kernels/<file>:<line>:<col>"
-// (the session names the kernel directory in use instead of kernels/ when there is one).
+size_t skip_digits(const std::string& s, size_t at) {
+  while (at < s.size() && std::isdigit(static_cast<unsigned char>(s[at]))) ++at;
+  return at;
+}
+
+}  // namespace
+
+std::string source_place(const std::string& source, long line) {
+  if (line < 1) return "";
+  std::istringstream in(source);
+  std::string file, text;
+  long logical = 0;  // the logical line of the current physical line
+  bool reached = false;
+  for (long physical = 1; std::getline(in, text); ++physical, ++logical) {
+    if ((reached = physical == line)) break;
+    if (text.rfind("#line ", 0) == 0) {  // #line N "file": the next line is line N of file
+      size_t n0 = 6, n1 = skip_digits(text, n0);
+      size_t q1 = text.find('"', n1), q2 = q1 == std::string::npos ? q1 : text.find('"', q1 + 1);
+      if (n1 == n0 || q2 == std::string::npos) continue;
+      logical = std::strtol(text.c_str() + n0, nullptr, 10) - 1;
+      file = text.substr(q1 + 1, q2 - q1 - 1);
+    }
+  }
+  if (!reached || file.empty()) return "";
+  return file + ":" + std::to_string(logical);
+}
+
+std::string map_source_places(const std::string& log, const std::string& source) {
+  std::istringstream in(log);
+  std::string out;
+  for (std::string line; std::getline(in, line);) {
+    // "<name>:<line>:<col>: ..." where <name> is not a kernels/ path: the physical line
+    size_t colon = line.find(':');
+    size_t e = colon == std::string::npos ? colon : skip_digits(line, colon + 1);
+    size_t c = e == std::string::npos || e >= line.size() || line[e] != ':'
+                   ? std::string::npos
+                   : skip_digits(line, e + 1);
+    if (colon != std::string::npos && colon > 0 && line.find(' ') > colon &&
+        line.rfind("kernels/", 0) != 0 && e > colon + 1 && c != std::string::npos && c > e + 1 &&
+        line.compare(c, 2, ": ") == 0) {
+      std::string place = source_place(source, std::strtol(line.c_str() + colon + 1, nullptr, 10));
+      if (!place.empty()) line = place + line.substr(e);
+    }
+    out += (out.empty() ? "" : "\n") + line;
+  }
+  return out;
+}
+
 std::string first_error_place(const std::string& log) {
   std::istringstream in(log);
   for (std::string line; std::getline(in, line);) {
@@ -50,21 +98,34 @@ std::string first_error_place(const std::string& log) {
     for (auto k = line.find("kernels/"); k != std::string::npos; k = line.find("kernels/", k + 1)) {
       // kernels/<file>:<line>[:<col>]
       size_t file_end = line.find(':', k + 8), e = file_end;
-      auto digits = [&](size_t at) {
-        size_t j = at;
-        while (j < line.size() && std::isdigit(static_cast<unsigned char>(line[j]))) ++j;
-        return j;
-      };
-      if (file_end == std::string::npos || (e = digits(file_end + 1)) == file_end + 1) continue;
-      if (e < line.size() && line[e] == ':' && digits(e + 1) > e + 1) e = digits(e + 1);
+      if (file_end == std::string::npos || (e = skip_digits(line, file_end + 1)) == file_end + 1)
+        continue;
+      if (e < line.size() && line[e] == ':' && skip_digits(line, e + 1) > e + 1)
+        e = skip_digits(line, e + 1);
       return line.substr(k, e - k);
     }
   }
   return "";
 }
 
-const char kNoPlatform[] =
-    "no OpenCL platform found: install an OpenCL driver (Debian: pocl-opencl-icd for the CPU)";
+namespace {
+
+// No platform: no driver is installed, or one failed to load. NVIDIA's fails under an
+// address-space limit of a few GiB (the CUDA driver reserves more address space than that), so
+// the message names a limit when one is set.
+std::string no_platform() {
+  std::string msg =
+      "no OpenCL platform found: install an OpenCL driver (Debian: pocl-opencl-icd for the CPU)";
+  struct rlimit lim {};
+  if (::getrlimit(RLIMIT_AS, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY) {
+    std::ostringstream gib;
+    gib.precision(3);
+    gib << static_cast<double>(lim.rlim_cur) / (1024.0 * 1024.0 * 1024.0);
+    msg += ", or raise the address-space limit (ulimit -v, now " + gib.str() +
+           " GiB), which can keep an installed driver from loading (NVIDIA's does)";
+  }
+  return msg;
+}
 
 }  // namespace
 
@@ -73,10 +134,10 @@ std::vector<Device> enumerate_devices() {
   try {
     cl::Platform::get(&platforms);
   } catch (const cl::Error& e) {
-    if (e.err() == -1001 || e.err() == CL_INVALID_VALUE) throw Error(kNoPlatform);
+    if (e.err() == -1001 || e.err() == CL_INVALID_VALUE) throw Error(no_platform());
     throw Error(describe(e));
   }
-  if (platforms.empty()) throw Error(kNoPlatform);
+  if (platforms.empty()) throw Error(no_platform());
   std::vector<Device> out;
   try {
     for (auto& p : platforms) {
@@ -172,6 +233,7 @@ cl::Program build_program(const Context& ctx, const std::string& source,
       log = trim(program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(ctx.device.device));
     } catch (const cl::Error&) {
     }
+    log = map_source_places(log, source);
     std::string place = first_error_place(log);
     std::string msg = (place.empty() ? std::string() : place + ": ") +
                       "kernel build failed: " + describe(e) +

@@ -28,6 +28,20 @@ struct Context {
   explicit Context(const std::string& selector, const std::string& origin = "--device");
 };
 
+/// "kernels/<file>:<line>" of physical line `line` (from 1) of an assembled source, by its #line
+/// markers; empty before the first marker.
+std::string source_place(const std::string& source, long line);
+
+/// A build log with every "<name>:<line>:<col>: " that gives a physical line of `source` (NVIDIA's
+/// compiler writes "<kernel>:3417:1: error: ...", ignoring #line) replaced by the place the #line
+/// markers give, "kernels/<file>:<line>:<col>: "; lines that already name kernels/ stay as they
+/// are.
+std::string map_source_places(const std::string& log, const std::string& source);
+
+/// The first "kernels/<file>:<line>:<col>: error" of a build log, as "kernels/<file>:<line>:<col>"
+/// (the session names the kernel directory in use instead of kernels/ when there is one).
+std::string first_error_place(const std::string& log);
+
 /// Builds `source` (already assembled, with #line markers) for the context's device. On a build
 /// failure throws lucent::Error holding the build log, whose lines name kernels/<file>:<line>,
 /// followed by "clBuildProgram: CL_BUILD_PROGRAM_FAILURE".
