@@ -7,6 +7,8 @@
 #   BENCH_MITSUBA_SCENES="cornell-box default dragon-box"          (scenes/NAME.json, the default)
 #   BENCH_LUCENT_SAMPLER=independent    lucent's sampler, as Mitsuba's (default: lucent's own, sobol,
 #                                       which costs 11-19% more per path; BENCHMARKS.md)
+#   BENCH_MITSUBA_VARIANT=cuda_ad_rgb    Mitsuba's variant (default llvm_ad_rgb); with a GPU variant
+#                                       lucent renders on LUCENT_DEVICE (default: the first GPU)
 #
 # Each scene is rendered SIZE x SIZE with a box filter (radius 0.5), SPP samples per pixel, its own
 # max_depth (cornell-box and dragon-box 8, default 6), Russian roulette at each renderer's default,
@@ -41,6 +43,7 @@ spp=${2:-64}
 pairs=${3:-3}
 size=${4:-256}
 threads=2
+variant=${BENCH_MITSUBA_VARIANT:-llvm_ad_rgb}
 scenes=${BENCH_MITSUBA_SCENES:-cornell-box default dragon-box}
 helper=$root/bench/mitsuba/bench_mitsuba.py
 lucent=$build/lucent
@@ -51,12 +54,13 @@ if ! python3 -c 'import mitsuba' >/dev/null 2>&1; then
 fi
 probe=$(python3 -c '
 import drjit as dr, mitsuba as mi
-mi.set_variant("llvm_ad_rgb")
+import sys
+mi.set_variant(sys.argv[1])
 img = mi.render(mi.load_dict(mi.cornell_box()), spp=1)
 dr.eval(img)
-print("ok")' 2>&1 | tail -1 || true)
+print("ok")' "$variant" 2>&1 | tail -1 || true)
 if [[ $probe != ok ]]; then
-  echo "bench-mitsuba: skipped: Mitsuba's llvm_ad_rgb variant cannot render here ($probe);" \
+  echo "bench-mitsuba: skipped: Mitsuba's $variant variant cannot render here ($probe);" \
     "it needs libLLVM >= 17 (Debian 12: apt-get install libllvm19)"
   exit 0
 fi
@@ -91,7 +95,7 @@ run_mitsuba() {  # $1 scene json, $2 max_depth
   local t0 t1 log=$work/mitsuba.log
   t0=$(now)
   python3 "$helper" render "$1" --size "$size" "$size" --spp "$spp" --max-depth "$2" \
-    --threads "$threads" >"$log" 2>&1 ||
+    --threads "$threads" --variant "$variant" >"$log" 2>&1 ||
     { echo "bench-mitsuba: mitsuba failed: $(tail -3 "$log")" >&2; exit 1; }
   t1=$(now)
   mi_render=$(sed -n 's/^mitsuba: render seconds //p' "$log")
