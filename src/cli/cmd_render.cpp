@@ -277,7 +277,7 @@ int render_with(const RenderArgs& a) {
   if (!a.quiet)
     std::fprintf(
         stderr,
-        "%s: %dx%d, %llu spp in %.2f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak host "
+        "%s: %dx%d, %llu spp in %.3f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak host "
         "memory %.0f MiB) on %s%s\n",
         a.output.c_str(), scene.film.width, scene.film.height,
         static_cast<unsigned long long>(r.spp), seconds,
