@@ -102,6 +102,61 @@ TEST(ProgramCache, CanBeDisabled) {
   EXPECT_EQ(run_probe(ctx, p), 64u);
 }
 
+// PoCL keeps its own cache unless POCL_KERNEL_CACHE reads as off to PoCL (a value not starting
+// with 1); other drivers: none that lucent knows of.
+TEST(ProgramCache, DriverCacheIsPoclsWhileItIsOn) {
+  lucent::cl_util::Device pocl, nvidia;
+  pocl.info.platform = "Portable Computing Language";
+  nvidia.info.platform = "NVIDIA CUDA";
+  const std::string kPocl = "PoCL's kernel cache";
+  {
+    lucent::test::ScopedEnv unset("POCL_KERNEL_CACHE", nullptr);
+    EXPECT_EQ(lucent::cl_util::driver_program_cache(pocl), kPocl);
+    EXPECT_EQ(lucent::cl_util::driver_program_cache(nvidia), "");
+  }
+  for (const char* on : {"1", "10", "1x"}) {
+    lucent::test::ScopedEnv env("POCL_KERNEL_CACHE", on);
+    EXPECT_EQ(lucent::cl_util::driver_program_cache(pocl), kPocl) << on;
+  }
+  for (const char* off : {"0", "no", "yes", "", " 1"}) {
+    lucent::test::ScopedEnv env("POCL_KERNEL_CACHE", off);
+    EXPECT_EQ(lucent::cl_util::driver_program_cache(pocl), "") << "'" << off << "'";
+  }
+}
+
+// A deferred entry is written by store(), not by the build; dropped unstored it writes nothing
+// and releases its lock (the next build is a miss that does not wait).
+TEST(ProgramCache, DeferredEntriesAreWrittenByStore) {
+  CacheDir c;
+  lucent::cl_util::Context ctx("");
+  std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
+  const std::string options = "-cl-std=CL1.2 -D LC_DEFERRED_ENTRY_TEST";
+  ProgramBuildInfo a, b, d, e;
+  {
+    lucent::cl_util::DeferredEntry dropped;
+    lucent::cl_util::build_program_cached(ctx, src, options, c.dir, &a, &dropped);
+    EXPECT_TRUE(dropped.pending());
+  }
+  EXPECT_FALSE(fs::exists(a.cache_file));
+  lucent::cl_util::DeferredEntry entry;
+  cl::Program p = lucent::cl_util::build_program_cached(ctx, src, options, c.dir, &b, &entry);
+  EXPECT_FALSE(b.cache_hit);
+  ASSERT_TRUE(entry.pending());
+  EXPECT_FALSE(fs::exists(b.cache_file));
+  EXPECT_EQ(run_probe(ctx, p), 64u);  // a launch first, as the session does
+  entry.store(p);
+  EXPECT_FALSE(entry.pending());
+  EXPECT_TRUE(fs::is_regular_file(b.cache_file));
+  lucent::cl_util::DeferredEntry none;
+  cl::Program q = lucent::cl_util::build_program_cached(ctx, src, options, c.dir, &d, &none);
+  EXPECT_TRUE(d.cache_hit);
+  EXPECT_FALSE(none.pending()) << "a hit leaves nothing to store";
+  EXPECT_EQ(run_probe(ctx, q), 64u);
+  lucent::cl_util::build_program_cached(ctx, src, options, "", &e, &none);
+  EXPECT_FALSE(e.cache_hit);
+  EXPECT_FALSE(none.pending()) << "no cache, nothing to store";
+}
+
 TEST(ProgramCache, CliClearsTheCache) {
   std::string dir = lucent::test::temp_dir() + "/clicache";
   auto r = lucent::test::run_cli("cache dir", "LUCENT_CACHE_DIR='" + dir + "'");

@@ -4,7 +4,9 @@
 // open file descriptions, so two threads of one process exclude each other as two processes do.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -53,6 +55,50 @@ TEST(ProgramCacheLock, SimultaneousMissesBuildOnce) {
   }
   EXPECT_EQ(built, 1) << "each builder that missed compiled the program itself";
   EXPECT_TRUE(std::filesystem::exists(info[0].cache_file));
+}
+
+// Without entries (a driver that caches its own builds, cl/program_cache.hpp) the lock is still
+// taken, and held by the deferred entry until store(): builders of the same program run one after
+// the other (each from its build's return to its store), and no entry is written.
+TEST(ProgramCacheLock, LockOnlyBuildsTakeTurns) {
+  const std::string dir = lucent::test::temp_dir() + "/cache";
+  const std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
+  const std::string options = "-cl-std=CL1.2 -D LC_PROGRAM_CACHE_LOCK_ONLY_TEST";
+  using clock = std::chrono::steady_clock;
+  constexpr int kBuilders = 3;
+  std::vector<std::unique_ptr<lucent::cl_util::Context>> contexts;
+  for (int i = 0; i < kBuilders; ++i)
+    contexts.push_back(std::make_unique<lucent::cl_util::Context>(""));
+  std::vector<std::pair<clock::time_point, clock::time_point>> held(kBuilders);
+  std::vector<std::string> errors(kBuilders);
+  std::atomic<int> ready{0};
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kBuilders; ++i)
+    threads.emplace_back([&, i] {
+      ++ready;
+      while (ready.load() < kBuilders) std::this_thread::yield();
+      try {
+        lucent::cl_util::DeferredEntry entry;
+        ProgramBuildInfo info;
+        cl::Program p = lucent::cl_util::build_program_cached(*contexts[i], src, options, dir,
+                                                              &info, &entry, false);
+        held[i].first = clock::now();
+        if (!entry.pending() || info.cache_hit || !info.cache_file.empty())
+          errors[i] = "no lock held, or an entry used";
+        std::this_thread::sleep_for(std::chrono::milliseconds(30));
+        held[i].second = clock::now();
+        entry.store(p);
+      } catch (const std::exception& e) {
+        errors[i] = e.what();
+      }
+    });
+  for (auto& t : threads) t.join();
+  for (int i = 0; i < kBuilders; ++i) EXPECT_EQ(errors[i], "") << "builder " << i;
+  std::sort(held.begin(), held.end());
+  for (int i = 1; i < kBuilders; ++i)
+    EXPECT_GE(held[i].first, held[i - 1].second) << "two builders held the lock at once";
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    EXPECT_EQ(e.path().extension(), ".lock") << e.path();
 }
 
 }  // namespace

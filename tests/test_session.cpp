@@ -4,15 +4,19 @@
 
 #include <atomic>
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "cl/context.hpp"
+#include "cl/program_cache.hpp"
 #include "lucent/session.hpp"
 #include "support.hpp"
 
 namespace {
 
+namespace fs = std::filesystem;
 using lucent::Renderer;
 using lucent::RenderResult;
 using lucent::Scene;
@@ -243,8 +247,9 @@ TEST(Session, WarningsGoToTheSessionsSink) {
 }
 
 // The kernel cache directory is the session's: "off" compiles, a directory is filled and then
-// read by the next session.
+// read by the next session (where the driver keeps no cache of its own: PoCL with its cache off).
 TEST(Session, CacheDirectoryIsAnOption) {
+  lucent::test::ScopedEnv pocl_cache("POCL_KERNEL_CACHE", "0");
   Scene s = lucent::test::scene_from(kScene);
   lucent::SessionOptions o = lucent::test::session_options();
   o.cache_dir = "off";
@@ -258,6 +263,29 @@ TEST(Session, CacheDirectoryIsAnOption) {
   c.set_scene(s);
   EXPECT_EQ(c.stats().kernel_cache_loads, 1u);
   EXPECT_EQ(c.stats().kernel_compiles, 0u);
+}
+
+// Where the driver caches its own builds (PoCL with POCL_KERNEL_CACHE on, its default), the
+// session leaves caching to it: no entry is written, and the next session builds from source
+// (from PoCL's cache). cl/program_cache.hpp says why.
+TEST(Session, DriverWithItsOwnCacheGetsNoEntries) {
+  lucent::test::ScopedEnv pocl_cache("POCL_KERNEL_CACHE", nullptr);
+  lucent::cl_util::Context ctx(lucent::test::device());
+  if (lucent::cl_util::driver_program_cache(ctx.device).empty())
+    GTEST_SKIP() << "the device's driver keeps no program cache: " << ctx.device.info.platform;
+  Scene s = lucent::test::scene_from(kScene);
+  lucent::SessionOptions o = lucent::test::session_options();
+  o.cache_dir = lucent::test::temp_dir() + "/cache";
+  Renderer a(o), b(o);
+  a.set_scene(s);
+  EXPECT_EQ(a.stats().kernel_compiles, 1u);
+  for (const auto& e : fs::directory_iterator(o.cache_dir))  // build locks only
+    EXPECT_EQ(e.path().extension(), ".lock") << e.path();
+  b.set_scene(s);
+  EXPECT_EQ(b.stats().kernel_compiles, 1u);
+  EXPECT_EQ(b.stats().kernel_cache_loads, 0u);
+  a.render(1);
+  EXPECT_EQ(a.spp(), 1u);
 }
 
 // Several devices share a render's passes (here two contexts on the same device, "0,0"): the

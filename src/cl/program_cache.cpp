@@ -135,6 +135,8 @@ void write_entry(const std::string& path, const std::string& key,
   }
 }
 
+}  // namespace
+
 /// An exclusive flock on `path` held while alive: processes that miss the same entry at the same
 /// time build it once (the others wait, then read what the first wrote) instead of each compiling
 /// it. Waits at most `max_wait` seconds (a holder stuck in a driver must not stall every other
@@ -166,8 +168,6 @@ class BuildLock {
  private:
   int fd_ = -1;
 };
-
-}  // namespace
 
 std::string default_program_cache_dir() {
   const char* xdg = std::getenv("XDG_CACHE_HOME");
@@ -205,21 +205,53 @@ std::string usable_cache_dir(const std::string& dir) {
 
 }  // namespace
 
+std::string driver_program_cache(const Device& device) {
+  if (device.info.platform.find("Portable Computing Language") == std::string::npos) return "";
+  // PoCL reads the variable as on when it is unset or starts with "1" (pocl_get_bool_option)
+  const char* v = std::getenv("POCL_KERNEL_CACHE");
+  if (v && v[0] != '1') return "";
+  return "PoCL's kernel cache";
+}
+
+DeferredEntry::DeferredEntry() = default;
+DeferredEntry::~DeferredEntry() = default;
+DeferredEntry::DeferredEntry(DeferredEntry&&) noexcept = default;
+DeferredEntry& DeferredEntry::operator=(DeferredEntry&&) noexcept = default;
+
+void DeferredEntry::store(const cl::Program& program) {
+  if (!file_.empty()) {
+    try {
+      auto bins = program.getInfo<CL_PROGRAM_BINARIES>();
+      if (bins.size() == 1 && !bins[0].empty()) write_entry(file_, key_, bins[0]);
+    } catch (const cl::Error&) {
+      // some drivers cannot return binaries: no cache, no harm
+    }
+  }
+  file_.clear();
+  key_.clear();
+  lock_.reset();
+}
+
 cl::Program build_program_cached(const Context& ctx, const std::string& source,
                                  const std::string& options, const std::string& cache_dir,
-                                 ProgramBuildInfo* info) {
+                                 ProgramBuildInfo* info, DeferredEntry* deferred, bool entries) {
   auto t0 = std::chrono::steady_clock::now();
   ProgramBuildInfo local;
   ProgramBuildInfo& bi = info ? *info : local;
   bi = ProgramBuildInfo{};
-  const std::string dir = usable_cache_dir(cache_dir);
+  // without entries the directory holds locks only: one that cannot serve goes unsaid (BuildLock
+  // fails quietly)
+  const std::string dir = entries ? usable_cache_dir(cache_dir) : cache_dir;
   std::string key = cache_key(ctx, source, options);
   auto finish = [&](cl::Program p) {
     bi.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return p;
   };
-  std::unique_ptr<BuildLock> lock;
-  if (!dir.empty()) {
+  DeferredEntry entry;
+  if (!dir.empty() && !entries) {
+    const std::string file = dir + "/" + hex(fnv1a(key.data(), key.size())) + ".bin";
+    entry.lock_ = std::make_unique<BuildLock>(file + ".lock", 600);
+  } else if (!dir.empty()) {
     bi.cache_file = dir + "/" + hex(fnv1a(key.data(), key.size())) + ".bin";
     std::string why;
     auto load = [&](cl::Program& p) {
@@ -240,23 +272,21 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
     cl::Program p;
     if (load(p)) return finish(p);
     // a miss: wait for another process that may be building this entry, then look again
-    lock = std::make_unique<BuildLock>(bi.cache_file + ".lock", 600);
+    entry.lock_ = std::make_unique<BuildLock>(bi.cache_file + ".lock", 600);
     if (load(p)) return finish(p);
     if (!why.empty()) {
       bi.note = (why.rfind(bi.cache_file, 0) == 0 ? why : bi.cache_file + ": " + why) + "; rebuilt";
       std::error_code ec;
       fs::remove(bi.cache_file, ec);
     }
+    entry.file_ = bi.cache_file;
+    entry.key_ = key;
   }
   cl::Program p = build_program(ctx, source, options);
-  if (!dir.empty()) {
-    try {
-      auto bins = p.getInfo<CL_PROGRAM_BINARIES>();
-      if (bins.size() == 1 && !bins[0].empty()) write_entry(bi.cache_file, key, bins[0]);
-    } catch (const cl::Error&) {
-      // some drivers cannot return binaries: no cache, no harm
-    }
-  }
+  if (deferred)
+    *deferred = std::move(entry);
+  else
+    entry.store(p);
   return finish(p);
 }
 

@@ -8,6 +8,15 @@
 // the CLI's default is LUCENT_CACHE_DIR, "off" disabling it); "" disables the cache.
 // A miss is built under an exclusive lock on <entry>.lock, so that processes missing the same
 // entry at once (a parallel test run on cold caches) compile it once and the others read it.
+//
+// Drivers that cache their own builds: PoCL keeps every program it builds and every work-group
+// function it compiles at a launch (POCL_CACHE_DIR, while POCL_KERNEL_CACHE is on, its default),
+// and rebuilds the megakernel from its cache in 0.03 s; answering CL_PROGRAM_BINARIES costs it a
+// work-group compile of its own (0.5 s, the largest part of a cold build). The session therefore
+// leaves caching to such a driver (driver_program_cache) and stores an entry only for the others,
+// after the first launch (DeferredEntry), so that the entry also holds what the driver compiled
+// there: a hit then launches at once instead of compiling again.
+#include <memory>
 #include <string>
 
 #include "cl/context.hpp"
@@ -25,10 +34,45 @@ struct ProgramBuildInfo {
 /// variable is set).
 std::string default_program_cache_dir();
 
-/// Builds `source` with `options`, through the cache in `cache_dir` ("": no cache).
+/// What caches the driver of `device` keeps of the programs it builds, when lucent's cache would
+/// add nothing to them: "PoCL's kernel cache" on PoCL unless POCL_KERNEL_CACHE is set to a value
+/// that PoCL reads as off (one not starting with 1); "" otherwise.
+std::string driver_program_cache(const Device& device);
+
+class BuildLock;
+
+/// A cache miss whose entry is written later, by store(), holding the miss's build lock until then
+/// (processes that miss the same entry still build it once). Writes nothing if dropped unstored.
+class DeferredEntry {
+ public:
+  DeferredEntry();
+  ~DeferredEntry();
+  DeferredEntry(DeferredEntry&&) noexcept;
+  DeferredEntry& operator=(DeferredEntry&&) noexcept;
+
+  /// An entry to write or a lock to release.
+  bool pending() const { return !file_.empty() || lock_; }
+  /// Writes the program's binaries, if an entry is due (a driver that cannot give them: no
+  /// entry, no error), and releases the lock.
+  void store(const cl::Program& program);
+
+ private:
+  friend cl::Program build_program_cached(const Context&, const std::string&, const std::string&,
+                                          const std::string&, ProgramBuildInfo*, DeferredEntry*,
+                                          bool);
+  std::string file_, key_;
+  std::unique_ptr<BuildLock> lock_;
+};
+
+/// Builds `source` with `options`, through the cache in `cache_dir` ("": no cache). A miss is
+/// stored at once, or, with `deferred`, when the caller calls deferred->store() (after a launch).
+/// With `entries` false (a driver that caches its own builds) no entry is read or written, but
+/// the build still takes the entry's lock (held by `deferred` until store()), so that processes
+/// building the same program at once wait for the first and then build from the driver's cache.
 cl::Program build_program_cached(const Context& ctx, const std::string& source,
                                  const std::string& options, const std::string& cache_dir,
-                                 ProgramBuildInfo* info = nullptr);
+                                 ProgramBuildInfo* info = nullptr,
+                                 DeferredEntry* deferred = nullptr, bool entries = true);
 
 /// Removes every cache entry of `dir`; returns how many files were removed.
 int clear_program_cache(const std::string& dir);

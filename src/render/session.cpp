@@ -231,7 +231,10 @@ struct Renderer::Impl {
   }
 
   /// The worker's program for these build options, built (or loaded from the cache) or reused.
-  Program& get_program(Worker& w, const std::string& opts, const std::string& source) {
+  /// A new build's cache entry is left in `entry`, to be stored after the warm-up launch; no entry
+  /// where the driver caches its own builds (cl/program_cache.hpp).
+  Program& get_program(Worker& w, const std::string& opts, const std::string& source,
+                       cl_util::DeferredEntry& entry) {
     auto it = w.programs.find(opts);
     if (it != w.programs.end()) {
       ++stats.kernel_reuses;
@@ -241,7 +244,9 @@ struct Renderer::Impl {
     cl_util::ProgramBuildInfo info;
     Program p;
     try {
-      p.program = cl_util::build_program_cached(w.ctx, source, opts, cache_dir, &info);
+      const bool entries = cl_util::driver_program_cache(w.ctx.device).empty();
+      p.program =
+          cl_util::build_program_cached(w.ctx, source, opts, cache_dir, &info, &entry, entries);
     } catch (const Error& e) {
       // the place of a build error is "kernels/<file>:<line>": the file in the kernel directory
       // in use when the sources came from one
@@ -315,7 +320,8 @@ struct Renderer::Impl {
         Program* previous_program = w.program;
         if (!w.programs.count(opts) && source.empty())
           source = detail::assemble_kernel_source("megakernel.cl", options.kernel_dir);
-        w.program = &get_program(w, opts, source);
+        cl_util::DeferredEntry entry;
+        w.program = &get_program(w, opts, source, entry);
         if (!w.dev) {
           w.dev.emplace(w.ctx, next);
           ++stats.buffer_uploads;
@@ -351,6 +357,16 @@ struct Renderer::Impl {
           packed.params = next.params;  // the warm-up launch's parameters
           stage = render_detail::ClStage::Pass;
           warm_up(w);
+        }
+        if (entry.pending()) {
+          // after the warm-up, so that the entry holds the work-group function the driver
+          // compiled at that launch (PoCL without its own cache: a hit launches at once); a
+          // driver that caches its own builds has had them cached under the lock
+          auto t0 = clock_type::now();
+          entry.store(w.program->program);
+          const double s = seconds_since(t0);
+          w.program->build_seconds += s;
+          stats.build_seconds += s;
         }
       }
     } catch (const cl::Error& e) {
