@@ -167,6 +167,13 @@ TEST(ProgramCache, CliClearsTheCache) {
   r = lucent::test::run_cli("cache clear", "LUCENT_CACHE_DIR='" + dir + "'");
   EXPECT_EQ(r.status, 0);
   EXPECT_NE(r.out.find("removed 1"), std::string::npos) << r.out;
+  // on PoCL with its cache on, where sessions leave caching to PoCL, it says so
+  bool pocl = false;
+  for (const lucent::cl_util::Device& d : lucent::cl_util::enumerate_devices())
+    pocl = pocl || !lucent::cl_util::driver_program_cache(d).empty();
+  EXPECT_EQ(r.out.find("kernels are cached by PoCL") != std::string::npos, pocl) << r.out;
+  r = lucent::test::run_cli("cache clear", "POCL_KERNEL_CACHE=0 LUCENT_CACHE_DIR='" + dir + "'");
+  EXPECT_EQ(r.out.find("kernels are cached by PoCL"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(dir + "/0123456789abcdef.bin"));
 }
 

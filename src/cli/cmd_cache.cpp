@@ -5,6 +5,7 @@
 
 #include "cl/program_cache.hpp"
 #include "cli/commands.hpp"
+#include "lucent/error.hpp"
 
 namespace lucent::cli {
 
@@ -33,6 +34,19 @@ int run_cache_command() {
   int n = cl_util::clear_program_cache(dir);
   std::printf("removed %d cached program(s) from %s\n", n,
               dir.empty() ? "(disabled)" : dir.c_str());
+  // on PoCL, sessions leave caching to PoCL's own cache (cl/program_cache.hpp): say where it is
+  try {
+    for (const cl_util::Device& d : cl_util::enumerate_devices())
+      if (!cl_util::driver_program_cache(d).empty()) {
+        std::printf(
+            "%s: kernels are cached by PoCL (POCL_CACHE_DIR, default ~/.cache/pocl/kcache), "
+            "not here; remove that directory to rebuild them from source\n",
+            d.info.name.c_str());
+        break;
+      }
+  } catch (const Error&) {
+    // no OpenCL platform: nothing more to say
+  }
   return 0;
 }
 
