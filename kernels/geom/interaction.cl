@@ -38,23 +38,37 @@ static inline lc_uint lc_prim_shape(lc_uint ref) {
 
 #define LC_SHAPE_INTERACTION(ID, Name, value, name, feature, file) \
   if (LC_ENABLED(feature) && shape == LC_SHAPE_##ID) file##_interaction(s, ray, hit, &it);
-static inline lc_interaction interaction_from_hit(const lc_scene* s, lc_ray ray,
-                                                  const lc_hit* hit) {
+/* The surface at the hit, its normals not yet oriented (front unset). */
+static inline lc_interaction interaction_surface(const lc_scene* s, lc_ray ray, const lc_hit* hit) {
   lc_interaction it;
   it.p = it.perr = it.ng = (lc_real3)(LC_REAL(0.0));
   it.ns = (float3)(0.0f);
   it.uv = (float2)(0.0f);
   it.material = 0;
   it.light = LC_INVALID;
+  it.front = 1;
   lc_uint shape = lc_prim_shape(hit->prim);
   LC_SHAPE_TYPES(LC_SHAPE_INTERACTION)
-  it.front = dot(ray.d, it.ng) < LC_REAL(0.0);
-  if (!it.front) {
-    it.ng = -it.ng;
-    it.ns = -it.ns;
+  return it;
+}
+
+/* Orients a surface's normals towards a ray of direction d arriving at it: front is set, ng
+ * faces the ray, ns is on its side (the geometric normal where the interpolated one faces away).
+ * `it` must hold interaction_surface's normals, not already oriented ones. */
+static inline void interaction_orient(lc_interaction* it, lc_real3 d) {
+  it->front = dot(d, it->ng) < LC_REAL(0.0);
+  if (!it->front) {
+    it->ng = -it->ng;
+    it->ns = -it->ns;
   }
   /* an interpolated normal facing away from the viewer: fall back to the geometric one */
-  if (dot(lc_float3_from_real3(ray.d), it.ns) >= 0.0f) it.ns = lc_float3_from_real3(it.ng);
+  if (dot(lc_float3_from_real3(d), it->ns) >= 0.0f) it->ns = lc_float3_from_real3(it->ng);
+}
+
+static inline lc_interaction interaction_from_hit(const lc_scene* s, lc_ray ray,
+                                                  const lc_hit* hit) {
+  lc_interaction it = interaction_surface(s, ray, hit);
+  interaction_orient(&it, ray.d);
   return it;
 }
 

@@ -47,15 +47,18 @@ static inline void caustics_splat(const lc_scene* s, float fx, float fy, float3 
     }
 }
 
-/* Connects the light path's vertex x at `hit` (reached by ray with weight beta) to the camera:
- * to the pinhole, or to the point (lu, lv) of a thin lens. The BSDF there is seen as a camera ray
- * hitting the point would see it (its normals facing the camera, the geometric one where the
- * interpolated one faces away), so that the contribution is exactly the one the path integrator
- * leaves out. Returns 0 when the contribution is not finite (it is then counted, not
- * splatted). */
-static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_hit* hit, lc_real3 x,
-                                   float lu, float lv, float3 beta, __global float4* light_sum,
-                                   __global float4* light_sumsq, lc_uint* rays) {
+/* Connects the light path's vertex at surface `surf` (interaction_surface's, reached by ray with
+ * weight beta; its BSDF b) to the camera: to the pinhole, or to the point (lu, lv) of a thin
+ * lens. The BSDF there is seen as a camera ray hitting the point would see it (its normals facing
+ * the camera, the geometric one where the interpolated one faces away; b's side), so that the
+ * contribution is exactly the one the path integrator leaves out. The surface and the BSDF are the
+ * light path's, re-oriented: not computed again (one copy less of each in the kernel). Returns 0
+ * when the contribution is not finite (it is then counted, not splatted). */
+static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_interaction* surf,
+                                   const lc_bsdf* b_light, float lu, float lv, float3 beta,
+                                   __global float4* light_sum, __global float4* light_sumsq,
+                                   lc_uint* rays) {
+  const lc_real3 x = surf->p;
   __global const lc_params* P = s->params;
   __global const lc_camera* cam = &P->camera;
   float fx, fy, cos_c;
@@ -68,14 +71,10 @@ static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_hit* 
   if (!(dist > LC_REAL(0.0))) return 1;
   lc_real3 wc = toc / dist;
   /* the interaction of the camera ray through this point */
-  lc_ray cray;
-  cray.o = cpos;
-  cray.d = -wc;
-  lc_hit ch = *hit;
-  ch.t = dist;
-  lc_interaction it = interaction_from_hit(s, cray, &ch);
-  __global const lc_material* m = &s->materials[it.material];
-  lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
+  lc_interaction it = *surf;
+  interaction_orient(&it, -wc);
+  lc_bsdf b = *b_light;
+  b.front = it.front;
   lc_frame fr = frame_from(it.ns);
   float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(wc));
   if (wo_l.z <= 0.0f) return 1;
@@ -121,7 +120,9 @@ static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
     lc_hit hit;
     ++*rays;
     if (!scene_intersect(s, ray, INFINITY, &hit)) break;
-    lc_interaction it = interaction_from_hit(s, ray, &hit);
+    lc_interaction surf = interaction_surface(s, ray, &hit);
+    lc_interaction it = surf;
+    interaction_orient(&it, ray.d);
     __global const lc_material* m = &s->materials[it.material];
     lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
     lc_uint dim = LC_DIM_LIGHT_PATH + 8u * i;
@@ -129,7 +130,7 @@ static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
     float4 ua = uv.lo, ub = uv.hi;
     if (state != 0 && !(bsdf_lobes(&b) & LC_BSDF_DELTA))
       nonfinite +=
-          !caustics_connect(s, ray, &hit, it.p, ua.x, ua.y, beta, light_sum, light_sumsq, rays);
+          !caustics_connect(s, ray, &surf, &b, ua.x, ua.y, beta, light_sum, light_sumsq, rays);
     /* continue while the lobes read S+ N* */
     lc_frame fr = frame_from(it.ns);
     float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
