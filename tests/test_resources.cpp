@@ -329,6 +329,37 @@ TEST(Resources, AddressSpaceLimitBoundsTheHost) {
   EXPECT_FALSE(lucent::test::read_file(dir + "/o.png").size() > 0);
 }
 
+// The work-group size is 64 where the device and the kernel allow it, else the largest power of
+// two they allow.
+TEST(Resources, WorkGroupSizeFitsTheDeviceAndTheKernel) {
+  using lucent::render_detail::work_group_size;
+  EXPECT_EQ(work_group_size(64, 4096, 4096, 4096), 64u);
+  EXPECT_EQ(work_group_size(64, 0, 0, 0), 64u) << "0: no limit known";
+  EXPECT_EQ(work_group_size(64, 32, 4096, 4096), 32u);
+  EXPECT_EQ(work_group_size(64, 1024, 48, 1024), 32u);
+  EXPECT_EQ(work_group_size(64, 1024, 1024, 40), 32u);
+  EXPECT_EQ(work_group_size(64, 1, 1, 1), 1u);
+}
+
+// A device whose work-groups are smaller than lucent's 64 (PoCL capped by
+// POCL_MAX_WORK_GROUP_SIZE) renders, with the same image bit for bit: a sample's numbers do not
+// depend on the work-group size. It failed with "clEnqueueNDRangeKernel:
+// CL_INVALID_WORK_GROUP_SIZE" before.
+TEST(Resources, SmallWorkGroupDeviceRendersTheSameImage) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/s.json", grid_scene(2, 4));
+  const std::string args = "render " + q(dir + "/s.json") + " --width 24 --height 20 --spp 2 -o ";
+  auto a = lucent::test::run_cli(args + q(dir + "/a.pfm") + " --quiet");
+  auto b =
+      lucent::test::run_cli(args + q(dir + "/b.pfm") + " --quiet", "POCL_MAX_WORK_GROUP_SIZE=8");
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_EQ(b.err, "");
+  const std::string pa = lucent::test::read_file(dir + "/a.pfm");
+  EXPECT_GT(pa.size(), 24u * 20u * 12u);
+  EXPECT_TRUE(pa == lucent::test::read_file(dir + "/b.pfm"));
+}
+
 // Each texture is bounded (8192 x 8192), and so are all of them together: as they load, the
 // scene's textures as linear RGBA float must stay within the host limit. 40 names of one 1024 x
 // 1024 run-length TGA (128 KiB, 16 MiB decoded) under `ulimit -v` 256 MiB: the 13th is refused.

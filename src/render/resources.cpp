@@ -1,6 +1,7 @@
 #include "render/resources.hpp"
 
 #include <algorithm>
+#include <initializer_list>
 
 #include "bvh/bvh.hpp"
 #include "core/host_memory.hpp"
@@ -253,6 +254,16 @@ std::string resource_error(const cl::Error& e, ClStage stage, const std::string&
   return (scene_path.empty() ? std::string("scene") : scene_path) + ": device '" + device +
          "' ran out of " + (code == CL_OUT_OF_HOST_MEMORY ? "host memory" : "memory or resources") +
          " " + doing + " (" + call + ": " + cl_util::error_name(code) + "): reduce " + reduce;
+}
+
+std::size_t work_group_size(std::size_t preferred, std::size_t device_max, std::size_t item_max,
+                            std::size_t kernel_max) {
+  std::size_t limit = preferred;
+  for (std::size_t m : {device_max, item_max, kernel_max})
+    if (m > 0) limit = std::min(limit, m);
+  std::size_t g = 1;
+  while (g * 2 <= limit) g *= 2;
+  return g;
 }
 
 }  // namespace lucent::render_detail

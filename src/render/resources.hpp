@@ -2,6 +2,7 @@
 // Bounded resources: what a scene asks of the host and of each device, checked before anything
 // large is allocated, and OpenCL's out-of-resources errors turned into a message saying what to
 // reduce. Every refusal is one line naming the scene, the culprit and the limit.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -41,6 +42,13 @@ class ScopedLimitOverride {
   ScopedLimitOverride(const ScopedLimitOverride&) = delete;
   ScopedLimitOverride& operator=(const ScopedLimitOverride&) = delete;
 };
+
+/// The work-group size of a launch: `preferred` (a power of two) when the device
+/// (CL_DEVICE_MAX_WORK_GROUP_SIZE, CL_DEVICE_MAX_WORK_ITEM_SIZES[0]) and the built kernel
+/// (CL_KERNEL_WORK_GROUP_SIZE) allow it, else the largest power of two they allow (at least 1;
+/// a limit of 0 counts as none).
+std::size_t work_group_size(std::size_t preferred, std::size_t device_max, std::size_t item_max,
+                            std::size_t kernel_max);
 
 /// One part of an estimate: what it is, its size, and what to reduce when it is too large.
 struct MemoryPart {

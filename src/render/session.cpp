@@ -32,7 +32,10 @@ namespace {
 
 using clock_type = std::chrono::steady_clock;
 
-constexpr size_t kWorkGroupSize = 64;  // fixed: each new size costs PoCL a work-group compile
+// The work-group size: 64 wherever the device and the built kernel allow it (fixed: each new size
+// costs PoCL a work-group compile); else the largest power of two they allow (devices whose
+// CL_DEVICE_MAX_WORK_GROUP_SIZE, or a kernel whose CL_KERNEL_WORK_GROUP_SIZE, is below 64).
+constexpr size_t kWorkGroupSize = 64;
 
 double seconds_since(clock_type::time_point t) {
   return std::chrono::duration<double>(clock_type::now() - t).count();
@@ -67,6 +70,7 @@ bool same_render_data(const render_detail::PackedScene& a, const render_detail::
 struct Program {
   cl::Program program;
   cl::Kernel kernel;
+  size_t work_group = kWorkGroupSize;  ///< render_detail::work_group_size for this kernel
   bool cache_hit = false;
   double build_seconds = 0;
 };
@@ -95,8 +99,9 @@ struct Worker {
     share.device = call.device = ctx.device.info.name;
   }
 
-  size_t global_size() const {
-    return (npix + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
+  size_t global_size(size_t items) const {
+    const size_t g = program->work_group;
+    return (items + g - 1) / g * g;
   }
 
   /// Makes the light buffers hold at least `elems` elements (an adaptive render's two films).
@@ -152,9 +157,8 @@ struct Worker {
       q.enqueueFillBuffer(b_light, z, 0, nl * sizeof(cl_float4));
       q.enqueueFillBuffer(b_lightsq, z, 0, nl * sizeof(cl_float4));
     }
-    const size_t global = (items + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
-    q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global),
-                           cl::NDRange(kWorkGroupSize));
+    q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global_size(items)),
+                           cl::NDRange(program->work_group));
     h_sum.resize(items);
     h_sumsq.resize(items);
     q.enqueueReadBuffer(b_sum, CL_FALSE, 0, items * sizeof(cl_float4), h_sum.data());
@@ -255,6 +259,10 @@ struct Renderer::Impl {
       throw Error(options.kernel_dir + what.substr(7), e.details());
     }
     p.kernel = cl::Kernel(p.program, "lucent_render");
+    p.work_group = render_detail::work_group_size(
+        kWorkGroupSize, w.ctx.device.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>(),
+        w.ctx.device.device.getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>().at(0),
+        p.kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(w.ctx.device.device));
     p.cache_hit = info.cache_hit;
     if (!info.note.empty()) scene_detail::warn(info.note);
     if (info.cache_hit)
@@ -273,8 +281,9 @@ struct Renderer::Impl {
     lc_params P0 = packed.params;
     P0.samples_per_pass = 0;
     w.ctx.queue.enqueueWriteBuffer(w.dev->params, CL_FALSE, 0, sizeof(P0), &P0);
-    w.ctx.queue.enqueueNDRangeKernel(w.program->kernel, cl::NullRange, cl::NDRange(w.global_size()),
-                                     cl::NDRange(kWorkGroupSize));
+    w.ctx.queue.enqueueNDRangeKernel(w.program->kernel, cl::NullRange,
+                                     cl::NDRange(w.global_size(w.npix)),
+                                     cl::NDRange(w.program->work_group));
     w.ctx.queue.finish();
     double s = seconds_since(t0);
     w.program->build_seconds += s;
