@@ -2,11 +2,13 @@
 // nothing on stdout and a non-zero exit status (never a crash, a hang or an uncaught exception).
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "cl/context.hpp"
 #include "support.hpp"
 
 namespace {
@@ -192,6 +194,64 @@ TEST(CliErrors, NoOpenClPlatform) {
 
   // and the same command without the override finds a device: the override is what hid it
   EXPECT_EQ(run_cli("devices").status, 0);
+}
+
+// PoCL cannot work without its cache directory: given a file, it fails every build with an empty
+// log; given a path that cannot be made, it lists no device. Both errors name the directory.
+TEST(CliErrors, UnusablePoclCacheDirIsNamed) {
+  {
+    lucent::test::ScopedEnv unset("POCL_CACHE_DIR", nullptr);
+    EXPECT_EQ(lucent::cl_util::pocl_cache_dir_problem(), "");
+  }
+  const std::string dir = lucent::test::temp_dir();
+  const std::string file = dir + "/a-file";
+  lucent::test::write_file(file, "x");
+  struct Case {
+    std::string value, problem;
+  } cases[] = {
+      {dir, ""},
+      {dir + "/new/sub", ""},
+      {file, "POCL_CACHE_DIR=" + file + " is not a directory"},
+      {file + "/sub",
+       "POCL_CACHE_DIR=" + file + "/sub cannot be created (" + file + " is not a directory)"},
+  };
+  for (const Case& c : cases) {
+    lucent::test::ScopedEnv env("POCL_CACHE_DIR", c.value.c_str());
+    EXPECT_EQ(lucent::cl_util::pocl_cache_dir_problem(), c.problem) << c.value;
+  }
+  if (::geteuid() != 0) {  // root writes anywhere
+    const std::string ro = dir + "/ro";
+    fs::create_directories(ro);
+    ::chmod(ro.c_str(), 0555);
+    lucent::test::ScopedEnv env("POCL_CACHE_DIR", ro.c_str());
+    EXPECT_EQ(lucent::cl_util::pocl_cache_dir_problem(),
+              "POCL_CACHE_DIR=" + ro + " is not writable (Permission denied)");
+    ::chmod(ro.c_str(), 0755);
+  }
+
+  // the CLI, where the device is PoCL's
+  lucent::cl_util::Context ctx(lucent::test::device());
+  if (ctx.device.info.platform.find("Portable Computing Language") == std::string::npos)
+    GTEST_SKIP() << "the device is not PoCL's: " << ctx.device.info.platform;
+  const std::string out = dir + "/o.png";
+  // the build log PoCL gave comes first ("kernel build log:" and its lines), then the error
+  CommandResult r =
+      run_cli("render " + q(small_scene()) + " -o " + q(out), "POCL_CACHE_DIR=" + q(file));
+  EXPECT_EQ(r.status, 1);
+  std::string err = r.err;
+  while (!err.empty() && err.back() == '\n') err.pop_back();
+  EXPECT_EQ(err.substr(err.rfind('\n') + 1),
+            "lucent: error: kernel build failed: clBuildProgram: CL_BUILD_PROGRAM_FAILURE (build "
+            "log above); POCL_CACHE_DIR=" +
+                file + " is not a directory, which PoCL needs for its kernels")
+      << r.err;
+  std::string msg;
+  EXPECT_FALSE(fs::exists(out));
+  msg = expect_one_error_line(run_cli("devices", "POCL_CACHE_DIR=" + q(file + "/sub")));
+  EXPECT_NE(msg.find("POCL_CACHE_DIR=" + file + "/sub cannot be created (" + file +
+                     " is not a directory), which PoCL needs for its kernels"),
+            std::string::npos)
+      << msg;
 }
 
 // A selector that matches nothing lists the devices there are, in the one error line.

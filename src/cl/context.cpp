@@ -1,10 +1,14 @@
 #include "cl/context.hpp"
 
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <sstream>
 
 #include "cl/kernel_source.hpp"
@@ -108,7 +112,38 @@ std::string first_error_place(const std::string& log) {
   return "";
 }
 
+std::string pocl_cache_dir_problem() {
+  const char* v = std::getenv("POCL_CACHE_DIR");
+  if (!v || !*v) return "";
+  namespace fs = std::filesystem;
+  const std::string name = std::string("POCL_CACHE_DIR=") + v;
+  std::error_code ec;
+  fs::path p(v);
+  // the directory itself, else the nearest ancestor that exists (PoCL creates the rest)
+  while (!fs::exists(fs::symlink_status(p, ec)) && p.has_parent_path() && p != p.parent_path())
+    p = p.parent_path();
+  if (!fs::exists(p, ec)) return name + " cannot be created";
+  if (!fs::is_directory(p, ec))
+    return name + (p == fs::path(v) ? " is not a directory"
+                                    : " cannot be created (" + p.string() + " is not a directory)");
+  if (::access(p.c_str(), W_OK | X_OK) != 0)
+    return name + (p == fs::path(v) ? " is not writable" : " cannot be created") + " (" +
+           std::strerror(errno) + ")";
+  // where permissions do not tell (root, /proc): make it as PoCL would (called on errors only)
+  if (p != fs::path(v) && !fs::create_directories(v, ec) && ec)
+    return name + " cannot be created (" + ec.message() + ")";
+  return "";
+}
+
 namespace {
+
+// PoCL keeps its kernels and temporary files in POCL_CACHE_DIR: when it cannot use that
+// directory it lists no device, or fails every build with an empty log. Errors that PoCL may
+// have caused name the directory's problem.
+std::string pocl_cache_hint() {
+  std::string problem = pocl_cache_dir_problem();
+  return problem.empty() ? "" : "; " + problem + ", which PoCL needs for its kernels";
+}
 
 // No platform: no driver is installed, or one failed to load. NVIDIA's fails under an
 // address-space limit of a few GiB (the CUDA driver reserves more address space than that), so
@@ -124,7 +159,7 @@ std::string no_platform() {
     msg += ", or raise the address-space limit (ulimit -v, now " + gib.str() +
            " GiB), which can keep an installed driver from loading (NVIDIA's does)";
   }
-  return msg;
+  return msg + pocl_cache_hint();
 }
 
 }  // namespace
@@ -176,7 +211,7 @@ std::vector<Device> enumerate_devices() {
   } catch (const cl::Error& e) {
     throw Error(describe(e));
   }
-  if (out.empty()) throw Error("no OpenCL device found on any platform");
+  if (out.empty()) throw Error("no OpenCL device found on any platform" + pocl_cache_hint());
   return out;
 }
 
@@ -238,6 +273,9 @@ cl::Program build_program(const Context& ctx, const std::string& source,
     std::string msg = (place.empty() ? std::string() : place + ": ") +
                       "kernel build failed: " + describe(e) +
                       (log.empty() ? "" : " (build log above)");
+    if (place.empty() &&
+        ctx.device.info.platform.find("Portable Computing Language") != std::string::npos)
+      msg += pocl_cache_hint();  // no error in the source: perhaps PoCL's directory
     throw Error(msg, log.empty() ? std::string() : "kernel build log:\n" + log);
   }
   return program;

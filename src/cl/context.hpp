@@ -42,6 +42,12 @@ std::string map_source_places(const std::string& log, const std::string& source)
 /// (the session names the kernel directory in use instead of kernels/ when there is one).
 std::string first_error_place(const std::string& log);
 
+/// What keeps PoCL from using its kernel cache directory, POCL_CACHE_DIR when set: "" when
+/// nothing does (or the variable is unset), else e.g. "POCL_CACHE_DIR=/dev/null is not a
+/// directory". PoCL then lists no device or fails every build; those errors name it. Creates the
+/// directory, as PoCL would, when only trying tells whether it can be made.
+std::string pocl_cache_dir_problem();
+
 /// Builds `source` (already assembled, with #line markers) for the context's device. On a build
 /// failure throws lucent::Error holding the build log, whose lines name kernels/<file>:<line>,
 /// followed by "clBuildProgram: CL_BUILD_PROGRAM_FAILURE".
