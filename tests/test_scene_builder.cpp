@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "lucent/lucent.hpp"
+#include "lucent/reference.hpp"
 #include "support.hpp"
 
 namespace {
@@ -408,6 +409,83 @@ TEST(SceneBuilder, CodeOnlyErrors) {
               SceneBuilder().add_sphere({{0, 0, 0}, 1, "m"});
             }),
             "/shapes/0/material: unknown material 'm'");
+}
+
+// A Scene's fields are public (and Python's attributes write them): the renderer and the
+// reference check the whole scene before packing it, with the builder's messages and places. A
+// NaN camera position crashed the kernel's traversal before; an index out of range read past
+// the scene's arrays when packing.
+TEST(SceneBuilder, ScenesEditedDirectlyAreCheckedBeforeRendering) {
+  SceneBuilder b("scene.json");
+  add_m(b);
+  b.add_sphere({{0, 0, -3}, 1, "m"});
+  lucent::MeshShape two = triangle();
+  two.positions.push_back({1, 1, 0});
+  two.indices = {0, 1, 2, 2, 1, 3};
+  b.add_mesh(two);
+  b.add_texture(lucent::texture_from_rgba(1, 1, {1, 1, 1, 1}));
+  lucent::Film film;
+  film.width = 8;
+  film.height = 6;
+  b.set_film(film);
+  const lucent::Scene good = b.build();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  struct Edit {
+    std::function<void(lucent::Scene&)> edit;
+    std::string message;
+  } edits[] = {
+      {[&](lucent::Scene& s) { s.camera.position.x = nan; },
+       "/camera/position/0: must be a finite number, got nan"},
+      {[](lucent::Scene& s) { s.film.width = -3; }, "/film/width: must be >= 1, got -3"},
+      {[](lucent::Scene& s) { s.film.filter.radius = 0; },
+       "/film/filter/radius: must be > 0, got 0"},
+      {[](lucent::Scene& s) { s.integrator.max_depth = 0; },
+       "/integrator/max_depth: must be in [1, 100000], got 0"},
+      {[](lucent::Scene& s) { s.spheres[0].material = 1; },
+       "/shapes/0/material: must index one of the scene's 1 materials, got 1"},
+      {[](lucent::Scene& s) { s.triangles[1].v[2] = 4; },
+       "/shapes/1 (triangle 1)/v/2: must index one of the scene's 4 positions, got 4"},
+      {[](lucent::Scene& s) {
+         s.triangles[0].uv[0] = s.triangles[0].uv[1] = s.triangles[0].uv[2] = 0;
+       },
+       "/shapes/1 (triangle 0)/uv/0: must index one of the scene's 0 uvs, got 0"},
+      {[](lucent::Scene& s) { s.textures[0].rgba.pop_back(); },
+       "/textures/0/rgba: must hold 4 x 1 x 1 = 4 floats, got 3"},
+      {[](lucent::Scene& s) {
+         s.materials[0].albedo = {0.5, -1, 0.5};
+       },
+       "/materials/m/albedo/1: must be >= 0, got -1"},
+      {[](lucent::Scene& s) {
+         s.materials[0].name = "";
+         s.materials[0].ior = 0;
+         s.materials[0].type = lucent::MaterialType::Dielectric;
+       },
+       "/materials/0/ior: must be > 0, got 0"},
+      {[](lucent::Scene& s) { s.materials[0].albedo_texture = 2; },
+       "/materials/m/albedo/texture: must be the index of a texture of the scene (1), or -1, got "
+       "2"},
+      {[](lucent::Scene& s) { s.lights.push_back(lucent::environment_map(5)); },
+       "/lights/0/texture: must be the index of a texture of the scene (1), got 5"},
+  };
+  for (const Edit& e : edits) {
+    lucent::Scene s = good;
+    e.edit(s);
+    lucent::Renderer r(lucent::test::session_options());
+    EXPECT_EQ(error_of([&] { r.set_scene(s); }), "scene.json: " + e.message);
+    EXPECT_EQ(error_of([&] { lucent::render_reference(s, lucent::ReferenceOptions{}); }),
+              "scene.json: " + e.message);
+  }
+  // primitives outside the shape list are named by their list
+  lucent::Scene s = good;
+  s.shapes.clear();
+  s.triangles[1].material = -1;
+  EXPECT_EQ(error_of([&] { lucent::render_reference(s, lucent::ReferenceOptions{}); }),
+            "scene.json: /triangles/1/material: must index one of the scene's 1 materials, got -1");
+  // and the unedited scene renders
+  lucent::Renderer r(lucent::test::session_options());
+  r.set_scene(good);
+  r.render(1);
+  EXPECT_EQ(r.spp(), 1u);
 }
 
 TEST(SceneBuilder, TexturesFromMemory) {

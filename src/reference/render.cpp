@@ -16,10 +16,12 @@
 #include "reference/camera/camera.hpp"
 #include "reference/integrator/integrator.hpp"
 #include "reference/integrator/light_tracer.hpp"
+#include "scene/validate.hpp"
 
 namespace lucent {
 
 RenderResult render_reference(const Scene& scene, const ReferenceOptions& options) {
+  scene_detail::validate_scene(scene);  // fields set directly may not have been checked
   const int W = scene.film.width, H = scene.film.height;
   if (W <= 0 || H <= 0) throw Error(scene.path + ": film size must be positive");
   const int spp = options.spp > 0 ? options.spp : scene.integrator.spp;

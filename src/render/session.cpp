@@ -25,6 +25,7 @@
 #include "render/resources.hpp"
 #include "render/sample_stats.hpp"
 #include "scene/loaders.hpp"
+#include "scene/validate.hpp"
 
 namespace lucent {
 
@@ -292,6 +293,7 @@ struct Renderer::Impl {
 
   void set_scene(const Scene& s) {
     scene_detail::ScopedWarningSink sink(options.on_warning);
+    scene_detail::validate_scene(s);  // fields set directly may not have been checked
     std::vector<render_detail::DeviceLimits> limits;
     for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
     render_detail::check_host_memory(s, limits, limits.front().host_mem, limits.front().host_what);

@@ -253,4 +253,93 @@ void validate_mesh(const MeshShape& m, const Reporter& at) {
   check_affine(at.at("transform"), m.transform);
 }
 
+namespace {
+
+// The place of primitive `i` of a type: its shape entry's ("/shapes/3", "/shapes/1 (triangle
+// 12)" for the 13th triangle of a mesh), else "/<list>/<i>".
+std::string primitive_place(const Scene& s, ShapeType type, std::size_t i, const char* list,
+                            const char* one) {
+  for (std::size_t k = 0; k < s.shapes.size(); ++k) {
+    const ShapeEntry& e = s.shapes[k];
+    if (e.type != type || i < e.first || i >= e.first + e.count) continue;
+    std::string place = "/shapes/" + std::to_string(k);
+    if (e.count > 1 || type == ShapeType::Triangle)
+      place += std::string(" (") + one + " " + std::to_string(i - e.first) + ")";
+    return place;
+  }
+  return std::string("/") + list + "/" + std::to_string(i);
+}
+
+void check_index(const Reporter& at, int index, std::size_t size, const char* what) {
+  if (index < 0 || static_cast<std::size_t>(index) >= size)
+    at.fail("must index one of the scene's " + std::to_string(size) + " " + what + ", got " +
+            std::to_string(index));
+}
+
+}  // namespace
+
+void validate_scene(const Scene& s) {
+  const std::string& file = s.path;
+  validate_camera(s.camera, Reporter(file, "/camera"));
+  {
+    // any film size from 1 up: a film larger than a scene file's is refused by the memory
+    // checks, with their own message (render/resources.hpp)
+    const Reporter at(file, "/film");
+    if (s.film.width < 1) at.at("width").fail("must be >= 1, got " + std::to_string(s.film.width));
+    if (s.film.height < 1)
+      at.at("height").fail("must be >= 1, got " + std::to_string(s.film.height));
+    Film rest = s.film;
+    rest.width = rest.height = 1;
+    validate_film(rest, at);
+  }
+  validate_integrator(s.integrator, Reporter(file, "/integrator"));
+  for (std::size_t i = 0; i < s.textures.size(); ++i) {
+    const Texture& t = s.textures[i];
+    const Reporter at(file, "/textures/" + std::to_string(i));
+    if (t.width < 1) at.at("width").fail("must be >= 1, got " + std::to_string(t.width));
+    if (t.height < 1) at.at("height").fail("must be >= 1, got " + std::to_string(t.height));
+    const std::size_t want = std::size_t(4) * std::size_t(t.width) * std::size_t(t.height);
+    if (t.rgba.size() != want)
+      at.at("rgba").fail("must hold 4 x " + std::to_string(t.width) + " x " +
+                         std::to_string(t.height) + " = " + std::to_string(want) + " floats, got " +
+                         std::to_string(t.rgba.size()));
+  }
+  for (std::size_t i = 0; i < s.materials.size(); ++i) {
+    // names only serve messages and the scene file's references: a nameless one is named by
+    // its index
+    Material m = s.materials[i];
+    if (m.name.empty()) m.name = std::to_string(i);
+    validate_material(m, s.textures.size(), Reporter(file, "/materials/" + m.name));
+  }
+  for (std::size_t i = 0; i < s.lights.size(); ++i)
+    validate_light(s.lights[i], s.textures.size(), Reporter(file, "/lights/" + std::to_string(i)));
+  const std::size_t nm = s.materials.size();
+  for (std::size_t i = 0; i < s.spheres.size(); ++i) {
+    // (a NaN centre or radius is allowed: such a sphere is never hit, tests/test_stability_scene)
+    const Sphere& sp = s.spheres[i];
+    if (sp.material >= 0 && static_cast<std::size_t>(sp.material) < nm) continue;
+    const Reporter at(file, primitive_place(s, ShapeType::Sphere, i, "spheres", "sphere"));
+    check_index(at.at("material"), sp.material, nm, "materials");
+  }
+  const std::size_t np = s.positions.size(), nn = s.normals.size(), nuv = s.uvs.size();
+  for (std::size_t i = 0; i < s.triangles.size(); ++i) {
+    const Triangle& t = s.triangles[i];
+    // (the place is made only for a bad triangle: meshes may be large)
+    bool ok = t.material >= 0 && static_cast<std::size_t>(t.material) < nm;
+    const bool has_n = t.n[0] >= 0 && t.n[1] >= 0 && t.n[2] >= 0;
+    const bool has_uv = t.uv[0] >= 0 && t.uv[1] >= 0 && t.uv[2] >= 0;
+    for (int k = 0; k < 3; ++k) {
+      ok = ok && t.v[k] >= 0 && static_cast<std::size_t>(t.v[k]) < np;
+      ok = ok && (!has_n || static_cast<std::size_t>(t.n[k]) < nn);
+      ok = ok && (!has_uv || static_cast<std::size_t>(t.uv[k]) < nuv);
+    }
+    if (ok) continue;
+    const Reporter at(file, primitive_place(s, ShapeType::Triangle, i, "triangles", "triangle"));
+    check_index(at.at("material"), t.material, nm, "materials");
+    for (int k = 0; k < 3; ++k) check_index(at.at("v").at(k), t.v[k], np, "positions");
+    for (int k = 0; k < 3 && has_n; ++k) check_index(at.at("n").at(k), t.n[k], nn, "normals");
+    for (int k = 0; k < 3 && has_uv; ++k) check_index(at.at("uv").at(k), t.uv[k], nuv, "uvs");
+  }
+}
+
 }  // namespace lucent::scene_detail

@@ -95,4 +95,17 @@ void validate_light(const Light& light, std::size_t textures, const Reporter& at
 void validate_sphere(const SphereShape& sphere, const Reporter& at);
 void validate_mesh(const MeshShape& mesh, const Reporter& at);
 
+/// A whole Scene, whose fields may have been set directly (the C++ struct, Python's attributes)
+/// rather than through SceneBuilder or a JSON file, before it is packed or rendered: the camera,
+/// integrator, materials (a nameless one allowed), lights and textures' sizes as the builder
+/// checks them, the film from size 1 up (larger than a file's allows: the memory checks bound
+/// it), and every index (materials, textures, positions, normals, uvs), so that nothing reads out
+/// of range and no NaN camera reaches the kernel. Places name the shape list's entry where
+/// `shapes` covers the primitive ("/shapes/3/material", "/shapes/1 (triangle 12)/v/0"), else
+/// "/spheres/<i>", "/triangles/<i>". What is rendered safely stays allowed: texel values (a
+/// non-finite texel makes the samples that read it non-finite, which are counted), spheres with
+/// a NaN centre or radius (never hit), non-finite or degenerate triangles (skipped with a
+/// warning when the scene is packed).
+void validate_scene(const Scene& scene);
+
 }  // namespace lucent::scene_detail
