@@ -8,7 +8,9 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -21,17 +23,15 @@ namespace {
 
 using lucent::cl_util::ProgramBuildInfo;
 
-TEST(ProgramCacheLock, SimultaneousMissesBuildOnce) {
-  const std::string dir = lucent::test::temp_dir() + "/cache";
-  const std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
-  // an option of its own: no other test's entry can be there already
-  const std::string options = "-cl-std=CL1.2 -D LC_PROGRAM_CACHE_LOCK_TEST";
+constexpr int kBuilders = 3;
 
-  constexpr int kBuilders = 3;
+// Runs build(ctx, i) for i < kBuilders at once, each in its own thread with its own context (all
+// start together); returns each one's exception message ("" when none).
+std::vector<std::string> run_builders(
+    const std::function<void(lucent::cl_util::Context&, int)>& build) {
   std::vector<std::unique_ptr<lucent::cl_util::Context>> contexts;
   for (int i = 0; i < kBuilders; ++i)
     contexts.push_back(std::make_unique<lucent::cl_util::Context>(""));
-  std::vector<ProgramBuildInfo> info(kBuilders);
   std::vector<std::string> errors(kBuilders);
   std::atomic<int> ready{0};
   std::vector<std::thread> threads;
@@ -40,12 +40,25 @@ TEST(ProgramCacheLock, SimultaneousMissesBuildOnce) {
       ++ready;
       while (ready.load() < kBuilders) std::this_thread::yield();  // all miss at once
       try {
-        lucent::cl_util::build_program_cached(*contexts[i], src, options, dir, &info[i]);
+        build(*contexts[i], i);
       } catch (const std::exception& e) {
         errors[i] = e.what();
       }
     });
   for (auto& t : threads) t.join();
+  return errors;
+}
+
+TEST(ProgramCacheLock, SimultaneousMissesBuildOnce) {
+  const std::string dir = lucent::test::temp_dir() + "/cache";
+  const std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
+  // an option of its own: no other test's entry can be there already
+  const std::string options = "-cl-std=CL1.2 -D LC_PROGRAM_CACHE_LOCK_TEST";
+
+  std::vector<ProgramBuildInfo> info(kBuilders);
+  std::vector<std::string> errors = run_builders([&](lucent::cl_util::Context& ctx, int i) {
+    lucent::cl_util::build_program_cached(ctx, src, options, dir, &info[i]);
+  });
 
   int built = 0;
   for (int i = 0; i < kBuilders; ++i) {
@@ -65,34 +78,19 @@ TEST(ProgramCacheLock, LockOnlyBuildsTakeTurns) {
   const std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
   const std::string options = "-cl-std=CL1.2 -D LC_PROGRAM_CACHE_LOCK_ONLY_TEST";
   using clock = std::chrono::steady_clock;
-  constexpr int kBuilders = 3;
-  std::vector<std::unique_ptr<lucent::cl_util::Context>> contexts;
-  for (int i = 0; i < kBuilders; ++i)
-    contexts.push_back(std::make_unique<lucent::cl_util::Context>(""));
   std::vector<std::pair<clock::time_point, clock::time_point>> held(kBuilders);
-  std::vector<std::string> errors(kBuilders);
-  std::atomic<int> ready{0};
-  std::vector<std::thread> threads;
-  for (int i = 0; i < kBuilders; ++i)
-    threads.emplace_back([&, i] {
-      ++ready;
-      while (ready.load() < kBuilders) std::this_thread::yield();
-      try {
-        lucent::cl_util::DeferredEntry entry;
-        ProgramBuildInfo info;
-        cl::Program p = lucent::cl_util::build_program_cached(*contexts[i], src, options, dir,
-                                                              &info, &entry, false);
-        held[i].first = clock::now();
-        if (!entry.pending() || info.cache_hit || !info.cache_file.empty())
-          errors[i] = "no lock held, or an entry used";
-        std::this_thread::sleep_for(std::chrono::milliseconds(30));
-        held[i].second = clock::now();
-        entry.store(p);
-      } catch (const std::exception& e) {
-        errors[i] = e.what();
-      }
-    });
-  for (auto& t : threads) t.join();
+  std::vector<std::string> errors = run_builders([&](lucent::cl_util::Context& ctx, int i) {
+    lucent::cl_util::DeferredEntry entry;
+    ProgramBuildInfo info;
+    cl::Program p =
+        lucent::cl_util::build_program_cached(ctx, src, options, dir, &info, &entry, false);
+    held[i].first = clock::now();
+    if (!entry.pending() || info.cache_hit || !info.cache_file.empty())
+      throw std::runtime_error("no lock held, or an entry used");
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    held[i].second = clock::now();
+    entry.store(p);
+  });
   for (int i = 0; i < kBuilders; ++i) EXPECT_EQ(errors[i], "") << "builder " << i;
   std::sort(held.begin(), held.end());
   for (int i = 1; i < kBuilders; ++i)
