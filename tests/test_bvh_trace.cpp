@@ -29,8 +29,8 @@
 
 #include "bvh/bvh.hpp"
 #include "cl/context.hpp"
-#include "support/device_tracer.hpp"
 #include "support.hpp"
+#include "support/device_tracer.hpp"
 #include "support/test_meshes.hpp"
 
 namespace {
@@ -165,7 +165,9 @@ Verdict judge(const Scene& s, const TraceRay& r, const TraceHit& k, bool any_hit
 
 class BvhTrace : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { ctx_ = std::make_unique<lucent::cl_util::Context>(lucent::test::device()); }
+  static void SetUpTestSuite() {
+    ctx_ = std::make_unique<lucent::cl_util::Context>(lucent::test::device());
+  }
   static void TearDownTestSuite() { ctx_.reset(); }
 
   std::vector<TraceHit> trace(const Scene& s, const Bvh& b, const std::vector<TraceRay>& rays,
@@ -383,6 +385,34 @@ TEST_F(BvhTrace, EmptySceneAndSinglePrimitive) {
   add_spheres(one, 1, 41, 0.45f, 0.5f, 0.45f, 0.1f);
   compare(one, random_rays(3000, 42), false, "one sphere");
   compare(one, random_rays(3000, 43, true), true, "one sphere any-hit");
+}
+
+// A ray with a NaN or infinite component (only a kernel bug could make one: scenes are checked)
+// hits nothing, closest-hit and any-hit alike, instead of entering every child of every node,
+// the empty slots too, and reading past the node array (a NaN camera crashed the renderer so).
+TEST_F(BvhTrace, NonFiniteRaysHitNothing) {
+  // 4 spheres: one wide node with empty slots (as the default scene's); 40: a deeper tree
+  for (int n : {4, 40}) {
+    Scene s;
+    add_spheres(s, n, 44, 0.45f, 0.5f, 0.45f, 0.1f);
+    Bvh b = lucent::bvh::build(s.tris, s.spheres);
+    std::vector<TraceRay> rays = random_rays(64, 45);
+    const float bad[] = {NAN, INFINITY, -INFINITY};
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      float* v = (i % 2) ? rays[i].o : rays[i].d;
+      v[i / 2 % 3] = bad[i / 6 % 3];
+      if (i % 8 == 0) {  // a NaN camera: every component, and no end
+        for (int c = 0; c < 3; ++c) rays[i].o[c] = rays[i].d[c] = NAN;
+        rays[i].tmax = INFINITY;
+      }
+    }
+    for (bool any : {false, true})
+      for (const TraceHit& h : trace(s, b, rays, any)) EXPECT_EQ(h.prim, LC_INVALID) << n;
+    // and finite rays still hit
+    std::size_t hits = 0;
+    for (const TraceHit& h : trace(s, b, random_rays(64, 45), false)) hits += h.prim != LC_INVALID;
+    EXPECT_GT(hits, 0u) << n;
+  }
 }
 
 // --- closed meshes: no ray passes through -------------------------------------------------------

@@ -239,7 +239,10 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
   hit->t = tmax;
   hit->prim = LC_INVALID;
   hit->b1 = hit->b2 = LC_REAL(0.0);
-  if (s->params->num_nodes == 0) return 0;
+  /* a non-finite origin or direction (a scene's NaN, or one computed from degenerate input)
+   * would enter every child, the empty slots too, and walk off the node array: such a ray hits
+   * nothing (its sample then counts as non-finite where its radiance is) */
+  if (s->params->num_nodes == 0 || !all(isfinite(o)) || !all(isfinite(d))) return 0;
   __global const lc_bvh_node* nodes = s->nodes;
   lc_real3 inv_d = bvh_inv_dir(d);
   /* rows of lc_bvh_node.bounds holding each axis's near plane; the far plane is the next row */
