@@ -5,12 +5,14 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "cl/context.hpp"
 #include "cl/program_cache.hpp"
+#include "lucent/render.hpp"
 #include "lucent/session.hpp"
 #include "support.hpp"
 
@@ -286,6 +288,39 @@ TEST(Session, DriverWithItsOwnCacheGetsNoEntries) {
   EXPECT_EQ(b.stats().kernel_cache_loads, 0u);
   a.render(1);
   EXPECT_EQ(a.spp(), 1u);
+}
+
+// Options out of range are errors, not defaults: a NaN pass duration made every pass 0 samples
+// long and render() never returned; a negative spp or a NaN target fell back to the scene's.
+TEST(Session, OptionsOutOfRangeAreErrors) {
+  Scene s = lucent::test::scene_from(kScene);
+  for (double bad : {std::nan(""), -1.0, 0.0, double(INFINITY)}) {
+    lucent::SessionOptions o = lucent::test::session_options();
+    o.pass_seconds = bad;
+    EXPECT_THROW(Renderer r(o), lucent::Error) << bad;
+  }
+  auto error_of = [&](const std::function<void(lucent::RenderOptions&)>& set) {
+    lucent::RenderOptions o = lucent::test::render_options();
+    set(o);
+    try {
+      lucent::render(s, o);
+    } catch (const lucent::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error_of([](lucent::RenderOptions& o) { o.spp = -5; }),
+            "render: RenderOptions::spp must be >= 0 (0: the scene's), got -5");
+  EXPECT_EQ(error_of([](lucent::RenderOptions& o) { o.min_spp = -1; }),
+            "render: RenderOptions::min_spp must be >= 0 (0: the default), got -1");
+  EXPECT_EQ(error_of([](lucent::RenderOptions& o) { o.target_error = std::nan(""); }),
+            "render: RenderOptions::target_error must be a finite number >= 0 (0: off), got nan");
+  EXPECT_EQ(
+      error_of([](lucent::RenderOptions& o) { o.target_error = -1e-3; }),
+      "render: RenderOptions::target_error must be a finite number >= 0 (0: off), got -0.001");
+  EXPECT_EQ(error_of([](lucent::RenderOptions& o) { o.pass_seconds = std::nan(""); }),
+            "SessionOptions::pass_seconds must be a positive number of seconds, got nan");
+  EXPECT_EQ(error_of([](lucent::RenderOptions& o) { o.spp = 2; }), "");
 }
 
 // Several devices share a render's passes (here two contexts on the same device, "0,0"): the

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -211,6 +212,14 @@ struct Renderer::Impl {
   SessionStats stats;
 
   explicit Impl(SessionOptions o) : options(std::move(o)) {
+    // a NaN pass duration made every pass 0 samples long: render() never ended
+    if (!(options.pass_seconds > 0) || !std::isfinite(options.pass_seconds)) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%g", options.pass_seconds);
+      throw Error(std::string("SessionOptions::pass_seconds must be a positive number of seconds, "
+                              "got ") +
+                  b);
+    }
     for (const DeviceInfo& d : select_devices(options.device, "device")) {
       workers.push_back(std::make_unique<Worker>(std::to_string(d.index)));
       device_infos.push_back(workers.back()->ctx.device.info);
