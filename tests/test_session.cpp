@@ -246,6 +246,12 @@ TEST(Session, WarningsGoToTheSessionsSink) {
   ASSERT_EQ(got.size(), 1u);
   EXPECT_NE(got[0].find("skipped 1 degenerate or non-finite triangle"), std::string::npos)
       << got[0];
+  // a scene without a name (built in code): the message starts with what happened
+  s.path.clear();
+  s.camera.position.x += 1;  // a new scene to pack
+  r.set_scene(s);
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[1].rfind("skipped 1 degenerate or non-finite triangle", 0), 0u) << got[1];
 }
 
 // The kernel cache directory is the session's: "off" compiles, a directory is filled and then

@@ -73,8 +73,8 @@ void pack_lights(const Scene& scene, PackedScene& p, std::vector<double> power) 
         d.p.env_map.cdf = LC_INVALID;  // below, after the selection CDF
         break;
       default:
-        throw Error(scene.path + ": a scene light cannot be of type " +
-                    std::to_string(static_cast<int>(l.type)) +
+        throw Error((scene.path.empty() ? "" : scene.path + ": ") +
+                    "a scene light cannot be of type " + std::to_string(static_cast<int>(l.type)) +
                     " (area lights are emissive shapes)");
     }
     if (l.type == LightType::Environment || l.type == LightType::EnvironmentMap) {
