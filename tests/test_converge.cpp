@@ -429,6 +429,19 @@ TEST(Converge, CommandErrors) {
   EXPECT_EQ(lucent::test::count_lines(mismatch.err), 1) << mismatch.err;
   EXPECT_NE(mismatch.err.find("small.exr: size 16x24 differs"), std::string::npos) << mismatch.err;
 
+  // a display image (8-bit PNG of the scene, the right size) is no reference: its values are
+  // tone-mapped and clipped (it was accepted, and the slopes came out at +13)
+  lucent::test::CommandResult png =
+      lucent::test::run_cli("render '" + dir + "/t.json' -q -o '" + dir + "/ref.png' --spp 4");
+  ASSERT_EQ(png.status, 0) << png.err;
+  lucent::test::CommandResult display = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --spp-ladder 2 --reference '" + dir + "/ref.png'");
+  EXPECT_EQ(display.status, 1);
+  EXPECT_EQ(display.err, "lucent: error: " + dir +
+                             "/ref.png: a PNG image holds display values (tone-mapped, clipped), "
+                             "not radiance: give a .exr, .pfm or .hdr reference (lucent render "
+                             "SCENE -o ref.exr)\n");
+
   lucent::test::CommandResult pdf = lucent::test::run_cli(
       "converge '" + dir + "/t.json' --spp-ladder 2 --plot '" + dir + "/p.pdf'");
   EXPECT_EQ(pdf.status, 1);

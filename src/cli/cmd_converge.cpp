@@ -18,6 +18,7 @@
 
 #include "cli/commands.hpp"
 #include "core/file_io.hpp"
+#include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
@@ -189,6 +190,19 @@ int run_converge_command() {
   RenderResult reference;
   if (!a.reference.empty()) {
     reference = read_render(a.reference);
+    {
+      // an 8-bit (or 16-bit PNG) image holds display values, tone-mapped and clipped: every
+      // relMSE against it would measure the display transform, not the render's error
+      const std::string bytes = io::read_file(a.reference, image_detail::image_read_spec());
+      const image_detail::Probe p =
+          image_detail::probe_image(reinterpret_cast<const unsigned char*>(bytes.data()),
+                                    bytes.size(), a.reference, image_detail::kMaxImagePixels);
+      using image_detail::Format;
+      if (p.format != Format::Exr && p.format != Format::Pfm && p.format != Format::Hdr)
+        throw Error(a.reference + ": a " + image_detail::format_name(p.format) +
+                    " image holds display values (tone-mapped, clipped), not radiance: give a "
+                    ".exr, .pfm or .hdr reference (lucent render SCENE -o ref.exr)");
+    }
     if (reference.mean.width != scene.film.width || reference.mean.height != scene.film.height)
       throw Error(a.reference + ": size " + std::to_string(reference.mean.width) + "x" +
                   std::to_string(reference.mean.height) + " differs from the scene's film (" +
