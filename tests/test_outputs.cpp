@@ -247,6 +247,9 @@ TEST(Outputs, NonFiniteOptionsAreRefused) {
   EXPECT_EQ(
       error_line(run_cli("render " + q(scene) + " -o " + q(out) + " --reference --aov depth")),
       "--aov is not supported with --reference");
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(out) +
+                               " --aov depth --aov albedo --aov depth")),
+            "--aov depth: given twice");
   EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(out) + " --reference --time 2")),
             "--time is not supported with --reference");
   CommandResult r = run_cli("converge " + q(scene) + " --time-ladder 1,nan");

@@ -164,6 +164,9 @@ int render_with(const RenderArgs& a) {
     throw lucent::Error("--aov is not supported with --reference");
   if (a.reference && a.sampling.target_error > 0)
     throw lucent::Error("--target-error is not supported with --reference");
+  for (size_t i = 0; i < a.aovs.size(); ++i)  // (one file each: twice would write it twice)
+    for (size_t j = 0; j < i; ++j)
+      if (a.aovs[i] == a.aovs[j]) throw lucent::Error("--aov " + a.aovs[i] + ": given twice");
   std::optional<lucent::SampleRange> range;  // --samples: a part for `lucent merge`
   if (!a.samples.empty()) {
     range = lucent::parse_sample_range(a.samples);
