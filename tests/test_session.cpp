@@ -329,6 +329,42 @@ TEST(Session, OptionsOutOfRangeAreErrors) {
   EXPECT_EQ(error_of([](lucent::RenderOptions& o) { o.spp = 2; }), "");
 }
 
+// Sessions created at once from several threads, the process's first OpenCL calls among them:
+// the ICD loader and PoCL initialise on the first platform query, and concurrent ones crashed
+// (SIGSEGV) or saw no platform before lucent serialised the enumeration. Each session renders
+// its scene, and the same seed gives the same image in every thread.
+TEST(Session, SessionsCreatedConcurrentlyFromThreads) {
+  Scene s = lucent::test::scene_from(kScene);
+  constexpr int kThreads = 4;
+  std::vector<std::string> errors(kThreads);
+  std::vector<std::vector<float>> images(kThreads);
+  std::atomic<int> ready{0};
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kThreads; ++i)
+    threads.emplace_back([&, i] {
+      ++ready;
+      while (ready.load() < kThreads) std::this_thread::yield();
+      try {
+        Renderer r(lucent::test::session_options());
+        Scene si = s;
+        si.integrator.seed = static_cast<std::uint32_t>(i % 2);
+        r.set_scene(si);
+        r.render(2);
+        images[i] = r.result().mean.rgb;
+      } catch (const std::exception& e) {
+        errors[i] = e.what();
+      }
+    });
+  for (auto& t : threads) t.join();
+  for (int i = 0; i < kThreads; ++i) {
+    EXPECT_EQ(errors[i], "") << "thread " << i;
+    EXPECT_FALSE(images[i].empty()) << "thread " << i;
+  }
+  EXPECT_TRUE(images[0] == images[2]);
+  EXPECT_TRUE(images[1] == images[3]);
+  EXPECT_FALSE(images[0] == images[1]) << "the seed changes the image";
+}
+
 // Several devices share a render's passes (here two contexts on the same device, "0,0"): the
 // image is a one-device render's up to float summation order (the same samples, other passes),
 // every device takes part, and their shares add up to the spp.

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <sstream>
 
 #include "cl/kernel_source.hpp"
@@ -165,6 +166,11 @@ std::string no_platform() {
 }  // namespace
 
 std::vector<Device> enumerate_devices() {
+  // one enumeration at a time in the process: the ICD loader and PoCL initialise on the first
+  // call, and sessions created at once from several threads crashed there (SIGSEGV) or saw no
+  // platform
+  static std::mutex mutex;
+  std::lock_guard<std::mutex> lock(mutex);
   std::vector<cl::Platform> platforms;
   try {
     cl::Platform::get(&platforms);
