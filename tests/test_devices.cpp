@@ -272,6 +272,23 @@ TEST(Devices, EnvironmentVariableIsTheCommandsDefault) {
   }
 }
 
+// Lists of selectors: an empty one, or "all" (which stands alone), is an error naming the list.
+TEST(Devices, SelectorListErrors) {
+  auto error_of = [](const std::string& list) {
+    try {
+      lucent::select_devices(list, "--device");
+    } catch (const lucent::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error_of("0,,0"), "--device '0,,0': an empty selector in the list");
+  EXPECT_EQ(error_of("0,all"),
+            "--device '0,all': 'all' selects every device and stands alone, not in a list");
+  EXPECT_EQ(error_of("all"), "");
+  EXPECT_EQ(lucent::select_devices("0, 0", "--device").size(), 2u);
+}
+
 // The render summary names the device used: --device and LUCENT_DEVICE reach the renderer.
 TEST(Devices, CliRenderUsesTheSelectedDevice) {
   std::vector<RawDevice> raw = raw_devices();

@@ -317,6 +317,9 @@ std::vector<DeviceInfo> select_devices(const std::string& selectors, const std::
     size_t b = item.find_first_not_of(' '), e = item.find_last_not_of(' ');
     if (b == std::string::npos)
       throw Error(origin + " '" + selectors + "': an empty selector in the list");
+    if (item.substr(b, e - b + 1) == "all")
+      throw Error(origin + " '" + selectors +
+                  "': 'all' selects every device and stands alone, not in a list");
     out.push_back(select_device(item.substr(b, e - b + 1), origin));
     item.clear();
   }
