@@ -440,7 +440,29 @@ TEST(Converge, CommandErrors) {
   EXPECT_EQ(display.err, "lucent: error: " + dir +
                              "/ref.png: a PNG image holds display values (tone-mapped, clipped), "
                              "not radiance: give a .exr, .pfm or .hdr reference (lucent render "
-                             "SCENE -o ref.exr)\n");
+                             "SCENE --seed S -o ref.exr, S not the scene's seed)\n");
+
+  // a reference rendered at the scene's own seed replays the rungs' samples: refused; at another
+  // seed it serves (lucent render writes the seed into its EXRs)
+  ASSERT_EQ(
+      lucent::test::run_cli("render '" + dir + "/t.json' -q --spp 8 -o '" + dir + "/same.exr'")
+          .status,
+      0);
+  lucent::test::CommandResult same = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --spp-ladder 2 -q --reference '" + dir + "/same.exr'");
+  EXPECT_EQ(same.status, 1);
+  EXPECT_EQ(same.err,
+            "lucent: error: " + dir +
+                "/same.exr: rendered with seed 3, the ladder's: its samples include "
+                "the rungs' own, which would hide their error; render it with another "
+                "--seed, or let converge render it (--reference-spp, --save-reference)\n");
+  ASSERT_EQ(lucent::test::run_cli("render '" + dir + "/t.json' -q --spp 8 --seed 7 -o '" + dir +
+                                  "/other.exr'")
+                .status,
+            0);
+  lucent::test::CommandResult other = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --spp-ladder 2 -q --reference '" + dir + "/other.exr'");
+  EXPECT_EQ(other.status, 0) << other.err;
 
   lucent::test::CommandResult pdf = lucent::test::run_cli(
       "converge '" + dir + "/t.json' --spp-ladder 2 --plot '" + dir + "/p.pdf'");

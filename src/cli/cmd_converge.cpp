@@ -201,7 +201,23 @@ int run_converge_command() {
       if (p.format != Format::Exr && p.format != Format::Pfm && p.format != Format::Hdr)
         throw Error(a.reference + ": a " + image_detail::format_name(p.format) +
                     " image holds display values (tone-mapped, clipped), not radiance: give a "
-                    ".exr, .pfm or .hdr reference (lucent render SCENE -o ref.exr)");
+                    ".exr, .pfm or .hdr reference (lucent render SCENE --seed S -o ref.exr, S not "
+                    "the scene's seed)");
+      if (p.format == Format::Exr) {
+        // a lucent render at the ladder's seed holds the rungs' own samples (the same numbers
+        // for the same pixel, index and dimension): its error against them is hidden
+        EXRHeader header;
+        image_detail::probe_exr(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(),
+                                a.reference, image_detail::kMaxImagePixels, header);
+        const auto attrs = image_detail::exr_string_attributes(header);
+        FreeEXRHeader(&header);
+        auto seed = attrs.find("lucent.seed");
+        if (seed != attrs.end() && seed->second == std::to_string(scene.integrator.seed))
+          throw Error(a.reference + ": rendered with seed " + seed->second +
+                      ", the ladder's: its samples include the rungs' own, which would hide "
+                      "their error; render it with another --seed, or let converge render it "
+                      "(--reference-spp, --save-reference)");
+      }
     }
     if (reference.mean.width != scene.film.width || reference.mean.height != scene.film.height)
       throw Error(a.reference + ": size " + std::to_string(reference.mean.width) + "x" +

@@ -20,6 +20,7 @@
 
 #include "cli/commands.hpp"
 #include "core/file_io.hpp"
+#include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/limits.hpp"
 #include "lucent/lucent.hpp"
@@ -268,9 +269,16 @@ int render_with(const RenderArgs& a) {
                                   scene.film.tonemap};
   if (range)
     lucent::write_render_part(a.output, lucent::make_part(*renderer, *range, a.scene));
-  else if (lucent::io::lower_extension(a.output) == ".exr")
-    lucent::write_render_exr(a.output, r);  // with var.R/G/B and n layers (docs/compare.md)
-  else
+  else if (lucent::io::lower_extension(a.output) == ".exr") {
+    // with var.R/G/B and n layers (docs/compare.md), and the key of its random numbers, by which
+    // `lucent converge` refuses a reference that would replay its ladder's samples
+    lucent::image_detail::ExrExtras extras;
+    extras.attributes = {
+        {"lucent.seed", std::to_string(scene.integrator.seed)},
+        {"lucent.sampler", lucent::type_name(scene.integrator.sampler)},
+    };
+    lucent::image_detail::write_render_exr(a.output, r, extras);
+  } else
     lucent::write_image(a.output, r.mean, display);
   if (r.nonfinite > 0)
     std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
