@@ -449,11 +449,19 @@ void bind_render(py::module_& m) {
           "Adds samples for about `seconds` (at least one pass).")
       .def(
           "reset",
-          [](PyRenderer& r, long long first_sample) {
-            if (first_sample < 0)
-              throw py::value_error("first_sample must be >= 0, got " +
-                                    std::to_string(first_sample));
-            r.call([&](Renderer& rr) { rr.reset(static_cast<std::uint64_t>(first_sample)); });
+          [](PyRenderer& r, const py::int_& first_sample) {
+            // any Python int: one out of range is a ValueError, not pybind11's TypeError
+            const std::string shown = py::repr(first_sample).cast<std::string>();
+            const unsigned long long first = PyLong_AsUnsignedLongLong(first_sample.ptr());
+            if (PyErr_Occurred()) {
+              PyErr_Clear();
+              throw py::value_error(shown.rfind('-', 0) == 0
+                                        ? "first_sample must be >= 0, got " + shown
+                                        : "first_sample must be below 2**32 (the sampler's "
+                                          "range), got " +
+                                              shown);
+            }
+            r.call([&](Renderer& rr) { rr.reset(static_cast<std::uint64_t>(first)); });
           },
           py::arg("first_sample") = 0,
           "Drops the accumulation; the next sample index is first_sample.")

@@ -276,6 +276,8 @@ def test_session_errors(renderer, small_scene):
         renderer.reset(-1)
     with pytest.raises(lucent.Error, match="below 2\\^32"):
         renderer.reset(2 ** 32)
+    with pytest.raises(ValueError, match="first_sample must be below 2\\*\\*32"):
+        renderer.reset(2 ** 64)  # beyond a C integer: not pybind11's TypeError
     with pytest.raises(TypeError):
         renderer.set_scene({"film": {}})
     with pytest.raises(TypeError):
