@@ -7,6 +7,7 @@
 #include "lucent/error.hpp"
 #include "render/pack.hpp"
 #include "scene/material_type.hpp"
+#include "scene/validate.hpp"
 
 namespace lucent::render_detail {
 
@@ -73,9 +74,9 @@ void pack_lights(const Scene& scene, PackedScene& p, std::vector<double> power) 
         d.p.env_map.cdf = LC_INVALID;  // below, after the selection CDF
         break;
       default:
-        throw Error((scene.path.empty() ? "" : scene.path + ": ") +
-                    "a scene light cannot be of type " + std::to_string(static_cast<int>(l.type)) +
-                    " (area lights are emissive shapes)");
+        throw Error(scene_detail::in_file(scene.path, "a scene light cannot be of type " +
+                                                          std::to_string(static_cast<int>(l.type)) +
+                                                          " (area lights are emissive shapes)"));
     }
     if (l.type == LightType::Environment || l.type == LightType::EnvironmentMap) {
       pw = luminance(l.radiance) * M_PI * 4 * M_PI * radius * radius;

@@ -8,6 +8,7 @@
 #include "lucent/error.hpp"
 #include "scene/loaders.hpp"
 #include "scene/material_type.hpp"
+#include "scene/validate.hpp"
 
 namespace lucent::render_detail {
 
@@ -91,8 +92,7 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
                       : INFINITY;
 
   if (scene.materials.empty() && (!scene.spheres.empty() || !scene.triangles.empty()))
-    throw Error((scene.path.empty() ? "" : scene.path + ": ") +
-                "shapes need at least one material");
+    throw Error(scene_detail::in_file(scene.path, "shapes need at least one material"));
   for (const Material& m : scene.materials) {
     lc_material d;
     std::fill(std::begin(d.p.words), std::end(d.p.words), 0.0f);
@@ -168,9 +168,9 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     p.tri_attrs.push_back(a);
   }
   if (p.skipped_triangles > 0)
-    scene_detail::warn((scene.path.empty() ? "" : scene.path + ": ") + "skipped " +
-                       std::to_string(p.skipped_triangles) +
-                       " degenerate or non-finite triangle(s)");
+    scene_detail::warn(
+        scene_detail::in_file(scene.path, "skipped " + std::to_string(p.skipped_triangles) +
+                                              " degenerate or non-finite triangle(s)"));
   // integrator.caustics: no surface that can scatter by a delta lobe (a mirror, smooth glass, a
   // rough dielectric of ior 1), no caustic path: the kernel is built and run without light paths
   if (P.flags & LC_FLAG_CAUSTICS) {

@@ -12,9 +12,13 @@
 
 namespace lucent::scene_detail {
 
+std::string in_file(const std::string& file, const std::string& what) {
+  return file.empty() ? what : file + ": " + what;
+}
+
 void Reporter::fail(const std::string& what) const {
   const std::string& ptr = pointer_.empty() ? std::string("/") : pointer_;
-  throw Error((file_.empty() ? "" : file_ + ": ") + ptr + ": " + what);
+  throw Error(in_file(file_, ptr + ": " + what));
 }
 
 std::string format_number(double v) {
@@ -169,7 +173,7 @@ void validate_integrator(const Integrator& in, const Reporter& at) {
   check_non_negative(at.at("clamp"), in.clamp);  // 0: off
 }
 
-void validate_texture(const Texture& t, const Reporter& at) {
+void validate_texture_size(const Texture& t, const Reporter& at) {
   if (t.width < 1) at.at("width").fail("must be >= 1, got " + std::to_string(t.width));
   if (t.height < 1) at.at("height").fail("must be >= 1, got " + std::to_string(t.height));
   std::size_t want = std::size_t(4) * std::size_t(t.width) * std::size_t(t.height);
@@ -177,6 +181,10 @@ void validate_texture(const Texture& t, const Reporter& at) {
     at.at("rgba").fail("must hold 4 x " + std::to_string(t.width) + " x " +
                        std::to_string(t.height) + " = " + std::to_string(want) + " floats, got " +
                        std::to_string(t.rgba.size()));
+}
+
+void validate_texture(const Texture& t, const Reporter& at) {
+  validate_texture_size(t, at);
   for (std::size_t i = 0; i < t.rgba.size(); ++i)  // the place is made only for a bad texel
     if (!(std::isfinite(t.rgba[i]) && t.rgba[i] >= 0))
       check_non_negative(at.at("rgba").at(i), t.rgba[i]);
@@ -293,17 +301,8 @@ void validate_scene(const Scene& s) {
     validate_film(rest, at);
   }
   validate_integrator(s.integrator, Reporter(file, "/integrator"));
-  for (std::size_t i = 0; i < s.textures.size(); ++i) {
-    const Texture& t = s.textures[i];
-    const Reporter at(file, "/textures/" + std::to_string(i));
-    if (t.width < 1) at.at("width").fail("must be >= 1, got " + std::to_string(t.width));
-    if (t.height < 1) at.at("height").fail("must be >= 1, got " + std::to_string(t.height));
-    const std::size_t want = std::size_t(4) * std::size_t(t.width) * std::size_t(t.height);
-    if (t.rgba.size() != want)
-      at.at("rgba").fail("must hold 4 x " + std::to_string(t.width) + " x " +
-                         std::to_string(t.height) + " = " + std::to_string(want) + " floats, got " +
-                         std::to_string(t.rgba.size()));
-  }
+  for (std::size_t i = 0; i < s.textures.size(); ++i)
+    validate_texture_size(s.textures[i], Reporter(file, "/textures/" + std::to_string(i)));
   for (std::size_t i = 0; i < s.materials.size(); ++i) {
     // names only serve messages and the scene file's references: a nameless one is named by
     // its index

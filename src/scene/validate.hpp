@@ -42,6 +42,9 @@ class Reporter {
 /// A number as messages show it (6 significant digits; nan, inf).
 std::string format_number(double v);
 
+/// "<file>: <what>", or `what` alone for a scene without a file (built in code).
+std::string in_file(const std::string& file, const std::string& what);
+
 // ---------------------------------------------------------------------------------------------
 // Checks of one value. Each fails at `at` with a message saying what the value must be and what
 // it is; the vector checks name the component (".../albedo/1").
@@ -87,6 +90,9 @@ std::string scene_light_names();
 void validate_camera(const Camera& camera, const Reporter& at);
 void validate_film(const Film& film, const Reporter& at);
 void validate_integrator(const Integrator& integrator, const Reporter& at);
+/// Its size: width and height from 1, 4 floats per texel.
+void validate_texture_size(const Texture& texture, const Reporter& at);
+/// Its size, then every texel finite and non-negative.
 void validate_texture(const Texture& texture, const Reporter& at);
 /// The parameters every material has (name, type, emission, albedo texture), then its type's
 /// own, by the type's parameter table (scene/material_type.hpp).
