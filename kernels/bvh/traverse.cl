@@ -241,7 +241,7 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
   hit->b1 = hit->b2 = LC_REAL(0.0);
   /* a non-finite origin or direction (a scene's NaN, or one computed from degenerate input)
    * would enter every child, the empty slots too, and walk off the node array: such a ray hits
-   * nothing (its sample then counts as non-finite where its radiance is) */
+   * nothing (a miss: the integrator adds what a miss adds, the environment's radiance) */
   if (s->params->num_nodes == 0 || !all(isfinite(o)) || !all(isfinite(d))) return 0;
   __global const lc_bvh_node* nodes = s->nodes;
   lc_real3 inv_d = bvh_inv_dir(d);

@@ -165,6 +165,10 @@ std::string no_platform() {
 
 }  // namespace
 
+bool is_pocl(const Device& device) {
+  return device.info.platform.find("Portable Computing Language") != std::string::npos;
+}
+
 std::vector<Device> enumerate_devices() {
   // one enumeration at a time in the process: the ICD loader and PoCL initialise on the first
   // call, and sessions created at once from several threads crashed there (SIGSEGV) or saw no
@@ -279,8 +283,7 @@ cl::Program build_program(const Context& ctx, const std::string& source,
     std::string msg = (place.empty() ? std::string() : place + ": ") +
                       "kernel build failed: " + describe(e) +
                       (log.empty() ? "" : " (build log above)");
-    if (place.empty() &&
-        ctx.device.info.platform.find("Portable Computing Language") != std::string::npos)
+    if (place.empty() && is_pocl(ctx.device))
       msg += pocl_cache_hint();  // no error in the source: perhaps PoCL's directory
     throw Error(msg, log.empty() ? std::string() : "kernel build log:\n" + log);
   }
@@ -317,10 +320,11 @@ std::vector<DeviceInfo> select_devices(const std::string& selectors, const std::
     size_t b = item.find_first_not_of(' '), e = item.find_last_not_of(' ');
     if (b == std::string::npos)
       throw Error(origin + " '" + selectors + "': an empty selector in the list");
-    if (item.substr(b, e - b + 1) == "all")
+    const std::string selector = item.substr(b, e - b + 1);
+    if (selector == "all")
       throw Error(origin + " '" + selectors +
                   "': 'all' selects every device and stands alone, not in a list");
-    out.push_back(select_device(item.substr(b, e - b + 1), origin));
+    out.push_back(select_device(selector, origin));
     item.clear();
   }
   return out;

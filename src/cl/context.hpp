@@ -20,6 +20,9 @@ std::vector<Device> enumerate_devices();
 /// `origin`, where the selector came from ("--device", "LUCENT_DEVICE", ...).
 Device pick_device(const std::string& selector, const std::string& origin = "--device");
 
+/// The device is PoCL's (any of its drivers: they share its kernel cache and POCL_* variables).
+bool is_pocl(const Device& device);
+
 /// A context and an in-order queue on one device.
 struct Context {
   Device device;

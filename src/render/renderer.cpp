@@ -2,11 +2,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <string>
 
 #include "lucent/error.hpp"
 #include "lucent/render.hpp"
 #include "lucent/session.hpp"
+#include "scene/validate.hpp"
 
 namespace lucent {
 
@@ -25,16 +25,6 @@ std::string target_shortfall(const RenderResult& r) {
   return line;
 }
 
-namespace {
-
-std::string shown(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
-
-}  // namespace
-
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   // (a negative count or a NaN target would otherwise fall back to a default without a word)
   if (options.spp < 0)
@@ -45,7 +35,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                 std::to_string(options.min_spp));
   if (!(options.target_error >= 0) || !std::isfinite(options.target_error))
     throw Error("render: RenderOptions::target_error must be a finite number >= 0 (0: off), got " +
-                shown(options.target_error));
+                scene_detail::format_number(options.target_error));
   SessionOptions so;
   so.device = options.device;
   so.kernel_dir = options.kernel_dir;

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -213,13 +212,9 @@ struct Renderer::Impl {
 
   explicit Impl(SessionOptions o) : options(std::move(o)) {
     // a NaN pass duration made every pass 0 samples long: render() never ended
-    if (!(options.pass_seconds > 0) || !std::isfinite(options.pass_seconds)) {
-      char b[32];
-      std::snprintf(b, sizeof b, "%g", options.pass_seconds);
-      throw Error(std::string("SessionOptions::pass_seconds must be a positive number of seconds, "
-                              "got ") +
-                  b);
-    }
+    if (!(options.pass_seconds > 0) || !std::isfinite(options.pass_seconds))
+      throw Error("SessionOptions::pass_seconds must be a positive number of seconds, got " +
+                  scene_detail::format_number(options.pass_seconds));
     for (const DeviceInfo& d : select_devices(options.device, "device")) {
       workers.push_back(std::make_unique<Worker>(std::to_string(d.index)));
       device_infos.push_back(workers.back()->ctx.device.info);
