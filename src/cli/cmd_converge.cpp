@@ -75,6 +75,38 @@ void write_text(const std::string& path, const std::string& text) {
   io::write_file_atomic(path, text);  // checked to the last byte, never left half-written
 }
 
+// The --reference image, read once: a linear image, and not a lucent render at the ladder's own
+// seed.
+RenderResult read_reference(const std::string& path, std::uint32_t ladder_seed) {
+  const std::string bytes = io::read_file(path, image_detail::image_read_spec());
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  // an 8-bit (or 16-bit PNG) image holds display values, tone-mapped and clipped: every relMSE
+  // against it would measure the display transform, not the render's error
+  const image_detail::Probe p =
+      image_detail::probe_image(data, bytes.size(), path, image_detail::kMaxImagePixels);
+  using image_detail::Format;
+  if (p.format != Format::Exr && p.format != Format::Pfm && p.format != Format::Hdr)
+    throw Error(path + ": a " + image_detail::format_name(p.format) +
+                " image holds display values (tone-mapped, clipped), not radiance: give a .exr, "
+                ".pfm or .hdr reference (lucent render SCENE --seed S -o ref.exr, S not the "
+                "scene's seed)");
+  if (p.format == Format::Exr) {
+    // a lucent render at the ladder's seed holds the rungs' own samples (the same numbers for
+    // the same pixel, index and dimension): its error against them is hidden
+    EXRHeader header;
+    image_detail::probe_exr(data, bytes.size(), path, image_detail::kMaxImagePixels, header);
+    const auto attrs = image_detail::exr_string_attributes(header);
+    FreeEXRHeader(&header);
+    auto seed = attrs.find("lucent.seed");
+    if (seed != attrs.end() && seed->second == std::to_string(ladder_seed))
+      throw Error(path + ": rendered with seed " + seed->second +
+                  ", the ladder's: its samples include the rungs' own, which would hide their "
+                  "error; render it with another --seed, or let converge render it "
+                  "(--reference-spp, --save-reference)");
+  }
+  return image_detail::read_render_memory(data, bytes.size(), path);
+}
+
 }  // namespace
 
 CLI::App* add_converge_command(CLI::App& app) {
@@ -189,36 +221,7 @@ int run_converge_command() {
   opt.renderer = &renderer;
   RenderResult reference;
   if (!a.reference.empty()) {
-    reference = read_render(a.reference);
-    {
-      // an 8-bit (or 16-bit PNG) image holds display values, tone-mapped and clipped: every
-      // relMSE against it would measure the display transform, not the render's error
-      const std::string bytes = io::read_file(a.reference, image_detail::image_read_spec());
-      const image_detail::Probe p =
-          image_detail::probe_image(reinterpret_cast<const unsigned char*>(bytes.data()),
-                                    bytes.size(), a.reference, image_detail::kMaxImagePixels);
-      using image_detail::Format;
-      if (p.format != Format::Exr && p.format != Format::Pfm && p.format != Format::Hdr)
-        throw Error(a.reference + ": a " + image_detail::format_name(p.format) +
-                    " image holds display values (tone-mapped, clipped), not radiance: give a "
-                    ".exr, .pfm or .hdr reference (lucent render SCENE --seed S -o ref.exr, S not "
-                    "the scene's seed)");
-      if (p.format == Format::Exr) {
-        // a lucent render at the ladder's seed holds the rungs' own samples (the same numbers
-        // for the same pixel, index and dimension): its error against them is hidden
-        EXRHeader header;
-        image_detail::probe_exr(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(),
-                                a.reference, image_detail::kMaxImagePixels, header);
-        const auto attrs = image_detail::exr_string_attributes(header);
-        FreeEXRHeader(&header);
-        auto seed = attrs.find("lucent.seed");
-        if (seed != attrs.end() && seed->second == std::to_string(scene.integrator.seed))
-          throw Error(a.reference + ": rendered with seed " + seed->second +
-                      ", the ladder's: its samples include the rungs' own, which would hide "
-                      "their error; render it with another --seed, or let converge render it "
-                      "(--reference-spp, --save-reference)");
-      }
-    }
+    reference = read_reference(a.reference, scene.integrator.seed);
     if (reference.mean.width != scene.film.width || reference.mean.height != scene.film.height)
       throw Error(a.reference + ": size " + std::to_string(reference.mean.width) + "x" +
                   std::to_string(reference.mean.height) + " differs from the scene's film (" +
