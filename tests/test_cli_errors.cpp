@@ -231,7 +231,7 @@ TEST(CliErrors, UnusablePoclCacheDirIsNamed) {
 
   // the CLI, where the device is PoCL's
   lucent::cl_util::Context ctx(lucent::test::device());
-  if (ctx.device.info.platform.find("Portable Computing Language") == std::string::npos)
+  if (!lucent::cl_util::is_pocl(ctx.device))
     GTEST_SKIP() << "the device is not PoCL's: " << ctx.device.info.platform;
   const std::string out = dir + "/o.png";
   // the build log PoCL gave comes first ("kernel build log:" and its lines), then the error
@@ -245,9 +245,8 @@ TEST(CliErrors, UnusablePoclCacheDirIsNamed) {
             "log above); POCL_CACHE_DIR=" +
                 file + " is not a directory, which PoCL needs for its kernels")
       << r.err;
-  std::string msg;
   EXPECT_FALSE(fs::exists(out));
-  msg = expect_one_error_line(run_cli("devices", "POCL_CACHE_DIR=" + q(file + "/sub")));
+  std::string msg = expect_one_error_line(run_cli("devices", "POCL_CACHE_DIR=" + q(file + "/sub")));
   EXPECT_NE(msg.find("POCL_CACHE_DIR=" + file + "/sub cannot be created (" + file +
                      " is not a directory), which PoCL needs for its kernels"),
             std::string::npos)
