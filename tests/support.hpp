@@ -146,4 +146,14 @@ std::string bounced_caustic_scene(
     const std::string& camera =
         R"({"position": [0, 0, 0.5], "look_at": [0, 0, 1.9], "up": [0, 1, 0], "fov": 60})");
 
+/// For bounced_caustic_scene: a vertical mirror x = 5.5 (y within +-3, z up to 3; `more`), and a
+/// camera at (2, 0, 1) looking down at the floor at x within about 1.5 .. 2.5, where the black
+/// square shades it from the lamp and from its image in the ceiling mirror. That floor's light
+/// comes mostly off the lit ring of the floor, seen in the mirrors: floor, mirror wall, ceiling
+/// mirror, lit floor, ceiling mirror, light (E N S S N S L), or through the wall alone.
+inline constexpr const char* kMirrorWall = R"(, {"type": "triangles", "material": "mirror",
+    "positions": [[5.5,-3,0],[5.5,3,0],[5.5,3,3],[5.5,-3,3]], "indices": [0,2,1, 0,3,2]})";
+inline constexpr const char* kFloorBesideTheMirrorWall =
+    R"({"position": [2, 0, 1], "look_at": [2, 0, 0], "up": [0, 1, 0], "fov": 50})";
+
 }  // namespace lucent::test

@@ -324,6 +324,19 @@ TEST(KernelVsReference, PathCausticsBouncedOffTheFloor) {
   EXPECT_GT(mean, 0.0) << "the panel is lit only by light tracing";
 }
 
+// A caustic seen in mirrors by a diffuse floor (E N S S N S L: floor, mirror wall, mirror
+// ceiling, lit floor, mirror ceiling, point light; tests/support.hpp's kMirrorWall), which only
+// light paths render: about a quarter of the image, which light paths that end at a delta lobe
+// after a non-delta one (the rule before 24 Nov 2026) leave out (image-mean z = -8.8 then).
+TEST(KernelVsReference, PathCausticsSeenInAMirror) {
+  Both b = render_both(
+      scene_from(lucent::test::bounced_caustic_scene(
+          true, 6, R"(], "lights": [{"type": "point", "position": [0, 0, 2.5], "intensity": [4, 4, 4]}])",
+          lucent::test::kMirrorWall, lucent::test::kFloorBesideTheMirrorWall)),
+                       8192);
+  EXPECT_AGREE(b);
+}
+
 TEST(KernelVsReference, PathConductor) {
   Both b = render_both(
       scene_from(scene_json(

@@ -363,6 +363,19 @@ TEST(ReferenceCaustics, SphereLightBouncedCausticMatchesPathTracing) {
   expect_bounced_caustic_matches();
 }
 
+// A caustic seen in mirrors (docs/rendering-model.md, "Caustics by light tracing"): the camera
+// looks down at floor that the black square shades from the lamp and its image in the ceiling
+// mirror, beside a vertical mirror wall (tests/support.hpp's kMirrorWall). Its light comes off
+// the lit ring of the floor seen in the mirrors (floor, wall, ceiling mirror, lit floor, ceiling
+// mirror, lamp: E N S S N S L), which light paths render (a non-delta lobe at the first hit, a
+// delta one into the lamp); before 24 Nov 2026 a delta lobe after a non-delta one ended a light
+// path and the camera path took these. Same comparison as above; it fails (z = -4.7) when only
+// the camera path follows the rule.
+TEST(ReferenceCaustics, SphereLightCausticSeenInAMirrorMatchesPathTracing) {
+  expect_bounced_caustic_matches(lucent::test::kMirrorWall,
+                                 lucent::test::kFloorBesideTheMirrorWall);
+}
+
 // The adjoint weight of a rough refraction (eta^2 = 2.25 entering): a frosted glass sheet
 // z = 0.3 (rough dielectric, ior 1.5, roughness 0.3, front side up) covers the floor, and the
 // camera at (4, 0, 1.8) looks down at it, at x within about 2.9 .. 5.1, in the mirror's light.

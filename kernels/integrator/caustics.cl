@@ -1,10 +1,11 @@
 /* lucent kernel: caustics by light tracing (integrator.caustics; docs/rendering-model.md,
  * "Caustics by light tracing"). Each camera sample also traces one light path: from a light,
- * through one or more delta scatterings, then through non-delta ones; each non-delta vertex is
- * connected to the camera (the pinhole, or a point of a thin lens) and splatted with the pixel
- * filter's density into the film's light sums (atomically: any work-item may reach any pixel). The
- * path integrator leaves out the same paths, E N+ S+ L (integrator/path.cl), so the two split path
- * space. The host divides the light sums by the number of light paths, W * H * spp. */
+ * through a delta scattering first, then through any scatterings; each non-delta vertex after the
+ * first is connected to the camera (the pinhole, or a point of a thin lens) and splatted with the
+ * pixel filter's density into the film's light sums (atomically: any work-item may reach any
+ * pixel). The path integrator leaves out the same paths, E N (N|S)* S L: a non-delta lobe at the
+ * first hit, a delta one into the light (integrator/path.cl), so the two split path space. The
+ * host divides the light sums by the number of light paths, W * H * spp. */
 #ifndef LUCENT_INTEGRATOR_CAUSTICS_CL
 #define LUCENT_INTEGRATOR_CAUSTICS_CL
 
@@ -114,7 +115,7 @@ static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
   if (!light_emit(s, ue.z, (float4)(ue.x, ue.y, ud.x, ud.y), &ray, &beta)) return 0;
   const float beta0 = lc_max3(beta);
   lc_uint nonfinite = 0;
-  int state = 0; /* the lobes sampled so far: 0 none, 1 S+, 2 S+ N+ */
+  int caustic = 0; /* 1 once the lobe sampled at y_1 was a delta one */
   /* scattering vertices 1 .. max_depth - 1: the camera path's segment limit */
   for (lc_uint i = 1; i < P->max_depth; ++i) {
     lc_hit hit;
@@ -128,17 +129,17 @@ static inline lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
     lc_uint dim = LC_DIM_LIGHT_PATH + 8u * i;
     float8 uv = lc_rand8(rng, dim);
     float4 ua = uv.lo, ub = uv.hi;
-    if (state != 0 && !(bsdf_lobes(&b) & LC_BSDF_DELTA))
+    if (caustic && !(bsdf_lobes(&b) & LC_BSDF_DELTA))
       nonfinite +=
           !caustics_connect(s, ray, &surf, &b, ua.x, ua.y, beta, light_sum, light_sumsq, rays);
-    /* continue while the lobes read S+ N* */
+    /* a light path goes on after a delta lobe at y_1, through any lobes after it */
     lc_frame fr = frame_from(it.ns);
     float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
     if (wo_l.z <= 0.0f) break;
     lc_bsdf_sample bs;
     if (!bsdf_sample(&b, wo_l, ua.w, ub.x, ub.y, &bs)) break;
-    if (bs.delta ? state == 2 : state == 0) break;
-    state = bs.delta ? 1 : 2;
+    if (!caustic && !bs.delta) break;
+    caustic = 1;
     lc_real3 wi = normalize(lc_real3_from_float3(frame_to_world(&fr, bs.wi)));
     int transmit = bs.wi.z < 0.0f;
     lc_real side = dot(wi, it.ng);

@@ -26,11 +26,11 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
   int prev_delta = 1; /* the camera ray: emitters count fully */
   lc_real3 prev_p = ray.o;
 #ifdef LC_HAS_CAUSTICS
-  /* integrator.caustics: emitters that the path reaches as E N+ S+ L (non-delta lobes from the
-   * first hit on, then delta ones) are left to the light paths (integrator/caustics.cl). The
-   * lobes so far: 1 while they read N+, 2 once they read N+ S+, 0 otherwise. */
+  /* integrator.caustics: emitters that a BSDF-sampled ray reaches after a delta lobe, on a path
+   * whose lobe at the first hit was a non-delta one (E N (N|S)* S L), are left to the light
+   * paths (integrator/caustics.cl). first_n: the lobe sampled at the first hit was non-delta. */
   const int caustics = (P->flags & LC_FLAG_CAUSTICS) != 0;
-  int caustic = 0;
+  int first_n = 0;
 #endif
   for (lc_uint depth = 0;; ++depth) {
     lc_hit hit;
@@ -47,7 +47,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     __global const lc_material* m = &s->materials[it.material];
     int emits = it.front && it.light != LC_INVALID;
 #ifdef LC_HAS_CAUSTICS
-    if (caustics && caustic == 2) emits = 0;
+    if (caustics && first_n && prev_delta) emits = 0;
 #endif
     if (emits) {
       float3 Le = lc_load3(m->emission);
@@ -100,10 +100,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     beta *= bs.weight;
     if (!(lc_max3(beta) > 0.0f)) break;
 #ifdef LC_HAS_CAUSTICS
-    if (depth == 0)
-      caustic = bs.delta ? 0 : 1;
-    else if (caustic)
-      caustic = bs.delta ? 2 : (caustic == 1 ? 1 : 0);
+    if (depth == 0) first_n = !bs.delta;
 #endif
     prev_delta = bs.delta;
     prev_pdf = bs.pdf;

@@ -1,8 +1,8 @@
 // Caustics by light tracing, written from docs/rendering-model.md ("Caustics by light tracing"):
 // a light chosen uniformly (Lights::emit), a point and direction from it (Light::emit),
-// scatterings with the adjoint weight while their lobes read S+ N*, a connection to the camera
-// at every vertex y_i with a non-delta BSDF that the path reaches with i >= 2 (paths E N+ S+ L),
-// Russian roulette on the product of the adjoint weights.
+// scatterings with the adjoint weight once the lobe sampled at y_1 was a delta one, a connection
+// to the camera at every vertex y_i with a non-delta BSDF that the path reaches with i >= 2
+// (paths E N (N|S)* S L), Russian roulette on the product of the adjoint weights.
 #include "reference/integrator/light_tracer.hpp"
 
 #include <cmath>
@@ -34,9 +34,8 @@ void LightTracer::trace(const Sampler& rng, std::vector<Splat>& out) const {
   dvec3 weight(1.0);  // product of the adjoint weights: beta = e.beta * weight
   Ray ray{e.y, e.d};
   int skip = e.skip;
-  // The lobes sampled at y_1 .. y_{i-1} read S+ N* at every vertex the path reaches with i >= 2
-  // (it ends where they would not); `diffused`: the N* part is not empty.
-  bool diffused = false;
+  // The lobe sampled at y_1 was a delta one at every vertex the path reaches with i >= 2 (it ends
+  // where it was not).
   for (int i = 1; i <= max_vertices; ++i) {
     Hit hit;
     if (!t_.trace(ray, hit, skip)) return;
@@ -53,10 +52,8 @@ void LightTracer::trace(const Sampler& rng, std::vector<Splat>& out) const {
         b->sample(wo, light_dim(rng, i, LC_DIM_BSDF_LOBE), light_dim(rng, i, LC_DIM_BSDF_UV),
                   light_dim(rng, i, LC_DIM_BSDF_UV + 1));
     if (!bs.valid) return;
-    // S+ N* goes on: a non-delta lobe at y_1 (no delta before it) or a delta lobe after a
-    // non-delta one ends the path
-    if (bs.delta ? diffused : i == 1) return;
-    diffused = !bs.delta || diffused;
+    // a non-delta lobe at y_1 ends the path; after a delta one there, any lobe goes on
+    if (i == 1 && !bs.delta) return;
     // The adjoint weight, for every lobe: the radiance weight without the 1 / eta^2 of
     // refraction (power is not compressed into a narrower cone as radiance is; bs.eta, delta or
     // rough), times the shading-normal correction |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) (Veach's

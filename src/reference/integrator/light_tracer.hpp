@@ -1,11 +1,10 @@
 #pragma once
 // Caustics by light tracing (integrator.caustics, docs/rendering-model.md, "Caustics by light
-// tracing"): one light path per camera sample, traced from a light through one or more delta
-// scatterings (mirror, smooth glass), then any non-delta ones, and connected to the camera (its
-// pinhole or a point of its thin lens) at every non-delta vertex after the delta ones (the paths E
-// N+ S+ L). The path integrator leaves out the same paths (path.cpp), so that the two estimators
-// split path space and their sum estimates the path integrator's image, plus point lights'
-// caustics.
+// tracing"): one light path per camera sample, traced from a light through a delta scattering
+// (mirror, smooth glass), then any scatterings, and connected to the camera (its pinhole or a
+// point of its thin lens) at every non-delta vertex after the first (the paths E N (N|S)* S L). The
+// path integrator leaves out the same paths (path.cpp), so that the two estimators split path space
+// and their sum estimates the path integrator's image, plus point lights' caustics.
 #include <vector>
 
 #include "reference/camera/camera.hpp"

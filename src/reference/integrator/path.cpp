@@ -2,7 +2,7 @@
 // light chosen uniformly, and multiple importance sampling (power heuristic) between light and
 // BSDF sampling. Expected value: the rendering equation truncated at max_depth segments (with
 // integrator.clamp, the expectation of the clamped estimator: docs/rendering-model.md). With
-// integrator.caustics, without the caustic paths E N+ S+ L that the light tracer renders.
+// integrator.caustics, without the caustic paths E N (N|S)* S L that the light tracer renders.
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -36,25 +36,6 @@ dvec3 next_event(const Tracer& t, const Surface& s, const Bsdf& b, const dvec3& 
   return f * ls.Le * power_heuristic(ls.pdf, b.pdf(wo, ls.wi)) / ls.pdf;
 }
 
-/// integrator.caustics: where the lobes sampled from the first hit on stand against N+ S+.
-enum class Caustic {
-  kDead,    ///< off, a delta lobe at the first hit, or a non-delta one after a delta one
-  kNPhase,  ///< only non-delta lobes so far (at least one)
-  kSPhase,  ///< N+ S+: an emitter that a BSDF-sampled ray finds now is the light tracer's
-};
-
-/// The phase after a lobe (`delta` or not) is sampled in phase `c`.
-Caustic next_phase(Caustic c, bool delta) {
-  switch (c) {
-    case Caustic::kNPhase:
-      return delta ? Caustic::kSPhase : Caustic::kNPhase;
-    case Caustic::kSPhase:
-      return delta ? Caustic::kSPhase : Caustic::kDead;
-    default:
-      return Caustic::kDead;
-  }
-}
-
 /// integrator.clamp: a contribution after a scattering whose largest component exceeds `bound`
 /// (> 0) is scaled down to it; non-finite ones stay non-finite.
 dvec3 clamped(const dvec3& c, double bound) {
@@ -73,10 +54,10 @@ dvec3 integrator_path(const Tracer& t, const Ray& camera_ray, const Sampler& rng
   dvec3 L(0.0), beta(1.0);
   double prev_pdf = 0;     // BSDF pdf of the previous direction
   bool prev_delta = true;  // camera rays and delta bounces: no MIS on what they hit
-  // integrator.caustics: the lobes sampled from the first hit on read N+ S+ (kSPhase), so an
-  // emitter found now closes a caustic path E N+ S+ L, which the light tracer renders
-  // (integrator/light_tracer.cpp)
-  Caustic caustic = Caustic::kDead;
+  // integrator.caustics: a caustic path, E N (N|S)* S L, samples a non-delta lobe at the first
+  // hit and a delta one at the vertex before the emitter; the light tracer renders those
+  // (integrator/light_tracer.cpp). first_nondelta: the lobe sampled at the first hit.
+  bool first_nondelta = false;
   for (int depth = 0;; ++depth) {
     Hit hit;
     if (!t.trace(ray, hit)) {
@@ -88,7 +69,8 @@ dvec3 integrator_path(const Tracer& t, const Ray& camera_ray, const Sampler& rng
     }
     Surface s = t.surface(ray, hit);
     dvec3 Le = t.emitted(s);
-    if (max3(Le) > 0 && caustic != Caustic::kSPhase) {
+    const bool caustic = in.caustics && first_nondelta && prev_delta;
+    if (max3(Le) > 0 && !caustic) {
       double w = 1;
       if (!prev_delta)
         w = power_heuristic(prev_pdf,
@@ -106,10 +88,7 @@ dvec3 integrator_path(const Tracer& t, const Ray& camera_ray, const Sampler& rng
     beta *= bs.weight;
     prev_pdf = bs.pdf;
     prev_delta = bs.delta;
-    if (depth == 0)
-      caustic = in.caustics && !bs.delta ? Caustic::kNPhase : Caustic::kDead;
-    else
-      caustic = next_phase(caustic, bs.delta);
+    if (depth == 0) first_nondelta = !bs.delta;
     ray = Tracer::spawn(s, bs.wi);
     // Russian roulette once the path has rr_depth segments: while the largest component of the
     // throughput is below 1 the path survives with that probability and the throughput is
