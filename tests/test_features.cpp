@@ -104,6 +104,20 @@ namespace {
 
 // integrator.caustics compiles the light paths only where a caustic path exists: a surface that
 // scatters by a delta lobe (a mirror, smooth glass, a rough dielectric of ior 1), used by a shape.
+// A device's own build options (added to the scene's for its build and its cache key): CPU
+// devices keep the integrator and the light path out of line (LC_CPU_NOINLINE,
+// kernels/util/math.cl), other devices get nothing. KernelSource.KernelsAreStrictOpenCL12ForClang
+// compiles both branches.
+TEST(Features, OnlyCpuDevicesGetTheCpuDefine) {
+  lucent::DeviceInfo d;
+  d.type = "CPU";
+  EXPECT_EQ(lucent::render_detail::device_defines(d), " -D LC_DEVICE_CPU");
+  for (const char* type : {"GPU", "accelerator", "other"}) {
+    d.type = type;
+    EXPECT_EQ(lucent::render_detail::device_defines(d), "") << type;
+  }
+}
+
 TEST(Features, CausticsOnlyWithADeltaSurface) {
   auto scene = [](const std::string& material) {
     std::string j = kDiffuseScene;

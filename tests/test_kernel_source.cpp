@@ -263,8 +263,10 @@ TEST(KernelSource, KernelsAreStrictOpenCL12ForClang) {
   struct Case {
     std::string name, prefix, path;
   };
-  // every feature, every feature in double precision, and none (the #else branches)
+  // every feature, every feature in double precision, every feature as a CPU device builds it
+  // (render_detail::device_defines), and none (the #else branches)
   std::vector<Case> cases = {{"megakernel", all, "megakernel.cl"},
+                             {"megakernel-cpu", all + "#define LC_DEVICE_CPU 1\n", "megakernel.cl"},
                              {"megakernel-double", all + "#define LC_DOUBLE 1\n", "megakernel.cl"},
                              {"megakernel-no-features", "", "megakernel.cl"}};
   for (int i = 0; i < lucent::detail::kEmbeddedKernelFileCount; ++i) {

@@ -19,8 +19,10 @@
 #define LC_INTEGRATOR_CALL(ID, Name, value, name, feature, file) \
   if (LC_ENABLED(feature) && integrator == LC_INTEGRATOR_##ID)   \
     return integrator_##file(s, ray, rng, rays);
-/* The radiance of one camera sample with the integrator of lc_params.integrator. */
-static inline float3 integrate(const lc_scene* s, lc_ray ray, const lc_rng* rng, lc_uint* rays) {
+/* The radiance of one camera sample with the integrator of lc_params.integrator (out of line on
+ * CPU devices: LC_CPU_NOINLINE, util/math.cl). */
+static LC_CPU_NOINLINE float3 integrate(const lc_scene* s, lc_ray ray, const lc_rng* rng,
+                                        lc_uint* rays) {
   lc_uint integrator = s->params->integrator;
   LC_INTEGRATOR_TYPES(LC_INTEGRATOR_CALL)
 #ifdef LC_HAS_INTEGRATOR_AOV

@@ -3,6 +3,20 @@
 #define LUCENT_UTIL_MATH_CL
 
 /*
+ * LC_CPU_NOINLINE: on CPU devices (LC_DEVICE_CPU, which the host adds to a device's build options:
+ * render_detail::device_defines) a function called once per sample is kept out of line, so that
+ * PoCL's work-group passes, which run at the first launch over the kernel with everything inlined
+ * into it, see a small kernel: the cold build of the Cornell box took 1.00 s with the integrator
+ * inlined, 0.80 s without, at the same speed (BENCHMARKS.md, "Kernel specialisation"). GPUs keep
+ * their compilers' choice.
+ */
+#ifdef LC_DEVICE_CPU
+#define LC_CPU_NOINLINE __attribute__((noinline))
+#else
+#define LC_CPU_NOINLINE inline
+#endif
+
+/*
  * Precision of ray and geometry arithmetic (--precision): lc_real is float by default and double
  * when the build defines LC_DOUBLE (devices with fp64). Buffers always hold float; values loaded
  * from them are widened with lc_load3r / lc_real3_from_float3. LC_REAL(x) writes a literal in the

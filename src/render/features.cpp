@@ -113,6 +113,10 @@ std::string build_options(const Scene& scene, const PackedScene& packed,
   return o;
 }
 
+std::string device_defines(const DeviceInfo& device) {
+  return device.type == "CPU" ? " -D LC_DEVICE_CPU" : "";
+}
+
 void check_precision_support(const DeviceInfo& device, Precision precision) {
   if (precision == Precision::Double && !device.fp64)
     throw Error("--precision double: device '" + device.name +

@@ -30,6 +30,11 @@ std::string feature_defines(const Scene& scene, const PackedScene& packed, bool 
 std::string build_options(const Scene& scene, const PackedScene& packed,
                           const RenderOptions& options);
 
+/// The build options that depend on the device, added to build_options' for each device's build
+/// (and so to its cache key): " -D LC_DEVICE_CPU" for a CPU device (kernels/util/math.cl,
+/// LC_CPU_NOINLINE), "" otherwise.
+std::string device_defines(const DeviceInfo& device);
+
 /// Throws lucent::Error (one line naming the device) when `precision` needs what the device lacks:
 /// Precision::Double needs fp64 (cl_khr_fp64 / CL_DEVICE_DOUBLE_FP_CONFIG).
 void check_precision_support(const DeviceInfo& device, Precision precision);

@@ -254,8 +254,9 @@ struct Renderer::Impl {
     Program p;
     try {
       const bool entries = cl_util::driver_program_cache(w.ctx.device).empty();
-      p.program =
-          cl_util::build_program_cached(w.ctx, source, opts, cache_dir, &info, &entry, entries);
+      p.program = cl_util::build_program_cached(
+          w.ctx, source, opts + render_detail::device_defines(w.ctx.device.info), cache_dir, &info,
+          &entry, entries);
     } catch (const Error& e) {
       // the place of a build error is "kernels/<file>:<line>": the file in the kernel directory
       // in use when the sources came from one
