@@ -184,4 +184,29 @@ TEST(Compare, CommandLine) {
   EXPECT_EQ(lucent::test::count_lines(missing.err), 1);
 }
 
+// A display image (PNG: tone-mapped, encoded, clipped) against a linear render compares the
+// display transform: refused in either order, one line naming the display image. Two display
+// images stay comparable (a tolerance test without variances).
+TEST(Compare, DisplayImageAgainstALinearOneIsRefused) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/s.json", kScene);
+  for (const char* out : {"a.exr", "a.png"}) {
+    auto r = lucent::test::run_cli("render -q --spp 4 --seed 1 '" + dir + "/s.json' -o '" + dir +
+                                   "/" + out + "'");
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  for (const std::string& args : {"'" + dir + "/a.exr' '" + dir + "/a.png'",
+                                  "'" + dir + "/a.png' '" + dir + "/a.exr'"}) {
+    auto c = lucent::test::run_cli("compare " + args);
+    EXPECT_EQ(c.status, 1) << args;
+    EXPECT_EQ(lucent::test::count_lines(c.err), 1) << c.err;
+    EXPECT_NE(c.err.find(dir + "/a.png: a PNG image holds display values"), std::string::npos)
+        << c.err;
+    EXPECT_EQ(c.out.find("FAIL"), std::string::npos) << c.out;
+  }
+  auto same = lucent::test::run_cli("compare '" + dir + "/a.png' '" + dir + "/a.png'");
+  EXPECT_EQ(same.status, 0) << same.out << same.err;
+  EXPECT_NE(same.out.find("PASS"), std::string::npos);
+}
+
 }  // namespace

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/file_io.hpp"
+#include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
@@ -23,6 +24,27 @@ struct CompareArgs {
 CompareArgs& compare_args() {
   static CompareArgs a;
   return a;
+}
+
+/// An input image, read once, and whether its format holds display values (PNG, JPEG, BMP, TGA:
+/// tone-mapped, encoded, clipped) rather than linear radiance (EXR, PFM, HDR).
+struct Input {
+  RenderResult render;
+  bool display = false;
+  std::string format;
+};
+
+Input read_input(const std::string& path) {
+  const std::string bytes = io::read_file(path, image_detail::image_read_spec());
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  const image_detail::Probe p =
+      image_detail::probe_image(data, bytes.size(), path, image_detail::kMaxImagePixels);
+  using image_detail::Format;
+  Input in;
+  in.display = p.format != Format::Exr && p.format != Format::Pfm && p.format != Format::Hdr;
+  in.format = image_detail::format_name(p.format);
+  in.render = image_detail::read_render_memory(data, bytes.size(), path);
+  return in;
 }
 
 }  // namespace
@@ -56,7 +78,17 @@ int run_compare_command() {
   for (const std::string& in : {a.a, a.b})
     if (!a.zmap.empty() && io::same_file(a.zmap, in))
       throw Error(a.zmap + ": is an input of the comparison; refusing to overwrite it");
-  RenderResult ra = read_render(a.a), rb = read_render(a.b);
+  Input ia = read_input(a.a), ib = read_input(a.b);
+  // a display image against a linear one compares the display transform, not the renders
+  if (ia.display != ib.display) {
+    const Input& d = ia.display ? ia : ib;
+    throw Error((ia.display ? a.a : a.b) + ": a " + d.format +
+                " image holds display values (tone-mapped, clipped), and " +
+                (ia.display ? a.b : a.a) +
+                " linear radiance: compare two linear images (.exr, .pfm, .hdr; lucent render "
+                "-o x.exr), or two display images");
+  }
+  const RenderResult &ra = ia.render, &rb = ib.render;
   if (ra.mean.width != rb.mean.width || ra.mean.height != rb.mean.height)
     throw Error(a.b + ": size " + std::to_string(rb.mean.width) + "x" +
                 std::to_string(rb.mean.height) + " differs from " + a.a + " (" +
