@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/reference.hpp"
 #include "support.hpp"
@@ -182,6 +183,41 @@ TEST(Compare, CommandLine) {
   EXPECT_EQ(missing.status, 1);
   EXPECT_NE(missing.err.find("nope.exr"), std::string::npos);
   EXPECT_EQ(lucent::test::count_lines(missing.err), 1);
+}
+
+// Renders carry the key of their random numbers (seed, sampler) through write_render_exr and
+// read_render: from the kernel (a session) and from the reference; a result made by hand has
+// none, and writes none. A seed attribute that is not a number is a one-line error.
+TEST(Compare, RendersKeepTheirSeedThroughExr) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::Scene scene = lucent::test::scene_from(kScene);
+  scene.integrator.seed = 77;
+  scene.integrator.sampler = lucent::SamplerType::Independent;
+  lucent::RenderOptions ko;
+  ko.spp = 2;
+  for (const RenderResult& r : {lucent::test::render(scene, ko), render_ref(77, 2)}) {
+    EXPECT_EQ(r.seed, 77u) << r.device;
+    lucent::write_render_exr(dir + "/r.exr", r);
+    RenderResult back = lucent::read_render(dir + "/r.exr");
+    EXPECT_EQ(back.seed, 77u) << r.device;
+    EXPECT_EQ(back.sampler, r.sampler) << r.device;
+  }
+  EXPECT_EQ(lucent::test::render(scene, ko).sampler, "independent");
+  EXPECT_EQ(render_ref(77, 2).sampler,  // kScene's own
+            lucent::type_name(lucent::test::scene_from(kScene).integrator.sampler));
+  lucent::write_render_exr(dir + "/c.exr", constant_image(3, 2, 1.0f));
+  EXPECT_EQ(lucent::read_render(dir + "/c.exr").sampler, "");
+
+  lucent::image_detail::ExrExtras extras;
+  extras.attributes = {{"lucent.seed", "12x"}, {"lucent.sampler", "sobol"}};
+  lucent::image_detail::write_render_exr(dir + "/bad.exr", constant_image(3, 2, 1.0f), extras);
+  try {
+    lucent::read_render(dir + "/bad.exr");
+    ADD_FAILURE() << "a seed of '12x' was read";
+  } catch (const lucent::Error& e) {
+    EXPECT_EQ(std::string(e.what()), dir + "/bad.exr: attribute lucent.seed: '12x' is not a seed "
+                                           "(an integer from 0 to 4294967295)");
+  }
 }
 
 // A display image (PNG: tone-mapped, encoded, clipped) against a linear render compares the

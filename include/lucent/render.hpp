@@ -91,6 +91,13 @@ struct RenderResult {
   /// relMSE the calibrated plans predicted; 0 otherwise.
   double model_gain_a = 0, model_gain_b = 0;
   double planned_relmse = 0;
+  /// The key of the render's random numbers: the scene's integrator seed and the sampler's name
+  /// ("sobol", "independent"), set by the kernel and reference renderers; sampler "" when unknown
+  /// (an image read from a file that does not say). write_render_exr stores both (lucent.seed,
+  /// lucent.sampler) and read_render reads them back, so that `lucent converge` can refuse a
+  /// reference rendered at its ladder's own seed.
+  std::uint32_t seed = 0;
+  std::string sampler;
 };
 
 /// A render with a target error whose halves' estimate (halves_relmse) is above 1.5 times the

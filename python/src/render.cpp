@@ -342,6 +342,11 @@ void bind_render(py::module_& m) {
       .def_property_readonly("target_shortfall", &lucent::target_shortfall,
                              "a target render's warning when its halves' relMSE is above 1.5 "
                              "times the target ('' otherwise)")
+      .def_readonly("seed", &RenderResult::seed,
+                    "the seed of the render's random numbers (meaningful when sampler is set)")
+      .def_readonly("sampler", &RenderResult::sampler,
+                    "the render's sampler ('sobol', 'independent'); '' when unknown (an image "
+                    "that did not say); write_render_exr stores both")
       .def_readonly("rays", &RenderResult::rays)
       .def_readonly("seconds", &RenderResult::seconds)
       .def_readonly("build_seconds", &RenderResult::build_seconds)

@@ -57,6 +57,11 @@ def test_render_exr_keeps_variance_and_counts(tmp_path, small_scene):
     np.testing.assert_array_equal(back.mean, res.mean)
     np.testing.assert_array_equal(back.variance, res.variance)
     np.testing.assert_array_equal(back.samples, res.samples)
+    # the key of its random numbers, which converge checks a reference against
+    assert (res.seed, res.sampler) == (small_scene.integrator.seed, "sobol")
+    assert (back.seed, back.sampler) == (res.seed, res.sampler)
+    lucent.write_render_exr(path, lucent.RenderResult(res.mean))  # from arrays: unknown
+    assert lucent.read_render(path).sampler == ""
     lucent.write_image(tmp_path / "r.png", res)  # a result's mean
     plain = lucent.read_render(tmp_path / "r.png")
     assert plain.variance is None and plain.samples is None and plain.mean.shape == (12, 16, 3)

@@ -39,9 +39,8 @@ Input read_input(const std::string& path) {
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   const image_detail::Probe p =
       image_detail::probe_image(data, bytes.size(), path, image_detail::kMaxImagePixels);
-  using image_detail::Format;
   Input in;
-  in.display = p.format != Format::Exr && p.format != Format::Pfm && p.format != Format::Hdr;
+  in.display = image_detail::is_display_format(p.format);
   in.format = image_detail::format_name(p.format);
   in.render = image_detail::read_render_memory(data, bytes.size(), path);
   return in;

@@ -84,27 +84,20 @@ RenderResult read_reference(const std::string& path, std::uint32_t ladder_seed) 
   // against it would measure the display transform, not the render's error
   const image_detail::Probe p =
       image_detail::probe_image(data, bytes.size(), path, image_detail::kMaxImagePixels);
-  using image_detail::Format;
-  if (p.format != Format::Exr && p.format != Format::Pfm && p.format != Format::Hdr)
+  if (image_detail::is_display_format(p.format))
     throw Error(path + ": a " + image_detail::format_name(p.format) +
                 " image holds display values (tone-mapped, clipped), not radiance: give a .exr, "
                 ".pfm or .hdr reference (lucent render SCENE --seed S -o ref.exr, S not the "
                 "scene's seed)");
-  if (p.format == Format::Exr) {
-    // a lucent render at the ladder's seed holds the rungs' own samples (the same numbers for
-    // the same pixel, index and dimension): its error against them is hidden
-    EXRHeader header;
-    image_detail::probe_exr(data, bytes.size(), path, image_detail::kMaxImagePixels, header);
-    const auto attrs = image_detail::exr_string_attributes(header);
-    FreeEXRHeader(&header);
-    auto seed = attrs.find("lucent.seed");
-    if (seed != attrs.end() && seed->second == std::to_string(ladder_seed))
-      throw Error(path + ": rendered with seed " + seed->second +
-                  ", the ladder's: its samples include the rungs' own, which would hide their "
-                  "error; render it with another --seed, or let converge render it "
-                  "(--reference-spp, --save-reference)");
-  }
-  return image_detail::read_render_memory(data, bytes.size(), path);
+  RenderResult r = image_detail::read_render_memory(data, bytes.size(), path);
+  // a lucent render at the ladder's seed holds the rungs' own samples (the same numbers for the
+  // same pixel, index and dimension): its error against them is hidden
+  if (!r.sampler.empty() && r.seed == ladder_seed)
+    throw Error(path + ": rendered with seed " + std::to_string(r.seed) +
+                ", the ladder's: its samples include the rungs' own, which would hide their "
+                "error; render it with another --seed, or let converge render it "
+                "(--reference-spp, --save-reference)");
+  return r;
 }
 
 }  // namespace

@@ -270,14 +270,10 @@ int render_with(const RenderArgs& a) {
   if (range)
     lucent::write_render_part(a.output, lucent::make_part(*renderer, *range, a.scene));
   else if (lucent::io::lower_extension(a.output) == ".exr") {
-    // with var.R/G/B and n layers (docs/compare.md), and the key of its random numbers, by which
-    // `lucent converge` refuses a reference that would replay its ladder's samples
-    lucent::image_detail::ExrExtras extras;
-    extras.attributes = {
-        {"lucent.seed", std::to_string(scene.integrator.seed)},
-        {"lucent.sampler", lucent::type_name(scene.integrator.sampler)},
-    };
-    lucent::image_detail::write_render_exr(a.output, r, extras);
+    // with var.R/G/B and n layers (docs/compare.md), and the key of its random numbers
+    // (RenderResult::seed, sampler), by which `lucent converge` refuses a reference that would
+    // replay its ladder's samples
+    lucent::write_render_exr(a.output, r);
   } else
     lucent::write_image(a.output, r.mean, display);
   if (r.nonfinite > 0)

@@ -22,6 +22,12 @@ enum class Format { Png, Jpeg, Bmp, Tga, Hdr, Pfm, Exr };
 
 const char* format_name(Format f);
 
+/// PNG, JPEG, BMP and TGA hold display values (tone-mapped, encoded, clipped: 8 or 16 bits);
+/// OpenEXR, PFM and Radiance HDR linear radiance.
+inline bool is_display_format(Format f) {
+  return f != Format::Exr && f != Format::Pfm && f != Format::Hdr;
+}
+
 #ifndef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
 /// Upper bound on width * height of any image lucent reads (the largest film, 16384 x 16384).
 constexpr std::uint64_t kMaxImagePixels = 16384ull * 16384ull;

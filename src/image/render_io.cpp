@@ -4,9 +4,11 @@
 #include <tinyexr.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "core/file_io.hpp"
@@ -18,7 +20,10 @@
 namespace lucent {
 
 void write_render_exr(const std::string& path, const RenderResult& r) {
-  image_detail::write_render_exr(path, r, {});
+  image_detail::ExrExtras extras;
+  if (!r.sampler.empty())
+    extras.attributes = {{"lucent.seed", std::to_string(r.seed)}, {"lucent.sampler", r.sampler}};
+  image_detail::write_render_exr(path, r, extras);
 }
 
 namespace image_detail {
@@ -129,6 +134,18 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
   }
   const int w = exr.width, h = exr.height;
   const size_t n = static_cast<size_t>(w) * h;
+  // the key of its random numbers, when a lucent render wrote it (write_render_exr)
+  auto seed = exr.attributes.find("lucent.seed"), sampler = exr.attributes.find("lucent.sampler");
+  if (seed != exr.attributes.end() && sampler != exr.attributes.end()) {
+    std::uint32_t v = 0;
+    const char *b = seed->second.data(), *e = b + seed->second.size();
+    auto [end, ec] = std::from_chars(b, e, v);
+    if (ec != std::errc() || end != e || b == e)
+      throw Error(path + ": attribute lucent.seed: '" + seed->second +
+                  "' is not a seed (an integer from 0 to 4294967295)");
+    r.seed = v;
+    r.sampler = sampler->second;
+  }
   r.mean = Image{w, h, std::vector<float>(n * 3)};
   for (int c = 0; c < 3; ++c)
     for (size_t i = 0; i < n; ++i) r.mean.rgb[i * 3 + c] = exr.planes[rgb[c]][i];

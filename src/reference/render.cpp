@@ -13,6 +13,7 @@
 
 #include "lucent/error.hpp"
 #include "lucent/reference.hpp"
+#include "lucent/types.hpp"
 #include "reference/camera/camera.hpp"
 #include "reference/integrator/integrator.hpp"
 #include "reference/integrator/light_tracer.hpp"
@@ -143,6 +144,8 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
   r.cancelled = cancelled;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.device = "reference (" + std::to_string(threads) + " thread" + (threads > 1 ? "s" : "") + ")";
+  r.seed = scene.integrator.seed;
+  r.sampler = type_name(scene.integrator.sampler);
   return r;
 }
 

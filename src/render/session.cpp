@@ -18,6 +18,7 @@
 #include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
 #include "lucent/error.hpp"
+#include "lucent/types.hpp"
 #include "render/adaptive.hpp"
 #include "render/device_scene.hpp"
 #include "render/features.hpp"
@@ -943,6 +944,8 @@ struct Renderer::Impl {
     r.seconds = render_seconds;
     r.build_options = build_options;
     r.cancelled = last_cancelled;
+    r.seed = scene->integrator.seed;
+    r.sampler = lucent::type_name(scene->integrator.sampler);
     for (const auto& w : workers) {
       if (w->program) {
         r.build_seconds = std::max(r.build_seconds, w->program->build_seconds);
