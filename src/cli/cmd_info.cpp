@@ -163,6 +163,11 @@ int run_info_command() {
               options.fast_math ? "fast (-cl-fast-relaxed-math)" : "IEEE");
   std::printf("  build options       %s\n",
               render_detail::build_options(scene, packed, options).c_str());
+  // what each device's build adds (render_detail::device_defines): info opens no device
+  DeviceInfo cpu;
+  cpu.type = "CPU";
+  std::printf("  device options      %s on CPU devices, none on others\n",
+              render_detail::device_defines(cpu).substr(1).c_str());
   return 0;
 }
 
