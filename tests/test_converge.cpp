@@ -184,9 +184,15 @@ TEST(Converge, SettingSyntax) {
   EXPECT_TRUE(opt.specialize);
   lucent::parse_converge_setting("no-specialize").apply(scene, opt);
   EXPECT_FALSE(opt.specialize);
+  EXPECT_EQ(scene.integrator.dielectric_splits, 2);
+  lucent::parse_converge_setting("splits=0").apply(scene, opt);
+  EXPECT_EQ(scene.integrator.dielectric_splits, 0);
+  lucent::parse_converge_setting("splits=4").apply(scene, opt);
+  EXPECT_EQ(scene.integrator.dielectric_splits, 4);
 
-  for (const char* bad : {"", "bogus", "max_depth=0", "max_depth=x", "max_depth", "fast-math=1",
-                          "filter=round", "filter=box:-1", "default+nope"}) {
+  for (const char* bad :
+       {"", "bogus", "max_depth=0", "max_depth=x", "max_depth", "fast-math=1", "filter=round",
+        "filter=box:-1", "default+nope", "splits=5", "splits=-1", "splits"}) {
     try {
       lucent::parse_converge_setting(bad);
       ADD_FAILURE() << "accepted '" << bad << "'";

@@ -139,4 +139,26 @@ TEST(Features, CausticsOnlyWithADeltaSurface) {
       has(features_of(scene(R"({"type": "rough_dielectric", "ior": 1})")), "LC_HAS_CAUSTICS"));
 }
 
+// integrator.dielectric_splits: compiled in only where a path-traced scene has a smooth dielectric
+// (the one BSDF that chooses between delta lobes) and the knob is on (default 2).
+TEST(Features, SplittingOnlyWithSmoothGlass) {
+  auto scene = [](const std::string& material, const std::string& integrator) {
+    std::string j = kDiffuseScene;
+    auto replace = [&j](const std::string& from, const std::string& to) {
+      j.replace(j.find(from), from.size(), to);
+    };
+    replace(R"("max_depth": 4)", R"("max_depth": 4)" + integrator);
+    replace(R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]})",
+            R"("w": {"type": "diffuse", "albedo": [0.7, 0.6, 0.5]}, "x": )" + material);
+    replace(R"("radius": 0.5, "material": "w")", R"("radius": 0.5, "material": "x")");
+    return j;
+  };
+  const std::string glass = R"({"type": "dielectric", "ior": 1.5})";
+  EXPECT_TRUE(has(features_of(scene(glass, "")), "LC_HAS_SPLITTING"));
+  EXPECT_FALSE(has(features_of(scene(glass, R"(, "dielectric_splits": 0)")), "LC_HAS_SPLITTING"));
+  EXPECT_FALSE(has(features_of(scene(R"({"type": "mirror"})", "")), "LC_HAS_SPLITTING"));
+  EXPECT_FALSE(has(features_of(scene(R"({"type": "rough_dielectric", "ior": 1.5})", "")),
+                   "LC_HAS_SPLITTING"));
+}
+
 }  // namespace

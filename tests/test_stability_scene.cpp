@@ -352,12 +352,16 @@ TEST(StabilityMaterial, GlassOfIor1IsInvisible) {
 }
 
 // Kernel against the independent reference (same two-sample test, reference with another seed).
+// The reference with 4 times the kernel's samples: the kernel follows both lobes of the glass at
+// its first two interfaces (integrator.dielectric_splits), the reference one chosen at random, so
+// at the same spp some pixels' rare lobe choices are drawn too seldom in the reference for its
+// variance estimate to hold (3 of 576 pixels failed the z-test, |z| up to 6.7, with 128 each).
 void expect_kernel_matches_reference(const Scene& scene, int spp) {
   RenderResult k = render(scene, spp, 10);
   Scene rs = scene;
   rs.integrator.seed = 11;
   lucent::ReferenceOptions ro;
-  ro.spp = spp;
+  ro.spp = 4 * spp;
   ro.threads = 2;
   RenderResult r = lucent::render_reference(rs, ro);
   EXPECT_SAME_IMAGE(k, r, "A = kernel, B = reference");

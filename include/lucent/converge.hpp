@@ -29,6 +29,7 @@ namespace lucent {
 ///   sampler=NAME       integrator.sampler: sobol or independent
 ///   clamp=X            integrator.clamp (X >= 0; 0: off)
 ///   caustics / no-caustics  integrator.caustics on / off
+///   splits=N           integrator.dielectric_splits (0 .. limits::kMaxDielectricSplits)
 ///   adaptive           each rung an adaptive render (Renderer::render_adaptive) whose samples
 ///                      average the rung's spp; rungs below the pilot are skipped
 ///   min-spp=N          adaptive: the pilot's samples per pixel (default 64)
@@ -48,6 +49,7 @@ struct ConvergeSetting {
   int sampler = -1;          ///< -1: the scene's; else a SamplerType
   double clamp = -1;         ///< < 0: the scene's; else integrator.clamp
   int caustics = -1;         ///< -1: the scene's; 0 off; 1 on (integrator.caustics)
+  int splits = -1;           ///< -1: the scene's; else integrator.dielectric_splits
   bool adaptive = false;     ///< rungs are adaptive renders of the rung's mean spp
   int min_spp = 0;           ///< adaptive: the pilot (0: AdaptiveOptions' default)
   double target_error = 0;   ///< > 0: one adaptive render to this relMSE

@@ -11,6 +11,10 @@ inline constexpr int kMaxImageSize = 16384;
 inline constexpr int kMaxSpp = 1 << 24;
 /// Integrator max_depth and rr_depth: 1 .. kMaxDepth path segments.
 inline constexpr int kMaxDepth = 100000;
+/// integrator.dielectric_splits: 0 .. kMaxDielectricSplits smooth-glass vertices per camera path
+/// at which both lobes are followed (up to 2^N branches per camera sample; the kernel's stack of
+/// waiting branches, LC_MAX_SPLITS, holds N).
+inline constexpr int kMaxDielectricSplits = 4;
 /// Pixel filter radius: (0, kMaxFilterRadius] pixels.
 inline constexpr double kMaxFilterRadius = 8;
 /// Random seed: 0 .. kMaxSeed (32 bits).

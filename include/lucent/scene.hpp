@@ -70,6 +70,12 @@ struct Integrator {
   /// camera) come from light tracing instead of the camera path (docs/rendering-model.md,
   /// "Caustics by light tracing"). Pinhole and thin-lens cameras.
   bool caustics = false;
+  /// path: at the first N smooth-dielectric vertices of a camera path (glass: a delta reflection
+  /// with probability F, a delta refraction with 1 - F) both lobes are followed, each weighted
+  /// by its probability, instead of one chosen at random (docs/rendering-model.md, "Integrators").
+  /// 0: off. The same expected image; less noise where the camera sees light through glass, at
+  /// up to 2^N branches per camera sample.
+  int dielectric_splits = 2;
 };
 
 enum class MaterialType { LC_MATERIAL_TYPES(LUCENT_REGISTRY_ENUMERATOR) };

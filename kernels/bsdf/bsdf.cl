@@ -36,7 +36,9 @@ typedef struct {
   float3 weight; /* f |cos| / pdf, or the delta weight */
   float pdf;     /* solid-angle pdf, 0 for delta */
   int delta;
-  float eta; /* refraction: eta_t / eta_o (weight has its 1 / eta^2); 1 otherwise */
+  float eta;  /* refraction: eta_t / eta_o (weight has its 1 / eta^2); 1 otherwise */
+  float prob; /* the probability of choosing this lobe among the BSDF's delta lobes (smooth glass:
+               * F or 1 - F; the weight has its 1 / prob); 1 for the other BSDFs */
 } lc_bsdf_sample;
 
 /* What the Whitted integrator (integrator/whitted.cl) takes of a BSDF: a lambertian part lit by
@@ -128,6 +130,7 @@ static inline int bsdf_sample(const lc_bsdf* b, float3 wo, float ul, float u1, f
   bs->delta = 0;
   bs->pdf = 0.0f;
   bs->eta = 1.0f;
+  bs->prob = 1.0f;
   if (wo.z <= 0.0f) return 0;
   LC_MATERIAL_TYPES(LC_BSDF_SAMPLE)
   return 0;

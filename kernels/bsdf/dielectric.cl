@@ -25,10 +25,12 @@ static inline int bsdf_dielectric_sample(const lc_bsdf* b, float3 wo, float ul, 
   if (ul < F) {
     bs->wi = (float3)(-wo.x, -wo.y, wo.z);
     bs->weight = (float3)(1.0f);
+    bs->prob = F;
   } else {
     bs->wi = (float3)(-wo.x / eta, -wo.y / eta, -cos_t);
     bs->weight = lc_load3p(b->p.dielectric.tint) / (eta * eta);
     bs->eta = eta;
+    bs->prob = 1.0f - F;
   }
   return 1;
 }

@@ -18,6 +18,18 @@ static inline float3 path_clamp(float3 c, float bound) {
   return c;
 }
 
+#ifdef LC_HAS_SPLITTING
+/* integrator.dielectric_splits (docs/rendering-model.md, "Integrators"): a branch that waits while
+ * the camera path follows the other lobe of a split vertex */
+#define LC_MAX_SPLITS 4 /* limits::kMaxDielectricSplits */
+typedef struct {
+  lc_real3 o, d, prev_p;
+  float3 beta;
+  lc_uint depth;  /* of the vertex the ray will hit */
+  lc_uint splits; /* splits along the branch so far */
+} lc_path_branch;
+#endif
+
 static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng* rng,
                                      lc_uint* rays) {
   __global const lc_params* P = s->params;
@@ -32,7 +44,15 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
   const int caustics = (P->flags & LC_FLAG_CAUSTICS) != 0;
   int first_n = 0;
 #endif
-  for (lc_uint depth = 0;; ++depth) {
+  lc_uint depth = 0;
+#ifdef LC_HAS_SPLITTING
+  lc_path_branch waiting[LC_MAX_SPLITS];
+  int nwaiting = 0;
+  lc_uint splits = 0;
+  const lc_uint max_splits = min(P->splits, (lc_uint)LC_MAX_SPLITS);
+  for (;;) {
+#endif
+  for (;; ++depth) {
     lc_hit hit;
     ++*rays;
     const int no_mis = (P->flags & LC_FLAG_NO_MIS) != 0;
@@ -92,7 +112,39 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
 
     /* continue the path */
     lc_bsdf_sample bs;
+#ifdef LC_HAS_SPLITTING
+    /* a BSDF that chooses between delta lobes (smooth glass: reflection with probability F,
+     * refraction with 1 - F), at one of the first max_splits such vertices of the branch: both
+     * lobes, each weighted by its probability; the refraction's branch waits */
+    int split = 0;
+    if (splits < max_splits && (lobes & LC_BSDF_DELTA)) {
+      lc_bsdf_sample bt;
+      if (bsdf_sample(&b, wo_l, 0.0f, u_bsdf.x, u_bsdf.y, &bs) &&
+          bsdf_sample(&b, wo_l, LC_ONE_MINUS_EPSILON, u_bsdf.x, u_bsdf.y, &bt) &&
+          bs.prob < 1.0f && bt.prob < 1.0f) {
+        split = 1;
+        ++splits;
+        bs.weight *= bs.prob;
+        lc_real3 wt = normalize(lc_real3_from_float3(frame_to_world(&fr, bt.wi)));
+        int t_transmit = bt.wi.z < 0.0f;
+        lc_real t_side = dot(wt, it.ng);
+        float3 t_beta = beta * bt.weight * bt.prob;
+        if ((t_transmit ? t_side < LC_REAL(0.0) : t_side > LC_REAL(0.0)) &&
+            lc_max3(t_beta) > 0.0f) {
+          lc_path_branch* w = &waiting[nwaiting++];
+          w->o = t_transmit ? lc_spawn_origin(it.p, it.perr, -it.ng) : o;
+          w->d = wt;
+          w->prev_p = o;
+          w->beta = t_beta;
+          w->depth = depth + 1;
+          w->splits = splits;
+        }
+      }
+    }
+    if (!split && !bsdf_sample(&b, wo_l, u_light.w, u_bsdf.x, u_bsdf.y, &bs)) break;
+#else
     if (!bsdf_sample(&b, wo_l, u_light.w, u_bsdf.x, u_bsdf.y, &bs)) break;
+#endif
     lc_real3 wi = normalize(lc_real3_from_float3(frame_to_world(&fr, bs.wi)));
     int transmit = bs.wi.z < 0.0f;
     lc_real side = dot(wi, it.ng);
@@ -116,6 +168,20 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
       beta /= q;
     }
   }
+#ifdef LC_HAS_SPLITTING
+    /* the next waiting branch: it left a delta vertex (no MIS on what it hits) */
+    if (nwaiting == 0) break;
+    lc_path_branch* w = &waiting[--nwaiting];
+    ray.o = w->o;
+    ray.d = w->d;
+    prev_p = w->prev_p;
+    beta = w->beta;
+    depth = w->depth;
+    splits = w->splits;
+    prev_delta = 1;
+    prev_pdf = 0.0f;
+  }
+#endif
   return L;
 }
 

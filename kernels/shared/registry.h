@@ -143,7 +143,8 @@
   X(LC_HAS_TEXTURES, "textured materials")                \
   X(LC_HAS_THIN_LENS, "thin-lens depth of field")         \
   X(LC_HAS_CLAMP, "clamped path contributions (integrator.clamp)")       \
-  X(LC_HAS_CAUSTICS, "caustics by light tracing (integrator.caustics)")
+  X(LC_HAS_CAUSTICS, "caustics by light tracing (integrator.caustics)")   \
+  X(LC_HAS_SPLITTING, "both lobes of smooth glass on camera paths (integrator.dielectric_splits)")
 
 /* ------------------------------------------------------------------------------------------ */
 /* Scene buffers: X(name, element type, what)                                                  */

@@ -308,8 +308,10 @@ typedef struct LC_ALIGN16 lc_params {
   lc_uint sampler;    /* LC_SAMPLER_*                                       */
   float clamp;        /* path: bound of a scattered contribution (0: off)   */
   lc_uint work_items; /* 0: every pixel; else the length of the work list  */
-} lc_params;          /* total: 144 bytes */
-LC_STATIC_ASSERT(sizeof(lc_params) == 144, params_size);
+  lc_uint splits;     /* path: smooth-dielectric vertices split per branch  */
+  lc_uint pad0, pad1, pad2;
+} lc_params; /* total: 160 bytes */
+LC_STATIC_ASSERT(sizeof(lc_params) == 160, params_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, width) == 64, params_width);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, num_triangles) == 96, params_num_triangles);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, env_light) == 112, params_env_light);

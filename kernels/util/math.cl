@@ -47,6 +47,7 @@ typedef float4 lc_real4;
 #endif
 
 #define LC_PI 3.14159265358979323846f
+#define LC_ONE_MINUS_EPSILON 0x1.fffffep-1f /* the largest float below 1 */
 #define LC_INV_PI 0.31830988618379067154f
 #define LC_INF INFINITY
 

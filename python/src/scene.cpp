@@ -353,7 +353,10 @@ void bind_scene(py::module_& m) {
       .def_readwrite("clamp", &Integrator::clamp,
                      "the largest sample contribution (0: off); biased, lower variance")
       .def_readwrite("caustics", &Integrator::caustics,
-                     "path: caustic paths by light tracing (pinhole cameras)");
+                     "path: caustic paths by light tracing (pinhole and thin-lens cameras)")
+      .def_readwrite("dielectric_splits", &Integrator::dielectric_splits,
+                     "path: smooth-glass vertices per camera path at which both lobes are "
+                     "followed (0 .. 4; default 2; 0: off)");
   enum_property(integrator, "type", &Integrator::type);
   enum_property(integrator, "sampler", &Integrator::sampler);
 

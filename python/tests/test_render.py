@@ -373,6 +373,8 @@ def test_samplers_clamp_and_adaptive(renderer, small_scene):
     assert (clamped <= images["independent"] + 1e-6).all()
 
     small_scene.integrator.clamp = 0
+    assert small_scene.integrator.dielectric_splits == 2  # the default
+    small_scene.integrator.dielectric_splits = 0
     renderer.set_scene(small_scene)
     renderer.reset()
     renderer.render_adaptive(target_error=0.05, min_spp=8, max_spp=256)

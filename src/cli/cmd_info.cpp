@@ -94,6 +94,7 @@ int run_info_command() {
     std::printf("clamp         %g\n", scene.integrator.clamp);
   else
     std::printf("clamp         off\n");
+  std::printf("glass splits  %d\n", scene.integrator.dielectric_splits);
 
   // the shape list as written: its entries by type (OBJ files apart), then the primitives
   std::map<ShapeType, std::size_t> by_shape;

@@ -50,6 +50,7 @@ struct SamplingArgs {
   std::string sampler;      ///< "" : the scene's integrator.sampler
   double clamp = -1;        ///< < 0: the scene's integrator.clamp
   int caustics = -1;        ///< < 0: the scene's integrator.caustics; 0 off; 1 on
+  int splits = -1;          ///< < 0: the scene's integrator.dielectric_splits
   double target_error = 0;  ///< > 0: adaptive sampling to this relMSE
   int min_spp = 0;          ///< adaptive: the pilot (0: the default)
 };

@@ -22,6 +22,10 @@ void add_sampling_options(CLI::App* cmd, SamplingArgs& a, bool adaptive) {
       "Caustic paths by light tracing (integrator.caustics; path integrator)");
   cmd->add_flag_callback(
       "--no-caustics", [&a] { a.caustics = 0; }, "Caustic paths by the camera path alone");
+  cmd->add_option("--dielectric-splits", a.splits,
+                  "Smooth-glass vertices per camera path at which both reflection and refraction "
+                  "are followed (overrides integrator.dielectric_splits; default 2; 0: off)")
+      ->check(CLI::Range(0, limits::kMaxDielectricSplits));
   if (!adaptive) return;
   cmd->add_option("--target-error", a.target_error,
                   "Adaptive sampling: render until the image's estimated relMSE is at most this, "
@@ -42,6 +46,7 @@ void apply_sampling_options(const SamplingArgs& a, Scene& scene) {
   }
   if (a.clamp >= 0) scene.integrator.clamp = a.clamp;
   if (a.caustics >= 0) scene.integrator.caustics = a.caustics == 1;
+  if (a.splits >= 0) scene.integrator.dielectric_splits = a.splits;
 }
 
 AdaptiveOptions adaptive_options(const SamplingArgs& a, int max_spp, double time_limit) {

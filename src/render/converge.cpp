@@ -21,13 +21,17 @@ namespace lucent {
 
 namespace {
 
-int parse_positive_int(const std::string& knob, const std::string& value, int max) {
+int parse_int(const std::string& knob, const std::string& value, int min, int max) {
   char* end = nullptr;
   long v = std::strtol(value.c_str(), &end, 10);
-  if (value.empty() || *end != '\0' || v < 1 || v > max)
-    throw Error("setting " + knob + "=" + value + ": expected an integer from 1 to " +
-                std::to_string(max));
+  if (value.empty() || *end != '\0' || v < min || v > max)
+    throw Error("setting " + knob + "=" + value + ": expected an integer from " +
+                std::to_string(min) + " to " + std::to_string(max));
   return static_cast<int>(v);
+}
+
+int parse_positive_int(const std::string& knob, const std::string& value, int max) {
+  return parse_int(knob, value, 1, max);
 }
 
 /// Least-squares slope of log(y) against log(x) over the points where both are > 0.
@@ -118,6 +122,7 @@ void ConvergeSetting::apply(Scene& scene, RenderOptions& options) const {
   if (sampler >= 0) scene.integrator.sampler = static_cast<SamplerType>(sampler);
   if (clamp >= 0) scene.integrator.clamp = clamp;
   if (caustics >= 0) scene.integrator.caustics = caustics == 1;
+  if (splits >= 0) scene.integrator.dielectric_splits = splits;
 }
 
 ConvergeSetting parse_converge_setting(const std::string& text) {
@@ -189,6 +194,8 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
       s.sampler = static_cast<int>(*t);
     } else if (key == "clamp") {
       s.clamp = parse_number(knob, value, 0, false);
+    } else if (key == "splits") {
+      s.splits = parse_int(key, value, 0, limits::kMaxDielectricSplits);
     } else if (key == "caustics" || key == "no_caustics") {
       no_value();
       s.caustics = key == "caustics" ? 1 : 0;
@@ -212,7 +219,8 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
                   "max_depth=N, rr_depth=N, filter=" +
                   type_names<FilterType>("|") +
                   "[:R], integrator=NAME, sampler=" + type_names<SamplerType>("|") +
-                  ", clamp=X, caustics, no-caustics, adaptive, min-spp=N, target-error=E, "
+                  ", clamp=X, caustics, no-caustics, splits=N, adaptive, min-spp=N, "
+                  "target-error=E, "
                   "joined by +)");
     }
   }

@@ -58,8 +58,10 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
   }
   const bool clamped = scene.integrator.clamp > 0 && scene.integrator.type == IntegratorType::Path;
   const bool caustics = (packed.params.flags & LC_FLAG_CAUSTICS) != 0;  // pack_scene decides
+  // a smooth dielectric (the only BSDF that chooses between delta lobes) on a path-traced scene
+  const bool splitting = packed.params.splits > 0 && material[LC_MAT_DIELECTRIC];
   const bool other[] = {smooth,  uvs && textured, textured, scene.camera.aperture > 0,
-                        clamped, caustics};
+                        clamped, caustics,        splitting};
 #define LUCENT_COUNT(feature, what) +1
   static_assert(sizeof(other) / sizeof(other[0]) == 0 LC_OTHER_FEATURES(LUCENT_COUNT),
                 "one condition per LC_OTHER_FEATURES entry, in its order");

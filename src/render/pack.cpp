@@ -83,6 +83,9 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
       (scene.integrator.caustics && scene.integrator.type == IntegratorType::Path ? LC_FLAG_CAUSTICS
                                                                                   : 0u);
   P.sampler = static_cast<lc_uint>(scene.integrator.sampler);
+  P.splits = scene.integrator.type == IntegratorType::Path
+                 ? static_cast<lc_uint>(scene.integrator.dielectric_splits)
+                 : 0u;
   // a positive clamp stays positive in float (0 is off)
   P.clamp = scene.integrator.clamp > 0
                 ? std::max(static_cast<float>(scene.integrator.clamp), FLT_MIN)

@@ -52,7 +52,7 @@ void parse_integrator(const JsonReader& r, const json& j, SceneBuilder& b) {
   const std::string p = "/integrator";
   r.check_keys(j, p,
                {"type", "max_depth", "rr_depth", "spp", "seed", "ao_distance", "mis", "sampler",
-                "clamp", "caustics"});
+                "clamp", "caustics", "dielectric_splits"});
   Integrator in = b.scene().integrator;
   if (j.contains("type")) in.type = r.type<IntegratorType>(j["type"], p + "/type");
   if (j.contains("max_depth"))
@@ -67,6 +67,9 @@ void parse_integrator(const JsonReader& r, const json& j, SceneBuilder& b) {
   if (j.contains("sampler")) in.sampler = r.type<SamplerType>(j["sampler"], p + "/sampler");
   if (j.contains("clamp")) in.clamp = r.number(j["clamp"], p + "/clamp");
   if (j.contains("caustics")) in.caustics = r.boolean(j["caustics"], p + "/caustics");
+  if (j.contains("dielectric_splits"))
+    in.dielectric_splits = static_cast<int>(
+        r.integer(j["dielectric_splits"], p + "/dielectric_splits", rules::kSplits));
   b.set_integrator(in);
 }
 

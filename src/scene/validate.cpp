@@ -171,6 +171,7 @@ void validate_integrator(const Integrator& in, const Reporter& at) {
   check_non_negative(at.at("ao_distance"), in.ao_distance);  // 0: unbounded
   check_type(at.at("sampler"), in.sampler);
   check_non_negative(at.at("clamp"), in.clamp);  // 0: off
+  check_range(at.at("dielectric_splits"), in.dielectric_splits, rules::kSplits);
 }
 
 void validate_texture_size(const Texture& t, const Reporter& at) {

@@ -54,10 +54,11 @@ struct IntRange {
   long long lo, hi;
 };
 namespace rules {
-inline constexpr IntRange kImageSize{1, limits::kMaxImageSize};  ///< film width and height
-inline constexpr IntRange kSpp{1, limits::kMaxSpp};              ///< samples per pixel
-inline constexpr IntRange kDepth{1, limits::kMaxDepth};          ///< max_depth, rr_depth
-inline constexpr IntRange kSeed{0, limits::kMaxSeed};            ///< the 32-bit seed
+inline constexpr IntRange kImageSize{1, limits::kMaxImageSize};      ///< film width and height
+inline constexpr IntRange kSpp{1, limits::kMaxSpp};                  ///< samples per pixel
+inline constexpr IntRange kDepth{1, limits::kMaxDepth};              ///< max_depth, rr_depth
+inline constexpr IntRange kSeed{0, limits::kMaxSeed};                ///< the 32-bit seed
+inline constexpr IntRange kSplits{0, limits::kMaxDielectricSplits};  ///< dielectric_splits
 /// A vertex index of a mesh of n positions.
 inline IntRange vertex_index(std::size_t n) { return {0, static_cast<long long>(n) - 1}; }
 }  // namespace rules
