@@ -26,26 +26,6 @@ CompareArgs& compare_args() {
   return a;
 }
 
-/// An input image, read once, and whether its format holds display values (PNG, JPEG, BMP, TGA:
-/// tone-mapped, encoded, clipped) rather than linear radiance (EXR, PFM, HDR).
-struct Input {
-  RenderResult render;
-  bool display = false;
-  std::string format;
-};
-
-Input read_input(const std::string& path) {
-  const std::string bytes = io::read_file(path, image_detail::image_read_spec());
-  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-  const image_detail::Probe p =
-      image_detail::probe_image(data, bytes.size(), path, image_detail::kMaxImagePixels);
-  Input in;
-  in.display = image_detail::is_display_format(p.format);
-  in.format = image_detail::format_name(p.format);
-  in.render = image_detail::read_render_memory(data, bytes.size(), path);
-  return in;
-}
-
 }  // namespace
 
 CLI::App* add_compare_command(CLI::App& app) {
@@ -77,17 +57,18 @@ int run_compare_command() {
   for (const std::string& in : {a.a, a.b})
     if (!a.zmap.empty() && io::same_file(a.zmap, in))
       throw Error(a.zmap + ": is an input of the comparison; refusing to overwrite it");
-  Input ia = read_input(a.a), ib = read_input(a.b);
-  // a display image against a linear one compares the display transform, not the renders
-  if (ia.display != ib.display) {
-    const Input& d = ia.display ? ia : ib;
-    throw Error((ia.display ? a.a : a.b) + ": a " + d.format +
+  image_detail::Format fa, fb;
+  const RenderResult ra = image_detail::read_render(a.a, &fa),
+                     rb = image_detail::read_render(a.b, &fb);
+  // a display image (PNG, JPEG, BMP, TGA: tone-mapped, encoded, clipped) against a linear one
+  // compares the display transform, not the renders
+  const bool display_a = image_detail::is_display_format(fa);
+  if (display_a != image_detail::is_display_format(fb))
+    throw Error((display_a ? a.a : a.b) + ": a " + image_detail::format_name(display_a ? fa : fb) +
                 " image holds display values (tone-mapped, clipped), and " +
-                (ia.display ? a.b : a.a) +
+                (display_a ? a.b : a.a) +
                 " linear radiance: compare two linear images (.exr, .pfm, .hdr; lucent render "
                 "-o x.exr), or two display images");
-  }
-  const RenderResult &ra = ia.render, &rb = ib.render;
   if (ra.mean.width != rb.mean.width || ra.mean.height != rb.mean.height)
     throw Error(a.b + ": size " + std::to_string(rb.mean.width) + "x" +
                 std::to_string(rb.mean.height) + " differs from " + a.a + " (" +

@@ -78,18 +78,15 @@ void write_text(const std::string& path, const std::string& text) {
 // The --reference image, read once: a linear image, and not a lucent render at the ladder's own
 // seed.
 RenderResult read_reference(const std::string& path, std::uint32_t ladder_seed) {
-  const std::string bytes = io::read_file(path, image_detail::image_read_spec());
-  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  image_detail::Format format;
+  RenderResult r = image_detail::read_render(path, &format);
   // an 8-bit (or 16-bit PNG) image holds display values, tone-mapped and clipped: every relMSE
   // against it would measure the display transform, not the render's error
-  const image_detail::Probe p =
-      image_detail::probe_image(data, bytes.size(), path, image_detail::kMaxImagePixels);
-  if (image_detail::is_display_format(p.format))
-    throw Error(path + ": a " + image_detail::format_name(p.format) +
+  if (image_detail::is_display_format(format))
+    throw Error(path + ": a " + image_detail::format_name(format) +
                 " image holds display values (tone-mapped, clipped), not radiance: give a .exr, "
                 ".pfm or .hdr reference (lucent render SCENE --seed S -o ref.exr, S not the "
                 "scene's seed)");
-  RenderResult r = image_detail::read_render_memory(data, bytes.size(), path);
   // a lucent render at the ladder's seed holds the rungs' own samples (the same numbers for the
   // same pixel, index and dimension): its error against them is hidden
   if (!r.sampler.empty() && r.seed == ladder_seed)

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -102,6 +103,12 @@ struct ExrChannels {
 /// The header's custom attributes of type string, by name.
 std::map<std::string, std::string> exr_string_attributes(const EXRHeader& header);
 
+/// A string attribute's whole unsigned decimal number of at most `max`; throws lucent::Error
+/// "<path>: attribute <what>: invalid number '<s>'".
+std::uint64_t parse_attribute_u64(const std::string& path, const std::string& what,
+                                  const std::string& s,
+                                  std::uint64_t max = std::numeric_limits<std::uint64_t>::max());
+
 /// Reads every channel of a scanline or tiled single-part OpenEXR held in memory.
 ExrChannels read_exr_channels(const unsigned char* data, std::size_t size, const std::string& path,
                               std::uint64_t max_pixels);
@@ -127,6 +134,9 @@ void write_render_exr(const std::string& path, const RenderResult& r, const ExrE
 /// image decode_image reads (variance and samples left empty).
 RenderResult read_render_memory(const unsigned char* data, std::size_t size,
                                 const std::string& path);
+
+/// read_render() that also says the file's format (decided from its bytes, which are read once).
+RenderResult read_render(const std::string& path, Format* format);
 
 /// sRGB-encoded value in [0, 1] to linear.
 double srgb_to_linear(double c);

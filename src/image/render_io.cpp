@@ -4,11 +4,10 @@
 #include <tinyexr.h>
 
 #include <algorithm>
-#include <charconv>
+#include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <string>
-#include <system_error>
 #include <vector>
 
 #include "core/file_io.hpp"
@@ -137,13 +136,8 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
   // the key of its random numbers, when a lucent render wrote it (write_render_exr)
   auto seed = exr.attributes.find("lucent.seed"), sampler = exr.attributes.find("lucent.sampler");
   if (seed != exr.attributes.end() && sampler != exr.attributes.end()) {
-    std::uint32_t v = 0;
-    const char *b = seed->second.data(), *e = b + seed->second.size();
-    auto [end, ec] = std::from_chars(b, e, v);
-    if (ec != std::errc() || end != e || b == e)
-      throw Error(path + ": attribute lucent.seed: '" + seed->second +
-                  "' is not a seed (an integer from 0 to 4294967295)");
-    r.seed = v;
+    r.seed = static_cast<std::uint32_t>(
+        parse_attribute_u64(path, "lucent.seed", seed->second, 0xffffffffu));
     r.sampler = sampler->second;
   }
   r.mean = Image{w, h, std::vector<float>(n * 3)};
@@ -168,6 +162,23 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
   }
   r.spp = most;
   return r;
+}
+
+RenderResult read_render(const std::string& path, Format* format) {
+  const std::string bytes = io::read_file(path, image_read_spec());
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  *format = probe_image(data, bytes.size(), path, kMaxImagePixels).format;
+  return read_render_memory(data, bytes.size(), path);
+}
+
+std::uint64_t parse_attribute_u64(const std::string& path, const std::string& what,
+                                  const std::string& s, std::uint64_t max) {
+  errno = 0;
+  char* end = nullptr;
+  const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
+  if (s.empty() || s[0] < '0' || s[0] > '9' || *end != '\0' || errno == ERANGE || v > max)
+    throw Error(path + ": attribute " + what + ": invalid number '" + s + "'");
+  return v;
 }
 
 }  // namespace image_detail

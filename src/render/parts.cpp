@@ -5,14 +5,12 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <limits>
 #include <map>
 
 #include "core/file_io.hpp"
@@ -37,17 +35,6 @@ const char* transfer_name(Transfer t) {
 }
 const char* tonemap_name(ToneMap t) {
   return t == ToneMap::Clamp ? "clamp" : t == ToneMap::Reinhard ? "reinhard" : "aces";
-}
-
-/// Parses a whole unsigned decimal number of at most `max`; throws naming the attribute.
-std::uint64_t parse_u64(const std::string& path, const std::string& what, const std::string& s,
-                        std::uint64_t max = std::numeric_limits<std::uint64_t>::max()) {
-  errno = 0;
-  char* end = nullptr;
-  const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
-  if (s.empty() || s[0] < '0' || s[0] > '9' || *end != '\0' || errno == ERANGE || v > max)
-    throw Error(path + ": attribute " + what + ": invalid number '" + s + "'");
-  return v;
 }
 
 double parse_double(const std::string& path, const std::string& what, const std::string& s) {
@@ -77,8 +64,9 @@ std::vector<SampleRange> parse_ranges(const std::string& path, const std::string
     const size_t colon = item.find(':');
     if (colon == std::string::npos)
       throw Error(path + ": attribute " + what + ": '" + item + "' is not a range A:B");
-    SampleRange r{parse_u64(path, what, item.substr(0, colon), 1ull << 32),
-                  parse_u64(path, what, item.substr(colon + 1), 1ull << 32)};
+    SampleRange r{
+        image_detail::parse_attribute_u64(path, what, item.substr(0, colon), 1ull << 32),
+        image_detail::parse_attribute_u64(path, what, item.substr(colon + 1), 1ull << 32)};
     if (r.end <= r.begin || (!out.empty() && r.begin < out.back().end))
       throw Error(path + ": attribute " + what + ": ranges must be non-empty, sorted and disjoint");
     out.push_back(r);
@@ -151,7 +139,8 @@ PartInfo info_from_attributes(const std::string& path,
   if (h.size() != 16 || h.find_first_not_of("0123456789abcdef") != std::string::npos)
     throw Error(path + ": attribute lucent.hash: invalid hash '" + h + "'");
   info.scene_hash = std::strtoull(h.c_str(), nullptr, 16);
-  info.seed = static_cast<std::uint32_t>(parse_u64(path, "lucent.seed", get("seed"), 0xffffffffu));
+  info.seed = static_cast<std::uint32_t>(
+      image_detail::parse_attribute_u64(path, "lucent.seed", get("seed"), 0xffffffffu));
   info.integrator = get("integrator");
   info.version = get("version");
   info.scene = get("scene");
@@ -161,8 +150,8 @@ PartInfo info_from_attributes(const std::string& path,
   if (unite(info.requested, info.samples) != info.requested)
     throw Error(path + ": attribute lucent.samples: " + ranges_text(info.samples) +
                 " lies outside the requested " + ranges_text(info.requested));
-  info.nonfinite = parse_u64(path, "lucent.nonfinite", get("nonfinite"));
-  info.rays = parse_u64(path, "lucent.rays", get("rays"));
+  info.nonfinite = image_detail::parse_attribute_u64(path, "lucent.nonfinite", get("nonfinite"));
+  info.rays = image_detail::parse_attribute_u64(path, "lucent.rays", get("rays"));
   info.seconds = parse_double(path, "lucent.seconds", get("seconds"));
   // display: transfer,gamma,exposure,tonemap
   const std::string& d = get("display");
