@@ -14,7 +14,7 @@ inline constexpr int kMaxDepth = 100000;
 /// integrator.dielectric_splits: 0 .. kMaxDielectricSplits smooth-glass vertices per camera path
 /// at which both lobes are followed (up to 2^N branches per camera sample; the kernel's stack of
 /// waiting branches, LC_MAX_SPLITS, holds N).
-inline constexpr int kMaxDielectricSplits = 4;
+inline constexpr int kMaxDielectricSplits = 4;  // = LC_MAX_SPLITS (kernels/shared/types.h)
 /// Pixel filter radius: (0, kMaxFilterRadius] pixels.
 inline constexpr double kMaxFilterRadius = 8;
 /// Random seed: 0 .. kMaxSeed (32 bits).

@@ -20,8 +20,7 @@ static inline float3 path_clamp(float3 c, float bound) {
 
 #ifdef LC_HAS_SPLITTING
 /* integrator.dielectric_splits (docs/rendering-model.md, "Integrators"): a branch that waits while
- * the camera path follows the other lobe of a split vertex */
-#define LC_MAX_SPLITS 4 /* limits::kMaxDielectricSplits */
+ * the camera path follows the other lobe of a split vertex (at most LC_MAX_SPLITS, shared/types.h) */
 typedef struct {
   lc_real3 o, d, prev_p;
   float3 beta;
@@ -119,9 +118,9 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     int split = 0;
     if (splits < max_splits && (lobes & LC_BSDF_DELTA)) {
       lc_bsdf_sample bt;
-      if (bsdf_sample(&b, wo_l, 0.0f, u_bsdf.x, u_bsdf.y, &bs) &&
+      if (bsdf_sample(&b, wo_l, 0.0f, u_bsdf.x, u_bsdf.y, &bs) && bs.prob < 1.0f &&
           bsdf_sample(&b, wo_l, LC_ONE_MINUS_EPSILON, u_bsdf.x, u_bsdf.y, &bt) &&
-          bs.prob < 1.0f && bt.prob < 1.0f) {
+          bt.prob < 1.0f) {
         split = 1;
         ++splits;
         bs.weight *= bs.prob;
@@ -129,6 +128,8 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
         int t_transmit = bt.wi.z < 0.0f;
         lc_real t_side = dot(wt, it.ng);
         float3 t_beta = beta * bt.weight * bt.prob;
+        /* the leak test and the origin of the continuation below; one helper for both measured
+         * 2% slower on course (the hot path's ray then computed before its throughput tests) */
         if ((t_transmit ? t_side < LC_REAL(0.0) : t_side > LC_REAL(0.0)) &&
             lc_max3(t_beta) > 0.0f) {
           lc_path_branch* w = &waiting[nwaiting++];

@@ -308,7 +308,8 @@ typedef struct LC_ALIGN16 lc_params {
   lc_uint sampler;    /* LC_SAMPLER_*                                       */
   float clamp;        /* path: bound of a scattered contribution (0: off)   */
   lc_uint work_items; /* 0: every pixel; else the length of the work list  */
-  lc_uint splits;     /* path: smooth-dielectric vertices split per branch  */
+  lc_uint splits;     /* path: smooth-dielectric vertices split per branch, */
+                      /* at most LC_MAX_SPLITS                              */
   lc_uint pad0, pad1, pad2;
 } lc_params; /* total: 160 bytes */
 LC_STATIC_ASSERT(sizeof(lc_params) == 160, params_size);
@@ -317,6 +318,10 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, num_triangles) == 96, params_num_triangl
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, env_light) == 112, params_env_light);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, filter) == 116, params_filter);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, sampler) == 132, params_sampler);
+
+/* lc_params.splits: the most (the path integrator's stack of waiting branches holds them);
+ * limits::kMaxDielectricSplits on the host, checked equal in src/render/pack.cpp */
+#define LC_MAX_SPLITS 4
 
 /* lc_params.flags */
 #define LC_FLAG_NO_MIS 1u   /* path: light sampling only for area lights (no BSDF-hit emission) */

@@ -6,6 +6,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "lucent/error.hpp"
+#include "lucent/limits.hpp"
 #include "scene/loaders.hpp"
 #include "scene/material_type.hpp"
 #include "scene/validate.hpp"
@@ -83,6 +84,8 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
       (scene.integrator.caustics && scene.integrator.type == IntegratorType::Path ? LC_FLAG_CAUSTICS
                                                                                   : 0u);
   P.sampler = static_cast<lc_uint>(scene.integrator.sampler);
+  static_assert(limits::kMaxDielectricSplits == LC_MAX_SPLITS,
+                "the kernel's stack of waiting branches holds the most splits a scene may ask");
   P.splits = scene.integrator.type == IntegratorType::Path
                  ? static_cast<lc_uint>(scene.integrator.dielectric_splits)
                  : 0u;
