@@ -10,6 +10,7 @@
 
 #include "lucent/compare.hpp"
 #include "lucent/reference.hpp"
+#include "lucent/session.hpp"
 #include "support.hpp"
 
 namespace {
@@ -53,6 +54,38 @@ TEST(DielectricSplits, SameImageLessNoise) {
       << variance_sum(split) << " against " << variance_sum(plain);
   lucent::Scene s = lucent::test::scene_from(glass_in_sky(0));
   s.integrator.seed = 7;
+  lucent::RenderOptions o;
+  o.spp = 1024;
+  lucent::CompareResult c = lucent::compare_images(split, lucent::test::render(s, o));
+  EXPECT_TRUE(c.passed) << c.summary();
+}
+
+// An adaptive render with a target error (Renderer::render_adaptive) renders its pilot without
+// splitting (docs/rendering-model.md, "Adaptive sampling"): the pilot's variances include the lobe
+// choice's and so bound those of the split samples that follow. So the plan, made from the pilots
+// alone, is the same with 2 splits as with none at the same seed (every pixel's count), while the
+// samples beyond the pilot split (the sphere's variance falls), and the image, which mixes unsplit
+// and split samples in each half, is unbiased: lucent compare against a uniform render without
+// splitting and another seed.
+TEST(DielectricSplits, AdaptivePilotIsUnsplit) {
+  auto adaptive = [](int splits) {
+    lucent::Renderer r(lucent::test::session_options());
+    r.set_scene(lucent::test::scene_from(glass_in_sky(splits)));
+    lucent::AdaptiveOptions ao;
+    ao.target_error = 2e-4;
+    r.render_adaptive(ao);
+    return r.result();
+  };
+  const RenderResult split = adaptive(2), plain = adaptive(0);
+  ASSERT_EQ(split.samples.size(), plain.samples.size());
+  EXPECT_TRUE(split.samples == plain.samples) << "the plans differ: the pilot was split";
+  RecordProperty("mean_spp", std::to_string(split.spp));
+  EXPECT_GT(split.spp, 2 * lucent::AdaptiveOptions{}.min_spp) << "no samples beyond the pilot";
+  EXPECT_LT(variance_sum(split), 0.5 * variance_sum(plain))
+      << variance_sum(split) << " against " << variance_sum(plain);
+
+  lucent::Scene s = lucent::test::scene_from(glass_in_sky(0));
+  s.integrator.seed = 11;
   lucent::RenderOptions o;
   o.spp = 1024;
   lucent::CompareResult c = lucent::compare_images(split, lucent::test::render(s, o));

@@ -24,6 +24,12 @@
 // samples only through the cost of tracing them; a render that completes its plan has none of
 // this. Non-finite samples are left out and counted, as in every render.)
 //
+// The pilot (A's, B's and C's) is rendered without glass splitting (integrator.dielectric_splits;
+// the session's unsplit passes), the samples after it with the scene's splits: splitting replaces
+// a lobe choice by its expectation, so the pilot's variances bound those of the split samples,
+// and the unbiasedness argument is unchanged (each of a half's samples, split or not, is an
+// unbiased sample of the pixel, and its count still reads only the other half's pilot).
+//
 // With a target error, the plan's scale comes from the model "relMSE of a pixel = v / n", which
 // holds for independent samples but over-predicts for Owen-scrambled Sobol samples (their error
 // falls faster). A third stream C (lc_stream_seed(seed, 2)) renders the same pilot on a sparse

@@ -496,10 +496,12 @@ struct Renderer::Impl {
           }
           lc_uint counters[LC_COUNTER_COUNT];
           auto tp = clock_type::now();
+          lc_params P = packed.params;
+          if (unsplit_passes) P.splits = 0;  // an adaptive pilot (run_adaptive)
           if (job.entries.empty())
-            w.pass(packed.params, job.begin, job.n, counters);
+            w.pass(P, job.begin, job.n, counters);
           else
-            w.pass_list(packed.params, job.entries, counters);
+            w.pass_list(P, job.entries, counters);
           double pass_time = seconds_since(tp);
           std::lock_guard<std::mutex> lock(cs.m);
           finish(w, job);
@@ -611,7 +613,8 @@ struct Renderer::Impl {
     bool piloted = false;
   };
   bool adaptive = false;
-  std::uint32_t pilot = 0;  // per pixel and half
+  bool unsplit_passes = false;  // passes render without glass splitting (an adaptive pilot)
+  std::uint32_t pilot = 0;      // per pixel and half
   /// A and B, then C: stream 2, the calibration's pilot (render_detail::calibrate_model) on
   /// calib_pixels only, never averaged into the image; its vectors stay empty until a render with
   /// a target needs it (a budget's plan has no use for the model's scale).
@@ -816,9 +819,14 @@ struct Renderer::Impl {
       calib_half.plan.assign(npix, 0u);
       for (std::size_t i : calib_pixels) calib_half.plan[i] = m;
     }
-    // the pilot: `pilot` samples in every pixel of both halves (and C's, above)
-    if (!render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress))
-      return progress();
+    // the pilot: `pilot` samples in every pixel of both halves (and C's, above), without glass
+    // splitting: its variances then bound those of the split samples that follow, which keeps
+    // room for the tails that no pilot sees where the glass is (docs/rendering-model.md)
+    unsplit_passes = true;
+    const bool piloted =
+        render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress);
+    unsplit_passes = false;
+    if (!piloted) return progress();
     for (int hi = 0; hi < 2; ++hi) {
       Half& h = halves[hi];
       if (h.piloted) continue;  // its samples are no longer only the pilot's
