@@ -4,6 +4,7 @@
 
 #include "lucent/error.hpp"
 #include "render/pack.hpp"
+#include "scene/material_type.hpp"
 
 namespace lucent::render_detail {
 
@@ -58,8 +59,13 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
   }
   const bool clamped = scene.integrator.clamp > 0 && scene.integrator.type == IntegratorType::Path;
   const bool caustics = (packed.params.flags & LC_FLAG_CAUSTICS) != 0;  // pack_scene decides
-  // a smooth dielectric (the only BSDF that chooses between delta lobes) on a path-traced scene
-  const bool splitting = packed.params.splits > 0 && material[LC_MAT_DIELECTRIC];
+  // a used BSDF that chooses between delta lobes (MaterialTypeDef::splits: smooth glass) on a
+  // path-traced scene
+  bool split_lobes = false;
+  for (size_t i = 0; i < scene.materials.size(); ++i)
+    split_lobes =
+        split_lobes || (used[i] && scene_detail::material_type_def(scene.materials[i].type).splits);
+  const bool splitting = packed.params.splits > 0 && split_lobes;
   const bool other[] = {smooth,  uvs && textured, textured, scene.camera.aperture > 0,
                         clamped, caustics,        splitting};
 #define LUCENT_COUNT(feature, what) +1

@@ -177,13 +177,14 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     scene_detail::warn(
         scene_detail::in_file(scene.path, "skipped " + std::to_string(p.skipped_triangles) +
                                               " degenerate or non-finite triangle(s)"));
-  // integrator.caustics: no surface that can scatter by a delta lobe (a mirror, smooth glass, a
-  // rough dielectric of ior 1), no caustic path: the kernel is built and run without light paths
+  // integrator.caustics: no surface that can scatter by a delta lobe (MaterialTypeDef::delta: a
+  // mirror, smooth glass, a rough dielectric of ior 1), no caustic path: the kernel is built and
+  // run without light paths
   if (P.flags & LC_FLAG_CAUSTICS) {
     auto delta = [&scene](lc_uint mi) {
       const Material& m = scene.materials[mi];
-      return m.type == MaterialType::Mirror || m.type == MaterialType::Dielectric ||
-             (m.type == MaterialType::RoughDielectric && static_cast<float>(m.ior) == 1.0f);
+      const auto is_delta = scene_detail::material_type_def(m.type).delta;
+      return is_delta && is_delta(m);
     };
     bool any = false;
     for (const lc_sphere& sp : p.spheres) any = any || delta(sp.material);

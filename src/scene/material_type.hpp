@@ -50,6 +50,12 @@ struct MaterialTypeDef {
   std::vector<MaterialParam> params;
   /// The device parameters (the union member of the type, shared/registry.h).
   void (*pack)(const Material& m, lc_material_params& p);
+  /// Whether a material of this type can scatter by a delta lobe (nullptr: never). A caustic
+  /// path needs such a surface: without one, integrator.caustics is dropped (pack_scene).
+  bool (*delta)(const Material& m) = nullptr;
+  /// Whether its BSDF chooses between two delta lobes, which integrator.dielectric_splits
+  /// follows both of (LC_HAS_SPLITTING: render_detail::kernel_features).
+  bool splits = false;
 };
 
 #define LUCENT_DECLARE_MATERIAL_TYPE(ID, Name, value, name, feature, file, params) \

@@ -12,7 +12,9 @@ const MaterialTypeDef& material_type_dielectric() {
       [](const Material& m, lc_material_params& p) {
         put3(p.dielectric.tint, m.specular);
         p.dielectric.ior = static_cast<float>(m.ior);
-      }};
+      },
+      [](const Material&) { return true; },
+      true};  // the reflection or the refraction, chosen with probability F
   return def;
 }
 

@@ -15,7 +15,9 @@ const MaterialTypeDef& material_type_rough_dielectric() {
         put3(p.rough_dielectric.tint, m.specular);
         p.rough_dielectric.ior = static_cast<float>(m.ior);
         p.rough_dielectric.roughness = static_cast<float>(m.roughness);
-      }};
+      },
+      // at ior 1 (as the device sees it) the transmission goes straight through: a delta lobe
+      [](const Material& m) { return static_cast<float>(m.ior) == 1.0f; }};
   return def;
 }
 
