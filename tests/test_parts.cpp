@@ -154,6 +154,11 @@ TEST(Parts, CommandLinePartsMergeIntoTheSingleRender) {
   // against a plain render of 8 spp: the same mean, variance and counts
   lucent::RenderResult single = lucent::read_render(dir + "/single.exr");
   lucent::RenderResult mine = lucent::read_render(dir + "/merged.exr");
+  // the seed and sampler that converge checks a reference by, as in the single render's file
+  EXPECT_EQ(mine.seed, 3u);
+  EXPECT_EQ(mine.sampler, single.sampler);
+  EXPECT_FALSE(mine.sampler.empty());
+  EXPECT_EQ(merged.info.sampler, single.sampler);
   ASSERT_EQ(single.mean.rgb.size(), mine.mean.rgb.size());
   EXPECT_EQ(single.samples, mine.samples);
   for (size_t i = 0; i < single.mean.rgb.size(); ++i) {

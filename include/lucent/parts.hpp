@@ -37,6 +37,7 @@ struct PartInfo {
   int width = 0, height = 0;
   std::uint64_t scene_hash = 0;  ///< Renderer::image_hash()
   std::uint32_t seed = 0;
+  std::string sampler;                 ///< its name ("sobol", ...); empty from older part files
   std::string integrator;              ///< its name ("path", ...)
   std::string version;                 ///< lucent's version that rendered it
   std::string scene;                   ///< the scene file (informative)

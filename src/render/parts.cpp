@@ -141,6 +141,8 @@ PartInfo info_from_attributes(const std::string& path,
   info.scene_hash = std::strtoull(h.c_str(), nullptr, 16);
   info.seed = static_cast<std::uint32_t>(
       image_detail::parse_attribute_u64(path, "lucent.seed", get("seed"), 0xffffffffu));
+  const auto sampler = attrs.find("lucent.sampler");  // absent from older part files
+  if (sampler != attrs.end()) info.sampler = sampler->second;
   info.integrator = get("integrator");
   info.version = get("version");
   info.scene = get("scene");
@@ -230,6 +232,7 @@ RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
   info.height = p.acc.height;
   info.scene_hash = renderer.image_hash();
   info.seed = scene.integrator.seed;
+  info.sampler = type_name(scene.integrator.sampler);
   info.integrator = type_name(scene.integrator.type);
   info.version = kVersion;
   info.scene = scene_path;
@@ -263,6 +266,8 @@ RenderResult part_result(const RenderPart& part) {
     }
   }
   r.spp = total(part.info.samples);
+  r.seed = part.info.seed;
+  r.sampler = part.info.sampler;
   r.nonfinite = part.info.nonfinite;
   r.rays = part.info.rays;
   r.seconds = part.info.seconds;
@@ -321,6 +326,8 @@ void write_render_part(const std::string& path, const RenderPart& part) {
       {"lucent.display", std::string(transfer_name(info.display.transfer)) + "," + gamma + "," +
                              exposure + "," + tonemap_name(info.display.tonemap)},
   };
+  // read_render's seed and sampler (what converge checks a reference by)
+  if (!info.sampler.empty()) extras.attributes.emplace_back("lucent.sampler", info.sampler);
   image_detail::write_render_exr(path, part_result(part), extras);
 }
 
@@ -438,6 +445,7 @@ void PartMerger::add(const std::string& name, const RenderPart& part) {
     }
     for (size_t i = 0; i < npix; ++i) t.count[i] += a.count[i];
     PartInfo& ti = total_.info;
+    if (ti.sampler.empty()) ti.sampler = part.info.sampler;  // the same: the scene hash has it
     ti.samples = unite(ti.samples, part.info.samples);
     ti.requested = unite(ti.requested, part.info.requested);
     ti.nonfinite += part.info.nonfinite;
