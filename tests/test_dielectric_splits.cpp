@@ -42,6 +42,15 @@ double variance_sum(const RenderResult& r) {
   return v;
 }
 
+// lucent compare of `r` against 1024 samples of the sphere without splitting at `seed`
+lucent::CompareResult against_unsplit(const RenderResult& r, std::uint32_t seed) {
+  lucent::Scene s = lucent::test::scene_from(glass_in_sky(0));
+  s.integrator.seed = seed;
+  lucent::RenderOptions o;
+  o.spp = 1024;
+  return lucent::compare_images(r, lucent::test::render(s, o));
+}
+
 // Same seed and samples, splits 2 against none: inside the sphere's image, less than 1% of the
 // per-sample variance (measured: 0.05%; what is left comes from the lobes after the second
 // interface). And the same image: against 1024 samples without splitting and another
@@ -52,11 +61,7 @@ TEST(DielectricSplits, SameImageLessNoise) {
   RenderResult plain = lucent::test::render_json(glass_in_sky(0), 64);
   EXPECT_LT(variance_sum(split), 0.01 * variance_sum(plain))
       << variance_sum(split) << " against " << variance_sum(plain);
-  lucent::Scene s = lucent::test::scene_from(glass_in_sky(0));
-  s.integrator.seed = 7;
-  lucent::RenderOptions o;
-  o.spp = 1024;
-  lucent::CompareResult c = lucent::compare_images(split, lucent::test::render(s, o));
+  const lucent::CompareResult c = against_unsplit(split, 7);
   EXPECT_TRUE(c.passed) << c.summary();
 }
 
@@ -84,11 +89,7 @@ TEST(DielectricSplits, AdaptivePilotIsUnsplit) {
   EXPECT_LT(variance_sum(split), 0.5 * variance_sum(plain))
       << variance_sum(split) << " against " << variance_sum(plain);
 
-  lucent::Scene s = lucent::test::scene_from(glass_in_sky(0));
-  s.integrator.seed = 11;
-  lucent::RenderOptions o;
-  o.spp = 1024;
-  lucent::CompareResult c = lucent::compare_images(split, lucent::test::render(s, o));
+  const lucent::CompareResult c = against_unsplit(split, 11);
   EXPECT_TRUE(c.passed) << c.summary();
 }
 
