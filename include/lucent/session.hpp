@@ -74,8 +74,8 @@ struct SessionStats {
 /// planned so that the image's estimated relMSE (as lucent compare defines it) reaches
 /// target_error, or so that the samples average budget_spp per pixel. Unbiased: the samples are
 /// kept in two independent halves, each planned from the other's pilot (src/render/adaptive.hpp).
-/// The pilot is rendered without glass splitting (integrator.dielectric_splits), the samples after
-/// it with the scene's splits.
+/// With a target error, the pilot is rendered without glass splitting
+/// (integrator.dielectric_splits), the samples after it with the scene's splits.
 struct AdaptiveOptions {
   double target_error = 0;        ///< relMSE to reach (> 0); 0: use budget_spp
   double budget_spp = 0;          ///< instead of a target: the mean samples per pixel

@@ -24,8 +24,9 @@
 // samples only through the cost of tracing them; a render that completes its plan has none of
 // this. Non-finite samples are left out and counted, as in every render.)
 //
-// The pilot (A's, B's and C's) is rendered without glass splitting (integrator.dielectric_splits;
-// the session's unsplit passes), the samples after it with the scene's splits: splitting replaces
+// With a target, the pilot (A's, B's and C's) is rendered without glass splitting
+// (integrator.dielectric_splits; the session's unsplit passes), the samples after it with the
+// scene's splits (a budget's pilot splits: its plan only shapes the counts): splitting replaces
 // a lobe choice by its expectation, so the pilot's variances bound those of the split samples,
 // and the unbiasedness argument is unchanged (each of a half's samples, split or not, is an
 // unbiased sample of the pixel, and its count still reads only the other half's pilot).

@@ -819,10 +819,11 @@ struct Renderer::Impl {
       calib_half.plan.assign(npix, 0u);
       for (std::size_t i : calib_pixels) calib_half.plan[i] = m;
     }
-    // the pilot: `pilot` samples in every pixel of both halves (and C's, above), without glass
-    // splitting: its variances then bound those of the split samples that follow, which keeps
-    // room for the tails that no pilot sees where the glass is (docs/rendering-model.md)
-    unsplit_passes = true;
+    // the pilot: `pilot` samples in every pixel of both halves (and C's, above); with a target,
+    // without glass splitting: its variances then bound those of the split samples that follow,
+    // which keeps room for the tails that no pilot sees where the glass is (a budget's plan wants
+    // the split samples' shape instead; docs/rendering-model.md)
+    unsplit_passes = o.target_error > 0;
     const bool piloted =
         render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress);
     unsplit_passes = false;
