@@ -6,6 +6,9 @@
 // gone.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "lucent/compare.hpp"
@@ -91,6 +94,30 @@ TEST(DielectricSplits, AdaptivePilotIsUnsplit) {
 
   const lucent::CompareResult c = against_unsplit(split, 11);
   EXPECT_TRUE(c.passed) << c.summary();
+}
+
+// A pilot cut by an exception (a progress callback that throws, as a Python one may) leaves the
+// session splitting again: after reset(), a uniform render equals a fresh session's.
+TEST(DielectricSplits, AThrowingPilotLeavesTheSessionSplitting) {
+  const lucent::Scene scene = lucent::test::scene_from(glass_in_sky(2));
+  lucent::Renderer r(lucent::test::session_options());
+  r.set_scene(scene);
+  lucent::AdaptiveOptions ao;
+  ao.target_error = 2e-4;
+  EXPECT_THROW(r.render_adaptive(
+                   ao, [](const lucent::RenderProgress&) { throw std::runtime_error("stop"); }),
+               std::runtime_error);
+  r.reset();
+  r.render(16);
+  lucent::Renderer fresh(lucent::test::session_options());
+  fresh.set_scene(scene);
+  fresh.render(16);
+  // the same samples (to the float rounding of passes of other sizes), not another estimator's
+  const std::vector<float>&a = r.result().mean.rgb, &b = fresh.result().mean.rgb;
+  ASSERT_EQ(a.size(), b.size());
+  double worst = 0;
+  for (size_t i = 0; i < a.size(); ++i) worst = std::max(worst, double(std::abs(a[i] - b[i])));
+  EXPECT_LT(worst, 1e-5) << "the uniform render did not split";
 }
 
 // The most splits (4: up to 16 branches per camera sample, the kernel's whole stack of waiting

@@ -823,10 +823,15 @@ struct Renderer::Impl {
     // without glass splitting: its variances then bound those of the split samples that follow,
     // which keeps room for the tails that no pilot sees where the glass is (a budget's plan wants
     // the split samples' shape instead; docs/rendering-model.md)
-    unsplit_passes = o.target_error > 0;
-    const bool piloted =
-        render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress);
-    unsplit_passes = false;
+    bool piloted = false;
+    {
+      struct Unsplit {  // reset even when a pass throws: later renders split again
+        bool& on;
+        ~Unsplit() { on = false; }
+      } unsplit{unsplit_passes};
+      unsplit_passes = o.target_error > 0;
+      piloted = render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress);
+    }
     if (!piloted) return progress();
     for (int hi = 0; hi < 2; ++hi) {
       Half& h = halves[hi];
