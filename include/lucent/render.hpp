@@ -66,7 +66,8 @@ struct RenderResult {
   Image mean;                          ///< per-pixel mean radiance
   Image variance;                      ///< per-pixel sample variance (of one sample)
   std::vector<std::uint32_t> samples;  ///< finite samples per pixel
-  std::uint64_t spp = 0;               ///< samples per pixel launched (adaptive: the mean)
+  std::uint64_t spp = 0;               ///< samples per pixel launched (adaptive: the mean,
+                                       ///< calibration samples included; see render_adaptive)
   std::uint64_t nonfinite = 0;         ///< NaN/Inf samples dropped and counted
   std::uint64_t rays = 0;              ///< rays traced, shadow rays included
   double seconds = 0;                  ///< rendering time (kernel passes)

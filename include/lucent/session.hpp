@@ -130,7 +130,9 @@ class Renderer {
   /// is progressive; calling it on a uniform accumulation that has samples, or render() on an
   /// adaptive one, throws lucent::Error: reset() first. result() gives the average of the halves,
   /// with per-pixel counts and a variance such that var / n is the variance of the pixel's mean;
-  /// RenderResult::spp is the mean count.
+  /// RenderResult::spp is the samples launched per pixel on average, the calibration stream's
+  /// (a target's, on a sparse grid, never in the image) included: the render's cost. The mean of
+  /// RenderResult::samples is the image's.
   RenderProgress render_adaptive(
       const AdaptiveOptions& options,
       const std::function<void(const RenderProgress&)>& on_progress = {});
