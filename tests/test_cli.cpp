@@ -203,6 +203,28 @@ TEST(Cli, IntegratorOverride) {
   EXPECT_EQ(back.rgb, path.rgb);
 }
 
+// --max-depth and --rr-depth override the scene's integrator.max_depth and rr_depth: the same
+// image as a scene file that asks for them (2 spp: the same float sums), black at max_depth 1
+// (the plane fills the view and emits nothing), and another image than the scene's depth 8
+TEST(Cli, DepthOverrides) {
+  std::string scene = plane_scene();
+  std::string text = read_all(scene);
+  const std::string key = "\"seed\": 0";
+  ASSERT_NE(text.find(key), std::string::npos);
+  std::string own = lucent::test::temp_dir() + "/depths.json";
+  lucent::test::write_file(
+      own, text.replace(text.find(key), key.size(), key + ", \"max_depth\": 2, \"rr_depth\": 1"));
+  lucent::Image flag = render_to(scene, "--max-depth 2 --rr-depth 1");
+  EXPECT_EQ(flag.rgb, render_to(own, "").rgb);
+  EXPECT_NE(flag.rgb, render_to(scene, "").rgb);
+  lucent::Image camera_only = render_to(scene, "--max-depth 1");
+  for (float v : camera_only.rgb) EXPECT_EQ(v, 0.0f);
+  EXPECT_NE(run_cli("render " + q(scene) + " -o " + q(lucent::test::temp_dir() + "/x.pfm") +
+                    " --max-depth 0")
+                .status,
+            0);
+}
+
 // A render longer than a second prints a progress line (percent, samples/s, elapsed, ETA);
 // --time stops it (the scene asks for 2^24 spp); --quiet silences everything.
 TEST(Cli, ProgressLineAndTimeLimit) {

@@ -91,6 +91,7 @@ struct RenderArgs {
   int height = 0;
   std::string device;
   long long seed = -1;
+  int max_depth = 0, rr_depth = 0;  ///< > 0: override integrator.max_depth / rr_depth
   double time_limit = 0;
   std::string integrator;
   bool quiet = false;
@@ -201,6 +202,8 @@ int render_with(const RenderArgs& a) {
   if (a.height > 0) scene.film.height = a.height;
   if (a.seed >= 0) scene.integrator.seed = static_cast<std::uint32_t>(a.seed);
   if (!a.integrator.empty()) scene.integrator.type = lucent::cli::parse_integrator(a.integrator);
+  if (a.max_depth > 0) scene.integrator.max_depth = a.max_depth;
+  if (a.rr_depth > 0) scene.integrator.rr_depth = a.rr_depth;
   lucent::cli::apply_sampling_options(a.sampling, scene);
   if (range) lucent::check_part_scene(scene, a.scene);
 
@@ -354,6 +357,16 @@ CLI::App* add_render_command(CLI::App& app) {
       ->check(CLI::Range(0LL, static_cast<long long>(lucent::limits::kMaxSeed)));
   render->add_option("--integrator", ra.integrator,
                      "Override the integrator: " + lucent::type_names<lucent::IntegratorType>());
+  render
+      ->add_option("--max-depth", ra.max_depth,
+                   "Most path segments: 1 shows the emitters the camera sees, 2 adds direct "
+                   "light (overrides integrator.max_depth)")
+      ->check(CLI::Range(1, lucent::limits::kMaxDepth));
+  render
+      ->add_option("--rr-depth", ra.rr_depth,
+                   "Path segments before Russian roulette may end a path (overrides "
+                   "integrator.rr_depth)")
+      ->check(CLI::Range(1, lucent::limits::kMaxDepth));
   render->add_flag("-q,--quiet", ra.quiet, "No progress line or summary");
   render->add_flag(
       "--fast-math", ra.fast_math,
