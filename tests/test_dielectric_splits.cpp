@@ -120,6 +120,36 @@ TEST(DielectricSplits, AThrowingPilotLeavesTheSessionSplitting) {
   EXPECT_LT(worst, 1e-5) << "the uniform render did not split";
 }
 
+// A target render cut after its pilot (a progress callback throws) and then resumed by another
+// call renders the same samples as one uninterrupted call: the resumed call renders the rest of
+// the plan with the scene's splits, and only pilot samples without.
+TEST(DielectricSplits, AResumedTargetRenderEqualsAnUninterruptedOne) {
+  const lucent::Scene scene = lucent::test::scene_from(glass_in_sky(2));
+  lucent::SessionOptions so = lucent::test::session_options();
+  so.pass_seconds = 1e-9;  // short passes: the callback runs often
+  lucent::AdaptiveOptions ao;
+  ao.target_error = 2e-4;
+  lucent::Renderer whole(so), cut(so);
+  whole.set_scene(scene);
+  whole.render_adaptive(ao);
+  cut.set_scene(scene);
+  EXPECT_THROW(cut.render_adaptive(ao,
+                                   [](const lucent::RenderProgress& p) {
+                                     if (p.samples_done > 150) throw std::runtime_error("stop");
+                                   }),
+               std::runtime_error);
+  ASSERT_LT(cut.result().spp, whole.result().spp) << "the cut came after the plan";
+  ASSERT_GT(cut.result().spp, 2 * lucent::AdaptiveOptions{}.min_spp) << "cut in the pilot";
+  cut.render_adaptive(ao);
+  const RenderResult a = cut.result(), b = whole.result();
+  EXPECT_EQ(a.samples, b.samples);
+  ASSERT_EQ(a.mean.rgb.size(), b.mean.rgb.size());
+  double worst = 0;
+  for (size_t i = 0; i < a.mean.rgb.size(); ++i)
+    worst = std::max(worst, double(std::abs(a.mean.rgb[i] - b.mean.rgb[i])));
+  EXPECT_LT(worst, 1e-5) << "the resumed samples are not the uninterrupted render's";
+}
+
 // The most splits (4: up to 16 branches per camera sample, the kernel's whole stack of waiting
 // branches) through two nested glass spheres, a sphere lamp inside them, on a diffuse floor
 // (the branches meet diffuse vertices, next-event estimation and light hits), against the scalar

@@ -825,10 +825,21 @@ struct Renderer::Impl {
     // the split samples' shape instead; docs/rendering-model.md)
     bool piloted = false;
     {
-      struct Unsplit {  // reset even when a pass throws: later renders split again
-        bool& on;
-        ~Unsplit() { on = false; }
-      } unsplit{unsplit_passes};
+      // the pilot's samples only: what an earlier call's plan left unrendered (a time limit, a
+      // cancel) comes after the plans below, with the scene's splits. Restored even when a pass
+      // throws, so that later renders split again.
+      struct PilotPhase {
+        Impl& s;
+        std::vector<std::uint32_t> plans[3];
+        ~PilotPhase() {
+          s.unsplit_passes = false;
+          for (int hi = 0; hi < 3; ++hi) s.halves[hi].plan.swap(plans[hi]);
+        }
+      } phase{*this, {}};
+      for (int hi = 0; hi < 3; ++hi) {
+        phase.plans[hi] = halves[hi].plan;
+        for (std::uint32_t& n : halves[hi].plan) n = std::min(n, m);
+      }
       unsplit_passes = o.target_error > 0;
       piloted = render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress);
     }
