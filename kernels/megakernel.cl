@@ -29,8 +29,14 @@
  * integrator.caustics each camera sample also traces a light path that adds to light_sum and
  * light_sumsq, any pixel's (integrator/caustics.cl): a uniform pass's to elements [0, W H), a
  * work list's stream s < 2 to elements [s W H, (s + 1) W H) (the adaptive halves' separate light
- * estimates); stream 2, the calibration's, traces none. */
-__kernel void lucent_render(LC_SCENE_KERNEL_ARGS, __global const uint4* work,
+ * estimates); stream 2, the calibration's, traces none.
+ * vec_type_hint(float4): one work-item is one path, written with vector types; an OpenCL compiler
+ * that packs work-items into SIMD lanes (Intel's CPU runtime does when its cost model says so)
+ * should not. Intel's CPU runtime 2026.2 packed them for small kernels (the AOV integrators) and
+ * then found spheres at t ~ 1e-7 in a scene of spheres and triangles; forced to pack the path
+ * tracer, it rendered 2.2-3.1x slower (BENCHMARKS.md, "Intel's CPU OpenCL runtime"). PoCL and
+ * GPU drivers ignore the hint. */
+__kernel __attribute__((vec_type_hint(float4))) void lucent_render(LC_SCENE_KERNEL_ARGS, __global const uint4* work,
                             __global float4* out_sum, __global float4* out_sumsq,
                             __global lc_uint* counters, __global float4* light_sum,
                             __global float4* light_sumsq) {

@@ -159,7 +159,8 @@ TEST(CliInfo, EmptyScene) {
       lucent::render_detail::feature_defines(s, lucent::render_detail::pack_scene(s));
   if (!defines.empty() && defines[0] == ' ') defines.erase(0, 1);
   EXPECT_EQ(m["kernel/feature defines"], defines.empty() ? "(none)" : defines);
-  EXPECT_EQ(m["kernel/device options"], "-D LC_DEVICE_CPU on CPU devices, none on others");
+  EXPECT_EQ(m["kernel/device options"],
+            "-D LC_DEVICE_POCL_CPU on PoCL's CPU device, none on others");
 }
 
 // info needs no OpenCL device: it works with every driver hidden.

@@ -104,17 +104,24 @@ namespace {
 
 // integrator.caustics compiles the light paths only where a caustic path exists: a surface that
 // scatters by a delta lobe (a mirror, smooth glass, a rough dielectric of ior 1), used by a shape.
-// A device's own build options (added to the scene's for its build and its cache key): CPU
-// devices keep the integrator and the light path out of line (LC_CPU_NOINLINE,
-// kernels/util/math.cl), other devices get nothing. KernelSource.KernelsAreStrictOpenCL12ForClang
-// compiles both branches.
-TEST(Features, OnlyCpuDevicesGetTheCpuDefine) {
+// A device's own build options (added to the scene's for its build and its cache key): PoCL's
+// CPU device keeps the integrator and the light path out of line (LC_POCL_NOINLINE,
+// kernels/util/math.cl), other devices get nothing: Intel's CPU runtime miscompiles the
+// out-of-line integrator (BENCHMARKS.md, "Intel's CPU OpenCL runtime").
+// KernelSource.KernelsAreStrictOpenCL12ForClang compiles both branches.
+TEST(Features, OnlyPoclsCpuDeviceGetsThePoclDefine) {
   lucent::DeviceInfo d;
   d.type = "CPU";
-  EXPECT_EQ(lucent::render_detail::device_defines(d), " -D LC_DEVICE_CPU");
+  d.platform = "Portable Computing Language";
+  EXPECT_EQ(lucent::render_detail::device_defines(d), " -D LC_DEVICE_POCL_CPU");
   for (const char* type : {"GPU", "accelerator", "other"}) {
-    d.type = type;
+    d.type = type;  // PoCL's CUDA or remote devices
     EXPECT_EQ(lucent::render_detail::device_defines(d), "") << type;
+  }
+  for (const char* platform : {"Intel(R) OpenCL", "AMD Accelerated Parallel Processing", ""}) {
+    d.type = "CPU";
+    d.platform = platform;
+    EXPECT_EQ(lucent::render_detail::device_defines(d), "") << platform;
   }
 }
 

@@ -102,8 +102,9 @@ static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_inter
 }
 
 /* The light path of the camera sample rng (random numbers from LC_DIM_LIGHT_PATH). Returns the
- * number of non-finite contributions it dropped. Out of line on CPU devices (LC_CPU_NOINLINE). */
-static LC_CPU_NOINLINE lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
+ * number of non-finite contributions it dropped. Out of line on PoCL's CPU device
+ * (LC_POCL_NOINLINE, util/math.cl). */
+static LC_POCL_NOINLINE lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
                                                    __global float4* light_sum,
                                                    __global float4* light_sumsq, lc_uint* rays) {
   __global const lc_params* P = s->params;

@@ -3,17 +3,20 @@
 #define LUCENT_UTIL_MATH_CL
 
 /*
- * LC_CPU_NOINLINE: on CPU devices (LC_DEVICE_CPU, which the host adds to a device's build options:
- * render_detail::device_defines) a function called once per sample is kept out of line, so that
- * PoCL's work-group passes, which run at the first launch over the kernel with everything inlined
- * into it, see a small kernel: the cold build of the Cornell box took 1.00 s with the integrator
- * inlined, 0.80 s without, at the same speed (BENCHMARKS.md, "Kernel specialisation"). GPUs keep
- * their compilers' choice.
+ * LC_POCL_NOINLINE: on PoCL's CPU device (LC_DEVICE_POCL_CPU, which the host adds to that device's
+ * build options: render_detail::device_defines) a function called once per sample is kept out of
+ * line, so that PoCL's work-group passes, which run at the first launch over the kernel with
+ * everything inlined into it, see a small kernel: the cold build of the Cornell box took 1.00 s
+ * with the integrator inlined, 0.80 s without, at the same speed (BENCHMARKS.md, "Kernel
+ * specialisation"). Other devices keep their compilers' choice: Intel's CPU runtime (2026.2)
+ * renders 2.2x slower with the integrator out of line, builds 3x slower, and miscompiles an
+ * out-of-line function that returns a float3 (each work-item read its neighbours' components),
+ * BENCHMARKS.md, "Intel's CPU OpenCL runtime".
  */
-#ifdef LC_DEVICE_CPU
-#define LC_CPU_NOINLINE __attribute__((noinline))
+#ifdef LC_DEVICE_POCL_CPU
+#define LC_POCL_NOINLINE __attribute__((noinline))
 #else
-#define LC_CPU_NOINLINE inline
+#define LC_POCL_NOINLINE inline
 #endif
 
 /*

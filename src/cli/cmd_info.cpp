@@ -167,7 +167,8 @@ int run_info_command() {
   // what each device's build adds (render_detail::device_defines): info opens no device
   DeviceInfo cpu;
   cpu.type = "CPU";
-  std::printf("  device options      %s on CPU devices, none on others\n",
+  cpu.platform = "Portable Computing Language";
+  std::printf("  device options      %s on PoCL's CPU device, none on others\n",
               render_detail::device_defines(cpu).substr(1).c_str());
   return 0;
 }

@@ -122,7 +122,8 @@ std::string build_options(const Scene& scene, const PackedScene& packed,
 }
 
 std::string device_defines(const DeviceInfo& device) {
-  return device.type == "CPU" ? " -D LC_DEVICE_CPU" : "";
+  const bool pocl = device.platform.find("Portable Computing Language") != std::string::npos;
+  return device.type == "CPU" && pocl ? " -D LC_DEVICE_POCL_CPU" : "";
 }
 
 void check_precision_support(const DeviceInfo& device, Precision precision) {

@@ -31,8 +31,8 @@ std::string build_options(const Scene& scene, const PackedScene& packed,
                           const RenderOptions& options);
 
 /// The build options that depend on the device, added to build_options' for each device's build
-/// (and so to its cache key): " -D LC_DEVICE_CPU" for a CPU device (kernels/util/math.cl,
-/// LC_CPU_NOINLINE), "" otherwise.
+/// (and so to its cache key): " -D LC_DEVICE_POCL_CPU" for PoCL's CPU device (kernels/util/math.cl,
+/// LC_POCL_NOINLINE: measured for PoCL's build time, wrong on Intel's CPU runtime), "" otherwise.
 std::string device_defines(const DeviceInfo& device);
 
 /// Throws lucent::Error (one line naming the device) when `precision` needs what the device lacks:
