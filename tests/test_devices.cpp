@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cl/context.hpp"
 #include "cl/opencl.hpp"
 #include "lucent/session.hpp"
 #include "support.hpp"
@@ -287,6 +288,23 @@ TEST(Devices, SelectorListErrors) {
             "--device '0,all': 'all' selects every device and stands alone, not in a list");
   EXPECT_EQ(error_of("all"), "");
   EXPECT_EQ(lucent::select_devices("0, 0", "--device").size(), 2u);
+}
+
+// A name selector: a device's whole name picks it, even listed after a device whose name contains
+// it (PoCL's "pthread-skylake-avx512-Intel(R) Xeon(R) Processor" before Intel's CPU runtime's
+// "Intel(R) Xeon(R) Processor"); else the first name that contains it, in any case.
+TEST(Devices, WholeNameWinsOverALongerNameContainingIt) {
+  std::vector<lucent::DeviceInfo> d(3);
+  d[0].name = "pthread-skylake-avx512-Intel(R) Xeon(R) Processor";
+  d[1].name = "Intel(R) Xeon(R) Processor";
+  d[2].name = "NVIDIA H100 80GB HBM3";
+  using lucent::cl_util::device_by_name;
+  EXPECT_EQ(device_by_name(d, "Intel(R) Xeon(R) Processor"), 1);
+  EXPECT_EQ(device_by_name(d, "intel(r) xeon(r) processor"), 1);
+  EXPECT_EQ(device_by_name(d, "xeon"), 0);
+  EXPECT_EQ(device_by_name(d, "PTHREAD"), 0);
+  EXPECT_EQ(device_by_name(d, "h100"), 2);
+  EXPECT_EQ(device_by_name(d, "amd"), -1);
 }
 
 // The render summary names the device used: --device and LUCENT_DEVICE reach the renderer.

@@ -21,7 +21,8 @@ struct DeviceInfo {
 /// Every OpenCL device of every platform. Throws lucent::Error when there is no platform.
 std::vector<DeviceInfo> list_devices();
 
-/// Picks a device: `selector` is an index or a case-insensitive substring of the device name;
+/// Picks a device: `selector` is an index, or a device's whole name (case-insensitive), or else a
+/// case-insensitive substring of the first device name that contains it;
 /// empty means the first GPU, else the first CPU device, else the first device. (The CLI takes
 /// LUCENT_DEVICE as its default selector: SessionOptions::from_environment.) Throws lucent::Error
 /// when nothing matches; its message calls the selector `origin` ("--device 'x': ...").

@@ -225,6 +225,18 @@ std::vector<Device> enumerate_devices() {
   return out;
 }
 
+int device_by_name(const std::vector<DeviceInfo>& devices, const std::string& selector) {
+  // a device's whole name picks it even where it is part of another's name (Intel's CPU runtime
+  // names its device "Intel(R) Xeon(R) Processor", PoCL the same CPU
+  // "pthread-skylake-avx512-Intel(R) Xeon(R) Processor"); else the first name containing it
+  const std::string want = lower(selector);
+  for (size_t i = 0; i < devices.size(); ++i)
+    if (lower(devices[i].name) == want) return static_cast<int>(i);
+  for (size_t i = 0; i < devices.size(); ++i)
+    if (lower(devices[i].name).find(want) != std::string::npos) return static_cast<int>(i);
+  return -1;
+}
+
 Device pick_device(const std::string& selector, const std::string& origin) {
   auto devices = enumerate_devices();
   if (selector.empty()) {
@@ -246,8 +258,10 @@ Device pick_device(const std::string& selector, const std::string& origin) {
   if (trim(want).empty())
     throw Error(origin + " '" + selector +
                 "': empty device selector (available: " + device_list(devices) + ")");
-  for (auto& d : devices)
-    if (lower(d.info.name).find(want) != std::string::npos) return d;
+  std::vector<DeviceInfo> infos;
+  for (const auto& d : devices) infos.push_back(d.info);
+  const int i = device_by_name(infos, selector);
+  if (i >= 0) return devices[i];
   throw Error(origin + " '" + selector +
               "': no device name contains it (available: " + device_list(devices) + ")");
 }

@@ -20,6 +20,10 @@ std::vector<Device> enumerate_devices();
 /// `origin`, where the selector came from ("--device", "LUCENT_DEVICE", ...).
 Device pick_device(const std::string& selector, const std::string& origin = "--device");
 
+/// The device a name selector picks among `devices` (its index), or -1: the device whose whole
+/// name it is (case-insensitive), else the first whose name contains it.
+int device_by_name(const std::vector<DeviceInfo>& devices, const std::string& selector);
+
 /// The device is PoCL's (any of its drivers: they share its kernel cache and POCL_* variables).
 bool is_pocl(const Device& device);
 
