@@ -110,7 +110,10 @@ __kernel void stability_spawn(__global const lc_sphere* spheres, lc_uint num_sph
     float b1 = U(1) * su, b0 = 1.0f - su;
     float3 q = b0 * v0 + b1 * v1 + (1.0f - b0 - b1) * v2;
     float size = length(v1 - v0) + length(v2 - v0);
-    float3 n = normalize(cross(v1 - v0, v2 - v0));
+    /* in lc_real: at 1e-30 (the double probe's smallest decade) the cross product of float edges
+     * underflows to 0, and normalize(0) is 0 on PoCL but NaN on Intel's CPU runtime */
+    lc_real3 e1 = lc_real3_from_float3(v1 - v0), e2 = lc_real3_from_float3(v2 - v0);
+    float3 n = lc_float3_from_real3(normalize(cross(e1, e2)));
     if (U(2) < 0.5f) n = -n;
     float3 w = n + spawn_uniform_sphere(U(3), U(4));
     float3 o = q + (size * pow(10.0f, -3.0f + 4.0f * U(5))) * normalize(w);

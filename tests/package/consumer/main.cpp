@@ -26,7 +26,8 @@ int main() {
   })",
                                             "consumer.json");
   try {
-    lucent::Renderer renderer(lucent::SessionOptions::from_environment());
+    const lucent::SessionOptions env = lucent::SessionOptions::from_environment();
+    lucent::Renderer renderer(env);
     renderer.set_scene(scene);
     renderer.render(2);
     lucent::RenderResult first = renderer.result();
@@ -47,7 +48,11 @@ int main() {
     if (second.mean.rgb == first.mean.rgb) return fail("moving the camera changed nothing");
     if (s.bvh_builds != 1 || s.kernel_compiles + s.kernel_cache_loads != 1 || s.scene_packs != 2)
       return fail("the camera move rebuilt the BVH or the kernel");
-    if (lucent::render(scene).mean.rgb != second.mean.rgb)
+    lucent::RenderOptions one_shot;  // the same device and kernels as the session's
+    one_shot.device = env.device;
+    one_shot.kernel_dir = env.kernel_dir;
+    one_shot.cache_dir = env.cache_dir;
+    if (lucent::render(scene, one_shot).mean.rgb != second.mean.rgb)
       return fail("the one-shot render differs from the session's");
     lucent::SceneBuilder b("consumer.json");
     lucent::Camera camera;
@@ -67,7 +72,7 @@ int main() {
     b.add_material(white);
     b.add_sphere({{0, 0, 0}, 1, "white"});
     b.add_light(lucent::point_light({0, 0, 4}, {10, 10, 10}));
-    lucent::RenderResult built = lucent::render(b.build());
+    lucent::RenderResult built = lucent::render(b.build(), one_shot);
     if (built.mean.rgb != first.mean.rgb)
       return fail("the scene built in code renders differently");
 
