@@ -34,12 +34,12 @@
  * that packs work-items into SIMD lanes (Intel's CPU runtime does when its cost model says so)
  * should not. Intel's CPU runtime 2026.2 packed them for small kernels (the AOV integrators) and
  * then found spheres at t ~ 1e-7 in a scene of spheres and triangles; forced to pack the path
- * tracer, it rendered 2.2-3.1x slower (BENCHMARKS.md, "Intel's CPU OpenCL runtime"). PoCL and
- * GPU drivers ignore the hint. */
-__kernel __attribute__((vec_type_hint(float4))) void lucent_render(LC_SCENE_KERNEL_ARGS, __global const uint4* work,
-                            __global float4* out_sum, __global float4* out_sumsq,
-                            __global lc_uint* counters, __global float4* light_sum,
-                            __global float4* light_sumsq) {
+ * tracer, it rendered 2-4x slower (BENCHMARKS.md, "Intel's CPU OpenCL runtime"). PoCL and GPU
+ * drivers ignore the hint. */
+__kernel __attribute__((vec_type_hint(float4))) void lucent_render(
+    LC_SCENE_KERNEL_ARGS, __global const uint4* work, __global float4* out_sum,
+    __global float4* out_sumsq, __global lc_uint* counters, __global float4* light_sum,
+    __global float4* light_sumsq) {
   lc_uint gid = (lc_uint)get_global_id(0);
   lc_uint width = params->width, height = params->height;
   lc_rng rng;

@@ -105,8 +105,8 @@ static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_inter
  * number of non-finite contributions it dropped. Out of line on PoCL's CPU device
  * (LC_POCL_NOINLINE, util/math.cl). */
 static LC_POCL_NOINLINE lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
-                                                   __global float4* light_sum,
-                                                   __global float4* light_sumsq, lc_uint* rays) {
+                                                    __global float4* light_sum,
+                                                    __global float4* light_sumsq, lc_uint* rays) {
   __global const lc_params* P = s->params;
   if (P->max_depth < 3u) return 0; /* a caustic path has at least 3 segments */
   float8 u0 = lc_rand8(rng, LC_DIM_LIGHT_PATH);

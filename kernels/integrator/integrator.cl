@@ -22,7 +22,7 @@
 /* The radiance of one camera sample with the integrator of lc_params.integrator (out of line on
  * PoCL's CPU device: LC_POCL_NOINLINE, util/math.cl). */
 static LC_POCL_NOINLINE float3 integrate(const lc_scene* s, lc_ray ray, const lc_rng* rng,
-                                        lc_uint* rays) {
+                                         lc_uint* rays) {
   lc_uint integrator = s->params->integrator;
   LC_INTEGRATOR_TYPES(LC_INTEGRATOR_CALL)
 #ifdef LC_HAS_INTEGRATOR_AOV
