@@ -231,7 +231,7 @@ TEST(CliErrors, UnusablePoclCacheDirIsNamed) {
 
   // the CLI, where the device is PoCL's
   lucent::cl_util::Context ctx(lucent::test::device());
-  if (!lucent::cl_util::is_pocl(ctx.device))
+  if (!lucent::cl_util::is_pocl(ctx.device.info))
     GTEST_SKIP() << "the device is not PoCL's: " << ctx.device.info.platform;
   const std::string out = dir + "/o.png";
   // the build log PoCL gave comes first ("kernel build log:" and its lines), then the error

@@ -165,8 +165,8 @@ std::string no_platform() {
 
 }  // namespace
 
-bool is_pocl(const Device& device) {
-  return device.info.platform.find("Portable Computing Language") != std::string::npos;
+bool is_pocl(const DeviceInfo& device) {
+  return device.platform.find(kPoclPlatform) != std::string::npos;
 }
 
 std::vector<Device> enumerate_devices() {
@@ -297,7 +297,7 @@ cl::Program build_program(const Context& ctx, const std::string& source,
     std::string msg = (place.empty() ? std::string() : place + ": ") +
                       "kernel build failed: " + describe(e) +
                       (log.empty() ? "" : " (build log above)");
-    if (place.empty() && is_pocl(ctx.device))
+    if (place.empty() && is_pocl(ctx.device.info))
       msg += pocl_cache_hint();  // no error in the source: perhaps PoCL's directory
     throw Error(msg, log.empty() ? std::string() : "kernel build log:\n" + log);
   }

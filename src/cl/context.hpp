@@ -24,8 +24,11 @@ Device pick_device(const std::string& selector, const std::string& origin = "--d
 /// name it is (case-insensitive), else the first whose name contains it.
 int device_by_name(const std::vector<DeviceInfo>& devices, const std::string& selector);
 
+/// PoCL's platform name (CL_PLATFORM_NAME).
+inline constexpr const char* kPoclPlatform = "Portable Computing Language";
+
 /// The device is PoCL's (any of its drivers: they share its kernel cache and POCL_* variables).
-bool is_pocl(const Device& device);
+bool is_pocl(const DeviceInfo& device);
 
 /// A context and an in-order queue on one device.
 struct Context {

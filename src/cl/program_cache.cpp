@@ -206,7 +206,7 @@ std::string usable_cache_dir(const std::string& dir) {
 }  // namespace
 
 std::string driver_program_cache(const Device& device) {
-  if (!is_pocl(device)) return "";
+  if (!is_pocl(device.info)) return "";
   // PoCL reads the variable as on when it is unset or starts with "1" (pocl_get_bool_option)
   const char* v = std::getenv("POCL_KERNEL_CACHE");
   if (v && v[0] != '1') return "";

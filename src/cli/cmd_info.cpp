@@ -6,6 +6,7 @@
 #include <string>
 
 #include "bvh/bvh.hpp"
+#include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
 #include "cli/commands.hpp"
 #include "lucent/scene.hpp"
@@ -167,7 +168,7 @@ int run_info_command() {
   // what each device's build adds (render_detail::device_defines): info opens no device
   DeviceInfo cpu;
   cpu.type = "CPU";
-  cpu.platform = "Portable Computing Language";
+  cpu.platform = cl_util::kPoclPlatform;
   std::printf("  device options      %s on PoCL's CPU device, none on others\n",
               render_detail::device_defines(cpu).substr(1).c_str());
   return 0;

@@ -135,7 +135,8 @@ void write_render_exr(const std::string& path, const RenderResult& r, const ExrE
 RenderResult read_render_memory(const unsigned char* data, std::size_t size,
                                 const std::string& path);
 
-/// read_render() that also says the file's format (decided from its bytes, which are read once).
+/// lucent::read_render(), which also says the file's format (decided from its bytes, which are
+/// read once) when `format` is not null.
 RenderResult read_render(const std::string& path, Format* format);
 
 /// sRGB-encoded value in [0, 1] to linear.

@@ -108,9 +108,7 @@ void write_render_exr(const std::string& path, const RenderResult& r, const ExrE
 }  // namespace image_detail
 
 RenderResult read_render(const std::string& path) {
-  const std::string bytes = io::read_file(path, image_detail::image_read_spec());
-  return image_detail::read_render_memory(reinterpret_cast<const unsigned char*>(bytes.data()),
-                                          bytes.size(), path);
+  return image_detail::read_render(path, nullptr);
 }
 
 namespace image_detail {
@@ -167,7 +165,7 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
 RenderResult read_render(const std::string& path, Format* format) {
   const std::string bytes = io::read_file(path, image_read_spec());
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-  *format = probe_image(data, bytes.size(), path, kMaxImagePixels).format;
+  if (format) *format = probe_image(data, bytes.size(), path, kMaxImagePixels).format;
   return read_render_memory(data, bytes.size(), path);
 }
 

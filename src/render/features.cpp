@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "cl/context.hpp"
 #include "lucent/error.hpp"
 #include "render/pack.hpp"
 #include "scene/material_type.hpp"
@@ -122,8 +123,7 @@ std::string build_options(const Scene& scene, const PackedScene& packed,
 }
 
 std::string device_defines(const DeviceInfo& device) {
-  const bool pocl = device.platform.find("Portable Computing Language") != std::string::npos;
-  return device.type == "CPU" && pocl ? " -D LC_DEVICE_POCL_CPU" : "";
+  return device.type == "CPU" && cl_util::is_pocl(device) ? " -D LC_DEVICE_POCL_CPU" : "";
 }
 
 void check_precision_support(const DeviceInfo& device, Precision precision) {
