@@ -6,8 +6,6 @@
 // gone.
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -113,11 +111,9 @@ TEST(DielectricSplits, AThrowingPilotLeavesTheSessionSplitting) {
   fresh.set_scene(scene);
   fresh.render(16);
   // the same samples (to the float rounding of passes of other sizes), not another estimator's
-  const std::vector<float>&a = r.result().mean.rgb, &b = fresh.result().mean.rgb;
-  ASSERT_EQ(a.size(), b.size());
-  double worst = 0;
-  for (size_t i = 0; i < a.size(); ++i) worst = std::max(worst, double(std::abs(a[i] - b[i])));
-  EXPECT_LT(worst, 1e-5) << "the uniform render did not split";
+  const RenderResult a = r.result(), b = fresh.result();
+  ASSERT_EQ(a.mean.rgb.size(), b.mean.rgb.size());
+  EXPECT_LT(lucent::compare_images(a, b).max_abs_error, 1e-5) << "the uniform render did not split";
 }
 
 // A target render cut after its pilot (a progress callback throws) and then resumed by another
@@ -144,10 +140,8 @@ TEST(DielectricSplits, AResumedTargetRenderEqualsAnUninterruptedOne) {
   const RenderResult a = cut.result(), b = whole.result();
   EXPECT_EQ(a.samples, b.samples);
   ASSERT_EQ(a.mean.rgb.size(), b.mean.rgb.size());
-  double worst = 0;
-  for (size_t i = 0; i < a.mean.rgb.size(); ++i)
-    worst = std::max(worst, double(std::abs(a.mean.rgb[i] - b.mean.rgb[i])));
-  EXPECT_LT(worst, 1e-5) << "the resumed samples are not the uninterrupted render's";
+  EXPECT_LT(lucent::compare_images(a, b).max_abs_error, 1e-5)
+      << "the resumed samples are not the uninterrupted render's";
 }
 
 // The most splits (4: up to 16 branches per camera sample, the kernel's whole stack of waiting
