@@ -15,8 +15,6 @@ namespace {
 
 using scene_detail::put3;
 
-double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
-
 /// The texel CDF of an environment map (luminance x sin(theta), n + 1 entries from 0 to 1),
 /// appended to `cdf`.
 void append_env_map_cdf(const Texture& t, std::vector<float>& cdf) {

@@ -17,8 +17,6 @@ namespace {
 
 using scene_detail::put3;
 
-double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
-
 bool finite3(const glm::dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }

@@ -11,6 +11,9 @@
 
 namespace lucent::render_detail {
 
+/// Rec. 709 luminance of a linear RGB colour: lights' power for their selection probabilities.
+inline double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
 struct PackedScene {
   lc_params params{};
 #define LUCENT_PACKED_BUFFER(name, type, ...) std::vector<type> name;
