@@ -811,6 +811,40 @@ TEST(Adaptive, MeanIsUnbiased) {
   EXPECT_FALSE(lucent::compare_images(a, brighter).passed) << "the test has no power";
 }
 
+// The one-shot lucent::render with RenderOptions::target_error renders adaptively, as a
+// session's render_adaptive does with the same target, pilot (min_spp) and cap (spp): the same
+// samples per pixel (the plan depends only on the pilot's samples), the same image to the float
+// rounding of the passes, every pixel at least its pilot, and a target low enough that the cap
+// binds on the noisiest pixels. Forwarding neither min_spp (default 64) nor spp (default 16384)
+// would change the counts.
+TEST(Adaptive, OneShotRenderForwardsTargetPilotAndCap) {
+  const double E = 1e-4;
+  Scene s = adaptive_scene();
+  lucent::RenderOptions o;
+  o.target_error = E;
+  o.min_spp = 16;
+  o.spp = 512;
+  RenderResult one = lucent::test::render(s, o);
+
+  lucent::Renderer r(lucent::test::session_options());
+  r.set_scene(s);
+  lucent::AdaptiveOptions ao;
+  ao.target_error = E;
+  ao.min_spp = 16;
+  ao.max_spp = 512;
+  r.render_adaptive(ao);
+  RenderResult session = r.result();
+
+  EXPECT_EQ(one.target_error, E);
+  EXPECT_GT(one.halves_relmse, 0.0);
+  ASSERT_EQ(one.samples.size(), session.samples.size());
+  EXPECT_TRUE(one.samples == session.samples);
+  const auto [lo, hi] = std::minmax_element(one.samples.begin(), one.samples.end());
+  EXPECT_GE(*lo, 16u);
+  EXPECT_EQ(*hi, 512u) << "the cap binds";
+  EXPECT_LT(lucent::compare_images(one, session).max_abs_error, 1e-5);
+}
+
 // ---- clamping --------------------------------------------------------------------------------
 
 // integrator.clamp: the kernel and the reference compute the same clamped estimator (z-test), its
