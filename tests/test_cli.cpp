@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -227,6 +229,53 @@ TEST(Cli, DepthOverrides) {
 
 // A render longer than a second prints a progress line (percent, samples/s, elapsed, ETA);
 // --time stops it (the scene asks for 2^24 spp); --quiet silences everything.
+// --aov: each AOV lands beside the image as <stem>.<name>.exr (float EXR), rendered on the same
+// session with the main render's spp, so each equals the library's render of that integrator
+// at the same seed and spp (the variance: the main render's own), and they say what they are:
+// the albedo of every pixel is the material's, the depths are the plane's 5 along the axis and
+// the sphere's nearer, the primitive ids are the sphere (1) and the two triangles (2, 3).
+// (The AOVs' values themselves: KernelVsReference.Aovs and ReferenceAnalytic.AovsOnAPlane.)
+TEST(Cli, AovsAreWrittenBesideTheImage) {
+  std::string scene = plane_scene();
+  std::string dir = lucent::test::temp_dir();
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(dir + "/x.exr") +
+                            " --aov albedo --aov depth --aov variance --aov primitive");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const lucent::Scene sc = lucent::load_scene(scene);
+  lucent::RenderOptions o;
+  o.spp = 2;
+  const lucent::RenderResult main_render = lucent::test::render(sc, o);
+  EXPECT_EQ(lucent::read_image(dir + "/x.exr").rgb, main_render.mean.rgb);
+  std::map<std::string, lucent::Image> aov;
+  for (const std::string name : {"albedo", "depth", "variance", "primitive"}) {
+    const std::string path = dir + "/x." + name + ".exr";
+    EXPECT_NE(r.err.find(path + ": " + name + " AOV\n"), std::string::npos) << r.err;
+    aov[name] = lucent::read_image(path);
+    ASSERT_EQ(aov[name].rgb.size(), 16u * 16u * 3u) << name;
+    if (name == "variance") {
+      EXPECT_EQ(aov[name].rgb, main_render.variance.rgb);
+    } else {
+      lucent::Scene s = sc;
+      s.integrator.type = *lucent::find_type<lucent::IntegratorType>(name);
+      EXPECT_EQ(aov[name].rgb, lucent::test::render(s, o).mean.rgb) << name;
+    }
+  }
+  const std::vector<float>& albedo = aov["albedo"].rgb;
+  for (size_t i = 0; i < albedo.size(); i += 3)
+    EXPECT_TRUE(albedo[i] == 0.25f && albedo[i + 1] == 0.5f && albedo[i + 2] == 0.75f) << i;
+  const std::vector<float>& depth = aov["depth"].rgb;
+  const float centre = depth[(8 * 16 + 8) * 3];  // 0.5 to 1.5 pixels off the axis: the plane
+  EXPECT_NEAR(centre, 5.0f, 0.01f);
+  EXPECT_NEAR(*std::min_element(depth.begin(), depth.end()), 4.2f, 0.05f);  // the sphere's front
+  // (averaged over the pixel's two samples: 1.5 or 2.5 on an edge)
+  std::set<float> ids(aov["primitive"].rgb.begin(), aov["primitive"].rgb.end());
+  for (float id : {1.0f, 2.0f, 3.0f}) EXPECT_EQ(ids.count(id), 1u) << id;
+  EXPECT_GE(*ids.begin(), 1.0f);
+  EXPECT_LE(*ids.rbegin(), 3.0f);
+  const std::vector<float>& var = aov["variance"].rgb;
+  EXPECT_GT(*std::max_element(var.begin(), var.end()), 0.0f) << "path tracing is noisy";
+}
+
 TEST(Cli, ProgressLineAndTimeLimit) {
   std::string scene = plane_scene(0, 1 << 24);
   std::string out = lucent::test::temp_dir() + "/o.png";
