@@ -399,6 +399,72 @@ TEST(Session, SeveralDevicesShareTheSamples) {
   EXPECT_EQ(both.render(100).samples_done, 0u);
 }
 
+// render_adaptive's options and the accumulation it may continue are checked: each misuse is an
+// error saying what is wrong, and the accumulation in the session stays as it was.
+TEST(Session, AdaptiveMisuseIsAnErrorAndLosesNothing) {
+  Renderer r = session();
+  r.set_scene(lucent::test::scene_from(kScene));
+  auto error_of = [&](const lucent::AdaptiveOptions& o) -> std::string {
+    try {
+      r.render_adaptive(o);
+    } catch (const lucent::Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  lucent::AdaptiveOptions neither, both, nan_target, inf_budget, small_pilot, low_cap, time;
+  both.target_error = 1e-3;
+  both.budget_spp = 16;
+  nan_target.target_error = std::nan("");
+  inf_budget.budget_spp = INFINITY;
+  const std::string either =
+      "render_adaptive: give either a target error or a budget, a positive number";
+  for (const lucent::AdaptiveOptions* o : {&neither, &both, &nan_target, &inf_budget})
+    EXPECT_EQ(error_of(*o), either);
+  small_pilot.budget_spp = low_cap.budget_spp = time.budget_spp = 16;
+  small_pilot.min_spp = 2;
+  EXPECT_EQ(error_of(small_pilot),
+            "render_adaptive: expected 4 <= min_spp <= max_spp, got 2 and 16384");
+  low_cap.min_spp = 64;
+  low_cap.max_spp = 32;
+  EXPECT_EQ(error_of(low_cap), "render_adaptive: expected 4 <= min_spp <= max_spp, got 64 and 32");
+  for (double t : {-1.0, double(NAN), double(INFINITY)}) {
+    time.max_seconds = t;
+    EXPECT_EQ(error_of(time),
+              "render_adaptive: the time limit must be a non-negative number of seconds");
+  }
+
+  // a uniform render is not continued adaptively, and keeps its samples
+  r.render(4);
+  lucent::AdaptiveOptions ok;
+  ok.budget_spp = 16;
+  ok.min_spp = 8;
+  EXPECT_NE(error_of(ok).find("the accumulation holds a uniform render's samples"),
+            std::string::npos);
+  EXPECT_EQ(r.result().spp, 4u);
+  // nor an adaptive render uniformly, or with another pilot
+  r.reset();
+  r.render_adaptive(ok);
+  const lucent::RenderResult adaptive = r.result();
+  EXPECT_GT(adaptive.halves_relmse, 0.0);
+  try {
+    r.render(1);
+    ADD_FAILURE() << "an adaptive render continued uniformly";
+  } catch (const lucent::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the accumulation is an adaptive render's"),
+              std::string::npos)
+        << e.what();
+  }
+  lucent::AdaptiveOptions other_pilot = ok;
+  other_pilot.budget_spp = 32;
+  other_pilot.min_spp = 16;
+  EXPECT_EQ(error_of(other_pilot),
+            "render_adaptive: min_spp 16 differs from the adaptive render in progress (call "
+            "reset() first)");
+  EXPECT_EQ(r.result().spp, adaptive.spp);
+  EXPECT_TRUE(r.result().mean.rgb == adaptive.mean.rgb);
+}
+
 TEST(Session, ErrorsAreLucentErrors) {
   Renderer r = session();
   EXPECT_THROW(r.render(1), lucent::Error) << "no scene yet";
