@@ -233,6 +233,70 @@ TEST(Parts, OverlapsAndMismatchesAreOneLineErrors) {
   EXPECT_NE(r.err.find("min 6, mean 6.00, max 6"), std::string::npos) << r.err;
 }
 
+// A damaged part file (an attribute edited, or not an EXR at all) is refused by merge with one
+// line naming the file, the attribute and what is wrong with it, and nothing is written. Each
+// copy of a good part has part of one attribute's value replaced by as many other bytes.
+TEST(Parts, DamagedPartFilesAreOneLineErrors) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string good = dir + "/good.exr";
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:4 -o " + q(good)).status, 0);
+  const std::string bytes = lucent::test::read_file(good);
+  const std::string out = dir + "/out.exr";
+  ASSERT_EQ(run_cli("merge " + q(good) + " -o " + q(out)).status, 0) << "the good part merges";
+  fs::remove(out);
+  // the value of a string attribute: its name, NUL, "string", NUL, a 4-byte size, the value
+  auto value_at = [&](const std::string& name) {
+    const size_t at = bytes.find(name + std::string("\0string\0", 8));
+    EXPECT_NE(at, std::string::npos) << name;
+    return at + name.size() + 8 + 4;
+  };
+  const size_t hash = value_at("lucent.hash");
+  const std::string hash_value = bytes.substr(hash, 16);
+  struct Damage {
+    std::string attribute, from, to, message;
+  };
+  const Damage damages[] = {
+      {"lucent.format", "lucent-part 1", "lucent-part 9",
+       "unsupported part format 'lucent-part 9' (expected 'lucent-part 1')"},
+      {"lucent.film", "12x10", "12x11",
+       "attribute lucent.film '12x11' differs from the image's 12x10"},
+      {"lucent.hash", hash_value, "Z" + hash_value.substr(1),
+       "attribute lucent.hash: invalid hash 'Z" + hash_value.substr(1) + "'"},
+      {"lucent.samples", "0:4", "0:5",
+       "attribute lucent.samples: [0, 5) lies outside the requested [0, 4)"},
+      {"lucent.samples", "0:4", "4:0",
+       "attribute lucent.samples: ranges must be non-empty, sorted and disjoint"},
+      {"lucent.requested", "0:4", "0-4", "attribute lucent.requested: '0-4' is not a range A:B"},
+      {"lucent.display", "srgb,", "srgx,", "attribute lucent.display: unknown transfer 'srgx'"},
+      {"lucent.display", ",clamp", ",clamq", "attribute lucent.display: unknown tone map 'clamq'"},
+      {"lucent.display", "srgb,", "srgb;", "attribute lucent.display: invalid 'srgb;"},
+  };
+  int n = 0;
+  for (const Damage& d : damages) {
+    const size_t at = bytes.find(d.from, value_at(d.attribute));
+    ASSERT_LT(at - value_at(d.attribute), 40u) << d.from << " is not in " << d.attribute;
+    std::string damaged = bytes;
+    damaged.replace(at, d.from.size(), d.to);
+    const std::string path = dir + "/damaged" + std::to_string(n++) + ".exr";
+    lucent::test::write_file(path, damaged);
+    const std::string line = error_line(run_cli("merge " + q(path) + " -o " + q(out)));
+    EXPECT_EQ(line.rfind(path + ": " + d.message, 0), 0u) << line;
+    EXPECT_FALSE(fs::exists(out)) << d.message;
+  }
+  lucent::test::write_file(dir + "/text.exr", "not an image\n");
+  EXPECT_EQ(error_line(run_cli("merge " + q(dir + "/text.exr") + " -o " + q(out))),
+            dir + "/text.exr: not an OpenEXR file");
+  EXPECT_FALSE(fs::exists(out));
+  try {
+    lucent::read_render_part(dir + "/text.exr");
+    ADD_FAILURE() << "read a text file as a part";
+  } catch (const lucent::Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              dir + "/text.exr: not a lucent part file (not an OpenEXR file)");
+  }
+}
+
 // A part stopped by SIGTERM (Slurm's signal at a job's time limit) keeps the samples it finished,
 // says which, and merges with a part of the range it left.
 TEST(Parts, SigtermedPartRecordsItsRangeAndMerges) {
