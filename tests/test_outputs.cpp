@@ -252,6 +252,14 @@ TEST(Outputs, NonFiniteOptionsAreRefused) {
             "--aov depth: given twice");
   EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(out) + " --reference --time 2")),
             "--time is not supported with --reference");
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(out) +
+                               " --reference --target-error 0.01")),
+            "--target-error is not supported with --reference");
+  for (const char* opt : {"--reference", "--aov depth", "--target-error 0.01"})
+    EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(dir + "/p.exr") +
+                                 " --samples 0:2 " + opt)),
+              "--samples is not supported with --reference, --aov or --target-error")
+        << opt;
   CommandResult r = run_cli("converge " + q(scene) + " --time-ladder 1,nan");
   EXPECT_EQ(error_line(r), "--time-ladder nan: must be a finite number (see lucent --help)");
   // out-of-range reals in one short line (CLI11's own checks wrote out a range up to 1.8e308)
