@@ -79,6 +79,15 @@ const std::map<std::string, std::string> kExpected = {
      ": OpenEXR file is truncated: its 5x2088 header needs 841 bytes of header and offset table, "
      "the file has 840"},
     {"exr-leak-env.bundle", "/img.exr: cannot read OpenEXR pixels:"},
+    // tiled EXRs (from the seed tiled.exr): tinyexr multiplied a chunk's unchecked tile
+    // coordinates by the tile size in int, 4 x 1767337573 and 4915204 x 32256 (signed overflow);
+    // the probe now checks every chunk's tile and level against the level's grid
+    {"exr-tile-coordinate-overflow.exr",
+     ": OpenEXR tile chunk at byte 523 names tile (0, 0) of level (1702390128, 1886601580), not "
+     "one of the 3x2 tiles of level (0, 0)"},
+    {"exr-tile-size-overflow.exr",
+     ": OpenEXR tile chunk at byte 431 names tile (1, 0) of level (10240, 0), not one of the 3x1 "
+     "tiles of level (0, 0)"},
     // a map_Kd name longer than the file system allows: std::filesystem::exists threw
     {"long-texture-name.bundle", ""},
     // a vw (skin weight) line whose joint 112147483648 tinyobjloader converted to int: undefined

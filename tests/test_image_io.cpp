@@ -7,9 +7,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <deque>
 #include <fstream>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support.hpp"
@@ -99,16 +101,23 @@ TEST(ImageIo, UnknownExtensionAndUnwritablePathAreErrors) {
   EXPECT_THROW(lucent::read_image(lucent::test::temp_dir() + "/missing.pfm"), lucent::Error);
 }
 
+/// How write_exr lays out its file: scanlines (tile 0), or tiles of `tile` pixels in one level or
+/// in mip-map or rip-map levels, each level's size rounded down or up (OpenEXR's rules).
+struct ExrLayout {
+  int tile = 0;
+  int levels = TINYEXR_TILE_ONE_LEVEL;
+  int rounding = TINYEXR_TILE_ROUND_DOWN;
+};
+
 /// Writes an OpenEXR file of float channels `names` (in that order), w x h, channel c of pixel
-/// (x, y) = value(c, x, y), with tinyexr: scanlines, or tiles of `tile` pixels when tile > 0
-/// (tinyexr's writer takes the tiles themselves, each a tile x tile buffer, cut at the edges).
+/// (x, y) of level 0 = value(c, x, y) (of level (lx, ly): that + 1000 (lx + ly)), with tinyexr.
+/// Its writer takes the tiles themselves, each a full tile buffer cut at the edges, level by
+/// level in the file's order, and checks each level's tile count against its own.
 void write_exr(const std::string& path, int w, int h, const std::vector<std::string>& names,
-               const std::function<float(int, int, int)>& value, int tile = 0) {
-  const int nc = static_cast<int>(names.size());
+               const std::function<float(int, int, int)>& value, ExrLayout layout = {}) {
+  const int nc = static_cast<int>(names.size()), tile = layout.tile;
   EXRHeader header;
   InitEXRHeader(&header);
-  EXRImage image;
-  InitEXRImage(&image);
   std::vector<EXRChannelInfo> channels(nc);
   for (int c = 0; c < nc; ++c) std::strncpy(channels[c].name, names[c].c_str(), 255);
   std::vector<int> types(nc, TINYEXR_PIXELTYPE_FLOAT);
@@ -117,48 +126,88 @@ void write_exr(const std::string& path, int w, int h, const std::vector<std::str
   header.pixel_types = types.data();
   header.requested_pixel_types = types.data();
   header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
-  image.num_channels = nc;
-  image.width = w;
-  image.height = h;
-  std::vector<std::vector<float>> planes;
-  std::vector<std::vector<unsigned char*>> pointers;
-  std::vector<EXRTile> tiles;
-  auto plane = [&](int tx, int ty, int stride, int tw, int th) {
+  header.data_window.max_x = header.display_window.max_x = w - 1;  // tile counts' source
+  header.data_window.max_y = header.display_window.max_y = h - 1;
+  std::deque<std::vector<float>> planes;  // stable addresses
+  std::deque<std::vector<unsigned char*>> pointers;
+  std::deque<std::vector<EXRTile>> tiles;
+  auto plane = [&](int x0, int y0, int stride, int rows, int tw, int th, float add) {
     pointers.emplace_back();
     for (int c = 0; c < nc; ++c) {
-      planes.emplace_back(static_cast<size_t>(stride) * (tile > 0 ? tile : th), 0.0f);
+      planes.emplace_back(static_cast<size_t>(stride) * rows, 0.0f);
       for (int j = 0; j < th; ++j)
         for (int i = 0; i < tw; ++i)
-          planes.back()[size_t(j) * stride + i] = value(c, tx + i, ty + j);
+          planes.back()[size_t(j) * stride + i] = value(c, x0 + i, y0 + j) + add;
       pointers.back().push_back(reinterpret_cast<unsigned char*>(planes.back().data()));
     }
     return pointers.back().data();
   };
-  planes.reserve(64 * nc);  // stable addresses
-  pointers.reserve(64);
+  std::deque<EXRImage> levels(1);
+  InitEXRImage(&levels[0]);
   if (tile == 0) {
-    image.images = plane(0, 0, w, w, h);
+    levels[0].images = plane(0, 0, w, h, w, h, 0);
   } else {
     header.tiled = 1;
     header.tile_size_x = header.tile_size_y = tile;
-    header.tile_level_mode = TINYEXR_TILE_ONE_LEVEL;
-    header.tile_rounding_mode = TINYEXR_TILE_ROUND_DOWN;
-    header.data_window.max_x = header.display_window.max_x = w - 1;  // the tile count's source
-    header.data_window.max_y = header.display_window.max_y = h - 1;
-    for (int ty = 0; ty * tile < h; ++ty)
-      for (int tx = 0; tx * tile < w; ++tx) {
-        EXRTile t{};
-        t.offset_x = tx;
-        t.offset_y = ty;
-        t.width = std::min(tile, w - tx * tile);
-        t.height = std::min(tile, h - ty * tile);
-        t.images = plane(tx * tile, ty * tile, tile, t.width, t.height);
-        tiles.push_back(t);
+    header.tile_level_mode = layout.levels;
+    header.tile_rounding_mode = layout.rounding;
+    const bool up = layout.rounding == TINYEXR_TILE_ROUND_UP;
+    auto log2 = [&](int x) {
+      int y = 0;
+      bool rest = false;
+      for (; x > 1; x >>= 1, ++y) rest = rest || (x & 1);
+      return y + (up && rest ? 1 : 0);
+    };
+    auto size = [&](int top, int l) {
+      return std::max(1, up ? (top + (1 << l) - 1) >> l : top >> l);
+    };
+    const int nx = layout.levels == TINYEXR_TILE_ONE_LEVEL
+                       ? 1
+                       : log2(layout.levels == TINYEXR_TILE_MIPMAP_LEVELS ? std::max(w, h) : w) + 1;
+    const int ny = layout.levels == TINYEXR_TILE_RIPMAP_LEVELS ? log2(h) + 1 : nx;
+    std::vector<std::pair<int, int>> order;
+    if (layout.levels == TINYEXR_TILE_RIPMAP_LEVELS) {
+      for (int ly = 0; ly < ny; ++ly)
+        for (int lx = 0; lx < nx; ++lx) order.emplace_back(lx, ly);
+    } else {
+      for (int l = 0; l < nx; ++l) order.emplace_back(l, l);
+    }
+    for (size_t k = 0; k < order.size(); ++k) {
+      const auto [lx, ly] = order[k];
+      const int lw = size(w, lx), lh = size(h, ly);
+      if (k > 0) {
+        levels.emplace_back();
+        InitEXRImage(&levels.back());
+        levels[k - 1].next_level = &levels.back();
       }
-    ASSERT_LE(tiles.size(), 64u);
-    image.tiles = tiles.data();
-    image.num_tiles = static_cast<int>(tiles.size());
+      EXRImage& level = levels.back();
+      level.level_x = lx;
+      level.level_y = ly;
+      level.width = lw;
+      level.height = lh;
+      level.num_channels = nc;
+      tiles.emplace_back();
+      for (int ty = 0; ty * tile < lh; ++ty)
+        for (int tx = 0; tx * tile < lw; ++tx) {
+          EXRTile t{};
+          t.offset_x = tx;
+          t.offset_y = ty;
+          t.level_x = lx;
+          t.level_y = ly;
+          t.width = std::min(tile, lw - tx * tile);
+          t.height = std::min(tile, lh - ty * tile);
+          t.images =
+              plane(tx * tile, ty * tile, tile, tile, t.width, t.height, 1000.0f * (lx + ly));
+          tiles.back().push_back(t);
+        }
+      level.tiles = tiles.back().data();
+      level.num_tiles = static_cast<int>(tiles.back().size());
+    }
   }
+  EXRImage& image = levels[0];
+  image.num_channels = nc;
+  image.width = w;
+  image.height = h;
   unsigned char* memory = nullptr;
   const char* err = nullptr;
   const size_t size = SaveEXRImageToMemory(&image, &header, &memory, &err);
@@ -172,7 +221,7 @@ void write_exr(const std::string& path, int w, int h, const std::vector<std::str
 TEST(ImageIo, TiledExrReadsAsScanlines) {
   auto value = [](int c, int x, int y) { return float(x + 100 * y) + 0.25f * float(c); };
   const std::string dir = lucent::test::temp_dir();
-  write_exr(dir + "/tiled.exr", 37, 21, {"B", "G", "R"}, value, 16);
+  write_exr(dir + "/tiled.exr", 37, 21, {"B", "G", "R"}, value, {16});
   write_exr(dir + "/lines.exr", 37, 21, {"B", "G", "R"}, value);
   const lucent::Image tiled = lucent::read_image(dir + "/tiled.exr");
   ASSERT_EQ(tiled.width, 37);
@@ -182,6 +231,85 @@ TEST(ImageIo, TiledExrReadsAsScanlines) {
       for (int c = 0; c < 3; ++c)  // R is channel 2 of the file
         ASSERT_EQ(tiled.pixel(x, y)[c], value(2 - c, x, y)) << x << "," << y << " channel " << c;
   EXPECT_EQ(tiled.rgb, lucent::read_image(dir + "/lines.exr").rgb);
+}
+
+// Tiled files with mip-map or rip-map levels (texture tools write them), their level sizes
+// rounded down or up: the probe's count of levels and tiles (which checks every chunk, against
+// tinyexr's unchecked tile coordinates) is tinyexr's, so each reads, as its level 0. (tinyexr's
+// writer refuses a level 0 smaller than a tile, so every size here is at least one tile.)
+TEST(ImageIo, MipMappedAndRipMappedTiledExrRead) {
+  auto value = [](int c, int x, int y) { return float(x + 100 * y) + 0.25f * float(c); };
+  const std::string dir = lucent::test::temp_dir();
+  for (int levels :
+       {TINYEXR_TILE_ONE_LEVEL, TINYEXR_TILE_MIPMAP_LEVELS, TINYEXR_TILE_RIPMAP_LEVELS})
+    for (int rounding : {TINYEXR_TILE_ROUND_DOWN, TINYEXR_TILE_ROUND_UP})
+      for (const auto& [w, h] : {std::pair{37, 21}, std::pair{16, 9}, std::pair{9, 17}}) {
+        const std::string what = "levels " + std::to_string(levels) + ", rounding " +
+                                 std::to_string(rounding) + ", " + std::to_string(w) + "x" +
+                                 std::to_string(h);
+        write_exr(dir + "/m.exr", w, h, {"B", "G", "R"}, value, {8, levels, rounding});
+        lucent::Image img;
+        try {
+          img = lucent::read_image(dir + "/m.exr");
+        } catch (const lucent::Error& e) {
+          ADD_FAILURE() << what << ": " << e.what();
+          continue;
+        }
+        ASSERT_EQ(img.width, w) << what;
+        ASSERT_EQ(img.height, h) << what;
+        for (int y = 0; y < h; ++y)
+          for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c)
+              ASSERT_EQ(img.pixel(x, y)[c], value(2 - c, x, y)) << what << " at " << x << "," << y;
+      }
+}
+
+// What the probe refuses in a tiled file before tinyexr decodes it (tinyexr would multiply
+// unchecked values in int, or walk the chunks unchecked to rebuild a damaged offset table), each
+// with one line naming the file: an offset table entry outside the tiles' data, an unknown level
+// mode, and tiles whose buffers exceed the pixel limit. Each is a good file with bytes replaced.
+TEST(ImageIo, DamagedTiledExrIsRefused) {
+  auto value = [](int c, int x, int y) { return float(x + y + c); };
+  const std::string dir = lucent::test::temp_dir(), path = dir + "/t.exr";
+  write_exr(path, 37, 21, {"B", "G", "R"}, value, {16});
+  const std::string good = lucent::test::read_file(path);
+  auto error_of = [&](const std::string& bytes) -> std::string {
+    lucent::test::write_file(path, bytes);
+    try {
+      lucent::read_image(path);
+    } catch (const lucent::Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  ASSERT_EQ(error_of(good), "");
+  // the offset table follows the header: 6 entries (3 x 2 tiles of 16)
+  EXRVersion version;
+  EXRHeader header;
+  InitEXRHeader(&header);
+  const auto* data = reinterpret_cast<const unsigned char*>(good.data());
+  ASSERT_EQ(ParseEXRVersionFromMemory(&version, data, good.size()), TINYEXR_SUCCESS);
+  ASSERT_EQ(ParseEXRHeaderFromMemory(&header, &version, data, good.size(), nullptr),
+            TINYEXR_SUCCESS);
+  const size_t table = 8 + header.header_len;
+  FreeEXRHeader(&header);
+  std::string zeroed = good;
+  zeroed.replace(table + 16, 8, std::string(8, '\0'));  // entry 2: tinyexr rebuilds the table
+  EXPECT_EQ(error_of(zeroed), path +
+                                  ": OpenEXR offset table entry 2 of 6 (0) points outside the "
+                                  "file's tiles (damaged offset table)");
+  // the "tiles" attribute: x size, y size (uint32), then the mode byte (level mode | rounding << 4)
+  const size_t tiles = good.find(std::string("tiles\0tiledesc\0", 15)) + 15 + 4;
+  ASSERT_EQ(good[tiles], 16);
+  std::string mode = good;
+  mode[tiles + 8] = 3;
+  EXPECT_EQ(error_of(mode), path + ": OpenEXR header has an unknown tile level mode 3");
+  std::string huge = good;
+  huge.replace(tiles, 8, std::string("\0\0\0\x01\0\0\0\x01", 8));  // tiles of 2^24 x 2^24
+  EXPECT_NE(error_of(huge).find(path + ": OpenEXR tiles of 16777216x16777216 for a 37x21 image "
+                                       "take more than the limit of "),
+            std::string::npos)
+      << error_of(huge);
 }
 
 // A single-channel OpenEXR file (Y, or one channel of any name) is grey; one without R, G, B or

@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <utility>
+#include <vector>
 
 #include "core/file_io.hpp"
 #include "lucent/error.hpp"
@@ -460,8 +462,7 @@ class Checker {
     if (header.tiled) {
       if (header.tile_size_x <= 0 || header.tile_size_y <= 0)
         fail("OpenEXR header has an invalid tile size");
-      chunks = ((u64(w) + header.tile_size_x - 1) / header.tile_size_x) *
-               ((u64(h) + header.tile_size_y - 1) / header.tile_size_y);
+      chunks = tile_chunks(p, header, u64(w), u64(h));
     } else {
       int lines = 1;
       switch (header.compression_type) {
@@ -489,6 +490,84 @@ class Checker {
       guard.keep = true;
     }
     return p;
+  }
+
+  // tinyexr 1.0.1 takes a tile's coordinates from its chunk unchecked and multiplies them by the
+  // tile size in int (signed overflow: found by fuzz_texture and fuzz_render_image from a tiled
+  // seed), and rebuilds an offset table with an entry <= 0 by walking the chunks unchecked. So
+  // the levels and tile grids of a tiled file are computed as tinyexr computes them, every entry
+  // of the offset table must point at a chunk inside the file, and every chunk must name a tile
+  // of the grid of the level its entry belongs to. The tile buffers tinyexr allocates (every tile
+  // of every level, each at the full tile size) count against the pixel limit. Returns the
+  // number of entries of the offset table.
+  u64 tile_chunks(const Probe& p, const EXRHeader& header, u64 w, u64 h) const {
+    const int mode = header.tile_level_mode, rounding = header.tile_rounding_mode;
+    if (mode != TINYEXR_TILE_ONE_LEVEL && mode != TINYEXR_TILE_MIPMAP_LEVELS &&
+        mode != TINYEXR_TILE_RIPMAP_LEVELS)
+      fail("OpenEXR header has an unknown tile level mode " + std::to_string(mode));
+    if (rounding != TINYEXR_TILE_ROUND_DOWN && rounding != TINYEXR_TILE_ROUND_UP)
+      fail("OpenEXR header has an unknown tile rounding mode " + std::to_string(rounding));
+    const bool up = rounding == TINYEXR_TILE_ROUND_UP;
+    auto log2 = [&](u64 x) {  // floor, or ceil when rounding up
+      int y = 0;
+      bool rest = false;
+      for (; x > 1; x >>= 1, ++y) rest = rest || (x & 1);
+      return y + (up && rest ? 1 : 0);
+    };
+    auto level_size = [&](u64 top, int l) {
+      const u64 b = u64(1) << l;
+      const u64 s = top / b + (up && top % b ? 1 : 0);
+      return std::max<u64>(s, 1);
+    };
+    const int x_levels = mode == TINYEXR_TILE_ONE_LEVEL       ? 1
+                         : mode == TINYEXR_TILE_MIPMAP_LEVELS ? log2(std::max(w, h)) + 1
+                                                              : log2(w) + 1;
+    const int y_levels = mode == TINYEXR_TILE_RIPMAP_LEVELS ? log2(h) + 1 : x_levels;
+    const u64 tx = u64(header.tile_size_x), ty = u64(header.tile_size_y);
+    std::vector<u64> nx(x_levels), ny(y_levels);
+    for (int l = 0; l < x_levels; ++l) nx[l] = (level_size(w, l) + tx - 1) / tx;
+    for (int l = 0; l < y_levels; ++l) ny[l] = (level_size(h, l) + ty - 1) / ty;
+    std::vector<std::pair<int, int>> levels;  // (x level, y level) in the offset table's order
+    if (mode == TINYEXR_TILE_RIPMAP_LEVELS) {
+      for (int ly = 0; ly < y_levels; ++ly)
+        for (int lx = 0; lx < x_levels; ++lx) levels.emplace_back(lx, ly);
+    } else {
+      for (int l = 0; l < x_levels; ++l) levels.emplace_back(l, l);
+    }
+    u64 entries = 0, pixels = 0;
+    for (const auto& [lx, ly] : levels) {
+      entries += nx[lx] * ny[ly];
+      if (tx > (1u << 30) || ty > (1u << 30) || nx[lx] * tx > (u64(1) << 31) ||
+          ny[ly] * ty > (u64(1) << 31))
+        pixels = max_pixels_ + 1;
+      else
+        pixels += nx[lx] * tx * ny[ly] * ty;
+      if (pixels > max_pixels_)
+        fail("OpenEXR tiles of " + std::to_string(tx) + "x" + std::to_string(ty) + " for a " +
+             std::to_string(w) + "x" + std::to_string(h) + " image take more than the limit of " +
+             std::to_string(max_pixels_) + " pixels (corrupt, or too large)");
+    }
+    const u64 table = 8 + u64(header.header_len), data = table + 8 * entries;
+    need(p, data, n_, "header and offset table");
+    auto i32 = [&](u64 at) { return static_cast<std::int32_t>(le32(d_ + at)); };
+    u64 i = 0;
+    for (const auto& [lx, ly] : levels)
+      for (u64 k = 0; k < nx[lx] * ny[ly]; ++k, ++i) {
+        const u64 offset = le32(d_ + table + 8 * i) | (u64(le32(d_ + table + 8 * i + 4)) << 32);
+        if (offset < data || offset > n_ || n_ - offset < 20)
+          fail("OpenEXR offset table entry " + std::to_string(i) + " of " +
+               std::to_string(entries) + " (" + std::to_string(offset) +
+               ") points outside the file's tiles (damaged offset table)");
+        const std::int32_t x = i32(offset), y = i32(offset + 4);
+        const std::int32_t cx = i32(offset + 8), cy = i32(offset + 12);
+        if (cx != lx || cy != ly || x < 0 || y < 0 || u64(x) >= nx[lx] || u64(y) >= ny[ly])
+          fail("OpenEXR tile chunk at byte " + std::to_string(offset) + " names tile (" +
+               std::to_string(x) + ", " + std::to_string(y) + ") of level (" + std::to_string(cx) +
+               ", " + std::to_string(cy) + "), not one of the " + std::to_string(nx[lx]) + "x" +
+               std::to_string(ny[ly]) + " tiles of level (" + std::to_string(lx) + ", " +
+               std::to_string(ly) + ")");
+      }
+    return entries;
   }
 
   // tinyexr 1.0.1 reads the value of two header attributes without checking its size: "tiles"
