@@ -181,10 +181,15 @@ class BvhTrace : public ::testing::Test {
                const char* what = "", const lucent::bvh::BuildOptions& options = {}) {
     Bvh b = lucent::bvh::build(s.tris, s.spheres, options);
     auto hits = trace(s, b, rays, any_hit);
-    std::size_t bad = 0, inexact = 0, hit = 0;
+    std::size_t bad = 0, inexact = 0, hit = 0, judged = 0;
+    // the kernel's answers do not depend on the host's sanitizers: under them (where the brute
+    // force runs unoptimised and instrumented) every fourth ray is judged
+    const std::size_t step = lucent::test::kAddressSanitizer ? 4 : 1;
     for (std::size_t i = 0; i < rays.size(); ++i) {
-      Verdict v = judge(s, rays[i], hits[i], any_hit);
       hit += hits[i].prim != LC_INVALID;
+      if (i % step) continue;
+      ++judged;
+      Verdict v = judge(s, rays[i], hits[i], any_hit);
       inexact += !v.exact;
       if (!v.ok && ++bad <= 5) {
         const TraceRay& r = rays[i];
@@ -196,6 +201,7 @@ class BvhTrace : public ::testing::Test {
     }
     EXPECT_EQ(bad, 0u) << what;
     EXPECT_LE(inexact, rays.size() / 1000) << what << ": too many rays differ within tolerance";
+    EXPECT_GE(judged, rays.size() / step);
     // the ray sets are built to hit often and miss often: a tracer that always misses fails here
     EXPECT_GT(hit, rays.size() / 10) << what;
     EXPECT_LT(hit, rays.size()) << what;
