@@ -7,13 +7,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <deque>
-#include <fstream>
 #include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "fuzz_common.hpp"
 #include "support.hpp"
 
 namespace {
@@ -101,119 +100,12 @@ TEST(ImageIo, UnknownExtensionAndUnwritablePathAreErrors) {
   EXPECT_THROW(lucent::read_image(lucent::test::temp_dir() + "/missing.pfm"), lucent::Error);
 }
 
-/// How write_exr lays out its file: scanlines (tile 0), or tiles of `tile` pixels in one level or
-/// in mip-map or rip-map levels, each level's size rounded down or up (OpenEXR's rules).
-struct ExrLayout {
-  int tile = 0;
-  int levels = TINYEXR_TILE_ONE_LEVEL;
-  int rounding = TINYEXR_TILE_ROUND_DOWN;
-};
+using lucent::fuzz::ExrLayout;
 
-/// Writes an OpenEXR file of float channels `names` (in that order), w x h, channel c of pixel
-/// (x, y) of level 0 = value(c, x, y) (of level (lx, ly): that + 1000 (lx + ly)), with tinyexr.
-/// Its writer takes the tiles themselves, each a full tile buffer cut at the edges, level by
-/// level in the file's order, and checks each level's tile count against its own.
+/// Writes lucent::fuzz::exr_file's OpenEXR file to `path`.
 void write_exr(const std::string& path, int w, int h, const std::vector<std::string>& names,
                const std::function<float(int, int, int)>& value, ExrLayout layout = {}) {
-  const int nc = static_cast<int>(names.size()), tile = layout.tile;
-  EXRHeader header;
-  InitEXRHeader(&header);
-  std::vector<EXRChannelInfo> channels(nc);
-  for (int c = 0; c < nc; ++c) std::strncpy(channels[c].name, names[c].c_str(), 255);
-  std::vector<int> types(nc, TINYEXR_PIXELTYPE_FLOAT);
-  header.num_channels = nc;
-  header.channels = channels.data();
-  header.pixel_types = types.data();
-  header.requested_pixel_types = types.data();
-  header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
-  header.data_window.max_x = header.display_window.max_x = w - 1;  // tile counts' source
-  header.data_window.max_y = header.display_window.max_y = h - 1;
-  std::deque<std::vector<float>> planes;  // stable addresses
-  std::deque<std::vector<unsigned char*>> pointers;
-  std::deque<std::vector<EXRTile>> tiles;
-  auto plane = [&](int x0, int y0, int stride, int rows, int tw, int th, float add) {
-    pointers.emplace_back();
-    for (int c = 0; c < nc; ++c) {
-      planes.emplace_back(static_cast<size_t>(stride) * rows, 0.0f);
-      for (int j = 0; j < th; ++j)
-        for (int i = 0; i < tw; ++i)
-          planes.back()[size_t(j) * stride + i] = value(c, x0 + i, y0 + j) + add;
-      pointers.back().push_back(reinterpret_cast<unsigned char*>(planes.back().data()));
-    }
-    return pointers.back().data();
-  };
-  std::deque<EXRImage> levels(1);
-  InitEXRImage(&levels[0]);
-  if (tile == 0) {
-    levels[0].images = plane(0, 0, w, h, w, h, 0);
-  } else {
-    header.tiled = 1;
-    header.tile_size_x = header.tile_size_y = tile;
-    header.tile_level_mode = layout.levels;
-    header.tile_rounding_mode = layout.rounding;
-    const bool up = layout.rounding == TINYEXR_TILE_ROUND_UP;
-    auto log2 = [&](int x) {
-      int y = 0;
-      bool rest = false;
-      for (; x > 1; x >>= 1, ++y) rest = rest || (x & 1);
-      return y + (up && rest ? 1 : 0);
-    };
-    auto size = [&](int top, int l) {
-      return std::max(1, up ? (top + (1 << l) - 1) >> l : top >> l);
-    };
-    const int nx = layout.levels == TINYEXR_TILE_ONE_LEVEL
-                       ? 1
-                       : log2(layout.levels == TINYEXR_TILE_MIPMAP_LEVELS ? std::max(w, h) : w) + 1;
-    const int ny = layout.levels == TINYEXR_TILE_RIPMAP_LEVELS ? log2(h) + 1 : nx;
-    std::vector<std::pair<int, int>> order;
-    if (layout.levels == TINYEXR_TILE_RIPMAP_LEVELS) {
-      for (int ly = 0; ly < ny; ++ly)
-        for (int lx = 0; lx < nx; ++lx) order.emplace_back(lx, ly);
-    } else {
-      for (int l = 0; l < nx; ++l) order.emplace_back(l, l);
-    }
-    for (size_t k = 0; k < order.size(); ++k) {
-      const auto [lx, ly] = order[k];
-      const int lw = size(w, lx), lh = size(h, ly);
-      if (k > 0) {
-        levels.emplace_back();
-        InitEXRImage(&levels.back());
-        levels[k - 1].next_level = &levels.back();
-      }
-      EXRImage& level = levels.back();
-      level.level_x = lx;
-      level.level_y = ly;
-      level.width = lw;
-      level.height = lh;
-      level.num_channels = nc;
-      tiles.emplace_back();
-      for (int ty = 0; ty * tile < lh; ++ty)
-        for (int tx = 0; tx * tile < lw; ++tx) {
-          EXRTile t{};
-          t.offset_x = tx;
-          t.offset_y = ty;
-          t.level_x = lx;
-          t.level_y = ly;
-          t.width = std::min(tile, lw - tx * tile);
-          t.height = std::min(tile, lh - ty * tile);
-          t.images =
-              plane(tx * tile, ty * tile, tile, tile, t.width, t.height, 1000.0f * (lx + ly));
-          tiles.back().push_back(t);
-        }
-      level.tiles = tiles.back().data();
-      level.num_tiles = static_cast<int>(tiles.back().size());
-    }
-  }
-  EXRImage& image = levels[0];
-  image.num_channels = nc;
-  image.width = w;
-  image.height = h;
-  unsigned char* memory = nullptr;
-  const char* err = nullptr;
-  const size_t size = SaveEXRImageToMemory(&image, &header, &memory, &err);
-  ASSERT_GT(size, 0u) << (err ? err : "");
-  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(memory), size);
-  std::free(memory);
+  lucent::test::write_file(path, lucent::fuzz::exr_file(w, h, names, value, layout));
 }
 
 // A tiled OpenEXR file (a texture from another tool) reads as its scanline twin: 37 x 21 pixels in

@@ -4,9 +4,11 @@
 
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 
+#include "image/image_probe.hpp"
 #include "scene/loaders.hpp"
 
 namespace lucent::fuzz {
@@ -126,6 +128,104 @@ void check_scene(const Scene& s) {
   check(finite_float(c.fov_degrees) && finite_float(c.aperture) && finite_float(c.focus_distance),
         "camera numbers");
   check(s.film.width >= 1 && s.film.height >= 1, "film size");
+}
+
+std::string exr_file(int w, int h, const std::vector<std::string>& names,
+                     const std::function<float(int, int, int)>& value, ExrLayout layout) {
+  const int nc = static_cast<int>(names.size()), tile = layout.tile;
+  EXRHeader header;
+  InitEXRHeader(&header);
+  std::vector<EXRChannelInfo> channels(nc);
+  for (int c = 0; c < nc; ++c) std::strncpy(channels[c].name, names[c].c_str(), 255);
+  std::vector<int> types(nc, TINYEXR_PIXELTYPE_FLOAT);
+  header.num_channels = nc;
+  header.channels = channels.data();
+  header.pixel_types = types.data();
+  header.requested_pixel_types = types.data();
+  header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
+  header.data_window.max_x = header.display_window.max_x = w - 1;  // tile counts' source
+  header.data_window.max_y = header.display_window.max_y = h - 1;
+  std::deque<std::vector<float>> planes;  // stable addresses
+  std::deque<std::vector<unsigned char*>> pointers;
+  std::deque<std::vector<EXRTile>> tiles;
+  auto plane = [&](int x0, int y0, int stride, int rows, int tw, int th, float add) {
+    pointers.emplace_back();
+    for (int c = 0; c < nc; ++c) {
+      planes.emplace_back(static_cast<size_t>(stride) * rows, 0.0f);
+      for (int j = 0; j < th; ++j)
+        for (int i = 0; i < tw; ++i)
+          planes.back()[size_t(j) * stride + i] = value(c, x0 + i, y0 + j) + add;
+      pointers.back().push_back(reinterpret_cast<unsigned char*>(planes.back().data()));
+    }
+    return pointers.back().data();
+  };
+  std::deque<EXRImage> levels(1);
+  InitEXRImage(&levels[0]);
+  if (tile == 0) {
+    levels[0].images = plane(0, 0, w, h, w, h, 0);
+  } else {
+    header.tiled = 1;
+    header.tile_size_x = header.tile_size_y = tile;
+    header.tile_level_mode = layout.levels;
+    header.tile_rounding_mode = layout.rounding;
+    const bool up = layout.rounding == TINYEXR_TILE_ROUND_UP;
+    auto log2 = [&](int x) {
+      int y = 0;
+      bool rest = false;
+      for (; x > 1; x >>= 1, ++y) rest = rest || (x & 1);
+      return y + (up && rest ? 1 : 0);
+    };
+    auto size = [&](int top, int l) {
+      return std::max(1, up ? (top + (1 << l) - 1) >> l : top >> l);
+    };
+    const int nx = layout.levels == TINYEXR_TILE_ONE_LEVEL
+                       ? 1
+                       : log2(layout.levels == TINYEXR_TILE_MIPMAP_LEVELS ? std::max(w, h) : w) + 1;
+    const int ny = layout.levels == TINYEXR_TILE_RIPMAP_LEVELS ? log2(h) + 1 : nx;
+    std::vector<std::pair<int, int>> order;
+    if (layout.levels == TINYEXR_TILE_RIPMAP_LEVELS) {
+      for (int ly = 0; ly < ny; ++ly)
+        for (int lx = 0; lx < nx; ++lx) order.emplace_back(lx, ly);
+    } else {
+      for (int l = 0; l < nx; ++l) order.emplace_back(l, l);
+    }
+    for (size_t k = 0; k < order.size(); ++k) {
+      const auto [lx, ly] = order[k];
+      const int lw = size(w, lx), lh = size(h, ly);
+      if (k > 0) {
+        levels.emplace_back();
+        InitEXRImage(&levels.back());
+        levels[k - 1].next_level = &levels.back();
+      }
+      EXRImage& level = levels.back();
+      level.level_x = lx;
+      level.level_y = ly;
+      level.width = lw;
+      level.height = lh;
+      level.num_channels = nc;
+      tiles.emplace_back();
+      for (int ty = 0; ty * tile < lh; ++ty)
+        for (int tx = 0; tx * tile < lw; ++tx) {
+          EXRTile t{};
+          t.offset_x = tx;
+          t.offset_y = ty;
+          t.level_x = lx;
+          t.level_y = ly;
+          t.width = std::min(tile, lw - tx * tile);
+          t.height = std::min(tile, lh - ty * tile);
+          t.images =
+              plane(tx * tile, ty * tile, tile, tile, t.width, t.height, 1000.0f * (lx + ly));
+          tiles.back().push_back(t);
+        }
+      level.tiles = tiles.back().data();
+      level.num_tiles = static_cast<int>(tiles.back().size());
+    }
+  }
+  EXRImage& image = levels[0];
+  image.num_channels = nc;
+  image.width = w;
+  image.height = h;
+  return image_detail::save_exr_to_memory("exr_file", image, header);
 }
 
 }  // namespace lucent::fuzz

@@ -7,11 +7,14 @@
 // starting with a dot, a newline); parts with other names are dropped. The loaders see the main
 // file and the parts as files of one directory, so that a scene's meshes and textures, and an
 // OBJ file's MTL libraries and textures, come from the same input.
+#include <tinyexr.h>
+
 #include <cfloat>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -49,5 +52,22 @@ inline void check(bool ok, const char* what) {
 /// What a loaded scene must satisfy: every index in range, every number finite and within float
 /// range where the device stores floats, every texture consistent.
 void check_scene(const Scene& s);
+
+/// How exr_file lays out its file: scanlines (tile 0), or tiles of `tile` pixels in one level or
+/// in mip-map or rip-map levels, each level's size rounded down or up (OpenEXR's rules).
+struct ExrLayout {
+  int tile = 0;
+  int levels = TINYEXR_TILE_ONE_LEVEL;
+  int rounding = TINYEXR_TILE_ROUND_DOWN;
+};
+
+/// An OpenEXR file (its bytes) of float channels `names` (in that order), w x h, ZIP-compressed;
+/// channel c of pixel (x, y) of level 0 = value(c, x, y) (of level (lx, ly): that + 1000 (lx +
+/// ly)), made by tinyexr. Its writer takes the tiles themselves, each a full tile buffer cut at
+/// the edges, level by level in the file's order, checks each level's tile count against its own
+/// and refuses a level 0 smaller than a tile. Throws lucent::Error when tinyexr cannot encode it.
+/// (Tests of tiled inputs, and the fuzz seeds.)
+std::string exr_file(int w, int h, const std::vector<std::string>& names,
+                     const std::function<float(int, int, int)>& value, ExrLayout layout = {});
 
 }  // namespace lucent::fuzz
