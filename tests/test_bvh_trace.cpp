@@ -181,14 +181,13 @@ class BvhTrace : public ::testing::Test {
                const char* what = "", const lucent::bvh::BuildOptions& options = {}) {
     Bvh b = lucent::bvh::build(s.tris, s.spheres, options);
     auto hits = trace(s, b, rays, any_hit);
-    std::size_t bad = 0, inexact = 0, hit = 0, judged = 0;
+    std::size_t bad = 0, inexact = 0, hit = 0;
     // the kernel's answers do not depend on the host's sanitizers: under them (where the brute
     // force runs unoptimised and instrumented) every fourth ray is judged
     const std::size_t step = lucent::test::kAddressSanitizer ? 4 : 1;
     for (std::size_t i = 0; i < rays.size(); ++i) {
       hit += hits[i].prim != LC_INVALID;
       if (i % step) continue;
-      ++judged;
       Verdict v = judge(s, rays[i], hits[i], any_hit);
       inexact += !v.exact;
       if (!v.ok && ++bad <= 5) {
@@ -201,7 +200,6 @@ class BvhTrace : public ::testing::Test {
     }
     EXPECT_EQ(bad, 0u) << what;
     EXPECT_LE(inexact, rays.size() / 1000) << what << ": too many rays differ within tolerance";
-    EXPECT_GE(judged, rays.size() / step);
     // the ray sets are built to hit often and miss often: a tracer that always misses fails here
     EXPECT_GT(hit, rays.size() / 10) << what;
     EXPECT_LT(hit, rays.size()) << what;
@@ -354,8 +352,8 @@ TEST_F(BvhTrace, RaysStartingOnBoxFaces) {
 
 // Leaves of 1 to 16 primitives (1 to 4 leaf blocks), spheres and triangles sharing blocks, the
 // classic per-primitive SAH cost too: closest hits, any-hit and axis-parallel rays. One test per
-// leaf size: each judges 15,000 rays against the brute force over 1,600 primitives (about 7 s
-// under the sanitizers).
+// leaf size: each judges 15,000 rays against the brute force over 1,600 primitives (it took 20 s
+// under the sanitizers as one test).
 class BvhTraceLeaves : public BvhTrace, public ::testing::WithParamInterface<int> {};
 
 TEST_P(BvhTraceLeaves, LeafSizesAndMixedBlocks) {
