@@ -17,7 +17,15 @@ struct CommandResult {
 
 // AddressSanitizer reserves terabytes of address space for its shadow memory: a CLI built with it
 // cannot start under `ulimit -v`, so the sanitizer build runs such cases without it.
+// GCC defines __SANITIZE_ADDRESS__; clang says so through __has_feature.
 #if defined(__SANITIZE_ADDRESS__)
+#define LUCENT_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define LUCENT_TEST_ASAN 1
+#endif
+#endif
+#ifdef LUCENT_TEST_ASAN
 constexpr bool kAddressSanitizer = true;
 #else
 constexpr bool kAddressSanitizer = false;
