@@ -23,11 +23,11 @@
 #include <vector>
 
 #include "bvh/bvh.hpp"
+#include "cl/context.hpp"
+#include "lucent/error.hpp"
 #include "support/device_tracer.hpp"
 #include "support/reorder.hpp"
 #include "support/test_meshes.hpp"
-#include "cl/context.hpp"
-#include "lucent/error.hpp"
 
 #ifdef LUCENT_BENCH_EMBREE
 #include <embree3/rtcore.h>
@@ -52,7 +52,6 @@ struct Options {
   bool reorder = false;  // trace triangles stored in leaf order (bvh::reorder_triangles)
   std::string device;
 };
-
 
 bool load_obj(const std::string& path, std::vector<lc_triangle>& out) {
   std::ifstream probe(path);
@@ -237,8 +236,8 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
   std::printf(
       "tree:  binary %zu nodes, max depth %zu, SAH cost %.2f; %d-wide %zu nodes, max depth %zu; "
       "%zu leaves, mean leaf %.2f, max leaf %zu\n",
-      s.binary_nodes, s.binary_max_depth, s.sah_cost, LC_BVH_WIDTH, s.nodes, s.max_depth,
-      s.leaves, s.mean_leaf_size, s.max_leaf_size);
+      s.binary_nodes, s.binary_max_depth, s.sah_cost, LC_BVH_WIDTH, s.nodes, s.max_depth, s.leaves,
+      s.mean_leaf_size, s.max_leaf_size);
   if (opt.build_only) return;
 
   std::vector<lc_triangle> stored = tris;

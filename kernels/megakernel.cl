@@ -86,8 +86,8 @@ __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
     float3 L = integrate(&s, ray, &rng, &rays);
 #ifdef LC_HAS_CAUSTICS
     if ((params->flags & LC_FLAG_CAUSTICS) && trace_light)
-      nonfinite += caustics_light_path(&s, &rng, light_sum + light_base,
-                                       light_sumsq + light_base, &rays);
+      nonfinite +=
+          caustics_light_path(&s, &rng, light_sum + light_base, light_sumsq + light_base, &rays);
 #endif
     if (lc_isfinite3(L)) {
       sum += L;

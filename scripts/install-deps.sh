@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian packages lucent needs, and only those that are missing.
-# Usage: scripts/install-deps.sh [--with-bench] [--with-fuzz] [--with-mpi]
-#   --with-bench adds Embree for the benchmark; --with-fuzz adds clang and its libFuzzer and
-#   sanitizer runtimes for scripts/fuzz.sh; --with-mpi adds OpenMPI for lucent-mpi (optional: the
-#   project builds and tests without them).
+# Usage: scripts/install-deps.sh [--with-bench] [--with-format] [--with-fuzz] [--with-mpi]
+#   --with-bench adds Embree for the benchmark; --with-format clang-format for the format check
+#   (scripts/check-format.sh; CI's test run asks for it); --with-fuzz adds clang and its libFuzzer
+#   and sanitizer runtimes for scripts/fuzz.sh (and the sanitizer build); --with-mpi adds OpenMPI
+#   for lucent-mpi (optional: the project builds and tests without them).
 set -euo pipefail
 
 packages=(
@@ -16,9 +17,10 @@ packages=(
 for arg in "$@"; do
   case "$arg" in
     --with-bench) packages+=(libembree-dev) ;;
+    --with-format) packages+=(clang-format) ;;
     --with-fuzz) packages+=(clang libclang-rt-14-dev) ;;
     --with-mpi) packages+=(libopenmpi-dev openmpi-bin) ;;
-    *) echo "install-deps: unknown option $arg (--with-bench, --with-fuzz, --with-mpi)" >&2; exit 2 ;;
+    *) echo "install-deps: unknown option $arg (--with-bench, --with-format, --with-fuzz, --with-mpi)" >&2; exit 2 ;;
   esac
 done
 

@@ -11,7 +11,10 @@
 # processes keep N CPUs busy instead of starting N x (host CPUs) threads.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh
+# CI (LUCENT_SANITIZE=1) checks the formatting too (the CTest entry format.clang_format)
+if [[ "${LUCENT_SANITIZE:-0}" == "1" ]]; then scripts/install-deps.sh --with-format; else
+  scripts/install-deps.sh
+fi
 jobs="${LUCENT_TEST_JOBS:-$(scripts/cpus.sh)}"
 echo "test: $jobs job(s) at a time (scripts/cpus.sh; LUCENT_TEST_JOBS overrides)"
 

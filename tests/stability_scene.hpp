@@ -5,9 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
-#include <string>
-
 #include <glm/glm.hpp>
+#include <string>
 
 #include "lucent/scene.hpp"
 

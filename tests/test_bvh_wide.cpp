@@ -75,8 +75,7 @@ class Checker {
       EXPECT_EQ(visited_[i], 1) << "node " << i << " reached " << visited_[i] << " times";
     for (std::size_t i = 0; i < block_used_.size(); ++i)
       EXPECT_EQ(block_used_[i], 1) << "leaf block " << i << " used " << block_used_[i] << " times";
-    for (std::size_t i = 0; i < tris_.size(); ++i)
-      EXPECT_EQ(seen_tri_[i], 1) << "triangle " << i;
+    for (std::size_t i = 0; i < tris_.size(); ++i) EXPECT_EQ(seen_tri_[i], 1) << "triangle " << i;
     for (std::size_t i = 0; i < spheres_.size(); ++i)
       EXPECT_EQ(seen_sphere_[i], 1) << "sphere " << i;
     for (int a = 0; a < 3; ++a) {  // the scene bounds the Bvh reports

@@ -129,7 +129,8 @@ TEST(Compare, NonFiniteValuesFail) {
 }
 
 TEST(Compare, SizeMismatchIsAnError) {
-  EXPECT_THROW(lucent::compare_images(constant_image(4, 4, 1), constant_image(4, 5, 1)), lucent::Error);
+  EXPECT_THROW(lucent::compare_images(constant_image(4, 4, 1), constant_image(4, 5, 1)),
+               lucent::Error);
 }
 
 // write_render_exr / read_render keep mean, variance and sample counts exactly.
@@ -154,9 +155,11 @@ TEST(Compare, ExrRoundTripKeepsStatistics) {
 TEST(Compare, CommandLine) {
   std::string dir = lucent::test::temp_dir();
   lucent::test::write_file(dir + "/s.json", kScene);
-  auto r1 = lucent::test::run_cli("render --reference -q --spp 16 --seed 1 '" + dir + "/s.json' -o '" + dir + "/a.exr'");
+  auto r1 = lucent::test::run_cli("render --reference -q --spp 16 --seed 1 '" + dir +
+                                  "/s.json' -o '" + dir + "/a.exr'");
   ASSERT_EQ(r1.status, 0) << r1.err;
-  auto r2 = lucent::test::run_cli("render --reference -q --spp 16 --seed 2 '" + dir + "/s.json' -o '" + dir + "/b.exr'");
+  auto r2 = lucent::test::run_cli("render --reference -q --spp 16 --seed 2 '" + dir +
+                                  "/s.json' -o '" + dir + "/b.exr'");
   ASSERT_EQ(r2.status, 0) << r2.err;
   RenderResult a = lucent::read_render(dir + "/a.exr");
   ASSERT_EQ(a.samples.size(), 32u * 24u);
@@ -230,8 +233,8 @@ TEST(Compare, DisplayImageAgainstALinearOneIsRefused) {
                                    "/" + out + "'");
     ASSERT_EQ(r.status, 0) << r.err;
   }
-  for (const std::string& args : {"'" + dir + "/a.exr' '" + dir + "/a.png'",
-                                  "'" + dir + "/a.png' '" + dir + "/a.exr'"}) {
+  for (const std::string& args :
+       {"'" + dir + "/a.exr' '" + dir + "/a.png'", "'" + dir + "/a.png' '" + dir + "/a.exr'"}) {
     auto c = lucent::test::run_cli("compare " + args);
     EXPECT_EQ(c.status, 1) << args;
     EXPECT_EQ(lucent::test::count_lines(c.err), 1) << c.err;

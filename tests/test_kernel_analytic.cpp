@@ -88,7 +88,8 @@ TEST(KernelAnalytic, PathPointLightOverPlane) {
     "film": {"width": 24, "height": 24},
     "integrator": {"type": "path", "max_depth": 6},
     "materials": {"plane": {"type": "diffuse", "albedo": [0.7, 0.5, 0.3]}},
-    "shapes": [)") + kPlane + R"(],
+    "shapes": [)") + kPlane +
+                      R"(],
     "lights": [{"type": "point", "position": [0.5, 0.3, 1.5], "intensity": [20, 20, 20]}]})";
   RenderResult r = render_full(scene, 32);
   const double pos[3] = {1, -2, 4}, look[3] = {0, 0, 0}, up[3] = {0, 0, 1};
@@ -130,7 +131,9 @@ void sphere_irradiance_case(double R, double Le, bool mis) {
 }
 
 TEST(KernelAnalytic, SphereEmitterIrradianceWithMis) { sphere_irradiance_case(0.5, 4.0, true); }
-TEST(KernelAnalytic, SphereEmitterIrradianceLightSamplingOnly) { sphere_irradiance_case(0.5, 4.0, false); }
+TEST(KernelAnalytic, SphereEmitterIrradianceLightSamplingOnly) {
+  sphere_irradiance_case(0.5, 4.0, false);
+}
 TEST(KernelAnalytic, TinyBrightSphereEmitter) { sphere_irradiance_case(0.005, 4.0 * 1e4, true); }
 
 // A mirror showing a known emitter: camera -> mirror -> emitting quad. The pixel is exactly
@@ -142,14 +145,16 @@ TEST(KernelAnalytic, MirrorShowsKnownEmitter) {
     "integrator": {"type": "path", "max_depth": 3},
     "materials": {"plane": {"type": "mirror", "reflectance": [0.9, 0.5, 0.2]},
                   "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [2, 3, 4]}},
-    "shapes": [)") + kPlane + R"(,
+    "shapes": [)") + kPlane +
+                      R"(,
       {"type": "triangles", "material": "lamp",
        "positions": [[-20, 8, -5], [20, 8, -5], [20, 8, 30], [-20, 8, 30]], "indices": [0, 1, 2, 0, 2, 3]}]})";
   RenderResult r = render_full(scene, 4);
   const double expected[3] = {0.9 * 2, 0.5 * 3, 0.2 * 4};
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 8; ++x)
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.mean.pixel(x, y)[c], expected[c], 1e-5) << x << "," << y;
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(r.mean.pixel(x, y)[c], expected[c], 1e-5) << x << "," << y;
 }
 
 // White furnace: an albedo-1 diffuse sphere in a constant environment renders the environment's
@@ -192,13 +197,15 @@ TEST(KernelAnalytic, MisOnAndOffConvergeToTheSameMean) {
     return std::string(R"({
       "camera": {"position": [0, -4, 2.5], "look_at": [0, 0, 0.5], "up": [0, 0, 1], "fov": 45},
       "film": {"width": 20, "height": 16},
-      "integrator": {"type": "path", "max_depth": 4, "mis": )") + (mis ? "true" : "false") + R"(},
+      "integrator": {"type": "path", "max_depth": 4, "mis": )") +
+           (mis ? "true" : "false") + R"(},
       "materials": {"plane": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
                     "gloss": {"type": "conductor", "specular": [0.9, 0.8, 0.6], "roughness": 0.2},
                     "plastic": {"type": "plastic", "albedo": [0.2, 0.4, 0.7], "roughness": 0.1},
                     "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [6, 6, 6]},
                     "panel": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [2, 3, 4]}},
-      "shapes": [)" + std::string(kPlane) + R"(,
+      "shapes": [)" +
+           std::string(kPlane) + R"(,
         {"type": "sphere", "center": [-0.8, 0, 0.6], "radius": 0.6, "material": "gloss"},
         {"type": "sphere", "center": [0.8, 0.3, 0.5], "radius": 0.5, "material": "plastic"},
         {"type": "sphere", "center": [1.5, -1, 2.5], "radius": 0.3, "material": "lamp"},
@@ -216,7 +223,8 @@ TEST(KernelAnalytic, MisOnAndOffConvergeToTheSameMean) {
       for (int c = 0; c < 3; ++c) {
         size_t i = static_cast<size_t>(y) * w + x;
         double se = std::sqrt(a.variance.pixel(x, y)[c] / a.samples[i] +
-                              b.variance.pixel(x, y)[c] / b.samples[i]) + 1e-6;
+                              b.variance.pixel(x, y)[c] / b.samples[i]) +
+                    1e-6;
         double z = std::abs(a.mean.pixel(x, y)[c] - b.mean.pixel(x, y)[c]) / se;
         if (z > zmax) ++failures;
         mean_a += a.mean.pixel(x, y)[c];
@@ -242,14 +250,16 @@ TEST(KernelAnalytic, SameSeedSameImageWhateverThePasses) {
   lucent::RenderOptions one_pass, many_passes;
   one_pass.spp = many_passes.spp = 24;
   one_pass.specialize = many_passes.specialize = false;
-  one_pass.pass_seconds = 1e9;     // grows to all remaining samples after the first pass
-  many_passes.pass_seconds = 1e-9; // one sample per pass
-  RenderResult a = lucent::test::render(scene, one_pass), b = lucent::test::render(scene, many_passes);
+  one_pass.pass_seconds = 1e9;      // grows to all remaining samples after the first pass
+  many_passes.pass_seconds = 1e-9;  // one sample per pass
+  RenderResult a = lucent::test::render(scene, one_pass),
+               b = lucent::test::render(scene, many_passes);
   ASSERT_EQ(a.spp, 24u);
   ASSERT_EQ(b.spp, 24u);
   double worst = 0;
   for (size_t i = 0; i < a.mean.rgb.size(); ++i)
-    worst = std::max(worst, double(std::abs(a.mean.rgb[i] - b.mean.rgb[i])) / (1e-3 + std::abs(a.mean.rgb[i])));
+    worst = std::max(
+        worst, double(std::abs(a.mean.rgb[i] - b.mean.rgb[i])) / (1e-3 + std::abs(a.mean.rgb[i])));
   EXPECT_LT(worst, 1e-5);  // only float summation order differs
   scene.integrator.seed = 8;
   RenderResult c = lucent::test::render(scene, one_pass);
@@ -278,13 +288,16 @@ std::string env_map_scene(bool mis, bool look_up) {
   std::string camera = look_up ? R"("position": [0, 1, 0], "look_at": [0, 2, 0], "up": [0, 0, 1])"
                                : R"("position": [0, 1, 0], "look_at": [0, 0, 0], "up": [0, 0, -1])";
   return std::string(R"({
-    "camera": {)") + camera + R"(, "fov": 60},
+    "camera": {)") +
+         camera + R"(, "fov": 60},
     "film": {"width": 16, "height": 16},
-    "integrator": {"type": "path", "max_depth": 3, "mis": )" + (mis ? "true" : "false") + R"(},
+    "integrator": {"type": "path", "max_depth": 3, "mis": )" +
+         (mis ? "true" : "false") + R"(},
     "materials": {"plane": {"type": "diffuse", "albedo": [0.5, 0.8, 0.25]}},
     "shapes": [{"type": "triangles", "material": "plane",
       "positions": [[-1e4,0,1e4],[1e4,0,1e4],[1e4,0,-1e4],[-1e4,0,-1e4]], "indices": [0,1,2, 0,2,3]}],
-    "lights": [{"type": "environment", "file": ")" + dir + R"(/env.pfm"}]})";
+    "lights": [{"type": "environment", "file": ")" +
+         dir + R"(/env.pfm"}]})";
 }
 
 TEST(KernelAnalytic, EnvironmentMapOverPlane) {

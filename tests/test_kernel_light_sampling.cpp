@@ -13,11 +13,11 @@
 
 namespace {
 
-
 struct Probe {
   lucent::cl_util::Context ctx{lucent::test::device()};
   cl::Program program = lucent::cl_util::build_program_cached(
-      ctx, lucent::detail::assemble_kernel_source("test/light_probe.cl", lucent::test::kernel_dir()),
+      ctx,
+      lucent::detail::assemble_kernel_source("test/light_probe.cl", lucent::test::kernel_dir()),
       "-cl-std=CL1.2", lucent::test::cache_dir());
 };
 
@@ -64,8 +64,8 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
 
   // the probe's pdf at a list of directions
   auto eval_pdf = [&](const std::vector<cl_float4>& dirs) {
-    cl::Buffer bd(pr.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(cl_float4),
-                  const_cast<cl_float4*>(dirs.data()));
+    cl::Buffer bd(pr.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                  dirs.size() * sizeof(cl_float4), const_cast<cl_float4*>(dirs.data()));
     cl::Buffer bp(pr.ctx.context, CL_MEM_WRITE_ONLY, dirs.size() * sizeof(float));
     cl::Kernel ke(pr.program, "probe_light_pdf");
     int arg = dev.set_args(ke);
@@ -81,7 +81,8 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
   auto cell_dirs = [&](int ti, int pi, int sub, std::vector<cl_float4>& dirs) {
     for (int i = 0; i < sub; ++i)
       for (int j = 0; j < sub; ++j) {
-        double z = -1 + 2 * (ti + (i + 0.5) / sub) / NT, phi = 2 * M_PI * (pi + (j + 0.5) / sub) / NP;
+        double z = -1 + 2 * (ti + (i + 0.5) / sub) / NT,
+               phi = 2 * M_PI * (pi + (j + 0.5) / sub) / NP;
         double r = std::sqrt(std::max(0.0, 1 - z * z));
         dirs.push_back({{float(r * std::cos(phi)), float(r * std::sin(phi)), float(z), 0}});
       }
@@ -160,7 +161,8 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
   EXPECT_GT(pval, 1e-4) << name << ": chi2 " << c.chi2 << " over " << c.cells << " cells";
 }
 
-const char* kMats = R"("materials": {"lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [2, 3, 4]},
+const char* kMats =
+    R"("materials": {"lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [2, 3, 4]},
                                       "dim": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [0.5, 0.5, 0.5]}})";
 
 TEST(KernelLightSampling, SphereLightCone) {
@@ -188,7 +190,8 @@ TEST(KernelLightSampling, EnvironmentMap) {
   for (int y = 0; y < 12; ++y)
     for (int x = 0; x < 24; ++x)
       for (int c = 0; c < 3; ++c)
-        env.pixel(x, y)[c] = float(0.05 + ((x * 7 + y * 3) % 11) * 0.3 + (x == 5 && y == 3 ? 40 : 0));
+        env.pixel(x, y)[c] =
+            float(0.05 + ((x * 7 + y * 3) % 11) * 0.3 + (x == 5 && y == 3 ? 40 : 0));
   lucent::write_image(dir + "/env.pfm", env);
   chi_square_lights(R"({"lights": [{"type": "environment", "file": ")" + dir + R"(/env.pfm"}]})",
                     "environment map");

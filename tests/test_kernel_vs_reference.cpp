@@ -43,17 +43,19 @@ Both render_both(Scene scene, int spp, const CompareOptions& options = {}) {
   return b;
 }
 
-#define EXPECT_AGREE(b)                                                               \
-  do {                                                                                \
+#define EXPECT_AGREE(b)                                                                \
+  do {                                                                                 \
     EXPECT_TRUE((b).cmp.passed) << "A = kernel, B = reference\n" << (b).cmp.summary(); \
-    EXPECT_EQ((b).kernel.nonfinite, 0u);                                              \
-    EXPECT_EQ((b).reference.nonfinite, 0u);                                           \
+    EXPECT_EQ((b).kernel.nonfinite, 0u);                                               \
+    EXPECT_EQ((b).reference.nonfinite, 0u);                                            \
   } while (0)
 
 /// A 32x32 scene around a floor quad with the given materials, shapes and lights (JSON snippets).
 std::string scene_json(const std::string& integrator, const std::string& materials,
                        const std::string& shapes, const std::string& lights,
                        const std::string& camera = "", const std::string& film = "") {
+  // one JSON line per source line
+  // clang-format off
   return R"({
     "camera": )" + (camera.empty() ? std::string(R"({"position": [0, 1.2, 5], "look_at": [0, 0.4, 0], "fov": 38})") : camera) + R"(,
     "film": )" + (film.empty() ? std::string(R"({"width": 32, "height": 32})") : film) + R"(,
@@ -64,11 +66,13 @@ std::string scene_json(const std::string& integrator, const std::string& materia
          shapes + R"(],
     "lights": [)" + lights + R"(]
   })";
+  // clang-format on
 }
 
 const char* kDiffuseMats = R"("red": {"type": "diffuse", "albedo": [0.8, 0.25, 0.2]},
                               "blue": {"type": "diffuse", "albedo": [0.2, 0.3, 0.8]})";
-const char* kSpheres = R"({"type": "sphere", "center": [-0.8, 0.6, 0], "radius": 0.6, "material": "red"},
+const char* kSpheres =
+    R"({"type": "sphere", "center": [-0.8, 0.6, 0], "radius": 0.6, "material": "red"},
                           {"type": "sphere", "center": [0.9, 0.5, 0.4], "radius": 0.5, "material": "blue"},
                           {"type": "triangles", "material": "blue",
                            "positions": [[-2,0,-1.5],[2,0,-1.5],[0,2,-1.8]], "indices": [0,1,2]})";
@@ -77,7 +81,8 @@ const char* kPointLights = R"({"type": "point", "position": [2, 4, 3], "intensit
 const char* kEnv = R"({"type": "environment", "radiance": [0.25, 0.3, 0.4]})";
 const char* kLamps = R"("lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [6, 5, 4]},
                         "panel": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5], "emission": [2, 3, 4]})";
-const char* kLampShapes = R"({"type": "sphere", "center": [1.2, 2.2, 1.0], "radius": 0.3, "material": "lamp"},
+const char* kLampShapes =
+    R"({"type": "sphere", "center": [1.2, 2.2, 1.0], "radius": 0.3, "material": "lamp"},
                              {"type": "triangles", "material": "panel",
                               "positions": [[-2.5,2.5,-1],[-1.5,2.5,-1],[-1.5,2.5,0],[-2.5,2.5,0]],
                               "indices": [0,1,2, 0,2,3]})";
@@ -102,10 +107,13 @@ TEST(KernelVsReference, PathDiffusePointLightsEnvironment) {
 
 TEST(KernelVsReference, PathMirror) {
   Both b = render_both(
-      scene_from(scene_json(R"({"type": "path", "max_depth": 5})",
-                            std::string(kDiffuseMats) + R"(, "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]})",
-                            std::string(kSpheres) + R"(, {"type": "sphere", "center": [0, 0.45, 1.2], "radius": 0.45, "material": "mirror"})",
-                            std::string(kPointLights) + ", " + kEnv)),
+      scene_from(scene_json(
+          R"({"type": "path", "max_depth": 5})",
+          std::string(kDiffuseMats) +
+              R"(, "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]})",
+          std::string(kSpheres) +
+              R"(, {"type": "sphere", "center": [0, 0.45, 1.2], "radius": 0.45, "material": "mirror"})",
+          std::string(kPointLights) + ", " + kEnv)),
       256);
   EXPECT_AGREE(b);
 }
@@ -156,25 +164,28 @@ TEST(KernelVsReference, LongPathsAndBackFacingEmitters) {
 }
 
 TEST(KernelVsReference, FilterTent) {
-  Scene s = scene_from(scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
-                                  std::string(kSpheres) + ", " + kLampShapes, kPointLights, "",
-                                  R"({"width": 32, "height": 32, "filter": {"type": "tent", "radius": 1.5}})"));
+  Scene s = scene_from(
+      scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
+                 std::string(kSpheres) + ", " + kLampShapes, kPointLights, "",
+                 R"({"width": 32, "height": 32, "filter": {"type": "tent", "radius": 1.5}})"));
   Both b = render_both(s, 128);
   EXPECT_AGREE(b);
 }
 
 TEST(KernelVsReference, FilterGaussian) {
-  Scene s = scene_from(scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
-                                  std::string(kSpheres) + ", " + kLampShapes, kPointLights, "",
-                                  R"({"width": 32, "height": 32, "filter": {"type": "gaussian", "radius": 2}})"));
+  Scene s = scene_from(
+      scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
+                 std::string(kSpheres) + ", " + kLampShapes, kPointLights, "",
+                 R"({"width": 32, "height": 32, "filter": {"type": "gaussian", "radius": 2}})"));
   Both b = render_both(s, 128);
   EXPECT_AGREE(b);
 }
 
 TEST(KernelVsReference, FilterWideBox) {
-  Scene s = scene_from(scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
-                                  std::string(kSpheres) + ", " + kLampShapes, kPointLights, "",
-                                  R"({"width": 32, "height": 32, "filter": {"type": "box", "radius": 1.25}})"));
+  Scene s = scene_from(
+      scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
+                 std::string(kSpheres) + ", " + kLampShapes, kPointLights, "",
+                 R"({"width": 32, "height": 32, "filter": {"type": "box", "radius": 1.25}})"));
   Both b = render_both(s, 128);
   EXPECT_AGREE(b);
 }
@@ -190,11 +201,11 @@ TEST(KernelVsReference, ThinLens) {
 
 // A non-square film: the scene is asymmetric, so a swapped aspect or a mirrored axis shows.
 TEST(KernelVsReference, CameraAspect) {
-  Scene s = scene_from(scene_json(
-      R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
-      std::string(kSpheres) + ", " + kLampShapes, kPointLights,
-      R"({"position": [0.5, 1.5, 5], "look_at": [0, 0.4, 0], "fov": 40})",
-      R"({"width": 40, "height": 24})"));
+  Scene s =
+      scene_from(scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
+                            std::string(kSpheres) + ", " + kLampShapes, kPointLights,
+                            R"({"position": [0.5, 1.5, 5], "look_at": [0, 0.4, 0], "fov": 40})",
+                            R"({"width": 40, "height": 24})"));
   Both b = render_both(s, 32);
   EXPECT_AGREE(b);
 }
@@ -203,11 +214,11 @@ TEST(KernelVsReference, CameraAspect) {
 // moves towards up'). (The first kernel turned them the other way: roll r matched the reference's
 // -r.)
 TEST(KernelVsReference, CameraRoll) {
-  Scene s = scene_from(scene_json(
-      R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
-      std::string(kSpheres) + ", " + kLampShapes, kPointLights,
-      R"({"position": [0.5, 1.5, 5], "look_at": [0, 0.4, 0], "fov": 40, "roll": 25})",
-      R"({"width": 40, "height": 24})"));
+  Scene s = scene_from(
+      scene_json(R"({"type": "direct"})", std::string(kDiffuseMats) + ", " + kLamps,
+                 std::string(kSpheres) + ", " + kLampShapes, kPointLights,
+                 R"({"position": [0.5, 1.5, 5], "look_at": [0, 0.4, 0], "fov": 40, "roll": 25})",
+                 R"({"width": 40, "height": 24})"));
   Both b = render_both(s, 32);
   EXPECT_AGREE(b);
 }
@@ -218,7 +229,8 @@ TEST(KernelVsReference, CameraRoll) {
 TEST(KernelVsReference, TexturedDiffuse) {
   Scene s = scene_from(scene_json(
       R"({"type": "direct"})", std::string(kDiffuseMats) + R"(, "tex": {"type": "diffuse"})",
-      std::string(kSpheres) + R"(, {"type": "sphere", "center": [0, 0.5, 1.3], "radius": 0.5, "material": "tex"},
+      std::string(kSpheres) +
+          R"(, {"type": "sphere", "center": [0, 0.5, 1.3], "radius": 0.5, "material": "tex"},
         {"type": "triangles", "material": "tex", "positions": [[1,0,-1],[2.5,0,-1],[2.5,1.5,-1],[1,1.5,-1]],
          "uvs": [[0,0],[2,0],[2,2],[0,2]], "indices": [0,1,2, 0,2,3]})",
       std::string(kPointLights) + ", " + kEnv));
@@ -243,12 +255,13 @@ TEST(KernelVsReference, TexturedDiffuse) {
 
 TEST(KernelVsReference, PathDielectric) {
   Both b = render_both(
-      scene_from(scene_json(R"({"type": "path", "max_depth": 8})",
-                            std::string(kDiffuseMats) + ", " + kLamps +
-                                R"(, "glass": {"type": "dielectric", "ior": 1.5, "tint": [1, 0.9, 0.8]})",
-                            std::string(kSpheres) + ", " + kLampShapes +
-                                R"(, {"type": "sphere", "center": [0.1, 0.5, 1.3], "radius": 0.5, "material": "glass"})",
-                            kEnv)),
+      scene_from(scene_json(
+          R"({"type": "path", "max_depth": 8})",
+          std::string(kDiffuseMats) + ", " + kLamps +
+              R"(, "glass": {"type": "dielectric", "ior": 1.5, "tint": [1, 0.9, 0.8]})",
+          std::string(kSpheres) + ", " + kLampShapes +
+              R"(, {"type": "sphere", "center": [0.1, 0.5, 1.3], "radius": 0.5, "material": "glass"})",
+          kEnv)),
       512);
   EXPECT_AGREE(b);
 }
@@ -258,16 +271,17 @@ TEST(KernelVsReference, PathDielectric) {
 // caustics only light tracing finds), a plastic sphere (a non-delta lobe that light paths end
 // on), seen by `camera` (empty: the default pinhole) on the 32 x 32 `film`.
 Scene caustics_scene(const std::string& camera, const std::string& film) {
-  return scene_from(scene_json(R"({"type": "path", "max_depth": 6, "caustics": true})",
-                               std::string(kDiffuseMats) + ", " + kLamps +
-                                   R"(, "glass": {"type": "dielectric", "ior": 1.5, "tint": [1, 0.9, 0.8]},
+  return scene_from(scene_json(
+      R"({"type": "path", "max_depth": 6, "caustics": true})",
+      std::string(kDiffuseMats) + ", " + kLamps +
+          R"(, "glass": {"type": "dielectric", "ior": 1.5, "tint": [1, 0.9, 0.8]},
                                    "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]},
                                    "plastic": {"type": "plastic", "albedo": [0.3, 0.6, 0.3], "roughness": 0.2})",
-                               std::string(kLampShapes) +
-                                   R"(, {"type": "sphere", "center": [0.1, 0.5, 1.3], "radius": 0.5, "material": "glass"},
+      std::string(kLampShapes) +
+          R"(, {"type": "sphere", "center": [0.1, 0.5, 1.3], "radius": 0.5, "material": "glass"},
                                    {"type": "sphere", "center": [-1.0, 0.4, 0.6], "radius": 0.4, "material": "mirror"},
                                    {"type": "sphere", "center": [1.3, 0.35, 0.2], "radius": 0.35, "material": "plastic"})",
-                               kPointLights, camera, film));
+      kPointLights, camera, film));
 }
 
 // With a tent filter that splats over 3x3 pixels.
@@ -297,13 +311,14 @@ TEST(KernelVsReference, PathCausticsThinLens) {
 // factors cancel). A sphere lamp inside one glass sphere, a point light inside another.
 TEST(KernelVsReference, PathCausticsLightsInsideGlass) {
   Both b = render_both(
-      scene_from(scene_json(R"({"type": "path", "max_depth": 5, "caustics": true})",
-                            std::string(kDiffuseMats) + ", " + kLamps +
-                                R"(, "glass": {"type": "dielectric", "ior": 1.5})",
-                            R"({"type": "sphere", "center": [-0.8, 0.9, 0.5], "radius": 0.6, "material": "glass"},
+      scene_from(scene_json(
+          R"({"type": "path", "max_depth": 5, "caustics": true})",
+          std::string(kDiffuseMats) + ", " + kLamps +
+              R"(, "glass": {"type": "dielectric", "ior": 1.5})",
+          R"({"type": "sphere", "center": [-0.8, 0.9, 0.5], "radius": 0.6, "material": "glass"},
                                {"type": "sphere", "center": [-0.8, 0.9, 0.5], "radius": 0.15, "material": "lamp"},
                                {"type": "sphere", "center": [0.9, 0.7, 0.2], "radius": 0.5, "material": "glass"})",
-                            R"({"type": "point", "position": [0.9, 0.7, 0.2], "intensity": [3, 3, 3]})")),
+          R"({"type": "point", "position": [0.9, 0.7, 0.2], "intensity": [3, 3, 3]})")),
       256);
   EXPECT_AGREE(b);
 }
@@ -316,8 +331,9 @@ TEST(KernelVsReference, PathCausticsLightsInsideGlass) {
 TEST(KernelVsReference, PathCausticsBouncedOffTheFloor) {
   Both b = render_both(
       scene_from(lucent::test::bounced_caustic_scene(
-          true, 4, R"(], "lights": [{"type": "point", "position": [0, 0, 2.5], "intensity": [4, 4, 4]}])")),
-                       1024);
+          true, 4,
+          R"(], "lights": [{"type": "point", "position": [0, 0, 2.5], "intensity": [4, 4, 4]}])")),
+      1024);
   EXPECT_AGREE(b);
   double mean = 0;
   for (float v : b.kernel.mean.rgb) mean += v;
@@ -332,9 +348,10 @@ TEST(KernelVsReference, PathCausticsBouncedOffTheFloor) {
 TEST(KernelVsReference, PathCausticsSeenInAMirror) {
   Both b = render_both(
       scene_from(lucent::test::bounced_caustic_scene(
-          true, 6, R"(], "lights": [{"type": "point", "position": [0, 0, 2.5], "intensity": [4, 4, 4]}])",
+          true, 6,
+          R"(], "lights": [{"type": "point", "position": [0, 0, 2.5], "intensity": [4, 4, 4]}])",
           lucent::test::kMirrorWall, lucent::test::kFloorBesideTheMirrorWall)),
-                       4096);
+      4096);
   EXPECT_AGREE(b);
 }
 
@@ -409,8 +426,9 @@ TEST(KernelVsReference, Aovs) {
                           "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]},
                           "metal": {"type": "conductor", "specular": [0.95, 0.64, 0.54]},
                           "plastic": {"type": "plastic", "albedo": [0.2, 0.5, 0.8]})";
-  std::string shapes = std::string(kSpheres) +
-                       R"(, {"type": "sphere", "center": [-1.5, 0.3, 1.2], "radius": 0.3, "material": "glass"},
+  std::string shapes =
+      std::string(kSpheres) +
+      R"(, {"type": "sphere", "center": [-1.5, 0.3, 1.2], "radius": 0.3, "material": "glass"},
                             {"type": "sphere", "center": [0, 0.3, 1.4], "radius": 0.3, "material": "mirror"},
                             {"type": "sphere", "center": [1.5, 0.3, 1.2], "radius": 0.3, "material": "metal"},
                             {"type": "sphere", "center": [0.3, 1.5, -0.5], "radius": 0.3, "material": "plastic"})";
@@ -432,8 +450,9 @@ TEST(KernelVsReference, DepthAndNormalDeterministic) {
   o.rel_epsilon = 1e-4;
   for (const char* integrator : {R"({"type": "normal"})", R"({"type": "depth"})"}) {
     SCOPED_TRACE(integrator);
-    Scene s = scene_from(scene_json(integrator, kDiffuseMats, kSpheres, "", "",
-                                    R"({"width": 32, "height": 32, "filter": {"type": "box", "radius": 1e-6}})"));
+    Scene s = scene_from(
+        scene_json(integrator, kDiffuseMats, kSpheres, "", "",
+                   R"({"width": 32, "height": 32, "filter": {"type": "box", "radius": 1e-6}})"));
     Both b = render_both(s, 1, o);
     EXPECT_AGREE(b);
     EXPECT_LT(b.cmp.max_abs_error, 0.01) << b.cmp.summary();
@@ -445,7 +464,8 @@ TEST(KernelVsReference, DepthAndNormalDeterministic) {
 TEST(KernelVsReference, EnvironmentMap) {
   Scene s = scene_from(scene_json(
       R"({"type": "path", "max_depth": 4})",
-      std::string(kDiffuseMats) + R"(, "plastic": {"type": "plastic", "albedo": [0.2, 0.5, 0.8], "roughness": 0.3})",
+      std::string(kDiffuseMats) +
+          R"(, "plastic": {"type": "plastic", "albedo": [0.2, 0.5, 0.8], "roughness": 0.3})",
       R"({"type": "sphere", "center": [-0.7, 0.6, 0.3], "radius": 0.6, "material": "red"},
          {"type": "sphere", "center": [0.8, 0.5, 0.6], "radius": 0.5, "material": "plastic"})",
       "", R"({"position": [0, 1.5, 5], "look_at": [0, 0.6, 0], "fov": 60})"));
@@ -456,7 +476,8 @@ TEST(KernelVsReference, EnvironmentMap) {
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 16; ++x) {
       float sun = (x == 3 && y == 2) ? 40.0f : 0.0f;
-      t.rgba.insert(t.rgba.end(), {0.2f + 0.05f * x + sun, 0.3f + 0.1f * (7 - y), 0.5f + sun, 1.0f});
+      t.rgba.insert(t.rgba.end(),
+                    {0.2f + 0.05f * x + sun, 0.3f + 0.1f * (7 - y), 0.5f + sun, 1.0f});
     }
   s.textures.push_back(t);
   lucent::Light env;
@@ -497,8 +518,7 @@ TEST(KernelVsReference, ShadingNormals) {
 // reference, were 5% and 20% too dark here; ReferenceAnalytic.SphericalEmitterIrradiance checks
 // the same kind of floor against the closed form).
 TEST(KernelVsReference, LargeSphereFloorUnderSphereLight) {
-  Both b = render_both(
-      scene_from(R"({
+  Both b = render_both(scene_from(R"({
         "camera": {"position": [0, 1.2, 8], "look_at": [0, 0.6, 0], "fov": 35},
         "film": {"width": 32, "height": 24},
         "integrator": {"type": "path", "max_depth": 2},
@@ -507,7 +527,7 @@ TEST(KernelVsReference, LargeSphereFloorUnderSphereLight) {
         "shapes": [{"type": "sphere", "center": [0, -1000, 0], "radius": 1000, "material": "floor"},
                    {"type": "sphere", "center": [-6, 9, 3], "radius": 1.5, "material": "sky"}]
       })"),
-      256);
+                       256);
   EXPECT_AGREE(b);
 }
 
@@ -562,7 +582,8 @@ TEST(KernelVsReference, PrimitiveIdDeterministic) {
     if (a >= 0 && a < 7) ++seen[int(a)];
   }
   const size_t pixels = k.mean.rgb.size() / 3;
-  EXPECT_LE(differ, int(pixels / 200)) << differ << " of " << pixels << " pixels name another primitive";
+  EXPECT_LE(differ, int(pixels / 200))
+      << differ << " of " << pixels << " pixels name another primitive";
   // misses (0), both spheres (1, 2), the floor (4, 5: triangles 1 and 2 of the list) and the
   // standing triangle (6) are all in view; the degenerate triangle (3) never is
   for (int id : {0, 1, 2, 4, 5, 6}) EXPECT_GT(seen[id], 0) << "id " << id;

@@ -37,7 +37,9 @@ TEST(Layout, DeviceSeesTheHostLayout) {
   auto entries = host_entries();
   lucent::cl_util::Context ctx{lucent::test::device()};
   cl::Program program = lucent::cl_util::build_program(
-      ctx, lucent::detail::assemble_kernel_source("test/layout_probe.cl", lucent::test::kernel_dir()), "-cl-std=CL1.2");
+      ctx,
+      lucent::detail::assemble_kernel_source("test/layout_probe.cl", lucent::test::kernel_dir()),
+      "-cl-std=CL1.2");
   cl::Kernel k(program, "lucent_layout_probe");
   cl::Buffer out(ctx.context, CL_MEM_WRITE_ONLY, entries.size() * sizeof(lc_uint));
   k.setArg(0, out);

@@ -41,8 +41,8 @@ bool device_has_fp64() {
   return fp64;
 }
 
-#define REQUIRE_FP64()                                                          \
-  do {                                                                          \
+#define REQUIRE_FP64()                                                       \
+  do {                                                                       \
     if (!device_has_fp64()) GTEST_SKIP() << "the OpenCL device has no fp64"; \
   } while (0)
 
@@ -94,7 +94,8 @@ TEST(Precision, BuildOptionsHaveLcDoubleOnlyInDouble) {
   EXPECT_EQ(lucent::render_detail::build_options(s, packed, o),
             "-cl-std=CL1.2" + defines + " -D LC_DOUBLE -cl-fast-relaxed-math");
   o.precision = Precision::Float;
-  EXPECT_EQ(lucent::render_detail::build_options(s, packed, o).find("LC_DOUBLE"), std::string::npos);
+  EXPECT_EQ(lucent::render_detail::build_options(s, packed, o).find("LC_DOUBLE"),
+            std::string::npos);
 }
 
 TEST(Precision, RenderReportsItsBuildOptions) {
@@ -115,7 +116,8 @@ TEST(Precision, ParseAndNames) {
     lucent::parse_precision("half", "--precision");
     FAIL() << "no error";
   } catch (const lucent::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("--precision: unknown precision 'half'"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("--precision: unknown precision 'half'"),
+              std::string::npos)
         << e.what();
   }
 }
@@ -292,7 +294,8 @@ class PrecisionTranslateLight : public ::testing::TestWithParam<double> {};
 
 TEST_P(PrecisionTranslateLight, DoubleMatchesOrigin) {
   REQUIRE_FP64();
-  static const RenderResult at_origin = render(sphere_light_over_plane(0), 256, 1, Precision::Double);
+  static const RenderResult at_origin =
+      render(sphere_light_over_plane(0), 256, 1, Precision::Double);
   const double t = GetParam();
   RenderResult r = render(sphere_light_over_plane(t), 256, 2, Precision::Double);
   EXPECT_SAME_IMAGE(r, at_origin, "A = translated by " << t << " in double, B = at the origin");

@@ -79,7 +79,8 @@ TEST(ReferenceAnalytic, PointLightOverPlane) {
     std::string scene = std::string(R"({
       "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 20},
       "film": {"width": 24, "height": 16, "filter": {"type": "box", "radius": 0.0001}},
-      "integrator": {"type": ")") + integrator + R"(", "max_depth": 2},
+      "integrator": {"type": ")") +
+                        integrator + R"(", "max_depth": 2},
       "materials": {"white": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}},
       "shapes": [{"type": "triangles", "material": "white",
                   "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]],
@@ -91,7 +92,8 @@ TEST(ReferenceAnalytic, PointLightOverPlane) {
     double worst = 0;
     for (int y = 0; y < 16; ++y)
       for (int x = 0; x < 24; ++x) {
-        double px = (2.0 * (x + 0.5) / 24 - 1) * t * 1.5 * 5.0, py = (1 - 2.0 * (y + 0.5) / 16) * t * 5.0;
+        double px = (2.0 * (x + 0.5) / 24 - 1) * t * 1.5 * 5.0,
+               py = (1 - 2.0 * (y + 0.5) / 16) * t * 5.0;
         double dx = lx - px, dy = ly - py, r2 = dx * dx + dy * dy + lz * lz;
         double expected = albedo / M_PI * I * (lz / std::sqrt(r2)) / r2;
         worst = std::max(worst, std::abs(r.mean.pixel(x, y)[1] - expected) / expected);
@@ -112,9 +114,10 @@ TEST(ReferenceAnalytic, SphericalEmitterIrradiance) {
   const glm::dvec3 c(0, 0, 2);
   for (bool sphere_floor : {false, true}) {
     SCOPED_TRACE(sphere_floor ? "sphere floor" : "plane floor");
-    std::string floor = sphere_floor
-                            ? R"({"type": "sphere", "center": [0, 0, -1000], "radius": 1000, "material": "white"})"
-                            : R"({"type": "triangles", "material": "white",
+    std::string floor =
+        sphere_floor
+            ? R"({"type": "sphere", "center": [0, 0, -1000], "radius": 1000, "material": "white"})"
+            : R"({"type": "triangles", "material": "white",
                                   "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]],
                                   "indices": [0,1,2, 0,2,3]})";
     std::string scene = R"({
@@ -123,12 +126,14 @@ TEST(ReferenceAnalytic, SphericalEmitterIrradiance) {
       "integrator": {"type": "path", "max_depth": 2},
       "materials": {"white": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
                     "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [3, 3, 3]}},
-      "shapes": [)" + floor + R"(,
+      "shapes": [)" + floor +
+                        R"(,
                  {"type": "sphere", "center": [0, 0, 2], "radius": 0.5, "material": "lamp"}]
     })";
     RenderResult r = render_ref(scene, 64);
     // the camera basis, as the model defines it, to find where each pixel centre meets the floor
-    glm::dvec3 pos(2, 0, 2), fwd = glm::normalize(-pos), right = glm::normalize(glm::cross(fwd, {0, 0, 1}));
+    glm::dvec3 pos(2, 0, 2), fwd = glm::normalize(-pos),
+                             right = glm::normalize(glm::cross(fwd, {0, 0, 1}));
     glm::dvec3 up = glm::cross(right, fwd);
     const double t = std::tan(5.0 * M_PI / 180.0);
     RenderResult e = expected_image(r, [&](int x, int y) {
@@ -173,8 +178,8 @@ TEST(ReferenceAnalytic, ClosedEmissiveBox) {
   expect_matches(r, expected_image(r, [&](int, int) { return Le / (glm::dvec3(1.0) - rho); }));
   RenderResult r3 = render_ref(scene(3), 64);
   expect_matches(r3, expected_image(r3, [&](int, int) {
-    return Le * (glm::dvec3(1.0) - rho * rho * rho) / (glm::dvec3(1.0) - rho);
-  }));
+                   return Le * (glm::dvec3(1.0) - rho * rho * rho) / (glm::dvec3(1.0) - rho);
+                 }));
 }
 
 // Surfaces emit from their front side only: inside an emissive sphere (seen from its back side)
@@ -200,7 +205,8 @@ TEST(ReferenceAnalytic, FresnelDielectric) {
   EXPECT_NEAR(fresnel_dielectric(1.0, 1.5), 0.04, 1e-12);
   EXPECT_NEAR(fresnel_dielectric(1.0, 1 / 1.5), 0.04, 1e-12);
   EXPECT_NEAR(fresnel_dielectric(0.0, 1.5), 1.0, 1e-12);
-  double tb = std::atan(1.5), ci = std::cos(tb), ct = std::sqrt(1 - std::sin(tb) * std::sin(tb) / 2.25);
+  double tb = std::atan(1.5), ci = std::cos(tb),
+         ct = std::sqrt(1 - std::sin(tb) * std::sin(tb) / 2.25);
   double rs = (ci - 1.5 * ct) / (ci + 1.5 * ct);
   EXPECT_NEAR(fresnel_dielectric(ci, 1.5), 0.5 * rs * rs, 1e-12);
   double critical = std::asin(1 / 1.5);
@@ -321,7 +327,8 @@ TEST(ReferenceAnalytic, AovsOnAPlane) {
     return std::string(R"({
       "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
       "film": {"width": 8, "height": 8, "filter": {"type": "box", "radius": 0.0001}},
-      "integrator": {"type": ")") + integrator + R"("},
+      "integrator": {"type": ")") +
+           integrator + R"("},
       "materials": {"m": {"type": "plastic", "albedo": [0.1, 0.2, 0.3]}},
       "shapes": [{"type": "triangles", "material": "m",
                   "positions": [[-9,-9,0],[9,-9,0],[9,9,0],[-9,9,0]], "indices": [0,1,2, 0,2,3]}]

@@ -19,7 +19,9 @@ namespace {
 struct Probe {
   lucent::cl_util::Context ctx{lucent::test::device()};
   cl::Program program = lucent::cl_util::build_program(
-      ctx, lucent::detail::assemble_kernel_source("test/texture_probe.cl", lucent::test::kernel_dir()), "-cl-std=CL1.2");
+      ctx,
+      lucent::detail::assemble_kernel_source("test/texture_probe.cl", lucent::test::kernel_dir()),
+      "-cl-std=CL1.2");
 };
 
 Probe& probe() {

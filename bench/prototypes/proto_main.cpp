@@ -112,14 +112,13 @@ int run(const Options& o) {
   std::string kdir = kdir_env && *kdir_env ? kdir_env : LUCENT_PROTO_KERNEL_DIR;
   int cdf_iters = 0;
   while ((1u << cdf_iters) < packed.params.num_lights) ++cdf_iters;
-  std::string wopts = opts + " -I " + kdir + " -D WF_PACKET=" + std::to_string(o.packet) +
-                      " -D WF_CDF_ITERS=" + std::to_string(cdf_iters) +
-                      " -D WF_PK=" + std::to_string(o.pk) +
-                      (o.packet_rays ? " -D WF_PK_PACKET_RAYS" : "") +
-                      // more build options for the prototypes' kernels (wavefront.cl: WF_PD, ...)
-                      (std::getenv("LUCENT_PROTO_DEFINES")
-                           ? std::string(" ") + std::getenv("LUCENT_PROTO_DEFINES")
-                           : std::string());
+  std::string wopts =
+      opts + " -I " + kdir + " -D WF_PACKET=" + std::to_string(o.packet) +
+      " -D WF_CDF_ITERS=" + std::to_string(cdf_iters) + " -D WF_PK=" + std::to_string(o.pk) +
+      (o.packet_rays ? " -D WF_PK_PACKET_RAYS" : "") +
+      // more build options for the prototypes' kernels (wavefront.cl: WF_PD, ...)
+      (std::getenv("LUCENT_PROTO_DEFINES") ? std::string(" ") + std::getenv("LUCENT_PROTO_DEFINES")
+                                           : std::string());
   std::printf("scene %s, %dx%d, %d spp, max_depth %d, device %s\nbuild options: %s\ntimes: %s\n",
               o.scene.c_str(), o.width, o.height, o.spp, scene.integrator.max_depth,
               ctx.device.info.name.c_str(), wopts.c_str(),

@@ -92,8 +92,8 @@ enum { U_FLAGS, U_PRIM, U_COUNT };
 #define LD(c) st[(c)*n + i]
 #define ST(c, v) st[(c)*n + i] = (v)
 
-WF_STAGE void wf_generate_at(LC_SCENE_KERNEL_ARGS, __global float* st, __global uint* su,
-                                  uint n, uint sample, uint i) {
+WF_STAGE void wf_generate_at(LC_SCENE_KERNEL_ARGS, __global float* st, __global uint* su, uint n,
+                             uint sample, uint i) {
   if (i >= n) return;
   lc_rng rng = {i, sample, params->seed};
   uint width = params->width, height = params->height;
@@ -128,7 +128,7 @@ __kernel void wf_generate(LC_SCENE_KERNEL_ARGS, __global float* st, __global uin
 }
 
 WF_STAGE void wf_trace_at(LC_SCENE_KERNEL_ARGS, __global float* st, __global uint* su, uint n,
-                               uint i) {
+                          uint i) {
   if (i >= n || !(su[U_FLAGS * n + i] & F_ALIVE)) return;
   lc_scene s = LC_SCENE_FROM_KERNEL_ARGS;
   lc_ray ray;
@@ -147,7 +147,7 @@ __kernel void wf_trace(LC_SCENE_KERNEL_ARGS, __global float* st, __global uint* 
 }
 
 WF_STAGE void wf_shadow_at(LC_SCENE_KERNEL_ARGS, __global float* st, __global uint* su, uint n,
-                                uint i) {
+                           uint i) {
   if (i >= n) return;
   uint flags = su[U_FLAGS * n + i];
   if (!(flags & F_SHADOW)) return;
@@ -296,7 +296,7 @@ __kernel void wf_shade(LC_SCENE_KERNEL_ARGS, __global float* st, __global uint* 
 
 /* Per-pixel sums of the finished samples (one path per pixel per wave). */
 WF_STAGE void wf_film_at(__global const float* st, uint n, __global float4* sum,
-                              __global float4* sumsq, uint i) {
+                         __global float4* sumsq, uint i) {
   if (i >= n) return;
   float3 L = (float3)(LD(S_LR), LD(S_LG), LD(S_LB));
   if (lc_isfinite3(L)) {
@@ -964,8 +964,8 @@ static inline kf pk_nudge(kf x, kf nn) {
 
 #undef V3T
 #define V3T pv3
-WF_STAGE void wf_shade_pk_at(LC_SCENE_KERNEL_ARGS, __global float* st, __global uint* su,
-                                  uint n, uint depth, uint sample, uint i) {
+WF_STAGE void wf_shade_pk_at(LC_SCENE_KERNEL_ARGS, __global float* st, __global uint* su, uint n,
+                             uint depth, uint sample, uint i) {
   if (i >= n) return;
   ku flags = kload(0, su + U_FLAGS * n + i);
   ki alive_in = (flags & F_ALIVE) != 0u;
@@ -1187,14 +1187,14 @@ __kernel void pk_mega(LC_SCENE_KERNEL_ARGS, __global float* st, __global uint* s
         wf_trace_packet_at(WF_SCENE, st, su, n, i);
       else
 #endif
-      for (uint k = 0; k < WF_PK; ++k) wf_trace_at(WF_SCENE, st, su, n, i + k);
+        for (uint k = 0; k < WF_PK; ++k) wf_trace_at(WF_SCENE, st, su, n, i + k);
       wf_shade_pk_at(WF_SCENE, st, su, n, depth, smp, i);
 #if defined(WF_PK_PACKET_RAYS) && WF_PACKET == WF_PK
       if (depth < WF_SD || (WF_COH && wf_coherent(st, su, n, i, 1)))
         wf_shadow_packet_at(WF_SCENE, st, su, n, i);
       else
 #endif
-      for (uint k = 0; k < WF_PK; ++k) wf_shadow_at(WF_SCENE, st, su, n, i + k);
+        for (uint k = 0; k < WF_PK; ++k) wf_shadow_at(WF_SCENE, st, su, n, i + k);
       uint any_alive = 0;
       for (uint k = 0; k < WF_PK; ++k) any_alive |= su[U_FLAGS * n + i + k] & F_ALIVE;
       if (!any_alive) break;

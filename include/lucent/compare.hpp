@@ -30,23 +30,23 @@ struct CompareOptions {
 struct CompareResult {
   int width = 0, height = 0;
   bool passed = false;
-  bool statistical = false;   ///< at least one image carried variances
-  double z_threshold = 0;     ///< per pixel-channel, from alpha and the number of tests
-  std::size_t tested = 0;     ///< pixel-channels tested (3 per pixel)
+  bool statistical = false;  ///< at least one image carried variances
+  double z_threshold = 0;    ///< per pixel-channel, from alpha and the number of tests
+  std::size_t tested = 0;    ///< pixel-channels tested (3 per pixel)
   std::size_t failed_channels = 0;
   std::size_t failed_pixels = 0;
-  double pass_fraction = 0;   ///< pixels whose three channels pass
+  double pass_fraction = 0;      ///< pixels whose three channels pass
   double required_fraction = 0;  ///< CompareOptions::min_pass_fraction
-  double max_z = 0;           ///< largest |z| over all pixel-channels
+  double max_z = 0;              ///< largest |z| over all pixel-channels
   int max_z_x = 0, max_z_y = 0, max_z_channel = 0;
   double mean_a[3] = {0, 0, 0}, mean_b[3] = {0, 0, 0};  ///< image means per channel
-  double mean_z[3] = {0, 0, 0};  ///< z of the difference of the image means
+  double mean_z[3] = {0, 0, 0};                         ///< z of the difference of the image means
   double mean_z_threshold = 0;
   bool mean_test_passed = true;
-  double rmse = 0;            ///< sqrt(mean over pixel-channels of (A - B)^2)
-  double relmse = 0;          ///< mean of (A - B)^2 / (B^2 + 0.01)
-  double max_abs_error = 0;   ///< largest |A - B|
-  Image z;                    ///< per pixel-channel z = (A - B) / standard error (signed)
+  double rmse = 0;              ///< sqrt(mean over pixel-channels of (A - B)^2)
+  double relmse = 0;            ///< mean of (A - B)^2 / (B^2 + 0.01)
+  double max_abs_error = 0;     ///< largest |A - B|
+  Image z;                      ///< per pixel-channel z = (A - B) / standard error (signed)
   std::string summary() const;  ///< multi-line report, as `lucent compare` prints it
 };
 

@@ -7,7 +7,7 @@
 #include "lucent/parts.hpp"
 #include "lucent/render.hpp"
 #include "lucent/scene.hpp"
-#include "lucent/session.hpp"
 #include "lucent/scene_builder.hpp"
+#include "lucent/session.hpp"
 #include "lucent/types.hpp"
 #include "lucent/version.hpp"

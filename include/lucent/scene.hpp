@@ -3,10 +3,9 @@
 // in double precision and world space; the renderer converts to the device's float layout.
 #include <cstddef>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "lucent/registry.h"
 
@@ -20,10 +19,10 @@ struct Camera {
   glm::dvec3 position{0, 0, 5};
   glm::dvec3 look_at{0, 0, 0};
   glm::dvec3 up{0, 1, 0};
-  double fov_degrees = 45;     ///< vertical field of view
-  double roll_degrees = 0;     ///< rotation about the viewing direction
-  double aperture = 0;         ///< thin-lens aperture radius (0: pinhole)
-  double focus_distance = 0;   ///< distance to the plane in focus (0: distance to look_at)
+  double fov_degrees = 45;    ///< vertical field of view
+  double roll_degrees = 0;    ///< rotation about the viewing direction
+  double aperture = 0;        ///< thin-lens aperture radius (0: pinhole)
+  double focus_distance = 0;  ///< distance to the plane in focus (0: distance to look_at)
 };
 
 enum class FilterType { LC_FILTER_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
@@ -40,8 +39,8 @@ struct Film {
   int height = 512;
   Filter filter;
   Transfer transfer = Transfer::Srgb;
-  double gamma = 2.2;     ///< used when transfer is Gamma
-  double exposure = 0;    ///< in stops, applied to 8-bit outputs
+  double gamma = 2.2;   ///< used when transfer is Gamma
+  double exposure = 0;  ///< in stops, applied to 8-bit outputs
   ToneMap tonemap = ToneMap::Clamp;
 };
 
@@ -57,7 +56,7 @@ enum class SamplerType { LC_SAMPLER_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
 struct Integrator {
   IntegratorType type = IntegratorType::Path;
   int max_depth = 8;
-  int rr_depth = 4;       ///< Russian roulette from this depth
+  int rr_depth = 4;  ///< Russian roulette from this depth
   int spp = 16;
   std::uint32_t seed = 0;
   double ao_distance = 0;  ///< ambient occlusion ray length; 0: unbounded
@@ -84,11 +83,11 @@ struct Material {
   std::string name;
   MaterialType type = MaterialType::Diffuse;
   glm::dvec3 albedo{0.8, 0.8, 0.8};
-  int albedo_texture = -1;            ///< index into Scene::textures, -1 for none
+  int albedo_texture = -1;  ///< index into Scene::textures, -1 for none
   glm::dvec3 emission{0, 0, 0};
-  glm::dvec3 specular{1, 1, 1};       ///< mirror reflectance / glass tint / glossy F0 colour
+  glm::dvec3 specular{1, 1, 1};  ///< mirror reflectance / glass tint / glossy F0 colour
   double ior = 1.5;
-  double roughness = 0.1;             ///< GGX alpha
+  double roughness = 0.1;  ///< GGX alpha
   bool emissive() const { return emission.x > 0 || emission.y > 0 || emission.z > 0; }
 };
 
@@ -100,9 +99,9 @@ struct Sphere {
 
 /// One triangle of the scene's single, world-space triangle list.
 struct Triangle {
-  int v[3] = {0, 0, 0};            ///< indices into Scene::positions
-  int n[3] = {-1, -1, -1};         ///< indices into Scene::normals, -1 when absent
-  int uv[3] = {-1, -1, -1};        ///< indices into Scene::uvs, -1 when absent
+  int v[3] = {0, 0, 0};      ///< indices into Scene::positions
+  int n[3] = {-1, -1, -1};   ///< indices into Scene::normals, -1 when absent
+  int uv[3] = {-1, -1, -1};  ///< indices into Scene::uvs, -1 when absent
   int material = 0;
 };
 
@@ -114,9 +113,9 @@ enum class LightType { LC_LIGHT_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
 struct Light {
   LightType type = LightType::Point;
   glm::dvec3 position{0, 0, 0};
-  glm::dvec3 intensity{0, 0, 0};   ///< point: W/sr
-  glm::dvec3 radiance{0, 0, 0};    ///< environment radiance, or the scale of a map
-  int texture = -1;                ///< environment map
+  glm::dvec3 intensity{0, 0, 0};  ///< point: W/sr
+  glm::dvec3 radiance{0, 0, 0};   ///< environment radiance, or the scale of a map
+  int texture = -1;               ///< environment map
 };
 
 /// Shape types: spheres, and triangles (inline triangle lists and OBJ meshes alike).
@@ -127,9 +126,9 @@ enum class ShapeType { LC_SHAPE_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
 /// name a shape by its index in this list ("/shapes/3/radius").
 struct ShapeEntry {
   ShapeType type = ShapeType::Sphere;
-  std::string file;        ///< the OBJ file of a mesh; empty for a sphere or an inline triangle list
-  std::size_t first = 0;   ///< first sphere (Scene::spheres) or triangle (Scene::triangles)
-  std::size_t count = 0;   ///< number of spheres or triangles
+  std::string file;       ///< the OBJ file of a mesh; empty for a sphere or an inline triangle list
+  std::size_t first = 0;  ///< first sphere (Scene::spheres) or triangle (Scene::triangles)
+  std::size_t count = 0;  ///< number of spheres or triangles
 };
 
 struct Texture {

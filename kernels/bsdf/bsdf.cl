@@ -60,7 +60,6 @@ static inline void lc_store3p(float* p, float3 v) {
   p[2] = v.z;
 }
 
-
 static inline void whitted_bsdf_none(lc_whitted_bsdf* w) {
   w->diffuse_lobe = 0;
   w->diffuse = w->reflect = w->transmit = w->transmit_wi = (float3)(0.0f);

@@ -37,7 +37,9 @@ static inline float2 filter_sample_gaussian(float radius, float u1, float u2) {
 static inline float filter_density_box(float r, float dx, float dy) {
   return (fabs(dx) <= r && fabs(dy) <= r) ? 1.0f / (4.0f * r * r) : 0.0f;
 }
-static inline float filter_density_tent1(float t, float r) { return fmax(0.0f, r - fabs(t)) / (r * r); }
+static inline float filter_density_tent1(float t, float r) {
+  return fmax(0.0f, r - fabs(t)) / (r * r);
+}
 static inline float filter_density_tent(float r, float dx, float dy) {
   return filter_density_tent1(dx, r) * filter_density_tent1(dy, r);
 }

@@ -20,7 +20,7 @@ static inline float3 path_clamp(float3 c, float bound) {
 
 #ifdef LC_HAS_SPLITTING
 /* integrator.dielectric_splits (docs/rendering-model.md, "Integrators"): a branch that waits while
- * the camera path follows the other lobe of a split vertex (at most LC_MAX_SPLITS, shared/types.h) */
+ * the camera path follows the other lobe of a split vertex (LC_MAX_SPLITS at most, types.h) */
 typedef struct {
   lc_real3 o, d, prev_p;
   float3 beta;
@@ -49,126 +49,127 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
   int nwaiting = 0;
   lc_uint splits = 0;
   const lc_uint max_splits = min(P->splits, (lc_uint)LC_MAX_SPLITS);
+#endif
+  /* one pass per branch: the camera path, then (LC_HAS_SPLITTING) each waiting branch */
   for (;;) {
-#endif
-  for (;; ++depth) {
-    lc_hit hit;
-    ++*rays;
-    const int no_mis = (P->flags & LC_FLAG_NO_MIS) != 0;
-    if (!scene_intersect(s, ray, INFINITY, &hit)) {
-      float pdf_l;
-      float3 Le = env_radiance(s, lc_float3_from_real3(ray.d), &pdf_l);
-      float3 c = beta * Le * (prev_delta ? 1.0f : (no_mis ? 0.0f : mis_power(prev_pdf, pdf_l)));
-      L += depth > 0 ? path_clamp(c, P->clamp) : c;
-      break;
-    }
-    lc_interaction it = interaction_from_hit(s, ray, &hit);
-    __global const lc_material* m = &s->materials[it.material];
-    int emits = it.front && it.light != LC_INVALID;
-#ifdef LC_HAS_CAUSTICS
-    if (caustics && first_n && prev_delta) emits = 0;
-#endif
-    if (emits) {
-      float3 Le = lc_load3(m->emission);
-      float w = 1.0f;
-      if (!prev_delta) {
-        float pdf_l =
-            light_pdf(s, it.light, prev_p, lc_float3_from_real3(ray.d), hit.t, dot(-ray.d, it.ng));
-        w = no_mis ? 0.0f : mis_power(prev_pdf, pdf_l);
+    for (;; ++depth) {
+      lc_hit hit;
+      ++*rays;
+      const int no_mis = (P->flags & LC_FLAG_NO_MIS) != 0;
+      if (!scene_intersect(s, ray, INFINITY, &hit)) {
+        float pdf_l;
+        float3 Le = env_radiance(s, lc_float3_from_real3(ray.d), &pdf_l);
+        float3 c = beta * Le * (prev_delta ? 1.0f : (no_mis ? 0.0f : mis_power(prev_pdf, pdf_l)));
+        L += depth > 0 ? path_clamp(c, P->clamp) : c;
+        break;
       }
-      L += depth > 0 ? path_clamp(beta * Le * w, P->clamp) : beta * Le * w;
-    }
-    if (depth + 2 > P->max_depth) break;
-    lc_uint dim = LC_DIM_BOUNCE + depth * LC_DIMS_PER_BOUNCE;
-    /* light point, light selection, lobe; BSDF direction, Russian roulette */
-    float8 u = lc_rand8(rng, dim);
-    float4 u_light = u.lo, u_bsdf = u.hi;
-    lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
-    lc_frame fr = frame_from(it.ns);
-    float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
-    if (wo_l.z <= 0.0f) break;
+      lc_interaction it = interaction_from_hit(s, ray, &hit);
+      __global const lc_material* m = &s->materials[it.material];
+      int emits = it.front && it.light != LC_INVALID;
+#ifdef LC_HAS_CAUSTICS
+      if (caustics && first_n && prev_delta) emits = 0;
+#endif
+      if (emits) {
+        float3 Le = lc_load3(m->emission);
+        float w = 1.0f;
+        if (!prev_delta) {
+          float pdf_l = light_pdf(s, it.light, prev_p, lc_float3_from_real3(ray.d), hit.t,
+                                  dot(-ray.d, it.ng));
+          w = no_mis ? 0.0f : mis_power(prev_pdf, pdf_l);
+        }
+        L += depth > 0 ? path_clamp(beta * Le * w, P->clamp) : beta * Le * w;
+      }
+      if (depth + 2 > P->max_depth) break;
+      lc_uint dim = LC_DIM_BOUNCE + depth * LC_DIMS_PER_BOUNCE;
+      /* light point, light selection, lobe; BSDF direction, Russian roulette */
+      float8 u = lc_rand8(rng, dim);
+      float4 u_light = u.lo, u_bsdf = u.hi;
+      lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
+      lc_frame fr = frame_from(it.ns);
+      float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
+      if (wo_l.z <= 0.0f) break;
 
-    /* next-event estimation, from the origin that the shadow ray will use; a BSDF that transmits
-     * also takes light from behind the surface, with a shadow ray from an origin behind it */
-    lc_real3 o = lc_spawn_origin(it.p, it.perr, it.ng);
-    lc_uint lobes = bsdf_lobes(&b);
-    if (!(lobes & LC_BSDF_DELTA) && P->num_lights > 0) {
-      lc_light_sample ls;
-      if (light_sample(s, o, u_light.z, u_light.x, u_light.y, &ls) && ls.pdf > 0.0f) {
-        int behind = !(dot(ls.wi, it.ng) > LC_REAL(0.0));
-        if (!behind || (lobes & LC_BSDF_TRANSMISSION)) {
-          float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
-          float pdf_b;
-          float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf_b);
-          if (lc_max3(f) > 0.0f && (behind ? shadow_visible_behind(s, &it, o, &ls, rays)
-                                           : shadow_visible(s, o, ls.wi, ls.dist, rays))) {
-            float w = (ls.delta || no_mis) ? 1.0f : mis_power(ls.pdf, pdf_b);
-            L += path_clamp(beta * f * ls.L * (fabs(wi_l.z) * w / ls.pdf), P->clamp);
+      /* next-event estimation, from the origin that the shadow ray will use; a BSDF that transmits
+       * also takes light from behind the surface, with a shadow ray from an origin behind it */
+      lc_real3 o = lc_spawn_origin(it.p, it.perr, it.ng);
+      lc_uint lobes = bsdf_lobes(&b);
+      if (!(lobes & LC_BSDF_DELTA) && P->num_lights > 0) {
+        lc_light_sample ls;
+        if (light_sample(s, o, u_light.z, u_light.x, u_light.y, &ls) && ls.pdf > 0.0f) {
+          int behind = !(dot(ls.wi, it.ng) > LC_REAL(0.0));
+          if (!behind || (lobes & LC_BSDF_TRANSMISSION)) {
+            float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
+            float pdf_b;
+            float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf_b);
+            if (lc_max3(f) > 0.0f && (behind ? shadow_visible_behind(s, &it, o, &ls, rays)
+                                             : shadow_visible(s, o, ls.wi, ls.dist, rays))) {
+              float w = (ls.delta || no_mis) ? 1.0f : mis_power(ls.pdf, pdf_b);
+              L += path_clamp(beta * f * ls.L * (fabs(wi_l.z) * w / ls.pdf), P->clamp);
+            }
           }
         }
       }
-    }
 
-    /* continue the path */
-    lc_bsdf_sample bs;
+      /* continue the path */
+      lc_bsdf_sample bs;
 #ifdef LC_HAS_SPLITTING
-    /* a BSDF that chooses between delta lobes (smooth glass: reflection with probability F,
-     * refraction with 1 - F), at one of the first max_splits such vertices of the branch: both
-     * lobes, each weighted by its probability; the refraction's branch waits */
-    int split = 0;
-    if (splits < max_splits && (lobes & LC_BSDF_DELTA)) {
-      lc_bsdf_sample bt;
-      if (bsdf_sample(&b, wo_l, 0.0f, u_bsdf.x, u_bsdf.y, &bs) && bs.prob < 1.0f &&
-          bsdf_sample(&b, wo_l, LC_ONE_MINUS_EPSILON, u_bsdf.x, u_bsdf.y, &bt) &&
-          bt.prob < 1.0f) {
-        split = 1;
-        ++splits;
-        bs.weight *= bs.prob;
-        lc_real3 wt = normalize(lc_real3_from_float3(frame_to_world(&fr, bt.wi)));
-        int t_transmit = bt.wi.z < 0.0f;
-        lc_real t_side = dot(wt, it.ng);
-        float3 t_beta = beta * bt.weight * bt.prob;
-        /* the leak test and the origin of the continuation below; one helper for both measured
-         * 2% slower on course (the hot path's ray then computed before its throughput tests) */
-        if ((t_transmit ? t_side < LC_REAL(0.0) : t_side > LC_REAL(0.0)) &&
-            lc_max3(t_beta) > 0.0f) {
-          lc_path_branch* w = &waiting[nwaiting++];
-          w->o = t_transmit ? lc_spawn_origin(it.p, it.perr, -it.ng) : o;
-          w->d = wt;
-          w->prev_p = o;
-          w->beta = t_beta;
-          w->depth = depth + 1;
-          w->splits = splits;
+      /* a BSDF that chooses between delta lobes (smooth glass: reflection with probability F,
+       * refraction with 1 - F), at one of the first max_splits such vertices of the branch: both
+       * lobes, each weighted by its probability; the refraction's branch waits */
+      int split = 0;
+      if (splits < max_splits && (lobes & LC_BSDF_DELTA)) {
+        lc_bsdf_sample bt;
+        if (bsdf_sample(&b, wo_l, 0.0f, u_bsdf.x, u_bsdf.y, &bs) && bs.prob < 1.0f &&
+            bsdf_sample(&b, wo_l, LC_ONE_MINUS_EPSILON, u_bsdf.x, u_bsdf.y, &bt) &&
+            bt.prob < 1.0f) {
+          split = 1;
+          ++splits;
+          bs.weight *= bs.prob;
+          lc_real3 wt = normalize(lc_real3_from_float3(frame_to_world(&fr, bt.wi)));
+          int t_transmit = bt.wi.z < 0.0f;
+          lc_real t_side = dot(wt, it.ng);
+          float3 t_beta = beta * bt.weight * bt.prob;
+          /* the leak test and the origin of the continuation below; one helper for both measured
+           * 2% slower on course (the hot path's ray then computed before its throughput tests) */
+          if ((t_transmit ? t_side < LC_REAL(0.0) : t_side > LC_REAL(0.0)) &&
+              lc_max3(t_beta) > 0.0f) {
+            lc_path_branch* w = &waiting[nwaiting++];
+            w->o = t_transmit ? lc_spawn_origin(it.p, it.perr, -it.ng) : o;
+            w->d = wt;
+            w->prev_p = o;
+            w->beta = t_beta;
+            w->depth = depth + 1;
+            w->splits = splits;
+          }
         }
       }
-    }
-    if (!split && !bsdf_sample(&b, wo_l, u_light.w, u_bsdf.x, u_bsdf.y, &bs)) break;
+      if (!split && !bsdf_sample(&b, wo_l, u_light.w, u_bsdf.x, u_bsdf.y, &bs)) break;
 #else
-    if (!bsdf_sample(&b, wo_l, u_light.w, u_bsdf.x, u_bsdf.y, &bs)) break;
+      if (!bsdf_sample(&b, wo_l, u_light.w, u_bsdf.x, u_bsdf.y, &bs)) break;
 #endif
-    lc_real3 wi = normalize(lc_real3_from_float3(frame_to_world(&fr, bs.wi)));
-    int transmit = bs.wi.z < 0.0f;
-    lc_real side = dot(wi, it.ng);
-    if (transmit ? side >= LC_REAL(0.0) : side <= LC_REAL(0.0)) break; /* shading normal leak */
-    beta *= bs.weight;
-    if (!(lc_max3(beta) > 0.0f)) break;
+      lc_real3 wi = normalize(lc_real3_from_float3(frame_to_world(&fr, bs.wi)));
+      int transmit = bs.wi.z < 0.0f;
+      lc_real side = dot(wi, it.ng);
+      if (transmit ? side >= LC_REAL(0.0) : side <= LC_REAL(0.0)) break; /* shading normal leak */
+      beta *= bs.weight;
+      if (!(lc_max3(beta) > 0.0f)) break;
 #ifdef LC_HAS_CAUSTICS
-    if (depth == 0) first_n = !bs.delta;
+      if (depth == 0) first_n = !bs.delta;
 #endif
-    prev_delta = bs.delta;
-    prev_pdf = bs.pdf;
-    ray.o = transmit ? lc_spawn_origin(it.p, it.perr, -it.ng) : o;
-    prev_p = o; /* light pdfs for MIS are evaluated from where light sampling sampled */
-    ray.d = wi;
-    /* Russian roulette: survive with probability max(beta) while it is below 1, so the
-     * throughput after the division never exceeds 1 (a cap such as min(0.95, max(beta)) makes
-     * beta grow like (albedo / 0.95)^n on albedos above 0.95: unbiased, infinite variance) */
-    float q = lc_max3(beta);
-    if (depth + 2 > P->rr_depth && q < 1.0f) {
-      if (u_bsdf.z >= q) break;
-      beta /= q;
+      prev_delta = bs.delta;
+      prev_pdf = bs.pdf;
+      ray.o = transmit ? lc_spawn_origin(it.p, it.perr, -it.ng) : o;
+      prev_p = o; /* light pdfs for MIS are evaluated from where light sampling sampled */
+      ray.d = wi;
+      /* Russian roulette: survive with probability max(beta) while it is below 1, so the
+       * throughput after the division never exceeds 1 (a cap such as min(0.95, max(beta)) makes
+       * beta grow like (albedo / 0.95)^n on albedos above 0.95: unbiased, infinite variance) */
+      float q = lc_max3(beta);
+      if (depth + 2 > P->rr_depth && q < 1.0f) {
+        if (u_bsdf.z >= q) break;
+        beta /= q;
+      }
     }
-  }
 #ifdef LC_HAS_SPLITTING
     /* the next waiting branch: it left a delta vertex (no MIS on what it hits) */
     if (nwaiting == 0) break;
@@ -181,8 +182,10 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
     splits = w->splits;
     prev_delta = 1;
     prev_pdf = 0.0f;
-  }
+#else
+    break;
 #endif
+  }
   return L;
 }
 

@@ -23,7 +23,7 @@ static inline float3 light_env_emitted(const lc_scene* s, __global const lc_ligh
 
 /* environments start no light paths: their caustics stay with the camera path */
 static inline int light_env_emit(const lc_scene* s, __global const lc_light* L, float4 u,
-                                lc_ray* ray, float3* beta) {
+                                 lc_ray* ray, float3* beta) {
   return 0;
 }
 #endif

@@ -60,7 +60,7 @@ static inline float3 light_env_map_emitted(const lc_scene* s, __global const lc_
 
 /* environments start no light paths: their caustics stay with the camera path */
 static inline int light_env_map_emit(const lc_scene* s, __global const lc_light* L, float4 u,
-                                lc_ray* ray, float3* beta) {
+                                     lc_ray* ray, float3* beta) {
   return 0;
 }
 #endif

@@ -1,8 +1,10 @@
-/* lucent kernel: texture lookups, bilinear filtering with repeat wrapping. Texels are linear RGBA. */
+/* lucent kernel: texture lookups, bilinear filtering with repeat wrapping. Texels are linear RGBA.
+ */
 #ifndef LUCENT_TEXTURE_TEXTURE_CL
 #define LUCENT_TEXTURE_TEXTURE_CL
 
-static inline float4 texture_texel(const lc_scene* s, __global const lc_texture* tex, int x, int y) {
+static inline float4 texture_texel(const lc_scene* s, __global const lc_texture* tex, int x,
+                                   int y) {
   int w = (int)tex->width, h = (int)tex->height;
   x %= w;
   if (x < 0) x += w;

@@ -78,18 +78,18 @@ static inline int lc_isfinite3(float3 v) { return isfinite(v.x) && isfinite(v.y)
  *  - lc_onb: orthonormal basis t, b around unit n (Duff et al. 2017, "Building an Orthonormal
  *    Basis, Revisited").
  */
-#define LC_MATH_HELPERS(SUFFIX, T, T2, T3)                                                         \
-  static inline T lc_max3##SUFFIX(T3 v) { return fmax(v.x, fmax(v.y, v.z)); }                      \
-  static inline T2 lc_unit_circle##SUFFIX(T u) {                                                   \
-    T x = (T)2 * u;                                                                                \
-    return (T2)(cospi(x), sinpi(x));                                                               \
-  }                                                                                                \
-  static inline void lc_onb##SUFFIX(T3 n, T3* t, T3* b) {                                          \
-    T s = copysign((T)1, n.z);                                                                     \
-    T a = (T)-1 / (s + n.z);                                                                       \
-    T c = n.x * n.y * a;                                                                           \
-    *t = (T3)((T)1 + s * n.x * n.x * a, s * c, -s * n.x);                                          \
-    *b = (T3)(c, s + n.y * n.y * a, -n.y);                                                         \
+#define LC_MATH_HELPERS(SUFFIX, T, T2, T3)                                    \
+  static inline T lc_max3##SUFFIX(T3 v) { return fmax(v.x, fmax(v.y, v.z)); } \
+  static inline T2 lc_unit_circle##SUFFIX(T u) {                              \
+    T x = (T)2 * u;                                                           \
+    return (T2)(cospi(x), sinpi(x));                                          \
+  }                                                                           \
+  static inline void lc_onb##SUFFIX(T3 n, T3* t, T3* b) {                     \
+    T s = copysign((T)1, n.z);                                                \
+    T a = (T)-1 / (s + n.z);                                                  \
+    T c = n.x * n.y * a;                                                      \
+    *t = (T3)((T)1 + s * n.x * n.x * a, s * c, -s * n.x);                     \
+    *b = (T3)(c, s + n.y * n.y * a, -n.y);                                    \
   }
 
 LC_MATH_HELPERS(, float, float2, float3)

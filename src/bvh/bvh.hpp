@@ -36,10 +36,10 @@ struct BuildStats {
 
 /// Binary tree node, host only (the build's intermediate tree).
 struct Node2 {
-  float bmin[3];      ///< bounds minimum
-  lc_uint left_first; ///< interior: left child (right = left + 1); leaf: first prim_refs entry
-  float bmax[3];      ///< bounds maximum
-  lc_uint count;      ///< 0 for an interior node, else the number of primitives in the leaf
+  float bmin[3];       ///< bounds minimum
+  lc_uint left_first;  ///< interior: left child (right = left + 1); leaf: first prim_refs entry
+  float bmax[3];       ///< bounds maximum
+  lc_uint count;       ///< 0 for an interior node, else the number of primitives in the leaf
 };
 static_assert(sizeof(Node2) == 32, "Node2 should stay 32 bytes");
 
@@ -47,8 +47,8 @@ static_assert(sizeof(Node2) == 32, "Node2 should stay 32 bytes");
 /// leaf, so that every sibling pair starts at an even index; children of an interior node are
 /// adjacent and laid out depth-first.
 struct Bvh2 {
-  std::vector<Node2> nodes;       ///< empty when there is no primitive
-  std::vector<lc_uint> prim_refs; ///< triangle index, or sphere index | LC_PRIM_SPHERE_BIT
+  std::vector<Node2> nodes;        ///< empty when there is no primitive
+  std::vector<lc_uint> prim_refs;  ///< triangle index, or sphere index | LC_PRIM_SPHERE_BIT
   BuildStats stats;
 };
 

@@ -3,8 +3,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <string>
-
 #include <glm/glm.hpp>
 #include <string>
 
