@@ -117,6 +117,7 @@ void bind_vector_type(py::module_& m, const char* name) {
       .def(
           "__array__",
           [](const V& v, py::object dtype) {
+            // V::length(), not N: clang 14 wants N captured to pass it to array_t
             py::array_t<double> a(static_cast<py::ssize_t>(V::length()));
             for (int i = 0; i < N; ++i) a.mutable_at(i) = v[i];
             return dtype.is_none() ? py::array(a) : py::array(a.attr("astype")(dtype));
