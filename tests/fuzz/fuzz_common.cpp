@@ -137,12 +137,12 @@ std::string exr_file(int w, int h, const std::vector<std::string>& names,
   InitEXRHeader(&header);
   std::vector<EXRChannelInfo> channels(nc);
   for (int c = 0; c < nc; ++c) std::strncpy(channels[c].name, names[c].c_str(), 255);
-  std::vector<int> types(nc, TINYEXR_PIXELTYPE_FLOAT);
+  std::vector<int> types(nc, TINYEXR_PIXELTYPE_FLOAT), stored(nc, layout.pixel_type);
   header.num_channels = nc;
   header.channels = channels.data();
   header.pixel_types = types.data();
-  header.requested_pixel_types = types.data();
-  header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
+  header.requested_pixel_types = stored.data();
+  header.compression_type = layout.compression;
   header.data_window.max_x = header.display_window.max_x = w - 1;  // tile counts' source
   header.data_window.max_y = header.display_window.max_y = h - 1;
   std::deque<std::vector<float>> planes;  // stable addresses

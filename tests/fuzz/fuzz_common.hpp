@@ -59,9 +59,12 @@ struct ExrLayout {
   int tile = 0;
   int levels = TINYEXR_TILE_ONE_LEVEL;
   int rounding = TINYEXR_TILE_ROUND_DOWN;
+  int compression = TINYEXR_COMPRESSIONTYPE_ZIP;
+  int pixel_type = TINYEXR_PIXELTYPE_FLOAT;  ///< as stored: tinyexr converts the floats to half
 };
 
-/// An OpenEXR file (its bytes) of float channels `names` (in that order), w x h, ZIP-compressed;
+/// An OpenEXR file (its bytes) of channels `names` (in that order), w x h, stored and compressed
+/// as `layout` says (default: float, ZIP);
 /// channel c of pixel (x, y) of level 0 = value(c, x, y) (of level (lx, ly): that + 1000 (lx +
 /// ly)), made by tinyexr. Its writer takes the tiles themselves, each a full tile buffer cut at
 /// the edges, level by level in the file's order, checks each level's tile count against its own

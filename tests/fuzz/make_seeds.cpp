@@ -72,42 +72,6 @@ void append(void* ctx, void* data, int size) {
   static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size);
 }
 
-// An EXR with the given compression, pixel type and channels, through tinyexr.
-std::string exr(int w, int h, int compression, int type, std::vector<std::string> names) {
-  EXRHeader header;
-  InitEXRHeader(&header);
-  EXRImage image;
-  InitEXRImage(&image);
-  const int nc = static_cast<int>(names.size());
-  std::vector<std::vector<float>> f(nc, std::vector<float>(static_cast<size_t>(w) * h));
-  std::vector<std::vector<std::uint16_t>> half(nc, std::vector<std::uint16_t>(f[0].size()));
-  std::vector<unsigned char*> ptrs;
-  for (int c = 0; c < nc; ++c) {
-    for (size_t i = 0; i < f[c].size(); ++i) {
-      f[c][i] = 0.25f * float((i * (c + 3)) % 7);
-      half[c][i] = static_cast<std::uint16_t>(0x3400 + ((i * (c + 1)) % 5) * 0x100);
-    }
-    ptrs.push_back(type == TINYEXR_PIXELTYPE_HALF ? reinterpret_cast<unsigned char*>(half[c].data())
-                                                  : reinterpret_cast<unsigned char*>(f[c].data()));
-  }
-  image.images = ptrs.data();
-  image.num_channels = nc;
-  image.width = w;
-  image.height = h;
-  std::vector<EXRChannelInfo> infos(nc);
-  for (int c = 0; c < nc; ++c) {
-    std::memset(&infos[c], 0, sizeof(EXRChannelInfo));
-    std::strncpy(infos[c].name, names[c].c_str(), 255);
-  }
-  std::vector<int> types(nc, type);
-  header.num_channels = nc;
-  header.channels = infos.data();
-  header.pixel_types = types.data();
-  header.requested_pixel_types = types.data();
-  header.compression_type = compression;
-  return lucent::image_detail::save_exr_to_memory("seed.exr", image, header);
-}
-
 // Small images of every format and variant lucent reads; name -> bytes.
 Parts images() {
   Parts out;
@@ -153,13 +117,25 @@ Parts images() {
   int compressions[] = {TINYEXR_COMPRESSIONTYPE_NONE, TINYEXR_COMPRESSIONTYPE_RLE,
                         TINYEXR_COMPRESSIONTYPE_ZIPS, TINYEXR_COMPRESSIONTYPE_ZIP,
                         TINYEXR_COMPRESSIONTYPE_PIZ};
-  for (int c : compressions)
+  // scanline files: half in every compression (0.25 to 0.5 in steps of 1/16), float (0 to 1.5)
+  using lucent::fuzz::ExrLayout;
+  for (int c : compressions) {
+    ExrLayout half;
+    half.compression = c;
+    half.pixel_type = TINYEXR_PIXELTYPE_HALF;
+    auto value = [](int ch, int x, int y) {
+      return 0.25f + 0.0625f * float(((y * 5 + x) * (ch + 1)) % 5);
+    };
     out.emplace_back("half" + std::to_string(c) + ".exr",
-                     exr(5, 40, c, TINYEXR_PIXELTYPE_HALF, {"B", "G", "R"}));
-  out.emplace_back("y.exr",
-                   exr(4, 4, TINYEXR_COMPRESSIONTYPE_NONE, TINYEXR_PIXELTYPE_FLOAT, {"Y"}));
-  out.emplace_back("rgba.exr", exr(4, 4, TINYEXR_COMPRESSIONTYPE_ZIP, TINYEXR_PIXELTYPE_FLOAT,
-                                   {"A", "B", "G", "R"}));
+                     lucent::fuzz::exr_file(5, 40, {"B", "G", "R"}, value, half));
+  }
+  auto quarters = [](int w) {
+    return [w](int ch, int x, int y) { return 0.25f * float(((y * w + x) * (ch + 3)) % 7); };
+  };
+  ExrLayout uncompressed;
+  uncompressed.compression = TINYEXR_COMPRESSIONTYPE_NONE;
+  out.emplace_back("y.exr", lucent::fuzz::exr_file(4, 4, {"Y"}, quarters(4), uncompressed));
+  out.emplace_back("rgba.exr", lucent::fuzz::exr_file(4, 4, {"A", "B", "G", "R"}, quarters(4)));
   // tiled: 11 x 6 in tiles of 4, cut at the right and bottom edges
   out.emplace_back(
       "tiled.exr",
