@@ -462,7 +462,7 @@ class Checker {
     if (header.tiled) {
       if (header.tile_size_x <= 0 || header.tile_size_y <= 0)
         fail("OpenEXR header has an invalid tile size");
-      chunks = tile_chunks(p, header, u64(w), u64(h));
+      chunks = tile_chunks(p, header, u64(w), u64(h));  // checks the offset table's extent too
     } else {
       int lines = 1;
       switch (header.compression_type) {
@@ -476,9 +476,9 @@ class Checker {
           lines = 1;
       }
       chunks = (u64(h) + lines - 1) / lines;
+      // the offset table follows the magic number, the version and the header
+      need(p, 8 + u64(header.header_len) + 8 * chunks, n_, "header and offset table");
     }
-    // the offset table follows the magic number, the version and the header
-    need(p, 8 + u64(header.header_len) + 8 * chunks, n_, "header and offset table");
     if (header.compression_type == TINYEXR_COMPRESSIONTYPE_PIZ) {
       if (header.tiled) fail("tiled PIZ-compressed OpenEXR files are not supported");
       piz_chunks(header, u64(w), chunks, bytes_per_pixel);
