@@ -1,4 +1,6 @@
 """Images, compare() and converge() from Python, with known answers and their error paths."""
+import re
+
 import numpy as np
 import pytest
 
@@ -164,6 +166,33 @@ def test_converge(small_scene):
     assert res.svg("t").lstrip().startswith("<")
     plot = res.plot_image("t")
     assert plot.ndim == 3 and plot.shape[2] == 3
+
+
+def test_converge_without_a_session(small_scene):
+    """Without renderer=, converge renders in a session of its own: the same ladder, packing
+    warnings as LucentWarning, and an on_point that raises stops it after that rung."""
+    reference = lucent.render_reference(small_scene, spp=16)
+    res = lucent.converge(small_scene, reference, spp_ladder=[1, 4])
+    assert [(p.setting, p.spp) for p in res.points] == [("default", 1), ("default", 4)]
+    assert res.points[1].relmse < res.points[0].relmse
+    assert re.fullmatch(r"<lucent\.ConvergePoint default 1 spp, relMSE [0-9.]+>",
+                        repr(res.points[0]))
+    fit, = res.fits
+    assert repr(fit) == "<lucent.ConvergeFit default: %s>" % fit.verdict
+    seen = []
+
+    def stop(point):
+        seen.append(point.spp)
+        raise RuntimeError("enough")
+    with pytest.raises(RuntimeError, match="enough"):
+        lucent.converge(small_scene, reference, spp_ladder=[1, 2, 4], on_point=stop)
+    assert seen == [1]
+    small_scene.positions = np.vstack([small_scene.positions, small_scene.positions[:1]])
+    t = lucent.Triangle()
+    t.v = (0, 4, 1)  # vertices 0 and 4 are equal: degenerate
+    small_scene.triangles.append(t)
+    with pytest.warns(lucent.LucentWarning, match="degenerate"):
+        lucent.converge(small_scene, reference, spp_ladder=[1])
 
 
 def test_converge_by_time_and_errors(small_scene):

@@ -1,6 +1,7 @@
 """The render session from Python: NumPy results without copies, progressive accumulation, what a
 change rebuilds (stats), AOVs, callbacks, the GIL, cancellation, and every error of the API."""
 import math
+import re
 import threading
 import time
 
@@ -315,6 +316,26 @@ def test_session_option_errors():
         r.set_build_options(precision="half")
 
 
+def test_reprs_say_what_they_hold(renderer, small_scene):
+    renderer.set_scene(small_scene)
+    name = renderer.device.name
+    d = renderer.device
+    assert repr(d) == "<lucent.DeviceInfo %d: %s (%s, %s)>" % (d.index, name, d.type, d.platform)
+    # the session's devices: one here, the session's own
+    assert [d.name for d in renderer.devices] == [name]
+    p = renderer.render(4)
+    assert re.fullmatch(r"<lucent\.RenderProgress samples_done=4 samples_target=4 accumulated=4 "
+                        r"elapsed=\S+ time_limit=0 samples_per_second=\S+>", repr(p)), repr(p)
+    share, = p.devices
+    assert repr(share) == "<lucent.DeviceShare %s: 4 spp>" % name
+    res = renderer.result()
+    assert re.fullmatch(r"<lucent\.RenderResult 16x12, 4 spp, \S+ s, %s>" % re.escape(res.device),
+                        repr(res)), repr(res)
+    assert re.fullmatch(r"<lucent\.CompareResult passed, max \|z\| 0\.0+, RMSE 0\.0+>",
+                        repr(lucent.compare(res.mean, res.mean)))
+    assert repr(lucent.compare(res.mean, res.mean + 1)).startswith("<lucent.CompareResult FAILED")
+
+
 def test_render_reference(small_scene):
     r = lucent.render_reference(small_scene, spp=2, threads=1)
     assert r.mean.shape == (12, 16, 3) and (r.samples == 2).all() and "reference" in r.device
@@ -322,6 +343,8 @@ def test_render_reference(small_scene):
         lucent.render_reference(small_scene, spp=-2)
     with pytest.raises(ValueError, match="threads must be >= 0"):
         lucent.render_reference(small_scene, threads=-1)
+    with pytest.raises(ValueError, match=r"spp must be at most 2\^30, got 1073741825"):
+        lucent.render_reference(small_scene, spp=2 ** 30 + 1)
     small_scene.spheres[0].material = 7
     with pytest.raises(lucent.Error):
         lucent.render_reference(small_scene, spp=1)

@@ -259,6 +259,30 @@ def test_bad_field_values():
         lucent.Texture().rgba = np.zeros((2, 2, 3))
 
 
+def test_vectors_index_compare_and_show():
+    v = lucent.Vec3((1, 2.5, -3))
+    assert (v[0], v[1], v[2], v[-1], v[-3]) == (1, 2.5, -3, -3, 1)
+    v[-1] = 4
+    assert v.z == 4 and list(v) == [1, 2.5, 4] and len(v) == 3
+    with pytest.raises(IndexError):
+        v[-4]
+    assert v == (1, 2.5, 4) and v == [1, 2.5, 4] and v == lucent.Vec3((1, 2.5, 4))
+    assert v != (1, 2.5, 5) and v != (1, 2.5) and v != "abc" and v != 3
+    assert repr(v) == "Vec3(1, 2.5, 4)"
+    w = lucent.Vec2((0.25, -1))
+    assert (w[0], w[-1]) == (0.25, -1) and repr(w) == "Vec2(0.25, -1)"
+
+
+def test_scene_repr_counts_what_it_holds(small_scene):
+    assert re.fullmatch(r"<lucent\.Scene '.*': 16x12, path, 2 materials, 1 spheres, 2 triangles, "
+                        r"1 lights, 0 textures>", repr(small_scene)), repr(small_scene)
+
+
+def test_array_fields_refuse_what_is_not_numbers():
+    with pytest.raises(TypeError, match=r"positions: expected an array of shape \(N, 3\)"):
+        lucent.Scene().positions = [["a", "b", "c"]]
+
+
 def test_scene_info_matches_the_cli(tmp_path, small_dict):
     small_dict["materials"]["lamp"] = {"type": "diffuse", "albedo": [0, 0, 0],
                                        "emission": [1, 1, 1]}
