@@ -5,6 +5,7 @@ import os
 import pathlib
 import re
 
+import numpy as np
 import pytest
 
 import lucent
@@ -36,6 +37,15 @@ def small_dict():
 @pytest.fixture
 def small_scene():
     return lucent.scene_from_dict(SMALL)
+
+
+def add_degenerate_triangle(scene):
+    """Appends a triangle whose vertices 0 and 4 (a copy of vertex 0) are equal: packing skips it
+    with a warning ("skipped 1 degenerate or non-finite triangle")."""
+    scene.positions = np.vstack([scene.positions, scene.positions[:1]])
+    t = lucent.Triangle()
+    t.v = (0, 4, 1)
+    scene.triangles.append(t)
 
 
 def session(**kwargs):

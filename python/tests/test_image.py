@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import lucent
-from conftest import session
+from conftest import add_degenerate_triangle, session
 
 
 def constant(value, h=4, w=5):
@@ -187,10 +187,7 @@ def test_converge_without_a_session(small_scene):
     with pytest.raises(RuntimeError, match="enough"):
         lucent.converge(small_scene, reference, spp_ladder=[1, 2, 4], on_point=stop)
     assert seen == [1]
-    small_scene.positions = np.vstack([small_scene.positions, small_scene.positions[:1]])
-    t = lucent.Triangle()
-    t.v = (0, 4, 1)  # vertices 0 and 4 are equal: degenerate
-    small_scene.triangles.append(t)
+    add_degenerate_triangle(small_scene)
     with pytest.warns(lucent.LucentWarning, match="degenerate"):
         lucent.converge(small_scene, reference, spp_ladder=[1])
 

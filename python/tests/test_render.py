@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import lucent
-from conftest import header_fields, session
+from conftest import add_degenerate_triangle, header_fields, session
 
 
 def kernel_builds(stats):
@@ -206,10 +206,7 @@ def test_one_call_at_a_time(renderer, small_scene):
 
 
 def test_warnings_of_packing(small_scene):
-    small_scene.positions = np.vstack([small_scene.positions, small_scene.positions[:1]])
-    t = lucent.Triangle()
-    t.v = (0, 4, 1)  # vertices 0 and 4 are equal: degenerate
-    small_scene.triangles.append(t)
+    add_degenerate_triangle(small_scene)
     got = []
     with session(on_warning=got.append) as r:
         r.set_scene(small_scene)
