@@ -183,7 +183,7 @@ class BvhTrace : public ::testing::Test {
     auto hits = trace(s, b, rays, any_hit);
     std::size_t bad = 0, inexact = 0, hit = 0;
     // the kernel's answers do not depend on the host's sanitizers: under them (where the brute
-    // force runs unoptimised and instrumented) every fourth ray is judged
+    // force runs instrumented) every fourth ray is judged
     const std::size_t step = lucent::test::kAddressSanitizer ? 4 : 1;
     for (std::size_t i = 0; i < rays.size(); ++i) {
       hit += hits[i].prim != LC_INVALID;

@@ -315,11 +315,11 @@ def test_session_option_errors():
 
 def test_reprs_say_what_they_hold(renderer, small_scene):
     renderer.set_scene(small_scene)
-    name = renderer.device.name
     d = renderer.device
+    name = d.name
     assert repr(d) == "<lucent.DeviceInfo %d: %s (%s, %s)>" % (d.index, name, d.type, d.platform)
     # the session's devices: one here, the session's own
-    assert [d.name for d in renderer.devices] == [name]
+    assert [dev.name for dev in renderer.devices] == [name]
     p = renderer.render(4)
     assert re.fullmatch(r"<lucent\.RenderProgress samples_done=4 samples_target=4 accumulated=4 "
                         r"elapsed=\S+ time_limit=0 samples_per_second=\S+>", repr(p)), repr(p)
