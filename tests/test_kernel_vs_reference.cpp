@@ -418,6 +418,26 @@ TEST(KernelVsReference, Whitted) {
   EXPECT_AGREE(b);
 }
 
+// max_depth counts segments in Whitted too: 1 shows what the camera sees emit (emitters and the
+// environment), 2 adds the point lights' direct light and one mirror bounce's emitters, 3 the
+// point-lit floor in the mirror. The kernel once lit the last segment's surfaces by the point
+// lights as well (a whole extra level of direct light; at max_depth 1 every diffuse pixel).
+TEST(KernelVsReference, WhittedShortPaths) {
+  for (int depth : {1, 2, 3}) {
+    SCOPED_TRACE("max_depth " + std::to_string(depth));
+    Both b = render_both(
+        scene_from(scene_json(
+            R"({"type": "whitted", "max_depth": )" + std::to_string(depth) + "}",
+            std::string(kDiffuseMats) + ", " + kLamps +
+                R"(, "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]})",
+            std::string(kSpheres) + ", " + kLampShapes +
+                R"(, {"type": "sphere", "center": [0, 0.45, 1.2], "radius": 0.45, "material": "mirror"})",
+            std::string(kPointLights) + ", " + kEnv)),
+        32);
+    EXPECT_AGREE(b);
+  }
+}
+
 // Every material's albedo AOV, normals, depth and ambient occlusion (bounded and unbounded),
 // statistically (the box filter jitters the first hit).
 TEST(KernelVsReference, Aovs) {
@@ -509,6 +529,55 @@ TEST(KernelVsReference, ShadingNormals) {
              "indices": [0,4,2, 4,1,2, 1,5,2, 5,0,2, 4,0,3, 1,4,3, 5,1,3, 0,5,3]})",
           std::string(kPointLights) + ", " + kEnv)),
       256);
+  EXPECT_AGREE(b);
+}
+
+// Smooth and rough glass on meshes whose vertex normals disagree with their faces (the octahedra
+// of ShadingNormals): a direction that crosses the geometric surface on the wrong side of what its
+// lobe says (a reflection below it, a refraction above it) carries nothing, both when the BSDF
+// samples it and when light sampling finds it (docs/rendering-model.md, "Materials"). The
+// reference once followed such smooth-glass directions (10 pixels of the first image failed), and
+// the kernel's light sampling once took the rough glass's reflection value for a light behind the
+// geometric surface (the second image's mean z was 141).
+TEST(KernelVsReference, ShadingNormalsOnGlass) {
+  const std::string octahedron =
+      R"("positions": [[-0.4,0,0],[0.4,0,0],[0,0.4,0],[0,-0.4,0],[0,0,0.4],[0,0,-0.4]],
+         "normals": [[-1,0,0],[1,0,0],[0,1,0],[0,-1,0],[0,0,1],[0,0,-1]],
+         "indices": [0,4,2, 4,1,2, 1,5,2, 5,0,2, 4,0,3, 1,4,3, 5,1,3, 0,5,3])";
+  auto at = [&](double x, double y, double z, const char* material) {
+    std::string m = R"({"type": "triangles", "material": ")" + std::string(material) +
+                    R"(", "transform": [{"translate": [)" + std::to_string(x) + ", " +
+                    std::to_string(y) + ", " + std::to_string(z) + "]}], " + octahedron + "}";
+    return m;
+  };
+  Both b = render_both(
+      scene_from(scene_json(R"({"type": "path", "max_depth": 6})",
+                            std::string(kDiffuseMats) + ", " + kLamps +
+                                R"(, "glass": {"type": "dielectric", "ior": 1.5},
+                   "frosted": {"type": "rough_dielectric", "ior": 1.5, "roughness": 0.3})",
+                            std::string(kLampShapes) + ", " + at(-0.8, 0.7, 0.3, "glass") + ", " +
+                                at(0.8, 0.7, 0.3, "frosted"),
+                            std::string(kPointLights) + ", " + kEnv)),
+      256);
+  EXPECT_AGREE(b);
+  // A rough glass quad whose shading normals lean 45 degrees towards -x, and a point light below
+  // its plane but above the shading normals' plane (at -x): light sampling must not take the
+  // reflection lobe's value for it (the kernel once did, with a shadow ray from behind). A second
+  // point light above both planes lights the quad as usual.
+  SCOPED_TRACE("rough glass quad, a light in the wedge between its two planes");
+  b = render_both(scene_from(R"({
+        "camera": {"position": [0, 3, 3], "look_at": [0, 0, 0], "fov": 40},
+        "film": {"width": 24, "height": 24},
+        "integrator": {"type": "path", "max_depth": 3},
+        "materials": {"frosted": {"type": "rough_dielectric", "ior": 1.5, "roughness": 0.3}},
+        "shapes": [{"type": "triangles", "material": "frosted",
+                    "positions": [[-1,0,-1],[1,0,-1],[1,0,1],[-1,0,1]],
+                    "normals": [[-0.7,0.7,0],[-0.7,0.7,0],[-0.7,0.7,0],[-0.7,0.7,0]],
+                    "indices": [0,2,1, 0,3,2]}],
+        "lights": [{"type": "point", "position": [-6, -0.5, 0], "intensity": [30, 30, 30]},
+                   {"type": "point", "position": [-1, 3, 1], "intensity": [2, 2, 2]}]
+      })"),
+                  64);
   EXPECT_AGREE(b);
 }
 

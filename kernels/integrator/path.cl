@@ -97,8 +97,11 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
         lc_light_sample ls;
         if (light_sample(s, o, u_light.z, u_light.x, u_light.y, &ls) && ls.pdf > 0.0f) {
           int behind = !(dot(ls.wi, it.ng) > LC_REAL(0.0));
-          if (!behind || (lobes & LC_BSDF_TRANSMISSION)) {
-            float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
+          float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
+          /* the side of the geometric surface decides the lobe, and the shading frame must
+           * agree (as for sampled directions below: a shading normal leak carries nothing) */
+          if ((!behind || (lobes & LC_BSDF_TRANSMISSION)) &&
+              (behind ? wi_l.z < 0.0f : wi_l.z > 0.0f)) {
             float pdf_b;
             float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf_b);
             if (lc_max3(f) > 0.0f && (behind ? shadow_visible_behind(s, &it, o, &ls, rays)

@@ -36,12 +36,14 @@ static inline float3 integrator_whitted(const lc_scene* s, lc_ray ray, const lc_
     lc_interaction it = interaction_from_hit(s, e.ray, &hit);
     __global const lc_material* m = &s->materials[it.material];
     if (it.front) L += e.w * lc_load3(m->emission);
+    /* max_depth counts segments: a point light's shadow ray would be one more */
+    if (e.segments >= P->max_depth) continue;
     lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
     lc_frame fr = frame_from(it.ns);
     float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-e.ray.d));
     lc_whitted_bsdf w = bsdf_whitted(&b, wo_l);
     if (w.diffuse_lobe) L += e.w * point_lights_direct(s, &it, 0, w.diffuse, &fr, wo_l, rays);
-    if (e.segments >= P->max_depth || wo_l.z <= 0.0f) continue;
+    if (wo_l.z <= 0.0f) continue;
     if (!(lc_max3(w.reflect) > 0.0f) && !(lc_max3(w.transmit) > 0.0f)) continue;
     if (lc_max3(w.transmit) > 0.0f && sp < LC_WHITTED_STACK) {
       lc_real3 refr = normalize(lc_real3_from_float3(frame_to_world(&fr, w.transmit_wi)));

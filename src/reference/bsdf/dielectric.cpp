@@ -1,6 +1,8 @@
 // dielectric (ior, tint = Material::specular): a smooth interface, exact Fresnel reflectance F;
 // reflection with weight F, refraction with weight (1 - F) tint / eta^2 (radiance transport),
 // eta = ior entering the front side, 1 / ior leaving it; total internal reflection reflects all.
+// A direction on the wrong side of the geometric surface for its lobe (possible with shading
+// normals) carries nothing, as for every BSDF (docs/rendering-model.md).
 #include "lucent/reference.hpp"
 #include "reference/bsdf/bsdf.hpp"
 #include "reference/bsdf/parts.hpp"
@@ -24,14 +26,16 @@ class Dielectric final : public Bsdf {
     if (co <= 0) return s;
     double F = reference::fresnel_dielectric(co, eta_);
     s.delta = true;
-    s.valid = true;
     if (u_lobe < F) {  // reflect with probability F: weight F / F
       s.wi = reflect(wo);
       s.weight = dvec3(1.0);
+      // a reflection must leave above the geometric surface, a refraction below it
+      s.valid = glm::dot(s.wi, ng_) > 0;
     } else {  // refract with probability 1 - F: weight tint / eta^2
       s.wi = refract(wo, n_, co, eta_);
       s.weight = tint_ / (eta_ * eta_);
       s.eta = eta_;
+      s.valid = glm::dot(s.wi, ng_) < 0;
     }
     return s;
   }
@@ -39,7 +43,7 @@ class Dielectric final : public Bsdf {
   dvec3 albedo() const override { return tint_; }
 
   WhittedLobes whitted(const dvec3& wo) const override {
-    return dielectric_whitted(wo, n_, eta_, tint_);
+    return dielectric_whitted(wo, n_, ng_, eta_, tint_);
   }
 
  private:

@@ -71,17 +71,18 @@ dvec3 ggx_sample_reflect(const dvec3& n, const dvec3& wo, double alpha, double u
   return glm::normalize(2 * glm::dot(wo, h) * h - wo);
 }
 
-WhittedLobes dielectric_whitted(const dvec3& wo, const dvec3& n, double eta, const dvec3& tint) {
+WhittedLobes dielectric_whitted(const dvec3& wo, const dvec3& n, const dvec3& ng, double eta,
+                                const dvec3& tint) {
   WhittedLobes w;
   double co = glm::dot(wo, n);
   if (co <= 0) return w;
   double F = reference::fresnel_dielectric(co, eta);
-  w.reflect = true;
   w.reflect_dir = glm::normalize(2 * co * n - wo);
+  w.reflect = glm::dot(w.reflect_dir, ng) > 0;
   w.reflect_weight = dvec3(F);
   if (F < 1) {
-    w.transmit = true;
     w.transmit_dir = refract(wo, n, co, eta);
+    w.transmit = glm::dot(w.transmit_dir, ng) < 0;
     w.transmit_weight = (1 - F) * tint;
   }
   return w;

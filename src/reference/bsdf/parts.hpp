@@ -38,8 +38,10 @@ dvec3 ggx_sample_reflect(const dvec3& n, const dvec3& wo, double alpha, double u
 
 /// The Whitted lobes of a dielectric interface about the shading normal n (smooth and rough
 /// dielectrics alike): reflection with weight F, refraction with weight (1 - F) tint, without
-/// the (eta_i / eta_t)^2 factor (docs/rendering-model.md, "whitted"); none when wo is below n.
-/// eta = n_transmitted / n_incident.
-WhittedLobes dielectric_whitted(const dvec3& wo, const dvec3& n, double eta, const dvec3& tint);
+/// the (eta_i / eta_t)^2 factor (docs/rendering-model.md, "whitted"); none when wo is below n,
+/// and neither a reflection below the geometric surface (normal ng, on wo's side) nor a
+/// refraction above it. eta = n_transmitted / n_incident.
+WhittedLobes dielectric_whitted(const dvec3& wo, const dvec3& n, const dvec3& ng, double eta,
+                                const dvec3& tint);
 
 }  // namespace lucent::ref

@@ -93,7 +93,7 @@ class RoughDielectric final : public Bsdf {
   dvec3 albedo() const override { return tint_; }
 
   WhittedLobes whitted(const dvec3& wo) const override {
-    return dielectric_whitted(wo, n_, eta_, tint_);
+    return dielectric_whitted(wo, n_, ng_, eta_, tint_);
   }
 
  private:
