@@ -141,7 +141,13 @@ TEST(ObjValidation, MtlNumbersAreChecked) {
 TEST(ObjValidation, TransformBeyondFloatRangeIsAnError) {
   glm::dmat4 xf = glm::scale(glm::dmat4(1.0), glm::dvec3(1e30));
   EXPECT_EQ(obj_error("v 0 0 0\nv 1e9 0 0\nv 0 1 0\nf 1 2 3\n", "", xf),
-            "m.obj:2: vertex 2 is (1e+39, 0, 0) after the transform, beyond the range of a float");
+            "m.obj:2: vertex 2 (1e+39, 0, 0) after the transform is beyond lucent's geometry range "
+            "(coordinates of magnitude at most 1e+12, where the kernel's float intersection "
+            "arithmetic still holds)");
+  EXPECT_EQ(obj_error("v 0 0 0\nv 0 0 0\nv 0 2e12 0\nf 1 2 3\n"),
+            "m.obj:3: vertex 3 (0, 2e+12, 0) is beyond lucent's geometry range (coordinates of "
+            "magnitude at most 1e+12, where the kernel's float intersection arithmetic still "
+            "holds)");
 }
 
 TEST(ObjValidation, FilesThatAreNotRegularAreRefused) {

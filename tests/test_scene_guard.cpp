@@ -12,6 +12,7 @@
 
 #include "core/file_io.hpp"
 #include "lucent/error.hpp"
+#include "scene/validate.hpp"
 #include "support.hpp"
 
 namespace {
@@ -94,13 +95,68 @@ TEST(SceneGuard, NumbersBeyondFloatRangeNameTheirPointer) {
       after_path(parse_error(R"({"materials": {"m": {"type": "diffuse",
     "emission": [1, 1e300, 1]}}})")),
       ": /materials/m/emission/1: must fit in a float (magnitude at most 3.4e38), got 1e+300");
-  EXPECT_EQ(parse_error(R"({"camera": {"position": [3.4e38, 0, 0], "look_at": [0, 0, 0]}})"), "");
+  EXPECT_EQ(parse_error(R"({"materials": {"m": {"type": "diffuse", "emission": [3.4e38, 0, 0]}}})"),
+            "");
   // inline triangles that a transform takes beyond float range
   EXPECT_EQ(after_path(parse_error(R"({"materials": {"m": {"type": "diffuse"}},
     "shapes": [{"type": "triangles", "positions": [[1, 0, 0], [0, 0, 0], [0, 1, 0]],
                 "indices": [0, 1, 2], "material": "m",
                 "transform": [{"scale": 1e30}, {"scale": 1e30}]}]})")),
-            ": /shapes/0/positions/0: the transform takes it beyond float range");
+            ": /shapes/0/positions/0: its largest coordinate after the transform, 1e+60, is "
+            "beyond lucent's geometry range (coordinates of magnitude at most 1e+12, where the "
+            "kernel's float intersection arithmetic still holds)");
+}
+
+// Geometry beyond limits::kMaxCoordinate (1e12) is an error naming its place: the kernel's float
+// triangle test overflows near 7e12 and a sphere's squared radius at 1.8e19, and such shapes
+// vanished from the image (a floor sphere of radius 1e20), or an emitter's area became infinite
+// and every light's selection probability NaN (a lamp of radius 1e19), without a word.
+TEST(SceneGuard, GeometryBeyondRangeNamesItsPlace) {
+  const std::string range =
+      " is beyond lucent's geometry range (coordinates of magnitude at most 1e+12, where the "
+      "kernel's float intersection arithmetic still holds)";
+  const std::string m = R"("materials": {"m": {"type": "diffuse"}}, )";
+  EXPECT_EQ(after_path(parse_error("{" + m + R"("shapes": [{"type": "sphere",
+    "center": [0, -1e20, 0], "radius": 1e20, "material": "m"}]})")),
+            ": /shapes/0/center/1: -1e+20" + range);
+  EXPECT_EQ(after_path(parse_error("{" + m + R"("shapes": [{"type": "sphere",
+    "center": [0, -1e12, 0], "radius": 1e6, "material": "m"}]})")),
+            ": /shapes/0/radius: the sphere's farthest coordinate, 1e+12," + range);
+  EXPECT_EQ(after_path(parse_error("{" + m + R"("shapes": [{"type": "sphere",
+    "center": [0, 0, 0], "radius": 1e19, "material": "m"}]})")),
+            ": /shapes/0/radius: the sphere's farthest coordinate, 1e+19," + range);
+  EXPECT_EQ(after_path(parse_error("{" + m + R"("shapes": [{"type": "triangles",
+    "positions": [[-2e12, 0, 0], [0, 0, 0], [0, 1, 0]], "indices": [0, 1, 2], "material": "m"}]})")),
+            ": /shapes/0/positions/0: its largest coordinate, 2e+12," + range);
+  EXPECT_EQ(after_path(parse_error(R"({"camera": {"position": [0, 5e12, 0]}})")),
+            ": /camera/position/1: 5e+12" + range);
+  EXPECT_EQ(
+      after_path(parse_error(
+          R"({"lights": [{"type": "point", "position": [0, 0, 3e15], "intensity": [1, 1, 1]}]})")),
+      ": /lights/0/position/2: 3e+15" + range);
+  // at the edge of the range: accepted
+  EXPECT_EQ(parse_error("{" + m + R"("shapes": [{"type": "sphere",
+    "center": [0, -5e11, 0], "radius": 5e11, "material": "m"}]})"),
+            "");
+  // built through the API, without SceneBuilder: validate_scene, run by every render
+  lucent::Scene s = lucent::test::scene_from("{" + m + R"("shapes": [{"type": "sphere",
+    "center": [0, 0, 0], "radius": 1, "material": "m"}, {"type": "triangles",
+    "positions": [[1, 0, 0], [0, 0, 0], [0, 1, 0]], "indices": [0, 1, 2], "material": "m"}]})");
+  lucent::Scene far_sphere = s, far_vertex = s;
+  far_sphere.spheres[0].radius = 1e20;
+  far_vertex.positions[1].z = -8e12;
+  auto validate_error = [](const lucent::Scene& scene) {
+    try {
+      lucent::scene_detail::validate_scene(scene);
+    } catch (const lucent::Error& e) {
+      return after_path(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(validate_error(s), "");
+  EXPECT_EQ(validate_error(far_sphere),
+            ": /shapes/0/radius: the sphere's farthest coordinate, 1e+20," + range);
+  EXPECT_EQ(validate_error(far_vertex), ": /shapes/1 (triangle 0)/v/1/2: -8e+12" + range);
 }
 
 TEST(SceneGuard, StreamsAndDevicesAreBounded) {

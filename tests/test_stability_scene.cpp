@@ -113,7 +113,7 @@ TEST_P(StabilityScale, SameImageAsUnitScene) {
   EXPECT_SAME_IMAGE(r, unit, "A = scaled by " << s << ", B = unit scene");
 }
 
-INSTANTIATE_TEST_SUITE_P(Scales, StabilityScale, ::testing::Values(1e-4, 1e-2, 1e2, 1e4, 1e6),
+INSTANTIATE_TEST_SUITE_P(Scales, StabilityScale, ::testing::Values(1e-4, 1e-2, 1e2, 1e4, 1e6, 1e11),
                          [](const ::testing::TestParamInfo<double>& i) {
                            return exp_name(i.param);
                          });

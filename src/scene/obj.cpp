@@ -12,6 +12,7 @@
 #include "lucent/error.hpp"
 #include "scene/loaders.hpp"
 #include "scene/obj_internal.hpp"
+#include "scene/validate.hpp"
 
 namespace lucent::scene_detail {
 
@@ -89,14 +90,15 @@ void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform
   for (long i = 0; i < nv; ++i) {
     glm::dvec3 p(attrib.vertices[3 * i], attrib.vertices[3 * i + 1], attrib.vertices[3 * i + 2]);
     glm::dvec3 w = glm::dvec3(transform * glm::dvec4(p, 1.0));
-    // the device stores floats: a vertex the transform takes beyond their range is refused
+    // a vertex (after the transform) beyond the geometry range is refused: the kernel's float
+    // arithmetic would make it vanish (lucent/limits.hpp)
     for (int c = 0; c < 3; ++c)
-      if (!(std::abs(w[c]) <= FLT_MAX)) {
+      if (!(std::abs(w[c]) <= limits::kMaxCoordinate)) {
         std::ostringstream where;
-        where << w.x << ", " << w.y << ", " << w.z;
-        throw Error(path + ":" + std::to_string(obj::line_of_statement(text, "v", i)) +
-                    ": vertex " + std::to_string(i + 1) + " is (" + where.str() +
-                    ") after the transform, beyond the range of a float");
+        where << "vertex " << i + 1 << " (" << w.x << ", " << w.y << ", " << w.z << ")"
+              << (transform == glm::dmat4(1.0) ? "" : " after the transform");
+        throw Error(path + ":" + std::to_string(obj::line_of_statement(text, "v", i)) + ": " +
+                    scene_detail::beyond_geometry_range(where.str()));
       }
     scene.positions.push_back(w);
   }

@@ -3,6 +3,7 @@
 // element's place, then adds it.
 #include "lucent/scene_builder.hpp"
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <utility>
@@ -115,9 +116,14 @@ void SceneBuilder::add_mesh(const MeshShape& mesh) {
   const int uvbase = static_cast<int>(scene_.uvs.size());
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     const glm::dvec3 w = glm::dvec3(xf * glm::dvec4(mesh.positions[i], 1.0));
-    if (!(std::abs(w.x) <= FLT_MAX && std::abs(w.y) <= FLT_MAX && std::abs(w.z) <= FLT_MAX))
+    const double m = std::max({std::abs(w.x), std::abs(w.y), std::abs(w.z)});
+    if (!(m <= limits::kMaxCoordinate))
       Reporter(scene_.path, p + "/positions/" + std::to_string(i))
-          .fail("the transform takes it beyond float range");
+          .fail(scene_detail::beyond_geometry_range(
+              std::string(mesh.transform == glm::dmat4(1.0) ? "its largest coordinate, "
+                                                            : "its largest coordinate after the "
+                                                              "transform, ") +
+              scene_detail::format_number(m) + ","));
     scene_.positions.push_back(w);
   }
   for (const glm::dvec3& n : mesh.normals) {

@@ -2,6 +2,7 @@
 // loader and SceneBuilder.
 #include "scene/validate.hpp"
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <sstream>
@@ -62,6 +63,19 @@ void check_between(const Reporter& at, double v, double lo, double hi) {
 
 void check_point(const Reporter& at, const glm::dvec3& v) {
   for (int i = 0; i < 3; ++i) check_finite(at.at(i), v[i]);
+}
+
+std::string beyond_geometry_range(const std::string& what) {
+  return what + " is beyond lucent's geometry range (coordinates of magnitude at most " +
+         format_number(limits::kMaxCoordinate) +
+         ", where the kernel's float intersection arithmetic still holds)";
+}
+
+void check_position(const Reporter& at, const glm::dvec3& v) {
+  check_point(at, v);
+  for (int i = 0; i < 3; ++i)
+    if (std::abs(v[i]) > limits::kMaxCoordinate)
+      at.at(i).fail(beyond_geometry_range(format_number(v[i])));
 }
 
 void check_colour(const Reporter& at, const glm::dvec3& c) {
@@ -132,8 +146,8 @@ void check_type(const Reporter& at, E value) {
 // ---------------------------------------------------------------------------------------------
 
 void validate_camera(const Camera& c, const Reporter& at) {
-  check_point(at.at("position"), c.position);
-  check_point(at.at("look_at"), c.look_at);
+  check_position(at.at("position"), c.position);
+  check_position(at.at("look_at"), c.look_at);
   check_nonzero(at.at("up"), c.up);
   if (!(check_finite(at.at("fov"), c.fov_degrees) > 0 && c.fov_degrees < 180))
     at.at("fov").fail("must be in (0, 180) degrees, got " + format_number(c.fov_degrees));
@@ -218,7 +232,7 @@ void validate_light(const Light& l, std::size_t textures, const Reporter& at) {
   check_light_type(at.at("type"), l.type);
   switch (l.type) {
     case LightType::Point:
-      check_point(at.at("position"), l.position);
+      check_position(at.at("position"), l.position);
       check_colour(at.at("intensity"), l.intensity);
       break;
     case LightType::Environment:
@@ -234,9 +248,25 @@ void validate_light(const Light& l, std::size_t textures, const Reporter& at) {
   }
 }
 
+namespace {
+
+/// The largest coordinate magnitude of a sphere's points.
+double sphere_reach(const glm::dvec3& c, double r) {
+  return std::max({std::abs(c.x), std::abs(c.y), std::abs(c.z)}) + r;
+}
+
+void check_sphere_reach(const Reporter& at, const glm::dvec3& c, double r) {
+  if (sphere_reach(c, r) > limits::kMaxCoordinate)
+    at.at("radius").fail(beyond_geometry_range("the sphere's farthest coordinate, " +
+                                               format_number(sphere_reach(c, r)) + ","));
+}
+
+}  // namespace
+
 void validate_sphere(const SphereShape& s, const Reporter& at) {
-  check_point(at.at("center"), s.center);
+  check_position(at.at("center"), s.center);
   check_positive(at.at("radius"), s.radius);
+  check_sphere_reach(at, s.center, s.radius);
 }
 
 void validate_mesh(const MeshShape& m, const Reporter& at) {
@@ -315,11 +345,14 @@ void validate_scene(const Scene& s) {
     validate_light(s.lights[i], s.textures.size(), Reporter(file, "/lights/" + std::to_string(i)));
   const std::size_t nm = s.materials.size();
   for (std::size_t i = 0; i < s.spheres.size(); ++i) {
-    // (a NaN centre or radius is allowed: such a sphere is never hit, tests/test_stability_scene)
+    // (a NaN centre or radius is allowed: such a sphere is never hit, tests/test_stability_scene;
+    // a finite one beyond the geometry range would vanish as silently, so it is an error)
     const Sphere& sp = s.spheres[i];
-    if (sp.material >= 0 && static_cast<std::size_t>(sp.material) < nm) continue;
+    const bool in_range = !(sphere_reach(sp.center, sp.radius) > limits::kMaxCoordinate);
+    if (sp.material >= 0 && static_cast<std::size_t>(sp.material) < nm && in_range) continue;
     const Reporter at(file, primitive_place(s, ShapeType::Sphere, i, "spheres", "sphere"));
     check_index(at.at("material"), sp.material, nm, "materials");
+    if (finite(sp.center) && std::isfinite(sp.radius)) check_sphere_reach(at, sp.center, sp.radius);
   }
   const std::size_t np = s.positions.size(), nn = s.normals.size(), nuv = s.uvs.size();
   for (std::size_t i = 0; i < s.triangles.size(); ++i) {
@@ -333,12 +366,20 @@ void validate_scene(const Scene& s) {
       ok = ok && (!has_n || static_cast<std::size_t>(t.n[k]) < nn);
       ok = ok && (!has_uv || static_cast<std::size_t>(t.uv[k]) < nuv);
     }
-    if (ok) continue;
+    // a finite vertex beyond the geometry range (non-finite ones are dropped by pack_scene)
+    int far = -1;
+    for (int k = 0; k < 3 && ok; ++k)
+      for (int c = 0; c < 3; ++c)
+        if (std::abs(s.positions[t.v[k]][c]) > limits::kMaxCoordinate &&
+            finite(s.positions[t.v[k]]))
+          far = k;
+    if (ok && far < 0) continue;
     const Reporter at(file, primitive_place(s, ShapeType::Triangle, i, "triangles", "triangle"));
     check_index(at.at("material"), t.material, nm, "materials");
     for (int k = 0; k < 3; ++k) check_index(at.at("v").at(k), t.v[k], np, "positions");
     for (int k = 0; k < 3 && has_n; ++k) check_index(at.at("n").at(k), t.n[k], nn, "normals");
     for (int k = 0; k < 3 && has_uv; ++k) check_index(at.at("uv").at(k), t.uv[k], nuv, "uvs");
+    if (far >= 0) check_position(at.at("v").at(far), s.positions[t.v[far]]);
   }
 }
 

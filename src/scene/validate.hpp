@@ -71,7 +71,12 @@ void check_positive(const Reporter& at, double v);                       ///< fi
 void check_non_negative(const Reporter& at, double v);                   ///< finite and >= 0
 void check_between(const Reporter& at, double v, double lo, double hi);  ///< finite, in [lo, hi]
 void check_point(const Reporter& at, const glm::dvec3& v);               ///< finite components
-void check_colour(const Reporter& at, const glm::dvec3& c);              ///< finite components >= 0
+/// A position in the scene: finite components of magnitude <= limits::kMaxCoordinate.
+void check_position(const Reporter& at, const glm::dvec3& v);
+/// "<subject> is beyond lucent's geometry range (...)": the message for a coordinate beyond
+/// limits::kMaxCoordinate.
+std::string beyond_geometry_range(const std::string& what);
+void check_colour(const Reporter& at, const glm::dvec3& c);   ///< finite components >= 0
 void check_nonzero(const Reporter& at, const glm::dvec3& v);  ///< finite and not (0, 0, 0)
 /// A scale given as RGB or as one number (all components equal: the place has no component).
 void check_scale(const Reporter& at, const glm::dvec3& s);
