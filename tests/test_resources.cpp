@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "lucent/error.hpp"
+#include "lucent/reference.hpp"
 #include "lucent/session.hpp"
 #include "render/pack.hpp"
 #include "render/resources.hpp"
@@ -516,4 +517,49 @@ TEST(Resources, AdaptiveRenderChecksItsHostMemory) {
       << msg;
   r.render(1);  // the uniform render was never refused
   EXPECT_EQ(r.result().spp, 1u);
+}
+
+// The CPU reference checks its host memory before it allocates, as the kernel's renders do: its
+// accumulation, and with caustics one set of light sums per thread (64 threads of 48 bytes per
+// pixel for a 4096x4096 film were 51 GiB, allocated unchecked and zero-filled).
+TEST(Resources, ReferenceChecksItsHostMemory) {
+  Scene s = lucent::test::scene_from(grid_scene(4, 4));
+  s.path = "r.json";
+  s.film.width = s.film.height = 256;
+  lucent::ReferenceOptions ro;
+  ro.spp = 1;
+  ro.threads = 1;
+  std::uint64_t need = 0;
+  for (const auto& p : lucent::render_detail::estimate_host_memory(s, {})) need += p.bytes;
+  DeviceLimits lim;
+  lim.host_mem = need - 1;
+  {
+    ScopedLimitOverride o(lim);
+    std::string msg = error_of([&] { lucent::render_reference(s, ro); });
+    EXPECT_EQ(msg.rfind("r.json: rendering needs about ", 0), 0u) << msg;
+    EXPECT_NE(msg.find("the largest part is the accumulation and result images of the 256x256 "
+                       "film"),
+              std::string::npos)
+        << msg;
+  }
+  // with caustics (a path tracer's option), the light sums of every thread
+  s.integrator.type = lucent::IntegratorType::Path;
+  s.integrator.caustics = true;
+  s.film.width = s.film.height = 64;
+  ro.threads = 16;
+  need = 0;
+  for (const auto& p : lucent::render_detail::estimate_host_memory(s, {})) need += p.bytes;
+  lim.host_mem = need + 64u * 64 * 48 * 8;  // room for the light sums of 9 threads, not 16
+  {
+    ScopedLimitOverride o(lim);
+    std::string msg = error_of([&] { lucent::render_reference(s, ro); });
+    EXPECT_NE(msg.find("the largest part is the caustics light sums of the 64x64 film, one per "
+                       "thread (16)"),
+              std::string::npos)
+        << msg;
+    EXPECT_NE(msg.find("reduce the film size or the reference's threads"), std::string::npos)
+        << msg;
+    ro.threads = 8;
+    EXPECT_EQ(error_of([&] { lucent::render_reference(s, ro); }), "");
+  }
 }

@@ -17,6 +17,7 @@
 #include "reference/camera/camera.hpp"
 #include "reference/integrator/integrator.hpp"
 #include "reference/integrator/light_tracer.hpp"
+#include "render/resources.hpp"
 #include "scene/validate.hpp"
 
 namespace lucent {
@@ -27,10 +28,16 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
   if (W <= 0 || H <= 0) throw Error(scene.path + ": film size must be positive");
   const int spp = options.spp > 0 ? options.spp : scene.integrator.spp;
   if (spp <= 0) throw Error(scene.path + ": samples per pixel must be positive");
+  int threads = options.threads > 0
+                    ? options.threads
+                    : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  threads = std::min(threads, H);
+  const bool caustics = scene.integrator.caustics && scene.integrator.type == IntegratorType::Path;
+  // refused before anything large is allocated, as the kernel's renders are
+  render_detail::check_reference_host_memory(scene, caustics ? threads : 1);
   auto t0 = std::chrono::steady_clock::now();
   const ref::Tracer tracer(scene);
   const ref::CameraModel camera(scene);
-  const bool caustics = scene.integrator.caustics && scene.integrator.type == IntegratorType::Path;
   std::unique_ptr<ref::LightTracer> light_tracer;
   if (caustics) light_tracer = std::make_unique<ref::LightTracer>(tracer, camera);
 
@@ -40,10 +47,6 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
   std::atomic<int> next_row{0};
   std::atomic<std::uint64_t> nonfinite{0}, rays{0}, light_paths{0};
   std::atomic<bool> cancelled{false};
-  int threads = options.threads > 0
-                    ? options.threads
-                    : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  threads = std::min(threads, H);
   // per thread: the sum and the sum of squares of the light paths' contributions per pixel and
   // channel (a light path gives a pixel at most one contribution c_jp)
   std::vector<std::vector<double>> light_sum(caustics ? threads : 0),

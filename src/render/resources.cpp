@@ -164,6 +164,24 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
   check_host_parts(scene, estimate_host_memory(scene, devices), host_limit, limit_what);
 }
 
+void check_reference_host_memory(const Scene& scene, int threads) {
+  const sys::HostMemory host = sys::host_memory();
+  std::uint64_t limit = host.limit();
+  if (g_override) limit = lowered(limit, g_override->host_mem);
+  if (limit == 0) return;
+  // the kernel's estimate without devices: the reference's accumulation (mean and M2 in double,
+  // a count) and result images take what the session's do; with caustics each thread keeps its
+  // own light sums (src/reference/render.cpp)
+  std::vector<MemoryPart> parts = estimate_host_memory(scene, {});
+  for (MemoryPart& p : parts)
+    if (p.what.rfind("the caustics light sums", 0) == 0) {
+      p.bytes *= std::uint64_t(std::max(threads, 1));
+      p.what += ", one per thread (" + std::to_string(threads) + ")";
+      p.reduce = "the film size or the reference's threads, or render without caustics";
+    }
+  check_host_parts(scene, parts, limit, host.what.empty() ? "physical memory" : host.what);
+}
+
 std::uint64_t adaptive_host_bytes(std::uint64_t npix, bool caustics) {
   // a half: 3 + 3 doubles and 3 uint32; a pilot: 7 doubles and a uint32; the temporaries of
   // the pilots' relative variances (sample means, light means, neighbour values) and of the

@@ -69,6 +69,12 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
 void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
                        std::uint64_t host_limit, const std::string& limit_what = "physical memory");
 
+/// Before the CPU reference (render_reference) allocates: its accumulation and result images, the
+/// scene's BVH, and with caustics one set of light sums per thread (`threads`), against
+/// host_memory_limit() (lowered by a ScopedLimitOverride's host_mem). Throws lucent::Error as
+/// check_host_memory does.
+void check_reference_host_memory(const Scene& scene, int threads);
+
 /// An adaptive render's host memory beyond a uniform render's (session.cpp run_adaptive): the
 /// halves A, B and C (sums and sums of squares, counts, launched samples, plans), A's and B's
 /// pilots, the planner's per-pixel temporaries, and with caustics A's and B's light sums.
