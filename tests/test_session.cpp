@@ -14,6 +14,7 @@
 #include "cl/program_cache.hpp"
 #include "lucent/render.hpp"
 #include "lucent/session.hpp"
+#include "render/resources.hpp"
 #include "support.hpp"
 
 namespace {
@@ -498,3 +499,49 @@ TEST(Session, ErrorsAreLucentErrors) {
 }
 
 }  // namespace
+
+// A set_scene that fails after it has begun to change the device (an allocation failing
+// part-way through the upload, simulated by ScopedUploadFault) leaves buffers that match neither
+// scene. The session drops them: rendering is refused until a set_scene succeeds, the image
+// rendered before stays readable, and going back to the first scene uploads it again (it once
+// kept the device's half-new buffers because the host's record still said "first scene", and
+// rendered the first scene's samples with the second scene's materials).
+TEST(Session, FailedUploadDropsTheDeviceScene) {
+  auto error_of = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const lucent::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  Scene s1 = lucent::test::scene_from(kScene);
+  Scene s2 = s1;
+  s2.materials[0].albedo = glm::dvec3(0.1, 0.9, 0.1);
+  Renderer r = session();
+  r.set_scene(s1);
+  r.render(4);
+  const RenderResult before = r.result();
+  {
+    lucent::render_detail::ScopedUploadFault fault;
+    std::string msg = error_of([&] { r.set_scene(s2); });
+    EXPECT_NE(msg.find("clCreateBuffer (injected by a test)"), std::string::npos) << msg;
+  }
+  std::string msg = error_of([&] { r.render(1); });
+  EXPECT_NE(msg.find("render: the last set_scene failed, so the devices hold no scene"),
+            std::string::npos)
+      << msg;
+  EXPECT_TRUE(same_image(r.result(), before));
+  r.set_scene(s1);
+  r.render(4);
+  Renderer fresh = session();
+  fresh.set_scene(s1);
+  fresh.render(4);
+  EXPECT_TRUE(same_image(r.result(), fresh.result()));
+  // set_build_options refused by the same failure keeps the options the programs were built with
+  {
+    lucent::render_detail::ScopedUploadFault fault;
+    EXPECT_NE(error_of([&] { r.set_build_options(lucent::Precision::Float, true, true); }), "");
+  }
+  EXPECT_FALSE(r.options().fast_math);
+}

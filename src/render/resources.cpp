@@ -79,6 +79,14 @@ ScopedLimitOverride::~ScopedLimitOverride() {
   g_override = nullptr;
 }
 
+namespace {
+bool g_upload_fault = false;
+}  // namespace
+
+ScopedUploadFault::ScopedUploadFault() { g_upload_fault = true; }
+ScopedUploadFault::~ScopedUploadFault() { g_upload_fault = false; }
+bool upload_fault() { return g_upload_fault; }
+
 std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                                              const std::vector<DeviceLimits>& devices) {
   const std::uint64_t npix = std::uint64_t(scene.film.width) * std::uint64_t(scene.film.height);

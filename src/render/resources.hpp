@@ -43,6 +43,19 @@ class ScopedLimitOverride {
   ScopedLimitOverride& operator=(const ScopedLimitOverride&) = delete;
 };
 
+/// For tests: while alive, a session's set_scene fails with CL_MEM_OBJECT_ALLOCATION_FAILURE
+/// right after it has updated a device's scene buffers, as an allocation failing part-way through
+/// an upload would (upload_fault()). One at a time.
+class ScopedUploadFault {
+ public:
+  ScopedUploadFault();
+  ~ScopedUploadFault();
+  ScopedUploadFault(const ScopedUploadFault&) = delete;
+  ScopedUploadFault& operator=(const ScopedUploadFault&) = delete;
+};
+/// Whether a ScopedUploadFault is alive.
+bool upload_fault();
+
 /// The work-group size of a launch: `preferred` (a power of two) when the device
 /// (CL_DEVICE_MAX_WORK_GROUP_SIZE, CL_DEVICE_MAX_WORK_ITEM_SIZES[0]) and the built kernel
 /// (CL_KERNEL_WORK_GROUP_SIZE) allow it, else the largest power of two they allow (at least 1;

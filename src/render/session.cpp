@@ -193,6 +193,10 @@ struct Renderer::Impl {
 
   std::optional<Scene> scene;
   render_detail::PackedScene packed;  // what the device buffers hold
+  /// A set_scene failed after it had begun to change the devices: their buffers match neither
+  /// `packed` nor `scene`. They were dropped (the next set_scene uploads everything), and
+  /// rendering is refused until a set_scene succeeds; the accumulation stays readable.
+  std::string stale;
   std::string build_options;
   size_t npix = 0;
 
@@ -297,6 +301,25 @@ struct Renderer::Impl {
     stats.build_seconds += s;
   }
 
+  /// After a set_scene that failed part-way (`what`): every device drops its scene and film
+  /// buffers, whatever they held, so that the next set_scene uploads everything (packed no
+  /// longer tells what they hold) and nothing renders from them meanwhile.
+  void drop_device_scenes(const std::string& what) {
+    for (auto& w : workers) {
+      w->dev.reset();
+      w->npix = 0;
+      w->b_sum = cl::Buffer();
+    }
+    stale = what;
+  }
+  void check_not_stale(const char* call) const {
+    if (!stale.empty())
+      throw Error(std::string(call) +
+                  ": the last set_scene failed, so the devices hold no scene (call set_scene "
+                  "again; result() still has what was rendered before): " +
+                  stale);
+  }
+
   void set_scene(const Scene& s) {
     scene_detail::ScopedWarningSink sink(options.on_warning);
     scene_detail::validate_scene(s);  // fields set directly may not have been checked
@@ -328,6 +351,7 @@ struct Renderer::Impl {
       render_detail::check_device_memory(s, next, l);
     std::string device;  // the one being set up, and what it does, for messages
     render_detail::ClStage stage = render_detail::ClStage::Upload;
+    bool touched = false;
     try {
       std::string source;
       for (auto& wp : workers) {
@@ -339,6 +363,7 @@ struct Renderer::Impl {
           source = detail::assemble_kernel_source("megakernel.cl", options.kernel_dir);
         cl_util::DeferredEntry entry;
         w.program = &get_program(w, opts, source, entry);
+        touched = true;  // from here on a failure leaves the devices' buffers in doubt
         if (!w.dev) {
           w.dev.emplace(w.ctx, next);
           ++stats.buffer_uploads;
@@ -350,6 +375,8 @@ struct Renderer::Impl {
           stats.buffer_uploads += up.buffers;
           stats.bytes_uploaded += up.bytes;
         }
+        if (render_detail::upload_fault())
+          throw cl::Error(CL_MEM_OBJECT_ALLOCATION_FAILURE, "clCreateBuffer (injected by a test)");
         // the light sums take a film's worth of memory only when the kernel traces light paths
         const bool light = next.params.flags & LC_FLAG_CAUSTICS;
         if (n != w.npix || !w.b_sum() || light != w.light_buffers) {
@@ -387,8 +414,14 @@ struct Renderer::Impl {
         }
       }
     } catch (const cl::Error& e) {
-      throw Error(render_detail::resource_error(e, stage, s.path, device));
+      const std::string what = render_detail::resource_error(e, stage, s.path, device);
+      if (touched) drop_device_scenes(what);
+      throw Error(what);
+    } catch (const std::exception& e) {
+      if (touched) drop_device_scenes(e.what());
+      throw;
     }
+    stale.clear();
     packed = std::move(next);
     build_options = opts;
     npix = n;
@@ -560,6 +593,7 @@ struct Renderer::Impl {
   RenderProgress run(std::uint64_t target_spp, double time_limit,
                      const std::function<void(const RenderProgress&)>& on_progress) {
     if (!scene) throw Error("render: the session has no scene (call set_scene first)");
+    check_not_stale("render");
     if (adaptive)
       throw Error("render: the accumulation is an adaptive render's (call reset() first)");
     begin_call();
@@ -739,6 +773,7 @@ struct Renderer::Impl {
   RenderProgress run_adaptive(const AdaptiveOptions& o,
                               const std::function<void(const RenderProgress&)>& on_progress) {
     if (!scene) throw Error("render_adaptive: the session has no scene (call set_scene first)");
+    check_not_stale("render_adaptive");
     if (!(o.target_error > 0) == !(o.budget_spp > 0) || !std::isfinite(o.target_error) ||
         !std::isfinite(o.budget_spp))
       throw Error("render_adaptive: give either a target error or a budget, a positive number");
@@ -993,10 +1028,20 @@ std::vector<DeviceInfo> Renderer::devices() const { return impl_->device_infos; 
 const SessionOptions& Renderer::options() const { return impl_->options; }
 
 void Renderer::set_build_options(Precision precision, bool fast_math, bool specialize) {
+  const SessionOptions before = impl_->options;
   impl_->options.precision = precision;
   impl_->options.fast_math = fast_math;
   impl_->options.specialize = specialize;
-  if (impl_->scene) impl_->set_scene(Scene(*impl_->scene));
+  try {
+    if (impl_->scene) impl_->set_scene(Scene(*impl_->scene));
+  } catch (...) {
+    // refused (a device without fp64, a kernel that does not build): the options stay those
+    // the session's programs were built with
+    impl_->options.precision = before.precision;
+    impl_->options.fast_math = before.fast_math;
+    impl_->options.specialize = before.specialize;
+    throw;
+  }
 }
 
 void Renderer::set_scene(const Scene& scene) { impl_->set_scene(scene); }
