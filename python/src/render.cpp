@@ -3,6 +3,7 @@
 // callback and Python's signal handlers run between passes, so Ctrl-C stops a render after the
 // current pass, keeps what it had accumulated and raises KeyboardInterrupt.
 #include <cmath>
+#include <mutex>
 #include <optional>
 
 #include "common.hpp"
@@ -69,7 +70,18 @@ void bind_device_shares(py::module_& m, py::class_<T>& c) {
 }
 
 /// A session as Python holds it: the Renderer, the sink of its warnings, and a guard against
-/// two Python threads using it at once (only cancel() is thread-safe).
+/// two Python threads using it at once. Calls (set_scene, render, result, ...) run one at a time:
+/// a second one, from another thread or from a callback of the first, raises. While a call runs:
+/// - cancel() and device (fixed for the session's life) work from any thread;
+/// - spp, first_sample and stats give the values the call began with, updated after each pass
+///   of render(), render_for() and render_adaptive() (a copy that the rendering thread writes
+///   under a mutex: the session's own counters change during passes, without the GIL);
+/// - scene and options raise, except while the call is stopped in its progress callback
+///   (between passes: nothing in the session changes then), from any thread;
+/// - close() raises; once close() began, everything raises that the renderer is closed.
+/// `busy_`, `closed_` and `paused_` change with the GIL held, and are read with it: holding the
+/// GIL, a thread that sees no call in progress (or one paused in its callback) reads the session
+/// before any other thread can start a call (or resume the render).
 class PyRenderer {
  public:
   PyRenderer(const std::string& device, const std::string& kernel_dir, const std::string& cache_dir,
@@ -94,9 +106,35 @@ class PyRenderer {
     renderer_->set_cancel_flag(&stop_);
   }
 
+  /// The session, for what does not change while a call runs (device(), cancel()). The GIL is
+  /// held. Raises once close() began (the session may be being destroyed without the GIL).
   Renderer& get() {
-    if (!renderer_) throw Error("the renderer is closed");
+    if (closed_) throw Error("the renderer is closed");
     return *renderer_;
+  }
+
+  /// The session, for reading what a call changes (scene, options): refused while a call runs,
+  /// unless it is paused in its progress callback.
+  const Renderer& read() {
+    Renderer& r = get();
+    if (busy_ && !paused_)
+      throw Error(
+          "the renderer is in use by another thread (its scene and options can be read between "
+          "calls, or from a progress callback)");
+    return r;
+  }
+
+  /// What spp, first_sample and stats read.
+  struct Counters {
+    std::uint64_t spp = 0, first_sample = 0;
+    SessionStats stats;
+  };
+  /// The session's counters; while a call runs, those it began with or the last pass's.
+  Counters counters() {
+    Renderer& r = get();
+    if (!busy_) return {r.spp(), r.first_sample(), r.stats()};
+    std::lock_guard<std::mutex> lock(counters_mutex_);
+    return counters_;
   }
 
   /// Runs `f(renderer)` with the GIL released, one call at a time; then raises what a warning
@@ -157,40 +195,74 @@ class PyRenderer {
   RenderProgress run_with_progress(py::object progress, F&& f) {
     check_callable(progress, "progress");
     CallbackErrors errors;
-    ProgressFn on_progress;
-    if (!progress.is_none())
-      on_progress = [&](const RenderProgress& p) {
-        py::gil_scoped_acquire gil;
-        if (!errors.run([&] { progress(p); })) stop_ = true;
-      };
+    const bool has_progress = !progress.is_none();
+    // after each pass, with the session's lock held (nothing in the session changes meanwhile)
+    ProgressFn on_progress = [&](const RenderProgress& p) {
+      save_counters();
+      if (!has_progress) return;
+      py::gil_scoped_acquire gil;
+      paused_ = true;  // scene and options can be read until the callback returns
+      if (!errors.run([&] { progress(p); })) stop_ = true;
+      paused_ = false;
+    };
     RenderProgress out;
     call_interruptible([&](Renderer& r, std::atomic<bool>&) { out = f(r, on_progress); });
     errors.rethrow();
     return out;
   }
 
+  /// Destroys the session (with the GIL released: a device may take a while to let go). Refused
+  /// while a call runs; claims the session first, so that no call starts meanwhile. Closing a
+  /// closed renderer does nothing.
   void close() {
-    if (busy_) throw Error("the renderer is in use by another thread");
-    py::gil_scoped_release release;
-    renderer_.reset();
+    if (closed_) return;
+    if (busy_.exchange(true))
+      throw Error(
+          "the renderer is in use by another thread (close it once that call has returned)");
+    closed_ = true;  // from here on every call raises, before touching renderer_
+    {
+      py::gil_scoped_release release;
+      renderer_.reset();
+    }
+    busy_ = false;
   }
 
  private:
-  /// Marks the session in use for a call; a second Python thread gets an error.
+  /// Marks the session in use for a call (the GIL held); a second call gets an error.
   struct Busy {
     explicit Busy(PyRenderer& r) : busy(r.busy_) {
+      if (r.closed_) throw Error("the renderer is closed");
       if (busy.exchange(true))
         throw Error(
             "the renderer is in use by another thread (a session renders one call at a time)");
+      try {
+        r.save_counters();  // what other threads read during the call
+      } catch (...) {
+        busy = false;
+        throw;
+      }
     }
     ~Busy() { busy = false; }
     std::atomic<bool>& busy;
   };
 
+  /// Copies the session's counters for other threads; called where nothing changes them (a call
+  /// starting, with the GIL; a render between passes, under its lock).
+  void save_counters() {
+    const Renderer& r = *renderer_;
+    Counters c{r.spp(), r.first_sample(), r.stats()};
+    std::lock_guard<std::mutex> lock(counters_mutex_);
+    counters_ = c;
+  }
+
   std::optional<Renderer> renderer_;
   std::shared_ptr<CallbackErrors> warning_errors_;
-  std::atomic<bool> busy_{false};
+  std::atomic<bool> busy_{false};  ///< a call (or close()) is in progress
+  bool closed_ = false;            ///< close() began (GIL)
+  bool paused_ = false;            ///< the call in progress is in its progress callback (GIL)
   std::atomic<bool> stop_{false};  ///< the session's cancel flag
+  std::mutex counters_mutex_;
+  Counters counters_;  ///< the counters while a call runs (counters_mutex_)
 };
 
 /// Renderer.devices: every device of the session, when the library has several per session.
@@ -374,20 +446,26 @@ void bind_render(py::module_& m) {
            "the first CPU); kernel_dir: \"\" for the embedded kernels; cache_dir: \"\" for the "
            "default, \"off\" for none; precision: \"float\" or \"double\"; on_warning(message): "
            "warnings of scene packing (None: warnings.warn with LucentWarning).")
-      .def_property_readonly("device", [](PyRenderer& r) { return r.get().device(); })
-      .def_property_readonly("options",
-                             [](PyRenderer& r) {
-                               const SessionOptions& o = r.get().options();
-                               py::dict d;
-                               d["device"] = o.device;
-                               d["kernel_dir"] = o.kernel_dir;
-                               d["cache_dir"] = o.cache_dir;
-                               d["precision"] = precision_name(o.precision);
-                               d["fast_math"] = o.fast_math;
-                               d["specialize"] = o.specialize;
-                               d["pass_seconds"] = o.pass_seconds;
-                               return d;
-                             })
+      .def_property_readonly(
+          "device", [](PyRenderer& r) { return r.get().device(); },
+          "The session's (first) device (any thread, at any time until close()).")
+      .def_property_readonly(
+          "options",
+          [](PyRenderer& r) {
+            // a copy: making the dict may let other threads run
+            const SessionOptions o = r.read().options();
+            py::dict d;
+            d["device"] = o.device;
+            d["kernel_dir"] = o.kernel_dir;
+            d["cache_dir"] = o.cache_dir;
+            d["precision"] = precision_name(o.precision);
+            d["fast_math"] = o.fast_math;
+            d["specialize"] = o.specialize;
+            d["pass_seconds"] = o.pass_seconds;
+            return d;
+          },
+          "The session's options, as a dict. Like scene, raises while "
+          "another thread's call runs.")
       .def(
           "set_build_options",
           [](PyRenderer& r, const std::string& precision, bool fast_math, bool specialize) {
@@ -406,8 +484,10 @@ void bind_render(py::module_& m) {
           "Makes a copy of `scene` the session's scene; keeps the BVH, the kernel and the "
           "accumulation when it can (see Renderer).")
       .def_property_readonly(
-          "scene", [](PyRenderer& r) { return Scene(r.get().scene()); },
-          "A copy of the session's scene.")
+          "scene", [](PyRenderer& r) { return Scene(r.read().scene()); },
+          "A copy of the session's scene. Raises lucent.Error while another thread's call "
+          "(set_scene, render, ...) runs, except from a render's progress callback (between "
+          "passes, from any thread).")
       .def(
           "render",
           [](PyRenderer& r, long long spp, double seconds, py::object progress) {
@@ -473,13 +553,23 @@ void bind_render(py::module_& m) {
       .def(
           "result", [](PyRenderer& r) { return r.call([](Renderer& rr) { return rr.result(); }); },
           "The accumulation so far (a RenderResult; its arrays are this call's own).")
-      .def_property_readonly("spp", [](PyRenderer& r) { return r.get().spp(); })
-      .def_property_readonly("first_sample", [](PyRenderer& r) { return r.get().first_sample(); })
-      .def_property_readonly("stats", [](PyRenderer& r) { return r.get().stats(); })
+      .def_property_readonly(
+          "spp", [](PyRenderer& r) { return r.counters().spp; },
+          "Samples per pixel accumulated. spp, first_sample and stats can be read from any "
+          "thread: while a call runs, they give the values it began with, updated after each "
+          "pass of render(), render_for() and render_adaptive().")
+      .def_property_readonly(
+          "first_sample", [](PyRenderer& r) { return r.counters().first_sample; },
+          "Index of the accumulation's first sample (reset's argument).")
+      .def_property_readonly(
+          "stats", [](PyRenderer& r) { return r.counters().stats; },
+          "What the session has built and done (a SessionStats).")
       .def(
           "cancel", [](PyRenderer& r) { r.get().cancel(); },
           "Stops a render in progress (in another thread) after its current pass.")
-      .def("close", &PyRenderer::close, "Releases the device; the renderer can no longer be used.")
+      .def("close", &PyRenderer::close,
+           "Releases the device; every later call raises lucent.Error (closing again does "
+           "nothing). Raises lucent.Error while another thread's call runs.")
       .def("__enter__", [](py::object self) { return self; })
       .def("__exit__", [](PyRenderer& r, py::args) { r.close(); });
 
