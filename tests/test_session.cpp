@@ -545,3 +545,21 @@ TEST(Session, FailedUploadDropsTheDeviceScene) {
   }
   EXPECT_FALSE(r.options().fast_math);
 }
+
+// An adaptive render's device shares add up to its samples per pixel: the jobs of its later
+// rounds hold fewer samples than the film has pixels, and each one's share was once truncated
+// to 0 samples per pixel.
+TEST(Session, AdaptiveDeviceSharesCountEverySample) {
+  Renderer r = session();
+  r.set_scene(lucent::test::scene_from(kScene));
+  lucent::AdaptiveOptions ao;
+  ao.budget_spp = 24;
+  ao.min_spp = 8;
+  lucent::RenderProgress p = r.render_adaptive(ao);
+  const RenderResult res = r.result();
+  ASSERT_EQ(p.devices.size(), 1u);
+  ASSERT_EQ(res.devices.size(), 1u);
+  EXPECT_GE(p.accumulated, 20u);
+  EXPECT_EQ(p.devices[0].samples, p.accumulated);
+  EXPECT_EQ(res.devices[0].samples, p.accumulated);
+}

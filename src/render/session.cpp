@@ -96,6 +96,9 @@ struct Worker {
   std::uint32_t pass_spp = 1;  // samples per pixel of its next pass (tuned to pass_seconds)
   DeviceShare share;           // of the accumulation
   DeviceShare call;            // of the render call in progress
+  // an adaptive render's camera samples (all pixels) behind share and call: their per-pixel
+  // counts are these divided by the film's pixels, not a sum of truncated per-job quotients
+  std::uint64_t share_samples = 0, call_samples = 0;
 
   explicit Worker(const std::string& selector) : ctx(selector, "device") {
     share.device = call.device = ctx.device.info.name;
@@ -240,7 +243,7 @@ struct Renderer::Impl {
     done = nonfinite = rays = 0;
     render_seconds = 0;
     last_cancelled = false;
-    for (auto& w : workers) w->share.samples = 0, w->share.seconds = 0;
+    for (auto& w : workers) w->share.samples = w->share_samples = 0, w->share.seconds = 0;
     clear_adaptive();
   }
 
@@ -494,7 +497,7 @@ struct Renderer::Impl {
   void begin_call() {
     cancel_requested = false;
     last_cancelled = false;
-    for (auto& w : workers) w->call.samples = 0, w->call.seconds = 0;
+    for (auto& w : workers) w->call.samples = w->call_samples = 0, w->call.seconds = 0;
   }
   void dispatch(CallState& cs, double time_limit, bool have_samples,
                 const std::function<bool(Worker&, Job&)>& next,
@@ -757,8 +760,10 @@ struct Renderer::Impl {
         }
         launched_total += samples;
         done = (launched_total + npix / 2) / npix;
-        w.call.samples += samples / npix;
-        w.share.samples += samples / npix;
+        w.call_samples += samples;
+        w.share_samples += samples;
+        w.call.samples = (w.call_samples + npix / 2) / npix;  // rounded as `done` is
+        w.share.samples = (w.share_samples + npix / 2) / npix;
       };
       auto on_pass = [&] {
         if (on_progress)
