@@ -3,6 +3,7 @@
 // scene's own setting; a shallow max_depth is flagged biased), the CSV, the SVG plot and the CLI.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -12,6 +13,7 @@
 
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
+#include "lucent/session.hpp"
 #include "support.hpp"
 
 namespace {
@@ -444,6 +446,33 @@ TEST(Converge, AdaptiveAndTargetErrorSettings) {
     EXPECT_NE(std::string(e.what()).find("is adaptive: use an spp ladder"), std::string::npos)
         << e.what();
   }
+}
+
+// A study on the caller's session: its cancel flag is the study's while it runs and the session's
+// own afterwards (the session once kept a pointer to the study's flag, which the caller may
+// destroy on return), and without a study flag the session's own stops the study.
+TEST(Converge, CallersSessionGetsItsCancelFlagBack) {
+  lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
+  scene.film.width = scene.film.height = 8;
+  lucent::RenderResult reference = lucent::test::render(scene, lucent::test::render_options());
+  lucent::Renderer session(lucent::test::session_options());
+  std::atomic<bool> own{false};
+  session.set_cancel_flag(&own);
+  lucent::ConvergeOptions opt;
+  opt.render = lucent::test::render_options();
+  opt.spp_ladder = {1, 2};
+  opt.renderer = &session;
+  {
+    std::atomic<bool> study{false};
+    opt.render.cancel = &study;
+    opt.on_point = [&](const ConvergePoint&) { EXPECT_EQ(session.cancel_flag(), &study); };
+    EXPECT_EQ(lucent::run_convergence(scene, reference, opt).points.size(), 2u);
+  }
+  EXPECT_EQ(session.cancel_flag(), &own);
+  opt.render.cancel = nullptr;
+  opt.on_point = [&](const ConvergePoint&) { own = true; };  // stops after the first rung
+  EXPECT_EQ(lucent::run_convergence(scene, reference, opt).points.size(), 1u);
+  EXPECT_EQ(session.cancel_flag(), &own);
 }
 
 TEST(Converge, XmlCheckerRejectsMalformedDocuments) {

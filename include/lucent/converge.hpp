@@ -120,7 +120,9 @@ struct ConvergeOptions {
   /// the ladder's; precision, fast math and specialisation the settings').
   RenderOptions render;
   /// The session to render with (its device, kernel and cache directories); null: a session
-  /// opened from `render`. Either way one session renders every rung of every setting.
+  /// opened from `render`. Either way one session renders every rung of every setting. A session
+  /// given here ends with the last setting's scene, build options and accumulation; its cancel
+  /// flag is `render.cancel` during the study (when set) and its own again afterwards.
   Renderer* renderer = nullptr;
   /// Called after each rung (progress output).
   std::function<void(const ConvergePoint&)> on_point;

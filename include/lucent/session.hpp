@@ -160,6 +160,8 @@ class Renderer {
   void cancel();
   /// An external flag checked before each pass, as cancel() (e.g. set by a SIGINT handler).
   void set_cancel_flag(const std::atomic<bool>* flag);
+  /// The flag set_cancel_flag gave (null: none).
+  const std::atomic<bool>* cancel_flag() const;
 
   SessionStats stats() const;
 

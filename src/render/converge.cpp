@@ -320,7 +320,14 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
     so.on_warning = options.render.on_warning;
     renderer = &own.emplace(so);
   }
-  renderer->set_cancel_flag(options.render.cancel);
+  // the study's cancel flag while it runs, the session's own again afterwards (a caller's
+  // session kept a pointer to a flag that may not outlive this call)
+  struct CancelFlag {
+    Renderer& r;
+    const std::atomic<bool>* before;
+    ~CancelFlag() { r.set_cancel_flag(before); }
+  } cancel_flag{*renderer, renderer->cancel_flag()};
+  if (options.render.cancel) renderer->set_cancel_flag(options.render.cancel);
 
   ConvergeResult result;
   CompareOptions co;

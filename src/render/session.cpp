@@ -1136,6 +1136,7 @@ std::uint64_t Renderer::spp() const { return impl_->done; }
 std::uint64_t Renderer::first_sample() const { return impl_->first; }
 void Renderer::cancel() { impl_->cancel_requested = true; }
 void Renderer::set_cancel_flag(const std::atomic<bool>* flag) { impl_->cancel_flag = flag; }
+const std::atomic<bool>* Renderer::cancel_flag() const { return impl_->cancel_flag; }
 SessionStats Renderer::stats() const { return impl_->stats; }
 
 }  // namespace lucent
