@@ -236,6 +236,23 @@ TEST(Parts, OverlapsAndMismatchesAreOneLineErrors) {
 // A damaged part file (an attribute edited, or not an EXR at all) is refused by merge with one
 // line naming the file, the attribute and what is wrong with it, and nothing is written. Each
 // copy of a good part has part of one attribute's value replaced by as many other bytes.
+// A session holding an adaptive render has no range of sample indices to make a part of: it once
+// made a part of zero sums that claimed the render's range.
+TEST(Parts, AdaptiveSessionMakesNoPart) {
+  lucent::Renderer renderer(lucent::test::session_options());
+  renderer.set_scene(lucent::load_scene(noisy_scene(lucent::test::temp_dir())));
+  lucent::AdaptiveOptions ao;
+  ao.budget_spp = 8;
+  renderer.render_adaptive(ao);
+  try {
+    lucent::make_part(renderer, {0, 8}, "scene.json");
+    ADD_FAILURE() << "a part of an adaptive render";
+  } catch (const lucent::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the session holds an adaptive render"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Parts, DamagedPartFilesAreOneLineErrors) {
   const std::string dir = lucent::test::temp_dir();
   const std::string scene = noisy_scene(dir);

@@ -148,7 +148,8 @@ class Renderer {
   /// Index of the first sample of the accumulation (reset's argument).
   std::uint64_t first_sample() const;
   /// The raw accumulation (double sums, sums of squares, counts) of the samples
-  /// [first_sample(), first_sample() + spp()), for sample-range renders (lucent/parts.hpp).
+  /// [first_sample(), first_sample() + spp()), for sample-range renders (lucent/parts.hpp). Throws
+  /// lucent::Error for an adaptive render (render_adaptive).
   Accumulation accumulation() const;
   /// A 64-bit hash of everything the image depends on: the packed scene (camera, film size and
   /// filter, seed, integrator settings, geometry, materials, lights, textures) and the kernel's

@@ -1093,6 +1093,12 @@ RenderResult Renderer::result() const { return impl_->result(); }
 Accumulation Renderer::accumulation() const {
   const Impl& m = *impl_;
   if (!m.scene) throw Error("accumulation: the session has no scene (call set_scene first)");
+  // an adaptive render's samples are in its halves, per-pixel counts of two streams, which a
+  // contiguous range of sample indices cannot describe (this returned zero sums claiming them)
+  if (m.adaptive)
+    throw Error(
+        "accumulation: the session holds an adaptive render, which is not a range of sample "
+        "indices (part files and MPI ranks take renders of a fixed number of samples)");
   Accumulation a;
   a.width = m.scene->film.width;
   a.height = m.scene->film.height;
