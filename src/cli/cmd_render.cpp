@@ -186,9 +186,8 @@ int render_with(const RenderArgs& a) {
   std::signal(SIGPIPE, SIG_IGN);  // a closed stderr pipe must not cost the image
   lucent::Scene scene = lucent::load_scene(a.scene);
   {
-    // the images the scene reads are inputs too
-    std::vector<std::string> inputs{a.scene};
-    for (const lucent::Texture& t : scene.textures) inputs.push_back(t.path);
+    // the files the scene reads (images, meshes) are inputs too
+    const std::vector<std::string> inputs = lucent::cli::scene_inputs(a.scene, scene);
     lucent::io::check_output_path(a.output, inputs);
     for (const std::string& name : a.aovs)
       lucent::io::check_output_path(aov_path(a.output, name), inputs);

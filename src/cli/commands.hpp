@@ -39,6 +39,10 @@ CLI::Validator real_range(double lo, double hi);
 /// "a, b, c".
 std::string joined(const std::vector<std::string>& names);
 
+/// The files a command's outputs must not overwrite because `scene` (loaded from `scene_path`)
+/// reads them: the scene file, then its textures and environment maps and its OBJ meshes.
+std::vector<std::string> scene_inputs(const std::string& scene_path, const Scene& scene);
+
 /// `lucent render` (cmd_render.cpp): registers the subcommand, runs it once parsed; the scene
 /// path given, for messages.
 CLI::App* add_render_command(CLI::App& app);
