@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "lucent/compare.hpp"
@@ -664,6 +665,44 @@ TEST(Converge, CommandOutputsOverwriteNoInputAndNoOtherOutput) {
   ASSERT_EQ(ok.status, 0) << ok.err;
   EXPECT_EQ(split(read_file(dir + "/c.csv"), '\n').size(), 3u);
   EXPECT_EQ(lucent::read_render(dir + "/sr.EXR").samples.size(), 64u);
+}
+
+// A reference holding a NaN or an infinity made every error NaN, and converge printed a
+// confident verdict with exit 0: refused, naming the file, the pixel and the channel.
+TEST(Converge, NonFiniteReferenceIsRefused) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/t.json", kScene);
+  for (const auto& [k, value, what] :
+       {std::tuple<size_t, float, const char*>{(1 * 8 + 2) * 3 + 1, NAN,
+                                               "(2, 1) channel G is "
+                                               "not finite (nan)"},
+        std::tuple<size_t, float, const char*>{(7 * 8 + 5) * 3 + 2, -INFINITY,
+                                               "(5, 7) channel B is not finite (-inf)"}}) {
+    lucent::Image img{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)};
+    img.rgb[k] = value;
+    lucent::write_image(dir + "/bad.pfm", img);
+    lucent::test::CommandResult r =
+        lucent::test::run_cli("converge '" + dir +
+                              "/t.json' --width 8 --height 8 --spp-ladder 1 "
+                              "--reference '" +
+                              dir + "/bad.pfm'");
+    EXPECT_EQ(r.status, 1) << r.out << r.err;
+    EXPECT_EQ(r.err, "lucent: error: " + dir + "/bad.pfm: pixel " + what + "\n");
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+  // and in a variance layer
+  lucent::RenderResult v;
+  v.mean = lucent::Image{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)};
+  v.variance = lucent::Image{8, 8, std::vector<float>(8 * 8 * 3, 0.1f)};
+  v.samples.assign(64, 16);
+  v.variance.rgb[3] = INFINITY;
+  lucent::write_render_exr(dir + "/var.exr", v);
+  lucent::test::CommandResult r = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --width 8 --height 8 --spp-ladder 1 --reference '" + dir +
+      "/var.exr'");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_EQ(r.err,
+            "lucent: error: " + dir + "/var.exr: pixel (1, 0) channel var.R is not finite (inf)\n");
 }
 
 }  // namespace

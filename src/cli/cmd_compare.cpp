@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <string>
 
+#include "cli/commands.hpp"
 #include "core/file_io.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
@@ -60,6 +61,10 @@ int run_compare_command() {
   image_detail::Format fa, fb;
   const RenderResult ra = image_detail::read_render(a.a, &fa),
                      rb = image_detail::read_render(a.b, &fb);
+  // a NaN or an infinity in an input is an error in the file, not a difference between renders
+  // (it failed its pixel, with "max |z| inf", as if the renders disagreed)
+  check_finite_pixels(a.a, ra);
+  check_finite_pixels(a.b, rb);
   // a display image (PNG, JPEG, BMP, TGA: tone-mapped, encoded, clipped) against a linear one
   // compares the display transform, not the renders
   const bool display_a = image_detail::is_display_format(fa);
