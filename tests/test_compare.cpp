@@ -283,4 +283,22 @@ TEST(Compare, NonFiniteInputIsAnInputError) {
   EXPECT_EQ(same.status, 0) << same.out << same.err;
 }
 
+// The z map's path is checked before the images are read (a .txt z map was refused only after
+// the comparison, and a PNG clipped the negative z values): the format, a directory that does
+// not exist, an input.
+TEST(Compare, ZmapPathIsCheckedBeforeReading) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string images = " '" + dir + "/missing-a.exr' '" + dir + "/missing-b.exr' --zmap '";
+  const std::pair<std::string, std::string> cases[] = {
+      {"z.txt", "z.txt: unknown z map format '.txt' (use .exr or .pfm: z values are signed)"},
+      {"z.png", "z.png: unknown z map format '.png' (use .exr or .pfm: z values are signed)"},
+      {"no/such/dir/z.exr", "no/such/dir/z.exr: cannot write output (No such file or directory)"}};
+  for (const auto& [zmap, want] : cases) {
+    auto r = lucent::test::run_cli("compare" + images + dir + "/" + zmap + "'");
+    EXPECT_EQ(r.status, 1) << zmap;
+    EXPECT_EQ(r.err, "lucent: error: " + dir + "/" + want + "\n") << zmap;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
 }  // namespace

@@ -55,9 +55,17 @@ CLI::App* add_compare_command(CLI::App& app) {
 int run_compare_command() {
   CompareArgs& a = compare_args();
   a.options.image_mean_test = !a.no_mean_test;
-  for (const std::string& in : {a.a, a.b})
-    if (!a.zmap.empty() && io::same_file(a.zmap, in))
-      throw Error(a.zmap + ": is an input of the comparison; refusing to overwrite it");
+  if (!a.zmap.empty()) {
+    for (const std::string& in : {a.a, a.b})
+      if (io::same_file(a.zmap, in))
+        throw Error(a.zmap + ": is an input of the comparison; refusing to overwrite it");
+    // before reading anything: the format, a directory, a place that cannot be written
+    const std::string ext = io::lower_extension(a.zmap);
+    if (ext != ".exr" && ext != ".pfm")
+      throw Error(a.zmap + ": unknown z map format '" + ext +
+                  "' (use .exr or .pfm: z values are signed)");
+    io::check_output_path(a.zmap, {a.a, a.b});
+  }
   image_detail::Format fa, fb;
   const RenderResult ra = image_detail::read_render(a.a, &fa),
                      rb = image_detail::read_render(a.b, &fb);
