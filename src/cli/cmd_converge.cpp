@@ -170,7 +170,8 @@ CLI::App* add_converge_command(CLI::App& app) {
                   ->check(CLI::Range(1, limits::kMaxSpp));
   auto* time = cmd->add_option("--time-ladder", a.time_ladder, "Seconds of rendering per rung")
                    ->delimiter(',')
-                   ->check(lucent::cli::positive_real());
+                   ->check(lucent::cli::positive_real())
+                   ->check(lucent::cli::real_range(0.0, 1e7));  // as render's --time
   spp->excludes(time);
   cmd->add_option("--max-spp", a.max_spp,
                   "Default ladder: powers of two from 1 to this (default 64)")

@@ -1,5 +1,6 @@
 #include "cli/commands.hpp"
 
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -30,12 +31,16 @@ std::vector<std::string> aov_names() {
 
 namespace {
 /// A real option's check: "" when ok(value), else "<what>, got <text>" ("must be a number, got
-/// <text>" when it is not one).
+/// <text>" when it is not one). Every real option is refused beyond a float's range, as the
+/// scene's numbers are (src/scene/validate.cpp): values that become scene fields (--clamp) would
+/// otherwise be blamed on the scene file, and no option means anything that large.
 CLI::Validator real_check(std::function<bool(double)> ok, std::string what, std::string name) {
   return CLI::Validator(
       [ok = std::move(ok), what = std::move(what)](std::string& text) -> std::string {
         double v = 0;
         if (!CLI::detail::lexical_cast(text, v)) return "must be a number, got " + text;
+        if (std::isfinite(v) && std::abs(v) > FLT_MAX)
+          return "must fit in a float (magnitude at most 3.4e38), got " + text;
         return ok(v) ? "" : what + ", got " + text;
       },
       std::move(name));
