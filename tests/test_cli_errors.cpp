@@ -377,4 +377,37 @@ TEST(CliErrors, RealOptionsBeyondAFloatNameTheOption) {
   EXPECT_FALSE(fs::exists(dir + "/missing.exr"));
 }
 
+// Options that would be silently ignored are refused: --min-spp without --target-error (the
+// pilot of an adaptive render: a uniform render has none), and the kernel's device and build
+// options with --reference (the scalar CPU integrator honours none of them). Nothing is written.
+TEST(CliErrors, IgnoredOptionsAreRefused) {
+  const std::string scene = small_scene();
+  const std::string dir = lucent::test::temp_dir();
+  const std::string render = "render " + q(scene) + " -o " + q(dir + "/x.exr") + " ";
+  const std::pair<std::string, std::string> cases[] = {
+      {"--min-spp 8", "--min-spp is the pilot of --target-error: it does nothing without it"},
+      {"--min-spp 8 --spp 16",
+       "--min-spp is the pilot of --target-error: it does nothing without it"},
+      {"--reference --device 0", "--device is not supported with --reference"},
+      {"--reference --precision double", "--precision is not supported with --reference"},
+      {"--reference --precision float", "--precision is not supported with --reference"},
+      {"--reference --fast-math", "--fast-math is not supported with --reference"},
+      {"--reference --no-specialize", "--no-specialize is not supported with --reference"}};
+  for (const auto& [args, want] : cases) {
+    CommandResult r = run_cli(render + args);
+    EXPECT_EQ(expect_one_error_line(r), want) << args;
+    EXPECT_EQ(r.status, 1) << args;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+  // what they belong to still works: the pilot of a target error, the reference alone, the
+  // kernel's options on the kernel
+  for (const std::string& args :
+       {std::string("--target-error 0.5 --min-spp 4 --spp 8"), std::string("--reference --spp 2"),
+        std::string("--precision float --no-specialize --fast-math --spp 2")}) {
+    CommandResult r = run_cli(render + "-q " + args);
+    EXPECT_EQ(r.status, 0) << args << ": " << r.err;
+  }
+  EXPECT_TRUE(fs::exists(dir + "/x.exr"));
+}
+
 }  // namespace
