@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cl/context.hpp"
@@ -324,6 +325,89 @@ TEST(CliErrors, CausticsRefusalsAreOneLine) {
       run_cli("render " + in + " -q --target-error 0.05 --spp 64 -o " + q(dir + "/a.exr"));
   EXPECT_EQ(adaptive.status, 0) << adaptive.err;
   EXPECT_TRUE(fs::exists(dir + "/a.exr"));
+}
+
+// A real option beyond a float's range is reported against the option, not against the scene
+// file it would have been written into ("scene.json: /integrator/clamp: must fit in a float"
+// for --clamp 1e300), as a usage error (exit 2) before anything is read: every real option of
+// every command alike, converge's --settings knobs too.
+TEST(CliErrors, RealOptionsBeyondAFloatNameTheOption) {
+  const std::string scene = small_scene();
+  const std::string dir = lucent::test::temp_dir();
+  const std::string render = "render " + q(scene) + " -o " + q(dir + "/o.png") + " ";
+  const std::string compare = "compare " + q(dir + "/a.pfm") + " " + q(dir + "/b.pfm") + " ";
+  // a reference that does not exist: before the fix the ladder would have started (1e300 s)
+  const std::string converge =
+      "converge " + q(scene) + " --reference " + q(dir + "/missing.exr") + " ";
+  const std::pair<std::string, std::string> cases[] = {
+      {render + "--clamp 1e300", "--clamp"},
+      {render + "--clamp -1e300", "--clamp"},
+      {render + "--target-error 1e300", "--target-error"},
+      {render + "--time 1e39", "--time"},
+      {"info " + q(scene) + " --clamp 1e39", "--clamp"},
+      {compare + "--abs-epsilon 1e300", "--abs-epsilon"},
+      {compare + "--rel-epsilon 4e38", "--rel-epsilon"},
+      {converge + "--time-ladder 1,1e300", "--time-ladder"}};
+  for (const auto& [args, option] : cases) {
+    CommandResult r = run_cli(args);
+    const std::string value = args.substr(args.rfind(' ') + 1);
+    const std::string last = value.substr(value.rfind(',') + 1);
+    EXPECT_EQ(expect_one_error_line(r), option +
+                                            ": must fit in a float (magnitude at most "
+                                            "3.4e38), got " +
+                                            last + " (see lucent --help)")
+        << args;
+    EXPECT_EQ(r.status, 2) << args;
+  }
+  // converge's --time-ladder is bounded as render's --time is
+  CommandResult r = run_cli(converge + "--time-ladder 1e8");
+  EXPECT_EQ(expect_one_error_line(r),
+            "--time-ladder: must be in [0, 1e+07], got 1e8 (see lucent "
+            "--help)");
+  // and converge's settings
+  r = run_cli(converge + "--settings default,clamp=1e300");
+  EXPECT_EQ(expect_one_error_line(r),
+            "--settings: setting clamp=1e300: must fit in a float (magnitude at most 3.4e38)");
+  r = run_cli(converge + "--settings target-error=1e39");
+  EXPECT_EQ(expect_one_error_line(r),
+            "--settings: setting target-error=1e39: must fit in a float (magnitude at most "
+            "3.4e38)");
+  // the largest float still renders (a clamp that never binds)
+  EXPECT_EQ(run_cli(render + "-q --integrator path --spp 1 --clamp 3.4e38").status, 0);
+  EXPECT_FALSE(fs::exists(dir + "/missing.exr"));
+}
+
+// Options that would be silently ignored are refused: --min-spp without --target-error (the
+// pilot of an adaptive render: a uniform render has none), and the kernel's device and build
+// options with --reference (the scalar CPU integrator honours none of them). Nothing is written.
+TEST(CliErrors, IgnoredOptionsAreRefused) {
+  const std::string scene = small_scene();
+  const std::string dir = lucent::test::temp_dir();
+  const std::string render = "render " + q(scene) + " -o " + q(dir + "/x.exr") + " ";
+  const std::pair<std::string, std::string> cases[] = {
+      {"--min-spp 8", "--min-spp is the pilot of --target-error: it does nothing without it"},
+      {"--min-spp 8 --spp 16",
+       "--min-spp is the pilot of --target-error: it does nothing without it"},
+      {"--reference --device 0", "--device is not supported with --reference"},
+      {"--reference --precision double", "--precision is not supported with --reference"},
+      {"--reference --precision float", "--precision is not supported with --reference"},
+      {"--reference --fast-math", "--fast-math is not supported with --reference"},
+      {"--reference --no-specialize", "--no-specialize is not supported with --reference"}};
+  for (const auto& [args, want] : cases) {
+    CommandResult r = run_cli(render + args);
+    EXPECT_EQ(expect_one_error_line(r), want) << args;
+    EXPECT_EQ(r.status, 1) << args;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+  // what they belong to still works: the pilot of a target error, the reference alone, the
+  // kernel's options on the kernel
+  for (const std::string& args :
+       {std::string("--target-error 0.5 --min-spp 4 --spp 8"), std::string("--reference --spp 2"),
+        std::string("--precision float --no-specialize --fast-math --spp 2")}) {
+    CommandResult r = run_cli(render + "-q " + args);
+    EXPECT_EQ(r.status, 0) << args << ": " << r.err;
+  }
+  EXPECT_TRUE(fs::exists(dir + "/x.exr"));
 }
 
 }  // namespace

@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
@@ -245,6 +249,56 @@ TEST(Compare, DisplayImageAgainstALinearOneIsRefused) {
   auto same = lucent::test::run_cli("compare '" + dir + "/a.png' '" + dir + "/a.png'");
   EXPECT_EQ(same.status, 0) << same.out << same.err;
   EXPECT_NE(same.out.find("PASS"), std::string::npos);
+}
+
+// An input image holding a NaN or an infinity (a PFM can) is an error in that file, not a
+// difference between renders: one line naming the file, the pixel and the channel, exit 1 as
+// every error, and no PASS/FAIL report (it printed FAIL with "max |z| inf", as if the renders
+// disagreed). A NaN in a variance layer too.
+TEST(Compare, NonFiniteInputIsAnInputError) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::Image img{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)};
+  lucent::write_image(dir + "/ok.pfm", img);
+  img.rgb[(3 * 8 + 4) * 3 + 1] = NAN;
+  lucent::write_image(dir + "/nan.pfm", img);
+  RenderResult v = constant_image(8, 8, 0.5f);
+  v.variance = lucent::Image{8, 8, std::vector<float>(8 * 8 * 3, 0.1f)};
+  v.samples.assign(64, 16);
+  v.variance.rgb[(7 * 8 + 7) * 3 + 2] = NAN;
+  lucent::write_render_exr(dir + "/var.exr", v);
+  const std::pair<std::string, std::string> cases[] = {
+      {"nan.pfm nan.pfm", "nan.pfm: pixel (4, 3) channel G is not finite (nan)"},
+      {"ok.pfm nan.pfm", "nan.pfm: pixel (4, 3) channel G is not finite (nan)"},
+      {"var.exr ok.pfm", "var.exr: pixel (7, 7) channel var.B is not finite (nan)"}};
+  for (const auto& [args, want] : cases) {
+    const size_t space = args.find(' ');
+    auto r = lucent::test::run_cli("compare '" + dir + "/" + args.substr(0, space) + "' '" + dir +
+                                   "/" + args.substr(space + 1) + "' --zmap '" + dir + "/z.exr'");
+    EXPECT_EQ(r.status, 1) << args;
+    EXPECT_EQ(r.err, "lucent: error: " + dir + "/" + want + "\n") << args;
+    EXPECT_TRUE(r.out.empty()) << args << ": " << r.out;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/z.exr"));
+  auto same = lucent::test::run_cli("compare '" + dir + "/ok.pfm' '" + dir + "/ok.pfm'");
+  EXPECT_EQ(same.status, 0) << same.out << same.err;
+}
+
+// The z map's path is checked before the images are read (a .txt z map was refused only after
+// the comparison, and a PNG clipped the negative z values): the format, a directory that does
+// not exist, an input.
+TEST(Compare, ZmapPathIsCheckedBeforeReading) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string images = " '" + dir + "/missing-a.exr' '" + dir + "/missing-b.exr' --zmap '";
+  const std::pair<std::string, std::string> cases[] = {
+      {"z.txt", "z.txt: unknown z map format '.txt' (use .exr or .pfm: z values are signed)"},
+      {"z.png", "z.png: unknown z map format '.png' (use .exr or .pfm: z values are signed)"},
+      {"no/such/dir/z.exr", "no/such/dir/z.exr: cannot write output (No such file or directory)"}};
+  for (const auto& [zmap, want] : cases) {
+    auto r = lucent::test::run_cli("compare" + images + dir + "/" + zmap + "'");
+    EXPECT_EQ(r.status, 1) << zmap;
+    EXPECT_EQ(r.err, "lucent: error: " + dir + "/" + want + "\n") << zmap;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
 }
 
 }  // namespace

@@ -6,11 +6,14 @@
 #include <atomic>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include "lucent/compare.hpp"
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
 #include "lucent/session.hpp"
@@ -606,6 +609,129 @@ TEST(Converge, CommandErrors) {
   lucent::test::CommandResult both =
       lucent::test::run_cli("converge '" + dir + "/t.json' --reference x.exr --reference-cpu");
   EXPECT_EQ(both.status, 2);
+}
+
+// The outputs (--csv, every --plot, --save-reference) never overwrite an input (the scene, the
+// --reference image, a texture or an OBJ file of the scene) nor each other, and are checked
+// before anything renders: one line, exit 1, every file as it was. (--csv on the --reference
+// image replaced it with CSV text, exit 0; --csv and --plot on one file kept only the plot.)
+TEST(Converge, CommandOutputsOverwriteNoInputAndNoOtherOutput) {
+  const std::string dir = lucent::test::temp_dir();
+  auto q = [](const std::string& s) { return "'" + s + "'"; };
+  lucent::write_image(dir + "/tex.png", lucent::Image{2, 2, std::vector<float>(12, 0.5f)});
+  lucent::test::write_file(dir + "/m.obj", "v -1 -1 -2\nv 1 -1 -2\nv 0 1 -2\nf 1 2 3\n");
+  lucent::test::write_file(dir + "/t.json", R"({
+    "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 45},
+    "film": {"width": 8, "height": 8},
+    "integrator": {"type": "path", "max_depth": 2, "seed": 3},
+    "materials": {"t": {"type": "diffuse", "albedo": {"texture": "tex.png"}}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "t"},
+               {"type": "mesh", "file": "m.obj", "material": "t"}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
+  })");
+  const std::string scene = q(dir + "/t.json");
+  ASSERT_EQ(
+      lucent::test::run_cli("render " + scene + " -q --spp 4 --seed 7 -o " + q(dir + "/ref.exr"))
+          .status,
+      0);
+  const std::string files[] = {"t.json", "ref.exr", "tex.png", "m.obj"};
+  std::vector<std::string> before;
+  for (const std::string& f : files) before.push_back(read_file(dir + "/" + f));
+  auto error = [&](const std::string& args) {
+    lucent::test::CommandResult r =
+        lucent::test::run_cli("converge " + scene + " --spp-ladder 1,2 " + args);
+    EXPECT_EQ(r.status, 1) << args << ": " << r.out << r.err;
+    EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    return r.err;
+  };
+  const std::string ref = " --reference " + q(dir + "/ref.exr");
+  EXPECT_EQ(
+      error(ref + " --csv " + q(dir + "/ref.exr")),
+      "lucent: error: " + dir + "/ref.exr: is the --reference image; refusing to overwrite it\n");
+  EXPECT_EQ(error(ref + " --csv " + q(dir + "/./t.json")),
+            "lucent: error: " + dir + "/./t.json: is the scene file; refusing to overwrite it\n");
+  EXPECT_EQ(error("--reference-spp 4 --plot " + q(dir + "/tex.png")),
+            "lucent: error: " + dir + "/tex.png: is an input of the scene (" + dir +
+                "/tex.png); refusing to overwrite it\n");
+  EXPECT_EQ(error("--reference-spp 4 --csv " + q(dir + "/m.obj")),
+            "lucent: error: " + dir + "/m.obj: is an input of the scene (" + dir +
+                "/m.obj); refusing to overwrite it\n");
+  EXPECT_EQ(error("--reference-spp 4 --save-reference " + q(dir + "/ref.exr") + " --csv " +
+                  q(dir + "/ref.exr")),
+            "lucent: error: " + dir +
+                "/ref.exr: given as --csv and as --save-reference; give "
+                "each output its own file\n");
+  EXPECT_EQ(error(ref + " --csv " + q(dir + "/c.svg") + " --plot " + q(dir + "/./c.svg")),
+            "lucent: error: " + dir +
+                "/./c.svg: given as --csv and as --plot; give each output "
+                "its own file\n");
+  EXPECT_EQ(error(ref + " --plot " + q(dir + "/p.svg") + " --plot " + q(dir + "/p.svg")),
+            "lucent: error: " + dir +
+                "/p.svg: given as --plot and as --plot; give each output "
+                "its own file\n");
+  for (size_t k = 0; k < before.size(); ++k)
+    EXPECT_EQ(read_file(dir + "/" + files[k]), before[k]) << files[k] << " was overwritten";
+  for (const char* f : {"/c.svg", "/p.svg"}) EXPECT_FALSE(std::filesystem::exists(dir + f)) << f;
+
+  // --save-reference saves a reference converge renders: with --reference it saved nothing,
+  // silently; and it writes OpenEXR, which went into a .png file
+  lucent::test::CommandResult both = lucent::test::run_cli(
+      "converge " + scene + " --spp-ladder 1" + ref + " --save-reference " + q(dir + "/never.exr"));
+  EXPECT_EQ(both.status, 2) << both.out << both.err;
+  EXPECT_EQ(lucent::test::count_lines(both.err), 1) << both.err;
+  EXPECT_NE(both.err.find("--reference excludes --save-reference"), std::string::npos) << both.err;
+  EXPECT_EQ(
+      error("--reference-spp 4 --save-reference " + q(dir + "/sr.png")),
+      "lucent: error: " + dir + "/sr.png: --save-reference writes OpenEXR: use an .exr file\n");
+  for (const char* f : {"/never.exr", "/sr.png"})
+    EXPECT_FALSE(std::filesystem::exists(dir + f)) << f;
+
+  // the outputs that are their own files are still written, the reference saved as EXR
+  lucent::test::CommandResult ok = lucent::test::run_cli(
+      "converge " + scene + " --spp-ladder 1,2 -q --reference-spp 4 --csv " + q(dir + "/c.csv") +
+      " --plot " + q(dir + "/c.svg") + " --save-reference " + q(dir + "/sr.EXR"));
+  ASSERT_EQ(ok.status, 0) << ok.err;
+  EXPECT_EQ(split(read_file(dir + "/c.csv"), '\n').size(), 3u);
+  EXPECT_EQ(lucent::read_render(dir + "/sr.EXR").samples.size(), 64u);
+}
+
+// A reference holding a NaN or an infinity made every error NaN, and converge printed a
+// confident verdict with exit 0: refused, naming the file, the pixel and the channel.
+TEST(Converge, NonFiniteReferenceIsRefused) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/t.json", kScene);
+  for (const auto& [k, value, what] :
+       {std::tuple<size_t, float, const char*>{(1 * 8 + 2) * 3 + 1, NAN,
+                                               "(2, 1) channel G is "
+                                               "not finite (nan)"},
+        std::tuple<size_t, float, const char*>{(7 * 8 + 5) * 3 + 2, -INFINITY,
+                                               "(5, 7) channel B is not finite (-inf)"}}) {
+    lucent::Image img{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)};
+    img.rgb[k] = value;
+    lucent::write_image(dir + "/bad.pfm", img);
+    lucent::test::CommandResult r =
+        lucent::test::run_cli("converge '" + dir +
+                              "/t.json' --width 8 --height 8 --spp-ladder 1 "
+                              "--reference '" +
+                              dir + "/bad.pfm'");
+    EXPECT_EQ(r.status, 1) << r.out << r.err;
+    EXPECT_EQ(r.err, "lucent: error: " + dir + "/bad.pfm: pixel " + what + "\n");
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+  // and in a variance layer
+  lucent::RenderResult v;
+  v.mean = lucent::Image{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)};
+  v.variance = lucent::Image{8, 8, std::vector<float>(8 * 8 * 3, 0.1f)};
+  v.samples.assign(64, 16);
+  v.variance.rgb[3] = INFINITY;
+  lucent::write_render_exr(dir + "/var.exr", v);
+  lucent::test::CommandResult r = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --width 8 --height 8 --spp-ladder 1 --reference '" + dir +
+      "/var.exr'");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_EQ(r.err,
+            "lucent: error: " + dir + "/var.exr: pixel (1, 0) channel var.R is not finite (inf)\n");
 }
 
 }  // namespace

@@ -233,6 +233,22 @@ TEST(Parts, OverlapsAndMismatchesAreOneLineErrors) {
   EXPECT_NE(r.err.find("min 6, mean 6.00, max 6"), std::string::npos) << r.err;
 }
 
+// merge's output is checked before any part is read (an unknown format was refused only after
+// every part had been read and added): here the parts do not even exist, so any other error
+// would name them.
+TEST(Parts, MergeChecksItsOutputBeforeReadingTheParts) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string parts = q(dir + "/missing-a.exr") + " " + q(dir + "/missing-b.exr");
+  EXPECT_EQ(error_line(run_cli("merge " + parts + " -o " + q(dir + "/out.txt"))),
+            dir + "/out.txt: unknown output format '.txt' (use .png, .pfm or .exr)");
+  EXPECT_EQ(error_line(run_cli("merge " + parts + " -o " + q(dir + "/no/dir/out.exr"))),
+            dir + "/no/dir/out.exr: cannot write output (No such file or directory)");
+  fs::create_directories(dir + "/d.exr");
+  EXPECT_EQ(error_line(run_cli("merge " + parts + " -o " + q(dir + "/d.exr"))),
+            dir + "/d.exr: is a directory");
+  EXPECT_FALSE(fs::exists(dir + "/out.txt"));
+}
+
 // A damaged part file (an attribute edited, or not an EXR at all) is refused by merge with one
 // line naming the file, the attribute and what is wrong with it, and nothing is written. Each
 // copy of a good part has part of one attribute's value replaced by as many other bytes.

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <string>
 
+#include "cli/commands.hpp"
 #include "core/file_io.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
@@ -54,12 +55,24 @@ CLI::App* add_compare_command(CLI::App& app) {
 int run_compare_command() {
   CompareArgs& a = compare_args();
   a.options.image_mean_test = !a.no_mean_test;
-  for (const std::string& in : {a.a, a.b})
-    if (!a.zmap.empty() && io::same_file(a.zmap, in))
-      throw Error(a.zmap + ": is an input of the comparison; refusing to overwrite it");
+  if (!a.zmap.empty()) {
+    for (const std::string& in : {a.a, a.b})
+      if (io::same_file(a.zmap, in))
+        throw Error(a.zmap + ": is an input of the comparison; refusing to overwrite it");
+    // before reading anything: the format, a directory, a place that cannot be written
+    const std::string ext = io::lower_extension(a.zmap);
+    if (ext != ".exr" && ext != ".pfm")
+      throw Error(a.zmap + ": unknown z map format '" + ext +
+                  "' (use .exr or .pfm: z values are signed)");
+    io::check_output_path(a.zmap, {a.a, a.b});
+  }
   image_detail::Format fa, fb;
   const RenderResult ra = image_detail::read_render(a.a, &fa),
                      rb = image_detail::read_render(a.b, &fb);
+  // a NaN or an infinity in an input is an error in the file, not a difference between renders
+  // (it failed its pixel, with "max |z| inf", as if the renders disagreed)
+  check_finite_pixels(a.a, ra);
+  check_finite_pixels(a.b, rb);
   // a display image (PNG, JPEG, BMP, TGA: tone-mapped, encoded, clipped) against a linear one
   // compares the display transform, not the renders
   const bool display_a = image_detail::is_display_format(fa);

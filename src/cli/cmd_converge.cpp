@@ -57,10 +57,18 @@ extern "C" void on_converge_sigint(int) {
   std::signal(SIGINT, SIG_DFL);
 }
 
-/// Fails before any rendering when `path` cannot be written.
-void check_writable(const std::string& path, const std::string& scene) {
-  if (io::same_file(path, scene))
-    throw Error(path + ": is the scene file; refusing to overwrite it");
+/// A file the command reads, by what it is for messages: "the scene file", "the --reference
+/// image", "an input of the scene (<path>)".
+struct Input {
+  std::string path, what;
+};
+
+/// Fails before any rendering when `path` cannot be written or is one of `inputs` (whose content
+/// it would replace).
+void check_writable(const std::string& path, const std::vector<Input>& inputs) {
+  for (const Input& in : inputs)
+    if (io::same_file(path, in.path))
+      throw Error(path + ": is " + in.what + "; refusing to overwrite it");
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory");
   bool existed = std::filesystem::exists(path, ec);
@@ -69,6 +77,28 @@ void check_writable(const std::string& path, const std::string& scene) {
   if (!f) throw Error(path + ": cannot write (" + std::string(std::strerror(errno)) + ")");
   std::fclose(f);
   if (!existed) std::filesystem::remove(path, ec);
+}
+
+/// The outputs, each with its option: --csv, every --plot, --save-reference.
+std::vector<Input> converge_outputs(const ConvergeArgs& a) {
+  std::vector<Input> out;
+  if (!a.csv.empty()) out.push_back({a.csv, "--csv"});
+  for (const std::string& plot : a.plots) out.push_back({plot, "--plot"});
+  if (!a.save_reference.empty()) out.push_back({a.save_reference, "--save-reference"});
+  return out;
+}
+
+/// Checks every output against the inputs and against the outputs before it (two outputs on one
+/// file would leave only the last one written).
+void check_outputs(const ConvergeArgs& a, const std::vector<Input>& inputs) {
+  const std::vector<Input> outputs = converge_outputs(a);
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    for (size_t j = 0; j < i; ++j)
+      if (io::same_file(outputs[i].path, outputs[j].path))
+        throw Error(outputs[i].path + ": given as " + outputs[j].what + " and as " +
+                    outputs[i].what + "; give each output its own file");
+    check_writable(outputs[i].path, inputs);
+  }
 }
 
 void write_text(const std::string& path, const std::string& text) {
@@ -80,6 +110,8 @@ void write_text(const std::string& path, const std::string& text) {
 RenderResult read_reference(const std::string& path, std::uint32_t ladder_seed) {
   image_detail::Format format;
   RenderResult r = image_detail::read_render(path, &format);
+  // a NaN or an infinity makes every error against the reference NaN (and the verdict nonsense)
+  check_finite_pixels(path, r);
   // an 8-bit (or 16-bit PNG) image holds display values, tone-mapped and clipped: every relMSE
   // against it would measure the display transform, not the render's error
   if (image_detail::is_display_format(format))
@@ -119,8 +151,11 @@ CLI::App* add_converge_command(CLI::App& app) {
   auto* ref_cpu = cmd->add_flag("--reference-cpu", a.reference_cpu,
                                 "Render the reference with the scalar reference integrator");
   ref->excludes(ref_spp)->excludes(ref_cpu);
-  cmd->add_option("--save-reference", a.save_reference,
-                  "Write the rendered reference to this .exr (reuse it with --reference)");
+  auto* save_ref =
+      cmd->add_option("--save-reference", a.save_reference,
+                      "Write the rendered reference to this .exr (reuse it with --reference)");
+  // a reference given is not rendered: there would be nothing to save (it was silently ignored)
+  ref->excludes(save_ref);
   cmd->add_option(
          "--settings", a.settings,
          "Comma-separated settings, knobs joined by +: default, fast-math, "
@@ -135,7 +170,8 @@ CLI::App* add_converge_command(CLI::App& app) {
                   ->check(CLI::Range(1, limits::kMaxSpp));
   auto* time = cmd->add_option("--time-ladder", a.time_ladder, "Seconds of rendering per rung")
                    ->delimiter(',')
-                   ->check(lucent::cli::positive_real());
+                   ->check(lucent::cli::positive_real())
+                   ->check(lucent::cli::real_range(0.0, 1e7));  // as render's --time
   spp->excludes(time);
   cmd->add_option("--max-spp", a.max_spp,
                   "Default ladder: powers of two from 1 to this (default 64)")
@@ -174,14 +210,19 @@ void print_time_to_common_error(const ConvergeResult& result) {
 
 int run_converge_command() {
   ConvergeArgs& a = converge_args();
-  if (!a.csv.empty()) check_writable(a.csv, a.scene);
   for (const std::string& plot : a.plots) {
     std::string ext = io::lower_extension(plot);
     if (ext != ".svg" && ext != ".png")
       throw Error(plot + ": unknown plot format '" + ext + "' (use .svg or .png)");
-    check_writable(plot, a.scene);
   }
-  if (!a.save_reference.empty()) check_writable(a.save_reference, a.scene);
+  if (!a.save_reference.empty()) {
+    // written with its variance layers and seed (write_render_exr): OpenEXR only
+    if (io::lower_extension(a.save_reference) != ".exr")
+      throw Error(a.save_reference + ": --save-reference writes OpenEXR: use an .exr file");
+  }
+  std::vector<Input> inputs{{a.scene, "the scene file"}};
+  if (!a.reference.empty()) inputs.push_back({a.reference, "the --reference image"});
+  check_outputs(a, inputs);
 
   ConvergeOptions opt;
   std::set<std::string> seen;
@@ -201,6 +242,13 @@ int run_converge_command() {
   opt.render.cancel = &g_stop;
 
   Scene scene = load_scene(a.scene);
+  {
+    // the files the scene reads (images, meshes) are inputs too
+    const std::vector<std::string> files = scene_inputs(a.scene, scene);
+    for (size_t i = 1; i < files.size(); ++i)
+      inputs.push_back({files[i], "an input of the scene (" + files[i] + ")"});
+    check_outputs(a, inputs);
+  }
   if (a.width > 0) scene.film.width = a.width;
   if (a.height > 0) scene.film.height = a.height;
 

@@ -48,6 +48,9 @@ int run_merge_command() {
   for (const std::string& in : a.parts)
     if (io::same_file(a.output, in))
       throw Error(a.output + ": is an input of the merge; refusing to overwrite it");
+  // the format (.exr, .png, .pfm, as write_merged writes) and a place that can be written, before
+  // reading any part
+  io::check_output_path(a.output, a.parts);
   MergeReport r = merge_render_parts(a.parts);
   const PartInfo& info = r.merged.info;
   if (!r.missing.empty()) {

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli/commands.hpp"
@@ -98,7 +99,7 @@ struct RenderArgs {
   bool reference = false;         ///< the scalar reference integrator instead of the kernel
   std::vector<std::string> aovs;  ///< extra outputs: albedo, normal, depth, variance
   bool fast_math = false;
-  std::string precision = "float";
+  std::string precision;  ///< "" : float
   bool no_specialize = false;
   lucent::cli::SamplingArgs sampling;  ///< --sampler, --clamp, --target-error, --min-spp
   std::string samples;  ///< "A:B": a part file of sample indices [A, B) (lucent/parts.hpp)
@@ -159,13 +160,24 @@ std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_sp
 }
 
 int render_with(const RenderArgs& a) {
-  // options the reference does not honour: refused, rather than silently ignored
-  if (a.reference && a.time_limit > 0)
-    throw lucent::Error("--time is not supported with --reference");
-  if (a.reference && !a.aovs.empty())
-    throw lucent::Error("--aov is not supported with --reference");
-  if (a.reference && a.sampling.target_error > 0)
-    throw lucent::Error("--target-error is not supported with --reference");
+  // options the reference does not honour: refused, rather than silently ignored (it runs on the
+  // CPU, in double precision, with its own code: the kernel's device and build options mean
+  // nothing to it)
+  if (a.reference) {
+    const std::pair<bool, const char*> kernel_only[] = {
+        {a.time_limit > 0, "--time"},
+        {!a.aovs.empty(), "--aov"},
+        {a.sampling.target_error > 0, "--target-error"},
+        {!a.device.empty(), "--device"},
+        {!a.precision.empty(), "--precision"},
+        {a.fast_math, "--fast-math"},
+        {a.no_specialize, "--no-specialize"}};
+    for (const auto& [given, name] : kernel_only)
+      if (given) throw lucent::Error(std::string(name) + " is not supported with --reference");
+  }
+  // the pilot of an adaptive render: without --target-error there is none
+  if (a.sampling.min_spp > 0 && !(a.sampling.target_error > 0))
+    throw lucent::Error("--min-spp is the pilot of --target-error: it does nothing without it");
   for (size_t i = 0; i < a.aovs.size(); ++i)  // (one file each: twice would write it twice)
     for (size_t j = 0; j < i; ++j)
       if (a.aovs[i] == a.aovs[j]) throw lucent::Error("--aov " + a.aovs[i] + ": given twice");
@@ -186,9 +198,8 @@ int render_with(const RenderArgs& a) {
   std::signal(SIGPIPE, SIG_IGN);  // a closed stderr pipe must not cost the image
   lucent::Scene scene = lucent::load_scene(a.scene);
   {
-    // the images the scene reads are inputs too
-    std::vector<std::string> inputs{a.scene};
-    for (const lucent::Texture& t : scene.textures) inputs.push_back(t.path);
+    // the files the scene reads (images, meshes) are inputs too
+    const std::vector<std::string> inputs = lucent::cli::scene_inputs(a.scene, scene);
     lucent::io::check_output_path(a.output, inputs);
     for (const std::string& name : a.aovs)
       lucent::io::check_output_path(aov_path(a.output, name), inputs);
@@ -211,7 +222,7 @@ int render_with(const RenderArgs& a) {
   opt.spp = a.spp;
   opt.time_limit = a.time_limit;
   opt.fast_math = a.fast_math;
-  opt.precision = lucent::parse_precision(a.precision);
+  opt.precision = lucent::parse_precision(a.precision.empty() ? "float" : a.precision);
   opt.specialize = !a.no_specialize;
   opt.cancel = &g_interrupted;
   const bool tty = isatty(STDERR_FILENO);

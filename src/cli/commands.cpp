@@ -1,5 +1,7 @@
 #include "cli/commands.hpp"
 
+#include <cfloat>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <string>
@@ -29,12 +31,16 @@ std::vector<std::string> aov_names() {
 
 namespace {
 /// A real option's check: "" when ok(value), else "<what>, got <text>" ("must be a number, got
-/// <text>" when it is not one).
+/// <text>" when it is not one). Every real option is refused beyond a float's range, as the
+/// scene's numbers are (src/scene/validate.cpp): values that become scene fields (--clamp) would
+/// otherwise be blamed on the scene file, and no option means anything that large.
 CLI::Validator real_check(std::function<bool(double)> ok, std::string what, std::string name) {
   return CLI::Validator(
       [ok = std::move(ok), what = std::move(what)](std::string& text) -> std::string {
         double v = 0;
         if (!CLI::detail::lexical_cast(text, v)) return "must be a number, got " + text;
+        if (std::isfinite(v) && std::abs(v) > FLT_MAX)
+          return "must fit in a float (magnitude at most 3.4e38), got " + text;
         return ok(v) ? "" : what + ", got " + text;
       },
       std::move(name));
@@ -59,6 +65,31 @@ std::string joined(const std::vector<std::string>& names) {
   std::string out;
   for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
   return out;
+}
+
+void check_finite_pixels(const std::string& path, const RenderResult& image) {
+  const int w = image.mean.width;
+  const char* const names[2][3] = {{"R", "G", "B"}, {"var.R", "var.G", "var.B"}};
+  const std::vector<float>* const planes[2] = {&image.mean.rgb, &image.variance.rgb};
+  for (int p = 0; p < 2; ++p)
+    for (size_t k = 0; k < planes[p]->size(); ++k) {
+      const float v = (*planes[p])[k];
+      if (std::isfinite(v)) continue;
+      const size_t i = k / 3;
+      const char* value = std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf";
+      throw Error(path + ": pixel (" + std::to_string(i % static_cast<size_t>(w)) + ", " +
+                  std::to_string(i / static_cast<size_t>(w)) + ") channel " + names[p][k % 3] +
+                  " is not finite (" + value + ")");
+    }
+}
+
+std::vector<std::string> scene_inputs(const std::string& scene_path, const Scene& scene) {
+  std::vector<std::string> inputs{scene_path};
+  for (const Texture& t : scene.textures)
+    if (!t.path.empty()) inputs.push_back(t.path);
+  for (const ShapeEntry& e : scene.shapes)
+    if (!e.file.empty()) inputs.push_back(e.file);
+  return inputs;
 }
 
 RenderOptions render_options_from_environment() {

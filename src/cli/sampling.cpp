@@ -32,7 +32,8 @@ void add_sampling_options(CLI::App* cmd, SamplingArgs& a, bool adaptive) {
                   "with --spp as the most samples per pixel and --time as a time limit")
       ->check(positive_real());
   cmd->add_option("--min-spp", a.min_spp,
-                  "Adaptive sampling: samples per pixel of the pilot, everywhere (default 64)")
+                  "Adaptive sampling (with --target-error): samples per pixel of the pilot, "
+                  "everywhere (default 64)")
       ->check(CLI::Range(4, limits::kMaxSpp));
 }
 

@@ -3,6 +3,7 @@
 #include "lucent/converge.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -58,6 +59,9 @@ double parse_number(const std::string& knob, const std::string& value, double lo
   if (value.empty() || *end != '\0' || !std::isfinite(v) || (strict ? !(v > lo) : !(v >= lo)))
     throw Error("setting " + knob + ": expected a number " + (strict ? ">" : ">=") + " " +
                 std::to_string(static_cast<int>(lo)));
+  // as the command line's real options (a larger clamp would be blamed on the scene file)
+  if (std::abs(v) > FLT_MAX)
+    throw Error("setting " + knob + ": must fit in a float (magnitude at most 3.4e38)");
   return v;
 }
 
