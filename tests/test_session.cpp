@@ -563,3 +563,23 @@ TEST(Session, AdaptiveDeviceSharesCountEverySample) {
   EXPECT_EQ(p.devices[0].samples, p.accumulated);
   EXPECT_EQ(res.devices[0].samples, p.accumulated);
 }
+
+// A light-transport render of a scene with nothing that emits is black: a warning says so (it
+// was silent). The AOVs need no light and get none.
+TEST(Session, SceneWithoutLightWarns) {
+  Scene dark = lucent::test::scene_from(kScene);
+  dark.lights.clear();
+  Renderer r = session();
+  {
+    lucent::test::CaptureWarnings warnings;
+    r.set_scene(dark);
+    EXPECT_EQ(warnings.count("the scene has no light (no light entry, no emissive material): the "
+                             "image is black"),
+              1)
+        << warnings.dump();
+  }
+  dark.integrator.type = lucent::IntegratorType::Albedo;
+  lucent::test::CaptureWarnings warnings;
+  r.set_scene(dark);
+  EXPECT_EQ(warnings.all().size(), 0u) << warnings.dump();
+}

@@ -7,6 +7,7 @@
 
 #include "lucent/error.hpp"
 #include "lucent/limits.hpp"
+#include "lucent/types.hpp"
 #include "scene/loaders.hpp"
 #include "scene/material_type.hpp"
 #include "scene/validate.hpp"
@@ -208,6 +209,13 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   }
 
   pack_lights(scene, p, std::move(power));
+  // a light-transport integrator with nothing that emits renders a black image: said, not
+  // silently written (the AOVs need no light)
+  if (p.lights.empty() && !lucent::is_aov(scene.integrator.type))
+    scene_detail::warn(scene_detail::in_file(
+        scene.path,
+        "the scene has no light (no light entry, no emissive material): the image is "
+        "black"));
 
   for (const Texture& t : scene.textures) {
     lc_texture d{};
