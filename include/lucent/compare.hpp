@@ -56,6 +56,11 @@ struct CompareResult {
 CompareResult compare_images(const RenderResult& a, const RenderResult& b,
                              const CompareOptions& options = {});
 
+/// Throws lucent::Error "<what>: pixel (x, y) channel G is not finite (nan)" at the first
+/// non-finite value of the mean or variance: an input error for compare and converge, whose tests
+/// would otherwise report NaN errors or a FAIL.
+void check_finite_image(const RenderResult& image, const std::string& what);
+
 /// Upper two-sided critical value of the standard normal: P(|Z| > z) = p.
 double normal_two_sided_critical(double p);
 

@@ -103,6 +103,9 @@ py::array_t<double> copy_rows(const double* first, std::size_t n, py::ssize_t co
 /// An (H, W, 3) float array (any real dtype, converted) as an Image; ValueError naming `what`
 /// when the shape is not (H, W, 3) with H, W >= 1.
 Image image_from_array(py::handle array, const char* what);
+/// Raises TypeError unless `object` converts to an array of booleans, integers or floats (NumPy
+/// would otherwise convert strings such as "3e400" to numbers).
+void require_numbers(py::handle object, const std::string& what);
 
 /// The image of a RenderResult or of an (H, W, 3) array.
 RenderResult render_result_from(py::handle object, const char* what);

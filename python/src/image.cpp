@@ -17,10 +17,22 @@ DisplaySettings display_settings(const Film* film, py::object transfer, py::obje
                                  py::object exposure, py::object tonemap) {
   DisplaySettings d;
   if (film) d = DisplaySettings{film->transfer, film->gamma, film->exposure, film->tonemap};
-  if (!transfer.is_none()) d.transfer = parse_enum<Transfer>(transfer.cast<std::string>());
-  if (!tonemap.is_none()) d.tonemap = parse_enum<ToneMap>(tonemap.cast<std::string>());
-  if (!gamma.is_none()) d.gamma = gamma.cast<double>();
-  if (!exposure.is_none()) d.exposure = exposure.cast<double>();
+  auto text = [](py::handle v, const char* what) {
+    if (!py::isinstance<py::str>(v))
+      throw py::type_error(std::string(what) + ": expected a string, got " +
+                           py::repr(v).cast<std::string>());
+    return v.cast<std::string>();
+  };
+  auto number = [](py::handle v, const char* what) {
+    if (py::isinstance<py::bool_>(v) || py::isinstance<py::str>(v) || !py::hasattr(v, "__float__"))
+      throw py::type_error(std::string(what) + ": expected a number, got " +
+                           py::repr(v).cast<std::string>());
+    return py::float_(py::reinterpret_borrow<py::object>(v)).cast<double>();
+  };
+  if (!transfer.is_none()) d.transfer = parse_enum<Transfer>(text(transfer, "transfer"));
+  if (!tonemap.is_none()) d.tonemap = parse_enum<ToneMap>(text(tonemap, "tonemap"));
+  if (!gamma.is_none()) d.gamma = number(gamma, "gamma");
+  if (!exposure.is_none()) d.exposure = number(exposure, "exposure");
   if (!(d.gamma > 0) || !std::isfinite(d.gamma))
     throw py::value_error("gamma must be a finite number > 0, got " +
                           py::repr(py::float_(d.gamma)).cast<std::string>());
@@ -133,6 +145,8 @@ void bind_image(py::module_& m) {
             !std::isfinite(rel_epsilon))
           throw py::value_error("abs_epsilon and rel_epsilon must be finite and >= 0");
         RenderResult ra = render_result_from(a, "a"), rb = render_result_from(b, "b");
+        check_finite_image(ra, "a");  // as `lucent compare`: an input error, not a FAIL
+        check_finite_image(rb, "b");
         CompareOptions o;
         o.alpha = alpha;
         o.min_pass_fraction = min_pass_fraction;

@@ -363,8 +363,26 @@ void bind_render(py::module_& m) {
               r.variance = image_from_array(variance, "variance");
               if (r.variance.width != r.mean.width || r.variance.height != r.mean.height)
                 throw py::value_error("variance: its shape differs from the mean's");
+              for (float v : r.variance.rgb)
+                if (!(v >= 0) || !std::isfinite(v))
+                  throw py::value_error("variance: every value must be finite and >= 0, got " +
+                                        std::to_string(v));
             }
             if (!samples.is_none()) {
+              // whole counts in [0, 2^32): forcecast wrapped -1 to 4294967295 and cut 2.9 to 2
+              py::array given = py::array::ensure(samples);
+              if (!given || given.ndim() != 2 || given.shape(0) != r.mean.height ||
+                  given.shape(1) != r.mean.width)
+                throw py::value_error("samples: expected an array of shape (H, W) like the mean's");
+              const char kind = given.dtype().kind();
+              if (kind != 'i' && kind != 'u')
+                throw py::type_error("samples: expected integer counts, got an array of dtype " +
+                                     py::str(given.dtype()).cast<std::string>());
+              py::array_t<std::int64_t, py::array::forcecast> wide(given);
+              for (py::ssize_t k = 0; k < wide.size(); ++k)
+                if (wide.data()[k] < 0 || wide.data()[k] > std::int64_t(UINT32_MAX))
+                  throw py::value_error("samples: counts must be in [0, 2^32), got " +
+                                        std::to_string(wide.data()[k]));
               auto a =
                   py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>::ensure(
                       samples);

@@ -4,6 +4,7 @@
 #include <pybind11/stl_bind.h>
 
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
@@ -12,7 +13,9 @@
 #include "lucent/error.hpp"
 #include "render/features.hpp"
 #include "render/pack.hpp"
+#include "scene/json_guard.hpp"
 #include "scene/loaders.hpp"
+#include "scene/validate.hpp"
 
 PYBIND11_MAKE_OPAQUE(std::vector<lucent::Material>)
 PYBIND11_MAKE_OPAQUE(std::vector<lucent::Sphere>)
@@ -152,13 +155,21 @@ void triple_property(py::class_<C>& c, const char* name, int (C::*member)[3]) {
       [member](C& o, py::sequence s) {
         if (s.size() != 3)
           throw py::value_error("expected 3 indices, got " + py::repr(s).cast<std::string>());
+        int v[3];
         for (int i = 0; i < 3; ++i) {
           py::object e = s[static_cast<std::size_t>(i)];
-          if (!py::isinstance<py::int_>(e))
+          // Python and NumPy integers (operator.index), not booleans
+          if (py::isinstance<py::bool_>(e) || !py::hasattr(e, "__index__"))
             throw py::type_error("expected 3 integer indices, got " +
                                  py::repr(s).cast<std::string>());
-          (o.*member)[i] = e.cast<int>();
+          const long long x = py::reinterpret_steal<py::int_>(PyNumber_Index(e.ptr()))
+                                  .cast<long long>();  // overflow raises
+          if (x < std::numeric_limits<int>::min() || x > std::numeric_limits<int>::max())
+            throw py::value_error("index " + std::to_string(i) +
+                                  " out of range: " + std::to_string(x));
+          v[i] = static_cast<int>(x);
         }
+        for (int i = 0; i < 3; ++i) (o.*member)[i] = v[i];
       });
 }
 
@@ -174,6 +185,7 @@ void vector_array_property(py::class_<Scene>& c, const char* name, std::vector<V
         return copy_rows(v.empty() ? nullptr : &v[0].x, v.size(), D);
       },
       [member, name](Scene& s, py::handle value) {
+        require_numbers(value, name);
         auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
         if (!a)
           throw py::type_error(std::string(name) + ": expected an array of shape (N, " +
@@ -192,10 +204,16 @@ void vector_array_property(py::class_<Scene>& c, const char* name, std::vector<V
 }
 
 /// Python value -> JSON, with the JSON path of the first value JSON cannot hold.
-nlohmann::json to_json(py::handle o, const std::string& path, const std::string& label) {
+nlohmann::json to_json(py::handle o, const std::string& path, const std::string& label,
+                       int depth = 0) {
   auto fail = [&](const std::string& what) -> nlohmann::json {
     throw Error(label + ": " + (path.empty() ? "/" : path) + ": " + what);
   };
+  // as deep as a scene file may nest (json_guard.hpp); a dict that contains itself recursed
+  // until the C stack overflowed
+  if (depth > scene_detail::kMaxJsonDepth)
+    return fail("nested deeper than " + std::to_string(scene_detail::kMaxJsonDepth) +
+                " levels (a value that contains itself?)");
   if (o.is_none()) return nullptr;
   if (py::isinstance<py::bool_>(o)) return o.cast<bool>();
   if (py::isinstance<py::int_>(o)) {
@@ -216,17 +234,18 @@ nlohmann::json to_json(py::handle o, const std::string& path, const std::string&
       if (!py::isinstance<py::str>(item.first))
         return fail("keys must be strings, got " + py::repr(item.first).cast<std::string>());
       std::string key = item.first.cast<std::string>();
-      j[key] = to_json(item.second, path + "/" + key, label);
+      j[key] = to_json(item.second, path + "/" + key, label, depth + 1);
     }
     return j;
   }
   if (py::hasattr(o, "tolist") && !py::isinstance<py::str>(o))  // NumPy arrays and scalars
-    return to_json(o.attr("tolist")(), path, label);
+    return to_json(o.attr("tolist")(), path, label, depth + 1);
   if (py::isinstance<py::list>(o) || py::isinstance<py::tuple>(o) ||
       py::isinstance<glm::dvec3>(o) || py::isinstance<glm::dvec2>(o)) {
     nlohmann::json j = nlohmann::json::array();
     std::size_t i = 0;
-    for (auto item : o) j.push_back(to_json(item, path + "/" + std::to_string(i++), label));
+    for (auto item : o)
+      j.push_back(to_json(item, path + "/" + std::to_string(i++), label, depth + 1));
     return j;
   }
   return fail("cannot be written as JSON: " + py::repr(o).cast<std::string>());
@@ -257,8 +276,10 @@ py::dict scene_info(const Scene& scene, const std::string& precision, bool fast_
   options.fast_math = fast_math;
   options.specialize = specialize;
   Scene copy = scene;
-  auto packed =
-      with_warnings(std::move(on_warning), [&] { return render_detail::pack_scene(copy); });
+  auto packed = with_warnings(std::move(on_warning), [&] {
+    scene_detail::validate_scene(copy);  // fields set from Python may index past the lists
+    return render_detail::pack_scene(copy);
+  });
   py::dict lights;
   for (const auto& [type, name] : enum_names<LightType>().entries) lights[name] = 0;
   for (const lc_light& l : packed.lights) {
@@ -409,11 +430,17 @@ void bind_scene(py::module_& m) {
       .def_readonly("height", &Texture::height)
       .def_property(
           "rgba",
-          [](py::object self) {
-            const Texture& t = self.cast<const Texture&>();
-            return view(t.rgba, {t.height, t.width, 4}, self);
+          [](const Texture& t) {
+            // a copy: a view of t.rgba dangled once the setter or the scene's texture list
+            // reallocated it (reading freed memory, a crash)
+            py::array_t<float> a({py::ssize_t(t.height), py::ssize_t(t.width), py::ssize_t(4)});
+            if (!t.rgba.empty())
+              std::copy(t.rgba.begin(), t.rgba.end(), static_cast<float*>(a.mutable_data()));
+            a.attr("flags").attr("writeable") = false;
+            return a;
           },
           [](Texture& t, py::handle value) {
+            require_numbers(value, "rgba");
             auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(value);
             if (!a || a.ndim() != 3 || a.shape(2) != 4 || a.shape(0) < 1 || a.shape(1) < 1)
               throw py::value_error("rgba: expected an array of shape (H, W, 4)");
@@ -421,7 +448,8 @@ void bind_scene(py::module_& m) {
             t.width = static_cast<int>(a.shape(1));
             t.rgba.assign(a.data(), a.data() + a.size());
           },
-          "(H, W, 4) float32, linear, row 0 at the top: a view (assign an array to resize)");
+          "(H, W, 4) float32, linear, row 0 at the top: a read-only copy (assign an array to "
+          "change it)");
 
   py::class_<ShapeEntry> shape_entry(
       m, "ShapeEntry",

@@ -1,4 +1,5 @@
 """Images, compare() and converge() from Python, with known answers and their error paths."""
+import math
 import re
 
 import numpy as np
@@ -226,3 +227,42 @@ def test_converge_by_time_and_errors(small_scene):
         # the session renders normally afterwards (its cancel flag is its own again)
         r.set_scene(small_scene)
         assert r.render(2).samples_done == 2
+
+
+def test_result_from_arrays_refuses_what_no_render_holds():
+    # counts are whole and in [0, 2^32): -1 wrapped to 4294967295 and 2.9 became 2
+    with pytest.raises(ValueError, match=r"samples: counts must be in \[0, 2\^32\), got -1"):
+        lucent.RenderResult(constant(1.0), samples=np.full((4, 5), -1))
+    with pytest.raises(TypeError, match="samples: expected integer counts"):
+        lucent.RenderResult(constant(1.0), samples=np.full((4, 5), 2.9))
+    # a variance is finite and >= 0
+    for bad in (-1.0, math.nan, math.inf):
+        with pytest.raises(ValueError, match="variance: every value must be finite and >= 0"):
+            lucent.RenderResult(constant(1.0), variance=constant(bad))
+    # strings are not numbers
+    with pytest.raises(TypeError, match="mean: expected numbers"):
+        lucent.RenderResult(np.full((2, 2, 3), "0.5"))
+
+
+def test_display_settings_of_the_wrong_type_name_the_setting(tmp_path):
+    with pytest.raises(TypeError, match="transfer: expected a string, got 3"):
+        lucent.write_image(tmp_path / "a.png", constant(1.0), transfer=3)
+    with pytest.raises(TypeError, match="gamma: expected a number, got 'x'"):
+        lucent.write_image(tmp_path / "a.png", constant(1.0), gamma="x")
+    lucent.write_image(tmp_path / "a.png", constant(1.0), gamma=np.float32(2.2), exposure=1)
+
+
+def test_non_finite_inputs_are_errors_not_results(small_scene):
+    # as `lucent compare` and `lucent converge`: an input error naming the pixel, not a FAIL or
+    # NaN errors
+    a = constant(1.0)
+    a[2, 3, 1] = math.nan
+    with pytest.raises(lucent.Error, match=r"a: pixel \(3, 2\) channel G is not finite \(nan\)"):
+        lucent.compare(a, constant(1.0))
+    with pytest.raises(lucent.Error, match=r"b: pixel \(3, 2\) channel G is not finite"):
+        lucent.compare(constant(1.0), a)
+    ref = np.ones((small_scene.film.height, small_scene.film.width, 3), np.float32)
+    ref[0, 0, 0] = math.inf
+    with pytest.raises(lucent.Error, match=r"the reference image: pixel \(0, 0\) channel R is "
+                                           r"not finite \(inf\)"):
+        lucent.converge(small_scene, ref, spp_ladder=[1])

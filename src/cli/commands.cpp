@@ -67,22 +67,6 @@ std::string joined(const std::vector<std::string>& names) {
   return out;
 }
 
-void check_finite_pixels(const std::string& path, const RenderResult& image) {
-  const int w = image.mean.width;
-  const char* const names[2][3] = {{"R", "G", "B"}, {"var.R", "var.G", "var.B"}};
-  const std::vector<float>* const planes[2] = {&image.mean.rgb, &image.variance.rgb};
-  for (int p = 0; p < 2; ++p)
-    for (size_t k = 0; k < planes[p]->size(); ++k) {
-      const float v = (*planes[p])[k];
-      if (std::isfinite(v)) continue;
-      const size_t i = k / 3;
-      const char* value = std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf";
-      throw Error(path + ": pixel (" + std::to_string(i % static_cast<size_t>(w)) + ", " +
-                  std::to_string(i / static_cast<size_t>(w)) + ") channel " + names[p][k % 3] +
-                  " is not finite (" + value + ")");
-    }
-}
-
 std::vector<std::string> scene_inputs(const std::string& scene_path, const Scene& scene) {
   std::vector<std::string> inputs{scene_path};
   for (const Texture& t : scene.textures)

@@ -39,12 +39,6 @@ CLI::Validator real_range(double lo, double hi);
 /// "a, b, c".
 std::string joined(const std::vector<std::string>& names);
 
-/// Refuses an image read as an input (compare's images, converge's --reference) that holds a NaN
-/// or an infinity in its mean or its variance layers: every error against it would be NaN or
-/// infinite, and look like a result. Throws lucent::Error("<path>: pixel (x, y) channel G is not
-/// finite (nan)"), for the first such value in reading order.
-void check_finite_pixels(const std::string& path, const RenderResult& image);
-
 /// The files a command's outputs must not overwrite because `scene` (loaded from `scene_path`)
 /// reads them: the scene file, then its textures and environment maps and its OBJ meshes.
 std::vector<std::string> scene_inputs(const std::string& scene_path, const Scene& scene);

@@ -49,6 +49,22 @@ void check_layers(const RenderResult& r, const char* which) {
 
 }  // namespace
 
+void check_finite_image(const RenderResult& image, const std::string& path) {
+  const int w = image.mean.width;
+  const char* const names[2][3] = {{"R", "G", "B"}, {"var.R", "var.G", "var.B"}};
+  const std::vector<float>* const planes[2] = {&image.mean.rgb, &image.variance.rgb};
+  for (int p = 0; p < 2; ++p)
+    for (size_t k = 0; k < planes[p]->size(); ++k) {
+      const float v = (*planes[p])[k];
+      if (std::isfinite(v)) continue;
+      const size_t i = k / 3;
+      const char* value = std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf";
+      throw Error(path + ": pixel (" + std::to_string(i % static_cast<size_t>(w)) + ", " +
+                  std::to_string(i / static_cast<size_t>(w)) + ") channel " + names[p][k % 3] +
+                  " is not finite (" + value + ")");
+    }
+}
+
 CompareResult compare_images(const RenderResult& a, const RenderResult& b,
                              const CompareOptions& o) {
   if (a.mean.width != b.mean.width || a.mean.height != b.mean.height)
