@@ -164,6 +164,40 @@ void build_and_check(const std::vector<lc_triangle>& tris, const std::vector<lc_
 
 TEST(BvhBuild, NoPrimitiveGivesAnEmptyTree) { build_and_check({}, {}); }
 
+// A primitive with non-finite bounds (a NaN sphere, which validate_scene lets through: it is
+// never hit) stays out of the tree, and the others keep their boxes. Growing a box by a NaN bound
+// once replaced it by the next finite one (SSE min/max return their second operand): sphere 0
+// fell outside every box and was never hit.
+TEST(BvhBuild, NonFinitePrimitivesStayOutAndTheOthersKeepTheirBoxes) {
+  auto sphere = [](float x, float r) {
+    lc_sphere s{};
+    s.center[0] = x;
+    s.radius = r;
+    return s;
+  };
+  const float nan = std::nanf("");
+  std::vector<lc_sphere> all{sphere(-50, 1), sphere(nan, 1), sphere(-4, 1),
+                             sphere(5, 1),   sphere(6, 1),   sphere(0, nan)};
+  std::vector<lc_sphere> finite{all[0], all[2], all[3], all[4]};
+  Bvh b = lucent::bvh::build_binary({}, all);
+  EXPECT_EQ(b.prim_refs.size(), 4u);
+  std::vector<lc_uint> refs = b.prim_refs;
+  std::sort(refs.begin(), refs.end());
+  EXPECT_EQ(refs, (std::vector<lc_uint>{0 | LC_PRIM_SPHERE_BIT, 2 | LC_PRIM_SPHERE_BIT,
+                                        3 | LC_PRIM_SPHERE_BIT, 4 | LC_PRIM_SPHERE_BIT}));
+  EXPECT_EQ(b.nodes[0].bmin[0], -51.0f);
+  EXPECT_EQ(b.nodes[0].bmax[0], 7.0f);
+  // every kept sphere inside the box of the leaf that holds it
+  for (const Node2& nd : b.nodes)
+    for (lc_uint i = nd.left_first; nd.count && i < nd.left_first + nd.count; ++i) {
+      const lc_sphere& s = all[b.prim_refs[i] & ~LC_PRIM_SPHERE_BIT];
+      EXPECT_LE(nd.bmin[0], s.center[0] - s.radius) << "sphere at " << s.center[0];
+      EXPECT_GE(nd.bmax[0], s.center[0] + s.radius) << "sphere at " << s.center[0];
+    }
+  // only NaN: an empty tree
+  EXPECT_TRUE(lucent::bvh::build_binary({}, {sphere(nan, 1)}).nodes.empty());
+}
+
 TEST(BvhBuild, OnePrimitiveIsARootLeaf) {
   std::vector<lc_triangle> t{tri(0, 0, 0, 1, 0, 0, 0, 1, 0)};
   Bvh b = lucent::bvh::build_binary(t, {});

@@ -60,8 +60,12 @@ Bvh2 build_binary(const std::vector<lc_triangle>& tris, const std::vector<lc_sph
   unsigned threads = options.threads > 0 ? static_cast<unsigned>(options.threads)
                                          : std::max(1u, std::thread::hardware_concurrency());
 
-  // primitive bounds, and the root's bounds and centroid bounds, one slice per thread
+  // primitive bounds, and the root's bounds and centroid bounds, one slice per thread. A
+  // primitive whose bounds are not finite (a NaN sphere, which validate_scene allows: it is never
+  // hit) stays out of the tree: growing a box by a NaN bound (SSE min/max return their second
+  // operand) dropped the primitives grown before it, which then were never hit either.
   std::vector<PrimRef> refs(n);
+  std::vector<char> kept(n, 1);
   std::vector<Box> part_box(threads), part_cbox(threads);
   parallel_for(n, threads, [&](std::size_t b, std::size_t e, unsigned p) {
     Box box, cbox;
@@ -89,6 +93,12 @@ Bvh2 build_binary(const std::vector<lc_triangle>& tris, const std::vector<lc_sph
       PrimRef& r = refs[i];
       r.lo = V4::load(lo);
       r.hi = V4::load(hi);
+      bool finite = true;
+      for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(lo[a]) && std::isfinite(hi[a]);
+      if (!finite) {
+        kept[i] = 0;
+        continue;
+      }
       box.grow(r.lo, r.hi);
       cbox.grow_point(r.centroid2());
     }
@@ -99,6 +109,13 @@ Bvh2 build_binary(const std::vector<lc_triangle>& tris, const std::vector<lc_sph
   for (unsigned p = 0; p < threads; ++p) {
     box.grow(part_box[p]);
     cbox.grow(part_cbox[p]);
+  }
+  if (std::find(kept.begin(), kept.end(), 0) != kept.end()) {
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (kept[i]) refs[k++] = refs[i];
+    refs.resize(k);
+    if (k == 0) return out;
   }
 
   detail::ScratchTree tree =
@@ -118,8 +135,8 @@ Bvh2 build_binary(const std::vector<lc_triangle>& tris, const std::vector<lc_sph
     pad.left_first = 0;
     pad.count = 0;
   }
-  out.prim_refs.resize(n);
-  parallel_for(n, threads, [&](std::size_t b, std::size_t e, unsigned) {
+  out.prim_refs.resize(refs.size());
+  parallel_for(refs.size(), threads, [&](std::size_t b, std::size_t e, unsigned) {
     for (std::size_t i = b; i < e; ++i) out.prim_refs[i] = refs[i].id();
   });
   struct Item {
@@ -149,7 +166,7 @@ Bvh2 build_binary(const std::vector<lc_triangle>& tris, const std::vector<lc_sph
       ++st.leaves;
       st.max_leaf_size = std::max<std::size_t>(st.max_leaf_size, nd.count);
     }
-  st.mean_leaf_size = double(n) / double(st.leaves);
+  st.mean_leaf_size = double(refs.size()) / double(st.leaves);
   st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   st.sah_cost = sah_cost(out.nodes);  // not part of the build time
   st.binary_nodes = st.nodes;
