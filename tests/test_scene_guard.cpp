@@ -224,3 +224,19 @@ TEST(SceneGuard, SilentPipeTimesOut) {
 }
 
 }  // namespace
+
+// validate_scene (run by every render) holds the loader's one-environment rule for scenes whose
+// lights were set directly: two were accepted, the last became the escape light and the first was
+// seen through light sampling only.
+TEST(SceneGuard, OneEnvironmentAlsoForScenesBuiltDirectly) {
+  lucent::Scene s =
+      lucent::test::scene_from(R"({"lights": [{"type": "environment", "radiance": [1, 1, 1]}]})");
+  lucent::scene_detail::validate_scene(s);
+  s.lights.push_back(s.lights[0]);
+  try {
+    lucent::scene_detail::validate_scene(s);
+    ADD_FAILURE() << "two environments";
+  } catch (const lucent::Error& e) {
+    EXPECT_EQ(after_path(e.what()), ": /lights/1: only one environment light is allowed");
+  }
+}

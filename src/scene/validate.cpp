@@ -343,6 +343,11 @@ void validate_scene(const Scene& s) {
   }
   for (std::size_t i = 0; i < s.lights.size(); ++i)
     validate_light(s.lights[i], s.textures.size(), Reporter(file, "/lights/" + std::to_string(i)));
+  // one environment at most, as the loader and SceneBuilder say: with two, the escape light was
+  // the last one and the first was seen only through light sampling (too dark)
+  for (std::size_t i = 0, envs = 0; i < s.lights.size(); ++i)
+    if (s.lights[i].type != LightType::Point && ++envs > 1)
+      Reporter(file, "/lights/" + std::to_string(i)).fail("only one environment light is allowed");
   const std::size_t nm = s.materials.size();
   for (std::size_t i = 0; i < s.spheres.size(); ++i) {
     // (a NaN centre or radius is allowed: such a sphere is never hit, tests/test_stability_scene;
