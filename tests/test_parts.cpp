@@ -17,10 +17,12 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "lucent/compare.hpp"
 #include "lucent/parts.hpp"
+#include "lucent/version.hpp"
 #include "support.hpp"
 
 namespace {
@@ -191,6 +193,7 @@ TEST(Parts, OverlapsAndMismatchesAreOneLineErrors) {
   std::string d = part(other, "4:6", "d.exr");
   std::string e = part(scene, "4:6", "e.exr", "--integrator direct");
   std::string f = part(scene, "6:8", "f.exr", "--fast-math");
+  part(scene, "6:8", "g0.exr");
   const std::string out = dir + "/out.exr";
   EXPECT_EQ(error_line(run_cli("merge " + a + " " + b + " -o " + q(out))),
             dir + "/b.exr: samples [2, 6) overlap " + dir + "/a.exr's [0, 4)");
@@ -203,6 +206,24 @@ TEST(Parts, OverlapsAndMismatchesAreOneLineErrors) {
   EXPECT_NE(error_line(run_cli("merge " + a + " " + f + " -o " + q(out)))
                 .find(dir + "/f.exr: scene hash "),
             std::string::npos);
+  // another kernel source (a copy of kernels/ with one comment more): the hash covers the
+  // source, so parts of two estimators do not mix (they merged before)
+  fs::copy(lucent::test::source_path("kernels"), dir + "/k", fs::copy_options::recursive);
+  std::ofstream(dir + "/k/megakernel.cl", std::ios::app) << "\n/* another kernel */\n";
+  CommandResult kr = run_cli("render " + q(scene) + " -q --samples 6:8 -o " + q(dir + "/k.exr"),
+                             "LUCENT_KERNEL_DIR=" + q(dir + "/k"));
+  ASSERT_EQ(kr.status, 0) << kr.err;
+  EXPECT_NE(error_line(run_cli("merge " + a + " " + q(dir + "/k.exr") + " -o " + q(out)))
+                .find("(another scene, camera, film, integrator setting, build option or kernel "
+                      "source)"),
+            std::string::npos);
+  // a part of another lucent version (its header rewritten)
+  lucent::RenderPart old = lucent::read_render_part(dir + "/g0.exr");
+  old.info.version = "0.0.1";
+  lucent::write_render_part(dir + "/v.exr", old);
+  EXPECT_EQ(error_line(run_cli("merge " + a + " " + q(dir + "/v.exr") + " -o " + q(out))),
+            dir + "/v.exr: made by lucent 0.0.1, " + dir + "/a.exr by lucent " + lucent::kVersion +
+                " (their kernels may differ: render every part with one version)");
   EXPECT_EQ(error_line(run_cli("merge " + a + " " + a + " -o " + q(out))),
             dir + "/a.exr: given twice (as " + dir + "/a.exr)");
   // a render EXR that is not a part

@@ -406,10 +406,14 @@ void PartMerger::check(const std::string& name, const PartInfo& info) {
   if (info.integrator != first.integrator)
     throw Error(name + ": integrator " + info.integrator + " differs from " + fname + "'s " +
                 first.integrator);
+  if (info.version != first.version)
+    throw Error(name + ": made by lucent " + info.version + ", " + fname + " by lucent " +
+                first.version + " (their kernels may differ: render every part with one version)");
   if (info.scene_hash != first.scene_hash)
     throw Error(name + ": scene hash " + hex64(info.scene_hash) + " differs from " + fname + "'s " +
                 hex64(first.scene_hash) +
-                " (another scene, camera, film, integrator setting or build option)");
+                " (another scene, camera, film, integrator setting, build option or kernel "
+                "source)");
   for (size_t k = 0; k < infos_.size(); ++k) {
     SampleRange a, b;
     if (overlap(info.samples, infos_[k].samples, &a, &b))

@@ -32,6 +32,14 @@ namespace lucent {
 
 namespace {
 
+/// 64-bit FNV-1a.
+std::uint64_t fnv1a(const void* data, std::size_t size) {
+  const unsigned char* p = static_cast<const unsigned char*>(data);
+  std::uint64_t h = 14695981039346656037ull;
+  for (std::size_t i = 0; i < size; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
+
 using clock_type = std::chrono::steady_clock;
 
 // The work-group size: 64 wherever the device and the built kernel allow it (fixed: each new size
@@ -201,6 +209,9 @@ struct Renderer::Impl {
   /// rendering is refused until a set_scene succeeds; the accumulation stays readable.
   std::string stale;
   std::string build_options;
+  /// FNV-1a of the kernel source the session assembled (the embedded copy or kernel_dir's): part
+  /// of image_hash, so that parts rendered by different kernels do not merge
+  std::uint64_t kernel_source_hash = 0;
   size_t npix = 0;
 
   // the accumulation
@@ -362,8 +373,10 @@ struct Renderer::Impl {
         device = w.ctx.device.info.name;
         stage = render_detail::ClStage::Upload;
         Program* previous_program = w.program;
-        if (!w.programs.count(opts) && source.empty())
+        if (!w.programs.count(opts) && source.empty()) {
           source = detail::assemble_kernel_source("megakernel.cl", options.kernel_dir);
+          if (kernel_source_hash == 0) kernel_source_hash = fnv1a(source.data(), source.size());
+        }
         cl_util::DeferredEntry entry;
         w.program = &get_program(w, opts, source, entry);
         touched = true;  // from here on a failure leaves the devices' buffers in doubt
@@ -1136,6 +1149,7 @@ std::uint64_t Renderer::image_hash() const {
   LC_SCENE_BUFFERS(LUCENT_HASH)
 #undef LUCENT_HASH
   add(m.build_options.data(), m.build_options.size());
+  add(&m.kernel_source_hash, sizeof m.kernel_source_hash);
   return h;
 }
 std::uint64_t Renderer::spp() const { return impl_->done; }
