@@ -21,6 +21,7 @@
 #include <string>
 
 #include "lucent/compare.hpp"
+#include "lucent/image.hpp"
 #include "lucent/parts.hpp"
 #include "lucent/version.hpp"
 #include "support.hpp"
@@ -483,6 +484,29 @@ TEST(Parts, MpiFailingRankEndsTheJobWithoutOutput) {
   for (const auto& entry : fs::directory_iterator(dir))
     EXPECT_EQ(entry.path().filename().string().find("mpi.exr"), std::string::npos)
         << "a temporary output was left: " << entry.path();
+}
+// lucent-mpi's output may not be a file the scene reads (an environment map here): rank 0 wrote
+// over it, as `lucent render` refuses to.
+TEST(Parts, MpiRefusesToOverwriteWhatTheSceneReads) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  std::string dir = lucent::test::temp_dir();
+  const std::string env = dir + "/sky.pfm";
+  lucent::Image sky{2, 1, std::vector<float>(6, 0.5f)};
+  lucent::write_image(env, sky);
+  const std::string before = lucent::test::read_file(env);
+  const std::string scene = dir + "/scene.json";
+  lucent::test::write_file(scene, R"({
+    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
+    "film": {"width": 8, "height": 8},
+    "integrator": {"type": "path", "max_depth": 2, "spp": 2},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+    "lights": [{"type": "environment", "file": "sky.pfm"}]})");
+  CommandResult r = run_shell(
+      mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " -o " + q(env)), dir);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find(": is an input of this render ("), std::string::npos) << r.err;
+  EXPECT_EQ(lucent::test::read_file(env), before);
 }
 #else
 TEST(Parts, MpiTwoRanksRenderTheOneProcessImage) {

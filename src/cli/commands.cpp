@@ -67,15 +67,6 @@ std::string joined(const std::vector<std::string>& names) {
   return out;
 }
 
-std::vector<std::string> scene_inputs(const std::string& scene_path, const Scene& scene) {
-  std::vector<std::string> inputs{scene_path};
-  for (const Texture& t : scene.textures)
-    if (!t.path.empty()) inputs.push_back(t.path);
-  for (const ShapeEntry& e : scene.shapes)
-    if (!e.file.empty()) inputs.push_back(e.file);
-  return inputs;
-}
-
 RenderOptions render_options_from_environment() {
   SessionOptions s = SessionOptions::from_environment();
   RenderOptions o;

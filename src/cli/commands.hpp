@@ -7,6 +7,7 @@
 #include "lucent/render.hpp"
 #include "lucent/scene.hpp"
 #include "lucent/session.hpp"
+#include "scene/loaders.hpp"
 
 namespace lucent::cli {
 
@@ -39,9 +40,7 @@ CLI::Validator real_range(double lo, double hi);
 /// "a, b, c".
 std::string joined(const std::vector<std::string>& names);
 
-/// The files a command's outputs must not overwrite because `scene` (loaded from `scene_path`)
-/// reads them: the scene file, then its textures and environment maps and its OBJ meshes.
-std::vector<std::string> scene_inputs(const std::string& scene_path, const Scene& scene);
+using scene_detail::scene_inputs;
 
 /// `lucent render` (cmd_render.cpp): registers the subcommand, runs it once parsed; the scene
 /// path given, for messages.

@@ -22,6 +22,7 @@
 #include "lucent/lucent.hpp"
 #include "lucent/parts.hpp"
 #include "lucent/types.hpp"
+#include "scene/loaders.hpp"
 
 namespace {
 
@@ -125,6 +126,9 @@ int run(const Args& a) {
   if (a.width > 0) scene.film.width = a.width;
   if (a.height > 0) scene.film.height = a.height;
   if (a.seed >= 0) scene.integrator.seed = static_cast<std::uint32_t>(a.seed);
+  // nor a file the scene reads (a texture or mesh: rank 0 replaced it)
+  if (root)
+    lucent::io::check_output_path(a.output, lucent::scene_detail::scene_inputs(a.scene, scene));
   lucent::check_part_scene(scene, a.scene);
   const std::uint64_t n = a.spp > 0 ? std::uint64_t(a.spp) : scene.integrator.spp;
   if (n < std::uint64_t(g_size))

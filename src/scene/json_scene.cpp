@@ -14,6 +14,7 @@
 #include "lucent/scene.hpp"
 #include "scene/json_guard.hpp"
 #include "scene/json_sections.hpp"
+#include "scene/loaders.hpp"
 
 namespace lucent {
 
@@ -93,5 +94,18 @@ Scene parse_scene(const std::string& text, const std::string& path) {
 Scene load_scene(const std::string& path) {
   return parse_scene(scene_detail::read_scene_text(path), path);  // bounded; pipes allowed
 }
+
+namespace scene_detail {
+
+std::vector<std::string> scene_inputs(const std::string& scene_path, const Scene& scene) {
+  std::vector<std::string> inputs{scene_path};
+  for (const Texture& t : scene.textures)
+    if (!t.path.empty()) inputs.push_back(t.path);
+  for (const ShapeEntry& e : scene.shapes)
+    if (!e.file.empty()) inputs.push_back(e.file);
+  return inputs;
+}
+
+}  // namespace scene_detail
 
 }  // namespace lucent

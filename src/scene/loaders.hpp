@@ -50,4 +50,8 @@ Texture decode_texture(const unsigned char* data, std::size_t size, const std::s
 /// each, to linear RGBA floats (alpha kept linear) at `rgba`.
 void decode_srgb8(const std::uint8_t* data, std::size_t texels, int channels, float* rgba);
 
+/// The files a command's outputs must not overwrite because `scene` (loaded from `scene_path`)
+/// reads them: the scene file, then its textures and environment maps and its OBJ meshes.
+std::vector<std::string> scene_inputs(const std::string& scene_path, const Scene& scene);
+
 }  // namespace lucent::scene_detail
