@@ -426,6 +426,30 @@ TEST(Parts, SlurmArrayScriptsRenderAndMerge) {
   EXPECT_EQ(merged.info.samples, (std::vector<lucent::SampleRange>{{0, 8}}));
   EXPECT_LT(max_relative_difference(merged.acc, lucent::read_render_part(dir + "/one.exr").acc),
             1e-5);
+
+  // one task again (sbatch --array=1): with the job's task count it renders its own range into
+  // its own file; without it the one-task array is refused (it took itself for a whole job of
+  // one task and wrote every sample over part 0)
+  const std::string part0 = lucent::test::read_file(dir + "/parts/part-0000.exr");
+  auto rerun = [&](const std::string& env) {
+    const std::string log1 = dir + "/rerun.log";
+    std::remove(log1.c_str());
+    const std::string c =
+        env + " PATH=" + q(lucent::test::source_path("tests/slurm")) +
+        ":\"$PATH\" LUCENT=" + q(LUCENT_CLI_PATH) + " FAKE_SBATCH_LOG=" + q(log1) +
+        " sbatch --array=1 " + q(lucent::test::source_path("scripts/slurm/render-part.sbatch")) +
+        " " + q(scene) + " 8 " + q(dir + "/parts") + " -q >/dev/null 2>" + q(dir + "/rerun.err");
+    EXPECT_EQ(std::system(c.c_str()), 0);
+    return lucent::test::read_file(log1);
+  };
+  EXPECT_NE(rerun("").find("_1: exit 2"), std::string::npos);
+  EXPECT_NE(lucent::test::read_file(dir + "/rerun.err").find("set LUCENT_TASKS"),
+            std::string::npos);
+  EXPECT_EQ(lucent::test::read_file(dir + "/parts/part-0000.exr"), part0);
+  EXPECT_NE(rerun("LUCENT_TASKS=3").find("_1: exit 0"), std::string::npos);
+  EXPECT_EQ(lucent::read_part_info(dir + "/parts/part-0001.exr").samples,
+            (std::vector<lucent::SampleRange>{{2, 5}}));
+  EXPECT_EQ(lucent::test::read_file(dir + "/parts/part-0000.exr"), part0);
 }
 
 #ifdef LUCENT_MPI_PATH

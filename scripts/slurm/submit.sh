@@ -19,7 +19,8 @@ if ! [[ $tasks =~ ^[1-9][0-9]*$ ]]; then
   exit 2
 fi
 # shellcheck disable=SC2086
-array=$(sbatch --parsable ${SBATCH_OPTS:-} --array="0-$((tasks - 1))" \
+# LUCENT_TASKS reaches the tasks through sbatch's default --export=ALL: each knows the split
+array=$(LUCENT_TASKS=$tasks sbatch --parsable ${SBATCH_OPTS:-} --array="0-$((tasks - 1))" \
   "$here/render-part.sbatch" "$scene" "$spp" "$parts" "$@")
 array=${array%%;*}  # "jobid;cluster" on federated clusters
 # shellcheck disable=SC2086
