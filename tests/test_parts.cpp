@@ -249,6 +249,13 @@ TEST(Parts, OverlapsAndMismatchesAreOneLineErrors) {
   EXPECT_EQ(error_line(run_cli("merge --complete " + a + " " + g + " -o " + q(out))),
             "merge: samples [4, 6) are missing (--complete)");
   EXPECT_FALSE(fs::exists(out));
+  // --expect: the range the parts should hold together, so that a last part that was never
+  // written is missing too (the default range ends where the last part given ends)
+  EXPECT_EQ(error_line(run_cli("merge --complete --expect 0:10 " + a + " " + g + " -o " + q(out))),
+            "merge: samples [4, 6), [8, 10) are missing (--complete)");
+  EXPECT_EQ(error_line(run_cli("merge --expect 0:6 " + a + " " + g + " -o " + q(out))),
+            "merge: the parts hold samples [0, 4), [6, 8), outside --expect [0, 6)");
+  EXPECT_FALSE(fs::exists(out));
   CommandResult r = run_cli("merge " + a + " " + g + " -o " + q(out));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("lucent: warning: samples [4, 6) are missing"), std::string::npos) << r.err;

@@ -28,6 +28,10 @@ struct SampleRange {
 std::string range_text(const SampleRange& r);
 std::string ranges_text(const std::vector<SampleRange>& rs);
 
+/// The parts of `want` that `have` (sorted, disjoint ranges) does not cover.
+std::vector<SampleRange> missing_ranges(const std::vector<SampleRange>& have,
+                                        const SampleRange& want);
+
 /// Parses "A:B" (0 <= A < B <= 2^32, B - A <= limits::kMaxSpp); throws lucent::Error naming
 /// `what` (e.g. "--samples") otherwise.
 SampleRange parse_sample_range(const std::string& text, const std::string& what = "--samples");

@@ -25,5 +25,5 @@ array=$(LUCENT_TASKS=$tasks sbatch --parsable ${SBATCH_OPTS:-} --array="0-$((tas
 array=${array%%;*}  # "jobid;cluster" on federated clusters
 # shellcheck disable=SC2086
 merge=$(sbatch --parsable ${SBATCH_OPTS:-} --dependency="afterany:$array" \
-  "$here/merge.sbatch" "$parts" "$out")
+  "$here/merge.sbatch" "$parts" "$out" --expect "0:$spp")
 echo "render array job $array ($tasks tasks), merge job ${merge%%;*} -> $out"

@@ -18,6 +18,7 @@ namespace {
 struct MergeArgs {
   std::vector<std::string> parts;
   std::string output;
+  std::string expect;
   bool complete = false;
   bool quiet = false;
 };
@@ -39,6 +40,10 @@ CLI::App* add_merge_command(CLI::App& app) {
       ->required();
   cmd->add_flag("--complete", a.complete,
                 "Fail (and write nothing) when sample ranges are missing");
+  cmd->add_option("--expect", a.expect,
+                  "A:B, the sample indices the parts should hold together: ranges missing from "
+                  "it are reported (default: [0, the highest end a part asked for), which cannot "
+                  "see a last part that was never written)");
   cmd->add_flag("-q,--quiet", a.quiet, "Print only warnings and errors");
   return cmd;
 }
@@ -51,8 +56,17 @@ int run_merge_command() {
   // the format (.exr, .png, .pfm, as write_merged writes) and a place that can be written, before
   // reading any part
   io::check_output_path(a.output, a.parts);
+  SampleRange expect;
+  if (!a.expect.empty()) expect = parse_sample_range(a.expect, "--expect");
   MergeReport r = merge_render_parts(a.parts);
   const PartInfo& info = r.merged.info;
+  if (!a.expect.empty()) {
+    for (const SampleRange& s : info.samples)
+      if (s.begin < expect.begin || s.end > expect.end)
+        throw Error("merge: the parts hold samples " + ranges_text(info.samples) +
+                    ", outside --expect " + range_text(expect));
+    r.missing = missing_ranges(info.samples, expect);
+  }
   if (!r.missing.empty()) {
     if (a.complete)
       throw Error("merge: samples " + ranges_text(r.missing) + " are missing (--complete)");

@@ -187,6 +187,20 @@ std::string range_text(const SampleRange& r) {
   return "[" + std::to_string(r.begin) + ", " + std::to_string(r.end) + ")";
 }
 
+std::vector<SampleRange> missing_ranges(const std::vector<SampleRange>& have,
+                                        const SampleRange& want) {
+  std::vector<SampleRange> out;
+  std::uint64_t at = want.begin;
+  for (const SampleRange& s : have) {
+    if (s.end <= at) continue;
+    if (s.begin >= want.end) break;
+    if (s.begin > at) out.push_back({at, s.begin});
+    at = std::max(at, s.end);
+  }
+  if (at < want.end) out.push_back({at, want.end});
+  return out;
+}
+
 std::string ranges_text(const std::vector<SampleRange>& rs) {
   if (rs.empty()) return "none";
   std::string out;
