@@ -89,9 +89,13 @@ __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
       nonfinite +=
           caustics_light_path(&s, &rng, light_sum + light_base, light_sumsq + light_base, &rays);
 #endif
-    if (lc_isfinite3(L)) {
+    /* a sample whose square (or the pass's sum of squares with it) overflows float counts as
+     * non-finite too: an infinite sum of squares made the variance infinite, sent every pixel of
+     * an adaptive render to its cap and wrote part files that merge refused */
+    float3 sq = L * L;
+    if (lc_isfinite3(L) && lc_isfinite3(sumsq + sq)) {
       sum += L;
-      sumsq += L * L;
+      sumsq += sq;
       ++accepted;
     } else {
       ++nonfinite;

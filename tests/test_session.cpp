@@ -583,3 +583,22 @@ TEST(Session, SceneWithoutLightWarns) {
   r.set_scene(dark);
   EXPECT_EQ(warnings.all().size(), 0u) << warnings.dump();
 }
+
+// Radiance whose square overflows float (a point light of 1e22 W/sr, which the scene checks
+// accept) is counted as non-finite, not summed: the pass's sum of squares became infinite, so
+// were the variances, and a part file of it was refused by merge.
+TEST(Session, SamplesWhoseSquareOverflowsAreCountedNotSummed) {
+  Scene s = lucent::test::scene_from(kScene);
+  s.lights[0].intensity = glm::dvec3(1e22);
+  Renderer r = session();
+  r.set_scene(s);
+  r.render(4);
+  const RenderResult res = r.result();
+  EXPECT_GT(res.nonfinite, 0u);
+  for (size_t i = 0; i < res.mean.rgb.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(res.mean.rgb[i])) << i;
+    ASSERT_TRUE(std::isfinite(res.variance.rgb[i])) << i;
+  }
+  const lucent::Accumulation a = r.accumulation();
+  for (size_t i = 0; i < a.sumsq.size(); ++i) ASSERT_TRUE(std::isfinite(a.sumsq[i])) << i;
+}
