@@ -9,6 +9,7 @@
 #include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
 #include "render/device_scene.hpp"
+#include "render/pack.hpp"
 #include "support.hpp"
 
 namespace {
@@ -204,6 +205,31 @@ TEST(KernelLightSampling, PowerProportionalMixture) {
       {"type": "triangles", "material": "lamp", "positions": [[-1, -2, -1], [1, -2, -1], [0, -2, 1]], "indices": [0, 1, 2]}],
     "lights": [{"type": "environment", "radiance": [0.2, 0.2, 0.2]}, {"type": "point", "position": [0, 0, 3], "intensity": [1, 1, 1]}]})",
                     "mixture", false);
+}
+
+// The light-selection CDF lies on the 2^-24 lattice of the kernel's random numbers (lc_u01), and
+// each light's pdf_select is exactly its interval: lc_cdf_search picks light i for the lattice
+// points in [cdf[i-1], cdf[i]), so the probability the kernel divides by is the one it draws
+// with. Rounded separately, the two differed by up to 2^-24 (6% of a light's share among 10^6).
+TEST(KernelLightSampling, SelectionProbabilitiesAreTheCdfsIntervals) {
+  std::string lights;
+  for (int i = 0; i < 300; ++i)
+    lights += std::string(i ? ", " : "") + R"({"type": "point", "position": [0, 0, 3], )" +
+              R"("intensity": [)" + std::to_string(1 + (i * 37) % 101) + ", 1, 1]}";
+  lucent::Scene s = lucent::test::scene_from(R"({"lights": [)" + lights + "]}");
+  const lucent::render_detail::PackedScene p = lucent::render_detail::pack_scene(s);
+  ASSERT_EQ(p.light_cdf.size(), 300u);
+  EXPECT_EQ(p.light_cdf.back(), 1.0f);
+  double total = 0;
+  for (size_t i = 0; i < p.light_cdf.size(); ++i) {
+    const double k = double(p.light_cdf[i]) * 16777216.0;
+    EXPECT_EQ(k, std::floor(k)) << "cdf[" << i << "] is not on the 2^-24 lattice";
+    const float below = i ? p.light_cdf[i - 1] : 0.0f;
+    EXPECT_EQ(p.lights[i].pdf_select, p.light_cdf[i] - below) << i;
+    EXPECT_GT(p.lights[i].pdf_select, 0.0f) << i;
+    total += p.lights[i].pdf_select;
+  }
+  EXPECT_EQ(total, 1.0);
 }
 
 }  // namespace
