@@ -563,3 +563,17 @@ TEST(Resources, ReferenceChecksItsHostMemory) {
     EXPECT_EQ(error_of([&] { lucent::render_reference(s, ro); }), "");
   }
 }
+
+// The kernel reaches texels through 32-bit offsets: textures holding more are refused when the
+// scene is packed (the memory checks refuse them on most devices, not on a large host's PoCL,
+// where the offsets wrapped). The texture here only claims its size: the check reads no texel.
+TEST(Resources, TexelsBeyondTheKernelsOffsetsAreRefused) {
+  Scene s = lucent::test::scene_from(grid_scene(1, 4));
+  s.path = "t.json";
+  lucent::Texture t;
+  t.width = t.height = 70000;
+  s.textures.push_back(t);
+  EXPECT_EQ(error_of([&] { lucent::render_detail::pack_scene(s); }),
+            "t.json: the textures hold 4900000000 texels, more than the kernel's 32-bit texel "
+            "offsets reach (4294967295): reduce the textures' resolution");
+}

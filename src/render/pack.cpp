@@ -66,6 +66,24 @@ lc_camera pack_camera(const Camera& c, int width, int height) {
 }
 
 PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bvh_reused) {
+  // what the kernel's 32-bit indices can reach, before anything is built: the BVH's leaf blocks
+  // (one per primitive at worst) and the texels (a texture's offset and offset + y w + x are
+  // lc_uint; the memory checks refuse such sizes on most devices, not on a large host's PoCL)
+  const std::uint64_t prims = std::uint64_t(scene.triangles.size()) + scene.spheres.size();
+  if (prims > std::uint64_t(LC_BVH_LEAF_FIRST_MASK) + 1)
+    throw Error(scene_detail::in_file(
+        scene.path, std::to_string(prims) + " primitives, more than the BVH can reference (" +
+                        std::to_string(std::uint64_t(LC_BVH_LEAF_FIRST_MASK) + 1) +
+                        "): reduce the number of triangles and spheres"));
+  std::uint64_t texels = 0;
+  for (const Texture& t : scene.textures)
+    texels += std::uint64_t(t.width) * std::uint64_t(t.height);
+  if (texels > std::uint64_t(UINT32_MAX))
+    throw Error(scene_detail::in_file(
+        scene.path, "the textures hold " + std::to_string(texels) +
+                        " texels, more than the kernel's 32-bit texel offsets reach (" +
+                        std::to_string(std::uint64_t(UINT32_MAX)) +
+                        "): reduce the textures' resolution"));
   PackedScene p;
   lc_params& P = p.params;
   P.camera = pack_camera(scene.camera, scene.film.width, scene.film.height);
