@@ -602,3 +602,48 @@ TEST(Session, SamplesWhoseSquareOverflowsAreCountedNotSummed) {
   const lucent::Accumulation a = r.accumulation();
   for (size_t i = 0; i < a.sumsq.size(); ++i) ASSERT_TRUE(std::isfinite(a.sumsq[i])) << i;
 }
+
+// Two devices, and the pass of samples [0, 1) fails on one while the other's [1, 2) is kept: the
+// accumulation is not one range from sample 0 any more. It once claimed [0, k) for the k samples
+// the other device kept (a part file of it would have said so, and merged wrongly), and the next
+// render started at first + done = k, rendering sample k twice. Now the accumulation is refused
+// until reset(), and the next render starts after the last sample held.
+TEST(Session, FailedPassOfOneDeviceLeavesNoFalseRange) {
+  auto error_of = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const lucent::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  Scene s = lucent::test::scene_from(kScene);
+  lucent::SessionOptions o = lucent::test::session_options();
+  std::string one = std::to_string(lucent::select_device(o.device).index);
+  o.device = one + "," + one;
+  Renderer r(o);
+  r.set_scene(s);
+  {
+    lucent::render_detail::ScopedPassFault fault(0);
+    EXPECT_NE(error_of([&] { r.render(8); }).find("clEnqueueNDRangeKernel (injected by a test)"),
+              std::string::npos);
+  }
+  // the other device's passes: [1, 1 + k), however many it finished before the failure stopped it
+  const std::uint64_t k = r.spp();
+  ASSERT_GE(k, 1u);
+  EXPECT_NE(error_of([&] { r.accumulation(); })
+                .find("accumulation: the session's samples [1, " + std::to_string(1 + k) +
+                      ") are not one range from 0"),
+            std::string::npos)
+      << error_of([&] { r.accumulation(); });
+  r.render(3);  // samples [1 + k, 4 + k): none twice
+  EXPECT_NE(error_of([&] {
+              r.accumulation();
+            }).find("samples [1, " + std::to_string(4 + k) + ") are not one range from 0"),
+            std::string::npos)
+      << error_of([&] { r.accumulation(); });
+  EXPECT_EQ(r.spp(), k + 3);
+  r.reset();
+  r.render(2);
+  EXPECT_EQ(r.accumulation().spp, 2u);
+}

@@ -1,6 +1,7 @@
 #include "render/resources.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <initializer_list>
 
 #include "bvh/bvh.hpp"
@@ -86,6 +87,14 @@ bool g_upload_fault = false;
 ScopedUploadFault::ScopedUploadFault() { g_upload_fault = true; }
 ScopedUploadFault::~ScopedUploadFault() { g_upload_fault = false; }
 bool upload_fault() { return g_upload_fault; }
+
+namespace {
+std::atomic<std::uint64_t> g_pass_fault{~std::uint64_t(0)};
+}  // namespace
+
+ScopedPassFault::ScopedPassFault(std::uint64_t begin) { g_pass_fault = begin; }
+ScopedPassFault::~ScopedPassFault() { g_pass_fault = ~std::uint64_t(0); }
+bool pass_fault(std::uint64_t begin) { return g_pass_fault.load() == begin; }
 
 std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                                              const std::vector<DeviceLimits>& devices) {

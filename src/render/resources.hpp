@@ -56,6 +56,18 @@ class ScopedUploadFault {
 /// Whether a ScopedUploadFault is alive.
 bool upload_fault();
 
+/// For tests: while alive, the pass of a uniform render whose first sample index is `begin` fails
+/// with CL_OUT_OF_RESOURCES, as a device's failing launch would (pass_fault()). One at a time.
+class ScopedPassFault {
+ public:
+  explicit ScopedPassFault(std::uint64_t begin);
+  ~ScopedPassFault();
+  ScopedPassFault(const ScopedPassFault&) = delete;
+  ScopedPassFault& operator=(const ScopedPassFault&) = delete;
+};
+/// Whether a ScopedPassFault for `begin` is alive.
+bool pass_fault(std::uint64_t begin);
+
 /// The work-group size of a launch: `preferred` (a power of two) when the device
 /// (CL_DEVICE_MAX_WORK_GROUP_SIZE, CL_DEVICE_MAX_WORK_ITEM_SIZES[0]) and the built kernel
 /// (CL_KERNEL_WORK_GROUP_SIZE) allow it, else the largest power of two they allow (at least 1;
