@@ -113,7 +113,11 @@ void bind_vector_type(py::module_& m, const char* name) {
              py::sequence s = py::reinterpret_borrow<py::sequence>(other);
              for (int i = 0; i < N; ++i) {
                py::object e = s[static_cast<std::size_t>(i)];
-               if (!PyNumber_Check(e.ptr()) || e.cast<double>() != v[i]) return false;
+               // a number that is not real (complex) compares unequal rather than raising
+               if (!PyNumber_Check(e.ptr()) || !py::hasattr(e, "__float__") ||
+                   py::isinstance<py::str>(e))
+                 return false;
+               if (py::float_(e).cast<double>() != v[i]) return false;
              }
              return true;
            })

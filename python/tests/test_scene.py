@@ -267,7 +267,7 @@ def test_vectors_index_compare_and_show():
     with pytest.raises(IndexError):
         v[-4]
     assert v == (1, 2.5, 4) and v == [1, 2.5, 4] and v == lucent.Vec3((1, 2.5, 4))
-    assert v != (1, 2.5, 5) and v != (1, 2.5) and v != "abc" and v != 3
+    assert v != (1, 2.5, 5) and v != (1, 2.5) and v != "abc" and v != 3 and v != (1j, 2.5, 4)
     assert repr(v) == "Vec3(1, 2.5, 4)"
     w = lucent.Vec2((0.25, -1))
     assert (w[0], w[-1]) == (0.25, -1) and repr(w) == "Vec2(0.25, -1)"
