@@ -58,6 +58,16 @@ void expect_same_samples(const RenderResult& a, const RenderResult& b) {
   EXPECT_LT(worst, 1e-5);
 }
 
+/// The message of the lucent::Error that f throws ("" when it throws none).
+std::string error_message(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const lucent::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
 uint64_t kernel_builds(const SessionStats& s) { return s.kernel_compiles + s.kernel_cache_loads; }
 
 // Moving the camera re-renders without rebuilding the BVH or the kernel; only the launch
@@ -507,14 +517,6 @@ TEST(Session, ErrorsAreLucentErrors) {
 // kept the device's half-new buffers because the host's record still said "first scene", and
 // rendered the first scene's samples with the second scene's materials).
 TEST(Session, FailedUploadDropsTheDeviceScene) {
-  auto error_of = [](const std::function<void()>& f) {
-    try {
-      f();
-    } catch (const lucent::Error& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
   Scene s1 = lucent::test::scene_from(kScene);
   Scene s2 = s1;
   s2.materials[0].albedo = glm::dvec3(0.1, 0.9, 0.1);
@@ -524,10 +526,10 @@ TEST(Session, FailedUploadDropsTheDeviceScene) {
   const RenderResult before = r.result();
   {
     lucent::render_detail::ScopedUploadFault fault;
-    std::string msg = error_of([&] { r.set_scene(s2); });
+    std::string msg = error_message([&] { r.set_scene(s2); });
     EXPECT_NE(msg.find("clCreateBuffer (injected by a test)"), std::string::npos) << msg;
   }
-  std::string msg = error_of([&] { r.render(1); });
+  std::string msg = error_message([&] { r.render(1); });
   EXPECT_NE(msg.find("render: the last set_scene failed, so the devices hold no scene"),
             std::string::npos)
       << msg;
@@ -541,7 +543,8 @@ TEST(Session, FailedUploadDropsTheDeviceScene) {
   // set_build_options refused by the same failure keeps the options the programs were built with
   {
     lucent::render_detail::ScopedUploadFault fault;
-    EXPECT_NE(error_of([&] { r.set_build_options(lucent::Precision::Float, true, true); }), "");
+    EXPECT_NE(error_message([&] { r.set_build_options(lucent::Precision::Float, true, true); }),
+              "");
   }
   EXPECT_FALSE(r.options().fast_math);
 }
@@ -609,14 +612,6 @@ TEST(Session, SamplesWhoseSquareOverflowsAreCountedNotSummed) {
 // render started at first + done = k, rendering sample k twice. Now the accumulation is refused
 // until reset(), and the next render starts after the last sample held.
 TEST(Session, FailedPassOfOneDeviceLeavesNoFalseRange) {
-  auto error_of = [](const std::function<void()>& f) {
-    try {
-      f();
-    } catch (const lucent::Error& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
   Scene s = lucent::test::scene_from(kScene);
   lucent::SessionOptions o = lucent::test::session_options();
   std::string one = std::to_string(lucent::select_device(o.device).index);
@@ -625,23 +620,24 @@ TEST(Session, FailedPassOfOneDeviceLeavesNoFalseRange) {
   r.set_scene(s);
   {
     lucent::render_detail::ScopedPassFault fault(0);
-    EXPECT_NE(error_of([&] { r.render(8); }).find("clEnqueueNDRangeKernel (injected by a test)"),
-              std::string::npos);
+    EXPECT_NE(
+        error_message([&] { r.render(8); }).find("clEnqueueNDRangeKernel (injected by a test)"),
+        std::string::npos);
   }
   // the other device's passes: [1, 1 + k), however many it finished before the failure stopped it
   const std::uint64_t k = r.spp();
   ASSERT_GE(k, 1u);
-  EXPECT_NE(error_of([&] { r.accumulation(); })
+  EXPECT_NE(error_message([&] { r.accumulation(); })
                 .find("accumulation: the session's samples [1, " + std::to_string(1 + k) +
                       ") are not one range from 0"),
             std::string::npos)
-      << error_of([&] { r.accumulation(); });
+      << error_message([&] { r.accumulation(); });
   r.render(3);  // samples [1 + k, 4 + k): none twice
-  EXPECT_NE(error_of([&] {
+  EXPECT_NE(error_message([&] {
               r.accumulation();
             }).find("samples [1, " + std::to_string(4 + k) + ") are not one range from 0"),
             std::string::npos)
-      << error_of([&] { r.accumulation(); });
+      << error_message([&] { r.accumulation(); });
   EXPECT_EQ(r.spp(), k + 3);
   r.reset();
   r.render(2);
