@@ -17,10 +17,10 @@ inline constexpr int kMaxDepth = 100000;
 inline constexpr int kMaxDielectricSplits = 4;  // = LC_MAX_SPLITS (kernels/shared/types.h)
 /// Pixel filter radius: (0, kMaxFilterRadius] pixels.
 inline constexpr double kMaxFilterRadius = 8;
-/// Geometry range: every coordinate of the camera, the shapes (a sphere's centre plus or minus its
-/// radius, a mesh's vertices after its transform) and the point lights is at most kMaxCoordinate
-/// in magnitude. The kernel's triangle test multiplies three coordinate differences (edge
-/// functions times a distance), which overflows float near 7e12: beyond this range geometry
+/// Geometry range: every coordinate of the camera position, the shapes (a sphere's centre plus or
+/// minus its radius, a mesh's vertices after its transform) and the point lights is at most
+/// kMaxCoordinate in magnitude. The kernel's triangle test multiplies three coordinate differences
+/// (edge functions times a distance), which overflows float near 7e12: beyond this range geometry
 /// vanished from the image instead of failing. Scales/StabilityScale renders its scene with
 /// coordinates up to 5e11 (at 5e12 it still passed when tried, at 5e13 it failed).
 inline constexpr double kMaxCoordinate = 1e12;

@@ -147,7 +147,7 @@ void check_type(const Reporter& at, E value) {
 
 void validate_camera(const Camera& c, const Reporter& at) {
   check_position(at.at("position"), c.position);
-  check_position(at.at("look_at"), c.look_at);
+  check_point(at.at("look_at"), c.look_at);  // aimed at, not intersected: not in the range
   check_nonzero(at.at("up"), c.up);
   if (!(check_finite(at.at("fov"), c.fov_degrees) > 0 && c.fov_degrees < 180))
     at.at("fov").fail("must be in (0, 180) degrees, got " + format_number(c.fov_degrees));
