@@ -230,9 +230,19 @@ TEST(ProgramCache, CliClearsTheCache) {
   EXPECT_NE(r.out.find(dir), std::string::npos);
   fs::create_directories(dir);
   lucent::test::write_file(dir + "/0123456789abcdef.bin", "x");
+  lucent::test::write_file(dir + "/0123456789abcdef.bin.lock", "");
+  lucent::test::write_file(dir + "/.0123456789abcdef.bin.tmp-12-0", "x");
+  // files the cache did not write stay, whatever their extension (a cache directory given by
+  // mistake, ".", lost every *.bin file in it)
+  lucent::test::write_file(dir + "/weights.bin", "keep");
+  lucent::test::write_file(dir + "/0123456789ABCDEF.bin", "keep");
   r = lucent::test::run_cli("cache clear", "LUCENT_CACHE_DIR='" + dir + "'");
   EXPECT_EQ(r.status, 0);
-  EXPECT_NE(r.out.find("removed 1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("removed 2"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(dir + "/weights.bin"));
+  EXPECT_TRUE(fs::exists(dir + "/0123456789ABCDEF.bin"));
+  EXPECT_FALSE(fs::exists(dir + "/0123456789abcdef.bin.lock"));
+  EXPECT_FALSE(fs::exists(dir + "/.0123456789abcdef.bin.tmp-12-0"));
   // on PoCL with its cache on, where sessions leave caching to PoCL, it says so
   bool pocl = false;
   for (const lucent::cl_util::Device& d : lucent::cl_util::enumerate_devices())

@@ -257,7 +257,8 @@ PYBIND11_MODULE(lucent, m) {
       "clear_cache",
       [](const std::string& dir) { return cl_util::clear_program_cache(resolved_cache_dir(dir)); },
       py::arg("cache_dir") = "",
-      "Removes every cached kernel program from that directory; returns how many.");
+      "Removes every cached kernel program from that directory (only the files the cache "
+      "wrote); returns how many.");
 
   bind_scene(m);
   bind_render(m);

@@ -4,6 +4,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdint>
@@ -290,12 +291,27 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
   return finish(p);
 }
 
+namespace {
+
+/// A file the cache writes: "<16 hex digits>.bin", its ".lock", or a write's hidden temporary
+/// (".<16 hex digits>.bin.tmp-..."). Nothing else in the directory is the cache's to delete: a
+/// cache directory given by mistake (".", a home directory) lost every *.bin file in it.
+bool cache_file_name(std::string name) {
+  if (!name.empty() && name[0] == '.') name.erase(0, 1);
+  if (name.size() < 20 || name.compare(16, 4, ".bin") != 0) return false;
+  return std::all_of(name.begin(), name.begin() + 16,
+                     [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
+}
+
+}  // namespace
+
 int clear_program_cache(const std::string& dir) {
   if (dir.empty()) return 0;
   int n = 0;
   std::error_code ec;
   for (auto& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
+    if (!cache_file_name(name)) continue;
     if (e.path().extension() == ".lock") {
       fs::remove(e.path(), ec);  // build locks: not entries, not counted
       continue;
