@@ -24,6 +24,7 @@
 #include "lucent/image.hpp"
 #include "lucent/parts.hpp"
 #include "lucent/version.hpp"
+#include "render/resources.hpp"
 #include "support.hpp"
 
 namespace {
@@ -294,6 +295,29 @@ TEST(Parts, AdaptiveSessionMakesNoPart) {
     ADD_FAILURE() << "a part of an adaptive render";
   } catch (const lucent::Error& e) {
     EXPECT_NE(std::string(e.what()).find("the session holds an adaptive render"), std::string::npos)
+        << e.what();
+  }
+}
+
+// Reading a part is checked against the host's memory before it decodes (about 256 bytes per
+// pixel): a merge of parts of the largest films could allocate tens of GB unchecked. Here the
+// limit is shrunk so that a 12x10 part stands for a huge one.
+TEST(Parts, ReadingAPartChecksItsMemoryFirst) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::Renderer renderer(lucent::test::session_options());
+  renderer.set_scene(lucent::load_scene(noisy_scene(dir)));
+  lucent::write_render_part(dir + "/p.exr", render_range(renderer, 0, 2));
+  lucent::render_detail::DeviceLimits lim;
+  lim.host_mem = 16 << 10;
+  lucent::render_detail::ScopedLimitOverride o(lim);
+  try {
+    lucent::read_render_part(dir + "/p.exr");
+    ADD_FAILURE() << "read past the memory limit";
+  } catch (const lucent::Error& e) {
+    EXPECT_NE(std::string(e.what()).find(dir + "/p.exr: reading this 12x10 part needs about "),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("more than the limit of 16.0 KiB"), std::string::npos)
         << e.what();
   }
 }

@@ -42,6 +42,13 @@ io::ReadSpec image_read_spec(const char* what) {
   return spec;
 }
 
+io::ReadSpec part_read_spec() {
+  io::ReadSpec spec;
+  spec.what = "part file";
+  spec.max_bytes = kMaxPartFileBytes;
+  return spec;
+}
+
 std::string save_exr_to_memory(const std::string& path, const EXRImage& image,
                                const EXRHeader& header) {
   unsigned char* memory = nullptr;

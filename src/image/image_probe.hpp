@@ -42,6 +42,11 @@ constexpr std::uint64_t kMaxTexturePixels = 1ull << 22;
 #endif
 /// Upper bound on an image file's size.
 constexpr std::uint64_t kMaxImageFileBytes = 4ull << 30;
+/// Upper bound on a part file's size (lucent/parts.hpp): 19 channels of 4 bytes per pixel of the
+/// largest film, and room for headers and compression's overhead. A 16384 x 16384 part holds
+/// about 20 GB; under kMaxImageFileBytes, parts of films above about 9000 x 9000 were written but
+/// could not be read back.
+constexpr std::uint64_t kMaxPartFileBytes = 80ull * kMaxImagePixels + (64ull << 20);
 
 struct Probe {
   Format format = Format::Png;
@@ -115,6 +120,8 @@ ExrChannels read_exr_channels(const unsigned char* data, std::size_t size, const
 
 /// How image files are read: regular files of at most kMaxImageFileBytes.
 io::ReadSpec image_read_spec(const char* what = "image");
+/// How part files are read: regular files of at most kMaxPartFileBytes.
+io::ReadSpec part_read_spec();
 
 /// Encodes `image` as OpenEXR in memory; throws lucent::Error("<path>: cannot encode EXR: ...").
 std::string save_exr_to_memory(const std::string& path, const EXRImage& image,

@@ -20,6 +20,7 @@
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
 #include "lucent/version.hpp"
+#include "render/resources.hpp"
 #include "render/sample_stats.hpp"
 
 namespace lucent {
@@ -346,7 +347,7 @@ void write_render_part(const std::string& path, const RenderPart& part) {
 }
 
 PartInfo read_part_info(const std::string& path) {
-  const std::string bytes = io::read_file(path, image_detail::image_read_spec("part file"));
+  const std::string bytes = io::read_file(path, image_detail::part_read_spec());
   EXRHeader header;
   image_detail::Probe probe =
       image_detail::probe_exr(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(),
@@ -357,9 +358,26 @@ PartInfo read_part_info(const std::string& path) {
 }
 
 RenderPart read_render_part(const std::string& path) {
-  const std::string bytes = io::read_file(path, image_detail::image_read_spec("part file"));
+  const std::string bytes = io::read_file(path, image_detail::part_read_spec());
   if (bytes.size() < 4 || std::memcmp(bytes.data(), "\x76\x2f\x31\x01", 4) != 0)
     throw Error(path + ": not a lucent part file (not an OpenEXR file)");
+  {
+    // what decoding takes, checked before it allocates: about 256 bytes per pixel (the decoded
+    // channels, their float and integer copies, the sums in double), and the file itself
+    EXRHeader header;
+    image_detail::Probe probe =
+        image_detail::probe_exr(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(),
+                                path, image_detail::kMaxImagePixels, header);
+    FreeEXRHeader(&header);
+    const std::uint64_t need =
+        std::uint64_t(probe.width) * std::uint64_t(probe.height) * 256 + bytes.size();
+    const std::uint64_t limit = render_detail::host_memory_allowed();
+    if (limit > 0 && need > limit)
+      throw Error(path + ": reading this " + std::to_string(probe.width) + "x" +
+                  std::to_string(probe.height) + " part needs about " + sys::format_bytes(need) +
+                  " of memory, more than the limit of " + sys::format_bytes(limit) +
+                  " (80% of the host's)");
+  }
   image_detail::ExrChannels exr =
       image_detail::read_exr_channels(reinterpret_cast<const unsigned char*>(bytes.data()),
                                       bytes.size(), path, image_detail::kMaxImagePixels);

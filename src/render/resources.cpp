@@ -181,10 +181,15 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
   check_host_parts(scene, estimate_host_memory(scene, devices), host_limit, limit_what);
 }
 
+std::uint64_t host_memory_allowed() {
+  std::uint64_t limit = sys::host_memory().limit();
+  if (g_override) limit = lowered(limit, g_override->host_mem);
+  return limit;
+}
+
 void check_reference_host_memory(const Scene& scene, int threads) {
   const sys::HostMemory host = sys::host_memory();
-  std::uint64_t limit = host.limit();
-  if (g_override) limit = lowered(limit, g_override->host_mem);
+  const std::uint64_t limit = host_memory_allowed();
   if (limit == 0) return;
   // the kernel's estimate without devices: the reference's accumulation (mean and M2 in double,
   // a count) and result images take what the session's do; with caustics each thread keeps its

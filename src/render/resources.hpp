@@ -100,6 +100,10 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
 /// check_host_memory does.
 void check_reference_host_memory(const Scene& scene, int threads);
 
+/// What lucent allows itself on the host: host_memory_limit(), lowered by a
+/// ScopedLimitOverride's host_mem (0: unknown).
+std::uint64_t host_memory_allowed();
+
 /// An adaptive render's host memory beyond a uniform render's (session.cpp run_adaptive): the
 /// halves A, B and C (sums and sums of squares, counts, launched samples, plans), A's and B's
 /// pilots, the planner's per-pixel temporaries, and with caustics A's and B's light sums.
