@@ -320,6 +320,17 @@ TEST(Parts, ReadingAPartChecksItsMemoryFirst) {
     EXPECT_NE(std::string(e.what()).find("more than the limit of 16.0 KiB"), std::string::npos)
         << e.what();
   }
+  // a file larger than the limit by itself is refused before it is read
+  lim.host_mem = 1 << 10;
+  lucent::render_detail::ScopedLimitOverride tiny(lim);
+  try {
+    lucent::read_part_info(dir + "/p.exr");
+    ADD_FAILURE() << "read a file larger than the memory limit";
+  } catch (const lucent::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is larger than the memory limit of 1.0 KiB"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Parts, DamagedPartFilesAreOneLineErrors) {

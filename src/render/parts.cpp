@@ -346,7 +346,24 @@ void write_render_part(const std::string& path, const RenderPart& part) {
   image_detail::write_render_exr(path, part_result(part), extras);
 }
 
+namespace {
+
+/// A part file is read whole: refused before reading when the file alone exceeds the memory
+/// lucent allows itself (a regular file's size; read_file bounds the rest).
+void check_part_file_size(const std::string& path) {
+  std::error_code ec;
+  const std::uint64_t size = std::filesystem::file_size(path, ec);
+  const std::uint64_t limit = render_detail::host_memory_allowed();
+  if (!ec && limit > 0 && size > limit)
+    throw Error(path + ": this part file (" + sys::format_bytes(size) +
+                ") is larger than the memory limit of " + sys::format_bytes(limit) +
+                " (80% of the host's)");
+}
+
+}  // namespace
+
 PartInfo read_part_info(const std::string& path) {
+  check_part_file_size(path);
   const std::string bytes = io::read_file(path, image_detail::part_read_spec());
   EXRHeader header;
   image_detail::Probe probe =
@@ -358,6 +375,7 @@ PartInfo read_part_info(const std::string& path) {
 }
 
 RenderPart read_render_part(const std::string& path) {
+  check_part_file_size(path);
   const std::string bytes = io::read_file(path, image_detail::part_read_spec());
   if (bytes.size() < 4 || std::memcmp(bytes.data(), "\x76\x2f\x31\x01", 4) != 0)
     throw Error(path + ": not a lucent part file (not an OpenEXR file)");
