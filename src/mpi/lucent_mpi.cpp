@@ -32,6 +32,7 @@ volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_stop_signal(int sig) {
   g_signal = sig;
   g_stop.store(true);
+  std::signal(sig, SIG_DFL);  // a second signal ends the rank at once, as with lucent render
 }
 
 int g_rank = 0, g_size = 1;
