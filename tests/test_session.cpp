@@ -643,3 +643,26 @@ TEST(Session, FailedPassOfOneDeviceLeavesNoFalseRange) {
   r.render(2);
   EXPECT_EQ(r.accumulation().spp, 2u);
 }
+
+// A target call then a budget call: the result's planned relMSE is the last call's plan's, which
+// a budget call has none of (it reported the target call's, stale); the calibration's gains stay,
+// since the estimate still uses them.
+TEST(Session, PlannedRelmseIsTheLastCallsPlan) {
+  Renderer r = session();
+  r.set_scene(lucent::test::scene_from(kScene));
+  lucent::AdaptiveOptions ao;
+  ao.target_error = 1e-2;
+  ao.min_spp = 8;
+  r.render_adaptive(ao);
+  const RenderResult t = r.result();
+  EXPECT_GT(t.planned_relmse, 0.0);
+  EXPECT_GT(t.model_gain_a, 0.0);
+  ao.target_error = 0;
+  ao.budget_spp = 2.0 * double(t.spp) + 8;
+  r.render_adaptive(ao);
+  const RenderResult b = r.result();
+  EXPECT_GT(b.spp, t.spp);
+  EXPECT_EQ(b.target_error, 0.0);
+  EXPECT_EQ(b.planned_relmse, 0.0);
+  EXPECT_EQ(b.model_gain_a, t.model_gain_a);
+}

@@ -88,8 +88,9 @@ struct RenderResult {
   /// error variance for any sampler, Sobol included (noisy on small films); 0 for uniform renders.
   double halves_relmse = 0;
   /// Adaptive renders with a target: the calibration's gains of halves A and B (measured error of
-  /// a pilot over the v / n model's; ~1 with independent samples, < 1 with Sobol), and the
-  /// relMSE the calibrated plans predicted; 0 otherwise.
+  /// a pilot over the v / n model's; ~1 with independent samples, < 1 with Sobol; kept when a
+  /// budget call continues the render, as estimated_relmse still uses them), and the relMSE the
+  /// calibrated plans of the last call predicted (0 when that call had a budget); 0 otherwise.
   double model_gain_a = 0, model_gain_b = 0;
   double planned_relmse = 0;
   /// The key of the render's random numbers: the scene's integrator seed and the sampler's name

@@ -426,7 +426,8 @@ void bind_render(py::module_& m) {
       .def_readonly("model_gain_b", &RenderResult::model_gain_b,
                     "a target render's calibration gain of half B's error model (0: none)")
       .def_readonly("planned_relmse", &RenderResult::planned_relmse,
-                    "the relMSE a target render's calibrated plans predicted (0: none)")
+                    "the relMSE the last call's calibrated plans predicted (0: none, or a budget "
+                    "call)")
       .def_readonly("target_error", &RenderResult::target_error,
                     "the relMSE an adaptive render aimed at (0: not adaptive)")
       .def_property_readonly("target_shortfall", &lucent::target_shortfall,

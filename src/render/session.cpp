@@ -1015,7 +1015,9 @@ struct Renderer::Impl {
       if (calibrated) {
         r.model_gain_a = calib[0].gain;
         r.model_gain_b = calib[1].gain;
-        r.planned_relmse = (planned_relmse[0] + planned_relmse[1]) / 4;
+        // the last call's plan only: after a budget call the target call's prediction is stale
+        // (the gains stay: they still scale estimated_relmse)
+        if (adaptive_target > 0) r.planned_relmse = (planned_relmse[0] + planned_relmse[1]) / 4;
       }
     } else {
       for (size_t i = 0; i < npix; ++i) {
