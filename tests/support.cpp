@@ -103,6 +103,17 @@ void write_file(const std::string& path, const std::string& text) {
 
 std::string read_file(const std::string& path) { return read_all(path); }
 
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const lucent::Error& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    return std::string("unexpected exception type: ") + e.what();
+  }
+  return "";
+}
+
 ScopedEnv::ScopedEnv(const char* name, const char* value) : name_(name) {
   if (const char* old = std::getenv(name)) {
     had_ = true;

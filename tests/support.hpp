@@ -44,6 +44,10 @@ void write_file(const std::string& path, const std::string& text);
 /// The content of `path` ("" when it cannot be read).
 std::string read_file(const std::string& path);
 
+/// The message of the lucent::Error that `f` throws, "" when it throws none, and "unexpected
+/// exception type: ..." for any other exception.
+std::string error_of(const std::function<void()>& f);
+
 /// Sets an environment variable (or unsets it, for nullptr) while alive; restores it after.
 class ScopedEnv {
  public:

@@ -58,15 +58,7 @@ void expect_same_samples(const RenderResult& a, const RenderResult& b) {
   EXPECT_LT(worst, 1e-5);
 }
 
-/// The message of the lucent::Error that f throws ("" when it throws none).
-std::string error_message(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const lucent::Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using lucent::test::error_of;
 
 uint64_t kernel_builds(const SessionStats& s) { return s.kernel_compiles + s.kernel_cache_loads; }
 
@@ -526,10 +518,10 @@ TEST(Session, FailedUploadDropsTheDeviceScene) {
   const RenderResult before = r.result();
   {
     lucent::render_detail::ScopedUploadFault fault;
-    std::string msg = error_message([&] { r.set_scene(s2); });
+    std::string msg = error_of([&] { r.set_scene(s2); });
     EXPECT_NE(msg.find("clCreateBuffer (injected by a test)"), std::string::npos) << msg;
   }
-  std::string msg = error_message([&] { r.render(1); });
+  std::string msg = error_of([&] { r.render(1); });
   EXPECT_NE(msg.find("render: the last set_scene failed, so the devices hold no scene"),
             std::string::npos)
       << msg;
@@ -543,8 +535,7 @@ TEST(Session, FailedUploadDropsTheDeviceScene) {
   // set_build_options refused by the same failure keeps the options the programs were built with
   {
     lucent::render_detail::ScopedUploadFault fault;
-    EXPECT_NE(error_message([&] { r.set_build_options(lucent::Precision::Float, true, true); }),
-              "");
+    EXPECT_NE(error_of([&] { r.set_build_options(lucent::Precision::Float, true, true); }), "");
   }
   EXPECT_FALSE(r.options().fast_math);
 }
@@ -620,24 +611,24 @@ TEST(Session, FailedPassOfOneDeviceLeavesNoFalseRange) {
   r.set_scene(s);
   {
     lucent::render_detail::ScopedPassFault fault(0);
-    EXPECT_NE(
-        error_message([&] { r.render(8); }).find("clEnqueueNDRangeKernel (injected by a test)"),
-        std::string::npos);
+    EXPECT_NE(error_of([&] { r.render(8); }).find("clEnqueueNDRangeKernel (injected by a test)"),
+              std::string::npos);
   }
   // the other device's passes: [1, 1 + k), however many it finished before the failure stopped it
   const std::uint64_t k = r.spp();
   ASSERT_GE(k, 1u);
-  EXPECT_NE(error_message([&] { r.accumulation(); })
-                .find("accumulation: the session's samples [1, " + std::to_string(1 + k) +
-                      ") are not one range from 0"),
-            std::string::npos)
-      << error_message([&] { r.accumulation(); });
+  EXPECT_NE(
+      error_of([&] { r.accumulation(); })
+          .find("accumulation: the session holds " + std::to_string(k) +
+                " samples per pixel of [0, " + std::to_string(1 + k) + "), not one range from 0"),
+      std::string::npos)
+      << error_of([&] { r.accumulation(); });
   r.render(3);  // samples [1 + k, 4 + k): none twice
-  EXPECT_NE(error_message([&] {
-              r.accumulation();
-            }).find("samples [1, " + std::to_string(4 + k) + ") are not one range from 0"),
+  EXPECT_NE(error_of([&] { r.accumulation(); })
+                .find("holds " + std::to_string(k + 3) + " samples per pixel of [0, " +
+                      std::to_string(4 + k) + "), not one range from 0"),
             std::string::npos)
-      << error_message([&] { r.accumulation(); });
+      << error_of([&] { r.accumulation(); });
   EXPECT_EQ(r.spp(), k + 3);
   r.reset();
   r.render(2);

@@ -353,11 +353,12 @@ namespace {
 void check_part_file_size(const std::string& path) {
   std::error_code ec;
   const std::uint64_t size = std::filesystem::file_size(path, ec);
-  const std::uint64_t limit = render_detail::host_memory_allowed();
+  std::string what;
+  const std::uint64_t limit = render_detail::host_memory_allowed(&what);
   if (!ec && limit > 0 && size > limit)
     throw Error(path + ": this part file (" + sys::format_bytes(size) +
-                ") is larger than the memory limit of " + sys::format_bytes(limit) +
-                " (80% of the host's)");
+                ") is larger than the memory limit of " + sys::format_bytes(limit) + " (80% of " +
+                what + ")");
 }
 
 }  // namespace
@@ -389,12 +390,13 @@ RenderPart read_render_part(const std::string& path) {
     FreeEXRHeader(&header);
     const std::uint64_t need =
         std::uint64_t(probe.width) * std::uint64_t(probe.height) * 256 + bytes.size();
-    const std::uint64_t limit = render_detail::host_memory_allowed();
+    std::string what;
+    const std::uint64_t limit = render_detail::host_memory_allowed(&what);
     if (limit > 0 && need > limit)
       throw Error(path + ": reading this " + std::to_string(probe.width) + "x" +
                   std::to_string(probe.height) + " part needs about " + sys::format_bytes(need) +
-                  " of memory, more than the limit of " + sys::format_bytes(limit) +
-                  " (80% of the host's)");
+                  " of memory, more than the limit of " + sys::format_bytes(limit) + " (80% of " +
+                  what + ")");
   }
   image_detail::ExrChannels exr =
       image_detail::read_exr_channels(reinterpret_cast<const unsigned char*>(bytes.data()),

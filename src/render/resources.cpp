@@ -57,15 +57,12 @@ DeviceLimits DeviceLimits::of(const cl_util::Device& device) {
   DeviceLimits d;
   d.max_alloc = device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
   d.global_mem = device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
-  const HostMemory host = host_memory();
-  d.host_mem = host.limit();
-  d.host_what = host.what;
+  d.host_mem = host_memory_allowed(&d.host_what);
   d.host_unified = (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
   d.device = device.info.name;
   if (g_override) {
     d.max_alloc = lowered(d.max_alloc, g_override->max_alloc);
     d.global_mem = lowered(d.global_mem, g_override->global_mem);
-    d.host_mem = lowered(d.host_mem, g_override->host_mem);
   }
   return d;
 }
@@ -181,15 +178,17 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
   check_host_parts(scene, estimate_host_memory(scene, devices), host_limit, limit_what);
 }
 
-std::uint64_t host_memory_allowed() {
-  std::uint64_t limit = sys::host_memory().limit();
+std::uint64_t host_memory_allowed(std::string* what) {
+  const sys::HostMemory host = sys::host_memory();
+  if (what) *what = host.what;
+  std::uint64_t limit = host.limit();
   if (g_override) limit = lowered(limit, g_override->host_mem);
   return limit;
 }
 
 void check_reference_host_memory(const Scene& scene, int threads) {
-  const sys::HostMemory host = sys::host_memory();
-  const std::uint64_t limit = host_memory_allowed();
+  std::string what;
+  const std::uint64_t limit = host_memory_allowed(&what);
   if (limit == 0) return;
   // the kernel's estimate without devices: the reference's accumulation (mean and M2 in double,
   // a count) and result images take what the session's do; with caustics each thread keeps its
@@ -201,7 +200,7 @@ void check_reference_host_memory(const Scene& scene, int threads) {
       p.what += ", one per thread (" + std::to_string(threads) + ")";
       p.reduce = "the film size or the reference's threads, or render without caustics";
     }
-  check_host_parts(scene, parts, limit, host.what.empty() ? "physical memory" : host.what);
+  check_host_parts(scene, parts, limit, what);
 }
 
 std::uint64_t adaptive_host_bytes(std::uint64_t npix, bool caustics) {

@@ -101,8 +101,9 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
 void check_reference_host_memory(const Scene& scene, int threads);
 
 /// What lucent allows itself on the host: host_memory_limit(), lowered by a
-/// ScopedLimitOverride's host_mem (0: unknown).
-std::uint64_t host_memory_allowed();
+/// ScopedLimitOverride's host_mem (0: unknown); `what` (when given) receives what the limit is
+/// 80% of ("physical memory", ...), for messages.
+std::uint64_t host_memory_allowed(std::string* what = nullptr);
 
 /// An adaptive render's host memory beyond a uniform render's (session.cpp run_adaptive): the
 /// halves A, B and C (sums and sums of squares, counts, launched samples, plans), A's and B's

@@ -218,23 +218,10 @@ struct Renderer::Impl {
   std::vector<double> sum, sumsq;
   std::vector<std::uint32_t> count;
   std::uint64_t first = 0, done = 0, nonfinite = 0, rays = 0;
-  /// The sample ranges accumulated, sorted and merged: [first, first + done) unless a pass failed
-  /// while other devices' later passes were accumulated (then with a gap). The next render starts
-  /// after the last, so that no sample index is rendered twice.
-  std::vector<std::pair<std::uint64_t, std::uint64_t>> ranges;
-  void add_range(std::uint64_t b, std::uint64_t e) {
-    auto it = std::lower_bound(ranges.begin(), ranges.end(), std::make_pair(b, e));
-    it = ranges.insert(it, {b, e});
-    // merge with the neighbours it touches
-    if (it != ranges.begin() && std::prev(it)->second == it->first) {
-      std::prev(it)->second = it->second;
-      it = std::prev(ranges.erase(it));
-    }
-    if (std::next(it) != ranges.end() && it->second == std::next(it)->first) {
-      it->second = std::next(it)->second;
-      ranges.erase(std::next(it));
-    }
-  }
+  /// The end of the sample indices accumulated: first + done, unless a pass failed while other
+  /// devices' later passes were accumulated (then the samples are not one range from first). The
+  /// next render starts there, so that no sample index is rendered twice.
+  std::uint64_t end_index = 0;
   // caustics (docs/rendering-model.md): the light paths' sums of contributions and of their
   // squares per pixel, and the number of light paths
   std::vector<double> light_sum, light_sumsq;
@@ -269,7 +256,7 @@ struct Renderer::Impl {
     light_paths = 0;
     first = first_sample;
     done = nonfinite = rays = 0;
-    ranges.clear();
+    end_index = first_sample;
     render_seconds = 0;
     last_cancelled = false;
     for (auto& w : workers) w->share.samples = w->share_samples = 0, w->share.seconds = 0;
@@ -635,7 +622,7 @@ struct Renderer::Impl {
     begin_call();
     CallState cs;
     std::uint64_t started = 0, finished = 0;  // samples per pixel of this call
-    const std::uint64_t start_index = ranges.empty() ? first + done : ranges.back().second;
+    const std::uint64_t start_index = end_index;
     // the sampler takes 32-bit sample indices: past 2^32 samples would repeat
     const std::uint64_t index_end = std::uint64_t(1) << 32;
     if (start_index >= index_end || (target_spp > 0 && target_spp > index_end - start_index))
@@ -656,7 +643,7 @@ struct Renderer::Impl {
     };
     auto finish = [&](Worker& w, const Job& job) {
       accumulate(w, job.n);
-      add_range(job.begin, job.begin + job.n);
+      end_index = std::max(end_index, job.begin + job.n);
       finished += job.n;
       w.call.samples += job.n;
       w.share.samples += job.n;
@@ -1146,17 +1133,12 @@ Accumulation Renderer::accumulation() const {
   a.light_paths = m.light_paths;
   // with a gap (a device's pass failed, later passes of others were kept) the samples are not one
   // range from first_sample: a part claiming [first, first + spp) would be wrong
-  if (!m.ranges.empty() &&
-      (m.ranges.size() > 1 || m.ranges.front() != std::make_pair(m.first, m.first + m.done))) {
-    std::string held;
-    for (const auto& r : m.ranges)
-      held += (held.empty() ? "" : ", ") + std::string("[") + std::to_string(r.first) + ", " +
-              std::to_string(r.second) + ")";
-    throw Error("accumulation: the session's samples " + held + " are not one range from " +
-                std::to_string(m.first) +
+  if (m.end_index != m.first + m.done)
+    throw Error("accumulation: the session holds " + std::to_string(m.done) +
+                " samples per pixel of [" + std::to_string(m.first) + ", " +
+                std::to_string(m.end_index) + "), not one range from " + std::to_string(m.first) +
                 " (a device's pass failed while others' later passes were kept); call reset() to "
                 "render a part again");
-  }
   a.first_sample = m.first;
   a.spp = m.done;
   a.nonfinite = m.nonfinite;
