@@ -31,6 +31,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using lucent::test::CommandResult;
+using lucent::test::error_of;
 using lucent::test::run_cli;
 
 std::string q(const std::string& s) { return "'" + s + "'"; }
@@ -290,13 +291,8 @@ TEST(Parts, AdaptiveSessionMakesNoPart) {
   lucent::AdaptiveOptions ao;
   ao.budget_spp = 8;
   renderer.render_adaptive(ao);
-  try {
-    lucent::make_part(renderer, {0, 8}, "scene.json");
-    ADD_FAILURE() << "a part of an adaptive render";
-  } catch (const lucent::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("the session holds an adaptive render"), std::string::npos)
-        << e.what();
-  }
+  const std::string msg = error_of([&] { lucent::make_part(renderer, {0, 8}, "scene.json"); });
+  EXPECT_NE(msg.find("the session holds an adaptive render"), std::string::npos) << msg;
 }
 
 // Reading a part is checked against the host's memory before it decodes (about 256 bytes per
@@ -310,27 +306,15 @@ TEST(Parts, ReadingAPartChecksItsMemoryFirst) {
   lucent::render_detail::DeviceLimits lim;
   lim.host_mem = 16 << 10;
   lucent::render_detail::ScopedLimitOverride o(lim);
-  try {
-    lucent::read_render_part(dir + "/p.exr");
-    ADD_FAILURE() << "read past the memory limit";
-  } catch (const lucent::Error& e) {
-    EXPECT_NE(std::string(e.what()).find(dir + "/p.exr: reading this 12x10 part needs about "),
-              std::string::npos)
-        << e.what();
-    EXPECT_NE(std::string(e.what()).find("more than the limit of 16.0 KiB"), std::string::npos)
-        << e.what();
-  }
+  std::string msg = error_of([&] { lucent::read_render_part(dir + "/p.exr"); });
+  EXPECT_NE(msg.find(dir + "/p.exr: reading this 12x10 part needs about "), std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("more than the limit of 16.0 KiB"), std::string::npos) << msg;
   // a file larger than the limit by itself is refused before it is read
   lim.host_mem = 1 << 10;
   lucent::render_detail::ScopedLimitOverride tiny(lim);
-  try {
-    lucent::read_part_info(dir + "/p.exr");
-    ADD_FAILURE() << "read a file larger than the memory limit";
-  } catch (const lucent::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("is larger than the memory limit of 1.0 KiB"),
-              std::string::npos)
-        << e.what();
-  }
+  msg = error_of([&] { lucent::read_part_info(dir + "/p.exr"); });
+  EXPECT_NE(msg.find("is larger than the memory limit of 1.0 KiB"), std::string::npos) << msg;
 }
 
 TEST(Parts, DamagedPartFilesAreOneLineErrors) {

@@ -84,14 +84,7 @@ std::uint64_t part(const std::vector<MemoryPart>& parts, const std::string& pref
   return 0;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const lucent::Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using lucent::test::error_of;
 
 // The estimate made before packing covers what packing then allocates, within a small factor.
 TEST(Resources, HostEstimateCoversThePackedScene) {

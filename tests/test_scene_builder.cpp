@@ -20,17 +20,7 @@ namespace {
 
 using lucent::SceneBuilder;
 
-/// The message of the lucent::Error `f` throws, or "" if none.
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const lucent::Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    return std::string("unexpected exception type: ") + e.what();
-  }
-  return "";
-}
+using lucent::test::error_of;
 
 std::string json_error(const std::string& json) {
   return error_of([&] { lucent::parse_scene(json, "scene.json"); });
