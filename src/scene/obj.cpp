@@ -3,7 +3,6 @@
 // triangle list, MTL materials mapped by obj_mtl.cpp (docs/obj-mtl.md).
 #include <tiny_obj_loader.h>
 
-#include <cfloat>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -92,14 +91,13 @@ void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform
     glm::dvec3 w = glm::dvec3(transform * glm::dvec4(p, 1.0));
     // a vertex (after the transform) beyond the geometry range is refused: the kernel's float
     // arithmetic would make it vanish (lucent/limits.hpp)
-    for (int c = 0; c < 3; ++c)
-      if (!(std::abs(w[c]) <= limits::kMaxCoordinate)) {
-        std::ostringstream where;
-        where << "vertex " << i + 1 << " (" << w.x << ", " << w.y << ", " << w.z << ")"
-              << (transform == glm::dmat4(1.0) ? "" : " after the transform");
-        throw Error(path + ":" + std::to_string(obj::line_of_statement(text, "v", i)) + ": " +
-                    scene_detail::beyond_geometry_range(where.str()));
-      }
+    if (!(max_abs(w) <= limits::kMaxCoordinate)) {
+      std::ostringstream where;
+      where << "vertex " << i + 1 << " (" << w.x << ", " << w.y << ", " << w.z << ")"
+            << (transform == glm::dmat4(1.0) ? "" : " after the transform");
+      throw Error(path + ":" + std::to_string(obj::line_of_statement(text, "v", i)) + ": " +
+                  beyond_geometry_range(where.str()));
+    }
     scene.positions.push_back(w);
   }
   std::vector<bool> normal_ok(nn);

@@ -3,8 +3,6 @@
 // element's place, then adds it.
 #include "lucent/scene_builder.hpp"
 
-#include <algorithm>
-#include <cfloat>
 #include <cmath>
 #include <utility>
 
@@ -116,7 +114,7 @@ void SceneBuilder::add_mesh(const MeshShape& mesh) {
   const int uvbase = static_cast<int>(scene_.uvs.size());
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     const glm::dvec3 w = glm::dvec3(xf * glm::dvec4(mesh.positions[i], 1.0));
-    const double m = std::max({std::abs(w.x), std::abs(w.y), std::abs(w.z)});
+    const double m = scene_detail::max_abs(w);
     if (!(m <= limits::kMaxCoordinate))
       Reporter(scene_.path, p + "/positions/" + std::to_string(i))
           .fail(scene_detail::beyond_geometry_range(

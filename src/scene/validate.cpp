@@ -65,6 +65,10 @@ void check_point(const Reporter& at, const glm::dvec3& v) {
   for (int i = 0; i < 3; ++i) check_finite(at.at(i), v[i]);
 }
 
+double max_abs(const glm::dvec3& v) {
+  return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+}
+
 std::string beyond_geometry_range(const std::string& what) {
   return what + " is beyond lucent's geometry range (coordinates of magnitude at most " +
          format_number(limits::kMaxCoordinate) +
@@ -251,9 +255,7 @@ void validate_light(const Light& l, std::size_t textures, const Reporter& at) {
 namespace {
 
 /// The largest coordinate magnitude of a sphere's points.
-double sphere_reach(const glm::dvec3& c, double r) {
-  return std::max({std::abs(c.x), std::abs(c.y), std::abs(c.z)}) + r;
-}
+double sphere_reach(const glm::dvec3& c, double r) { return max_abs(c) + r; }
 
 void check_sphere_reach(const Reporter& at, const glm::dvec3& c, double r) {
   if (sphere_reach(c, r) > limits::kMaxCoordinate)
@@ -374,10 +376,8 @@ void validate_scene(const Scene& s) {
     // a finite vertex beyond the geometry range (non-finite ones are dropped by pack_scene)
     int far = -1;
     for (int k = 0; k < 3 && ok; ++k)
-      for (int c = 0; c < 3; ++c)
-        if (std::abs(s.positions[t.v[k]][c]) > limits::kMaxCoordinate &&
-            finite(s.positions[t.v[k]]))
-          far = k;
+      if (finite(s.positions[t.v[k]]) && max_abs(s.positions[t.v[k]]) > limits::kMaxCoordinate)
+        far = k;
     if (ok && far < 0) continue;
     const Reporter at(file, primitive_place(s, ShapeType::Triangle, i, "triangles", "triangle"));
     check_index(at.at("material"), t.material, nm, "materials");

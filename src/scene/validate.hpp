@@ -71,6 +71,8 @@ void check_positive(const Reporter& at, double v);                       ///< fi
 void check_non_negative(const Reporter& at, double v);                   ///< finite and >= 0
 void check_between(const Reporter& at, double v, double lo, double hi);  ///< finite, in [lo, hi]
 void check_point(const Reporter& at, const glm::dvec3& v);               ///< finite components
+/// The largest magnitude of v's components (what limits::kMaxCoordinate bounds).
+double max_abs(const glm::dvec3& v);
 /// A position in the scene: finite components of magnitude <= limits::kMaxCoordinate.
 void check_position(const Reporter& at, const glm::dvec3& v);
 /// "<subject> is beyond lucent's geometry range (...)": the message for a coordinate beyond
