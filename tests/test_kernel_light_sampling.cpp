@@ -198,6 +198,94 @@ TEST(KernelLightSampling, EnvironmentMap) {
                     "environment map");
 }
 
+// An environment map whose texels' shares lie far apart: texel (10, 16) holds nearly all the
+// weight, every other texel about 2.8 lattice steps (2^-24) of it.
+std::string write_lopsided_env_map(int w, int h) {
+  lucent::Image env{w, h, std::vector<float>(size_t(w) * h * 3, 1.0f)};
+  for (int c = 0; c < 3; ++c) env.pixel(10, h / 2)[c] = 6e6f;
+  std::string path = lucent::test::temp_dir() + "/lopsided.pfm";
+  lucent::write_image(path, env);
+  return path;
+}
+
+// The texel CDF of an environment map lies on the lattice of the kernel's random numbers, as the
+// light-selection CDF does (below): a texel's probability is exactly its interval, the pdf the
+// kernel divides by. Rounded to floats on their own, the entries below 1/2 fell between lattice
+// points, and a texel of 2.8 steps was drawn with 2 or 3 steps' probability (+-36%).
+TEST(KernelLightSampling, EnvironmentMapCdfLiesOnTheLattice) {
+  const int w = 64, h = 32;
+  lucent::Scene s = lucent::test::scene_from(R"({"lights": [{"type": "environment", "file": ")" +
+                                             write_lopsided_env_map(w, h) + R"("}]})");
+  const lucent::render_detail::PackedScene p = lucent::render_detail::pack_scene(s);
+  ASSERT_EQ(p.lights.size(), 1u);
+  const size_t first = p.lights[0].p.env_map.cdf;
+  ASSERT_EQ(p.light_cdf.size(), first + w * h + 1);
+  EXPECT_EQ(p.light_cdf[first], 0.0f);
+  EXPECT_EQ(p.light_cdf.back(), 1.0f);
+  int small = 0;
+  for (size_t i = first; i < p.light_cdf.size(); ++i) {
+    const double k = double(p.light_cdf[i]) * 16777216.0;
+    ASSERT_EQ(k, std::floor(k)) << "texel cdf[" << i - first << "] is not on the 2^-24 lattice";
+    if (i > first) {
+      ASSERT_GE(p.light_cdf[i], p.light_cdf[i - 1]) << i - first;
+      small += p.light_cdf[i] - p.light_cdf[i - 1] < 4.0f / 16777216.0f;
+    }
+  }
+  EXPECT_GT(small, w * h / 2) << "the map no longer has texels of a few lattice steps";
+}
+
+// The point inside the chosen texel is uniform over the texel, however few lattice points choose
+// it: (u3, u2) place it across and down the texel. It used to be u1 rescaled to the texel's
+// interval, which for a texel of 2 or 3 lattice points gave 2 or 3 columns of directions.
+// Stratified (u3, u2) must come back as the point's position in the texel (to 1e-3), the
+// direction must fall in the texel, and its pdf must be the texel's interval over its solid
+// angle, as the pdf function gives.
+TEST(KernelLightSampling, EnvironmentMapPointsFillTheTexel) {
+  const int w = 64, h = 32, tx = 40, ty = h / 2, G = 16;
+  lucent::Scene scene =
+      lucent::test::scene_from(R"({"lights": [{"type": "environment", "file": ")" +
+                               write_lopsided_env_map(w, h) + R"("}]})");
+  const lucent::render_detail::PackedScene packed = lucent::render_detail::pack_scene(scene);
+  const size_t k = packed.lights[0].p.env_map.cdf + size_t(ty) * w + tx;
+  const double lo = double(packed.light_cdf[k]) * 16777216.0,
+               hi = double(packed.light_cdf[k + 1]) * 16777216.0;
+  ASSERT_GE(hi - lo, 1.0) << "the texel has no lattice point";
+  ASSERT_LE(hi - lo, 4.0) << "the texel should have a few lattice points only";
+
+  std::vector<cl_float4> u;
+  for (double m = lo; m < hi; ++m)
+    for (int i = 0; i < G; ++i)
+      for (int j = 0; j < G; ++j)
+        u.push_back({{0.5f, float(m / 16777216.0), (i + 0.5f) / G, (j + 0.5f) / G}});
+  Probe& pr = probe();
+  lucent::render_detail::DeviceScene dev(pr.ctx, packed);
+  const cl_float4 p = {{0, 0, 0, 0}};
+  cl::Buffer bu(pr.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                u.size() * sizeof(cl_float4), u.data());
+  cl::Buffer out(pr.ctx.context, CL_MEM_WRITE_ONLY, u.size() * sizeof(cl_float4));
+  cl::Kernel ks(pr.program, "probe_light_sample_with");
+  int a = dev.set_args(ks);
+  ks.setArg(a++, p);
+  ks.setArg(a++, bu);
+  ks.setArg(a++, out);
+  pr.ctx.queue.enqueueNDRangeKernel(ks, cl::NullRange, cl::NDRange(u.size()), cl::NullRange);
+  std::vector<cl_float4> s(u.size());
+  pr.ctx.queue.enqueueReadBuffer(out, CL_TRUE, 0, s.size() * sizeof(cl_float4), s.data());
+
+  const double n = double(w) * h, texel_p = (hi - lo) / 16777216.0;
+  for (size_t i = 0; i < s.size(); ++i) {
+    ASSERT_GT(s[i].s[3], 0.0f) << "sample " << i << " was not produced";
+    const double dx = s[i].s[0], dy = s[i].s[1], dz = s[i].s[2];
+    // docs/rendering-model.md: u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi
+    const double uu = 0.5 + std::atan2(dx, -dz) / (2 * M_PI), vv = std::acos(dy) / M_PI;
+    const double fu = uu * w - tx, fv = vv * h - ty;
+    ASSERT_NEAR(fu, u[i].s[3], 1e-3) << "sample " << i << ": across the texel";
+    ASSERT_NEAR(fv, u[i].s[2], 1e-3) << "sample " << i << ": down the texel";
+    const double sin_t = std::sqrt(dx * dx + dz * dz);
+    EXPECT_NEAR(s[i].s[3], texel_p * n / (2 * M_PI * M_PI * sin_t), 1e-4 * s[i].s[3]) << i;
+  }
+}
+
 TEST(KernelLightSampling, PowerProportionalMixture) {
   chi_square_lights(std::string("{") + kMats + R"(, "shapes": [
       {"type": "sphere", "center": [2, 0.3, 0.2], "radius": 0.5, "material": "lamp"},

@@ -81,7 +81,8 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
       }
       if (depth + 2 > P->max_depth) break;
       lc_uint dim = LC_DIM_BOUNCE + depth * LC_DIMS_PER_BOUNCE;
-      /* light point, light selection, lobe; BSDF direction, Russian roulette */
+      /* light point, light selection, lobe; BSDF direction, Russian roulette, the point inside
+       * an environment map's texel */
       float8 u = lc_rand8(rng, dim);
       float4 u_light = u.lo, u_bsdf = u.hi;
       lc_bsdf b = bsdf_from_material(s, m, it.uv, it.front);
@@ -95,7 +96,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
       lc_uint lobes = bsdf_lobes(&b);
       if (!(lobes & LC_BSDF_DELTA) && P->num_lights > 0) {
         lc_light_sample ls;
-        if (light_sample(s, o, u_light.z, u_light.x, u_light.y, &ls) && ls.pdf > 0.0f) {
+        if (light_sample(s, o, u_light.z, u_light.x, u_light.y, u_bsdf.w, &ls) && ls.pdf > 0.0f) {
           int behind = !(dot(ls.wi, it.ng) > LC_REAL(0.0));
           float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
           /* the side of the geometric surface decides the lobe, and the shading frame must

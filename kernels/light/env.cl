@@ -4,7 +4,7 @@
 #define LUCENT_LIGHT_ENV_CL
 
 static inline int light_env_sample(const lc_scene* s, __global const lc_light* L, lc_real3 p,
-                                   float u1, float u2, lc_light_sample* ls) {
+                                   float u1, float u2, float u3, lc_light_sample* ls) {
   ls->wi = lc_real3_from_float3(sample_uniform_sphere(u1, u2));
   ls->dist = INFINITY;
   ls->L = lc_load3(L->p.env.radiance);

@@ -18,15 +18,18 @@ static inline float3 env_map_radiance(const lc_scene* s, __global const lc_light
 }
 
 static inline int light_env_map_sample(const lc_scene* s, __global const lc_light* L, lc_real3 p,
-                                       float u1, float u2, lc_light_sample* ls) {
+                                       float u1, float u2, float u3, lc_light_sample* ls) {
   __global const lc_texture* tex = &s->textures[L->p.env_map.texture];
   lc_uint n = tex->width * tex->height;
   __global const float* cdf = s->light_cdf + L->p.env_map.cdf; /* n + 1 entries, cdf[0] = 0 */
+  /* u1 chooses the texel: the CDF lies on the 2^-24 lattice of u1 (src/render/lights.cpp), so
+   * hi - lo is exactly the texel's probability. The point inside the texel comes from two other
+   * numbers: u1 rescaled to the texel would take only (hi - lo) 2^24 values, a handful for the
+   * texels of a large map. */
   lc_uint k = lc_cdf_search(cdf + 1, n, u1);
   float lo = cdf[k], hi = cdf[k + 1];
-  float fx = hi > lo ? (u1 - lo) / (hi - lo) : 0.5f;
   lc_uint x = k % tex->width, y = k / tex->width;
-  float u = ((float)x + clamp(fx, 0.0f, 0.99999f)) / (float)tex->width;
+  float u = ((float)x + u3) / (float)tex->width;
   float v = ((float)y + u2) / (float)tex->height;
   /* theta = pi v, phi = 2 pi (u - 1/2) */
   float st = sinpi(v);

@@ -3,8 +3,10 @@
  * sets them: 90% by power, 10% uniform). Each light type of shared/registry.h (LC_LIGHT_TYPES)
  * has its file light/<file>.cl defining
  *   int    light_<file>_sample(const lc_scene* s, __global const lc_light* L, lc_real3 p,
- *                              float u1, float u2, lc_light_sample* ls)
- *            a direction from p towards the light, its radiance and pdf (selection included)
+ *                              float u1, float u2, float u3, lc_light_sample* ls)
+ *            a direction from p towards the light, its radiance and pdf (selection included);
+ *            u1, u2 a pair (a point on the light), u3 a number for lights that need a third
+ *            (an environment map: u1 chooses the texel, u3 and u2 the point inside it)
  *   float  light_<file>_pdf(const lc_scene* s, __global const lc_light* L, lc_real3 p, float3 d,
  *                           lc_real dist, float cos_l)
  *            the solid-angle pdf (selection included) with which _sample from p produces the
@@ -87,10 +89,10 @@ static inline float light_pdf(const lc_scene* s, lc_uint light, lc_real3 p, floa
 
 #define LC_LIGHT_SAMPLE(ID, Name, value, name, feature, file, params) \
   if (LC_ENABLED(feature) && L->type == LC_LIGHT_##ID)                \
-    return light_##file##_sample(s, L, p, u1, u2, ls);
-/* Chooses a light with us and samples it from p with u1, u2. */
+    return light_##file##_sample(s, L, p, u1, u2, u3, ls);
+/* Chooses a light with us and samples it from p with u1, u2, u3. */
 static inline int light_sample(const lc_scene* s, lc_real3 p, float us, float u1, float u2,
-                               lc_light_sample* ls) {
+                               float u3, lc_light_sample* ls) {
   __global const lc_params* P = s->params;
   if (P->num_lights == 0) return 0;
   lc_uint li = lc_cdf_search(s->light_cdf, P->num_lights, us);

@@ -4,7 +4,7 @@
 #define LUCENT_LIGHT_POINT_CL
 
 static inline int light_point_sample(const lc_scene* s, __global const lc_light* L, lc_real3 p,
-                                     float u1, float u2, lc_light_sample* ls) {
+                                     float u1, float u2, float u3, lc_light_sample* ls) {
   lc_real3 to = lc_load3r(L->p.point.position) - p;
   lc_real d2 = dot(to, to);
   if (!(d2 > LC_REAL(0.0))) return 0;

@@ -5,7 +5,7 @@
 #define LUCENT_LIGHT_SPHERE_CL
 
 static inline int light_sphere_sample(const lc_scene* s, __global const lc_light* L, lc_real3 p,
-                                      float u1, float u2, lc_light_sample* ls) {
+                                      float u1, float u2, float u3, lc_light_sample* ls) {
   __global const lc_sphere* sp = &s->spheres[L->p.sphere.sphere];
   lc_real3 c = lc_load3r(sp->center);
   lc_real r = sp->radius;

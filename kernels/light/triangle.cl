@@ -5,7 +5,7 @@
 #define LUCENT_LIGHT_TRIANGLE_CL
 
 static inline int light_triangle_sample(const lc_scene* s, __global const lc_light* L, lc_real3 p,
-                                        float u1, float u2, lc_light_sample* ls) {
+                                        float u1, float u2, float u3, lc_light_sample* ls) {
   __global const lc_triangle* tri = &s->triangles[L->p.triangle.triangle];
   lc_real3 v0 = lc_load3r(tri->v0), v1 = lc_load3r(tri->v1), v2 = lc_load3r(tri->v2);
   /* barycentrics in lc_real: in float their sum is off 1 by an ulp, which puts q ~1e-7 |v| off

@@ -12,7 +12,8 @@
  *   0,1  pixel filter offset       2,3  lens point
  *   then LC_DIMS_PER_BOUNCE = 8 per bounce, from LC_DIM_BOUNCE + 8 * depth:
  *   +0,+1 point on the light   +2 light selection, +3 BSDF lobe   +4,+5 BSDF direction
- *   +6 Russian roulette, +7 unused
+ *   +6 Russian roulette, +7 the point inside an environment map's texel (with +1; +0 picks
+ *   the texel)
  * Groups of four (4k .. 4k + 3) are what one call of lc_independent_quad gives; lc_*_pair give
  * one pair. The reference's filters draw extra pairs from dimension 0x40000000 on.
  *
@@ -48,7 +49,8 @@
 #define LC_DIM_LIGHT_SELECT 2u /* pair with the lobe: choose a light                  */
 #define LC_DIM_BSDF_LOBE 3u    /* choose a lobe (glass, plastic)                      */
 #define LC_DIM_BSDF_UV 4u      /* pair: BSDF direction                                */
-#define LC_DIM_RR 6u           /* pair with an unused number: Russian roulette        */
+#define LC_DIM_RR 6u           /* pair with the next: Russian roulette                */
+#define LC_DIM_LIGHT_TEXEL 7u  /* across an env. map's texel (down: LC_DIM_LIGHT_UV+1) */
 /* The light path of a camera sample (integrator.caustics, docs/rendering-model.md): from
  * LC_DIM_LIGHT_PATH, +0,+1 point on the light, +2 light selection, +4,+5 emitted direction; then
  * 8 per scattering vertex i = 1, 2, ... from LC_DIM_LIGHT_PATH + 8 i with the offsets above

@@ -15,8 +15,32 @@ namespace {
 
 using scene_detail::put3;
 
-/// The texel CDF of an environment map (luminance x sin(theta), n + 1 entries from 0 to 1),
-/// appended to `cdf`.
+/// The kernel draws its numbers on the lattice k / 2^24 (lc_u01) and lc_cdf_search takes the
+/// first entry i with u < cdf[i]. A CDF whose entries lie on that lattice gives each interval
+/// exactly the probability the kernel divides by, the difference of its two ends: rounded to
+/// floats on their own, the two differ by up to 2^-24, which is 6% of a light's share among a
+/// million lights or of a texel's among a 2048 x 1024 map's.
+constexpr double kLattice = 16777216.0;  // 2^24
+
+/// Appends the lattice CDF of the weights `w` (non-negative, summing to `total` > 0): entry i is
+/// the running sum rounded to the lattice, kept non-decreasing; the last is 1.
+void append_lattice_cdf(const std::vector<double>& w, double total, std::vector<float>& cdf) {
+  double run = 0;
+  std::uint32_t prev = 0;
+  for (size_t i = 0; i < w.size(); ++i) {
+    run += w[i];
+    std::uint32_t q = i + 1 == w.size()
+                          ? std::uint32_t(kLattice)
+                          : std::uint32_t(std::clamp(std::llround(run / total * kLattice),
+                                                     (long long)prev, (long long)kLattice));
+    cdf.push_back(static_cast<float>(q / kLattice));
+    prev = q;
+  }
+}
+
+/// The texel CDF of an environment map (luminance x sin(theta), n + 1 entries from 0 to 1, on
+/// the lattice), appended to `cdf`. A texel whose share is below a lattice step may get
+/// none: light sampling then never picks it, its pdf is 0, and BSDF sampling alone covers it.
 void append_env_map_cdf(const Texture& t, std::vector<float>& cdf) {
   std::vector<double> w(static_cast<size_t>(t.width) * t.height);
   double total_w = 0;
@@ -29,13 +53,9 @@ void append_env_map_cdf(const Texture& t, std::vector<float>& cdf) {
       total_w += lum * sin_t;
     }
   }
-  double run = 0;
+  if (!(total_w > 0)) std::fill(w.begin(), w.end(), 1.0), total_w = double(w.size());
   cdf.push_back(0.0f);
-  for (double v : w) {
-    run += total_w > 0 ? v / total_w : 1.0 / w.size();
-    cdf.push_back(static_cast<float>(run));
-  }
-  cdf.back() = 1.0f;
+  append_lattice_cdf(w, total_w, cdf);
 }
 
 }  // namespace
@@ -85,27 +105,17 @@ void pack_lights(const Scene& scene, PackedScene& p, std::vector<double> power) 
   }
   double total = 0;
   for (double w : power) total += w;
-  double acc = 0;
-  // The kernel draws the light with a random number on the lattice k / 2^24 (lc_u01) and takes
-  // the first i with u < cdf[i] (lc_cdf_search). With the CDF on that lattice too, a light's
-  // probability is exactly its interval, which is what pdf_select says: rounded to floats on
-  // their own, the two differed by up to 2^-24, 6% of a light's share among a million.
-  constexpr double kLattice = 16777216.0;  // 2^24
-  std::uint32_t prev = 0;
+  // 90% by power, 10% uniform: a defensive mixture, so that no light starves when one power
+  // estimate dwarfs the others (an environment behind a 1000-unit floor sphere). On the lattice,
+  // pdf_select is exactly each light's interval of the CDF.
+  std::vector<double> select(p.lights.size());
   for (size_t i = 0; i < p.lights.size(); ++i) {
-    // 90% by power, 10% uniform: a defensive mixture, so that no light starves when one
-    // power estimate dwarfs the others (an environment behind a 1000-unit floor sphere)
     double uniform = 1.0 / p.lights.size();
-    double pdf = total > 0 ? 0.9 * power[i] / total + 0.1 * uniform : uniform;
-    acc += pdf;
-    std::uint32_t q = i + 1 == p.lights.size()
-                          ? std::uint32_t(kLattice)
-                          : std::uint32_t(std::clamp(std::llround(acc * kLattice), (long long)prev,
-                                                     (long long)kLattice));
-    p.lights[i].pdf_select = static_cast<float>((q - prev) / kLattice);
-    p.light_cdf.push_back(static_cast<float>(q / kLattice));
-    prev = q;
+    select[i] = total > 0 ? 0.9 * power[i] / total + 0.1 * uniform : uniform;
   }
+  if (!select.empty()) append_lattice_cdf(select, 1.0, p.light_cdf);
+  for (size_t i = 0; i < p.lights.size(); ++i)
+    p.lights[i].pdf_select = p.light_cdf[i] - (i ? p.light_cdf[i - 1] : 0.0f);
 
   for (lc_light& l : p.lights) {
     if (l.type != LC_LIGHT_ENV_MAP) continue;
