@@ -558,6 +558,38 @@ TEST(Parts, MpiRefusesToOverwriteWhatTheSceneReads) {
   EXPECT_NE(r.err.find(": is an input of this render ("), std::string::npos) << r.err;
   EXPECT_EQ(lucent::test::read_file(env), before);
 }
+// Slurm (and a user's Ctrl-C) signal mpirun, not the ranks: Open MPI's mpirun passes SIGTERM on
+// to them, and they stop after their pass, send what they rendered, and rank 0 writes it with its
+// ranges, before mpirun's own time to kill them runs out.
+TEST(Parts, MpiSigtermToMpirunWritesWhatTheRanksRendered) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  const std::string out = dir + "/mpi.exr", err = dir + "/mpi.err";
+  // in the background; SIGTERM to mpirun once rank 0's progress line shows its render running
+  const std::string script = dir + "/stop.sh";
+  lucent::test::write_file(script, mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " +
+                                          q(scene) + " --spp 16000000 -o " + q(out)) +
+                                       " 2>" + q(err) +
+                                       " </dev/null & pid=$!\nfor i in $(seq 600); do grep -q " +
+                                       "'rank 0 of 2:' " + q(err) +
+                                       " && break; sleep 0.1; done\nkill -TERM $pid\nwait $pid\n");
+  int raw = std::system(("bash " + q(script)).c_str());
+  ASSERT_TRUE(WIFEXITED(raw));
+  const std::string text = lucent::test::read_file(err);
+  EXPECT_NE(WEXITSTATUS(raw), 0) << text;
+  ASSERT_TRUE(fs::exists(out)) << text;
+  lucent::PartInfo info = lucent::read_part_info(out);
+  ASSERT_EQ(info.samples.size(), 2u) << text;
+  EXPECT_EQ(info.samples[0].begin, 0u);
+  EXPECT_EQ(info.samples[1].begin, 8000000u);
+  EXPECT_GT(info.samples[0].end, 0u);
+  EXPECT_LT(info.samples[0].end, 8000000u);
+  EXPECT_GT(info.samples[1].end, 8000000u);
+  EXPECT_LT(info.samples[1].end, 16000000u);
+  EXPECT_NE(text.find("lucent-mpi: interrupted: " + out + " holds samples [0, "), std::string::npos)
+      << text;
+}
 #else
 TEST(Parts, MpiTwoRanksRenderTheOneProcessImage) {
   GTEST_SKIP() << "lucent-mpi is not built (no MPI found; see LUCENT_MPI)";
