@@ -224,6 +224,12 @@ TEST(ImageIo, GreyExrIsGreyAndOtherChannelsAreRefused) {
   } catch (const lucent::Error& e) {
     EXPECT_EQ(std::string(e.what()), dir + "/uv.exr: OpenEXR file has no R, G, B or Y channels");
   }
+  // luminance/chroma is a colour image: read from Y alone it came out grey, without a word
+  write_exr(dir + "/ryby.exr", 5, 3, {"BY", "RY", "Y"}, value);
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::read_image(dir + "/ryby.exr"); }),
+            dir +
+                "/ryby.exr: OpenEXR file is luminance/chroma (Y, RY, BY channels), which lucent "
+                "does not read; save it as RGB");
 }
 
 }  // namespace

@@ -8,7 +8,9 @@
 #include <stb/stb_image_write.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdint>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -149,6 +151,48 @@ TEST(ImageLimits, TruncatedFilesAreRefused) {
   ASSERT_EQ(texture_error(jpg), "");
   EXPECT_EQ(texture_error(jpg.substr(0, jpg.size() - 20)),
             "JPEG file is truncated: no end-of-image marker");
+}
+
+// The PFM header ends with the scale's line, whatever precedes its newline: "\r\n" (Windows) or a
+// space before it used to end the header one byte early, and the floats were read shifted by a
+// byte (values like -8e-44, exit 0). Bytes beyond the pixels are refused: they are what a
+// misread header end leaves.
+TEST(ImageLimits, PfmHeaderEndsAtTheScalesNewline) {
+  std::string floats;
+  for (int i = 0; i < 6; ++i) {
+    float v = 0.25f * float(i + 1);
+    floats.append(reinterpret_cast<const char*>(&v), 4);
+  }
+  for (const char* end : {"\n", "\r\n", " \n", "\t\r\n", " "}) {
+    lucent::Texture t = texture("PF\n2 1\n-1.0" + std::string(end) + floats);
+    ASSERT_EQ(t.width, 2);
+    for (int i = 0; i < 6; ++i)
+      EXPECT_EQ(t.rgba[(i / 3) * 4 + i % 3], 0.25f * float(i + 1))
+          << "header end '" << end << "', value " << i;
+  }
+  EXPECT_EQ(texture_error("PF\r\n2 1\r\n-1.0\r\n" + floats), "");
+  EXPECT_EQ(texture_error("PF\n2 1\n-1.0\n" + floats + "\n"),
+            "PFM file has 1 bytes after its 2x1 pixels (a header it misreads, or a corrupt file)");
+}
+
+// A float image used as a texture or an environment map may not hold a negative, NaN or infinite
+// value: they rendered with exit 0 (negative pixels, black in a PNG; dropped non-finite samples),
+// where SceneBuilder::add_texture refuses the same texels.
+TEST(ImageLimits, FloatTexturesMustBeFiniteAndNonNegative) {
+  for (float bad : {-5.0f, std::nanf(""), INFINITY}) {
+    std::vector<float> px(2 * 2 * 3, 0.5f);
+    px[4] = bad;  // the file's first row is the image's bottom row: pixel (1, 1), channel G
+    std::string f =
+        "PF\n2 2\n-1.0\n" + std::string(reinterpret_cast<const char*>(px.data()), px.size() * 4);
+    std::ostringstream v;
+    v << bad;
+    EXPECT_EQ(texture_error(f), "pixel (1, 1) channel G is " + v.str() +
+                                    "; a texture's values must be finite and >= 0");
+  }
+  std::vector<float> zero(2 * 2 * 3, 0.0f);
+  EXPECT_EQ(texture_error("PF\n2 2\n-1.0\n" +
+                          std::string(reinterpret_cast<const char*>(zero.data()), zero.size() * 4)),
+            "");
 }
 
 // stb_image loops forever on a run-length scanline whose run is 0, which is what it reads past

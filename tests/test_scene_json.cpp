@@ -385,6 +385,21 @@ TEST(SceneJson, MissingMeshAndTextureFiles) {
   }
 }
 
+// "\u0000" is valid JSON. A path holding one opened the file named by what precedes it
+// ("sky.pfm\u0000junk.exr" loaded sky.pfm, exit 0), and the messages that quoted it stopped there.
+TEST(SceneJson, StringsWithANulCharacterAreRefused) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::write_image(dir + "/sky.pfm", lucent::Image{2, 1, std::vector<float>(6, 0.5f)});
+  EXPECT_EQ(
+      error_of(R"({"lights": [{"type": "environment", "file": ")" + dir +
+               R"(/sky.pfm\u0000junk.exr"}]})"),
+      "scene.json: /lights/0/file: must not contain a NUL character (\\u0000), at character " +
+          std::to_string(dir.size() + 8));
+  EXPECT_EQ(error_of(R"({"integrator": {"type": "pa\u0000th"}})"),
+            "scene.json: /integrator/type: must not contain a NUL character (\\u0000), at "
+            "character 2");
+}
+
 // ---------------------------------------------------------------------------------------------
 // The whole format
 

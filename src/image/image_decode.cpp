@@ -193,7 +193,12 @@ Decoded decode_image(const unsigned char* data, std::size_t size, const std::str
     ExrChannels exr = read_exr_channels(data, size, path, max_pixels);
     int src[3] = {exr.find("R"), exr.find("G"), exr.find("B")};
     if (src[0] < 0 || src[1] < 0 || src[2] < 0) {
-      // a single channel (Y, or anything else) is grey
+      // a single channel (Y, or anything else) is grey; luminance with chroma (Y, RY, BY: a
+      // colour image) is not, and its colour would be lost
+      if (exr.find("RY") >= 0 || exr.find("BY") >= 0)
+        fail(
+            "OpenEXR file is luminance/chroma (Y, RY, BY channels), which lucent does not read; "
+            "save it as RGB");
       int grey = exr.find("Y");
       if (grey < 0 && exr.names.size() == 1) grey = 0;
       if (grey < 0) fail("OpenEXR file has no R, G, B or Y channels");

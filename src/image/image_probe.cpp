@@ -357,10 +357,19 @@ class Checker {
         scale == 0)
       fail("PFM header: scale '" + sc + "' is not a finite non-zero number");
     if (!space(pos)) fail("PFM header: no pixel data");
-    ++pos;  // exactly one whitespace byte before the data
+    // The scale's line ends the header: spaces, tabs or a CR may precede its newline ("\r\n" from
+    // Windows). Without a newline, one whitespace byte. The pixels must then fill the rest of
+    // the file exactly: a header end misread by a byte would shift every float.
+    u64 end = pos;
+    while (end < n_ && (d_[end] == ' ' || d_[end] == '\t' || d_[end] == '\r')) ++end;
+    pos = end < n_ && d_[end] == '\n' ? end + 1 : pos + 1;
     size(p, w, h);
     const int ch = d_[1] == 'F' ? 3 : 1;
     need(p, pos + w * h * ch * 4, n_, "header and pixels");
+    if (n_ > pos + w * h * ch * 4)
+      fail("PFM file has " + std::to_string(n_ - pos - w * h * ch * 4) + " bytes after its " +
+           std::to_string(w) + "x" + std::to_string(h) +
+           " pixels (a header it misreads, or a corrupt file)");
     if (data_offset) *data_offset = pos;
     if (channels) *channels = ch;
     if (big_endian) *big_endian = scale > 0;

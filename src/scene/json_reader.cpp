@@ -95,7 +95,13 @@ bool JsonReader::boolean(const json& j, const std::string& ptr) const {
 
 std::string JsonReader::string(const json& j, const std::string& ptr) const {
   if (!j.is_string()) fail(ptr, "must be a string, got " + json_type_name(j) + " " + show(j));
-  return j.get<std::string>();
+  std::string s = j.get<std::string>();
+  // "\u0000" is valid JSON, but a path or a name ends there for the C functions that use it
+  // ("a.pfm\u0000junk.exr" opened a.pfm), and messages would be cut short
+  if (s.find('\0') != std::string::npos)
+    fail(ptr, "must not contain a NUL character (\\u0000), at character " +
+                  std::to_string(s.find('\0')));
+  return s;
 }
 
 std::string JsonReader::choice(const json& j, const std::string& ptr,

@@ -2,7 +2,9 @@
 // texture pixel limit and the file's length before any pixel is allocated
 // (image/image_probe.cpp), then decoded to linear RGBA float: 8-bit and 16-bit data from sRGB
 // (alpha stays linear), Radiance HDR, PFM and EXR kept linear with alpha 1. Row 0 at the top.
+#include <cmath>
 #include <filesystem>
+#include <sstream>
 
 #include "core/file_io.hpp"
 #include "core/host_memory.hpp"
@@ -33,8 +35,23 @@ Texture decode_texture(const unsigned char* data, std::size_t size, const std::s
   t.width = d.width;
   t.height = d.height;
   t.rgba = std::move(d.pixels);
-  if (d.format == Format::Pfm || d.format == Format::Exr)
-    for (size_t i = 3; i < t.rgba.size(); i += 4) t.rgba[i] = 1.0f;
+  if (d.format == Format::Pfm || d.format == Format::Exr) {
+    // float formats can hold what no texture means: a NaN or an infinity makes every sample
+    // that reads it non-finite, a negative value negative light (SceneBuilder::add_texture
+    // refuses both too)
+    for (size_t i = 0; i < t.rgba.size(); ++i) {
+      if (i % 4 == 3) {
+        t.rgba[i] = 1.0f;
+      } else if (!(std::isfinite(t.rgba[i]) && t.rgba[i] >= 0)) {
+        const size_t px = i / 4;
+        std::ostringstream v;
+        v << t.rgba[i];
+        throw Error(path + ": pixel (" + std::to_string(px % size_t(t.width)) + ", " +
+                    std::to_string(px / size_t(t.width)) + ") channel " + "RGB"[i % 4] + " is " +
+                    v.str() + "; a texture's values must be finite and >= 0");
+      }
+    }
+  }
   return t;
 }
 
