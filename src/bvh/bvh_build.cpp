@@ -81,10 +81,15 @@ Bvh2 build_binary(const std::vector<lc_triangle>& tris, const std::vector<lc_sph
         id = static_cast<lc_uint>(i);
       } else {
         const lc_sphere& s = spheres[i - nt];
-        float rad = std::fabs(s.radius);
+        // centre -+ radius rounded outward: to the nearest float, a face of the box could fall
+        // inside the sphere, and rays grazing it were culled (5% of the radius at 1e6)
+        const double rad = std::fabs(double(s.radius));
         for (int a = 0; a < 3; ++a) {
-          lo[a] = s.center[a] - rad;
-          hi[a] = s.center[a] + rad;
+          const double l = double(s.center[a]) - rad, h = double(s.center[a]) + rad;
+          lo[a] = static_cast<float>(l);
+          hi[a] = static_cast<float>(h);
+          if (double(lo[a]) > l) lo[a] = std::nextafter(lo[a], -INFINITY);
+          if (double(hi[a]) < h) hi[a] = std::nextafter(hi[a], INFINITY);
         }
         id = static_cast<lc_uint>(i - nt) | LC_PRIM_SPHERE_BIT;
       }
