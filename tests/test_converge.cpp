@@ -612,21 +612,26 @@ TEST(Converge, CommandErrors) {
 }
 
 // The outputs (--csv, every --plot, --save-reference) never overwrite an input (the scene, the
-// --reference image, a texture or an OBJ file of the scene) nor each other, and are checked
-// before anything renders: one line, exit 1, every file as it was. (--csv on the --reference
-// image replaced it with CSV text, exit 0; --csv and --plot on one file kept only the plot.)
+// --reference image, a texture, an OBJ file or an MTL library of the scene) nor each other, and
+// are checked before anything renders: one line, exit 1, every file as it was. (--csv on the
+// --reference image replaced it with CSV text, exit 0; --csv and --plot on one file kept only the
+// plot; --csv on an MTL library replaced it.)
 TEST(Converge, CommandOutputsOverwriteNoInputAndNoOtherOutput) {
   const std::string dir = lucent::test::temp_dir();
   auto q = [](const std::string& s) { return "'" + s + "'"; };
   lucent::write_image(dir + "/tex.png", lucent::Image{2, 2, std::vector<float>(12, 0.5f)});
   lucent::test::write_file(dir + "/m.obj", "v -1 -1 -2\nv 1 -1 -2\nv 0 1 -2\nf 1 2 3\n");
+  lucent::test::write_file(dir + "/lib.obj",
+                           "mtllib lib.mtl\nv -1 1 -2\nv 1 1 -2\nv 0 2 -2\nusemtl a\nf 1 2 3\n");
+  lucent::test::write_file(dir + "/lib.mtl", "newmtl a\nKd 0.5 0.25 0.125\n");
   lucent::test::write_file(dir + "/t.json", R"({
     "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 45},
     "film": {"width": 8, "height": 8},
     "integrator": {"type": "path", "max_depth": 2, "seed": 3},
     "materials": {"t": {"type": "diffuse", "albedo": {"texture": "tex.png"}}},
     "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "t"},
-               {"type": "mesh", "file": "m.obj", "material": "t"}],
+               {"type": "mesh", "file": "m.obj", "material": "t"},
+               {"type": "mesh", "file": "lib.obj"}],
     "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
   })");
   const std::string scene = q(dir + "/t.json");
@@ -634,7 +639,7 @@ TEST(Converge, CommandOutputsOverwriteNoInputAndNoOtherOutput) {
       lucent::test::run_cli("render " + scene + " -q --spp 4 --seed 7 -o " + q(dir + "/ref.exr"))
           .status,
       0);
-  const std::string files[] = {"t.json", "ref.exr", "tex.png", "m.obj"};
+  const std::string files[] = {"t.json", "ref.exr", "tex.png", "m.obj", "lib.obj", "lib.mtl"};
   std::vector<std::string> before;
   for (const std::string& f : files) before.push_back(read_file(dir + "/" + f));
   auto error = [&](const std::string& args) {
@@ -657,6 +662,9 @@ TEST(Converge, CommandOutputsOverwriteNoInputAndNoOtherOutput) {
   EXPECT_EQ(error("--reference-spp 4 --csv " + q(dir + "/m.obj")),
             "lucent: error: " + dir + "/m.obj: is an input of the scene (" + dir +
                 "/m.obj); refusing to overwrite it\n");
+  EXPECT_EQ(error("--reference-spp 4 --csv " + q(dir + "/lib.mtl")),
+            "lucent: error: " + dir + "/lib.mtl: is an input of the scene (" + dir +
+                "/lib.mtl); refusing to overwrite it\n");
   EXPECT_EQ(error("--reference-spp 4 --save-reference " + q(dir + "/ref.exr") + " --csv " +
                   q(dir + "/ref.exr")),
             "lucent: error: " + dir +

@@ -559,6 +559,41 @@ TEST(Obj, MaterialOverrideIgnoresTheMtl) {
   for (const Triangle& t : s.triangles) EXPECT_EQ(t.material, 1);
 }
 
+// The MTL libraries an OBJ file names are inputs of the scene, as its textures are: outputs
+// (render -o, converge --csv, --plot and --save-reference, lucent-mpi -o) must not overwrite them.
+// scene_inputs listed the OBJ files but not their libraries (`converge --csv lib/m.mtl` replaced
+// a material library with CSV text). A library that does not exist is no input, nor is one of a
+// mesh whose material override reads no MTL; a texture of an MTL material is one of the scene's.
+TEST(Obj, MtlLibrariesAreInputsOfTheScene) {
+  std::string dir = lucent::test::temp_dir();
+  std::filesystem::create_directories(dir + "/lib/tex");
+  const unsigned char px[] = {255, 255, 255, 0, 0, 0};
+  ASSERT_TRUE(stbi_write_png((dir + "/lib/tex/t.png").c_str(), 2, 1, 3, px, 6));
+  write(dir, "lib/m.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd tex/t.png\n");
+  write(dir, "over.mtl", "newmtl b\nKd 0.5 0.5 0.5\n");
+  const std::string triangle = "v 0 0 -1\nv 1 0 -1\nv 1 1 -1\n";
+  write(dir, "mesh.obj",
+        "mtllib lib/m.mtl\nmtllib missing.mtl\n" + triangle + "usemtl a\nf 1 2 3\n");
+  write(dir, "over.obj", "mtllib over.mtl\n" + triangle + "usemtl b\nf 1 2 3\n");
+  const std::string scene_path = write(dir, "s.json", R"({
+    "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 45},
+    "film": {"width": 4, "height": 4},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "mesh", "file": "mesh.obj"},
+               {"type": "mesh", "file": "over.obj", "material": "m"}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
+  })");
+  CaptureWarnings w;  // missing.mtl
+  const Scene scene = lucent::load_scene(scene_path);
+  ASSERT_EQ(scene.shapes.size(), 2u);
+  EXPECT_EQ(scene.shapes[0].libraries, std::vector<std::string>{dir + "/lib/m.mtl"});
+  EXPECT_TRUE(scene.shapes[1].libraries.empty());
+  EXPECT_EQ(lucent::scene_detail::scene_inputs(scene_path, scene),
+            (std::vector<std::string>{scene_path, dir + "/lib/tex/t.png", dir + "/mesh.obj",
+                                      dir + "/lib/m.mtl", dir + "/over.obj"}));
+  EXPECT_EQ(w.count("missing.mtl"), 1) << w.dump();
+}
+
 TEST(Obj, MeshesAppendToTheScene) {
   std::string dir = lucent::test::temp_dir();
   std::string path =

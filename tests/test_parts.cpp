@@ -18,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 
 #include "lucent/compare.hpp"
@@ -376,6 +377,106 @@ TEST(Parts, DamagedPartFilesAreOneLineErrors) {
     EXPECT_EQ(std::string(e.what()),
               dir + "/text.exr: not a lucent part file (not an OpenEXR file)");
   }
+}
+
+// A part's counts agree with its header: each pixel holds the part's samples (the total of its
+// ranges) less its non-finite ones, and those add up to lucent.nonfinite. Reading checked only that
+// no count exceeded the samples: a part whose counts, ranges or non-finite count were altered
+// merged into an image claiming samples it did not have (a part of [0, 6) holding 4 samples a
+// pixel merged as 6 spp). Each damaged part is the good one altered and written again.
+TEST(Parts, CountsDisagreeingWithTheHeaderAreOneLineErrors) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::Renderer renderer(lucent::test::session_options());
+  renderer.set_scene(lucent::load_scene(noisy_scene(dir)));
+  const lucent::RenderPart good = render_range(renderer, 0, 4);
+  ASSERT_EQ(good.info.nonfinite, 0u);
+  lucent::write_render_part(dir + "/good.exr", good);
+  EXPECT_EQ(lucent::read_render_part(dir + "/good.exr").acc.count, good.acc.count);
+  const std::string out = dir + "/out.exr";
+  const size_t px = 3 * 12 + 5;  // pixel 5, 3
+  struct Damage {
+    std::function<void(lucent::RenderPart&)> alter;
+    std::string message;
+  };
+  const Damage damages[] = {
+      {[&](lucent::RenderPart& p) { p.acc.count[px] = 3; },
+       "channel n: pixel 5, 3 counts 3 samples of the part's 4 (samples [0, 4)), and the part "
+       "records no non-finite sample (lucent.nonfinite 0)"},
+      {[&](lucent::RenderPart& p) { p.acc.count[px] = 5; },
+       "channel n: pixel 5, 3 counts 5 samples, more than the part's 4 (samples [0, 4))"},
+      {[](lucent::RenderPart& p) {
+         p.info.samples = p.info.requested = {{0, 6}};
+       },
+       "channel n: pixel 0, 0 counts 4 samples of the part's 6 (samples [0, 6)), and the part "
+       "records no non-finite sample (lucent.nonfinite 0)"},
+      {[](lucent::RenderPart& p) { p.info.nonfinite = 7; },
+       "attribute lucent.nonfinite: 7 non-finite samples recorded, but the pixels (channel n) "
+       "miss 0 of the part's 4 (samples [0, 4)) per pixel"},
+  };
+  int n = 0;
+  for (const Damage& d : damages) {
+    lucent::RenderPart damaged = good;
+    d.alter(damaged);
+    const std::string path = dir + "/damaged" + std::to_string(n++) + ".exr";
+    lucent::write_render_part(path, damaged);
+    EXPECT_EQ(error_of([&] { lucent::read_render_part(path); }), path + ": " + d.message);
+    EXPECT_EQ(error_line(run_cli("merge " + q(path) + " -o " + q(out))), path + ": " + d.message);
+    EXPECT_FALSE(fs::exists(out)) << d.message;
+    // the merger checks parts it is handed in memory too (lucent-mpi's ranks)
+    lucent::PartMerger merger;
+    EXPECT_EQ(error_of([&] { merger.add("rank 1", damaged); }), "rank 1: " + d.message);
+  }
+
+  // a part with non-finite samples (a point light whose radiance squared overflows float) reads
+  // and merges: its pixels miss exactly the samples it records as non-finite
+  std::string text = lucent::test::read_file(noisy_scene(dir));
+  const std::string dim = R"("intensity": [20, 20, 20])";
+  ASSERT_NE(text.find(dim), std::string::npos);
+  text.replace(text.find(dim), dim.size(), R"("intensity": [1e20, 1e20, 1e20])");
+  lucent::test::write_file(dir + "/hot.json", text);
+  renderer.set_scene(lucent::load_scene(dir + "/hot.json"));
+  const lucent::RenderPart hot = render_range(renderer, 0, 4);
+  ASSERT_GT(hot.info.nonfinite, 0u);
+  ASSERT_LT(hot.info.nonfinite, 4u * 120);
+  lucent::write_render_part(dir + "/hot0.exr", hot);
+  lucent::write_render_part(dir + "/hot1.exr", render_range(renderer, 4, 8));
+  CommandResult r =
+      run_cli("merge " + q(dir + "/hot0.exr") + " " + q(dir + "/hot1.exr") + " -o " + q(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("non-finite sample(s) (NaN or Inf) were dropped"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(lucent::read_render_part(out).info.samples, (std::vector<lucent::SampleRange>{{0, 8}}));
+  // one sample fewer in a pixel: the pixels miss one more than the non-finite samples, which
+  // shows at the last pixel missing any
+  const auto& counts = hot.acc.count;
+  const size_t full = std::find(counts.begin(), counts.end(), 4u) - counts.begin();
+  const size_t short_one =
+      std::find_if(counts.begin(), counts.end(), [](std::uint32_t c) { return c < 4; }) -
+      counts.begin();
+  ASSERT_LT(full, counts.size()) << "no pixel holds every sample";
+  ASSERT_LT(short_one, counts.size());
+  lucent::RenderPart fewer = hot;
+  fewer.acc.count[full] -= 1;
+  size_t last = 0;
+  for (size_t i = 0; i < counts.size(); ++i)
+    if (fewer.acc.count[i] < 4) last = i;
+  const std::string nf = std::to_string(hot.info.nonfinite);
+  lucent::write_render_part(dir + "/fewer.exr", fewer);
+  EXPECT_EQ(error_of([&] { lucent::read_render_part(dir + "/fewer.exr"); }),
+            dir + "/fewer.exr: channel n: pixel " + std::to_string(last % 12) + ", " +
+                std::to_string(last / 12) + " counts " + std::to_string(fewer.acc.count[last]) +
+                " samples of the part's 4 (samples [0, 4)): the pixels up to it miss " +
+                std::to_string(hot.info.nonfinite + 1) + " samples, more than the " + nf +
+                " non-finite ones the part records (lucent.nonfinite)");
+  // one sample more: fewer missing than recorded
+  lucent::RenderPart more = hot;
+  more.acc.count[short_one] += 1;
+  lucent::write_render_part(dir + "/more.exr", more);
+  EXPECT_EQ(error_of([&] { lucent::read_render_part(dir + "/more.exr"); }),
+            dir + "/more.exr: attribute lucent.nonfinite: " + nf +
+                " non-finite samples recorded, but the pixels (channel n) miss " +
+                std::to_string(hot.info.nonfinite - 1) +
+                " of the part's 4 (samples [0, 4)) per pixel");
 }
 
 // A part stopped by SIGTERM (Slurm's signal at a job's time limit) keeps the samples it finished,

@@ -129,6 +129,9 @@ struct ShapeEntry {
   std::string file;       ///< the OBJ file of a mesh; empty for a sphere or an inline triangle list
   std::size_t first = 0;  ///< first sphere (Scene::spheres) or triangle (Scene::triangles)
   std::size_t count = 0;  ///< number of spheres or triangles
+  /// The MTL libraries a mesh's OBJ file named that exist (read, or refused as unreadable): the
+  /// scene reads them, so outputs must not overwrite them (scene_inputs)
+  std::vector<std::string> libraries;
 };
 
 struct Texture {

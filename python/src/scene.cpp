@@ -458,11 +458,13 @@ void bind_scene(py::module_& m) {
   py::class_<ShapeEntry> shape_entry(
       m, "ShapeEntry",
       "One entry of the scene's shape list as given (for messages and statistics): type, the "
-      "OBJ file of a mesh, its first sphere or triangle and their count.");
+      "OBJ file of a mesh, its first sphere or triangle and their count, and the MTL libraries "
+      "the OBJ file named that exist (inputs of the scene).");
   shape_entry.def(py::init<>())
       .def_readwrite("file", &ShapeEntry::file)
       .def_readwrite("first", &ShapeEntry::first)
-      .def_readwrite("count", &ShapeEntry::count);
+      .def_readwrite("count", &ShapeEntry::count)
+      .def_readwrite("libraries", &ShapeEntry::libraries);
   enum_property(shape_entry, "type", &ShapeEntry::type);
 
   py::bind_vector<std::vector<ShapeEntry>>(m, "ShapeList");

@@ -134,10 +134,13 @@ def test_texture_from_an_array(small_scene):
 
 
 def test_relative_files_are_relative_to_base_dir(tmp_path):
-    (tmp_path / "tri.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    (tmp_path / "tri.obj").write_text("mtllib tri.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    (tmp_path / "tri.mtl").write_text("newmtl a\nKd 0.5 0.5 0.5\n")
     d = {"shapes": [{"type": "mesh", "file": "tri.obj"}]}
     s = lucent.scene_from_dict(d, base_dir=tmp_path)
     assert len(s.triangles) == 1
+    # the MTL library the OBJ read, relative to the OBJ file (an input of the scene)
+    assert list(s.shapes[0].libraries) == [str(tmp_path / "tri.mtl")]
     with pytest.raises(lucent.Error, match=r"tri\.obj"):
         lucent.scene_from_dict(d)  # "." holds no tri.obj
 

@@ -182,6 +182,41 @@ std::string channel_name(int plane, int c, bool high) {
   return std::string(kPlanes[plane]) + "." + kRgb[c] + (high ? ".hi" : ".lo");
 }
 
+std::string pixel_text(size_t i, int width) {
+  return "pixel " + std::to_string(i % width) + ", " + std::to_string(i / width);
+}
+
+/// Checks a part's counts against its header. The kernel counts every sample of a pixel either in
+/// the pixel's n or as non-finite (a part holds no light-traced caustics, whose paths are counted
+/// too), so each pixel holds the part's number of samples (the total of its ranges) less its
+/// non-finite ones, and the samples the pixels miss add up to info.nonfinite: true of a rendered
+/// part and, the counts, ranges and non-finite counts adding up, of a merge of parts. A part
+/// whose counts were altered once merged into an image claiming samples it did not have. Throws
+/// lucent::Error naming `name`, the pixel (or the attribute) and the mismatch.
+void check_counts(const std::string& name, const PartInfo& info, const Accumulation& a) {
+  const std::uint64_t spp = total(info.samples);
+  const std::string part_spp = std::to_string(spp) + " (samples " + ranges_text(info.samples) + ")";
+  std::uint64_t missing = 0;  // samples the pixels so far miss
+  for (size_t i = 0; i < a.count.size(); ++i) {
+    if (a.count[i] > spp)
+      throw Error(name + ": channel n: " + pixel_text(i, a.width) + " counts " +
+                  std::to_string(a.count[i]) + " samples, more than the part's " + part_spp);
+    missing += spp - a.count[i];
+    if (missing > info.nonfinite)
+      throw Error(name + ": channel n: " + pixel_text(i, a.width) + " counts " +
+                  std::to_string(a.count[i]) + " samples of the part's " + part_spp +
+                  (info.nonfinite == 0
+                       ? ", and the part records no non-finite sample (lucent.nonfinite 0)"
+                       : ": the pixels up to it miss " + std::to_string(missing) +
+                             " samples, more than the " + std::to_string(info.nonfinite) +
+                             " non-finite ones the part records (lucent.nonfinite)"));
+  }
+  if (missing != info.nonfinite)
+    throw Error(name + ": attribute lucent.nonfinite: " + std::to_string(info.nonfinite) +
+                " non-finite samples recorded, but the pixels (channel n) miss " +
+                std::to_string(missing) + " of the part's " + part_spp + " per pixel");
+}
+
 }  // namespace
 
 std::string range_text(const SampleRange& r) {
@@ -431,13 +466,8 @@ RenderPart read_render_part(const std::string& path) {
     }
   }
   a.count = uint_channel("n");
-  const std::uint64_t spp = total(p.info.samples);
-  for (size_t i = 0; i < npix; ++i)
-    if (a.count[i] > spp)
-      throw Error(path + ": channel n: pixel " + std::to_string(i % a.width) + ", " +
-                  std::to_string(i / a.width) + " counts " + std::to_string(a.count[i]) +
-                  " samples, more than the part's " + std::to_string(spp));
-  a.spp = spp;
+  check_counts(path, p.info, a);
+  a.spp = total(p.info.samples);
   a.nonfinite = p.info.nonfinite;
   a.rays = p.info.rays;
   a.seconds = p.info.seconds;
@@ -487,6 +517,7 @@ void PartMerger::add(const std::string& name, const RenderPart& part) {
   if (a.sum.size() != npix * 3 || a.sumsq.size() != npix * 3 || a.count.size() != npix ||
       a.width != part.info.width || a.height != part.info.height)
     throw Error(name + ": inconsistent part (film and accumulation sizes differ)");
+  check_counts(name, part.info, a);  // a part of lucent-mpi's ranks, or of a library caller
   if (names_.empty()) {
     total_ = part;
   } else {

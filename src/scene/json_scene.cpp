@@ -101,8 +101,10 @@ std::vector<std::string> scene_inputs(const std::string& scene_path, const Scene
   std::vector<std::string> inputs{scene_path};
   for (const Texture& t : scene.textures)
     if (!t.path.empty()) inputs.push_back(t.path);
-  for (const ShapeEntry& e : scene.shapes)
+  for (const ShapeEntry& e : scene.shapes) {
     if (!e.file.empty()) inputs.push_back(e.file);
+    inputs.insert(inputs.end(), e.libraries.begin(), e.libraries.end());
+  }
   return inputs;
 }
 

@@ -33,9 +33,11 @@ class ScopedWarningSink {
 /// and appended to the scene's triangle list. When `material_override` >= 0 every face uses it;
 /// otherwise MTL materials become scene materials named "<obj file name>:<mtl name>" and faces
 /// without one use a default diffuse material. Missing MTL or texture files give a warning naming
-/// the file and fall back. Throws lucent::Error naming the file (and line) of a parse error.
-void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform,
-              int material_override);
+/// the file and fall back. Returns the MTL libraries the OBJ names that exist (none with a
+/// material override, which reads none): inputs of the scene, as its textures are. Throws
+/// lucent::Error naming the file (and line) of a parse error.
+std::vector<std::string> load_obj(Scene& scene, const std::string& path,
+                                  const glm::dmat4& transform, int material_override);
 
 /// Loads an image (PNG, JPG, BMP, TGA: 8-bit decoded from sRGB to linear; HDR, PFM, EXR kept
 /// linear) as a scene texture, reusing an already loaded one with the same path. Returns its
@@ -51,7 +53,8 @@ Texture decode_texture(const unsigned char* data, std::size_t size, const std::s
 void decode_srgb8(const std::uint8_t* data, std::size_t texels, int channels, float* rgba);
 
 /// The files a command's outputs must not overwrite because `scene` (loaded from `scene_path`)
-/// reads them: the scene file, then its textures and environment maps and its OBJ meshes.
+/// reads them: the scene file, then its textures and environment maps (those of MTL materials
+/// too), its OBJ meshes and their MTL libraries.
 std::vector<std::string> scene_inputs(const std::string& scene_path, const Scene& scene);
 
 }  // namespace lucent::scene_detail

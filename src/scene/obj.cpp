@@ -18,8 +18,8 @@ namespace lucent::scene_detail {
 namespace fs = std::filesystem;
 using obj::lines_of;
 
-void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform,
-              int material_override) {
+std::vector<std::string> load_obj(Scene& scene, const std::string& path,
+                                  const glm::dmat4& transform, int material_override) {
   io::ReadSpec spec;
   spec.what = "OBJ file";
   spec.max_bytes = obj::kMaxObjBytes;
@@ -141,6 +141,7 @@ void load_obj(Scene& scene, const std::string& path, const glm::dmat4& transform
     }
   }
   if (faces == 0) warn(path + ": no faces");
+  return reader.libraries;
 }
 
 }  // namespace lucent::scene_detail

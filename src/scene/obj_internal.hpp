@@ -62,6 +62,7 @@ class MtlReader : public tinyobj::MaterialReader {
   bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                   std::map<std::string, int>* map, std::string* warn, std::string* err) override;
 
+  std::vector<std::string> libraries;   ///< libraries that exist (read or unreadable)
   std::vector<std::string> missing;     ///< libraries that do not exist
   std::vector<std::string> unreadable;  ///< libraries that exist but cannot be read (messages)
   std::vector<std::string> origin;      ///< the library of each material, by index

@@ -49,12 +49,15 @@ bool MtlReader::operator()(const std::string& name, std::vector<tinyobj::materia
     text = io::read_file(p.string(), spec);
   } catch (const Error& e) {
     std::error_code ec;
-    if (!fs::exists(p, ec))
+    if (!fs::exists(p, ec)) {
       missing.push_back(p.string());
-    else
+    } else {
+      libraries.push_back(p.string());
       unreadable.push_back(e.what());
+    }
     return false;
   }
+  libraries.push_back(p.string());
   try {
     check_mtl_text(p.string(), text);
   } catch (const Error& e) {

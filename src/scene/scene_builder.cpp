@@ -97,7 +97,7 @@ void SceneBuilder::add_sphere(const SphereShape& sphere) {
   scene_detail::validate_sphere(sphere, Reporter(scene_.path, p));
   s.center = sphere.center;
   s.radius = sphere.radius;
-  scene_.shapes.push_back({ShapeType::Sphere, "", scene_.spheres.size(), 1});
+  scene_.shapes.push_back({ShapeType::Sphere, "", scene_.spheres.size(), 1, {}});
   scene_.spheres.push_back(s);
 }
 
@@ -130,7 +130,7 @@ void SceneBuilder::add_mesh(const MeshShape& mesh) {
     scene_.normals.push_back(len > 0 ? t / len : t);
   }
   for (const glm::dvec2& uv : mesh.uvs) scene_.uvs.push_back(uv);
-  ShapeEntry entry{ShapeType::Triangle, "", scene_.triangles.size(), mesh.indices.size() / 3};
+  ShapeEntry entry{ShapeType::Triangle, "", scene_.triangles.size(), mesh.indices.size() / 3, {}};
   for (std::size_t i = 0; i < mesh.indices.size(); i += 3) {
     Triangle tri;
     tri.material = material;
@@ -155,13 +155,13 @@ void SceneBuilder::add_obj(const ObjShape& obj) {
   Reporter at(scene_.path, p);
   const int material = obj.material.empty() ? -1 : material_index(obj.material, p + "/material");
   scene_detail::check_affine(at.at("transform"), obj.transform);
-  ShapeEntry entry{ShapeType::Triangle, obj.file, scene_.triangles.size(), 0};
+  ShapeEntry entry{ShapeType::Triangle, obj.file, scene_.triangles.size(), 0, {}};
   // a failed load leaves the scene as it was
   const std::size_t materials = scene_.materials.size(), positions = scene_.positions.size(),
                     normals = scene_.normals.size(), uvs = scene_.uvs.size(),
                     triangles = scene_.triangles.size(), textures = scene_.textures.size();
   try {
-    scene_detail::load_obj(scene_, obj.file, obj.transform, material);
+    entry.libraries = scene_detail::load_obj(scene_, obj.file, obj.transform, material);
   } catch (const Error& e) {
     scene_.materials.resize(materials);
     scene_.positions.resize(positions);
