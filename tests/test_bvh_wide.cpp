@@ -32,7 +32,12 @@ Box prim_box(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>&
   Box b;
   if (ref & LC_PRIM_SPHERE_BIT) {
     const lc_sphere& s = spheres[ref & ~LC_PRIM_SPHERE_BIT];
-    for (int a = 0; a < 3; ++a) b.lo[a] = s.center[a] - s.radius, b.hi[a] = s.center[a] + s.radius;
+    // the smallest float box that holds the sphere: centre -+ radius rounded outward
+    for (int a = 0; a < 3; ++a) {
+      const double l = double(s.center[a]) - s.radius, h = double(s.center[a]) + s.radius;
+      b.lo[a] = float(l) > l ? std::nextafter(float(l), -INFINITY) : float(l);
+      b.hi[a] = float(h) < h ? std::nextafter(float(h), INFINITY) : float(h);
+    }
     return b;
   }
   const lc_triangle& t = tris[ref];
