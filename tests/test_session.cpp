@@ -657,3 +657,33 @@ TEST(Session, PlannedRelmseIsTheLastCallsPlan) {
   EXPECT_EQ(b.planned_relmse, 0.0);
   EXPECT_EQ(b.model_gain_a, t.model_gain_a);
 }
+
+// A pass's ray and non-finite counts are 64 bits: the kernel's 32-bit counters carry into a high
+// word. They wrapped: a pass of more than 2^32 rays (a 16-megapixel film at several samples per
+// pixel and deep paths) reported its rays modulo 2^32. Here each pass's counters start at
+// 2^32 - 1 (ScopedCounterStart, which the session takes off again), so that the first ray or
+// sample counted carries as the 2^32nd would: the counts equal those of the same samples counted
+// from 0 (a wrap without the carry read as a count near 2^64).
+TEST(Session, PassCountsCarryPast2To32) {
+  Scene s = lucent::test::scene_from(kScene);
+  s.lights[0].intensity = glm::dvec3(1e22);  // non-finite samples too (their squares overflow)
+  Renderer r = session();
+  r.set_scene(s);
+  // passes of one sample each, the same passes every time: whether a sample counts as non-finite
+  // depends on the pass's sum of squares before it
+  auto render = [&r] {
+    r.reset();
+    for (int i = 0; i < 3; ++i) r.render(1);
+    return r.result();
+  };
+  const RenderResult plain = render();
+  ASSERT_GT(plain.rays, 0u);
+  ASSERT_GT(plain.nonfinite, 0u);
+  ASSERT_LT(plain.rays, 1u << 31);
+  lucent::render_detail::ScopedCounterStart start(0xffffffffu);
+  const RenderResult carried = render();
+  EXPECT_EQ(carried.rays, plain.rays);
+  EXPECT_EQ(carried.nonfinite, plain.nonfinite);
+  EXPECT_EQ(r.accumulation().rays, plain.rays);
+  EXPECT_EQ(r.accumulation().nonfinite, plain.nonfinite);
+}

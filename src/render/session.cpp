@@ -77,6 +77,12 @@ bool same_render_data(const render_detail::PackedScene& a, const render_detail::
   return same;
 }
 
+/// What one pass counted (its counters, kernels/shared/types.h).
+struct PassCounts {
+  std::uint64_t nonfinite = 0;  ///< samples whose radiance was not finite
+  std::uint64_t rays = 0;
+};
+
 struct Program {
   cl::Program program;
   cl::Kernel kernel;
@@ -137,30 +143,32 @@ struct Worker {
   }
 
   /// Launches samples [first, first + n) of every pixel and reads back their sums.
-  void pass(const lc_params& params, std::uint64_t first, std::uint32_t n,
-            lc_uint counters[LC_COUNTER_COUNT]) {
+  void pass(const lc_params& params, std::uint64_t first, std::uint32_t n, PassCounts& counts) {
     lc_params P = params;
     P.sample_offset = static_cast<lc_uint>(first);
     P.samples_per_pass = n;
     P.work_items = 0;
-    launch(P, npix, nullptr, counters);
+    launch(P, npix, nullptr, counts);
   }
 
   /// Launches the work list `entries` (pixel, first sample, samples, stream; at most npix) and
   /// reads back their sums, entry by entry.
   void pass_list(const lc_params& params, const std::vector<cl_uint4>& entries,
-                 lc_uint counters[LC_COUNTER_COUNT]) {
+                 PassCounts& counts) {
     lc_params P = params;
     P.work_items = static_cast<lc_uint>(entries.size());
-    launch(P, entries.size(), &entries, counters);
+    launch(P, entries.size(), &entries, counts);
   }
 
   void launch(const lc_params& P, size_t items, const std::vector<cl_uint4>* entries,
-              lc_uint counters[LC_COUNTER_COUNT]) {
-    lc_uint zero[LC_COUNTER_COUNT] = {0, 0, 0, 0};
+              PassCounts& counts) {
+    // each count's low word starts at 0 (at counter_start() in a test, taken off again below)
+    const lc_uint start = render_detail::counter_start();
+    lc_uint initial[LC_COUNTER_COUNT] = {};
+    initial[LC_COUNTER_NONFINITE] = initial[LC_COUNTER_RAYS] = start;
     cl::CommandQueue& q = ctx.queue;
     q.enqueueWriteBuffer(dev->params, CL_FALSE, 0, sizeof(P), &P);
-    q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(zero), zero);
+    q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(initial), initial);
     if (entries)
       q.enqueueWriteBuffer(b_work, CL_FALSE, 0, items * sizeof(cl_uint4), entries->data());
     const bool light = P.flags & LC_FLAG_CAUSTICS;
@@ -182,7 +190,12 @@ struct Worker {
       q.enqueueReadBuffer(b_light, CL_FALSE, 0, nl * sizeof(cl_float4), h_light.data());
       q.enqueueReadBuffer(b_lightsq, CL_FALSE, 0, nl * sizeof(cl_float4), h_lightsq.data());
     }
-    q.enqueueReadBuffer(b_counters, CL_TRUE, 0, LC_COUNTER_COUNT * sizeof(lc_uint), counters);
+    lc_uint c[LC_COUNTER_COUNT];
+    q.enqueueReadBuffer(b_counters, CL_TRUE, 0, sizeof(c), c);
+    // 64-bit counts: the high word holds the carries out of the low word (megakernel.cl)
+    auto count = [&](int low, int high) { return (std::uint64_t(c[high]) << 32 | c[low]) - start; };
+    counts.nonfinite = count(LC_COUNTER_NONFINITE, LC_COUNTER_NONFINITE_HIGH);
+    counts.rays = count(LC_COUNTER_RAYS, LC_COUNTER_RAYS_HIGH);
   }
 };
 
@@ -502,7 +515,7 @@ struct Renderer::Impl {
 
   /// Launches jobs on every device until `next` has none (or the time limit, a cancel or an
   /// error), with the accumulation and the call's statistics guarded by one lock. `next(w, job)`
-  /// (under the lock) fills the worker's next job or returns false; `finish(w, job, counters)`
+  /// (under the lock) fills the worker's next job or returns false; `finish(w, job)`
   /// (under the lock) takes its results. At least one job runs unless cancelled with samples
   /// already accumulated.
   struct CallState {
@@ -550,19 +563,19 @@ struct Renderer::Impl {
           }
           if (render_detail::pass_fault(job.begin))
             throw cl::Error(CL_OUT_OF_RESOURCES, "clEnqueueNDRangeKernel (injected by a test)");
-          lc_uint counters[LC_COUNTER_COUNT];
+          PassCounts counts;
           auto tp = clock_type::now();
           lc_params P = packed.params;
           if (unsplit_passes) P.splits = 0;  // an adaptive pilot (run_adaptive)
           if (job.entries.empty())
-            w.pass(P, job.begin, job.n, counters);
+            w.pass(P, job.begin, job.n, counts);
           else
-            w.pass_list(P, job.entries, counters);
+            w.pass_list(P, job.entries, counts);
           double pass_time = seconds_since(tp);
           std::lock_guard<std::mutex> lock(cs.m);
           finish(w, job);
-          nonfinite += counters[LC_COUNTER_NONFINITE];
-          rays += counters[LC_COUNTER_RAYS];
+          nonfinite += counts.nonfinite;
+          rays += counts.rays;
           cs.call_seconds += pass_time;
           render_seconds += pass_time;
           stats.render_seconds += pass_time;
