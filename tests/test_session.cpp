@@ -687,3 +687,28 @@ TEST(Session, PassCountsCarryPast2To32) {
   EXPECT_EQ(r.accumulation().rays, plain.rays);
   EXPECT_EQ(r.accumulation().nonfinite, plain.nonfinite);
 }
+
+// Two devices and a time limit that is up once the first passes have run: an adaptive render
+// dispatches round after round in one call, and each round after the limit still gave every
+// device one pass (the pre-assignment of each device's first job did not look at the clock). With
+// one-sample passes every round went to the pre-assigned jobs alone, so the render went on through
+// its whole pilot and plan. Now the first round's two passes are all.
+TEST(Session, SeveralDevicesStopAtTheTimeLimit) {
+  lucent::SessionOptions o = lucent::test::session_options();
+  std::string one = std::to_string(lucent::select_device(o.device).index);
+  o.device = one + "," + one;
+  Renderer r(o);
+  ASSERT_EQ(r.devices().size(), 2u);
+  r.set_scene(lucent::test::scene_from(kScene));
+  lucent::AdaptiveOptions ao;
+  ao.budget_spp = 32;
+  ao.min_spp = 8;
+  ao.max_seconds = 1e-6;  // up before any pass ends
+  int calls = 0;
+  lucent::RenderProgress p = r.render_adaptive(ao, [&](const lucent::RenderProgress&) { ++calls; });
+  EXPECT_EQ(r.stats().passes, 2u) << "one pass per device, none after the time limit";
+  EXPECT_EQ(calls, 2);
+  EXPECT_GT(p.samples_done, 0u);
+  EXPECT_LT(r.spp(), 8u) << "the pilot alone is 8 samples per pixel";
+  EXPECT_FALSE(r.result().cancelled);
+}

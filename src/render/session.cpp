@@ -536,11 +536,17 @@ struct Renderer::Impl {
                 const std::function<void()>& on_pass) {
     bool& started = cs.started;
     std::exception_ptr failure;
+    // the call's time is up (a call that has launched nothing yet launches a job)
+    auto out_of_time = [&] {
+      return time_limit > 0 && started && seconds_since(cs.t_start) >= time_limit;
+    };
     // With several devices each takes its first job before any takes a second: a device whose
     // thread starts late still gets its share (the others do not drain a short render first).
+    // Not once the time is up: an adaptive render dispatches round after round in one call, and
+    // each round after the limit ran one more pass on every device.
     std::vector<Job> first_job(workers.size());
     std::vector<char> has_first(workers.size(), 0);
-    if (workers.size() > 1 && !cancelled())
+    if (workers.size() > 1 && !cancelled() && !out_of_time())
       for (size_t i = 0; i < workers.size(); ++i)
         if (next(*workers[i], first_job[i])) has_first[i] = 1, started = true;
     auto work = [&](Worker& w, size_t index) {
@@ -552,8 +558,7 @@ struct Renderer::Impl {
           } else {
             std::lock_guard<std::mutex> lock(cs.m);
             if (failure) return;
-            double elapsed = seconds_since(cs.t_start);
-            if (time_limit > 0 && started && elapsed >= time_limit) return;
+            if (out_of_time()) return;
             if (cancelled() && (have_samples || started)) {
               last_cancelled = true;
               return;
