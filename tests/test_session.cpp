@@ -14,6 +14,7 @@
 #include "cl/program_cache.hpp"
 #include "lucent/render.hpp"
 #include "lucent/session.hpp"
+#include "render/cancel_scope.hpp"
 #include "render/resources.hpp"
 #include "support.hpp"
 
@@ -711,4 +712,31 @@ TEST(Session, SeveralDevicesStopAtTheTimeLimit) {
   EXPECT_GT(p.samples_done, 0u);
   EXPECT_LT(r.spp(), 8u) << "the pilot alone is 8 samples per pixel";
   EXPECT_FALSE(r.result().cancelled);
+}
+
+// A CancelScope (a convergence study's) makes a session's calls one operation for cancel(): a
+// cancel asked for between two of them stops the next at once (each call's start cleared it, so
+// the study went on), and once the scope ends a call's start drops such a cancel again, as the
+// API says of a cancel while no render runs.
+TEST(Session, CancelBetweenTheCallsOfAScopeStopsTheNext) {
+  Renderer r = session();
+  r.set_scene(lucent::test::scene_from(kScene));
+  r.cancel();  // before the scope: not its operation's
+  {
+    lucent::render_detail::CancelScope scope(r);
+    EXPECT_FALSE(scope.cancelled());
+    r.render(1);
+    EXPECT_FALSE(r.result().cancelled);
+    r.cancel();
+    EXPECT_TRUE(scope.cancelled());
+    EXPECT_EQ(r.render(4).samples_done, 0u);
+    EXPECT_TRUE(r.result().cancelled);
+    EXPECT_EQ(r.spp(), 1u);
+  }
+  r.render(1);
+  EXPECT_FALSE(r.result().cancelled);
+  r.cancel();
+  r.render(1);
+  EXPECT_FALSE(r.result().cancelled) << "no render ran when it was asked for";
+  EXPECT_EQ(r.spp(), 3u);
 }

@@ -20,6 +20,7 @@
 #include "lucent/error.hpp"
 #include "lucent/types.hpp"
 #include "render/adaptive.hpp"
+#include "render/cancel_scope.hpp"
 #include "render/device_scene.hpp"
 #include "render/features.hpp"
 #include "render/pack.hpp"
@@ -244,6 +245,9 @@ struct Renderer::Impl {
 
   std::atomic<bool> cancel_requested{false};
   const std::atomic<bool>* cancel_flag = nullptr;
+  /// render_detail::CancelScopes alive: while one is, the calls are one operation, whose cancel a
+  /// call's start keeps (begin_call)
+  int cancel_scopes = 0;
   SessionStats stats;
 
   explicit Impl(SessionOptions o) : options(std::move(o)) {
@@ -524,9 +528,10 @@ struct Renderer::Impl {
     double call_seconds = 0;  // kernel time, summed over devices
     bool started = false;     // a job of this call was launched
   };
-  /// The start of a render call: no cancel pending, the call's shares at zero.
+  /// The start of a render call: no cancel pending (but one asked for during a CancelScope's
+  /// operation), the call's shares at zero.
   void begin_call() {
-    cancel_requested = false;
+    if (cancel_scopes == 0) cancel_requested = false;
     last_cancelled = false;
     for (auto& w : workers) w->call.samples = w->call_samples = 0, w->call.seconds = 0;
   }
@@ -1194,5 +1199,15 @@ void Renderer::cancel() { impl_->cancel_requested = true; }
 void Renderer::set_cancel_flag(const std::atomic<bool>* flag) { impl_->cancel_flag = flag; }
 const std::atomic<bool>* Renderer::cancel_flag() const { return impl_->cancel_flag; }
 SessionStats Renderer::stats() const { return impl_->stats; }
+
+namespace render_detail {
+
+CancelScope::CancelScope(Renderer& renderer) : renderer_(renderer) {
+  if (renderer_.impl_->cancel_scopes++ == 0) renderer_.impl_->cancel_requested = false;
+}
+CancelScope::~CancelScope() { --renderer_.impl_->cancel_scopes; }
+bool CancelScope::cancelled() const { return renderer_.impl_->cancelled(); }
+
+}  // namespace render_detail
 
 }  // namespace lucent
