@@ -36,6 +36,13 @@
  * then found spheres at t ~ 1e-7 in a scene of spheres and triangles; forced to pack the path
  * tracer, it rendered 2-4x slower (BENCHMARKS.md, "Intel's CPU OpenCL runtime"). PoCL and GPU
  * drivers ignore the hint. */
+/* Adds v to the 64-bit count of counters[low] and counters[high] (shared/types.h): the add whose
+ * old value plus v wraps past 2^32 carries one into the high word. */
+static inline void lc_count64(__global lc_uint* counters, int low, int high, lc_uint v) {
+  const lc_uint old = atomic_add(&counters[low], v);
+  if (old + v < old) atomic_inc(&counters[high]);
+}
+
 __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
     LC_SCENE_KERNEL_ARGS, __global const uint4* work, __global float4* out_sum,
     __global float4* out_sumsq, __global lc_uint* counters, __global float4* light_sum,
@@ -103,6 +110,6 @@ __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
   }
   out_sum[gid] = (float4)(sum, (float)accepted);
   out_sumsq[gid] = (float4)(sumsq, 0.0f);
-  if (nonfinite) atomic_add(&counters[LC_COUNTER_NONFINITE], nonfinite);
-  atomic_add(&counters[LC_COUNTER_RAYS], rays);
+  if (nonfinite) lc_count64(counters, LC_COUNTER_NONFINITE, LC_COUNTER_NONFINITE_HIGH, nonfinite);
+  lc_count64(counters, LC_COUNTER_RAYS, LC_COUNTER_RAYS_HIGH, rays);
 }

@@ -478,6 +478,50 @@ TEST(Converge, CallersSessionGetsItsCancelFlagBack) {
   EXPECT_EQ(session.cancel_flag(), &own);
 }
 
+// The caller's session's cancel() between two rungs stops the study, as its cancel flag does:
+// each rung's render call cleared a cancel asked for before it began, so one asked for from
+// on_point (or from another thread while a rung was compared, or a setting's kernel built) was
+// forgotten and the ladder went on. What was rendered stays in the session, and the session's
+// next render is not cancelled.
+TEST(Converge, CallersSessionsCancelBetweenRungsStopsTheStudy) {
+  lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
+  scene.film.width = scene.film.height = 8;
+  lucent::RenderResult reference = lucent::test::render(scene, lucent::test::render_options());
+  lucent::Renderer session(lucent::test::session_options());
+  lucent::ConvergeOptions opt;
+  opt.render = lucent::test::render_options();
+  opt.spp_ladder = {1, 2, 4};
+  opt.settings = {lucent::parse_converge_setting("default"),
+                  lucent::parse_converge_setting("max_depth=1")};
+  opt.renderer = &session;
+  int points = 0;
+  opt.on_point = [&](const ConvergePoint&) {
+    if (++points == 1) session.cancel();  // after the first rung
+  };
+  lucent::ConvergeResult r = lucent::run_convergence(scene, reference, opt);
+  EXPECT_EQ(r.points.size(), 1u);
+  EXPECT_EQ(points, 1);
+  EXPECT_EQ(session.spp(), 1u) << "the first rung's samples, no more";
+  session.render(1);
+  EXPECT_FALSE(session.result().cancelled);
+
+  // after a setting's last rung: the next setting is not rendered
+  points = 0;
+  opt.on_point = [&](const ConvergePoint&) {
+    if (++points == 3) session.cancel();
+  };
+  r = lucent::run_convergence(scene, reference, opt);
+  ASSERT_EQ(r.points.size(), 3u);
+  EXPECT_EQ(r.fits.size(), 1u);
+  EXPECT_EQ(r.points.back().setting, "default");
+  EXPECT_EQ(session.result().spp, 4u);
+
+  // a cancel asked for before the study is not the study's
+  session.cancel();
+  opt.on_point = nullptr;
+  EXPECT_EQ(lucent::run_convergence(scene, reference, opt).points.size(), 6u);
+}
+
 TEST(Converge, XmlCheckerRejectsMalformedDocuments) {
   int n = 0;
   EXPECT_EQ(check_xml("<svg><path d=\"M0 0\"/></svg>", "path", &n), "");

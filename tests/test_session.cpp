@@ -14,6 +14,7 @@
 #include "cl/program_cache.hpp"
 #include "lucent/render.hpp"
 #include "lucent/session.hpp"
+#include "render/cancel_scope.hpp"
 #include "render/resources.hpp"
 #include "support.hpp"
 
@@ -656,4 +657,86 @@ TEST(Session, PlannedRelmseIsTheLastCallsPlan) {
   EXPECT_EQ(b.target_error, 0.0);
   EXPECT_EQ(b.planned_relmse, 0.0);
   EXPECT_EQ(b.model_gain_a, t.model_gain_a);
+}
+
+// A pass's ray and non-finite counts are 64 bits: the kernel's 32-bit counters carry into a high
+// word. They wrapped: a pass of more than 2^32 rays (a 16-megapixel film at several samples per
+// pixel and deep paths) reported its rays modulo 2^32. Here each pass's counters start at
+// 2^32 - 1 (ScopedCounterStart, which the session takes off again), so that the first ray or
+// sample counted carries as the 2^32nd would: the counts equal those of the same samples counted
+// from 0 (a wrap without the carry read as a count near 2^64).
+TEST(Session, PassCountsCarryPast2To32) {
+  Scene s = lucent::test::scene_from(kScene);
+  s.lights[0].intensity = glm::dvec3(1e22);  // non-finite samples too (their squares overflow)
+  Renderer r = session();
+  r.set_scene(s);
+  // passes of one sample each, the same passes every time: whether a sample counts as non-finite
+  // depends on the pass's sum of squares before it
+  auto render = [&r] {
+    r.reset();
+    for (int i = 0; i < 3; ++i) r.render(1);
+    return r.result();
+  };
+  const RenderResult plain = render();
+  ASSERT_GT(plain.rays, 0u);
+  ASSERT_GT(plain.nonfinite, 0u);
+  ASSERT_LT(plain.rays, 1u << 31);
+  lucent::render_detail::ScopedCounterStart start(0xffffffffu);
+  const RenderResult carried = render();
+  EXPECT_EQ(carried.rays, plain.rays);
+  EXPECT_EQ(carried.nonfinite, plain.nonfinite);
+  EXPECT_EQ(r.accumulation().rays, plain.rays);
+  EXPECT_EQ(r.accumulation().nonfinite, plain.nonfinite);
+}
+
+// Two devices and a time limit that is up once the first passes have run: an adaptive render
+// dispatches round after round in one call, and each round after the limit still gave every
+// device one pass (the pre-assignment of each device's first job did not look at the clock). With
+// one-sample passes every round went to the pre-assigned jobs alone, so the render went on through
+// its whole pilot and plan. Now the first round's two passes are all.
+TEST(Session, SeveralDevicesStopAtTheTimeLimit) {
+  lucent::SessionOptions o = lucent::test::session_options();
+  std::string one = std::to_string(lucent::select_device(o.device).index);
+  o.device = one + "," + one;
+  Renderer r(o);
+  ASSERT_EQ(r.devices().size(), 2u);
+  r.set_scene(lucent::test::scene_from(kScene));
+  lucent::AdaptiveOptions ao;
+  ao.budget_spp = 32;
+  ao.min_spp = 8;
+  ao.max_seconds = 1e-6;  // up before any pass ends
+  int calls = 0;
+  lucent::RenderProgress p = r.render_adaptive(ao, [&](const lucent::RenderProgress&) { ++calls; });
+  EXPECT_EQ(r.stats().passes, 2u) << "one pass per device, none after the time limit";
+  EXPECT_EQ(calls, 2);
+  EXPECT_GT(p.samples_done, 0u);
+  EXPECT_LT(r.spp(), 8u) << "the pilot alone is 8 samples per pixel";
+  EXPECT_FALSE(r.result().cancelled);
+}
+
+// A CancelScope (a convergence study's) makes a session's calls one operation for cancel(): a
+// cancel asked for between two of them stops the next at once (each call's start cleared it, so
+// the study went on), and once the scope ends a call's start drops such a cancel again, as the
+// API says of a cancel while no render runs.
+TEST(Session, CancelBetweenTheCallsOfAScopeStopsTheNext) {
+  Renderer r = session();
+  r.set_scene(lucent::test::scene_from(kScene));
+  r.cancel();  // before the scope: not its operation's
+  {
+    lucent::render_detail::CancelScope scope(r);
+    EXPECT_FALSE(scope.cancelled());
+    r.render(1);
+    EXPECT_FALSE(r.result().cancelled);
+    r.cancel();
+    EXPECT_TRUE(scope.cancelled());
+    EXPECT_EQ(r.render(4).samples_done, 0u);
+    EXPECT_TRUE(r.result().cancelled);
+    EXPECT_EQ(r.spp(), 1u);
+  }
+  r.render(1);
+  EXPECT_FALSE(r.result().cancelled);
+  r.cancel();
+  r.render(1);
+  EXPECT_FALSE(r.result().cancelled) << "no render ran when it was asked for";
+  EXPECT_EQ(r.spp(), 3u);
 }

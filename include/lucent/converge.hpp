@@ -122,7 +122,9 @@ struct ConvergeOptions {
   /// The session to render with (its device, kernel and cache directories); null: a session
   /// opened from `render`. Either way one session renders every rung of every setting. A session
   /// given here ends with the last setting's scene, build options and accumulation; its cancel
-  /// flag is `render.cancel` during the study (when set) and its own again afterwards.
+  /// flag is `render.cancel` during the study (when set) and its own again afterwards. Its
+  /// cancel() (or the flag) stops the study after the current pass, or before the next rung when
+  /// asked for between two; the result has the points of the rungs finished.
   Renderer* renderer = nullptr;
   /// Called after each rung (progress output).
   std::function<void(const ConvergePoint&)> on_point;

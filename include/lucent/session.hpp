@@ -26,6 +26,10 @@
 
 namespace lucent {
 
+namespace render_detail {
+class CancelScope;  // src/render/cancel_scope.hpp
+}  // namespace render_detail
+
 /// How a session is set up. Every field has a built-in default; the environment is consulted
 /// only through from_environment().
 struct SessionOptions {
@@ -157,7 +161,9 @@ class Renderer {
   std::uint64_t image_hash() const;
 
   /// Stops a render in progress after its current pass (callable from another thread or a
-  /// signal handler through set_cancel_flag).
+  /// signal handler through set_cancel_flag). A cancel asked for while no render runs is dropped
+  /// when the next one starts, but during a convergence study on this session
+  /// (ConvergeOptions::renderer), which it stops, between two rungs too.
   void cancel();
   /// An external flag checked before each pass, as cancel() (e.g. set by a SIGINT handler).
   void set_cancel_flag(const std::atomic<bool>* flag);
@@ -167,6 +173,7 @@ class Renderer {
   SessionStats stats() const;
 
  private:
+  friend class render_detail::CancelScope;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

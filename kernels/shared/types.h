@@ -327,9 +327,14 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_params, sampler) == 132, params_sampler);
 #define LC_FLAG_NO_MIS 1u   /* path: light sampling only for area lights (no BSDF-hit emission) */
 #define LC_FLAG_CAUSTICS 2u /* path: caustic paths by light tracing (integrator/caustics.cl) */
 
-/* Counters accumulated by one launch (atomics on the device). */
-#define LC_COUNTER_NONFINITE 0 /* samples whose radiance was NaN or Inf (not added to the film) */
-#define LC_COUNTER_RAYS 1      /* rays traced, shadow rays included                              */
+/* Counters accumulated by one launch (atomics on the device). Each is a 64-bit count in two
+ * 32-bit words, as OpenCL 1.2 has no 64-bit atomics: the low word, and the high word, which the
+ * work-item whose atomic_add carried out of the low word increments (megakernel.cl, lc_count64).
+ * A pass of a large film at several samples per pixel traces more than 2^32 rays. */
+#define LC_COUNTER_NONFINITE 0      /* samples whose radiance was NaN or Inf (not in the film) */
+#define LC_COUNTER_RAYS 1           /* rays traced, shadow rays included                        */
+#define LC_COUNTER_NONFINITE_HIGH 2 /* the high word of LC_COUNTER_NONFINITE's count            */
+#define LC_COUNTER_RAYS_HIGH 3      /* the high word of LC_COUNTER_RAYS's count                 */
 #define LC_COUNTER_COUNT 4
 
 #endif /* LUCENT_SHARED_TYPES_H */

@@ -17,6 +17,7 @@
 #include "lucent/limits.hpp"
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
+#include "render/cancel_scope.hpp"
 
 namespace lucent {
 
@@ -333,6 +334,10 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
     ~CancelFlag() { r.set_cancel_flag(before); }
   } cancel_flag{*renderer, renderer->cancel_flag()};
   if (options.render.cancel) renderer->set_cancel_flag(options.render.cancel);
+  // the study is one operation for the session's cancel(): one asked for between two rungs (from
+  // on_point, or another thread while a rung is compared or a setting's kernel built) stops it
+  // too; each render call cleared it as it began, and the ladder went on
+  render_detail::CancelScope cancel_scope(*renderer);
 
   ConvergeResult result;
   CompareOptions co;
@@ -340,6 +345,7 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
   bool cancelled = false;
   const double ref_noise = reference_noise(reference);
   for (const ConvergeSetting& setting : settings) {
+    if (cancel_scope.cancelled()) break;
     Scene s = scene;
     RenderOptions o = options.render;
     setting.apply(s, o);
@@ -355,6 +361,10 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
     // a target-error setting is one render, whatever the ladder
     const std::size_t setting_rungs = setting.target_error > 0 ? 1 : rungs;
     for (std::size_t i = 0; i < setting_rungs && !cancelled; ++i) {
+      if (cancel_scope.cancelled()) {
+        cancelled = true;
+        break;
+      }
       if (setting.target_error > 0) {
         ao.target_error = setting.target_error;
         renderer->render_adaptive(ao, options.render.on_progress);

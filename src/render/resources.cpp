@@ -93,6 +93,14 @@ ScopedPassFault::ScopedPassFault(std::uint64_t begin) { g_pass_fault = begin; }
 ScopedPassFault::~ScopedPassFault() { g_pass_fault = ~std::uint64_t(0); }
 bool pass_fault(std::uint64_t begin) { return g_pass_fault.load() == begin; }
 
+namespace {
+std::atomic<std::uint32_t> g_counter_start{0};
+}  // namespace
+
+ScopedCounterStart::ScopedCounterStart(std::uint32_t start) { g_counter_start = start; }
+ScopedCounterStart::~ScopedCounterStart() { g_counter_start = 0; }
+std::uint32_t counter_start() { return g_counter_start.load(); }
+
 std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                                              const std::vector<DeviceLimits>& devices) {
   const std::uint64_t npix = std::uint64_t(scene.film.width) * std::uint64_t(scene.film.height);

@@ -68,6 +68,20 @@ class ScopedPassFault {
 /// Whether a ScopedPassFault for `begin` is alive.
 bool pass_fault(std::uint64_t begin);
 
+/// For tests: while alive, the low words of a pass's counters (rays, non-finite samples; each a
+/// 64-bit count in two 32-bit words, kernels/shared/types.h) start at `start` instead of 0, and
+/// the session takes `start` off the count it reads back: a pass of a few rays then carries past
+/// 2^32 as one of billions would (counter_start()). One at a time.
+class ScopedCounterStart {
+ public:
+  explicit ScopedCounterStart(std::uint32_t start);
+  ~ScopedCounterStart();
+  ScopedCounterStart(const ScopedCounterStart&) = delete;
+  ScopedCounterStart& operator=(const ScopedCounterStart&) = delete;
+};
+/// The start of a pass's counters: a ScopedCounterStart's, else 0.
+std::uint32_t counter_start();
+
 /// The work-group size of a launch: `preferred` (a power of two) when the device
 /// (CL_DEVICE_MAX_WORK_GROUP_SIZE, CL_DEVICE_MAX_WORK_ITEM_SIZES[0]) and the built kernel
 /// (CL_KERNEL_WORK_GROUP_SIZE) allow it, else the largest power of two they allow (at least 1;

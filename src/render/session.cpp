@@ -20,6 +20,7 @@
 #include "lucent/error.hpp"
 #include "lucent/types.hpp"
 #include "render/adaptive.hpp"
+#include "render/cancel_scope.hpp"
 #include "render/device_scene.hpp"
 #include "render/features.hpp"
 #include "render/pack.hpp"
@@ -76,6 +77,12 @@ bool same_render_data(const render_detail::PackedScene& a, const render_detail::
 #undef LUCENT_SAME
   return same;
 }
+
+/// What one pass counted (its counters, kernels/shared/types.h).
+struct PassCounts {
+  std::uint64_t nonfinite = 0;  ///< samples whose radiance was not finite
+  std::uint64_t rays = 0;
+};
 
 struct Program {
   cl::Program program;
@@ -137,30 +144,32 @@ struct Worker {
   }
 
   /// Launches samples [first, first + n) of every pixel and reads back their sums.
-  void pass(const lc_params& params, std::uint64_t first, std::uint32_t n,
-            lc_uint counters[LC_COUNTER_COUNT]) {
+  void pass(const lc_params& params, std::uint64_t first, std::uint32_t n, PassCounts& counts) {
     lc_params P = params;
     P.sample_offset = static_cast<lc_uint>(first);
     P.samples_per_pass = n;
     P.work_items = 0;
-    launch(P, npix, nullptr, counters);
+    launch(P, npix, nullptr, counts);
   }
 
   /// Launches the work list `entries` (pixel, first sample, samples, stream; at most npix) and
   /// reads back their sums, entry by entry.
   void pass_list(const lc_params& params, const std::vector<cl_uint4>& entries,
-                 lc_uint counters[LC_COUNTER_COUNT]) {
+                 PassCounts& counts) {
     lc_params P = params;
     P.work_items = static_cast<lc_uint>(entries.size());
-    launch(P, entries.size(), &entries, counters);
+    launch(P, entries.size(), &entries, counts);
   }
 
   void launch(const lc_params& P, size_t items, const std::vector<cl_uint4>* entries,
-              lc_uint counters[LC_COUNTER_COUNT]) {
-    lc_uint zero[LC_COUNTER_COUNT] = {0, 0, 0, 0};
+              PassCounts& counts) {
+    // each count's low word starts at 0 (at counter_start() in a test, taken off again below)
+    const lc_uint start = render_detail::counter_start();
+    lc_uint initial[LC_COUNTER_COUNT] = {};
+    initial[LC_COUNTER_NONFINITE] = initial[LC_COUNTER_RAYS] = start;
     cl::CommandQueue& q = ctx.queue;
     q.enqueueWriteBuffer(dev->params, CL_FALSE, 0, sizeof(P), &P);
-    q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(zero), zero);
+    q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(initial), initial);
     if (entries)
       q.enqueueWriteBuffer(b_work, CL_FALSE, 0, items * sizeof(cl_uint4), entries->data());
     const bool light = P.flags & LC_FLAG_CAUSTICS;
@@ -182,7 +191,12 @@ struct Worker {
       q.enqueueReadBuffer(b_light, CL_FALSE, 0, nl * sizeof(cl_float4), h_light.data());
       q.enqueueReadBuffer(b_lightsq, CL_FALSE, 0, nl * sizeof(cl_float4), h_lightsq.data());
     }
-    q.enqueueReadBuffer(b_counters, CL_TRUE, 0, LC_COUNTER_COUNT * sizeof(lc_uint), counters);
+    lc_uint c[LC_COUNTER_COUNT];
+    q.enqueueReadBuffer(b_counters, CL_TRUE, 0, sizeof(c), c);
+    // 64-bit counts: the high word holds the carries out of the low word (megakernel.cl)
+    auto count = [&](int low, int high) { return (std::uint64_t(c[high]) << 32 | c[low]) - start; };
+    counts.nonfinite = count(LC_COUNTER_NONFINITE, LC_COUNTER_NONFINITE_HIGH);
+    counts.rays = count(LC_COUNTER_RAYS, LC_COUNTER_RAYS_HIGH);
   }
 };
 
@@ -231,6 +245,9 @@ struct Renderer::Impl {
 
   std::atomic<bool> cancel_requested{false};
   const std::atomic<bool>* cancel_flag = nullptr;
+  /// render_detail::CancelScopes alive: while one is, the calls are one operation, whose cancel a
+  /// call's start keeps (begin_call)
+  int cancel_scopes = 0;
   SessionStats stats;
 
   explicit Impl(SessionOptions o) : options(std::move(o)) {
@@ -502,7 +519,7 @@ struct Renderer::Impl {
 
   /// Launches jobs on every device until `next` has none (or the time limit, a cancel or an
   /// error), with the accumulation and the call's statistics guarded by one lock. `next(w, job)`
-  /// (under the lock) fills the worker's next job or returns false; `finish(w, job, counters)`
+  /// (under the lock) fills the worker's next job or returns false; `finish(w, job)`
   /// (under the lock) takes its results. At least one job runs unless cancelled with samples
   /// already accumulated.
   struct CallState {
@@ -511,9 +528,10 @@ struct Renderer::Impl {
     double call_seconds = 0;  // kernel time, summed over devices
     bool started = false;     // a job of this call was launched
   };
-  /// The start of a render call: no cancel pending, the call's shares at zero.
+  /// The start of a render call: no cancel pending (but one asked for during a CancelScope's
+  /// operation), the call's shares at zero.
   void begin_call() {
-    cancel_requested = false;
+    if (cancel_scopes == 0) cancel_requested = false;
     last_cancelled = false;
     for (auto& w : workers) w->call.samples = w->call_samples = 0, w->call.seconds = 0;
   }
@@ -523,11 +541,17 @@ struct Renderer::Impl {
                 const std::function<void()>& on_pass) {
     bool& started = cs.started;
     std::exception_ptr failure;
+    // the call's time is up (a call that has launched nothing yet launches a job)
+    auto out_of_time = [&] {
+      return time_limit > 0 && started && seconds_since(cs.t_start) >= time_limit;
+    };
     // With several devices each takes its first job before any takes a second: a device whose
     // thread starts late still gets its share (the others do not drain a short render first).
+    // Not once the time is up: an adaptive render dispatches round after round in one call, and
+    // each round after the limit ran one more pass on every device.
     std::vector<Job> first_job(workers.size());
     std::vector<char> has_first(workers.size(), 0);
-    if (workers.size() > 1 && !cancelled())
+    if (workers.size() > 1 && !cancelled() && !out_of_time())
       for (size_t i = 0; i < workers.size(); ++i)
         if (next(*workers[i], first_job[i])) has_first[i] = 1, started = true;
     auto work = [&](Worker& w, size_t index) {
@@ -539,8 +563,7 @@ struct Renderer::Impl {
           } else {
             std::lock_guard<std::mutex> lock(cs.m);
             if (failure) return;
-            double elapsed = seconds_since(cs.t_start);
-            if (time_limit > 0 && started && elapsed >= time_limit) return;
+            if (out_of_time()) return;
             if (cancelled() && (have_samples || started)) {
               last_cancelled = true;
               return;
@@ -550,19 +573,19 @@ struct Renderer::Impl {
           }
           if (render_detail::pass_fault(job.begin))
             throw cl::Error(CL_OUT_OF_RESOURCES, "clEnqueueNDRangeKernel (injected by a test)");
-          lc_uint counters[LC_COUNTER_COUNT];
+          PassCounts counts;
           auto tp = clock_type::now();
           lc_params P = packed.params;
           if (unsplit_passes) P.splits = 0;  // an adaptive pilot (run_adaptive)
           if (job.entries.empty())
-            w.pass(P, job.begin, job.n, counters);
+            w.pass(P, job.begin, job.n, counts);
           else
-            w.pass_list(P, job.entries, counters);
+            w.pass_list(P, job.entries, counts);
           double pass_time = seconds_since(tp);
           std::lock_guard<std::mutex> lock(cs.m);
           finish(w, job);
-          nonfinite += counters[LC_COUNTER_NONFINITE];
-          rays += counters[LC_COUNTER_RAYS];
+          nonfinite += counts.nonfinite;
+          rays += counts.rays;
           cs.call_seconds += pass_time;
           render_seconds += pass_time;
           stats.render_seconds += pass_time;
@@ -1176,5 +1199,15 @@ void Renderer::cancel() { impl_->cancel_requested = true; }
 void Renderer::set_cancel_flag(const std::atomic<bool>* flag) { impl_->cancel_flag = flag; }
 const std::atomic<bool>* Renderer::cancel_flag() const { return impl_->cancel_flag; }
 SessionStats Renderer::stats() const { return impl_->stats; }
+
+namespace render_detail {
+
+CancelScope::CancelScope(Renderer& renderer) : renderer_(renderer) {
+  if (renderer_.impl_->cancel_scopes++ == 0) renderer_.impl_->cancel_requested = false;
+}
+CancelScope::~CancelScope() { --renderer_.impl_->cancel_scopes; }
+bool CancelScope::cancelled() const { return renderer_.impl_->cancelled(); }
+
+}  // namespace render_detail
 
 }  // namespace lucent

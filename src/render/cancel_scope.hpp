@@ -1,0 +1,28 @@
+#pragma once
+// Several calls of one session as one operation for Renderer::cancel(): run_convergence's ladder
+// (src/render/converge.cpp) renders rung after rung on one session, and a call clears the cancel
+// asked for before it began, so a cancel between two rungs was forgotten and the ladder went on.
+#include "lucent/session.hpp"
+
+namespace lucent::render_detail {
+
+/// While alive, the calls of `renderer` are one operation for Renderer::cancel(): a cancel asked
+/// for during any of them or between two of them stays asked for (no call clears it as it
+/// starts), so that every call after it stops at once, and cancelled() tells the caller to stop
+/// calling. A cancel asked for before the scope began is dropped, as a call's start drops it.
+/// Created and destroyed on the thread that makes the calls; scopes may nest.
+class CancelScope {
+ public:
+  explicit CancelScope(Renderer& renderer);
+  ~CancelScope();
+  CancelScope(const CancelScope&) = delete;
+  CancelScope& operator=(const CancelScope&) = delete;
+
+  /// cancel() was called since the scope began, or the session's cancel flag is raised.
+  bool cancelled() const;
+
+ private:
+  Renderer& renderer_;
+};
+
+}  // namespace lucent::render_detail
