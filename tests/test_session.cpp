@@ -233,6 +233,24 @@ TEST(Session, CancelStopsAfterThePassInProgress) {
   EXPECT_TRUE(r.result().cancelled);
 }
 
+// A cancel that comes once every sample of the call is rendered (from the last pass's progress
+// callback) cuts nothing short: the render is complete, not cancelled. It was marked cancelled,
+// and a convergence study dropped the finished rung.
+TEST(Session, CancelAfterTheLastPassLeavesTheRenderComplete) {
+  Renderer r = session();
+  r.set_scene(lucent::test::scene_from(kScene));
+  lucent::RenderProgress p = r.render(3, [&](const lucent::RenderProgress& q) {
+    if (q.samples_done == 3) r.cancel();
+  });
+  EXPECT_EQ(p.samples_done, 3u);
+  EXPECT_EQ(r.spp(), 3u);
+  EXPECT_FALSE(r.result().cancelled);
+  // with samples left to render, the render is cut short
+  r.render(1000000, [&](const lucent::RenderProgress&) { r.cancel(); });
+  EXPECT_LT(r.spp(), 1000003u);
+  EXPECT_TRUE(r.result().cancelled);
+}
+
 // Warnings of packing go to the session's sink, not to stderr.
 TEST(Session, WarningsGoToTheSessionsSink) {
   std::vector<std::string> got;

@@ -675,6 +675,8 @@ struct Renderer::Impl {
       if (on_progress) on_progress(make_progress(cs, finished, target_spp, time_limit));
     };
     dispatch(cs, time_limit, done > 0, next, finish, on_pass);
+    // a cancel once every sample was rendered (from the last pass's callback) cut nothing short
+    if (target_spp > 0 && finished >= target_spp) last_cancelled = false;
     return make_progress(cs, finished, target_spp, time_limit);
   }
 
