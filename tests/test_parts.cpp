@@ -353,6 +353,7 @@ TEST(Parts, DamagedPartFilesAreOneLineErrors) {
       {"lucent.display", "srgb,", "srgx,", "attribute lucent.display: unknown transfer 'srgx'"},
       {"lucent.display", ",clamp", ",clamq", "attribute lucent.display: unknown tone map 'clamq'"},
       {"lucent.display", "srgb,", "srgb;", "attribute lucent.display: invalid 'srgb;"},
+      {"lucent.seconds", "0.", "-.", "attribute lucent.seconds: negative time '-."},
   };
   int n = 0;
   for (const Damage& d : damages) {

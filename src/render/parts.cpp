@@ -156,6 +156,8 @@ PartInfo info_from_attributes(const std::string& path,
   info.nonfinite = image_detail::parse_attribute_u64(path, "lucent.nonfinite", get("nonfinite"));
   info.rays = image_detail::parse_attribute_u64(path, "lucent.rays", get("rays"));
   info.seconds = parse_double(path, "lucent.seconds", get("seconds"));
+  if (info.seconds < 0)  // a merge adds them: a negative time would hide another part's
+    throw Error(path + ": attribute lucent.seconds: negative time '" + get("seconds") + "'");
   // display: transfer,gamma,exposure,tonemap
   const std::string& d = get("display");
   char transfer[16] = {0}, tonemap[16] = {0};
