@@ -11,6 +11,7 @@
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/reference.hpp"
+#include "render/resources.hpp"
 #include "support.hpp"
 
 namespace {
@@ -286,6 +287,23 @@ TEST(Compare, NonFiniteInputIsAnInputError) {
 // The z map's path is checked before the images are read (a .txt z map was refused only after
 // the comparison, and a PNG clipped the negative z values): the format, a directory that does
 // not exist, an input.
+// An image to compare is checked against the host's memory from its header, before it is
+// decoded: two 16384x16384 PNGs took 9.4 GB, and past the host's memory the process is killed.
+TEST(Compare, ReadingAnImageChecksItsMemoryFirst) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::write_image(dir + "/a.pfm", lucent::Image{64, 32, std::vector<float>(64 * 32 * 3, 0.5f)});
+  ASSERT_EQ(lucent::read_render(dir + "/a.pfm").mean.width, 64);
+  lucent::render_detail::DeviceLimits lim;
+  lim.host_mem = 64 << 10;  // 64 KiB: less than 64 x 32 pixels at 32 bytes
+  lucent::render_detail::ScopedLimitOverride o(lim);
+  const std::string msg = lucent::test::error_of([&] { lucent::read_render(dir + "/a.pfm"); });
+  EXPECT_EQ(msg.rfind(dir + "/a.pfm: reading this 64x32 image needs about 88.0 KiB of memory, " +
+                          "more than the limit of 64.0 KiB (80% of ",
+                      0),
+            0u)
+      << msg;
+}
+
 TEST(Compare, ZmapPathIsCheckedBeforeReading) {
   const std::string dir = lucent::test::temp_dir();
   const std::string images = " '" + dir + "/missing-a.exr' '" + dir + "/missing-b.exr' --zmap '";

@@ -152,9 +152,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "lucent: error: %s\n", one_line(e.what()).c_str());
     return 1;
   } catch (const std::bad_alloc&) {
+    // name what was being done: the scene, or the command (compare, merge, ...)
+    std::string doing = "lucent";
+    for (const CLI::App* sub : app.get_subcommands()) doing += " " + sub->get_name();
     std::fprintf(stderr, "lucent: error: out of memory (%s)\n",
                  *render ? ("rendering " + one_line(lucent::cli::render_scene())).c_str()
-                         : "no scene loaded");
+                         : ("in " + doing).c_str());
     return 1;
   } catch (const std::exception& e) {
     // not a lucent::Error (a limit of the standard library): name what was being done
