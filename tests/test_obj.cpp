@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <glm/gtc/matrix_transform.hpp>
+#include <iterator>
 #include <map>
 #include <set>
 #include <string>
@@ -557,6 +558,52 @@ TEST(Obj, MaterialOverrideIgnoresTheMtl) {
   EXPECT_TRUE(s.textures.empty());
   ASSERT_EQ(s.triangles.size(), 2u);
   for (const Triangle& t : s.triangles) EXPECT_EQ(t.material, 1);
+}
+
+// The MTL specification makes v and w optional in `-o u [v [w]]`, `-s` and `-t`; tinyobjloader
+// takes three numbers, the file name among them: `map_Kd -o 0.5 tex.png` had no texture, and no
+// warning. Each option takes the arguments that fit it; the file name is never one of them.
+TEST(Obj, TextureOptionsKeepTheFileName) {
+  std::string dir = lucent::test::temp_dir();
+  const unsigned char px[] = {255, 255, 255, 0, 0, 0};
+  ASSERT_TRUE(stbi_write_png((dir + "/t.png").c_str(), 2, 1, 3, px, 6));
+  ASSERT_TRUE(stbi_write_png((dir + "/my t.png").c_str(), 2, 1, 3, px, 6));
+  const char* maps[] = {"-o 0.5 t.png",
+                        "-s 2 t.png",
+                        "-t 0.1 0.2 t.png",
+                        "-o 0.5 0.5 0 t.png",
+                        "-s 2 -o 1 t.png",
+                        "-clamp on -bm 1 -mm 0 1 t.png",
+                        "-blendu off\t-blendv on -boost 2 -texres 512 t.png",
+                        "-imfchan r -type sphere -colorspace sRGB t.png",
+                        "-cc on t.png",
+                        "-clamp t.png",
+                        "-s 2 my t.png",
+                        "t.png",
+                        "my t.png"};
+  std::string mtl, obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n";
+  for (std::size_t i = 0; i < std::size(maps); ++i) {
+    mtl += "newmtl m" + std::to_string(i) + "\nKd 0.1 0.2 0.3\nmap_Kd " + maps[i] + "\n";
+    obj += "usemtl m" + std::to_string(i) + "\nf 1 2 3\n";
+  }
+  // a missing texture of an unused map is still named, options or not
+  mtl += "newmtl d\nKd 0.1 0.2 0.3\nmap_d -o 0.5 nothere.dds\n";
+  obj += "usemtl d\nf 1 2 3\n";
+  write(dir, "m.mtl", mtl);
+  std::string path = write(dir, "m.obj", obj);
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), std::size(maps) + 1);
+  ASSERT_EQ(s.textures.size(), 2u) << w.dump();
+  for (std::size_t i = 0; i < std::size(maps); ++i) {
+    const Material& m = s.materials[s.triangles[i].material];
+    EXPECT_EQ(m.albedo_texture, std::string(maps[i]).find("my t") == std::string::npos ? 0 : 1)
+        << "map_Kd " << maps[i];
+    EXPECT_EQ(m.albedo, glm::dvec3(1.0)) << "map_Kd " << maps[i];
+  }
+  EXPECT_EQ(w.count("'nothere.dds' not found"), 1) << w.dump();
+  EXPECT_EQ(w.all().size(), 1u) << w.dump();
 }
 
 // The MTL libraries an OBJ file names are inputs of the scene, as its textures are: outputs

@@ -2,6 +2,7 @@
 // coordinate that is not a number ("v 1 abc 0", "v nan 0 0") as 0 without a word, lets 1e39
 // overflow to infinity in its floats, and reports out-of-range indices only as a warning at the
 // last line: every number and index is checked here, and the first bad one named with its line.
+#include <algorithm>
 #include <cctype>
 #include <cfloat>
 #include <charconv>
@@ -284,6 +285,102 @@ void check_mtl_text(const std::string& path, const std::string& text) {
         fail("illum line: '" + str(t) + "' is not an illumination model (0 to 10)");
     }
   });
+}
+
+namespace {
+
+// A token of a texture statement's options, split as tinyobjloader splits them (spaces and tabs).
+struct Word {
+  std::size_t begin, end;  // offsets in the line
+};
+
+bool is_number(std::string_view t) {
+  if (!t.empty() && t[0] == '+') t.remove_prefix(1);
+  double v = 0;
+  auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  return !t.empty() && ptr == t.data() + t.size() &&
+         (ec == std::errc() || ec == std::errc::result_out_of_range);
+}
+
+// The texture statements tinyobjloader reads (ParseTextureNameAndOption): the tag, then one space
+// or tab.
+bool texture_tag(std::string_view tag) {
+  static const char* const tags[] = {"map_Ka",   "map_Kd", "map_Ks", "map_Ns",   "map_bump",
+                                     "map_Bump", "bump",   "map_d",  "map_disp", "map_Disp",
+                                     "disp",     "refl",   "map_Pr", "map_Pm",   "map_Ps",
+                                     "map_Ke",   "norm"};
+  for (const char* t : tags)
+    if (tag == t) return true;
+  return false;
+}
+
+// The texture options of the MTL specification (and tinyobjloader's -colorspace): how many
+// arguments each takes at most, and of which kind.
+enum class Arg { Number, OnOff, Word };
+struct TextureOption {
+  const char* name;
+  int most;
+  Arg kind;
+};
+constexpr TextureOption kTextureOptions[] = {
+    {"-blendu", 1, Arg::OnOff},  {"-blendv", 1, Arg::OnOff},   {"-cc", 1, Arg::OnOff},
+    {"-clamp", 1, Arg::OnOff},   {"-boost", 1, Arg::Number},   {"-bm", 1, Arg::Number},
+    {"-texres", 1, Arg::Number}, {"-mm", 2, Arg::Number},      {"-o", 3, Arg::Number},
+    {"-s", 3, Arg::Number},      {"-t", 3, Arg::Number},       {"-imfchan", 1, Arg::Word},
+    {"-type", 1, Arg::Word},     {"-colorspace", 1, Arg::Word}};
+
+// Where the file name of a texture statement's `args` (the line after the tag and its space)
+// starts: after the options and their arguments. The last word is always (part of) the name.
+std::size_t texture_name_start(std::string_view args) {
+  std::vector<Word> words;
+  for (std::size_t i = 0; i < args.size();) {
+    std::size_t b = args.find_first_not_of(" \t", i);
+    if (b == std::string_view::npos) break;
+    std::size_t e = std::min(args.find_first_of(" \t", b), args.size());
+    words.push_back({b, e});
+    i = e;
+  }
+  auto word = [&](std::size_t k) {
+    return args.substr(words[k].begin, words[k].end - words[k].begin);
+  };
+  std::size_t k = 0;
+  while (k + 1 < words.size()) {
+    const TextureOption* option = nullptr;
+    for (const TextureOption& o : kTextureOptions)
+      if (word(k) == o.name) option = &o;
+    if (!option) break;
+    ++k;
+    for (int n = 0; n < option->most && k + 1 < words.size(); ++n, ++k) {
+      std::string_view a = word(k);
+      bool fits = option->kind == Arg::Word ||
+                  (option->kind == Arg::OnOff && (a == "on" || a == "off")) ||
+                  (option->kind == Arg::Number && is_number(a));
+      if (!fits) break;
+    }
+  }
+  return k < words.size() ? words[k].begin : args.size();
+}
+
+}  // namespace
+
+std::string strip_texture_options(const std::string& text) {
+  std::string out;
+  std::size_t copied = 0;  // text before this offset is in `out`
+  for_each_line(text, [&](std::string_view line, long) {
+    std::size_t b = line.find_first_not_of(" \t");
+    if (b == std::string_view::npos) return;
+    std::size_t e = line.find_first_of(" \t", b);
+    if (e == std::string_view::npos || !texture_tag(line.substr(b, e - b))) return;
+    std::string_view args = line.substr(e + 1);
+    std::size_t name = texture_name_start(args);
+    if (args.find_first_not_of(" \t") >= name) return;  // no options
+    const std::size_t at = static_cast<std::size_t>(args.data() - text.data());
+    out.append(text, copied, at - copied);
+    copied = at + name;
+  });
+  if (copied == 0) return text;
+  out.append(text, copied, std::string::npos);
+  return out;
 }
 
 long line_of_statement(const std::string& text, const char* tag, std::int64_t n) {

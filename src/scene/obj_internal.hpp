@@ -41,6 +41,13 @@ TextCounts check_obj_text(const std::string& path, const std::string& text);
 /// lucent::Error("<path>:<line>: ...").
 void check_mtl_text(const std::string& path, const std::string& text);
 
+/// The MTL text tinyobjloader reads: `text` with the options of its texture statements (map_Kd,
+/// bump, ...: `-o u [v [w]]`, `-clamp on`, ...) removed, lucent using none of them. Each option
+/// takes the arguments that fit it, up to its count (tinyobjloader takes three numbers after
+/// -o, -s and -t, and `map_Kd -o 0.5 tex.png` lost its file name); the last word of a statement
+/// is always (part of) the file name. The lines are kept.
+std::string strip_texture_options(const std::string& text);
+
 /// Line (1-based) of the `n`-th (0-based) statement `tag` of `text`, or 0.
 long line_of_statement(const std::string& text, const char* tag, std::int64_t n);
 

@@ -64,7 +64,7 @@ bool MtlReader::operator()(const std::string& name, std::vector<tinyobj::materia
     if (error.empty()) error = e.what();
     return false;
   }
-  std::istringstream in(text);
+  std::istringstream in(strip_texture_options(text));
   size_t before = materials->size();
   std::string mtl_warn, mtl_err;
   tinyobj::LoadMtl(map, materials, &in, &mtl_warn, &mtl_err);
