@@ -606,6 +606,32 @@ TEST(Obj, TextureOptionsKeepTheFileName) {
   EXPECT_EQ(w.all().size(), 1u) << w.dump();
 }
 
+// A material defined twice: tinyobjloader keeps the first definition, silently (a JSON scene
+// refuses a material name given twice). A warning names both places, in one library or two.
+TEST(Obj, MaterialDefinedTwiceWarnsNamingBothPlaces) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "twice.mtl", "newmtl m\nKd 1 0 0\n\nnewmtl m\nKd 0 1 0\nnewmtl n  \nKd 0 0 1\n");
+  write(dir, "more.mtl", "# n again\nnewmtl n\nKd 1 1 0\n");
+  std::string path = write(dir, "m.obj",
+                           "mtllib twice.mtl\nmtllib more.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                           "usemtl m\nf 1 2 3\nusemtl n\nf 1 3 2\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), 2u);
+  EXPECT_EQ(s.materials[s.triangles[0].material].albedo, glm::dvec3(1, 0, 0));
+  EXPECT_EQ(s.materials[s.triangles[1].material].albedo, glm::dvec3(0, 0, 1));
+  EXPECT_EQ(w.count(dir + "/twice.mtl:4: material 'm' is defined again (first at line 1); "
+                          "faces use the first definition"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.count(dir + "/more.mtl:2: material 'n' is defined again (first at " + dir +
+                    "/twice.mtl:6); faces use the first definition"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.all().size(), 2u) << w.dump();
+}
+
 // The MTL libraries an OBJ file names are inputs of the scene, as its textures are: outputs
 // (render -o, converge --csv, --plot and --save-reference, lucent-mpi -o) must not overwrite them.
 // scene_inputs listed the OBJ files but not their libraries (`converge --csv lib/m.mtl` replaced

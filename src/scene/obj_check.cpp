@@ -383,6 +383,21 @@ std::string strip_texture_options(const std::string& text) {
   return out;
 }
 
+std::vector<MtlName> mtl_material_names(const std::string& text) {
+  std::vector<MtlName> out;
+  for_each_line(text, [&](std::string_view line, long ln) {
+    std::size_t b = line.find_first_not_of(" \t");
+    if (b == std::string_view::npos || line.compare(b, 6, "newmtl") != 0 || b + 6 >= line.size() ||
+        (line[b + 6] != ' ' && line[b + 6] != '\t'))
+      return;
+    std::string_view name = line.substr(b + 7);
+    std::size_t last = name.find_last_not_of(" \t");
+    if (last == std::string_view::npos) return;  // "newmtl" and spaces: no statement
+    out.push_back({std::string(name.substr(0, last + 1)), ln});
+  });
+  return out;
+}
+
 long line_of_statement(const std::string& text, const char* tag, std::int64_t n) {
   long found = 0;
   std::int64_t seen = 0;

@@ -48,6 +48,14 @@ void check_mtl_text(const std::string& path, const std::string& text);
 /// is always (part of) the file name. The lines are kept.
 std::string strip_texture_options(const std::string& text);
 
+/// A `newmtl` statement of an MTL file: the material's name as tinyobjloader reads it (the rest
+/// of the line, trailing spaces removed) and its line.
+struct MtlName {
+  std::string name;
+  long line = 0;
+};
+std::vector<MtlName> mtl_material_names(const std::string& text);
+
 /// Line (1-based) of the `n`-th (0-based) statement `tag` of `text`, or 0.
 long line_of_statement(const std::string& text, const char* tag, std::int64_t n);
 
@@ -60,8 +68,8 @@ std::vector<std::string> lines_of(const std::string& text);
 /// Reads the libraries named by `mtllib` (relative to the OBJ's directory) with a bound and
 /// checks their text, and remembers which file each material came from, since texture paths are
 /// relative to it. Missing or unreadable libraries are recorded (the caller warns); a malformed
-/// one is recorded as `error` (the caller throws). When disabled (a material override) nothing
-/// is read.
+/// one is recorded as `error` (the caller throws). A material name defined again is a warning.
+/// When disabled (a material override) nothing is read.
 class MtlReader : public tinyobj::MaterialReader {
  public:
   MtlReader(std::filesystem::path dir, bool enabled) : dir_(std::move(dir)), enabled_(enabled) {}
@@ -79,6 +87,8 @@ class MtlReader : public tinyobj::MaterialReader {
  private:
   std::filesystem::path dir_;
   bool enabled_;
+  /// each material name's first definition: library and line
+  std::map<std::string, std::pair<std::string, long>> defined_;
 };
 
 /// Creates scene materials from MTL materials on first use (docs/obj-mtl.md).

@@ -64,6 +64,16 @@ bool MtlReader::operator()(const std::string& name, std::vector<tinyobj::materia
     if (error.empty()) error = e.what();
     return false;
   }
+  // a name defined again (in this library or an earlier one): tinyobjloader keeps the first
+  for (const MtlName& m : mtl_material_names(text)) {
+    auto [first, added] = defined_.insert({m.name, {p.string(), m.line}});
+    if (added) continue;
+    const auto& [first_path, first_line] = first->second;
+    warnings.push_back(p.string() + ":" + std::to_string(m.line) + ": material '" + m.name +
+                       "' is defined again (first at " +
+                       (first_path == p.string() ? "line " : first_path + ":") +
+                       std::to_string(first_line) + "); faces use the first definition");
+  }
   std::istringstream in(strip_texture_options(text));
   size_t before = materials->size();
   std::string mtl_warn, mtl_err;
