@@ -606,6 +606,50 @@ TEST(Obj, TextureOptionsKeepTheFileName) {
   EXPECT_EQ(w.all().size(), 1u) << w.dump();
 }
 
+// A usemtl before the file's mtllib: tinyobjloader looks the name up when it reads the usemtl,
+// and had read no library yet: the faces got the default material and the warning said the MTL
+// file has no such material. The libraries of every mtllib are read first; tinyobjloader's line
+// numbers stay those of the file. An mtllib naming two libraries read only the first one.
+TEST(Obj, UsemtlBeforeMtllibUsesTheLibrary) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "a.mtl", "newmtl red\nKd 1 0 0\n");
+  write(dir, "b.mtl", "newmtl blue\nKd 0 0 1\n");
+  write(dir, "c.mtl", "newmtl green\nKd 0 1 0\n");
+  std::string path = write(dir, "late.obj",
+                           "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                           "usemtl red\nf 1 2 3\n"    // lines 4, 5
+                           "g \n"                     // line 6: tinyobjloader warns
+                           "usemtl green\nf 1 3 2\n"  // lines 7, 8
+                           "mtllib a.mtl\n"           // line 9
+                           "usemtl blue\nf 2 1 3\n"   // lines 10, 11
+                           "mtllib b.mtl c.mtl\n"     // line 12
+                           "usemtl green\nf 3 2 1\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), 4u);
+  EXPECT_EQ(s.materials[s.triangles[0].material].name, "late.obj:red");
+  EXPECT_EQ(s.materials[s.triangles[0].material].albedo, glm::dvec3(1, 0, 0));
+  EXPECT_EQ(s.materials[s.triangles[1].material].name, "late.obj:green");
+  EXPECT_EQ(s.materials[s.triangles[1].material].albedo, glm::dvec3(0, 1, 0));
+  EXPECT_EQ(s.materials[s.triangles[2].material].name, "late.obj:blue");
+  EXPECT_EQ(s.materials[s.triangles[2].material].albedo, glm::dvec3(0, 0, 1));
+  EXPECT_EQ(s.materials[s.triangles[3].material].name, "late.obj:green") << "c.mtl is read";
+  EXPECT_EQ(w.count("Empty group name. line: 6"), 1) << w.dump();
+  EXPECT_EQ(w.all().size(), 1u) << w.dump();
+
+  // no mtllib at all: the warning says so
+  std::string none = write(dir, "none.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
+  CaptureWarnings w2;
+  Scene s2;
+  load(s2, none);
+  EXPECT_EQ(w2.count(none + ": usemtl 'red' but the file names no material library (mtllib); "
+                            "faces use the default material"),
+            1)
+      << w2.dump();
+  EXPECT_EQ(w2.all().size(), 1u) << w2.dump();
+}
+
 // A material defined twice: tinyobjloader keeps the first definition, silently (a JSON scene
 // refuses a material name given twice). A warning names both places, in one library or two.
 TEST(Obj, MaterialDefinedTwiceWarnsNamingBothPlaces) {

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string_view>
 
@@ -143,8 +144,33 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
   std::int64_t wanted[3] = {0, 0, 0};
   long wanted_line[3] = {0, 0, 0};
   TextCounts out;
+  bool mtllib_seen = false;
+  std::set<std::string> libraries;
   for_each_line(text, [&](std::string_view rest, long ln) {
     const LineError fail(path, ln);
+    // usemtl and mtllib as tinyobjloader tells them: "usemtl" starts the line, "mtllib" and a
+    // space or tab start it
+    const std::string_view line = rest.substr(std::min(rest.find_first_not_of(" \t"), rest.size()));
+    if (line.substr(0, 6) == "usemtl" && !mtllib_seen) out.usemtl_before_mtllib = true;
+    if (line.size() > 6 && line.substr(0, 6) == "mtllib" && (line[6] == ' ' || line[6] == '\t')) {
+      mtllib_seen = true;
+      std::vector<std::string> names(1);
+      for (std::size_t i = 7; i < line.size(); ++i) {
+        if (line[i] == '\\') {
+          if (i + 1 < line.size()) names.back() += line[++i];
+        } else if (line[i] != ' ') {
+          names.back() += line[i];
+        } else if (!names.back().empty()) {
+          names.emplace_back();
+        }
+      }
+      for (const std::string& n : names) {
+        if (n.empty()) continue;
+        if (n[0] == '#') break;
+        if (libraries.insert(n).second) out.libraries.push_back(n);
+      }
+      return;
+    }
     std::string_view tag = token(rest);
     if (tag.empty()) return;
     int need = 0;
@@ -405,6 +431,20 @@ long line_of_statement(const std::string& text, const char* tag, std::int64_t n)
     if (found == 0 && token(rest) == tag && seen++ == n) found = ln;
   });
   return found;
+}
+
+std::string shift_line_numbers(const std::string& text, long by) {
+  static const std::regex line_re(R"((line:? )(\d+))");
+  std::string out;
+  auto last = text.cbegin();
+  for (std::sregex_iterator it(text.begin(), text.end(), line_re), end; it != end; ++it) {
+    const std::smatch& m = *it;
+    out.append(last, m[2].first);
+    out += std::to_string(std::strtol(m[2].str().c_str(), nullptr, 10) - by);
+    last = m[2].second;
+  }
+  out.append(last, text.cend());
+  return out;
 }
 
 [[noreturn]] void throw_parse_error(const std::string& path, const std::string& err) {

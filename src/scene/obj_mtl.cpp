@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <set>
 #include <sstream>
 
 #include "core/file_io.hpp"
@@ -36,51 +37,65 @@ fs::path texture_path(const std::string& mtl_path, const std::string& name) {
 
 }  // namespace
 
-bool MtlReader::operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
+bool MtlReader::operator()(const std::string&, std::vector<tinyobj::material_t>* materials,
                            std::map<std::string, int>* map, std::string*, std::string*) {
-  if (!enabled_) return true;
-  fs::path p = fs::path(name).is_absolute() ? fs::path(name) : dir_ / name;
+  // tinyobjloader calls at each mtllib statement, and reads one library of a statement naming
+  // several: all of them are read at the first call
+  if (!enabled_ || done_) return true;
+  done_ = true;
+  std::set<std::string> seen;  // canonical paths: a library named twice is read once
+  for (const std::string& name : names_) {
+    fs::path p = fs::path(name).is_absolute() ? fs::path(name) : dir_ / name;
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(p, ec);
+    if (!seen.insert(ec ? p.string() : canonical.string()).second) continue;
+    if (!read(p.string(), materials, map)) break;
+  }
+  return true;
+}
+
+bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* materials,
+                     std::map<std::string, int>* map) {
   std::string text;
   try {
     io::ReadSpec spec;
     spec.what = "MTL file";
     spec.max_bytes = kMaxMtlBytes;
     spec.text = true;
-    text = io::read_file(p.string(), spec);
+    text = io::read_file(path, spec);
   } catch (const Error& e) {
     std::error_code ec;
-    if (!fs::exists(p, ec)) {
-      missing.push_back(p.string());
+    if (!fs::exists(path, ec)) {
+      missing.push_back(path);
     } else {
-      libraries.push_back(p.string());
+      libraries.push_back(path);
       unreadable.push_back(e.what());
     }
-    return false;
+    return true;
   }
-  libraries.push_back(p.string());
+  libraries.push_back(path);
   try {
-    check_mtl_text(p.string(), text);
+    check_mtl_text(path, text);
   } catch (const Error& e) {
-    if (error.empty()) error = e.what();
+    error = e.what();
     return false;
   }
   // a name defined again (in this library or an earlier one): tinyobjloader keeps the first
   for (const MtlName& m : mtl_material_names(text)) {
-    auto [first, added] = defined_.insert({m.name, {p.string(), m.line}});
+    auto [first, added] = defined_.insert({m.name, {path, m.line}});
     if (added) continue;
     const auto& [first_path, first_line] = first->second;
-    warnings.push_back(p.string() + ":" + std::to_string(m.line) + ": material '" + m.name +
+    warnings.push_back(path + ":" + std::to_string(m.line) + ": material '" + m.name +
                        "' is defined again (first at " +
-                       (first_path == p.string() ? "line " : first_path + ":") +
+                       (first_path == path ? "line " : first_path + ":") +
                        std::to_string(first_line) + "); faces use the first definition");
   }
   std::istringstream in(strip_texture_options(text));
   size_t before = materials->size();
   std::string mtl_warn, mtl_err;
   tinyobj::LoadMtl(map, materials, &in, &mtl_warn, &mtl_err);
-  for (size_t i = before; i < materials->size(); ++i) origin.push_back(p.string());
-  for (const std::string& w : lines_of(mtl_warn + mtl_err))
-    warnings.push_back(p.string() + ": " + w);
+  for (size_t i = before; i < materials->size(); ++i) origin.push_back(path);
+  for (const std::string& w : lines_of(mtl_warn + mtl_err)) warnings.push_back(path + ": " + w);
   return true;
 }
 
