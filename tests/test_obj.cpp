@@ -31,8 +31,8 @@ using lucent::Triangle;
 using lucent::test::CaptureWarnings;
 
 void load(Scene& scene, const std::string& path, const glm::dmat4& xf = glm::dmat4(1.0),
-          int material_override = -1) {
-  lucent::scene_detail::load_obj(scene, path, xf, material_override);
+          int material_override = -1, lucent::scene_detail::ObjMaterials* known = nullptr) {
+  lucent::scene_detail::load_obj(scene, path, xf, material_override, known);
 }
 
 std::string write(const std::string& dir, const std::string& name, const std::string& text) {
@@ -175,9 +175,10 @@ TEST(Obj, MissingMtlWarnsOnceAndUsesOneDefaultMaterial) {
                            "usemtl paint\nf 1 2 3\nusemtl other\nf 1 3 2\n");
   CaptureWarnings w;
   Scene s;
-  s.materials.push_back(Material{});  // a material of the scene's own, left alone
-  load(s, path);
-  load(s, path);
+  s.materials.push_back(Material{});         // a material of the scene's own, left alone
+  lucent::scene_detail::ObjMaterials known;  // as SceneBuilder keeps them
+  load(s, path, glm::dmat4(1.0), -1, &known);
+  load(s, path, glm::dmat4(1.0), -1, &known);
   ASSERT_EQ(w.all().size(), 2u) << "one warning per load:\n" << w.dump();
   EXPECT_EQ(w.count("nothere.mtl"), 2) << w.dump();
   EXPECT_EQ(w.count(path), 2) << w.dump();
@@ -558,6 +559,92 @@ TEST(Obj, MaterialOverrideIgnoresTheMtl) {
   EXPECT_TRUE(s.textures.empty());
   ASSERT_EQ(s.triangles.size(), 2u);
   for (const Triangle& t : s.triangles) EXPECT_EQ(t.material, 1);
+}
+
+// A scene of `shapes` (JSON array items) and `materials` (JSON object items) in `dir`.
+Scene load_json_scene(const std::string& dir, const std::string& materials,
+                      const std::string& shapes) {
+  const std::string path = write(dir, "s.json", R"({
+    "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 45},
+    "film": {"width": 4, "height": 4},
+    "materials": {)" + materials + R"(},
+    "shapes": [)" + shapes + R"(],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
+  })");
+  return lucent::load_scene(path);
+}
+
+// The material of each shape's triangles (all of them the same).
+std::vector<int> shape_materials(const Scene& s) {
+  std::vector<int> out;
+  for (const lucent::ShapeEntry& e : s.shapes) {
+    EXPECT_GT(e.count, 0u) << e.file;
+    for (std::size_t i = e.first; i < e.first + e.count; ++i)
+      EXPECT_EQ(s.triangles[i].material, s.triangles[e.first].material) << e.file;
+    out.push_back(e.count > 0 ? s.triangles[e.first].material : -1);
+  }
+  return out;
+}
+
+// Two OBJ files with the same file name, a/model.obj and b/model.obj, each with its model.mtl
+// defining 'paint' (red, blue): the second mesh took the first one's material ("model.obj:paint",
+// found by name, was taken for "the same OBJ loaded again"): both red, "materials 1", no warning.
+// A material is shared only when it is the same MTL material (library and name); the same OBJ
+// loaded again, or another OBJ naming the same library, shares it. The second name gets the
+// parent directory in front.
+TEST(Obj, SameNamedObjFilesKeepTheirOwnMaterials) {
+  std::string dir = lucent::test::temp_dir();
+  const std::string triangle = "v -1 -1 0\nv 1 -1 0\nv 0 1 0\n";
+  write(dir, "a/model.mtl", "newmtl paint\nKd 1 0 0\n");
+  write(dir, "a/model.obj", "mtllib model.mtl\n" + triangle + "usemtl paint\nf 1 2 3\n");
+  write(dir, "b/model.mtl", "newmtl paint\nKd 0 0 1\n");
+  write(dir, "b/model.obj", "mtllib model.mtl\n" + triangle + "usemtl paint\nf 1 2 3\n");
+  write(dir, "a/other.obj", "mtllib model.mtl\n" + triangle + "usemtl paint\nf 1 2 3\n");
+  CaptureWarnings w;
+  const Scene s = load_json_scene(dir, "",
+                                  R"({"type": "mesh", "file": "a/model.obj"},
+                                     {"type": "mesh", "file": "b/model.obj"},
+                                     {"type": "mesh", "file": "a/model.obj"},
+                                     {"type": "mesh", "file": "a/other.obj"})");
+  EXPECT_TRUE(w.all().empty()) << w.dump();
+  ASSERT_EQ(s.materials.size(), 2u);
+  const std::vector<int> m = shape_materials(s);
+  ASSERT_EQ(m.size(), 4u);
+  EXPECT_EQ(s.materials[m[0]].name, "model.obj:paint");
+  EXPECT_EQ(s.materials[m[0]].albedo, glm::dvec3(1, 0, 0));
+  EXPECT_EQ(s.materials[m[1]].name, "b/model.obj:paint");
+  EXPECT_EQ(s.materials[m[1]].albedo, glm::dvec3(0, 0, 1));
+  EXPECT_EQ(m[2], m[0]) << "the same OBJ loaded again shares its materials";
+  EXPECT_EQ(m[3], m[0]) << "an OBJ naming the same library shares its materials";
+}
+
+// A material of the scene's own named like an MTL material ("model.obj:paint") replaced it, and
+// one named "obj:default" became the OBJ default material, silently. The OBJ's faces keep their
+// own materials, under names made free.
+TEST(Obj, SceneMaterialsNamedLikeObjMaterialsAreNotUsedForTheObj) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "a/model.mtl", "newmtl paint\nKd 1 0 0\n");
+  write(dir, "a/model.obj",
+        "mtllib model.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl paint\nf 1 2 3\n"
+        "usemtl nosuch\nf 1 3 2\n");
+  CaptureWarnings w;  // nosuch
+  const Scene s = load_json_scene(dir,
+                                  R"("model.obj:paint": {"type": "diffuse", "albedo": [0, 1, 0]},
+         "obj:default": {"type": "diffuse", "albedo": [0, 0.5, 0]})",
+                                  R"({"type": "mesh", "file": "a/model.obj"},
+         {"type": "sphere", "center": [0, 0, -5], "radius": 1, "material": "model.obj:paint"})");
+  EXPECT_EQ(w.count("'nosuch'"), 1) << w.dump();
+  ASSERT_EQ(s.materials.size(), 4u);
+  ASSERT_EQ(s.triangles.size(), 2u);
+  const Material& paint = s.materials[s.triangles[0].material];
+  const Material& fallback = s.materials[s.triangles[1].material];
+  EXPECT_EQ(paint.name, "a/model.obj:paint");
+  EXPECT_EQ(paint.albedo, glm::dvec3(1, 0, 0));
+  EXPECT_EQ(fallback.name, "obj:default#2");
+  EXPECT_EQ(fallback.albedo, glm::dvec3(0.8));
+  EXPECT_EQ(s.spheres.at(0).material, s.find_material("model.obj:paint"));
+  EXPECT_EQ(material_named(s, "model.obj:paint").albedo, glm::dvec3(0, 1, 0));
+  EXPECT_EQ(material_named(s, "obj:default").albedo, glm::dvec3(0, 0.5, 0));
 }
 
 // The MTL specification makes v and w optional in `-o u [v [w]]`, `-s` and `-t`; tinyobjloader

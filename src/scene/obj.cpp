@@ -47,7 +47,8 @@ class JoinedText : public std::streambuf {
 }  // namespace
 
 std::vector<std::string> load_obj(Scene& scene, const std::string& path,
-                                  const glm::dmat4& transform, int material_override) {
+                                  const glm::dmat4& transform, int material_override,
+                                  ObjMaterials* known) {
   io::ReadSpec spec;
   spec.what = "OBJ file";
   spec.max_bytes = obj::kMaxObjBytes;
@@ -153,7 +154,8 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
     scene.uvs.push_back({attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]});
 
   // faces
-  obj::MaterialMapper mapper(scene, path, mats, reader.origin);
+  ObjMaterials own;
+  obj::MaterialMapper mapper(scene, known ? *known : own, path, mats, reader.origin);
   size_t faces = 0;
   for (const auto& s : shapes) {
     for (size_t f = 0; f < s.mesh.num_face_vertices.size(); ++f) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "lucent/scene.hpp"
+#include "scene/loaders.hpp"
 
 namespace lucent::scene_detail::obj {
 
@@ -112,7 +113,7 @@ class MtlReader : public tinyobj::MaterialReader {
 /// Creates scene materials from MTL materials on first use (docs/obj-mtl.md).
 class MaterialMapper {
  public:
-  MaterialMapper(Scene& scene, const std::string& obj_path,
+  MaterialMapper(Scene& scene, ObjMaterials& known, const std::string& obj_path,
                  const std::vector<tinyobj::material_t>& mats,
                  const std::vector<std::string>& origin);
 
@@ -122,12 +123,16 @@ class MaterialMapper {
 
  private:
   int convert(const tinyobj::material_t& t, const std::string& mtl_path);
+  /// `name` when no material has it, else with the OBJ file's parent directories in front
+  /// ("b/model.obj:paint"), else with "#2", "#3", ... after it.
+  std::string free_name(const std::string& name, bool with_path) const;
 
   Scene& scene_;
+  ObjMaterials& known_;
+  std::filesystem::path obj_path_;  ///< canonical
   const std::vector<tinyobj::material_t>& mats_;
   const std::vector<std::string>& origin_;
   std::vector<int> index_;
-  std::string obj_name_;
   int default_ = -1;
   std::set<std::string> warned_;
 };
