@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <glm/gtc/matrix_transform.hpp>
+#include <iterator>
 #include <map>
 #include <set>
 #include <string>
@@ -30,8 +31,8 @@ using lucent::Triangle;
 using lucent::test::CaptureWarnings;
 
 void load(Scene& scene, const std::string& path, const glm::dmat4& xf = glm::dmat4(1.0),
-          int material_override = -1) {
-  lucent::scene_detail::load_obj(scene, path, xf, material_override);
+          int material_override = -1, lucent::scene_detail::ObjMaterials* known = nullptr) {
+  lucent::scene_detail::load_obj(scene, path, xf, material_override, known);
 }
 
 std::string write(const std::string& dir, const std::string& name, const std::string& text) {
@@ -174,9 +175,10 @@ TEST(Obj, MissingMtlWarnsOnceAndUsesOneDefaultMaterial) {
                            "usemtl paint\nf 1 2 3\nusemtl other\nf 1 3 2\n");
   CaptureWarnings w;
   Scene s;
-  s.materials.push_back(Material{});  // a material of the scene's own, left alone
-  load(s, path);
-  load(s, path);
+  s.materials.push_back(Material{});         // a material of the scene's own, left alone
+  lucent::scene_detail::ObjMaterials known;  // as SceneBuilder keeps them
+  load(s, path, glm::dmat4(1.0), -1, &known);
+  load(s, path, glm::dmat4(1.0), -1, &known);
   ASSERT_EQ(w.all().size(), 2u) << "one warning per load:\n" << w.dump();
   EXPECT_EQ(w.count("nothere.mtl"), 2) << w.dump();
   EXPECT_EQ(w.count(path), 2) << w.dump();
@@ -557,6 +559,208 @@ TEST(Obj, MaterialOverrideIgnoresTheMtl) {
   EXPECT_TRUE(s.textures.empty());
   ASSERT_EQ(s.triangles.size(), 2u);
   for (const Triangle& t : s.triangles) EXPECT_EQ(t.material, 1);
+}
+
+// A scene of `shapes` (JSON array items) and `materials` (JSON object items) in `dir`.
+Scene load_json_scene(const std::string& dir, const std::string& materials,
+                      const std::string& shapes) {
+  const std::string path = write(dir, "s.json", R"({
+    "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 45},
+    "film": {"width": 4, "height": 4},
+    "materials": {)" + materials + R"(},
+    "shapes": [)" + shapes + R"(],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
+  })");
+  return lucent::load_scene(path);
+}
+
+// The material of each shape's triangles (all of them the same).
+std::vector<int> shape_materials(const Scene& s) {
+  std::vector<int> out;
+  for (const lucent::ShapeEntry& e : s.shapes) {
+    EXPECT_GT(e.count, 0u) << e.file;
+    for (std::size_t i = e.first; i < e.first + e.count; ++i)
+      EXPECT_EQ(s.triangles[i].material, s.triangles[e.first].material) << e.file;
+    out.push_back(e.count > 0 ? s.triangles[e.first].material : -1);
+  }
+  return out;
+}
+
+// Two OBJ files with the same file name, a/model.obj and b/model.obj, each with its model.mtl
+// defining 'paint' (red, blue): the second mesh took the first one's material ("model.obj:paint",
+// found by name, was taken for "the same OBJ loaded again"): both red, "materials 1", no warning.
+// A material is shared only when it is the same MTL material (library and name); the same OBJ
+// loaded again, or another OBJ naming the same library, shares it. The second name gets the
+// parent directory in front.
+TEST(Obj, SameNamedObjFilesKeepTheirOwnMaterials) {
+  std::string dir = lucent::test::temp_dir();
+  const std::string triangle = "v -1 -1 0\nv 1 -1 0\nv 0 1 0\n";
+  write(dir, "a/model.mtl", "newmtl paint\nKd 1 0 0\n");
+  write(dir, "a/model.obj", "mtllib model.mtl\n" + triangle + "usemtl paint\nf 1 2 3\n");
+  write(dir, "b/model.mtl", "newmtl paint\nKd 0 0 1\n");
+  write(dir, "b/model.obj", "mtllib model.mtl\n" + triangle + "usemtl paint\nf 1 2 3\n");
+  write(dir, "a/other.obj", "mtllib model.mtl\n" + triangle + "usemtl paint\nf 1 2 3\n");
+  CaptureWarnings w;
+  const Scene s = load_json_scene(dir, "",
+                                  R"({"type": "mesh", "file": "a/model.obj"},
+                                     {"type": "mesh", "file": "b/model.obj"},
+                                     {"type": "mesh", "file": "a/model.obj"},
+                                     {"type": "mesh", "file": "a/other.obj"})");
+  EXPECT_TRUE(w.all().empty()) << w.dump();
+  ASSERT_EQ(s.materials.size(), 2u);
+  const std::vector<int> m = shape_materials(s);
+  ASSERT_EQ(m.size(), 4u);
+  EXPECT_EQ(s.materials[m[0]].name, "model.obj:paint");
+  EXPECT_EQ(s.materials[m[0]].albedo, glm::dvec3(1, 0, 0));
+  EXPECT_EQ(s.materials[m[1]].name, "b/model.obj:paint");
+  EXPECT_EQ(s.materials[m[1]].albedo, glm::dvec3(0, 0, 1));
+  EXPECT_EQ(m[2], m[0]) << "the same OBJ loaded again shares its materials";
+  EXPECT_EQ(m[3], m[0]) << "an OBJ naming the same library shares its materials";
+}
+
+// A material of the scene's own named like an MTL material ("model.obj:paint") replaced it, and
+// one named "obj:default" became the OBJ default material, silently. The OBJ's faces keep their
+// own materials, under names made free.
+TEST(Obj, SceneMaterialsNamedLikeObjMaterialsAreNotUsedForTheObj) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "a/model.mtl", "newmtl paint\nKd 1 0 0\n");
+  write(dir, "a/model.obj",
+        "mtllib model.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl paint\nf 1 2 3\n"
+        "usemtl nosuch\nf 1 3 2\n");
+  CaptureWarnings w;  // nosuch
+  const Scene s = load_json_scene(dir,
+                                  R"("model.obj:paint": {"type": "diffuse", "albedo": [0, 1, 0]},
+         "obj:default": {"type": "diffuse", "albedo": [0, 0.5, 0]})",
+                                  R"({"type": "mesh", "file": "a/model.obj"},
+         {"type": "sphere", "center": [0, 0, -5], "radius": 1, "material": "model.obj:paint"})");
+  EXPECT_EQ(w.count("'nosuch'"), 1) << w.dump();
+  ASSERT_EQ(s.materials.size(), 4u);
+  ASSERT_EQ(s.triangles.size(), 2u);
+  const Material& paint = s.materials[s.triangles[0].material];
+  const Material& fallback = s.materials[s.triangles[1].material];
+  EXPECT_EQ(paint.name, "a/model.obj:paint");
+  EXPECT_EQ(paint.albedo, glm::dvec3(1, 0, 0));
+  EXPECT_EQ(fallback.name, "obj:default#2");
+  EXPECT_EQ(fallback.albedo, glm::dvec3(0.8));
+  EXPECT_EQ(s.spheres.at(0).material, s.find_material("model.obj:paint"));
+  EXPECT_EQ(material_named(s, "model.obj:paint").albedo, glm::dvec3(0, 1, 0));
+  EXPECT_EQ(material_named(s, "obj:default").albedo, glm::dvec3(0, 0.5, 0));
+}
+
+// The MTL specification makes v and w optional in `-o u [v [w]]`, `-s` and `-t`; tinyobjloader
+// takes three numbers, the file name among them: `map_Kd -o 0.5 tex.png` had no texture, and no
+// warning. Each option takes the arguments that fit it; the file name is never one of them.
+TEST(Obj, TextureOptionsKeepTheFileName) {
+  std::string dir = lucent::test::temp_dir();
+  const unsigned char px[] = {255, 255, 255, 0, 0, 0};
+  ASSERT_TRUE(stbi_write_png((dir + "/t.png").c_str(), 2, 1, 3, px, 6));
+  ASSERT_TRUE(stbi_write_png((dir + "/my t.png").c_str(), 2, 1, 3, px, 6));
+  const char* maps[] = {"-o 0.5 t.png",
+                        "-s 2 t.png",
+                        "-t 0.1 0.2 t.png",
+                        "-o 0.5 0.5 0 t.png",
+                        "-s 2 -o 1 t.png",
+                        "-clamp on -bm 1 -mm 0 1 t.png",
+                        "-blendu off\t-blendv on -boost 2 -texres 512 t.png",
+                        "-imfchan r -type sphere -colorspace sRGB t.png",
+                        "-cc on t.png",
+                        "-clamp t.png",
+                        "-s 2 my t.png",
+                        "t.png",
+                        "my t.png"};
+  std::string mtl, obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n";
+  for (std::size_t i = 0; i < std::size(maps); ++i) {
+    mtl += "newmtl m" + std::to_string(i) + "\nKd 0.1 0.2 0.3\nmap_Kd " + maps[i] + "\n";
+    obj += "usemtl m" + std::to_string(i) + "\nf 1 2 3\n";
+  }
+  // a missing texture of an unused map is still named, options or not
+  mtl += "newmtl d\nKd 0.1 0.2 0.3\nmap_d -o 0.5 nothere.dds\n";
+  obj += "usemtl d\nf 1 2 3\n";
+  write(dir, "m.mtl", mtl);
+  std::string path = write(dir, "m.obj", obj);
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), std::size(maps) + 1);
+  ASSERT_EQ(s.textures.size(), 2u) << w.dump();
+  for (std::size_t i = 0; i < std::size(maps); ++i) {
+    const Material& m = s.materials[s.triangles[i].material];
+    EXPECT_EQ(m.albedo_texture, std::string(maps[i]).find("my t") == std::string::npos ? 0 : 1)
+        << "map_Kd " << maps[i];
+    EXPECT_EQ(m.albedo, glm::dvec3(1.0)) << "map_Kd " << maps[i];
+  }
+  EXPECT_EQ(w.count("'nothere.dds' not found"), 1) << w.dump();
+  EXPECT_EQ(w.all().size(), 1u) << w.dump();
+}
+
+// A usemtl before the file's mtllib: tinyobjloader looks the name up when it reads the usemtl,
+// and had read no library yet: the faces got the default material and the warning said the MTL
+// file has no such material. The libraries of every mtllib are read first; tinyobjloader's line
+// numbers stay those of the file. An mtllib naming two libraries read only the first one.
+TEST(Obj, UsemtlBeforeMtllibUsesTheLibrary) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "a.mtl", "newmtl red\nKd 1 0 0\n");
+  write(dir, "b.mtl", "newmtl blue\nKd 0 0 1\n");
+  write(dir, "c.mtl", "newmtl green\nKd 0 1 0\n");
+  std::string path = write(dir, "late.obj",
+                           "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                           "usemtl red\nf 1 2 3\n"    // lines 4, 5
+                           "g \n"                     // line 6: tinyobjloader warns
+                           "usemtl green\nf 1 3 2\n"  // lines 7, 8
+                           "mtllib a.mtl\n"           // line 9
+                           "usemtl blue\nf 2 1 3\n"   // lines 10, 11
+                           "mtllib b.mtl c.mtl\n"     // line 12
+                           "usemtl green\nf 3 2 1\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), 4u);
+  EXPECT_EQ(s.materials[s.triangles[0].material].name, "late.obj:red");
+  EXPECT_EQ(s.materials[s.triangles[0].material].albedo, glm::dvec3(1, 0, 0));
+  EXPECT_EQ(s.materials[s.triangles[1].material].name, "late.obj:green");
+  EXPECT_EQ(s.materials[s.triangles[1].material].albedo, glm::dvec3(0, 1, 0));
+  EXPECT_EQ(s.materials[s.triangles[2].material].name, "late.obj:blue");
+  EXPECT_EQ(s.materials[s.triangles[2].material].albedo, glm::dvec3(0, 0, 1));
+  EXPECT_EQ(s.materials[s.triangles[3].material].name, "late.obj:green") << "c.mtl is read";
+  EXPECT_EQ(w.count("Empty group name. line: 6"), 1) << w.dump();
+  EXPECT_EQ(w.all().size(), 1u) << w.dump();
+
+  // no mtllib at all: the warning says so
+  std::string none = write(dir, "none.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
+  CaptureWarnings w2;
+  Scene s2;
+  load(s2, none);
+  EXPECT_EQ(w2.count(none + ": usemtl 'red' but the file names no material library (mtllib); "
+                            "faces use the default material"),
+            1)
+      << w2.dump();
+  EXPECT_EQ(w2.all().size(), 1u) << w2.dump();
+}
+
+// A material defined twice: tinyobjloader keeps the first definition, silently (a JSON scene
+// refuses a material name given twice). A warning names both places, in one library or two.
+TEST(Obj, MaterialDefinedTwiceWarnsNamingBothPlaces) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "twice.mtl", "newmtl m\nKd 1 0 0\n\nnewmtl m\nKd 0 1 0\nnewmtl n  \nKd 0 0 1\n");
+  write(dir, "more.mtl", "# n again\nnewmtl n\nKd 1 1 0\n");
+  std::string path = write(dir, "m.obj",
+                           "mtllib twice.mtl\nmtllib more.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                           "usemtl m\nf 1 2 3\nusemtl n\nf 1 3 2\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), 2u);
+  EXPECT_EQ(s.materials[s.triangles[0].material].albedo, glm::dvec3(1, 0, 0));
+  EXPECT_EQ(s.materials[s.triangles[1].material].albedo, glm::dvec3(0, 0, 1));
+  EXPECT_EQ(w.count(dir + "/twice.mtl:4: material 'm' is defined again (first at line 1); "
+                          "faces use the first definition"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.count(dir + "/more.mtl:2: material 'n' is defined again (first at " + dir +
+                    "/twice.mtl:6); faces use the first definition"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.all().size(), 2u) << w.dump();
 }
 
 // The MTL libraries an OBJ file names are inputs of the scene, as its textures are: outputs

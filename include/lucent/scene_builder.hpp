@@ -17,6 +17,7 @@
 // "/lights/<n>", the n-th add_texture "/textures/<n>" (0-based, in call order).
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -107,6 +108,9 @@ class SceneBuilder {
   int material_index(const std::string& name, const std::string& pointer) const;
   std::string shape_place() const;
   Scene scene_;
+  /// The materials OBJ meshes made from MTL materials, by MTL library and material name
+  /// (scene_detail::ObjMaterials), for the meshes after them to share.
+  std::map<std::string, int> obj_materials_;
 };
 
 }  // namespace lucent

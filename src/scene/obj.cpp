@@ -6,6 +6,7 @@
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <streambuf>
 
 #include "core/file_io.hpp"
 #include "lucent/error.hpp"
@@ -18,23 +19,62 @@ namespace lucent::scene_detail {
 namespace fs = std::filesystem;
 using obj::lines_of;
 
+namespace {
+
+// Serves `head`, then `body`, to tinyobjloader without copying them.
+class JoinedText : public std::streambuf {
+ public:
+  JoinedText(const std::string& head, const std::string& body) : body_(body) {
+    char* h = const_cast<char*>(head.data());
+    setg(h, h, h + head.size());
+  }
+
+ protected:
+  int_type underflow() override {
+    if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+    if (in_body_ || body_.empty()) return traits_type::eof();
+    in_body_ = true;
+    char* b = const_cast<char*>(body_.data());
+    setg(b, b, b + body_.size());
+    return traits_type::to_int_type(*gptr());
+  }
+
+ private:
+  const std::string& body_;
+  bool in_body_ = false;
+};
+
+}  // namespace
+
 std::vector<std::string> load_obj(Scene& scene, const std::string& path,
-                                  const glm::dmat4& transform, int material_override) {
+                                  const glm::dmat4& transform, int material_override,
+                                  ObjMaterials* known) {
   io::ReadSpec spec;
   spec.what = "OBJ file";
   spec.max_bytes = obj::kMaxObjBytes;
   spec.text = true;
   const std::string text = io::read_file(path, spec);
   const obj::TextCounts counts = obj::check_obj_text(path, text);  // before tinyobjloader
-  std::istringstream in(text);
   const bool use_mtl = material_override < 0;
-  obj::MtlReader reader(fs::path(path).parent_path(), use_mtl);
+  // tinyobjloader looks a usemtl name up when it reads the statement, in the libraries read so
+  // far: the reader reads all of the file's libraries at the first mtllib, and when a usemtl
+  // comes before that, an mtllib line is put first (the line numbers of tinyobjloader's messages
+  // are moved back by one)
+  const bool head = use_mtl && counts.usemtl_before_mtllib && !counts.libraries.empty();
+  const std::string first_line = head ? "mtllib libraries\n" : "";
+  JoinedText joined(first_line, text);
+  std::istream in(&joined);
+  obj::MtlReader reader(fs::path(path).parent_path(), counts.libraries, use_mtl);
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> mats;
   std::string twarn, terr;
   bool ok = tinyobj::LoadObj(&attrib, &shapes, &mats, &twarn, &terr, &in, &reader,
                              /*triangulate=*/true, /*default_vcols_fallback=*/false);
+  if (head) {
+    twarn = obj::shift_line_numbers(twarn, 1);
+    terr = obj::shift_line_numbers(terr, 1);
+  }
   if (!reader.error.empty()) throw Error(reader.error);
   if (!ok) obj::throw_parse_error(path, terr);
 
@@ -74,7 +114,9 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
       size_t a = w.find('\''), b = w.rfind('\'');
       std::string name = (a != std::string::npos && b > a) ? w.substr(a + 1, b - a - 1) : w;
       warn(path + ": usemtl '" + name +
-           "' names no material of the MTL file; faces use the default material");
+           (counts.libraries.empty() ? "' but the file names no material library (mtllib)"
+                                     : "' names no material of the MTL file") +
+           "; faces use the default material");
       continue;
     }
     warn(path + ": " + w);
@@ -112,7 +154,8 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
     scene.uvs.push_back({attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]});
 
   // faces
-  obj::MaterialMapper mapper(scene, path, mats, reader.origin);
+  ObjMaterials own;
+  obj::MaterialMapper mapper(scene, known ? *known : own, path, mats, reader.origin);
   size_t faces = 0;
   for (const auto& s : shapes) {
     for (size_t f = 0; f < s.mesh.num_face_vertices.size(); ++f) {

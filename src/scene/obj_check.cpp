@@ -2,6 +2,7 @@
 // coordinate that is not a number ("v 1 abc 0", "v nan 0 0") as 0 without a word, lets 1e39
 // overflow to infinity in its floats, and reports out-of-range indices only as a warning at the
 // last line: every number and index is checked here, and the first bad one named with its line.
+#include <algorithm>
 #include <cctype>
 #include <cfloat>
 #include <charconv>
@@ -10,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string_view>
 
@@ -142,8 +144,33 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
   std::int64_t wanted[3] = {0, 0, 0};
   long wanted_line[3] = {0, 0, 0};
   TextCounts out;
+  bool mtllib_seen = false;
+  std::set<std::string> libraries;
   for_each_line(text, [&](std::string_view rest, long ln) {
     const LineError fail(path, ln);
+    // usemtl and mtllib as tinyobjloader tells them: "usemtl" starts the line, "mtllib" and a
+    // space or tab start it
+    const std::string_view line = rest.substr(std::min(rest.find_first_not_of(" \t"), rest.size()));
+    if (line.substr(0, 6) == "usemtl" && !mtllib_seen) out.usemtl_before_mtllib = true;
+    if (line.size() > 6 && line.substr(0, 6) == "mtllib" && (line[6] == ' ' || line[6] == '\t')) {
+      mtllib_seen = true;
+      std::vector<std::string> names(1);
+      for (std::size_t i = 7; i < line.size(); ++i) {
+        if (line[i] == '\\') {
+          if (i + 1 < line.size()) names.back() += line[++i];
+        } else if (line[i] != ' ') {
+          names.back() += line[i];
+        } else if (!names.back().empty()) {
+          names.emplace_back();
+        }
+      }
+      for (const std::string& n : names) {
+        if (n.empty()) continue;
+        if (n[0] == '#') break;
+        if (libraries.insert(n).second) out.libraries.push_back(n);
+      }
+      return;
+    }
     std::string_view tag = token(rest);
     if (tag.empty()) return;
     int need = 0;
@@ -286,6 +313,117 @@ void check_mtl_text(const std::string& path, const std::string& text) {
   });
 }
 
+namespace {
+
+// A token of a texture statement's options, split as tinyobjloader splits them (spaces and tabs).
+struct Word {
+  std::size_t begin, end;  // offsets in the line
+};
+
+bool is_number(std::string_view t) {
+  if (!t.empty() && t[0] == '+') t.remove_prefix(1);
+  double v = 0;
+  auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  return !t.empty() && ptr == t.data() + t.size() &&
+         (ec == std::errc() || ec == std::errc::result_out_of_range);
+}
+
+// The texture statements tinyobjloader reads (ParseTextureNameAndOption): the tag, then one space
+// or tab.
+bool texture_tag(std::string_view tag) {
+  static const char* const tags[] = {"map_Ka",   "map_Kd", "map_Ks", "map_Ns",   "map_bump",
+                                     "map_Bump", "bump",   "map_d",  "map_disp", "map_Disp",
+                                     "disp",     "refl",   "map_Pr", "map_Pm",   "map_Ps",
+                                     "map_Ke",   "norm"};
+  for (const char* t : tags)
+    if (tag == t) return true;
+  return false;
+}
+
+// The texture options of the MTL specification (and tinyobjloader's -colorspace): how many
+// arguments each takes at most, and of which kind.
+enum class Arg { Number, OnOff, Word };
+struct TextureOption {
+  const char* name;
+  int most;
+  Arg kind;
+};
+constexpr TextureOption kTextureOptions[] = {
+    {"-blendu", 1, Arg::OnOff},  {"-blendv", 1, Arg::OnOff},   {"-cc", 1, Arg::OnOff},
+    {"-clamp", 1, Arg::OnOff},   {"-boost", 1, Arg::Number},   {"-bm", 1, Arg::Number},
+    {"-texres", 1, Arg::Number}, {"-mm", 2, Arg::Number},      {"-o", 3, Arg::Number},
+    {"-s", 3, Arg::Number},      {"-t", 3, Arg::Number},       {"-imfchan", 1, Arg::Word},
+    {"-type", 1, Arg::Word},     {"-colorspace", 1, Arg::Word}};
+
+// Where the file name of a texture statement's `args` (the line after the tag and its space)
+// starts: after the options and their arguments. The last word is always (part of) the name.
+std::size_t texture_name_start(std::string_view args) {
+  std::vector<Word> words;
+  for (std::size_t i = 0; i < args.size();) {
+    std::size_t b = args.find_first_not_of(" \t", i);
+    if (b == std::string_view::npos) break;
+    std::size_t e = std::min(args.find_first_of(" \t", b), args.size());
+    words.push_back({b, e});
+    i = e;
+  }
+  auto word = [&](std::size_t k) {
+    return args.substr(words[k].begin, words[k].end - words[k].begin);
+  };
+  std::size_t k = 0;
+  while (k + 1 < words.size()) {
+    const TextureOption* option = nullptr;
+    for (const TextureOption& o : kTextureOptions)
+      if (word(k) == o.name) option = &o;
+    if (!option) break;
+    ++k;
+    for (int n = 0; n < option->most && k + 1 < words.size(); ++n, ++k) {
+      std::string_view a = word(k);
+      bool fits = option->kind == Arg::Word ||
+                  (option->kind == Arg::OnOff && (a == "on" || a == "off")) ||
+                  (option->kind == Arg::Number && is_number(a));
+      if (!fits) break;
+    }
+  }
+  return k < words.size() ? words[k].begin : args.size();
+}
+
+}  // namespace
+
+std::string strip_texture_options(const std::string& text) {
+  std::string out;
+  std::size_t copied = 0;  // text before this offset is in `out`
+  for_each_line(text, [&](std::string_view line, long) {
+    std::size_t b = line.find_first_not_of(" \t");
+    if (b == std::string_view::npos) return;
+    std::size_t e = line.find_first_of(" \t", b);
+    if (e == std::string_view::npos || !texture_tag(line.substr(b, e - b))) return;
+    std::string_view args = line.substr(e + 1);
+    std::size_t name = texture_name_start(args);
+    if (args.find_first_not_of(" \t") >= name) return;  // no options
+    const std::size_t at = static_cast<std::size_t>(args.data() - text.data());
+    out.append(text, copied, at - copied);
+    copied = at + name;
+  });
+  if (copied == 0) return text;
+  out.append(text, copied, std::string::npos);
+  return out;
+}
+
+std::vector<MtlName> mtl_material_names(const std::string& text) {
+  std::vector<MtlName> out;
+  for_each_line(text, [&](std::string_view line, long ln) {
+    std::size_t b = line.find_first_not_of(" \t");
+    if (b == std::string_view::npos || line.compare(b, 6, "newmtl") != 0 || b + 6 >= line.size() ||
+        (line[b + 6] != ' ' && line[b + 6] != '\t'))
+      return;
+    std::string_view name = line.substr(b + 7);
+    std::size_t last = name.find_last_not_of(" \t");
+    if (last == std::string_view::npos) return;  // "newmtl" and spaces: no statement
+    out.push_back({std::string(name.substr(0, last + 1)), ln});
+  });
+  return out;
+}
+
 long line_of_statement(const std::string& text, const char* tag, std::int64_t n) {
   long found = 0;
   std::int64_t seen = 0;
@@ -293,6 +431,20 @@ long line_of_statement(const std::string& text, const char* tag, std::int64_t n)
     if (found == 0 && token(rest) == tag && seen++ == n) found = ln;
   });
   return found;
+}
+
+std::string shift_line_numbers(const std::string& text, long by) {
+  static const std::regex line_re(R"((line:? )(\d+))");
+  std::string out;
+  auto last = text.cbegin();
+  for (std::sregex_iterator it(text.begin(), text.end(), line_re), end; it != end; ++it) {
+    const std::smatch& m = *it;
+    out.append(last, m[2].first);
+    out += std::to_string(std::strtol(m[2].str().c_str(), nullptr, 10) - by);
+    last = m[2].second;
+  }
+  out.append(last, text.cend());
+  return out;
 }
 
 [[noreturn]] void throw_parse_error(const std::string& path, const std::string& err) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "lucent/scene.hpp"
+#include "scene/loaders.hpp"
 
 namespace lucent::scene_detail::obj {
 
@@ -27,13 +28,19 @@ constexpr int kMaxFaceVertices = 1024;
 /// What the check of an OBJ file's text counted.
 struct TextCounts {
   std::int64_t vertices = 0, normals = 0, texcoords = 0, triangles = 0;
+  /// The names of the `mtllib` statements, in order, each once (split as tinyobjloader splits
+  /// them: at spaces, `\ ` escaping one; a word starting with '#' ends the list)
+  std::vector<std::string> libraries;
+  /// A `usemtl` comes before the first `mtllib`.
+  bool usemtl_before_mtllib = false;
 };
 
 /// Checks an OBJ file's text before tinyobjloader sees it: every number of a v, vn and vt line
 /// (present, a number, finite, within float range), every index of an f, l and p element (an
 /// integer, not 0, within the vertices, texture coordinates and normals the file defines, the
 /// negative ones relative to those defined so far), polygons of at most kMaxFaceVertices corners
-/// and at most kMaxTriangles triangles. Throws lucent::Error("<path>:<line>: ...").
+/// and at most kMaxTriangles triangles; notes the MTL libraries. Throws
+/// lucent::Error("<path>:<line>: ...").
 TextCounts check_obj_text(const std::string& path, const std::string& text);
 
 /// Checks the numbers of an MTL file's statements that carry them (Ka, Kd, Ks, Ke, Tf, Ns, Ni,
@@ -41,8 +48,26 @@ TextCounts check_obj_text(const std::string& path, const std::string& text);
 /// lucent::Error("<path>:<line>: ...").
 void check_mtl_text(const std::string& path, const std::string& text);
 
+/// The MTL text tinyobjloader reads: `text` with the options of its texture statements (map_Kd,
+/// bump, ...: `-o u [v [w]]`, `-clamp on`, ...) removed, lucent using none of them. Each option
+/// takes the arguments that fit it, up to its count (tinyobjloader takes three numbers after
+/// -o, -s and -t, and `map_Kd -o 0.5 tex.png` lost its file name); the last word of a statement
+/// is always (part of) the file name. The lines are kept.
+std::string strip_texture_options(const std::string& text);
+
+/// A `newmtl` statement of an MTL file: the material's name as tinyobjloader reads it (the rest
+/// of the line, trailing spaces removed) and its line.
+struct MtlName {
+  std::string name;
+  long line = 0;
+};
+std::vector<MtlName> mtl_material_names(const std::string& text);
+
 /// Line (1-based) of the `n`-th (0-based) statement `tag` of `text`, or 0.
 long line_of_statement(const std::string& text, const char* tag, std::int64_t n);
+
+/// `text` (tinyobjloader's messages) with each "line N" and "line: N" made "line N-by".
+std::string shift_line_numbers(const std::string& text, long by);
 
 /// Turns tinyobjloader's error text into one lucent::Error naming the file and line.
 [[noreturn]] void throw_parse_error(const std::string& path, const std::string& err);
@@ -50,14 +75,17 @@ long line_of_statement(const std::string& text, const char* tag, std::int64_t n)
 /// The non-empty lines of `text`, trimmed (tinyobjloader's warnings and errors).
 std::vector<std::string> lines_of(const std::string& text);
 
-/// Reads the libraries named by `mtllib` (relative to the OBJ's directory) with a bound and
-/// checks their text, and remembers which file each material came from, since texture paths are
-/// relative to it. Missing or unreadable libraries are recorded (the caller warns); a malformed
-/// one is recorded as `error` (the caller throws). When disabled (a material override) nothing
-/// is read.
+/// Reads the libraries named by `mtllib` (relative to the OBJ's directory), all of them at
+/// tinyobjloader's first call, with a bound, checks their text, and remembers which file each
+/// material came from, since texture paths are relative to it. Missing or unreadable libraries
+/// are recorded (the caller warns); a malformed one is recorded as `error` (the caller throws).
+/// A material name defined again is a warning. When disabled (a material override) nothing is
+/// read.
 class MtlReader : public tinyobj::MaterialReader {
  public:
-  MtlReader(std::filesystem::path dir, bool enabled) : dir_(std::move(dir)), enabled_(enabled) {}
+  /// `names`: the OBJ's libraries (TextCounts::libraries).
+  MtlReader(std::filesystem::path dir, std::vector<std::string> names, bool enabled)
+      : dir_(std::move(dir)), names_(std::move(names)), enabled_(enabled) {}
 
   bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                   std::map<std::string, int>* map, std::string* warn, std::string* err) override;
@@ -70,14 +98,22 @@ class MtlReader : public tinyobj::MaterialReader {
   std::string error;                    ///< the first malformed library's error
 
  private:
+  /// Reads one library; false when it is malformed.
+  bool read(const std::string& path, std::vector<tinyobj::material_t>* materials,
+            std::map<std::string, int>* map);
+
   std::filesystem::path dir_;
+  std::vector<std::string> names_;
   bool enabled_;
+  bool done_ = false;
+  /// each material name's first definition: library and line
+  std::map<std::string, std::pair<std::string, long>> defined_;
 };
 
 /// Creates scene materials from MTL materials on first use (docs/obj-mtl.md).
 class MaterialMapper {
  public:
-  MaterialMapper(Scene& scene, const std::string& obj_path,
+  MaterialMapper(Scene& scene, ObjMaterials& known, const std::string& obj_path,
                  const std::vector<tinyobj::material_t>& mats,
                  const std::vector<std::string>& origin);
 
@@ -87,12 +123,16 @@ class MaterialMapper {
 
  private:
   int convert(const tinyobj::material_t& t, const std::string& mtl_path);
+  /// `name` when no material has it, else with the OBJ file's parent directories in front
+  /// ("b/model.obj:paint"), else with "#2", "#3", ... after it.
+  std::string free_name(const std::string& name, bool with_path) const;
 
   Scene& scene_;
+  ObjMaterials& known_;
+  std::filesystem::path obj_path_;  ///< canonical
   const std::vector<tinyobj::material_t>& mats_;
   const std::vector<std::string>& origin_;
   std::vector<int> index_;
-  std::string obj_name_;
   int default_ = -1;
   std::set<std::string> warned_;
 };

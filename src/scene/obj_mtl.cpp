@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <set>
 #include <sstream>
 
 #include "core/file_io.hpp"
@@ -36,49 +37,75 @@ fs::path texture_path(const std::string& mtl_path, const std::string& name) {
 
 }  // namespace
 
-bool MtlReader::operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
+bool MtlReader::operator()(const std::string&, std::vector<tinyobj::material_t>* materials,
                            std::map<std::string, int>* map, std::string*, std::string*) {
-  if (!enabled_) return true;
-  fs::path p = fs::path(name).is_absolute() ? fs::path(name) : dir_ / name;
+  // tinyobjloader calls at each mtllib statement, and reads one library of a statement naming
+  // several: all of them are read at the first call
+  if (!enabled_ || done_) return true;
+  done_ = true;
+  std::set<std::string> seen;  // canonical paths: a library named twice is read once
+  for (const std::string& name : names_) {
+    fs::path p = fs::path(name).is_absolute() ? fs::path(name) : dir_ / name;
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(p, ec);
+    if (!seen.insert(ec ? p.string() : canonical.string()).second) continue;
+    if (!read(p.string(), materials, map)) break;
+  }
+  return true;
+}
+
+bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* materials,
+                     std::map<std::string, int>* map) {
   std::string text;
   try {
     io::ReadSpec spec;
     spec.what = "MTL file";
     spec.max_bytes = kMaxMtlBytes;
     spec.text = true;
-    text = io::read_file(p.string(), spec);
+    text = io::read_file(path, spec);
   } catch (const Error& e) {
     std::error_code ec;
-    if (!fs::exists(p, ec)) {
-      missing.push_back(p.string());
+    if (!fs::exists(path, ec)) {
+      missing.push_back(path);
     } else {
-      libraries.push_back(p.string());
+      libraries.push_back(path);
       unreadable.push_back(e.what());
     }
-    return false;
+    return true;
   }
-  libraries.push_back(p.string());
+  libraries.push_back(path);
   try {
-    check_mtl_text(p.string(), text);
+    check_mtl_text(path, text);
   } catch (const Error& e) {
-    if (error.empty()) error = e.what();
+    error = e.what();
     return false;
   }
-  std::istringstream in(text);
+  // a name defined again (in this library or an earlier one): tinyobjloader keeps the first
+  for (const MtlName& m : mtl_material_names(text)) {
+    auto [first, added] = defined_.insert({m.name, {path, m.line}});
+    if (added) continue;
+    const auto& [first_path, first_line] = first->second;
+    warnings.push_back(path + ":" + std::to_string(m.line) + ": material '" + m.name +
+                       "' is defined again (first at " +
+                       (first_path == path ? "line " : first_path + ":") +
+                       std::to_string(first_line) + "); faces use the first definition");
+  }
+  std::istringstream in(strip_texture_options(text));
   size_t before = materials->size();
   std::string mtl_warn, mtl_err;
   tinyobj::LoadMtl(map, materials, &in, &mtl_warn, &mtl_err);
-  for (size_t i = before; i < materials->size(); ++i) origin.push_back(p.string());
-  for (const std::string& w : lines_of(mtl_warn + mtl_err))
-    warnings.push_back(p.string() + ": " + w);
+  for (size_t i = before; i < materials->size(); ++i) origin.push_back(path);
+  for (const std::string& w : lines_of(mtl_warn + mtl_err)) warnings.push_back(path + ": " + w);
   return true;
 }
 
-MaterialMapper::MaterialMapper(Scene& scene, const std::string& obj_path,
+MaterialMapper::MaterialMapper(Scene& scene, ObjMaterials& known, const std::string& obj_path,
                                const std::vector<tinyobj::material_t>& mats,
                                const std::vector<std::string>& origin)
-    : scene_(scene), mats_(mats), origin_(origin), index_(mats.size(), -1) {
-  obj_name_ = fs::path(obj_path).filename().string();
+    : scene_(scene), known_(known), mats_(mats), origin_(origin), index_(mats.size(), -1) {
+  std::error_code ec;
+  obj_path_ = fs::weakly_canonical(obj_path, ec);
+  if (ec) obj_path_ = obj_path;
 }
 
 int MaterialMapper::get(int id) {
@@ -87,28 +114,53 @@ int MaterialMapper::get(int id) {
   return index_[id];
 }
 
+std::string MaterialMapper::free_name(const std::string& name, bool with_path) const {
+  // "model.obj:paint", then "b/model.obj:paint", "a/b/model.obj:paint", ... the whole path
+  std::string prefix = with_path ? obj_path_.filename().string() : "";
+  fs::path dir = obj_path_.parent_path();
+  for (;;) {
+    std::string candidate = with_path ? prefix + ":" + name : name;
+    if (scene_.find_material(candidate) < 0) return candidate;
+    if (!with_path || dir.empty() || dir == dir.parent_path()) break;
+    prefix = (dir.filename() / prefix).generic_string();
+    if (dir.parent_path() == dir.root_path()) prefix = dir.root_path().generic_string() + prefix;
+    dir = dir.parent_path();
+  }
+  const std::string base = with_path ? obj_path_.filename().string() + ":" + name : name;
+  for (int n = 2;; ++n) {
+    std::string candidate = base + "#" + std::to_string(n);
+    if (scene_.find_material(candidate) < 0) return candidate;
+  }
+}
+
 int MaterialMapper::default_material() {
   if (default_ < 0) {
-    default_ = scene_.find_material(kDefaultMaterial);
-    if (default_ < 0) {
+    auto it = known_.find(kDefaultMaterial);
+    if (it != known_.end()) {
+      default_ = it->second;
+    } else {
       Material m;
-      m.name = kDefaultMaterial;
+      m.name = free_name(kDefaultMaterial, false);
       m.type = MaterialType::Diffuse;
       m.albedo = glm::dvec3(0.8);
       scene_.materials.push_back(m);
       default_ = static_cast<int>(scene_.materials.size() - 1);
+      known_[kDefaultMaterial] = default_;
     }
   }
   return default_;
 }
 
 int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl_path) {
-  std::string name = obj_name_ + ":" + t.name;
-  int existing = scene_.find_material(name);
-  if (existing >= 0) return existing;  // the same OBJ loaded again
+  // the same MTL material (library by canonical path, and name) made before: by this OBJ loaded
+  // again, or another naming the same library
+  std::error_code ec;
+  fs::path library = fs::weakly_canonical(mtl_path, ec);
+  const std::string key = (ec ? mtl_path : library.string()) + "\n" + t.name;
+  if (auto it = known_.find(key); it != known_.end()) return it->second;
 
   Material m;
-  m.name = name;
+  m.name = free_name(t.name, true);
   glm::dvec3 kd = rgb(t.diffuse), ks = rgb(t.specular);
   m.albedo = kd;
   m.emission = glm::max(rgb(t.emission), glm::dvec3(0.0));
@@ -174,7 +226,8 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
   }
 
   scene_.materials.push_back(m);
-  return static_cast<int>(scene_.materials.size() - 1);
+  known_[key] = static_cast<int>(scene_.materials.size() - 1);
+  return known_[key];
 }
 
 }  // namespace lucent::scene_detail::obj

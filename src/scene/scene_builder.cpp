@@ -160,9 +160,12 @@ void SceneBuilder::add_obj(const ObjShape& obj) {
   const std::size_t materials = scene_.materials.size(), positions = scene_.positions.size(),
                     normals = scene_.normals.size(), uvs = scene_.uvs.size(),
                     triangles = scene_.triangles.size(), textures = scene_.textures.size();
+  const scene_detail::ObjMaterials obj_materials = obj_materials_;
   try {
-    entry.libraries = scene_detail::load_obj(scene_, obj.file, obj.transform, material);
+    entry.libraries =
+        scene_detail::load_obj(scene_, obj.file, obj.transform, material, &obj_materials_);
   } catch (const Error& e) {
+    obj_materials_ = obj_materials;
     scene_.materials.resize(materials);
     scene_.positions.resize(positions);
     scene_.normals.resize(normals);
@@ -189,6 +192,7 @@ Scene SceneBuilder::build() {
   if (c.focus_distance <= 0) c.focus_distance = glm::length(c.look_at - c.position);
   Scene out = std::move(scene_);
   scene_ = Scene{};
+  obj_materials_.clear();
   scene_.path = out.path;
   return out;
 }
