@@ -1,6 +1,7 @@
 #pragma once
-// Shared pieces of the Python module: enum names from the registries, arrays that own or view
-// C++ vectors, images from arrays, and calling Python back from a render that released the GIL.
+// Shared pieces of the Python module: enum names from the registries, vectors from sequences,
+// arrays that own or view C++ vectors, images from arrays, and calling Python back from a render
+// that released the GIL.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -84,8 +85,39 @@ py::tuple enum_name_tuple() {
 }
 
 // ------------------------------------------------------------------------------------------
-// Arrays
+// Vectors and arrays
 // ------------------------------------------------------------------------------------------
+
+/// A glm vector from a Vec3/Vec2 or a sequence of N numbers (tuple, list, NumPy array), with
+/// clear errors: ValueError for a wrong length, TypeError for anything else.
+template <class V>
+V to_vec(py::handle o) {
+  constexpr int N = V::length();
+  if (py::isinstance<V>(o)) return o.cast<V>();
+  if (!py::isinstance<py::sequence>(o) || py::isinstance<py::str>(o)) {
+    if (py::isinstance<py::str>(o))
+      throw py::value_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
+                            py::repr(o).cast<std::string>());
+    throw py::type_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
+                         py::repr(o).cast<std::string>());
+  }
+  py::sequence s = py::reinterpret_borrow<py::sequence>(o);
+  if (s.size() != static_cast<std::size_t>(N))
+    throw py::value_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
+                          py::repr(o).cast<std::string>());
+  V v;
+  for (int i = 0; i < N; ++i) {
+    py::object e = s[static_cast<std::size_t>(i)];
+    double d = PyFloat_AsDouble(e.ptr());
+    if (d == -1.0 && PyErr_Occurred()) {
+      PyErr_Clear();
+      throw py::type_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
+                           py::repr(o).cast<std::string>());
+    }
+    v[i] = d;
+  }
+  return v;
+}
 
 /// A NumPy array over `data` (C order, `shape`), kept valid by `owner` (the Python object that
 /// holds the vector): no copy.

@@ -11,6 +11,7 @@
 #include "lucent/error.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/session.hpp"
+#include "state.hpp"
 
 namespace lucent::python {
 
@@ -308,6 +309,107 @@ std::string result_repr(const RenderResult& r) {
          ">";
 }
 
+/// An image's pixels as an (H, W, 3) float32 array (a copy), for a pickled state.
+py::array_t<float> image_copy(const Image& image) {
+  py::array_t<float> a({py::ssize_t(image.height), py::ssize_t(image.width), py::ssize_t(3)});
+  std::copy(image.rgb.begin(), image.rgb.end(), a.mutable_data());
+  return a;
+}
+
+/// A RenderResult's pickled state: its fields by attribute name, the images and counts as NumPy
+/// arrays (variance and samples None when the result has none), read back strictly (state.hpp).
+py::dict result_state(const RenderResult& r) {
+  py::dict d;
+  d["mean"] = image_copy(r.mean);
+  d["variance"] = r.variance.rgb.empty() ? py::object(py::none()) : image_copy(r.variance);
+  if (r.samples.empty()) {
+    d["samples"] = py::none();
+  } else {
+    py::array_t<std::uint32_t> n({py::ssize_t(r.mean.height), py::ssize_t(r.mean.width)});
+    std::copy(r.samples.begin(), r.samples.end(), n.mutable_data());
+    d["samples"] = n;
+  }
+  d["spp"] = r.spp;
+  d["nonfinite"] = r.nonfinite;
+  d["rays"] = r.rays;
+  d["seconds"] = r.seconds;
+  d["build_seconds"] = r.build_seconds;
+  d["program_cache_hit"] = r.program_cache_hit;
+  d["build_options"] = r.build_options;
+  d["cancelled"] = r.cancelled;
+  d["device"] = r.device;
+  if constexpr (has_device_shares<RenderResult>::value) {
+    py::list devices;
+    for (const auto& share : r.devices) {
+      py::dict s;
+      s["device"] = share.device;
+      s["samples"] = share.samples;
+      s["seconds"] = share.seconds;
+      devices.append(s);
+    }
+    d["devices"] = devices;
+  }
+  d["estimated_relmse"] = r.estimated_relmse;
+  d["target_error"] = r.target_error;
+  d["halves_relmse"] = r.halves_relmse;
+  d["model_gain_a"] = r.model_gain_a;
+  d["model_gain_b"] = r.model_gain_b;
+  d["planned_relmse"] = r.planned_relmse;
+  d["seed"] = r.seed;
+  d["sampler"] = r.sampler;
+  return d;
+}
+
+RenderResult result_from_state(const py::object& state) {
+  StateReader s(state, "lucent.RenderResult");
+  RenderResult r;
+  auto image = [&](const char* key, py::ssize_t h, py::ssize_t w) {
+    py::array_t<float> a = s.array<float>(key, {h, w, 3});
+    Image img;
+    img.height = static_cast<int>(a.shape(0));
+    img.width = static_cast<int>(a.shape(1));
+    img.rgb.assign(a.data(), a.data() + a.size());
+    return img;
+  };
+  r.mean = image("mean", -1, -1);
+  if (!s.get("variance").is_none()) r.variance = image("variance", r.mean.height, r.mean.width);
+  if (!s.get("samples").is_none()) {
+    py::array_t<std::uint32_t> n = s.array<std::uint32_t>("samples", {r.mean.height, r.mean.width});
+    r.samples.assign(n.data(), n.data() + n.size());
+  }
+  r.spp = s.integer<std::uint64_t>("spp");
+  r.nonfinite = s.integer<std::uint64_t>("nonfinite");
+  r.rays = s.integer<std::uint64_t>("rays");
+  r.seconds = s.number("seconds");
+  r.build_seconds = s.number("build_seconds");
+  r.program_cache_hit = s.boolean("program_cache_hit");
+  r.build_options = s.text("build_options");
+  r.cancelled = s.boolean("cancelled");
+  r.device = s.text("device");
+  if constexpr (has_device_shares<RenderResult>::value) {
+    using Share = typename decltype(r.devices)::value_type;
+    r.devices = s.list<Share>("devices", [](py::handle item, const std::string& where) {
+      StateReader d(item, where);
+      Share share;
+      share.device = d.text("device");
+      share.samples = d.integer<decltype(share.samples)>("samples");
+      share.seconds = d.number("seconds");
+      d.finish();
+      return share;
+    });
+  }
+  r.estimated_relmse = s.number("estimated_relmse");
+  r.target_error = s.number("target_error");
+  r.halves_relmse = s.number("halves_relmse");
+  r.model_gain_a = s.number("model_gain_a");
+  r.model_gain_b = s.number("model_gain_b");
+  r.planned_relmse = s.number("planned_relmse");
+  r.seed = s.integer<std::uint32_t>("seed");
+  r.sampler = s.text("sampler");
+  s.finish();
+  return r;
+}
+
 }  // namespace
 
 void bind_render(py::module_& m) {
@@ -445,6 +547,8 @@ void bind_render(py::module_& m) {
       .def_readonly("build_options", &RenderResult::build_options)
       .def_readonly("cancelled", &RenderResult::cancelled)
       .def_readonly("device", &RenderResult::device)
+      .def(py::pickle([](const RenderResult& r) -> py::object { return result_state(r); },
+                      &result_from_state))
       .def("__repr__", &result_repr);
 
   py::class_<PyRenderer> renderer(

@@ -1,6 +1,6 @@
-"""Pickling and copying: scenes and the values they hold round-trip exactly (pickle protocol 2, the
-highest protocol, copy.deepcopy, a multiprocessing worker), a round-tripped scene renders the same
-image, and a corrupted state raises a ValueError naming the class and the key."""
+"""Pickling and copying: scenes, the values they hold and render results round-trip exactly (pickle
+protocol 2, the highest protocol, copy.deepcopy, a multiprocessing worker), a round-tripped scene
+renders the same image, and a corrupted state raises a ValueError naming the class and the key."""
 import copy
 import math
 import multiprocessing
@@ -187,17 +187,72 @@ def test_a_round_tripped_scene_renders_the_same_image(rich_scene):
     assert images[3].tobytes() != images[0].tobytes()
 
 
-def describe(scene):
-    """In a worker process: what it received."""
-    return (repr(scene), scene.textures[1].rgba.tobytes(), scene.integrator.seed,
-            scene.__getstate__()["triangles"]["uv"].tolist())
+def render_here(scene):
+    """Renders `scene` in a session of its own (in a worker process, or here)."""
+    with session() as r:
+        r.set_scene(scene)
+        r.render(2)
+        return r.result()
 
 
-def test_a_scene_goes_to_a_multiprocessing_worker(rich_scene):
+def test_a_worker_process_renders_a_scene_and_returns_its_result(rich_scene):
+    """The scene goes to a spawned multiprocessing worker and its RenderResult comes back: the
+    same image as a render here."""
     s = rich_scene
+    s.integrator.caustics = False
+    s.textures[1].rgba = np.random.default_rng(3).random((3, 6, 4), dtype=np.float32)
     with multiprocessing.get_context("spawn").Pool(1) as pool:
-        got = pool.apply(describe, (s,))
-    assert got == describe(s)
+        there = pool.apply(render_here, (s,))
+    here = render_here(s)
+    assert type(there) is lucent.RenderResult and (there.spp, there.width) == (2, 16)
+    assert there.mean.tobytes() == here.mean.tobytes()
+    assert np.array_equal(there.samples, here.samples)
+
+
+@pytest.mark.parametrize("name, round_trip", round_trips())
+def test_a_render_result_round_trips_exactly(renderer, small_scene, name, round_trip):
+    renderer.set_scene(small_scene)
+    renderer.render(3)
+    res = renderer.result()
+    state = res.__getstate__()
+    assert list(state) == header_fields("render.hpp", "RenderResult")
+    c = round_trip(res)
+    assert type(c) is lucent.RenderResult and c is not res
+    same(state, c.__getstate__())
+    assert c.mean.tobytes() == res.mean.tobytes() and c.variance.tobytes() == res.variance.tobytes()
+    assert c.samples.dtype == np.uint32 and np.array_equal(c.samples, res.samples)
+    assert (c.spp, c.rays, c.seconds, c.device, c.build_options, c.sampler) == (
+        res.spp, res.rays, res.seconds, res.device, res.build_options, res.sampler)
+    assert [(d.device, d.samples) for d in c.devices] == [(d.device, d.samples) for d in res.devices]
+    assert lucent.compare(res, c).max_z == 0
+    # a result made of arrays: no variance, no counts
+    a = round_trip(lucent.RenderResult(np.full((2, 3, 3), 0.5), spp=7))
+    assert a.variance is None and a.samples is None and a.spp == 7 and a.mean.shape == (2, 3, 3)
+
+
+@pytest.mark.parametrize("key, value, message", [
+    ("mean", np.zeros((12, 16)), "/mean: expected a (N, N, 3) array of float32, got a (12, 16) "
+                                 "array of float64"),
+    ("variance", np.zeros((12, 15, 3), np.float32), "/variance: expected a (12, 16, 3) array"),
+    ("samples", np.zeros((12, 16), np.int32), "/samples: expected a (12, 16) array of uint32, got "
+                                              "a (12, 16) array of int32"),
+    ("spp", -2, "/spp: integer out of range: -2"),
+    ("spp", 2 ** 64, "/spp: integer out of range: 18446744073709551616"),
+    ("devices", [{"device": "cpu"}], "/devices/0/samples: missing"),
+    ("sampler", None, "/sampler: expected a str, got NoneType"),
+])
+def test_a_corrupted_result_state_raises_value_error(renderer, small_scene, key, value, message):
+    renderer.set_scene(small_scene)
+    renderer.render(1)
+    state = renderer.result().__getstate__()
+    state[key] = value
+    with pytest.raises(ValueError) as e:
+        restore(lucent.RenderResult, state)
+    assert str(e.value).startswith("cannot unpickle lucent.RenderResult: ")
+    assert message in str(e.value)
+    state = renderer.result().__getstate__()
+    state["spp"] = 2 ** 64 - 1  # the largest uint64 is a count like the others
+    assert restore(lucent.RenderResult, state).spp == 2 ** 64 - 1
 
 
 def restore(cls, state):
