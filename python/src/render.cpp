@@ -693,6 +693,16 @@ void bind_render(py::module_& m) {
       .def("close", &PyRenderer::close,
            "Releases the device; every later call raises lucent.Error (closing again does "
            "nothing). Raises lucent.Error while another thread's call runs.")
+      .def(
+          "__reduce_ex__",
+          [](const PyRenderer&, py::handle) -> py::object {
+            // pickle, copy.copy and copy.deepcopy ask for this first
+            throw py::type_error(
+                "cannot pickle or copy a lucent.Renderer: it is a session on a device (its "
+                "kernel, buffers and accumulation live there); pickle its scene and result() "
+                "instead and make a Renderer where they are used");
+          },
+          py::arg("protocol"))
       .def("__enter__", [](py::object self) { return self; })
       .def("__exit__", [](PyRenderer& r, py::args) { r.close(); });
 

@@ -346,3 +346,21 @@ def test_a_corrupted_pickle_raises_not_crashes(rich_scene):
     assert s.camera.fov_degrees == math.inf and s.triangles[0].v == (99, 99, 99)
     with pytest.raises(lucent.Error, match="fov"):
         lucent.scene_info(s)  # a render validates it, as a scene changed field by field
+
+
+def test_a_renderer_refuses_pickling_and_copying(renderer, small_scene):
+    """A session lives on its device: pickling or copying it raises a TypeError that says so and
+    what to send instead (before: "cannot pickle 'lucent.Renderer' object", no more)."""
+    renderer.set_scene(small_scene)
+    refused = r"^cannot pickle or copy a lucent\.Renderer: it is a session on a device .*pickle " \
+              r"its scene and result\(\) instead"
+    for attempt in (lambda: pickle.dumps(renderer, 2),
+                    lambda: pickle.dumps({"session": renderer}, pickle.HIGHEST_PROTOCOL),
+                    lambda: copy.copy(renderer), lambda: copy.deepcopy([renderer])):
+        with pytest.raises(TypeError, match=refused):
+            attempt()
+    renderer.render(1)  # the session is untouched
+    assert renderer.spp == 1
+    # what the message suggests works
+    scene, result = pickled(renderer.scene, 2), pickled(renderer.result(), 2)
+    assert scene.film.width == 16 and result.spp == 1
