@@ -148,7 +148,11 @@ void run_interruptible(const std::function<void()>& work, std::atomic<bool>& can
   std::exception_ptr failure;
   {
     py::gil_scoped_release release;
-    std::packaged_task<void()> task(work);
+    const CallbackFrame* callbacks = t_callbacks;  // valid while this thread waits
+    std::packaged_task<void()> task([&] {
+      t_callbacks = callbacks;
+      work();
+    });
     std::future<void> done = task.get_future();
     std::thread worker(std::move(task));
     while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
