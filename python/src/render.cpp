@@ -801,6 +801,9 @@ void bind_render(py::module_& m) {
          std::optional<std::vector<int>> spp_ladder, std::optional<std::vector<double>> time_ladder,
          py::object renderer, py::object on_point) {
         check_callable(on_point, "on_point");
+        if (!renderer.is_none() && !py::isinstance<PyRenderer>(renderer))
+          throw py::type_error("renderer must be a lucent.Renderer or None, got " +
+                               py::repr(renderer).cast<std::string>());
         if (spp_ladder && time_ladder)
           throw py::value_error("give spp_ladder or time_ladder, not both");
         ConvergeOptions o;
