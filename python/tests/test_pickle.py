@@ -14,6 +14,7 @@ import lucent
 from conftest import header_fields, session
 
 PROTOCOLS = [2, pickle.HIGHEST_PROTOCOL]
+WORKER_WAIT = 120  # seconds: a bound on a worker's answer, never reached when the test passes
 
 
 def pickled(obj, protocol):
@@ -202,7 +203,8 @@ def test_a_worker_process_renders_a_scene_and_returns_its_result(rich_scene):
     s.integrator.caustics = False
     s.textures[1].rgba = np.random.default_rng(3).random((3, 6, 4), dtype=np.float32)
     with multiprocessing.get_context("spawn").Pool(1) as pool:
-        there = pool.apply(render_here, (s,))
+        # a bound on the wait: a worker that cannot start leaves apply() waiting for ever
+        there = pool.apply_async(render_here, (s,)).get(timeout=WORKER_WAIT)
     here = render_here(s)
     assert type(there) is lucent.RenderResult and (there.spp, there.width) == (2, 16)
     assert there.mean.tobytes() == here.mean.tobytes()
