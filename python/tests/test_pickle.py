@@ -6,6 +6,8 @@ import math
 import multiprocessing
 import pickle
 import struct
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -255,6 +257,47 @@ def test_a_corrupted_result_state_raises_value_error(renderer, small_scene, key,
     state = renderer.result().__getstate__()
     state["spp"] = 2 ** 64 - 1  # the largest uint64 is a count like the others
     assert restore(lucent.RenderResult, state).spp == 2 ** 64 - 1
+
+
+# Run in a child process: pickling with protocol 0 or 1 aborted the interpreter. Reads a list of
+# values (pickled with the highest protocol) and writes back their pickles with protocols 0 and 1
+# and the errors of values that do not pickle.
+OLD_PROTOCOLS = """
+import pickle, sys
+import numpy as np
+import lucent
+values = pickle.load(sys.stdin.buffer)
+refused = []
+with lucent.Renderer(**lucent.environment()) as r:
+    for obj in (r, lucent.compare(np.zeros((1, 1, 3)), np.zeros((1, 1, 3))), r.device):
+        for protocol in (0, 1):
+            try:
+                pickle.dumps(obj, protocol)
+                refused.append("pickled")
+            except TypeError as e:
+                refused.append(str(e))
+pickles = [[pickle.dumps(v, protocol) for protocol in (0, 1)] for v in values]
+pickle.dump((pickles, refused), sys.stdout.buffer, 2)
+"""
+
+
+def test_protocols_0_and_1_pickle_or_refuse_and_never_abort(rich_scene):
+    """Protocols 0 and 1 went through copyreg._reduce_ex, which calls pybind11's base type: an
+    uncaught C++ exception, and the interpreter aborted ("instance allocation failed"), even for
+    classes that do not pickle."""
+    s = rich_scene
+    values = [s, s.camera, s.textures, lucent.Vec2((1, 2)), lucent.RenderResult(np.ones((2, 2, 3)))]
+    child = subprocess.run([sys.executable, "-c", OLD_PROTOCOLS], capture_output=True,
+                           input=pickle.dumps(values, pickle.HIGHEST_PROTOCOL), timeout=WORKER_WAIT)
+    assert child.returncode == 0, child.stderr.decode()
+    pickles, refused = pickle.loads(child.stdout)
+    for v, by_protocol in zip(values, pickles):
+        for data in by_protocol:
+            same(v.__getstate__(), pickle.loads(data).__getstate__(), type(v).__name__)
+    renderer_refused = [r for r in refused[:2] if r.startswith("cannot pickle or copy a lucent.")]
+    assert len(renderer_refused) == 2, refused
+    assert refused[2:] == ["cannot pickle 'lucent.CompareResult' object"] * 2 + [
+        "cannot pickle 'lucent.DeviceInfo' object"] * 2
 
 
 def restore(cls, state):
