@@ -1,6 +1,7 @@
 #pragma once
-// Shared pieces of the Python module: enum names from the registries, arrays that own or view
-// C++ vectors, images from arrays, and calling Python back from a render that released the GIL.
+// Shared pieces of the Python module: enum names from the registries, vectors from sequences,
+// arrays that own or view C++ vectors, images from arrays, and calling Python back from a render
+// that released the GIL.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -84,8 +85,39 @@ py::tuple enum_name_tuple() {
 }
 
 // ------------------------------------------------------------------------------------------
-// Arrays
+// Vectors and arrays
 // ------------------------------------------------------------------------------------------
+
+/// A glm vector from a Vec3/Vec2 or a sequence of N numbers (tuple, list, NumPy array), with
+/// clear errors: ValueError for a wrong length, TypeError for anything else.
+template <class V>
+V to_vec(py::handle o) {
+  constexpr int N = V::length();
+  if (py::isinstance<V>(o)) return o.cast<V>();
+  if (!py::isinstance<py::sequence>(o) || py::isinstance<py::str>(o)) {
+    if (py::isinstance<py::str>(o))
+      throw py::value_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
+                            py::repr(o).cast<std::string>());
+    throw py::type_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
+                         py::repr(o).cast<std::string>());
+  }
+  py::sequence s = py::reinterpret_borrow<py::sequence>(o);
+  if (s.size() != static_cast<std::size_t>(N))
+    throw py::value_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
+                          py::repr(o).cast<std::string>());
+  V v;
+  for (int i = 0; i < N; ++i) {
+    py::object e = s[static_cast<std::size_t>(i)];
+    double d = PyFloat_AsDouble(e.ptr());
+    if (d == -1.0 && PyErr_Occurred()) {
+      PyErr_Clear();
+      throw py::type_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
+                           py::repr(o).cast<std::string>());
+    }
+    v[i] = d;
+  }
+  return v;
+}
 
 /// A NumPy array over `data` (C order, `shape`), kept valid by `owner` (the Python object that
 /// holds the vector): no copy.
@@ -164,9 +196,46 @@ class CallbackErrors {
 /// when `callback` is None. Exceptions go to `errors`.
 WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackErrors> errors);
 
+/// A callback of a session's call in progress (the progress callback of a render, a warning
+/// callback, converge's on_point), in the chain of those running on this thread, innermost
+/// first: a call on the same session from one of them, or from anything they call, would
+/// re-enter the call in progress. The session refuses it saying so, not that another thread
+/// uses the session.
+struct CallbackFrame {
+  const void* session;
+  const char* callback;  ///< "progress callback", for messages
+  const CallbackFrame* outer;
+};
+
+/// The chain of this thread (run_interruptible's worker inherits its caller's: the caller waits
+/// for it).
+inline thread_local const CallbackFrame* t_callbacks = nullptr;
+
+/// Adds a callback of `session`'s call to this thread's chain while it lives.
+class InCallback {
+ public:
+  InCallback(const void* session, const char* callback) : frame_{session, callback, t_callbacks} {
+    t_callbacks = &frame_;
+  }
+  ~InCallback() { t_callbacks = frame_.outer; }
+  InCallback(const InCallback&) = delete;
+  InCallback& operator=(const InCallback&) = delete;
+
+ private:
+  CallbackFrame frame_;
+};
+
+/// The innermost callback of `session`'s call in this thread's chain, or nullptr.
+inline const CallbackFrame* callback_of(const void* session) {
+  for (const CallbackFrame* f = t_callbacks; f; f = f->outer)
+    if (f->session == session) return f;
+  return nullptr;
+}
+
 /// Runs `work` on a worker thread with the GIL released while this thread checks Python's
 /// signals every 50 ms: on KeyboardInterrupt (or any exception of a signal handler) `cancel` is
-/// set, the work is awaited (it stops early on the flag) and the exception is raised.
+/// set, the work is awaited (it stops early on the flag) and the exception is raised. The worker
+/// has this thread's chain of callbacks.
 void run_interruptible(const std::function<void()>& work, std::atomic<bool>& cancel);
 
 /// Module parts.

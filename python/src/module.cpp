@@ -148,7 +148,11 @@ void run_interruptible(const std::function<void()>& work, std::atomic<bool>& can
   std::exception_ptr failure;
   {
     py::gil_scoped_release release;
-    std::packaged_task<void()> task(work);
+    const CallbackFrame* callbacks = t_callbacks;  // valid while this thread waits
+    std::packaged_task<void()> task([&] {
+      t_callbacks = callbacks;
+      work();
+    });
     std::future<void> done = task.get_future();
     std::thread worker(std::move(task));
     while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
@@ -177,6 +181,39 @@ std::string resolved_cache_dir(const std::string& dir) {
   std::string d = dir.empty() ? SessionOptions::from_environment().cache_dir : dir;
   if (d == "off") return "";
   return d.empty() ? cl_util::default_program_cache_dir() : d;
+}
+
+/// Gives every class of the module without a __reduce_ex__ of its own one for every pickle
+/// protocol. Protocols 0 and 1 otherwise reduce an object through copyreg._reduce_ex, which calls
+/// pybind11's base type on it: a C++ exception that nothing catches, and the interpreter aborts
+/// ("instance allocation failed: new instance has no pybind11-registered base types", pybind11
+/// issue 3745). A class with py::pickle reduces as protocol 2 does (copyreg.__newobj__, then
+/// __setstate__ with its state), in any protocol; the others raise the TypeError that protocol 2
+/// raises for them.
+void reduce_in_every_protocol(py::module_& m) {
+  const py::object newobj = py::module_::import("copyreg").attr("__newobj__");
+  for (auto item : py::reinterpret_borrow<py::dict>(m.attr("__dict__"))) {
+    py::handle cls = item.second;
+    if (!PyType_Check(cls.ptr()) ||
+        !py::detail::get_type_info(reinterpret_cast<PyTypeObject*>(cls.ptr())) ||
+        cls.attr("__dict__").contains("__reduce_ex__"))
+      continue;  // not a bound class (lucent.Error), or one that says itself (Renderer)
+    if (py::hasattr(cls, "__setstate__")) {
+      cls.attr("__reduce_ex__") = py::cpp_function(
+          [newobj](py::handle self, int) {
+            return py::make_tuple(newobj, py::make_tuple(py::type::handle_of(self)),
+                                  self.attr("__getstate__")());
+          },
+          py::is_method(cls), py::arg("protocol"));
+    } else {
+      const std::string name = cls.attr("__name__").cast<std::string>();
+      cls.attr("__reduce_ex__") = py::cpp_function(
+          [name](py::handle, int) -> py::object {
+            throw py::type_error("cannot pickle 'lucent." + name + "' object");
+          },
+          py::is_method(cls), py::arg("protocol"));
+    }
+  }
 }
 
 py::dict environment() {
@@ -263,4 +300,5 @@ PYBIND11_MODULE(lucent, m) {
   bind_scene(m);
   bind_render(m);
   bind_image(m);
+  reduce_in_every_protocol(m);
 }

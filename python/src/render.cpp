@@ -11,6 +11,7 @@
 #include "lucent/error.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/session.hpp"
+#include "state.hpp"
 
 namespace lucent::python {
 
@@ -71,7 +72,8 @@ void bind_device_shares(py::module_& m, py::class_<T>& c) {
 
 /// A session as Python holds it: the Renderer, the sink of its warnings, and a guard against
 /// two Python threads using it at once. Calls (set_scene, render, result, ...) run one at a time:
-/// a second one, from another thread or from a callback of the first, raises. While a call runs:
+/// a second one, from another thread or from a callback of the first, raises (saying which of
+/// the two it is). While a call runs:
 /// - cancel() and device (fixed for the session's life) work from any thread;
 /// - spp, first_sample and stats give the values the call began with, updated after each pass
 ///   of render(), render_for() and render_adaptive() (a copy that the rendering thread writes
@@ -100,7 +102,11 @@ class PyRenderer {
     o.fast_math = fast_math;
     o.specialize = specialize;
     o.pass_seconds = pass_seconds;
-    o.on_warning = python_warning_sink(SharedObject(std::move(on_warning)), warning_errors_);
+    WarningSink sink = python_warning_sink(SharedObject(std::move(on_warning)), warning_errors_);
+    o.on_warning = [this, sink](const std::string& message) {
+      InCallback frame(this, "warning callback");
+      sink(message);
+    };
     py::gil_scoped_release release;
     renderer_.emplace(std::move(o));
     renderer_->set_cancel_flag(&stop_);
@@ -113,14 +119,14 @@ class PyRenderer {
     return *renderer_;
   }
 
-  /// The session, for reading what a call changes (scene, options): refused while a call runs,
-  /// unless it is paused in its progress callback.
-  const Renderer& read() {
+  /// The session, for reading what a call changes (`what`: scene, options): refused while a
+  /// call runs, unless it is paused in its progress callback.
+  const Renderer& read(const char* what) {
     Renderer& r = get();
     if (busy_ && !paused_)
-      throw Error(
-          "the renderer is in use by another thread (its scene and options can be read between "
-          "calls, or from a progress callback)");
+      throw Error(refusal("read", what,
+                          "its scene and options can be read between calls, or from a progress "
+                          "callback"));
     return r;
   }
 
@@ -137,11 +143,11 @@ class PyRenderer {
     return counters_;
   }
 
-  /// Runs `f(renderer)` with the GIL released, one call at a time; then raises what a warning
-  /// callback raised.
+  /// Runs `f(renderer)` with the GIL released, one call at a time (`what`: its name, for
+  /// messages); then raises what a warning callback raised.
   template <class F>
-  auto call(F&& f) {
-    Busy busy(*this);
+  auto call(const char* what, F&& f) {
+    Busy busy(*this, what);
     Renderer& r = get();
     using Result = decltype(f(r));
     if constexpr (std::is_void_v<Result>) {
@@ -165,8 +171,8 @@ class PyRenderer {
   /// Python's signal handlers (run_interruptible): KeyboardInterrupt raises `stop`, the
   /// session's cancel flag, and a render in progress ends after its current pass.
   template <class F>
-  void call_interruptible(F&& f) {
-    Busy busy(*this);
+  void call_interruptible(const char* what, F&& f) {
+    Busy busy(*this, what);
     Renderer& r = get();
     stop_ = false;
     run_interruptible([&] { f(r, stop_); }, stop_);
@@ -176,23 +182,26 @@ class PyRenderer {
   /// A render call: `progress(p)` runs after each pass (on the rendering thread, with the GIL);
   /// an exception it raises, or Ctrl-C, stops the render after the current pass and is raised
   /// once the render returned. The accumulation keeps what was rendered.
-  RenderProgress render(std::uint64_t spp, double seconds, py::object progress) {
-    return run_with_progress(std::move(progress), [&](Renderer& r, const ProgressFn& on_progress) {
-      return r.render(spp, seconds, on_progress);
-    });
+  /// `what`: render or render_for, for messages.
+  RenderProgress render(const char* what, std::uint64_t spp, double seconds, py::object progress) {
+    return run_with_progress(what, std::move(progress),
+                             [&](Renderer& r, const ProgressFn& on_progress) {
+                               return r.render(spp, seconds, on_progress);
+                             });
   }
 
   RenderProgress render_adaptive(const AdaptiveOptions& options, py::object progress) {
-    return run_with_progress(std::move(progress), [&](Renderer& r, const ProgressFn& on_progress) {
-      return r.render_adaptive(options, on_progress);
-    });
+    return run_with_progress("render_adaptive", std::move(progress),
+                             [&](Renderer& r, const ProgressFn& on_progress) {
+                               return r.render_adaptive(options, on_progress);
+                             });
   }
 
   using ProgressFn = std::function<void(const RenderProgress&)>;
   /// Runs `f(renderer, on_progress)` interruptibly, with `progress` (a callable or None) called
   /// under the GIL after each pass.
   template <class F>
-  RenderProgress run_with_progress(py::object progress, F&& f) {
+  RenderProgress run_with_progress(const char* what, py::object progress, F&& f) {
     check_callable(progress, "progress");
     CallbackErrors errors;
     const bool has_progress = !progress.is_none();
@@ -201,12 +210,13 @@ class PyRenderer {
       save_counters();
       if (!has_progress) return;
       py::gil_scoped_acquire gil;
+      InCallback frame(this, "progress callback");
       paused_ = true;  // scene and options can be read until the callback returns
       if (!errors.run([&] { progress(p); })) stop_ = true;
       paused_ = false;
     };
     RenderProgress out;
-    call_interruptible([&](Renderer& r, std::atomic<bool>&) { out = f(r, on_progress); });
+    call_interruptible(what, [&](Renderer& r, std::atomic<bool>&) { out = f(r, on_progress); });
     errors.rethrow();
     return out;
   }
@@ -217,8 +227,7 @@ class PyRenderer {
   void close() {
     if (closed_) return;
     if (busy_.exchange(true))
-      throw Error(
-          "the renderer is in use by another thread (close it once that call has returned)");
+      throw Error(refusal("call", "close", "close it once that call has returned"));
     closed_ = true;  // from here on every call raises, before touching renderer_
     {
       py::gil_scoped_release release;
@@ -228,23 +237,35 @@ class PyRenderer {
   }
 
  private:
-  /// Marks the session in use for a call (the GIL held); a second call gets an error.
+  /// Marks the session in use for a call named `what` (the GIL held); a second call gets an
+  /// error.
   struct Busy {
-    explicit Busy(PyRenderer& r) : busy(r.busy_) {
+    Busy(PyRenderer& r, const char* what) : session(r) {
       if (r.closed_) throw Error("the renderer is closed");
-      if (busy.exchange(true))
-        throw Error(
-            "the renderer is in use by another thread (a session renders one call at a time)");
+      if (r.busy_.exchange(true))
+        throw Error(r.refusal("call", what, "a session renders one call at a time"));
+      r.call_ = what;
       try {
         r.save_counters();  // what other threads read during the call
       } catch (...) {
-        busy = false;
+        r.busy_ = false;
         throw;
       }
     }
-    ~Busy() { busy = false; }
-    std::atomic<bool>& busy;
+    ~Busy() { session.busy_ = false; }
+    PyRenderer& session;
   };
+
+  /// Why `what` (a call, or a property to read: `verb`) is refused while a call is in progress
+  /// (the GIL held): made from a callback of that call on this thread, it would re-enter it;
+  /// otherwise another thread's call is in progress (`hint`: what to do then).
+  std::string refusal(const char* verb, const char* what, const char* hint) const {
+    if (const CallbackFrame* f = callback_of(this))
+      return std::string("cannot ") + verb + " " + what + " from the " + f->callback +
+             " of this renderer's own " + call_ + " (a session runs one call at a time: " + verb +
+             " it once " + call_ + " has returned)";
+    return std::string("the renderer is in use by another thread (") + hint + ")";
+  }
 
   /// Copies the session's counters for other threads; called where nothing changes them (a call
   /// starting, with the GIL; a render between passes, under its lock).
@@ -260,6 +281,7 @@ class PyRenderer {
   std::atomic<bool> busy_{false};  ///< a call (or close()) is in progress
   bool closed_ = false;            ///< close() began (GIL)
   bool paused_ = false;            ///< the call in progress is in its progress callback (GIL)
+  const char* call_ = "";          ///< the name of the call in progress, for messages (GIL)
   std::atomic<bool> stop_{false};  ///< the session's cancel flag
   std::mutex counters_mutex_;
   Counters counters_;  ///< the counters while a call runs (counters_mutex_)
@@ -306,6 +328,107 @@ std::string result_repr(const RenderResult& r) {
          std::to_string(r.mean.height) + ", " + std::to_string(r.spp) + " spp, " +
          format_field(r.seconds) + " s" + (r.cancelled ? ", cancelled" : "") + ", " + r.device +
          ">";
+}
+
+/// An image's pixels as an (H, W, 3) float32 array (a copy), for a pickled state.
+py::array_t<float> image_copy(const Image& image) {
+  py::array_t<float> a({py::ssize_t(image.height), py::ssize_t(image.width), py::ssize_t(3)});
+  std::copy(image.rgb.begin(), image.rgb.end(), a.mutable_data());
+  return a;
+}
+
+/// A RenderResult's pickled state: its fields by attribute name, the images and counts as NumPy
+/// arrays (variance and samples None when the result has none), read back strictly (state.hpp).
+py::dict result_state(const RenderResult& r) {
+  py::dict d;
+  d["mean"] = image_copy(r.mean);
+  d["variance"] = r.variance.rgb.empty() ? py::object(py::none()) : image_copy(r.variance);
+  if (r.samples.empty()) {
+    d["samples"] = py::none();
+  } else {
+    py::array_t<std::uint32_t> n({py::ssize_t(r.mean.height), py::ssize_t(r.mean.width)});
+    std::copy(r.samples.begin(), r.samples.end(), n.mutable_data());
+    d["samples"] = n;
+  }
+  d["spp"] = r.spp;
+  d["nonfinite"] = r.nonfinite;
+  d["rays"] = r.rays;
+  d["seconds"] = r.seconds;
+  d["build_seconds"] = r.build_seconds;
+  d["program_cache_hit"] = r.program_cache_hit;
+  d["build_options"] = r.build_options;
+  d["cancelled"] = r.cancelled;
+  d["device"] = r.device;
+  if constexpr (has_device_shares<RenderResult>::value) {
+    py::list devices;
+    for (const auto& share : r.devices) {
+      py::dict s;
+      s["device"] = share.device;
+      s["samples"] = share.samples;
+      s["seconds"] = share.seconds;
+      devices.append(s);
+    }
+    d["devices"] = devices;
+  }
+  d["estimated_relmse"] = r.estimated_relmse;
+  d["target_error"] = r.target_error;
+  d["halves_relmse"] = r.halves_relmse;
+  d["model_gain_a"] = r.model_gain_a;
+  d["model_gain_b"] = r.model_gain_b;
+  d["planned_relmse"] = r.planned_relmse;
+  d["seed"] = r.seed;
+  d["sampler"] = r.sampler;
+  return d;
+}
+
+RenderResult result_from_state(const py::object& state) {
+  StateReader s(state, "lucent.RenderResult");
+  RenderResult r;
+  auto image = [&](const char* key, py::ssize_t h, py::ssize_t w) {
+    py::array_t<float> a = s.array<float>(key, {h, w, 3});
+    Image img;
+    img.height = static_cast<int>(a.shape(0));
+    img.width = static_cast<int>(a.shape(1));
+    img.rgb.assign(a.data(), a.data() + a.size());
+    return img;
+  };
+  r.mean = image("mean", -1, -1);
+  if (!s.get("variance").is_none()) r.variance = image("variance", r.mean.height, r.mean.width);
+  if (!s.get("samples").is_none()) {
+    py::array_t<std::uint32_t> n = s.array<std::uint32_t>("samples", {r.mean.height, r.mean.width});
+    r.samples.assign(n.data(), n.data() + n.size());
+  }
+  r.spp = s.integer<std::uint64_t>("spp");
+  r.nonfinite = s.integer<std::uint64_t>("nonfinite");
+  r.rays = s.integer<std::uint64_t>("rays");
+  r.seconds = s.number("seconds");
+  r.build_seconds = s.number("build_seconds");
+  r.program_cache_hit = s.boolean("program_cache_hit");
+  r.build_options = s.text("build_options");
+  r.cancelled = s.boolean("cancelled");
+  r.device = s.text("device");
+  if constexpr (has_device_shares<RenderResult>::value) {
+    using Share = typename decltype(r.devices)::value_type;
+    r.devices = s.list<Share>("devices", [](py::handle item, const std::string& where) {
+      StateReader d(item, where);
+      Share share;
+      share.device = d.text("device");
+      share.samples = d.integer<decltype(share.samples)>("samples");
+      share.seconds = d.number("seconds");
+      d.finish();
+      return share;
+    });
+  }
+  r.estimated_relmse = s.number("estimated_relmse");
+  r.target_error = s.number("target_error");
+  r.halves_relmse = s.number("halves_relmse");
+  r.model_gain_a = s.number("model_gain_a");
+  r.model_gain_b = s.number("model_gain_b");
+  r.planned_relmse = s.number("planned_relmse");
+  r.seed = s.integer<std::uint32_t>("seed");
+  r.sampler = s.text("sampler");
+  s.finish();
+  return r;
 }
 
 }  // namespace
@@ -445,6 +568,8 @@ void bind_render(py::module_& m) {
       .def_readonly("build_options", &RenderResult::build_options)
       .def_readonly("cancelled", &RenderResult::cancelled)
       .def_readonly("device", &RenderResult::device)
+      .def(py::pickle([](const RenderResult& r) -> py::object { return result_state(r); },
+                      &result_from_state))
       .def("__repr__", &result_repr);
 
   py::class_<PyRenderer> renderer(
@@ -472,7 +597,7 @@ void bind_render(py::module_& m) {
           "options",
           [](PyRenderer& r) {
             // a copy: making the dict may let other threads run
-            const SessionOptions o = r.read().options();
+            const SessionOptions o = r.read("options").options();
             py::dict d;
             d["device"] = o.device;
             d["kernel_dir"] = o.kernel_dir;
@@ -489,7 +614,8 @@ void bind_render(py::module_& m) {
           "set_build_options",
           [](PyRenderer& r, const std::string& precision, bool fast_math, bool specialize) {
             Precision p = parse_enum<Precision>(precision);
-            r.call([&](Renderer& rr) { rr.set_build_options(p, fast_math, specialize); });
+            r.call("set_build_options",
+                   [&](Renderer& rr) { rr.set_build_options(p, fast_math, specialize); });
           },
           py::kw_only(), py::arg("precision") = "float", py::arg("fast_math") = false,
           py::arg("specialize") = true, "Build settings for the next set_scene/render.")
@@ -497,20 +623,20 @@ void bind_render(py::module_& m) {
           "set_scene",
           [](PyRenderer& r, const Scene& scene) {
             Scene copy = scene;  // Python threads may change `scene` while the GIL is released
-            r.call([&](Renderer& rr) { rr.set_scene(copy); });
+            r.call("set_scene", [&](Renderer& rr) { rr.set_scene(copy); });
           },
           py::arg("scene"),
           "Makes a copy of `scene` the session's scene; keeps the BVH, the kernel and the "
           "accumulation when it can (see Renderer).")
       .def_property_readonly(
-          "scene", [](PyRenderer& r) { return Scene(r.read().scene()); },
+          "scene", [](PyRenderer& r) { return Scene(r.read("scene").scene()); },
           "A copy of the session's scene. Raises lucent.Error while another thread's call "
           "(set_scene, render, ...) runs, except from a render's progress callback (between "
           "passes, from any thread).")
       .def(
           "render",
           [](PyRenderer& r, long long spp, double seconds, py::object progress) {
-            return r.render(checked_spp(spp, true), checked_seconds(seconds, "seconds"),
+            return r.render("render", checked_spp(spp, true), checked_seconds(seconds, "seconds"),
                             std::move(progress));
           },
           py::arg("spp"), py::arg("seconds") = 0.0, py::arg("progress") = py::none(),
@@ -547,7 +673,7 @@ void bind_render(py::module_& m) {
             if (!(seconds > 0) || !std::isfinite(seconds))
               throw py::value_error("seconds must be a finite number > 0, got " +
                                     format_field(seconds));
-            return r.render(0, seconds, std::move(progress));
+            return r.render("render_for", 0, seconds, std::move(progress));
           },
           py::arg("seconds"), py::arg("progress") = py::none(),
           "Adds samples for about `seconds` (at least one pass).")
@@ -565,12 +691,13 @@ void bind_render(py::module_& m) {
                                           "range), got " +
                                               shown);
             }
-            r.call([&](Renderer& rr) { rr.reset(static_cast<std::uint64_t>(first)); });
+            r.call("reset", [&](Renderer& rr) { rr.reset(static_cast<std::uint64_t>(first)); });
           },
           py::arg("first_sample") = 0,
           "Drops the accumulation; the next sample index is first_sample.")
       .def(
-          "result", [](PyRenderer& r) { return r.call([](Renderer& rr) { return rr.result(); }); },
+          "result",
+          [](PyRenderer& r) { return r.call("result", [](Renderer& rr) { return rr.result(); }); },
           "The accumulation so far (a RenderResult; its arrays are this call's own).")
       .def_property_readonly(
           "spp", [](PyRenderer& r) { return r.counters().spp; },
@@ -588,7 +715,18 @@ void bind_render(py::module_& m) {
           "Stops a render in progress (in another thread) after its current pass.")
       .def("close", &PyRenderer::close,
            "Releases the device; every later call raises lucent.Error (closing again does "
-           "nothing). Raises lucent.Error while another thread's call runs.")
+           "nothing). Raises lucent.Error while a call runs: another thread's, or the one whose "
+           "callback (progress, on_warning, converge's on_point) calls close().")
+      .def(
+          "__reduce_ex__",
+          [](const PyRenderer&, py::handle) -> py::object {
+            // pickle, copy.copy and copy.deepcopy ask for this first
+            throw py::type_error(
+                "cannot pickle or copy a lucent.Renderer: it is a session on a device (its "
+                "kernel, buffers and accumulation live there); pickle its scene and result() "
+                "instead and make a Renderer where they are used");
+          },
+          py::arg("protocol"))
       .def("__enter__", [](py::object self) { return self; })
       .def("__exit__", [](PyRenderer& r, py::args) { r.close(); });
 
@@ -663,6 +801,9 @@ void bind_render(py::module_& m) {
          std::optional<std::vector<int>> spp_ladder, std::optional<std::vector<double>> time_ladder,
          py::object renderer, py::object on_point) {
         check_callable(on_point, "on_point");
+        if (!renderer.is_none() && !py::isinstance<PyRenderer>(renderer))
+          throw py::type_error("renderer must be a lucent.Renderer or None, got " +
+                               py::repr(renderer).cast<std::string>());
         if (spp_ladder && time_ladder)
           throw py::value_error("give spp_ladder or time_ladder, not both");
         ConvergeOptions o;
@@ -681,9 +822,12 @@ void bind_render(py::module_& m) {
         Scene copy = scene;
         CallbackErrors errors;
         std::atomic<bool>* stop = nullptr;
+        // on_point is a callback of the session's converge call when it renders in one
+        const PyRenderer* session = renderer.is_none() ? nullptr : &renderer.cast<PyRenderer&>();
         if (!on_point.is_none())
           o.on_point = [&](const ConvergePoint& p) {
             py::gil_scoped_acquire gil;
+            InCallback frame(session, "on_point callback");
             if (!errors.run([&] { on_point(p); })) *stop = true;
           };
         ConvergeResult out;
@@ -698,7 +842,7 @@ void bind_render(py::module_& m) {
         } else {
           // the session given renders every rung, with its own cancel flag
           renderer.cast<PyRenderer&>().call_interruptible(
-              [&](Renderer& r, std::atomic<bool>& cancel) {
+              "converge", [&](Renderer& r, std::atomic<bool>& cancel) {
                 stop = &cancel;
                 o.render.cancel = &cancel;
                 o.renderer = &r;

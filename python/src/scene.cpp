@@ -16,6 +16,7 @@
 #include "scene/json_guard.hpp"
 #include "scene/loaders.hpp"
 #include "scene/validate.hpp"
+#include "state.hpp"
 
 PYBIND11_MAKE_OPAQUE(std::vector<lucent::Material>)
 PYBIND11_MAKE_OPAQUE(std::vector<lucent::Sphere>)
@@ -35,37 +36,6 @@ std::string format_number(double v) {
   return s.str();
 }
 
-/// A glm vector from a Vec3/Vec2 or a sequence of N numbers (tuple, list, NumPy array), with
-/// clear errors: ValueError for a wrong length, TypeError for anything else.
-template <class V>
-V to_vec(py::handle o) {
-  constexpr int N = V::length();
-  if (py::isinstance<V>(o)) return o.cast<V>();
-  if (!py::isinstance<py::sequence>(o) || py::isinstance<py::str>(o)) {
-    if (py::isinstance<py::str>(o))
-      throw py::value_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
-                            py::repr(o).cast<std::string>());
-    throw py::type_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
-                         py::repr(o).cast<std::string>());
-  }
-  py::sequence s = py::reinterpret_borrow<py::sequence>(o);
-  if (s.size() != static_cast<std::size_t>(N))
-    throw py::value_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
-                          py::repr(o).cast<std::string>());
-  V v;
-  for (int i = 0; i < N; ++i) {
-    py::object e = s[static_cast<std::size_t>(i)];
-    double d = PyFloat_AsDouble(e.ptr());
-    if (d == -1.0 && PyErr_Occurred()) {
-      PyErr_Clear();
-      throw py::type_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
-                           py::repr(o).cast<std::string>());
-    }
-    v[i] = d;
-  }
-  return v;
-}
-
 /// A vector member: reading gives the vector itself (`camera.position.x += 1` changes the
 /// camera), assigning takes any sequence of numbers.
 template <class C, class V>
@@ -79,7 +49,7 @@ void vec_property(py::class_<C>& c, const char* name, V C::*member, const char* 
 /// Vec3 / Vec2: glm vectors with x, y, (z), indexing, iteration, comparison with sequences and
 /// conversion from any sequence of numbers (function arguments accept tuples, lists, arrays).
 template <class V>
-void bind_vector_type(py::module_& m, const char* name) {
+py::class_<V> bind_vector_type(py::module_& m, const char* name) {
   constexpr int N = V::length();
   auto get = [](const V& v, py::ssize_t i) {
     if (i < 0) i += N;
@@ -138,6 +108,7 @@ void bind_vector_type(py::module_& m, const char* name) {
   if constexpr (N == 3) c.def_readwrite("z", &V::z);
   c.attr("__hash__") = py::none();
   py::implicitly_convertible<py::sequence, V>();
+  return c;
 }
 
 /// A property holding an enum by its registry name.
@@ -177,34 +148,495 @@ void triple_property(py::class_<C>& c, const char* name, int (C::*member)[3]) {
       });
 }
 
+/// A list of glm vectors as an (N, D) float64 array (a read-only copy).
+template <class V>
+py::array_t<double> vectors_array(const std::vector<V>& v) {
+  return copy_rows(v.empty() ? nullptr : &v[0].x, v.size(), V::length());
+}
+
+/// An (N, D) array of numbers (or an empty sequence) as a list of glm vectors; TypeError or
+/// ValueError naming `name` otherwise.
+template <class V>
+std::vector<V> vectors_from(py::handle value, const std::string& name) {
+  constexpr int D = V::length();
+  require_numbers(value, name);
+  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (!a)
+    throw py::type_error(name + ": expected an array of shape (N, " + std::to_string(D) + ")");
+  if (!(a.ndim() == 2 && a.shape(1) == D) && !(a.ndim() == 1 && a.shape(0) == 0))
+    throw py::value_error(name + ": expected an array of shape (N, " + std::to_string(D) + ")");
+  std::vector<V> out(static_cast<std::size_t>(a.ndim() == 2 ? a.shape(0) : 0));
+  for (std::size_t i = 0; i < out.size(); ++i)
+    for (int k = 0; k < D; ++k) out[i][k] = a.at(static_cast<py::ssize_t>(i), k);
+  return out;
+}
+
 /// A list of glm vectors as an (N, D) float64 array: a read-only copy (assign the attribute to
 /// change it).
 template <class V>
 void vector_array_property(py::class_<Scene>& c, const char* name, std::vector<V> Scene::*member) {
   constexpr int D = V::length();
   c.def_property(
-      name,
-      [member](const Scene& s) {
-        const std::vector<V>& v = s.*member;
-        return copy_rows(v.empty() ? nullptr : &v[0].x, v.size(), D);
-      },
-      [member, name](Scene& s, py::handle value) {
-        require_numbers(value, name);
-        auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
-        if (!a)
-          throw py::type_error(std::string(name) + ": expected an array of shape (N, " +
-                               std::to_string(D) + ")");
-        if (!(a.ndim() == 2 && a.shape(1) == D) && !(a.ndim() == 1 && a.shape(0) == 0))
-          throw py::value_error(std::string(name) + ": expected an array of shape (N, " +
-                                std::to_string(D) + ")");
-        std::vector<V> out(static_cast<std::size_t>(a.ndim() == 2 ? a.shape(0) : 0));
-        for (std::size_t i = 0; i < out.size(); ++i)
-          for (int k = 0; k < D; ++k) out[i][k] = a.at(static_cast<py::ssize_t>(i), k);
-        s.*member = std::move(out);
-      },
+      name, [member](const Scene& s) { return vectors_array(s.*member); },
+      [member, name](Scene& s, py::handle value) { s.*member = vectors_from<V>(value, name); },
       (std::string(name) + ": an (N, " + std::to_string(D) +
        ") float64 array (a read-only copy; assign to change)")
           .c_str());
+}
+
+/// A texture's texels as an (H, W, 4) float32 array: a read-only copy (a view of t.rgba
+/// dangled once the setter or the scene's texture list reallocated it: reading freed memory,
+/// a crash).
+py::array_t<float> texture_texels(const Texture& t) {
+  py::array_t<float> a({py::ssize_t(t.height), py::ssize_t(t.width), py::ssize_t(4)});
+  if (!t.rgba.empty())
+    std::copy(t.rgba.begin(), t.rgba.end(), static_cast<float*>(a.mutable_data()));
+  a.attr("flags").attr("writeable") = false;
+  return a;
+}
+
+/// Sets a texture's texels, width and height from an (H, W, 4) array of numbers (H, W >= 1).
+void set_texture_texels(Texture& t, py::handle value) {
+  require_numbers(value, "rgba");
+  auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (!a || a.ndim() != 3 || a.shape(2) != 4 || a.shape(0) < 1 || a.shape(1) < 1)
+    throw py::value_error("rgba: expected an array of shape (H, W, 4)");
+  t.height = static_cast<int>(a.shape(0));
+  t.width = static_cast<int>(a.shape(1));
+  t.rgba.assign(a.data(), a.data() + a.size());
+}
+
+// ------------------------------------------------------------------------------------------
+// Pickling (py::pickle; copy.copy and copy.deepcopy use it too). A value's state is plain Python
+// data: a dict of its fields by their attribute names (numbers, strings, tuples, enums by their
+// names, nested structs by their states), read back by StateReader (state.hpp). A scene's spheres
+// and triangles are columns (NumPy arrays named by the fields), its vertex lists the (N, 3) /
+// (N, 2) arrays of its attributes and a texture's texels its (H, W, 4) float32 array, so that a
+// scene of millions of triangles pickles without a Python object per triangle. Indices are not
+// checked against the lists, as when the fields are set from Python: a render validates the
+// scene.
+// ------------------------------------------------------------------------------------------
+
+py::tuple vec_state(const glm::dvec3& v) { return py::make_tuple(v.x, v.y, v.z); }
+py::tuple triple_state(const int (&v)[3]) { return py::make_tuple(v[0], v[1], v[2]); }
+
+/// Each pickled class's state (`state`) and the value a state gives back (`from`, ValueError
+/// naming `where` for a bad state).
+template <class T>
+struct Pickled;
+
+template <>
+struct Pickled<Camera> {
+  static py::dict state(const Camera& c) {
+    py::dict d;
+    d["position"] = vec_state(c.position);
+    d["look_at"] = vec_state(c.look_at);
+    d["up"] = vec_state(c.up);
+    d["fov_degrees"] = c.fov_degrees;
+    d["roll_degrees"] = c.roll_degrees;
+    d["aperture"] = c.aperture;
+    d["focus_distance"] = c.focus_distance;
+    return d;
+  }
+  static Camera from(py::handle state, const std::string& where) {
+    StateReader r(state, where);
+    Camera c;
+    c.position = r.vec<glm::dvec3>("position");
+    c.look_at = r.vec<glm::dvec3>("look_at");
+    c.up = r.vec<glm::dvec3>("up");
+    c.fov_degrees = r.number("fov_degrees");
+    c.roll_degrees = r.number("roll_degrees");
+    c.aperture = r.number("aperture");
+    c.focus_distance = r.number("focus_distance");
+    r.finish();
+    return c;
+  }
+};
+
+template <>
+struct Pickled<Filter> {
+  static py::dict state(const Filter& f) {
+    py::dict d;
+    d["type"] = enum_name(f.type);
+    d["radius"] = f.radius;
+    return d;
+  }
+  static Filter from(py::handle state, const std::string& where) {
+    StateReader r(state, where);
+    Filter f;
+    f.type = r.name<FilterType>("type");
+    f.radius = r.number("radius");
+    r.finish();
+    return f;
+  }
+};
+
+template <>
+struct Pickled<Film> {
+  static py::dict state(const Film& f) {
+    py::dict d;
+    d["width"] = f.width;
+    d["height"] = f.height;
+    d["filter"] = Pickled<Filter>::state(f.filter);
+    d["transfer"] = enum_name(f.transfer);
+    d["gamma"] = f.gamma;
+    d["exposure"] = f.exposure;
+    d["tonemap"] = enum_name(f.tonemap);
+    return d;
+  }
+  static Film from(py::handle state, const std::string& where) {
+    StateReader r(state, where);
+    Film f;
+    f.width = r.integer<int>("width");
+    f.height = r.integer<int>("height");
+    f.filter = r.nested("filter", &Pickled<Filter>::from);
+    f.transfer = r.name<Transfer>("transfer");
+    f.gamma = r.number("gamma");
+    f.exposure = r.number("exposure");
+    f.tonemap = r.name<ToneMap>("tonemap");
+    r.finish();
+    return f;
+  }
+};
+
+template <>
+struct Pickled<Integrator> {
+  static py::dict state(const Integrator& i) {
+    py::dict d;
+    d["type"] = enum_name(i.type);
+    d["max_depth"] = i.max_depth;
+    d["rr_depth"] = i.rr_depth;
+    d["spp"] = i.spp;
+    d["seed"] = i.seed;
+    d["ao_distance"] = i.ao_distance;
+    d["mis"] = i.mis;
+    d["sampler"] = enum_name(i.sampler);
+    d["clamp"] = i.clamp;
+    d["caustics"] = i.caustics;
+    d["dielectric_splits"] = i.dielectric_splits;
+    return d;
+  }
+  static Integrator from(py::handle state, const std::string& where) {
+    StateReader r(state, where);
+    Integrator i;
+    i.type = r.name<IntegratorType>("type");
+    i.max_depth = r.integer<int>("max_depth");
+    i.rr_depth = r.integer<int>("rr_depth");
+    i.spp = r.integer<int>("spp");
+    i.seed = r.integer<std::uint32_t>("seed");
+    i.ao_distance = r.number("ao_distance");
+    i.mis = r.boolean("mis");
+    i.sampler = r.name<SamplerType>("sampler");
+    i.clamp = r.number("clamp");
+    i.caustics = r.boolean("caustics");
+    i.dielectric_splits = r.integer<int>("dielectric_splits");
+    r.finish();
+    return i;
+  }
+};
+
+template <>
+struct Pickled<Material> {
+  static py::dict state(const Material& m) {
+    py::dict d;
+    d["name"] = m.name;
+    d["type"] = enum_name(m.type);
+    d["albedo"] = vec_state(m.albedo);
+    d["albedo_texture"] = m.albedo_texture;
+    d["emission"] = vec_state(m.emission);
+    d["specular"] = vec_state(m.specular);
+    d["ior"] = m.ior;
+    d["roughness"] = m.roughness;
+    return d;
+  }
+  static Material from(py::handle state, const std::string& where) {
+    StateReader r(state, where);
+    Material m;
+    m.name = r.text("name");
+    m.type = r.name<MaterialType>("type");
+    m.albedo = r.vec<glm::dvec3>("albedo");
+    m.albedo_texture = r.integer<int>("albedo_texture");
+    m.emission = r.vec<glm::dvec3>("emission");
+    m.specular = r.vec<glm::dvec3>("specular");
+    m.ior = r.number("ior");
+    m.roughness = r.number("roughness");
+    r.finish();
+    return m;
+  }
+};
+
+template <>
+struct Pickled<Sphere> {
+  static py::dict state(const Sphere& s) {
+    py::dict d;
+    d["center"] = vec_state(s.center);
+    d["radius"] = s.radius;
+    d["material"] = s.material;
+    return d;
+  }
+  static Sphere from(py::handle state, const std::string& where) {
+    StateReader r(state, where);
+    Sphere s;
+    s.center = r.vec<glm::dvec3>("center");
+    s.radius = r.number("radius");
+    s.material = r.integer<int>("material");
+    r.finish();
+    return s;
+  }
+};
+
+template <>
+struct Pickled<Triangle> {
+  static py::dict state(const Triangle& t) {
+    py::dict d;
+    d["v"] = triple_state(t.v);
+    d["n"] = triple_state(t.n);
+    d["uv"] = triple_state(t.uv);
+    d["material"] = t.material;
+    return d;
+  }
+  static Triangle from(py::handle state, const std::string& where) {
+    StateReader r(state, where);
+    Triangle t;
+    r.triple("v", t.v);
+    r.triple("n", t.n);
+    r.triple("uv", t.uv);
+    t.material = r.integer<int>("material");
+    r.finish();
+    return t;
+  }
+};
+
+template <>
+struct Pickled<Light> {
+  static py::dict state(const Light& l) {
+    py::dict d;
+    d["type"] = enum_name(l.type);
+    d["position"] = vec_state(l.position);
+    d["intensity"] = vec_state(l.intensity);
+    d["radiance"] = vec_state(l.radiance);
+    d["texture"] = l.texture;
+    return d;
+  }
+  static Light from(py::handle state, const std::string& where) {
+    StateReader r(state, where);
+    Light l;
+    l.type = r.name<LightType>("type");
+    l.position = r.vec<glm::dvec3>("position");
+    l.intensity = r.vec<glm::dvec3>("intensity");
+    l.radiance = r.vec<glm::dvec3>("radiance");
+    l.texture = r.integer<int>("texture");
+    r.finish();
+    return l;
+  }
+};
+
+template <>
+struct Pickled<Texture> {
+  static py::dict state(const Texture& t) {
+    py::dict d;
+    d["path"] = t.path;
+    d["width"] = t.width;
+    d["height"] = t.height;
+    d["rgba"] = texture_texels(t);
+    return d;
+  }
+  static Texture from(py::handle state, const std::string& where) {
+    StateReader r(state, where);
+    Texture t;
+    t.path = r.text("path");
+    t.width = r.integer<int>("width");
+    t.height = r.integer<int>("height");
+    // a texture has texels (the rgba setter's H, W >= 1), or none: Texture() is 0 x 0
+    if (t.width < 0 || t.height < 0 || (t.width == 0) != (t.height == 0))
+      r.fail("width", "a texture of " + std::to_string(t.width) + " x " + std::to_string(t.height) +
+                          " texels");
+    py::array_t<float> rgba = r.array<float>("rgba", {t.height, t.width, 4});
+    t.rgba.assign(rgba.data(), rgba.data() + rgba.size());
+    r.finish();
+    return t;
+  }
+};
+
+template <>
+struct Pickled<ShapeEntry> {
+  static py::dict state(const ShapeEntry& e) {
+    py::dict d;
+    d["type"] = enum_name(e.type);
+    d["file"] = e.file;
+    d["first"] = e.first;
+    d["count"] = e.count;
+    return d;
+  }
+  static ShapeEntry from(py::handle state, const std::string& where) {
+    StateReader r(state, where);
+    ShapeEntry e;
+    e.type = r.name<ShapeType>("type");
+    e.file = r.text("file");
+    e.first = r.integer<std::size_t>("first");
+    e.count = r.integer<std::size_t>("count");
+    r.finish();
+    return e;
+  }
+};
+
+/// The bound lists (MaterialList, ...): a list of their elements' states.
+template <class T>
+struct Pickled<std::vector<T>> {
+  static py::list state(const std::vector<T>& v) {
+    py::list l;
+    for (const T& e : v) l.append(Pickled<T>::state(e));
+    return l;
+  }
+  static std::vector<T> from(py::handle state, const std::string& where) {
+    return read_list<T>(state, where, &Pickled<T>::from);
+  }
+};
+
+/// Vec3 and Vec2: a tuple of their numbers.
+template <int N>
+struct Pickled<glm::vec<N, double>> {
+  using V = glm::vec<N, double>;
+  static py::tuple state(const V& v) {
+    py::list l;
+    for (int i = 0; i < N; ++i) l.append(v[i]);
+    return py::tuple(l);
+  }
+  static V from(py::handle state, const std::string& where) {
+    if (!py::isinstance<py::tuple>(state))
+      throw py::value_error("cannot unpickle " + where + ": expected a tuple, got " +
+                            py::repr(state).cast<std::string>());
+    try {
+      return to_vec<V>(state);
+    } catch (const py::builtin_exception& e) {
+      throw py::value_error("cannot unpickle " + where + ": " + e.what());
+    }
+  }
+};
+
+template <>
+struct Pickled<Scene> {
+  static py::dict state(const Scene& s) {
+    const auto n_spheres = static_cast<py::ssize_t>(s.spheres.size());
+    py::array_t<double> center({n_spheres, py::ssize_t(3)}), radius(n_spheres);
+    py::array_t<int> sphere_material(n_spheres);
+    for (py::ssize_t i = 0; i < n_spheres; ++i) {
+      const Sphere& sp = s.spheres[static_cast<std::size_t>(i)];
+      for (int k = 0; k < 3; ++k) center.mutable_at(i, k) = sp.center[k];
+      radius.mutable_at(i) = sp.radius;
+      sphere_material.mutable_at(i) = sp.material;
+    }
+    py::dict spheres;
+    spheres["center"] = center;
+    spheres["radius"] = radius;
+    spheres["material"] = sphere_material;
+
+    const auto n_triangles = static_cast<py::ssize_t>(s.triangles.size());
+    py::array_t<int> v({n_triangles, py::ssize_t(3)}), n({n_triangles, py::ssize_t(3)}),
+        uv({n_triangles, py::ssize_t(3)}), triangle_material(n_triangles);
+    for (py::ssize_t i = 0; i < n_triangles; ++i) {
+      const Triangle& t = s.triangles[static_cast<std::size_t>(i)];
+      for (int k = 0; k < 3; ++k) {
+        v.mutable_at(i, k) = t.v[k];
+        n.mutable_at(i, k) = t.n[k];
+        uv.mutable_at(i, k) = t.uv[k];
+      }
+      triangle_material.mutable_at(i) = t.material;
+    }
+    py::dict triangles;
+    triangles["v"] = v;
+    triangles["n"] = n;
+    triangles["uv"] = uv;
+    triangles["material"] = triangle_material;
+
+    py::dict d;
+    d["path"] = s.path;
+    d["camera"] = Pickled<Camera>::state(s.camera);
+    d["film"] = Pickled<Film>::state(s.film);
+    d["integrator"] = Pickled<Integrator>::state(s.integrator);
+    d["materials"] = Pickled<std::vector<Material>>::state(s.materials);
+    d["spheres"] = spheres;
+    d["positions"] = vectors_array(s.positions);
+    d["normals"] = vectors_array(s.normals);
+    d["uvs"] = vectors_array(s.uvs);
+    d["triangles"] = triangles;
+    d["lights"] = Pickled<std::vector<Light>>::state(s.lights);
+    d["textures"] = Pickled<std::vector<Texture>>::state(s.textures);
+    d["shapes"] = Pickled<std::vector<ShapeEntry>>::state(s.shapes);
+    return d;
+  }
+
+  static Scene from(py::handle state, const std::string& where) {
+    StateReader r(state, where);
+    Scene s;
+    s.path = r.text("path");
+    s.camera = r.nested("camera", &Pickled<Camera>::from);
+    s.film = r.nested("film", &Pickled<Film>::from);
+    s.integrator = r.nested("integrator", &Pickled<Integrator>::from);
+    s.materials = r.list<Material>("materials", &Pickled<Material>::from);
+    {
+      StateReader c(r.get("spheres"), r.path("spheres"));
+      auto center = c.array<double>("center", {-1, 3});
+      const py::ssize_t count = center.shape(0);
+      auto radius = c.array<double>("radius", {count});
+      auto material = c.array<int>("material", {count});
+      c.finish();
+      s.spheres.resize(static_cast<std::size_t>(count));
+      for (py::ssize_t i = 0; i < count; ++i) {
+        Sphere& sp = s.spheres[static_cast<std::size_t>(i)];
+        sp.center = {center.at(i, 0), center.at(i, 1), center.at(i, 2)};
+        sp.radius = radius.at(i);
+        sp.material = material.at(i);
+      }
+    }
+    s.positions = vertices<glm::dvec3>(r, "positions");
+    s.normals = vertices<glm::dvec3>(r, "normals");
+    s.uvs = vertices<glm::dvec2>(r, "uvs");
+    {
+      StateReader c(r.get("triangles"), r.path("triangles"));
+      auto v = c.array<int>("v", {-1, 3});
+      const py::ssize_t count = v.shape(0);
+      auto n = c.array<int>("n", {count, 3});
+      auto uv = c.array<int>("uv", {count, 3});
+      auto material = c.array<int>("material", {count});
+      c.finish();
+      s.triangles.resize(static_cast<std::size_t>(count));
+      for (py::ssize_t i = 0; i < count; ++i) {
+        Triangle& t = s.triangles[static_cast<std::size_t>(i)];
+        for (int k = 0; k < 3; ++k) {
+          t.v[k] = v.at(i, k);
+          t.n[k] = n.at(i, k);
+          t.uv[k] = uv.at(i, k);
+        }
+        t.material = material.at(i);
+      }
+    }
+    s.lights = r.list<Light>("lights", &Pickled<Light>::from);
+    s.textures = r.list<Texture>("textures", &Pickled<Texture>::from);
+    s.shapes = r.list<ShapeEntry>("shapes", &Pickled<ShapeEntry>::from);
+    r.finish();
+    return s;
+  }
+
+ private:
+  /// An (N, D) float64 array as a list of vectors.
+  template <class V>
+  static std::vector<V> vertices(StateReader& r, const char* key) {
+    constexpr int D = V::length();
+    auto a = r.array<double>(key, {-1, D});
+    std::vector<V> out(static_cast<std::size_t>(a.shape(0)));
+    for (std::size_t i = 0; i < out.size(); ++i)
+      for (int k = 0; k < D; ++k) out[i][k] = a.at(static_cast<py::ssize_t>(i), k);
+    return out;
+  }
+};
+
+/// Pickling for a bound class: its state (Pickled<T>), read back with errors naming the class.
+template <class T, class... Options>
+void def_pickle(py::class_<T, Options...>& c) {
+  const std::string where = "lucent." + c.attr("__name__").template cast<std::string>();
+  c.def(py::pickle([](const T& v) -> py::object { return Pickled<T>::state(v); },
+                   [where](const py::object& state) { return Pickled<T>::from(state, where); }));
 }
 
 /// Python value -> JSON, with the JSON path of the first value JSON cannot hold.
@@ -340,8 +772,10 @@ std::string scene_repr(const Scene& s) {
 }  // namespace
 
 void bind_scene(py::module_& m) {
-  bind_vector_type<glm::dvec3>(m, "Vec3");
-  bind_vector_type<glm::dvec2>(m, "Vec2");
+  auto vec3 = bind_vector_type<glm::dvec3>(m, "Vec3");
+  auto vec2 = bind_vector_type<glm::dvec2>(m, "Vec2");
+  def_pickle(vec3);
+  def_pickle(vec2);
 
   py::class_<Camera> camera(m, "Camera", "Pinhole or thin-lens camera (README, \"camera\").");
   camera.def(py::init<>())
@@ -352,10 +786,12 @@ void bind_scene(py::module_& m) {
   vec_property(camera, "position", &Camera::position);
   vec_property(camera, "look_at", &Camera::look_at);
   vec_property(camera, "up", &Camera::up);
+  def_pickle(camera);
 
   py::class_<Filter> filter(m, "Filter", "Pixel filter: type (FILTER_TYPES) and radius in pixels.");
   filter.def(py::init<>()).def_readwrite("radius", &Filter::radius);
   enum_property(filter, "type", &Filter::type);
+  def_pickle(filter);
 
   py::class_<Film> film(m, "Film", "Image size, pixel filter and display settings.");
   film.def(py::init<>())
@@ -366,6 +802,7 @@ void bind_scene(py::module_& m) {
       .def_readwrite("exposure", &Film::exposure);
   enum_property(film, "transfer", &Film::transfer);
   enum_property(film, "tonemap", &Film::tonemap);
+  def_pickle(film);
 
   py::class_<Integrator> integrator(m, "Integrator",
                                     "type: an integrator or AOV name (INTEGRATORS).");
@@ -385,6 +822,7 @@ void bind_scene(py::module_& m) {
                      "followed (0 .. 4; default 2; 0: off)");
   enum_property(integrator, "type", &Integrator::type);
   enum_property(integrator, "sampler", &Integrator::sampler);
+  def_pickle(integrator);
 
   py::class_<Material> material(m, "Material", "type: MATERIAL_TYPES; README, \"materials\".");
   material.def(py::init<>())
@@ -400,6 +838,7 @@ void bind_scene(py::module_& m) {
   vec_property(material, "emission", &Material::emission);
   vec_property(material, "specular", &Material::specular);
   enum_property(material, "type", &Material::type);
+  def_pickle(material);
 
   py::class_<Sphere> sphere(m, "Sphere");
   sphere.def(py::init<>())
@@ -410,6 +849,7 @@ void bind_scene(py::module_& m) {
       .def_readwrite("radius", &Sphere::radius)
       .def_readwrite("material", &Sphere::material, "index into Scene.materials");
   vec_property(sphere, "center", &Sphere::center);
+  def_pickle(sphere);
 
   py::class_<Triangle> triangle(m, "Triangle",
                                 "Indices into Scene.positions (v), .normals (n) and .uvs (uv); "
@@ -418,6 +858,7 @@ void bind_scene(py::module_& m) {
   triple_property(triangle, "v", &Triangle::v);
   triple_property(triangle, "n", &Triangle::n);
   triple_property(triangle, "uv", &Triangle::uv);
+  def_pickle(triangle);
 
   py::class_<Light> light(m, "Light", "An explicit light: point, environment or environment_map.");
   light.def(py::init<>())
@@ -426,34 +867,19 @@ void bind_scene(py::module_& m) {
   vec_property(light, "intensity", &Light::intensity, "point: W/sr");
   vec_property(light, "radiance", &Light::radiance, "environment radiance, or the map's scale");
   enum_property(light, "type", &Light::type);
+  def_pickle(light);
 
-  py::class_<Texture>(m, "Texture", "A linear RGBA image: rgba is an (H, W, 4) float32 array.")
-      .def(py::init<>())
+  py::class_<Texture> texture(m, "Texture",
+                              "A linear RGBA image: rgba is an (H, W, 4) float32 array.");
+  texture.def(py::init<>())
       .def_readwrite("path", &Texture::path)
       .def_readonly("width", &Texture::width)
       .def_readonly("height", &Texture::height)
       .def_property(
-          "rgba",
-          [](const Texture& t) {
-            // a copy: a view of t.rgba dangled once the setter or the scene's texture list
-            // reallocated it (reading freed memory, a crash)
-            py::array_t<float> a({py::ssize_t(t.height), py::ssize_t(t.width), py::ssize_t(4)});
-            if (!t.rgba.empty())
-              std::copy(t.rgba.begin(), t.rgba.end(), static_cast<float*>(a.mutable_data()));
-            a.attr("flags").attr("writeable") = false;
-            return a;
-          },
-          [](Texture& t, py::handle value) {
-            require_numbers(value, "rgba");
-            auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(value);
-            if (!a || a.ndim() != 3 || a.shape(2) != 4 || a.shape(0) < 1 || a.shape(1) < 1)
-              throw py::value_error("rgba: expected an array of shape (H, W, 4)");
-            t.height = static_cast<int>(a.shape(0));
-            t.width = static_cast<int>(a.shape(1));
-            t.rgba.assign(a.data(), a.data() + a.size());
-          },
+          "rgba", &texture_texels, &set_texture_texels,
           "(H, W, 4) float32, linear, row 0 at the top: a read-only copy (assign an array to "
           "change it)");
+  def_pickle(texture);
 
   py::class_<ShapeEntry> shape_entry(
       m, "ShapeEntry",
@@ -466,13 +892,20 @@ void bind_scene(py::module_& m) {
       .def_readwrite("count", &ShapeEntry::count)
       .def_readwrite("libraries", &ShapeEntry::libraries);
   enum_property(shape_entry, "type", &ShapeEntry::type);
+  def_pickle(shape_entry);
 
-  py::bind_vector<std::vector<ShapeEntry>>(m, "ShapeList");
-  py::bind_vector<std::vector<Material>>(m, "MaterialList");
-  py::bind_vector<std::vector<Sphere>>(m, "SphereList");
-  py::bind_vector<std::vector<Triangle>>(m, "TriangleList");
-  py::bind_vector<std::vector<Light>>(m, "LightList");
-  py::bind_vector<std::vector<Texture>>(m, "TextureList");
+  auto shape_list = py::bind_vector<std::vector<ShapeEntry>>(m, "ShapeList");
+  auto material_list = py::bind_vector<std::vector<Material>>(m, "MaterialList");
+  auto sphere_list = py::bind_vector<std::vector<Sphere>>(m, "SphereList");
+  auto triangle_list = py::bind_vector<std::vector<Triangle>>(m, "TriangleList");
+  auto light_list = py::bind_vector<std::vector<Light>>(m, "LightList");
+  auto texture_list = py::bind_vector<std::vector<Texture>>(m, "TextureList");
+  def_pickle(shape_list);
+  def_pickle(material_list);
+  def_pickle(sphere_list);
+  def_pickle(triangle_list);
+  def_pickle(light_list);
+  def_pickle(texture_list);
 
   py::class_<Scene> scene(m, "Scene",
                           "A scene: camera, film, integrator and lists of materials, spheres, "
@@ -495,6 +928,7 @@ void bind_scene(py::module_& m) {
       .def("__copy__", [](const Scene& s) { return Scene(s); })
       .def("__deepcopy__", [](const Scene& s, py::dict) { return Scene(s); })
       .def("__repr__", &scene_repr);
+  def_pickle(scene);
   vector_array_property(scene, "positions", &Scene::positions);
   vector_array_property(scene, "normals", &Scene::normals);
   vector_array_property(scene, "uvs", &Scene::uvs);

@@ -218,6 +218,10 @@ def test_converge_by_time_and_errors(small_scene):
             lucent.converge(small_scene, constant(1.0), spp_ladder=[1], renderer=r)
         with pytest.raises(TypeError, match="on_point must be callable"):
             lucent.converge(small_scene, reference, on_point=1, renderer=r)
+        # not pybind11's RuntimeError "Unable to cast Python instance to C++ type"
+        with pytest.raises(TypeError, match=r"^renderer must be a lucent\.Renderer or None, got "
+                                            r"<lucent\.Scene "):
+            lucent.converge(small_scene, reference, spp_ladder=[1], renderer=small_scene)
 
         def stop(point):
             raise RuntimeError("enough")

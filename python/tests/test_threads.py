@@ -1,8 +1,12 @@
 """A session used from several Python threads: one call at a time, close() against calls in
 progress, and what other threads may read meanwhile. The threads are ordered by events set from
 the session's own callbacks (a progress callback between passes, a warning callback inside
-set_scene, a finaliser that runs inside close()), never by sleeps."""
+set_scene, a finaliser that runs inside close()), never by sleeps. A call from a callback of the
+session's own call, on the same thread, is refused as a re-entry, not as another thread's."""
 import threading
+
+import numpy as np
+import pytest
 
 import lucent
 from conftest import add_degenerate_triangle, session
@@ -198,3 +202,110 @@ def test_counters_are_read_from_another_thread_during_a_render(renderer, small_s
     spps = [spp for spp, _, _ in reads]
     assert spps == sorted(spps) and progress[0] <= spps[0] and spps[-1] <= renderer.spp
     assert all(passes >= 1 for _, _, passes in reads)
+
+
+def reentry(verb, what, callback, call):
+    """The message of `what` refused in `callback` of the session's own `call`."""
+    return (f"cannot {verb} {what} from the {callback} of this renderer's own {call} (a session "
+            f"runs one call at a time: {verb} it once {call} has returned)")
+
+
+def session_calls(r, scene):
+    """Every call of the session that a call in progress refuses, by name."""
+    reference = np.zeros((12, 16, 3), np.float32)
+    return {"render": lambda: r.render(1), "render_for": lambda: r.render_for(0.01),
+            "render_adaptive": lambda: r.render_adaptive(budget_spp=4, min_spp=4),
+            "set_scene": lambda: r.set_scene(scene), "set_build_options": r.set_build_options,
+            "reset": r.reset, "result": r.result, "close": r.close,
+            "converge": lambda: lucent.converge(scene, reference, renderer=r, spp_ladder=[1])}
+
+
+@pytest.mark.parametrize("call", ["render", "render_for", "render_adaptive"])
+def test_calls_from_a_renders_own_progress_callback_say_so(renderer, small_scene, call):
+    """From its own progress callback every call of the session is refused as a re-entry (it was
+    "in use by another thread", which it is not); what is safe between passes works: spp,
+    first_sample, stats, scene, options, device, cancel()."""
+    renderer.set_scene(small_scene)
+    renderer.reset(5)
+    calls = session_calls(renderer, small_scene)
+    errors, reads = {}, {}
+
+    def progress(p):
+        if errors:
+            return
+        errors.update({name: error_of(c) or "returned" for name, c in calls.items()})
+        errors["__exit__"] = error_of(lambda: renderer.__exit__(None, None, None)) or "returned"
+        reads.update(spp=renderer.spp, accumulated=p.accumulated, first=renderer.first_sample,
+                     passes=renderer.stats.passes, width=renderer.scene.film.width,
+                     precision=renderer.options["precision"], device=renderer.device.name)
+        renderer.cancel()  # ends this render after the pass
+
+    run = {"render": lambda: renderer.render(10 ** 9, progress=progress),
+           "render_for": lambda: renderer.render_for(60, progress=progress),
+           "render_adaptive": lambda: renderer.render_adaptive(
+               budget_spp=10 ** 6, min_spp=4, max_spp=10 ** 6, progress=progress)}[call]
+    run()
+    assert errors.pop("__exit__") == reentry("call", "close", "progress callback", call)
+    for name, error in errors.items():
+        assert error == reentry("call", name, "progress callback", call), name
+    assert reads["spp"] == reads["accumulated"] > 0 and reads["first"] == 5
+    assert reads["passes"] >= 1 and reads["width"] == 16 and reads["precision"] == "float"
+    assert reads["device"] == renderer.device.name
+    assert renderer.result().cancelled, "cancel() from the callback stopped the render"
+    renderer.reset()
+    renderer.render(1)  # the session is open and works
+    assert renderer.spp == 1
+
+
+def test_calls_from_a_warning_callback_of_set_scene_say_so(small_scene):
+    """A warning callback runs inside set_scene: every call and scene and options are refused
+    there as re-entries of set_scene; spp and device work."""
+    got = {}
+
+    def on_warning(message):
+        calls = session_calls(r, small_scene)
+        got.update({name: error_of(c) or "returned" for name, c in calls.items()})
+        got["scene"] = error_of(lambda: r.scene) or "returned"
+        got["options"] = error_of(lambda: r.options) or "returned"
+        got["reads"] = (r.spp, r.first_sample, r.device.name)
+
+    with session(on_warning=on_warning) as r:
+        bad = small_scene.copy()
+        add_degenerate_triangle(bad)  # packing warns once
+        r.set_scene(bad)
+        assert got.pop("reads") == (0, 0, r.device.name)
+        assert got.pop("scene") == reentry("read", "scene", "warning callback", "set_scene")
+        assert got.pop("options") == reentry("read", "options", "warning callback", "set_scene")
+        for name, error in got.items():
+            assert error == reentry("call", name, "warning callback", "set_scene"), name
+        assert len(r.scene.triangles) == len(small_scene.triangles) + 1
+
+
+def test_calls_from_converges_own_on_point_callback_say_so(renderer, small_scene):
+    renderer.set_scene(small_scene)
+    got = []
+    lucent.converge(small_scene, np.zeros((12, 16, 3), np.float32), renderer=renderer,
+                    spp_ladder=[1, 2], on_point=lambda p: got.append(error_of(renderer.result)))
+    assert got == [reentry("call", "result", "on_point callback", "converge")] * 2
+
+
+def test_a_reentry_through_another_sessions_callback_says_so(small_scene):
+    """Session a's progress callback renders with session b, whose progress callback calls a: a
+    re-entry of a's render on this thread, two callbacks down."""
+    got = {}
+    with session() as a, session() as b:
+        a.set_scene(small_scene)
+        b.set_scene(small_scene)
+
+        def b_progress(p):
+            got.setdefault("a", error_of(lambda: a.render(1)))
+            got.setdefault("b", error_of(b.result))
+
+        def a_progress(p):
+            if "outer" not in got:
+                got["outer"] = b.render(1, progress=b_progress).samples_done
+
+        a.render(1, progress=a_progress)
+        assert got == {"outer": 1, "a": reentry("call", "render", "progress callback", "render"),
+                       "b": reentry("call", "result", "progress callback", "render")}
+        assert a.spp == 1 and b.spp == 1
