@@ -466,6 +466,9 @@ struct Pickled<ShapeEntry> {
     d["file"] = e.file;
     d["first"] = e.first;
     d["count"] = e.count;
+    py::list libraries;
+    for (const std::string& l : e.libraries) libraries.append(l);
+    d["libraries"] = libraries;
     return d;
   }
   static ShapeEntry from(py::handle state, const std::string& where) {
@@ -475,6 +478,12 @@ struct Pickled<ShapeEntry> {
     e.file = r.text("file");
     e.first = r.integer<std::size_t>("first");
     e.count = r.integer<std::size_t>("count");
+    e.libraries = r.list<std::string>("libraries", [](py::handle v, const std::string& at) {
+      if (!py::isinstance<py::str>(v))
+        throw py::value_error("cannot unpickle " + at + ": expected a str, got " +
+                              py::type::handle_of(v).attr("__name__").cast<std::string>());
+      return v.cast<std::string>();
+    });
     r.finish();
     return e;
   }

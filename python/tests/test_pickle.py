@@ -96,6 +96,7 @@ def rich_scene(small_scene):
     sky = lucent.Light()
     sky.type, sky.radiance, sky.texture = "environment_map", (0.5, 0.5, 0.5), 1
     s.lights.append(sky)
+    s.shapes[1].file, s.shapes[1].libraries = "mesh.obj", ["lib/a.mtl", "b.mtl"]
     return s
 
 
@@ -137,6 +138,7 @@ def test_a_scene_round_trips_exactly(rich_scene, name, round_trip):
     assert c.triangles[1].n == (0, 3, 2) and c.triangles[1].uv == (0, 3, 2)
     assert c.lights[1].type == "environment_map" and c.lights[1].texture == 1
     assert [e.type for e in c.shapes] == ["sphere", "triangles"]
+    assert c.shapes[1].libraries == ["lib/a.mtl", "b.mtl"] and c.shapes[0].libraries == []
     assert np.array_equal(c.uvs, s.uvs) and np.array_equal(c.normals, s.normals)
     # texels to the bit (NaN payloads, -0.0, infinities, subnormals)
     for t, orig in zip(c.textures, s.textures):
@@ -351,6 +353,8 @@ def corrupt(state, path, value):
     ("textures/0/rgba", np.zeros((4, 5, 4)), "/textures/0/rgba: expected a (4, 5, 4) array of "
                                              "float32, got a (4, 5, 4) array of float64"),
     ("shapes/0/count", -1, "/shapes/0/count: integer out of range: -1"),
+    ("shapes/1/libraries", "a.mtl", "/shapes/1/libraries: expected a list, got str"),
+    ("shapes/1/libraries", ["a.mtl", 2], "/shapes/1/libraries/1: expected a str, got int"),
     ("lights/1/texture", True, "/lights/1/texture: expected an integer, got bool"),
 ])
 def test_a_corrupted_scene_state_raises_value_error(rich_scene, path, value, message):
