@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 
@@ -55,6 +56,20 @@ HostMemory host_memory() {
 }
 
 std::uint64_t host_memory_limit() { return host_memory().limit(); }
+
+namespace {
+std::uint64_t g_host_override = 0;
+}  // namespace
+
+std::uint64_t host_memory_allowed(std::string* what) {
+  const HostMemory host = host_memory();
+  if (what) *what = host.what;
+  const std::uint64_t limit = host.limit();
+  if (g_host_override == 0) return limit;
+  return limit == 0 ? g_host_override : std::min(limit, g_host_override);
+}
+
+void set_host_limit_override(std::uint64_t bytes) { g_host_override = bytes; }
 
 std::string format_bytes(std::uint64_t bytes) {
   char buf[64];

@@ -20,6 +20,14 @@ HostMemory host_memory();
 /// What lucent allows itself: 80% of host_memory() (0 when unknown).
 std::uint64_t host_memory_limit();
 
+/// host_memory_limit(), lowered to a test's override where one is set (`what`: what the limit is
+/// 80% of). The memory checks of every layer use it (render_detail::ScopedLimitOverride sets the
+/// override).
+std::uint64_t host_memory_allowed(std::string* what);
+
+/// Tests: a lower host limit for host_memory_allowed (0: none).
+void set_host_limit_override(std::uint64_t bytes);
+
 /// Bytes as "12.3 GiB", "512.0 MiB", "96.0 KiB", "100 bytes".
 std::string format_bytes(std::uint64_t bytes);
 

@@ -16,7 +16,6 @@
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
-#include "render/resources.hpp"
 
 namespace lucent {
 
@@ -177,7 +176,7 @@ RenderResult read_render(const std::string& path, Format* format) {
       std::uint64_t(p.width) * std::uint64_t(p.height) * (p.format == Format::Exr ? 128 : 32) +
       bytes.size();
   std::string what;
-  const std::uint64_t limit = render_detail::host_memory_allowed(&what);
+  const std::uint64_t limit = sys::host_memory_allowed(&what);
   if (limit > 0 && need > limit)
     throw Error(path + ": reading this " + std::to_string(p.width) + "x" +
                 std::to_string(p.height) + " image needs about " + sys::format_bytes(need) +

@@ -70,11 +70,13 @@ DeviceLimits DeviceLimits::of(const cl_util::Device& device) {
 ScopedLimitOverride::ScopedLimitOverride(const DeviceLimits& limits) {
   delete g_override;
   g_override = new DeviceLimits(limits);
+  sys::set_host_limit_override(limits.host_mem);
 }
 
 ScopedLimitOverride::~ScopedLimitOverride() {
   delete g_override;
   g_override = nullptr;
+  sys::set_host_limit_override(0);
 }
 
 namespace {
@@ -186,13 +188,7 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
   check_host_parts(scene, estimate_host_memory(scene, devices), host_limit, limit_what);
 }
 
-std::uint64_t host_memory_allowed(std::string* what) {
-  const sys::HostMemory host = sys::host_memory();
-  if (what) *what = host.what;
-  std::uint64_t limit = host.limit();
-  if (g_override) limit = lowered(limit, g_override->host_mem);
-  return limit;
-}
+std::uint64_t host_memory_allowed(std::string* what) { return sys::host_memory_allowed(what); }
 
 void check_reference_host_memory(const Scene& scene, int threads) {
   std::string what;
