@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/file_io.hpp"
+#include "core/host_memory.hpp"
 #include "lucent/error.hpp"
 
 namespace lucent::image_detail {
@@ -696,6 +697,19 @@ Probe probe_exr(const unsigned char* data, std::size_t size, const std::string& 
   Checker check(data, size, path, max_pixels);
   if (!starts_with(data, size, "\x76\x2f\x31\x01", 4)) check.fail("not an OpenEXR file");
   return check.exr(&header);
+}
+
+void check_decode_memory(const std::string& path, const char* thing, const Probe& p,
+                         std::uint64_t bytes_per_pixel, std::uint64_t file_bytes) {
+  const std::uint64_t need =
+      std::uint64_t(p.width) * std::uint64_t(p.height) * bytes_per_pixel + file_bytes;
+  std::string what;
+  const std::uint64_t limit = sys::host_memory_allowed(&what);
+  if (limit > 0 && need > limit)
+    throw Error(path + ": reading this " + std::to_string(p.width) + "x" +
+                std::to_string(p.height) + " " + thing + " needs about " + sys::format_bytes(need) +
+                " of memory, more than the limit of " + sys::format_bytes(limit) + " (80% of " +
+                what + ")");
 }
 
 }  // namespace lucent::image_detail

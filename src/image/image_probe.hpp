@@ -74,6 +74,12 @@ struct PfmLayout {
 Probe probe_pfm(const unsigned char* data, std::size_t size, const std::string& path,
                 std::uint64_t max_pixels, PfmLayout& layout);
 
+/// Refuses to decode the `thing` ("image", "part") of `path` that `p` describes when its file
+/// (`file_bytes`) and `bytes_per_pixel` for each of its pixels exceed the host's memory limit
+/// (sys::host_memory_allowed): past it the process would be killed without a word.
+void check_decode_memory(const std::string& path, const char* thing, const Probe& p,
+                         std::uint64_t bytes_per_pixel, std::uint64_t file_bytes);
+
 /// probe_image for an OpenEXR file (checks its PIZ chunks too), with its header parsed by
 /// tinyexr into `header` (the caller frees it with FreeEXRHeader).
 Probe probe_exr(const unsigned char* data, std::size_t size, const std::string& path,

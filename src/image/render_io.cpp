@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "core/file_io.hpp"
-#include "core/host_memory.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
@@ -168,20 +167,10 @@ RenderResult read_render(const std::string& path, Format* format) {
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   const Probe p = probe_image(data, bytes.size(), path, kMaxImagePixels);
   if (format) *format = p.format;
-  // Decoding holds the file and, per pixel, the decoded planes and the result's images: about
+  // decoding holds the file and, per pixel, the decoded planes and the result's images: about
   // 128 bytes a pixel for an OpenEXR (lucent's seven channels, tinyexr's buffers, mean, variance
-  // and counts), 32 for the others. Checked before, as for a part: past the host's memory the
-  // process would be killed without a word (two 16384x16384 PNGs took 9.4 GB in compare).
-  const std::uint64_t need =
-      std::uint64_t(p.width) * std::uint64_t(p.height) * (p.format == Format::Exr ? 128 : 32) +
-      bytes.size();
-  std::string what;
-  const std::uint64_t limit = sys::host_memory_allowed(&what);
-  if (limit > 0 && need > limit)
-    throw Error(path + ": reading this " + std::to_string(p.width) + "x" +
-                std::to_string(p.height) + " image needs about " + sys::format_bytes(need) +
-                " of memory, more than the limit of " + sys::format_bytes(limit) + " (80% of " +
-                what + ")");
+  // and counts), 32 for the others (two 16384x16384 PNGs took 9.4 GB in compare)
+  check_decode_memory(path, "image", p, p.format == Format::Exr ? 128 : 32, bytes.size());
   return read_render_memory(data, bytes.size(), path);
 }
 

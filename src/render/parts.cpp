@@ -425,15 +425,7 @@ RenderPart read_render_part(const std::string& path) {
         image_detail::probe_exr(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(),
                                 path, image_detail::kMaxImagePixels, header);
     FreeEXRHeader(&header);
-    const std::uint64_t need =
-        std::uint64_t(probe.width) * std::uint64_t(probe.height) * 256 + bytes.size();
-    std::string what;
-    const std::uint64_t limit = render_detail::host_memory_allowed(&what);
-    if (limit > 0 && need > limit)
-      throw Error(path + ": reading this " + std::to_string(probe.width) + "x" +
-                  std::to_string(probe.height) + " part needs about " + sys::format_bytes(need) +
-                  " of memory, more than the limit of " + sys::format_bytes(limit) + " (80% of " +
-                  what + ")");
+    image_detail::check_decode_memory(path, "part", probe, 256, bytes.size());
   }
   image_detail::ExrChannels exr =
       image_detail::read_exr_channels(reinterpret_cast<const unsigned char*>(bytes.data()),
