@@ -59,7 +59,12 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
       if (!scene_intersect(s, ray, INFINITY, &hit)) {
         float pdf_l;
         float3 Le = env_radiance(s, lc_float3_from_real3(ray.d), &pdf_l);
-        float3 c = beta * Le * (prev_delta ? 1.0f : (no_mis ? 0.0f : mis_power(prev_pdf, pdf_l)));
+        /* without MIS, light sampling alone covers what it can produce: a direction it never
+         * picks (pdf 0: an environment texel without a lattice step) is BSDF sampling's */
+        float3 c =
+            beta * Le *
+            (prev_delta ? 1.0f
+                        : (no_mis ? (pdf_l > 0.0f ? 0.0f : 1.0f) : mis_power(prev_pdf, pdf_l)));
         L += depth > 0 ? path_clamp(c, P->clamp) : c;
         break;
       }
@@ -75,7 +80,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
         if (!prev_delta) {
           float pdf_l = light_pdf(s, it.light, prev_p, lc_float3_from_real3(ray.d), hit.t,
                                   dot(-ray.d, it.ng));
-          w = no_mis ? 0.0f : mis_power(prev_pdf, pdf_l);
+          w = no_mis ? (pdf_l > 0.0f ? 0.0f : 1.0f) : mis_power(prev_pdf, pdf_l);
         }
         L += depth > 0 ? path_clamp(beta * Le * w, P->clamp) : beta * Le * w;
       }
