@@ -17,6 +17,7 @@
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
+#include "render/resources.hpp"
 #include "scene/loaders.hpp"
 #include "support.hpp"
 
@@ -193,6 +194,25 @@ TEST(ImageLimits, FloatTexturesMustBeFiniteAndNonNegative) {
   EXPECT_EQ(texture_error("PF\n2 2\n-1.0\n" +
                           std::string(reinterpret_cast<const char*>(zero.data()), zero.size() * 4)),
             "");
+}
+
+// A texture file is checked against the host's memory limit before it is decoded (the limit
+// lowered here as the other memory tests lower it; the texture check read the host's memory
+// directly and ignored the override).
+TEST(ImageLimits, TexturesCheckTheHostMemoryLimitBeforeDecoding) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::write_image(dir + "/t.pfm", lucent::Image{64, 64, std::vector<float>(64 * 64 * 3, 0.5f)});
+  lucent::render_detail::DeviceLimits lim;
+  lim.host_mem = 32 << 10;  // 32 KiB: less than 64 x 64 RGBA floats (64 KiB)
+  lucent::render_detail::ScopedLimitOverride o(lim);
+  lucent::Scene scene;
+  const std::string msg =
+      lucent::test::error_of([&] { lucent::scene_detail::load_texture(scene, dir + "/t.pfm"); });
+  EXPECT_EQ(msg.rfind(dir + "/t.pfm: with this 64x64 texture (64.0 KiB) the scene's 1 textures "
+                            "need 64.0 KiB, more than the limit of 32.0 KiB (80% of ",
+                      0),
+            0u)
+      << msg;
 }
 
 // stb_image loops forever on a run-length scanline whose run is 0, which is what it reads past

@@ -398,6 +398,11 @@ TEST(SceneJson, StringsWithANulCharacterAreRefused) {
   EXPECT_EQ(error_of(R"({"integrator": {"type": "pa\u0000th"}})"),
             "scene.json: /integrator/type: must not contain a NUL character (\\u0000), at "
             "character 2");
+  // keys too: a material's name, or a key whose error was cut off at the NUL
+  EXPECT_EQ(error_of(R"({"materials": {"red\u0000junk": {"type": "diffuse"}}})"),
+            "scene.json: /materials: the key 'red\\u0000junk' contains a NUL character (\\u0000)");
+  EXPECT_EQ(error_of(R"({"film\u0000x": {}})"),
+            "scene.json: /: the key 'film\\u0000x' contains a NUL character (\\u0000)");
 }
 
 // ---------------------------------------------------------------------------------------------

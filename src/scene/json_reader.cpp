@@ -45,6 +45,14 @@ const json& JsonReader::require(const json& obj, const std::string& ptr, const c
 
 void JsonReader::check_object(const json& j, const std::string& ptr) const {
   if (!j.is_object()) fail(ptr, "must be an object, got " + json_type_name(j));
+  // a key is a name or a place in messages, which a NUL would cut short (as in strings)
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& k = it.key();
+    if (k.find('\0') == std::string::npos) continue;
+    std::string shown;
+    for (char c : k) shown += c ? std::string(1, c) : std::string("\\u0000");
+    fail(ptr, "the key '" + shown + "' contains a NUL character (\\u0000)");
+  }
 }
 
 void JsonReader::check_array(const json& j, const std::string& ptr) const {

@@ -69,14 +69,14 @@ int load_texture(Scene& scene, const std::string& path) {
   std::uint64_t loaded = 0;
   for (const Texture& t : scene.textures) loaded += std::uint64_t(t.width) * t.height * texel;
   const std::uint64_t adds = std::uint64_t(p.width) * std::uint64_t(p.height) * texel;
-  const sys::HostMemory host = sys::host_memory();
-  const std::uint64_t limit = host.limit();
+  std::string what;
+  const std::uint64_t limit = sys::host_memory_allowed(&what);
   if (limit > 0 && loaded + adds > limit)
     throw Error(path + ": with this " + std::to_string(p.width) + "x" + std::to_string(p.height) +
                 " texture (" + sys::format_bytes(adds) + ") the scene's " +
                 std::to_string(scene.textures.size() + 1) + " textures need " +
                 sys::format_bytes(loaded + adds) + ", more than the limit of " +
-                sys::format_bytes(limit) + " (80% of " + host.what +
+                sys::format_bytes(limit) + " (80% of " + what +
                 "): reduce the textures' resolution or number");
   scene.textures.push_back(decode_texture(data, bytes.size(), path));
   return static_cast<int>(scene.textures.size() - 1);
