@@ -264,14 +264,19 @@ def test_a_corrupted_result_state_raises_value_error(renderer, small_scene, key,
 # Run in a child process: pickling with protocol 0 or 1 aborted the interpreter. Reads a list of
 # values (pickled with the highest protocol) and writes back their pickles with protocols 0 and 1
 # and the errors of values that do not pickle.
-OLD_PROTOCOLS = """
+LISTS = ["ShapeList", "MaterialList", "SphereList", "TriangleList", "LightList", "TextureList"]
+OLD_PROTOCOLS = f"LISTS = {LISTS!r}" + """
 import pickle, sys
 import numpy as np
 import lucent
 values = pickle.load(sys.stdin.buffer)
 refused = []
+scene = lucent.Scene()
+scene.materials.append(lucent.Material())
+# the iterators of the bound lists: pybind11 classes outside the module (pybind11_builtins)
+iterators = [iter(scene.materials)] + [iter(getattr(lucent, name)()) for name in LISTS]
 with lucent.Renderer(**lucent.environment()) as r:
-    for obj in (r, lucent.compare(np.zeros((1, 1, 3)), np.zeros((1, 1, 3))), r.device):
+    for obj in (r, lucent.compare(np.zeros((1, 1, 3)), np.zeros((1, 1, 3))), r.device, *iterators):
         for protocol in (0, 1):
             try:
                 pickle.dumps(obj, protocol)
@@ -286,7 +291,7 @@ pickle.dump((pickles, refused), sys.stdout.buffer, 2)
 def test_protocols_0_and_1_pickle_or_refuse_and_never_abort(rich_scene):
     """Protocols 0 and 1 went through copyreg._reduce_ex, which calls pybind11's base type: an
     uncaught C++ exception, and the interpreter aborted ("instance allocation failed"), even for
-    classes that do not pickle."""
+    classes that do not pickle, and for the iterators of the bound lists."""
     s = rich_scene
     values = [s, s.camera, s.textures, lucent.Vec2((1, 2)), lucent.RenderResult(np.ones((2, 2, 3)))]
     child = subprocess.run([sys.executable, "-c", OLD_PROTOCOLS], capture_output=True,
@@ -299,7 +304,12 @@ def test_protocols_0_and_1_pickle_or_refuse_and_never_abort(rich_scene):
     renderer_refused = [r for r in refused[:2] if r.startswith("cannot pickle or copy a lucent.")]
     assert len(renderer_refused) == 2, refused
     assert refused[2:] == ["cannot pickle 'lucent.CompareResult' object"] * 2 + [
-        "cannot pickle 'lucent.DeviceInfo' object"] * 2
+        "cannot pickle 'lucent.DeviceInfo' object"] * 2 + [
+        "cannot pickle 'iterator' object"] * 2 * (1 + len(LISTS))
+    # protocol 2 and above refuse them the same way
+    for name in LISTS:
+        with pytest.raises(TypeError, match="cannot pickle 'iterator' object"):
+            pickle.dumps(iter(getattr(lucent, name)()), pickle.HIGHEST_PROTOCOL)
 
 
 def restore(cls, state):
