@@ -3,6 +3,7 @@
 // callback and Python's signal handlers run between passes, so Ctrl-C stops a render after the
 // current pass, keeps what it had accumulated and raises KeyboardInterrupt.
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <optional>
 
@@ -386,6 +387,12 @@ RenderResult result_from_state(const py::object& state) {
   RenderResult r;
   auto image = [&](const char* key, py::ssize_t h, py::ssize_t w) {
     py::array_t<float> a = s.array<float>(key, {h, w, 3});
+    // as image_from_array: an image has a row and a column, and its sizes are ints
+    constexpr py::ssize_t most = std::numeric_limits<int>::max();
+    if (a.shape(0) < 1 || a.shape(0) > most || a.shape(1) < 1 || a.shape(1) > most)
+      s.fail(key, "expected an (H, W, 3) image with 1 <= H, W <= " + std::to_string(most) +
+                      ", got a (" + std::to_string(a.shape(0)) + ", " + std::to_string(a.shape(1)) +
+                      ", 3) array");
     Image img;
     img.height = static_cast<int>(a.shape(0));
     img.width = static_cast<int>(a.shape(1));

@@ -246,6 +246,14 @@ def test_a_render_result_round_trips_exactly(renderer, small_scene, name, round_
     ("spp", 2 ** 64, "/spp: integer out of range: 18446744073709551616"),
     ("devices", [{"device": "cpu"}], "/devices/0/samples: missing"),
     ("sampler", None, "/sampler: expected a str, got NoneType"),
+    # the sizes of an image are 1 to the largest int (height -2**31 and 2 before)
+    ("mean", np.empty((0, 0, 3), np.float32), "/mean: expected an (H, W, 3) image with 1 <= H, "
+                                              "W <= 2147483647, got a (0, 0, 3) array"),
+    ("mean", np.empty((2, 0, 3), np.float32), "/mean: expected an (H, W, 3) image with 1 <= H, "
+                                              "W <= 2147483647, got a (2, 0, 3) array"),
+    ("mean", np.empty((2 ** 31, 0, 3), np.float32), "got a (2147483648, 0, 3) array"),
+    ("mean", np.empty((2 ** 32 + 2, 0, 3), np.float32), "got a (4294967298, 0, 3) array"),
+    ("mean", np.empty((0, 2 ** 31, 3), np.float32), "got a (0, 2147483648, 3) array"),
 ])
 def test_a_corrupted_result_state_raises_value_error(renderer, small_scene, key, value, message):
     renderer.set_scene(small_scene)
@@ -259,6 +267,24 @@ def test_a_corrupted_result_state_raises_value_error(renderer, small_scene, key,
     state = renderer.result().__getstate__()
     state["spp"] = 2 ** 64 - 1  # the largest uint64 is a count like the others
     assert restore(lucent.RenderResult, state).spp == 2 ** 64 - 1
+
+
+@pytest.mark.parametrize("shape", [(0, 0, 3), (1, 0, 3), (0, 1, 3), (2 ** 31, 0, 3),
+                                   (2 ** 32 + 2, 0, 3), (0, 2 ** 31, 3)])
+def test_a_result_state_with_an_empty_or_huge_image_raises_value_error(shape):
+    """An image has 1 to 2**31 - 1 rows and columns, as the constructor requires: a state of an
+    array-made result (no variance, no counts) with an empty image was accepted, its sizes cast
+    to int (a height of -2**31, or 2 for 2**32 + 2)."""
+    state = lucent.RenderResult(np.zeros((2, 3, 3), np.float32)).__getstate__()
+    assert state["variance"] is None and state["samples"] is None
+    state["mean"] = np.empty(shape, np.float32)
+    with pytest.raises(ValueError) as e:
+        restore(lucent.RenderResult, state)
+    assert str(e.value) == (
+        "cannot unpickle lucent.RenderResult: /mean: expected an (H, W, 3) image with 1 <= H, W <= "
+        f"2147483647, got a ({shape[0]}, {shape[1]}, 3) array")
+    with pytest.raises(ValueError, match=r"expected an array of shape \(H, W, 3\)"):
+        lucent.RenderResult(np.empty(shape, np.float32))
 
 
 # Run in a child process: pickling with protocol 0 or 1 aborted the interpreter. Reads a list of
