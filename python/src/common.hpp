@@ -225,6 +225,24 @@ class InCallback {
   CallbackFrame frame_;
 };
 
+/// Gives this thread, while it lives, the chain of the thread that made a call (`chain`,
+/// captured when the call began): a callback of the call that runs on a thread of the library
+/// (a session with several devices runs its passes on threads of its own, which start with an
+/// empty chain) is then in the chain of the call that it belongs to. Does nothing when `chain`
+/// is nullptr (the call was made outside every callback: this thread's chain stays).
+class WithChain {
+ public:
+  explicit WithChain(const CallbackFrame* chain) : saved_(t_callbacks) {
+    if (chain) t_callbacks = chain;
+  }
+  ~WithChain() { t_callbacks = saved_; }
+  WithChain(const WithChain&) = delete;
+  WithChain& operator=(const WithChain&) = delete;
+
+ private:
+  const CallbackFrame* saved_;
+};
+
 /// The innermost callback of `session`'s call in this thread's chain, or nullptr.
 inline const CallbackFrame* callback_of(const void* session) {
   for (const CallbackFrame* f = t_callbacks; f; f = f->outer)

@@ -189,14 +189,34 @@ std::string resolved_cache_dir(const std::string& dir) {
 /// ("instance allocation failed: new instance has no pybind11-registered base types", pybind11
 /// issue 3745). A class with py::pickle reduces as protocol 2 does (copyreg.__newobj__, then
 /// __setstate__ with its state), in any protocol; the others raise the TypeError that protocol 2
-/// raises for them.
+/// raises for them. The iterators of the bound lists (ShapeList, ...: a pybind11 'iterator'
+/// class each, in pybind11_builtins, not in the module) raise it too.
 void reduce_in_every_protocol(py::module_& m) {
   const py::object newobj = py::module_::import("copyreg").attr("__newobj__");
+  const auto is_bound = [](py::handle cls) {
+    return PyType_Check(cls.ptr()) &&
+           py::detail::get_type_info(reinterpret_cast<PyTypeObject*>(cls.ptr()));
+  };
   for (auto item : py::reinterpret_borrow<py::dict>(m.attr("__dict__"))) {
     py::handle cls = item.second;
-    if (!PyType_Check(cls.ptr()) ||
-        !py::detail::get_type_info(reinterpret_cast<PyTypeObject*>(cls.ptr())) ||
-        cls.attr("__dict__").contains("__reduce_ex__"))
+    if (!is_bound(cls) || !cls.attr("__dict__").contains("__iter__")) continue;
+    py::object empty;
+    try {
+      empty = cls();  // the lists; Vec3 and Vec2 need values (and iterate as Python lists)
+    } catch (py::error_already_set&) {
+      continue;
+    }
+    py::object iterator = py::type::of(py::iter(empty));
+    if (!is_bound(iterator) || iterator.attr("__dict__").contains("__reduce_ex__")) continue;
+    iterator.attr("__reduce_ex__") = py::cpp_function(
+        [](py::handle, int) -> py::object {
+          throw py::type_error("cannot pickle 'iterator' object");
+        },
+        py::is_method(iterator), py::arg("protocol"));
+  }
+  for (auto item : py::reinterpret_borrow<py::dict>(m.attr("__dict__"))) {
+    py::handle cls = item.second;
+    if (!is_bound(cls) || cls.attr("__dict__").contains("__reduce_ex__"))
       continue;  // not a bound class (lucent.Error), or one that says itself (Renderer)
     if (py::hasattr(cls, "__setstate__")) {
       cls.attr("__reduce_ex__") = py::cpp_function(

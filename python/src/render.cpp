@@ -3,6 +3,7 @@
 // callback and Python's signal handlers run between passes, so Ctrl-C stops a render after the
 // current pass, keeps what it had accumulated and raises KeyboardInterrupt.
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <optional>
 
@@ -104,12 +105,15 @@ class PyRenderer {
     o.pass_seconds = pass_seconds;
     WarningSink sink = python_warning_sink(SharedObject(std::move(on_warning)), warning_errors_);
     o.on_warning = [this, sink](const std::string& message) {
+      WithChain chain(caller_chain_);  // on a device thread, the chain of the call's caller
       InCallback frame(this, "warning callback");
       sink(message);
     };
+    caller_chain_ = t_callbacks;  // the warnings of the construction are its caller's callbacks
     py::gil_scoped_release release;
     renderer_.emplace(std::move(o));
     renderer_->set_cancel_flag(&stop_);
+    caller_chain_ = nullptr;
   }
 
   /// The session, for what does not change while a call runs (device(), cancel()). The GIL is
@@ -210,6 +214,7 @@ class PyRenderer {
       save_counters();
       if (!has_progress) return;
       py::gil_scoped_acquire gil;
+      WithChain chain(caller_chain_);  // on a device thread, the chain of the call's caller
       InCallback frame(this, "progress callback");
       paused_ = true;  // scene and options can be read until the callback returns
       if (!errors.run([&] { progress(p); })) stop_ = true;
@@ -245,14 +250,19 @@ class PyRenderer {
       if (r.busy_.exchange(true))
         throw Error(r.refusal("call", what, "a session renders one call at a time"));
       r.call_ = what;
+      r.caller_chain_ = t_callbacks;
       try {
         r.save_counters();  // what other threads read during the call
       } catch (...) {
+        r.caller_chain_ = nullptr;
         r.busy_ = false;
         throw;
       }
     }
-    ~Busy() { session.busy_ = false; }
+    ~Busy() {
+      session.caller_chain_ = nullptr;
+      session.busy_ = false;
+    }
     PyRenderer& session;
   };
 
@@ -282,6 +292,10 @@ class PyRenderer {
   bool closed_ = false;            ///< close() began (GIL)
   bool paused_ = false;            ///< the call in progress is in its progress callback (GIL)
   const char* call_ = "";          ///< the name of the call in progress, for messages (GIL)
+  /// The chain of callbacks of the thread that made the call in progress (or constructs the
+  /// session), for its callbacks on threads of the library. Set with the GIL before the call
+  /// starts the threads that read it, unchanged until it returned.
+  const CallbackFrame* caller_chain_ = nullptr;
   std::atomic<bool> stop_{false};  ///< the session's cancel flag
   std::mutex counters_mutex_;
   Counters counters_;  ///< the counters while a call runs (counters_mutex_)
@@ -386,6 +400,12 @@ RenderResult result_from_state(const py::object& state) {
   RenderResult r;
   auto image = [&](const char* key, py::ssize_t h, py::ssize_t w) {
     py::array_t<float> a = s.array<float>(key, {h, w, 3});
+    // as image_from_array: an image has a row and a column, and its sizes are ints
+    constexpr py::ssize_t most = std::numeric_limits<int>::max();
+    if (a.shape(0) < 1 || a.shape(0) > most || a.shape(1) < 1 || a.shape(1) > most)
+      s.fail(key, "expected an (H, W, 3) image with 1 <= H, W <= " + std::to_string(most) +
+                      ", got a (" + std::to_string(a.shape(0)) + ", " + std::to_string(a.shape(1)) +
+                      ", 3) array");
     Image img;
     img.height = static_cast<int>(a.shape(0));
     img.width = static_cast<int>(a.shape(1));

@@ -246,6 +246,14 @@ def test_a_render_result_round_trips_exactly(renderer, small_scene, name, round_
     ("spp", 2 ** 64, "/spp: integer out of range: 18446744073709551616"),
     ("devices", [{"device": "cpu"}], "/devices/0/samples: missing"),
     ("sampler", None, "/sampler: expected a str, got NoneType"),
+    # the sizes of an image are 1 to the largest int (height -2**31 and 2 before)
+    ("mean", np.empty((0, 0, 3), np.float32), "/mean: expected an (H, W, 3) image with 1 <= H, "
+                                              "W <= 2147483647, got a (0, 0, 3) array"),
+    ("mean", np.empty((2, 0, 3), np.float32), "/mean: expected an (H, W, 3) image with 1 <= H, "
+                                              "W <= 2147483647, got a (2, 0, 3) array"),
+    ("mean", np.empty((2 ** 31, 0, 3), np.float32), "got a (2147483648, 0, 3) array"),
+    ("mean", np.empty((2 ** 32 + 2, 0, 3), np.float32), "got a (4294967298, 0, 3) array"),
+    ("mean", np.empty((0, 2 ** 31, 3), np.float32), "got a (0, 2147483648, 3) array"),
 ])
 def test_a_corrupted_result_state_raises_value_error(renderer, small_scene, key, value, message):
     renderer.set_scene(small_scene)
@@ -261,17 +269,40 @@ def test_a_corrupted_result_state_raises_value_error(renderer, small_scene, key,
     assert restore(lucent.RenderResult, state).spp == 2 ** 64 - 1
 
 
+@pytest.mark.parametrize("shape", [(0, 0, 3), (1, 0, 3), (0, 1, 3), (2 ** 31, 0, 3),
+                                   (2 ** 32 + 2, 0, 3), (0, 2 ** 31, 3)])
+def test_a_result_state_with_an_empty_or_huge_image_raises_value_error(shape):
+    """An image has 1 to 2**31 - 1 rows and columns, as the constructor requires: a state of an
+    array-made result (no variance, no counts) with an empty image was accepted, its sizes cast
+    to int (a height of -2**31, or 2 for 2**32 + 2)."""
+    state = lucent.RenderResult(np.zeros((2, 3, 3), np.float32)).__getstate__()
+    assert state["variance"] is None and state["samples"] is None
+    state["mean"] = np.empty(shape, np.float32)
+    with pytest.raises(ValueError) as e:
+        restore(lucent.RenderResult, state)
+    assert str(e.value) == (
+        "cannot unpickle lucent.RenderResult: /mean: expected an (H, W, 3) image with 1 <= H, W <= "
+        f"2147483647, got a ({shape[0]}, {shape[1]}, 3) array")
+    with pytest.raises(ValueError, match=r"expected an array of shape \(H, W, 3\)"):
+        lucent.RenderResult(np.empty(shape, np.float32))
+
+
 # Run in a child process: pickling with protocol 0 or 1 aborted the interpreter. Reads a list of
 # values (pickled with the highest protocol) and writes back their pickles with protocols 0 and 1
 # and the errors of values that do not pickle.
-OLD_PROTOCOLS = """
+LISTS = ["ShapeList", "MaterialList", "SphereList", "TriangleList", "LightList", "TextureList"]
+OLD_PROTOCOLS = f"LISTS = {LISTS!r}" + """
 import pickle, sys
 import numpy as np
 import lucent
 values = pickle.load(sys.stdin.buffer)
 refused = []
+scene = lucent.Scene()
+scene.materials.append(lucent.Material())
+# the iterators of the bound lists: pybind11 classes outside the module (pybind11_builtins)
+iterators = [iter(scene.materials)] + [iter(getattr(lucent, name)()) for name in LISTS]
 with lucent.Renderer(**lucent.environment()) as r:
-    for obj in (r, lucent.compare(np.zeros((1, 1, 3)), np.zeros((1, 1, 3))), r.device):
+    for obj in (r, lucent.compare(np.zeros((1, 1, 3)), np.zeros((1, 1, 3))), r.device, *iterators):
         for protocol in (0, 1):
             try:
                 pickle.dumps(obj, protocol)
@@ -286,7 +317,7 @@ pickle.dump((pickles, refused), sys.stdout.buffer, 2)
 def test_protocols_0_and_1_pickle_or_refuse_and_never_abort(rich_scene):
     """Protocols 0 and 1 went through copyreg._reduce_ex, which calls pybind11's base type: an
     uncaught C++ exception, and the interpreter aborted ("instance allocation failed"), even for
-    classes that do not pickle."""
+    classes that do not pickle, and for the iterators of the bound lists."""
     s = rich_scene
     values = [s, s.camera, s.textures, lucent.Vec2((1, 2)), lucent.RenderResult(np.ones((2, 2, 3)))]
     child = subprocess.run([sys.executable, "-c", OLD_PROTOCOLS], capture_output=True,
@@ -299,7 +330,12 @@ def test_protocols_0_and_1_pickle_or_refuse_and_never_abort(rich_scene):
     renderer_refused = [r for r in refused[:2] if r.startswith("cannot pickle or copy a lucent.")]
     assert len(renderer_refused) == 2, refused
     assert refused[2:] == ["cannot pickle 'lucent.CompareResult' object"] * 2 + [
-        "cannot pickle 'lucent.DeviceInfo' object"] * 2
+        "cannot pickle 'lucent.DeviceInfo' object"] * 2 + [
+        "cannot pickle 'iterator' object"] * 2 * (1 + len(LISTS))
+    # protocol 2 and above refuse them the same way
+    for name in LISTS:
+        with pytest.raises(TypeError, match="cannot pickle 'iterator' object"):
+            pickle.dumps(iter(getattr(lucent, name)()), pickle.HIGHEST_PROTOCOL)
 
 
 def restore(cls, state):

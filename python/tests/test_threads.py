@@ -289,11 +289,14 @@ def test_calls_from_converges_own_on_point_callback_say_so(renderer, small_scene
     assert got == [reentry("call", "result", "on_point callback", "converge")] * 2
 
 
-def test_a_reentry_through_another_sessions_callback_says_so(small_scene):
+@pytest.mark.parametrize("b_options", [{}, {"device": "0,0"}], ids=["one device", "two contexts"])
+def test_a_reentry_through_another_sessions_callback_says_so(small_scene, b_options):
     """Session a's progress callback renders with session b, whose progress callback calls a: a
-    re-entry of a's render on this thread, two callbacks down."""
+    re-entry of a's render on this thread, two callbacks down. With two contexts ("0,0"), b's
+    passes, and its progress callback, run on threads of the session's own, which have the chain
+    of callbacks of b.render's caller (they said "in use by another thread")."""
     got = {}
-    with session() as a, session() as b:
+    with session() as a, session(**b_options) as b:
         a.set_scene(small_scene)
         b.set_scene(small_scene)
 
@@ -303,9 +306,9 @@ def test_a_reentry_through_another_sessions_callback_says_so(small_scene):
 
         def a_progress(p):
             if "outer" not in got:
-                got["outer"] = b.render(1, progress=b_progress).samples_done
+                got["outer"] = b.render(4, progress=b_progress).samples_done
 
         a.render(1, progress=a_progress)
-        assert got == {"outer": 1, "a": reentry("call", "render", "progress callback", "render"),
+        assert got == {"outer": 4, "a": reentry("call", "render", "progress callback", "render"),
                        "b": reentry("call", "result", "progress callback", "render")}
-        assert a.spp == 1 and b.spp == 1
+        assert a.spp == 1 and b.spp == 4
