@@ -479,10 +479,14 @@ struct Pickled<ShapeEntry> {
     e.first = r.integer<std::size_t>("first");
     e.count = r.integer<std::size_t>("count");
     e.libraries = r.list<std::string>("libraries", [](py::handle v, const std::string& at) {
+      std::string text;
       if (!py::isinstance<py::str>(v))
         throw py::value_error("cannot unpickle " + at + ": expected a str, got " +
                               py::type::handle_of(v).attr("__name__").cast<std::string>());
-      return v.cast<std::string>();
+      if (!utf8_text(v, text))
+        throw py::value_error("cannot unpickle " + at +
+                              ": a str that is not valid Unicode (a lone surrogate)");
+      return text;
     });
     r.finish();
     return e;

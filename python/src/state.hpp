@@ -34,6 +34,18 @@ std::vector<T> read_list(py::handle state, const std::string& where, F&& from_st
   return out;
 }
 
+/// The UTF-8 text of the str `v`, or false when it has none (a lone surrogate, "\ud800").
+inline bool utf8_text(py::handle v, std::string& out) {
+  Py_ssize_t n = 0;
+  const char* p = PyUnicode_AsUTF8AndSize(v.ptr(), &n);
+  if (!p) {
+    PyErr_Clear();
+    return false;
+  }
+  out.assign(p, static_cast<std::size_t>(n));
+  return true;
+}
+
 /// A state being read; `where` names the class and the path of the value ("lucent.Scene:
 /// /materials/0"), for messages.
 class StateReader {
@@ -78,7 +90,9 @@ class StateReader {
   std::string text(const char* key) {
     py::object v = get(key);
     if (!py::isinstance<py::str>(v)) fail(key, "expected a str, got " + type_name(v));
-    return v.cast<std::string>();
+    std::string text;
+    if (!utf8_text(v, text)) fail(key, "a str that is not valid Unicode (a lone surrogate)");
+    return text;
   }
 
   template <class V>
@@ -150,9 +164,11 @@ class StateReader {
 
   /// Raises for a key that no getter read (a state of another version of the module).
   void finish() const {
-    for (auto item : dict_)
-      if (!py::isinstance<py::str>(item.first) || !read_.count(item.first.cast<std::string>()))
+    for (auto item : dict_) {
+      std::string key;
+      if (!py::isinstance<py::str>(item.first) || !utf8_text(item.first, key) || !read_.count(key))
         fail("", "unknown key " + py::repr(item.first).cast<std::string>());
+    }
   }
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
