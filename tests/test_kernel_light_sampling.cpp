@@ -27,6 +27,26 @@ Probe& probe() {
   return p;
 }
 
+// Runs the probe kernel `name` (scene arguments, point p, an input and an output buffer), one
+// work-item per element of `in`, and returns its outputs.
+template <class Out>
+std::vector<Out> run_probe(const lucent::render_detail::DeviceScene& dev, const char* name,
+                           const cl_float4& p, const std::vector<cl_float4>& in) {
+  Probe& pr = probe();
+  cl::Buffer bi(pr.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                in.size() * sizeof(cl_float4), const_cast<cl_float4*>(in.data()));
+  cl::Buffer bo(pr.ctx.context, CL_MEM_WRITE_ONLY, in.size() * sizeof(Out));
+  cl::Kernel k(pr.program, name);
+  int a = dev.set_args(k);
+  k.setArg(a++, p);
+  k.setArg(a++, bi);
+  k.setArg(a++, bo);
+  pr.ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(in.size()), cl::NullRange);
+  std::vector<Out> out(in.size());
+  pr.ctx.queue.enqueueReadBuffer(bo, CL_TRUE, 0, out.size() * sizeof(Out), out.data());
+  return out;
+}
+
 // Samples N directions from point (0,0,0) with the scene's lights, bins them over
 // (cos theta, phi) of the whole sphere (the lights sit near the equator, z ~ 0, where the bins
 // are regular), and compares with N times the integral of the probe's pdf over each bin (see
@@ -65,18 +85,7 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
 
   // the probe's pdf at a list of directions
   auto eval_pdf = [&](const std::vector<cl_float4>& dirs) {
-    cl::Buffer bd(pr.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                  dirs.size() * sizeof(cl_float4), const_cast<cl_float4*>(dirs.data()));
-    cl::Buffer bp(pr.ctx.context, CL_MEM_WRITE_ONLY, dirs.size() * sizeof(float));
-    cl::Kernel ke(pr.program, "probe_light_pdf");
-    int arg = dev.set_args(ke);
-    ke.setArg(arg++, p);
-    ke.setArg(arg++, bd);
-    ke.setArg(arg++, bp);
-    pr.ctx.queue.enqueueNDRangeKernel(ke, cl::NullRange, cl::NDRange(dirs.size()), cl::NullRange);
-    std::vector<float> pdf(dirs.size());
-    pr.ctx.queue.enqueueReadBuffer(bp, CL_TRUE, 0, pdf.size() * sizeof(float), pdf.data());
-    return pdf;
+    return run_probe<float>(dev, "probe_light_pdf", p, dirs);
   };
   // sub x sub midpoint directions of cell (ti, pi) in (z, phi)
   auto cell_dirs = [&](int ti, int pi, int sub, std::vector<cl_float4>& dirs) {
@@ -257,20 +266,9 @@ TEST(KernelLightSampling, EnvironmentMapPointsFillTheTexel) {
     for (int i = 0; i < G; ++i)
       for (int j = 0; j < G; ++j)
         u.push_back({{0.5f, float(m / 16777216.0), (i + 0.5f) / G, (j + 0.5f) / G}});
-  Probe& pr = probe();
-  lucent::render_detail::DeviceScene dev(pr.ctx, packed);
-  const cl_float4 p = {{0, 0, 0, 0}};
-  cl::Buffer bu(pr.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                u.size() * sizeof(cl_float4), u.data());
-  cl::Buffer out(pr.ctx.context, CL_MEM_WRITE_ONLY, u.size() * sizeof(cl_float4));
-  cl::Kernel ks(pr.program, "probe_light_sample_with");
-  int a = dev.set_args(ks);
-  ks.setArg(a++, p);
-  ks.setArg(a++, bu);
-  ks.setArg(a++, out);
-  pr.ctx.queue.enqueueNDRangeKernel(ks, cl::NullRange, cl::NDRange(u.size()), cl::NullRange);
-  std::vector<cl_float4> s(u.size());
-  pr.ctx.queue.enqueueReadBuffer(out, CL_TRUE, 0, s.size() * sizeof(cl_float4), s.data());
+  lucent::render_detail::DeviceScene dev(probe().ctx, packed);
+  const std::vector<cl_float4> s =
+      run_probe<cl_float4>(dev, "probe_light_sample_with", cl_float4{{0, 0, 0, 0}}, u);
 
   const double n = double(w) * h, texel_p = (hi - lo) / 16777216.0;
   for (size_t i = 0; i < s.size(); ++i) {
