@@ -18,16 +18,16 @@
 #define LC_BVH_STACK_SIZE ((LC_BVH_WIDTH - 1) * LC_BVH_MAX_DEPTH + 1)
 
 /* One lane per child. lc_bvh_fw: float per child (a row of lc_bvh_node.bounds); lc_bvh_rw:
- * lc_real per child; lc_bvh_iw, lc_bvh_uw, lc_bvh_lw: int, uint, long per child (stack entries). */
+ * lc_real per child; lc_bvh_iw, lc_bvh_uw: int, uint per child (keys, child references). */
 #if LC_BVH_WIDTH == 4
 typedef float4 lc_bvh_fw;
 typedef int4 lc_bvh_iw;
 typedef uint4 lc_bvh_uw;
-typedef long4 lc_bvh_lw;
 #define lc_bvh_vstorew vstore4
 #define lc_bvh_sum(v) ((v).s0 + (v).s1 + (v).s2 + (v).s3)
 #define lc_bvh_as_iw as_int4
-#define lc_bvh_long(v) convert_long4(v)
+#define lc_bvh_as_uw as_uint4
+#define LC_BVH_SLOTS ((int4)(0, 1, 2, 3))
 #ifdef LC_DOUBLE
 typedef double4 lc_bvh_rw;
 #define lc_bvh_rw_from_float(v) convert_double4(v)
@@ -40,19 +40,19 @@ typedef float4 lc_bvh_rw;
 #define lc_bvh_int_mask(m) (m)
 #endif
 /* Sorting network for 4 keys, descending: (0,1)(2,3), (0,2)(1,3), (1,2). */
-static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
-  lc_bvh_lw p = k.s1032, lo = min(k, p), hi = max(k, p);
-  k = (lc_bvh_lw)(hi.s0, lo.s1, hi.s2, lo.s3);
+static inline lc_bvh_iw bvh_sort_desc(lc_bvh_iw k) {
+  lc_bvh_iw p = k.s1032, lo = min(k, p), hi = max(k, p);
+  k = (lc_bvh_iw)(hi.s0, lo.s1, hi.s2, lo.s3);
   p = k.s2301;
   lo = min(k, p);
   hi = max(k, p);
-  k = (lc_bvh_lw)(hi.s0, hi.s1, lo.s2, lo.s3);
+  k = (lc_bvh_iw)(hi.s0, hi.s1, lo.s2, lo.s3);
   p = k.s0213;
   lo = min(k, p);
   hi = max(k, p);
-  return (lc_bvh_lw)(hi.s0, hi.s1, lo.s2, lo.s3);
+  return (lc_bvh_iw)(hi.s0, hi.s1, lo.s2, lo.s3);
 }
-static inline long bvh_min_key(lc_bvh_lw k) {
+static inline int bvh_min_key(lc_bvh_iw k) {
   k = min(k, k.s2301);
   k = min(k, k.s1032);
   return k.s0;
@@ -61,11 +61,11 @@ static inline long bvh_min_key(lc_bvh_lw k) {
 typedef float8 lc_bvh_fw;
 typedef int8 lc_bvh_iw;
 typedef uint8 lc_bvh_uw;
-typedef long8 lc_bvh_lw;
 #define lc_bvh_vstorew vstore8
 #define lc_bvh_sum(v) ((v).s0 + (v).s1 + (v).s2 + (v).s3 + (v).s4 + (v).s5 + (v).s6 + (v).s7)
 #define lc_bvh_as_iw as_int8
-#define lc_bvh_long(v) convert_long8(v)
+#define lc_bvh_as_uw as_uint8
+#define LC_BVH_SLOTS ((int8)(0, 1, 2, 3, 4, 5, 6, 7))
 #ifdef LC_DOUBLE
 typedef double8 lc_bvh_rw;
 #define lc_bvh_rw_from_float(v) convert_double8(v)
@@ -83,9 +83,9 @@ typedef float8 lc_bvh_rw;
   p = k.sw;                                              \
   lo = min(k, p);                                        \
   hi = max(k, p);                                        \
-  k = (lc_bvh_lw)(l0.s0, l1.s1, l2.s2, l3.s3, l4.s4, l5.s5, l6.s6, l7.s7);
-static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
-  lc_bvh_lw p, lo, hi;
+  k = (lc_bvh_iw)(l0.s0, l1.s1, l2.s2, l3.s3, l4.s4, l5.s5, l6.s6, l7.s7);
+static inline lc_bvh_iw bvh_sort_desc(lc_bvh_iw k) {
+  lc_bvh_iw p, lo, hi;
   LC_BVH_LAYER(s10325476, hi, lo, lo, hi, hi, lo, lo, hi)
   LC_BVH_LAYER(s23016745, hi, hi, lo, lo, lo, lo, hi, hi)
   LC_BVH_LAYER(s10325476, hi, lo, hi, lo, lo, hi, lo, hi)
@@ -95,8 +95,8 @@ static inline lc_bvh_lw bvh_sort_desc(lc_bvh_lw k) {
   return k;
 }
 #undef LC_BVH_LAYER
-static inline long bvh_min_key(lc_bvh_lw k) {
-  long4 h = min(k.lo, k.hi);
+static inline int bvh_min_key(lc_bvh_iw k) {
+  int4 h = min(k.lo, k.hi);
   h = min(h, h.s2301);
   h = min(h, h.s1032);
   return h.s0;
@@ -104,6 +104,10 @@ static inline long bvh_min_key(lc_bvh_lw k) {
 #else
 #error "kernels/bvh/traverse.cl: LC_BVH_WIDTH must be 4 or 8"
 #endif
+
+/* any lane of an int4 mask set: one tree of ORs, which PoCL's any() (two halves, each with its
+ * own branch) is not */
+static inline int bvh_any4(int4 m) { return ((m.s0 | m.s1) | (m.s2 | m.s3)) < 0; }
 
 /* leaf blocks: 4 lanes of lc_real */
 #ifdef LC_DOUBLE
@@ -168,7 +172,7 @@ static inline int bvh_leaf_triangles(__global const lc_bvh_leaf* lf, int4 tri, c
   lc_real4 W = Bx * Ay - By * Ax;
 #ifdef LC_BVH_FP64_FALLBACK
   int4 zero = tri & ((U == 0.0f) | (V == 0.0f) | (W == 0.0f));
-  if (any(zero)) {
+  if (bvh_any4(zero)) {
     double4 ax = convert_double4(Ax), ay = convert_double4(Ay), bx = convert_double4(Bx);
     double4 by = convert_double4(By), cx = convert_double4(Cx), cy = convert_double4(Cy);
     U = select(U, convert_float4(cx * by - cy * bx), zero);
@@ -180,12 +184,12 @@ static inline int bvh_leaf_triangles(__global const lc_bvh_leaf* lf, int4 tri, c
   int4 ok = tri & ~lc_bvh_m4(((U < z) | (V < z) | (W < z)) & ((U > z) | (V > z) | (W > z)));
   lc_real4 det = U + V + W;
   ok &= lc_bvh_m4(det != z);
-  if (!any(ok)) return 0;
+  if (!bvh_any4(ok)) return 0;
   lc_real4 T = U * (r->sz * Az) + V * (r->sz * Bz) + W * (r->sz * Cz);
   lc_real4 inv = LC_REAL(1.0) / det;
   lc_real4 t = T * inv;
   ok &= lc_bvh_m4((t > tmin) & (t < hit->t));
-  if (!any(ok)) return 0;
+  if (!bvh_any4(ok)) return 0;
   lc_real4 tt = select((lc_real4)(INFINITY), t, lc_bvh_rm4(ok));
   lc_real a = tt.s0 < tt.s1 ? tt.s0 : tt.s1, c = tt.s2 < tt.s3 ? tt.s2 : tt.s3;
   lc_real m = a < c ? a : c;
@@ -218,8 +222,6 @@ static inline int bvh_intersect_sphere(const lc_scene* s, lc_uint ref, lc_real3 
 #define LC_BVH_SPHERES 1
 #endif
 
-static inline lc_real bvh_get(lc_real3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
-
 /*
  * Closest hit with t in (tmin, tmax). With any_hit set, returns at the first hit found (shadow
  * rays); hit then holds that hit, not necessarily the closest.
@@ -242,7 +244,7 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
   /* a non-finite origin or direction (a scene's NaN, or one computed from degenerate input)
    * would enter every child, the empty slots too, and walk off the node array: such a ray hits
    * nothing (a miss: the integrator adds what a miss adds, the environment's radiance) */
-  if (s->params->num_nodes == 0 || !all(isfinite(o)) || !all(isfinite(d))) return 0;
+  if (s->params->num_nodes == 0 || !all(isfinite(o) & isfinite(d))) return 0;
   __global const lc_bvh_node* nodes = s->nodes;
   lc_real3 inv_d = bvh_inv_dir(d);
   /* rows of lc_bvh_node.bounds holding each axis's near plane; the far plane is the next row */
@@ -250,9 +252,12 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
   const int ny = inv_d.y >= LC_REAL(0.0) ? 2 : 3;
   const int nz = inv_d.z >= LC_REAL(0.0) ? 4 : 5;
   lc_tri_ray tr = triangle_ray_setup(d);
-  const lc_real okx = bvh_get(o, tr.kx), oky = bvh_get(o, tr.ky), okz = bvh_get(o, tr.kz);
-  /* pending children: entry distance (float bits, rounded down) << 32 | child reference */
-  long stack[LC_BVH_STACK_SIZE];
+  const lc_real4 ok = lc_tri_lanes(o, tr.kx, tr.ky, tr.kz);
+  const lc_real okx = ok.x, oky = ok.y, okz = ok.z;
+  /* pending children: their keys (entry distance rounded down, slot in the parent; see below)
+   * and their parents' node indices */
+  int stack_t[LC_BVH_STACK_SIZE];
+  lc_uint stack_node[LC_BVH_STACK_SIZE];
   int sp = 0;
   lc_uint ref = 0; /* the root node */
   for (;;) {
@@ -277,18 +282,19 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
       lc_bvh_iw hm = lc_bvh_int_mask(t < (lc_bvh_rw)(INFINITY)); /* -1: child entered */
       int cnt = -lc_bvh_sum(hm);
       if (cnt > 0) {
-        /* keys (entry distance, child), sorted farthest first, the children missed (LONG_MIN)
-         * last: stored whole, the first cnt - 1 become the stack's top (second nearest on top);
-         * the nearest (smallest key) is visited next. Signed order of the keys is the order of
-         * the distances for t >= 0. */
-        lc_bvh_lw key = (lc_bvh_long(lc_bvh_as_iw(lc_bvh_float_down(t))) << 32) |
-                        lc_bvh_long(*(__global const lc_bvh_uw*)n->child);
-        lc_bvh_lw lhm = lc_bvh_long(hm);
-        long near_ = bvh_min_key(select((lc_bvh_lw)(LONG_MAX), key, lhm));
-        key = bvh_sort_desc(select((lc_bvh_lw)(LONG_MIN), key, lhm));
-        lc_bvh_vstorew(key, 0, &stack[sp]);
+        /* keys: the entry distance's float bits (t >= 0, so their signed order is the
+         * distances'), rounded down to a multiple of 8 ulps, with the child's slot in the three
+         * low bits: 32-bit lanes, so the sort is one register's min and max on AVX2 as well as
+         * AVX-512. Sorted farthest first, the children missed (INT_MIN) last, the keys are
+         * stored whole, each beside this node's index: the first cnt - 1 become the stack's top
+         * (second nearest on top); the nearest (smallest key) is visited next. */
+        lc_bvh_iw key = (lc_bvh_as_iw(lc_bvh_float_down(t)) & ~7) | LC_BVH_SLOTS;
+        int near_ = bvh_min_key(select((lc_bvh_iw)(INT_MAX), key, hm));
+        key = bvh_sort_desc(select((lc_bvh_iw)(INT_MIN), key, hm));
+        lc_bvh_vstorew(key, 0, &stack_t[sp]);
+        lc_bvh_vstorew((lc_bvh_uw)(ref), 0, &stack_node[sp]);
         sp += cnt - 1;
-        ref = (lc_uint)near_;
+        ref = n->child[near_ & 7];
         continue;
       }
     } else {
@@ -300,13 +306,18 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
         int4 sphere = (prim & LC_PRIM_SPHERE_BIT) != 0;
 #ifdef LC_BVH_TRIANGLES
         int4 tri = ~sphere;
-        if (any(tri) && bvh_leaf_triangles(lf, tri, &tr, okx, oky, okz, tmin, hit) && any_hit)
+#ifndef LC_BVH_SPHERES
+        /* every used column is a triangle, and a block has at least one */
+        if (bvh_leaf_triangles(lf, tri, &tr, okx, oky, okz, tmin, hit) && any_hit) return 1;
+#else
+        if (bvh_any4(tri) && bvh_leaf_triangles(lf, tri, &tr, okx, oky, okz, tmin, hit) && any_hit)
           return 1;
+#endif
 #endif
 #ifdef LC_BVH_SPHERES
         /* LC_INVALID (an unused column) has the sphere bit too */
         int4 used_sphere = sphere & (prim != LC_INVALID);
-        if (any(used_sphere)) {
+        if (bvh_any4(used_sphere)) {
           lc_uint refs[4] = {prim.s0, prim.s1, prim.s2, prim.s3};
           for (int k = 0; k < 4; ++k)
             if (refs[k] != LC_INVALID && (refs[k] & LC_PRIM_SPHERE_BIT) &&
@@ -317,12 +328,12 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
       }
     }
     /* pop the nearest pending child that may still hold a closer hit */
-    long e;
+    int e;
     do {
       if (sp == 0) return hit->prim != LC_INVALID;
-      e = stack[--sp];
-    } while (!(as_float((int)(e >> 32)) < hit->t));
-    ref = (lc_uint)e;
+      e = stack_t[--sp];
+    } while (!(as_float(e & ~7) < hit->t));
+    ref = nodes[stack_node[sp]].child[e & 7];
   }
 }
 

@@ -23,23 +23,31 @@ typedef struct {
 
 static inline lc_real lc_get(lc_real3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 
+/* (v[a], v[b], v[c], 0): one permutation, where three chains of comparisons on a, b, c would be
+ * branches that a diffuse ray's random direction mispredicts */
+#ifdef LC_DOUBLE
+#define lc_tri_lanes(v, a, b, c) \
+  shuffle((double4)((v), 0.0), convert_ulong4((int4)((a), (b), (c), 3)))
+#else
+#define lc_tri_lanes(v, a, b, c) shuffle((float4)((v), 0.0f), as_uint4((int4)((a), (b), (c), 3)))
+#endif
+
 static inline lc_tri_ray triangle_ray_setup(lc_real3 d) {
   lc_tri_ray r;
   lc_real3 ad = fabs(d);
-  r.kz = (ad.x > ad.y) ? ((ad.x > ad.z) ? 0 : 2) : ((ad.y > ad.z) ? 1 : 2);
-  r.kx = r.kz + 1;
-  if (r.kx == 3) r.kx = 0;
-  r.ky = r.kx + 1;
-  if (r.ky == 3) r.ky = 0;
-  lc_real dz = lc_get(d, r.kz);
-  if (dz < LC_REAL(0.0)) { /* keep the winding, so U, V, W keep their meaning */
-    int tmp = r.kx;
-    r.kx = r.ky;
-    r.ky = tmp;
-  }
-  r.sx = lc_get(d, r.kx) / dz;
-  r.sy = lc_get(d, r.ky) / dz;
-  r.sz = LC_REAL(1.0) / dz;
+  int kz = (ad.x > ad.y) ? ((ad.x > ad.z) ? 0 : 2) : ((ad.y > ad.z) ? 1 : 2);
+  int kx = kz == 2 ? 0 : kz + 1;
+  int ky = kx == 2 ? 0 : kx + 1;
+  lc_real4 p = lc_tri_lanes(d, kx, ky, kz);
+  /* d[kz] < 0: kx and ky swap, to keep the winding, so U, V, W keep their meaning */
+  int swap = p.z < LC_REAL(0.0);
+  r.kz = kz;
+  r.kx = swap ? ky : kx;
+  r.ky = swap ? kx : ky;
+  lc_real4 q = (lc_real4)(swap ? p.y : p.x, swap ? p.x : p.y, LC_REAL(1.0), LC_REAL(1.0)) / p.z;
+  r.sx = q.x; /* d[kx] / d[kz] */
+  r.sy = q.y; /* d[ky] / d[kz] */
+  r.sz = q.z; /* 1 / d[kz] */
   return r;
 }
 
