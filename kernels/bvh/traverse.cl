@@ -4,9 +4,10 @@
  * src/bvh/bvh_wide.cpp). A primitive reference is a triangle index, or a sphere index with
  * LC_PRIM_SPHERE_BIT set.
  * Traversal: one vector operation per slab plane tests all children of a node; the children
- * entered become (entry distance, child reference) keys, sorted by a sorting network, the nearest
- * is visited next and the others are pushed farthest first with one vector store, so a popped
- * child is dropped without touching its node once a closer hit is known. The triangles of a leaf
+ * entered become 32-bit (entry distance, child slot) keys, sorted by a sorting network, the nearest
+ * is visited next and the others are pushed farthest first with one vector store (beside their
+ * parent's index), so a popped child is dropped without touching a node once a closer hit is
+ * known. The triangles of a leaf
  * block are tested at once. Ray quantities are lc_real (float, or double under LC_DOUBLE); boxes
  * and vertices are loaded from the float buffers and widened. The hit record (lc_hit) is in
  * geom/interaction.cl, the scene (lc_scene) in scene/scene.cl. */
