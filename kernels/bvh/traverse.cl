@@ -7,10 +7,9 @@
  * entered become 32-bit (entry distance, child slot) keys, sorted by a sorting network, the nearest
  * is visited next and the others are pushed farthest first with one vector store (beside their
  * parent's index), so a popped child is dropped without touching a node once a closer hit is
- * known. The triangles of a leaf
- * block are tested at once. Ray quantities are lc_real (float, or double under LC_DOUBLE); boxes
- * and vertices are loaded from the float buffers and widened. The hit record (lc_hit) is in
- * geom/interaction.cl, the scene (lc_scene) in scene/scene.cl. */
+ * known. The triangles of a leaf block are tested at once. Ray quantities are lc_real (float, or
+ * double under LC_DOUBLE); boxes and vertices are loaded from the float buffers and widened. The
+ * hit record (lc_hit) is in geom/interaction.cl, the scene (lc_scene) in scene/scene.cl. */
 #ifndef LUCENT_BVH_TRAVERSE_CL
 #define LUCENT_BVH_TRAVERSE_CL
 
@@ -19,7 +18,8 @@
 #define LC_BVH_STACK_SIZE ((LC_BVH_WIDTH - 1) * LC_BVH_MAX_DEPTH + 1)
 
 /* One lane per child. lc_bvh_fw: float per child (a row of lc_bvh_node.bounds); lc_bvh_rw:
- * lc_real per child; lc_bvh_iw, lc_bvh_uw: int, uint per child (keys, child references). */
+ * lc_real per child; lc_bvh_iw, lc_bvh_uw: int, uint per child (stack keys, parent node indices).
+ */
 #if LC_BVH_WIDTH == 4
 typedef float4 lc_bvh_fw;
 typedef int4 lc_bvh_iw;
@@ -27,7 +27,6 @@ typedef uint4 lc_bvh_uw;
 #define lc_bvh_vstorew vstore4
 #define lc_bvh_sum(v) ((v).s0 + (v).s1 + (v).s2 + (v).s3)
 #define lc_bvh_as_iw as_int4
-#define lc_bvh_as_uw as_uint4
 #define LC_BVH_SLOTS ((int4)(0, 1, 2, 3))
 #ifdef LC_DOUBLE
 typedef double4 lc_bvh_rw;
@@ -65,7 +64,6 @@ typedef uint8 lc_bvh_uw;
 #define lc_bvh_vstorew vstore8
 #define lc_bvh_sum(v) ((v).s0 + (v).s1 + (v).s2 + (v).s3 + (v).s4 + (v).s5 + (v).s6 + (v).s7)
 #define lc_bvh_as_iw as_int8
-#define lc_bvh_as_uw as_uint8
 #define LC_BVH_SLOTS ((int8)(0, 1, 2, 3, 4, 5, 6, 7))
 #ifdef LC_DOUBLE
 typedef double8 lc_bvh_rw;
