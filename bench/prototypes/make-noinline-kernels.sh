@@ -7,8 +7,9 @@
 #   bench/prototypes/make-noinline-kernels.sh OUT_DIR      # then LUCENT_KERNEL_DIR=OUT_DIR/kernels
 #
 # The noinline calls cost the kernel about 11% more instructions and 17% more CPU time (Cornell
-# box, measured). The patterns match the kernel sources of commit f227b8a (before issue 10's
-# refactor): the script stops with a message when one of them no longer matches.
+# box, measured at f227b8a). The patterns match the kernel sources of 28 Nov 2026 (f5cbc08); the
+# script stops with a message when one of them no longer matches. integrate() itself is a
+# function of its own in every build (LC_POCL_NOINLINE); stage_profile.py looks inside it.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 out=${1:?usage: make-noinline-kernels.sh OUT_DIR}
@@ -29,9 +30,10 @@ patch_one bsdf/bsdf.cl 'static inline lc_bsdf bsdf_from_material(' "$NI lc_bsdf 
 patch_one bsdf/bsdf.cl 'static inline float3 bsdf_eval(' "$NI float3 bsdf_eval("
 patch_one bsdf/bsdf.cl 'static inline int bsdf_sample(' "$NI int bsdf_sample("
 patch_one light/light.cl 'static inline float3 env_radiance(' "$NI float3 env_radiance("
-patch_one light/light.cl 'static inline float light_pdf_area(' "$NI float light_pdf_area("
+patch_one light/light.cl 'static inline float light_pdf(' "$NI float light_pdf("
 patch_one light/light.cl 'static inline int light_sample(' "$NI int light_sample("
 patch_one camera/camera.cl 'static inline lc_ray camera_generate_ray(' "$NI lc_ray camera_generate_ray("
 patch_one film/filter.cl 'static inline float2 filter_sample(' "$NI float2 filter_sample("
-patch_one integrator/path.cl 'static inline float lc_rand(' "$NI float lc_rand("
+patch_one sampler/sampler.cl 'static inline float8 lc_rand8(' "$NI float8 lc_rand8("
+patch_one sampler/sampler.cl 'static inline float2 lc_rand2(' "$NI float2 lc_rand2("
 echo "make-noinline-kernels: wrote $k (use LUCENT_KERNEL_DIR=$k)"

@@ -60,19 +60,29 @@ def callgrind(path, paths=None):
     flat = run(["callgrind_annotate", "--threshold=100", path])
     num = lambda s: int(s.replace(",", ""))
     lines = tree.splitlines()
-    wg, callees = None, {}
-    for i, line in enumerate(lines):
-        m = re.match(r"\s*([\d,]+) \([^)]*\)\s+\*\s+\S+:(\S+)", line)
-        if m and m.group(2) == "_pocl_kernel_lucent_render_workgroup":
-            wg = num(m.group(1))
-            for l2 in lines[i + 1:]:
-                m2 = re.match(r"\s*([\d,]+) \([^)]*\)\s+>\s+\S+:(\S+) \(([\d,]+)x\)", l2)
-                if not m2:
-                    break
-                callees[m2.group(2)] = (num(m2.group(1)), num(m2.group(3)))
-            break
+    def callees_of(fn):
+        for i, line in enumerate(lines):
+            m = re.match(r"\s*([\d,]+) \([^)]*\)\s+\*\s+\S+:(\S+)", line)
+            if m and m.group(2) == fn:
+                out = {}
+                for l2 in lines[i + 1:]:
+                    m2 = re.match(r"\s*([\d,]+) \([^)]*\)\s+>\s+\S+:(\S+) \(([\d,]+)x\)", l2)
+                    if not m2:
+                        break
+                    out[m2.group(2)] = (num(m2.group(1)), num(m2.group(3)))
+                return num(m.group(1)), out
+        return None, {}
+
+    wg, callees = callees_of("_pocl_kernel_lucent_render_workgroup")
     if wg is None:
         sys.exit("stage_profile.py: no _pocl_kernel_lucent_render_workgroup in " + path)
+    # integrate() is a function of its own (LC_POCL_NOINLINE): its callees are the stages.
+    if "integrate" in callees:
+        total, inner = callees_of("integrate")
+        del callees["integrate"]
+        for k, v in inner.items():
+            old = callees.get(k, (0, 0))
+            callees[k] = (old[0] + v[0], old[1] + v[1])
     rest = wg - sum(v[0] for v in callees.values())
     print("kernel (work-group function, inclusive): %d instructions" % wg)
     rows = sorted(callees.items(), key=lambda kv: -kv[1][0])
