@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "bvh/bvh.hpp"
@@ -365,6 +366,45 @@ TEST(BvhBuild, ReorderTrianglesIntoLeafOrder) {
     }
   }
   check_bvh(b, moved, s, 4);
+}
+
+// The default traversal cost (BuildOptions::traversal_cost, about what a binary step costs in the
+// kernel's 8-wide nodes relative to a leaf block) keeps the walls of a box in leaves of their own:
+// a leaf holding two walls spans the box's volume, and every ray inside the box entered it. The
+// classic cost of 1 filled blocks of 4 with two walls (the Cornell box's rays then entered 2.5
+// leaves each, BENCHMARKS.md).
+TEST(BvhBuild, BoxWallsGetFlatLeaves) {
+  std::vector<lc_triangle> t;
+  auto quad = [&](float ax, float ay, float az, float bx, float by, float bz, float cx, float cy,
+                  float cz, float dx, float dy, float dz) {
+    t.push_back(tri(ax, ay, az, bx, by, bz, cx, cy, cz));
+    t.push_back(tri(ax, ay, az, cx, cy, cz, dx, dy, dz));
+  };
+  quad(-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1);    // floor
+  quad(-1, 2, -1, 1, 2, -1, 1, 2, 1, -1, 2, 1);    // ceiling
+  quad(-1, 0, -1, 1, 0, -1, 1, 2, -1, -1, 2, -1);  // back
+  quad(-1, 0, -1, -1, 0, 1, -1, 2, 1, -1, 2, -1);  // left
+  quad(1, 0, -1, 1, 0, 1, 1, 2, 1, 1, 2, -1);      // right
+  auto flat_leaves = [](const Bvh& b) {
+    int flat = 0, leaves = 0;
+    for (std::size_t i = 0; i < b.nodes.size(); ++i) {
+      const Node2& n = b.nodes[i];
+      if (n.count == 0 || (i == 1 && b.nodes.size() > 1)) continue;
+      ++leaves;
+      float ext = std::min({n.bmax[0] - n.bmin[0], n.bmax[1] - n.bmin[1], n.bmax[2] - n.bmin[2]});
+      flat += ext == 0.0f;
+    }
+    return std::make_pair(flat, leaves);
+  };
+  Bvh b = lucent::bvh::build_binary(t, {});
+  auto [flat, leaves] = flat_leaves(b);
+  EXPECT_EQ(flat, leaves);
+  EXPECT_EQ(leaves, 5);
+  check_bvh(b, t, {}, 4);
+  BuildOptions classic;
+  classic.traversal_cost = 1.0f;
+  auto [flat1, leaves1] = flat_leaves(lucent::bvh::build_binary(t, {}, classic));
+  EXPECT_LT(flat1, leaves1);  // the comparison this test stands on
 }
 
 }  // namespace

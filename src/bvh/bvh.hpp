@@ -12,9 +12,15 @@ struct BuildOptions {
   /// A leaf is forced to split above this many primitives (clamped to 1..LC_BVH_LEAF_MAX).
   int max_leaf_size = 4;
   int threads = 0;  ///< 0: hardware concurrency
-  /// SAH cost of one traversal step relative to one primitive intersection: larger values give
-  /// larger leaves and fewer nodes.
-  float traversal_cost = 1.0f;
+  /// SAH cost of one binary traversal step relative to one leaf block's intersection: larger
+  /// values give larger leaves and fewer nodes. The kernel walks 8-wide nodes, each about three
+  /// binary levels, and one wide node's test costs about one leaf block's (~120 instructions
+  /// each, AVX2), so a binary step costs about a fifth to a third of a block. At 1 (the classic
+  /// value) leaves always filled their block, and a leaf holding two walls of a box spans the
+  /// box's volume: rays inside it entered 2.5 leaves each. 0.2 separates such walls:
+  /// traversal instructions -29% on the Cornell box, -17% on the dragon box, unchanged on a bare
+  /// mesh, +6% on a scene of spheres on a plane (BENCHMARKS.md, "Throughput against Mitsuba 3").
+  float traversal_cost = 0.2f;
   /// Triangles the kernel tests together (lc_bvh_leaf holds 4): the SAH counts a leaf's
   /// intersection cost in blocks of this many triangles, plus one per sphere (spheres are tested
   /// one by one), so leaves fill blocks when that is no worse.
