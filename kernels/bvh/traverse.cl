@@ -62,7 +62,14 @@ typedef float8 lc_bvh_fw;
 typedef int8 lc_bvh_iw;
 typedef uint8 lc_bvh_uw;
 #define lc_bvh_vstorew vstore8
-#define lc_bvh_sum(v) ((v).s0 + (v).s1 + (v).s2 + (v).s3 + (v).s4 + (v).s5 + (v).s6 + (v).s7)
+/* the sum of the lanes as a tree of vector additions (a chain of lane extracts measured 16
+ * instructions on AVX2, the tree 6) */
+static inline int lc_bvh_sum(int8 v) {
+  int4 h = v.lo + v.hi;
+  h += h.s2301;
+  h += h.s1032;
+  return h.s0;
+}
 #define lc_bvh_as_iw as_int8
 #define LC_BVH_SLOTS ((int8)(0, 1, 2, 3, 4, 5, 6, 7))
 #ifdef LC_DOUBLE
