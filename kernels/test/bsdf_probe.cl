@@ -1,5 +1,5 @@
-/* lucent test kernel: evaluates the device's Fresnel and BSDF code on inputs given by the host
- * (tests/test_kernel_bsdf.cpp). */
+/* lucent test kernel: evaluates the device's Fresnel and BSDF code, and the unit circle its
+ * sampling uses, on inputs given by the host (tests/test_kernel_bsdf.cpp). */
 /* clang-format off */
 #include "generated/all_features.cl" /* every material type */
 #include "shared/types.h"
@@ -13,6 +13,12 @@
 #include "bsdf/microfacet.cl"
 #include "bsdf/bsdf.cl"
 /* clang-format on */
+
+/* lc_unit_circle (util/math.cl) of each u */
+__kernel void probe_unit_circle(__global const float* u, __global float2* out) {
+  size_t i = get_global_id(0);
+  out[i] = lc_unit_circle(u[i]);
+}
 
 /* in: (cos_i, eta) pairs; out: (F, cos_t) pairs */
 __kernel void probe_fresnel(__global const float2* in, __global float2* out) {
