@@ -249,8 +249,11 @@ static inline int bvh_trace(const lc_scene* s, lc_real3 o, lc_real3 d, lc_real t
   hit->b1 = hit->b2 = LC_REAL(0.0);
   /* a non-finite origin or direction (a scene's NaN, or one computed from degenerate input)
    * would enter every child, the empty slots too, and walk off the node array: such a ray hits
-   * nothing (a miss: the integrator adds what a miss adds, the environment's radiance) */
-  if (s->params->num_nodes == 0 || !all(isfinite(o) & isfinite(d))) return 0;
+   * nothing (a miss: the integrator adds what a miss adds, the environment's radiance).
+   * (o - o) + (d - d) is 0 where finite and NaN where a component is infinite or NaN: its sum
+   * decides in 6 instructions what isfinite() of the six components took 20 for. */
+  lc_real3 fin = (o - o) + (d - d);
+  if (s->params->num_nodes == 0 || !(fin.x + fin.y + fin.z == LC_REAL(0.0))) return 0;
   __global const lc_bvh_node* nodes = s->nodes;
   lc_real3 inv_d = bvh_inv_dir(d);
   /* rows of lc_bvh_node.bounds holding each axis's near plane; the far plane is the next row */
