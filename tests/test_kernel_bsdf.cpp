@@ -22,6 +22,22 @@ struct Probe {
   cl::Program program = lucent::cl_util::build_program_cached(
       ctx, lucent::detail::assemble_kernel_source("test/bsdf_probe.cl", lucent::test::kernel_dir()),
       "-cl-std=CL1.2", lucent::test::cache_dir());
+
+  /// Runs the probe kernel `name(__global const In* in, __global Out* out)`, one work-item per
+  /// input, and returns its outputs.
+  template <class Out, class In>
+  std::vector<Out> map(const char* name, const std::vector<In>& in) {
+    cl::Buffer bin(ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, in.size() * sizeof(In),
+                   const_cast<In*>(in.data()));
+    cl::Buffer bout(ctx.context, CL_MEM_WRITE_ONLY, in.size() * sizeof(Out));
+    cl::Kernel k(program, name);
+    k.setArg(0, bin);
+    k.setArg(1, bout);
+    ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(in.size()), cl::NullRange);
+    std::vector<Out> out(in.size());
+    ctx.queue.enqueueReadBuffer(bout, CL_TRUE, 0, out.size() * sizeof(Out), out.data());
+    return out;
+  }
 };
 
 Probe& probe() {
@@ -42,16 +58,7 @@ TEST(KernelBsdf, FresnelDielectricKnownValues) {
   std::vector<cl_float2> in;
   for (double eta : {1.5, 1.0 / 1.5, 1.0, 1.333, 10.0})
     for (double c : {1.0, 0.9, 0.5, 0.2, 0.05, 1e-3, 0.0}) in.push_back({{float(c), float(eta)}});
-  Probe& p = probe();
-  cl::Buffer bin(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                 in.size() * sizeof(cl_float2), in.data());
-  cl::Buffer bout(p.ctx.context, CL_MEM_WRITE_ONLY, in.size() * sizeof(cl_float2));
-  cl::Kernel k(p.program, "probe_fresnel");
-  k.setArg(0, bin);
-  k.setArg(1, bout);
-  p.ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(in.size()), cl::NullRange);
-  std::vector<cl_float2> out(in.size());
-  p.ctx.queue.enqueueReadBuffer(bout, CL_TRUE, 0, out.size() * sizeof(cl_float2), out.data());
+  std::vector<cl_float2> out = probe().map<cl_float2>("probe_fresnel", in);
   for (size_t i = 0; i < in.size(); ++i) {
     double c = in[i].s[0], eta = in[i].s[1];
     EXPECT_NEAR(out[i].s[0], fresnel_ref(c, eta), 2e-6) << "cos " << c << " eta " << eta;
@@ -84,16 +91,7 @@ TEST(KernelBsdf, UnitCircleIsAccurate) {
   for (int i = 0; i < (1 << 18); ++i) u.push_back(float((gen() >> 8) * step));
   const size_t quarter = u.size();
   for (float q : {0.0f, 0.25f, 0.5f, 0.75f}) u.push_back(q);
-  Probe& p = probe();
-  cl::Buffer bin(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, u.size() * sizeof(float),
-                 u.data());
-  cl::Buffer bout(p.ctx.context, CL_MEM_WRITE_ONLY, u.size() * sizeof(cl_float2));
-  cl::Kernel k(p.program, "probe_unit_circle");
-  k.setArg(0, bin);
-  k.setArg(1, bout);
-  p.ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(u.size()), cl::NullRange);
-  std::vector<cl_float2> out(u.size());
-  p.ctx.queue.enqueueReadBuffer(bout, CL_TRUE, 0, out.size() * sizeof(cl_float2), out.data());
+  std::vector<cl_float2> out = probe().map<cl_float2>("probe_unit_circle", u);
   const double two_pi = 6.283185307179586476925;
   double worst = 0, worst_unit = 0;
   for (size_t i = 0; i < u.size(); ++i) {
