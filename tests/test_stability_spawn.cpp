@@ -15,6 +15,7 @@
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
+#include "render/pack.hpp"
 #include "shared/types.h"
 #include "support.hpp"
 
@@ -77,6 +78,7 @@ Counts run_decade(double m, int rays_wanted, std::uint32_t seed, bool in_double 
     put(t.v1, v[1]);
     put(t.v2, v[2]);
     t.light = LC_INVALID;
+    if (!lucent::render_detail::set_triangle_normal(t)) continue;  // collinear in float
     triangles.push_back(t);
   }
   SpawnProbe& p = probe(in_double);

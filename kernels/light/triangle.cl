@@ -13,7 +13,7 @@ static inline int light_triangle_sample(const lc_scene* s, __global const lc_lig
   lc_real su = sqrt((lc_real)u1);
   lc_real b0 = LC_REAL(1.0) - su, b1 = u2 * su;
   lc_real3 q = b0 * v0 + b1 * v1 + (LC_REAL(1.0) - b0 - b1) * v2;
-  lc_real3 nl = normalize(cross(v1 - v0, v2 - v0));
+  lc_real3 nl = triangle_normal(tri, v0, v1, v2);
   lc_real3 to = q - p;
   lc_real d2 = dot(to, to);
   lc_real dist = sqrt(d2);
@@ -47,7 +47,7 @@ static inline int light_triangle_emit(const lc_scene* s, __global const lc_light
   lc_real b0 = LC_REAL(1.0) - su, b1 = u.y * su, b2 = LC_REAL(1.0) - b0 - b1;
   lc_real3 q = b0 * v0 + b1 * v1 + b2 * v2;
   lc_real3 perr = triangle_point_error(b0, b1, b2, v0, v1, v2);
-  lc_real3 nl = normalize(cross(v1 - v0, v2 - v0));
+  lc_real3 nl = triangle_normal(tri, v0, v1, v2);
   lc_real3 t, b;
   lc_onbr(nl, &t, &b);
   float3 d = sample_cosine_hemisphere(u.z, u.w);

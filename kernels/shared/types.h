@@ -162,7 +162,10 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_sphere, material) == 16, sphere_material);
 #define LC_TRI_HAS_NORMALS 1u
 #define LC_TRI_HAS_UVS 2u
 
-/* Intersection data of one triangle: its three world-space vertices. */
+/* One triangle as hits and lights read it: its three world-space vertices and its unit geometric
+ * normal normalize((v1 - v0) x (v2 - v0)), computed on the host in double from the float
+ * vertices (lc_triangle_set_normal); one 64-byte cache line. (Traversal reads the vertices of
+ * lc_bvh_leaf instead.) */
 typedef struct LC_ALIGN16 lc_triangle {
   float v0[3];
   lc_uint material; /* index into materials                     */
@@ -170,11 +173,14 @@ typedef struct LC_ALIGN16 lc_triangle {
   lc_uint light; /* index into lights if emissive, LC_INVALID */
   float v2[3];
   lc_uint flags; /* LC_TRI_HAS_NORMALS | LC_TRI_HAS_UVS        */
-} lc_triangle;   /* total: 48 bytes */
-LC_STATIC_ASSERT(sizeof(lc_triangle) == 48, triangle_size);
+  float ng[3];   /* unit geometric normal                       */
+  lc_uint pad;
+} lc_triangle; /* total: 64 bytes */
+LC_STATIC_ASSERT(sizeof(lc_triangle) == 64, triangle_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, v1) == 16, triangle_v1);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, v2) == 32, triangle_v2);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, flags) == 44, triangle_flags);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, ng) == 48, triangle_ng);
 
 /* Shading data of one triangle, read only at the closest hit. */
 typedef struct LC_ALIGN16 lc_triangle_attr {

@@ -41,6 +41,16 @@ bool same_geometry(const PackedScene& a, const PackedScene& b) {
 
 }  // namespace
 
+bool set_triangle_normal(lc_triangle& t) {
+  glm::dvec3 v0(t.v0[0], t.v0[1], t.v0[2]), v1(t.v1[0], t.v1[1], t.v1[2]);
+  glm::dvec3 v2(t.v2[0], t.v2[1], t.v2[2]);
+  glm::dvec3 n = glm::cross(v1 - v0, v2 - v0);
+  double len = glm::length(n);
+  if (!(len > 0) || !std::isfinite(len)) return false;
+  put3(t.ng, n / len);
+  return true;
+}
+
 lc_camera pack_camera(const Camera& c, int width, int height) {
   lc_camera cam{};
   glm::dvec3 fwd = glm::normalize(c.look_at - c.position);
@@ -164,6 +174,8 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     put3(d.v0, v[0]);
     put3(d.v1, v[1]);
     put3(d.v2, v[2]);
+    // collinear after rounding to float (it is never hit, but it may emit): the normal before
+    if (!set_triangle_normal(d)) put3(d.ng, glm::normalize(glm::cross(v[1] - v[0], v[2] - v[0])));
     d.material = static_cast<lc_uint>(t.material);
     d.light = LC_INVALID;
     lc_triangle_attr a{};
