@@ -164,8 +164,8 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_sphere, material) == 16, sphere_material);
 
 /* One triangle as hits and lights read it: its three world-space vertices and its unit geometric
  * normal normalize((v1 - v0) x (v2 - v0)), computed on the host in double from the float
- * vertices (lc_triangle_set_normal); one 64-byte cache line. (Traversal reads the vertices of
- * lc_bvh_leaf instead.) */
+ * vertices (render_detail::set_triangle_normal); one 64-byte cache line. (Traversal reads the
+ * vertices of lc_bvh_leaf instead.) */
 typedef struct LC_ALIGN16 lc_triangle {
   float v0[3];
   lc_uint material; /* index into materials                     */

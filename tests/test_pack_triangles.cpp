@@ -1,0 +1,92 @@
+// Packed triangles carry their unit geometric normal (lc_triangle.ng), which hits and triangle
+// lights read instead of computing it: render_detail::set_triangle_normal and pack_scene.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <glm/glm.hpp>
+#include <random>
+
+#include "render/pack.hpp"
+#include "support.hpp"
+
+namespace {
+
+using lucent::render_detail::set_triangle_normal;
+
+lc_triangle make(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+  lc_triangle t{};
+  for (int k = 0; k < 3; ++k) {
+    t.v0[k] = static_cast<float>(a[k]);
+    t.v1[k] = static_cast<float>(b[k]);
+    t.v2[k] = static_cast<float>(c[k]);
+  }
+  return t;
+}
+
+glm::dvec3 ng(const lc_triangle& t) { return {t.ng[0], t.ng[1], t.ng[2]}; }
+
+TEST(PackTriangles, NormalFollowsTheWindingOfTheFloatVertices) {
+  lc_triangle t = make({0, 0, 0}, {1, 0, 0}, {0, 1, 0});
+  ASSERT_TRUE(set_triangle_normal(t));
+  EXPECT_EQ(ng(t), glm::dvec3(0, 0, 1));
+  t = make({0, 0, 0}, {0, 1, 0}, {1, 0, 0});  // the other winding
+  ASSERT_TRUE(set_triangle_normal(t));
+  EXPECT_EQ(ng(t), glm::dvec3(0, 0, -1));
+}
+
+// Random triangles from 1e-30 to 1e30 (the float cross product underflows or overflows at the
+// ends; the double one does not): the normal is unit and orthogonal to both float edges within
+// a few float ulps, from the float vertices the kernel sees.
+TEST(PackTriangles, NormalIsUnitAndOrthogonalAtEveryScale) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int e = -30; e <= 30; e += 5) {
+    double m = std::pow(10.0, e);
+    for (int i = 0; i < 200; ++i) {
+      glm::dvec3 a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng)), c(u(rng), u(rng), u(rng));
+      lc_triangle t = make(m * a, m * b, m * c);
+      glm::dvec3 v0(t.v0[0], t.v0[1], t.v0[2]), v1(t.v1[0], t.v1[1], t.v1[2]);
+      glm::dvec3 v2(t.v2[0], t.v2[1], t.v2[2]);
+      glm::dvec3 e1 = v1 - v0, e2 = v2 - v0;
+      if (glm::length(glm::cross(e1, e2)) < 1e-3 * glm::length(e1) * glm::length(e2)) continue;
+      ASSERT_TRUE(set_triangle_normal(t)) << "1e" << e;
+      glm::dvec3 n = ng(t);
+      EXPECT_NEAR(glm::length(n), 1.0, 2e-7) << "1e" << e;
+      // |cos| of the angle to each edge: 0 up to the float rounding of n (a few 1e-8), over a
+      // sine of at least 1e-3 between the edges
+      EXPECT_LT(std::fabs(glm::dot(n, glm::normalize(e1))), 1e-6) << "1e" << e;
+      EXPECT_LT(std::fabs(glm::dot(n, glm::normalize(e2))), 1e-6) << "1e" << e;
+      EXPECT_GT(glm::dot(n, glm::cross(e1, e2)), 0.0) << "1e" << e;
+    }
+  }
+}
+
+TEST(PackTriangles, CollinearFloatVerticesHaveNoNormal) {
+  lc_triangle t = make({0, 0, 0}, {1, 1, 1}, {2, 2, 2});
+  t.ng[0] = 7;
+  EXPECT_FALSE(set_triangle_normal(t));
+  EXPECT_EQ(t.ng[0], 7.0f);  // left unchanged
+}
+
+// pack_scene fills ng for every triangle it keeps, a triangle that is collinear only after
+// rounding to float included (it takes the normal of its double vertices).
+TEST(PackTriangles, PackSceneSetsEveryNormal) {
+  lucent::Scene s = lucent::parse_scene(R"({
+    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 40},
+    "film": {"width": 8, "height": 8},
+    "materials": {"w": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1, 1, 1]}},
+    "shapes": [
+      {"type": "triangles", "material": "w", "positions": [[0, 0, 0], [0, 0, 1], [0, 1, 0]],
+       "indices": [0, 1, 2]},
+      {"type": "triangles", "material": "lamp",
+       "positions": [[1, 1, 1], [1.0000000001, 1, 1], [1, 1.0000000001, 1]],
+       "indices": [0, 1, 2]}]})",
+                                        "pack.json");
+  lucent::render_detail::PackedScene p = lucent::render_detail::pack_scene(s);
+  ASSERT_EQ(p.triangles.size(), 2u);
+  EXPECT_EQ(ng(p.triangles[0]), glm::dvec3(-1, 0, 0));
+  EXPECT_NEAR(glm::length(ng(p.triangles[1]) - glm::dvec3(0, 0, 1)), 0.0, 1e-7);
+}
+
+}  // namespace
