@@ -138,46 +138,47 @@ void expect_no_self_intersection(int e, int rays, bool in_double) {
   EXPECT_EQ(c.far_misses, 0) << "of " << c.rays << " rays at magnitude 1e" << e << "; " << where();
 }
 
-// lc_spawn_origin's one-ulp step (integer steps of the bits) is nextafter(o, copysign(inf, n))
-// per component where n is not zero, and o where it is: checked against std::nextafter on the
-// host for zeros of either sign (o = +-0 with n of either sign), subnormals, the largest floats,
-// powers of two (where an ulp changes size) and random values, in float and in double.
+// lc_step_along, lc_spawn_origin's one-ulp step (integer steps of the bits), is
+// nextafter(o, copysign(inf, n)) per component where n is not zero, and o where it is: checked
+// against std::nextafter on the host for zeros of either sign (o = +-0 with n of either sign),
+// subnormals, the largest values, powers of two (where an ulp changes size), values between
+// floats (in double) and random values, in float and in double.
 template <typename Real>
 void expect_spawn_step_is_nextafter(bool in_double) {
-  std::vector<float> values = {0.0f, -0.0f, 1e-45f,  -1e-45f,  1e-39f, -3e-39f, 1.0f,  -1.0f,
-                               2.0f, -0.5f, 3.4e38f, -3.4e38f, 1e-30f, 7.5f,    -1e8f, 0.1f};
+  std::vector<Real> values;  // finite in Real (the step is nextafter for finite o)
+  for (double v : {0.0,    -0.0,    1e-45,   -1e-45, 1e-39,
+                   -3e-39, 1.0,     -1.0,    2.0,    -0.5,
+                   3.4e38, -3.4e38, 1e-30,   7.5,    -1e8,
+                   0.1,    1e-320,  -5e-324, 1e300,  1.0 + std::ldexp(1.0, -40)})
+    if (std::isfinite(Real(v))) values.push_back(Real(v));
   std::mt19937 rng(7);
-  std::uniform_real_distribution<float> u(-1, 1);
+  std::uniform_real_distribution<double> u(-1, 1);
   std::uniform_int_distribution<int> ex(-40, 38);
-  for (int k = 0; k < 48; ++k) values.push_back(std::ldexp(u(rng), ex(rng)));
-  const float signs[] = {1.0f, -1.0f, 0.0f, -0.0f, 0.25f, -3.0f};
-  std::vector<cl_float4> in;
+  for (int k = 0; k < 48; ++k) values.push_back(Real(std::ldexp(u(rng), ex(rng))));
+  const Real signs[] = {1, -1, 0, -Real(0), 0.25, -3};
+  std::vector<Real> in;  // (o, 0) then (n, 0) per work-item
   for (size_t a = 0; a < values.size(); ++a)
-    for (int s = 0; s < 6; ++s) {
-      float p = values[a], n0 = signs[s], n1 = signs[(s + 1) % 6], n2 = signs[(s + a) % 6];
-      // perr 0 (o = p exactly: zeros reach the step) or a bound that moves o
-      float e = (a + s) % 3 == 0 ? 0.0f : std::fabs(p) * 1e-6f;
-      in.push_back({{p, -p, values[(a + 3) % values.size()], 0}});
-      in.push_back({{e, 0.0f, e, 0}});
-      in.push_back({{n0, n1, n2, 0}});
+    for (size_t s = 0; s < 6; ++s) {
+      Real o[3] = {values[a], -values[a], values[(a + 3) % values.size()]};
+      Real n[3] = {signs[s], signs[(s + 1) % 6], signs[(s + a) % 6]};
+      in.insert(in.end(), {o[0], o[1], o[2], 0, n[0], n[1], n[2], 0});
     }
-  const size_t count = in.size() / 3;
+  const size_t count = in.size() / 8;
   SpawnProbe& pr = probe(in_double);
-  cl::Buffer bi(pr.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                in.size() * sizeof(cl_float4), in.data());
-  cl::Buffer bo(pr.ctx.context, CL_MEM_WRITE_ONLY, 2 * count * 4 * sizeof(Real));
+  cl::Buffer bi(pr.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, in.size() * sizeof(Real),
+                in.data());
+  cl::Buffer bo(pr.ctx.context, CL_MEM_WRITE_ONLY, count * 4 * sizeof(Real));
   cl::Kernel k(pr.program, "probe_spawn_step");
   k.setArg(0, bi);
   k.setArg(1, bo);
   pr.ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(count));
-  std::vector<Real> out(2 * count * 4);
+  std::vector<Real> out(count * 4);
   pr.ctx.queue.enqueueReadBuffer(bo, CL_TRUE, 0, out.size() * sizeof(Real), out.data());
   int checked_zero = 0;
   for (size_t i = 0; i < count; ++i)
     for (int c = 0; c < 3; ++c) {
-      Real o = out[8 * i + c], got = out[8 * i + 4 + c];
-      float n = in[3 * i + 2].s[c];
-      Real want = n == 0 ? o : std::nextafter(o, std::copysign(Real(INFINITY), Real(n)));
+      Real o = in[8 * i + c], n = in[8 * i + 4 + c], got = out[4 * i + c];
+      Real want = n == 0 ? o : std::nextafter(o, std::copysign(Real(INFINITY), n));
       checked_zero += o == 0 && n != 0;
       ASSERT_TRUE(std::memcmp(&got, &want, sizeof(Real)) == 0)
           << "o = " << o << ", n = " << n << ": got " << got << ", nextafter gives " << want;

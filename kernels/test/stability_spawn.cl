@@ -165,20 +165,15 @@ __kernel void stability_spawn(__global const lc_sphere* spheres, lc_uint num_sph
 #undef U
 }
 
-/* lc_spawn_origin's last step, one input per work-item: in[3i .. 3i+2] = (p, perr, n) as float4
- * (w unused), widened to lc_real. out[2i] = p + d n, the point before the step (d as in
- * lc_spawn_origin), out[2i + 1] = lc_spawn_origin(p, perr, n); the host checks the second against
- * nextafter of the first (tests/test_stability_spawn.cpp, SpawnStep). */
+/* lc_step_along (util/math.cl), lc_spawn_origin's one-ulp step: in[2i] = o, in[2i + 1] = n (w
+ * unused); out[i] = lc_step_along(o, n), which the host checks against nextafter
+ * (tests/test_stability_spawn.cpp, SpawnStep). */
 #ifdef LC_DOUBLE
 typedef double4 spawn_real4;
 #else
 typedef float4 spawn_real4;
 #endif
-__kernel void probe_spawn_step(__global const float4* in, __global spawn_real4* out) {
+__kernel void probe_spawn_step(__global const spawn_real4* in, __global spawn_real4* out) {
   size_t i = get_global_id(0);
-  lc_real3 p = lc_real3_from_float3(in[3 * i].xyz), perr = lc_real3_from_float3(in[3 * i + 1].xyz);
-  lc_real3 n = lc_real3_from_float3(in[3 * i + 2].xyz);
-  lc_real d = dot(fabs(n), perr) + LC_REAL(2.0) * lc_max3r(perr);
-  out[2 * i] = (spawn_real4)(p + d * n, LC_REAL(0.0));
-  out[2 * i + 1] = (spawn_real4)(lc_spawn_origin(p, perr, n), LC_REAL(0.0));
+  out[i] = (spawn_real4)(lc_step_along(in[2 * i].xyz, in[2 * i + 1].xyz), LC_REAL(0.0));
 }

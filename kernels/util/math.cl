@@ -133,6 +133,18 @@ static inline float2 lc_unit_circle(float u) {
   return (q & 2) ? -v : v;
 }
 
+/* nextafter(o, copysign(INFINITY, n)) per component for finite o, o where n is 0, as integer
+ * steps of o's bits: +1 where o and n have the same sign, -1 where they differ, the smallest
+ * subnormal with n's sign from a zero. A dozen vector instructions where PoCL's vector nextafter
+ * took ~37 (tests/test_stability_spawn.cpp, SpawnStep). */
+static inline lc_real3 lc_step_along(lc_real3 o, lc_real3 n) {
+  lc_real3_bits ob = lc_as_real3_bits(o), nb = lc_as_real3_bits(n);
+  /* (ob ^ nb) < 0: the signs differ (-1, true), so the step is -1; otherwise +1 */
+  lc_real3_bits r = ob + (((ob ^ nb) < 0) | 1);
+  r = select(r, (nb & LC_REAL_SIGN_BIT) | 1, o == (lc_real3)(LC_REAL(0.0)));
+  return lc_real3_from_bits(select(r, ob, n == (lc_real3)(LC_REAL(0.0))));
+}
+
 /*
  * Origin for a ray leaving a surface point p towards the side the geometric normal n points to,
  * given perr, a bound on the absolute error of p per component. No fixed epsilon: the offset
@@ -142,10 +154,8 @@ static inline float2 lc_unit_circle(float u) {
  *    primitive's coordinates, which perr's component along n alone need not cover (a floor at
  *    y = 0 has perr.y = 0 however large it is);
  *  - then one ulp further per component along the sign of n (pbrt-v4; nothing where n is 0), so
- *    that rounding p + d n cannot undo it: nextafter(o, copysign(INFINITY, n)) for finite o, as
- *    integer steps of o's bits (+1 where o and n have the same sign, -1 where they differ, the
- *    smallest subnormal with n's sign from a zero): a dozen vector instructions where PoCL's
- *    vector nextafter took ~37 (and three scalar ones behind branches 90 more per path).
+ *    that rounding p + d n cannot undo it: lc_step_along (three scalar nextafter calls behind
+ *    branches on n's signs took 90 more instructions per path).
  * Everything is in lc_real: with --precision double, perr holds double's error bounds (a few ulps
  * of double, set by interaction_from_hit) and the ulp is double's, so the offset is ~5e8 times
  * smaller than in float.
@@ -157,12 +167,7 @@ static inline float2 lc_unit_circle(float u) {
  */
 static inline lc_real3 lc_spawn_origin(lc_real3 p, lc_real3 perr, lc_real3 n) {
   lc_real d = dot(fabs(n), perr) + LC_REAL(2.0) * lc_max3r(perr);
-  lc_real3 o = p + d * n;
-  lc_real3_bits ob = lc_as_real3_bits(o), nb = lc_as_real3_bits(n);
-  /* (ob ^ nb) < 0: the signs differ (-1, true), so the step is -1; otherwise +1 */
-  lc_real3_bits r = ob + (((ob ^ nb) < 0) | 1);
-  r = select(r, (nb & LC_REAL_SIGN_BIT) | 1, o == (lc_real3)(LC_REAL(0.0)));
-  return lc_real3_from_bits(select(r, ob, n == (lc_real3)(LC_REAL(0.0))));
+  return lc_step_along(p + d * n, n);
 }
 
 /* A cosine-distributed direction about +z (BSDFs, and lights emitting light paths). */

@@ -165,7 +165,8 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   for (size_t i = 0; i < scene.triangles.size(); ++i) {
     const Triangle& t = scene.triangles[i];
     glm::dvec3 v[3] = {scene.positions[t.v[0]], scene.positions[t.v[1]], scene.positions[t.v[2]]};
-    double area = 0.5 * glm::length(glm::cross(v[1] - v[0], v[2] - v[0]));
+    glm::dvec3 cr = glm::cross(v[1] - v[0], v[2] - v[0]);
+    double area = 0.5 * glm::length(cr);
     if (!finite3(v[0]) || !finite3(v[1]) || !finite3(v[2]) || !(area > 0) || !std::isfinite(area)) {
       ++p.skipped_triangles;
       continue;
@@ -175,7 +176,7 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     put3(d.v1, v[1]);
     put3(d.v2, v[2]);
     // collinear after rounding to float (it is never hit, but it may emit): the normal before
-    if (!set_triangle_normal(d)) put3(d.ng, glm::normalize(glm::cross(v[1] - v[0], v[2] - v[0])));
+    if (!set_triangle_normal(d)) put3(d.ng, cr / (2 * area));
     d.material = static_cast<lc_uint>(t.material);
     d.light = LC_INVALID;
     lc_triangle_attr a{};
