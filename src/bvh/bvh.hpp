@@ -72,10 +72,10 @@ struct Bvh {
 Bvh2 build_binary(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere>& spheres,
                   const BuildOptions& options = {});
 
-/// Collapses a binary tree built over `triangles` (then spheres) into wide nodes: each node takes
-/// the children of a binary node and opens its interior child of largest surface area until it
-/// has LC_BVH_WIDTH children or only leaves. Each leaf becomes 1 to 4 consecutive leaf blocks
-/// holding the vertices of its triangles.
+/// Collapses a binary tree built over `triangles` (then spheres) into wide nodes: each wide node
+/// is made from an interior binary node, opened, and takes as its children (at most LC_BVH_WIDTH)
+/// the descendants that give the wide tree the least SAH cost (bvh_wide.cpp). Each leaf becomes
+/// 1 to 4 consecutive leaf blocks holding the vertices of its triangles.
 Bvh collapse(const Bvh2& binary, const std::vector<lc_triangle>& triangles);
 
 /// build_binary, then collapse.
