@@ -43,9 +43,29 @@ static inline void lc_count64(__global lc_uint* counters, int low, int high, lc_
   if (old + v < old) atomic_inc(&counters[high]);
 }
 
+/* A pass's per-pixel sums: in double where the host defines LC_ACCUM_DOUBLE (devices with fp64,
+ * src/render/features.cpp), so that how a render's samples fall into passes (which follows the
+ * passes' measured times) changes its sums only in double rounding, far below what the float
+ * image keeps: a render with more than one pass is then the same image from run to run. In
+ * float otherwise. A sample's square of floats is exact in double. */
+#ifdef LC_ACCUM_DOUBLE
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+typedef double lc_accum;
+typedef double3 lc_accum3;
+typedef double4 lc_accum4;
+#define lc_accum3_from(v) convert_double3(v)
+#define lc_accum_float3(v) convert_float3(v)
+#else
+typedef float lc_accum;
+typedef float3 lc_accum3;
+typedef float4 lc_accum4;
+#define lc_accum3_from(v) (v)
+#define lc_accum_float3(v) (v)
+#endif
+
 __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
-    LC_SCENE_KERNEL_ARGS, __global const uint4* work, __global float4* out_sum,
-    __global float4* out_sumsq, __global lc_uint* counters, __global float4* light_sum,
+    LC_SCENE_KERNEL_ARGS, __global const uint4* work, __global lc_accum4* out_sum,
+    __global lc_accum4* out_sumsq, __global lc_uint* counters, __global float4* light_sum,
     __global float4* light_sumsq) {
   lc_uint gid = (lc_uint)get_global_id(0);
   lc_uint width = params->width, height = params->height;
@@ -77,7 +97,7 @@ __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
   lc_scene s = LC_SCENE_FROM_KERNEL_ARGS;
 
   lc_uint px = rng.pixel % width, py = rng.pixel / width;
-  float3 sum = (float3)(0.0f), sumsq = (float3)(0.0f);
+  lc_accum3 sum = (lc_accum3)(0.0f), sumsq = (lc_accum3)(0.0f);
   lc_uint accepted = 0, nonfinite = 0, rays = 0;
   for (lc_uint k = 0; k < count; ++k) {
     rng.sample = first + k;
@@ -99,17 +119,17 @@ __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
     /* a sample whose square (or the pass's sum of squares with it) overflows float counts as
      * non-finite too: an infinite sum of squares made the variance infinite, sent every pixel of
      * an adaptive render to its cap and wrote part files that merge refused */
-    float3 sq = L * L;
-    if (lc_isfinite3(L) && lc_isfinite3(sumsq + sq)) {
-      sum += L;
+    lc_accum3 l = lc_accum3_from(L), sq = l * l;
+    if (lc_isfinite3(L) && lc_isfinite3(lc_accum_float3(sumsq + sq))) {
+      sum += l;
       sumsq += sq;
       ++accepted;
     } else {
       ++nonfinite;
     }
   }
-  out_sum[gid] = (float4)(sum, (float)accepted);
-  out_sumsq[gid] = (float4)(sumsq, 0.0f);
+  out_sum[gid] = (lc_accum4)(sum, (lc_accum)accepted);
+  out_sumsq[gid] = (lc_accum4)(sumsq, (lc_accum)0.0f);
   if (nonfinite) lc_count64(counters, LC_COUNTER_NONFINITE, LC_COUNTER_NONFINITE_HIGH, nonfinite);
   lc_count64(counters, LC_COUNTER_RAYS, LC_COUNTER_RAYS_HIGH, rays);
 }

@@ -131,7 +131,8 @@ TEST(KernelSource, KernelDirOverridesTheEmbeddedCopy) {
   for (std::string& line : mk)
     if (line.find("out_sum[gid] =") != std::string::npos) {
       line =
-          "  out_sum[gid] = (float4)(0.25f, 0.5f, 0.75f, 1.0f) * (float)params->samples_per_pass;";
+          "  out_sum[gid] = (lc_accum4)(0.25f, 0.5f, 0.75f, 1.0f) * "
+          "(lc_accum)params->samples_per_pass;";
       changed = true;
     }
   ASSERT_TRUE(changed) << "megakernel.cl no longer writes out_sum[gid]: update this test";

@@ -3,13 +3,14 @@
 // overlapping or mismatched parts are refused with one line; a part cut short by SIGTERM records
 // the range it completed and merges; mpirun -np 2 lucent-mpi renders the one-process image.
 //
-// Equality: the kernel sums each pass's samples in float and the session adds the pass sums in
-// double. Rendered with one sample per pass (pass_seconds tiny), a split render adds the same
-// floats in another order, so the sums agree to double rounding (relative 1e-12). Through the
-// command line the pass sizes (1, 4, 16, ... spp, tuned to the device's speed) differ between a
-// part and the whole, so the float pass sums round differently: relative 1e-5 on the sums, while
-// a one-sample shift of the range (the error this guards against) changes them by the noise,
-// ~10% (checked below, so the tolerance can fail).
+// Equality: the kernel sums each pass's samples in double on a device with fp64 (in float on one
+// without) and the session adds the pass sums in double. Rendered with one sample per pass
+// (pass_seconds tiny), a split render adds the same floats in another order, so the sums agree to
+// double rounding (relative 1e-12). Through the command line the pass sizes (1, 4, 16, ... spp,
+// tuned to the device's speed) differ between a part and the whole, so float pass sums would
+// round differently: the tolerance is relative 1e-5 on the sums, while a one-sample shift of the
+// range (the error this guards against) changes them by the noise, ~10% (checked below, so the
+// tolerance can fail).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 

@@ -123,7 +123,9 @@ std::string build_options(const Scene& scene, const PackedScene& packed,
 }
 
 std::string device_defines(const DeviceInfo& device) {
-  return device.type == "CPU" && cl_util::is_pocl(device) ? " -D LC_DEVICE_POCL_CPU" : "";
+  std::string d = device.type == "CPU" && cl_util::is_pocl(device) ? " -D LC_DEVICE_POCL_CPU" : "";
+  if (device.fp64) d += " -D LC_ACCUM_DOUBLE";  // a pass's sums in double (megakernel.cl)
+  return d;
 }
 
 void check_precision_support(const DeviceInfo& device, Precision precision) {

@@ -59,6 +59,7 @@ DeviceLimits DeviceLimits::of(const cl_util::Device& device) {
   d.global_mem = device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
   d.host_mem = host_memory_allowed(&d.host_what);
   d.host_unified = (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+  d.fp64 = device.info.fp64;
   d.device = device.info.name;
   if (g_override) {
     d.max_alloc = lowered(d.max_alloc, g_override->max_alloc);
@@ -151,9 +152,13 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                    "the number of triangles and spheres"});
   const std::uint64_t scene_buffers = tri_bytes + sph_bytes + tex_bytes + bvh_tree;
   for (const DeviceLimits& d : devices) {
-    // the pass read-back (session.cpp: h_sum, h_sumsq, and with caustics h_light, h_lightsq:
-    // two films each, an adaptive work list's halves A and B)
-    const std::uint64_t film_bufs = (caustics ? 6 : 2) * npix * sizeof(cl_float4);
+    // the device's pass sums (double4 with fp64, else float4) and with caustics its light
+    // sums (float4: two films each, an adaptive work list's halves A and B)
+    const std::uint64_t sum_elem = d.fp64 ? sizeof(cl_double4) : sizeof(cl_float4);
+    const std::uint64_t light_bufs = (caustics ? 4 : 0) * npix * sizeof(cl_float4);
+    const std::uint64_t film_bufs = 2 * npix * sum_elem + light_bufs;
+    // the pass read-back (session.cpp: h_sum, h_sumsq, and with caustics h_light, h_lightsq),
+    // as large as the device's buffers
     std::uint64_t bytes = film_bufs;
     // a CPU device's buffers are host memory: the film's (and the work list), and the scene's
     if (d.host_unified) bytes += film_bufs + npix * sizeof(cl_uint4);
@@ -231,14 +236,15 @@ void check_adaptive_host_memory(const Scene& scene, const std::vector<DeviceLimi
   check_host_parts(scene, parts, host_limit, limit_what);
 }
 
-std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics) {
+std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics, bool fp64) {
   const std::uint64_t npix = std::uint64_t(width) * std::uint64_t(height);
   const std::string film = film_size(width, height);
-  // session.cpp's Worker: the work list, the pass sums, and the light paths' sums (one element
-  // each without caustics)
+  // session.cpp's Worker: the work list, the pass sums (double4 with fp64), and the light paths'
+  // sums (one element each without caustics)
+  const std::uint64_t sum = fp64 ? sizeof(cl_double4) : sizeof(cl_float4);
   std::vector<MemoryPart> parts = {
-      {"film sample sums (" + film + ")", npix * sizeof(cl_float4), "the film size"},
-      {"film sums of squares (" + film + ")", npix * sizeof(cl_float4), "the film size"},
+      {"film sample sums (" + film + ")", npix * sum, "the film size"},
+      {"film sums of squares (" + film + ")", npix * sum, "the film size"},
       {"film work list (" + film + ")", npix * sizeof(cl_uint4), "the film size"}};
   const std::uint64_t nl = caustics ? 2 * npix : 1;  // an adaptive work list's halves A and B
   parts.push_back({"caustics light sums (" + film + ")", nl * sizeof(cl_float4),
@@ -257,8 +263,9 @@ void check_device_memory(const Scene& scene, const PackedScene& packed,
                    reduce_buffer(#name)});
   LC_SCENE_BUFFERS(LUCENT_BUFFER_PART)
 #undef LUCENT_BUFFER_PART
-  for (MemoryPart& p : film_device_buffers(scene.film.width, scene.film.height,
-                                           (packed.params.flags & LC_FLAG_CAUSTICS) != 0))
+  for (MemoryPart& p :
+       film_device_buffers(scene.film.width, scene.film.height,
+                           (packed.params.flags & LC_FLAG_CAUSTICS) != 0, limits.fp64))
     parts.push_back(std::move(p));
   const std::string device = "device '" + limits.device + "'";
   // the largest buffer is the one to reduce first

@@ -107,7 +107,12 @@ struct Worker {
   cl::Buffer b_light, b_lightsq;
   bool light_buffers = false;
   size_t light_elems = 0;
-  std::vector<cl_float4> h_sum, h_sumsq, h_light, h_lightsq;
+  // a pass's sums as the kernel writes them: double4 where the device has fp64 (accum_double:
+  // LC_ACCUM_DOUBLE, render_detail::device_defines; h_sum, h_sumsq), else float4 (h_sum_f,
+  // h_sumsq_f); read through sum_at and sumsq_at
+  bool accum_double = false;
+  std::vector<cl_double4> h_sum, h_sumsq;
+  std::vector<cl_float4> h_sum_f, h_sumsq_f, h_light, h_lightsq;
   std::uint32_t pass_spp = 1;  // samples per pixel of its next pass (tuned to pass_seconds)
   DeviceShare share;           // of the accumulation
   DeviceShare call;            // of the render call in progress
@@ -115,8 +120,17 @@ struct Worker {
   // counts are these divided by the film's pixels, not a sum of truncated per-job quotients
   std::uint64_t share_samples = 0, call_samples = 0;
 
-  explicit Worker(const std::string& selector) : ctx(selector, "device") {
+  explicit Worker(const std::string& selector)
+      : ctx(selector, "device"), accum_double(ctx.device.info.fp64) {
     share.device = call.device = ctx.device.info.name;
+  }
+
+  /// Bytes of one element of the pass sums (b_sum, b_sumsq).
+  size_t sum_bytes() const { return accum_double ? sizeof(cl_double4) : sizeof(cl_float4); }
+  /// Component c of the last pass's sum (c = 3: accepted samples) and sum of squares of item k.
+  double sum_at(size_t k, int c) const { return accum_double ? h_sum[k].s[c] : h_sum_f[k].s[c]; }
+  double sumsq_at(size_t k, int c) const {
+    return accum_double ? h_sumsq[k].s[c] : h_sumsq_f[k].s[c];
   }
 
   size_t global_size(size_t items) const {
@@ -181,10 +195,17 @@ struct Worker {
     }
     q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global_size(items)),
                            cl::NDRange(program->work_group));
-    h_sum.resize(items);
-    h_sumsq.resize(items);
-    q.enqueueReadBuffer(b_sum, CL_FALSE, 0, items * sizeof(cl_float4), h_sum.data());
-    q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, items * sizeof(cl_float4), h_sumsq.data());
+    if (accum_double) {
+      h_sum.resize(items);
+      h_sumsq.resize(items);
+      q.enqueueReadBuffer(b_sum, CL_FALSE, 0, items * sizeof(cl_double4), h_sum.data());
+      q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, items * sizeof(cl_double4), h_sumsq.data());
+    } else {
+      h_sum_f.resize(items);
+      h_sumsq_f.resize(items);
+      q.enqueueReadBuffer(b_sum, CL_FALSE, 0, items * sizeof(cl_float4), h_sum_f.data());
+      q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, items * sizeof(cl_float4), h_sumsq_f.data());
+    }
     if (light) {
       h_light.resize(nl);
       h_lightsq.resize(nl);
@@ -420,8 +441,8 @@ struct Renderer::Impl {
         if (n != w.npix || !w.b_sum() || light != w.light_buffers) {
           w.npix = n;
           w.b_work = cl::Buffer(w.ctx.context, CL_MEM_READ_ONLY, n * sizeof(cl_uint4));
-          w.b_sum = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
-          w.b_sumsq = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float4));
+          w.b_sum = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * w.sum_bytes());
+          w.b_sumsq = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * w.sum_bytes());
           w.b_counters =
               cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
           const size_t nl = light ? n : 1;  // an adaptive render doubles it (ensure_light)
@@ -480,10 +501,10 @@ struct Renderer::Impl {
   void accumulate(const Worker& w, std::uint32_t n) {
     for (size_t i = 0; i < npix; ++i) {
       for (int c = 0; c < 3; ++c) {
-        sum[i * 3 + c] += w.h_sum[i].s[c];
-        sumsq[i * 3 + c] += w.h_sumsq[i].s[c];
+        sum[i * 3 + c] += w.sum_at(i, c);
+        sumsq[i * 3 + c] += w.sumsq_at(i, c);
       }
-      count[i] += static_cast<std::uint32_t>(w.h_sum[i].s[3]);
+      count[i] += static_cast<std::uint32_t>(w.sum_at(i, 3));
     }
     if (!light_sum.empty()) {
       for (size_t i = 0; i < npix; ++i)
@@ -787,10 +808,10 @@ struct Renderer::Impl {
           Half& h = halves[e.s[3]];
           const size_t i = e.s[0];
           for (int c = 0; c < 3; ++c) {
-            h.sum[i * 3 + c] += w.h_sum[k].s[c];
-            h.sumsq[i * 3 + c] += w.h_sumsq[k].s[c];
+            h.sum[i * 3 + c] += w.sum_at(k, c);
+            h.sumsq[i * 3 + c] += w.sumsq_at(k, c);
           }
-          h.count[i] += static_cast<std::uint32_t>(w.h_sum[k].s[3]);
+          h.count[i] += static_cast<std::uint32_t>(w.sum_at(k, 3));
           h.launched[i] += e.s[2];
           if (!h.light_sum.empty()) h.light_paths += e.s[2];  // one per camera sample
           samples += e.s[2];
