@@ -46,7 +46,8 @@ static inline void lc_count64(__global lc_uint* counters, int low, int high, lc_
 /* A pass's per-pixel sums: in double where the host defines LC_ACCUM_DOUBLE (devices with fp64,
  * src/render/features.cpp), so that how a render's samples fall into passes (which follows the
  * passes' measured times) changes its sums only in double rounding, far below what the float
- * image keeps: a render with more than one pass is then the same image from run to run. In
+ * image keeps: a render with more than one pass is then the same image from run to run (unless
+ * a pass's sum of squares comes near FLT_MAX, where the check below rejects samples by pass). In
  * float otherwise. A sample's square of floats is exact in double. */
 #ifdef LC_ACCUM_DOUBLE
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
