@@ -49,7 +49,7 @@ if ! command -v "$cxx" >/dev/null ||
 fi
 
 flags="${FUZZ_FLAGS:--O1 -g1} -DNDEBUG"
-cmake -S . -B build-fuzz -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" \
+cmake -S . -B build-fuzz $(scripts/generator.sh build-fuzz) -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLUCENT_FUZZ=ON -DLUCENT_BUILD_TESTS=OFF \
   -DLUCENT_BUILD_BENCH=OFF -DLUCENT_FUZZ_DECODER_CMP="${FUZZ_DECODER_CMP:-ON}" \
   "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$flags" \

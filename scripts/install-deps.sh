@@ -8,7 +8,7 @@
 set -euo pipefail
 
 packages=(
-  cmake g++ make pkg-config
+  cmake g++ make ninja-build pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers
   libglm-dev libtinyobjloader-dev libstb-dev libgtest-dev
   nlohmann-json3-dev libcli11-dev libtinyexr-dev

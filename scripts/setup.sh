@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+cmake -S . -B build $(scripts/generator.sh build) -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(scripts/cpus.sh)" --target lucent_cli
 mkdir -p out
 build/lucent render scenes/default.json -o out/default.png

@@ -33,7 +33,7 @@ timed() {
   time "$@"
 }
 
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+cmake -S . -B build $(scripts/generator.sh build) -DCMAKE_BUILD_TYPE=Release
 timed "release build" cmake --build build -j"$jobs"
 timed "release tests" ctest --test-dir build --output-on-failure -j"$jobs"
 
@@ -57,7 +57,7 @@ if [[ "${LUCENT_SANITIZE:-0}" == "1" ]]; then
   rm -rf "$probe"
   echo "test: sanitizer build (ASan + UBSan; $asan_name, $asan_opt)"
   # -g1: file:line in every report at a fraction of -g's compile time
-  cmake -S . -B build-asan "${asan_compiler[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  cmake -S . -B build-asan $(scripts/generator.sh build-asan) "${asan_compiler[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DLUCENT_SANITIZE=ON -DLUCENT_BUILD_BENCH=OFF \
     "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$asan_opt -g1 -DNDEBUG" \
     "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$asan_opt -g1 -DNDEBUG"
