@@ -53,12 +53,16 @@ std::uint64_t total(const std::vector<MemoryPart>& parts) {
 
 }  // namespace
 
+bool buffers_in_host_memory(const cl::Device& device) {
+  return (device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+}
+
 DeviceLimits DeviceLimits::of(const cl_util::Device& device) {
   DeviceLimits d;
   d.max_alloc = device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
   d.global_mem = device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
   d.host_mem = host_memory_allowed(&d.host_what);
-  d.host_unified = (device.device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+  d.host_unified = buffers_in_host_memory(device.device);
   d.fp64 = device.info.fp64;
   d.device = device.info.name;
   if (g_override) {
@@ -157,11 +161,12 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
     const std::uint64_t sum_elem = d.fp64 ? sizeof(cl_double4) : sizeof(cl_float4);
     const std::uint64_t light_bufs = (caustics ? 4 : 0) * npix * sizeof(cl_float4);
     const std::uint64_t film_bufs = 2 * npix * sum_elem + light_bufs;
-    // the pass read-back (session.cpp: h_sum, h_sumsq, and with caustics h_light, h_lightsq),
-    // as large as the device's buffers
+    // a CPU device's buffers are host memory: the film's (and the work list), and the scene's;
+    // its pass results are mapped there (session.cpp). Another device's results are read back
+    // into host copies as large as its buffers (h_sum, h_sumsq, and with caustics h_light,
+    // h_lightsq).
     std::uint64_t bytes = film_bufs;
-    // a CPU device's buffers are host memory: the film's (and the work list), and the scene's
-    if (d.host_unified) bytes += film_bufs + npix * sizeof(cl_uint4);
+    if (d.host_unified) bytes += npix * sizeof(cl_uint4);
     parts.push_back({"the buffers of device '" + d.device + "' for the " + film + " film" +
                          (d.host_unified ? " (host memory)" : ""),
                      bytes, "the film size"});

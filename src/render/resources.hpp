@@ -17,6 +17,10 @@ namespace lucent::render_detail {
 using sys::format_bytes;
 using sys::host_memory_limit;
 
+/// A CPU device: its buffers are host memory. A session maps its pass results there instead of
+/// copying them (session.cpp), and the host memory estimate counts its buffers.
+bool buffers_in_host_memory(const cl::Device& device);
+
 /// The limits a scene is checked against. Tests shrink them to exercise the checks without
 /// allocating; 0 means "no limit known".
 struct DeviceLimits {

@@ -92,6 +92,46 @@ struct Program {
   double build_seconds = 0;
 };
 
+/// A pass output buffer's contents on the host, from `fetch` until the next `release`: on a
+/// device whose buffers are host memory (a CPU device) the buffer itself, mapped for reading
+/// (no copy: with fp64 sums 64 bytes per pixel less host memory), else a copy read into `copy`.
+template <class T>
+struct HostView {
+  std::vector<T> copy;
+  const T* data = nullptr;
+  cl::Buffer mapped_buffer;  // set while mapped
+  void* mapped = nullptr;
+
+  /// Enqueues the read (or the map) of the first `n` elements of `b`; valid once the queue has
+  /// finished it.
+  void fetch(cl::CommandQueue& q, const cl::Buffer& b, size_t n, bool map) {
+    release(q);
+    if (map) {
+      mapped = q.enqueueMapBuffer(b, CL_FALSE, CL_MAP_READ, 0, n * sizeof(T));
+      mapped_buffer = b;
+      data = static_cast<const T*>(mapped);
+    } else {
+      copy.resize(n);
+      q.enqueueReadBuffer(b, CL_FALSE, 0, n * sizeof(T), copy.data());
+      data = copy.data();
+    }
+  }
+  /// Enqueues the unmap, before anything writes the buffer again or releases it.
+  void release(cl::CommandQueue& q) {
+    if (mapped) q.enqueueUnmapMemObject(mapped_buffer, mapped);
+    mapped = nullptr;
+    mapped_buffer = cl::Buffer();
+    data = copy.empty() ? nullptr : copy.data();
+  }
+  /// Frees the copy (its buffer is gone).
+  void drop(cl::CommandQueue& q) {
+    release(q);
+    std::vector<T>().swap(copy);
+    data = nullptr;
+  }
+  const T& operator[](size_t k) const { return data[k]; }
+};
+
 /// One device of a session: its context, the programs built for it, the scene's buffers on it,
 /// the pass output buffers, and its part of the work.
 struct Worker {
@@ -109,10 +149,12 @@ struct Worker {
   size_t light_elems = 0;
   // a pass's sums as the kernel writes them: double4 where the device has fp64 (accum_double:
   // LC_ACCUM_DOUBLE, render_detail::device_defines; h_sum, h_sumsq), else float4 (h_sum_f,
-  // h_sumsq_f); read through sum_at and sumsq_at
+  // h_sumsq_f); read through sum_at and sumsq_at. Mapped, not copied, where the device's
+  // buffers are host memory (map_results: a CPU device, as resources.cpp counts it).
   bool accum_double = false;
-  std::vector<cl_double4> h_sum, h_sumsq;
-  std::vector<cl_float4> h_sum_f, h_sumsq_f, h_light, h_lightsq;
+  bool map_results = false;
+  HostView<cl_double4> h_sum, h_sumsq;
+  HostView<cl_float4> h_sum_f, h_sumsq_f, h_light, h_lightsq;
   std::uint32_t pass_spp = 1;  // samples per pixel of its next pass (tuned to pass_seconds)
   DeviceShare share;           // of the accumulation
   DeviceShare call;            // of the render call in progress
@@ -121,8 +163,26 @@ struct Worker {
   std::uint64_t share_samples = 0, call_samples = 0;
 
   explicit Worker(const std::string& selector)
-      : ctx(selector, "device"), accum_double(ctx.device.info.fp64) {
+      : ctx(selector, "device"),
+        accum_double(ctx.device.info.fp64),
+        map_results(render_detail::buffers_in_host_memory(ctx.device.device)) {
     share.device = call.device = ctx.device.info.name;
+  }
+  Worker(const Worker&) = delete;
+  Worker& operator=(const Worker&) = delete;
+  ~Worker() {
+    try {  // no mapping outlives its buffer
+      release_results();
+      ctx.queue.finish();
+    } catch (...) {
+    }
+  }
+
+  /// Unmaps the last pass's results: before a launch writes the buffers or they are replaced.
+  void release_results() {
+    for (HostView<cl_double4>* v : {&h_sum, &h_sumsq}) v->release(ctx.queue);
+    for (HostView<cl_float4>* v : {&h_sum_f, &h_sumsq_f, &h_light, &h_lightsq})
+      v->release(ctx.queue);
   }
 
   /// Bytes of one element of the pass sums (b_sum, b_sumsq).
@@ -141,8 +201,10 @@ struct Worker {
   /// Makes the light buffers hold at least `elems` elements (an adaptive render's two films).
   void ensure_light(size_t elems) {
     if (light_elems >= elems) return;
-    b_light = cl::Buffer(ctx.context, CL_MEM_READ_WRITE, elems * sizeof(cl_float4));
-    b_lightsq = cl::Buffer(ctx.context, CL_MEM_READ_WRITE, elems * sizeof(cl_float4));
+    release_results();
+    const cl_mem_flags host = map_results ? CL_MEM_ALLOC_HOST_PTR : 0;
+    b_light = cl::Buffer(ctx.context, CL_MEM_READ_WRITE | host, elems * sizeof(cl_float4));
+    b_lightsq = cl::Buffer(ctx.context, CL_MEM_READ_WRITE | host, elems * sizeof(cl_float4));
     light_elems = elems;
     set_args();
   }
@@ -182,6 +244,7 @@ struct Worker {
     lc_uint initial[LC_COUNTER_COUNT] = {};
     initial[LC_COUNTER_NONFINITE] = initial[LC_COUNTER_RAYS] = start;
     cl::CommandQueue& q = ctx.queue;
+    release_results();
     q.enqueueWriteBuffer(dev->params, CL_FALSE, 0, sizeof(P), &P);
     q.enqueueWriteBuffer(b_counters, CL_FALSE, 0, sizeof(initial), initial);
     if (entries)
@@ -196,21 +259,15 @@ struct Worker {
     q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global_size(items)),
                            cl::NDRange(program->work_group));
     if (accum_double) {
-      h_sum.resize(items);
-      h_sumsq.resize(items);
-      q.enqueueReadBuffer(b_sum, CL_FALSE, 0, items * sizeof(cl_double4), h_sum.data());
-      q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, items * sizeof(cl_double4), h_sumsq.data());
+      h_sum.fetch(q, b_sum, items, map_results);
+      h_sumsq.fetch(q, b_sumsq, items, map_results);
     } else {
-      h_sum_f.resize(items);
-      h_sumsq_f.resize(items);
-      q.enqueueReadBuffer(b_sum, CL_FALSE, 0, items * sizeof(cl_float4), h_sum_f.data());
-      q.enqueueReadBuffer(b_sumsq, CL_FALSE, 0, items * sizeof(cl_float4), h_sumsq_f.data());
+      h_sum_f.fetch(q, b_sum, items, map_results);
+      h_sumsq_f.fetch(q, b_sumsq, items, map_results);
     }
     if (light) {
-      h_light.resize(nl);
-      h_lightsq.resize(nl);
-      q.enqueueReadBuffer(b_light, CL_FALSE, 0, nl * sizeof(cl_float4), h_light.data());
-      q.enqueueReadBuffer(b_lightsq, CL_FALSE, 0, nl * sizeof(cl_float4), h_lightsq.data());
+      h_light.fetch(q, b_light, nl, map_results);
+      h_lightsq.fetch(q, b_lightsq, nl, map_results);
     }
     lc_uint c[LC_COUNTER_COUNT];
     q.enqueueReadBuffer(b_counters, CL_TRUE, 0, sizeof(c), c);
@@ -439,20 +496,23 @@ struct Renderer::Impl {
         // the light sums take a film's worth of memory only when the kernel traces light paths
         const bool light = next.params.flags & LC_FLAG_CAUSTICS;
         if (n != w.npix || !w.b_sum() || light != w.light_buffers) {
+          w.release_results();
           w.npix = n;
           w.b_work = cl::Buffer(w.ctx.context, CL_MEM_READ_ONLY, n * sizeof(cl_uint4));
-          w.b_sum = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * w.sum_bytes());
-          w.b_sumsq = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY, n * w.sum_bytes());
+          // mapped for reading on a CPU device (HostView): host memory the device writes
+          const cl_mem_flags host = w.map_results ? CL_MEM_ALLOC_HOST_PTR : 0;
+          w.b_sum = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY | host, n * w.sum_bytes());
+          w.b_sumsq = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY | host, n * w.sum_bytes());
           w.b_counters =
               cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
           const size_t nl = light ? n : 1;  // an adaptive render doubles it (ensure_light)
-          w.b_light = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
-          w.b_lightsq = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
+          w.b_light = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE | host, nl * sizeof(cl_float4));
+          w.b_lightsq = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE | host, nl * sizeof(cl_float4));
           w.light_buffers = light;
           w.light_elems = nl;
           if (!light) {
-            std::vector<cl_float4>().swap(w.h_light);
-            std::vector<cl_float4>().swap(w.h_lightsq);
+            w.h_light.drop(w.ctx.queue);
+            w.h_lightsq.drop(w.ctx.queue);
           }
         }
         w.set_args();
