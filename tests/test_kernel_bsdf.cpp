@@ -11,6 +11,7 @@
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
+#include "probe_launch.hpp"
 #include "scene/material_type.hpp"
 #include "shared/types.h"
 #include "support.hpp"
@@ -33,7 +34,7 @@ struct Probe {
     cl::Kernel k(program, name);
     k.setArg(0, bin);
     k.setArg(1, bout);
-    ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(in.size()), cl::NullRange);
+    lucent::test::launch_probe(ctx.queue, k, in.size());
     std::vector<Out> out(in.size());
     ctx.queue.enqueueReadBuffer(bout, CL_TRUE, 0, out.size() * sizeof(Out), out.data());
     return out;
@@ -161,7 +162,7 @@ void chi_square(const ChiSquareCase& tc) {
   ks.setArg(2, cl_int(tc.front));
   ks.setArg(3, bwi);
   ks.setArg(4, bw);
-  p.ctx.queue.enqueueNDRangeKernel(ks, cl::NullRange, cl::NDRange(N), cl::NullRange);
+  lucent::test::launch_probe(p.ctx.queue, ks, N);
   std::vector<cl_float4> wi(N), weight(N);
   p.ctx.queue.enqueueReadBuffer(bwi, CL_TRUE, 0, N * sizeof(cl_float4), wi.data());
   p.ctx.queue.enqueueReadBuffer(bw, CL_TRUE, 0, N * sizeof(cl_float4), weight.data());
@@ -204,7 +205,7 @@ void chi_square(const ChiSquareCase& tc) {
   ke.setArg(2, bwi2);
   ke.setArg(3, bout);
   ke.setArg(4, cl_int(tc.front));
-  p.ctx.queue.enqueueNDRangeKernel(ke, cl::NullRange, cl::NDRange(dirs.size()), cl::NullRange);
+  lucent::test::launch_probe(p.ctx.queue, ke, dirs.size());
   std::vector<cl_float4> ev(dirs.size());
   p.ctx.queue.enqueueReadBuffer(bout, CL_TRUE, 0, ev.size() * sizeof(cl_float4), ev.data());
   // solid angle of a sub-cell in (z, phi): dz dphi
@@ -263,7 +264,7 @@ void chi_square(const ChiSquareCase& tc) {
   ke.setArg(1, b4);
   ke.setArg(2, b3);
   ke.setArg(3, b5);
-  p.ctx.queue.enqueueNDRangeKernel(ke, cl::NullRange, cl::NDRange(some_wi.size()), cl::NullRange);
+  lucent::test::launch_probe(p.ctx.queue, ke, some_wi.size());
   std::vector<cl_float4> fe(some_wi.size());
   p.ctx.queue.enqueueReadBuffer(b5, CL_TRUE, 0, fe.size() * sizeof(cl_float4), fe.data());
   for (size_t i = 0; i < fe.size(); ++i) {

@@ -8,6 +8,7 @@
 
 #include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
+#include "probe_launch.hpp"
 #include "render/device_scene.hpp"
 #include "render/pack.hpp"
 #include "support.hpp"
@@ -41,7 +42,7 @@ std::vector<Out> run_probe(const lucent::render_detail::DeviceScene& dev, const 
   k.setArg(a++, p);
   k.setArg(a++, bi);
   k.setArg(a++, bo);
-  pr.ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(in.size()), cl::NullRange);
+  lucent::test::launch_probe(pr.ctx.queue, k, in.size());
   std::vector<Out> out(in.size());
   pr.ctx.queue.enqueueReadBuffer(bo, CL_TRUE, 0, out.size() * sizeof(Out), out.data());
   return out;
@@ -66,7 +67,7 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
   int a = dev.set_args(ks);
   ks.setArg(a++, p);
   ks.setArg(a++, out);
-  pr.ctx.queue.enqueueNDRangeKernel(ks, cl::NullRange, cl::NDRange(N), cl::NullRange);
+  lucent::test::launch_probe(pr.ctx.queue, ks, N);
   std::vector<cl_float4> s(N);
   pr.ctx.queue.enqueueReadBuffer(out, CL_TRUE, 0, N * sizeof(cl_float4), s.data());
 

@@ -21,6 +21,7 @@
 #include "lucent/compare.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/session.hpp"
+#include "probe_launch.hpp"
 #include "render/adaptive.hpp"
 #include "shared/rng.h"
 #include "support.hpp"
@@ -211,7 +212,7 @@ TEST(SobolSampler, KernelVectorNumbersEqualTheScalarOnes) {
     k.setArg(1, static_cast<cl_uint>(t == SamplerType::Sobol ? LC_SAMPLER_SOBOL
                                                              : LC_SAMPLER_INDEPENDENT));
     k.setArg(2, b_out);
-    ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(query.size()), cl::NullRange);
+    lucent::test::launch_probe(ctx.queue, k, query.size());
     std::vector<float> out(query.size() * 10);
     ctx.queue.enqueueReadBuffer(b_out, CL_TRUE, 0, out.size() * sizeof(float), out.data());
     size_t wrong = 0;

@@ -16,6 +16,7 @@
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
+#include "probe_launch.hpp"
 #include "render/pack.hpp"
 #include "shared/types.h"
 #include "support.hpp"
@@ -100,7 +101,7 @@ Counts run_decade(double m, int rays_wanted, std::uint32_t seed, bool in_double 
   k.setArg(6, be);
   // two rays per hit point; a few aimed rays miss (grazing a triangle's edge) and are skipped
   const std::size_t items = static_cast<std::size_t>(rays_wanted / 2 * 1.02);
-  p.ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(items), cl::NullRange);
+  lucent::test::launch_probe(p.ctx.queue, k, items);
   cl_int out[21];
   Counts c;
   p.ctx.queue.enqueueReadBuffer(bc, CL_TRUE, 0, sizeof out, out);
@@ -171,7 +172,7 @@ void expect_spawn_step_is_nextafter(bool in_double) {
   cl::Kernel k(pr.program, "probe_spawn_step");
   k.setArg(0, bi);
   k.setArg(1, bo);
-  pr.ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(count));
+  lucent::test::launch_probe(pr.ctx.queue, k, count);
   std::vector<Real> out(count * 4);
   pr.ctx.queue.enqueueReadBuffer(bo, CL_TRUE, 0, out.size() * sizeof(Real), out.data());
   int checked_zero = 0;

@@ -11,6 +11,7 @@
 
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
+#include "probe_launch.hpp"
 #include "render/pack.hpp"
 #include "support.hpp"
 
@@ -72,7 +73,7 @@ std::vector<cl_float4> lookup(const lucent::Scene& scene, const std::vector<Quer
   k.setArg(2, b_index);
   k.setArg(3, b_uv);
   k.setArg(4, b_out);
-  p.ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(q.size()), cl::NullRange);
+  lucent::test::launch_probe(p.ctx.queue, k, q.size());
   std::vector<cl_float4> out(q.size());
   p.ctx.queue.enqueueReadBuffer(b_out, CL_TRUE, 0, out.size() * sizeof(cl_float4), out.data());
   return out;

@@ -57,8 +57,11 @@ std::vector<TraceHit> DeviceTracer::trace(const std::vector<TraceRay>& rays, boo
     kernel_.setArg(a++, static_cast<cl_uint>(any_hit ? 1 : 0));
     ctx_.queue.finish();
     auto t0 = std::chrono::steady_clock::now();
-    ctx_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(rays.size()),
-                                    cl::NullRange);
+    // work-groups of 64, as the renderer's (the kernel skips the items past `count`): PoCL
+    // compiles a work-group function per local size, and left to choose it follows the number
+    // of rays (nine functions of this kernel over the suite)
+    const size_t global = (rays.size() + 63) / 64 * 64;
+    ctx_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(global), cl::NDRange(64));
     ctx_.queue.finish();
     kernel_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ctx_.queue.enqueueReadBuffer(hb, CL_TRUE, 0, hits.size() * sizeof(TraceHit), hits.data());
