@@ -171,6 +171,7 @@ struct Worker {
   Worker(const Worker&) = delete;
   Worker& operator=(const Worker&) = delete;
   ~Worker() {
+    if (!map_results) return;
     try {  // no mapping outlives its buffer
       release_results();
       ctx.queue.finish();
