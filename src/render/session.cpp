@@ -186,6 +186,12 @@ struct Worker {
       v->release(ctx.queue);
   }
 
+  /// A pass output buffer of `bytes`: on a CPU device host memory the device writes, mapped for
+  /// reading after each pass (HostView), elsewhere device memory read back.
+  cl::Buffer result_buffer(cl_mem_flags access, size_t bytes) const {
+    return cl::Buffer(ctx.context, access | (map_results ? CL_MEM_ALLOC_HOST_PTR : 0), bytes);
+  }
+
   /// Bytes of one element of the pass sums (b_sum, b_sumsq).
   size_t sum_bytes() const { return accum_double ? sizeof(cl_double4) : sizeof(cl_float4); }
   /// Component c of the last pass's sum (c = 3: accepted samples) and sum of squares of item k.
@@ -203,9 +209,8 @@ struct Worker {
   void ensure_light(size_t elems) {
     if (light_elems >= elems) return;
     release_results();
-    const cl_mem_flags host = map_results ? CL_MEM_ALLOC_HOST_PTR : 0;
-    b_light = cl::Buffer(ctx.context, CL_MEM_READ_WRITE | host, elems * sizeof(cl_float4));
-    b_lightsq = cl::Buffer(ctx.context, CL_MEM_READ_WRITE | host, elems * sizeof(cl_float4));
+    b_light = result_buffer(CL_MEM_READ_WRITE, elems * sizeof(cl_float4));
+    b_lightsq = result_buffer(CL_MEM_READ_WRITE, elems * sizeof(cl_float4));
     light_elems = elems;
     set_args();
   }
@@ -500,15 +505,13 @@ struct Renderer::Impl {
           w.release_results();
           w.npix = n;
           w.b_work = cl::Buffer(w.ctx.context, CL_MEM_READ_ONLY, n * sizeof(cl_uint4));
-          // mapped for reading on a CPU device (HostView): host memory the device writes
-          const cl_mem_flags host = w.map_results ? CL_MEM_ALLOC_HOST_PTR : 0;
-          w.b_sum = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY | host, n * w.sum_bytes());
-          w.b_sumsq = cl::Buffer(w.ctx.context, CL_MEM_WRITE_ONLY | host, n * w.sum_bytes());
+          w.b_sum = w.result_buffer(CL_MEM_WRITE_ONLY, n * w.sum_bytes());
+          w.b_sumsq = w.result_buffer(CL_MEM_WRITE_ONLY, n * w.sum_bytes());
           w.b_counters =
               cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
           const size_t nl = light ? n : 1;  // an adaptive render doubles it (ensure_light)
-          w.b_light = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE | host, nl * sizeof(cl_float4));
-          w.b_lightsq = cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE | host, nl * sizeof(cl_float4));
+          w.b_light = w.result_buffer(CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
+          w.b_lightsq = w.result_buffer(CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
           w.light_buffers = light;
           w.light_elems = nl;
           if (!light) {
