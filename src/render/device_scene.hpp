@@ -32,4 +32,15 @@ struct DeviceScene {
   int set_args(cl::Kernel& kernel, int first = 0) const;
 };
 
+/// A CPU device's scene buffers of kHugePageMinBuffer bytes or more live in host blocks of whole
+/// huge pages (device_scene.cpp); host_block_bytes() is the host memory a buffer of `bytes` then
+/// takes on such a device.
+constexpr std::size_t kHugePageBytes = std::size_t(2) << 20;
+constexpr std::size_t kHugePageMinBuffer = std::size_t(1) << 20;
+std::uint64_t host_block_bytes(std::uint64_t bytes);
+
+/// Host blocks in huge pages that scene buffers of CPU devices use now (device_scene.cpp): each
+/// is freed when its buffer is deleted. For tests.
+int huge_page_blocks();
+
 }  // namespace lucent::render_detail

@@ -7,6 +7,7 @@
 #include "bvh/bvh.hpp"
 #include "core/host_memory.hpp"
 #include "lucent/error.hpp"
+#include "render/device_scene.hpp"
 
 namespace lucent::render_detail {
 
@@ -154,7 +155,12 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                    tex_bytes, "the textures' resolution"});
   parts.push_back({"the BVH of " + std::to_string(nprim) + " primitives", bvh_bytes,
                    "the number of triangles and spheres"});
-  const std::uint64_t scene_buffers = tri_bytes + sph_bytes + tex_bytes + bvh_tree;
+  // on a CPU device each large buffer takes whole huge pages (device_scene.cpp)
+  std::uint64_t scene_buffers = 0;
+  for (std::uint64_t b :
+       {ntri * sizeof(lc_triangle), ntri * sizeof(lc_triangle_attr), sph_bytes, tex_bytes,
+        (nprim / 2 + 1) * sizeof(lc_bvh_leaf), (nprim / 4 + 1) * sizeof(lc_bvh_node)})
+    scene_buffers += host_block_bytes(b);
   for (const DeviceLimits& d : devices) {
     // the device's pass sums (double4 with fp64, else float4) and with caustics its light
     // sums (float4: two films each, an adaptive work list's halves A and B)
