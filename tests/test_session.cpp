@@ -794,7 +794,7 @@ TEST(Session, LargeSceneBuffersOfACpuDeviceLiveInHugePageBlocks) {
     r.set_scene(scene);
     r.render(4);
     huge = r.result();
-    const lucent::DeviceInfo& d = r.devices().at(0);
+    const lucent::DeviceInfo d = r.devices().at(0);  // devices() returns a copy
     if (d.type != "CPU") GTEST_SKIP() << "not a CPU device: " << d.name;
     EXPECT_EQ(lucent::render_detail::huge_page_blocks() - before, 2)
         << "the triangles and their attributes";
