@@ -764,8 +764,9 @@ TEST(Session, CancelBetweenTheCallsOfAScopeStopsTheNext) {
 
 // A CPU device's scene buffers of 1 MiB or more live in host blocks of whole huge pages
 // (device_scene.cpp), each freed when its buffer is deleted; LUCENT_HUGE_PAGES=0 copies them as
-// before, and both render the same image. An icosphere of 20,480 triangles: its triangles and
-// their attributes (1.25 MiB each) take such blocks.
+// before, and both render the same images, also after the mesh moved (the new contents written
+// into the blocks in place). An icosphere of 20,480 triangles: its triangles and their
+// attributes (1.25 MiB each) take such blocks.
 TEST(Session, LargeSceneBuffersOfACpuDeviceLiveInHugePageBlocks) {
   const lucent::bvh::meshes::IndexedMesh ico = lucent::bvh::meshes::icosphere(5);
   lucent::SceneBuilder b;
@@ -787,8 +788,12 @@ TEST(Session, LargeSceneBuffersOfACpuDeviceLiveInHugePageBlocks) {
   const Scene scene = b.build();
   ASSERT_EQ(scene.triangles.size(), 20480u);
 
+  // the mesh moved: buffers of the same sizes, written into the blocks in place
+  Scene moved = scene;
+  for (glm::dvec3& p : moved.positions) p.x += 0.25;
+
   const int before = lucent::render_detail::huge_page_blocks();
-  RenderResult huge;
+  RenderResult huge, huge_moved;
   {
     Renderer r = session();
     r.set_scene(scene);
@@ -798,6 +803,10 @@ TEST(Session, LargeSceneBuffersOfACpuDeviceLiveInHugePageBlocks) {
     if (d.type != "CPU") GTEST_SKIP() << "not a CPU device: " << d.name;
     EXPECT_EQ(lucent::render_detail::huge_page_blocks() - before, 2)
         << "the triangles and their attributes";
+    r.set_scene(moved);
+    r.render(4);
+    huge_moved = r.result();
+    EXPECT_EQ(lucent::render_detail::huge_page_blocks() - before, 2);
   }
   // freed with the session's buffers (by their destructor callbacks, which may run late)
   for (int i = 0; i < 100 && lucent::render_detail::huge_page_blocks() != before; ++i)
@@ -805,10 +814,13 @@ TEST(Session, LargeSceneBuffersOfACpuDeviceLiveInHugePageBlocks) {
   EXPECT_EQ(lucent::render_detail::huge_page_blocks(), before);
 
   lucent::test::ScopedEnv off("LUCENT_HUGE_PAGES", "0");
-  Renderer r = session();
-  r.set_scene(scene);
-  r.render(4);
-  EXPECT_EQ(lucent::render_detail::huge_page_blocks(), before);
-  EXPECT_TRUE(same_image(huge, r.result()));
+  for (const Scene* sc : std::vector<const Scene*>{&scene, &moved}) {
+    Renderer r = session();
+    r.set_scene(*sc);
+    r.render(4);
+    EXPECT_EQ(lucent::render_detail::huge_page_blocks(), before);
+    EXPECT_TRUE(same_image(sc == &scene ? huge : huge_moved, r.result()));
+  }
+  EXPECT_FALSE(same_image(huge, huge_moved)) << "the mesh moved";
   EXPECT_GT(huge.mean.pixel(8, 6)[0], 0.0f) << "the sphere is lit";
 }
