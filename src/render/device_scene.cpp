@@ -69,18 +69,9 @@ cl::Buffer huge_page_buffer(const cl_util::Context& ctx, const void* data, std::
 
 template <typename T>
 cl::Buffer make_buffer(const cl_util::Context& ctx, const std::vector<T>& v) {
-  // OpenCL forbids empty buffers: keep one element. The data is copied when the buffer is
-  // created (CL_MEM_COPY_HOST_PTR, or into the huge-page block), so `v` may be a temporary: an
-  // asynchronous write from it would read freed memory (AddressSanitizer caught exactly that).
+  // OpenCL forbids empty buffers: keep one element
   if (v.empty()) return cl::Buffer(ctx.context, CL_MEM_READ_ONLY, sizeof(T));
-  const std::size_t bytes = v.size() * sizeof(T);
-  if (bytes >= kHugePageMinBuffer && buffers_in_host_memory(ctx.device.device) &&
-      huge_pages_wanted()) {
-    cl::Buffer b = huge_page_buffer(ctx, v.data(), bytes);
-    if (b() != nullptr) return b;
-  }
-  return cl::Buffer(ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes,
-                    const_cast<T*>(v.data()));
+  return read_only_buffer(ctx, v.data(), v.size() * sizeof(T));
 }
 
 template <typename T>
@@ -99,6 +90,19 @@ void update_buffer(const cl_util::Context& ctx, cl::Buffer& buffer, const std::v
 }
 
 }  // namespace
+
+cl::Buffer read_only_buffer(const cl_util::Context& ctx, const void* data, std::size_t bytes) {
+  // The data is copied when the buffer is created (CL_MEM_COPY_HOST_PTR, or into the huge-page
+  // block), so it may be a temporary: an asynchronous write from it would read freed memory
+  // (AddressSanitizer caught exactly that).
+  if (bytes >= kHugePageMinBuffer && buffers_in_host_memory(ctx.device.device) &&
+      huge_pages_wanted()) {
+    cl::Buffer b = huge_page_buffer(ctx, data, bytes);
+    if (b() != nullptr) return b;
+  }
+  return cl::Buffer(ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes,
+                    const_cast<void*>(data));
+}
 
 int huge_page_blocks() { return g_huge_blocks.load(); }
 

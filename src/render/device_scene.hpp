@@ -39,6 +39,11 @@ constexpr std::size_t kHugePageBytes = std::size_t(2) << 20;
 constexpr std::size_t kHugePageMinBuffer = std::size_t(1) << 20;
 std::uint64_t host_block_bytes(std::uint64_t bytes);
 
+/// A read-only buffer holding `bytes` (at least 1) of `data`, copied at creation: in a huge-page
+/// block on a CPU device when it is that large, else copied by OpenCL (CL_MEM_COPY_HOST_PTR).
+/// The scene's buffers, and the traversal test and benchmark's (tests/support/device_tracer.cpp).
+cl::Buffer read_only_buffer(const cl_util::Context& ctx, const void* data, std::size_t bytes);
+
 /// Host blocks in huge pages that scene buffers of CPU devices use now (device_scene.cpp): each
 /// is freed when its buffer is deleted. For tests.
 int huge_page_blocks();

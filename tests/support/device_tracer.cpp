@@ -5,6 +5,7 @@
 #include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
 #include "lucent/error.hpp"
+#include "render/device_scene.hpp"
 
 namespace lucent::bvh {
 
@@ -13,9 +14,9 @@ namespace {
 template <class T>
 cl::Buffer upload(const cl_util::Context& ctx, const std::vector<T>& v) {
   // OpenCL refuses empty buffers: keep one zeroed element
+  // (the renderer's buffers: huge pages on a CPU device when large, render/device_scene.cpp)
   std::vector<T> data = v.empty() ? std::vector<T>(1) : v;
-  return cl::Buffer(ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data.size() * sizeof(T),
-                    data.data());
+  return render_detail::read_only_buffer(ctx, data.data(), data.size() * sizeof(T));
 }
 
 }  // namespace
