@@ -144,8 +144,9 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
   // and primitive indices; then the wide tree's leaf blocks (about one per 2 primitives) and
   // nodes (about one per 4)
   const std::uint64_t nprim = ntri + nsph;
-  const std::uint64_t bvh_tree =
-      (nprim / 2 + 1) * sizeof(lc_bvh_leaf) + (nprim / 4 + 1) * sizeof(lc_bvh_node);
+  const std::uint64_t leaf_bytes = (nprim / 2 + 1) * sizeof(lc_bvh_leaf);
+  const std::uint64_t node_bytes = (nprim / 4 + 1) * sizeof(lc_bvh_node);
+  const std::uint64_t bvh_tree = leaf_bytes + node_bytes;
   const std::uint64_t bvh_bytes =
       nprim * (32 + 2 * sizeof(bvh::Node2) + sizeof(lc_uint)) + bvh_tree;
   parts.push_back(
@@ -157,9 +158,8 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                    "the number of triangles and spheres"});
   // on a CPU device each large buffer takes whole huge pages (device_scene.cpp)
   std::uint64_t scene_buffers = 0;
-  for (std::uint64_t b :
-       {ntri * sizeof(lc_triangle), ntri * sizeof(lc_triangle_attr), sph_bytes, tex_bytes,
-        (nprim / 2 + 1) * sizeof(lc_bvh_leaf), (nprim / 4 + 1) * sizeof(lc_bvh_node)})
+  for (std::uint64_t b : {ntri * sizeof(lc_triangle), ntri * sizeof(lc_triangle_attr), sph_bytes,
+                          tex_bytes, leaf_bytes, node_bytes})
     scene_buffers += host_block_bytes(b);
   for (const DeviceLimits& d : devices) {
     // the device's pass sums (double4 with fp64, else float4) and with caustics its light

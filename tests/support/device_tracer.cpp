@@ -13,10 +13,11 @@ namespace {
 
 template <class T>
 cl::Buffer upload(const cl_util::Context& ctx, const std::vector<T>& v) {
-  // OpenCL refuses empty buffers: keep one zeroed element
-  // (the renderer's buffers: huge pages on a CPU device when large, render/device_scene.cpp)
-  std::vector<T> data = v.empty() ? std::vector<T>(1) : v;
-  return render_detail::read_only_buffer(ctx, data.data(), data.size() * sizeof(T));
+  // made as the renderer's (huge pages on a CPU device when large, render/device_scene.cpp), which
+  // copy the data; OpenCL refuses empty buffers: keep one zeroed element
+  const T zero{};
+  return v.empty() ? render_detail::read_only_buffer(ctx, &zero, sizeof(T))
+                   : render_detail::read_only_buffer(ctx, v.data(), v.size() * sizeof(T));
 }
 
 }  // namespace
