@@ -102,6 +102,41 @@ void check_exponent(std::string_view tok, const LineError& fail) {
   if (digits >= 10) fail("'" + str(tok) + "': the exponent is out of range");
 }
 
+// tinyobjloader computes a number as (its digits, accumulated in a double) x 5^e x 2^e. Where the
+// true value is a finite float, that arithmetic still gives NaN or infinity in two cases, which
+// fuzz_obj found ("vt 0 0e761": 0 x 5^761 = 0 x inf, read as NaN):
+// - a decimal exponent e above 441, where 5^e overflows, so a mantissa of 0 gives NaN; and the
+//   mantissa is also 0 when its digits lie more than ~323 places behind the point (each digit's
+//   10^-k underflows): "0.<430 zeros>1e432" is 10, read as NaN, and with an exponent below 441
+//   it is read as 0;
+// - more than 308 significant digits before the point, where the mantissa overflows, so that a
+//   negative exponent gives infinity or NaN.
+// Such numbers are refused: exponents above 300 and over 308 digits before the point. Neither
+// occurs in a real file. What remains read as 0 is below 1e-23 (digits beyond 323 places behind
+// the point, times at most 10^300). Negative exponents of any size (up to the nine digits
+// check_exponent leaves) underflow to 0, as tinyobjloader reads them too.
+void check_tinyobj_arithmetic(std::string_view tok, const LineError& fail, const char* what) {
+  std::size_t i = 0;
+  if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
+  while (i < tok.size() && tok[i] == '0') ++i;
+  std::size_t integer_digits = 0;
+  while (i < tok.size() && std::isdigit(static_cast<unsigned char>(tok[i]))) ++i, ++integer_digits;
+  if (integer_digits > 308)
+    fail(std::string(what) + " line: '" + str(tok) +
+         "' has more than 308 digits before the point (tinyobjloader cannot read it)");
+  while (i < tok.size() && (std::isdigit(static_cast<unsigned char>(tok[i])) || tok[i] == '.')) ++i;
+  if (i >= tok.size() || (tok[i] != 'e' && tok[i] != 'E')) return;
+  ++i;
+  const bool negative = i < tok.size() && tok[i] == '-';
+  if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
+  long exponent = 0;  // at most nine significant digits (check_exponent)
+  for (; i < tok.size() && std::isdigit(static_cast<unsigned char>(tok[i])); ++i)
+    exponent = std::min(10 * exponent + (tok[i] - '0'), 1000000000L);
+  if (!negative && exponent > 300)
+    fail(std::string(what) + " line: '" + str(tok) +
+         "' has an exponent above 300 (tinyobjloader cannot read it)");
+}
+
 double number(std::string_view tok, const LineError& fail, const char* what) {
   check_exponent(tok, fail);
   std::string_view t = tok;
@@ -110,7 +145,10 @@ double number(std::string_view tok, const LineError& fail, const char* what) {
   auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
   if (ec == std::errc::result_out_of_range && ptr == t.data() + t.size()) {
     v = std::strtod(std::string(t).c_str(), nullptr);  // tells overflow from underflow
-    if (std::abs(v) <= 1.0) return 0.0;
+    if (std::abs(v) <= 1.0) {
+      check_tinyobj_arithmetic(tok, fail, what);
+      return 0.0;
+    }
     fail(std::string(what) + " line: '" + str(tok) + "' is out of range");
   }
   if (ec != std::errc() || ptr != t.data() + t.size())
@@ -119,6 +157,7 @@ double number(std::string_view tok, const LineError& fail, const char* what) {
     fail(std::string(what) + " line: '" + str(tok) + "' is not a finite number");
   if (std::abs(v) > FLT_MAX)
     fail(std::string(what) + " line: '" + str(tok) + "' is out of range for a float");
+  check_tinyobj_arithmetic(tok, fail, what);
   return v;
 }
 
