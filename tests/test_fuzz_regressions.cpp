@@ -88,6 +88,12 @@ const std::map<std::string, std::string> kExpected = {
     {"exr-tile-size-overflow.exr",
      ": OpenEXR tile chunk at byte 431 names tile (1, 0) of level (10240, 0), not one of the 3x1 "
      "tiles of level (0, 0)"},
+    // a PIZ chunk whose table of Huffman code lengths tinyexr cannot unpack (a zero run past the
+    // last symbol, or lengths past the data): tinyexr ignored the failure and decoded with run
+    // codes as lengths, computing (1 << 63) - 1 (signed overflow, found by fuzz_texture)
+    {"exr-piz-huffman-run-past-table.exr",
+     ": OpenEXR PIZ chunk at byte 329 is corrupt: a run of zero code lengths passes the last "
+     "symbol of its Huffman table"},
     // a map_Kd name longer than the file system allows: std::filesystem::exists threw
     {"long-texture-name.bundle", ""},
     // a vw (skin weight) line whose joint 112147483648 tinyobjloader converted to int: undefined

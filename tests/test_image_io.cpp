@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -202,6 +203,74 @@ TEST(ImageIo, DamagedTiledExrIsRefused) {
                                        "take more than the limit of "),
             std::string::npos)
       << error_of(huge);
+}
+
+// PIZ-compressed scanline files read; the probe walks each PIZ chunk's table of Huffman code
+// lengths as tinyexr unpacks it (tinyexr ignores a failed unpacking and decodes with run codes as
+// lengths: signed overflow, found by fuzz_texture), so a good table passes and a table whose
+// lengths run past the Huffman data, or whose zero run passes its last symbol, is refused.
+TEST(ImageIo, PizExrReadsAndDamagedHuffmanTablesAreRefused) {
+  auto value = [](int c, int x, int y) { return float((x * 7 + y * 13 + c * 5) % 23) * 0.125f; };
+  const std::string dir = lucent::test::temp_dir(), path = dir + "/p.exr";
+  ExrLayout piz;
+  piz.compression = TINYEXR_COMPRESSIONTYPE_PIZ;
+  write_exr(path, 64, 40, {"B", "G", "R"}, value, piz);
+  const std::string good = lucent::test::read_file(path);
+  const lucent::Image img = lucent::read_image(path);
+  ASSERT_EQ(img.width, 64);
+  ASSERT_EQ(img.height, 40);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(img.pixel(x, y)[c], value(2 - c, x, y));
+  // the first chunk: line, size, then the PIZ data: bitmap bounds and bitmap, the Huffman
+  // data's size, then its im, iM, table length, bit count, a reserved word and the table
+  EXRVersion version;
+  EXRHeader header;
+  InitEXRHeader(&header);
+  const auto* data = reinterpret_cast<const unsigned char*>(good.data());
+  ASSERT_EQ(ParseEXRVersionFromMemory(&version, data, good.size()), TINYEXR_SUCCESS);
+  ASSERT_EQ(ParseEXRHeaderFromMemory(&header, &version, data, good.size(), nullptr),
+            TINYEXR_SUCCESS);
+  const size_t table = 8 + header.header_len;
+  FreeEXRHeader(&header);
+  std::uint64_t chunk = 0;
+  std::memcpy(&chunk, good.data() + table, 8);
+  std::int32_t size = 0;
+  std::memcpy(&size, good.data() + chunk + 4, 4);
+  ASSERT_LT(size, 64 * 32 * 12) << "the first chunk is stored raw, not PIZ-compressed";
+  const size_t piz_data = chunk + 8;
+  std::uint16_t lo = 0, hi = 0;
+  std::memcpy(&lo, good.data() + piz_data, 2);
+  std::memcpy(&hi, good.data() + piz_data + 2, 2);
+  const size_t huffman = piz_data + 4 + (lo <= hi ? hi - lo + 1 : 0);  // its size, then its data
+  std::int32_t im = 0, iM = 0;
+  std::memcpy(&im, good.data() + huffman + 4, 4);
+  std::memcpy(&iM, good.data() + huffman + 8, 4);
+  ASSERT_LT(im, iM);
+  auto error_of = [&](const std::string& bytes) -> std::string {
+    lucent::test::write_file(path, bytes);
+    try {
+      lucent::read_image(path);
+    } catch (const lucent::Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string at =
+      path + ": OpenEXR PIZ chunk at byte " + std::to_string(chunk) + " is corrupt: ";
+  std::string short_table = good;  // the Huffman data: its 20-byte header and one table byte
+  const std::int32_t one = 21;
+  short_table.replace(huffman, 4, reinterpret_cast<const char*>(&one), 4);
+  EXPECT_EQ(error_of(short_table), at + "its Huffman code lengths run past its Huffman data");
+  std::string long_run = good;  // one symbol, whose length is a run of at least 6 zeros
+  long_run.replace(huffman + 8, 4, reinterpret_cast<const char*>(&im), 4);
+  long_run[huffman + 4 + 20] = static_cast<char>(0xFC);  // 111111..: 63, a long zero run
+  EXPECT_EQ(error_of(long_run),
+            at + "a run of zero code lengths passes the last symbol of its Huffman table");
+  std::string short_run = long_run;  // 111011..: 59, a run of 2 zeros
+  short_run[huffman + 4 + 20] = static_cast<char>(0xEC);
+  EXPECT_EQ(error_of(short_run),
+            at + "a run of zero code lengths passes the last symbol of its Huffman table");
 }
 
 // A single-channel OpenEXR file (Y, or one channel of any name) is grey; one without R, G, B or

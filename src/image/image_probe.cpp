@@ -641,6 +641,51 @@ class Checker {
       // (8 - bits) & 7 on a negative count (signed overflow at INT_MIN, found by fuzzing)
       const std::int64_t bits = i32(at + 4 + bitmap + 4 + 12);
       if (bits < 0) bad("its Huffman bit count " + std::to_string(bits) + " is negative");
+      huffman_code_lengths(at + 4 + bitmap + 4, huffman, bad);
+    }
+  }
+
+  // The Huffman data starts with im, iM (the first and last symbol of the code table) and the
+  // table of code lengths: 6 bits each, MSB first, where 59-62 stand for runs of 2-5 zeros and
+  // 63 for a run of 6-261 given by the next 8 bits. tinyexr 1.0.1 ignores the result of its
+  // unpacking: a table whose lengths run past the Huffman data, or whose zero run passes iM,
+  // leaves a run code (59-63) as a code length, and its decoder then computes (1 << 63) - 1
+  // (signed overflow, found by fuzzing). The lengths are read here as tinyexr reads them
+  // (bytes past the file as the zeros of its padded copy), and a table it could not unpack is
+  // refused. A table with im or iM outside 0..65536 tinyexr refuses itself.
+  template <class Bad>
+  void huffman_code_lengths(u64 at, std::int64_t size, const Bad& bad) const {
+    const std::int64_t im = static_cast<std::int32_t>(le32(d_ + at));
+    const std::int64_t iM = static_cast<std::int32_t>(le32(d_ + at + 4));
+    const std::int64_t symbols = 65537;
+    if (im < 0 || im >= symbols || iM < 0 || iM >= symbols) return;
+    const u64 start = at + 20;
+    const std::int64_t table_bytes = size - 20;
+    u64 p = start, c = 0;
+    int lc = 0;
+    auto take = [&](int n) {  // the next n bits
+      while (lc < n) {
+        c = (c << 8) | (p < n_ ? d_[p] : 0);
+        ++p;
+        lc += 8;
+      }
+      lc -= n;
+      return static_cast<std::int64_t>((c >> lc) & ((u64(1) << n) - 1));
+    };
+    auto used = [&] { return static_cast<std::int64_t>(p - start); };
+    for (std::int64_t k = im; k <= iM; ++k) {
+      if (used() >= table_bytes) bad("its Huffman code lengths run past its Huffman data");
+      const std::int64_t l = take(6);
+      std::int64_t run = 0;
+      if (l == 63) {
+        if (used() > table_bytes) bad("its Huffman code lengths run past its Huffman data");
+        run = take(8) + 6;
+      } else if (l >= 59) {
+        run = l - 57;
+      }
+      if (run > 0 && k + run > iM + 1)
+        bad("a run of zero code lengths passes the last symbol of its Huffman table");
+      if (run > 0) k += run - 1;
     }
   }
 
