@@ -109,6 +109,31 @@ void write_exr(const std::string& path, int w, int h, const std::vector<std::str
   lucent::test::write_file(path, lucent::fuzz::exr_file(w, h, names, value, layout));
 }
 
+/// The error of reading `bytes` as the image file `path` ("" when it reads).
+std::string read_error(const std::string& path, const std::string& bytes) {
+  lucent::test::write_file(path, bytes);
+  try {
+    lucent::read_image(path);
+  } catch (const lucent::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+/// Where the offset table of an OpenEXR file starts: after its magic number, version and header.
+size_t exr_offset_table(const std::string& bytes) {
+  EXRVersion version;
+  EXRHeader header;
+  InitEXRHeader(&header);
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  EXPECT_EQ(ParseEXRVersionFromMemory(&version, data, bytes.size()), TINYEXR_SUCCESS);
+  EXPECT_EQ(ParseEXRHeaderFromMemory(&header, &version, data, bytes.size(), nullptr),
+            TINYEXR_SUCCESS);
+  const size_t table = 8 + header.header_len;
+  FreeEXRHeader(&header);
+  return table;
+}
+
 // A tiled OpenEXR file (a texture from another tool) reads as its scanline twin: 37 x 21 pixels in
 // tiles of 16, so the right and bottom tiles are cut; every pixel's value is its own.
 TEST(ImageIo, TiledExrReadsAsScanlines) {
@@ -166,26 +191,10 @@ TEST(ImageIo, DamagedTiledExrIsRefused) {
   const std::string dir = lucent::test::temp_dir(), path = dir + "/t.exr";
   write_exr(path, 37, 21, {"B", "G", "R"}, value, {16});
   const std::string good = lucent::test::read_file(path);
-  auto error_of = [&](const std::string& bytes) -> std::string {
-    lucent::test::write_file(path, bytes);
-    try {
-      lucent::read_image(path);
-    } catch (const lucent::Error& e) {
-      return e.what();
-    }
-    return "";
-  };
+  auto error_of = [&](const std::string& bytes) { return read_error(path, bytes); };
   ASSERT_EQ(error_of(good), "");
   // the offset table follows the header: 6 entries (3 x 2 tiles of 16)
-  EXRVersion version;
-  EXRHeader header;
-  InitEXRHeader(&header);
-  const auto* data = reinterpret_cast<const unsigned char*>(good.data());
-  ASSERT_EQ(ParseEXRVersionFromMemory(&version, data, good.size()), TINYEXR_SUCCESS);
-  ASSERT_EQ(ParseEXRHeaderFromMemory(&header, &version, data, good.size(), nullptr),
-            TINYEXR_SUCCESS);
-  const size_t table = 8 + header.header_len;
-  FreeEXRHeader(&header);
+  const size_t table = exr_offset_table(good);
   std::string zeroed = good;
   zeroed.replace(table + 16, 8, std::string(8, '\0'));  // entry 2: tinyexr rebuilds the table
   EXPECT_EQ(error_of(zeroed), path +
@@ -224,15 +233,7 @@ TEST(ImageIo, PizExrReadsAndDamagedHuffmanTablesAreRefused) {
       for (int c = 0; c < 3; ++c) ASSERT_EQ(img.pixel(x, y)[c], value(2 - c, x, y));
   // the first chunk: line, size, then the PIZ data: bitmap bounds and bitmap, the Huffman
   // data's size, then its im, iM, table length, bit count, a reserved word and the table
-  EXRVersion version;
-  EXRHeader header;
-  InitEXRHeader(&header);
-  const auto* data = reinterpret_cast<const unsigned char*>(good.data());
-  ASSERT_EQ(ParseEXRVersionFromMemory(&version, data, good.size()), TINYEXR_SUCCESS);
-  ASSERT_EQ(ParseEXRHeaderFromMemory(&header, &version, data, good.size(), nullptr),
-            TINYEXR_SUCCESS);
-  const size_t table = 8 + header.header_len;
-  FreeEXRHeader(&header);
+  const size_t table = exr_offset_table(good);
   std::uint64_t chunk = 0;
   std::memcpy(&chunk, good.data() + table, 8);
   std::int32_t size = 0;
@@ -247,15 +248,7 @@ TEST(ImageIo, PizExrReadsAndDamagedHuffmanTablesAreRefused) {
   std::memcpy(&im, good.data() + huffman + 4, 4);
   std::memcpy(&iM, good.data() + huffman + 8, 4);
   ASSERT_LT(im, iM);
-  auto error_of = [&](const std::string& bytes) -> std::string {
-    lucent::test::write_file(path, bytes);
-    try {
-      lucent::read_image(path);
-    } catch (const lucent::Error& e) {
-      return e.what();
-    }
-    return "";
-  };
+  auto error_of = [&](const std::string& bytes) { return read_error(path, bytes); };
   const std::string at =
       path + ": OpenEXR PIZ chunk at byte " + std::to_string(chunk) + " is corrupt: ";
   std::string short_table = good;  // the Huffman data: its 20-byte header and one table byte
