@@ -683,9 +683,10 @@ class Checker {
       } else if (l >= 59) {
         run = l - 57;
       }
-      if (run > 0 && k + run > iM + 1)
+      if (run == 0) continue;
+      if (k + run > iM + 1)
         bad("a run of zero code lengths passes the last symbol of its Huffman table");
-      if (run > 0) k += run - 1;
+      k += run - 1;
     }
   }
 

@@ -81,25 +81,45 @@ class LineError {
   long line_;
 };
 
-// A number as tinyobjloader stores it (a float): finite and within float range. Underflow to 0
-// is fine.
-// tinyobjloader's number parser (tryParseDouble) reads a decimal exponent into an int and guards
-// against overflow one digit too late: "1e-2147483648" is undefined behaviour (found by
-// fuzz_obj). It runs on every number of v, vt, vn, vw and t lines and of MTL files (texture
-// options too), so every token of those lines that reads as a number with an exponent of ten or
-// more significant digits is refused (no float has such an exponent).
-void check_exponent(std::string_view tok, const LineError& fail) {
+// A token split as tinyobjloader's number parser (tryParseDouble) reads it: [sign] digits [.
+// digits] [e|E [sign] digits]. Leading zeros are not counted.
+struct NumberParts {
+  std::size_t integer_digits = 0;  // before the point
+  bool exponent_negative = false;
+  std::size_t exponent_digits = 0;  // 0 without an exponent
+  long exponent = 0;                // its magnitude, capped at 10^9
+};
+
+NumberParts number_parts(std::string_view tok) {
+  NumberParts n;
+  auto digit = [&](std::size_t i) {
+    return i < tok.size() && std::isdigit(static_cast<unsigned char>(tok[i]));
+  };
   std::size_t i = 0;
   if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
-  while (i < tok.size() && (std::isdigit(static_cast<unsigned char>(tok[i])) || tok[i] == '.')) ++i;
-  if (i == 0 || i >= tok.size() || (tok[i] != 'e' && tok[i] != 'E')) return;
+  while (i < tok.size() && tok[i] == '0') ++i;
+  for (; digit(i); ++i) ++n.integer_digits;
+  while (digit(i) || (i < tok.size() && tok[i] == '.')) ++i;
+  if (i == 0 || i >= tok.size() || (tok[i] != 'e' && tok[i] != 'E')) return n;
   ++i;
+  n.exponent_negative = i < tok.size() && tok[i] == '-';
   if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
   while (i < tok.size() && tok[i] == '0') ++i;
-  std::size_t digits = 0;
-  while (i + digits < tok.size() && std::isdigit(static_cast<unsigned char>(tok[i + digits])))
-    ++digits;
-  if (digits >= 10) fail("'" + str(tok) + "': the exponent is out of range");
+  for (; digit(i); ++i, ++n.exponent_digits)
+    n.exponent = std::min(10 * n.exponent + (tok[i] - '0'), 1000000000L);
+  return n;
+}
+
+// tinyobjloader's number parser reads a decimal exponent into an int and guards against overflow
+// one digit too late: "1e-2147483648" is undefined behaviour (found by fuzz_obj). It runs on every
+// number of v, vt, vn, vw and t lines and of MTL files (texture options too), so every token of
+// those lines that reads as a number with an exponent of ten or more significant digits is refused
+// (no float has such an exponent).
+void check_exponent(std::string_view tok, const NumberParts& n, const LineError& fail) {
+  if (n.exponent_digits >= 10) fail("'" + str(tok) + "': the exponent is out of range");
+}
+void check_exponent(std::string_view tok, const LineError& fail) {
+  check_exponent(tok, number_parts(tok), fail);
 }
 
 // tinyobjloader computes a number as (its digits, accumulated in a double) x 5^e x 2^e. Where the
@@ -115,30 +135,21 @@ void check_exponent(std::string_view tok, const LineError& fail) {
 // occurs in a real file. What remains read as 0 is below 1e-23 (digits beyond 323 places behind
 // the point, times at most 10^300). Negative exponents of any size (up to the nine digits
 // check_exponent leaves) underflow to 0, as tinyobjloader reads them too.
-void check_tinyobj_arithmetic(std::string_view tok, const LineError& fail, const char* what) {
-  std::size_t i = 0;
-  if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
-  while (i < tok.size() && tok[i] == '0') ++i;
-  std::size_t integer_digits = 0;
-  while (i < tok.size() && std::isdigit(static_cast<unsigned char>(tok[i]))) ++i, ++integer_digits;
-  if (integer_digits > 308)
+void check_tinyobj_arithmetic(std::string_view tok, const NumberParts& n, const LineError& fail,
+                              const char* what) {
+  if (n.integer_digits > 308)
     fail(std::string(what) + " line: '" + str(tok) +
          "' has more than 308 digits before the point (tinyobjloader cannot read it)");
-  while (i < tok.size() && (std::isdigit(static_cast<unsigned char>(tok[i])) || tok[i] == '.')) ++i;
-  if (i >= tok.size() || (tok[i] != 'e' && tok[i] != 'E')) return;
-  ++i;
-  const bool negative = i < tok.size() && tok[i] == '-';
-  if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
-  long exponent = 0;  // at most nine significant digits (check_exponent)
-  for (; i < tok.size() && std::isdigit(static_cast<unsigned char>(tok[i])); ++i)
-    exponent = std::min(10 * exponent + (tok[i] - '0'), 1000000000L);
-  if (!negative && exponent > 300)
+  if (!n.exponent_negative && n.exponent > 300)
     fail(std::string(what) + " line: '" + str(tok) +
          "' has an exponent above 300 (tinyobjloader cannot read it)");
 }
 
+// A number as tinyobjloader stores it (a float): finite and within float range, and read by
+// tinyobjloader as the value it is. Underflow to 0 is fine.
 double number(std::string_view tok, const LineError& fail, const char* what) {
-  check_exponent(tok, fail);
+  const NumberParts parts = number_parts(tok);
+  check_exponent(tok, parts, fail);
   std::string_view t = tok;
   if (!t.empty() && t[0] == '+') t.remove_prefix(1);
   double v = 0;
@@ -146,7 +157,7 @@ double number(std::string_view tok, const LineError& fail, const char* what) {
   if (ec == std::errc::result_out_of_range && ptr == t.data() + t.size()) {
     v = std::strtod(std::string(t).c_str(), nullptr);  // tells overflow from underflow
     if (std::abs(v) <= 1.0) {
-      check_tinyobj_arithmetic(tok, fail, what);
+      check_tinyobj_arithmetic(tok, parts, fail, what);
       return 0.0;
     }
     fail(std::string(what) + " line: '" + str(tok) + "' is out of range");
@@ -157,7 +168,7 @@ double number(std::string_view tok, const LineError& fail, const char* what) {
     fail(std::string(what) + " line: '" + str(tok) + "' is not a finite number");
   if (std::abs(v) > FLT_MAX)
     fail(std::string(what) + " line: '" + str(tok) + "' is out of range for a float");
-  check_tinyobj_arithmetic(tok, fail, what);
+  check_tinyobj_arithmetic(tok, parts, fail, what);
   return v;
 }
 
