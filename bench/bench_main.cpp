@@ -7,6 +7,10 @@
 // usage: lucent_bench [--runs N] [--reps N] [--width W] [--height H] [--device SELECTOR]
 //                     [--threads N] [--build-only] [--only NAME] [--no-embree]
 //                     [--traversal-cost C] [--max-leaf N] [--leaf-block N] [--reorder]
+//                     [--embree-quality low|medium|high] [--embree-robust]
+// --embree-quality: Embree's build quality (default medium, Embree's own default; Mitsuba 3 builds
+// with high, which adds spatial splits). --embree-robust: RTC_SCENE_FLAG_ROBUST, Embree's
+// watertight mode (lucent's triangle test is watertight; Mitsuba 3 leaves the flag off).
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
@@ -51,6 +55,10 @@ struct Options {
   int max_leaf = lucent::bvh::BuildOptions().max_leaf_size;
   bool reorder = false;  // trace triangles stored in leaf order (bvh::reorder_triangles)
   std::string device;
+#ifdef LUCENT_BENCH_EMBREE
+  RTCBuildQuality embree_quality = RTC_BUILD_QUALITY_MEDIUM;
+  bool embree_robust = false;
+#endif
 };
 
 bool load_obj(const std::string& path, std::vector<lc_triangle>& out) {
@@ -161,10 +169,12 @@ struct Embree {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   double build_seconds = 0;
-  explicit Embree(const std::vector<lc_triangle>& tris) {
+  Embree(const std::vector<lc_triangle>& tris, RTCBuildQuality quality, bool robust) {
     device = rtcNewDevice("threads=2");
     double t0 = now();
     scene = rtcNewScene(device);
+    rtcSetSceneBuildQuality(scene, quality);
+    rtcSetSceneFlags(scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     float* v = static_cast<float*>(rtcSetNewGeometryBuffer(
         g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * tris.size()));
@@ -242,7 +252,9 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
 
   std::vector<lc_triangle> stored = tris;
   if (opt.reorder) lucent::bvh::reorder_triangles(bvh, stored);
-  lucent::bvh::DeviceTracer tracer(ctx, stored, {}, bvh);
+  // LUCENT_KERNEL_DIR: the kernel sources from there, as the CLI reads them (kernel experiments)
+  const char* kernel_dir = std::getenv("LUCENT_KERNEL_DIR");
+  lucent::bvh::DeviceTracer tracer(ctx, stored, {}, bvh, "", "", kernel_dir ? kernel_dir : "");
   double scale = 0;
   for (int a = 0; a < 3; ++a) scale = std::max(scale, double(bvh.bmax[a] - bvh.bmin[a]));
   auto primary = primary_rays(bvh, opt.width, opt.height);
@@ -257,7 +269,7 @@ void bench_mesh(const std::string& name, const std::vector<lc_triangle>& tris, c
   std::unique_ptr<Embree> em;
   std::vector<TraceHit> eh;
   if (opt.embree) {
-    em = std::make_unique<Embree>(tris);
+    em = std::make_unique<Embree>(tris, opt.embree_quality, opt.embree_robust);
     em->trace(primary, eh);  // warm-up
   }
 #endif
@@ -339,11 +351,28 @@ int main(int argc, char** argv) {
       opt.max_leaf = std::max(1, std::atoi(next().c_str()));
     else if (a == "--traversal-cost")
       opt.traversal_cost = float(std::atof(next().c_str()));
+#ifdef LUCENT_BENCH_EMBREE
+    else if (a == "--embree-quality") {
+      std::string q = next();
+      if (q == "low")
+        opt.embree_quality = RTC_BUILD_QUALITY_LOW;
+      else if (q == "medium")
+        opt.embree_quality = RTC_BUILD_QUALITY_MEDIUM;
+      else if (q == "high")
+        opt.embree_quality = RTC_BUILD_QUALITY_HIGH;
+      else {
+        std::fprintf(stderr, "lucent_bench: --embree-quality: low, medium or high\n");
+        return 2;
+      }
+    } else if (a == "--embree-robust")
+      opt.embree_robust = true;
+#endif
     else {
       std::fprintf(stderr,
                    "usage: lucent_bench [--runs N] [--reps N] [--width W] [--height H] "
                    "[--device S] [--threads N] [--build-only] [--only NAME] [--no-embree] "
-                   "[--traversal-cost C] [--max-leaf N] [--leaf-block N] [--reorder]\n");
+                   "[--traversal-cost C] [--max-leaf N] [--leaf-block N] [--reorder] "
+                   "[--embree-quality low|medium|high] [--embree-robust]\n");
       return 2;
     }
   }

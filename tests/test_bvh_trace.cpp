@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <string>
@@ -294,6 +295,43 @@ TEST_F(BvhTrace, MixedTrianglesAndSpheres) {
   // shadow rays: any-hit with finite tmax
   compare(s, random_rays(20000, 20, true), true, "mix any-hit");
   compare(s, random_rays(5000, 20, true), false, "mix finite tmax");
+}
+
+// On PoCL's x86-64 CPU device the traversal reduces its masks with movmskps and popcnt
+// (kernels/bvh/traverse.cl, LC_BVH_MOVMSK; the renderer's device defines turn it on); without the
+// device defines it compiles the portable forms that other devices run. Both must find the same
+// hits, bit for bit: closest hits (t, primitive, barycentrics) and any-hit answers, on triangles
+// and spheres together (the leaf's two mask tests) and on triangles alone.
+TEST_F(BvhTrace, MaskIntrinsicsFindTheSameHitsAsThePortableForm) {
+  Scene mix = soup(500, 41, 0.08f);
+  add_spheres(mix, 200, 42, 0.01f, 0.06f);
+  Scene tris = soup(1500, 43, 0.08f);
+  for (const Scene* s : {&mix, &tris}) {
+    SCOPED_TRACE(s == &mix ? "triangles and spheres" : "triangles");
+    Bvh b = lucent::bvh::build(s->tris, s->spheres);
+    lucent::bvh::DeviceTracer device(*ctx_, s->tris, s->spheres, b, "", lucent::test::cache_dir());
+    lucent::bvh::DeviceTracer portable(*ctx_, s->tris, s->spheres, b, "", lucent::test::cache_dir(),
+                                       "", false);
+#if defined(__x86_64__)
+    const bool expected =
+        ctx_->device.info.type == "CPU" && lucent::cl_util::is_pocl(ctx_->device.info);
+#else
+    const bool expected = false;
+#endif
+    EXPECT_EQ(device.mask_intrinsics(), expected) << ctx_->device.info.name;
+    EXPECT_FALSE(portable.mask_intrinsics());
+    for (bool any_hit : {false, true}) {
+      auto rays = random_rays(6000, 44 + any_hit, any_hit);
+      auto a = device.trace(rays, any_hit), p = portable.trace(rays, any_hit);
+      std::size_t differ = 0, hit = 0;
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        hit += a[i].prim != LC_INVALID;
+        differ += std::memcmp(&a[i], &p[i], sizeof(TraceHit)) != 0;
+      }
+      EXPECT_EQ(differ, 0u) << (any_hit ? "any-hit" : "closest hit");
+      EXPECT_GT(hit, rays.size() / 20) << "the rays must hit something to compare";
+    }
+  }
 }
 
 // Rays along the axes (two direction components exactly 0: 1 / d is infinite).

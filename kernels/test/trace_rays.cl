@@ -3,7 +3,9 @@
  * force reference on the host) and bench/ (rays per second).
  *   rays[2 i]     = (origin, tmax)      rays[2 i + 1] = (direction, unused)
  *   hits[i]       = (t, as_float(prim), b1, b2); prim = LC_INVALID on a miss. With any_hit set
- *                   only the occlusion answer is meaningful: prim != LC_INVALID when occluded. */
+ *                   only the occlusion answer is meaningful: prim != LC_INVALID when occluded.
+ * lucent_trace_info writes which form of the traversal this build compiled: info[0] = 1 with the
+ * mask reductions of PoCL's x86-64 CPU device (LC_BVH_MOVMSK), 0 with the portable ones. */
 /* clang-format off */
 #include "shared/types.h"
 #include "util/math.cl"
@@ -32,4 +34,12 @@ __kernel void lucent_trace_rays(__global const lc_params* params, __global const
     scene_intersect(&s, ray, a.w, &hit);
     hits[i] = (float4)((float)hit.t, as_float(hit.prim), (float)hit.b1, (float)hit.b2);
   }
+}
+
+__kernel void lucent_trace_info(__global int* info) {
+#ifdef LC_BVH_MOVMSK
+  info[0] = 1;
+#else
+  info[0] = 0;
+#endif
 }

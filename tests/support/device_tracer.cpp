@@ -6,6 +6,7 @@
 #include "cl/program_cache.hpp"
 #include "lucent/error.hpp"
 #include "render/device_scene.hpp"
+#include "render/features.hpp"
 
 namespace lucent::bvh {
 
@@ -24,13 +25,17 @@ cl::Buffer upload(const cl_util::Context& ctx, const std::vector<T>& v) {
 
 DeviceTracer::DeviceTracer(const cl_util::Context& ctx, const std::vector<lc_triangle>& triangles,
                            const std::vector<lc_sphere>& spheres, const Bvh& bvh,
-                           const std::string& build_options, const std::string& cache_dir)
+                           const std::string& build_options, const std::string& cache_dir,
+                           const std::string& kernel_dir, bool device_defines)
     : ctx_(ctx) {
-  cl::Program program = cl_util::build_program_cached(
-      ctx, detail::assemble_kernel_source("test/trace_rays.cl"),
-      "-cl-std=CL1.2" + (build_options.empty() ? "" : " " + build_options), cache_dir);
+  program_ = cl_util::build_program_cached(
+      ctx, detail::assemble_kernel_source("test/trace_rays.cl", kernel_dir),
+      "-cl-std=CL1.2" +
+          (device_defines ? render_detail::device_defines(ctx.device.info) : std::string()) +
+          (build_options.empty() ? "" : " " + build_options),
+      cache_dir);
   try {
-    kernel_ = cl::Kernel(program, "lucent_trace_rays");
+    kernel_ = cl::Kernel(program_, "lucent_trace_rays");
     lc_params p{};
     p.num_triangles = static_cast<lc_uint>(triangles.size());
     p.num_spheres = static_cast<lc_uint>(spheres.size());
@@ -71,6 +76,20 @@ std::vector<TraceHit> DeviceTracer::trace(const std::vector<TraceRay>& rays, boo
     throw Error(cl_util::describe(e));
   }
   return hits;
+}
+
+bool DeviceTracer::mask_intrinsics() {
+  try {
+    cl::Kernel k(program_, "lucent_trace_info");
+    cl::Buffer b(ctx_.context, CL_MEM_WRITE_ONLY, sizeof(cl_int));
+    k.setArg(0, b);
+    ctx_.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1), cl::NDRange(1));
+    cl_int v = -1;
+    ctx_.queue.enqueueReadBuffer(b, CL_TRUE, 0, sizeof v, &v);
+    return v == 1;
+  } catch (const cl::Error& e) {
+    throw Error(cl_util::describe(e));
+  }
 }
 
 }  // namespace lucent::bvh

@@ -25,19 +25,26 @@ struct TraceHit {
 
 class DeviceTracer {
  public:
-  /// Uploads the scene and builds the trace kernel, with `build_options` added to the OpenCL
-  /// build options (e.g. "-D LC_DOUBLE"), through the program cache in `cache_dir` ("" none).
-  /// Throws lucent::Error.
+  /// Uploads the scene and builds the trace kernel with the device's defines, as the renderer
+  /// builds its own (render_detail::device_defines; without them when `device_defines` is false:
+  /// the portable form of everything), then `build_options` (e.g. "-D LC_DOUBLE"), through the
+  /// program cache in `cache_dir` ("" none), from the kernel sources in `kernel_dir` ("" the
+  /// embedded ones). Throws lucent::Error.
   DeviceTracer(const cl_util::Context& ctx, const std::vector<lc_triangle>& triangles,
                const std::vector<lc_sphere>& spheres, const Bvh& bvh,
-               const std::string& build_options = "", const std::string& cache_dir = "");
+               const std::string& build_options = "", const std::string& cache_dir = "",
+               const std::string& kernel_dir = "", bool device_defines = true);
   /// Closest hits, or with any_hit only occlusion (prim != LC_INVALID when occluded).
   std::vector<TraceHit> trace(const std::vector<TraceRay>& rays, bool any_hit = false);
   /// Seconds the last trace() spent in the kernel alone (rays already on the device).
   double last_kernel_seconds() const { return kernel_seconds_; }
+  /// Whether this build traverses with the mask reductions of PoCL's x86-64 CPU device
+  /// (kernels/bvh/traverse.cl, LC_BVH_MOVMSK) rather than the portable ones.
+  bool mask_intrinsics();
 
  private:
   const cl_util::Context& ctx_;
+  cl::Program program_;
   cl::Kernel kernel_;
   cl::Buffer params_, nodes_, leaves_, tris_, spheres_;
   double kernel_seconds_ = 0;
