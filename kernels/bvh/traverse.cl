@@ -113,13 +113,14 @@ static inline int bvh_min_key(lc_bvh_iw k) {
 
 /*
  * Reductions of masks (lanes -1 or 0): bvh_any4, whether a lane of an int4 is set; bvh_count, how
- * many lanes of a node's mask are. On PoCL's CPU device for x86-64 (LC_DEVICE_POCL_CPU, which the
- * host adds: render_detail::device_defines) they gather the lanes' sign bits with movmskps and
- * count them with popcnt, 2 instructions each, where LLVM compiles the portable forms below
- * lane by lane (any of 4: three shuffles, three ORs, a move and a test; the count of 8: a tree
- * of additions): bvh_trace runs 5% fewer instructions (BENCHMARKS.md, "Mask reductions").
- * Elsewhere (GPUs, other CPU runtimes) the portable forms: one tree of ORs, which PoCL's any()
- * (two halves, each with its own branch) is not, and a tree of additions.
+ * many lanes of a node's mask are; bvh_bits4, the lanes as bits (a leaf block's nearest hit). On
+ * PoCL's CPU device for x86-64 (LC_DEVICE_POCL_CPU, which the host adds:
+ * render_detail::device_defines) they gather the lanes' sign bits with movmskps and count them with
+ * popcnt, 2 instructions each, where LLVM compiles the portable forms below lane by lane (any of 4:
+ * three shuffles, three ORs, a move and a test; the count of 8: a tree of additions): bvh_trace
+ * runs 5% fewer instructions (BENCHMARKS.md, "Mask reductions"). Elsewhere (GPUs, other CPU
+ * runtimes) the portable forms: one tree of ORs, which PoCL's any() (two halves, each with its own
+ * branch) is not, and a tree of additions.
  */
 #if defined(LC_DEVICE_POCL_CPU) && defined(__x86_64__) && defined(__has_builtin)
 #if __has_builtin(__builtin_ia32_movmskps)
@@ -227,9 +228,17 @@ static inline int bvh_leaf_triangles(__global const lc_bvh_leaf* lf, int4 tri, c
   ok &= lc_bvh_m4((t > tmin) & (t < hit->t));
   if (!bvh_any4(ok)) return 0;
   lc_real4 tt = select((lc_real4)(INFINITY), t, lc_bvh_rm4(ok));
+#if defined(LC_BVH_MOVMSK) && !defined(LC_DOUBLE)
+  /* the nearest and its first lane: a tree of minimums and one bit scan */
+  float4 mv = min(tt, tt.s1032);
+  mv = min(mv, mv.s2301);
+  lc_real m = mv.s0;
+  int k = __builtin_ctz(bvh_bits4(tt == mv));
+#else
   lc_real a = tt.s0 < tt.s1 ? tt.s0 : tt.s1, c = tt.s2 < tt.s3 ? tt.s2 : tt.s3;
   lc_real m = a < c ? a : c;
   int k = tt.s0 == m ? 0 : (tt.s1 == m ? 1 : (tt.s2 == m ? 2 : 3));
+#endif
   hit->t = m;
   hit->prim = lf->prim[k];
   hit->b1 = bvh_lane(V, k) * bvh_lane(inv, k);
