@@ -118,7 +118,7 @@ static inline int bvh_min_key(lc_bvh_iw k) {
  * render_detail::device_defines) they gather the lanes' sign bits with movmskps and count them with
  * popcnt, 2 instructions each, where LLVM compiles the portable forms below lane by lane (any of 4:
  * three shuffles, three ORs, a move and a test; the count of 8: a tree of additions): bvh_trace
- * runs 5% fewer instructions (BENCHMARKS.md, "Mask reductions"). Elsewhere (GPUs, other CPU
+ * runs 6% fewer instructions (BENCHMARKS.md, "Mask reductions"). Elsewhere (GPUs, other CPU
  * runtimes) the portable forms: one tree of ORs, which PoCL's any() (two halves, each with its own
  * branch) is not, and a tree of additions.
  */
