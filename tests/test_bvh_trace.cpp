@@ -334,6 +334,97 @@ TEST_F(BvhTrace, MaskIntrinsicsFindTheSameHitsAsThePortableForm) {
   }
 }
 
+// Woop, Benthin and Wald's watertight test as the paper writes it, in float on the host: kx and
+// ky swapped when d[kz] < 0, no fused multiply-add, and the kernel's recomputation in double of
+// edge functions that round to 0. Returns t in (0, tmax), or INFINITY.
+struct WoopHit {
+  float t = INFINITY, b1 = 0, b2 = 0;
+};
+// x rounded to float where it stands: no product below is fused into an addition
+float f32(float x) {
+  volatile float v = x;
+  return v;
+}
+WoopHit woop_with_swap(const lc_triangle& tri, const TraceRay& r) {
+  const float* d = r.d;
+  float ad[3] = {std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])};
+  int kz = ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
+  int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
+  if (d[kz] < 0) std::swap(kx, ky);
+  float sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0f / d[kz];
+  const float* v[3] = {tri.v0, tri.v1, tri.v2};
+  float X[3], Y[3], Z[3];
+  for (int j = 0; j < 3; ++j) {
+    Z[j] = f32(v[j][kz] - r.o[kz]);
+    X[j] = f32(f32(v[j][kx] - r.o[kx]) - f32(sx * Z[j]));
+    Y[j] = f32(f32(v[j][ky] - r.o[ky]) - f32(sy * Z[j]));
+  }
+  float U = f32(f32(X[2] * Y[1]) - f32(Y[2] * X[1]));
+  float V = f32(f32(X[0] * Y[2]) - f32(Y[0] * X[2]));
+  float W = f32(f32(X[1] * Y[0]) - f32(Y[1] * X[0]));
+  if (U == 0 || V == 0 || W == 0) {
+    U = float(double(X[2]) * Y[1] - double(Y[2]) * X[1]);
+    V = float(double(X[0]) * Y[2] - double(Y[0]) * X[2]);
+    W = float(double(X[1]) * Y[0] - double(Y[1]) * X[0]);
+  }
+  WoopHit h;
+  if ((U < 0 || V < 0 || W < 0) && (U > 0 || V > 0 || W > 0)) return h;
+  float det = f32(f32(U + V) + W);
+  if (det == 0) return h;
+  float T = f32(f32(f32(U * f32(sz * Z[0])) + f32(V * f32(sz * Z[1]))) + f32(W * f32(sz * Z[2])));
+  float inv = f32(1.0f / det);
+  float t = f32(T * inv);
+  if (!(t > 0 && t < r.tmax)) return h;
+  h.t = t;
+  h.b1 = f32(V * inv);
+  h.b2 = f32(W * inv);
+  return h;
+}
+
+// The kernel leaves out the paper's swap of kx and ky for d[kz] < 0 (geom/triangle.cl): its test
+// is two-sided, and the swap only changes the signs of U, V, W, det and T, exactly. So its hits
+// must be the paper's to the bit: t and barycentrics of the nearest triangle of a random soup,
+// with the rays' dominant components of both signs.
+TEST_F(BvhTrace, ShearWithoutSwapGivesTheWatertightTestsBits) {
+  Scene s = soup(1000, 51, 0.08f);
+  auto rays = random_rays(4000, 52);
+  Bvh b = lucent::bvh::build(s.tris, s.spheres);
+  auto hits = trace(s, b, rays);
+  std::size_t compared = 0, negative = 0, differ = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    WoopHit best, second;
+    lc_uint prim = LC_INVALID;
+    for (std::size_t k = 0; k < s.tris.size(); ++k) {
+      WoopHit h = woop_with_swap(s.tris[k], rays[i]);
+      if (h.t < best.t) {
+        second = best;
+        best = h;
+        prim = lc_uint(k);
+      } else if (h.t < second.t) {
+        second = h;
+      }
+    }
+    if (prim == LC_INVALID || second.t == best.t) continue;  // a miss, or a tie the order decides
+    ++compared;
+    const float* d = rays[i].d;
+    int kz = std::fabs(d[0]) > std::fabs(d[1]) ? (std::fabs(d[0]) > std::fabs(d[2]) ? 0 : 2)
+                                               : (std::fabs(d[1]) > std::fabs(d[2]) ? 1 : 2);
+    negative += d[kz] < 0;
+    const TraceHit& k = hits[i];
+    if (k.prim != prim || std::memcmp(&k.t, &best.t, 4) || std::memcmp(&k.b1, &best.b1, 4) ||
+        std::memcmp(&k.b2, &best.b2, 4)) {
+      if (++differ <= 5)
+        ADD_FAILURE() << "ray " << i << ": kernel prim " << k.prim << " t " << k.t << " b " << k.b1
+                      << " " << k.b2 << ", paper's test prim " << prim << " t " << best.t << " b "
+                      << best.b1 << " " << best.b2;
+    }
+  }
+  EXPECT_EQ(differ, 0u);
+  EXPECT_GT(compared, rays.size() / 5);
+  EXPECT_GT(negative, compared / 3) << "rays whose dominant component is negative";
+  EXPECT_GT(compared - negative, compared / 3) << "and positive";
+}
+
 // Rays along the axes (two direction components exactly 0: 1 / d is infinite).
 TEST_F(BvhTrace, AxisParallelRays) {
   Scene s = soup(500, 21, 0.08f);

@@ -17,7 +17,7 @@
 
 /* Per-ray constants of the watertight test. */
 typedef struct {
-  int kx, ky, kz;     /* kz: the dominant axis of d; kx, ky: the others, swapped when d[kz] < 0 */
+  int kx, ky, kz;     /* kz: the dominant axis of d; kx, ky: the next two, cyclically */
   lc_real sx, sy, sz; /* shear: d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz] */
 } lc_tri_ray;
 
@@ -32,6 +32,13 @@ static inline lc_real lc_get(lc_real3 v, int k) { return k == 0 ? v.x : (k == 1 
 #define lc_tri_lanes(v, a, b, c) shuffle((float4)((v), 0.0f), as_uint4((int4)((a), (b), (c), 3)))
 #endif
 
+/* Woop et al. swap kx and ky when d[kz] < 0, to keep the triangles' winding for back-face
+ * culling. The test here is two-sided, and without the swap U, V, W, det and T only change sign,
+ * exactly (a - b is -(b - a) in IEEE arithmetic, and so are the sums and products built from
+ * them): t = T / det and the barycentrics V / det, W / det are the same bits, and so is every
+ * decision. Leaving it out saves a select on the direction's sign, which a diffuse ray's random
+ * direction mispredicted as a branch: renders 1.04x (BENCHMARKS.md, "The shear without the
+ * swap"). */
 static inline lc_tri_ray triangle_ray_setup(lc_real3 d) {
   lc_tri_ray r;
   lc_real3 ad = fabs(d);
@@ -39,12 +46,10 @@ static inline lc_tri_ray triangle_ray_setup(lc_real3 d) {
   int kx = kz == 2 ? 0 : kz + 1;
   int ky = kx == 2 ? 0 : kx + 1;
   lc_real4 p = lc_tri_lanes(d, kx, ky, kz);
-  /* d[kz] < 0: kx and ky swap, to keep the winding, so U, V, W keep their meaning */
-  int swap = p.z < LC_REAL(0.0);
   r.kz = kz;
-  r.kx = swap ? ky : kx;
-  r.ky = swap ? kx : ky;
-  lc_real4 q = (lc_real4)(swap ? p.y : p.x, swap ? p.x : p.y, LC_REAL(1.0), LC_REAL(1.0)) / p.z;
+  r.kx = kx;
+  r.ky = ky;
+  lc_real4 q = (lc_real4)(p.x, p.y, LC_REAL(1.0), LC_REAL(1.0)) / p.z;
   r.sx = q.x; /* d[kx] / d[kz] */
   r.sy = q.y; /* d[ky] / d[kz] */
   r.sz = q.z; /* 1 / d[kz] */
