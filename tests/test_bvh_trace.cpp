@@ -297,9 +297,10 @@ TEST_F(BvhTrace, MixedTrianglesAndSpheres) {
   compare(s, random_rays(5000, 20, true), false, "mix finite tmax");
 }
 
-// On PoCL's x86-64 CPU device the traversal reduces its masks with movmskps and popcnt
-// (kernels/bvh/traverse.cl, LC_BVH_MOVMSK; the renderer's device defines turn it on); without the
-// device defines it compiles the portable forms that other devices run. Both must find the same
+// On PoCL's x86-64 CPU device the traversal reduces its masks with movmskps and popcnt and takes a
+// leaf block's nearest lane by vpermilps (kernels/bvh/traverse.cl, LC_BVH_MOVMSK; the renderer's
+// device defines turn it on); without the device defines it compiles the portable forms that
+// other devices run. Both must find the same
 // hits, bit for bit: closest hits (t, primitive, barycentrics) and any-hit answers, on triangles
 // and spheres together (the leaf's two mask tests) and on triangles alone.
 TEST_F(BvhTrace, MaskIntrinsicsFindTheSameHitsAsThePortableForm) {

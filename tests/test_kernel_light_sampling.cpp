@@ -3,7 +3,9 @@
 // texel, and a power-proportional mixture), through kernels/test/light_probe.cl.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "cl/kernel_source.hpp"
@@ -319,4 +321,51 @@ TEST(KernelLightSampling, SelectionProbabilitiesAreTheCdfsIntervals) {
   EXPECT_EQ(total, 1.0);
 }
 
+// lc_cdf_search, the binary search of light selection and environment-map texels, takes its
+// halves by a select in a number of steps that depends on n alone. Its index must be the
+// definition's: the number of entries <= u, at most n - 1. CDFs of 1 to 70 entries with runs of
+// equal entries (lights of zero share) and a last entry of 1 or just below; u at, just below and
+// just above every entry, 0 and random.
+TEST(KernelLightSampling, CdfSearchPicksTheIntervalOfU) {
+  Probe& pr = probe();
+  std::mt19937 gen(23);
+  std::uniform_real_distribution<float> U(0.0f, 1.0f);
+  std::size_t checked = 0, wrong = 0;
+  for (cl_uint n = 1; n <= 70; ++n) {
+    std::vector<float> cdf(n);
+    for (float& c : cdf) c = U(gen);
+    for (cl_uint i = 1; i + 1 < n; i += 3) cdf[i] = cdf[i - 1];  // equal neighbours
+    std::sort(cdf.begin(), cdf.end());
+    cdf.back() = n % 4 == 0 ? std::nextafter(1.0f, 0.0f) : 1.0f;
+    std::sort(cdf.begin(), cdf.end());
+    std::vector<float> u{0.0f, std::nextafter(1.0f, 0.0f)};
+    for (float c : cdf)
+      for (float v : {c, std::nextafter(c, 0.0f), std::nextafter(c, 2.0f)})
+        if (v < 1.0f) u.push_back(v);
+    for (int k = 0; k < 50; ++k) u.push_back(U(gen));
+    cl::Buffer bc(pr.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n * sizeof(float),
+                  cdf.data());
+    cl::Buffer bu(pr.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, u.size() * sizeof(float),
+                  u.data());
+    cl::Buffer bo(pr.ctx.context, CL_MEM_WRITE_ONLY, u.size() * sizeof(cl_uint));
+    cl::Kernel k(pr.program, "probe_cdf_search");
+    k.setArg(0, bc);
+    k.setArg(1, n);
+    k.setArg(2, bu);
+    k.setArg(3, bo);
+    lucent::test::launch_probe(pr.ctx.queue, k, u.size());
+    std::vector<cl_uint> out(u.size());
+    pr.ctx.queue.enqueueReadBuffer(bo, CL_TRUE, 0, out.size() * sizeof(cl_uint), out.data());
+    for (std::size_t j = 0; j < u.size(); ++j) {
+      const auto below = std::upper_bound(cdf.begin(), cdf.end(), u[j]) - cdf.begin();
+      const cl_uint expected = std::min<cl_uint>(static_cast<cl_uint>(below), n - 1);
+      ++checked;
+      if (out[j] != expected && ++wrong <= 5)
+        ADD_FAILURE() << "n " << n << ", u " << u[j] << ": kernel " << out[j] << ", expected "
+                      << expected;
+    }
+  }
+  EXPECT_EQ(wrong, 0u);
+  EXPECT_GT(checked, 10000u);
+}
 }  // namespace

@@ -120,7 +120,9 @@ static inline int bvh_min_key(lc_bvh_iw k) {
  * three shuffles, three ORs, a move and a test; the count of 8: a tree of additions): bvh_trace
  * runs 6% fewer instructions (BENCHMARKS.md, "Mask reductions"). Elsewhere (GPUs, other CPU
  * runtimes) the portable forms: one tree of ORs, which PoCL's any() (two halves, each with its own
- * branch) is not, and a tree of additions.
+ * branch) is not, and a tree of additions. With AVX, bvh_lane_var also takes the nearest hit's
+ * lane of a leaf block's barycentrics by one vpermilps, where bvh_lane's chain of selects compiled
+ * to branches on the lane that random rays mispredict.
  */
 #if defined(LC_DEVICE_POCL_CPU) && defined(__x86_64__) && defined(__has_builtin)
 #if __has_builtin(__builtin_ia32_movmskps)
@@ -140,6 +142,13 @@ static inline int bvh_count(int8 m) {
 static inline int bvh_count(int8 m) { return popcount(bvh_bits4(m.lo) | (bvh_bits4(m.hi) << 4)); }
 #else
 static inline int bvh_count(int4 m) { return popcount(bvh_bits4(m)); }
+#endif
+#if defined(__AVX__) && __has_builtin(__builtin_ia32_vpermilvarps)
+#define LC_BVH_VPERMILVAR 1
+typedef int lc_bvh_v4si __attribute__((__vector_size__(16)));
+static inline float bvh_lane_var(float4 v, int k) {
+  return __builtin_ia32_vpermilvarps((lc_bvh_m128)v, (lc_bvh_v4si)(k, k, k, k))[0];
+}
 #endif
 #else
 static inline int bvh_any4(int4 m) { return ((m.s0 | m.s1) | (m.s2 | m.s3)) < 0; }
@@ -241,8 +250,14 @@ static inline int bvh_leaf_triangles(__global const lc_bvh_leaf* lf, int4 tri, c
 #endif
   hit->t = m;
   hit->prim = lf->prim[k];
+#if defined(LC_BVH_VPERMILVAR) && !defined(LC_DOUBLE)
+  /* lane k of the products (the same bits as the products of lane k) */
+  hit->b1 = bvh_lane_var(V * inv, k);
+  hit->b2 = bvh_lane_var(W * inv, k);
+#else
   hit->b1 = bvh_lane(V, k) * bvh_lane(inv, k);
   hit->b2 = bvh_lane(W, k) * bvh_lane(inv, k);
+#endif
   return 1;
 }
 

@@ -33,17 +33,17 @@ typedef struct {
   int delta;    /* point light: no MIS                                        */
 } lc_light_sample;
 
-/* Index i with cdf[i-1] <= u < cdf[i] over n entries (cdf[n-1] = 1). */
+/* Index i with cdf[i-1] <= u < cdf[i] over n entries (cdf[n-1] = 1): the number of entries
+ * <= u, at most n - 1. A binary search whose steps depend on n alone (the halves are chosen by a
+ * select, not a branch that a random u mispredicts). */
 static inline lc_uint lc_cdf_search(__global const float* cdf, lc_uint n, float u) {
-  lc_uint lo = 0, hi = n - 1;
-  while (lo < hi) {
-    lc_uint mid = (lo + hi) >> 1;
-    if (cdf[mid] <= u)
-      lo = mid + 1;
-    else
-      hi = mid;
+  lc_uint base = 0, len = n;
+  while (len > 1) {
+    lc_uint step = len >> 1;
+    base = cdf[base + step] <= u ? base + step : base;
+    len -= step;
   }
-  return lo;
+  return min(base + (cdf[base] <= u ? 1u : 0u), n - 1u);
 }
 
 static inline float3 sample_uniform_sphere(float u1, float u2) {

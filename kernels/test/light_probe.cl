@@ -66,3 +66,10 @@ __kernel void probe_light_pdf(LC_SCENE_KERNEL_ARGS, float4 p, __global const flo
   }
   pdf[i] = sum;
 }
+
+/* out[i] = lc_cdf_search(cdf, n, u[i]): the index that light selection and environment maps pick */
+__kernel void probe_cdf_search(__global const float* cdf, uint n, __global const float* u,
+                               __global uint* out) {
+  size_t i = get_global_id(0);
+  out[i] = lc_cdf_search(cdf, n, u[i]);
+}

@@ -128,9 +128,11 @@ static inline float2 lc_unit_circle(float u) {
                         x2 * (1.0f / 120.0f + x2 * (-1.0f / 5040.0f + x2 * (1.0f / 362880.0f)))));
   float cs =
       1.0f + x2 * (-0.5f + x2 * (1.0f / 24.0f + x2 * (-1.0f / 720.0f + x2 * (1.0f / 40320.0f))));
-  int q = (int)k;
-  float2 v = (q & 1) ? (float2)(-sn, cs) : (float2)(cs, sn);
-  return (q & 2) ? -v : v;
+  /* the quarter turn's rotation without branches (a random u mispredicted both): lanes swapped by
+   * a vector select on odd k, signs flipped by their bits */
+  uint q = (uint)(int)k;
+  float2 v = select((float2)(cs, sn), (float2)(-sn, cs), (int2)(-(int)(q & 1u)));
+  return as_float2(as_uint2(v) ^ (uint2)((q & 2u) << 30));
 }
 
 /* nextafter(o, copysign(INFINITY, n)) per component for finite o, o where n is 0, as integer
