@@ -104,15 +104,15 @@ static inline lc_real3 triangle_point_error(lc_real b0, lc_real b1, lc_real b2, 
          (LC_REAL(7.0) * LC_REAL_U * LC_REAL(1.0001));
 }
 
-/* The unit geometric normal, normalize((v1 - v0) x (v2 - v0)): lc_triangle.ng, computed on the
- * host in double and rounded once (the cross product and normalize in float took ~100
- * instructions per hit and per light sample); under LC_DOUBLE computed here in double. */
+/* The unit geometric normal, normalize((v1 - v0) x (v2 - v0)): lc_triangle.ng_x, ng_y, ng_z,
+ * computed on the host in double and rounded once (the cross product and normalize in float took
+ * ~100 instructions per hit and per light sample); under LC_DOUBLE computed here in double. */
 static inline lc_real3 triangle_normal(__global const lc_triangle* tri, lc_real3 v0, lc_real3 v1,
                                        lc_real3 v2) {
 #ifdef LC_DOUBLE
   return normalize(cross(v1 - v0, v2 - v0));
 #else
-  return lc_load3(tri->ng);
+  return (lc_real3)(tri->ng_x, tri->ng_y, tri->ng_z);
 #endif
 }
 
@@ -121,7 +121,7 @@ static inline lc_real3 triangle_normal(__global const lc_triangle* tri, lc_real3
 static inline void triangle_interaction(const lc_scene* s, lc_ray ray, const lc_hit* hit,
                                         lc_interaction* it) {
   __global const lc_triangle* tri = &s->triangles[hit->prim];
-  lc_real3 v0 = lc_load3r(tri->v0), v1 = lc_load3r(tri->v1), v2 = lc_load3r(tri->v2);
+  lc_real3 v0 = lc_load3ra(tri->v0), v1 = lc_load3ra(tri->v1), v2 = lc_load3ra(tri->v2);
   lc_real b1 = hit->b1, b2 = hit->b2, b0 = LC_REAL(1.0) - b1 - b2;
   it->p = b0 * v0 + b1 * v1 + b2 * v2;
   it->perr = triangle_point_error(b0, b1, b2, v0, v1, v2);

@@ -7,7 +7,7 @@
 static inline int light_triangle_sample(const lc_scene* s, __global const lc_light* L, lc_real3 p,
                                         float u1, float u2, float u3, lc_light_sample* ls) {
   __global const lc_triangle* tri = &s->triangles[L->p.triangle.triangle];
-  lc_real3 v0 = lc_load3r(tri->v0), v1 = lc_load3r(tri->v1), v2 = lc_load3r(tri->v2);
+  lc_real3 v0 = lc_load3ra(tri->v0), v1 = lc_load3ra(tri->v1), v2 = lc_load3ra(tri->v2);
   /* barycentrics in lc_real: in float their sum is off 1 by an ulp, which puts q ~1e-7 |v| off
    * the light's plane (covered by shadow_visible's float margin, not by its double one) */
   lc_real su = sqrt((lc_real)u1);
@@ -42,7 +42,7 @@ static inline float3 light_triangle_emitted(const lc_scene* s, __global const lc
 static inline int light_triangle_emit(const lc_scene* s, __global const lc_light* L, float4 u,
                                       lc_ray* ray, float3* beta) {
   __global const lc_triangle* tri = &s->triangles[L->p.triangle.triangle];
-  lc_real3 v0 = lc_load3r(tri->v0), v1 = lc_load3r(tri->v1), v2 = lc_load3r(tri->v2);
+  lc_real3 v0 = lc_load3ra(tri->v0), v1 = lc_load3ra(tri->v1), v2 = lc_load3ra(tri->v2);
   lc_real su = sqrt((lc_real)u.x);
   lc_real b0 = LC_REAL(1.0) - su, b1 = u.y * su, b2 = LC_REAL(1.0) - b0 - b1;
   lc_real3 q = b0 * v0 + b1 * v1 + b2 * v2;

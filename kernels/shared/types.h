@@ -165,22 +165,30 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_sphere, material) == 16, sphere_material);
 /* One triangle as hits and lights read it: its three world-space vertices and its unit geometric
  * normal normalize((v1 - v0) x (v2 - v0)), computed on the host in double from the float
  * vertices (render_detail::set_triangle_normal); one 64-byte cache line. (Traversal reads the
- * vertices of lc_bvh_leaf instead.) */
+ * vertices of lc_bvh_leaf instead.) Each vertex is a 16-byte row whose fourth float is a
+ * component of the normal, so the kernel loads a vertex as one aligned float4 (lc_load3a). The
+ * fourth lane of such a load is computed along with the others, so it must be an ordinary float:
+ * an integer field there reads as a subnormal, and arithmetic on subnormals made renders 0.90x
+ * (BENCHMARKS.md, "Aligned float3 loads"); the host flushes a subnormal component to 0. */
 typedef struct LC_ALIGN16 lc_triangle {
   float v0[3];
-  lc_uint material; /* index into materials                     */
+  float ng_x; /* unit geometric normal, x                    */
   float v1[3];
-  lc_uint light; /* index into lights if emissive, LC_INVALID */
+  float ng_y; /* y                                           */
   float v2[3];
-  lc_uint flags; /* LC_TRI_HAS_NORMALS | LC_TRI_HAS_UVS        */
-  float ng[3];   /* unit geometric normal                       */
+  float ng_z;       /* z                                           */
+  lc_uint material; /* index into materials                     */
+  lc_uint light;    /* index into lights if emissive, LC_INVALID */
+  lc_uint flags;    /* LC_TRI_HAS_NORMALS | LC_TRI_HAS_UVS        */
   lc_uint pad;
 } lc_triangle; /* total: 64 bytes */
 LC_STATIC_ASSERT(sizeof(lc_triangle) == 64, triangle_size);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, ng_x) == 12, triangle_ng_x);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, v1) == 16, triangle_v1);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, ng_y) == 28, triangle_ng_y);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, v2) == 32, triangle_v2);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, flags) == 44, triangle_flags);
-LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, ng) == 48, triangle_ng);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, ng_z) == 44, triangle_ng_z);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_triangle, material) == 48, triangle_material);
 
 /* Shading data of one triangle, read only at the closest hit. */
 typedef struct LC_ALIGN16 lc_triangle_attr {

@@ -72,6 +72,18 @@ static inline float3 lc_load3(const __global float* p) { return (float3)(p[0], p
 static inline lc_real3 lc_load3r(const __global float* p) {
   return (lc_real3)((lc_real)p[0], (lc_real)p[1], (lc_real)p[2]);
 }
+/* The same from a 16-byte aligned float[3] whose struct puts an ordinary float after it (one
+ * vector load where lc_load3 takes four instructions): the fourth lane is loaded and computed
+ * with, so an integer field there, a subnormal as a float, would slow every operation on the
+ * triple (shared/types.h, lc_triangle). */
+static inline float3 lc_load3a(const __global float* p) { return (*(const __global float4*)p).xyz; }
+#ifdef LC_DOUBLE
+static inline lc_real3 lc_load3ra(const __global float* p) {
+  return convert_double3((*(const __global float4*)p).xyz);
+}
+#else
+#define lc_load3ra lc_load3a
+#endif
 static inline float3 lc_load3c(__constant float* p) { return (float3)(p[0], p[1], p[2]); }
 static inline float lc_luminance(float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 static inline int lc_isfinite3(float3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }

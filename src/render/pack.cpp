@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
+#include <limits>
 
 #include "lucent/error.hpp"
 #include "lucent/limits.hpp"
@@ -39,6 +40,19 @@ bool same_geometry(const PackedScene& a, const PackedScene& b) {
   return true;
 }
 
+/// Stores the unit normal n in t's fourth lanes, rounded to float; a component below the smallest
+/// normal float becomes 0, so that the kernel's aligned vertex loads never carry a subnormal
+/// (types.h, lc_triangle).
+void put_normal(lc_triangle& t, const glm::dvec3& n) {
+  auto f = [](double c) {
+    const float r = static_cast<float>(c);
+    return std::fabs(r) < std::numeric_limits<float>::min() ? 0.0f : r;
+  };
+  t.ng_x = f(n.x);
+  t.ng_y = f(n.y);
+  t.ng_z = f(n.z);
+}
+
 }  // namespace
 
 bool set_triangle_normal(lc_triangle& t) {
@@ -47,7 +61,7 @@ bool set_triangle_normal(lc_triangle& t) {
   glm::dvec3 n = glm::cross(v1 - v0, v2 - v0);
   double len = glm::length(n);
   if (!(len > 0) || !std::isfinite(len)) return false;
-  put3(t.ng, n / len);
+  put_normal(t, n / len);
   return true;
 }
 
@@ -176,7 +190,7 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     put3(d.v1, v[1]);
     put3(d.v2, v[2]);
     // collinear after rounding to float (it is never hit, but it may emit): the normal before
-    if (!set_triangle_normal(d)) put3(d.ng, cr / (2 * area));
+    if (!set_triangle_normal(d)) put_normal(d, cr / (2 * area));
     d.material = static_cast<lc_uint>(t.material);
     d.light = LC_INVALID;
     lc_triangle_attr a{};

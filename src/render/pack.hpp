@@ -24,8 +24,9 @@ struct PackedScene {
   std::size_t skipped_triangles = 0;  ///< degenerate or non-finite, left out with a warning
 };
 
-/// Sets t.ng to the unit normal of (v1 - v0) x (v2 - v0) of t's float vertices, computed in double
-/// and rounded once; returns false, leaving t.ng unchanged, where those vertices are collinear.
+/// Sets t.ng_x, ng_y, ng_z to the unit normal of (v1 - v0) x (v2 - v0) of t's float vertices,
+/// computed in double and rounded once; returns false, leaving the normal unchanged, where those
+/// vertices are collinear.
 bool set_triangle_normal(lc_triangle& t);
 
 /// The camera basis (right, up, forward, with roll applied) as the kernel uses it.
