@@ -37,8 +37,7 @@ static inline lc_real lc_get(lc_real3 v, int k) { return k == 0 ? v.x : (k == 1 
  * exactly (a - b is -(b - a) in IEEE arithmetic, and so are the sums and products built from
  * them): t = T / det and the barycentrics V / det, W / det are the same bits, and so is every
  * decision. Leaving it out saves a select on the direction's sign, which a diffuse ray's random
- * direction mispredicted as a branch: renders 1.04x (BENCHMARKS.md, "The shear without the
- * swap"). */
+ * direction mispredicted as a branch: renders 1.04x (BENCHMARKS.md, "Mispredicted branches"). */
 static inline lc_tri_ray triangle_ray_setup(lc_real3 d) {
   lc_tri_ray r;
   lc_real3 ad = fabs(d);
