@@ -300,9 +300,9 @@ TEST_F(BvhTrace, MixedTrianglesAndSpheres) {
 // On PoCL's x86-64 CPU device the traversal reduces its masks with movmskps and popcnt and takes a
 // leaf block's nearest lane by vpermilps (kernels/bvh/traverse.cl, LC_BVH_MOVMSK; the renderer's
 // device defines turn it on); without the device defines it compiles the portable forms that
-// other devices run. Both must find the same
-// hits, bit for bit: closest hits (t, primitive, barycentrics) and any-hit answers, on triangles
-// and spheres together (the leaf's two mask tests) and on triangles alone.
+// other devices run. Both must find the same hits, bit for bit: closest hits (t, primitive,
+// barycentrics) and any-hit answers, on triangles and spheres together (the leaf's two mask
+// tests) and on triangles alone.
 TEST_F(BvhTrace, MaskIntrinsicsFindTheSameHitsAsThePortableForm) {
   Scene mix = soup(500, 41, 0.08f);
   add_spheres(mix, 200, 42, 0.01f, 0.06f);
@@ -346,10 +346,14 @@ float f32(float x) {
   volatile float v = x;
   return v;
 }
+// the axis of d's largest component, ties broken as geom/triangle.cl breaks them
+int dominant_axis(const float* d) {
+  float ad[3] = {std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])};
+  return ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
+}
 WoopHit woop_with_swap(const lc_triangle& tri, const TraceRay& r) {
   const float* d = r.d;
-  float ad[3] = {std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])};
-  int kz = ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
+  int kz = dominant_axis(d);
   int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
   if (d[kz] < 0) std::swap(kx, ky);
   float sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0f / d[kz];
@@ -407,10 +411,7 @@ TEST_F(BvhTrace, ShearWithoutSwapGivesTheWatertightTestsBits) {
     }
     if (prim == LC_INVALID || second.t == best.t) continue;  // a miss, or a tie the order decides
     ++compared;
-    const float* d = rays[i].d;
-    int kz = std::fabs(d[0]) > std::fabs(d[1]) ? (std::fabs(d[0]) > std::fabs(d[2]) ? 0 : 2)
-                                               : (std::fabs(d[1]) > std::fabs(d[2]) ? 1 : 2);
-    negative += d[kz] < 0;
+    negative += rays[i].d[dominant_axis(rays[i].d)] < 0;
     const TraceHit& k = hits[i];
     if (k.prim != prim || std::memcmp(&k.t, &best.t, 4) || std::memcmp(&k.b1, &best.b1, 4) ||
         std::memcmp(&k.b2, &best.b2, 4)) {
