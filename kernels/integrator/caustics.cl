@@ -141,7 +141,7 @@ static LC_POCL_NOINLINE lc_uint caustics_light_path(const lc_scene* s, const lc_
     if (!bsdf_sample(&b, wo_l, ua.w, ub.x, ub.y, &bs)) break;
     if (!caustic && !bs.delta) break;
     caustic = 1;
-    lc_real3 wi = normalize(lc_real3_from_float3(frame_to_world(&fr, bs.wi)));
+    lc_real3 wi = frame_to_world_dir(&fr, bs.wi);
     int transmit = bs.wi.z < 0.0f;
     lc_real side = dot(wi, it.ng);
     if (transmit ? side >= LC_REAL(0.0) : side <= LC_REAL(0.0)) break;

@@ -27,6 +27,22 @@ static inline float3 frame_to_world(const lc_frame* f, float3 v) {
   return v.x * f->t + v.y * f->b + v.z * f->n;
 }
 
+/* A direction of the shading frame (a sampled or mirrored one) as the world-space direction of
+ * the next ray. In float it is not normalised again: the frame is orthonormal and the direction
+ * unit to a few ulps, so the result is unit to about 1e-7, and every cosine taken from it is
+ * clamped where a square root or an arccosine follows (pbrt-v4 and Mitsuba 3 do the same). The
+ * normalize() it replaced put a square root and a division on the way to the next ray's
+ * traversal: 1.058x on the Cornell box, 1.039x on the dragon box (BENCHMARKS.md, "Directions
+ * not normalised again"). Under LC_DOUBLE it is normalised in double, so that rays stay unit to
+ * double precision. */
+static inline lc_real3 frame_to_world_dir(const lc_frame* f, float3 v) {
+#ifdef LC_DOUBLE
+  return normalize(lc_real3_from_float3(frame_to_world(f, v)));
+#else
+  return frame_to_world(f, v);
+#endif
+}
+
 /* Unoccluded test from a spawned origin o towards a sampled light point (or direction) at
  * distance dist from o. Light samples are taken from o itself, not from the surface point: the
  * offset of o is large on huge spheres (it scales with their float precision), and a direction

@@ -134,7 +134,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
           split = 1;
           ++splits;
           bs.weight *= bs.prob;
-          lc_real3 wt = normalize(lc_real3_from_float3(frame_to_world(&fr, bt.wi)));
+          lc_real3 wt = frame_to_world_dir(&fr, bt.wi);
           int t_transmit = bt.wi.z < 0.0f;
           lc_real t_side = dot(wt, it.ng);
           float3 t_beta = beta * bt.weight * bt.prob;
@@ -156,7 +156,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
 #else
       if (!bsdf_sample(&b, wo_l, u_light.w, u_bsdf.x, u_bsdf.y, &bs)) break;
 #endif
-      lc_real3 wi = normalize(lc_real3_from_float3(frame_to_world(&fr, bs.wi)));
+      lc_real3 wi = frame_to_world_dir(&fr, bs.wi);
       int transmit = bs.wi.z < 0.0f;
       lc_real side = dot(wi, it.ng);
       if (transmit ? side >= LC_REAL(0.0) : side <= LC_REAL(0.0)) break; /* shading normal leak */

@@ -46,7 +46,7 @@ static inline float3 integrator_whitted(const lc_scene* s, lc_ray ray, const lc_
     if (wo_l.z <= 0.0f) continue;
     if (!(lc_max3(w.reflect) > 0.0f) && !(lc_max3(w.transmit) > 0.0f)) continue;
     if (lc_max3(w.transmit) > 0.0f && sp < LC_WHITTED_STACK) {
-      lc_real3 refr = normalize(lc_real3_from_float3(frame_to_world(&fr, w.transmit_wi)));
+      lc_real3 refr = frame_to_world_dir(&fr, w.transmit_wi);
       if (dot(refr, it.ng) < LC_REAL(0.0)) {
         stack[sp].ray.o = lc_spawn_origin(it.p, it.perr, -it.ng);
         stack[sp].ray.d = refr;
@@ -55,8 +55,7 @@ static inline float3 integrator_whitted(const lc_scene* s, lc_ray ray, const lc_
         ++sp;
       }
     }
-    lc_real3 refl =
-        normalize(lc_real3_from_float3(frame_to_world(&fr, (float3)(-wo_l.x, -wo_l.y, wo_l.z))));
+    lc_real3 refl = frame_to_world_dir(&fr, (float3)(-wo_l.x, -wo_l.y, wo_l.z));
     if (lc_max3(w.reflect) > 0.0f && dot(refl, it.ng) > LC_REAL(0.0) && sp < LC_WHITTED_STACK) {
       stack[sp].ray.o = lc_spawn_origin(it.p, it.perr, it.ng);
       stack[sp].ray.d = refl;

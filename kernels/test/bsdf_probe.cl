@@ -1,5 +1,6 @@
-/* lucent test kernel: evaluates the device's Fresnel and BSDF code, and the unit circle its
- * sampling uses, on inputs given by the host (tests/test_kernel_bsdf.cpp). */
+/* lucent test kernel: evaluates the device's Fresnel and BSDF code, the unit circle its sampling
+ * uses, and the shading frame's directions, on inputs given by the host
+ * (tests/test_kernel_bsdf.cpp). */
 /* clang-format off */
 #include "generated/all_features.cl" /* every material type */
 #include "shared/types.h"
@@ -12,6 +13,8 @@
 #include "bsdf/fresnel.cl"
 #include "bsdf/microfacet.cl"
 #include "bsdf/bsdf.cl"
+#include "light/light.cl"
+#include "integrator/common.cl"
 /* clang-format on */
 
 /* lc_unit_circle (util/math.cl) of each u */
@@ -52,4 +55,31 @@ __kernel void probe_bsdf_eval(__global const lc_material* mat, __global const fl
   float pdf;
   float3 f = bsdf_eval(&b, wo_in[i].xyz, wi_in[i].xyz, &pdf);
   out[i] = (float4)(f, pdf);
+}
+
+/* The next ray's direction as the path integrator makes it (integrator/common.cl): in (n.xyz, u1,
+ * u2, steps, -, -) with n a unit normal. out.s012: frame_to_world_dir of the cosine-distributed
+ * direction of (u1, u2) in the frame of n; out.s3: that direction's local z. out.s456: the
+ * direction after `steps` more bounces off mirrors, each in a frame of its own (a normal between
+ * the reversed direction and a random one, as interaction_from_hit's: normalised in float), wo
+ * taken with frame_to_local and mirrored as the mirror BSDF does; no step normalises it again. */
+__kernel void probe_frame_dir(__global const float8* in, __global float8* out) {
+  lc_uint i = (lc_uint)get_global_id(0);
+  float8 a = in[i];
+  lc_frame fr = frame_from(a.s012);
+  float3 wl = sample_cosine_hemisphere(a.s3, a.s4);
+  lc_real3 w = frame_to_world_dir(&fr, wl);
+  lc_real3 d = w;
+  for (int k = 0; k < (int)a.s5; ++k) {
+    float3 r = sample_cosine_hemisphere(lc_rng_uniform(i, (lc_uint)k, 0u, 11u),
+                                        lc_rng_uniform(i, (lc_uint)k, 1u, 11u));
+    float3 m = -lc_float3_from_real3(d) + 0.9f * r; /* |r| <= 1: m faces -d */
+    float len = length(m);
+    if (!(len > 0.0f)) continue;
+    lc_frame f = frame_from(m / len);
+    float3 wo = frame_to_local(&f, lc_float3_from_real3(-d));
+    if (wo.z <= 0.0f) continue;
+    d = frame_to_world_dir(&f, (float3)(-wo.x, -wo.y, wo.z));
+  }
+  out[i] = (float8)(lc_float3_from_real3(w), wl.z, lc_float3_from_real3(d), 0.0f);
 }
