@@ -34,12 +34,9 @@ struct Probe {
                    const_cast<In*>(in.data()));
     cl::Buffer bout(ctx.context, CL_MEM_WRITE_ONLY, in.size() * sizeof(Out));
     cl::Kernel k(program, name);
-    k.setArg(0, bin);
-    k.setArg(1, bout);
+    lucent::test::set_args(k, 0, bin, bout);
     lucent::test::launch_probe(ctx.queue, k, in.size());
-    std::vector<Out> out(in.size());
-    ctx.queue.enqueueReadBuffer(bout, CL_TRUE, 0, out.size() * sizeof(Out), out.data());
-    return out;
+    return lucent::test::read_back<Out>(ctx.queue, bout, in.size());
   }
 };
 
@@ -211,15 +208,10 @@ void chi_square(const ChiSquareCase& tc) {
   cl::Buffer bw(p.ctx.context, CL_MEM_WRITE_ONLY, N * sizeof(cl_float4));
   cl_float4 wo = {{float(std::sin(tc.wo_theta)), 0.0f, float(std::cos(tc.wo_theta)), 0.0f}};
   cl::Kernel ks(p.program, "probe_bsdf_sample");
-  ks.setArg(0, bmat);
-  ks.setArg(1, wo);
-  ks.setArg(2, cl_int(tc.front));
-  ks.setArg(3, bwi);
-  ks.setArg(4, bw);
+  lucent::test::set_args(ks, 0, bmat, wo, cl_int(tc.front), bwi, bw);
   lucent::test::launch_probe(p.ctx.queue, ks, N);
-  std::vector<cl_float4> wi(N), weight(N);
-  p.ctx.queue.enqueueReadBuffer(bwi, CL_TRUE, 0, N * sizeof(cl_float4), wi.data());
-  p.ctx.queue.enqueueReadBuffer(bw, CL_TRUE, 0, N * sizeof(cl_float4), weight.data());
+  std::vector<cl_float4> wi = lucent::test::read_back<cl_float4>(p.ctx.queue, bwi, N);
+  std::vector<cl_float4> weight = lucent::test::read_back<cl_float4>(p.ctx.queue, bw, N);
 
   std::vector<double> observed(NT * NP, 0.0);
   int produced = 0;
@@ -254,14 +246,9 @@ void chi_square(const ChiSquareCase& tc) {
                   dirs.size() * sizeof(cl_float4), dirs.data());
   cl::Buffer bout(p.ctx.context, CL_MEM_WRITE_ONLY, dirs.size() * sizeof(cl_float4));
   cl::Kernel ke(p.program, "probe_bsdf_eval");
-  ke.setArg(0, bmat);
-  ke.setArg(1, bwo2);
-  ke.setArg(2, bwi2);
-  ke.setArg(3, bout);
-  ke.setArg(4, cl_int(tc.front));
+  lucent::test::set_args(ke, 0, bmat, bwo2, bwi2, bout, cl_int(tc.front));
   lucent::test::launch_probe(p.ctx.queue, ke, dirs.size());
-  std::vector<cl_float4> ev(dirs.size());
-  p.ctx.queue.enqueueReadBuffer(bout, CL_TRUE, 0, ev.size() * sizeof(cl_float4), ev.data());
+  std::vector<cl_float4> ev = lucent::test::read_back<cl_float4>(p.ctx.queue, bout, dirs.size());
   // solid angle of a sub-cell in (z, phi): dz dphi
   const double dA = (zspan / NT / SUB) * (2 * M_PI / NP / SUB);
   std::vector<double> expected(NT * NP, 0.0);
@@ -315,12 +302,9 @@ void chi_square(const ChiSquareCase& tc) {
   cl::Buffer b4(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                 some_wo.size() * sizeof(cl_float4), some_wo.data());
   cl::Buffer b5(p.ctx.context, CL_MEM_WRITE_ONLY, some_wi.size() * sizeof(cl_float4));
-  ke.setArg(1, b4);
-  ke.setArg(2, b3);
-  ke.setArg(3, b5);
+  lucent::test::set_args(ke, 1, b4, b3, b5);
   lucent::test::launch_probe(p.ctx.queue, ke, some_wi.size());
-  std::vector<cl_float4> fe(some_wi.size());
-  p.ctx.queue.enqueueReadBuffer(b5, CL_TRUE, 0, fe.size() * sizeof(cl_float4), fe.data());
+  std::vector<cl_float4> fe = lucent::test::read_back<cl_float4>(p.ctx.queue, b5, some_wi.size());
   for (size_t i = 0; i < fe.size(); ++i) {
     int idx = int(some_wi[i].s[3]);
     for (int c = 0; c < 3; ++c) {

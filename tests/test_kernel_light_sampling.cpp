@@ -40,14 +40,9 @@ std::vector<Out> run_probe(const lucent::render_detail::DeviceScene& dev, const 
                 in.size() * sizeof(cl_float4), const_cast<cl_float4*>(in.data()));
   cl::Buffer bo(pr.ctx.context, CL_MEM_WRITE_ONLY, in.size() * sizeof(Out));
   cl::Kernel k(pr.program, name);
-  int a = dev.set_args(k);
-  k.setArg(a++, p);
-  k.setArg(a++, bi);
-  k.setArg(a++, bo);
+  lucent::test::set_args(k, dev.set_args(k), p, bi, bo);
   lucent::test::launch_probe(pr.ctx.queue, k, in.size());
-  std::vector<Out> out(in.size());
-  pr.ctx.queue.enqueueReadBuffer(bo, CL_TRUE, 0, out.size() * sizeof(Out), out.data());
-  return out;
+  return lucent::test::read_back<Out>(pr.ctx.queue, bo, in.size());
 }
 
 // Samples N directions from point (0,0,0) with the scene's lights, bins them over
@@ -66,12 +61,9 @@ void chi_square_lights(const std::string& json, const char* name, bool single_li
 
   cl::Buffer out(pr.ctx.context, CL_MEM_WRITE_ONLY, N * sizeof(cl_float4));
   cl::Kernel ks(pr.program, "probe_light_sample");
-  int a = dev.set_args(ks);
-  ks.setArg(a++, p);
-  ks.setArg(a++, out);
+  lucent::test::set_args(ks, dev.set_args(ks), p, out);
   lucent::test::launch_probe(pr.ctx.queue, ks, N);
-  std::vector<cl_float4> s(N);
-  pr.ctx.queue.enqueueReadBuffer(out, CL_TRUE, 0, N * sizeof(cl_float4), s.data());
+  std::vector<cl_float4> s = lucent::test::read_back<cl_float4>(pr.ctx.queue, out, N);
 
   std::vector<double> observed(NT * NP, 0.0);
   int produced = 0;
@@ -349,13 +341,9 @@ TEST(KernelLightSampling, CdfSearchPicksTheIntervalOfU) {
                   u.data());
     cl::Buffer bo(pr.ctx.context, CL_MEM_WRITE_ONLY, u.size() * sizeof(cl_uint));
     cl::Kernel k(pr.program, "probe_cdf_search");
-    k.setArg(0, bc);
-    k.setArg(1, n);
-    k.setArg(2, bu);
-    k.setArg(3, bo);
+    lucent::test::set_args(k, 0, bc, n, bu, bo);
     lucent::test::launch_probe(pr.ctx.queue, k, u.size());
-    std::vector<cl_uint> out(u.size());
-    pr.ctx.queue.enqueueReadBuffer(bo, CL_TRUE, 0, out.size() * sizeof(cl_uint), out.data());
+    std::vector<cl_uint> out = lucent::test::read_back<cl_uint>(pr.ctx.queue, bo, u.size());
     for (std::size_t j = 0; j < u.size(); ++j) {
       const auto below = std::upper_bound(cdf.begin(), cdf.end(), u[j]) - cdf.begin();
       const cl_uint expected = std::min<cl_uint>(static_cast<cl_uint>(below), n - 1);

@@ -10,6 +10,7 @@
 
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
+#include "probe_launch.hpp"
 #include "shared/types.h"
 #include "support.hpp"
 
@@ -44,8 +45,7 @@ TEST(Layout, DeviceSeesTheHostLayout) {
   cl::Buffer out(ctx.context, CL_MEM_WRITE_ONLY, entries.size() * sizeof(lc_uint));
   k.setArg(0, out);
   ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1), cl::NullRange);
-  std::vector<lc_uint> device(entries.size());
-  ctx.queue.enqueueReadBuffer(out, CL_TRUE, 0, device.size() * sizeof(lc_uint), device.data());
+  std::vector<lc_uint> device = lucent::test::read_back<lc_uint>(ctx.queue, out, entries.size());
   for (size_t i = 0; i < entries.size(); ++i)
     EXPECT_EQ(device[i], entries[i].host)
         << entries[i].what << " differs on " << ctx.device.info.name;

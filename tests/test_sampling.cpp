@@ -208,13 +208,10 @@ TEST(SobolSampler, KernelVectorNumbersEqualTheScalarOnes) {
                        query.size() * sizeof(cl_uint4), query.data());
     cl::Buffer b_out(ctx.context, CL_MEM_WRITE_ONLY, query.size() * 10 * sizeof(float));
     cl::Kernel k(program, "probe_rng");
-    k.setArg(0, b_query);
-    k.setArg(1, static_cast<cl_uint>(t == SamplerType::Sobol ? LC_SAMPLER_SOBOL
-                                                             : LC_SAMPLER_INDEPENDENT));
-    k.setArg(2, b_out);
+    const cl_uint sampler = t == SamplerType::Sobol ? LC_SAMPLER_SOBOL : LC_SAMPLER_INDEPENDENT;
+    lucent::test::set_args(k, 0, b_query, sampler, b_out);
     lucent::test::launch_probe(ctx.queue, k, query.size());
-    std::vector<float> out(query.size() * 10);
-    ctx.queue.enqueueReadBuffer(b_out, CL_TRUE, 0, out.size() * sizeof(float), out.data());
+    std::vector<float> out = lucent::test::read_back<float>(ctx.queue, b_out, query.size() * 10);
     size_t wrong = 0;
     for (size_t i = 0; i < query.size(); ++i) {
       const cl_uint4& q = query[i];

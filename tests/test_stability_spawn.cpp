@@ -92,13 +92,9 @@ Counts run_decade(double m, int rays_wanted, std::uint32_t seed, bool in_double 
   cl::Buffer bc(p.ctx.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zero, zero);
   cl::Buffer be(p.ctx.context, CL_MEM_READ_WRITE, 2 * sizeof(cl_float4));
   cl::Kernel k(p.program, "stability_spawn");
-  k.setArg(0, bs);
-  k.setArg(1, static_cast<cl_uint>(spheres.size()));
-  k.setArg(2, bt);
-  k.setArg(3, static_cast<cl_uint>(triangles.size()));
-  k.setArg(4, static_cast<cl_uint>(seed));
-  k.setArg(5, bc);
-  k.setArg(6, be);
+  lucent::test::set_args(k, 0, bs, static_cast<cl_uint>(spheres.size()), bt,
+                         static_cast<cl_uint>(triangles.size()), static_cast<cl_uint>(seed), bc,
+                         be);
   // two rays per hit point; a few aimed rays miss (grazing a triangle's edge) and are skipped
   const std::size_t items = static_cast<std::size_t>(rays_wanted / 2 * 1.02);
   lucent::test::launch_probe(p.ctx.queue, k, items);
@@ -170,11 +166,9 @@ void expect_spawn_step_is_nextafter(bool in_double) {
                 in.data());
   cl::Buffer bo(pr.ctx.context, CL_MEM_WRITE_ONLY, count * 4 * sizeof(Real));
   cl::Kernel k(pr.program, "probe_spawn_step");
-  k.setArg(0, bi);
-  k.setArg(1, bo);
+  lucent::test::set_args(k, 0, bi, bo);
   lucent::test::launch_probe(pr.ctx.queue, k, count);
-  std::vector<Real> out(count * 4);
-  pr.ctx.queue.enqueueReadBuffer(bo, CL_TRUE, 0, out.size() * sizeof(Real), out.data());
+  std::vector<Real> out = lucent::test::read_back<Real>(pr.ctx.queue, bo, count * 4);
   int checked_zero = 0;
   for (size_t i = 0; i < count; ++i)
     for (int c = 0; c < 3; ++c) {

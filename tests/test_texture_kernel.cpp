@@ -68,14 +68,9 @@ std::vector<cl_float4> lookup(const lucent::Scene& scene, const std::vector<Quer
                   uv.data());
   cl::Buffer b_out(c, CL_MEM_WRITE_ONLY, q.size() * sizeof(cl_float4));
   cl::Kernel k(p.program, "probe_texture_lookup");
-  k.setArg(0, b_tex);
-  k.setArg(1, b_texels);
-  k.setArg(2, b_index);
-  k.setArg(3, b_uv);
-  k.setArg(4, b_out);
+  lucent::test::set_args(k, 0, b_tex, b_texels, b_index, b_uv, b_out);
   lucent::test::launch_probe(p.ctx.queue, k, q.size());
-  std::vector<cl_float4> out(q.size());
-  p.ctx.queue.enqueueReadBuffer(b_out, CL_TRUE, 0, out.size() * sizeof(cl_float4), out.data());
+  std::vector<cl_float4> out = lucent::test::read_back<cl_float4>(p.ctx.queue, b_out, q.size());
   return out;
 }
 
