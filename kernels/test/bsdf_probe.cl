@@ -73,7 +73,7 @@ __kernel void probe_frame_dir(__global const float8* in, __global float8* out) {
   for (int k = 0; k < (int)a.s5; ++k) {
     float3 r = sample_cosine_hemisphere(lc_rng_uniform(i, (lc_uint)k, 0u, 11u),
                                         lc_rng_uniform(i, (lc_uint)k, 1u, 11u));
-    float3 m = -lc_float3_from_real3(d) + 0.9f * r; /* |r| <= 1: m faces -d */
+    float3 m = -lc_float3_from_real3(d) + 0.9f * r; /* |0.9 r| < |d|: m faces -d */
     float len = length(m);
     if (!(len > 0.0f)) continue;
     lc_frame f = frame_from(m / len);
