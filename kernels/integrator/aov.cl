@@ -41,12 +41,11 @@ static inline float3 aov_ao(const lc_scene* s, lc_ray ray, const lc_rng* rng, co
                             const lc_interaction* it, lc_uint* rays) {
   lc_frame fr = frame_from(it->ns);
   float2 u = lc_rand2(rng, LC_DIM_BOUNCE + LC_DIM_BSDF_UV);
-  float3 wi = frame_to_world(&fr, sample_cosine_hemisphere(u.x, u.y));
-  lc_real3 wir = lc_real3_from_float3(wi);
-  if (dot(wir, it->ng) <= LC_REAL(0.0)) return (float3)(0.0f);
+  lc_real3 wi = frame_to_world_dir(&fr, sample_cosine_hemisphere(u.x, u.y));
+  if (dot(wi, it->ng) <= LC_REAL(0.0)) return (float3)(0.0f);
   lc_ray sr;
   sr.o = lc_spawn_origin(it->p, it->perr, it->ng);
-  sr.d = normalize(wir);
+  sr.d = wi;
   ++*rays;
   return scene_occluded(s, sr, s->params->ao_distance) ? (float3)(0.0f) : (float3)(1.0f);
 }
