@@ -94,6 +94,10 @@ const std::map<std::string, std::string> kExpected = {
     {"exr-piz-huffman-run-past-table.exr",
      ": OpenEXR PIZ chunk at byte 329 is corrupt: a run of zero code lengths passes the last "
      "symbol of its Huffman table"},
+    // a scanline EXR whose chunkCount attribute (452,989,026) tinyexr took for the size of its
+    // offset table: it allocated 3.6 GB before reading an entry
+    {"exr-chunk-count-huge.exr",
+     ": OpenEXR header's chunkCount is 452989026, but its 40 scanlines make 40 chunks"},
     // a map_Kd name longer than the file system allows: std::filesystem::exists threw
     {"long-texture-name.bundle", ""},
     // a vw (skin weight) line whose joint 112147483648 tinyobjloader converted to int: undefined

@@ -214,6 +214,54 @@ TEST(ImageIo, DamagedTiledExrIsRefused) {
       << error_of(huge);
 }
 
+// The chunkCount attribute of a scanline file: tinyexr sizes the offset table by it, allocating 8
+// bytes an entry before reading any (fuzz_render_image found a 735-byte file that asked for
+// 3.6 GB: docs/reliability.md), so the probe requires it to be the file's count of chunks, one
+// per block of scanlines. A good file with the attribute inserted reads as before; with any other
+// count it is refused with one line, before anything is allocated for the table.
+TEST(ImageIo, ExrChunkCountMustBeTheChunksOfItsScanlines) {
+  auto value = [](int c, int x, int y) { return float(x + 100 * y) + 0.25f * float(c); };
+  const std::string dir = lucent::test::temp_dir(), path = dir + "/c.exr";
+  for (int compression : {TINYEXR_COMPRESSIONTYPE_NONE, TINYEXR_COMPRESSIONTYPE_ZIP}) {
+    ExrLayout layout;
+    layout.compression = compression;
+    write_exr(path, 37, 21, {"B", "G", "R"}, value, layout);
+    const std::string good = lucent::test::read_file(path);
+    const int chunks = compression == TINYEXR_COMPRESSIONTYPE_ZIP ? 2 : 21;  // 16 lines or 1
+    // the header ends with a 0 byte just before the offset table; the attribute goes before it,
+    // and every offset (from the start of the file) moves by its length
+    auto with_count = [&](std::int32_t count) {
+      const size_t table = exr_offset_table(good);
+      std::string attr("chunkCount\0int\0", 15);
+      const std::int32_t four = 4;
+      attr.append(reinterpret_cast<const char*>(&four), 4);
+      attr.append(reinterpret_cast<const char*>(&count), 4);
+      std::string bytes = good;
+      bytes.insert(table - 1, attr);
+      for (int k = 0; k < chunks; ++k) {
+        std::uint64_t offset = 0;
+        std::memcpy(&offset, bytes.data() + table + attr.size() + 8 * k, 8);
+        offset += attr.size();
+        std::memcpy(&bytes[table + attr.size() + 8 * k], &offset, 8);
+      }
+      return bytes;
+    };
+    const std::string what = "compression " + std::to_string(compression);
+    ASSERT_EQ(read_error(path, with_count(chunks)), "") << what;
+    const lucent::Image img = lucent::read_image(path);
+    ASSERT_EQ(img.width, 37) << what;
+    ASSERT_EQ(img.height, 21) << what;
+    for (int y = 0; y < 21; ++y)
+      for (int x = 0; x < 37; ++x)
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(img.pixel(x, y)[c], value(2 - c, x, y)) << what;
+    for (std::int32_t count : {1, chunks + 1, 2147483647})
+      EXPECT_EQ(read_error(path, with_count(count)),
+                path + ": OpenEXR header's chunkCount is " + std::to_string(count) +
+                    ", but its 21 scanlines make " + std::to_string(chunks) + " chunks")
+          << what;
+  }
+}
+
 // PIZ-compressed scanline files read; the probe walks each PIZ chunk's table of Huffman code
 // lengths as tinyexr unpacks it (tinyexr ignores a failed unpacking and decodes with run codes as
 // lengths: signed overflow, found by fuzz_texture), so a good table passes and a table whose
