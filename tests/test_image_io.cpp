@@ -230,8 +230,8 @@ TEST(ImageIo, ExrChunkCountMustBeTheChunksOfItsScanlines) {
     const int chunks = compression == TINYEXR_COMPRESSIONTYPE_ZIP ? 2 : 21;  // 16 lines or 1
     // the header ends with a 0 byte just before the offset table; the attribute goes before it,
     // and every offset (from the start of the file) moves by its length
+    const size_t table = exr_offset_table(good);
     auto with_count = [&](std::int32_t count) {
-      const size_t table = exr_offset_table(good);
       std::string attr("chunkCount\0int\0", 15);
       const std::int32_t four = 4;
       attr.append(reinterpret_cast<const char*>(&four), 4);
