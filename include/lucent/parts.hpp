@@ -24,7 +24,9 @@ struct SampleRange {
   bool operator==(const SampleRange& o) const { return begin == o.begin && end == o.end; }
 };
 
-/// "[0, 16)"; a list: "[0, 16), [32, 48)" ("none" when empty).
+/// "[0, 16)"; a list: "[0, 16), [32, 48)" ("none" when empty); a list of more than 8 ranges
+/// names the first 6 and the last, and counts them:
+/// "[0, 1), [2, 3), [4, 5), [6, 7), [8, 9), [10, 11), ..., [98, 99) (50 ranges)".
 std::string range_text(const SampleRange& r);
 std::string ranges_text(const std::vector<SampleRange>& rs);
 
