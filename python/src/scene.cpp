@@ -1,7 +1,7 @@
 // Scenes in Python: the scene structs with every field readable and writable (enums by their
 // scene-file names), scenes from files and from dicts of the JSON format (the same parser and
 // its one-line errors).
-#include <pybind11/stl_bind.h>
+#include <pybind11/pybind11.h>
 
 #include <cmath>
 #include <limits>
@@ -16,6 +16,7 @@
 #include "scene/json_guard.hpp"
 #include "scene/loaders.hpp"
 #include "scene/validate.hpp"
+#include "scene_list.hpp"
 #include "state.hpp"
 
 PYBIND11_MAKE_OPAQUE(std::vector<lucent::Material>)
@@ -907,12 +908,12 @@ void bind_scene(py::module_& m) {
   enum_property(shape_entry, "type", &ShapeEntry::type);
   def_pickle(shape_entry);
 
-  auto shape_list = py::bind_vector<std::vector<ShapeEntry>>(m, "ShapeList");
-  auto material_list = py::bind_vector<std::vector<Material>>(m, "MaterialList");
-  auto sphere_list = py::bind_vector<std::vector<Sphere>>(m, "SphereList");
-  auto triangle_list = py::bind_vector<std::vector<Triangle>>(m, "TriangleList");
-  auto light_list = py::bind_vector<std::vector<Light>>(m, "LightList");
-  auto texture_list = py::bind_vector<std::vector<Texture>>(m, "TextureList");
+  auto shape_list = bind_scene_list<ShapeEntry>(m, "ShapeList");
+  auto material_list = bind_scene_list<Material>(m, "MaterialList");
+  auto sphere_list = bind_scene_list<Sphere>(m, "SphereList");
+  auto triangle_list = bind_scene_list<Triangle>(m, "TriangleList");
+  auto light_list = bind_scene_list<Light>(m, "LightList");
+  auto texture_list = bind_scene_list<Texture>(m, "TextureList");
   def_pickle(shape_list);
   def_pickle(material_list);
   def_pickle(sphere_list);
@@ -922,19 +923,20 @@ void bind_scene(py::module_& m) {
 
   py::class_<Scene> scene(m, "Scene",
                           "A scene: camera, film, integrator and lists of materials, spheres, "
-                          "triangles, lights and textures (a reference to a list element stays "
-                          "valid while the list is not resized).");
+                          "triangles, lights and textures (a reference to a list's element "
+                          "follows the element when the list changes, as in a Python list).");
   scene.def(py::init<>())
       .def_readwrite("path", &Scene::path, "the file the scene came from, for messages")
       .def_readwrite("camera", &Scene::camera)
       .def_readwrite("film", &Scene::film)
-      .def_readwrite("integrator", &Scene::integrator)
-      .def_readwrite("materials", &Scene::materials)
-      .def_readwrite("spheres", &Scene::spheres)
-      .def_readwrite("triangles", &Scene::triangles)
-      .def_readwrite("lights", &Scene::lights)
-      .def_readwrite("textures", &Scene::textures)
-      .def_readwrite("shapes", &Scene::shapes, "the shape list as given (ShapeEntry)")
+      .def_readwrite("integrator", &Scene::integrator);
+  list_property(scene, "materials", &Scene::materials);
+  list_property(scene, "spheres", &Scene::spheres);
+  list_property(scene, "triangles", &Scene::triangles);
+  list_property(scene, "lights", &Scene::lights);
+  list_property(scene, "textures", &Scene::textures);
+  list_property(scene, "shapes", &Scene::shapes, "the shape list as given (ShapeEntry)");
+  scene
       .def("find_material", &Scene::find_material, py::arg("name"),
            "Index of the material named `name`, or -1.")
       .def("copy", [](const Scene& s) { return Scene(s); })

@@ -1,0 +1,200 @@
+"""The scene's lists (MaterialList, TriangleList, ...) behave as Python lists whose elements are
+objects of their own: a reference to an element (`w = scene.materials[0]`, an iterator's item, a
+member such as `w.albedo`) follows the element when the list changes, and outlives it when it
+leaves the list. With pybind11's bind_vector such a reference pointed at freed memory once the
+list reallocated: edits were lost, reads returned garbage, writes crashed the interpreter
+(`free(): invalid pointer`), and `del lst[::-1]` erased out of bounds. The sanitizer build runs
+these tests with AddressSanitizer, which reports any access to freed memory."""
+import random
+
+import pytest
+
+import lucent
+from conftest import SMALL
+
+
+def material(name):
+    m = lucent.Material()
+    m.name = name
+    return m
+
+
+def test_reference_follows_its_element_when_the_list_reallocates(small_scene):
+    w = small_scene.materials[0]
+    name = w.name
+    albedo = w.albedo  # a member: a reference into the element too
+    for i in range(100):  # several reallocations
+        small_scene.materials.append(material(f"n{i}"))
+    w.albedo = (1, 0, 0)
+    assert small_scene.materials[0] is w
+    assert w.name == name
+    assert tuple(small_scene.materials[0].albedo) == (1, 0, 0)
+    assert tuple(albedo) == (1, 0, 0)
+    albedo.y = 0.25
+    assert small_scene.materials[0].albedo.y == 0.25
+
+
+def test_element_removed_from_the_list_lives_on_as_a_copy(small_scene):
+    w = small_scene.materials[1]
+    name = w.name
+    small_scene.materials.clear()
+    for i in range(50):
+        small_scene.materials.append(material(f"n{i}"))
+    assert w.name == name
+    w.name = "a name long enough to need its own allocation " * 4  # crashed: free() on junk
+    assert all(m.name.startswith("n") for m in small_scene.materials)
+    assert all(m is not w for m in small_scene.materials)
+
+
+def test_iterator_follows_the_list_by_index(small_scene):
+    it = iter(small_scene.triangles)
+    first = next(it)
+    v = tuple(first.v)
+    for _ in range(100):
+        small_scene.triangles.append(lucent.Triangle())
+    assert tuple(first.v) == v
+    assert next(it) is small_scene.triangles[1]
+    # items appended during an iteration are visited, and a list that shrinks ends it
+    seen = 0
+    for t in small_scene.triangles:
+        seen += 1
+        if seen == 1:
+            small_scene.triangles.append(lucent.Triangle())
+        if seen == 50:
+            del small_scene.triangles[60:]
+    assert seen == 60
+
+
+def test_slices_delete_and_assign_as_in_a_python_list(small_scene):
+    for i in range(4):
+        small_scene.materials.append(material(f"n{i}"))
+    names = [m.name for m in small_scene.materials]
+    del small_scene.materials[::-1]  # erased out of bounds with bind_vector
+    assert len(small_scene.materials) == 0
+    small_scene.materials = [material(n) for n in names]  # a Python list converts
+    assert [m.name for m in small_scene.materials] == names
+    small_scene.materials = tuple(small_scene.materials)  # and a tuple, and itself
+    assert [m.name for m in small_scene.materials] == names
+    small_scene.materials[1:3] = [material("x")]  # a simple slice: any length
+    assert [m.name for m in small_scene.materials] == [names[0], "x"] + names[3:]
+    with pytest.raises(ValueError, match="extended slice of size 3"):
+        small_scene.materials[::2] = [material("y")]
+    with pytest.raises(IndexError, match="pop from empty list"):
+        lucent.MaterialList().pop()
+    with pytest.raises(IndexError):
+        small_scene.materials[len(small_scene.materials)]
+    small_scene.materials.insert(-100, material("first"))
+    small_scene.materials.insert(100, material("last"))
+    assert small_scene.materials[0].name == "first"
+    assert small_scene.materials[-1].name == "last"
+    small_scene.materials.extend(small_scene.materials)  # itself: read before it grows
+    assert len(small_scene.materials) == 2 * (len(names) + 1)
+
+
+def test_random_changes_match_a_python_list_and_keep_references():
+    """Model check: random changes to a MaterialList and to a Python list of the same names, with
+    references held to some elements. After each change the names agree, every held reference
+    still names its element, is that element where the model has it, and is no element of the
+    list once the model dropped it; an edit through a reference reaches the list exactly then."""
+    rng = random.Random(2026)
+
+    class Item:  # the model's element: an object of its own, like a list element
+        def __init__(self, name):
+            self.name = name
+
+    lst, model = lucent.MaterialList(), []
+    held = []  # (model item, the reference taken when it was in the list, its albedo)
+    counter = 0
+
+    def new_name():
+        nonlocal counter
+        counter += 1
+        return f"m{counter}"
+
+    def random_slice(n):
+        a = rng.randint(-n - 2, n + 2)
+        b = rng.randint(-n - 2, n + 2)
+        step = rng.choice([None, 1, 2, 3, -1, -2, -3])
+        return slice(rng.choice([None, a]), rng.choice([None, b]), step)
+
+    for step in range(600):
+        n = len(model)
+        op = rng.choice(["append", "append", "extend", "extend_self", "insert", "pop", "del",
+                         "del_slice", "set", "set_slice", "hold", "hold", "clear"]
+                        if n else ["append", "extend", "insert", "hold"])
+        if op == "append":
+            name = new_name()
+            lst.append(material(name))
+            model.append(Item(name))
+        elif op == "extend":
+            names = [new_name() for _ in range(rng.randint(0, 4))]
+            lst.extend([material(x) for x in names])
+            model.extend(Item(x) for x in names)
+        elif op == "extend_self" and n < 40:
+            lst.extend(lst)
+            model.extend([Item(x.name) for x in model])
+        elif op == "insert":
+            i, name = rng.randint(-n - 3, n + 3), new_name()
+            lst.insert(i, material(name))
+            model.insert(i, Item(name))
+        elif op == "pop":
+            i = rng.randint(-n, n - 1)
+            assert lst.pop(i).name == model.pop(i).name
+        elif op == "del":
+            i = rng.randint(-n, n - 1)
+            del lst[i]
+            del model[i]
+        elif op == "del_slice":
+            s = random_slice(n)
+            del lst[s]
+            del model[s]
+        elif op == "set":
+            i, name = rng.randint(-n, n - 1), new_name()
+            lst[i] = material(name)
+            model[i] = Item(name)
+        elif op == "set_slice":
+            s = random_slice(n)
+            size = len(range(*s.indices(n)))
+            if s.step not in (None, 1):
+                names = [new_name() for _ in range(size)]
+            else:
+                names = [new_name() for _ in range(rng.randint(0, 3))]
+            lst[s] = [material(x) for x in names]
+            model[s] = [Item(x) for x in names]
+        elif op == "hold" and n:
+            i = rng.randrange(n)
+            ref = lst[i]
+            held.append((model[i], ref, ref.albedo if rng.random() < 0.5 else None))
+        elif op == "clear" and rng.random() < 0.2:
+            lst.clear()
+            model.clear()
+
+        assert [m.name for m in lst] == [x.name for x in model], f"step {step}: {op}"
+        at = {id(x): k for k, x in enumerate(model)}
+        for item, ref, albedo in held:
+            assert ref.name == item.name, f"step {step}: {op}"
+            k = at.get(id(item))
+            mark = float(step)
+            if albedo is not None:
+                albedo.x = mark
+                assert ref.albedo.x == mark
+            else:
+                ref.albedo = (mark, 0, 0)
+            if k is not None:
+                assert lst[k] is ref, f"step {step}: {op}"
+                assert lst[k].albedo.x == mark
+            else:
+                assert all(m is not ref for m in lst), f"step {step}: {op}"
+        if len(held) > 30:
+            del held[: len(held) - 30]
+    assert counter > 300
+
+
+def test_scene_renders_after_its_lists_changed_under_references():
+    s = lucent.scene_from_dict(SMALL)
+    w = s.materials[0]
+    s.materials.append(material("extra"))
+    s.spheres.append(lucent.Sphere((1, 0.5, 0), 0.25, material=2))
+    w.albedo = (0.9, 0.1, 0.1)
+    lucent.scene_info(s)  # validates: every index in range
+    assert tuple(s.materials[0].albedo) == pytest.approx((0.9, 0.1, 0.1))
