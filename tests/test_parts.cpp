@@ -269,6 +269,50 @@ TEST(Parts, OverlapsAndMismatchesAreOneLineErrors) {
   EXPECT_NE(r.err.find("min 6, mean 6.00, max 6"), std::string::npos) << r.err;
 }
 
+/// A part of a 1x1 film made without rendering: `samples` of `requested`, all of them finite.
+lucent::RenderPart handmade_part(const std::vector<lucent::SampleRange>& samples,
+                                 lucent::SampleRange requested) {
+  lucent::RenderPart p;
+  p.info.width = p.info.height = 1;
+  p.info.seed = 1;
+  p.info.integrator = "path";
+  p.info.version = lucent::kVersion;
+  p.info.scene_hash = 7;
+  p.info.scene = "scene.json";
+  p.info.samples = samples;
+  p.info.requested = {requested};
+  p.acc.width = p.acc.height = 1;
+  p.acc.sum = p.acc.sumsq = {0.5, 0.5, 0.5};
+  std::uint64_t n = 0;
+  for (const lucent::SampleRange& r : samples) n += r.end - r.begin;
+  p.acc.count = {static_cast<std::uint32_t>(n)};
+  return p;
+}
+
+// A part holds at most 2^24 samples (--samples), but parts together may hold up to 2^32:
+// `merge --expect` took the per-part limit, so a Slurm job of more than 2^24 spp
+// (scripts/slurm/submit.sh passes --expect 0:SPP) rendered every part, then failed to merge.
+TEST(Parts, ExpectMayCoverMoreSamplesThanOnePart) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::uint64_t m = 1ull << 24;
+  lucent::write_render_part(dir + "/a.exr", handmade_part({{0, m}}, {0, m}));
+  lucent::write_render_part(dir + "/b.exr", handmade_part({{m, 2 * m}}, {m, 2 * m}));
+  const std::string parts =
+      q(dir + "/a.exr") + " " + q(dir + "/b.exr") + " -o " + q(dir + "/o.exr");
+  CommandResult r = run_cli("merge --complete --expect 0:33554432 " + parts);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(lucent::read_render_part(dir + "/o.exr").acc.count,
+            (std::vector<std::uint32_t>{1u << 25}));
+  EXPECT_EQ(error_line(run_cli("merge --complete --expect 0:33554433 " + parts)),
+            "merge: samples [33554432, 33554433) are missing (--complete)");
+  EXPECT_EQ(error_line(run_cli("merge --expect 0:4294967297 " + parts)),
+            "--expect '0:4294967297': need 0 <= A < B <= 4294967296");
+  // one part is still limited
+  EXPECT_EQ(error_line(run_cli("render " + q(dir + "/none.json") + " --samples 0:16777217 -o " +
+                               q(dir + "/x.exr"))),
+            "--samples '0:16777217': at most 16777216 samples per part");
+}
+
 // A part's header may list many ranges (a merge of parts with gaps between them, or a file made
 // to hurt). The overlap check ran a loop over every pair of ranges: two crafted part files of
 // 0.5 MB each (4*10^4 interleaved ranges) took 1.7 s to merge, and ten times as many ranges
@@ -350,17 +394,11 @@ TEST(Parts, ManyRangesAreCheckedInOnePassAndListedBriefly) {
   // through the command line: parts of a 1x1 film whose headers list 2000 ranges each merge,
   // and the warning naming the samples one of them misses is one short line
   std::string dir = lucent::test::temp_dir();
-  for (int f = 0; f < 2; ++f) {
-    lucent::RenderPart p;
-    p.info = header({});
-    p.info.scene_hash = 7;
-    p.info.scene = "scene.json";
-    p.info.requested = {{0, 4000}};
-    for (std::uint64_t k = 0; k < 2000; ++k) p.info.samples.push_back({2 * k + f, 2 * k + f + 1});
-    p.acc.width = p.acc.height = 1;
-    p.acc.sum = p.acc.sumsq = {0.5, 0.5, 0.5};
-    p.acc.count = {2000};
-    lucent::write_render_part(dir + "/p" + std::to_string(f) + ".exr", p);
+  for (std::uint64_t f = 0; f < 2; ++f) {
+    std::vector<lucent::SampleRange> samples;
+    for (std::uint64_t k = 0; k < 2000; ++k) samples.push_back({2 * k + f, 2 * k + f + 1});
+    lucent::write_render_part(dir + "/p" + std::to_string(f) + ".exr",
+                              handmade_part(samples, {0, 4000}));
   }
   const std::string out = dir + "/out.exr";
   CommandResult one = run_cli("merge " + q(dir + "/p0.exr") + " -o " + q(out));

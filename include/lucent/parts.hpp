@@ -34,9 +34,11 @@ std::string ranges_text(const std::vector<SampleRange>& rs);
 std::vector<SampleRange> missing_ranges(const std::vector<SampleRange>& have,
                                         const SampleRange& want);
 
-/// Parses "A:B" (0 <= A < B <= 2^32, B - A <= limits::kMaxSpp); throws lucent::Error naming
-/// `what` (e.g. "--samples") otherwise.
-SampleRange parse_sample_range(const std::string& text, const std::string& what = "--samples");
+/// Parses "A:B" (0 <= A < B <= 2^32); throws lucent::Error naming `what` (e.g. "--samples")
+/// otherwise. `per_part`: a range one render makes, so B - A <= limits::kMaxSpp too; a range that
+/// many parts hold together (merge --expect) may be as long as 2^32.
+SampleRange parse_sample_range(const std::string& text, const std::string& what = "--samples",
+                               bool per_part = true);
 
 /// What identifies a part's image and where its samples come from (a part file's header).
 struct PartInfo {

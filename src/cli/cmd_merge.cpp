@@ -57,7 +57,8 @@ int run_merge_command() {
   // reading any part
   io::check_output_path(a.output, a.parts);
   SampleRange expect;
-  if (!a.expect.empty()) expect = parse_sample_range(a.expect, "--expect");
+  // what the parts hold together: many parts of at most 2^24 samples each (the per-part limit)
+  if (!a.expect.empty()) expect = parse_sample_range(a.expect, "--expect", false);
   MergeReport r = merge_render_parts(a.parts);
   const PartInfo& info = r.merged.info;
   if (!a.expect.empty()) {

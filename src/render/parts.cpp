@@ -259,7 +259,7 @@ std::string ranges_text(const std::vector<SampleRange>& rs) {
   return out;
 }
 
-SampleRange parse_sample_range(const std::string& text, const std::string& what) {
+SampleRange parse_sample_range(const std::string& text, const std::string& what, bool per_part) {
   const size_t colon = text.find(':');
   auto number = [&](const std::string& s, std::uint64_t* v) {
     if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos || s.size() > 11)
@@ -273,7 +273,7 @@ SampleRange parse_sample_range(const std::string& text, const std::string& what)
     throw Error(what + " '" + text + "': expected A:B, the sample indices [A, B)");
   if (r.end <= r.begin || r.end > (1ull << 32))
     throw Error(what + " '" + text + "': need 0 <= A < B <= 4294967296");
-  if (r.end - r.begin > static_cast<std::uint64_t>(limits::kMaxSpp))
+  if (per_part && r.end - r.begin > static_cast<std::uint64_t>(limits::kMaxSpp))
     throw Error(what + " '" + text + "': at most " + std::to_string(limits::kMaxSpp) +
                 " samples per part");
   return r;
