@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <string>
 
 #include "core/file_io.hpp"
@@ -184,6 +185,29 @@ TEST(SceneGuard, StreamsAndDevicesAreBounded) {
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   r = run_cli("render " + q(fifo) + " -o " + q(out));
   EXPECT_NE(r.err.find(fifo + ":1:1: invalid JSON"), std::string::npos) << r.err;
+}
+
+// A piped scene has no directory of its own: its relative file names are taken from the current
+// directory, as a shell's would be (they were looked for in /dev), and /dev/stdin redirected from
+// a file is that file, in its directory.
+TEST(SceneGuard, PipedSceneFindsItsFilesFromTheCurrentDirectory) {
+  std::string dir = lucent::test::temp_dir();
+  std::filesystem::create_directories(dir + "/sub");
+  lucent::test::write_file(dir + "/sub/tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  lucent::test::write_file(dir + "/sub/s.json",
+                           R"({"film": {"width": 4, "height": 4},
+    "integrator": {"type": "albedo", "spp": 1},
+    "shapes": [{"type": "mesh", "file": "tri.obj"}]})");
+  const std::string out = q(dir + "/o.pfm") + " --quiet";
+  CommandResult r =
+      piped("cd " + q(dir + "/sub") + " && cat s.json", "render /dev/stdin -o " + out);
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = piped("cd " + q(dir) + " && true", "render /dev/stdin -o " + out + " < sub/s.json");
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = piped("cd " + q(dir) + " && cat sub/s.json", "render /dev/stdin -o " + out);
+  EXPECT_EQ(r.err,
+            "lucent: error: /dev/stdin: /shapes/0/file: tri.obj: cannot open OBJ file (No such "
+            "file or directory)\n");
 }
 
 // A writer that holds a pipe open and sends nothing: the read gives up after the idle time.

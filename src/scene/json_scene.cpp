@@ -47,9 +47,10 @@ struct ErrorLocator : nlohmann::json_sax<json> {
 };
 
 /// The scene in `root`: its sections in a fixed order (materials before the shapes naming them).
-Scene build_scene(const json& root, const std::string& path) {
+/// Relative file names are taken from `dir`.
+Scene build_scene(const json& root, const std::string& path, const fs::path& dir) {
   using namespace scene_detail;
-  JsonReader r(path, fs::path(path).parent_path());
+  JsonReader r(path, dir);
   SceneBuilder b(path);
   r.check_keys(root, "", {"camera", "film", "integrator", "materials", "shapes", "lights"});
   if (root.contains("camera")) parse_camera(r, root["camera"], b);
@@ -61,9 +62,8 @@ Scene build_scene(const json& root, const std::string& path) {
   return b.build();
 }
 
-}  // namespace
-
-Scene parse_scene(const std::string& text, const std::string& path) {
+/// parse_scene, with the relative file names taken from `dir`.
+Scene parse_scene_in(const std::string& text, const std::string& path, const fs::path& dir) {
   scene_detail::check_json_structure(text, path);  // nesting depth, duplicate keys
   json root;
   try {
@@ -88,11 +88,39 @@ Scene parse_scene(const std::string& text, const std::string& path) {
                      ? "number out of range (not a finite double): " + literal
                      : std::string(e.what())));
   }
-  return build_scene(root, path);
+  return build_scene(root, path, dir);
 }
 
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& path) {
+  return parse_scene_in(text, path, fs::path(path).parent_path());
+}
+
+namespace {
+
+/// Where a scene file's relative file names start: its directory. A scene read from a pipe
+/// (/dev/stdin, <(command), a FIFO) has none, so the current directory, as for a shell; they were
+/// looked for in /dev or /dev/fd. /dev/stdin redirected from a file (`< scene.json`) is that
+/// file, so its directory.
+fs::path scene_dir(const std::string& path) {
+  std::error_code ec;
+  const fs::path dir = fs::path(path).parent_path();
+  const bool fd_alias = dir == "/dev" || dir == "/dev/fd" ||
+                        (dir.filename() == "fd" && dir.parent_path().parent_path() == "/proc");
+  if (fd_alias) {
+    // a file descriptor's link names its file; a pipe's ("pipe:[1234]") is no path
+    const fs::path target = fs::canonical(path, ec);
+    return !ec && fs::is_regular_file(target, ec) ? target.parent_path() : fs::path();
+  }
+  return fs::is_regular_file(path, ec) ? dir : fs::path();
+}
+
+}  // namespace
+
 Scene load_scene(const std::string& path) {
-  return parse_scene(scene_detail::read_scene_text(path), path);  // bounded; pipes allowed
+  const std::string text = scene_detail::read_scene_text(path);  // bounded; pipes allowed
+  return parse_scene_in(text, path, scene_dir(path));
 }
 
 namespace scene_detail {
