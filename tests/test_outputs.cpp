@@ -126,6 +126,28 @@ TEST(Outputs, WritesAreAtomicAndFollowSymlinks) {
   lucent::Image img = lucent::read_image(dir + "/real/img.pfm");
   EXPECT_EQ(img.width, 32);
   EXPECT_TRUE(others(dir + "/real", {"img.pfm"}).empty());
+  // a link to a file not yet written, through a second link: the file is written, the links stay
+  // (the first link was replaced by the image: weakly_canonical does not resolve a dangling link)
+  fs::create_symlink("real/new.pfm", dir + "/to-new.pfm");
+  fs::create_symlink("to-new.pfm", dir + "/to-to-new.pfm");
+  r = run_cli("render " + q(scene) + " -o " + q(dir + "/to-to-new.pfm") + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(dir + "/to-to-new.pfm")) << "the link was replaced";
+  EXPECT_TRUE(fs::is_symlink(dir + "/to-new.pfm")) << "the link was replaced";
+  EXPECT_EQ(lucent::read_image(dir + "/real/new.pfm").width, 32);
+  // a link into a directory that does not exist, and a loop: refused before rendering
+  fs::create_symlink("nowhere/x.pfm", dir + "/dangling.pfm");
+  fs::create_symlink("loop-b.pfm", dir + "/loop-a.pfm");
+  fs::create_symlink("loop-a.pfm", dir + "/loop-b.pfm");
+  EXPECT_EQ(run_cli("render " + q(scene) + " -o " + q(dir + "/dangling.pfm")).err,
+            "lucent: error: " + dir +
+                "/dangling.pfm: cannot write output (No such file or "
+                "directory)\n");
+  EXPECT_EQ(run_cli("render " + q(scene) + " -o " + q(dir + "/loop-a.pfm")).err,
+            "lucent: error: " + dir +
+                "/loop-a.pfm: cannot write (Too many levels of symbolic "
+                "links)\n");
+  EXPECT_TRUE(fs::is_symlink(dir + "/dangling.pfm") && fs::is_symlink(dir + "/loop-a.pfm"));
   // the library's writer: replaced whole, mode from the umask like any new file
   std::string plain = dir + "/plain.bin";
   lucent::io::write_file_atomic(plain, std::string("first"));

@@ -50,6 +50,23 @@ const char* kind_of(mode_t mode) {
   return "not a regular file";
 }
 
+/// The file an output path writes: `path`, or where its chain of symbolic links ends, whether
+/// that file exists or not (a link to a file not yet written is written through, as `>` does;
+/// weakly_canonical cannot resolve such a link, and the link itself was replaced by the file).
+/// A loop of links is an error.
+fs::path write_target(const std::string& path) {
+  fs::path target(path);
+  std::error_code ec;
+  for (int depth = 0; fs::is_symlink(target, ec); ++depth) {
+    if (depth == 40)  // the kernel's own limit (ELOOP)
+      throw Error(path + ": cannot write (" + reason(ELOOP) + ")");
+    const fs::path link = fs::read_symlink(target, ec);
+    if (ec) break;
+    target = link.is_absolute() ? link : target.parent_path() / link;
+  }
+  return target;
+}
+
 }  // namespace
 
 std::string format_size(std::uint64_t b) {
@@ -138,7 +155,8 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
       throw Error(out + ": is an input of this render (" + in + "); refusing to overwrite it");
   if (fs::exists(out, ec) && ::access(out.c_str(), W_OK) != 0)
     throw Error(out + ": cannot write output (" + std::strerror(errno) + ")");
-  fs::path dir = fs::path(out).parent_path();
+  const fs::path target = write_target(out);  // the directory the write will go to
+  fs::path dir = target.parent_path();
   std::string probe = (dir.empty() ? fs::path(".") : dir).string() + "/.lucent-write-test-" +
                       std::to_string(::getpid());
   int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
@@ -170,12 +188,7 @@ void write_all(int fd, const void* data, std::size_t size, const std::string& pa
 
 void write_file_atomic(const std::string& path, const void* data, std::size_t size) {
   // write where a symbolic link points: replacing the link itself would surprise
-  fs::path target(path);
-  std::error_code ec;
-  if (fs::is_symlink(target, ec)) {
-    fs::path resolved = fs::weakly_canonical(target, ec);
-    if (!ec) target = resolved;
-  }
+  const fs::path target = write_target(path);
   const std::string name = target.filename().string();
   if (name.empty() || name == "." || name == "..")
     throw Error(path + ": cannot write (not a file name)");
