@@ -13,12 +13,15 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <regex>
 #include <string>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "core/file_io.hpp"
+#include "lucent/compare.hpp"
 #include "support.hpp"
 
 namespace {
@@ -305,22 +308,14 @@ TEST(Outputs, NonFiniteOptionsAreRefused) {
   EXPECT_FALSE(fs::exists(out));
 }
 
-// SIGINT and SIGTERM while rendering: the image rendered so far is written, the last line says
-// how far the render got, the exit status is 128 + the signal. The signal is sent once the
-// progress line shows the render loop is running, and --time bounds the render should it be lost.
-void interrupt_render(int sig, const char* name, int status_expected) {
-  std::string dir = lucent::test::temp_dir();
-  std::string scene = scene_in(dir);
-  lucent::test::write_file(scene, R"({
-    "film": {"width": 64, "height": 48},
-    "integrator": {"type": "path", "spp": 16777216},
-    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
-    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
-    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
-  })");
-  std::string out = dir + "/partial.pfm", err_path = dir + "/stderr";
+/// Runs `lucent args...` (stderr to `err_path`), waits until `running(stderr)` says the render
+/// loop is under way, sends `sig` and waits for the end; returns the wait status, or fails the
+/// test if lucent does not stop within `stop_seconds`.
+int interrupt_cli(const std::vector<std::string>& args, const std::string& err_path,
+                  const std::function<bool(const std::string&)>& running, int sig,
+                  double stop_seconds) {
   pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
+  EXPECT_GE(pid, 0);
   if (pid == 0) {
     int fd = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     int null = ::open("/dev/null", O_RDWR);
@@ -329,8 +324,10 @@ void interrupt_render(int sig, const char* name, int status_expected) {
     ::dup2(null, 1);
     ::dup2(fd, 2);
     ::signal(sig, SIG_DFL);
-    ::execl(LUCENT_CLI_PATH, "lucent", "render", scene.c_str(), "-o", out.c_str(), "--time", "120",
-            static_cast<char*>(nullptr));
+    std::vector<char*> argv{const_cast<char*>("lucent")};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(LUCENT_CLI_PATH, argv.data());
     ::_exit(127);
   }
   using clock = std::chrono::steady_clock;
@@ -348,25 +345,47 @@ void interrupt_render(int sig, const char* name, int status_expected) {
     if (!exited && ::waitpid(pid, &status, WNOHANG) == pid) exited = true;
     return exited;
   };
-  bool running = wait_for(90, [&] {
-    return reaped() || read_file(err_path).find("Msamples/s  elapsed") != std::string::npos;
-  });
-  ASSERT_TRUE(running && !exited) << "no progress line: " << read_file(err_path);
-  EXPECT_FALSE(fs::exists(out)) << "nothing under the output's name before the end";
-  ASSERT_EQ(::kill(pid, sig), 0);
-  if (!wait_for(60, reaped)) {
+  bool started = wait_for(90, [&] { return reaped() || running(read_file(err_path)); });
+  EXPECT_TRUE(started && !exited) << "not running: " << read_file(err_path);
+  if (exited) return status;
+  EXPECT_EQ(::kill(pid, sig), 0);
+  if (!wait_for(stop_seconds, reaped)) {
     ::kill(pid, SIGKILL);
     ::waitpid(pid, &status, 0);
-    FAIL() << "lucent did not stop after " << name;
+    ADD_FAILURE() << "lucent did not stop within " << stop_seconds << " s of the signal";
   }
+  return status;
+}
+
+// SIGINT and SIGTERM while rendering: the image rendered so far is written, the last line says
+// how far the render got, the exit status is 128 + the signal. The signal is sent once the
+// progress line shows the render loop is running, and --time bounds the render should it be lost.
+// The variance AOV, which is the main render's, is written too; the albedo AOV, which needs a
+// render of its own, is not, and the last line says so.
+void interrupt_render(int sig, const char* name, int status_expected) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  lucent::test::write_file(scene, R"({
+    "film": {"width": 64, "height": 48},
+    "integrator": {"type": "path", "spp": 16777216},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
+  })");
+  std::string out = dir + "/partial.pfm", err_path = dir + "/stderr";
+  const int status = interrupt_cli(
+      {"render", scene, "-o", out, "--time", "120", "--aov", "variance", "albedo"}, err_path,
+      [](const std::string& err) { return err.find("Msamples/s  elapsed") != std::string::npos; },
+      sig, 60);
   std::string err = read_file(err_path);
   ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
   EXPECT_EQ(WEXITSTATUS(status), status_expected) << err;
   std::smatch m;
-  ASSERT_TRUE(
-      std::regex_search(err, m,
-                        std::regex(std::string("lucent: interrupted by ") + name + ": wrote " +
-                                   out + " with (\\d+) spp after [0-9.]+ of 120 s\n$")))
+  ASSERT_TRUE(std::regex_search(
+      err, m,
+      std::regex(std::string("lucent: interrupted by ") + name + ": wrote " + out +
+                 " with (\\d+) spp after [0-9.]+ of 120 s \\(AOVs not "
+                 "written: albedo\\)\n$")))
       << err;
   EXPECT_GE(std::stoll(m[1]), 1);
   lucent::Image img = lucent::read_image(out);
@@ -378,11 +397,51 @@ void interrupt_render(int sig, const char* name, int status_expected) {
     sum += v;
   }
   EXPECT_GT(sum, 0) << "the partial image is black";
-  EXPECT_TRUE(others(dir, {"scene.json", "partial.pfm", "stderr"}).empty());
+  EXPECT_EQ(lucent::read_image(dir + "/partial.variance.exr").width, 64);
+  EXPECT_TRUE(others(dir, {"scene.json", "partial.pfm", "partial.variance.exr", "stderr"}).empty());
 }
 
 TEST(Outputs, SigintWritesThePartialImage) { interrupt_render(SIGINT, "SIGINT \\(Ctrl-C\\)", 130); }
 
 TEST(Outputs, SigtermWritesThePartialImage) { interrupt_render(SIGTERM, "SIGTERM", 143); }
+
+// The CPU reference stops between two samples: it checked only between rows, and a row of eight
+// pixels of 2^24 samples each took about half a minute here before Ctrl-C was seen. Its pixels
+// then hold all their samples, some or none, and the last line says how much it rendered.
+TEST(Outputs, SigintStopsTheReferenceWithinAPixel) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = dir + "/scene.json";
+  lucent::test::write_file(scene, R"({
+    "integrator": {"type": "path"},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
+  })");
+  std::string out = dir + "/ref.exr", err_path = dir + "/stderr";
+  // the reference prints nothing while it renders: a second is enough to be inside a pixel
+  const auto t0 = std::chrono::steady_clock::now();
+  auto after_a_second = [&](const std::string&) {
+    return std::chrono::steady_clock::now() - t0 > std::chrono::seconds(1);
+  };
+  const int status = interrupt_cli({"render", scene, "-o", out, "--reference", "--width", "8",
+                                    "--height", "1", "--spp", "16777216"},
+                                   err_path, after_a_second, SIGINT, 10);
+  std::string err = read_file(err_path);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(
+      err, m,
+      std::regex("lucent: interrupted by SIGINT \\(Ctrl-C\\): wrote " + out +
+                 " with ([0-9.]+)% of its 16777216 spp per pixel \\(([0-9.]+)% of the pixels "
+                 "have samples, the others are black\\)\n$")))
+      << err;
+  EXPECT_LT(std::stod(m[1]), 100);
+  EXPECT_GT(std::stod(m[2]), 0);
+  const lucent::RenderResult r = lucent::read_render(out);
+  ASSERT_EQ(r.samples.size(), 8u);
+  EXPECT_GT(r.samples[0], 0u);
+  EXPECT_LT(r.samples[7], 16777216u);
+}
 
 }  // namespace

@@ -112,15 +112,20 @@ std::string aov_path(const std::string& output, const std::string& name) {
 }
 
 /// Renders and writes the requested AOV images (linear EXR) after the main render, on the same
-/// session (the BVH is reused, only the AOV kernel is built); stops when interrupted (the AOVs
-/// written so far stay).
-void write_aovs(const RenderArgs& a, const lucent::Scene& scene, lucent::Renderer* renderer,
-                const lucent::RenderResult& main_result) {
+/// session (the BVH is reused, only the AOV kernel is built); returns the names of those not
+/// written. The variance AOV is the main render's, so an interrupted render writes it too; the
+/// others need renders of their own, which an interrupt skips (the AOVs written so far stay).
+std::vector<std::string> write_aovs(const RenderArgs& a, const lucent::Scene& scene,
+                                    lucent::Renderer* renderer,
+                                    const lucent::RenderResult& main_result) {
+  std::vector<std::string> missing;
   for (const std::string& name : a.aovs) {
-    if (g_interrupted.load()) return;
     std::string path = aov_path(a.output, name);
     if (name == "variance") {
       lucent::write_image(path, main_result.variance);
+    } else if (main_result.cancelled || g_interrupted.load()) {
+      missing.push_back(name);
+      continue;
     } else {
       lucent::Scene s = scene;
       s.integrator.type = lucent::cli::parse_integrator(name);
@@ -128,24 +133,37 @@ void write_aovs(const RenderArgs& a, const lucent::Scene& scene, lucent::Rendere
       renderer->reset();
       renderer->render(std::max<std::uint64_t>(1, main_result.spp));
       lucent::RenderResult aov = renderer->result();
-      if (aov.cancelled) return;  // a partial AOV is not worth a file
+      if (aov.cancelled) {  // a partial AOV is not worth a file
+        missing.push_back(name);
+        continue;
+      }
       lucent::write_image(path, aov.mean);
     }
     if (!a.quiet) std::fprintf(stderr, "%s: %s AOV\n", path.c_str(), name.c_str());
   }
+  return missing;
 }
 
 /// How far an interrupted render got, for its last line.
 std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_spp,
-                          double time_limit) {
-  char buf[160];
-  if (!r.samples.empty() && r.spp > 0) {
+                          double time_limit, bool reference) {
+  char buf[200];
+  if (reference && !r.samples.empty() && r.spp > 0) {
+    // the reference renders pixel by pixel, and stops between two samples: its pixels hold
+    // all their samples, some (the one it stopped in) or none
     size_t covered = 0;
-    for (std::uint32_t n : r.samples) covered += n > 0;
-    if (covered < r.samples.size()) {  // the reference renders row by row
-      std::snprintf(buf, sizeof buf, "%.1f%% of the pixels at %llu spp (the others are black)",
-                    100.0 * double(covered) / double(r.samples.size()),
-                    static_cast<unsigned long long>(r.spp));
+    double taken = double(r.nonfinite);
+    for (std::uint32_t n : r.samples) {
+      covered += n > 0;
+      taken += n;
+    }
+    const double all = double(r.samples.size()) * double(r.spp);
+    if (taken < all) {
+      std::snprintf(buf, sizeof buf,
+                    "%.1f%% of its %llu spp per pixel (%.1f%% of the pixels have samples, the "
+                    "others are black)",
+                    100.0 * taken / all, static_cast<unsigned long long>(r.spp),
+                    100.0 * double(covered) / double(r.samples.size()));
       return buf;
     }
   }
@@ -313,15 +331,20 @@ int render_with(const RenderArgs& a) {
                  r.target_error, r.model_gain_a, r.model_gain_b, r.halves_relmse);
   if (std::string s = lucent::target_shortfall(r); !s.empty())
     std::fprintf(stderr, "lucent: warning: %s: %s\n", a.output.c_str(), s.c_str());
-  if (!r.cancelled && !a.reference) write_aovs(a, scene, &*renderer, r);
+  std::vector<std::string> missing_aovs;
+  if (!a.reference) missing_aovs = write_aovs(a, scene, &*renderer, r);
   if (r.cancelled || g_interrupted.load()) {
     const int sig = g_signal ? static_cast<int>(g_signal) : SIGINT;
     std::uint64_t target = a.spp > 0 ? std::uint64_t(a.spp)
                                      : (a.time_limit > 0 ? 0 : std::uint64_t(scene.integrator.spp));
     if (range) target = range->end - range->begin;
+    std::string aovs;  // the AOVs asked for and not written
+    for (const std::string& name : missing_aovs)
+      aovs += (aovs.empty() ? " (AOVs not written: " : ", ") + name;
+    if (!aovs.empty()) aovs += ")";
     std::fprintf(stderr, "lucent: interrupted by %s: wrote %s with %s%s\n", signal_name(sig),
-                 a.output.c_str(), progress_note(r, target, a.time_limit).c_str(),
-                 r.cancelled ? "" : " (the AOVs were not all written)");
+                 a.output.c_str(), progress_note(r, target, a.time_limit, a.reference).c_str(),
+                 aovs.c_str());
     if (range)
       std::fprintf(stderr, "lucent: %s holds samples [%llu, %llu) of %s\n", a.output.c_str(),
                    static_cast<unsigned long long>(range->begin),

@@ -60,14 +60,16 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
       light_sum[thread].assign(npix * 3, 0.0);
       light_sq[thread].assign(npix * 3, 0.0);
     }
-    for (int y; (y = next_row.fetch_add(1)) < H;) {
-      if (options.cancel && options.cancel->load()) {
-        cancelled = true;
-        break;
-      }
+    // checked before every sample: a pixel of many samples took seconds, and a row of them
+    // minutes (Ctrl-C waited for the row)
+    auto stop = [&] {
+      if (options.cancel && options.cancel->load(std::memory_order_relaxed)) cancelled = true;
+      return cancelled.load(std::memory_order_relaxed);
+    };
+    for (int y; !stop() && (y = next_row.fetch_add(1)) < H;) {
       for (int x = 0; x < W; ++x) {
         const size_t i = static_cast<size_t>(y) * W + x;
-        for (int k = 0; k < spp; ++k) {
+        for (int k = 0; k < spp && !stop(); ++k) {
           ref::Sampler rng{static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k),
                            scene.integrator.seed, scene.integrator.sampler};
           glm::dvec3 v = ref::radiance(tracer, camera.ray(x, y, rng), rng);
@@ -87,7 +89,7 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
       if (!caustics) continue;
       // the row's light paths: one per camera sample, with that sample's random numbers
       for (int x = 0; x < W; ++x)
-        for (int k = 0; k < spp; ++k) {
+        for (int k = 0; k < spp && !stop(); ++k) {
           ref::Sampler rng{static_cast<std::uint32_t>(static_cast<size_t>(y) * W + x),
                            static_cast<std::uint32_t>(k), scene.integrator.seed,
                            scene.integrator.sampler};
