@@ -284,6 +284,34 @@ TEST(Compare, NonFiniteInputIsAnInputError) {
   EXPECT_EQ(same.status, 0) << same.out << same.err;
 }
 
+// A pixel whose count (the n layer) is 0 holds no estimate: an interrupted reference's pixels
+// after the one it stopped in, or a render whose every sample was non-finite. compare took its
+// value for an exact black and passed such a render against a black one. Now an input error
+// naming the file and the pixel, as for a NaN; converge's reference and Python's compare too.
+TEST(Compare, PixelWithoutSamplesIsAnInputError) {
+  const std::string dir = lucent::test::temp_dir();
+  RenderResult black = constant_image(4, 4, 0.0f);
+  black.variance = lucent::Image{4, 4, std::vector<float>(4 * 4 * 3, 0.0f)};
+  black.samples.assign(16, 8);
+  lucent::write_render_exr(dir + "/black.exr", black);
+  RenderResult empty = black;
+  empty.samples[2 * 4 + 3] = 0;
+  lucent::write_render_exr(dir + "/empty.exr", empty);
+  for (const std::string args : {"empty.exr black.exr", "black.exr empty.exr"}) {
+    const size_t space = args.find(' ');
+    auto r = lucent::test::run_cli("compare '" + dir + "/" + args.substr(0, space) + "' '" + dir +
+                                   "/" + args.substr(space + 1) + "'");
+    EXPECT_EQ(r.status, 1) << args;
+    EXPECT_EQ(r.err, "lucent: error: " + dir +
+                         "/empty.exr: pixel (3, 2) holds no samples (n = 0): its value is no "
+                         "estimate (an interrupted render, or one whose samples were all "
+                         "non-finite)\n")
+        << args;
+  }
+  auto same = lucent::test::run_cli("compare '" + dir + "/black.exr' '" + dir + "/black.exr'");
+  EXPECT_EQ(same.status, 0) << same.out << same.err;
+}
+
 // The z map's path is checked before the images are read (a .txt z map was refused only after
 // the comparison, and a PNG clipped the negative z values): the format, a directory that does
 // not exist, an input.

@@ -308,6 +308,38 @@ TEST(Outputs, NonFiniteOptionsAreRefused) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// A render whose every sample is non-finite (here their squares overflow a float) holds no
+// estimate: it wrote a black image with a warning and exit 0, which `compare` then passed against
+// a black render. Now an error, and nothing under the output's name.
+TEST(Outputs, RenderWithoutAFiniteSampleWritesNothing) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = dir + "/scene.json";
+  lucent::test::write_file(scene, R"({
+    "film": {"width": 8, "height": 6},
+    "integrator": {"type": "path", "spp": 2},
+    "materials": {"hot": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1e30, 1e30, 1e30]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "hot"}],
+    "lights": [{"type": "environment", "radiance": [1e30, 1e30, 1e30]}]
+  })");
+  for (const char* name : {"o.exr", "o.png"}) {
+    CommandResult r = run_cli("render " + q(scene) + " -o " + q(dir + "/" + name));
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.err, "lucent: error: " + dir + "/" + name +
+                         ": not written: all 96 samples were non-finite (NaN or Inf, or a square "
+                         "beyond a float's range: a radiance or intensity above about 1.8e19?)\n");
+    EXPECT_FALSE(fs::exists(dir + "/" + name));
+  }
+  // the pixels beside the emitter see a sky of 1: written, with the warning
+  std::string text = read_file(scene);
+  const std::string sky = R"("radiance": [1e30, 1e30, 1e30])";
+  text.replace(text.find(sky), sky.size(), R"("radiance": [1, 1, 1])");
+  lucent::test::write_file(scene, text);
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(dir + "/o.exr") + " --quiet");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("non-finite sample(s) (NaN or Inf) were dropped"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir + "/o.exr"));
+}
+
 /// Runs `lucent args...` (stderr to `err_path`), waits until `running(stderr)` says the render
 /// loop is under way, sends `sig` and waits for the end; returns the wait status, or fails the
 /// test if lucent does not stop within `stop_seconds`.

@@ -57,9 +57,12 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
                              const CompareOptions& options = {});
 
 /// Throws lucent::Error "<what>: pixel (x, y) channel G is not finite (nan)" at the first
-/// non-finite value of the mean or variance: an input error for compare and converge, whose tests
-/// would otherwise report NaN errors or a FAIL.
-void check_finite_image(const RenderResult& image, const std::string& what);
+/// non-finite value of the mean or variance, and "<what>: pixel (x, y) holds no samples (n = 0)
+/// ..." at the first pixel whose count (the n layer, when the image has one) is 0: input errors
+/// for compare and converge, whose tests would otherwise report NaN errors or a FAIL, or take a
+/// pixel without an estimate (an interrupted reference, a render whose every sample was
+/// non-finite) for an exact black one and pass it.
+void check_comparable_image(const RenderResult& image, const std::string& what);
 
 /// Upper two-sided critical value of the standard normal: P(|Z| > z) = p.
 double normal_two_sided_critical(double p);

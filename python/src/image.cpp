@@ -145,8 +145,8 @@ void bind_image(py::module_& m) {
             !std::isfinite(rel_epsilon))
           throw py::value_error("abs_epsilon and rel_epsilon must be finite and >= 0");
         RenderResult ra = render_result_from(a, "a"), rb = render_result_from(b, "b");
-        check_finite_image(ra, "a");  // as `lucent compare`: an input error, not a FAIL
-        check_finite_image(rb, "b");
+        check_comparable_image(ra, "a");  // as `lucent compare`: an input error, not a FAIL
+        check_comparable_image(rb, "b");
         CompareOptions o;
         o.alpha = alpha;
         o.min_pass_fraction = min_pass_fraction;

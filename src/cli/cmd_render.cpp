@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
@@ -299,6 +300,13 @@ int render_with(const RenderArgs& a) {
 
   lucent::DisplaySettings display{scene.film.transfer, scene.film.gamma, scene.film.exposure,
                                   scene.film.tonemap};
+  // every sample non-finite: the image holds no estimate, and a black file would pass for one
+  // (`compare` passed it against a black render). A part keeps its counts, and is written.
+  if (!range && r.nonfinite > 0 && !r.samples.empty() &&
+      std::all_of(r.samples.begin(), r.samples.end(), [](std::uint32_t n) { return n == 0; }))
+    throw lucent::Error(a.output + ": not written: all " + std::to_string(r.nonfinite) +
+                        " samples were non-finite (NaN or Inf, or a square beyond a float's "
+                        "range: a radiance or intensity above about 1.8e19?)");
   if (range)
     lucent::write_render_part(a.output, lucent::make_part(*renderer, *range, a.scene));
   else if (lucent::io::lower_extension(a.output) == ".exr") {

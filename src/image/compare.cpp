@@ -49,8 +49,14 @@ void check_layers(const RenderResult& r, const char* which) {
 
 }  // namespace
 
-void check_finite_image(const RenderResult& image, const std::string& path) {
+void check_comparable_image(const RenderResult& image, const std::string& path) {
   const int w = image.mean.width;
+  for (size_t i = 0; i < image.samples.size(); ++i)
+    if (image.samples[i] == 0)
+      throw Error(path + ": pixel (" + std::to_string(i % static_cast<size_t>(w)) + ", " +
+                  std::to_string(i / static_cast<size_t>(w)) +
+                  ") holds no samples (n = 0): its value is no estimate (an interrupted render, "
+                  "or one whose samples were all non-finite)");
   const char* const names[2][3] = {{"R", "G", "B"}, {"var.R", "var.G", "var.B"}};
   const std::vector<float>* const planes[2] = {&image.mean.rgb, &image.variance.rgb};
   for (int p = 0; p < 2; ++p)

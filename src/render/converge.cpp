@@ -296,7 +296,7 @@ ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
 
 ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference,
                                const ConvergeOptions& options) {
-  check_finite_image(reference, "the reference image");  // every error against it would be NaN
+  check_comparable_image(reference, "the reference image");  // every error against it would be NaN
   if (reference.mean.width != scene.film.width || reference.mean.height != scene.film.height)
     throw Error("the reference image is " + std::to_string(reference.mean.width) + "x" +
                 std::to_string(reference.mean.height) + ", the scene renders " +
