@@ -21,11 +21,17 @@ struct MaterialParam {
     ColourOrTexture,  ///< Colour, or {"texture": file} (Material::albedo_texture)
     Positive,         ///< a number > 0
     UnitInterval,     ///< a number in [0, 1]
+    Ior,              ///< an index of refraction, in [kMinIor, kMaxIor]
   };
+  /// The kernel squares an index of refraction (and its inverse) in float: above ~1.8e19 that
+  /// overflowed, and glass of ior 1e20 rendered black pixels without a word. Real dielectrics
+  /// lie between 1 and 5 (a ratio of two media between their inverses); the kernel matches the
+  /// reference far beyond that, at 1e10.
+  static constexpr double kMinIor = 1e-6, kMaxIor = 1e6;
   const char* key;
   Kind kind;
   glm::dvec3 Material::*colour = nullptr;  ///< Colour and ColourOrTexture
-  double Material::*number = nullptr;      ///< Positive and UnitInterval
+  double Material::*number = nullptr;      ///< Positive, UnitInterval and Ior
   glm::dvec3 default_colour{0.0};
   double default_number = 0;
 

@@ -228,6 +228,9 @@ void validate_material(const Material& m, std::size_t textures, const Reporter& 
       case MaterialParam::UnitInterval:
         check_between(p, m.*param.number, 0, 1);
         break;
+      case MaterialParam::Ior:
+        check_between(p, m.*param.number, MaterialParam::kMinIor, MaterialParam::kMaxIor);
+        break;
     }
   }
 }

@@ -7,7 +7,7 @@ namespace lucent::scene_detail {
 
 const MaterialTypeDef& material_type_dielectric() {
   static const MaterialTypeDef def{
-      {MaterialParam::number_param("ior", MaterialParam::Positive, &Material::ior, 1.5),
+      {MaterialParam::number_param("ior", MaterialParam::Ior, &Material::ior, 1.5),
        MaterialParam::colour_param("tint", &Material::specular, glm::dvec3(1.0))},
       [](const Material& m, lc_material_params& p) {
         put3(p.dielectric.tint, m.specular);

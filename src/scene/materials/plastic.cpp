@@ -12,7 +12,7 @@ const MaterialTypeDef& material_type_plastic() {
        MaterialParam::colour_param("specular", &Material::specular, glm::dvec3(1.0)),
        MaterialParam::number_param("roughness", MaterialParam::UnitInterval, &Material::roughness,
                                    0.1),
-       MaterialParam::number_param("ior", MaterialParam::Positive, &Material::ior, 1.5)},
+       MaterialParam::number_param("ior", MaterialParam::Ior, &Material::ior, 1.5)},
       [](const Material& m, lc_material_params& p) {
         put3(p.plastic.albedo, m.albedo);
         p.plastic.albedo_tex = m.albedo_texture;

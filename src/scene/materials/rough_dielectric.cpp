@@ -7,7 +7,7 @@ namespace lucent::scene_detail {
 
 const MaterialTypeDef& material_type_rough_dielectric() {
   static const MaterialTypeDef def{
-      {MaterialParam::number_param("ior", MaterialParam::Positive, &Material::ior, 1.5),
+      {MaterialParam::number_param("ior", MaterialParam::Ior, &Material::ior, 1.5),
        MaterialParam::number_param("roughness", MaterialParam::UnitInterval, &Material::roughness,
                                    0.1),
        MaterialParam::colour_param("tint", &Material::specular, glm::dvec3(1.0))},
