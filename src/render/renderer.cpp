@@ -16,9 +16,10 @@ std::string target_shortfall(const RenderResult& r) {
   const double npix = std::max(1.0, double(r.mean.width) * double(r.mean.height));
   const double limit = 1.5 * r.target_error * (1 + 2 * std::sqrt(2 / (3 * npix)));
   if (!(r.target_error > 0) || r.cancelled || !(r.halves_relmse > limit)) return "";
+  // %.3g: a tiny target made %.1f print hundreds of digits, and the line was cut short
   char line[320];
   std::snprintf(line, sizeof line,
-                "the halves' difference estimates relMSE %.3g, %.1f times the target %.3g (rare "
+                "the halves' difference estimates relMSE %.3g, %.3g times the target %.3g (rare "
                 "bright samples that no pilot foresees, or the --spp cap): lower --target-error or "
                 "raise --spp; integrator.clamp trades such samples for bias",
                 r.halves_relmse, r.halves_relmse / r.target_error, r.target_error);
