@@ -157,6 +157,15 @@ TEST(SceneJson, OtherDomainErrors) {
             "scene.json: /camera/up: must be a non-zero vector");
   EXPECT_EQ(error_of(R"({"camera": {"aperture": -0.5}})"),
             "scene.json: /camera/aperture: must be >= 0, got -0.5");
+  // a lens far wider than the focus distance: its rays missed the focal plane in float, and the
+  // geometry vanished from the image (aperture 1e9 at 6 units)
+  EXPECT_EQ(
+      error_of(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "aperture": 501}})"),
+      "scene.json: /camera/aperture: must be at most 100 times the focus distance (5), got "
+      "501");
+  EXPECT_EQ(error_of(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "aperture": 501,
+                                    "focus_distance": 10}})"),
+            "");
   EXPECT_EQ(error_of(R"({"materials": {"m": {"type": "diffuse", "albedo": [0.5, -0.1, 0]}}})"),
             "scene.json: /materials/m/albedo/1: must be >= 0, got -0.1");
   EXPECT_EQ(error_of(R"({"materials": {"m": {"type": "conductor", "roughness": 1.5}}})"),
