@@ -302,6 +302,21 @@ TEST(Converge, FitOfSyntheticCurves) {
   std::vector<double> zero(5, 0.0);
   EXPECT_FALSE(lucent::fit_convergence(synthetic(e, zero)).biased);
   EXPECT_TRUE(lucent::fit_convergence(synthetic(floor_e, zero)).biased);
+
+  // one rung, or one spp repeated: no slope (they were 0.00, which reads as a measured one),
+  // while the verdict from the noise estimate stands
+  std::vector<ConvergePoint> one = synthetic({e[0]}, {e[0]});
+  std::vector<ConvergePoint> same = synthetic(e, e);
+  for (ConvergePoint& p : same) p.spp = 4, p.seconds *= 1 + 0.01 * double(&p - &same[0]);
+  for (const auto& points : {one, same}) {
+    const ConvergeFit g = lucent::fit_convergence(points);
+    EXPECT_TRUE(std::isnan(g.slope_spp) && std::isnan(g.slope_time) && std::isnan(g.tail_slope_spp))
+        << g.slope_spp << " " << g.slope_time << " " << g.tail_slope_spp;
+    EXPECT_FALSE(g.biased);
+    EXPECT_NE(g.verdict.find("unbiased (error/noise 1.00"), std::string::npos) << g.verdict;
+  }
+  EXPECT_EQ(lucent::fit_convergence(synthetic({e[0]}, {0.0})).verdict,
+            "unbiased (no variance estimate, and too few rungs for a slope)");
 }
 
 TEST(Converge, KernelLadderAgainstKernelReference) {
@@ -553,6 +568,11 @@ TEST(Converge, CommandWritesCsvAndPlot) {
       "converge '" + dir + "/t.json' --spp-ladder 2 -q --reference '" + dir + "/ref.exr'");
   EXPECT_EQ(again.status, 0) << again.err;
   EXPECT_EQ(lucent::test::count_lines(again.err), 0) << again.err;
+  // one rung: no slope to print (it printed 0.00)
+  EXPECT_NE(again.out.find("  default                   n/a  (against spp   n/a, last 3 rungs   "
+                           "n/a)  unbiased"),
+            std::string::npos)
+      << again.out;
 }
 
 TEST(Converge, CommandTimeLadderAndCpuReference) {

@@ -88,6 +88,8 @@ struct ConvergePoint {
 struct ConvergeFit {
   std::string setting;
   std::size_t points = 0;
+  // The slopes are NaN when the points hold fewer than two different spp (one rung, a
+  // repeated one, a target-error setting's single render).
   double slope_time = 0;      ///< least-squares slope of log(relMSE) against log(seconds)
   double slope_spp = 0;       ///< least-squares slope of log(relMSE) against log(spp)
   double tail_slope_spp = 0;  ///< the same over the last three rungs (flattens when biased)

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -311,9 +312,17 @@ int run_converge_command() {
 
   std::printf("%sslope of log(relMSE) against log(time) (about -1 when unbiased; RMSE: half):\n",
               a.quiet ? "" : "\n");
+  // "n/a": a slope needs rungs of two different spp (it printed 0.00 for one rung)
+  auto slope = [](double v, int width) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%*.2f", width, v);
+    return std::isnan(v) ? std::string(static_cast<size_t>(width) - 3, ' ') + "n/a"
+                         : std::string(buf);
+  };
   for (const ConvergeFit& f : result.fits)
-    std::printf("  %-22s %6.2f  (against spp %5.2f, last 3 rungs %5.2f)  %s\n", f.setting.c_str(),
-                f.slope_time, f.slope_spp, f.tail_slope_spp, f.verdict.c_str());
+    std::printf("  %-22s %s  (against spp %s, last 3 rungs %s)  %s\n", f.setting.c_str(),
+                slope(f.slope_time, 6).c_str(), slope(f.slope_spp, 5).c_str(),
+                slope(f.tail_slope_spp, 5).c_str(), f.verdict.c_str());
 
   print_time_to_common_error(result);
 

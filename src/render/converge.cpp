@@ -36,7 +36,8 @@ int parse_positive_int(const std::string& knob, const std::string& value, int ma
   return parse_int(knob, value, 1, max);
 }
 
-/// Least-squares slope of log(y) against log(x) over the points where both are > 0.
+/// Least-squares slope of log(y) against log(x) over the points where both are > 0; NaN when
+/// fewer than two such points have different x (it was 0, which read as a measured slope).
 double log_log_slope(const std::vector<double>& x, const std::vector<double>& y) {
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
   for (std::size_t i = 0; i < x.size(); ++i) {
@@ -49,7 +50,7 @@ double log_log_slope(const std::vector<double>& x, const std::vector<double>& y)
     sxy += lx * ly;
   }
   double den = n * sxx - sx * sx;
-  if (n < 2 || !(std::abs(den) > 1e-12)) return 0;
+  if (n < 2 || !(std::abs(den) > 1e-12)) return std::numeric_limits<double>::quiet_NaN();
   return (n * sxy - sx * sy) / den;
 }
 
@@ -259,8 +260,10 @@ ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
     spp.push_back(static_cast<double>(p.spp));
     e.push_back(p.relmse);
   }
-  f.slope_time = log_log_slope(t, e);
   f.slope_spp = log_log_slope(spp, e);
+  // one spp repeated (a ladder 2 2 2, a target-error setting's one render): the times differ by
+  // noise alone, and a slope against them would be noise too
+  f.slope_time = std::isnan(f.slope_spp) ? f.slope_spp : log_log_slope(t, e);
   std::size_t k = std::min<std::size_t>(3, points.size());
   f.tail_slope_spp = log_log_slope(std::vector<double>(spp.end() - k, spp.end()),
                                    std::vector<double>(e.end() - k, e.end()));
@@ -276,6 +279,8 @@ ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
     f.verdict =
         last.noise_relmse > 0
             ? "unbiased (error/noise " + fmt("%.2f", f.excess_ratio) + " at the last rung)"
+        : std::isnan(f.tail_slope_spp)
+            ? "unbiased (no variance estimate, and too few rungs for a slope)"
             : "unbiased (no variance estimate; tail slope " + fmt("%.2f", f.tail_slope_spp) + ")";
     return f;
   }
@@ -458,7 +463,9 @@ plot::LogLogPlot convergence_plot(const ConvergeResult& result, const std::strin
   plot.y_label = "relMSE against the reference";
   for (const ConvergeFit& f : result.fits) {
     plot::Series s;
-    s.name = f.setting + " (slope " + fmt("%.2f", f.slope_time) + (f.biased ? ", biased)" : ")");
+    s.name = f.setting + " (slope " +
+             (std::isnan(f.slope_time) ? std::string("n/a") : fmt("%.2f", f.slope_time)) +
+             (f.biased ? ", biased)" : ")");
     for (const ConvergePoint& p : result.points)
       if (p.setting == f.setting) {
         s.x.push_back(p.seconds);
