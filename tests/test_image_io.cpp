@@ -54,6 +54,17 @@ TEST(ImageIo, GammaExposureAndToneMaps) {
   a.tonemap = lucent::ToneMap::Aces;       // Narkowicz 2015: 1 -> 2.54 / 3.16 = 0.8038
   EXPECT_EQ(encode_display(1.0, a), 232);  // sRGB(0.8038) = 0.9084
   EXPECT_EQ(encode_display(100.0, a), 255);
+  // exposures that overflow: white, as the curves tend to (inf / inf made them black), and black
+  // stays black (0 times an infinite scale was NaN)
+  for (DisplaySettings m : {r, a, DisplaySettings{}}) {
+    for (double stops : {1000.0, 1e30}) {
+      m.exposure = stops;
+      EXPECT_EQ(encode_display(0.5, m), 255) << stops;
+      EXPECT_EQ(encode_display(0.0, m), 0) << stops;
+    }
+    m.exposure = -1e30;
+    EXPECT_EQ(encode_display(0.5, m), 0);
+  }
 }
 
 lucent::Image gradient(int w, int h) {

@@ -27,13 +27,17 @@ std::string extension(const std::string& path) {
   return ext;
 }
 
+/// A tone map of v >= 0 (infinity included: an exposure of 1e30 stops makes one, and inf / inf
+/// was NaN, written as black where the curve tends to white).
 double tonemap(double v, ToneMap t) {
   switch (t) {
     case ToneMap::Reinhard:
-      return v / (1.0 + v);
+      return std::isinf(v) ? 1.0 : v / (1.0 + v);
     case ToneMap::Aces: {
-      // Narkowicz 2015 fit of the ACES filmic curve
+      // Narkowicz 2015 fit of the ACES filmic curve; beyond 1e100 its products overflow, and it
+      // is a / c there to double precision
       const double a = 2.51, b = 0.03, c = 2.43, d = 0.59, e = 0.14;
+      if (v > 1e100) return a / c;
       return (v * (a * v + b)) / (v * (c * v + d) + e);
     }
     default:
@@ -101,8 +105,9 @@ std::string encode_png(const std::string& path, const Image& img, const DisplayS
 
 unsigned char encode_display(double v, const DisplaySettings& d) {
   if (!std::isfinite(v)) v = 0;  // NaN/Inf never reach the film; guard the encoder anyway
-  v *= std::exp2(d.exposure);
-  v = tonemap(std::max(0.0, v), d.tonemap);
+  // (0 times an infinite scale is NaN: black stays black)
+  v = v > 0 ? v * std::exp2(d.exposure) : 0.0;
+  v = tonemap(v, d.tonemap);
   v = std::clamp(v, 0.0, 1.0);
   switch (d.transfer) {
     case Transfer::Srgb:
