@@ -87,7 +87,10 @@ TEST(ProgramCache, HitsMissesAndRebuildsCorruptEntries) {
   EXPECT_FALSE(g.cache_hit);
   EXPECT_NE(g.note.find("header"), std::string::npos) << g.note;
 
-  // clear removes the entries
+  // clear removes the entries; a cache directory that is a file is an error, not "removed 0"
+  EXPECT_EQ(lucent::test::error_of([] { lucent::cl_util::clear_program_cache("/etc/passwd"); }),
+            "/etc/passwd: not a directory (the kernel cache, LUCENT_CACHE_DIR)");
+  EXPECT_EQ(lucent::cl_util::clear_program_cache(cache.dir + "/none"), 0);
   EXPECT_GE(lucent::cl_util::clear_program_cache(cache.dir), 2);
   ProgramBuildInfo h;
   lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", cache.dir, &h);

@@ -309,7 +309,14 @@ int clear_program_cache(const std::string& dir) {
   if (dir.empty()) return 0;
   int n = 0;
   std::error_code ec;
-  for (auto& e : fs::directory_iterator(dir, ec)) {
+  // a directory that does not exist holds nothing; a file, or one that cannot be listed, is an
+  // error (it said "removed 0" for LUCENT_CACHE_DIR=/etc/passwd)
+  if (!fs::exists(dir, ec) && !ec) return 0;
+  if (!fs::is_directory(dir, ec))
+    throw Error(dir + ": not a directory (the kernel cache, LUCENT_CACHE_DIR)");
+  fs::directory_iterator it(dir, ec);
+  if (ec) throw Error(dir + ": cannot list the kernel cache (" + ec.message() + ")");
+  for (auto& e : it) {
     const std::string name = e.path().filename().string();
     if (!cache_file_name(name)) continue;
     if (e.path().extension() == ".lock") {

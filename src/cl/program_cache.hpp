@@ -74,7 +74,8 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
                                  ProgramBuildInfo* info = nullptr,
                                  DeferredEntry* deferred = nullptr, bool entries = true);
 
-/// Removes every cache entry of `dir`; returns how many files were removed.
+/// Removes every cache entry of `dir`; returns how many files were removed (0 when `dir` does not
+/// exist). Throws lucent::Error when `dir` is not a directory or cannot be listed.
 int clear_program_cache(const std::string& dir);
 
 }  // namespace lucent::cl_util
