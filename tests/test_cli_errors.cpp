@@ -392,12 +392,22 @@ TEST(CliErrors, IgnoredOptionsAreRefused) {
       {"--reference --precision double", "--precision is not supported with --reference"},
       {"--reference --precision float", "--precision is not supported with --reference"},
       {"--reference --fast-math", "--fast-math is not supported with --reference"},
-      {"--reference --no-specialize", "--no-specialize is not supported with --reference"}};
+      {"--reference --no-specialize", "--no-specialize is not supported with --reference"},
+      // what only the path integrator reads, for another (an AOV render took them in silence)
+      {"--integrator albedo --clamp 0.1",
+       "--clamp: only the path integrator has it, and this render's is albedo"},
+      {"--integrator direct --caustics",
+       "--caustics: only the path integrator has it, and this render's is direct"},
+      {"--integrator whitted --dielectric-splits 4",
+       "--dielectric-splits: only the path integrator has it, and this render's is whitted"}};
   for (const auto& [args, want] : cases) {
     CommandResult r = run_cli(render + args);
     EXPECT_EQ(expect_one_error_line(r), want) << args;
     EXPECT_EQ(r.status, 1) << args;
   }
+  // and two options that contradict each other (the last one won)
+  EXPECT_EQ(expect_one_error_line(run_cli(render + "--caustics --no-caustics")),
+            "--caustics excludes --no-caustics (see lucent --help)");
   EXPECT_TRUE(fs::is_empty(dir));
   // what they belong to still works: the pilot of a target error, the reference alone, the
   // kernel's options on the kernel

@@ -221,31 +221,16 @@ TEST(Converge, SettingSyntax) {
   EXPECT_FALSE(t.adaptive);
   EXPECT_EQ(lucent::parse_converge_setting("integrator=direct").integrator,
             static_cast<int>(lucent::IntegratorType::Direct));
+  EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("caustics+no-caustics"); }),
+            "setting 'caustics+no-caustics': no-caustics and caustics set the same thing");
 
-  for (const char* bad : {"",
-                          "bogus",
-                          "max_depth=0",
-                          "max_depth=x",
-                          "max_depth",
-                          "fast-math=1",
-                          "filter=round",
-                          "filter=box:-1",
-                          "default+nope",
-                          "splits=5",
-                          "splits=-1",
-                          "splits",
-                          "sampler=halton",
-                          "clamp=-1",
-                          "clamp=x",
-                          "clamp",
-                          "target-error=0",
-                          "target-error=nan",
-                          "adaptive+min-spp=2",
-                          "min-spp=8",
-                          "adaptive+target-error=1e-3",
-                          "integrator=bogus",
-                          "mis=1",
-                          "caustics=1"}) {
+  for (const char* bad :
+       {"", "bogus", "max_depth=0", "max_depth=x", "max_depth", "fast-math=1", "filter=round",
+        "filter=box:-1", "default+nope", "splits=5", "splits=-1", "splits", "sampler=halton",
+        "clamp=-1", "clamp=x", "clamp", "target-error=0", "target-error=nan", "adaptive+min-spp=2",
+        "min-spp=8", "adaptive+target-error=1e-3", "integrator=bogus", "mis=1", "caustics=1",
+        // two knobs setting one thing: the last one won without a word
+        "caustics+no-caustics", "clamp=1+clamp=2", "float+double", "mis+no_mis"}) {
     try {
       lucent::parse_converge_setting(bad);
       ADD_FAILURE() << "accepted '" << bad << "'";

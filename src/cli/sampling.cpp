@@ -17,11 +17,12 @@ void add_sampling_options(CLI::App* cmd, SamplingArgs& a, bool adaptive) {
                   "Largest contribution of a path vertex after a scattering (overrides "
                   "integrator.clamp; 0: off; biased when it binds)")
       ->check(non_negative_real());
-  cmd->add_flag_callback(
+  CLI::Option* caustics = cmd->add_flag_callback(
       "--caustics", [&a] { a.caustics = 1; },
       "Caustic paths by light tracing (integrator.caustics; path integrator)");
   cmd->add_flag_callback(
-      "--no-caustics", [&a] { a.caustics = 0; }, "Caustic paths by the camera path alone");
+         "--no-caustics", [&a] { a.caustics = 0; }, "Caustic paths by the camera path alone")
+      ->excludes(caustics);  // (both were accepted, the last one winning)
   cmd->add_option("--dielectric-splits", a.splits,
                   "Smooth-glass vertices per camera path at which both reflection and refraction "
                   "are followed (overrides integrator.dielectric_splits; default 2; 0: off)")
@@ -44,6 +45,16 @@ void apply_sampling_options(const SamplingArgs& a, Scene& scene) {
       throw Error("--sampler " + a.sampler + ": unknown sampler (expected " +
                   type_names<SamplerType>() + ")");
     scene.integrator.sampler = *t;
+  }
+  // what only the path integrator reads: refused for another, rather than ignored without a word
+  if (scene.integrator.type != IntegratorType::Path) {
+    const char* option = a.clamp >= 0      ? "--clamp"
+                         : a.caustics == 1 ? "--caustics"
+                         : a.splits >= 0   ? "--dielectric-splits"
+                                           : nullptr;
+    if (option)
+      throw Error(std::string(option) + ": only the path integrator has it, and this render's is " +
+                  type_name(scene.integrator.type));
   }
   if (a.clamp >= 0) scene.integrator.clamp = a.clamp;
   if (a.caustics >= 0) scene.integrator.caustics = a.caustics == 1;

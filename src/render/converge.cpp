@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -137,6 +138,7 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
   if (text.empty()) throw Error("empty setting (expected e.g. default, fast-math, max_depth=2)");
   std::stringstream ss(text);
   std::string knob;
+  std::map<std::string, std::string> given;  // what each knob sets -> the knob that set it
   while (std::getline(ss, knob, '+')) {
     std::string key = knob, value;
     std::size_t eq = knob.find('=');
@@ -146,6 +148,18 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
     }
     for (char& c : key)
       if (c == '-') c = '_';
+    // a knob that sets what another knob of the setting set (caustics+no-caustics, clamp=1+clamp=2,
+    // float+double): refused, rather than the last one winning without a word
+    std::string field = key;
+    if (key == "no_caustics") field = "caustics";
+    if (key == "no_mis") field = "mis";
+    if (key == "double" || key == "float") field = "precision";
+    if (key != "default") {
+      auto [it, fresh] = given.emplace(field, knob);
+      if (!fresh)
+        throw Error("setting '" + text + "': " + knob + " and " + it->second +
+                    " set the same thing");
+    }
     auto no_value = [&] {
       if (eq != std::string::npos) throw Error("setting " + knob + ": " + key + " takes no value");
     };
