@@ -442,6 +442,10 @@ TEST(SceneBuilder, ScenesEditedDirectlyAreCheckedBeforeRendering) {
        "/integrator/dielectric_splits: must be in [0, 4], got -1"},
       {[](lucent::Scene& s) { s.spheres[0].material = 1; },
        "/shapes/0/material: must index one of the scene's 1 materials, got 1"},
+      // as the loader says: a negative radius rendered the sphere inside out
+      {[](lucent::Scene& s) { s.spheres[0].radius = -0.5; },
+       "/shapes/0/radius: must be > 0, got -0.5"},
+      {[](lucent::Scene& s) { s.spheres[0].radius = 0; }, "/shapes/0/radius: must be > 0, got 0"},
       {[](lucent::Scene& s) { s.triangles[1].v[2] = 4; },
        "/shapes/1 (triangle 1)/v/2: must index one of the scene's 4 positions, got 4"},
       {[](lucent::Scene& s) {

@@ -370,12 +370,17 @@ void validate_scene(const Scene& s) {
   const std::size_t nm = s.materials.size();
   for (std::size_t i = 0; i < s.spheres.size(); ++i) {
     // (a NaN centre or radius is allowed: such a sphere is never hit, tests/test_stability_scene;
-    // a finite one beyond the geometry range would vanish as silently, so it is an error)
+    // a finite one beyond the geometry range would vanish as silently, so it is an error, and so
+    // is a radius <= 0, which the loader refuses: from Python a negative one rendered the sphere
+    // inside out, its normals pointing in)
     const Sphere& sp = s.spheres[i];
     const bool in_range = !(sphere_reach(sp.center, sp.radius) > limits::kMaxCoordinate);
-    if (sp.material >= 0 && static_cast<std::size_t>(sp.material) < nm && in_range) continue;
+    if (sp.material >= 0 && static_cast<std::size_t>(sp.material) < nm && in_range &&
+        !(sp.radius <= 0))
+      continue;
     const Reporter at(file, primitive_place(s, ShapeType::Sphere, i, "spheres", "sphere"));
     check_index(at.at("material"), sp.material, nm, "materials");
+    if (sp.radius <= 0) at.at("radius").fail("must be > 0, got " + format_number(sp.radius));
     if (finite(sp.center) && std::isfinite(sp.radius)) check_sphere_reach(at, sp.center, sp.radius);
   }
   const std::size_t np = s.positions.size(), nn = s.normals.size(), nuv = s.uvs.size();
