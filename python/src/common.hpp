@@ -11,6 +11,7 @@
 #include <exception>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -146,6 +147,44 @@ RenderResult render_result_from(py::handle object, const char* what);
 // Calling Python from C++ code that runs without the GIL
 // ------------------------------------------------------------------------------------------
 
+/// At interpreter exit, CPython ends a thread other than the main one that asks for the GIL (a
+/// daemon thread returning from a call that released it, a thread of the library calling Python
+/// back) with pthread_exit: an unwinding of the thread's C++ frames that aborts the process
+/// ("terminate called without an active exception") at the first destructor, noexcept function
+/// or joinable std::thread it meets. These take the GIL as pybind11's gil_scoped_release and
+/// gil_scoped_acquire do, but park such a thread instead: it sleeps until the process exits (as
+/// Python 3.14 does with such threads).
+
+/// Takes the GIL back with `state` (PyEval_RestoreThread), or parks this thread at interpreter
+/// exit after setting `*cancel` (when given: the work the thread waits for then stops).
+void restore_gil(PyThreadState* state, std::atomic<bool>* cancel = nullptr) noexcept;
+
+/// Releases the GIL while it lives (py::gil_scoped_release), then takes it back with
+/// restore_gil.
+class ReleaseGil {
+ public:
+  ReleaseGil();
+  ~ReleaseGil() { restore_gil(state_); }
+  ReleaseGil(const ReleaseGil&) = delete;
+  ReleaseGil& operator=(const ReleaseGil&) = delete;
+  PyThreadState* state() const { return state_; }
+
+ private:
+  PyThreadState* state_;
+};
+
+/// Holds the GIL while it lives, on any thread (py::gil_scoped_acquire); parks this thread at
+/// interpreter exit.
+class AcquireGil {
+ public:
+  AcquireGil();
+  AcquireGil(const AcquireGil&) = delete;
+  AcquireGil& operator=(const AcquireGil&) = delete;
+
+ private:
+  std::optional<py::gil_scoped_acquire> gil_;
+};
+
 /// TypeError unless `f` is None or callable.
 inline void check_callable(const py::object& f, const char* what) {
   if (!f.is_none() && !PyCallable_Check(f.ptr()))
@@ -253,7 +292,9 @@ inline const CallbackFrame* callback_of(const void* session) {
 /// Runs `work` on a worker thread with the GIL released while this thread checks Python's
 /// signals every 50 ms: on KeyboardInterrupt (or any exception of a signal handler) `cancel` is
 /// set, the work is awaited (it stops early on the flag) and the exception is raised. The worker
-/// has this thread's chain of callbacks.
+/// has this thread's chain of callbacks. Interpreter exit sets `cancel` too, and waits a while
+/// for the call to end (a daemon thread's render would otherwise run on while the process tears
+/// down the libraries it uses).
 void run_interruptible(const std::function<void()>& work, std::atomic<bool>& cancel);
 
 /// Module parts.

@@ -50,7 +50,7 @@ void bind_image(py::module_& m) {
         DisplaySettings d = display_settings(film, transfer, gamma, exposure, tonemap);
         RenderResult r = render_result_from(image, "image");
         std::string p = path.string();
-        py::gil_scoped_release release;
+        ReleaseGil release;
         write_image(p, r.mean, d);
       },
       py::arg("path"), py::arg("image"), py::kw_only(), py::arg("film") = nullptr,
@@ -64,7 +64,7 @@ void bind_image(py::module_& m) {
         Image img;
         std::string p = path.string();
         {
-          py::gil_scoped_release release;
+          ReleaseGil release;
           img = read_image(p);
         }
         return image_array(std::move(img));
@@ -77,7 +77,7 @@ void bind_image(py::module_& m) {
       [](const std::filesystem::path& path, py::handle result) {
         RenderResult r = render_result_from(result, "result");
         std::string p = path.string();
-        py::gil_scoped_release release;
+        ReleaseGil release;
         write_render_exr(p, r);
       },
       py::arg("path"), py::arg("result"),
@@ -87,7 +87,7 @@ void bind_image(py::module_& m) {
       "read_render",
       [](const std::filesystem::path& path) {
         std::string p = path.string();
-        py::gil_scoped_release release;
+        ReleaseGil release;
         return read_render(p);
       },
       py::arg("path"),
@@ -153,7 +153,7 @@ void bind_image(py::module_& m) {
         o.abs_epsilon = abs_epsilon;
         o.rel_epsilon = rel_epsilon;
         o.image_mean_test = image_mean_test;
-        py::gil_scoped_release release;
+        ReleaseGil release;
         return compare_images(ra, rb, o);
       },
       py::arg("a"), py::arg("b"), py::kw_only(), py::arg("alpha") = CompareOptions{}.alpha,

@@ -1,8 +1,14 @@
 // The `lucent` Python module: errors, enum names, devices, the environment's defaults, and the
 // helpers shared by the other parts (scene.cpp, render.cpp, image.cpp).
 #include <chrono>
+#include <condition_variable>
 #include <future>
+#include <mutex>
+#include <set>
 #include <thread>
+#ifdef __GLIBCXX__
+#include <cxxabi.h>  // abi::__forced_unwind
+#endif
 
 #include "cl/program_cache.hpp"
 #include "common.hpp"
@@ -125,13 +131,13 @@ RenderResult render_result_from(py::handle object, const char* what) {
 
 SharedObject::SharedObject(py::object o)
     : object_(new py::object(std::move(o)), [](py::object* p) {
-        py::gil_scoped_acquire gil;
+        AcquireGil gil;
         delete p;
       }) {}
 
 WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackErrors> errors) {
   return [callback, errors](const std::string& message) {
-    py::gil_scoped_acquire gil;
+    AcquireGil gil;
     errors->run([&] {
       if (callback) {
         callback.get()(message);
@@ -143,11 +149,108 @@ WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackE
   };
 }
 
+namespace {
+
+[[noreturn]] void park_thread() {
+  for (;;) std::this_thread::sleep_for(std::chrono::hours(1));
+}
+
+/// The calls of run_interruptible in progress, by their cancel flags: interpreter exit cancels
+/// them and waits for them to end. Never destroyed: threads may still use it while the process
+/// exits.
+struct Calls {
+  std::mutex mutex;
+  std::condition_variable ended;
+  std::multiset<std::atomic<bool>*> cancels;
+  bool exiting = false;  ///< a call that begins now is cancelled at once
+};
+Calls& calls() {
+  static Calls* c = new Calls;
+  return *c;
+}
+
+/// Registers a call of run_interruptible while it lives.
+class InProgress {
+ public:
+  explicit InProgress(std::atomic<bool>& cancel) : cancel_(cancel) {
+    Calls& c = calls();
+    std::lock_guard<std::mutex> lock(c.mutex);
+    if (c.exiting) cancel.store(true);
+    c.cancels.insert(&cancel);
+  }
+  ~InProgress() {
+    Calls& c = calls();
+    std::lock_guard<std::mutex> lock(c.mutex);
+    c.cancels.erase(c.cancels.find(&cancel_));
+    if (c.cancels.empty()) c.ended.notify_all();
+  }
+  InProgress(const InProgress&) = delete;
+  InProgress& operator=(const InProgress&) = delete;
+
+ private:
+  std::atomic<bool>& cancel_;
+};
+
+/// How long interpreter exit waits for the calls it cancelled: a render stops after its current
+/// pass (0.25 s by default), the reference renderer after its current row, which may take long
+/// with a large spp: the process then exits without waiting further (the threads of the call
+/// park when they ask for the GIL).
+constexpr std::chrono::seconds kExitWait{5};
+
+/// Runs at interpreter exit (atexit: after the non-daemon threads ended, before the interpreter
+/// finalizes, while daemon threads still run): cancels the calls in progress and waits for them
+/// to end, so that their threads return to Python rather than park, and no render runs on while
+/// the process exits.
+void end_calls_at_exit() {
+  ReleaseGil release;  // the calls' threads take the GIL to return
+  Calls& c = calls();
+  std::unique_lock<std::mutex> lock(c.mutex);
+  c.exiting = true;
+  for (std::atomic<bool>* cancel : c.cancels) cancel->store(true);
+  c.ended.wait_for(lock, kExitWait, [&] { return c.cancels.empty(); });
+}
+
+}  // namespace
+
+void restore_gil(PyThreadState* state, std::atomic<bool>* cancel) noexcept {
+#ifdef __GLIBCXX__
+  try {
+    PyEval_RestoreThread(state);
+  } catch (abi::__forced_unwind&) {
+    // the unwinding must end here (this function is noexcept): the thread never returns
+    if (cancel) cancel->store(true);
+    park_thread();
+  }
+#else
+  (void)cancel;
+  PyEval_RestoreThread(state);
+#endif
+}
+
+ReleaseGil::ReleaseGil() {
+  // as py::gil_scoped_release: pybind11's internals exist before a thread of ours asks for them
+  py::detail::get_internals();
+  state_ = PyEval_SaveThread();
+}
+
+AcquireGil::AcquireGil() {
+#ifdef __GLIBCXX__
+  try {
+    gil_.emplace();
+  } catch (abi::__forced_unwind&) {
+    park_thread();
+  }
+#else
+  gil_.emplace();
+#endif
+}
+
 void run_interruptible(const std::function<void()>& work, std::atomic<bool>& cancel) {
+  InProgress in_progress(cancel);  // ends once this thread holds the GIL again
   std::exception_ptr interrupt;
   std::exception_ptr failure;
   {
-    py::gil_scoped_release release;
+    ReleaseGil release;
     const CallbackFrame* callbacks = t_callbacks;  // valid while this thread waits
     std::packaged_task<void()> task([&] {
       t_callbacks = callbacks;
@@ -157,11 +260,14 @@ void run_interruptible(const std::function<void()>& work, std::atomic<bool>& can
     std::thread worker(std::move(task));
     while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
       if (interrupt) continue;
-      py::gil_scoped_acquire gil;
+      // at interpreter exit the thread parks here with the work cancelled (the worker stays
+      // joinable)
+      restore_gil(release.state(), &cancel);
       if (PyErr_CheckSignals() != 0) {
         interrupt = std::make_exception_ptr(py::error_already_set());
         cancel.store(true);
       }
+      PyEval_SaveThread();
     }
     worker.join();
     try {
@@ -321,4 +427,5 @@ PYBIND11_MODULE(lucent, m) {
   bind_render(m);
   bind_image(m);
   reduce_in_every_protocol(m);
+  py::module_::import("atexit").attr("register")(py::cpp_function(&end_calls_at_exit));
 }

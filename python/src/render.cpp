@@ -110,7 +110,7 @@ class PyRenderer {
       sink(message);
     };
     caller_chain_ = t_callbacks;  // the warnings of the construction are its caller's callbacks
-    py::gil_scoped_release release;
+    ReleaseGil release;
     renderer_.emplace(std::move(o));
     renderer_->set_cancel_flag(&stop_);
     caller_chain_ = nullptr;
@@ -156,14 +156,14 @@ class PyRenderer {
     using Result = decltype(f(r));
     if constexpr (std::is_void_v<Result>) {
       {
-        py::gil_scoped_release release;
+        ReleaseGil release;
         f(r);
       }
       warning_errors_->rethrow();
     } else {
       std::optional<Result> out;
       {
-        py::gil_scoped_release release;
+        ReleaseGil release;
         out.emplace(f(r));
       }
       warning_errors_->rethrow();
@@ -213,7 +213,7 @@ class PyRenderer {
     ProgressFn on_progress = [&](const RenderProgress& p) {
       save_counters();
       if (!has_progress) return;
-      py::gil_scoped_acquire gil;
+      AcquireGil gil;
       WithChain chain(caller_chain_);  // on a device thread, the chain of the call's caller
       InCallback frame(this, "progress callback");
       paused_ = true;  // scene and options can be read until the callback returns
@@ -235,7 +235,7 @@ class PyRenderer {
       throw Error(refusal("call", "close", "close it once that call has returned"));
     closed_ = true;  // from here on every call raises, before touching renderer_
     {
-      py::gil_scoped_release release;
+      ReleaseGil release;
       renderer_.reset();
     }
     busy_ = false;
@@ -846,7 +846,7 @@ void bind_render(py::module_& m) {
         const PyRenderer* session = renderer.is_none() ? nullptr : &renderer.cast<PyRenderer&>();
         if (!on_point.is_none())
           o.on_point = [&](const ConvergePoint& p) {
-            py::gil_scoped_acquire gil;
+            AcquireGil gil;
             InCallback frame(session, "on_point callback");
             if (!errors.run([&] { on_point(p); })) *stop = true;
           };

@@ -709,7 +709,7 @@ auto with_warnings(py::object on_warning, F&& load) {
   WarningSink sink = python_warning_sink(SharedObject(std::move(on_warning)), errors);
   std::optional<decltype(load())> out;
   {
-    py::gil_scoped_release release;
+    ReleaseGil release;
     scene_detail::ScopedWarningSink scoped(sink);
     out.emplace(load());
   }

@@ -2,14 +2,20 @@
 progress, and what other threads may read meanwhile. The threads are ordered by events set from
 the session's own callbacks (a progress callback between passes, a warning callback inside
 set_scene, a finaliser that runs inside close()), never by sleeps. A call from a callback of the
-session's own call, on the same thread, is refused as a re-entry, not as another thread's."""
+session's own call, on the same thread, is refused as a re-entry, not as another thread's. The
+interpreter exits cleanly while a daemon thread is in a call (a child process)."""
+import json
+import subprocess
+import sys
+import textwrap
 import threading
+import time
 
 import numpy as np
 import pytest
 
 import lucent
-from conftest import add_degenerate_triangle, session
+from conftest import SMALL, add_degenerate_triangle, session
 
 IN_USE = "in use by another thread"
 WAIT = 10  # seconds: a bound on every wait, never reached when the test passes
@@ -312,3 +318,48 @@ def test_a_reentry_through_another_sessions_callback_says_so(small_scene, b_opti
         assert got == {"outer": 4, "a": reentry("call", "render", "progress callback", "render"),
                        "b": reentry("call", "result", "progress callback", "render")}
         assert a.spp == 1 and b.spp == 4
+
+
+EXIT_CHILD = textwrap.dedent("""
+    import json, sys, threading, time
+    import numpy as np
+    import lucent
+    mode, scene, path = sys.argv[1], lucent.scene_from_dict(json.loads(sys.argv[2])), sys.argv[3]
+    started = threading.Event()
+
+    def body():
+        if mode == "render":
+            r = lucent.Renderer(**lucent.environment())
+            r.set_scene(scene)
+            r.render(10 ** 9, progress=lambda p: started.set())
+        elif mode == "reference":
+            scene.film.height = 100000  # many short rows: the reference stops after a row
+            started.set()
+            lucent.render_reference(scene, spp=64, threads=1)
+        else:  # a call that releases the GIL, then takes it back
+            image = np.zeros((300, 300, 3), np.float32)
+            while True:
+                lucent.write_image(path, image)
+                started.set()
+    class Finalizer:  # deleted as the interpreter finalizes: the daemon thread asks for the GIL
+        def __del__(self):
+            time.sleep(0.2)
+    finalizer = Finalizer()
+    threading.Thread(target=body, daemon=True).start()
+    started.wait(30)
+    time.sleep(0.2)  # well into the call (the test passes if not)
+    print("exiting", flush=True)
+""")
+
+
+@pytest.mark.parametrize("mode", ["render", "reference", "write_image"])
+def test_the_interpreter_exits_cleanly_while_a_daemon_thread_is_in_a_call(mode, tmp_path):
+    # CPython ends a daemon thread that asks for the GIL during finalization with pthread_exit;
+    # the unwinding met a joinable std::thread or a noexcept destructor and aborted the process
+    start = time.monotonic()
+    child = subprocess.run([sys.executable, "-c", EXIT_CHILD, mode, json.dumps(SMALL),
+                            str(tmp_path / "image.png")],
+                           capture_output=True, text=True, timeout=60)
+    assert child.stdout.split() == ["exiting"], child.stdout + child.stderr
+    assert "terminate" not in child.stderr and child.returncode == 0, child.stderr
+    assert time.monotonic() - start < 20, "exit waits for the render's current pass only"
