@@ -64,6 +64,22 @@ const char* enum_name(E value) {
   return "?";
 }
 
+// ------------------------------------------------------------------------------------------
+// Text in messages
+// ------------------------------------------------------------------------------------------
+
+/// `text` with each NUL written \x00: an exception's message is a C string (what()), and would
+/// end at the first NUL.
+std::string visible_nul(const std::string& text);
+
+/// ValueError naming `what` when `text` holds a NUL: lucent takes it as a C string (a file name,
+/// a device selector), which would end there.
+void refuse_nul(const std::string& text, const char* what);
+
+/// A message as a str: UTF-8, with each byte that is not (from a file name or a file's contents)
+/// written \xNN, as errors="backslashreplace" does.
+py::str message_text(const char* message);
+
 /// The value named `name`; ValueError naming the valid names otherwise.
 template <class E>
 E parse_enum(const std::string& name) {
@@ -73,8 +89,8 @@ E parse_enum(const std::string& name) {
     if (name == n) return v;
     valid += (valid.empty() ? "" : ", ") + std::string(n);
   }
-  throw py::value_error("unknown " + std::string(t.what) + " '" + name + "' (expected one of " +
-                        valid + ")");
+  throw py::value_error("unknown " + std::string(t.what) + " '" + visible_nul(name) +
+                        "' (expected one of " + valid + ")");
 }
 
 /// The names, in registry order (module attributes such as lucent.MATERIAL_TYPES).

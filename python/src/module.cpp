@@ -2,6 +2,7 @@
 // helpers shared by the other parts (scene.cpp, render.cpp, image.cpp).
 #include <chrono>
 #include <condition_variable>
+#include <cstring>
 #include <future>
 #include <mutex>
 #include <set>
@@ -80,6 +81,25 @@ const EnumNames<Precision>& enum_names<Precision>() {
   static const EnumNames<Precision> t{"precision",
                                       {{Precision::Float, "float"}, {Precision::Double, "double"}}};
   return t;
+}
+
+std::string visible_nul(const std::string& text) {
+  std::string out;
+  for (char c : text) out += c == '\0' ? std::string("\\x00") : std::string(1, c);
+  return out;
+}
+
+void refuse_nul(const std::string& text, const char* what) {
+  if (text.find('\0') != std::string::npos)
+    throw py::value_error(std::string(what) + ": embedded null character in '" + visible_nul(text) +
+                          "'");
+}
+
+py::str message_text(const char* message) {
+  PyObject* text = PyUnicode_DecodeUTF8(message, static_cast<Py_ssize_t>(std::strlen(message)),
+                                        "backslashreplace");
+  if (!text) throw py::error_already_set();
+  return py::reinterpret_steal<py::str>(text);
 }
 
 py::array_t<float> image_array(Image&& image) {
@@ -284,6 +304,7 @@ namespace {
 
 /// The cache directory of a session whose cache_dir option is `dir` ("" when disabled).
 std::string resolved_cache_dir(const std::string& dir) {
+  refuse_nul(dir, "cache_dir");
   std::string d = dir.empty() ? SessionOptions::from_environment().cache_dir : dir;
   if (d == "off") return "";
   return d.empty() ? cl_util::default_program_cache_dir() : d;
@@ -368,11 +389,22 @@ PYBIND11_MODULE(lucent, m) {
   static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
   error.doc() =
       "A failure reported by lucent: one line naming the file and the place, or the call.";
+  // PyErr_SetString (pybind11's translators) decodes the message as strict UTF-8: a message
+  // naming a file whose name is not UTF-8 became an exception without a message
   py::register_exception_translator([](std::exception_ptr p) {
+    const auto raise = [](PyObject* type, const std::exception& e) {
+      PyErr_SetObject(type, message_text(e.what()).ptr());
+    };
     try {
       if (p) std::rethrow_exception(p);
     } catch (const Error& e) {
-      error(e.what());
+      raise(error.ptr(), e);
+    } catch (const py::value_error& e) {
+      raise(PyExc_ValueError, e);
+    } catch (const py::type_error& e) {
+      raise(PyExc_TypeError, e);
+    } catch (const py::index_error& e) {
+      raise(PyExc_IndexError, e);
     }
   });
   py::object warning = py::reinterpret_steal<py::object>(
@@ -407,9 +439,16 @@ PYBIND11_MODULE(lucent, m) {
                ", " + d.platform + ")>";
       });
   m.def("list_devices", &list_devices, "Every OpenCL device of every platform.");
-  m.def("select_device", &select_device, py::arg("selector") = "", py::arg("origin") = "device",
-        "The device a selector picks (an index or a case-insensitive substring of the name; \"\": "
-        "the first GPU, else the first CPU device).");
+  m.def(
+      "select_device",
+      [](const std::string& selector, const std::string& origin) {
+        refuse_nul(selector, "selector");
+        refuse_nul(origin, "origin");
+        return select_device(selector, origin);
+      },
+      py::arg("selector") = "", py::arg("origin") = "device",
+      "The device a selector picks (an index or a case-insensitive substring of the name; \"\": "
+      "the first GPU, else the first CPU device).");
   m.def("environment", &environment,
         "The `lucent` command's session defaults from LUCENT_DEVICE, LUCENT_KERNEL_DIR and "
         "LUCENT_CACHE_DIR, as keyword arguments for Renderer: Renderer(**lucent.environment()).");

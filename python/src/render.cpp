@@ -92,6 +92,9 @@ class PyRenderer {
              py::object on_warning)
       : warning_errors_(std::make_shared<CallbackErrors>()) {
     check_callable(on_warning, "on_warning");
+    refuse_nul(device, "device");
+    refuse_nul(kernel_dir, "kernel_dir");
+    refuse_nul(cache_dir, "cache_dir");
     if (!(pass_seconds > 0) || !std::isfinite(pass_seconds))
       throw py::value_error("pass_seconds must be a positive number of seconds, got " +
                             format_field(pass_seconds));
@@ -326,6 +329,7 @@ double checked_seconds(double s, const char* what) {
 std::vector<ConvergeSetting> parse_settings(const std::vector<std::string>& names) {
   std::vector<ConvergeSetting> out;
   for (const std::string& n : names) {
+    refuse_nul(n, "settings");
     for (const ConvergeSetting& s : out)
       if (s.name == n) throw Error("settings: '" + n + "' is given twice");
     try {

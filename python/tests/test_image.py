@@ -1,5 +1,6 @@
 """Images, compare() and converge() from Python, with known answers and their error paths."""
 import math
+import os
 import re
 
 import numpy as np
@@ -144,6 +145,11 @@ def test_image_errors(tmp_path):
     for bad in ({"alpha": 0}, {"alpha": 1.5}, {"min_pass_fraction": 2}, {"abs_epsilon": -1}):
         with pytest.raises(ValueError):
             lucent.compare(constant(1.0), constant(1.0), **bad)
+    # names that are not UTF-8 (surrogateescape) are shown as \xNN, not lost with the message
+    with pytest.raises(lucent.Error, match=r"caf\\xe9\.png: cannot open image"):
+        lucent.read_image(os.path.join(str(tmp_path), "caf\udce9.png"))
+    with pytest.raises(lucent.Error, match=r"no\\xe8dir/a\.png: cannot write"):
+        lucent.write_image(os.path.join(str(tmp_path), "no\udce8dir", "a.png"), constant(1.0))
 
 
 def test_converge(small_scene):

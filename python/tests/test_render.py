@@ -312,6 +312,21 @@ def test_session_option_errors():
         r.set_build_options(precision="half")
 
 
+
+def test_a_nul_in_a_device_or_directory_is_refused_not_cut():
+    # a file name ends at a NUL for the system, and a message at its first NUL: "device 'gpu"
+    for kwargs, name in [({"device": "gpu\0 1"}, "device"), ({"kernel_dir": "k\0 1"}, "kernel_dir"),
+                         ({"cache_dir": "c\0 1"}, "cache_dir")]:
+        with pytest.raises(ValueError, match=r"%s: embedded null character in '.*\\x00 1'" % name):
+            session(**kwargs)
+    with pytest.raises(ValueError, match=r"selector: embedded null character in 'gpu\\x00 1'"):
+        lucent.select_device("gpu\0 1")
+    with pytest.raises(ValueError, match=r"cache_dir: embedded null character"):
+        lucent.clear_cache("c\0 1")
+    with pytest.raises(ValueError, match=r"unknown precision 'flo\\x00at'"):
+        session(precision="flo\0at")
+
+
 def test_reprs_say_what_they_hold(renderer, small_scene):
     renderer.set_scene(small_scene)
     d = renderer.device

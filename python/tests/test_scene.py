@@ -218,6 +218,14 @@ def test_load_scene_errors(tmp_path):
         lucent.load_scene(3)
 
 
+def test_error_messages_keep_bytes_that_are_not_utf8(tmp_path):
+    # a file name from os.listdir may hold any byte (surrogateescape): the message is not lost
+    with pytest.raises(lucent.Error) as e:
+        lucent.load_scene(os.path.join(str(tmp_path), "sc\udce8ne.json"))
+    assert str(e.value).endswith("sc\\xe8ne.json: cannot open scene file (No such file or directory)")
+    assert e.value.args == (str(e.value),)
+
+
 def test_bad_field_values():
     m = lucent.Material()
     with pytest.raises(ValueError,
