@@ -24,6 +24,52 @@ namespace py = pybind11;
 
 namespace lucent::python {
 
+/// Text that may come from files or the file system (file names, the names in OBJ and MTL
+/// files, directories): bytes that need not be UTF-8. Python sees them as os.fsdecode does (a
+/// byte that is not UTF-8 as a lone surrogate U+DC80..U+DCFF, errors="surrogateescape"), and a
+/// str (or bytes) given back becomes the same bytes; a str with another lone surrogate is
+/// refused (TypeError). A plain std::string raised UnicodeDecodeError on reading such text.
+struct FileText {
+  std::string bytes;
+};
+
+}  // namespace lucent::python
+
+namespace pybind11::detail {
+template <>
+struct type_caster<lucent::python::FileText> {
+  PYBIND11_TYPE_CASTER(lucent::python::FileText, const_name("str"));
+  bool load(handle src, bool) {
+    if (PyBytes_Check(src.ptr())) {
+      value.bytes.assign(PyBytes_AS_STRING(src.ptr()),
+                         static_cast<std::size_t>(PyBytes_GET_SIZE(src.ptr())));
+      return true;
+    }
+    if (!PyUnicode_Check(src.ptr())) return false;
+    object bytes =
+        reinterpret_steal<object>(PyUnicode_AsEncodedString(src.ptr(), "utf-8", "surrogateescape"));
+    if (!bytes) {
+      PyErr_Clear();
+      return false;
+    }
+    value.bytes.assign(PyBytes_AS_STRING(bytes.ptr()),
+                       static_cast<std::size_t>(PyBytes_GET_SIZE(bytes.ptr())));
+    return true;
+  }
+  static handle cast(const lucent::python::FileText& text, return_value_policy, handle) {
+    return PyUnicode_DecodeUTF8(text.bytes.data(), static_cast<Py_ssize_t>(text.bytes.size()),
+                                "surrogateescape");
+  }
+};
+}  // namespace pybind11::detail
+
+namespace lucent::python {
+
+/// `bytes` as a str (FileText).
+inline py::str file_text(const std::string& bytes) {
+  return py::reinterpret_steal<py::str>(py::cast(FileText{bytes}).release());
+}
+
 // ------------------------------------------------------------------------------------------
 // Enums by name: the registries' scene-file names (kernels/shared/registry.h), so that Python
 // code reads and writes `material.type = "mirror"` as a scene file would.
@@ -78,7 +124,7 @@ void refuse_nul(const std::string& text, const char* what);
 
 /// A message as a str: UTF-8, with each byte that is not (from a file name or a file's contents)
 /// written \xNN, as errors="backslashreplace" does.
-py::str message_text(const char* message);
+py::str message_text(const std::string& message);
 
 /// The value named `name`; ValueError naming the valid names otherwise.
 template <class E>

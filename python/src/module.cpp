@@ -95,8 +95,8 @@ void refuse_nul(const std::string& text, const char* what) {
                           "'");
 }
 
-py::str message_text(const char* message) {
-  PyObject* text = PyUnicode_DecodeUTF8(message, static_cast<Py_ssize_t>(std::strlen(message)),
+py::str message_text(const std::string& message) {
+  PyObject* text = PyUnicode_DecodeUTF8(message.data(), static_cast<Py_ssize_t>(message.size()),
                                         "backslashreplace");
   if (!text) throw py::error_already_set();
   return py::reinterpret_steal<py::str>(text);
@@ -160,10 +160,11 @@ WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackE
     AcquireGil gil;
     errors->run([&] {
       if (callback) {
-        callback.get()(message);
+        callback.get()(message_text(message));
       } else {
         py::module_ lucent = py::module_::import("lucent");
-        py::module_::import("warnings").attr("warn")(message, lucent.attr("LucentWarning"), 2);
+        py::module_::import("warnings")
+            .attr("warn")(message_text(message), lucent.attr("LucentWarning"), 2);
       }
     });
   };
@@ -303,11 +304,12 @@ void run_interruptible(const std::function<void()>& work, std::atomic<bool>& can
 namespace {
 
 /// The cache directory of a session whose cache_dir option is `dir` ("" when disabled).
-std::string resolved_cache_dir(const std::string& dir) {
+FileText resolved_cache_dir(const FileText& given) {
+  const std::string& dir = given.bytes;
   refuse_nul(dir, "cache_dir");
   std::string d = dir.empty() ? SessionOptions::from_environment().cache_dir : dir;
-  if (d == "off") return "";
-  return d.empty() ? cl_util::default_program_cache_dir() : d;
+  if (d == "off") return {};
+  return {d.empty() ? cl_util::default_program_cache_dir() : d};
 }
 
 /// Gives every class of the module without a __reduce_ex__ of its own one for every pickle
@@ -367,8 +369,8 @@ py::dict environment() {
   SessionOptions o = SessionOptions::from_environment();
   py::dict d;
   d["device"] = o.device;
-  d["kernel_dir"] = o.kernel_dir;
-  d["cache_dir"] = o.cache_dir;
+  d["kernel_dir"] = file_text(o.kernel_dir);
+  d["cache_dir"] = file_text(o.cache_dir);
   return d;
 }
 
@@ -457,7 +459,9 @@ PYBIND11_MODULE(lucent, m) {
         "LUCENT_CACHE_DIR, else the default), or \"\" when disabled (\"off\").");
   m.def(
       "clear_cache",
-      [](const std::string& dir) { return cl_util::clear_program_cache(resolved_cache_dir(dir)); },
+      [](const FileText& dir) {
+        return cl_util::clear_program_cache(resolved_cache_dir(dir).bytes);
+      },
       py::arg("cache_dir") = "",
       "Removes every cached kernel program from that directory (only the files the cache "
       "wrote); returns how many.");

@@ -87,21 +87,21 @@ void bind_device_shares(py::module_& m, py::class_<T>& c) {
 /// before any other thread can start a call (or resume the render).
 class PyRenderer {
  public:
-  PyRenderer(const std::string& device, const std::string& kernel_dir, const std::string& cache_dir,
+  PyRenderer(const std::string& device, const FileText& kernel_dir, const FileText& cache_dir,
              const std::string& precision, bool fast_math, bool specialize, double pass_seconds,
              py::object on_warning)
       : warning_errors_(std::make_shared<CallbackErrors>()) {
     check_callable(on_warning, "on_warning");
     refuse_nul(device, "device");
-    refuse_nul(kernel_dir, "kernel_dir");
-    refuse_nul(cache_dir, "cache_dir");
+    refuse_nul(kernel_dir.bytes, "kernel_dir");
+    refuse_nul(cache_dir.bytes, "cache_dir");
     if (!(pass_seconds > 0) || !std::isfinite(pass_seconds))
       throw py::value_error("pass_seconds must be a positive number of seconds, got " +
                             format_field(pass_seconds));
     SessionOptions o;
     o.device = device;
-    o.kernel_dir = kernel_dir;
-    o.cache_dir = cache_dir;
+    o.kernel_dir = kernel_dir.bytes;
+    o.cache_dir = cache_dir.bytes;
     o.precision = parse_enum<Precision>(precision);
     o.fast_math = fast_math;
     o.specialize = specialize;
@@ -374,7 +374,7 @@ py::dict result_state(const RenderResult& r) {
   d["seconds"] = r.seconds;
   d["build_seconds"] = r.build_seconds;
   d["program_cache_hit"] = r.program_cache_hit;
-  d["build_options"] = r.build_options;
+  d["build_options"] = file_text(r.build_options);
   d["cancelled"] = r.cancelled;
   d["device"] = r.device;
   if constexpr (has_device_shares<RenderResult>::value) {
@@ -589,7 +589,8 @@ void bind_render(py::module_& m) {
       .def_readonly("seconds", &RenderResult::seconds)
       .def_readonly("build_seconds", &RenderResult::build_seconds)
       .def_readonly("program_cache_hit", &RenderResult::program_cache_hit)
-      .def_readonly("build_options", &RenderResult::build_options)
+      .def_property_readonly("build_options",
+                             [](const RenderResult& r) { return FileText{r.build_options}; })
       .def_readonly("cancelled", &RenderResult::cancelled)
       .def_readonly("device", &RenderResult::device)
       .def(py::pickle([](const RenderResult& r) -> py::object { return result_state(r); },
@@ -604,8 +605,8 @@ void bind_render(py::module_& m) {
       "the `lucent` command's defaults.");
   bind_session_devices<Renderer>(renderer);
   renderer
-      .def(py::init<const std::string&, const std::string&, const std::string&, const std::string&,
-                    bool, bool, double, py::object>(),
+      .def(py::init<const std::string&, const FileText&, const FileText&, const std::string&, bool,
+                    bool, double, py::object>(),
            py::kw_only(), py::arg("device") = "", py::arg("kernel_dir") = "",
            py::arg("cache_dir") = "", py::arg("precision") = "float", py::arg("fast_math") = false,
            py::arg("specialize") = true, py::arg("pass_seconds") = 0.25,
@@ -624,8 +625,8 @@ void bind_render(py::module_& m) {
             const SessionOptions o = r.read("options").options();
             py::dict d;
             d["device"] = o.device;
-            d["kernel_dir"] = o.kernel_dir;
-            d["cache_dir"] = o.cache_dir;
+            d["kernel_dir"] = file_text(o.kernel_dir);
+            d["cache_dir"] = file_text(o.cache_dir);
             d["precision"] = precision_name(o.precision);
             d["fast_math"] = o.fast_math;
             d["specialize"] = o.specialize;

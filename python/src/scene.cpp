@@ -112,6 +112,15 @@ py::class_<V> bind_vector_type(py::module_& m, const char* name) {
   return c;
 }
 
+/// A property holding text from files (FileText: a file name, a name in an MTL file).
+template <class C>
+void text_property(py::class_<C>& c, const char* name, std::string C::*member,
+                   const char* doc = "") {
+  c.def_property(
+      name, [member](const C& o) { return FileText{o.*member}; },
+      [member](C& o, const FileText& v) { o.*member = v.bytes; }, doc);
+}
+
 /// A property holding an enum by its registry name.
 template <class C, class E>
 void enum_property(py::class_<C>& c, const char* name, E C::*member) {
@@ -340,7 +349,7 @@ template <>
 struct Pickled<Material> {
   static py::dict state(const Material& m) {
     py::dict d;
-    d["name"] = m.name;
+    d["name"] = file_text(m.name);
     d["type"] = enum_name(m.type);
     d["albedo"] = vec_state(m.albedo);
     d["albedo_texture"] = m.albedo_texture;
@@ -436,7 +445,7 @@ template <>
 struct Pickled<Texture> {
   static py::dict state(const Texture& t) {
     py::dict d;
-    d["path"] = t.path;
+    d["path"] = file_text(t.path);
     d["width"] = t.width;
     d["height"] = t.height;
     d["rgba"] = texture_texels(t);
@@ -464,11 +473,11 @@ struct Pickled<ShapeEntry> {
   static py::dict state(const ShapeEntry& e) {
     py::dict d;
     d["type"] = enum_name(e.type);
-    d["file"] = e.file;
+    d["file"] = file_text(e.file);
     d["first"] = e.first;
     d["count"] = e.count;
     py::list libraries;
-    for (const std::string& l : e.libraries) libraries.append(l);
+    for (const std::string& l : e.libraries) libraries.append(file_text(l));
     d["libraries"] = libraries;
     return d;
   }
@@ -484,7 +493,7 @@ struct Pickled<ShapeEntry> {
       if (!py::isinstance<py::str>(v))
         throw py::value_error("cannot unpickle " + at + ": expected a str, got " +
                               py::type::handle_of(v).attr("__name__").cast<std::string>());
-      if (!utf8_text(v, text))
+      if (!file_bytes(v, text))
         throw py::value_error("cannot unpickle " + at +
                               ": a str that is not valid Unicode (a lone surrogate)");
       return text;
@@ -564,7 +573,7 @@ struct Pickled<Scene> {
     triangles["material"] = triangle_material;
 
     py::dict d;
-    d["path"] = s.path;
+    d["path"] = file_text(s.path);
     d["camera"] = Pickled<Camera>::state(s.camera);
     d["film"] = Pickled<Film>::state(s.film);
     d["integrator"] = Pickled<Integrator>::state(s.integrator);
@@ -775,12 +784,12 @@ py::dict scene_info(const Scene& scene, const std::string& precision, bool fast_
 }
 
 std::string scene_repr(const Scene& s) {
-  return "<lucent.Scene '" + s.path + "': " + std::to_string(s.film.width) + "x" +
-         std::to_string(s.film.height) + ", " + enum_name(s.integrator.type) + ", " +
-         std::to_string(s.materials.size()) + " materials, " + std::to_string(s.spheres.size()) +
-         " spheres, " + std::to_string(s.triangles.size()) + " triangles, " +
-         std::to_string(s.lights.size()) + " lights, " + std::to_string(s.textures.size()) +
-         " textures>";
+  return "<lucent.Scene " + py::repr(file_text(s.path)).cast<std::string>() + ": " +
+         std::to_string(s.film.width) + "x" + std::to_string(s.film.height) + ", " +
+         enum_name(s.integrator.type) + ", " + std::to_string(s.materials.size()) + " materials, " +
+         std::to_string(s.spheres.size()) + " spheres, " + std::to_string(s.triangles.size()) +
+         " triangles, " + std::to_string(s.lights.size()) + " lights, " +
+         std::to_string(s.textures.size()) + " textures>";
 }
 
 }  // namespace
@@ -840,14 +849,15 @@ void bind_scene(py::module_& m) {
 
   py::class_<Material> material(m, "Material", "type: MATERIAL_TYPES; README, \"materials\".");
   material.def(py::init<>())
-      .def_readwrite("name", &Material::name)
       .def_readwrite("albedo_texture", &Material::albedo_texture, "index into Scene.textures or -1")
       .def_readwrite("ior", &Material::ior)
       .def_readwrite("roughness", &Material::roughness)
       .def_property_readonly("emissive", &Material::emissive)
       .def("__repr__", [](const Material& mt) {
-        return "<lucent.Material '" + mt.name + "' " + enum_name(mt.type) + ">";
+        return "<lucent.Material " + py::repr(file_text(mt.name)).cast<std::string>() + " " +
+               enum_name(mt.type) + ">";
       });
+  text_property(material, "name", &Material::name);
   vec_property(material, "albedo", &Material::albedo);
   vec_property(material, "emission", &Material::emission);
   vec_property(material, "specular", &Material::specular);
@@ -886,13 +896,13 @@ void bind_scene(py::module_& m) {
   py::class_<Texture> texture(m, "Texture",
                               "A linear RGBA image: rgba is an (H, W, 4) float32 array.");
   texture.def(py::init<>())
-      .def_readwrite("path", &Texture::path)
       .def_readonly("width", &Texture::width)
       .def_readonly("height", &Texture::height)
       .def_property(
           "rgba", &texture_texels, &set_texture_texels,
           "(H, W, 4) float32, linear, row 0 at the top: a read-only copy (assign an array to "
           "change it)");
+  text_property(texture, "path", &Texture::path);
   def_pickle(texture);
 
   py::class_<ShapeEntry> shape_entry(
@@ -901,10 +911,20 @@ void bind_scene(py::module_& m) {
       "OBJ file of a mesh, its first sphere or triangle and their count, and the MTL libraries "
       "the OBJ file named that exist (inputs of the scene).");
   shape_entry.def(py::init<>())
-      .def_readwrite("file", &ShapeEntry::file)
       .def_readwrite("first", &ShapeEntry::first)
       .def_readwrite("count", &ShapeEntry::count)
-      .def_readwrite("libraries", &ShapeEntry::libraries);
+      .def_property(
+          "libraries",
+          [](const ShapeEntry& e) {
+            std::vector<FileText> out;
+            for (const std::string& l : e.libraries) out.push_back({l});
+            return out;
+          },
+          [](ShapeEntry& e, const std::vector<FileText>& libraries) {
+            e.libraries.clear();
+            for (const FileText& l : libraries) e.libraries.push_back(l.bytes);
+          });
+  text_property(shape_entry, "file", &ShapeEntry::file);
   enum_property(shape_entry, "type", &ShapeEntry::type);
   def_pickle(shape_entry);
 
@@ -926,10 +946,10 @@ void bind_scene(py::module_& m) {
                           "triangles, lights and textures (a reference to a list's element "
                           "follows the element when the list changes, as in a Python list).");
   scene.def(py::init<>())
-      .def_readwrite("path", &Scene::path, "the file the scene came from, for messages")
       .def_readwrite("camera", &Scene::camera)
       .def_readwrite("film", &Scene::film)
       .def_readwrite("integrator", &Scene::integrator);
+  text_property(scene, "path", &Scene::path, "the file the scene came from, for messages");
   list_property(scene, "materials", &Scene::materials);
   list_property(scene, "spheres", &Scene::spheres);
   list_property(scene, "triangles", &Scene::triangles);
@@ -937,8 +957,10 @@ void bind_scene(py::module_& m) {
   list_property(scene, "textures", &Scene::textures);
   list_property(scene, "shapes", &Scene::shapes, "the shape list as given (ShapeEntry)");
   scene
-      .def("find_material", &Scene::find_material, py::arg("name"),
-           "Index of the material named `name`, or -1.")
+      .def(
+          "find_material",
+          [](const Scene& s, const FileText& name) { return s.find_material(name.bytes); },
+          py::arg("name"), "Index of the material named `name`, or -1.")
       .def("copy", [](const Scene& s) { return Scene(s); })
       .def("__copy__", [](const Scene& s) { return Scene(s); })
       .def("__deepcopy__", [](const Scene& s, py::dict) { return Scene(s); })

@@ -393,7 +393,7 @@ def corrupt(state, path, value):
     ("shapes/1/libraries", ["a.mtl", 2], "/shapes/1/libraries/1: expected a str, got int"),
     # a lone surrogate is a str without UTF-8: pybind11's cast raised a RuntimeError
     ("path", "rich/\ud800.json", "/path: a str that is not valid Unicode (a lone surrogate)"),
-    ("shapes/1/libraries", ["\udc80.mtl"],
+    ("shapes/1/libraries", ["\ud800.mtl"],
      "/shapes/1/libraries/0: a str that is not valid Unicode (a lone surrogate)"),
     ("x\ud800", 1, "lucent.Scene: unknown key 'x\\ud800'"),
     ("lights/1/texture", True, "/lights/1/texture: expected an integer, got bool"),

@@ -3,6 +3,7 @@ writable, enums by their registry names, and every error of the scene API."""
 import json
 import math
 import os
+import pickle
 import re
 import subprocess
 
@@ -224,6 +225,51 @@ def test_error_messages_keep_bytes_that_are_not_utf8(tmp_path):
         lucent.load_scene(os.path.join(str(tmp_path), "sc\udce8ne.json"))
     assert str(e.value).endswith("sc\\xe8ne.json: cannot open scene file (No such file or directory)")
     assert e.value.args == (str(e.value),)
+
+
+def test_text_from_files_that_is_not_utf8_reads_back_as_os_fsdecode_gives_it(tmp_path):
+    # a Latin-1 file name and material name: they loaded, then every read raised
+    # UnicodeDecodeError (scene.path, the names, repr, pickle)
+    d = os.fsencode(tmp_path)
+    (tmp_path / "m.mtl").write_bytes(b"newmtl caf\xe9\nKd 0.8 0.2 0.2\n")
+    (tmp_path / "m.obj").write_bytes(b"mtllib m.mtl\nmtllib gon\xe9.mtl\nv -1 0 -1\nv 1 0 -1\n"
+                                     b"v 0 0 1\nusemtl caf\xe9\nf 1 2 3\n")
+    scene = dict(SMALL, shapes=[{"type": "mesh", "file": "m.obj"}], materials={})
+    with open(os.path.join(d, b"sc\xe8ne.json"), "w") as f:
+        json.dump(scene, f)
+    name, = [n for n in os.listdir(tmp_path) if n.endswith(".json")]
+    assert name == "sc\udce8ne.json"
+    warnings = []
+    s = lucent.load_scene(os.path.join(str(tmp_path), name), on_warning=warnings.append)
+    assert s.path == os.path.join(str(tmp_path), name)
+    assert os.fsencode(s.path) == os.path.join(d, b"sc\xe8ne.json")
+    assert [m.name for m in s.materials] == ["m.obj:caf\udce9"]
+    assert s.find_material("m.obj:caf\udce9") == 0
+    assert s.shapes[0].file == os.path.join(str(tmp_path), "m.obj")
+    assert s.shapes[0].libraries == [os.path.join(str(tmp_path), "m.mtl")]
+    assert any("gon\\xe9.mtl" in w for w in warnings), warnings  # a message: backslashreplace
+    assert "sc\\udce8ne.json" in repr(s)
+    assert repr(s.materials[0]) == "<lucent.Material 'm.obj:caf\\udce9' diffuse>"
+    # assigned text keeps its bytes too (str with surrogateescape, or bytes)
+    s.materials[0].name = "x\udcff"
+    assert s.materials[0].name == "x\udcff"
+    s.materials[0].name = b"y\xfe"
+    assert s.materials[0].name == "y\udcfe"
+    s.shapes[0].libraries = ["a\udce4.mtl", b"b\xe4.mtl"]
+    assert s.shapes[0].libraries == ["a\udce4.mtl", "b\udce4.mtl"]
+    t = lucent.Texture()
+    t.path = "t\udce9.png"
+    t.rgba = np.ones((1, 1, 4))
+    s.textures.append(t)
+    with pytest.raises(TypeError):
+        s.materials[0].name = "z\ud800"  # a lone surrogate that no byte gives
+    # pickle keeps the bytes: to the bit
+    data = pickle.dumps(s)
+    back = pickle.loads(data)
+    assert pickle.dumps(back) == data
+    assert (back.path, back.materials[0].name, back.textures[0].path, back.shapes[0].libraries) == \
+        (s.path, "y\udcfe", "t\udce9.png", ["a\udce4.mtl", "b\udce4.mtl"])
+    assert lucent.scene_info(back)["triangles"] == 1
 
 
 def test_bad_field_values():
