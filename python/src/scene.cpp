@@ -686,13 +686,22 @@ nlohmann::json to_json(py::handle o, const std::string& path, const std::string&
     if (!std::isfinite(d)) return fail("must be a finite number, got " + format_number(d));
     return d;
   }
-  if (py::isinstance<py::str>(o)) return o.cast<std::string>();
+  // JSON text is UTF-8: a lone surrogate (a file name from os.listdir, "w\udce8") has none
+  const auto not_unicode = [](py::handle s) {
+    return "that is not valid Unicode (a lone surrogate): " + py::repr(s).cast<std::string>();
+  };
+  if (py::isinstance<py::str>(o)) {
+    std::string text;
+    if (!utf8_text(o, text)) return fail("a str " + not_unicode(o));
+    return text;
+  }
   if (py::isinstance<py::dict>(o)) {
     nlohmann::json j = nlohmann::json::object();
     for (auto item : py::reinterpret_borrow<py::dict>(o)) {
       if (!py::isinstance<py::str>(item.first))
         return fail("keys must be strings, got " + py::repr(item.first).cast<std::string>());
-      std::string key = item.first.cast<std::string>();
+      std::string key;
+      if (!utf8_text(item.first, key)) return fail("a key " + not_unicode(item.first));
       j[key] = to_json(item.second, path + "/" + key, label, depth + 1);
     }
     return j;
@@ -987,9 +996,9 @@ void bind_scene(py::module_& m) {
         "for these settings. Packs the scene and builds its BVH; needs no device.");
   m.def(
       "scene_from_dict",
-      [](py::dict d, const std::filesystem::path& base_dir, const std::string& name,
+      [](py::dict d, const std::filesystem::path& base_dir, const FileText& name,
          py::object on_warning) {
-        std::string label = (base_dir / name).string();
+        std::string label = (base_dir / name.bytes).string();
         std::string text = to_json(d, "", label).dump();
         return with_warnings(std::move(on_warning), [&] { return parse_scene(text, label); });
       },

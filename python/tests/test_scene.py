@@ -200,6 +200,22 @@ def test_dict_keys_must_be_strings():
         lucent.scene_from_dict([1, 2])
 
 
+def test_dict_strings_with_a_lone_surrogate_are_errors_with_the_json_path(small_dict):
+    # JSON text is UTF-8; a name from os.listdir ("w\udce8") raised "RuntimeError: Unable to
+    # cast Python instance to C++ type"
+    small_dict["shapes"][0]["material"] = "w\udce8"
+    with pytest.raises(lucent.Error) as e:
+        lucent.scene_from_dict(small_dict)
+    assert str(e.value) == ("./<dict>: /shapes/0/material: a str that is not valid Unicode (a "
+                            "lone surrogate): 'w\\udce8'")
+    with pytest.raises(lucent.Error, match=r"^./<dict>: /materials: a key that is not valid "
+                                           r"Unicode \(a lone surrogate\): 'g\\ud800'$"):
+        lucent.scene_from_dict({"materials": {"g\ud800": {"type": "diffuse"}}})
+    # the name is a file name for messages: any bytes
+    with pytest.raises(lucent.Error, match=r"^./sc\\xe8ne\.json: /camera/fvo: unknown key"):
+        lucent.scene_from_dict({"camera": {"fvo": 3}}, name="sc\udce8ne.json")
+
+
 def test_numpy_values_in_dicts(small_dict):
     small_dict["camera"]["position"] = np.array([0.0, 1, 5])
     small_dict["film"]["width"] = np.int64(16)
