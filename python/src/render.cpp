@@ -422,6 +422,8 @@ RenderResult result_from_state(const py::object& state) {
     py::array_t<std::uint32_t> n = s.array<std::uint32_t>("samples", {r.mean.height, r.mean.width});
     r.samples.assign(n.data(), n.data() + n.size());
   }
+  if (!r.variance.rgb.empty() && r.samples.empty())  // as the constructor
+    s.fail("samples", "a variance needs the per-pixel sample counts");
   r.spp = s.integer<std::uint64_t>("spp");
   r.nonfinite = s.integer<std::uint64_t>("nonfinite");
   r.rays = s.integer<std::uint64_t>("rays");
@@ -525,11 +527,17 @@ void bind_render(py::module_& m) {
               if (kind != 'i' && kind != 'u')
                 throw py::type_error("samples: expected integer counts, got an array of dtype " +
                                      py::str(given.dtype()).cast<std::string>());
-              py::array_t<std::int64_t, py::array::forcecast> wide(given);
-              for (py::ssize_t k = 0; k < wide.size(); ++k)
-                if (wide.data()[k] < 0 || wide.data()[k] > std::int64_t(UINT32_MAX))
-                  throw py::value_error("samples: counts must be in [0, 2^32), got " +
-                                        std::to_string(wide.data()[k]));
+              // unsigned counts as unsigned: 2^63 as int64 was "got -9223372036854775808"
+              const auto check = [](auto wide) {
+                for (py::ssize_t k = 0; k < wide.size(); ++k)
+                  if (wide.data()[k] < 0 || wide.data()[k] > UINT32_MAX)
+                    throw py::value_error("samples: counts must be in [0, 2^32), got " +
+                                          std::to_string(wide.data()[k]));
+              };
+              if (kind == 'u')
+                check(py::array_t<std::uint64_t, py::array::forcecast>(given));
+              else
+                check(py::array_t<std::int64_t, py::array::forcecast>(given));
               auto a =
                   py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>::ensure(
                       samples);
@@ -537,6 +545,11 @@ void bind_render(py::module_& m) {
                 throw py::value_error("samples: expected an array of shape (H, W) like the mean's");
               r.samples.assign(a.data(), a.data() + a.size());
             }
+            // a variance is per sample: compare() divides it by the counts (without them it
+            // took one sample a pixel) and write_render_exr() writes both or neither
+            if (!r.variance.rgb.empty() && r.samples.empty())
+              throw py::value_error(
+                  "variance: a variance needs the per-pixel sample counts (samples=...)");
             r.spp = spp;
             return r;
           }),

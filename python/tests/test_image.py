@@ -245,6 +245,19 @@ def test_result_from_arrays_refuses_what_no_render_holds():
         lucent.RenderResult(constant(1.0), samples=np.full((4, 5), -1))
     with pytest.raises(TypeError, match="samples: expected integer counts"):
         lucent.RenderResult(constant(1.0), samples=np.full((4, 5), 2.9))
+    # unsigned counts are shown unsigned (2^63 was "got -9223372036854775808")
+    with pytest.raises(ValueError, match=r"counts must be in \[0, 2\^32\), got 9223372036854775808$"):
+        lucent.RenderResult(constant(1.0), samples=np.full((4, 5), 2 ** 63, np.uint64))
+    with pytest.raises(ValueError, match=r"got 4294967296$"):
+        lucent.RenderResult(constant(1.0), samples=np.full((4, 5), 2 ** 32, np.uint64))
+    # a variance is per sample: without the counts compare() took one sample a pixel and
+    # write_render_exr() dropped it
+    with pytest.raises(ValueError, match=r"^variance: a variance needs the per-pixel sample counts "
+                                         r"\(samples=\.\.\.\)$"):
+        lucent.RenderResult(constant(1.0), variance=constant(4.0))
+    # counts without a variance say nothing to compare(): a tolerance test, as for images
+    counts = lucent.RenderResult(constant(1.0), samples=np.full((4, 5), 16))
+    assert not lucent.compare(counts, constant(1.0)).statistical
     # a variance is finite and >= 0
     for bad in (-1.0, math.nan, math.inf):
         with pytest.raises(ValueError, match="variance: every value must be finite and >= 0"):

@@ -246,6 +246,8 @@ def test_a_render_result_round_trips_exactly(renderer, small_scene, name, round_
     ("spp", 2 ** 64, "/spp: integer out of range: 18446744073709551616"),
     ("devices", [{"device": "cpu"}], "/devices/0/samples: missing"),
     ("sampler", None, "/sampler: expected a str, got NoneType"),
+    # a per-sample variance without the counts (the constructor refuses it too)
+    ("samples", None, "/samples: a variance needs the per-pixel sample counts"),
     # the sizes of an image are 1 to the largest int (height -2**31 and 2 before)
     ("mean", np.empty((0, 0, 3), np.float32), "/mean: expected an (H, W, 3) image with 1 <= H, "
                                               "W <= 2147483647, got a (0, 0, 3) array"),
