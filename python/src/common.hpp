@@ -189,6 +189,24 @@ py::array_t<T> view(const std::vector<T>& data, std::vector<py::ssize_t> shape, 
   return py::array_t<T>(std::move(shape), data.data(), owner);
 }
 
+/// `object` as an array of type A (py::array, or py::array_t with its flags: converted as NumPy
+/// converts), or a null array when NumPy cannot convert it (the caller says what it expected).
+/// A MemoryError (a copy too large for memory) is raised: A::ensure cleared it, and the caller
+/// reported a wrong shape or type.
+template <class A>
+A array_or_null(py::handle object) {
+  try {
+    return A(py::reinterpret_borrow<py::object>(object));
+  } catch (py::error_already_set& e) {
+    if (e.matches(PyExc_MemoryError)) throw;
+    return py::reinterpret_steal<A>(py::handle());
+  }
+}
+
+/// A C-contiguous array of T converted from `object` (array_or_null).
+template <class T>
+using CArray = py::array_t<T, py::array::c_style | py::array::forcecast>;
+
 /// An (H, W, 3) float32 array that owns the image's pixels (moved into a capsule: no copy).
 py::array_t<float> image_array(Image&& image);
 

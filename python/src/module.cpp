@@ -116,7 +116,7 @@ py::array_t<double> copy_rows(const double* first, std::size_t n, py::ssize_t co
 }
 
 void require_numbers(py::handle object, const std::string& what) {
-  py::array a = py::array::ensure(object);
+  py::array a = array_or_null<py::array>(object);
   if (!a) return;  // not convertible at all: the caller's conversion says so
   const char kind = a.dtype().kind();
   if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
@@ -126,7 +126,7 @@ void require_numbers(py::handle object, const std::string& what) {
 
 Image image_from_array(py::handle object, const char* what) {
   require_numbers(object, what);
-  auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(object);
+  auto a = array_or_null<CArray<float>>(object);
   if (!a) throw py::type_error(std::string(what) + ": expected an array of shape (H, W, 3)");
   if (a.ndim() != 3 || a.shape(2) != 3 || a.shape(0) < 1 || a.shape(1) < 1) {
     std::string shape;

@@ -519,7 +519,7 @@ void bind_render(py::module_& m) {
             }
             if (!samples.is_none()) {
               // whole counts in [0, 2^32): forcecast wrapped -1 to 4294967295 and cut 2.9 to 2
-              py::array given = py::array::ensure(samples);
+              py::array given = array_or_null<py::array>(samples);
               if (!given || given.ndim() != 2 || given.shape(0) != r.mean.height ||
                   given.shape(1) != r.mean.width)
                 throw py::value_error("samples: expected an array of shape (H, W) like the mean's");
@@ -538,9 +538,7 @@ void bind_render(py::module_& m) {
                 check(py::array_t<std::uint64_t, py::array::forcecast>(given));
               else
                 check(py::array_t<std::int64_t, py::array::forcecast>(given));
-              auto a =
-                  py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>::ensure(
-                      samples);
+              auto a = array_or_null<CArray<std::uint32_t>>(samples);
               if (!a || a.ndim() != 2 || a.shape(0) != r.mean.height || a.shape(1) != r.mean.width)
                 throw py::value_error("samples: expected an array of shape (H, W) like the mean's");
               r.samples.assign(a.data(), a.data() + a.size());

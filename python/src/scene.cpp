@@ -170,7 +170,7 @@ template <class V>
 std::vector<V> vectors_from(py::handle value, const std::string& name) {
   constexpr int D = V::length();
   require_numbers(value, name);
-  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+  auto a = array_or_null<CArray<double>>(value);
   if (!a)
     throw py::type_error(name + ": expected an array of shape (N, " + std::to_string(D) + ")");
   if (!(a.ndim() == 2 && a.shape(1) == D) && !(a.ndim() == 1 && a.shape(0) == 0))
@@ -208,7 +208,7 @@ py::array_t<float> texture_texels(const Texture& t) {
 /// Sets a texture's texels, width and height from an (H, W, 4) array of numbers (H, W >= 1).
 void set_texture_texels(Texture& t, py::handle value) {
   require_numbers(value, "rgba");
-  auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(value);
+  auto a = array_or_null<CArray<float>>(value);
   if (!a || a.ndim() != 3 || a.shape(2) != 4 || a.shape(0) < 1 || a.shape(1) < 1)
     throw py::value_error("rgba: expected an array of shape (H, W, 4)");
   t.height = static_cast<int>(a.shape(0));

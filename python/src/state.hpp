@@ -173,7 +173,7 @@ class StateReader {
     if (!ok)
       fail(key, expected + ", got a " + shape_text(got) + " array of " +
                     a.dtype().attr("name").cast<std::string>());
-    return py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
+    return CArray<T>(a);  // raises MemoryError (ensure() gave a null array)
   }
 
   /// Raises for a key that no getter read (a state of another version of the module).

@@ -2,6 +2,9 @@
 import math
 import os
 import re
+import subprocess
+import sys
+import textwrap
 
 import numpy as np
 import pytest
@@ -265,6 +268,47 @@ def test_result_from_arrays_refuses_what_no_render_holds():
     # strings are not numbers
     with pytest.raises(TypeError, match="mean: expected numbers"):
         lucent.RenderResult(np.full((2, 2, 3), "0.5"))
+
+
+class OutOfMemory:
+    """An array-like whose conversion runs out of memory (as a copy too large for memory does)."""
+    def __array__(self, dtype=None):
+        raise MemoryError("no memory for the copy")
+
+
+def test_out_of_memory_is_raised_not_reported_as_a_wrong_shape(tmp_path):
+    # array_t::ensure cleared NumPy's MemoryError: "expected an array of shape (H, W, 3)"
+    for f in (lambda: lucent.write_image(tmp_path / "a.png", OutOfMemory()),
+              lambda: lucent.RenderResult(OutOfMemory()),
+              lambda: lucent.RenderResult(constant(1.0), variance=OutOfMemory(),
+                                          samples=np.ones((4, 5), np.uint32)),
+              lambda: lucent.RenderResult(constant(1.0), samples=OutOfMemory()),
+              lambda: lucent.compare(constant(1.0), OutOfMemory())):
+        with pytest.raises(MemoryError, match="no memory for the copy"):
+            f()
+
+
+OUT_OF_MEMORY_CHILD = textwrap.dedent("""
+    import resource, sys
+    import numpy as np
+    import lucent
+    # the address space in use and 1 GiB more: a 3 GiB copy cannot be made
+    used = int(open("/proc/self/statm").read().split()[0]) * resource.getpagesize()
+    resource.setrlimit(resource.RLIMIT_AS, (used + 2 ** 30, resource.getrlimit(resource.RLIMIT_AS)[1]))
+    big = np.broadcast_to(np.float32(0.5), (16384, 16384, 3))  # 12 bytes of data
+    for f in (lambda: lucent.write_image(sys.argv[1], big), lambda: lucent.RenderResult(big)):
+        try:
+            f()
+        except Exception as e:
+            print(type(e).__name__)
+""")
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self/statm"), reason="needs Linux's /proc")
+def test_an_image_too_large_to_copy_raises_memory_error(tmp_path):
+    child = subprocess.run([sys.executable, "-c", OUT_OF_MEMORY_CHILD, str(tmp_path / "big.png")],
+                           capture_output=True, text=True, timeout=60)
+    assert child.stdout.split() == ["MemoryError", "MemoryError"], child.stdout + child.stderr
 
 
 def test_display_settings_of_the_wrong_type_name_the_setting(tmp_path):

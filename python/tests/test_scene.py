@@ -430,6 +430,16 @@ def test_indices_take_numpy_integers_and_refuse_the_rest():
     assert t.v == (0, 1, 2)  # unchanged by a refused assignment
 
 
+def test_out_of_memory_in_array_fields_is_raised_not_reported_as_a_wrong_shape(small_scene):
+    class OutOfMemory:  # a conversion that runs out of memory (a copy too large for memory)
+        def __array__(self, dtype=None):
+            raise MemoryError("no memory for the copy")
+    with pytest.raises(MemoryError, match="no memory for the copy"):
+        small_scene.positions = OutOfMemory()
+    with pytest.raises(MemoryError, match="no memory for the copy"):
+        lucent.Texture().rgba = OutOfMemory()
+
+
 def test_array_fields_refuse_strings_that_look_like_numbers():
     with pytest.raises(TypeError, match="positions: expected numbers"):
         lucent.Scene().positions = [["1", "2", "3e400"]]
