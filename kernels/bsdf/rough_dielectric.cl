@@ -5,7 +5,8 @@
  * otherwise. Radiance transport: the transmitted term is divided by eta^2 and multiplied by tint,
  * as the smooth dielectric's refraction weight tint / eta^2. Two-sided: eta = ior from the outside,
  * 1 / ior from the inside. An ior of 1 is no interface: light passes straight through, weighted
- * by tint (a delta BSDF; the generalized half vector of refraction does not exist there).
+ * by tint (a delta BSDF; the generalized half vector of refraction does not exist there). The
+ * host packs an ior within 1e-5 of 1 as 1 (src/scene/materials/rough_dielectric.cpp).
  * Parameters (lc_rough_dielectric_params): tint, ior, roughness (GGX alpha, at least 1e-3). */
 #ifndef LUCENT_BSDF_ROUGH_DIELECTRIC_CL
 #define LUCENT_BSDF_ROUGH_DIELECTRIC_CL
