@@ -59,6 +59,44 @@ TEST(RenderAnalytic, DiffusePlaneUnderPointLight) {
   EXPECT_EQ(r.nonfinite, 0u);
 }
 
+// The plane above, but the top of a huge ground sphere (smallpt's walls are spheres of radius
+// 1e5), rendered by the path integrator. Float knows points of such a sphere only to about its
+// ulp (0.008 at 1e5), and the shadow ray's origin is pushed off the surface by 8 times that
+// error bound: 0.3 at radius 1e5, 3 at 1e6. The path integrator measured a point light's
+// distance and direction from that origin, so this image came out 32% too bright, and black at
+// radius 1e6 (the origin above the light). Measured from the surface point, it is the plane's
+// image to float's precision there: each pixel's radiance moves by up to about 1% with its
+// point's error, so the test is the image mean within 1% of the analytic one.
+TEST(RenderAnalytic, PointLightOverAHugeGroundSphere) {
+  const double albedo = 0.6, I = 50.0, lx = 0.7, ly = 0.4, lz = 2.0;
+  const double t = std::tan(10.0 * M_PI / 180.0);
+  double expected = 0;  // the image mean: the plane's radiance over the film, midpoint rule
+  for (int j = 0; j < 256; ++j)
+    for (int i = 0; i < 256; ++i) {
+      double px = (2.0 * (i + 0.5) / 256 - 1) * t * 5.0, py = (1 - 2.0 * (j + 0.5) / 256) * t * 5.0;
+      double dx = lx - px, dy = ly - py, r2 = dx * dx + dy * dy + lz * lz;
+      expected += albedo / M_PI * I * (lz / std::sqrt(r2)) / r2;
+    }
+  expected /= 256 * 256;
+  for (const char* radius : {"1e5", "1e6"}) {
+    const std::string scene = std::string(R"({
+      "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 20},
+      "film": {"width": 32, "height": 32},
+      "integrator": {"type": "path", "max_depth": 2},
+      "materials": {"white": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}},
+      "shapes": [{"type": "sphere", "center": [0, 0, -)") +
+                              radius + R"(], "radius": )" + radius + R"(, "material": "white"}],
+      "lights": [{"type": "point", "position": [0.7, 0.4, 2.0], "intensity": [50, 50, 50]}]
+    })";
+    lucent::RenderResult r = lucent::test::render_json(scene, 16, false);
+    double sum = 0;
+    for (int y = 0; y < 32; ++y)
+      for (int x = 0; x < 32; ++x) sum += r.mean.pixel(x, y)[0];
+    EXPECT_NEAR(sum / 1024 / expected, 1.0, 0.01) << "radius " << radius;
+    EXPECT_EQ(r.nonfinite, 0u);
+  }
+}
+
 // A sphere lit head-on: the pixel at the centre of the image sees the point of the sphere
 // nearest the camera and light, where cos(theta) = 1 and r = distance - radius.
 TEST(RenderAnalytic, SphereFacingPointLight) {

@@ -44,10 +44,11 @@ static inline lc_real3 frame_to_world_dir(const lc_frame* f, float3 v) {
 }
 
 /* Unoccluded test from a spawned origin o towards a sampled light point (or direction) at
- * distance dist from o. Light samples are taken from o itself, not from the surface point: the
+ * distance dist from o. Area lights are sampled from o itself, not from the surface point: the
  * offset of o is large on huge spheres (it scales with their float precision), and a direction
  * computed from the surface point would, seen from o, pass just inside a sphere light near its
- * silhouette. */
+ * silhouette. Point lights are sampled from the surface point (light/light.cl), and their
+ * shadow rays go from o to the light (shadow_visible_to). */
 /* Relative shortening of shadow rays (see shadow_visible): float's 2e-4, and for double about
  * 2e-4 times the ratio of the two epsilons (3.7e-13), rounded up. The sampled light point must
  * then be computed in lc_real throughout (kernels/light/light.cl): a float barycentric sum or a
@@ -76,17 +77,23 @@ static inline int shadow_visible(const lc_scene* s, lc_real3 o, lc_real3 wi, lc_
   return !scene_occluded(s, sr, tmax);
 }
 
-/* Unoccluded test of a light sample drawn from the origin o in front of the surface of `it`
- * whose direction passes behind it (a transmitting BSDF): the shadow ray leaves from an origin
- * behind the surface towards the sampled point (or along the direction, for environments). */
-static inline int shadow_visible_behind(const lc_scene* s, const lc_interaction* it, lc_real3 o,
+/* Unoccluded test from a spawned origin o towards the sampled light point q. */
+static inline int shadow_visible_to(const lc_scene* s, lc_real3 o, lc_real3 q, lc_uint* rays) {
+  lc_real3 to = q - o;
+  lc_real dist = length(to);
+  if (!(dist > LC_REAL(0.0))) return 0;
+  return shadow_visible(s, o, to / dist, dist, rays);
+}
+
+/* Unoccluded test of a light sample drawn from the point `from` (the origin o in front of the
+ * surface of `it`, or the surface point for a point light) whose direction passes behind the
+ * surface (a transmitting BSDF): the shadow ray leaves from an origin behind the surface towards
+ * the sampled point (or along the direction, for environments). */
+static inline int shadow_visible_behind(const lc_scene* s, const lc_interaction* it, lc_real3 from,
                                         const lc_light_sample* ls, lc_uint* rays) {
   lc_real3 ob = lc_spawn_origin(it->p, it->perr, -it->ng);
   if (isinf(ls->dist)) return shadow_visible(s, ob, ls->wi, ls->dist, rays);
-  lc_real3 to = (o + ls->dist * ls->wi) - ob;
-  lc_real dist = length(to);
-  if (!(dist > LC_REAL(0.0))) return 0;
-  return shadow_visible(s, ob, to / dist, dist, rays);
+  return shadow_visible_to(s, ob, from + ls->dist * ls->wi, rays);
 }
 
 /* Sum over point lights of f * cos * I / r^2 (direct and whitted integrators): f is the BSDF b,

@@ -101,7 +101,8 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
       lc_uint lobes = bsdf_lobes(&b);
       if (!(lobes & LC_BSDF_DELTA) && P->num_lights > 0) {
         lc_light_sample ls;
-        if (light_sample(s, o, u_light.z, u_light.x, u_light.y, u_bsdf.w, &ls) && ls.pdf > 0.0f) {
+        if (light_sample(s, it.p, o, u_light.z, u_light.x, u_light.y, u_bsdf.w, &ls) &&
+            ls.pdf > 0.0f) {
           int behind = !(dot(ls.wi, it.ng) > LC_REAL(0.0));
           float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
           /* the side of the geometric surface decides the lobe, and the shading frame must
@@ -110,8 +111,12 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
               (behind ? wi_l.z < 0.0f : wi_l.z > 0.0f)) {
             float pdf_b;
             float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf_b);
-            if (lc_max3(f) > 0.0f && (behind ? shadow_visible_behind(s, &it, o, &ls, rays)
-                                             : shadow_visible(s, o, ls.wi, ls.dist, rays))) {
+            /* (a point light was sampled from it.p: the shadow ray goes from o to it) */
+            lc_real3 from = ls.delta ? it.p : o;
+            if (lc_max3(f) > 0.0f &&
+                (behind ? shadow_visible_behind(s, &it, from, &ls, rays)
+                        : (ls.delta ? shadow_visible_to(s, o, from + ls.dist * ls.wi, rays)
+                                    : shadow_visible(s, o, ls.wi, ls.dist, rays)))) {
               float w = (ls.delta || no_mis) ? 1.0f : mis_power(ls.pdf, pdf_b);
               L += path_clamp(beta * f * ls.L * (fabs(wi_l.z) * w / ls.pdf), P->clamp);
             }
