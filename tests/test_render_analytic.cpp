@@ -3,6 +3,7 @@
 // known-answer, stability and precision tests (see test_kernel_analytic.cpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -136,6 +137,31 @@ TEST(RenderAnalytic, ShadowRaysAreBoundedByTheLightDistance) {
   const float* c = r.mean.pixel(4, 4);
   // the pixel sees (about) the origin: E = 1 * 1 / 1, L = 1/pi
   EXPECT_NEAR(c[0], 1.0 / M_PI, 0.02 / M_PI);
+}
+
+// A point light 0.003 under an opaque floor lights nothing above it: a sphere 20 above is black
+// in every integrator. The path integrator's shadow rays stopped 2e-4 of their length short of
+// the light (a margin for an area light's own surface, which a point light has not), so the floor
+// did not hide this light from the sphere: mean 0.007 instead of 0.
+TEST(RenderAnalytic, PointLightJustUnderAFloorLightsNothingAboveIt) {
+  for (const char* integrator : {"path", "direct", "whitted"}) {
+    const std::string scene = std::string(R"({
+      "camera": {"position": [0, 25, 10], "look_at": [0, 20, 0], "fov": 40},
+      "film": {"width": 16, "height": 16},
+      "integrator": {"type": ")") +
+                              integrator + R"(", "max_depth": 4},
+      "materials": {"white": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]}},
+      "shapes": [
+        {"type": "triangles", "material": "white", "indices": [0,2,1, 0,3,2],
+         "positions": [[-100,0,-100],[100,0,-100],[100,0,100],[-100,0,100]]},
+        {"type": "sphere", "center": [0, 20, 0], "radius": 3, "material": "white"}],
+      "lights": [{"type": "point", "position": [0, -0.003, 0], "intensity": [1000, 1000, 1000]}]
+    })";
+    lucent::RenderResult r = lucent::test::render_json(scene, 4, false);
+    double brightest = 0;
+    for (float v : r.mean.rgb) brightest = std::max(brightest, double(v));
+    EXPECT_EQ(brightest, 0.0) << integrator;
+  }
 }
 
 // A diffuse floor (albedo 0.5) under a sky of radiance 1, whose map also holds a 3x3 sun of 1e12

@@ -89,7 +89,8 @@ static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_inter
   lc_real3 o = lc_spawn_origin(it.p, it.perr, it.ng); /* ng faces the camera */
   lc_real3 to = cpos - o;
   lc_real od = length(to);
-  if (!(od > LC_REAL(0.0)) || !shadow_visible(s, o, to / od, od, rays)) return 1;
+  if (!(od > LC_REAL(0.0)) || !shadow_visible(s, o, to / od, od, LC_SHADOW_REL_MARGIN, rays))
+    return 1;
   /* |wl.ns| |wc.ng| / |wl.ng|, and the importance 1 / (s^2 cos^3) over r^2, for a pinhole and
    * for a thin lens alike (with r and cos from the lens point: the lens point's density
    * 1 / area cancels the importance's 1 / area) */
