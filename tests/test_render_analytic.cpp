@@ -164,6 +164,31 @@ TEST(RenderAnalytic, PointLightJustUnderAFloorLightsNothingAboveIt) {
   }
 }
 
+// The same for an emitting quad with an opaque quad 1e-4 under it: the floor below is black.
+// Shadow rays towards every light's surface stopped 2e-4 of their length short of it, so the
+// cover, 1e-4 / 2 of the distance in front of the lamp, let its light through (mean 0.49). A
+// triangle light now bounds that margin by its own rounding (light/triangle.cl).
+TEST(RenderAnalytic, CoverJustUnderAnEmittingQuadHidesIt) {
+  const char* scene = R"({
+    "camera": {"position": [0, 1, 4], "look_at": [0, 0.5, 0], "fov": 45},
+    "film": {"width": 16, "height": 16},
+    "integrator": {"type": "path", "max_depth": 4},
+    "materials": {"white": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [10, 10, 10]}},
+    "shapes": [
+      {"type": "triangles", "material": "white", "indices": [0,2,1, 0,3,2],
+       "positions": [[-5,0,-5],[5,0,-5],[5,0,5],[-5,0,5]]},
+      {"type": "triangles", "material": "lamp", "indices": [0,1,2, 0,2,3],
+       "positions": [[-1,2,-1],[1,2,-1],[1,2,1],[-1,2,1]]},
+      {"type": "triangles", "material": "white", "indices": [0,1,2, 0,2,3],
+       "positions": [[-2,1.9999,-2],[2,1.9999,-2],[2,1.9999,2],[-2,1.9999,2]]}]
+  })";
+  lucent::RenderResult r = lucent::test::render_json(scene, 8, false);
+  double brightest = 0;
+  for (float v : r.mean.rgb) brightest = std::max(brightest, double(v));
+  EXPECT_EQ(brightest, 0.0);
+}
+
 // A diffuse floor (albedo 0.5) under a sky of radiance 1, whose map also holds a 3x3 sun of 1e12
 // below the horizon: the floor's radiance is 0.5 x 1 exactly, with or without MIS. The sun takes
 // the whole texel CDF (the sky's 32,000 texels together hold 0.06 of a lattice step), so light

@@ -49,20 +49,9 @@ static inline lc_real3 frame_to_world_dir(const lc_frame* f, float3 v) {
  * computed from the surface point would, seen from o, pass just inside a sphere light near its
  * silhouette. Point lights are sampled from the surface point (light/light.cl), and their
  * shadow rays go from o to the light (shadow_visible_to). */
-/* Relative shortening of shadow rays (see shadow_visible): float's 2e-4, and for double about
- * 2e-4 times the ratio of the two epsilons (3.7e-13), rounded up. The sampled light point must
- * then be computed in lc_real throughout (kernels/light/light.cl): a float barycentric sum or a
- * float sin/cos pair puts it ~1e-7 off the light's surface, which this margin does not cover
- * (the Cornell box's NEE was 15% too dark in double until they were lc_real). */
-#ifdef LC_DOUBLE
-#define LC_SHADOW_REL_MARGIN 1e-12
-#else
-#define LC_SHADOW_REL_MARGIN 2e-4f
-#endif
 
-/* rel_margin: LC_SHADOW_REL_MARGIN towards a point on a light's surface; 0 towards a point
- * light, which has no surface to stop short of (the relative margin let an occluder within
- * 2e-4 of the distance from a point light through: a floor 0.003 above a light 20 away). */
+/* rel_margin: the light sample's (lc_light_sample.rel_margin, light/light.cl): how far short
+ * of the sampled point, relative to dist, the ray stops. */
 static inline int shadow_visible(const lc_scene* s, lc_real3 o, lc_real3 wi, lc_real dist,
                                  lc_real rel_margin, lc_uint* rays) {
   lc_ray sr;
@@ -96,9 +85,8 @@ static inline int shadow_visible_to(const lc_scene* s, lc_real3 o, lc_real3 q, l
 static inline int shadow_visible_behind(const lc_scene* s, const lc_interaction* it, lc_real3 from,
                                         const lc_light_sample* ls, lc_uint* rays) {
   lc_real3 ob = lc_spawn_origin(it->p, it->perr, -it->ng);
-  if (isinf(ls->dist)) return shadow_visible(s, ob, ls->wi, ls->dist, LC_SHADOW_REL_MARGIN, rays);
-  return shadow_visible_to(s, ob, from + ls->dist * ls->wi,
-                           ls->delta ? LC_REAL(0.0) : LC_SHADOW_REL_MARGIN, rays);
+  if (isinf(ls->dist)) return shadow_visible(s, ob, ls->wi, ls->dist, ls->rel_margin, rays);
+  return shadow_visible_to(s, ob, from + ls->dist * ls->wi, ls->rel_margin, rays);
 }
 
 /* Sum over point lights of f * cos * I / r^2 (direct and whitted integrators): f is the BSDF b,

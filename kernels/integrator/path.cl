@@ -114,11 +114,10 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
             /* (a point light was sampled from it.p: the shadow ray goes from o to it) */
             lc_real3 from = ls.delta ? it.p : o;
             if (lc_max3(f) > 0.0f &&
-                (behind
-                     ? shadow_visible_behind(s, &it, from, &ls, rays)
-                     : (ls.delta
-                            ? shadow_visible_to(s, o, from + ls.dist * ls.wi, LC_REAL(0.0), rays)
-                            : shadow_visible(s, o, ls.wi, ls.dist, LC_SHADOW_REL_MARGIN, rays)))) {
+                (behind ? shadow_visible_behind(s, &it, from, &ls, rays)
+                        : (ls.delta ? shadow_visible_to(s, o, from + ls.dist * ls.wi, ls.rel_margin,
+                                                        rays)
+                                    : shadow_visible(s, o, ls.wi, ls.dist, ls.rel_margin, rays)))) {
               float w = (ls.delta || no_mis) ? 1.0f : mis_power(ls.pdf, pdf_b);
               L += path_clamp(beta * f * ls.L * (fabs(wi_l.z) * w / ls.pdf), P->clamp);
             }
