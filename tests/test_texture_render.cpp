@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <stb/stb_image_write.h>
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,24 @@ TEST(TextureRender, TexturedObjQuadShowsTheImageUpright) {
   const float* mid = r.mean.pixel(16, 8);
   EXPECT_GT(mid[0], 0.05f);
   EXPECT_GT(mid[1], 0.05f);
+
+  // the same quad with its uvs moved by whole numbers, up to 1.6e7 (exact in float, as
+  // tinyobjloader reads them): lookups repeat with period 1, so the image is the same to the bit.
+  // Interpolated in float at that magnitude the uvs lost their fraction (a texture rendered as
+  // blocks of one texel); the host now takes each triangle's whole part off.
+  for (const char* shift : {"1 -3", "10000000 10000000", "-10000000 16000000"}) {
+    double su = 0, sv = 0;
+    std::sscanf(shift, "%lf %lf", &su, &sv);
+    std::string obj = "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n";
+    for (int k = 0; k < 4; ++k) {
+      char vt[96];
+      std::snprintf(vt, sizeof vt, "vt %.1f %.1f\n", (k == 1 || k == 2) + su, (k >= 2) + sv);
+      obj += vt;
+    }
+    lucent::test::write_file(dir + "/quad.obj", obj + "usemtl tex\nf 1/1 2/2 3/3 4/4\n");
+    lucent::RenderResult moved = lucent::test::render_json(json, 4);
+    EXPECT_EQ(moved.mean.rgb, r.mean.rgb) << "uvs moved by " << shift;
+  }
 }
 
 }  // namespace

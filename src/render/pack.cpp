@@ -196,11 +196,20 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     lc_triangle_attr a{};
     bool has_n = t.n[0] >= 0 && t.n[1] >= 0 && t.n[2] >= 0;
     bool has_uv = t.uv[0] >= 0 && t.uv[1] >= 0 && t.uv[2] >= 0;
+    // The uvs less the whole part of their smallest: texture lookups repeat with period 1, so
+    // the image is the same, and the kernel's float interpolation keeps the fraction (uvs near
+    // 1e7 lost it: a texture there rendered as blocks, 64 standard errors off the reference).
+    glm::dvec2 whole(0.0);
+    if (has_uv) {
+      glm::dvec2 lo = scene.uvs[t.uv[0]];
+      for (int k = 1; k < 3; ++k) lo = glm::min(lo, scene.uvs[t.uv[k]]);
+      if (std::isfinite(lo.x) && std::isfinite(lo.y)) whole = glm::floor(lo);
+    }
     for (int k = 0; k < 3; ++k) {
       if (has_n) put3(a.n + 3 * k, scene.normals[t.n[k]]);
       if (has_uv) {
-        a.uv[2 * k] = static_cast<float>(scene.uvs[t.uv[k]].x);
-        a.uv[2 * k + 1] = static_cast<float>(scene.uvs[t.uv[k]].y);
+        a.uv[2 * k] = static_cast<float>(scene.uvs[t.uv[k]].x - whole.x);
+        a.uv[2 * k + 1] = static_cast<float>(scene.uvs[t.uv[k]].y - whole.y);
       }
     }
     d.flags = (has_n ? LC_TRI_HAS_NORMALS : 0u) | (has_uv ? LC_TRI_HAS_UVS : 0u);
