@@ -46,6 +46,33 @@ void expect_matches(const RenderResult& got, const RenderResult& expected) {
   EXPECT_EQ(got.nonfinite, 0u);
 }
 
+// A sphere resting on a floor under a point light, the floor one triangle that reaches 10 or
+// 1e9 from the origin: the same view, so the same image (the same samples: a compare at family-
+// wise alpha 0.01 with the images' own variances). The reference pushed its spawned rays off a
+// surface by 1e-9 of the primitive's coordinates, an offset of 1 on the 1e9 floor: the
+// sphere's contact shadow vanished (max |z| 1711).
+TEST(ReferenceAnalytic, LargeFloorKeepsTheContactShadow) {
+  RenderResult images[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string size = k == 0 ? "10" : "1e9";
+    images[k] = render_ref(R"({
+      "camera": {"position": [0, 3, 0.5], "look_at": [0, 0, 0], "fov": 60},
+      "film": {"width": 32, "height": 32},
+      "integrator": {"type": "path", "max_depth": 3, "seed": 5},
+      "materials": {"white": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]}},
+      "shapes": [{"type": "triangles", "material": "white", "indices": [0, 2, 1],
+                  "positions": [[-)" +
+                               size + ", 0, -" + size + "], [" + size + ", 0, -" + size +
+                               "], [0, 0, " + size + R"(]]},
+                 {"type": "sphere", "center": [0, 0.3, 0], "radius": 0.3, "material": "white"}],
+      "lights": [{"type": "point", "position": [0.5, 2, 0.2], "intensity": [5, 5, 5]}]
+    })",
+                           64);
+  }
+  lucent::CompareResult c = lucent::compare_images(images[1], images[0]);
+  EXPECT_TRUE(c.passed) << c.summary();
+}
+
 // White furnace: every surface reflects all it receives (diffuse albedo 1, mirror reflectance 1,
 // clear glass), lit by a uniform environment L: the constant L solves the rendering equation, so
 // every pixel's expected value is L, at unbounded depth (max_depth 10000, Russian roulette).
