@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -436,6 +437,34 @@ void interrupt_render(int sig, const char* name, int status_expected) {
 TEST(Outputs, SigintWritesThePartialImage) { interrupt_render(SIGINT, "SIGINT \\(Ctrl-C\\)", 130); }
 
 TEST(Outputs, SigtermWritesThePartialImage) { interrupt_render(SIGTERM, "SIGTERM", 143); }
+
+// converge ends on SIGTERM (Slurm's at a job's time limit) as on SIGINT: the rungs done are in
+// the CSV, the exit status is 128 + the signal. Only SIGINT was caught: SIGTERM killed it with
+// nothing written.
+TEST(Outputs, SigtermEndsConvergeWithTheRungsDone) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  const std::string csv = dir + "/c.csv", err_path = dir + "/stderr";
+  const int status = interrupt_cli(
+      {"converge", scene, "--width", "16", "--height", "16", "--spp-ladder", "1", "16777216",
+       "--reference-spp", "64", "--csv", csv},
+      err_path,
+      [](const std::string& err) {
+        // the reference done ("reference: 64 spp in 0.0 s"), then a moment for the first rung
+        if (err.find(" spp in ") == std::string::npos) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(500));
+        return true;
+      },
+      SIGTERM, 60);
+  const std::string err = read_file(err_path);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
+  EXPECT_EQ(WEXITSTATUS(status), 143) << err;
+  EXPECT_NE(err.find("lucent: interrupted: the results cover the rungs rendered so far"),
+            std::string::npos)
+      << err;
+  const std::string rows = read_file(csv);
+  EXPECT_EQ(std::count(rows.begin(), rows.end(), '\n'), 2) << rows;  // the header and rung 1
+}
 
 // The CPU reference stops between two samples: it checked only between rows, and a row of eight
 // pixels of 2^24 samples each took about half a minute here before Ctrl-C was seen. Its pixels

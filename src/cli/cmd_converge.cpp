@@ -53,9 +53,13 @@ ConvergeArgs& converge_args() {
 }
 
 std::atomic<bool> g_stop{false};
-extern "C" void on_converge_sigint(int) {
+volatile std::sig_atomic_t g_stop_signal = 0;
+/// SIGINT, SIGTERM (Slurm's at a job's time limit; it killed the study, without the CSV or plots
+/// of the rungs done) and SIGHUP end the study after the current rung; a second one stops at once.
+extern "C" void on_converge_signal(int sig) {
+  g_stop_signal = sig;
   g_stop.store(true);
-  std::signal(SIGINT, SIG_DFL);
+  std::signal(sig, SIG_DFL);
 }
 
 /// A file the command reads, by what it is for messages: "the scene file", "the --reference
@@ -253,7 +257,9 @@ int run_converge_command() {
   if (a.width > 0) scene.film.width = a.width;
   if (a.height > 0) scene.film.height = a.height;
 
-  auto previous = std::signal(SIGINT, on_converge_sigint);
+  const int stop_signals[] = {SIGINT, SIGTERM, SIGHUP};
+  void (*previous[3])(int);
+  for (int i = 0; i < 3; ++i) previous[i] = std::signal(stop_signals[i], on_converge_signal);
   // one session renders the kernel reference and every rung (a different seed is only data)
   Renderer renderer(session_options(a.device));
   renderer.set_cancel_flag(&g_stop);
@@ -308,7 +314,7 @@ int run_converge_command() {
     };
   }
   ConvergeResult result = run_convergence(scene, reference, opt);
-  std::signal(SIGINT, previous);
+  for (int i = 0; i < 3; ++i) std::signal(stop_signals[i], previous[i]);
 
   std::printf("%sslope of log(relMSE) against log(time) (about -1 when unbiased; RMSE: half):\n",
               a.quiet ? "" : "\n");
@@ -337,8 +343,9 @@ int run_converge_command() {
       write_text(plot, convergence_svg(result, title));
   }
   if (g_stop.load()) {
+    const int sig = g_stop_signal ? static_cast<int>(g_stop_signal) : SIGINT;
     std::fprintf(stderr, "lucent: interrupted: the results cover the rungs rendered so far\n");
-    return 130;
+    return 128 + sig;
   }
   return 0;
 }
