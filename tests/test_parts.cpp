@@ -710,14 +710,15 @@ TEST(Parts, SlurmArrayScriptsRenderAndMerge) {
   // its own file; without it the one-task array is refused (it took itself for a whole job of
   // one task and wrote every sample over part 0)
   const std::string part0 = lucent::test::read_file(dir + "/parts/part-0000.exr");
-  auto rerun = [&](const std::string& env) {
+  auto rerun = [&](const std::string& env, const std::string& spp = "8") {
     const std::string log1 = dir + "/rerun.log";
     std::remove(log1.c_str());
-    const std::string c =
-        env + " PATH=" + q(lucent::test::source_path("tests/slurm")) +
-        ":\"$PATH\" LUCENT=" + q(LUCENT_CLI_PATH) + " FAKE_SBATCH_LOG=" + q(log1) +
-        " sbatch --array=1 " + q(lucent::test::source_path("scripts/slurm/render-part.sbatch")) +
-        " " + q(scene) + " 8 " + q(dir + "/parts") + " -q >/dev/null 2>" + q(dir + "/rerun.err");
+    const std::string c = env + " PATH=" + q(lucent::test::source_path("tests/slurm")) +
+                          ":\"$PATH\" LUCENT=" + q(LUCENT_CLI_PATH) +
+                          " FAKE_SBATCH_LOG=" + q(log1) + " sbatch --array=1 " +
+                          q(lucent::test::source_path("scripts/slurm/render-part.sbatch")) + " " +
+                          q(scene) + " " + spp + " " + q(dir + "/parts") + " -q >/dev/null 2>" +
+                          q(dir + "/rerun.err");
     EXPECT_EQ(std::system(c.c_str()), 0);
     return lucent::test::read_file(log1);
   };
@@ -729,6 +730,17 @@ TEST(Parts, SlurmArrayScriptsRenderAndMerge) {
   EXPECT_EQ(lucent::read_part_info(dir + "/parts/part-0001.exr").samples,
             (std::vector<lucent::SampleRange>{{2, 5}}));
   EXPECT_EQ(lucent::test::read_file(dir + "/parts/part-0000.exr"), part0);
+
+  // an SPP with a leading zero: refused (bash read 010 as octal 8, and the tasks split 8 of the
+  // 10 samples, every job succeeding), by the task and before anything is queued
+  EXPECT_NE(rerun("LUCENT_TASKS=3", "010").find("_1: exit 2"), std::string::npos);
+  EXPECT_NE(lucent::test::read_file(dir + "/rerun.err").find("SPP must be"), std::string::npos);
+  std::string bad = cmd;
+  bad.replace(bad.find(" 8 3 "), 5, " 010 3 ");
+  raw = std::system(bad.c_str());
+  EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 2);
+  EXPECT_EQ(lucent::test::read_file(dir + "/submit.err"),
+            "submit: SPP must be a number of at least the 3 tasks (no leading zero), got '010'\n");
 }
 
 #ifdef LUCENT_MPI_PATH

@@ -18,6 +18,11 @@ if ! [[ $tasks =~ ^[1-9][0-9]*$ ]]; then
   echo "submit: TASKS must be a positive number, got '$tasks'" >&2
   exit 2
 fi
+# checked here too, before anything is queued (a leading zero read as octal split 010 as 8)
+if ! [[ $spp =~ ^[1-9][0-9]*$ ]] || ((spp < tasks)); then
+  echo "submit: SPP must be a number of at least the $tasks tasks (no leading zero), got '$spp'" >&2
+  exit 2
+fi
 # shellcheck disable=SC2086
 # LUCENT_TASKS reaches the tasks through sbatch's default --export=ALL: each knows the split
 array=$(LUCENT_TASKS=$tasks sbatch --parsable ${SBATCH_OPTS:-} --array="0-$((tasks - 1))" \
