@@ -280,23 +280,43 @@ int render_with(const RenderArgs& a) {
     so.specialize = opt.specialize;
     renderer.emplace(so);
     renderer->set_cancel_flag(&g_interrupted);
-    renderer->set_scene(scene);
-    std::uint64_t spp = a.spp > 0 ? static_cast<std::uint64_t>(a.spp)
-                                  : (a.time_limit > 0 ? 0 : scene.integrator.spp);
-    if (range) {
-      renderer->reset(range->begin);
-      spp = range->end - range->begin;
+    try {
+      renderer->set_scene(scene);
+      std::uint64_t spp = a.spp > 0 ? static_cast<std::uint64_t>(a.spp)
+                                    : (a.time_limit > 0 ? 0 : scene.integrator.spp);
+      if (range) {
+        renderer->reset(range->begin);
+        spp = range->end - range->begin;
+      }
+      auto t0 = std::chrono::steady_clock::now();
+      if (a.sampling.target_error > 0)
+        renderer->render_adaptive(lucent::cli::adaptive_options(a.sampling, a.spp, a.time_limit),
+                                  opt.on_progress);
+      else
+        renderer->render(spp, a.time_limit, opt.on_progress);
+      wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      r = renderer->result();
+    } catch (const lucent::Error&) {
+      // a stop signal during the kernel build: PoCL's LLVM handles it too (it removes its
+      // temporary files, then passes it on), and the build fails. That is the interruption,
+      // not a build error (it was reported as "kernel build failed", exit 1).
+      if (!g_interrupted.load()) throw;
+      if (printed && tty) std::fprintf(stderr, "\n");
+      std::fprintf(stderr, "lucent: interrupted by %s before rendering: nothing written\n",
+                   signal_name(g_signal));
+      return 128 + g_signal;
     }
-    auto t0 = std::chrono::steady_clock::now();
-    if (a.sampling.target_error > 0)
-      renderer->render_adaptive(lucent::cli::adaptive_options(a.sampling, a.spp, a.time_limit),
-                                opt.on_progress);
-    else
-      renderer->render(spp, a.time_limit, opt.on_progress);
-    wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    r = renderer->result();
   }
   if (printed && tty) std::fprintf(stderr, "\n");
+  // interrupted before its first sample (an adaptive render's pilot, the reference's first
+  // pixel): no image to write; it wrote a black one claiming "0 of 256 spp". A part keeps its
+  // (empty) range, and is written.
+  if (!range && g_interrupted.load() && r.nonfinite == 0 &&
+      std::all_of(r.samples.begin(), r.samples.end(), [](std::uint32_t n) { return n == 0; })) {
+    std::fprintf(stderr, "lucent: interrupted by %s before the first sample: nothing written\n",
+                 signal_name(g_signal));
+    return 128 + g_signal;
+  }
 
   lucent::DisplaySettings display{scene.film.transfer, scene.film.gamma, scene.film.exposure,
                                   scene.film.tonemap};
