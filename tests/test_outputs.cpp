@@ -330,6 +330,16 @@ TEST(Outputs, RenderWithoutAFiniteSampleWritesNothing) {
                          "beyond a float's range: a radiance or intensity above about 1.8e19?)\n");
     EXPECT_FALSE(fs::exists(dir + "/" + name));
   }
+  // a part keeps its counts (all 0) and merges into a part; not into an image (lucent-mpi writes
+  // through the same function)
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:2 -o " + q(dir + "/p.exr")).status, 0);
+  EXPECT_EQ(run_cli("merge -q " + q(dir + "/p.exr") + " -o " + q(dir + "/m.exr")).status, 0);
+  CommandResult m = run_cli("merge -q " + q(dir + "/p.exr") + " -o " + q(dir + "/m.png"));
+  EXPECT_EQ(m.status, 1);
+  EXPECT_NE(m.err.find(dir + "/m.png: not written: all 96 samples were non-finite"),
+            std::string::npos)
+      << m.err;
+  EXPECT_FALSE(fs::exists(dir + "/m.png"));
   // the pixels beside the emitter see a sky of 1: written, with the warning
   std::string text = read_file(scene);
   const std::string sky = R"("radiance": [1e30, 1e30, 1e30])";

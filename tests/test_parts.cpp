@@ -799,6 +799,29 @@ TEST(Parts, MpiFailingRankEndsTheJobWithoutOutput) {
   for (const auto& entry : fs::directory_iterator(dir))
     EXPECT_EQ(entry.path().filename().string().find("mpi.exr"), std::string::npos)
         << "a temporary output was left: " << entry.path();
+
+  // ranks given other arguments (mpirun's A : B): one that cannot parse them, where rank 0 hung
+  // waiting for its part; one of another --spp, whose share left a gap in an image written
+  // with exit 0
+  r = run_shell("timeout 60 env " + mpirun("-np 1 " + prog + " : -np 1 " + prog + " --bogus"), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("lucent-mpi: error: rank 1 of 2: The following argument was not expected: "
+                       "--bogus (its arguments are not rank 0's)"),
+            std::string::npos)
+      << r.err;
+  r = run_shell(mpirun("-np 1 " + prog + " --spp 8 : -np 1 " + prog + " --spp 100"), dir);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("rank 1 was given samples [50, 100), its share of rank 0's is [4, 8) "
+                       "(another --spp?)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  // a rank that stops early (here by a time limit that rank 0 has not): the image is written,
+  // and the exit status and the last line say that samples are missing
+  r = run_shell(mpirun("-np 1 " + prog + " --spp 8 : -np 1 " + prog + " --spp 8 --time 1e-9"), dir);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("are missing (a rank stopped early)"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(out));
 }
 // lucent-mpi's output may not be a file the scene reads (an environment map here): rank 0 wrote
 // over it, as `lucent render` refuses to.

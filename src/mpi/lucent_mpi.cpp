@@ -86,13 +86,19 @@ void send_part(const lucent::RenderPart& p) {
 
 /// Rank `from`'s part; the header fields that are not sent (display, version, scene) are
 /// rank 0's.
-lucent::RenderPart receive_part(int from, const lucent::PartInfo& mine) {
+lucent::RenderPart receive_part(int from, const lucent::PartInfo& mine,
+                                const lucent::SampleRange& expected) {
   Header h{};
   MPI_Recv(&h, sizeof h, MPI_BYTE, from, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
   if (h.width != std::uint64_t(mine.width) || h.height != std::uint64_t(mine.height))
     fail("rank " + std::to_string(from) + " rendered a " + std::to_string(h.width) + "x" +
          std::to_string(h.height) + " film, rank 0 " + std::to_string(mine.width) + "x" +
          std::to_string(mine.height));
+  // its share of rank 0's samples per pixel (another --spp made a merge with a gap, exit 0)
+  if (h.req_begin != expected.begin || h.req_end != expected.end)
+    fail("rank " + std::to_string(from) + " was given samples " +
+         lucent::range_text({h.req_begin, h.req_end}) + ", its share of rank 0's is " +
+         lucent::range_text(expected) + " (another --spp?)");
   lucent::RenderPart p;
   p.info = mine;
   p.info.scene_hash = h.hash;
@@ -167,7 +173,7 @@ int run(const Args& a) {
   lucent::PartMerger merger;
   merger.add("rank 0", part);
   for (int r = 1; r < g_size; ++r) {
-    lucent::RenderPart p = receive_part(r, part.info);
+    lucent::RenderPart p = receive_part(r, part.info, {n * r / g_size, n * (r + 1) / g_size});
     try {
       merger.add("rank " + std::to_string(r), p);
     } catch (const lucent::Error& e) {
@@ -180,11 +186,28 @@ int run(const Args& a) {
     std::fprintf(stderr, "%s: %dx%d, samples %s from %d ranks (%.2f s of kernel time in all)\n",
                  a.output.c_str(), m.merged.info.width, m.merged.info.height,
                  lucent::ranges_text(m.merged.info.samples).c_str(), g_size, m.merged.info.seconds);
+  if (m.merged.info.nonfinite > 0)
+    std::fprintf(stderr,
+                 "lucent-mpi: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
+                 static_cast<unsigned long long>(m.merged.info.nonfinite));
   if (g_stop.load()) {
     std::fprintf(stderr, "lucent-mpi: interrupted: %s holds samples %s of [0, %llu)\n",
                  a.output.c_str(), lucent::ranges_text(m.merged.info.samples).c_str(),
                  static_cast<unsigned long long>(n));
     return 128 + (g_signal ? int(g_signal) : SIGINT);
+  }
+  // a rank stopped early (a signal to that rank alone) without --time: the image is written,
+  // with fewer samples than asked, which it said nothing about (exit 0, and a PNG looks
+  // complete)
+  const std::vector<lucent::SampleRange> missing =
+      lucent::missing_ranges(m.merged.info.samples, {0, n});
+  if (!missing.empty() && !(a.time_limit > 0)) {
+    std::fprintf(stderr,
+                 "lucent-mpi: error: %s holds samples %s of [0, %llu): samples %s are missing (a "
+                 "rank stopped early)\n",
+                 a.output.c_str(), lucent::ranges_text(m.merged.info.samples).c_str(),
+                 static_cast<unsigned long long>(n), lucent::ranges_text(missing).c_str());
+    return 1;
   }
   return 0;
 }
@@ -217,13 +240,31 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"float", "double"}));
   app.add_flag("--fast-math", a.fast_math, "Build the kernel with -cl-fast-relaxed-math");
   app.add_flag("-q,--quiet", a.quiet, "No progress line or summary");
+  // the ranks agree on whether the arguments parse: a rank that ended alone on a parse error
+  // (different arguments per rank, mpirun's A : B) left rank 0 waiting for its part for ever
+  int failed = 0, parse_status = 0, code = 0;
+  std::string message;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    int status = 0;
-    if (g_rank == 0) status = app.exit(e);
+    failed = 1;
+    code = e.get_exit_code();
+    if (g_rank == 0)
+      parse_status = app.exit(e);
+    else
+      message = e.what();
+  }
+  int root_failed = failed, any_failed = 0;
+  MPI_Bcast(&root_failed, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  MPI_Allreduce(&failed, &any_failed, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (any_failed) {
+    if (failed && !root_failed)
+      std::fprintf(stderr,
+                   "lucent-mpi: error: rank %d of %d: %s (its arguments are not rank 0's)\n",
+                   g_rank, g_size, message.c_str());
     MPI_Finalize();
-    return status ? status : (e.get_exit_code() ? 2 : 0);
+    if (!failed || (!root_failed && g_rank != 0)) return 2;
+    return parse_status ? parse_status : (code ? 2 : 0);
   }
   int status = 0;
   try {
