@@ -399,7 +399,11 @@ TEST(CliErrors, IgnoredOptionsAreRefused) {
       {"--integrator direct --caustics",
        "--caustics: only the path integrator has it, and this render's is direct"},
       {"--integrator whitted --dielectric-splits 4",
-       "--dielectric-splits: only the path integrator has it, and this render's is whitted"}};
+       "--dielectric-splits: only the path integrator has it, and this render's is whitted"},
+      // (not ignored, but exceeded: an odd pilot's halves round it up, and the cap of 5 spp
+      // rendered 6)
+      {"--target-error 0.05 --min-spp 5 --spp 5",
+       "--spp 5 is below the adaptive pilot (--min-spp 5, rounded up to the even 6)"}};
   for (const auto& [args, want] : cases) {
     CommandResult r = run_cli(render + args);
     EXPECT_EQ(expect_one_error_line(r), want) << args;

@@ -449,10 +449,20 @@ TEST(Session, AdaptiveMisuseIsAnErrorAndLosesNothing) {
   small_pilot.budget_spp = low_cap.budget_spp = time.budget_spp = 16;
   small_pilot.min_spp = 2;
   EXPECT_EQ(error_of(small_pilot),
-            "render_adaptive: expected 4 <= min_spp <= max_spp, got 2 and 16384");
+            "render_adaptive: expected 4 <= min_spp and its pilot (min_spp rounded up to even, 2) "
+            "<= max_spp, got 2 and 16384");
   low_cap.min_spp = 64;
   low_cap.max_spp = 32;
-  EXPECT_EQ(error_of(low_cap), "render_adaptive: expected 4 <= min_spp <= max_spp, got 64 and 32");
+  EXPECT_EQ(error_of(low_cap),
+            "render_adaptive: expected 4 <= min_spp and its pilot (min_spp rounded up to even, 64) "
+            "<= max_spp, got 64 and 32");
+  // an odd pilot rounds up to two halves of 3: 6 samples, which a cap of 5 cannot hold (it
+  // rendered 6 per pixel)
+  low_cap.min_spp = 5;
+  low_cap.max_spp = 5;
+  EXPECT_EQ(error_of(low_cap),
+            "render_adaptive: expected 4 <= min_spp and its pilot (min_spp rounded up to even, 6) "
+            "<= max_spp, got 5 and 5");
   for (double t : {-1.0, double(NAN), double(INFINITY)}) {
     time.max_seconds = t;
     EXPECT_EQ(error_of(time),

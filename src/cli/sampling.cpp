@@ -66,9 +66,13 @@ AdaptiveOptions adaptive_options(const SamplingArgs& a, int max_spp, double time
   o.target_error = a.target_error;
   if (a.min_spp > 0) o.min_spp = static_cast<std::uint32_t>(a.min_spp);
   if (max_spp > 0) o.max_spp = static_cast<std::uint32_t>(max_spp);
-  if (o.max_spp < o.min_spp)
+  // the pilot's two halves hold (min_spp + 1) / 2 samples each: an odd --min-spp rounds up
+  const std::uint32_t pilot = 2 * ((o.min_spp + 1) / 2);
+  if (o.max_spp < pilot)
     throw Error("--spp " + std::to_string(o.max_spp) + " is below the adaptive pilot (--min-spp " +
-                std::to_string(o.min_spp) + ")");
+                std::to_string(o.min_spp) +
+                (pilot != o.min_spp ? ", rounded up to the even " + std::to_string(pilot) : "") +
+                ")");
   o.max_seconds = time_limit;
   return o;
 }

@@ -913,9 +913,15 @@ struct Renderer::Impl {
     if (!(o.target_error > 0) == !(o.budget_spp > 0) || !std::isfinite(o.target_error) ||
         !std::isfinite(o.budget_spp))
       throw Error("render_adaptive: give either a target error or a budget, a positive number");
-    if (o.min_spp < 4 || o.max_spp < o.min_spp)
-      throw Error("render_adaptive: expected 4 <= min_spp <= max_spp, got " +
-                  std::to_string(o.min_spp) + " and " + std::to_string(o.max_spp));
+    // the pilot is split into two halves of (min_spp + 1) / 2 samples: an odd min_spp is
+    // rounded up, and max_spp must hold that (min_spp 5 and max_spp 5 rendered 6)
+    const std::uint64_t pilot_spp = 2 * ((std::uint64_t(o.min_spp) + 1) / 2);
+    if (o.min_spp < 4 || o.max_spp < pilot_spp)
+      throw Error(
+          "render_adaptive: expected 4 <= min_spp and its pilot (min_spp rounded up to "
+          "even, " +
+          std::to_string(pilot_spp) + ") <= max_spp, got " + std::to_string(o.min_spp) + " and " +
+          std::to_string(o.max_spp));
     if (!(o.max_seconds >= 0) || !std::isfinite(o.max_seconds))
       throw Error("render_adaptive: the time limit must be a non-negative number of seconds");
     const std::uint32_t m = (o.min_spp + 1) / 2;
