@@ -303,6 +303,13 @@ TEST(AdaptivePlan, CombinedVarianceIsThatOfTheAverageOfTheHalves) {
   EXPECT_FLOAT_EQ(mean[0], 2.5f);  // (2 + 3) / 2, not the pooled 16 / 6
   // pooled s^2 = (2 + 4) / (6 - 2) = 1.5; var(mean) = s^2 (1/2 + 1/4) / 4; var = n var(mean)
   EXPECT_FLOAT_EQ(var[0] / 6, static_cast<float>(1.5 * (0.5 + 0.25) / 4));
+  // one sample per half, {1} and {3} (a render stopped by --time in its pilot): their variance,
+  // s^2 = (1 - 2)^2 + (3 - 2)^2 = 2 over 1 degree of freedom, not 0 (every pixel exact)
+  const double s1[3] = {1, 1, 1}, q1[3] = {1, 1, 1}, s3[3] = {3, 3, 3}, q3[3] = {9, 9, 9};
+  lucent::render_detail::combine_halves(s1, q1, 1, s3, q3, 1, mean, var, &n);
+  EXPECT_EQ(n, 2u);
+  EXPECT_FLOAT_EQ(mean[0], 2.0f);
+  EXPECT_FLOAT_EQ(var[0] / 2, static_cast<float>(2.0 * (1.0 + 1.0) / 4));
 }
 
 /// Pilot sums of one pixel: `values` as samples in all 3 channels.

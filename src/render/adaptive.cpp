@@ -285,7 +285,12 @@ void combine_halves(const double* sum_a, const double* sumsq_a, std::uint32_t n_
   for (int c = 0; c < 3; ++c) {
     const double ma = n_a ? sum_a[c] / n_a : 0, mb = n_b ? sum_b[c] / n_b : 0;
     double m = n_a && n_b ? 0.5 * (ma + mb) : (n_a ? ma : mb);
-    const double s2 = pooled_variance(sum_a[c], sumsq_a[c], n_a, sum_b[c], sumsq_b[c], n_b);
+    // one sample in each half (a render stopped by --time in its pilot): no degree of freedom
+    // within the halves, so their two samples' variance, the halves estimating one mean (it was
+    // 0, which claimed every pixel exact)
+    const double s2 = n_a == 1 && n_b == 1
+                          ? sample_variance(sum_a[c] + sum_b[c], sumsq_a[c] + sumsq_b[c], 2)
+                          : pooled_variance(sum_a[c], sumsq_a[c], n_a, sum_b[c], sumsq_b[c], n_b);
     double v = 0;
     if (n_a && n_b)
       v = double(*n) * s2 * (1.0 / n_a + 1.0 / n_b) / 4;
