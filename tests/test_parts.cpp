@@ -505,6 +505,10 @@ TEST(Parts, DamagedPartFilesAreOneLineErrors) {
       {"lucent.display", ",clamp", ",clamq", "attribute lucent.display: unknown tone map 'clamq'"},
       {"lucent.display", "srgb,", "srgb;", "attribute lucent.display: invalid 'srgb;"},
       {"lucent.seconds", "0.", "-.", "attribute lucent.seconds: negative time '-."},
+      // names of no integrator or sampler (they were read as given)
+      {"lucent.integrator", "path", "patz",
+       "attribute lucent.integrator: unknown integrator 'patz'"},
+      {"lucent.sampler", "sobol", "sobox", "attribute lucent.sampler: unknown sampler 'sobox'"},
   };
   int n = 0;
   for (const Damage& d : damages) {

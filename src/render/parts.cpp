@@ -151,8 +151,15 @@ PartInfo info_from_attributes(const std::string& path,
   info.seed = static_cast<std::uint32_t>(
       image_detail::parse_attribute_u64(path, "lucent.seed", get("seed"), 0xffffffffu));
   const auto sampler = attrs.find("lucent.sampler");  // absent from older part files
-  if (sampler != attrs.end()) info.sampler = sampler->second;
+  if (sampler != attrs.end()) {
+    info.sampler = sampler->second;
+    if (!find_type<SamplerType>(info.sampler))
+      throw Error(path + ": attribute lucent.sampler: unknown sampler '" + info.sampler + "'");
+  }
   info.integrator = get("integrator");
+  if (!find_type<IntegratorType>(info.integrator))
+    throw Error(path + ": attribute lucent.integrator: unknown integrator '" + info.integrator +
+                "'");
   info.version = get("version");
   info.scene = get("scene");
   info.samples = parse_ranges(path, "lucent.samples", get("samples"));
