@@ -131,6 +131,14 @@ inline std::vector<std::ptrdiff_t> index_after_erase(const std::vector<char>& go
   return to;
 }
 
+/// Erases the flagged elements, moving the references to all of them (change()).
+template <class T>
+void erase(std::vector<T>& v, const std::vector<char>& gone) {
+  const std::vector<std::ptrdiff_t> to = index_after_erase(gone);
+  change(
+      v, [&](std::vector<T>& x) { erase_flagged(x, gone); }, [&](std::size_t j) { return to[j]; });
+}
+
 template <class T>
 struct Iterator {
   py::object list;
@@ -240,19 +248,13 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
                  list_detail::wrap_index(i, v.size(), "list assignment index out of range");
              std::vector<char> gone(v.size(), 0);
              gone[k] = 1;
-             const std::vector<std::ptrdiff_t> to = list_detail::index_after_erase(gone);
-             change(
-                 v, [&](V& x) { list_detail::erase_flagged(x, gone); },
-                 [&](std::size_t j) { return to[j]; });
+             list_detail::erase(v, gone);
            })
       .def("__delitem__",
            [](V& v, const py::slice& s) {
              std::vector<char> gone(v.size(), 0);
              for (std::size_t i : list_detail::slice_indices(s, v.size())) gone[i] = 1;
-             const std::vector<std::ptrdiff_t> to = list_detail::index_after_erase(gone);
-             change(
-                 v, [&](V& x) { list_detail::erase_flagged(x, gone); },
-                 [&](std::size_t j) { return to[j]; });
+             list_detail::erase(v, gone);
            })
       .def(
           "append",
@@ -300,10 +302,7 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
             T out = v[k];
             std::vector<char> gone(v.size(), 0);
             gone[k] = 1;
-            const std::vector<std::ptrdiff_t> to = list_detail::index_after_erase(gone);
-            change(
-                v, [&](V& x) { list_detail::erase_flagged(x, gone); },
-                [&](std::size_t j) { return to[j]; });
+            list_detail::erase(v, gone);
             return out;
           },
           py::arg("i") = -1, "Removes the item at index i (the last by default) and returns it.")
