@@ -312,6 +312,21 @@ TEST(Compare, PixelWithoutSamplesIsAnInputError) {
   EXPECT_EQ(same.status, 0) << same.out << same.err;
 }
 
+// Layers of other sizes, or no pixels, are an input error too (a 0-wide image with an n layer
+// divided by its width: SIGFPE).
+TEST(Compare, InconsistentLayersAreAnInputError) {
+  RenderResult z;
+  z.samples = {0};
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::check_comparable_image(z, "z"); }),
+            "z: inconsistent image (no pixels, or layers of other sizes)");
+  RenderResult short_n = constant_image(4, 4, 0.5f);
+  short_n.samples.assign(15, 8);
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::check_comparable_image(short_n, "s"); }),
+            "s: inconsistent image (no pixels, or layers of other sizes)");
+  short_n.samples.assign(16, 8);
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::check_comparable_image(short_n, "s"); }), "");
+}
+
 // The z map's path is checked before the images are read (a .txt z map was refused only after
 // the comparison, and a PNG clipped the negative z values): the format, a directory that does
 // not exist, an input.

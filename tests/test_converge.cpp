@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -244,6 +245,13 @@ TEST(Converge, DefaultLadder) {
   EXPECT_EQ(lucent::default_spp_ladder(64), (std::vector<int>{1, 2, 4, 8, 16, 32, 64}));
   EXPECT_EQ(lucent::default_spp_ladder(48), (std::vector<int>{1, 2, 4, 8, 16, 32, 48}));
   EXPECT_EQ(lucent::default_spp_ladder(1), (std::vector<int>{1}));
+  // from the API, past 2^30: an int doubling overflowed and the loop never ended
+  const std::vector<int> big = lucent::default_spp_ladder(1 << 30);
+  EXPECT_EQ(big.size(), 31u);
+  EXPECT_EQ(big.back(), 1 << 30);
+  const std::vector<int> top = lucent::default_spp_ladder(std::numeric_limits<int>::max());
+  EXPECT_EQ(top.size(), 32u);
+  EXPECT_EQ(top.back(), std::numeric_limits<int>::max());
 }
 
 TEST(Converge, FitOfSyntheticCurves) {

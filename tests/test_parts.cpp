@@ -313,6 +313,35 @@ TEST(Parts, ExpectMayCoverMoreSamplesThanOnePart) {
             "--samples '0:16777217': at most 16777216 samples per part");
 }
 
+// Misuse of the library's merger and parts by another tool is a lucent::Error: add() after
+// add_header() read empty sums as a film's (a segfault), finish() after headers alone returned a
+// 0x0 image, and part_result read past the vectors of a part whose sizes disagree.
+TEST(Parts, MergerAndPartsMisusedAreErrors) {
+  const lucent::RenderPart a = handmade_part({{0, 4}}, {0, 4}), b = handmade_part({{4, 8}}, {4, 8});
+  lucent::PartMerger headers;
+  headers.add_header("a", a.info);
+  EXPECT_EQ(error_of([&] { headers.add("b", b); }),
+            "b: PartMerger: add() after add_header(): a merger checks headers or adds parts, not "
+            "both");
+  EXPECT_EQ(error_of([&] { headers.finish(); }),
+            "merge: no parts added (add_header() checks headers, add() adds parts)");
+  lucent::RenderPart bad = a;
+  bad.acc.width = bad.acc.height = 512;
+  EXPECT_EQ(error_of([&] { lucent::part_result(bad); }),
+            "part_result: inconsistent part (film and accumulation sizes differ)");
+  bad = a;
+  bad.acc.count.clear();
+  EXPECT_EQ(error_of([&] { lucent::part_result(bad); }),
+            "part_result: inconsistent part (film and accumulation sizes differ)");
+  lucent::RenderPart empty;
+  lucent::PartMerger parts;
+  EXPECT_EQ(error_of([&] { parts.add("e", empty); }),
+            "e: inconsistent part (film and accumulation sizes differ)");
+  parts.add("a", a);
+  parts.add("b", b);
+  EXPECT_EQ(parts.finish().merged.acc.count, (std::vector<std::uint32_t>{8}));
+}
+
 // A part's header may list many ranges (a merge of parts with gaps between them, or a file made
 // to hurt). The overlap check ran a loop over every pair of ranges: two crafted part files of
 // 0.5 MB each (4*10^4 interleaved ranges) took 1.7 s to merge, and ten times as many ranges

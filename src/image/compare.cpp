@@ -51,6 +51,12 @@ void check_layers(const RenderResult& r, const char* which) {
 
 void check_comparable_image(const RenderResult& image, const std::string& path) {
   const int w = image.mean.width;
+  // layers of the image's size first (a 0-wide image with an n layer divided by its width)
+  const size_t npix = static_cast<size_t>(std::max(0, w)) * std::max(0, image.mean.height);
+  if (w <= 0 || image.mean.height <= 0 || image.mean.rgb.size() != npix * 3 ||
+      (!image.variance.rgb.empty() && image.variance.rgb.size() != npix * 3) ||
+      (!image.samples.empty() && image.samples.size() != npix))
+    throw Error(path + ": inconsistent image (no pixels, or layers of other sizes)");
   for (size_t i = 0; i < image.samples.size(); ++i)
     if (image.samples[i] == 0)
       throw Error(path + ": pixel (" + std::to_string(i % static_cast<size_t>(w)) + ", " +

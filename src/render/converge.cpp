@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
@@ -255,7 +256,8 @@ std::uint32_t reference_seed(std::uint32_t scene_seed) { return scene_seed ^ 0x5
 
 std::vector<int> default_spp_ladder(int max_spp) {
   std::vector<int> out;
-  for (int s = 1; s <= max_spp && s > 0; s *= 2) out.push_back(s);
+  // (in 64 bits: an int doubling past 2^30 overflowed, and the loop never ended)
+  for (std::int64_t s = 1; s <= max_spp; s *= 2) out.push_back(static_cast<int>(s));
   if (max_spp >= 1 && (out.empty() || out.back() != max_spp)) out.push_back(max_spp);
   return out;
 }

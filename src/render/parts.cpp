@@ -324,6 +324,10 @@ RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
 RenderResult part_result(const RenderPart& part) {
   const Accumulation& a = part.acc;
   const size_t npix = static_cast<size_t>(a.width) * a.height;
+  // (a part built by hand with other sizes was read past its vectors' ends)
+  if (a.width < 0 || a.height < 0 || a.sum.size() != npix * 3 || a.sumsq.size() != npix * 3 ||
+      a.count.size() != npix)
+    throw Error("part_result: inconsistent part (film and accumulation sizes differ)");
   RenderResult r;
   r.mean = Image{a.width, a.height, std::vector<float>(npix * 3)};
   r.variance = Image{a.width, a.height, std::vector<float>(npix * 3)};
@@ -525,11 +529,17 @@ void PartMerger::add_header(const std::string& name, const PartInfo& info) {
 }
 
 void PartMerger::add(const std::string& name, const RenderPart& part) {
+  // headers or parts, not both: after add_header there is no sum to add to (it read empty
+  // vectors as a full film's)
+  if (!names_.empty() && total_.info.width == 0)
+    throw Error(name +
+                ": PartMerger: add() after add_header(): a merger checks headers or adds "
+                "parts, not both");
   check(name, part.info);
   const Accumulation& a = part.acc;
   const size_t npix = static_cast<size_t>(a.width) * a.height;
-  if (a.sum.size() != npix * 3 || a.sumsq.size() != npix * 3 || a.count.size() != npix ||
-      a.width != part.info.width || a.height != part.info.height)
+  if (a.width <= 0 || a.height <= 0 || a.sum.size() != npix * 3 || a.sumsq.size() != npix * 3 ||
+      a.count.size() != npix || a.width != part.info.width || a.height != part.info.height)
     throw Error(name + ": inconsistent part (film and accumulation sizes differ)");
   check_counts(name, part.info, a);  // a part of lucent-mpi's ranks, or of a library caller
   if (names_.empty()) {
@@ -563,6 +573,8 @@ void PartMerger::add(const std::string& name, const RenderPart& part) {
 
 MergeReport PartMerger::finish() {
   if (names_.empty()) throw Error("merge: no parts");
+  if (total_.info.width == 0)
+    throw Error("merge: no parts added (add_header() checks headers, add() adds parts)");
   MergeReport r;
   r.merged = total_;
   r.order = names_;
