@@ -325,6 +325,27 @@ TEST(Compare, InconsistentLayersAreAnInputError) {
             "s: inconsistent image (no pixels, or layers of other sizes)");
   short_n.samples.assign(16, 8);
   EXPECT_EQ(lucent::test::error_of([&] { lucent::check_comparable_image(short_n, "s"); }), "");
+  // options out of range (an alpha of NaN or 2 made the threshold 0: everything passed), and an
+  // image of no pixels, which no reader took back
+  lucent::CompareOptions o;
+  for (double alpha : {std::nan(""), 2.0, 0.0}) {
+    o.alpha = alpha;
+    EXPECT_NE(lucent::test::error_of([&] {
+                lucent::compare_images(short_n, short_n, o);
+              }).find("compare: alpha must be in [1e-12, 0.5]"),
+              std::string::npos)
+        << alpha;
+  }
+  o = lucent::CompareOptions{};
+  o.min_pass_fraction = 1.5;
+  EXPECT_NE(lucent::test::error_of([&] {
+              lucent::compare_images(short_n, short_n, o);
+            }).find("min_pass_fraction must be in [0, 1]"),
+            std::string::npos);
+  const std::string dir = lucent::test::temp_dir();
+  EXPECT_EQ(
+      lucent::test::error_of([&] { lucent::write_render_exr(dir + "/e.exr", RenderResult{}); }),
+      dir + "/e.exr: cannot write EXR: the image has no pixels");
 }
 
 // The z map's path is checked before the images are read (a .txt z map was refused only after

@@ -224,6 +224,11 @@ TEST(Converge, SettingSyntax) {
             static_cast<int>(lucent::IntegratorType::Direct));
   EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("caustics+no-caustics"); }),
             "setting 'caustics+no-caustics': no-caustics and caustics set the same thing");
+  // a number's knob as written, and the pilot's true range (it said min_spp, from 1)
+  EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("adaptive+min-spp=-4"); }),
+            "setting min-spp=-4: expected an integer from 4 to 16777216");
+  EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("max-depth=0"); }),
+            "setting max-depth=0: expected an integer from 1 to 100000");
 
   for (const char* bad :
        {"", "bogus", "max_depth=0", "max_depth=x", "max_depth", "fast-math=1", "filter=round",

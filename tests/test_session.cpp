@@ -200,6 +200,15 @@ TEST(Session, SampleIndicesStopAt2To32) {
   EXPECT_EQ(p.samples_done, 1u) << "stops at 2^32";
   EXPECT_EQ(r.spp(), 4u);
   EXPECT_THROW(r.render(1), lucent::Error);
+  // a count that wraps past 2^64 is named as given (it read "[6, 5)")
+  r.reset(6);
+  EXPECT_EQ(lucent::test::error_of([&] { r.render(~std::uint64_t(0)); }),
+            "render: 18446744073709551615 samples from sample index 6 go past 2^32, the "
+            "sampler's range (samples would repeat)");
+  // the build options take the precisions there are
+  EXPECT_EQ(lucent::test::error_of(
+                [&] { r.set_build_options(static_cast<lucent::Precision>(7), false, true); }),
+            "set_build_options: unknown precision 7");
 }
 
 TEST(Session, RenderForRendersAtLeastOnePass) {

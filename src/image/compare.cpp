@@ -79,6 +79,16 @@ void check_comparable_image(const RenderResult& image, const std::string& path) 
 
 CompareResult compare_images(const RenderResult& a, const RenderResult& b,
                              const CompareOptions& o) {
+  // as the command line's ranges: an alpha of NaN or 2 made the threshold 0, and every
+  // comparison passed
+  if (!(o.alpha >= 1e-12 && o.alpha <= 0.5))
+    throw Error("compare: alpha must be in [1e-12, 0.5], got " + std::to_string(o.alpha));
+  if (!(o.min_pass_fraction >= 0 && o.min_pass_fraction <= 1))
+    throw Error("compare: min_pass_fraction must be in [0, 1], got " +
+                std::to_string(o.min_pass_fraction));
+  if (!(o.abs_epsilon >= 0) || !(o.rel_epsilon >= 0) || !std::isfinite(o.abs_epsilon) ||
+      !std::isfinite(o.rel_epsilon))
+    throw Error("compare: abs_epsilon and rel_epsilon must be finite and >= 0");
   if (a.mean.width != b.mean.width || a.mean.height != b.mean.height)
     throw Error("compare: image sizes differ: " + std::to_string(a.mean.width) + "x" +
                 std::to_string(a.mean.height) + " and " + std::to_string(b.mean.width) + "x" +

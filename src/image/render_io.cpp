@@ -31,6 +31,8 @@ void write_render_exr(const std::string& path, const RenderResult& r, const ExrE
   const int w = r.mean.width, h = r.mean.height;
   const size_t n = static_cast<size_t>(w) * h;
   if (r.mean.rgb.size() != n * 3) throw Error(path + ": cannot write EXR: inconsistent image");
+  // (a 0x0 image made a file that read_render refused: "empty data window")
+  if (n == 0) throw Error(path + ": cannot write EXR: the image has no pixels");
   const bool stats = r.variance.rgb.size() == n * 3 && r.samples.size() == n;
   // the mean (B G R), then the statistics (n var.B var.G var.R) and the extras, sorted below
   std::vector<std::string> names = {"B", "G", "R"};

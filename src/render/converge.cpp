@@ -184,9 +184,9 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
       no_value();
       s.mis = 1;
     } else if (key == "max_depth") {
-      s.max_depth = parse_positive_int(key, value, limits::kMaxDepth);
+      s.max_depth = parse_positive_int(knob.substr(0, eq), value, limits::kMaxDepth);
     } else if (key == "rr_depth") {
-      s.rr_depth = parse_positive_int(key, value, limits::kMaxDepth);
+      s.rr_depth = parse_positive_int(knob.substr(0, eq), value, limits::kMaxDepth);
     } else if (key == "filter") {
       std::string type = value, radius;
       std::size_t colon = value.find(':');
@@ -216,7 +216,7 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
     } else if (key == "clamp") {
       s.clamp = parse_number(knob, value, 0, false);
     } else if (key == "splits") {
-      s.splits = parse_int(key, value, 0, limits::kMaxDielectricSplits);
+      s.splits = parse_int(knob.substr(0, eq), value, 0, limits::kMaxDielectricSplits);
     } else if (key == "caustics" || key == "no_caustics") {
       no_value();
       s.caustics = key == "caustics" ? 1 : 0;
@@ -224,8 +224,8 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
       no_value();
       s.adaptive = true;
     } else if (key == "min_spp") {
-      s.min_spp = parse_positive_int(key, value, limits::kMaxSpp);
-      if (s.min_spp < 4) throw Error("setting " + knob + ": the pilot needs at least 4 spp");
+      // (from 4: "min-spp=-4" said "an integer from 1", and under the spelling min_spp)
+      s.min_spp = parse_int(knob.substr(0, eq), value, 4, limits::kMaxSpp);
     } else if (key == "target_error") {
       s.target_error = parse_number(knob, value, 0, true);
     } else if (key == "integrator") {

@@ -734,9 +734,9 @@ struct Renderer::Impl {
     // the sampler takes 32-bit sample indices: past 2^32 samples would repeat
     const std::uint64_t index_end = std::uint64_t(1) << 32;
     if (start_index >= index_end || (target_spp > 0 && target_spp > index_end - start_index))
-      throw Error("render: sample indices [" + std::to_string(start_index) + ", " +
-                  std::to_string(start_index + (target_spp > 0 ? target_spp : 1)) +
-                  ") go past 2^32, the sampler's range (samples would repeat)");
+      throw Error("render: " + std::to_string(target_spp > 0 ? target_spp : 1) +
+                  " samples from sample index " + std::to_string(start_index) +
+                  " go past 2^32, the sampler's range (samples would repeat)");
     auto next = [&](Worker& w, Job& job) {
       if (target_spp > 0 && started >= target_spp) return false;
       if (start_index + started >= index_end) return false;  // a time-limited render stops there
@@ -1172,6 +1172,9 @@ std::vector<DeviceInfo> Renderer::devices() const { return impl_->device_infos; 
 const SessionOptions& Renderer::options() const { return impl_->options; }
 
 void Renderer::set_build_options(Precision precision, bool fast_math, bool specialize) {
+  if (precision != Precision::Float && precision != Precision::Double)  // (7 was taken as float)
+    throw Error("set_build_options: unknown precision " +
+                std::to_string(static_cast<int>(precision)));
   const SessionOptions before = impl_->options;
   impl_->options.precision = precision;
   impl_->options.fast_math = fast_math;
