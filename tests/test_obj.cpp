@@ -95,6 +95,41 @@ TEST(Obj, QuadsAndNgonsAreTriangulatedKeepingAreaAndOrientation) {
   EXPECT_NEAR(area_by_z[2], 3.0, 1e-12);
 }
 
+// Concave polygons keep their area and their winding in every triangle: a concave quad was split
+// along its shorter diagonal, which lies outside it (area 10 + 1 facing the other way, for 9),
+// and tinyobjloader's ear clipping covered points outside a concave pentagon with triangles of
+// both windings (11.5 for 6.5). A polygon that cuts itself is fanned, with a warning.
+TEST(Obj, ConcavePolygonsKeepTheirAreaAndWinding) {
+  std::string dir = lucent::test::temp_dir();
+  std::string path = write(dir, "concave.obj",
+                           // an arrowhead quad, its reflex corner last, then first
+                           "v 0 0 0\nv 10 1 0\nv 0 2 0\nv 1 1 0\n"
+                           "f 1 2 3 4\nf 4 1 2 3\n"
+                           // a pentagon with two reflex corners
+                           "v 0 0 0\nv 5 1 0\nv 10 1 0\nv 0 2 0\nv 1 1 0\n"
+                           "f 5 6 7 8 9\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  EXPECT_TRUE(w.all().empty()) << w.dump();
+  ASSERT_EQ(s.triangles.size(), 2u + 2u + 3u);
+  double areas[3] = {0, 0, 0};
+  for (size_t i = 0; i < s.triangles.size(); ++i) {
+    EXPECT_GT(geometric_normal(s, s.triangles[i]).z, 0) << "triangle " << i;
+    areas[i < 2 ? 0 : (i < 4 ? 1 : 2)] += area(s, s.triangles[i]);
+  }
+  EXPECT_NEAR(areas[0], 9.0, 1e-9);
+  EXPECT_NEAR(areas[1], 9.0, 1e-9);
+  EXPECT_NEAR(areas[2], 6.5, 1e-9);
+  // a polygon of no area (its corners on a line): fanned, and said
+  path = write(dir, "line.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nv 4 0 0\nf 1 2 3 4 5\n");
+  Scene t;
+  load(t, path);
+  EXPECT_EQ(t.triangles.size(), 3u);
+  EXPECT_EQ(w.count("polygon(s) that cut themselves or have no area were split as fans"), 1)
+      << w.dump();
+}
+
 TEST(Obj, NegativeIndicesAreRelativeToTheVerticesSoFar) {
   std::string dir = lucent::test::temp_dir();
   std::string a = write(dir, "abs.obj",

@@ -1,8 +1,9 @@
 // OBJ meshes through tinyobjloader: the file read with a bound and its text checked first
-// (obj_check.cpp), faces triangulated by the library and appended to the scene's world-space
-// triangle list, MTL materials mapped by obj_mtl.cpp (docs/obj-mtl.md).
+// (obj_check.cpp), polygons triangulated here (concave ones included) and appended to the scene's
+// world-space triangle list, MTL materials mapped by obj_mtl.cpp (docs/obj-mtl.md).
 #include <tiny_obj_loader.h>
 
+#include <array>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -44,6 +45,90 @@ class JoinedText : public std::streambuf {
   bool in_body_ = false;
 };
 
+/// The triangles of a planar polygon (its corners' positions, in order), as index triples into
+/// the corners, wound as the polygon is. tinyobjloader's own triangulation split a concave quad
+/// along its shorter diagonal even when that diagonal lies outside it, and its ear clipping
+/// covered points outside a concave pentagon with triangles of both windings. A quad takes its
+/// shorter diagonal when both lie inside (tinyobjloader's triangles, so convex quads keep their
+/// bits), else the one inside; a larger polygon is ear-clipped in the plane of its Newell normal.
+/// What cannot be clipped (a self-intersecting or degenerate polygon) is fanned from its first
+/// corner, and *fanned says so.
+std::vector<std::array<int, 3>> triangulate(const std::vector<glm::vec3>& p, bool* fanned) {
+  const int n = static_cast<int>(p.size());
+  std::vector<std::array<int, 3>> out;
+  auto fan = [&](const std::vector<int>& idx) {
+    for (size_t k = 1; k + 1 < idx.size(); ++k) out.push_back({idx[0], idx[k], idx[k + 1]});
+  };
+  if (n < 3) return out;
+  if (n == 3) return {{0, 1, 2}};
+  glm::dvec3 normal(0.0);  // Newell's: twice the polygon's vector area
+  for (int i = 0; i < n; ++i) normal += glm::cross(glm::dvec3(p[i]), glm::dvec3(p[(i + 1) % n]));
+  const glm::dvec3 an = glm::abs(normal);
+  const int axis = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
+  std::vector<glm::dvec2> q(n);  // the corners in the plane, counter-clockwise
+  const double flip = normal[axis] < 0 ? -1.0 : 1.0;
+  for (int i = 0; i < n; ++i) {
+    const glm::dvec3 v(p[i]);
+    q[i] = glm::dvec2(v[(axis + 1) % 3], flip * v[(axis + 2) % 3]);
+  }
+  auto turn = [&](int a, int b, int c) {  // > 0: a, b, c counter-clockwise
+    const glm::dvec2 u = q[b] - q[a], w = q[c] - q[a];
+    return u.x * w.y - u.y * w.x;
+  };
+  std::vector<int> idx(n);
+  for (int i = 0; i < n; ++i) idx[i] = i;
+  if (!(an[axis] > 0) || !std::isfinite(an[axis])) {
+    *fanned = true;
+    fan(idx);
+    return out;
+  }
+  if (n == 4) {
+    const glm::vec3 e02 = p[2] - p[0], e13 = p[3] - p[1];
+    const bool in02 = turn(0, 1, 2) > 0 && turn(0, 2, 3) > 0;
+    const bool in13 = turn(0, 1, 3) > 0 && turn(1, 2, 3) > 0;
+    const bool short02 = glm::dot(e02, e02) < glm::dot(e13, e13);
+    if (in02 && (short02 || !in13)) return {{0, 1, 2}, {0, 2, 3}};
+    if (in13) return {{0, 1, 3}, {1, 2, 3}};
+    *fanned = true;
+    fan(idx);
+    return out;
+  }
+  auto inside = [&](int j, int a, int b, int c) {  // j in triangle a b c, edges included
+    if (q[j] == q[a] || q[j] == q[b] || q[j] == q[c]) return false;
+    return turn(a, b, j) >= 0 && turn(b, c, j) >= 0 && turn(c, a, j) >= 0;
+  };
+  // at most 1024 corners (the OBJ check), but each ear is tested against the corners left: a
+  // budget keeps a pathological polygon from taking seconds
+  long budget = 16L * n * n;  // a convex polygon takes about n^2 / 2
+  while (idx.size() > 3) {
+    const int m = static_cast<int>(idx.size());
+    int ear = -1;
+    for (int k = 0; k < m && ear < 0; ++k) {
+      const int a = idx[(k + m - 1) % m], b = idx[k], c = idx[(k + 1) % m];
+      if (!(turn(a, b, c) > 0)) continue;
+      bool empty = true;
+      for (int j : idx) {
+        if (--budget < 0) break;
+        if (j != a && j != b && j != c && inside(j, a, b, c)) {
+          empty = false;
+          break;
+        }
+      }
+      if (budget < 0) break;
+      if (empty) ear = k;
+    }
+    if (ear < 0) {
+      *fanned = true;
+      fan(idx);
+      return out;
+    }
+    out.push_back({idx[(ear + m - 1) % m], idx[ear], idx[(ear + 1) % m]});
+    idx.erase(idx.begin() + ear);
+  }
+  out.push_back({idx[0], idx[1], idx[2]});
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::string> load_obj(Scene& scene, const std::string& path,
@@ -69,8 +154,9 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> mats;
   std::string twarn, terr;
+  // polygons as they are: lucent triangulates them (triangulate() above)
   bool ok = tinyobj::LoadObj(&attrib, &shapes, &mats, &twarn, &terr, &in, &reader,
-                             /*triangulate=*/true, /*default_vcols_fallback=*/false);
+                             /*triangulate=*/false, /*default_vcols_fallback=*/false);
   if (head) {
     twarn = obj::shift_line_numbers(twarn, 1);
     terr = obj::shift_line_numbers(terr, 1);
@@ -91,12 +177,15 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
     for (const auto& i : s.mesh.indices) {
       if (i.vertex_index < 0 || i.vertex_index >= nv || i.normal_index < -1 ||
           i.normal_index >= nn || i.texcoord_index < -1 || i.texcoord_index >= nt)
-        throw Error(path + ": a face index is out of range after triangulation");
+        throw Error(path + ": a face index is out of range");
     }
-    for (unsigned int fv : s.mesh.num_face_vertices)
-      if (fv != 3) throw Error(path + ": a face could not be triangulated");
-    if (s.mesh.indices.size() != 3 * s.mesh.num_face_vertices.size())
-      throw Error(path + ": inconsistent face list after triangulation");
+    size_t corners = 0;
+    for (unsigned int fv : s.mesh.num_face_vertices) {
+      if (fv < 3 || fv > static_cast<unsigned int>(obj::kMaxFaceVertices))
+        throw Error(path + ": a face has " + std::to_string(fv) + " corners");
+      corners += fv;
+    }
+    if (s.mesh.indices.size() != corners) throw Error(path + ": inconsistent face list");
   }
 
   // warnings: the missing MTL libraries, then the library's own remarks once each
@@ -156,34 +245,52 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   // faces
   ObjMaterials own;
   obj::MaterialMapper mapper(scene, known ? *known : own, path, mats, reader.origin);
-  size_t faces = 0;
+  size_t faces = 0, fanned_faces = 0;
+  std::vector<glm::vec3> corners;
   for (const auto& s : shapes) {
+    size_t first = 0;  // the face's first index
     for (size_t f = 0; f < s.mesh.num_face_vertices.size(); ++f) {
-      const tinyobj::index_t* idx = &s.mesh.indices[3 * f];
-      Triangle t;
-      bool has_n = true, has_uv = true;
-      for (int k = 0; k < 3; ++k) {
-        t.v[k] = vbase + idx[k].vertex_index;
-        has_n = has_n && idx[k].normal_index >= 0 && normal_ok[idx[k].normal_index];
-        has_uv = has_uv && idx[k].texcoord_index >= 0;
+      const unsigned int fv = s.mesh.num_face_vertices[f];
+      const tinyobj::index_t* face = &s.mesh.indices[first];
+      first += fv;
+      corners.clear();
+      for (unsigned int k = 0; k < fv; ++k) {
+        const float* v = &attrib.vertices[3 * size_t(face[k].vertex_index)];
+        corners.emplace_back(v[0], v[1], v[2]);
       }
-      for (int k = 0; k < 3; ++k) {
-        t.n[k] = has_n ? nbase + idx[k].normal_index : -1;
-        t.uv[k] = has_uv ? tbase + idx[k].texcoord_index : -1;
+      bool fanned = false;
+      for (const std::array<int, 3>& tri : triangulate(corners, &fanned)) {
+        const tinyobj::index_t idx[3] = {face[tri[0]], face[tri[1]], face[tri[2]]};
+        Triangle t;
+        bool has_n = true, has_uv = true;
+        for (int k = 0; k < 3; ++k) {
+          t.v[k] = vbase + idx[k].vertex_index;
+          has_n = has_n && idx[k].normal_index >= 0 && normal_ok[idx[k].normal_index];
+          has_uv = has_uv && idx[k].texcoord_index >= 0;
+        }
+        for (int k = 0; k < 3; ++k) {
+          t.n[k] = has_n ? nbase + idx[k].normal_index : -1;
+          t.uv[k] = has_uv ? tbase + idx[k].texcoord_index : -1;
+        }
+        if (mirrored) {
+          std::swap(t.v[1], t.v[2]);
+          std::swap(t.n[1], t.n[2]);
+          std::swap(t.uv[1], t.uv[2]);
+        }
+        t.material = use_mtl
+                         ? mapper.get(f < s.mesh.material_ids.size() ? s.mesh.material_ids[f] : -1)
+                         : material_override;
+        scene.triangles.push_back(t);
+        ++faces;
       }
-      if (mirrored) {
-        std::swap(t.v[1], t.v[2]);
-        std::swap(t.n[1], t.n[2]);
-        std::swap(t.uv[1], t.uv[2]);
-      }
-      t.material = use_mtl
-                       ? mapper.get(f < s.mesh.material_ids.size() ? s.mesh.material_ids[f] : -1)
-                       : material_override;
-      scene.triangles.push_back(t);
-      ++faces;
+      fanned_faces += fanned;
     }
   }
   if (faces == 0) warn(path + ": no faces");
+  if (fanned_faces > 0)
+    warn(path + ": " + std::to_string(fanned_faces) +
+         " polygon(s) that cut themselves or have no area were split as fans from their first "
+         "corner");
   return reader.libraries;
 }
 
