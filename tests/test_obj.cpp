@@ -65,6 +65,7 @@ const Material& material_named(const Scene& s, const std::string& name) {
   return i >= 0 ? s.materials[i] : none;
 }
 
+// Polygons keep their area and their winding in every triangle, concave ones included.
 TEST(Obj, QuadsAndNgonsAreTriangulatedKeepingAreaAndOrientation) {
   std::string dir = lucent::test::temp_dir();
   std::string path = write(dir, "poly.obj",
@@ -74,13 +75,22 @@ TEST(Obj, QuadsAndNgonsAreTriangulatedKeepingAreaAndOrientation) {
                            "f 5 6 7 8 9\n"
                            // a concave L (area 3) starting at a vertex a fan would get wrong
                            "v 2 1 2\nv 1 1 2\nv 1 2 2\nv 0 2 2\nv 0 0 2\nv 2 0 2\n"
-                           "f 10 11 12 13 14 15\n");
+                           "f 10 11 12 13 14 15\n"
+                           // an arrowhead quad (area 9), its reflex corner last, then first:
+                           // tinyobjloader split it along its shorter diagonal, outside it (area
+                           // 10 + 1 facing the other way)
+                           "v 0 0 3\nv 10 1 3\nv 0 2 3\nv 1 1 3\nf 16 17 18 19\n"
+                           "v 0 0 4\nv 10 1 4\nv 0 2 4\nv 1 1 4\nf 23 20 21 22\n"
+                           // a pentagon with two reflex corners (area 6.5): tinyobjloader's ear
+                           // clipping covered points outside it (11.5 in all)
+                           "v 0 0 5\nv 5 1 5\nv 10 1 5\nv 0 2 5\nv 1 1 5\nf 24 25 26 27 28\n");
   CaptureWarnings w;
   Scene s;
   load(s, path);
   EXPECT_TRUE(w.all().empty()) << w.dump();
-  ASSERT_EQ(s.triangles.size(), 2u + 3u + 4u);
-  double area_by_z[3] = {0, 0, 0};  // the quad is 2 x 1, the pentagon 5 (shoelace), the L 3
+  ASSERT_EQ(s.triangles.size(), 2u + 3u + 4u + 2u + 2u + 3u);
+  // the quad is 2 x 1, the pentagon 5 (shoelace), the L 3, the arrowheads 9, the last one 6.5
+  double area_by_z[6] = {0, 0, 0, 0, 0, 0};
   for (const Triangle& t : s.triangles) {
     glm::dvec3 n = geometric_normal(s, t);
     EXPECT_GT(n.z, 0) << "counter-clockwise polygons face +z";
@@ -90,38 +100,9 @@ TEST(Obj, QuadsAndNgonsAreTriangulatedKeepingAreaAndOrientation) {
       EXPECT_EQ(t.uv[k], -1);
     }
   }
-  EXPECT_NEAR(area_by_z[0], 2.0, 1e-12);
-  EXPECT_NEAR(area_by_z[1], 5.0, 1e-12);
-  EXPECT_NEAR(area_by_z[2], 3.0, 1e-12);
-}
-
-// Concave polygons keep their area and their winding in every triangle: a concave quad was split
-// along its shorter diagonal, which lies outside it (area 10 + 1 facing the other way, for 9),
-// and tinyobjloader's ear clipping covered points outside a concave pentagon with triangles of
-// both windings (11.5 for 6.5). A polygon that cuts itself is fanned, with a warning.
-TEST(Obj, ConcavePolygonsKeepTheirAreaAndWinding) {
-  std::string dir = lucent::test::temp_dir();
-  std::string path = write(dir, "concave.obj",
-                           // an arrowhead quad, its reflex corner last, then first
-                           "v 0 0 0\nv 10 1 0\nv 0 2 0\nv 1 1 0\n"
-                           "f 1 2 3 4\nf 4 1 2 3\n"
-                           // a pentagon with two reflex corners
-                           "v 0 0 0\nv 5 1 0\nv 10 1 0\nv 0 2 0\nv 1 1 0\n"
-                           "f 5 6 7 8 9\n");
-  CaptureWarnings w;
-  Scene s;
-  load(s, path);
-  EXPECT_TRUE(w.all().empty()) << w.dump();
-  ASSERT_EQ(s.triangles.size(), 2u + 2u + 3u);
-  double areas[3] = {0, 0, 0};
-  for (size_t i = 0; i < s.triangles.size(); ++i) {
-    EXPECT_GT(geometric_normal(s, s.triangles[i]).z, 0) << "triangle " << i;
-    areas[i < 2 ? 0 : (i < 4 ? 1 : 2)] += area(s, s.triangles[i]);
-  }
-  EXPECT_NEAR(areas[0], 9.0, 1e-9);
-  EXPECT_NEAR(areas[1], 9.0, 1e-9);
-  EXPECT_NEAR(areas[2], 6.5, 1e-9);
-  // a polygon of no area (its corners on a line): fanned, and said
+  const double want[6] = {2.0, 5.0, 3.0, 9.0, 9.0, 6.5};
+  for (int z = 0; z < 6; ++z) EXPECT_NEAR(area_by_z[z], want[z], 1e-9) << "z = " << z;
+  // a polygon of no area (its corners on a line) cannot be ear-clipped: fanned, and said
   path = write(dir, "line.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nv 4 0 0\nf 1 2 3 4 5\n");
   Scene t;
   load(t, path);
