@@ -29,6 +29,7 @@
 #include "lucent/parts.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/types.hpp"
+#include "render/sample_stats.hpp"
 
 namespace lucent::cli {
 
@@ -312,7 +313,7 @@ int render_with(const RenderArgs& a) {
   // pixel): no image to write; it wrote a black one claiming "0 of 256 spp". A part keeps its
   // (empty) range, and is written.
   if (!range && g_interrupted.load() && r.nonfinite == 0 &&
-      std::all_of(r.samples.begin(), r.samples.end(), [](std::uint32_t n) { return n == 0; })) {
+      lucent::render_detail::holds_no_sample(r.samples)) {
     std::fprintf(stderr, "lucent: interrupted by %s before the first sample: nothing written\n",
                  signal_name(g_signal));
     return 128 + g_signal;
@@ -320,13 +321,8 @@ int render_with(const RenderArgs& a) {
 
   lucent::DisplaySettings display{scene.film.transfer, scene.film.gamma, scene.film.exposure,
                                   scene.film.tonemap};
-  // every sample non-finite: the image holds no estimate, and a black file would pass for one
-  // (`compare` passed it against a black render). A part keeps its counts, and is written.
-  if (!range && r.nonfinite > 0 && !r.samples.empty() &&
-      std::all_of(r.samples.begin(), r.samples.end(), [](std::uint32_t n) { return n == 0; }))
-    throw lucent::Error(a.output + ": not written: all " + std::to_string(r.nonfinite) +
-                        " samples were non-finite (NaN or Inf, or a square beyond a float's "
-                        "range: a radiance or intensity above about 1.8e19?)");
+  // every sample non-finite: nothing written (a part keeps its counts, and is written)
+  if (!range) lucent::render_detail::check_some_sample_finite(a.output, r.nonfinite, r.samples);
   if (range)
     lucent::write_render_part(a.output, lucent::make_part(*renderer, *range, a.scene));
   else if (lucent::io::lower_extension(a.output) == ".exr") {

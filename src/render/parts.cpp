@@ -629,14 +629,7 @@ void write_merged(const std::string& path, const RenderPart& part) {
   if (ext == ".exr") {
     write_render_part(path, part);  // a part file keeps its counts, whatever they are
   } else if (ext == ".png" || ext == ".pfm") {
-    // every sample non-finite: an image without an estimate, which a black file would pass
-    // for (as lucent render refuses it)
-    const std::vector<std::uint32_t>& n = part.acc.count;
-    if (part.info.nonfinite > 0 &&
-        std::all_of(n.begin(), n.end(), [](std::uint32_t c) { return c == 0; }))
-      throw Error(path + ": not written: all " + std::to_string(part.info.nonfinite) +
-                  " samples were non-finite (NaN or Inf, or a square beyond a float's range: a "
-                  "radiance or intensity above about 1.8e19?)");
+    render_detail::check_some_sample_finite(path, part.info.nonfinite, part.acc.count);
     write_image(path, part_result(part).mean, part.info.display);
   } else {
     throw Error(path + ": unknown output format '" + ext + "' (use .exr, .png or .pfm)");

@@ -3,8 +3,30 @@
 // files, an adaptive render's halves, its calibration and its light paths): from running sums
 // and sums of squares, never from stored samples.
 #include <algorithm>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "lucent/error.hpp"
 
 namespace lucent::render_detail {
+
+/// Whether no pixel holds a sample (every count 0).
+inline bool holds_no_sample(const std::vector<std::uint32_t>& counts) {
+  return std::all_of(counts.begin(), counts.end(), [](std::uint32_t n) { return n == 0; });
+}
+
+/// Refuses to write the image `path` of pixel counts `counts` when every one of its samples was
+/// non-finite: it holds no estimate, and a black file would pass for one (`compare` passed it
+/// against a black render). Throws lucent::Error "<path>: not written: ...". (lucent render,
+/// merge and lucent-mpi; a part file keeps its counts instead.)
+inline void check_some_sample_finite(const std::string& path, std::uint64_t nonfinite,
+                                     const std::vector<std::uint32_t>& counts) {
+  if (nonfinite > 0 && !counts.empty() && holds_no_sample(counts))
+    throw Error(path + ": not written: all " + std::to_string(nonfinite) +
+                " samples were non-finite (NaN or Inf, or a square beyond a float's range: a "
+                "radiance or intensity above about 1.8e19?)");
+}
 
 /// The unbiased variance of one sample, from n samples' sum and sum of squares; 0 below 2 samples
 /// (and never negative: the sums' rounding can make it so).
