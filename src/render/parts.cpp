@@ -199,6 +199,14 @@ std::string channel_name(int plane, int c, bool high) {
   return std::string(kPlanes[plane]) + "." + kRgb[c] + (high ? ".hi" : ".lo");
 }
 
+/// Whether an accumulation's sums and counts have its film's size (a part made by hand may not:
+/// read as they were, they were read past their ends).
+bool sums_fit_film(const Accumulation& a) {
+  if (a.width < 0 || a.height < 0) return false;
+  const size_t npix = static_cast<size_t>(a.width) * a.height;
+  return a.sum.size() == npix * 3 && a.sumsq.size() == npix * 3 && a.count.size() == npix;
+}
+
 std::string pixel_text(size_t i, int width) {
   return "pixel " + std::to_string(i % width) + ", " + std::to_string(i / width);
 }
@@ -324,9 +332,7 @@ RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
 RenderResult part_result(const RenderPart& part) {
   const Accumulation& a = part.acc;
   const size_t npix = static_cast<size_t>(a.width) * a.height;
-  // (a part built by hand with other sizes was read past its vectors' ends)
-  if (a.width < 0 || a.height < 0 || a.sum.size() != npix * 3 || a.sumsq.size() != npix * 3 ||
-      a.count.size() != npix)
+  if (!sums_fit_film(a))
     throw Error("part_result: inconsistent part (film and accumulation sizes differ)");
   RenderResult r;
   r.mean = Image{a.width, a.height, std::vector<float>(npix * 3)};
@@ -354,8 +360,7 @@ void write_render_part(const std::string& path, const RenderPart& part) {
   const PartInfo& info = part.info;
   const Accumulation& a = part.acc;
   const size_t npix = static_cast<size_t>(a.width) * a.height;
-  if (a.width != info.width || a.height != info.height || a.sum.size() != npix * 3 ||
-      a.sumsq.size() != npix * 3 || a.count.size() != npix)
+  if (a.width != info.width || a.height != info.height || !sums_fit_film(a))
     throw Error(path + ": cannot write part: inconsistent accumulation");
   if (a.light_paths > 0)
     throw Error(path +
@@ -538,8 +543,8 @@ void PartMerger::add(const std::string& name, const RenderPart& part) {
   check(name, part.info);
   const Accumulation& a = part.acc;
   const size_t npix = static_cast<size_t>(a.width) * a.height;
-  if (a.width <= 0 || a.height <= 0 || a.sum.size() != npix * 3 || a.sumsq.size() != npix * 3 ||
-      a.count.size() != npix || a.width != part.info.width || a.height != part.info.height)
+  if (a.width <= 0 || a.height <= 0 || !sums_fit_film(a) || a.width != part.info.width ||
+      a.height != part.info.height)
     throw Error(name + ": inconsistent part (film and accumulation sizes differ)");
   check_counts(name, part.info, a);  // a part of lucent-mpi's ranks, or of a library caller
   if (names_.empty()) {
