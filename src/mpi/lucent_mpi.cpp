@@ -141,7 +141,11 @@ int run(const Args& a) {
   if (n < std::uint64_t(g_size))
     throw lucent::Error(std::to_string(g_size) + " ranks for " + std::to_string(n) +
                         " samples per pixel: use at most one rank per sample");
-  const lucent::SampleRange range{n * g_rank / g_size, n * (g_rank + 1) / g_size};
+  // rank r's share of the samples [0, n)
+  auto share = [&](int r) {
+    return lucent::SampleRange{n * std::uint64_t(r) / g_size, n * std::uint64_t(r + 1) / g_size};
+  };
+  const lucent::SampleRange range = share(g_rank);
 
   lucent::SessionOptions so = lucent::SessionOptions::from_environment();
   if (!a.device.empty()) so.device = a.device;
@@ -173,7 +177,7 @@ int run(const Args& a) {
   lucent::PartMerger merger;
   merger.add("rank 0", part);
   for (int r = 1; r < g_size; ++r) {
-    lucent::RenderPart p = receive_part(r, part.info, {n * r / g_size, n * (r + 1) / g_size});
+    lucent::RenderPart p = receive_part(r, part.info, share(r));
     try {
       merger.add("rank " + std::to_string(r), p);
     } catch (const lucent::Error& e) {
