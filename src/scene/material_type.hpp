@@ -19,7 +19,6 @@ struct MaterialParam {
   enum Kind {
     Colour,           ///< RGB, every component >= 0
     ColourOrTexture,  ///< Colour, or {"texture": file} (Material::albedo_texture)
-    Positive,         ///< a number > 0
     UnitInterval,     ///< a number in [0, 1]
     Ior,              ///< an index of refraction, in [kMinIor, kMaxIor]
   };
@@ -31,7 +30,7 @@ struct MaterialParam {
   const char* key;
   Kind kind;
   glm::dvec3 Material::*colour = nullptr;  ///< Colour and ColourOrTexture
-  double Material::*number = nullptr;      ///< Positive, UnitInterval and Ior
+  double Material::*number = nullptr;      ///< UnitInterval and Ior
   glm::dvec3 default_colour{0.0};
   double default_number = 0;
 

@@ -236,9 +236,6 @@ void validate_material(const Material& m, std::size_t textures, const Reporter& 
       case MaterialParam::ColourOrTexture:
         check_colour(p, m.*param.colour);
         break;
-      case MaterialParam::Positive:
-        check_positive(p, m.*param.number);
-        break;
       case MaterialParam::UnitInterval:
         check_between(p, m.*param.number, 0, 1);
         break;
