@@ -33,6 +33,20 @@ struct FileText {
   std::string bytes;
 };
 
+/// The bytes of the str `v` as FileText takes them (UTF-8, surrogateescape: a file name from
+/// os.listdir), or false when it has none (another lone surrogate, "\ud800").
+inline bool file_bytes(py::handle v, std::string& out) {
+  py::object bytes = py::reinterpret_steal<py::object>(
+      PyUnicode_AsEncodedString(v.ptr(), "utf-8", "surrogateescape"));
+  if (!bytes) {
+    PyErr_Clear();
+    return false;
+  }
+  out.assign(PyBytes_AS_STRING(bytes.ptr()),
+             static_cast<std::size_t>(PyBytes_GET_SIZE(bytes.ptr())));
+  return true;
+}
+
 }  // namespace lucent::python
 
 namespace pybind11::detail {
@@ -45,16 +59,7 @@ struct type_caster<lucent::python::FileText> {
                          static_cast<std::size_t>(PyBytes_GET_SIZE(src.ptr())));
       return true;
     }
-    if (!PyUnicode_Check(src.ptr())) return false;
-    object bytes =
-        reinterpret_steal<object>(PyUnicode_AsEncodedString(src.ptr(), "utf-8", "surrogateescape"));
-    if (!bytes) {
-      PyErr_Clear();
-      return false;
-    }
-    value.bytes.assign(PyBytes_AS_STRING(bytes.ptr()),
-                       static_cast<std::size_t>(PyBytes_GET_SIZE(bytes.ptr())));
-    return true;
+    return PyUnicode_Check(src.ptr()) && lucent::python::file_bytes(src, value.bytes);
   }
   static handle cast(const lucent::python::FileText& text, return_value_policy, handle) {
     return PyUnicode_DecodeUTF8(text.bytes.data(), static_cast<Py_ssize_t>(text.bytes.size()),

@@ -46,20 +46,6 @@ inline bool utf8_text(py::handle v, std::string& out) {
   return true;
 }
 
-/// The bytes of the str `v` as FileText takes them (UTF-8, surrogateescape: a file name from
-/// os.listdir), or false when it has none (another lone surrogate, "\ud800").
-inline bool file_bytes(py::handle v, std::string& out) {
-  py::object bytes = py::reinterpret_steal<py::object>(
-      PyUnicode_AsEncodedString(v.ptr(), "utf-8", "surrogateescape"));
-  if (!bytes) {
-    PyErr_Clear();
-    return false;
-  }
-  out.assign(PyBytes_AS_STRING(bytes.ptr()),
-             static_cast<std::size_t>(PyBytes_GET_SIZE(bytes.ptr())));
-  return true;
-}
-
 /// A state being read; `where` names the class and the path of the value ("lucent.Scene:
 /// /materials/0"), for messages.
 class StateReader {
