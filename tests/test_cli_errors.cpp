@@ -425,3 +425,33 @@ TEST(CliErrors, IgnoredOptionsAreRefused) {
 }
 
 }  // namespace
+
+namespace {
+
+// Warnings and summary lines carry names from files and the command line, as errors do: a
+// control character (a terminal escape in an OBJ's usemtl, a newline in the output's name) is
+// shown escaped, so that each stays one line and cannot drive the terminal.
+TEST(CliErrors, WarningAndSummaryLinesShowControlCharactersEscaped) {
+  std::string dir = lucent::test::temp_dir() + "/esc";
+  fs::create_directories(dir);
+  lucent::test::write_file(dir + "/m.obj",
+                           "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\x1b[2J\xc2\x9b"
+                           "1m\nf 1 2 3\n");
+  lucent::test::write_file(dir + "/s.json", R"({
+    "film": {"width": 4, "height": 4},
+    "integrator": {"type": "albedo", "spp": 1},
+    "camera": {"position": [0.3, 0.3, 3], "look_at": [0.3, 0.3, 0], "fov": 30},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "mesh", "file": "m.obj"}]
+  })");
+  std::string out = dir + "/two\nlines.pfm";
+  CommandResult r = run_cli("render " + q(dir + "/s.json") + " -o " + q(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_NE(r.err.find("usemtl 'red\\x1b[2J\\xc2\\x9b1m'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/two\\nlines.pfm: 4x4, 1 spp"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos);
+  EXPECT_EQ(lucent::test::count_lines(r.err), 2) << r.err;
+}
+
+}  // namespace

@@ -88,8 +88,8 @@ int run_compare_command() {
                 std::to_string(ra.mean.width) + "x" + std::to_string(ra.mean.height) + ")");
   CompareResult r = compare_images(ra, rb, a.options);
   if (!a.zmap.empty()) write_image(a.zmap, r.z);
-  std::printf("A             %s%s\nB             %s%s\n", a.a.c_str(),
-              ra.variance.rgb.empty() ? " (no variance layers)" : "", a.b.c_str(),
+  std::printf("A             %s%s\nB             %s%s\n", one_line(a.a).c_str(),
+              ra.variance.rgb.empty() ? " (no variance layers)" : "", one_line(a.b).c_str(),
               rb.variance.rgb.empty() ? " (no variance layers)" : "");
   std::fputs(r.summary().c_str(), stdout);
   return r.passed ? 0 : 1;

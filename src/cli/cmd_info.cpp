@@ -83,7 +83,7 @@ int run_info_command() {
   apply_sampling_options(info_args().sampling, scene);
   render_detail::PackedScene packed = render_detail::pack_scene(scene);
 
-  std::printf("scene         %s\n", path.c_str());
+  std::printf("scene         %s\n", one_line(path).c_str());
   std::printf("film          %dx%d\n", scene.film.width, scene.film.height);
   std::printf("integrator    %s, max_depth %d, spp %d, seed %u\n", type_name(scene.integrator.type),
               scene.integrator.max_depth, scene.integrator.spp,
@@ -128,7 +128,7 @@ int run_info_command() {
               format_bytes(texel_bytes).c_str());
   for (const Texture& t : scene.textures)
     std::printf("  %dx%d  %-10s  %s\n", t.width, t.height,
-                format_bytes(double(t.width) * t.height * 16).c_str(), t.path.c_str());
+                format_bytes(double(t.width) * t.height * 16).c_str(), one_line(t.path).c_str());
 
   // the packed lights: the scene's lights and one per emissive sphere or triangle
   std::map<LightType, std::size_t> lights;

@@ -76,8 +76,8 @@ int run_merge_command() {
   }
   write_merged(a.output, r.merged);
   if (!a.quiet) {
-    std::fprintf(stderr, "%s: %dx%d, %zu part(s), samples %s\n", a.output.c_str(), info.width,
-                 info.height, r.order.size(), ranges_text(info.samples).c_str());
+    std::fprintf(stderr, "%s: %dx%d, %zu part(s), samples %s\n", one_line(a.output).c_str(),
+                 info.width, info.height, r.order.size(), ranges_text(info.samples).c_str());
     std::fprintf(stderr, "effective samples per pixel (finite): min %u, mean %.2f, max %u\n",
                  r.min_spp, r.mean_spp, r.max_spp);
     if (info.nonfinite > 0)

@@ -141,7 +141,7 @@ std::vector<std::string> write_aovs(const RenderArgs& a, const lucent::Scene& sc
       }
       lucent::write_image(path, aov.mean);
     }
-    if (!a.quiet) std::fprintf(stderr, "%s: %s AOV\n", path.c_str(), name.c_str());
+    if (!a.quiet) std::fprintf(stderr, "%s: %s AOV\n", one_line(path).c_str(), name.c_str());
   }
   return missing;
 }
@@ -342,7 +342,7 @@ int render_with(const RenderArgs& a) {
         stderr,
         "%s: %dx%d, %llu spp in %.3f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak host "
         "memory %.0f MiB) on %s%s\n",
-        a.output.c_str(), scene.film.width, scene.film.height,
+        one_line(a.output).c_str(), scene.film.width, scene.film.height,
         static_cast<unsigned long long>(r.spp), seconds,
         seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / seconds * 1e-6 : 0,
         seconds > 0 ? double(r.rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
@@ -351,10 +351,11 @@ int render_with(const RenderArgs& a) {
     std::fprintf(stderr,
                  "%s: adaptive: %llu spp on average, estimated relMSE %.3g (target %.3g; model "
                  "gains %.3g, %.3g), from the halves' difference %.3g\n",
-                 a.output.c_str(), static_cast<unsigned long long>(r.spp), r.estimated_relmse,
-                 r.target_error, r.model_gain_a, r.model_gain_b, r.halves_relmse);
+                 one_line(a.output).c_str(), static_cast<unsigned long long>(r.spp),
+                 r.estimated_relmse, r.target_error, r.model_gain_a, r.model_gain_b,
+                 r.halves_relmse);
   if (std::string s = lucent::target_shortfall(r); !s.empty())
-    std::fprintf(stderr, "lucent: warning: %s: %s\n", a.output.c_str(), s.c_str());
+    std::fprintf(stderr, "lucent: warning: %s: %s\n", one_line(a.output).c_str(), s.c_str());
   std::vector<std::string> missing_aovs;
   if (!a.reference) missing_aovs = write_aovs(a, scene, &*renderer, r);
   if (r.cancelled || g_interrupted.load()) {
@@ -367,11 +368,11 @@ int render_with(const RenderArgs& a) {
       aovs += (aovs.empty() ? " (AOVs not written: " : ", ") + name;
     if (!aovs.empty()) aovs += ")";
     std::fprintf(stderr, "lucent: interrupted by %s: wrote %s with %s%s\n", signal_name(sig),
-                 a.output.c_str(), progress_note(r, target, a.time_limit, a.reference).c_str(),
-                 aovs.c_str());
+                 one_line(a.output).c_str(),
+                 progress_note(r, target, a.time_limit, a.reference).c_str(), aovs.c_str());
     if (range)
-      std::fprintf(stderr, "lucent: %s holds samples [%llu, %llu) of %s\n", a.output.c_str(),
-                   static_cast<unsigned long long>(range->begin),
+      std::fprintf(stderr, "lucent: %s holds samples [%llu, %llu) of %s\n",
+                   one_line(a.output).c_str(), static_cast<unsigned long long>(range->begin),
                    static_cast<unsigned long long>(range->begin + r.spp),
                    lucent::range_text(*range).c_str());
     return 128 + sig;

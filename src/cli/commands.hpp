@@ -4,12 +4,15 @@
 #include <string>
 #include <vector>
 
+#include "core/text.hpp"
 #include "lucent/render.hpp"
 #include "lucent/scene.hpp"
 #include "lucent/session.hpp"
 #include "scene/loaders.hpp"
 
 namespace lucent::cli {
+
+using io::one_line;
 
 /// "path", "whitted", ... -> IntegratorType; throws lucent::Error on an unknown name.
 IntegratorType parse_integrator(const std::string& name);

@@ -13,37 +13,12 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "core/text.hpp"
 #include "lucent/lucent.hpp"
 
 namespace {
 
-// Control characters and bytes that are not UTF-8 in an error message (they come from file names
-// and file contents) would break the one-line contract or the terminal: shown escaped.
-std::string one_line(const std::string& s) {
-  std::string out;
-  for (size_t i = 0; i < s.size();) {
-    unsigned char c = static_cast<unsigned char>(s[i]);
-    int n = c < 0x80 ? 1 : (c >> 5) == 6 ? 2 : (c >> 4) == 14 ? 3 : (c >> 3) == 30 ? 4 : 0;
-    bool ok = n > 0 && i + n <= s.size() && !(n == 2 && c < 0xC2);
-    for (int k = 1; ok && k < n; ++k) ok = (static_cast<unsigned char>(s[i + k]) >> 6) == 2;
-    if (ok && n == 1 && (c < 0x20 || c == 0x7F)) {
-      char buf[8];
-      const char* named = c == '\n' ? "\\n" : c == '\r' ? "\\r" : c == '\t' ? "\\t" : nullptr;
-      if (!named) std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += named ? named : buf;
-      ++i;
-    } else if (ok) {
-      out.append(s, i, static_cast<size_t>(n));
-      i += static_cast<size_t>(n);
-    } else {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-      ++i;
-    }
-  }
-  return out;
-}
+using lucent::io::one_line;
 
 std::string format_bytes(std::uint64_t b) {
   char buf[32];

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/file_io.hpp"
+#include "core/text.hpp"
 #include "lucent/limits.hpp"
 #include "lucent/lucent.hpp"
 #include "lucent/parts.hpp"
@@ -25,6 +26,8 @@
 #include "scene/loaders.hpp"
 
 namespace {
+
+using lucent::io::one_line;
 
 std::atomic<bool> g_stop{false};
 volatile std::sig_atomic_t g_signal = 0;
@@ -42,7 +45,7 @@ int g_rank = 0, g_size = 1;
   char host[256] = "?";
   gethostname(host, sizeof host - 1);
   std::fprintf(stderr, "lucent-mpi: error: rank %d of %d (%s): %s\n", g_rank, g_size, host,
-               what.c_str());
+               one_line(what).c_str());
   std::fflush(stderr);
   MPI_Abort(MPI_COMM_WORLD, 1);
   std::_Exit(1);  // not reached
@@ -188,7 +191,7 @@ int run(const Args& a) {
   lucent::write_merged(a.output, m.merged);
   if (!a.quiet)
     std::fprintf(stderr, "%s: %dx%d, samples %s from %d ranks (%.2f s of kernel time in all)\n",
-                 a.output.c_str(), m.merged.info.width, m.merged.info.height,
+                 one_line(a.output).c_str(), m.merged.info.width, m.merged.info.height,
                  lucent::ranges_text(m.merged.info.samples).c_str(), g_size, m.merged.info.seconds);
   if (m.merged.info.nonfinite > 0)
     std::fprintf(stderr,
@@ -196,7 +199,7 @@ int run(const Args& a) {
                  static_cast<unsigned long long>(m.merged.info.nonfinite));
   if (g_stop.load()) {
     std::fprintf(stderr, "lucent-mpi: interrupted: %s holds samples %s of [0, %llu)\n",
-                 a.output.c_str(), lucent::ranges_text(m.merged.info.samples).c_str(),
+                 one_line(a.output).c_str(), lucent::ranges_text(m.merged.info.samples).c_str(),
                  static_cast<unsigned long long>(n));
     return 128 + (g_signal ? int(g_signal) : SIGINT);
   }
@@ -209,7 +212,7 @@ int run(const Args& a) {
     std::fprintf(stderr,
                  "lucent-mpi: error: %s holds samples %s of [0, %llu): samples %s are missing (a "
                  "rank stopped early)\n",
-                 a.output.c_str(), lucent::ranges_text(m.merged.info.samples).c_str(),
+                 one_line(a.output).c_str(), lucent::ranges_text(m.merged.info.samples).c_str(),
                  static_cast<unsigned long long>(n), lucent::ranges_text(missing).c_str());
     return 1;
   }
@@ -265,7 +268,7 @@ int main(int argc, char** argv) {
     if (failed && !root_failed)
       std::fprintf(stderr,
                    "lucent-mpi: error: rank %d of %d: %s (its arguments are not rank 0's)\n",
-                   g_rank, g_size, message.c_str());
+                   g_rank, g_size, one_line(message).c_str());
     MPI_Finalize();
     if (!failed || (!root_failed && g_rank != 0)) return 2;
     return parse_status ? parse_status : (code ? 2 : 0);

@@ -1,12 +1,13 @@
 #include <cstdio>
 
+#include "core/text.hpp"
 #include "scene/loaders.hpp"
 
 namespace lucent::scene_detail {
 
 namespace {
 void stderr_sink(const std::string& message) {
-  std::fprintf(stderr, "lucent: warning: %s\n", message.c_str());
+  std::fprintf(stderr, "lucent: warning: %s\n", io::one_line(message).c_str());
 }
 void (*g_sink)(const std::string&) = stderr_sink;
 thread_local const std::function<void(const std::string&)>* t_sink = nullptr;
