@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 
@@ -89,6 +90,32 @@ lc_camera pack_camera(const Camera& c, int width, int height) {
   return cam;
 }
 
+// The camera and the geometry are stored in float with either --precision: a pixel whose
+// footprint at the look-at distance spans a few float steps of the coordinates there (a fov of
+// 1e-4 degrees, a camera 1e8 from the origin looking at something 10 away) renders their
+// rounding, staircase edges and a shift of up to a pixel, without a word (the reference, in
+// double, does not). Said when a pixel spans fewer than 4 steps.
+static void warn_camera_precision(const Scene& scene) {
+  const Camera& c = scene.camera;
+  const double distance = glm::length(c.look_at - c.position);
+  const double pitch = 2.0 * std::tan(glm::radians(c.fov_degrees) * 0.5) / scene.film.height;
+  double coordinate = distance;
+  for (int i = 0; i < 3; ++i)
+    coordinate = std::max({coordinate, std::abs(c.position[i]), std::abs(c.look_at[i])});
+  const double step = coordinate * std::ldexp(1.0, -23);  // float's spacing there, at most
+  const double steps = distance * pitch / step;
+  if (!(steps < 4)) return;
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "camera: a pixel spans %.2g float steps of the coordinates at the look-at "
+                "distance (fov %.3g degrees on %d rows, look-at %.3g away, coordinates up to "
+                "%.3g), fewer than 4: the image shows the float rounding of the camera and the "
+                "scene (staircase edges, a shift of up to a pixel) with either precision; widen "
+                "the fov, lower the film's height or move the scene nearer the origin",
+                steps, c.fov_degrees, scene.film.height, distance, coordinate);
+  scene_detail::warn(scene_detail::in_file(scene.path, buf));
+}
+
 PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bvh_reused) {
   // what the kernel's 32-bit indices can reach, before anything is built: the BVH's leaf blocks
   // (one per primitive at worst) and the texels (a texture's offset and offset + y w + x are
@@ -111,6 +138,7 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   PackedScene p;
   lc_params& P = p.params;
   P.camera = pack_camera(scene.camera, scene.film.width, scene.film.height);
+  warn_camera_precision(scene);
   P.width = static_cast<lc_uint>(scene.film.width);
   P.height = static_cast<lc_uint>(scene.film.height);
   P.seed = scene.integrator.seed;
