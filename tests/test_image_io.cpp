@@ -162,6 +162,64 @@ TEST(ImageIo, TiledExrReadsAsScanlines) {
   EXPECT_EQ(tiled.rgb, lucent::read_image(dir + "/lines.exr").rgb);
 }
 
+/// `bytes` (an OpenEXR file of one part and level) as OpenEXR writes it with lineOrder
+/// DECREASING_Y: the header says so and the chunks are stored last first; the offset table
+/// still names each chunk's place (indexed by its y, or its tile), and each chunk its y or tile.
+std::string with_decreasing_y(const std::string& bytes) {
+  std::string out = bytes;
+  const std::string attr("lineOrder\0lineOrder\0\1\0\0\0", 24);
+  const size_t at = out.find(attr);
+  EXPECT_NE(at, std::string::npos);
+  EXPECT_EQ(out[at + attr.size()], '\0');  // INCREASING_Y, as tinyexr writes
+  out[at + attr.size()] = '\1';
+  const size_t table = exr_offset_table(bytes);
+  std::uint64_t first;
+  std::memcpy(&first, bytes.data() + table, 8);
+  const size_t n = (first - table) / 8;
+  std::vector<std::uint64_t> offsets(n);
+  std::memcpy(offsets.data(), bytes.data() + table, 8 * n);
+  std::vector<std::uint64_t> sorted = offsets;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(sorted, offsets);  // tinyexr stores chunks in table order
+  std::string chunks;
+  std::vector<std::uint64_t> moved(n);
+  for (size_t i = n; i-- > 0;) {
+    const std::uint64_t end = i + 1 < n ? offsets[i + 1] : bytes.size();
+    moved[i] = first + chunks.size();
+    chunks += bytes.substr(offsets[i], end - offsets[i]);
+  }
+  std::memcpy(&out[table], moved.data(), 8 * n);
+  return out.substr(0, first) + chunks;
+}
+
+// OpenEXR's lineOrder only says in which order the chunks are stored; every chunk names its own
+// rows (or tile). tinyexr 1.0.1 wrote the rows of a DECREASING_Y file flipped (its issue 213):
+// scanline files came out upside down (a texture, an environment map's sky and ground swapped,
+// compare failing two files of the same pixels), tiled ones flipped each tile and left the rows
+// past a cut edge tile's height uninitialised (garbage texels, a different image each run).
+TEST(ImageIo, ExrOfDecreasingLineOrderReadsAsItsPixels) {
+  auto value = [](int c, int x, int y) { return float(x + 100 * y) + 0.25f * float(c); };
+  const std::string dir = lucent::test::temp_dir();
+  for (lucent::fuzz::ExrLayout layout :
+       {lucent::fuzz::ExrLayout{},
+        lucent::fuzz::ExrLayout{0, TINYEXR_TILE_ONE_LEVEL, TINYEXR_TILE_ROUND_DOWN,
+                                TINYEXR_COMPRESSIONTYPE_NONE},
+        lucent::fuzz::ExrLayout{16}, lucent::fuzz::ExrLayout{4}}) {
+    SCOPED_TRACE("tile " + std::to_string(layout.tile) + ", compression " +
+                 std::to_string(layout.compression));
+    const std::string path = dir + "/decreasing.exr";
+    lucent::test::write_file(
+        path, with_decreasing_y(lucent::fuzz::exr_file(37, 21, {"B", "G", "R"}, value, layout)));
+    const lucent::Image image = lucent::read_image(path);
+    ASSERT_EQ(image.width, 37);
+    ASSERT_EQ(image.height, 21);
+    for (int y = 0; y < 21; ++y)
+      for (int x = 0; x < 37; ++x)
+        for (int c = 0; c < 3; ++c)
+          ASSERT_EQ(image.pixel(x, y)[c], value(2 - c, x, y)) << x << "," << y << " channel " << c;
+  }
+}
+
 // Tiled files with mip-map or rip-map levels (texture tools write them), their level sizes
 // rounded down or up: the probe's count of levels and tiles (which checks every chunk, against
 // tinyexr's unchecked tile coordinates) is tinyexr's, so each reads, as its level 0. (tinyexr's

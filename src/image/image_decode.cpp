@@ -98,6 +98,11 @@ ExrChannels read_exr_channels(const unsigned char* data, std::size_t size, const
   const Fail fail{path};
   EXRHeader header;
   probe_exr(data, size, path, max_pixels, header);
+  // lineOrder only says in which order the chunks are stored, and each chunk names its rows or
+  // tile; tinyexr 1.0.1 flips the rows of every chunk of a DECREASING_Y file (its issue 213,
+  // fixed upstream by always decoding as INCREASING_Y): an image upside down, or tiles flipped
+  // with rows left uninitialised
+  header.line_order = 0;
   for (int c = 0; c < header.num_channels; ++c)
     if (header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF)
       header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
