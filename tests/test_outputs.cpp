@@ -152,11 +152,15 @@ TEST(Outputs, WritesAreAtomicAndFollowSymlinks) {
                 "/loop-a.pfm: cannot write (Too many levels of symbolic "
                 "links)\n");
   EXPECT_TRUE(fs::is_symlink(dir + "/dangling.pfm") && fs::is_symlink(dir + "/loop-a.pfm"));
-  // the library's writer: replaced whole, mode from the umask like any new file
+  // the library's writer: replaced whole, as a new file that keeps the old one's permissions
+  // (they came from the umask: a private image became readable by all)
   std::string plain = dir + "/plain.bin";
   lucent::io::write_file_atomic(plain, std::string("first"));
+  fs::permissions(plain, fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
   lucent::io::write_file_atomic(plain, std::string("second, longer"));
   EXPECT_EQ(read_file(plain), "second, longer");
+  EXPECT_EQ(fs::status(plain).permissions(),
+            fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
   try {
     lucent::io::write_file_atomic(dir + "/missing/x.png", std::string("x"));
     ADD_FAILURE() << "no error";
@@ -164,6 +168,32 @@ TEST(Outputs, WritesAreAtomicAndFollowSymlinks) {
     EXPECT_STREQ(e.what(),
                  (dir + "/missing/x.png: cannot write (No such file or directory)").c_str());
   }
+}
+
+// Names near the file system's limit (255 bytes): one that fits is written (its temporary name
+// was its whole name plus a suffix, refused after the render: the image was lost), one that does
+// not is refused before rendering, as an AOV's would be.
+TEST(Outputs, LongNamesAreWrittenOrRefusedBeforeRendering) {
+  std::string dir = lucent::test::temp_dir();
+  if (::pathconf(dir.c_str(), _PC_NAME_MAX) != 255) GTEST_SKIP() << "names are not 255 bytes here";
+  std::string scene = scene_in(dir);
+  const std::string fits = dir + "/" + std::string(251, 'a') + ".pfm";
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(fits) + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(lucent::read_image(fits).width, 32);
+  const std::string too_long = dir + "/" + std::string(252, 'b') + ".pfm";
+  r = run_cli("render " + q(scene) + " -o " + q(too_long));
+  EXPECT_EQ(r.err, "lucent: error: " + too_long +
+                       ": cannot write output (a file name of 256 bytes, more than the 255 this "
+                       "file system allows)\n");
+  EXPECT_EQ(r.status, 1);
+  const std::string aov_too_long = dir + "/" + std::string(245, 'c') + ".exr";
+  r = run_cli("render " + q(scene) + " -o " + q(aov_too_long) + " --aov albedo");
+  EXPECT_NE(r.err.find(".albedo.exr: cannot write output (a file name of 256 bytes"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.status, 1);
+  EXPECT_FALSE(fs::exists(aov_too_long));
 }
 
 // Inputs are never overwritten: the scene file (named like an image, through a symbolic or a hard

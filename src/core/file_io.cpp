@@ -67,6 +67,15 @@ fs::path write_target(const std::string& path) {
   return target;
 }
 
+// The temporary file a write of `name` into `dir` goes through: a hidden name beside it, of at
+// most 128 bytes of the name, so that a name near the file system's limit (255 bytes) has one
+// too (its whole name plus the suffix was refused, after the render).
+fs::path temp_path(const fs::path& dir, const std::string& name) {
+  static std::atomic<unsigned> counter{0};
+  return dir / ("." + name.substr(0, 128) + ".tmp-" + std::to_string(::getpid()) + "-" +
+                std::to_string(counter++));
+}
+
 }  // namespace
 
 std::string format_size(std::uint64_t b) {
@@ -156,9 +165,15 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
   if (fs::exists(out, ec) && ::access(out.c_str(), W_OK) != 0)
     throw Error(out + ": cannot write output (" + std::strerror(errno) + ")");
   const fs::path target = write_target(out);  // the directory the write will go to
-  fs::path dir = target.parent_path();
-  std::string probe = (dir.empty() ? fs::path(".") : dir).string() + "/.lucent-write-test-" +
-                      std::to_string(::getpid());
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const std::string name = target.filename().string();
+  // the name itself, which only the final rename would refuse
+  const long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  if (name_max > 0 && name.size() > static_cast<size_t>(name_max))
+    throw Error(out + ": cannot write output (a file name of " + std::to_string(name.size()) +
+                " bytes, more than the " + std::to_string(name_max) + " this file system allows)");
+  // the temporary file the write goes through
+  const std::string probe = temp_path(dir, name).string();
   int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0) throw Error(out + ": cannot write output (" + std::strerror(errno) + ")");
   ::close(fd);
@@ -193,10 +208,7 @@ void write_file_atomic(const std::string& path, const void* data, std::size_t si
   if (name.empty() || name == "." || name == "..")
     throw Error(path + ": cannot write (not a file name)");
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  static std::atomic<unsigned> counter{0};
-  const std::string tmp =
-      (dir / ("." + name + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++)))
-          .string();
+  const std::string tmp = temp_path(dir, name).string();
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd < 0) throw Error(path + ": cannot write (" + reason(errno) + ")");
   auto fail = [&](int err) {
@@ -211,6 +223,11 @@ void write_file_atomic(const std::string& path, const void* data, std::size_t si
     ::unlink(tmp.c_str());
     throw;
   }
+  // a file replaced keeps its permissions (a private image stayed private; a new file's mode
+  // comes from the umask); as it is a new file, its other hard links keep the old content
+  struct stat old;
+  if (::stat(target.c_str(), &old) == 0 && S_ISREG(old.st_mode))
+    (void)::fchmod(fd, old.st_mode & 07777);
   // a full disk or an I/O error may only show when the data reaches the device
   if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) fail(errno);
   int rc = ::close(fd);

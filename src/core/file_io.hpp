@@ -29,7 +29,8 @@ std::string read_file(const std::string& path, const ReadSpec& spec);
 /// Writes `size` bytes to `path` through a temporary file in the same directory that is renamed
 /// into place once every byte is written and flushed: a crash, a kill or a full disk never
 /// leaves a truncated file under `path` (an existing file stays as it was). A symbolic link is
-/// followed (its target is replaced). Throws lucent::Error("<path>: cannot write (<reason>)").
+/// followed (its target is replaced). A file replaced keeps its permissions; being a new file, its
+/// other hard links keep the old content. Throws lucent::Error("<path>: cannot write (<reason>)").
 void write_file_atomic(const std::string& path, const void* data, std::size_t size);
 inline void write_file_atomic(const std::string& path, const std::string& bytes) {
   write_file_atomic(path, bytes.data(), bytes.size());
@@ -48,7 +49,8 @@ std::string lower_extension(const std::string& path);
 
 /// Fails early (before rendering) when `out` cannot be written as an image: not a format lucent
 /// writes (.png, .pfm, .exr), a directory, a directory that does not exist or cannot be written
-/// to (tested by creating a file there, as the final write does), a read-only file, or one of
+/// to (tested by creating the temporary file the final write goes through), a name longer than
+/// the file system allows, a read-only file, or one of
 /// `inputs` ("<out>: is an input of this render (<input>); refusing to overwrite it").
 void check_output_path(const std::string& out, const std::vector<std::string>& inputs);
 
