@@ -176,6 +176,30 @@ TEST(ImageLimits, PfmHeaderEndsAtTheScalesNewline) {
             "PFM file has 1 bytes after its 2x1 pixels (a header it misreads, or a corrupt file)");
 }
 
+// A positive scale marks big-endian floats (the format's own byte order flag): such files, which
+// other tools write, were refused ("big-endian PFM files are not supported"); they read as their
+// little-endian twins, grey and colour, whatever the scale's magnitude.
+TEST(ImageLimits, BigEndianPfmReadsAsItsLittleEndianTwin) {
+  for (int channels : {1, 3}) {
+    std::string le, be;
+    for (int i = 0; i < 2 * channels; ++i) {
+      float v = 0.25f * float(i + 1) + 1e-3f;
+      char b[4];
+      std::memcpy(b, &v, 4);
+      le.append(b, 4);
+      be.append({b[3], b[2], b[1], b[0]});
+    }
+    const std::string magic = channels == 3 ? "PF\n" : "Pf\n";
+    const lucent::Texture a = texture(magic + "2 1\n-1.0\n" + le);
+    for (const char* scale : {"1.0", "2.5"}) {
+      const lucent::Texture b = texture(magic + "2 1\n" + scale + "\n" + be);
+      ASSERT_EQ(b.width, 2);
+      EXPECT_EQ(b.rgba, a.rgba) << channels << " channel(s), scale " << scale;
+    }
+    EXPECT_EQ(a.rgba[4 * 1 + 0], 0.25f * float(channels + 1) + 1e-3f);  // pixel 1, R
+  }
+}
+
 // A float image used as a texture or an environment map may not hold a negative, NaN or infinite
 // value: they rendered with exit 0 (negative pixels, black in a PNG; dropped non-finite samples),
 // where SceneBuilder::add_texture refuses the same texels.

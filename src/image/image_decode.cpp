@@ -179,7 +179,6 @@ Decoded decode_image(const unsigned char* data, std::size_t size, const std::str
   if (p.format == Format::Pfm) {
     PfmLayout layout;
     probe_pfm(data, size, path, max_pixels, layout);
-    if (layout.big_endian) fail("big-endian PFM files are not supported");
     const std::uint64_t offset = layout.data_offset;
     const int ch = layout.channels;
     allocate(p.width, p.height);
@@ -189,7 +188,10 @@ Decoded decode_image(const unsigned char* data, std::size_t size, const std::str
         for (int c = 0; c < 3; ++c) {
           float v;
           const size_t i = (static_cast<size_t>(y) * p.width + x) * ch + (ch == 3 ? c : 0);
-          std::memcpy(&v, src + 4 * i, 4);
+          // a positive scale marks big-endian floats (the scale's magnitude is not applied)
+          unsigned char b[4] = {src[4 * i], src[4 * i + 1], src[4 * i + 2], src[4 * i + 3]};
+          if (layout.big_endian) std::swap(b[0], b[3]), std::swap(b[1], b[2]);
+          std::memcpy(&v, b, 4);
           out.pixels[(static_cast<size_t>(p.height - 1 - y) * p.width + x) * channels + c] = v;
         }
     return out;
