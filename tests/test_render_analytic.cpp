@@ -164,6 +164,39 @@ TEST(RenderAnalytic, PointLightJustUnderAFloorLightsNothingAboveIt) {
   }
 }
 
+// An emitter never lights its own surface: every pixel well inside an emissive rough glass
+// sphere, alone in the dark, is its emission exactly (seen directly; its light reaches its inside
+// only through its back faces, which do not emit). Next-event estimation sampled the sphere from
+// the origin just outside it, a cone of almost a hemisphere, and the shadow ray behind the glass
+// reached those points from inside: a bright ring up to 1.249 (image mean 4% high, z = 84
+// against the reference).
+TEST(RenderAnalytic, EmissiveRoughGlassSphereDoesNotLightItself) {
+  for (int depth : {2, 8}) {
+    const std::string scene = R"({
+      "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 30},
+      "film": {"width": 24, "height": 24},
+      "integrator": {"type": "path", "max_depth": )" +
+                              std::to_string(depth) + R"(},
+      "materials": {"e": {"type": "rough_dielectric", "ior": 1.3, "roughness": 0.4,
+                          "emission": [1, 1, 1]}},
+      "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "e"}]
+    })";
+    lucent::RenderResult r = lucent::test::render_json(scene, 16, false);
+    int inside = 0;
+    for (int y = 0; y < 24; ++y)
+      for (int x = 0; x < 24; ++x) {
+        // the silhouette's radius is 0.964 of the half height; pixels within 0.8 of it are
+        // wholly inside
+        if (std::hypot(x + 0.5 - 12, y + 0.5 - 12) > 0.8 * 12) continue;
+        ++inside;
+        for (int c = 0; c < 3; ++c)
+          ASSERT_EQ(r.mean.pixel(x, y)[c], 1.0f)
+              << "depth " << depth << ", pixel " << x << "," << y;
+      }
+    EXPECT_GT(inside, 250);
+  }
+}
+
 // The same for an emitting quad with an opaque quad 1e-4 under it: the floor below is black.
 // Shadow rays towards every light's surface stopped 2e-4 of their length short of it, so the
 // cover, 1e-4 / 2 of the distance in front of the lamp, let its light through (mean 0.49). A

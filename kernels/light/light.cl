@@ -43,6 +43,7 @@ typedef struct {
   float pdf;          /* solid-angle pdf including the selection probability;
                          for point lights the selection probability                */
   int delta;          /* point light: no MIS                                        */
+  lc_uint light;      /* the light chosen (a light never lights its own primitive)   */
   lc_real rel_margin; /* how far short of dist, relative to it, the shadow ray stops:
                          LC_SHADOW_REL_MARGIN unless the light type knows better (0 for a
                          point light, which has no surface; a triangle light's own bound) */
@@ -120,6 +121,7 @@ static inline int light_sample(const lc_scene* s, lc_real3 p, lc_real3 o, float 
   lc_uint li = lc_cdf_search(s->light_cdf, P->num_lights, us);
   __global const lc_light* L = &s->lights[li];
   ls->delta = 0;
+  ls->light = li;
   ls->rel_margin = LC_SHADOW_REL_MARGIN;
   LC_LIGHT_TYPES(LC_LIGHT_SAMPLE)
   return 0;
