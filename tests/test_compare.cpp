@@ -125,6 +125,52 @@ TEST(Compare, DeterministicImagesUseTheTolerance) {
   EXPECT_NEAR(r2.relmse, 0.0001 / (0.51 * 0.51 + 0.01), 1e-8);
 }
 
+// With both epsilons 0, a pixel-channel of variance 0 is tested for exact equality
+// (docs/compare.md, "Zero variances"): equal means score z = 0 and pass (0/0 was NaN, which
+// failed identical images), unequal ones score +-inf and fail; the image mean likewise.
+TEST(Compare, ZeroEpsilonsTestZeroVariancePixelsForEquality) {
+  CompareOptions o;
+  o.abs_epsilon = 0;
+  o.rel_epsilon = 0;
+  o.min_pass_fraction = 1.0;
+  RenderResult a = constant_image(4, 3, 0.5f);
+  // a variance layer, 0 except in pixel 0 (a constant sky beside a noisy pixel)
+  a.variance = lucent::Image{4, 3, std::vector<float>(4 * 3 * 3, 0.0f)};
+  a.samples.assign(4 * 3, 16);
+  a.variance.rgb[0] = a.variance.rgb[1] = a.variance.rgb[2] = 0.04f;
+  RenderResult b = a;
+  b.mean.rgb[0] = 0.52f;  // within the noise of pixel 0
+  CompareResult same = lucent::compare_images(a, a, o);
+  EXPECT_TRUE(same.passed) << same.summary();
+  EXPECT_EQ(same.failed_channels, 0u);
+  EXPECT_EQ(same.max_z, 0.0);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(same.mean_z[c], 0.0);
+  for (float z : same.z.rgb) EXPECT_EQ(z, 0.0f);
+  CompareResult noisy = lucent::compare_images(a, b, o);
+  EXPECT_TRUE(noisy.passed) << noisy.summary();
+  EXPECT_EQ(noisy.failed_channels, 0u);
+  EXPECT_TRUE(std::isfinite(noisy.mean_z[0]));
+  // an exact difference in a zero-variance pixel fails, with an infinite z of its sign
+  RenderResult c = a;
+  c.mean.rgb[3 * 5 + 1] = 0.5f + 1e-6f;
+  CompareResult diff = lucent::compare_images(a, c, o);
+  EXPECT_FALSE(diff.passed);
+  EXPECT_EQ(diff.failed_channels, 1u);
+  EXPECT_EQ(diff.z.rgb[3 * 5 + 1], -INFINITY);
+  EXPECT_TRUE(std::isinf(diff.max_z));
+  // deterministic images (no variance layers): the same, for the image mean too
+  RenderResult d = constant_image(4, 3, 0.25f), e = constant_image(4, 3, 0.25f);
+  CompareResult det = lucent::compare_images(d, e, o);
+  EXPECT_TRUE(det.passed) << det.summary();
+  EXPECT_TRUE(det.mean_test_passed);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(det.mean_z[ch], 0.0);
+  e.mean.rgb[7] = 0.75f;
+  CompareResult det2 = lucent::compare_images(d, e, o);
+  EXPECT_FALSE(det2.passed);
+  EXPECT_FALSE(det2.mean_test_passed);
+  EXPECT_EQ(det2.mean_z[1], -INFINITY);
+}
+
 TEST(Compare, NonFiniteValuesFail) {
   RenderResult a = constant_image(4, 4, 1.0f), b = constant_image(4, 4, 1.0f);
   b.mean.rgb[5] = NAN;

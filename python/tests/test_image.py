@@ -112,6 +112,13 @@ def test_compare_arrays_without_variance():
     c = lucent.compare(a, constant(1.5))
     assert not c.passed and c.max_abs_error == pytest.approx(0.5)
     assert c.rmse == pytest.approx(0.5)
+    # both epsilons 0: an exact comparison, which identical arrays pass (0/0 was NaN: FAIL)
+    c = lucent.compare(a, a, abs_epsilon=0, rel_epsilon=0)
+    assert c.passed and c.max_z == 0 and list(c.mean_z) == [0, 0, 0]
+    b = constant(1.0)
+    b[1, 2, 0] = np.nextafter(np.float32(1), np.float32(2))
+    c = lucent.compare(a, b, abs_epsilon=0, rel_epsilon=0)
+    assert not c.passed and c.failed_channels == 1 and c.max_z == math.inf
 
 
 def test_image_errors(tmp_path):

@@ -36,6 +36,15 @@ double variance_of_mean(const RenderResult& r, size_t i, int c) {
   return std::max(0.0, static_cast<double>(r.variance.rgb[i * 3 + c])) / n;
 }
 
+/// The z score of a difference d with standard error sqrt(var_eps) (both standard errors and
+/// the tolerance eps squared). With no error at all (variances 0 and eps = 0) the test is exact
+/// equality: equal means score 0 (0/0 was NaN, which failed identical images), unequal ones
+/// +-inf. A NaN difference stays NaN, and fails.
+double z_score(double d, double var_eps) {
+  if (var_eps == 0 && d == 0) return 0;
+  return d / std::sqrt(var_eps);
+}
+
 void check_layers(const RenderResult& r, const char* which) {
   size_t npix = static_cast<size_t>(r.mean.width) * r.mean.height;
   if (r.mean.rgb.size() != npix * 3)
@@ -118,7 +127,7 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
       double d = va - vb;
       double var = variance_of_mean(a, i, c) + variance_of_mean(b, i, c);
       double eps = o.abs_epsilon + o.rel_epsilon * std::max(std::abs(va), std::abs(vb));
-      double z = d / std::sqrt(var + eps * eps);
+      double z = z_score(d, var + eps * eps);
       r.z.rgb[i * 3 + c] = static_cast<float>(z);
       bool ok = std::isfinite(z) && std::abs(z) <= r.z_threshold;
       if (!ok) {
@@ -154,7 +163,7 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
     r.mean_b[c] /= n;
     double eps =
         o.abs_epsilon + o.rel_epsilon * std::max(std::abs(r.mean_a[c]), std::abs(r.mean_b[c]));
-    r.mean_z[c] = (r.mean_a[c] - r.mean_b[c]) / std::sqrt(sum_var[c] / (n * n) + eps * eps);
+    r.mean_z[c] = z_score(r.mean_a[c] - r.mean_b[c], sum_var[c] / (n * n) + eps * eps);
     if (o.image_mean_test && !(std::abs(r.mean_z[c]) <= r.mean_z_threshold))
       r.mean_test_passed = false;
   }
