@@ -159,8 +159,11 @@ TEST(CliInfo, EmptyScene) {
       lucent::render_detail::feature_defines(s, lucent::render_detail::pack_scene(s));
   if (!defines.empty() && defines[0] == ' ') defines.erase(0, 1);
   EXPECT_EQ(m["kernel/feature defines"], defines.empty() ? "(none)" : defines);
+  // what render adds for each device (render_detail::device_defines): a pass's sums are in
+  // double (LC_ACCUM_DOUBLE) on every device with fp64, PoCL's CPU device included
   EXPECT_EQ(m["kernel/device options"],
-            "-D LC_DEVICE_POCL_CPU on PoCL's CPU device, none on others");
+            "-D LC_DEVICE_POCL_CPU -D LC_ACCUM_DOUBLE on PoCL's CPU device, -D LC_ACCUM_DOUBLE "
+            "on other devices with fp64, none on others");
 }
 
 // info needs no OpenCL device: it works with every driver hidden.

@@ -165,12 +165,25 @@ int run_info_command() {
               options.fast_math ? "fast (-cl-fast-relaxed-math)" : "IEEE");
   std::printf("  build options       %s\n",
               render_detail::build_options(scene, packed, options).c_str());
-  // what each device's build adds (render_detail::device_defines): info opens no device
-  DeviceInfo cpu;
-  cpu.type = "CPU";
-  cpu.platform = cl_util::kPoclPlatform;
-  std::printf("  device options      %s on PoCL's CPU device, none on others\n",
-              render_detail::device_defines(cpu).substr(1).c_str());
+  // what each device's build adds, from render_detail::device_defines itself (info opens no
+  // device): PoCL's CPU device (which has fp64), another device with fp64 and one without
+  DeviceInfo pocl_cpu;
+  pocl_cpu.type = "CPU";
+  pocl_cpu.platform = cl_util::kPoclPlatform;
+  pocl_cpu.fp64 = true;
+  DeviceInfo with_fp64;
+  with_fp64.type = "GPU";
+  with_fp64.fp64 = true;
+  const DeviceInfo without_fp64;
+  auto device_options = [](const DeviceInfo& d) {
+    std::string s = render_detail::device_defines(d);
+    return s.empty() ? std::string("none") : s.substr(1);
+  };
+  std::printf(
+      "  device options      %s on PoCL's CPU device, %s on other devices with fp64, %s on "
+      "others\n",
+      device_options(pocl_cpu).c_str(), device_options(with_fp64).c_str(),
+      device_options(without_fp64).c_str());
   return 0;
 }
 
