@@ -464,6 +464,40 @@ TEST(Converge, AdaptiveAndTargetErrorSettings) {
   }
 }
 
+// An adaptive setting skips the rungs below its pilot: with none at or above it, it rendered
+// nothing and vanished from the table, the CSV and the plot (exit 0, after the reference). It is
+// refused up front, naming the setting, its pilot and the largest rung.
+TEST(Converge, AdaptiveSettingWithNoRungAtItsPilotIsRefused) {
+  lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
+  scene.film.width = scene.film.height = 4;
+  lucent::RenderResult reference;
+  reference.mean = lucent::Image{4, 4, std::vector<float>(4 * 4 * 3, 0.5f)};
+  lucent::ConvergeOptions opt;
+  opt.render = lucent::test::render_options();
+  opt.spp_ladder = {1, 2, 4};
+  opt.settings = {lucent::parse_converge_setting("default"),
+                  lucent::parse_converge_setting("adaptive+min-spp=8")};
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::run_convergence(scene, reference, opt); }),
+            "converge: setting 'adaptive+min-spp=8' has no rung at or above its pilot of 8 spp "
+            "(the ladder's largest rung is 4): add a rung of at least 8 spp or lower its min-spp");
+  opt.spp_ladder = {8, 2};  // one rung at the pilot is enough, wherever it is
+  EXPECT_NO_THROW(lucent::check_convergence_options(opt));
+
+  // the command: one line, before the reference is rendered, no CSV written
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/t.json", kScene);
+  lucent::test::CommandResult r = lucent::test::run_cli(
+      "converge '" + dir +
+      "/t.json' --width 8 --height 8 --max-spp 16 --settings adaptive --csv '" + dir + "/c.csv'");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err,
+            "lucent: error: converge: setting 'adaptive' has no rung at or above its pilot of 64 "
+            "spp (the ladder's largest rung is 16): add a rung of at least 64 spp or lower its "
+            "min-spp\n");
+  EXPECT_EQ(r.out, "");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/c.csv"));
+}
+
 // A study on the caller's session: its cancel flag is the study's while it runs and the session's
 // own afterwards (the session once kept a pointer to the study's flag, which the caller may
 // destroy on return), and without a study flag the session's own stops the study.

@@ -137,6 +137,12 @@ struct ConvergeResult {
   std::vector<ConvergeFit> fits;      ///< one per setting, in the order given
 };
 
+/// Checks a study's ladder and settings before anything is rendered (run_convergence does it
+/// too): an empty ladder, an spp below 1 or a time not above 0, an adaptive or target-error
+/// setting with a time ladder, an adaptive setting whose pilot (min-spp, default
+/// AdaptiveOptions::min_spp) is above every rung (it would render nothing). Throws lucent::Error.
+void check_convergence_options(const ConvergeOptions& options);
+
 /// Renders every setting at every rung and compares each render with `reference` (which must
 /// have the scene's film size; its variance and samples may be empty). Throws lucent::Error.
 ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference,

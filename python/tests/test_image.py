@@ -229,6 +229,11 @@ def test_converge_by_time_and_errors(small_scene):
             lucent.converge(small_scene, reference, time_ladder=[-1], renderer=r)
         with pytest.raises(lucent.Error, match="ladder is empty"):
             lucent.converge(small_scene, reference, spp_ladder=[], renderer=r)
+        # an adaptive setting with no rung at its pilot rendered nothing, and was dropped
+        with pytest.raises(lucent.Error, match=r"setting 'adaptive' has no rung at or above its "
+                                               r"pilot of 64 spp \(the ladder's largest rung is 4\)"):
+            lucent.converge(small_scene, reference, settings=["default", "adaptive"],
+                            spp_ladder=[1, 4], renderer=r)
         with pytest.raises(lucent.Error,
                            match="the reference image is 5x4, the scene renders 16x12"):
             lucent.converge(small_scene, constant(1.0), spp_ladder=[1], renderer=r)

@@ -245,6 +245,8 @@ int run_converge_command() {
                        ? (a.spp_ladder.empty() ? default_spp_ladder(a.max_spp) : a.spp_ladder)
                        : std::vector<int>{};
   opt.render.cancel = &g_stop;
+  // before the scene is loaded and the reference rendered: a setting that would render nothing
+  check_convergence_options(opt);
 
   Scene scene = load_scene(a.scene);
   {

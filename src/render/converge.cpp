@@ -315,6 +315,33 @@ ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
   return f;
 }
 
+void check_convergence_options(const ConvergeOptions& options) {
+  const bool by_time = !options.time_ladder.empty();
+  if ((by_time ? options.time_ladder.size() : options.spp_ladder.size()) == 0)
+    throw Error("converge: the ladder is empty");
+  int largest = 0;
+  for (int s : options.spp_ladder) {
+    if (s < 1) throw Error("converge: spp ladder values must be >= 1, got " + std::to_string(s));
+    largest = std::max(largest, s);
+  }
+  for (double t : options.time_ladder)
+    if (!(t > 0)) throw Error("converge: time ladder values must be > 0 seconds");
+  for (const ConvergeSetting& setting : options.settings) {
+    if ((setting.adaptive || setting.target_error > 0) && by_time)
+      throw Error("converge: setting " + setting.name + " is adaptive: use an spp ladder");
+    // an adaptive setting skips the rungs below its pilot (run_convergence): with none at or
+    // above it, it rendered nothing and vanished from the table, the CSV and the plot
+    if (!setting.adaptive) continue;
+    const int pilot =
+        setting.min_spp > 0 ? setting.min_spp : static_cast<int>(AdaptiveOptions{}.min_spp);
+    if (largest < pilot)
+      throw Error("converge: setting '" + setting.name + "' has no rung at or above its pilot of " +
+                  std::to_string(pilot) + " spp (the ladder's largest rung is " +
+                  std::to_string(largest) + "): add a rung of at least " + std::to_string(pilot) +
+                  " spp or lower its min-spp");
+  }
+}
+
 ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference,
                                const ConvergeOptions& options) {
   check_comparable_image(reference, "the reference image");  // every error against it would be NaN
@@ -322,15 +349,11 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
     throw Error("the reference image is " + std::to_string(reference.mean.width) + "x" +
                 std::to_string(reference.mean.height) + ", the scene renders " +
                 std::to_string(scene.film.width) + "x" + std::to_string(scene.film.height));
+  check_convergence_options(options);
   std::vector<ConvergeSetting> settings = options.settings;
   if (settings.empty()) settings.push_back(ConvergeSetting{});
   const bool by_time = !options.time_ladder.empty();
   const std::size_t rungs = by_time ? options.time_ladder.size() : options.spp_ladder.size();
-  if (rungs == 0) throw Error("converge: the ladder is empty");
-  for (int s : options.spp_ladder)
-    if (s < 1) throw Error("converge: spp ladder values must be >= 1, got " + std::to_string(s));
-  for (double t : options.time_ladder)
-    if (!(t > 0)) throw Error("converge: time ladder values must be > 0 seconds");
 
   // one session for the whole study: settings change only the scene's data or the build
   // options, so the BVH is built once and each kernel variant once; the rungs of a setting
@@ -370,9 +393,6 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
     Scene s = scene;
     RenderOptions o = options.render;
     setting.apply(s, o);
-    const bool adaptive = setting.adaptive || setting.target_error > 0;
-    if (adaptive && by_time)
-      throw Error("converge: setting " + setting.name + " is adaptive: use an spp ladder");
     renderer->set_build_options(o.precision, o.fast_math, o.specialize);
     renderer->set_scene(s);
     renderer->reset();
