@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -14,6 +15,7 @@
 #include <tuple>
 #include <vector>
 
+#include "image/plot_svg.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
@@ -57,10 +59,41 @@ std::vector<std::string> split(const std::string& s, char sep) {
   return out;
 }
 
-/// A minimal XML well-formedness check: declaration, comments, start/end/empty tags with quoted
-/// attributes, properly nested, one root element, only the predefined or numeric entities.
-/// Returns "" when well formed, else what is wrong. Counts the start tags named `count_tag`.
+/// "" when `x` is UTF-8 (shortest forms, no surrogates, at most U+10FFFF) of XML 1.0 characters
+/// only (tab, newline, CR, U+0020..U+D7FF, U+E000..U+FFFD, U+10000..U+10FFFF), else the first
+/// offending byte's offset.
+std::string check_xml_chars(const std::string& x) {
+  for (size_t i = 0; i < x.size();) {
+    const unsigned char c = static_cast<unsigned char>(x[i]);
+    const int n = c < 0x80                ? 1
+                  : c >= 0xC2 && c < 0xE0 ? 2
+                  : c >= 0xE0 && c < 0xF0 ? 3
+                  : c >= 0xF0 && c < 0xF5 ? 4
+                                          : 0;
+    std::uint32_t cp = n == 1 ? c : n == 2 ? c & 0x1Fu : n == 3 ? c & 0x0Fu : c & 0x07u;
+    bool ok = n > 0 && i + n <= x.size();
+    for (int k = 1; ok && k < n; ++k) {
+      const unsigned char d = static_cast<unsigned char>(x[i + k]);
+      ok = (d >> 6) == 2;
+      cp = (cp << 6) | (d & 0x3Fu);
+    }
+    const std::uint32_t min[] = {0, 0, 0x80, 0x800, 0x10000};
+    ok = ok && cp >= min[n] &&
+         (cp == 0x9 || cp == 0xA || cp == 0xD || (cp >= 0x20 && cp <= 0xD7FF) ||
+          (cp >= 0xE000 && cp <= 0xFFFD) || (cp >= 0x10000 && cp <= 0x10FFFF));
+    if (!ok) return "not an XML 1.0 character in UTF-8 at byte " + std::to_string(i);
+    i += static_cast<size_t>(n);
+  }
+  return "";
+}
+
+/// A minimal XML well-formedness check: UTF-8 of XML 1.0 characters, declaration, comments,
+/// start/end/empty tags with quoted attributes, properly nested, one root element, only the
+/// predefined or numeric entities. Returns "" when well formed, else what is wrong. Counts the
+/// start tags named `count_tag`.
 std::string check_xml(const std::string& x, const std::string& count_tag, int* count) {
+  *count = 0;
+  if (std::string e = check_xml_chars(x); !e.empty()) return e;
   std::vector<std::string> stack;
   int roots = 0;
   *count = 0;
@@ -577,6 +610,38 @@ TEST(Converge, XmlCheckerRejectsMalformedDocuments) {
   EXPECT_NE(check_xml("<svg><path d=M0/></svg>", "path", &n), "");
   EXPECT_NE(check_xml("<svg>a & b</svg>", "path", &n), "");
   EXPECT_NE(check_xml("<svg/><svg/>", "path", &n), "");
+  EXPECT_EQ(check_xml("<svg>\t\xc3\xa9\xe2\x82\xac\xf0\x9f\x98\x80\xef\xbf\xbd</svg>", "path", &n),
+            "");
+  for (const char* bad :
+       {"<svg>\x01</svg>", "<svg>\xff</svg>", "<svg>\xc3</svg>", "<svg>\xc0\xaf</svg>",
+        "<svg>\xed\xa0\x80</svg>", "<svg>\xef\xbf\xbe</svg>", "<svg a=\"\x1b\"/>"})
+    EXPECT_NE(check_xml(bad, "path", &n), "") << bad;
+}
+
+// The plot's title (the scene's file name, which may hold any bytes), legend and labels are
+// valid XML 1.0 in UTF-8 whatever their bytes: a control byte or one that is not UTF-8 made the
+// SVG ill-formed (browsers refused it). They are written as \xNN, as the command line shows names.
+TEST(Converge, SvgOfAnyTitleIsValidXml) {
+  EXPECT_EQ(lucent::plot::xml_escape("a\x01"
+                                     "b\xff<&>\"' \xc3\xa9\t\x7f\xef\xbf\xbf\xef\xbf\xbd"),
+            "a\\x01b\\xff&lt;&amp;&gt;&quot;&apos; \xc3\xa9\\t\\x7f\\xef\\xbf\\xbf\xef\xbf\xbd");
+  lucent::ConvergeResult r;
+  r.points = synthetic({1e-2, 5e-3}, {1e-2, 5e-3});
+  r.points[0].setting = r.points[1].setting = "s\x02\xfe";
+  r.fits.push_back(lucent::fit_convergence(r.points));
+  // a NUL too: a file name cannot hold one, a Python title can
+  const std::string title = std::string(
+                                "a\x01"
+                                "b\xff.json\x1b[31m \xed\xa0\x80\xef\xbf\xbe") +
+                            '\0' + ", 16x16";
+  const std::string svg = lucent::convergence_svg(r, title);
+  int paths = 0;
+  EXPECT_EQ(check_xml(svg, "path", &paths), "") << svg;
+  EXPECT_EQ(paths, 1);
+  EXPECT_NE(svg.find("a\\x01b\\xff.json\\x1b[31m \\xed\\xa0\\x80\\xef\\xbf\\xbe\\x00, 16x16"),
+            std::string::npos)
+      << svg;
+  EXPECT_NE(svg.find("s\\x02\\xfe"), std::string::npos) << svg;
 }
 
 TEST(Converge, CommandWritesCsvAndPlot) {

@@ -5,6 +5,7 @@ import re
 import subprocess
 import sys
 import textwrap
+from xml.etree import ElementTree
 
 import numpy as np
 import pytest
@@ -181,6 +182,10 @@ def test_converge(small_scene):
     assert res.csv().startswith("setting,spp,seconds,samples_per_s,rmse,relmse")
     assert res.csv().count("\n") == 7
     assert res.svg("t").lstrip().startswith("<")
+    # any title is valid XML: control characters and XML's non-characters as \xNN
+    svg = res.svg("a\x01b\x1b\ufffe \u00e9 <&>")
+    title = ElementTree.fromstring(svg.encode()).find("{http://www.w3.org/2000/svg}text")
+    assert title is not None and title.text == "a\\x01b\\x1b\\xef\\xbf\\xbe \u00e9 <&>"
     plot = res.plot_image("t")
     assert plot.ndim == 3 and plot.shape[2] == 3
 

@@ -8,6 +8,8 @@
 #include <limits>
 #include <sstream>
 
+#include "core/text.hpp"
+
 namespace lucent::plot {
 
 namespace {
@@ -51,8 +53,22 @@ std::string power_label(int k) {
 }  // namespace
 
 std::string xml_escape(const std::string& text) {
+  // Only XML 1.0 characters, in UTF-8 (the prolog's encoding): a byte that is not UTF-8, a C0
+  // control (a scene file named "a\x01b\xff.json" made the plot ill-formed XML, which browsers
+  // refuse to show) and DEL are written as \xNN, tab, newline and CR as \t, \n, \r
+  // (io::one_line, as the command line shows names), and the non-characters U+FFFE and U+FFFF,
+  // which XML forbids too, as the \xNN of their bytes.
+  const std::string clean = io::one_line(text);
   std::string out;
-  for (char c : text) {
+  for (size_t i = 0; i < clean.size(); ++i) {
+    const char c = clean[i];
+    // (0xEF is always a lead byte in UTF-8: this is the start of a character)
+    if (c == '\xEF' && i + 2 < clean.size() && clean[i + 1] == '\xBF' &&
+        (clean[i + 2] == '\xBE' || clean[i + 2] == '\xBF')) {
+      out += clean[i + 2] == '\xBE' ? "\\xef\\xbf\\xbe" : "\\xef\\xbf\\xbf";
+      i += 2;
+      continue;
+    }
     switch (c) {
       case '&':
         out += "&amp;";

@@ -27,7 +27,9 @@ std::string log_log_svg(const LogLogPlot& plot);
 /// text (stb_easy_font) drawn at 3x the size and box-filtered down.
 Image log_log_image(const LogLogPlot& plot);
 
-/// Text with &, <, >, " and ' escaped for XML.
+/// Text with &, <, >, " and ' escaped for XML, and valid XML 1.0 whatever its bytes: what is not
+/// UTF-8, the C0 controls, DEL, U+FFFE and U+FFFF are written as \xNN (tab, newline and CR as \t,
+/// \n, \r), as io::one_line shows names.
 std::string xml_escape(const std::string& text);
 
 }  // namespace lucent::plot
