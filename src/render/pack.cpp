@@ -116,6 +116,60 @@ static void warn_camera_precision(const Scene& scene) {
   scene_detail::warn(scene_detail::in_file(scene.path, buf));
 }
 
+std::string float_rounding_note(const PackedScene& packed) {
+  double largest = 0;  // the largest coordinate magnitude of a primitive
+  std::vector<double> sizes;
+  const size_t n = packed.triangles.size() + packed.spheres.size();
+  const size_t stride = std::max<size_t>(1, n / 100000);  // a sample of at most ~1e5 sizes
+  size_t i = 0;
+  for (const lc_triangle& t : packed.triangles) {
+    const float* v[3] = {t.v0, t.v1, t.v2};
+    lc_triangle normal = t;  // a triangle of no area in float is never hit: nothing leaves it
+    if (!set_triangle_normal(normal)) continue;
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 3; ++c) largest = std::max(largest, std::abs(double(v[k][c])));
+    if (i++ % stride) continue;
+    double edge = 0;
+    for (int k = 0; k < 3; ++k) {
+      const float *a = v[k], *b = v[(k + 1) % 3];
+      edge =
+          std::max(edge, std::hypot(double(a[0]) - b[0], double(a[1]) - b[1], double(a[2]) - b[2]));
+    }
+    sizes.push_back(edge);
+  }
+  for (const lc_sphere& sp : packed.spheres) {
+    if (!(sp.radius > 0) || !std::isfinite(sp.radius)) continue;  // never hit
+    for (int c = 0; c < 3; ++c)
+      largest = std::max(largest, std::abs(double(sp.center[c])) + sp.radius);
+    if (i++ % stride == 0) sizes.push_back(2.0 * sp.radius);
+  }
+  if (sizes.empty()) return "";
+  const size_t k = (sizes.size() - 1) / 10;
+  std::nth_element(sizes.begin(), sizes.begin() + k, sizes.end());
+  const double feature = sizes[k];
+  const double offset = largest * std::ldexp(1.0, -20);  // 2 x 7 float epsilons, about
+  double diagonal = 0;                                   // of the scene's bounds
+  for (int c = 0; c < 3; ++c) {
+    const double e = double(packed.bounds_max[c]) - packed.bounds_min[c];
+    diagonal += e * e;
+  }
+  diagonal = std::sqrt(diagonal);
+  // offsets beyond 1/64 of the small features (a huge ground triangle under small objects), or
+  // coordinates 1000 times the scene's size (a scene far from the origin: its offsets and the
+  // rounding of its hit points, a thousandth of its size, let rays out of closed shells at
+  // their edges)
+  if (!(offset > feature / 64) && !(largest > 1000 * diagonal)) return "";
+  char buf[640];
+  std::snprintf(buf, sizeof buf,
+                "in float precision, rays leave surfaces offset by their rounding, up to %.2g "
+                "here (coordinates up to %.3g, a scene of size %.3g, small features of %.2g, "
+                "the 10th percentile of primitive sizes): shadows and contacts of small objects "
+                "may be wrong and closed shells may leak light at their edges; use --precision "
+                "double, split large triangles or move the scene nearer the origin",
+                offset, largest, diagonal, feature);
+  return buf;
+}
+
 PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bvh_reused) {
   // what the kernel's 32-bit indices can reach, before anything is built: the BVH's leaf blocks
   // (one per primitive at worst) and the texels (a texture's offset and offset + y w + x are

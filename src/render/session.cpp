@@ -453,6 +453,9 @@ struct Renderer::Impl {
     const bool uploaded = workers.front()->dev.has_value();
     render_detail::PackedScene next =
         render_detail::pack_scene(s, uploaded ? &packed : nullptr, &bvh_reused);
+    if (options.precision == Precision::Float)
+      if (std::string note = render_detail::float_rounding_note(next); !note.empty())
+        scene_detail::warn(scene_detail::in_file(s.path, note));
     ++stats.scene_packs;
     if (!bvh_reused) {
       ++stats.bvh_builds;
