@@ -387,6 +387,12 @@ PYBIND11_MODULE(lucent, m) {
       "convergence studies (converge). Every failure raises lucent.Error with lucent's one-line "
       "message.";
   m.attr("__version__") = kVersion;
+  // NumPy imported now, with the import lock alone: pybind11 imported it on the first array,
+  // inside a function-local static's initialisation, so that two threads making their first
+  // arrays at once deadlocked (one in the guard holding the GIL, the other importing NumPy
+  // waiting for the GIL; pybind11 PR 4877)
+  py::module_::import("numpy");
+  (void)py::detail::npy_api::get();
 
   static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
   error.doc() =
