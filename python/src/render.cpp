@@ -229,6 +229,16 @@ class PyRenderer {
     return out;
   }
 
+  /// Stops a render in progress after its current pass. Renderer::cancel() alone was lost when
+  /// it came after another thread saw this session busy but before the call reached the library
+  /// (whose start drops an earlier cancel): the call's own stop flag is raised too. It is
+  /// lowered when a call starts, with the GIL held, before any thread can see it busy.
+  void cancel() {
+    Renderer& r = get();
+    r.cancel();
+    if (busy_) stop_ = true;
+  }
+
   /// Destroys the session (with the GIL released: a device may take a while to let go). Refused
   /// while a call runs; claims the session first, so that no call starts meanwhile. Closing a
   /// closed renderer does nothing.
@@ -747,7 +757,7 @@ void bind_render(py::module_& m) {
           "stats", [](PyRenderer& r) { return r.counters().stats; },
           "What the session has built and done (a SessionStats).")
       .def(
-          "cancel", [](PyRenderer& r) { r.get().cancel(); },
+          "cancel", [](PyRenderer& r) { r.cancel(); },
           "Stops a render in progress (in another thread) after its current pass.")
       .def("close", &PyRenderer::close,
            "Releases the device; every later call raises lucent.Error (closing again does "
