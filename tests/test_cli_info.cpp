@@ -164,6 +164,17 @@ TEST(CliInfo, EmptyScene) {
   EXPECT_EQ(m["kernel/device options"],
             "-D LC_DEVICE_POCL_CPU -D LC_ACCUM_DOUBLE on PoCL's CPU device, -D LC_ACCUM_DOUBLE "
             "on other devices with fp64, none on others");
+  // --no-specialize: every feature, as the build options line (and Python's scene_info) say;
+  // the feature defines line listed the scene's
+  r = run_cli("info '" + scene + "' --no-specialize", "env -u LUCENT_KERNEL_DIR");
+  ASSERT_EQ(r.status, 0) << r.err;
+  m = parse_report(r.out);
+  defines = lucent::render_detail::feature_defines(s, lucent::render_detail::pack_scene(s), false);
+  if (!defines.empty() && defines[0] == ' ') defines.erase(0, 1);
+  EXPECT_NE(defines.find("-D LC_HAS_DIELECTRIC"), std::string::npos) << defines;
+  EXPECT_EQ(m["kernel/feature defines"], defines);
+  EXPECT_NE(m["kernel/build options"].find(defines), std::string::npos)
+      << m["kernel/build options"];
 }
 
 // info needs no OpenCL device: it works with every driver hidden.

@@ -148,12 +148,13 @@ int run_info_command() {
   std::printf("  max depth           %zu binary, %zu wide\n", s.binary_max_depth, s.max_depth);
   std::printf("  SAH cost            %.3f\n", s.sah_cost);
 
-  std::string defines = render_detail::feature_defines(scene, packed);
-  if (!defines.empty() && defines[0] == ' ') defines.erase(0, 1);
   RenderOptions options;
   options.precision = parse_precision(info_args().precision);
   options.fast_math = info_args().fast_math;
   options.specialize = !info_args().no_specialize;
+  // (--no-specialize: every feature, as the build options below and Python's scene_info say)
+  std::string defines = render_detail::feature_defines(scene, packed, options.specialize);
+  if (!defines.empty() && defines[0] == ' ') defines.erase(0, 1);
   std::printf("\nkernel\n");
   std::string kernel_dir = SessionOptions::from_environment().kernel_dir;
   std::printf("  sources             %s\n", kernel_dir.empty() ? "embedded" : kernel_dir.c_str());
