@@ -13,6 +13,8 @@
 
 namespace lucent::scene_detail {
 
+class Reporter;  // scene/validate.hpp
+
 /// One parameter of a material type: its scene-file key, the lucent::Material field it sets, the
 /// values it accepts and its default.
 struct MaterialParam {
@@ -61,6 +63,12 @@ struct MaterialTypeDef {
   /// Whether its BSDF chooses between two delta lobes, which integrator.dielectric_splits
   /// follows both of (LC_HAS_SPLITTING: render_detail::kernel_features).
   bool splits = false;
+  /// The type's own checks beyond each parameter's kind (nullptr: none), after those: values
+  /// that depend on each other (diffuse_mirror: albedo + reflectance <= 1) or on the textures
+  /// the material uses (`textures`: the scene's, the material's albedo texture index checked).
+  /// Fails at `at`, the material's place, or below it.
+  void (*check)(const Material& m, const std::vector<Texture>& textures,
+                const Reporter& at) = nullptr;
 };
 
 #define LUCENT_DECLARE_MATERIAL_TYPE(ID, Name, value, name, feature, file, params) \

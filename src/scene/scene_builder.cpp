@@ -73,7 +73,7 @@ int SceneBuilder::load_texture(const std::string& file) {
 
 int SceneBuilder::add_material(const Material& material) {
   Reporter at(scene_.path, "/materials/" + material.name);
-  scene_detail::validate_material(material, scene_.textures.size(), at);
+  scene_detail::validate_material(material, scene_.textures, at);
   if (scene_.find_material(material.name) >= 0)
     at.fail("there is already a material named '" + material.name + "'");
   scene_.materials.push_back(material);

@@ -223,13 +223,15 @@ void validate_texture(const Texture& t, const Reporter& at) {
       check_non_negative(at.at("rgba").at(i), t.rgba[i]);
 }
 
-void validate_material(const Material& m, std::size_t textures, const Reporter& at) {
+void validate_material(const Material& m, const std::vector<Texture>& textures,
+                       const Reporter& at) {
   if (m.name.empty()) at.fail("material names must not be empty");
   check_type(at.at("type"), m.type);
   check_colour(at.at("emission"), m.emission);
-  check_texture_index(at.at("albedo").at("texture"), m.albedo_texture, textures, true);
+  check_texture_index(at.at("albedo").at("texture"), m.albedo_texture, textures.size(), true);
   // the type's parameters, by its parameter table (src/scene/materials/<file>.cpp)
-  for (const MaterialParam& param : material_type_def(m.type).params) {
+  const MaterialTypeDef& def = material_type_def(m.type);
+  for (const MaterialParam& param : def.params) {
     const Reporter p = at.at(param.key);
     switch (param.kind) {
       case MaterialParam::Colour:
@@ -244,6 +246,7 @@ void validate_material(const Material& m, std::size_t textures, const Reporter& 
         break;
     }
   }
+  if (def.check) def.check(m, textures, at);
 }
 
 void validate_light(const Light& l, std::size_t textures, const Reporter& at) {
@@ -355,7 +358,7 @@ void validate_scene(const Scene& s) {
     // its index
     Material m = s.materials[i];
     if (m.name.empty()) m.name = std::to_string(i);
-    validate_material(m, s.textures.size(), Reporter(file, "/materials/" + m.name));
+    validate_material(m, s.textures, Reporter(file, "/materials/" + m.name));
   }
   for (std::size_t i = 0; i < s.lights.size(); ++i)
     validate_light(s.lights[i], s.textures.size(), Reporter(file, "/lights/" + std::to_string(i)));

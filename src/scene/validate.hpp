@@ -103,8 +103,9 @@ void validate_texture_size(const Texture& texture, const Reporter& at);
 /// Its size, then every texel finite and non-negative.
 void validate_texture(const Texture& texture, const Reporter& at);
 /// The parameters every material has (name, type, emission, albedo texture), then its type's
-/// own, by the type's parameter table (scene/material_type.hpp).
-void validate_material(const Material& material, std::size_t textures, const Reporter& at);
+/// own, by the type's parameter table and its own check (scene/material_type.hpp).
+void validate_material(const Material& material, const std::vector<Texture>& textures,
+                       const Reporter& at);
 void validate_light(const Light& light, std::size_t textures, const Reporter& at);
 void validate_sphere(const SphereShape& sphere, const Reporter& at);
 void validate_mesh(const MeshShape& mesh, const Reporter& at);
