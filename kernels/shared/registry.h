@@ -65,7 +65,9 @@
   X(PLASTIC, Plastic, 4, "plastic", LC_HAS_PLASTIC, plastic,                                       \
     LC_PARAMS(float albedo[3]; lc_int albedo_tex; float specular[3]; float ior; float roughness;)) \
   X(ROUGH_DIELECTRIC, RoughDielectric, 5, "rough_dielectric", LC_HAS_ROUGH_DIELECTRIC,             \
-    rough_dielectric, LC_PARAMS(float tint[3]; float ior; float roughness;))
+    rough_dielectric, LC_PARAMS(float tint[3]; float ior; float roughness;))                       \
+  X(DIFFUSE_MIRROR, DiffuseMirror, 6, "diffuse_mirror", LC_HAS_DIFFUSE_MIRROR, diffuse_mirror,     \
+    LC_PARAMS(float albedo[3]; lc_int albedo_tex; float reflectance[3];))
 
 /* ------------------------------------------------------------------------------------------ */
 /* Lights: X(ID, Name, value, name, feature, file, params)                                     */

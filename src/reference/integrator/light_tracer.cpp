@@ -42,8 +42,8 @@ void LightTracer::trace(const Sampler& rng, std::vector<Splat>& out) const {
     skip = -1;
     Surface s = t_.surface(ray, hit);
     std::unique_ptr<Bsdf> b = t_.bsdf(s);
-    // The reference's BSDFs are wholly delta or not: a non-delta one is the non-delta part that
-    // the connection evaluates, and samples non-delta lobes only.
+    // A BSDF that is not wholly delta is connected through its non-delta part (eval); its delta
+    // lobes, if any (diffuse_mirror's mirror), are sampled below like a delta BSDF's.
     if (i >= 2 && !b->is_delta())
       connect(ray, hit, e.beta * weight, light_dim(rng, i, 0), light_dim(rng, i, 1), out);
     if (i == max_vertices) return;
