@@ -172,6 +172,9 @@ struct ChiSquareCase {
   double wo_theta;      // radians
   bool sphere = false;  // the BSDF transmits: bin the whole sphere of directions, not z > 0
   int front = 1;        // wo on the outside of the surface (0: inside; dielectrics)
+  // A BSDF with a delta lobe beside its non-delta ones (diffuse_mirror): the delta samples'
+  // expected mean weight (their directional albedo); 0 for the others.
+  double delta_albedo[3] = {0, 0, 0};
 };
 
 // A material of the given type packed for the device as the renderer packs it.
@@ -197,7 +200,9 @@ lc_material make(lc_uint type, float r, float g, float b, float spec, float roug
 // evaluation code (the same grid; 5 standard errors plus 1% for the quadrature), and no BSDF
 // creates energy: with the radiance scaling of refraction taken out (transmitted weights times
 // eta^2, eta = eta_t / eta_o, which radiance transport divides by), the albedo is at most 1
-// within 5 standard errors.
+// within 5 standard errors. A BSDF with a delta lobe beside non-delta ones: its delta samples
+// are left out of the bins (the pdf is the non-delta lobes'), each must be the mirror
+// direction, and the directional albedo is the quadrature plus tc.delta_albedo.
 void chi_square(const ChiSquareCase& tc) {
   const int N = 400000, NP = 32, NT = tc.sphere ? 32 : 16;
   const double zlo = tc.sphere ? -1.0 : 0.0, zspan = 1.0 - zlo;
@@ -214,9 +219,17 @@ void chi_square(const ChiSquareCase& tc) {
   std::vector<cl_float4> weight = lucent::test::read_back<cl_float4>(p.ctx.queue, bw, N);
 
   std::vector<double> observed(NT * NP, 0.0);
-  int produced = 0;
-  for (const auto& s : wi) {
+  int produced = 0, delta_samples = 0;
+  for (int i = 0; i < N; ++i) {
+    const cl_float4& s = wi[i];
     if (s.s[3] < 0) continue;
+    if (weight[i].s[3] > 0) {  // a delta sample: the mirror direction, no density
+      ++delta_samples;
+      EXPECT_NEAR(s.s[0], -wo.s[0], 1e-6) << tc.name << " delta sample " << i;
+      EXPECT_NEAR(s.s[1], -wo.s[1], 1e-6) << tc.name << " delta sample " << i;
+      EXPECT_NEAR(s.s[2], wo.s[2], 1e-6) << tc.name << " delta sample " << i;
+      continue;
+    }
     ++produced;
     double z = std::clamp<double>(s.s[2], -1, 1);
     if (z <= zlo) continue;  // reflection only unless the BSDF transmits
@@ -266,13 +279,18 @@ void chi_square(const ChiSquareCase& tc) {
   double pval = lucent::test::chi2_pvalue(c.chi2, dof);
   EXPECT_GT(pval, 1e-4) << tc.name << ": chi2 " << c.chi2 << " with " << dof << " dof";
 
-  // energy, for non-delta BSDFs (a delta BSDF has no pdf to integrate)
+  // energy, for BSDFs with a non-delta lobe (a delta BSDF has no pdf to integrate)
+  const bool mixed = tc.delta_albedo[0] > 0 || tc.delta_albedo[1] > 0 || tc.delta_albedo[2] > 0;
+  if (mixed) {
+    EXPECT_GT(delta_samples, 0) << tc.name << ": no delta sample";
+    EXPECT_GT(produced, 0) << tc.name << ": no non-delta sample";
+  }
   bool delta = false;
   double ior = tc.mat.type == LC_MAT_ROUGH_DIELECTRIC ? tc.mat.p.rough_dielectric.ior : 1.0;
   double eta = tc.front ? ior : 1 / ior;
   double mean[3] = {0, 0, 0}, mean2[3] = {0, 0, 0}, energy[3] = {0, 0, 0}, energy2[3] = {0, 0, 0};
   for (int i = 0; i < N; ++i) {
-    delta = delta || weight[i].s[3] > 0;
+    delta = delta || (!mixed && weight[i].s[3] > 0);
     double scale = wi[i].s[2] < 0 ? eta * eta : 1;
     for (int c = 0; c < 3; ++c) {
       double w = weight[i].s[c];
@@ -284,8 +302,10 @@ void chi_square(const ChiSquareCase& tc) {
   }
   for (int c = 0; c < 3 && !delta; ++c) {
     double se = std::sqrt(std::max(0.0, mean2[c] - mean[c] * mean[c]) / N);
-    EXPECT_NEAR(mean[c], albedo_quadrature[c], 5 * se + 0.01 * albedo_quadrature[c])
-        << tc.name << ": albedo from sampling weights vs quadrature of f |cos|, channel " << c;
+    const double want = albedo_quadrature[c] + tc.delta_albedo[c];
+    EXPECT_NEAR(mean[c], want, 5 * se + 0.01 * want)
+        << tc.name << ": albedo from sampling weights vs quadrature of f |cos|"
+        << (mixed ? " plus the delta lobe's" : "") << ", channel " << c;
     double se_e = std::sqrt(std::max(0.0, energy2[c] - energy[c] * energy[c]) / N);
     EXPECT_LE(energy[c], 1 + 5 * se_e) << tc.name << ": the BSDF reflects more than it receives";
   }
@@ -326,6 +346,24 @@ TEST(KernelBsdf, ChiSquareConductorSmooth) {
 }
 TEST(KernelBsdf, ChiSquarePlastic) {
   chi_square({"plastic", make(LC_MAT_PLASTIC, 0.3f, 0.5f, 0.8f, 1.0f, 0.2f, 1.5f), 0.9});
+}
+// Diffuse plus mirror: the diffuse directions against (1 - pm) cos / pi, the mirror ones with
+// probability pm = sum(r) / (sum(r) + sum(albedo)) and weight r / pm, whose mean is r; grey,
+// and a mirror for red that is matte for blue (the tutorial's example).
+TEST(KernelBsdf, ChiSquareDiffuseMirror) {
+  ChiSquareCase grey{"diffuse_mirror", make(LC_MAT_DIFFUSE_MIRROR, 0.6f, 0.3f, 0.1f, 0.3f, 0, 1.5f),
+                     0.8};
+  for (double& a : grey.delta_albedo) a = 0.3;
+  chi_square(grey);
+  lucent::Material m;
+  m.type = lucent::MaterialType::DiffuseMirror;
+  m.albedo = {0.05, 0.2, 0.9};
+  m.specular = {0.9, 0.3, 0.0};
+  ChiSquareCase red{"diffuse_mirror red mirror, blue matte", {}, 0.4};
+  red.mat.type = LC_MAT_DIFFUSE_MIRROR;
+  lucent::scene_detail::material_type_def(m.type).pack(m, red.mat.p);
+  for (int c = 0; c < 3; ++c) red.delta_albedo[c] = m.specular[c];
+  chi_square(red);
 }
 // Rough dielectric: reflection and transmission over the whole sphere, from outside and inside
 // (where total internal reflection takes part), smooth-ish to rough.

@@ -196,6 +196,30 @@ TEST(ReferenceSampling, BsdfPlastic) {
   chi_square_bsdf("plastic", material(MaterialType::Plastic, dvec3(0.3, 0.5, 0.8), 1.0, 0.2), 0.9);
 }
 
+// Diffuse plus mirror: the diffuse directions (uniform over the hemisphere, chosen half the time)
+// against Bsdf::pdf, which integrates to the non-delta half; the mirror ones (the other half,
+// left out of the bins) are the reflection of wo with weight reflectance / (1/2).
+TEST(ReferenceSampling, BsdfDiffuseMirror) {
+  lucent::Material m = material(MaterialType::DiffuseMirror, dvec3(0.05, 0.2, 0.9), 0, 0);
+  m.specular = dvec3(0.9, 0.3, 0.0);
+  chi_square_bsdf("diffuse_mirror", m, 0.8);
+  lucent::ref::ShadingPoint sp;
+  sp.n = sp.ng = glm::normalize(dvec3(0.3, -0.5, 0.8));
+  auto b = lucent::ref::make_bsdf(lucent::Scene{}, m, sp);
+  const dvec3 wo = glm::normalize(dvec3(0.6, 0.1, 0.5));
+  int deltas = 0;
+  for (int i = 0; i < 1000; ++i) {
+    lucent::ref::BsdfSample s = b->sample(wo, (i + 0.5) / 1000, 0.3, 0.7);
+    ASSERT_TRUE(s.valid);
+    if (!s.delta) continue;
+    ++deltas;
+    const dvec3 mirror = 2 * glm::dot(wo, sp.n) * sp.n - wo;
+    EXPECT_NEAR(glm::length(s.wi - mirror), 0, 1e-12);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(s.weight[c], 2 * m.specular[c], 1e-12);
+  }
+  EXPECT_EQ(deltas, 500);
+}
+
 // Rough dielectric (GGX reflection and transmission, Walter et al. 2007): both hemispheres,
 // from outside (eta = 1.5) and inside (eta = 1 / 1.5; at 0.9 rad, beyond the critical angle of
 // 0.73 rad, most microfacets reflect everything), three roughnesses. 64 x 64 cells over the

@@ -205,6 +205,43 @@ std::vector<Case> cases() {
       {"plastic roughness", R"({"materials": {"m": {"type": "plastic", "roughness": -0.5}}})",
        mat(MaterialType::Plastic, [](auto& m) { m.roughness = -0.5; }),
        "scene.json: /materials/m/roughness: must be in [0, 1], got -0.5"},
+      // diffuse_mirror: components in [0, 1], and no channel reflects more than it receives
+      {"diffuse_mirror albedo",
+       R"({"materials": {"m": {"type": "diffuse_mirror", "albedo": [0.5, 0.5, 1.2], "reflectance": [0, 0, 0]}}})",
+       mat(MaterialType::DiffuseMirror,
+           [](auto& m) {
+             m.albedo = {0.5, 0.5, 1.2};
+             m.specular = {0, 0, 0};
+           }),
+       "scene.json: /materials/m/albedo/2: must be in [0, 1], got 1.2"},
+      {"diffuse_mirror reflectance",
+       R"({"materials": {"m": {"type": "diffuse_mirror", "albedo": [0, 0, 0], "reflectance": [0.5, -0.5, 0]}}})",
+       mat(MaterialType::DiffuseMirror,
+           [](auto& m) {
+             m.albedo = {0, 0, 0};
+             m.specular = {0.5, -0.5, 0};
+           }),
+       "scene.json: /materials/m/reflectance/1: must be >= 0, got -0.5"},
+      {"diffuse_mirror energy",
+       R"({"materials": {"m": {"type": "diffuse_mirror", "albedo": [0.7, 0.5, 0.3], "reflectance": [0.3, 0.6, 0.3]}}})",
+       mat(MaterialType::DiffuseMirror,
+           [](auto& m) {
+             m.albedo = {0.7, 0.5, 0.3};
+             m.specular = {0.3, 0.6, 0.3};
+           }),
+       "scene.json: /materials/m/reflectance/1: albedo + reflectance must be <= 1 in each "
+       "channel (the surface would reflect more light than it receives), got 0.5 + 0.6 = 1.1 in "
+       "green"},
+      {"diffuse_mirror default reflectance",
+       R"({"materials": {"m": {"type": "diffuse_mirror", "albedo": [0.9, 0.8, 0.8]}}})",
+       mat(MaterialType::DiffuseMirror,
+           [](auto& m) {
+             m.albedo = {0.9, 0.8, 0.8};
+             m.specular = {0.2, 0.2, 0.2};
+           }),
+       "scene.json: /materials/m/reflectance/0: albedo + reflectance must be <= 1 in each "
+       "channel (the surface would reflect more light than it receives), got 0.9 + 0.2 = 1.1 in "
+       "red"},
       {"empty name", R"({"materials": {"": {"type": "diffuse"}}})",
        [](SceneBuilder& b) { b.add_material(material("", MaterialType::Diffuse)); },
        "scene.json: /materials/: material names must not be empty"},
@@ -401,6 +438,24 @@ TEST(SceneBuilder, CodeOnlyErrors) {
             }),
             "scene.json: /integrator/type: unknown integrator 99 (expected one of: " +
                 lucent::type_names<lucent::IntegratorType>() + ")");
+  // diffuse_mirror with a textured albedo: its brightest texel in each channel plus the
+  // reflectance must not exceed 1 (the colour, which the texture replaces, is not checked)
+  auto textured = [](float texel_green, double reflectance) {
+    return code_error([=](SceneBuilder& b) {
+      b.add_texture(
+          lucent::texture_from_rgba(2, 1, {0.1f, 0.2f, 0.3f, 1, 0.4f, texel_green, 0, 1}));
+      lucent::Material m = material("m", lucent::MaterialType::DiffuseMirror);
+      m.albedo = {5, 5, 5};
+      m.albedo_texture = 0;
+      m.specular = glm::dvec3(reflectance);
+      b.add_material(m);
+    });
+  };
+  EXPECT_EQ(textured(0.5f, 0.5), "");
+  EXPECT_EQ(textured(0.75f, 0.5),
+            "scene.json: /materials/m/reflectance/1: albedo + reflectance must be <= 1 in each "
+            "channel (the surface would reflect more light than it receives), got 0.75 (the "
+            "albedo texture's brightest texel) + 0.5 = 1.25 in green");
   // a scene without a name: the messages start with the place
   EXPECT_EQ(error_of([] {
               SceneBuilder().add_sphere({{0, 0, 0}, 1, "m"});
