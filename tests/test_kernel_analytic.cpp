@@ -171,6 +171,75 @@ TEST(KernelAnalytic, WhiteFurnace) {
   expect_matches(r, [](int, int, int) { return 0.5; });
 }
 
+// White furnace of diffuse_mirror: albedo + reflectance = 1 in each channel (grey, and a red
+// mirror that is matte in blue) under a constant environment of 1 renders 1 everywhere: the
+// diffuse part (light sampling and BSDF sampling, MIS) and the mirror part (chosen by the lobe
+// choice, weight reflectance / its probability) add up to the whole hemisphere's light.
+TEST(KernelAnalytic, DiffuseMirrorWhiteFurnace) {
+  RenderResult r = render_full(R"({
+    "camera": {"position": [0, 0, 4.5], "look_at": [0, 0, 0], "fov": 40},
+    "film": {"width": 16, "height": 16},
+    "integrator": {"type": "path", "max_depth": 1000, "rr_depth": 3},
+    "materials": {"grey": {"type": "diffuse_mirror", "albedo": [0.6, 0.6, 0.6], "reflectance": [0.4, 0.4, 0.4]},
+                  "red": {"type": "diffuse_mirror", "albedo": [0.1, 0.5, 0.9], "reflectance": [0.9, 0.5, 0.1]}},
+    "shapes": [{"type": "sphere", "center": [-0.8, 0, 0], "radius": 0.7, "material": "grey"},
+               {"type": "sphere", "center": [0.8, 0, 0], "radius": 0.7, "material": "red"}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]})",
+                               64);
+  expect_matches(r, [](int, int, int) { return 1.0; });
+}
+
+// diffuse_mirror plane (albedo a, reflectance r) under a point light I and a constant environment
+// E, nothing else in the scene: the mirror shows the environment, the diffuse part is lit by the
+// light and the whole sky. Pixel values (over the pixel's footprint):
+//   whitted  a/pi I cos / d^2 + r E              (the tutorial's model, lucent's albedo/pi)
+//   path     a/pi I cos / d^2 + r E + a E        (the sky's irradiance pi E through a/pi)
+//   direct   a/pi I cos / d^2                    (point lights through the BSDF; no mirror)
+// and, for whitted, the mirror image of an emissive quad Le instead of the sky: r Le.
+TEST(KernelAnalytic, DiffuseMirrorPlaneUnderAPointLight) {
+  const double a[3] = {0.1, 0.3, 0.7}, refl[3] = {0.8, 0.4, 0.0}, E[3] = {0.5, 1.0, 2.0};
+  const double Le[3] = {2, 3, 4};
+  const double pos[3] = {0, -3, 3}, look[3] = {0, 0, 0}, up[3] = {0, 0, 1};
+  PinholeToPlane cam(pos, look, up, 10, 8, 8);
+  auto point_light = [&](const double* q, int c) {
+    double dx = 0.5 - q[0], dy = 0.3 - q[1], dz = 1.5 - q[2];
+    double r2 = dx * dx + dy * dy + dz * dz;
+    return a[c] / M_PI * 20 * (dz / std::sqrt(r2)) / r2;
+  };
+  auto scene = [&](const std::string& integrator, bool quad) {
+    return std::string(R"({
+      "camera": {"position": [0, -3, 3], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 10},
+      "film": {"width": 8, "height": 8},
+      "integrator": {"type": ")") +
+           integrator + R"(", "max_depth": 4},
+      "materials": {"plane": {"type": "diffuse_mirror", "albedo": [0.1, 0.3, 0.7], "reflectance": [0.8, 0.4, 0]},
+                    "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [2, 3, 4]}},
+      "shapes": [)" +
+           kPlane +
+           (quad ? R"(, {"type": "triangles", "material": "lamp",
+       "positions": [[-20, 8, -5], [20, 8, -5], [20, 8, 30], [-20, 8, 30]], "indices": [0, 1, 2, 0, 2, 3]})"
+                 : "") +
+           R"(],
+      "lights": [{"type": "point", "position": [0.5, 0.3, 1.5], "intensity": [20, 20, 20]})" +
+           (quad ? "" : R"(, {"type": "environment", "radiance": [0.5, 1.0, 2.0]})") + "]}";
+  };
+  for (const char* integrator : {"whitted", "path", "direct"}) {
+    SCOPED_TRACE(integrator);
+    const std::string in = integrator;
+    RenderResult r = render_full(scene(in, false), in == "path" ? 256 : 16);
+    expect_matches(r, [&](int x, int y, int c) {
+      double sky = in == "whitted" ? refl[c] * E[c] : in == "path" ? (refl[c] + a[c]) * E[c] : 0;
+      return cam.pixel_mean(x, y, [&](const double* q) { return point_light(q, c) + sky; });
+    });
+  }
+  SCOPED_TRACE("whitted, the mirror image of an emissive quad");
+  RenderResult r = render_full(scene("whitted", true), 16);
+  expect_matches(r, [&](int x, int y, int c) {
+    return cam.pixel_mean(x, y,
+                          [&](const double* q) { return point_light(q, c) + refl[c] * Le[c]; });
+  });
+}
+
 // A closed box (inward-facing triangles) of albedo rho and emission Le seen from inside
 // renders Le / (1 - rho) at unbounded depth. 256 spp: a sample's value grows with its path
 // length (geometric after Russian roulette), a skewed distribution whose low pixel means come with
