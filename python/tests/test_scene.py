@@ -125,6 +125,36 @@ def test_scene_built_in_code_renders(renderer):
     assert renderer.result().mean[4, 4] == pytest.approx([0.5, 0.25, 1.0], rel=1e-6)
 
 
+def test_diffuse_mirror_from_python(renderer, small_dict):
+    # reflectance is Material.specular, as for mirror; the albedo AOV is albedo + reflectance
+    s = lucent.Scene()
+    s.film.width, s.film.height = 8, 8
+    s.camera.position = (0, 0, 4)
+    s.camera.look_at = (0, 0, 0)
+    m = lucent.Material()
+    m.type = "diffuse_mirror"
+    m.albedo = (0.1, 0.5, 0.9)
+    m.specular = (0.9, 0.25, 0.0)
+    s.materials.append(m)
+    s.spheres.append(lucent.Sphere((0, 0, 0), 1.5))
+    s.integrator.type = "albedo"
+    renderer.set_scene(s)
+    renderer.render(1)
+    assert renderer.result().mean[4, 4] == pytest.approx([1.0, 0.75, 0.9], rel=1e-6)
+    # more than it receives, in a channel: refused with the JSON path, from code and from a dict
+    m.specular = (0.9, 0.6, 0.0)
+    s.materials[0] = m
+    with pytest.raises(lucent.Error, match=r"/materials/0/reflectance/1: albedo \+ reflectance "
+                                           r"must be <= 1 in each channel .* = 1\.1 in green"):
+        renderer.set_scene(s)
+    small_dict["materials"]["w"] = {"type": "diffuse_mirror", "albedo": [0.5, 0.5, 0.5],
+                                    "reflectance": [0.5, 0.5, 0.75]}
+    with pytest.raises(lucent.Error) as e:
+        lucent.scene_from_dict(small_dict)
+    assert one_line(e).startswith("./<dict>: /materials/w/reflectance/2: albedo + reflectance "
+                                  "must be <= 1 in each channel")
+
+
 def test_texture_from_an_array(small_scene):
     t = lucent.Texture()
     t.rgba = np.ones((2, 3, 4), np.float32) * [0.1, 0.2, 0.3, 1]
