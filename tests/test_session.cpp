@@ -433,6 +433,59 @@ TEST(Session, SeveralDevicesShareTheSamples) {
   EXPECT_EQ(both.render(100).samples_done, 0u);
 }
 
+// SessionStats counts set_scene() calls (scene_packs, kernel_reuses) once per call and work on
+// the devices (kernel builds, buffer uploads) per device, in the same unit for a first upload and
+// a later one: the first writes every scene buffer that holds data, not "1".
+TEST(Session, StatsCountCallsOnceAndBuffersPerDevice) {
+  Scene s = lucent::test::scene_from(kScene);
+  bool reused = false;
+  const lucent::render_detail::PackedScene packed =
+      lucent::render_detail::pack_scene(s, nullptr, &reused);
+  uint64_t buffers = 0, bytes = 0;
+#define LUCENT_COUNT(name, type, ...)           \
+  if (!packed.name.empty()) {                   \
+    ++buffers;                                  \
+    bytes += packed.name.size() * sizeof(type); \
+  }
+  LC_SCENE_BUFFERS(LUCENT_COUNT)
+#undef LUCENT_COUNT
+  ASSERT_GE(buffers, 6u) << "BVH nodes and leaves, triangles, spheres, materials, lights";
+
+  Renderer one = session();
+  one.set_scene(s);
+  EXPECT_EQ(one.stats().buffer_uploads, buffers);
+  EXPECT_EQ(one.stats().bytes_uploaded, bytes);
+
+  lucent::SessionOptions o = lucent::test::session_options();
+  std::string index = std::to_string(lucent::select_device(o.device).index);
+  o.device = index + "," + index;
+  Renderer both(o);
+  ASSERT_EQ(both.devices().size(), 2u);
+  both.set_scene(s);
+  SessionStats st = both.stats();
+  EXPECT_EQ(st.scene_packs, 1u);
+  EXPECT_EQ(kernel_builds(st), 2u) << "one program per device";
+  EXPECT_EQ(st.kernel_reuses, 0u);
+  EXPECT_EQ(st.buffer_uploads, 2 * buffers) << "every buffer on each device";
+  EXPECT_EQ(st.bytes_uploaded, 2 * bytes);
+
+  s.camera.position.x += 0.5;
+  both.set_scene(s);
+  SessionStats moved = both.stats();
+  EXPECT_EQ(moved.scene_packs, 2u);
+  EXPECT_EQ(moved.kernel_reuses, 1u) << "one set_scene call kept the program";
+  EXPECT_EQ(kernel_builds(moved), 2u);
+  EXPECT_EQ(moved.buffer_uploads, st.buffer_uploads);
+
+  s.materials[0].albedo = {0.2, 0.9, 0.2};
+  both.set_scene(s);
+  SessionStats changed = both.stats();
+  EXPECT_EQ(changed.kernel_reuses, 2u);
+  EXPECT_EQ(changed.buffer_uploads, st.buffer_uploads + 2) << "the materials buffer, twice";
+  EXPECT_EQ(changed.bytes_uploaded,
+            st.bytes_uploaded + 2 * packed.materials.size() * sizeof(packed.materials[0]));
+}
+
 // render_adaptive's options and the accumulation it may continue are checked: each misuse is an
 // error saying what is wrong, and the accumulation in the session stays as it was.
 TEST(Session, AdaptiveMisuseIsAnErrorAndLosesNothing) {

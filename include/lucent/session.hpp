@@ -58,19 +58,27 @@ struct SessionOptions {
 };
 
 /// What a session has built and done, for tools that want to know what a change cost.
+/// scene_packs, bvh_builds and kernel_reuses count set_scene() calls (set_build_options() with a
+/// scene makes one); the other counters and the times count work on the devices, summed over the
+/// session's devices: with two devices a new program is two builds, a buffer written is written
+/// to each (two uploads), and each device's passes count.
 struct SessionStats {
   std::uint64_t scene_packs = 0;         ///< set_scene() calls that packed a scene
   std::uint64_t bvh_builds = 0;          ///< BVH builds (not counted when the geometry was reused)
-  std::uint64_t kernel_compiles = 0;     ///< kernel programs compiled from source
-  std::uint64_t kernel_cache_loads = 0;  ///< programs loaded from the binary cache
-  std::uint64_t kernel_reuses = 0;       ///< set_scene() calls that kept the session's program
-  std::uint64_t buffer_uploads = 0;      ///< scene buffers written to the device
-  std::uint64_t bytes_uploaded = 0;
-  std::uint64_t passes = 0;  ///< kernel launches that rendered samples
-  double pack_seconds = 0;   ///< packing, BVH included
+  std::uint64_t kernel_compiles = 0;     ///< kernel programs compiled from source, per device
+  std::uint64_t kernel_cache_loads = 0;  ///< programs loaded from the binary cache, per device
+  /// set_scene() calls that kept the session's program: no device built or loaded one (one per
+  /// call, whatever the number of devices)
+  std::uint64_t kernel_reuses = 0;
+  /// scene buffers written to each device: the first set_scene writes every buffer that holds
+  /// data (an empty one is not counted), a later one the buffers whose contents changed
+  std::uint64_t buffer_uploads = 0;
+  std::uint64_t bytes_uploaded = 0;  ///< the bytes of those buffers
+  std::uint64_t passes = 0;          ///< kernel launches that rendered samples
+  double pack_seconds = 0;           ///< packing, BVH included
   double bvh_seconds = 0;
   double build_seconds = 0;   ///< kernel builds and cache loads
-  double render_seconds = 0;  ///< kernel passes
+  double render_seconds = 0;  ///< kernel passes (each device's time: they overlap)
 };
 
 /// An adaptive render (Renderer::render_adaptive; docs/rendering-model.md, "Adaptive sampling"):

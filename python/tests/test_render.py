@@ -69,6 +69,33 @@ def test_camera_change_rebuilds_neither_bvh_nor_kernel(renderer, small_scene):
     assert s2.buffer_uploads == s1.buffer_uploads + 1
 
 
+def test_stats_count_calls_once_and_buffers_per_device(small_scene):
+    """scene_packs and kernel_reuses count set_scene calls, once whatever the number of devices;
+    kernel builds and buffer uploads count work on each device, and a first upload counts every
+    buffer it writes (not 1), as a later one counts the buffers that changed."""
+    with session() as one:
+        one.set_scene(small_scene)
+        buffers, bytes_ = one.stats.buffer_uploads, one.stats.bytes_uploaded
+    assert buffers >= 6, "BVH nodes and leaves, triangles, spheres, materials, lights"
+    index = lucent.select_device(lucent.environment()["device"]).index
+    with session(device=f"{index},{index}") as two:
+        assert len(two.devices) == 2
+        two.set_scene(small_scene)
+        s0 = two.stats
+        assert (s0.scene_packs, kernel_builds(s0), s0.kernel_reuses) == (1, 2, 0)
+        assert (s0.buffer_uploads, s0.bytes_uploaded) == (2 * buffers, 2 * bytes_)
+        small_scene.camera.position.x += 0.5
+        two.set_scene(small_scene)
+        s1 = two.stats
+        assert (s1.scene_packs, kernel_builds(s1), s1.kernel_reuses) == (2, 2, 1)
+        assert s1.buffer_uploads == s0.buffer_uploads
+        small_scene.materials[0].albedo = (0.2, 0.9, 0.2)
+        two.set_scene(small_scene)
+        s2 = two.stats
+        assert s2.kernel_reuses == 2
+        assert s2.buffer_uploads == s1.buffer_uploads + 2, "the materials buffer on each device"
+
+
 def test_stats_expose_every_field(renderer, small_scene):
     renderer.set_scene(small_scene)
     renderer.render(1)

@@ -370,10 +370,7 @@ struct Renderer::Impl {
   Program& get_program(Worker& w, const std::string& opts, const std::string& source,
                        cl_util::DeferredEntry& entry) {
     auto it = w.programs.find(opts);
-    if (it != w.programs.end()) {
-      ++stats.kernel_reuses;
-      return it->second;
-    }
+    if (it != w.programs.end()) return it->second;
     auto t0 = clock_type::now();
     cl_util::ProgramBuildInfo info;
     Program p;
@@ -475,6 +472,7 @@ struct Renderer::Impl {
     std::string device;  // the one being set up, and what it does, for messages
     render_detail::ClStage stage = render_detail::ClStage::Upload;
     bool touched = false;
+    bool built = false;  // a device built (or loaded) a program: the call did not keep it
     try {
       std::string source;
       for (auto& wp : workers) {
@@ -487,12 +485,18 @@ struct Renderer::Impl {
           if (kernel_source_hash == 0) kernel_source_hash = fnv1a(source.data(), source.size());
         }
         cl_util::DeferredEntry entry;
+        if (!w.programs.count(opts)) built = true;
         w.program = &get_program(w, opts, source, entry);
         touched = true;  // from here on a failure leaves the devices' buffers in doubt
         if (!w.dev) {
           w.dev.emplace(w.ctx, next);
-          ++stats.buffer_uploads;
-#define LUCENT_BYTES(name, type, ...) stats.bytes_uploaded += next.name.size() * sizeof(type);
+          // every buffer that holds data was written (an empty one is created without any, as
+          // update() does not count an empty buffer that stays empty)
+#define LUCENT_BYTES(name, type, ...)                        \
+  if (!next.name.empty()) {                                  \
+    ++stats.buffer_uploads;                                  \
+    stats.bytes_uploaded += next.name.size() * sizeof(type); \
+  }
           LC_SCENE_BUFFERS(LUCENT_BYTES)
 #undef LUCENT_BYTES
         } else {
@@ -547,6 +551,7 @@ struct Renderer::Impl {
       if (touched) drop_device_scenes(e.what());
       throw;
     }
+    if (!built) ++stats.kernel_reuses;  // once per call, whatever the number of devices
     stale.clear();
     packed = std::move(next);
     build_options = opts;
