@@ -8,6 +8,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <atomic>
+#include <cstdint>
 #include <exception>
 #include <functional>
 #include <memory>
@@ -64,6 +65,32 @@ struct type_caster<lucent::python::FileText> {
   static handle cast(const lucent::python::FileText& text, return_value_policy, handle) {
     return PyUnicode_DecodeUTF8(text.bytes.data(), static_cast<Py_ssize_t>(text.bytes.size()),
                                 "surrogateescape");
+  }
+};
+}  // namespace pybind11::detail
+
+namespace lucent::python {
+
+/// An integer argument as given: any Python object, for int_argument() to check. A C++ integer
+/// parameter made pybind11 refuse an int beyond its type (2**63 for a long long) with a TypeError
+/// "incompatible function arguments" that names neither the argument nor its range, and let each
+/// binding check the rest its own way; the signature still says "int".
+struct IntArg {
+  py::object value;
+};
+
+}  // namespace lucent::python
+
+namespace pybind11::detail {
+template <>
+struct type_caster<lucent::python::IntArg> {
+  PYBIND11_TYPE_CASTER(lucent::python::IntArg, const_name("int"));
+  bool load(handle src, bool) {
+    value.value = reinterpret_borrow<object>(src);
+    return true;
+  }
+  static handle cast(const lucent::python::IntArg& arg, return_value_policy, handle) {
+    return arg.value.inc_ref();
   }
 };
 }  // namespace pybind11::detail
@@ -186,6 +213,17 @@ V to_vec(py::handle o) {
   }
   return v;
 }
+
+/// `arg` as an integer in [lo, hi], the one check of the integer arguments of the session's
+/// methods (and render_reference's): TypeError naming `what` unless it is an integer (an int, a
+/// NumPy integer: what operator.index takes, not a float or a str); ValueError
+/// "<what> must be an integer in [lo, hi]<note>, got <value>" for any integer outside, negative
+/// or beyond 64 bits alike (never clamped).
+std::uint64_t int_argument(const IntArg& arg, const char* what, std::uint64_t lo, std::uint64_t hi,
+                           const char* note = "");
+
+/// `n` as messages write a range's bound: 2**k or 2**k - 1 from 2**16 on, else in decimal.
+std::string range_bound(std::uint64_t n);
 
 /// A NumPy array over `data` (C order, `shape`), kept valid by `owner` (the Python object that
 /// holds the vector): no copy.

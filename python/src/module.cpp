@@ -89,6 +89,52 @@ std::string visible_nul(const std::string& text) {
   return out;
 }
 
+std::string range_bound(std::uint64_t n) {
+  for (int k = 16; k <= 64; ++k) {
+    const std::uint64_t p = k < 64 ? std::uint64_t(1) << k : 0;  // 2**64 wraps to 0
+    if (k < 64 && n == p) return "2**" + std::to_string(k);
+    if (n == p - 1) return "2**" + std::to_string(k) + " - 1";
+  }
+  return std::to_string(n);
+}
+
+std::uint64_t int_argument(const IntArg& arg, const char* what, std::uint64_t lo, std::uint64_t hi,
+                           const char* note) {
+  const auto shown = [](py::handle v) {
+    try {
+      return py::repr(v).cast<std::string>();
+    } catch (py::error_already_set&) {  // an int past sys.get_int_max_str_digits()
+      return std::string("an integer too long to show");
+    }
+  };
+  py::object i = py::reinterpret_steal<py::object>(PyNumber_Index(arg.value.ptr()));
+  if (!i) {
+    PyErr_Clear();
+    throw py::type_error(std::string(what) + " must be an integer, got " + shown(arg.value));
+  }
+  int overflow = 0;
+  const long long x = PyLong_AsLongLongAndOverflow(i.ptr(), &overflow);
+  if (x == -1 && PyErr_Occurred()) throw py::error_already_set();
+  bool in_range = false;
+  std::uint64_t v = 0;
+  if (overflow > 0) {  // 2**63 and more: within 64 bits?
+    const unsigned long long u = PyLong_AsUnsignedLongLong(i.ptr());
+    if (PyErr_Occurred()) {
+      PyErr_Clear();
+    } else {
+      v = u;
+      in_range = v >= lo && v <= hi;
+    }
+  } else if (overflow == 0 && x >= 0) {
+    v = static_cast<std::uint64_t>(x);
+    in_range = v >= lo && v <= hi;
+  }
+  if (!in_range)
+    throw py::value_error(std::string(what) + " must be an integer in [" + range_bound(lo) + ", " +
+                          range_bound(hi) + "]" + note + ", got " + shown(i));
+  return v;
+}
+
 void refuse_nul(const std::string& text, const char* what) {
   if (text.find('\0') != std::string::npos)
     throw py::value_error(std::string(what) + ": embedded null character in '" + visible_nul(text) +

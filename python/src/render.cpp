@@ -322,12 +322,11 @@ void bind_session_devices(py::class_<PyRenderer>& c) {
                             [](PyRenderer& r) { return static_cast<const R&>(r.get()).devices(); });
 }
 
-std::uint64_t checked_spp(long long spp, bool allow_zero) {
-  if (spp < 0 || (spp == 0 && !allow_zero))
-    throw py::value_error("spp must be " + std::string(allow_zero ? ">= 0" : "> 0") + ", got " +
-                          std::to_string(spp));
-  return static_cast<std::uint64_t>(spp);
-}
+// The sampler's sample indices are 32-bit: a render adds at most 2**32 samples per pixel, and
+// reset() starts below 2**32.
+constexpr std::uint64_t kSampleIndices = std::uint64_t(1) << 32;
+constexpr const char* kSampleNote = " (the sampler's sample indices are 32-bit)";
+constexpr std::uint64_t kMaxAdaptiveSpp = std::numeric_limits<std::uint32_t>::max();
 
 double checked_seconds(double s, const char* what) {
   if (!(s >= 0) || !std::isfinite(s))
@@ -681,9 +680,14 @@ void bind_render(py::module_& m) {
           "passes, from any thread).")
       .def(
           "render",
-          [](PyRenderer& r, long long spp, double seconds, py::object progress) {
-            return r.render("render", checked_spp(spp, true), checked_seconds(seconds, "seconds"),
-                            std::move(progress));
+          [](PyRenderer& r, const IntArg& spp_arg, double seconds, py::object progress) {
+            const std::uint64_t spp = int_argument(spp_arg, "spp", 0, kSampleIndices, kSampleNote);
+            seconds = checked_seconds(seconds, "seconds");
+            if (spp == 0 && seconds == 0)
+              throw py::value_error(
+                  "render: give spp > 0, seconds > 0 or both, got spp=0 and "
+                  "seconds=0");
+            return r.render("render", spp, seconds, std::move(progress));
           },
           py::arg("spp"), py::arg("seconds") = 0.0, py::arg("progress") = py::none(),
           "Adds `spp` samples per pixel, or samples for `seconds` when that comes first (0: no "
@@ -691,17 +695,28 @@ void bind_render(py::module_& m) {
           "after the current pass (the accumulation keeps it) and raises KeyboardInterrupt.")
       .def(
           "render_adaptive",
-          [](PyRenderer& r, double target_error, double budget_spp, long long min_spp,
-             long long max_spp, double max_seconds, py::object progress) {
+          [](PyRenderer& r, double target_error, double budget_spp, const IntArg& min_spp,
+             const IntArg& max_spp, double max_seconds, py::object progress) {
             AdaptiveOptions o;
             o.target_error = checked_seconds(target_error, "target_error");
             o.budget_spp = checked_seconds(budget_spp, "budget_spp");
-            if (!(o.target_error > 0) && !(o.budget_spp > 0))
-              throw py::value_error("render_adaptive: give target_error > 0 or budget_spp > 0");
-            o.min_spp = static_cast<std::uint32_t>(std::min<std::uint64_t>(
-                checked_spp(min_spp, false), std::numeric_limits<std::uint32_t>::max()));
-            o.max_spp = static_cast<std::uint32_t>(std::min<std::uint64_t>(
-                checked_spp(max_spp, false), std::numeric_limits<std::uint32_t>::max()));
+            if ((o.target_error > 0) == (o.budget_spp > 0))
+              throw py::value_error(
+                  "render_adaptive: give one of target_error and budget_spp, a number > 0, got "
+                  "target_error=" +
+                  format_field(o.target_error) + " and budget_spp=" + format_field(o.budget_spp));
+            o.min_spp =
+                static_cast<std::uint32_t>(int_argument(min_spp, "min_spp", 4, kMaxAdaptiveSpp));
+            o.max_spp =
+                static_cast<std::uint32_t>(int_argument(max_spp, "max_spp", 4, kMaxAdaptiveSpp));
+            // the pilot is two halves of (min_spp + 1) / 2 samples (Renderer::render_adaptive)
+            const std::uint64_t pilot = 2 * ((std::uint64_t(o.min_spp) + 1) / 2);
+            if (o.max_spp < pilot)
+              throw py::value_error(
+                  "max_spp must be at least min_spp's pilot (min_spp rounded up "
+                  "to even, " +
+                  std::to_string(pilot) + "), got min_spp=" + std::to_string(o.min_spp) +
+                  " and max_spp=" + std::to_string(o.max_spp));
             o.max_seconds = checked_seconds(max_seconds, "max_seconds");
             return r.render_adaptive(o, std::move(progress));
           },
@@ -725,19 +740,10 @@ void bind_render(py::module_& m) {
           "Adds samples for about `seconds` (at least one pass).")
       .def(
           "reset",
-          [](PyRenderer& r, const py::int_& first_sample) {
-            // any Python int: one out of range is a ValueError, not pybind11's TypeError
-            const std::string shown = py::repr(first_sample).cast<std::string>();
-            const unsigned long long first = PyLong_AsUnsignedLongLong(first_sample.ptr());
-            if (PyErr_Occurred()) {
-              PyErr_Clear();
-              throw py::value_error(shown.rfind('-', 0) == 0
-                                        ? "first_sample must be >= 0, got " + shown
-                                        : "first_sample must be below 2**32 (the sampler's "
-                                          "range), got " +
-                                              shown);
-            }
-            r.call("reset", [&](Renderer& rr) { rr.reset(static_cast<std::uint64_t>(first)); });
+          [](PyRenderer& r, const IntArg& first_sample) {
+            const std::uint64_t first =
+                int_argument(first_sample, "first_sample", 0, kSampleIndices - 1, kSampleNote);
+            r.call("reset", [&](Renderer& rr) { rr.reset(first); });
           },
           py::arg("first_sample") = 0,
           "Drops the accumulation; the next sample index is first_sample.")
@@ -778,15 +784,13 @@ void bind_render(py::module_& m) {
 
   m.def(
       "render_reference",
-      [](const Scene& scene, long long spp, int threads) {
-        if (threads < 0)
-          throw py::value_error("threads must be >= 0, got " + std::to_string(threads));
+      [](const Scene& scene, const IntArg& spp, const IntArg& threads_arg) {
+        const int threads = static_cast<int>(
+            int_argument(threads_arg, "threads", 0, std::numeric_limits<int>::max()));
         Scene copy = scene;
         std::atomic<bool> cancel{false};
         ReferenceOptions o;
-        if (checked_spp(spp, true) > static_cast<std::uint64_t>(1 << 30))
-          throw py::value_error("spp must be at most 2^30, got " + std::to_string(spp));
-        o.spp = static_cast<int>(spp);
+        o.spp = static_cast<int>(int_argument(spp, "spp", 0, std::uint64_t(1) << 30));
         o.threads = threads;
         o.cancel = &cancel;
         RenderResult out;

@@ -282,9 +282,9 @@ def test_session_errors(renderer, small_scene):
     with pytest.raises(lucent.Error, match="no scene"):
         renderer.scene
     renderer.set_scene(small_scene)
-    with pytest.raises(ValueError, match="spp must be >= 0, got -1"):
+    with pytest.raises(ValueError, match=r"spp must be an integer in \[0, 2\*\*32\]"):
         renderer.render(-1)
-    with pytest.raises(lucent.Error, match="give a number of samples per pixel, a time limit"):
+    with pytest.raises(ValueError, match="render: give spp > 0, seconds > 0 or both"):
         renderer.render(0)
     with pytest.raises(TypeError):
         renderer.render(1.5)
@@ -296,12 +296,8 @@ def test_session_errors(renderer, small_scene):
         renderer.render_for(0)
     with pytest.raises(ValueError, match="seconds must be a finite number > 0"):
         renderer.render_for(float("nan"))
-    with pytest.raises(ValueError, match="first_sample must be >= 0"):
+    with pytest.raises(ValueError, match=r"first_sample must be an integer in \[0, 2\*\*32 - 1\]"):
         renderer.reset(-1)
-    with pytest.raises(lucent.Error, match="below 2\\^32"):
-        renderer.reset(2 ** 32)
-    with pytest.raises(ValueError, match="first_sample must be below 2\\*\\*32"):
-        renderer.reset(2 ** 64)  # beyond a C integer: not pybind11's TypeError
     with pytest.raises(TypeError):
         renderer.set_scene({"film": {}})
     with pytest.raises(TypeError):
@@ -318,6 +314,79 @@ def test_session_errors(renderer, small_scene):
     renderer.close()
     with pytest.raises(lucent.Error, match="closed"):
         renderer.render(1)
+
+
+U32 = "the sampler's sample indices are 32-bit"
+
+
+@pytest.mark.parametrize("call, message", [
+    # integers out of range, whatever their size: ValueError naming the argument and its range
+    (lambda r: r.render(2 ** 32 + 1), r"^spp must be an integer in \[0, 2\*\*32\] \(%s\), got "
+     r"4294967297$" % U32),
+    (lambda r: r.render(2 ** 63), r"^spp must be an integer in \[0, 2\*\*32\] \(%s\), got "
+     r"9223372036854775808$" % U32),
+    (lambda r: r.render(2 ** 64), r"^spp must be .*, got 18446744073709551616$"),
+    (lambda r: r.render(-2 ** 70), r"^spp must be .*, got -1180591620717411303424$"),
+    (lambda r: r.render(0), r"^render: give spp > 0, seconds > 0 or both, got spp=0 and seconds=0$"),
+    (lambda r: r.render(0, seconds=0), r"^render: give spp > 0, seconds > 0 or both"),
+    (lambda r: r.reset(2 ** 32), r"^first_sample must be an integer in \[0, 2\*\*32 - 1\] "
+     r"\(%s\), got 4294967296$" % U32),
+    (lambda r: r.reset(2 ** 64), r"^first_sample must be an integer in \[0, 2\*\*32 - 1\]"),
+    (lambda r: r.reset(-1), r"^first_sample must be an integer in \[0, 2\*\*32 - 1\] .*, got -1$"),
+    # render_adaptive: never clamped, and its combinations are arguments too
+    (lambda r: r.render_adaptive(budget_spp=8, max_spp=2 ** 40),
+     r"^max_spp must be an integer in \[4, 2\*\*32 - 1\], got 1099511627776$"),
+    (lambda r: r.render_adaptive(budget_spp=8, min_spp=2 ** 32),
+     r"^min_spp must be an integer in \[4, 2\*\*32 - 1\], got 4294967296$"),
+    (lambda r: r.render_adaptive(target_error=0.1, min_spp=3),
+     r"^min_spp must be an integer in \[4, 2\*\*32 - 1\], got 3$"),
+    (lambda r: r.render_adaptive(budget_spp=8, min_spp=0), r"^min_spp must be .*, got 0$"),
+    (lambda r: r.render_adaptive(budget_spp=8, min_spp=5, max_spp=5),
+     r"^max_spp must be at least min_spp's pilot \(min_spp rounded up to even, 6\), got "
+     r"min_spp=5 and max_spp=5$"),
+    (lambda r: r.render_adaptive(target_error=0.1, budget_spp=8),
+     r"^render_adaptive: give one of target_error and budget_spp, a number > 0, got "
+     r"target_error=0.1 and budget_spp=8$"),
+    (lambda r: r.render_adaptive(), r"^render_adaptive: give one of target_error and budget_spp"),
+    (lambda r: r.render_adaptive(budget_spp=float("inf")), r"^budget_spp must be a finite number"),
+    (lambda r: r.render_adaptive(budget_spp=8, max_seconds=-1), r"^max_seconds must be a finite"),
+    (lambda r: r.render(1, seconds=float("inf")), r"^seconds must be a finite number >= 0"),
+    (lambda r: r.render_for(float("nan")), r"^seconds must be a finite number > 0"),
+])
+def test_numeric_argument_errors_are_value_errors(renderer, small_scene, call, message):
+    """Every out-of-range or invalid numeric argument of the session's methods raises ValueError
+    with one message naming it and its range: not pybind11's TypeError for an int beyond a C
+    integer, not lucent.Error for one the library refuses, never a silent clamp. The session is
+    untouched."""
+    renderer.set_scene(small_scene)
+    renderer.render(2)
+    before = renderer.result()
+    with pytest.raises(ValueError, match=message) as e:
+        call(renderer)
+    assert not isinstance(e.value, lucent.Error)
+    assert renderer.spp == 2 and renderer.first_sample == 0
+    assert np.array_equal(renderer.result().mean, before.mean)
+
+
+def test_integer_arguments_take_any_integer_and_refuse_the_rest(renderer, small_scene):
+    """Python and NumPy integers are integers; a float or a str is a TypeError naming the
+    argument (not pybind11's "incompatible function arguments"). A value in range works."""
+    renderer.set_scene(small_scene)
+    renderer.render(np.int64(2))
+    renderer.reset(np.uint32(2 ** 32 - 1))
+    assert renderer.first_sample == 2 ** 32 - 1
+    renderer.render(1)  # the last sample index
+    with pytest.raises(lucent.Error, match="go past 2\\^32"):  # the session's state, not spp
+        renderer.render(1)
+    renderer.reset()
+    for call, name in [(lambda: renderer.render(1.5), "spp"), (lambda: renderer.render("8"), "spp"),
+                       (lambda: renderer.reset(0.0), "first_sample"),
+                       (lambda: renderer.render_adaptive(budget_spp=8, min_spp=8.0), "min_spp"),
+                       (lambda: lucent.render_reference(small_scene, spp=1, threads="2"),
+                        "threads")]:
+        with pytest.raises(TypeError, match="^%s must be an integer, got " % name):
+            call()
+    assert "spp: int" in renderer.render.__doc__ and "first_sample: int = 0" in renderer.reset.__doc__
 
 
 def test_session_option_errors():
