@@ -161,14 +161,15 @@ CLI::App* add_converge_command(CLI::App& app) {
                       "Write the rendered reference to this .exr (reuse it with --reference)");
   // a reference given is not rendered: there would be nothing to save (it was silently ignored)
   ref->excludes(save_ref);
-  cmd->add_option(
-         "--settings", a.settings,
-         "Comma-separated settings, knobs joined by +: default, fast-math, "
-         "double, float, no-specialize, no-mis, mis, max_depth=N, rr_depth=N, filter=" +
-             type_names<FilterType>("|") + "[:R], integrator=" + type_names<IntegratorType>("|") +
-             ", sampler=" + type_names<SamplerType>("|") +
-             ", clamp=X, caustics, no-caustics, adaptive, min-spp=N, target-error=E (default: "
-             "default)")
+  cmd->add_option("--settings", a.settings,
+                  "Comma-separated settings, knobs joined by +: default, fast-math, "
+                  "double, float, no-specialize, no-mis, mis, max_depth=N, rr_depth=N, filter=" +
+                      type_names<FilterType>("|") +
+                      "[:R], integrator=" + type_names<IntegratorType>("|") +
+                      ", sampler=" + type_names<SamplerType>("|") +
+                      ", clamp=X, caustics, no-caustics, splits=N, adaptive, min-spp=N, "
+                      "target-error=E (default: "
+                      "default)")
       ->delimiter(',');
   auto* spp = cmd->add_option("--spp-ladder", a.spp_ladder, "Samples per pixel of each rung")
                   ->delimiter(',')
