@@ -101,12 +101,8 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
       lc_uint lobes = bsdf_lobes(&b);
       if (!(lobes & LC_BSDF_DELTA) && P->num_lights > 0) {
         lc_light_sample ls;
-        /* an emitter never lights its own surface (a sphere is convex, a triangle flat), but
-         * sampled from o, just outside a sphere light that the shading point lies on, its cone
-         * is almost a hemisphere: an emissive rough glass sphere took those samples through its
-         * own back face, up to 25% too bright */
-        if (light_sample(s, it.p, o, u_light.z, u_light.x, u_light.y, u_bsdf.w, &ls) &&
-            ls.pdf > 0.0f && ls.light != it.light) {
+        if (light_sample(s, it.p, o, it.light, u_light.z, u_light.x, u_light.y, u_bsdf.w, &ls) &&
+            ls.pdf > 0.0f) {
           int behind = !(dot(ls.wi, it.ng) > LC_REAL(0.0));
           float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
           /* the side of the geometric surface decides the lobe, and the shading frame must

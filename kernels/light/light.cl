@@ -43,7 +43,6 @@ typedef struct {
   float pdf;          /* solid-angle pdf including the selection probability;
                          for point lights the selection probability                */
   int delta;          /* point light: no MIS                                        */
-  lc_uint light;      /* the light chosen (a light never lights its own primitive)   */
   lc_real rel_margin; /* how far short of dist, relative to it, the shadow ray stops:
                          LC_SHADOW_REL_MARGIN unless the light type knows better (0 for a
                          point light, which has no surface; a triangle light's own bound) */
@@ -113,15 +112,19 @@ static inline float light_pdf(const lc_scene* s, lc_uint light, lc_real3 p, floa
  * sphere of radius 1e5 the lighting came out 32% too bright, and black at radius 1e6. An area
  * light is sampled from o: a direction from p, seen from o, could pass just inside a sphere
  * light near its silhouette (integrator/common.cl). p and o are the same point for a caller
- * without an offset. */
-static inline int light_sample(const lc_scene* s, lc_real3 p, lc_real3 o, float us, float u1,
-                               float u2, float u3, lc_light_sample* ls) {
+ * without an offset. Choosing light `self` (the shading point's own emitter, LC_INVALID for
+ * none) gives no sample: an emitter never lights its own surface (a sphere is convex, a triangle
+ * flat), but sampled from o, just outside a sphere light that p lies on, its cone is almost a
+ * hemisphere, and an emissive rough glass sphere took those samples through its own back face,
+ * up to 25% too bright. */
+static inline int light_sample(const lc_scene* s, lc_real3 p, lc_real3 o, lc_uint self, float us,
+                               float u1, float u2, float u3, lc_light_sample* ls) {
   __global const lc_params* P = s->params;
   if (P->num_lights == 0) return 0;
   lc_uint li = lc_cdf_search(s->light_cdf, P->num_lights, us);
   __global const lc_light* L = &s->lights[li];
+  if (li == self) return 0;
   ls->delta = 0;
-  ls->light = li;
   ls->rel_margin = LC_SHADOW_REL_MARGIN;
   LC_LIGHT_TYPES(LC_LIGHT_SAMPLE)
   return 0;
