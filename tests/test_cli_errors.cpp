@@ -402,11 +402,11 @@ TEST(CliErrors, IgnoredOptionsAreRefused) {
        "--dielectric-splits: only the path integrator has it, and this render's is whitted"},
       // depths an integrator does not read (direct took --max-depth in silence)
       {"--integrator direct --max-depth 3",
-       "--max-depth: the direct integrator does not use it (only path and whitted do)"},
+       "--max-depth: only the path and whitted integrators have it, and this render's is direct"},
       {"--integrator normal --max-depth 3",
-       "--max-depth: the normal integrator does not use it (only path and whitted do)"},
+       "--max-depth: only the path and whitted integrators have it, and this render's is normal"},
       {"--integrator whitted --rr-depth 2",
-       "--rr-depth: the whitted integrator has no Russian roulette (only path has)"},
+       "--rr-depth: only the path integrator has it, and this render's is whitted"},
       // (not ignored, but exceeded: an odd pilot's halves round it up, and the cap of 5 spp
       // rendered 6)
       {"--target-error 0.05 --min-spp 5 --spp 5",

@@ -531,6 +531,51 @@ TEST(Converge, AdaptiveSettingWithNoRungAtItsPilotIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/c.csv"));
 }
 
+// A setting whose knob the integrator it renders with does not read changes nothing, and the
+// study reported it as if it did (clamp=1 on a whitted scene: "x0.53 of default", noise): it is
+// refused, by the library and by the command before the reference is rendered; the same knob
+// with integrator=path is a real setting.
+TEST(Converge, SettingsTheIntegratorIgnoresAreRefused) {
+  lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
+  scene.film.width = scene.film.height = 4;
+  scene.integrator.type = lucent::IntegratorType::Whitted;
+  lucent::RenderResult reference;
+  reference.mean = lucent::Image{4, 4, std::vector<float>(4 * 4 * 3, 0.5f)};
+  lucent::ConvergeOptions opt;
+  opt.render = lucent::test::render_options();
+  opt.spp_ladder = {1, 2};
+  const std::pair<const char*, const char*> cases[] = {
+      {"clamp=1", "clamp: only the path integrator has it, and the setting renders with whitted"},
+      {"no-mis", "mis: only the path integrator has it, and the setting renders with whitted"},
+      {"splits=0", "splits: only the path integrator has it, and the setting renders with whitted"},
+      {"rr_depth=2",
+       "rr_depth: only the path integrator has it, and the setting renders with whitted"},
+      {"integrator=direct+max_depth=2",
+       "max_depth: only the path and whitted integrators have it, and the setting renders with "
+       "direct"}};
+  for (const auto& [text, why] : cases) {
+    opt.settings = {lucent::parse_converge_setting("default"),
+                    lucent::parse_converge_setting(text)};
+    EXPECT_EQ(lucent::test::error_of([&] { lucent::run_convergence(scene, reference, opt); }),
+              std::string("converge: setting '") + text + "': " + why);
+  }
+  opt.settings = {lucent::parse_converge_setting("max_depth=2"),
+                  lucent::parse_converge_setting("integrator=path+clamp=1+no-mis")};
+  EXPECT_NO_THROW(lucent::check_convergence_options(opt, &scene));
+
+  // the command: one line, before the reference is rendered, no CSV written
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/t.json", kScene);
+  lucent::test::CommandResult r = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --width 8 --height 8 --max-spp 2 --settings " +
+      "integrator=albedo+clamp=1 --csv '" + dir + "/c.csv'");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err,
+            "lucent: error: converge: setting 'integrator=albedo+clamp=1': clamp: only the path "
+            "integrator has it, and the setting renders with albedo\n");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/c.csv"));
+}
+
 // A study on the caller's session: its cancel flag is the study's while it runs and the session's
 // own afterwards (the session once kept a pointer to the study's flag, which the caller may
 // destroy on return), and without a study flag the session's own stops the study.

@@ -140,8 +140,10 @@ struct ConvergeResult {
 /// Checks a study's ladder and settings before anything is rendered (run_convergence does it
 /// too): an empty ladder, an spp below 1 or a time not above 0, an adaptive or target-error
 /// setting with a time ladder, an adaptive setting whose pilot (min-spp, default
-/// AdaptiveOptions::min_spp) is above every rung (it would render nothing). Throws lucent::Error.
-void check_convergence_options(const ConvergeOptions& options);
+/// AdaptiveOptions::min_spp) is above every rung (it would render nothing); with `scene`, a
+/// setting's knob that its integrator does not read (clamp, caustics, splits, mis and rr_depth:
+/// path only; max_depth: path and whitted). Throws lucent::Error.
+void check_convergence_options(const ConvergeOptions& options, const Scene* scene = nullptr);
 
 /// Renders every setting at every rung and compares each render with `reference` (which must
 /// have the scene's film size; its variance and samples may be empty). Throws lucent::Error.

@@ -259,6 +259,7 @@ int run_converge_command() {
   }
   if (a.width > 0) scene.film.width = a.width;
   if (a.height > 0) scene.film.height = a.height;
+  check_convergence_options(opt, &scene);  // the settings against the scene's integrator
 
   const int stop_signals[] = {SIGINT, SIGTERM, SIGHUP};
   void (*previous[3])(int);

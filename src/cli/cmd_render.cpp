@@ -236,14 +236,9 @@ int render_with(const RenderArgs& a) {
   // depths that this render's integrator does not read: refused, rather than ignored without a
   // word (direct is always first-hit emission plus point lights, the AOVs read the first hit,
   // whitted has no Russian roulette)
-  const lucent::IntegratorType type = scene.integrator.type;
-  if (a.max_depth > 0 && type != lucent::IntegratorType::Path &&
-      type != lucent::IntegratorType::Whitted)
-    throw Error(std::string("--max-depth: the ") + type_name(type) +
-                " integrator does not use it (only path and whitted do)");
-  if (a.rr_depth > 0 && type != lucent::IntegratorType::Path)
-    throw Error(std::string("--rr-depth: the ") + type_name(type) +
-                " integrator has no Russian roulette (only path has)");
+  using lucent::render_detail::IntegratorKnob;
+  lucent::cli::check_knob(scene, a.max_depth > 0, IntegratorKnob::MaxDepth, "--max-depth");
+  lucent::cli::check_knob(scene, a.rr_depth > 0, IntegratorKnob::RrDepth, "--rr-depth");
   if (a.max_depth > 0) scene.integrator.max_depth = a.max_depth;
   if (a.rr_depth > 0) scene.integrator.rr_depth = a.rr_depth;
   lucent::cli::apply_sampling_options(a.sampling, scene);

@@ -8,6 +8,7 @@
 #include "lucent/render.hpp"
 #include "lucent/scene.hpp"
 #include "lucent/session.hpp"
+#include "render/integrator_knobs.hpp"
 #include "scene/loaders.hpp"
 
 namespace lucent::cli {
@@ -64,6 +65,11 @@ struct SamplingArgs {
 void add_sampling_options(CLI::App* cmd, SamplingArgs& args, bool adaptive);
 /// Applies --sampler and --clamp to the scene.
 void apply_sampling_options(const SamplingArgs& args, Scene& scene);
+
+/// When `given`, refuses `option` (as the command line names it) if the scene's integrator does
+/// not read `knob`: "--clamp: only the path integrator has it, and this render's is albedo".
+void check_knob(const Scene& scene, bool given, render_detail::IntegratorKnob knob,
+                const char* option);
 /// The adaptive render of --target-error: --min-spp, --spp as the maximum, --time.
 AdaptiveOptions adaptive_options(const SamplingArgs& args, int max_spp, double time_limit);
 

@@ -38,6 +38,14 @@ void add_sampling_options(CLI::App* cmd, SamplingArgs& a, bool adaptive) {
       ->check(CLI::Range(4, limits::kMaxSpp));
 }
 
+void check_knob(const Scene& scene, bool given, render_detail::IntegratorKnob knob,
+                const char* option) {
+  if (!given) return;
+  if (const char* why = render_detail::knob_ignored(scene.integrator.type, knob))
+    throw Error(std::string(option) + ": " + why + ", and this render's is " +
+                type_name(scene.integrator.type));
+}
+
 void apply_sampling_options(const SamplingArgs& a, Scene& scene) {
   if (!a.sampler.empty()) {
     std::optional<SamplerType> t = find_type<SamplerType>(a.sampler);
@@ -47,15 +55,10 @@ void apply_sampling_options(const SamplingArgs& a, Scene& scene) {
     scene.integrator.sampler = *t;
   }
   // what only the path integrator reads: refused for another, rather than ignored without a word
-  if (scene.integrator.type != IntegratorType::Path) {
-    const char* option = a.clamp >= 0      ? "--clamp"
-                         : a.caustics == 1 ? "--caustics"
-                         : a.splits >= 0   ? "--dielectric-splits"
-                                           : nullptr;
-    if (option)
-      throw Error(std::string(option) + ": only the path integrator has it, and this render's is " +
-                  type_name(scene.integrator.type));
-  }
+  using render_detail::IntegratorKnob;
+  check_knob(scene, a.clamp >= 0, IntegratorKnob::Clamp, "--clamp");
+  check_knob(scene, a.caustics == 1, IntegratorKnob::Caustics, "--caustics");
+  check_knob(scene, a.splits >= 0, IntegratorKnob::Splits, "--dielectric-splits");
   if (a.clamp >= 0) scene.integrator.clamp = a.clamp;
   if (a.caustics >= 0) scene.integrator.caustics = a.caustics == 1;
   if (a.splits >= 0) scene.integrator.dielectric_splits = a.splits;

@@ -20,6 +20,7 @@
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
 #include "render/cancel_scope.hpp"
+#include "render/integrator_knobs.hpp"
 
 namespace lucent {
 
@@ -315,7 +316,7 @@ ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
   return f;
 }
 
-void check_convergence_options(const ConvergeOptions& options) {
+void check_convergence_options(const ConvergeOptions& options, const Scene* scene) {
   const bool by_time = !options.time_ladder.empty();
   if ((by_time ? options.time_ladder.size() : options.spp_ladder.size()) == 0)
     throw Error("converge: the ladder is empty");
@@ -329,6 +330,26 @@ void check_convergence_options(const ConvergeOptions& options) {
   for (const ConvergeSetting& setting : options.settings) {
     if ((setting.adaptive || setting.target_error > 0) && by_time)
       throw Error("converge: setting " + setting.name + " is adaptive: use an spp ladder");
+    // a knob that the setting's integrator does not read would be a setting that changes
+    // nothing, reported as if it did (clamp=1 on a whitted scene: "x0.53 of default", noise)
+    if (scene) {
+      using render_detail::IntegratorKnob;
+      const IntegratorType type = setting.integrator >= 0
+                                      ? static_cast<IntegratorType>(setting.integrator)
+                                      : scene->integrator.type;
+      const std::pair<bool, std::pair<IntegratorKnob, const char*>> knobs[] = {
+          {setting.max_depth > 0, {IntegratorKnob::MaxDepth, "max_depth"}},
+          {setting.rr_depth > 0, {IntegratorKnob::RrDepth, "rr_depth"}},
+          {setting.clamp >= 0, {IntegratorKnob::Clamp, "clamp"}},
+          {setting.caustics >= 0, {IntegratorKnob::Caustics, "caustics"}},
+          {setting.splits >= 0, {IntegratorKnob::Splits, "splits"}},
+          {setting.mis >= 0, {IntegratorKnob::Mis, "mis"}}};
+      for (const auto& [given, knob] : knobs)
+        if (given)
+          if (const char* why = render_detail::knob_ignored(type, knob.first))
+            throw Error("converge: setting '" + setting.name + "': " + knob.second + ": " + why +
+                        ", and the setting renders with " + type_name(type));
+    }
     // an adaptive setting skips the rungs below its pilot (run_convergence): with none at or
     // above it, it rendered nothing and vanished from the table, the CSV and the plot
     if (!setting.adaptive) continue;
@@ -349,7 +370,7 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
     throw Error("the reference image is " + std::to_string(reference.mean.width) + "x" +
                 std::to_string(reference.mean.height) + ", the scene renders " +
                 std::to_string(scene.film.width) + "x" + std::to_string(scene.film.height));
-  check_convergence_options(options);
+  check_convergence_options(options, &scene);
   std::vector<ConvergeSetting> settings = options.settings;
   if (settings.empty()) settings.push_back(ConvergeSetting{});
   const bool by_time = !options.time_ladder.empty();
