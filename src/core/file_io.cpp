@@ -211,6 +211,12 @@ void write_file_atomic(const std::string& path, const void* data, std::size_t si
   const std::string tmp = temp_path(dir, name).string();
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd < 0) throw Error(path + ": cannot write (" + reason(errno) + ")");
+  // a file replaced keeps its permissions (a new file's mode comes from the umask: a private
+  // image became readable by all), set before any byte is written; as it is a new file, its
+  // other hard links keep the old content
+  struct stat old;
+  if (::stat(target.c_str(), &old) == 0 && S_ISREG(old.st_mode))
+    (void)::fchmod(fd, old.st_mode & 07777);
   auto fail = [&](int err) {
     if (fd >= 0) ::close(fd);
     ::unlink(tmp.c_str());
@@ -223,11 +229,6 @@ void write_file_atomic(const std::string& path, const void* data, std::size_t si
     ::unlink(tmp.c_str());
     throw;
   }
-  // a file replaced keeps its permissions (a private image stayed private; a new file's mode
-  // comes from the umask); as it is a new file, its other hard links keep the old content
-  struct stat old;
-  if (::stat(target.c_str(), &old) == 0 && S_ISREG(old.st_mode))
-    (void)::fchmod(fd, old.st_mode & 07777);
   // a full disk or an I/O error may only show when the data reaches the device
   if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) fail(errno);
   int rc = ::close(fd);
