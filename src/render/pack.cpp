@@ -154,11 +154,11 @@ std::string float_rounding_note(const PackedScene& packed) {
     diagonal += e * e;
   }
   diagonal = std::sqrt(diagonal);
-  // offsets beyond 1/64 of the small features (a huge ground triangle under small objects), or
+  // offsets beyond 1/8 of the small features (a huge ground triangle under small objects), or
   // coordinates 1000 times the scene's size (a scene far from the origin: its offsets and the
   // rounding of its hit points, a thousandth of its size, let rays out of closed shells at
   // their edges)
-  if (!(offset > feature / 64) && !(largest > 1000 * diagonal)) return "";
+  if (!(offset > feature / 8) && !(largest > 1000 * diagonal)) return "";
   char buf[640];
   std::snprintf(buf, sizeof buf,
                 "in float precision, rays leave surfaces offset by their rounding, up to %.2g "
