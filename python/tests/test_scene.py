@@ -109,38 +109,37 @@ def test_lists_grow_and_copies_are_independent(small_scene):
         s.positions[0, 0] = 5  # a read-only copy: assign the attribute instead
 
 
-def test_scene_built_in_code_renders(renderer):
+def albedo_of_a_sphere(renderer, m):
+    """A scene built in code, a sphere of material m filling the centre of the albedo AOV: the
+    scene and the AOV's centre pixel."""
     s = lucent.Scene()
     s.film.width, s.film.height = 8, 8
     s.camera.position = (0, 0, 4)
     s.camera.look_at = (0, 0, 0)
-    m = lucent.Material()
-    m.albedo = (0.5, 0.25, 1.0)
     s.materials.append(m)
     s.spheres.append(lucent.Sphere((0, 0, 0), 1.5))
     s.integrator.type = "albedo"
     renderer.set_scene(s)
     renderer.render(1)
+    return s, renderer.result().mean[4, 4]
+
+
+def test_scene_built_in_code_renders(renderer):
+    m = lucent.Material()
+    m.albedo = (0.5, 0.25, 1.0)
     # the albedo AOV of a sphere filling the centre is the material's albedo
-    assert renderer.result().mean[4, 4] == pytest.approx([0.5, 0.25, 1.0], rel=1e-6)
+    _, centre = albedo_of_a_sphere(renderer, m)
+    assert centre == pytest.approx([0.5, 0.25, 1.0], rel=1e-6)
 
 
 def test_diffuse_mirror_from_python(renderer, small_dict):
     # reflectance is Material.specular, as for mirror; the albedo AOV is albedo + reflectance
-    s = lucent.Scene()
-    s.film.width, s.film.height = 8, 8
-    s.camera.position = (0, 0, 4)
-    s.camera.look_at = (0, 0, 0)
     m = lucent.Material()
     m.type = "diffuse_mirror"
     m.albedo = (0.1, 0.5, 0.9)
     m.specular = (0.9, 0.25, 0.0)
-    s.materials.append(m)
-    s.spheres.append(lucent.Sphere((0, 0, 0), 1.5))
-    s.integrator.type = "albedo"
-    renderer.set_scene(s)
-    renderer.render(1)
-    assert renderer.result().mean[4, 4] == pytest.approx([1.0, 0.75, 0.9], rel=1e-6)
+    s, centre = albedo_of_a_sphere(renderer, m)
+    assert centre == pytest.approx([1.0, 0.75, 0.9], rel=1e-6)
     # more than it receives, in a channel: refused with the JSON path, from code and from a dict
     m.specular = (0.9, 0.6, 0.0)
     s.materials[0] = m
