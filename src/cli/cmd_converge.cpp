@@ -168,8 +168,7 @@ CLI::App* add_converge_command(CLI::App& app) {
                       "[:R], integrator=" + type_names<IntegratorType>("|") +
                       ", sampler=" + type_names<SamplerType>("|") +
                       ", clamp=X, caustics, no-caustics, splits=N, adaptive, min-spp=N, "
-                      "target-error=E (default: "
-                      "default)")
+                      "target-error=E (default: default)")
       ->delimiter(',');
   auto* spp = cmd->add_option("--spp-ladder", a.spp_ladder, "Samples per pixel of each rung")
                   ->delimiter(',')
