@@ -676,15 +676,22 @@ TEST(Session, SceneWithoutLightWarns) {
 // than 4 float steps at the look-at distance renders their rounding (at fov 1e-4 degrees a
 // reviewer's sphere silhouette came out in steps of whole pixels, its mean 13.9 standard errors
 // from the reference's, 17.3 with --precision double), which a warning now says. fov 1e-2
-// degrees here spans 120 steps, a camera 1e8 from the origin 0.03.
+// degrees here spans 120 steps, a camera and its scene 1e8 from the origin 0.03. The distance is
+// the scene's bounds' when they are farther than the look-at (a look-at just ahead of a camera far
+// from what it sees warned).
 TEST(Session, CameraFinerThanFloatWarns) {
   Renderer r = session();
   const std::string what = "float steps of the coordinates at the look-at distance";
-  auto warnings_for = [&](double fov, double x) {
+  // the camera (and with `scene`, the scene) moved by x
+  auto warnings_for = [&](double fov, double x, bool scene = true) {
     Scene s = lucent::test::scene_from(kScene);
     s.camera.fov_degrees = fov;
     s.camera.position.x += x;
     s.camera.look_at.x += x;
+    if (scene) {
+      for (glm::dvec3& p : s.positions) p.x += x;
+      s.spheres[0].center.x += x;
+    }
     lucent::test::CaptureWarnings warnings;
     r.set_scene(s);
     int n = 0;
@@ -695,6 +702,8 @@ TEST(Session, CameraFinerThanFloatWarns) {
   EXPECT_EQ(warnings_for(1e-2, 0), 0);
   EXPECT_EQ(warnings_for(1e-4, 0), 1);
   EXPECT_EQ(warnings_for(40, 1e8), 1);
+  // a look-at 5 ahead of a camera whose scene is 1e8 away: its pixels there span many steps
+  EXPECT_EQ(warnings_for(40, 1e8, false), 0);
 }
 
 // In float precision, rays leave surfaces offset by their rounding, which scales with their

@@ -94,10 +94,18 @@ lc_camera pack_camera(const Camera& c, int width, int height) {
 // footprint at the look-at distance spans a few float steps of the coordinates there (a fov of
 // 1e-4 degrees, a camera 1e8 from the origin looking at something 10 away) renders their
 // rounding, staircase edges and a shift of up to a pixel, without a word (the reference, in
-// double, does not). Said when a pixel spans fewer than 4 steps.
-static void warn_camera_precision(const Scene& scene) {
+// double, does not). Said when a pixel spans fewer than 4 steps. The distance is the look-at's,
+// or the scene's bounds' when they are farther (a look-at 1 ahead of a camera 5000 from what it
+// sees warned).
+static void warn_camera_precision(const Scene& scene, const PackedScene& p) {
   const Camera& c = scene.camera;
-  const double distance = glm::length(c.look_at - c.position);
+  double to_bounds = 0;  // from the camera to the nearest point of the scene's bounds
+  for (int i = 0; i < 3; ++i) {
+    const double out =
+        std::max({0.0, p.bounds_min[i] - c.position[i], c.position[i] - p.bounds_max[i]});
+    to_bounds += out * out;
+  }
+  const double distance = std::max(glm::length(c.look_at - c.position), std::sqrt(to_bounds));
   const double pitch = 2.0 * std::tan(glm::radians(c.fov_degrees) * 0.5) / scene.film.height;
   double coordinate = distance;
   for (int i = 0; i < 3; ++i)
@@ -192,7 +200,6 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   PackedScene p;
   lc_params& P = p.params;
   P.camera = pack_camera(scene.camera, scene.film.width, scene.film.height);
-  warn_camera_precision(scene);
   P.width = static_cast<lc_uint>(scene.film.width);
   P.height = static_cast<lc_uint>(scene.film.height);
   P.seed = scene.integrator.seed;
@@ -344,6 +351,7 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     std::copy(bvh.bmax, bvh.bmax + 3, p.bounds_max);
   }
 
+  warn_camera_precision(scene, p);
   pack_lights(scene, p, std::move(power));
   // a light-transport integrator with nothing that emits renders a black image: said, not
   // silently written (the AOVs need no light)
