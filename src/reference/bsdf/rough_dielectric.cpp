@@ -19,8 +19,9 @@
 // pdf = D(h) |h.n| * (F / (4 wo.h) | (1 - F) eta^2 |wi.h| / (wo.h + eta wi.h)^2). Directions
 // that land on the other side of n than their lobe's are rejected (the pdf counts only those that
 // do not). Whitted: the smooth dielectric's lobes about the shading normal. Albedo AOV: tint.
-// ior = 1 (an invisible interface, whatever its roughness) is a delta pass-through with weight
-// tint.
+// An ior within 1e-5 of 1 (an invisible interface, whatever its roughness) is a delta
+// pass-through with weight tint (docs/rendering-model.md: the model's own limit as ior -> 1 still
+// loses light, and the kernel cannot resolve the refraction's half vector there).
 #include <cmath>
 
 #include "lucent/reference.hpp"
@@ -36,7 +37,9 @@ class RoughDielectric final : public Bsdf {
   RoughDielectric(const ShadingPoint& sp, const Material& m)
       : Bsdf(sp),
         tint_(m.specular),
-        eta_(sp.front ? m.ior : 1 / m.ior),
+        eta_(std::abs(m.ior - 1) <= 1e-5 ? 1.0
+             : sp.front                  ? m.ior
+                                         : 1 / m.ior),
         alpha_(ggx_alpha(m.roughness)) {}
 
   bool is_delta() const override { return eta_ == 1; }
