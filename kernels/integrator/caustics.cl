@@ -97,7 +97,7 @@ static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_inter
   float cos_x = fabs(wi_l.z) * (float)dot(wc, it.ng) / (float)fabs(side);
   float pitch = 2.0f * cam->tan_half_fov / (float)P->height;
   float3 c = beta * f * (cos_x / ((float)(dist * dist) * pitch * pitch * cos_c * cos_c * cos_c));
-  if (!lc_isfinite3(c)) return 0;
+  if (!lc_isfinite3(c * c)) return 0; /* non-finite, or its square overflows (megakernel.cl) */
   caustics_splat(s, fx, fy, c, light_sum, light_sumsq);
   return 1;
 }

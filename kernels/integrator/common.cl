@@ -5,9 +5,12 @@
 
 /* Power heuristic with beta = 2. */
 static inline float mis_power(float a, float b) {
+  /* a^2 / (a^2 + b^2) as 1 / (1 + (b/a)^2): the squares of pdfs above 1.8e19 (a sphere light
+   * subtending 1e-10 rad) overflowed float, and inf / inf made nearly every lit sample NaN */
   if (isinf(a)) return 1.0f;
-  float a2 = a * a, b2 = b * b;
-  return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+  if (!(a > 0.0f)) return 0.0f;
+  float r = b / a;
+  return 1.0f / (1.0f + r * r);
 }
 
 /* Local shading frame around n. */
