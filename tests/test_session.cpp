@@ -740,6 +740,29 @@ TEST(Session, FloatRoundingLargeAgainstTheSceneWarns) {
   EXPECT_EQ(warnings_for(far, lucent::Precision::Float), 0);
 }
 
+// A material colour above 1 reflects more light than it receives: a diffuse albedo of 2 rendered
+// a white furnace 1.73, without a word (diffuse_mirror refuses such values; the others warn).
+// Once per set_scene; not for colours of 1.
+TEST(Session, MaterialsThatGainEnergyWarn) {
+  Renderer r = session();
+  Scene s = lucent::test::scene_from(kScene);
+  s.materials[0].albedo = glm::dvec3(0.7, 2.0, 0.5);
+  {
+    lucent::test::CaptureWarnings warnings;
+    r.set_scene(s);
+    EXPECT_EQ(warnings.count("/materials/" + s.materials[0].name +
+                             "/albedo: 2 in green is above 1: the surface reflects more light "
+                             "than it receives (each bounce gains energy, and Russian roulette "
+                             "does not end such paths)"),
+              1)
+        << warnings.dump();
+  }
+  s.materials[0].albedo = glm::dvec3(1.0);
+  lucent::test::CaptureWarnings warnings;
+  r.set_scene(s);
+  EXPECT_EQ(warnings.all().size(), 0u) << warnings.dump();
+}
+
 // Radiance whose square overflows float (a point light of 1e22 W/sr, which the scene checks
 // accept) is counted as non-finite, not summed: the pass's sum of squares became infinite, so
 // were the variances, and a part file of it was refused by merge.

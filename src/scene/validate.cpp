@@ -9,6 +9,7 @@
 
 #include "lucent/error.hpp"
 #include "lucent/types.hpp"
+#include "scene/loaders.hpp"
 #include "scene/material_type.hpp"
 
 namespace lucent::scene_detail {
@@ -407,6 +408,30 @@ void validate_scene(const Scene& s) {
     for (int k = 0; k < 3 && has_n; ++k) check_index(at.at("n").at(k), t.n[k], nn, "normals");
     for (int k = 0; k < 3 && has_uv; ++k) check_index(at.at("uv").at(k), t.uv[k], nuv, "uvs");
     if (far >= 0) check_position(at.at("v").at(far), s.positions[t.v[far]]);
+  }
+  warn_energy_gain(s);
+}
+
+void warn_energy_gain(const Scene& s) {
+  const char* channel[3] = {"red", "green", "blue"};
+  for (std::size_t i = 0; i < s.materials.size(); ++i) {
+    const Material& m = s.materials[i];
+    const std::string name = m.name.empty() ? std::to_string(i) : m.name;
+    for (const MaterialParam& param : material_type_def(m.type).params) {
+      if (param.kind != MaterialParam::Colour && param.kind != MaterialParam::ColourOrTexture)
+        continue;
+      if (param.kind == MaterialParam::ColourOrTexture && m.albedo_texture >= 0) continue;
+      const glm::dvec3& v = m.*param.colour;
+      int c = 0;
+      for (int k = 1; k < 3; ++k)
+        if (v[k] > v[c]) c = k;
+      if (!(v[c] > 1 + 1e-6)) continue;
+      warn(in_file(s.path, "/materials/" + name + "/" + param.key + ": " + format_number(v[c]) +
+                               " in " + channel[c] +
+                               " is above 1: the surface reflects more light than it receives "
+                               "(each bounce gains energy, and Russian roulette does not end "
+                               "such paths)"));
+    }
   }
 }
 
