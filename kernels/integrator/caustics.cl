@@ -22,9 +22,14 @@ static inline void lc_atomic_add_float(volatile __global float* p, float v) {
 }
 
 /* Adds contribution c (before the filter) at film position (fx, fy) to every pixel whose filter
- * reaches it, and its square to the sums of squares. */
-static inline void caustics_splat(const lc_scene* s, float fx, float fy, float3 c,
-                                  __global float4* light_sum, __global float4* light_sumsq) {
+ * reaches it, and its square to the sums of squares. Returns the number of pixel shares dropped:
+ * a share (c times the filter's density there) whose square overflows a float, as the reference
+ * judges each pixel's share, or that would take the pixel's float sum of squares past FLT_MAX
+ * (the light sums are floats: a few splats of 1e19 on one pixel in one pass made its variance
+ * infinite). The second test reads the sum before the atomic adds: work-items that race there
+ * may still pass it together, near 3.4e38. */
+static inline lc_uint caustics_splat(const lc_scene* s, float fx, float fy, float3 c,
+                                     __global float4* light_sum, __global float4* light_sumsq) {
   __global const lc_params* P = s->params;
   const float r = P->filter_radius;
   const int W = (int)P->width, H = (int)P->height;
@@ -32,20 +37,26 @@ static inline void caustics_splat(const lc_scene* s, float fx, float fy, float3 
    * below are in range); the pixels whose centre (x + 0.5) lies within r of fx: */
   int x0 = max(0, (int)ceil(fx - r - 0.5f)), x1 = min(W - 1, (int)floor(fx + r - 0.5f));
   int y0 = max(0, (int)ceil(fy - r - 0.5f)), y1 = min(H - 1, (int)floor(fy + r - 0.5f));
+  lc_uint dropped = 0;
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
       float w = filter_density(P->filter, r, fx - ((float)x + 0.5f), fy - ((float)y + 0.5f));
       if (!(w > 0.0f)) continue;
-      float3 v = c * w;
+      float3 v = c * w, v2 = v * v;
       volatile __global float* a = (volatile __global float*)&light_sum[y * W + x];
       volatile __global float* b = (volatile __global float*)&light_sumsq[y * W + x];
+      if (!lc_isfinite3(v2) || !lc_isfinite3((float3)(b[0], b[1], b[2]) + v2)) {
+        ++dropped;
+        continue;
+      }
       lc_atomic_add_float(a + 0, v.x);
       lc_atomic_add_float(a + 1, v.y);
       lc_atomic_add_float(a + 2, v.z);
-      lc_atomic_add_float(b + 0, v.x * v.x);
-      lc_atomic_add_float(b + 1, v.y * v.y);
-      lc_atomic_add_float(b + 2, v.z * v.z);
+      lc_atomic_add_float(b + 0, v2.x);
+      lc_atomic_add_float(b + 1, v2.y);
+      lc_atomic_add_float(b + 2, v2.z);
     }
+  return dropped;
 }
 
 /* Connects the light path's vertex at surface `surf` (interaction_surface's, reached by ray with
@@ -53,23 +64,24 @@ static inline void caustics_splat(const lc_scene* s, float fx, float fy, float3 
  * lens. The BSDF there is seen as a camera ray hitting the point would see it (its normals facing
  * the camera, the geometric one where the interpolated one faces away; b's side), so that the
  * contribution is exactly the one the path integrator leaves out. The surface and the BSDF are the
- * light path's, re-oriented: not computed again (one copy less of each in the kernel). Returns 0
- * when the contribution is not finite (it is then counted, not splatted). */
-static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_interaction* surf,
-                                   const lc_bsdf* b_light, float lu, float lv, float3 beta,
-                                   __global float4* light_sum, __global float4* light_sumsq,
-                                   lc_uint* rays) {
+ * light path's, re-oriented: not computed again (one copy less of each in the kernel). Returns the
+ * number of non-finite contributions dropped: 1 when the contribution is not finite, else the
+ * pixel shares caustics_splat dropped (they are counted, not splatted). */
+static inline lc_uint caustics_connect(const lc_scene* s, lc_ray ray, const lc_interaction* surf,
+                                       const lc_bsdf* b_light, float lu, float lv, float3 beta,
+                                       __global float4* light_sum, __global float4* light_sumsq,
+                                       lc_uint* rays) {
   const lc_real3 x = surf->p;
   __global const lc_params* P = s->params;
   __global const lc_camera* cam = &P->camera;
   float fx, fy, cos_c;
   lc_real3 cpos; /* the pinhole, or the lens point */
-  if (!camera_project_lens(cam, x, lu, lv, P->width, P->height, &fx, &fy, &cos_c, &cpos)) return 1;
+  if (!camera_project_lens(cam, x, lu, lv, P->width, P->height, &fx, &fy, &cos_c, &cpos)) return 0u;
   const float r = P->filter_radius;
-  if (!(fx > -r && fx < (float)P->width + r && fy > -r && fy < (float)P->height + r)) return 1;
+  if (!(fx > -r && fx < (float)P->width + r && fy > -r && fy < (float)P->height + r)) return 0u;
   lc_real3 toc = cpos - x;
   lc_real dist = length(toc);
-  if (!(dist > LC_REAL(0.0))) return 1;
+  if (!(dist > LC_REAL(0.0))) return 0u;
   lc_real3 wc = toc / dist;
   /* the interaction of the camera ray through this point */
   lc_interaction it = *surf;
@@ -78,28 +90,27 @@ static inline int caustics_connect(const lc_scene* s, lc_ray ray, const lc_inter
   b.front = it.front;
   lc_frame fr = frame_from(it.ns);
   float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(wc));
-  if (wo_l.z <= 0.0f) return 1;
+  if (wo_l.z <= 0.0f) return 0u;
   lc_real3 wl = -ray.d; /* towards the arriving light */
   float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(wl));
   lc_real side = dot(wl, it.ng);
-  if (wi_l.z < 0.0f ? side >= LC_REAL(0.0) : side <= LC_REAL(0.0)) return 1; /* as path.cl */
+  if (wi_l.z < 0.0f ? side >= LC_REAL(0.0) : side <= LC_REAL(0.0)) return 0u; /* as path.cl */
   float pdf;
   float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf);
-  if (!(lc_max3(f) > 0.0f)) return 1;
+  if (!(lc_max3(f) > 0.0f)) return 0u;
   lc_real3 o = lc_spawn_origin(it.p, it.perr, it.ng); /* ng faces the camera */
   lc_real3 to = cpos - o;
   lc_real od = length(to);
   if (!(od > LC_REAL(0.0)) || !shadow_visible(s, o, to / od, od, LC_SHADOW_REL_MARGIN, rays))
-    return 1;
+    return 0u;
   /* |wl.ns| |wc.ng| / |wl.ng|, and the importance 1 / (s^2 cos^3) over r^2, for a pinhole and
    * for a thin lens alike (with r and cos from the lens point: the lens point's density
    * 1 / area cancels the importance's 1 / area) */
   float cos_x = fabs(wi_l.z) * (float)dot(wc, it.ng) / (float)fabs(side);
   float pitch = 2.0f * cam->tan_half_fov / (float)P->height;
   float3 c = beta * f * (cos_x / ((float)(dist * dist) * pitch * pitch * cos_c * cos_c * cos_c));
-  if (!lc_isfinite3(c * c)) return 0; /* non-finite, or its square overflows (megakernel.cl) */
-  caustics_splat(s, fx, fy, c, light_sum, light_sumsq);
-  return 1;
+  if (!lc_isfinite3(c)) return 1u;
+  return caustics_splat(s, fx, fy, c, light_sum, light_sumsq);
 }
 
 /* The light path of the camera sample rng (random numbers from LC_DIM_LIGHT_PATH). Returns the
@@ -133,7 +144,7 @@ static LC_POCL_NOINLINE lc_uint caustics_light_path(const lc_scene* s, const lc_
     float4 ua = uv.lo, ub = uv.hi;
     if (caustic && !(bsdf_lobes(&b) & LC_BSDF_DELTA))
       nonfinite +=
-          !caustics_connect(s, ray, &surf, &b, ua.x, ua.y, beta, light_sum, light_sumsq, rays);
+          caustics_connect(s, ray, &surf, &b, ua.x, ua.y, beta, light_sum, light_sumsq, rays);
     /* a light path goes on after a delta lobe at y_1, through any lobes after it */
     lc_frame fr = frame_from(it.ns);
     float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
