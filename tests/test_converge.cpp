@@ -560,7 +560,8 @@ TEST(Converge, SettingsTheIntegratorIgnoresAreRefused) {
               std::string("converge: setting '") + text + "': " + why);
   }
   opt.settings = {lucent::parse_converge_setting("max_depth=2"),
-                  lucent::parse_converge_setting("integrator=path+clamp=1+no-mis")};
+                  lucent::parse_converge_setting("integrator=path+clamp=1+no-mis"),
+                  lucent::parse_converge_setting("no-caustics")};  // as render --no-caustics
   EXPECT_NO_THROW(lucent::check_convergence_options(opt, &scene));
 
   // the command: one line, before the reference is rendered, no CSV written

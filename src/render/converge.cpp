@@ -341,7 +341,8 @@ void check_convergence_options(const ConvergeOptions& options, const Scene* scen
           {setting.max_depth > 0, {IntegratorKnob::MaxDepth, "max_depth"}},
           {setting.rr_depth > 0, {IntegratorKnob::RrDepth, "rr_depth"}},
           {setting.clamp >= 0, {IntegratorKnob::Clamp, "clamp"}},
-          {setting.caustics >= 0, {IntegratorKnob::Caustics, "caustics"}},
+          // (no-caustics is not: turning off what is off, as render's --no-caustics)
+          {setting.caustics == 1, {IntegratorKnob::Caustics, "caustics"}},
           {setting.splits >= 0, {IntegratorKnob::Splits, "splits"}},
           {setting.mis >= 0, {IntegratorKnob::Mis, "mis"}}};
       for (const auto& [given, knob] : knobs)
