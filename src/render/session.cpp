@@ -327,6 +327,7 @@ struct Renderer::Impl {
   double render_seconds = 0;
   bool last_cancelled = false;
 
+  std::set<std::string> energy_warned;  ///< the energy_gain_notes this session has given
   std::atomic<bool> cancel_requested{false};
   const std::atomic<bool>* cancel_flag = nullptr;
   /// render_detail::CancelScopes alive: while one is, the calls are one operation, whose cancel a
@@ -440,6 +441,10 @@ struct Renderer::Impl {
   void set_scene(const Scene& s) {
     scene_detail::ScopedWarningSink sink(options.on_warning);
     scene_detail::validate_scene(s);  // fields set directly may not have been checked
+    // once per session: an AOV render, a converge study's settings and an application's camera
+    // moves set the scene again (the warning came 4 times for a render with 3 AOVs)
+    for (const std::string& note : scene_detail::energy_gain_notes(s))
+      if (energy_warned.insert(note).second) scene_detail::warn(note);
     std::vector<render_detail::DeviceLimits> limits;
     for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
     render_detail::check_host_memory(s, limits, limits.front().host_mem, limits.front().host_what);

@@ -35,12 +35,23 @@ struct MaterialParam {
   double Material::*number = nullptr;      ///< UnitInterval and Ior
   glm::dvec3 default_colour{0.0};
   double default_number = 0;
+  /// A colour that scales the light a lobe reflects or transmits (an albedo, a reflectance, a
+  /// conductor's F0, a tint): above 1 the surface gains energy, which a render warns of. False
+  /// for a colour that scales a Fresnel term (plastic's specular: its reflectance averages about
+  /// 0.09 at ior 1.5, and MTL files give it Ks).
+  bool energy = true;
 
   static MaterialParam colour_param(const char* key, glm::dvec3 Material::*field, glm::dvec3 def,
                                     Kind kind = Colour) {
     MaterialParam p{key, kind};
     p.colour = field;
     p.default_colour = def;
+    return p;
+  }
+  /// This colour with `energy` false.
+  MaterialParam not_energy() const {
+    MaterialParam p = *this;
+    p.energy = false;
     return p;
   }
   static MaterialParam number_param(const char* key, Kind kind, double Material::*field,

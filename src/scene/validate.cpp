@@ -409,30 +409,47 @@ void validate_scene(const Scene& s) {
     for (int k = 0; k < 3 && has_uv; ++k) check_index(at.at("uv").at(k), t.uv[k], nuv, "uvs");
     if (far >= 0) check_position(at.at("v").at(far), s.positions[t.v[far]]);
   }
-  warn_energy_gain(s);
 }
 
-void warn_energy_gain(const Scene& s) {
+std::vector<std::string> energy_gain_notes(const Scene& s) {
+  std::vector<std::string> notes;
+  if (is_aov(s.integrator.type)) return notes;  // nothing is reflected
   const char* channel[3] = {"red", "green", "blue"};
+  std::vector<double> brightest(s.textures.size(), -1.0);  // each texture's largest texel
   for (std::size_t i = 0; i < s.materials.size(); ++i) {
     const Material& m = s.materials[i];
     const std::string name = m.name.empty() ? std::to_string(i) : m.name;
     for (const MaterialParam& param : material_type_def(m.type).params) {
-      if (param.kind != MaterialParam::Colour && param.kind != MaterialParam::ColourOrTexture)
+      if ((param.kind != MaterialParam::Colour && param.kind != MaterialParam::ColourOrTexture) ||
+          !param.energy)
         continue;
-      if (param.kind == MaterialParam::ColourOrTexture && m.albedo_texture >= 0) continue;
-      const glm::dvec3& v = m.*param.colour;
+      glm::dvec3 v = m.*param.colour;
+      std::string what = param.key;
+      const int t = param.kind == MaterialParam::ColourOrTexture ? m.albedo_texture : -1;
+      if (t >= 0 && static_cast<std::size_t>(t) < s.textures.size()) {
+        // a float texture (PFM, EXR) may hold texels above 1
+        if (brightest[t] < 0) {
+          double b = 0;
+          const Texture& tex = s.textures[t];
+          for (std::size_t k = 0; k + 4 <= tex.rgba.size(); k += 4)
+            for (int c = 0; c < 3; ++c) b = std::max<double>(b, tex.rgba[k + c]);
+          brightest[t] = b;
+        }
+        v = glm::dvec3(brightest[t]);
+        what += " texture's brightest texel";
+      }
       int c = 0;
       for (int k = 1; k < 3; ++k)
         if (v[k] > v[c]) c = k;
       if (!(v[c] > 1 + 1e-6)) continue;
-      warn(in_file(s.path, "/materials/" + name + "/" + param.key + ": " + format_number(v[c]) +
-                               " in " + channel[c] +
-                               " is above 1: the surface reflects more light than it receives "
-                               "(each bounce gains energy, and Russian roulette does not end "
-                               "such paths)"));
+      notes.push_back(in_file(
+          s.path, "material '" + name + "': " + what + " " + format_number(v[c]) +
+                      (t >= 0 ? "" : std::string(" in ") + channel[c]) +
+                      " is above 1: the surface reflects more light than it receives (each "
+                      "bounce gains energy, and Russian roulette does not end such paths)"));
     }
   }
+  return notes;
 }
 
 }  // namespace lucent::scene_detail

@@ -123,10 +123,11 @@ void validate_mesh(const MeshShape& mesh, const Reporter& at);
 /// warning when the scene is packed).
 void validate_scene(const Scene& scene);
 
-/// Warns (scene_detail::warn) of every material colour that reflects more than it receives: a
-/// component of an albedo, reflectance, specular colour or tint above 1 (diffuse albedo 2
-/// rendered a white furnace 1.73; diffuse_mirror refuses such values). validate_scene ends with
-/// it, so that a render says it once.
-void warn_energy_gain(const Scene& scene);
+/// A warning's text for every material colour that reflects more than it receives: a component
+/// of an albedo (or an albedo texture's texel), a reflectance, a conductor's F0 or a tint above 1
+/// (MaterialParam::energy; a diffuse albedo of 2 rendered a white furnace 1.73; diffuse_mirror
+/// refuses such values). None for the AOV integrators, which reflect nothing. A session says
+/// each once (Renderer::set_scene), the reference each time.
+std::vector<std::string> energy_gain_notes(const Scene& scene);
 
 }  // namespace lucent::scene_detail

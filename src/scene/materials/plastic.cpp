@@ -9,7 +9,7 @@ const MaterialTypeDef& material_type_plastic() {
   static const MaterialTypeDef def{
       {MaterialParam::colour_param("albedo", &Material::albedo, glm::dvec3(0.8),
                                    MaterialParam::ColourOrTexture),
-       MaterialParam::colour_param("specular", &Material::specular, glm::dvec3(1.0)),
+       MaterialParam::colour_param("specular", &Material::specular, glm::dvec3(1.0)).not_energy(),
        MaterialParam::number_param("roughness", MaterialParam::UnitInterval, &Material::roughness,
                                    0.1),
        MaterialParam::number_param("ior", MaterialParam::Ior, &Material::ior, 1.5)},
