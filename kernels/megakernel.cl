@@ -63,11 +63,14 @@ typedef float4 lc_accum4;
 #define lc_accum3_from(v) (v)
 #define lc_accum_float3(v) (v)
 #endif
+#ifndef LC_HAS_CAUSTICS
+typedef float4 lc_lsum4; /* the light sums' element (integrator/caustics.cl): unused here */
+#endif
 
 __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
     LC_SCENE_KERNEL_ARGS, __global const uint4* work, __global lc_accum4* out_sum,
-    __global lc_accum4* out_sumsq, __global lc_uint* counters, __global float4* light_sum,
-    __global float4* light_sumsq) {
+    __global lc_accum4* out_sumsq, __global lc_uint* counters, __global lc_lsum4* light_sum,
+    __global lc_lsum4* light_sumsq) {
   lc_uint gid = (lc_uint)get_global_id(0);
   lc_uint width = params->width, height = params->height;
   lc_rng rng;

@@ -160,10 +160,12 @@ TEST(CliInfo, EmptyScene) {
   if (!defines.empty() && defines[0] == ' ') defines.erase(0, 1);
   EXPECT_EQ(m["kernel/feature defines"], defines.empty() ? "(none)" : defines);
   // what render adds for each device (render_detail::device_defines): a pass's sums are in
-  // double (LC_ACCUM_DOUBLE) on every device with fp64, PoCL's CPU device included
+  // double (LC_ACCUM_DOUBLE) on every device with fp64, PoCL's CPU device included, and so are
+  // the light sums (LC_LIGHT_DOUBLE) where it also has 64-bit atomics
   EXPECT_EQ(m["kernel/device options"],
-            "-D LC_DEVICE_POCL_CPU -D LC_ACCUM_DOUBLE on PoCL's CPU device, -D LC_ACCUM_DOUBLE "
-            "on other devices with fp64, none on others");
+            "-D LC_DEVICE_POCL_CPU -D LC_ACCUM_DOUBLE -D LC_LIGHT_DOUBLE on PoCL's CPU device, "
+            "-D LC_ACCUM_DOUBLE -D LC_LIGHT_DOUBLE on other devices with fp64 and 64-bit atomics, "
+            "-D LC_ACCUM_DOUBLE on those with fp64 only, none on others");
   // --no-specialize: every feature, as the build options line (and Python's scene_info) say;
   // the feature defines line listed the scene's
   r = run_cli("info '" + scene + "' --no-specialize", "env -u LUCENT_KERNEL_DIR");

@@ -23,6 +23,7 @@ struct RawDevice {
   unsigned compute_units = 0;
   unsigned long long memory = 0;
   bool fp64 = false;
+  bool int64_atomics = false;
 };
 
 std::string trim(std::string s) {
@@ -83,7 +84,9 @@ std::vector<RawDevice> raw_devices() {
       cl_ulong mem = 0;
       clGetDeviceInfo(d, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof mem, &mem, nullptr);
       r.memory = mem;
-      r.fp64 = device_string(d, CL_DEVICE_EXTENSIONS).find("cl_khr_fp64") != std::string::npos;
+      const std::string ext = device_string(d, CL_DEVICE_EXTENSIONS);
+      r.fp64 = ext.find("cl_khr_fp64") != std::string::npos;
+      r.int64_atomics = ext.find("cl_khr_int64_base_atomics") != std::string::npos;
       out.push_back(r);
     }
   }
@@ -127,6 +130,7 @@ TEST(Devices, ListMatchesTheOpenClApi) {
     EXPECT_EQ(listed[i].global_memory, raw[i].memory);
     EXPECT_EQ(listed[i].opencl_c_version, raw[i].opencl_c);
     EXPECT_EQ(listed[i].fp64, raw[i].fp64);
+    EXPECT_EQ(listed[i].int64_atomics, raw[i].int64_atomics);
     EXPECT_GT(listed[i].compute_units, 0u);
     EXPECT_GT(listed[i].global_memory, 0u);
   }

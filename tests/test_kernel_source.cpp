@@ -265,10 +265,13 @@ TEST(KernelSource, KernelsAreStrictOpenCL12ForClang) {
     std::string name, prefix, path;
   };
   // every feature, every feature in double precision, every feature as PoCL's CPU device builds it
-  // (render_detail::device_defines), and none (the #else branches)
+  // (render_detail::device_defines) and with the light sums in double, and none (the #else
+  // branches)
   std::vector<Case> cases = {
       {"megakernel", all, "megakernel.cl"},
       {"megakernel-pocl", all + "#define LC_DEVICE_POCL_CPU 1\n", "megakernel.cl"},
+      {"megakernel-light-double", all + "#define LC_ACCUM_DOUBLE 1\n#define LC_LIGHT_DOUBLE 1\n",
+       "megakernel.cl"},
       {"megakernel-double", all + "#define LC_DOUBLE 1\n", "megakernel.cl"},
       {"megakernel-no-features", "", "megakernel.cl"}};
   for (int i = 0; i < lucent::detail::kEmbeddedKernelFileCount; ++i) {

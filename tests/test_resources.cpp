@@ -164,6 +164,7 @@ TEST(Resources, PeakHostMemoryOfALargeFilmIsWithinTheEstimate) {
   device.device = info.name;
   device.host_unified = info.type == "CPU";
   device.fp64 = info.fp64;
+  device.light_double = info.fp64 && info.int64_atomics;
   auto estimate = [&](int film) {
     Scene sc = lucent::test::scene_from(grid_scene(2, film));
     std::uint64_t bytes = 0;

@@ -16,6 +16,7 @@ struct DeviceInfo {
   unsigned compute_units = 0;
   std::uint64_t global_memory = 0;  ///< bytes
   bool fp64 = false;
+  bool int64_atomics = false;  ///< cl_khr_int64_base_atomics: 64-bit atom_cmpxchg
 };
 
 /// Every OpenCL device of every platform. Throws lucent::Error when there is no platform.

@@ -9,6 +9,38 @@
 #ifndef LUCENT_INTEGRATOR_CAUSTICS_CL
 #define LUCENT_INTEGRATOR_CAUSTICS_CL
 
+/* The light sums: in double where the host defines LC_LIGHT_DOUBLE (devices with fp64 and
+ * cl_khr_int64_base_atomics, src/render/features.cpp), added by a 64-bit compare-and-swap; a
+ * pass's sum of squares cannot then overflow. In float otherwise. */
+#ifdef LC_LIGHT_DOUBLE
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+#pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
+typedef double lc_lsum;
+typedef double3 lc_lsum3;
+typedef double4 lc_lsum4;
+#define lc_lsum3_from(v) convert_double3(v)
+#define lc_atomic_add_lsum lc_atomic_add_double
+#else
+typedef float lc_lsum;
+typedef float3 lc_lsum3;
+typedef float4 lc_lsum4;
+#define lc_lsum3_from(v) (v)
+#define lc_atomic_add_lsum lc_atomic_add_float
+#endif
+
+#ifdef LC_LIGHT_DOUBLE
+/* *p += v for a double in global memory */
+static inline void lc_atomic_add_double(volatile __global double* p, double v) {
+  union {
+    ulong u;
+    double f;
+  } old, sum;
+  do {
+    old.f = *p;
+    sum.f = old.f + v;
+  } while (atom_cmpxchg((volatile __global ulong*)p, old.u, sum.u) != old.u);
+}
+#else
 /* *p += v for a float in global memory (OpenCL 1.2 has integer atomics only) */
 static inline void lc_atomic_add_float(volatile __global float* p, float v) {
   union {
@@ -20,16 +52,18 @@ static inline void lc_atomic_add_float(volatile __global float* p, float v) {
     sum.f = old.f + v;
   } while (atomic_cmpxchg((volatile __global unsigned int*)p, old.u, sum.u) != old.u);
 }
+#endif
 
 /* Adds contribution c (before the filter) at film position (fx, fy) to every pixel whose filter
  * reaches it, and its square to the sums of squares. Returns the number of pixel shares dropped:
  * a share (c times the filter's density there) whose square overflows a float, as the reference
- * judges each pixel's share, or that would take the pixel's float sum of squares past FLT_MAX
- * (the light sums are floats: a few splats of 1e19 on one pixel in one pass made its variance
- * infinite). The second test reads the sum before the atomic adds: work-items that race there
- * may still pass it together, near 3.4e38. */
+ * judges each pixel's share, or, where the light sums are floats (no LC_LIGHT_DOUBLE), that would
+ * take the pixel's float sum of squares past FLT_MAX (a few splats of 1e19 on one pixel in one
+ * pass made its variance infinite). That second test reads the sum before the atomic adds:
+ * work-items that race there may still pass it together, near 3.4e38. In double a pass's sums
+ * keep every share the first test keeps, as the reference's do. */
 static inline lc_uint caustics_splat(const lc_scene* s, float fx, float fy, float3 c,
-                                     __global float4* light_sum, __global float4* light_sumsq) {
+                                     __global lc_lsum4* light_sum, __global lc_lsum4* light_sumsq) {
   __global const lc_params* P = s->params;
   const float r = P->filter_radius;
   const int W = (int)P->width, H = (int)P->height;
@@ -43,18 +77,24 @@ static inline lc_uint caustics_splat(const lc_scene* s, float fx, float fy, floa
       float w = filter_density(P->filter, r, fx - ((float)x + 0.5f), fy - ((float)y + 0.5f));
       if (!(w > 0.0f)) continue;
       float3 v = c * w, v2 = v * v;
-      volatile __global float* a = (volatile __global float*)&light_sum[y * W + x];
-      volatile __global float* b = (volatile __global float*)&light_sumsq[y * W + x];
+      volatile __global lc_lsum* a = (volatile __global lc_lsum*)&light_sum[y * W + x];
+      volatile __global lc_lsum* b = (volatile __global lc_lsum*)&light_sumsq[y * W + x];
+#ifdef LC_LIGHT_DOUBLE
+      if (!lc_isfinite3(v2)) {
+#else
       if (!lc_isfinite3(v2) || !lc_isfinite3((float3)(b[0], b[1], b[2]) + v2)) {
+#endif
         ++dropped;
         continue;
       }
-      lc_atomic_add_float(a + 0, v.x);
-      lc_atomic_add_float(a + 1, v.y);
-      lc_atomic_add_float(a + 2, v.z);
-      lc_atomic_add_float(b + 0, v2.x);
-      lc_atomic_add_float(b + 1, v2.y);
-      lc_atomic_add_float(b + 2, v2.z);
+      /* a share's square of floats is exact in double */
+      lc_lsum3 lv = lc_lsum3_from(v), lv2 = lv * lv;
+      lc_atomic_add_lsum(a + 0, lv.x);
+      lc_atomic_add_lsum(a + 1, lv.y);
+      lc_atomic_add_lsum(a + 2, lv.z);
+      lc_atomic_add_lsum(b + 0, lv2.x);
+      lc_atomic_add_lsum(b + 1, lv2.y);
+      lc_atomic_add_lsum(b + 2, lv2.z);
     }
   return dropped;
 }
@@ -69,7 +109,7 @@ static inline lc_uint caustics_splat(const lc_scene* s, float fx, float fy, floa
  * pixel shares caustics_splat dropped (they are counted, not splatted). */
 static inline lc_uint caustics_connect(const lc_scene* s, lc_ray ray, const lc_interaction* surf,
                                        const lc_bsdf* b_light, float lu, float lv, float3 beta,
-                                       __global float4* light_sum, __global float4* light_sumsq,
+                                       __global lc_lsum4* light_sum, __global lc_lsum4* light_sumsq,
                                        lc_uint* rays) {
   const lc_real3 x = surf->p;
   __global const lc_params* P = s->params;
@@ -117,8 +157,8 @@ static inline lc_uint caustics_connect(const lc_scene* s, lc_ray ray, const lc_i
  * number of non-finite contributions it dropped. Out of line on PoCL's CPU device
  * (LC_POCL_NOINLINE, util/math.cl). */
 static LC_POCL_NOINLINE lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
-                                                    __global float4* light_sum,
-                                                    __global float4* light_sumsq, lc_uint* rays) {
+                                                    __global lc_lsum4* light_sum,
+                                                    __global lc_lsum4* light_sumsq, lc_uint* rays) {
   __global const lc_params* P = s->params;
   if (P->max_depth < 3u) return 0; /* a caustic path has at least 3 segments */
   float8 u0 = lc_rand8(rng, LC_DIM_LIGHT_PATH);

@@ -488,6 +488,7 @@ PYBIND11_MODULE(lucent, m) {
       .def_readonly("compute_units", &DeviceInfo::compute_units)
       .def_readonly("global_memory", &DeviceInfo::global_memory)
       .def_readonly("fp64", &DeviceInfo::fp64)
+      .def_readonly("int64_atomics", &DeviceInfo::int64_atomics)
       .def("__repr__", [](const DeviceInfo& d) {
         return "<lucent.DeviceInfo " + std::to_string(d.index) + ": " + d.name + " (" + d.type +
                ", " + d.platform + ")>";

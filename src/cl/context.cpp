@@ -207,6 +207,7 @@ std::vector<Device> enumerate_devices() {
         i.global_memory = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
         std::string ext = d.getInfo<CL_DEVICE_EXTENSIONS>();
         i.fp64 = ext.find("cl_khr_fp64") != std::string::npos;
+        i.int64_atomics = ext.find("cl_khr_int64_base_atomics") != std::string::npos;
         if (!i.fp64) {
           // fp64 is optional: the extension, or (OpenCL 1.2+) a non-empty double FP config; a
           // driver that rejects the query has none

@@ -167,11 +167,15 @@ int run_info_command() {
   std::printf("  build options       %s\n",
               render_detail::build_options(scene, packed, options).c_str());
   // what each device's build adds, from render_detail::device_defines itself (info opens no
-  // device): PoCL's CPU device (which has fp64), another device with fp64 and one without
+  // device): PoCL's CPU device (which has fp64 and 64-bit atomics), another device with both,
+  // one with fp64 only and one without
   DeviceInfo pocl_cpu;
   pocl_cpu.type = "CPU";
   pocl_cpu.platform = cl_util::kPoclPlatform;
-  pocl_cpu.fp64 = true;
+  pocl_cpu.fp64 = pocl_cpu.int64_atomics = true;
+  DeviceInfo with_atomics;
+  with_atomics.type = "GPU";
+  with_atomics.fp64 = with_atomics.int64_atomics = true;
   DeviceInfo with_fp64;
   with_fp64.type = "GPU";
   with_fp64.fp64 = true;
@@ -181,10 +185,10 @@ int run_info_command() {
     return s.empty() ? std::string("none") : s.substr(1);
   };
   std::printf(
-      "  device options      %s on PoCL's CPU device, %s on other devices with fp64, %s on "
-      "others\n",
-      device_options(pocl_cpu).c_str(), device_options(with_fp64).c_str(),
-      device_options(without_fp64).c_str());
+      "  device options      %s on PoCL's CPU device, %s on other devices with fp64 and 64-bit "
+      "atomics, %s on those with fp64 only, %s on others\n",
+      device_options(pocl_cpu).c_str(), device_options(with_atomics).c_str(),
+      device_options(with_fp64).c_str(), device_options(without_fp64).c_str());
   return 0;
 }
 

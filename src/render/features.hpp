@@ -33,9 +33,11 @@ std::string build_options(const Scene& scene, const PackedScene& packed,
 /// The build options that depend on the device, added to build_options' for each device's build
 /// (and so to its cache key): " -D LC_DEVICE_POCL_CPU" for PoCL's CPU device (kernels/util/math.cl,
 /// LC_POCL_NOINLINE: measured for PoCL's build time, wrong on Intel's CPU runtime; on x86-64 also
-/// the traversal's mask reductions by movmskps and popcnt, kernels/bvh/traverse.cl), and
+/// the traversal's mask reductions by movmskps and popcnt, kernels/bvh/traverse.cl),
 /// " -D LC_ACCUM_DOUBLE" for a device with fp64 (a pass's sums in double, kernels/megakernel.cl;
-/// the session reads them back as double4).
+/// the session reads them back as double4), and " -D LC_LIGHT_DOUBLE" for one with fp64 and
+/// 64-bit atomics (cl_khr_int64_base_atomics: the caustics' light sums in double, added by a
+/// 64-bit compare-and-swap, kernels/integrator/caustics.cl; read back as double4 too).
 std::string device_defines(const DeviceInfo& device);
 
 /// Throws lucent::Error (one line naming the device) when `precision` needs what the device lacks:

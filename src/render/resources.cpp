@@ -65,6 +65,7 @@ DeviceLimits DeviceLimits::of(const cl_util::Device& device) {
   d.host_mem = host_memory_allowed(&d.host_what);
   d.host_unified = buffers_in_host_memory(device.device);
   d.fp64 = device.info.fp64;
+  d.light_double = device.info.fp64 && device.info.int64_atomics;
   d.device = device.info.name;
   if (g_override) {
     d.max_alloc = lowered(d.max_alloc, g_override->max_alloc);
@@ -163,9 +164,11 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
     scene_buffers += host_block_bytes(b);
   for (const DeviceLimits& d : devices) {
     // the device's pass sums (double4 with fp64, else float4) and with caustics its light
-    // sums (float4: two films each, an adaptive work list's halves A and B)
+    // sums (double4 with fp64 and 64-bit atomics, else float4: two films each, an adaptive work
+    // list's halves A and B)
     const std::uint64_t sum_elem = d.fp64 ? sizeof(cl_double4) : sizeof(cl_float4);
-    const std::uint64_t light_bufs = (caustics ? 4 : 0) * npix * sizeof(cl_float4);
+    const std::uint64_t light_elem = d.light_double ? sizeof(cl_double4) : sizeof(cl_float4);
+    const std::uint64_t light_bufs = (caustics ? 4 : 0) * npix * light_elem;
     const std::uint64_t film_bufs = 2 * npix * sum_elem + light_bufs;
     // a CPU device's buffers are host memory: the film's (and the work list), and the scene's;
     // its pass results are mapped there (session.cpp). Another device's results are read back
@@ -247,20 +250,22 @@ void check_adaptive_host_memory(const Scene& scene, const std::vector<DeviceLimi
   check_host_parts(scene, parts, host_limit, limit_what);
 }
 
-std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics, bool fp64) {
+std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics, bool fp64,
+                                            bool light_double) {
   const std::uint64_t npix = std::uint64_t(width) * std::uint64_t(height);
   const std::string film = film_size(width, height);
   // session.cpp's Worker: the work list, the pass sums (double4 with fp64), and the light paths'
-  // sums (one element each without caustics)
+  // sums (one element each without caustics; double4 with fp64 and 64-bit atomics)
   const std::uint64_t sum = fp64 ? sizeof(cl_double4) : sizeof(cl_float4);
+  const std::uint64_t light = light_double ? sizeof(cl_double4) : sizeof(cl_float4);
   std::vector<MemoryPart> parts = {
       {"film sample sums (" + film + ")", npix * sum, "the film size"},
       {"film sums of squares (" + film + ")", npix * sum, "the film size"},
       {"film work list (" + film + ")", npix * sizeof(cl_uint4), "the film size"}};
   const std::uint64_t nl = caustics ? 2 * npix : 1;  // an adaptive work list's halves A and B
-  parts.push_back({"caustics light sums (" + film + ")", nl * sizeof(cl_float4),
+  parts.push_back({"caustics light sums (" + film + ")", nl * light,
                    caustics ? "the film size, or render without caustics" : "the film size"});
-  parts.push_back({"caustics light sums of squares (" + film + ")", nl * sizeof(cl_float4),
+  parts.push_back({"caustics light sums of squares (" + film + ")", nl * light,
                    caustics ? "the film size, or render without caustics" : "the film size"});
   return parts;
 }
@@ -274,9 +279,9 @@ void check_device_memory(const Scene& scene, const PackedScene& packed,
                    reduce_buffer(#name)});
   LC_SCENE_BUFFERS(LUCENT_BUFFER_PART)
 #undef LUCENT_BUFFER_PART
-  for (MemoryPart& p :
-       film_device_buffers(scene.film.width, scene.film.height,
-                           (packed.params.flags & LC_FLAG_CAUSTICS) != 0, limits.fp64))
+  for (MemoryPart& p : film_device_buffers(scene.film.width, scene.film.height,
+                                           (packed.params.flags & LC_FLAG_CAUSTICS) != 0,
+                                           limits.fp64, limits.light_double))
     parts.push_back(std::move(p));
   const std::string device = "device '" + limits.device + "'";
   // the largest buffer is the one to reduce first

@@ -30,6 +30,7 @@ struct DeviceLimits {
   std::string host_what = "physical memory";  ///< what host_mem is 80% of, for messages
   bool host_unified = false;  ///< the device's buffers live in host memory (a CPU device)
   bool fp64 = false;          ///< a pass's sums are double4 (LC_ACCUM_DOUBLE), else float4
+  bool light_double = false;  ///< the light sums are double4 (LC_LIGHT_DOUBLE), else float4
   std::string device;         ///< the device's name, for messages
 
   /// The limits of an OpenCL device, with host_mem = host_memory_limit(), each lowered to the
@@ -135,10 +136,11 @@ void check_adaptive_host_memory(const Scene& scene, const std::vector<DeviceLimi
                                 const std::string& limit_what = "physical memory");
 
 /// The film buffers of a device: the pass's sums and sums of squares (double4 per pixel with
-/// `fp64`, else float4), the
-/// work list (uint4 per pixel), and the light paths' sums and sums of squares (float4 per pixel
-/// with `caustics`, one element without).
-std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics, bool fp64);
+/// `fp64`, else float4), the work list (uint4 per pixel), and the light paths' sums and sums of
+/// squares (two films with `caustics`, one element without; double4 with `light_double`, else
+/// float4).
+std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics, bool fp64,
+                                            bool light_double);
 
 /// Before upload: every scene buffer of `packed` (by its LC_SCENE_BUFFERS description) and film
 /// buffer must fit in one allocation of the device, and all of them in its global memory.

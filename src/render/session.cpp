@@ -149,12 +149,16 @@ struct Worker {
   size_t light_elems = 0;
   // a pass's sums as the kernel writes them: double4 where the device has fp64 (accum_double:
   // LC_ACCUM_DOUBLE, render_detail::device_defines; h_sum, h_sumsq), else float4 (h_sum_f,
-  // h_sumsq_f); read through sum_at and sumsq_at. Mapped, not copied, where the device's
-  // buffers are host memory (map_results: a CPU device, as resources.cpp counts it).
+  // h_sumsq_f); read through sum_at and sumsq_at. The light sums likewise: double4 where the
+  // device has fp64 and 64-bit atomics (light_double: LC_LIGHT_DOUBLE; h_light, h_lightsq), else
+  // float4 (h_light_f, h_lightsq_f); read through light_at and lightsq_at. Mapped, not copied,
+  // where the device's buffers are host memory (map_results: a CPU device, as resources.cpp
+  // counts it).
   bool accum_double = false;
+  bool light_double = false;
   bool map_results = false;
-  HostView<cl_double4> h_sum, h_sumsq;
-  HostView<cl_float4> h_sum_f, h_sumsq_f, h_light, h_lightsq;
+  HostView<cl_double4> h_sum, h_sumsq, h_light, h_lightsq;
+  HostView<cl_float4> h_sum_f, h_sumsq_f, h_light_f, h_lightsq_f;
   std::uint32_t pass_spp = 1;  // samples per pixel of its next pass (tuned to pass_seconds)
   DeviceShare share;           // of the accumulation
   DeviceShare call;            // of the render call in progress
@@ -165,6 +169,7 @@ struct Worker {
   explicit Worker(const std::string& selector)
       : ctx(selector, "device"),
         accum_double(ctx.device.info.fp64),
+        light_double(ctx.device.info.fp64 && ctx.device.info.int64_atomics),
         map_results(render_detail::buffers_in_host_memory(ctx.device.device)) {
     share.device = call.device = ctx.device.info.name;
   }
@@ -181,8 +186,8 @@ struct Worker {
 
   /// Unmaps the last pass's results: before a launch writes the buffers or they are replaced.
   void release_results() {
-    for (HostView<cl_double4>* v : {&h_sum, &h_sumsq}) v->release(ctx.queue);
-    for (HostView<cl_float4>* v : {&h_sum_f, &h_sumsq_f, &h_light, &h_lightsq})
+    for (HostView<cl_double4>* v : {&h_sum, &h_sumsq, &h_light, &h_lightsq}) v->release(ctx.queue);
+    for (HostView<cl_float4>* v : {&h_sum_f, &h_sumsq_f, &h_light_f, &h_lightsq_f})
       v->release(ctx.queue);
   }
 
@@ -199,6 +204,22 @@ struct Worker {
   double sumsq_at(size_t k, int c) const {
     return accum_double ? h_sumsq[k].s[c] : h_sumsq_f[k].s[c];
   }
+  /// Bytes of one element of the light sums (b_light, b_lightsq).
+  size_t light_bytes() const { return light_double ? sizeof(cl_double4) : sizeof(cl_float4); }
+  /// Component c of the last pass's light sum and sum of squares of element k.
+  double light_at(size_t k, int c) const {
+    return light_double ? h_light[k].s[c] : h_light_f[k].s[c];
+  }
+  double lightsq_at(size_t k, int c) const {
+    return light_double ? h_lightsq[k].s[c] : h_lightsq_f[k].s[c];
+  }
+  /// Drops the light sums' host views (a scene without caustics).
+  void drop_light_views() {
+    h_light.drop(ctx.queue);
+    h_lightsq.drop(ctx.queue);
+    h_light_f.drop(ctx.queue);
+    h_lightsq_f.drop(ctx.queue);
+  }
 
   size_t global_size(size_t items) const {
     const size_t g = program->work_group;
@@ -209,8 +230,8 @@ struct Worker {
   void ensure_light(size_t elems) {
     if (light_elems >= elems) return;
     release_results();
-    b_light = result_buffer(CL_MEM_READ_WRITE, elems * sizeof(cl_float4));
-    b_lightsq = result_buffer(CL_MEM_READ_WRITE, elems * sizeof(cl_float4));
+    b_light = result_buffer(CL_MEM_READ_WRITE, elems * light_bytes());
+    b_lightsq = result_buffer(CL_MEM_READ_WRITE, elems * light_bytes());
     light_elems = elems;
     set_args();
   }
@@ -258,9 +279,9 @@ struct Worker {
     const bool light = P.flags & LC_FLAG_CAUSTICS;
     const size_t nl = entries ? 2 * npix : npix;  // a work list's: halves A and B
     if (light) {
-      const cl_float4 z = {{0, 0, 0, 0}};
-      q.enqueueFillBuffer(b_light, z, 0, nl * sizeof(cl_float4));
-      q.enqueueFillBuffer(b_lightsq, z, 0, nl * sizeof(cl_float4));
+      const cl_float4 z = {{0, 0, 0, 0}};  // zero bits: 0.0 in double too
+      q.enqueueFillBuffer(b_light, z, 0, nl * light_bytes());
+      q.enqueueFillBuffer(b_lightsq, z, 0, nl * light_bytes());
     }
     q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global_size(items)),
                            cl::NDRange(program->work_group));
@@ -271,9 +292,12 @@ struct Worker {
       h_sum_f.fetch(q, b_sum, items, map_results);
       h_sumsq_f.fetch(q, b_sumsq, items, map_results);
     }
-    if (light) {
+    if (light && light_double) {
       h_light.fetch(q, b_light, nl, map_results);
       h_lightsq.fetch(q, b_lightsq, nl, map_results);
+    } else if (light) {
+      h_light_f.fetch(q, b_light, nl, map_results);
+      h_lightsq_f.fetch(q, b_lightsq, nl, map_results);
     }
     lc_uint c[LC_COUNTER_COUNT];
     q.enqueueReadBuffer(b_counters, CL_TRUE, 0, sizeof(c), c);
@@ -522,14 +546,11 @@ struct Renderer::Impl {
           w.b_counters =
               cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
           const size_t nl = light ? n : 1;  // an adaptive render doubles it (ensure_light)
-          w.b_light = w.result_buffer(CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
-          w.b_lightsq = w.result_buffer(CL_MEM_READ_WRITE, nl * sizeof(cl_float4));
+          w.b_light = w.result_buffer(CL_MEM_READ_WRITE, nl * w.light_bytes());
+          w.b_lightsq = w.result_buffer(CL_MEM_READ_WRITE, nl * w.light_bytes());
           w.light_buffers = light;
           w.light_elems = nl;
-          if (!light) {
-            w.h_light.drop(w.ctx.queue);
-            w.h_lightsq.drop(w.ctx.queue);
-          }
+          if (!light) w.drop_light_views();
         }
         w.set_args();
         if (w.program != previous_program) {
@@ -586,8 +607,8 @@ struct Renderer::Impl {
     if (!light_sum.empty()) {
       for (size_t i = 0; i < npix; ++i)
         for (int c = 0; c < 3; ++c) {
-          light_sum[i * 3 + c] += w.h_light[i].s[c];
-          light_sumsq[i * 3 + c] += w.h_lightsq[i].s[c];
+          light_sum[i * 3 + c] += w.light_at(i, c);
+          light_sumsq[i * 3 + c] += w.lightsq_at(i, c);
         }
       light_paths += std::uint64_t(n) * npix;
     }
@@ -898,8 +919,8 @@ struct Renderer::Impl {
           if (h.light_sum.empty()) continue;
           for (size_t i = 0; i < npix; ++i)
             for (int c = 0; c < 3; ++c) {
-              h.light_sum[i * 3 + c] += w.h_light[hi * npix + i].s[c];
-              h.light_sumsq[i * 3 + c] += w.h_lightsq[hi * npix + i].s[c];
+              h.light_sum[i * 3 + c] += w.light_at(hi * npix + i, c);
+              h.light_sumsq[i * 3 + c] += w.lightsq_at(hi * npix + i, c);
             }
         }
         launched_total += samples;
