@@ -126,9 +126,11 @@ std::string device_defines(const DeviceInfo& device) {
   std::string d = device.type == "CPU" && cl_util::is_pocl(device) ? " -D LC_DEVICE_POCL_CPU" : "";
   if (device.fp64) d += " -D LC_ACCUM_DOUBLE";  // a pass's sums in double (megakernel.cl)
   // the light sums in double: a double CAS add (integrator/caustics.cl)
-  if (device.fp64 && device.int64_atomics) d += " -D LC_LIGHT_DOUBLE";
+  if (light_sums_double(device)) d += " -D LC_LIGHT_DOUBLE";
   return d;
 }
+
+bool light_sums_double(const DeviceInfo& device) { return device.fp64 && device.int64_atomics; }
 
 void check_precision_support(const DeviceInfo& device, Precision precision) {
   if (precision == Precision::Double && !device.fp64)

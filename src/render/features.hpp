@@ -40,6 +40,11 @@ std::string build_options(const Scene& scene, const PackedScene& packed,
 /// 64-bit compare-and-swap, kernels/integrator/caustics.cl; read back as double4 too).
 std::string device_defines(const DeviceInfo& device);
 
+/// Whether `device`'s kernels keep the caustics' light sums in double (LC_LIGHT_DOUBLE: fp64 and
+/// cl_khr_int64_base_atomics): the one rule for the define, the session's read-back and the
+/// memory estimate.
+bool light_sums_double(const DeviceInfo& device);
+
 /// Throws lucent::Error (one line naming the device) when `precision` needs what the device lacks:
 /// Precision::Double needs fp64 (cl_khr_fp64 / CL_DEVICE_DOUBLE_FP_CONFIG).
 void check_precision_support(const DeviceInfo& device, Precision precision);

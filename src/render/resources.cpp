@@ -8,6 +8,7 @@
 #include "core/host_memory.hpp"
 #include "lucent/error.hpp"
 #include "render/device_scene.hpp"
+#include "render/features.hpp"
 
 namespace lucent::render_detail {
 
@@ -65,7 +66,7 @@ DeviceLimits DeviceLimits::of(const cl_util::Device& device) {
   d.host_mem = host_memory_allowed(&d.host_what);
   d.host_unified = buffers_in_host_memory(device.device);
   d.fp64 = device.info.fp64;
-  d.light_double = device.info.fp64 && device.info.int64_atomics;
+  d.light_double = light_sums_double(device.info);
   d.device = device.info.name;
   if (g_override) {
     d.max_alloc = lowered(d.max_alloc, g_override->max_alloc);

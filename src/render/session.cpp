@@ -169,7 +169,7 @@ struct Worker {
   explicit Worker(const std::string& selector)
       : ctx(selector, "device"),
         accum_double(ctx.device.info.fp64),
-        light_double(ctx.device.info.fp64 && ctx.device.info.int64_atomics),
+        light_double(render_detail::light_sums_double(ctx.device.info)),
         map_results(render_detail::buffers_in_host_memory(ctx.device.device)) {
     share.device = call.device = ctx.device.info.name;
   }
