@@ -411,6 +411,13 @@ void validate_scene(const Scene& s) {
   }
 }
 
+glm::dvec3 brightest_texel(const Texture& t) {
+  glm::dvec3 b(0.0);
+  for (std::size_t k = 0; k + 4 <= t.rgba.size(); k += 4)
+    for (int c = 0; c < 3; ++c) b[c] = std::max<double>(b[c], t.rgba[k + c]);
+  return b;
+}
+
 std::vector<std::string> energy_gain_notes(const Scene& s) {
   std::vector<std::string> notes;
   if (is_aov(s.integrator.type)) return notes;  // nothing is reflected
@@ -429,11 +436,8 @@ std::vector<std::string> energy_gain_notes(const Scene& s) {
       if (t >= 0 && static_cast<std::size_t>(t) < s.textures.size()) {
         // a float texture (PFM, EXR) may hold texels above 1
         if (brightest[t] < 0) {
-          double b = 0;
-          const Texture& tex = s.textures[t];
-          for (std::size_t k = 0; k + 4 <= tex.rgba.size(); k += 4)
-            for (int c = 0; c < 3; ++c) b = std::max<double>(b, tex.rgba[k + c]);
-          brightest[t] = b;
+          const glm::dvec3 b = brightest_texel(s.textures[t]);
+          brightest[t] = std::max({b.x, b.y, b.z});
         }
         v = glm::dvec3(brightest[t]);
         what += " texture's brightest texel";

@@ -130,4 +130,7 @@ void validate_scene(const Scene& scene);
 /// each once (Renderer::set_scene), the reference each time.
 std::vector<std::string> energy_gain_notes(const Scene& scene);
 
+/// A texture's largest red, green and blue texels (0 for an empty one).
+glm::dvec3 brightest_texel(const Texture& texture);
+
 }  // namespace lucent::scene_detail

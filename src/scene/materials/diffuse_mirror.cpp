@@ -6,7 +6,6 @@
 // reflects more light than it receives is refused. Defaults: albedo 0.8 (diffuse's),
 // reflectance 0.2 (their sum is 1).
 // Kernel: kernels/bsdf/diffuse_mirror.cl; reference: src/reference/bsdf/diffuse_mirror.cpp.
-#include <algorithm>
 #include <string>
 
 #include "scene/material_type.hpp"
@@ -22,10 +21,7 @@ void check_diffuse_mirror(const Material& m, const std::vector<Texture>& texture
   glm::dvec3 albedo = m.albedo;  // the texture's largest texel per channel, when textured
   std::string texel;
   if (m.albedo_texture >= 0 && static_cast<std::size_t>(m.albedo_texture) < textures.size()) {
-    const Texture& t = textures[m.albedo_texture];
-    albedo = glm::dvec3(0.0);
-    for (std::size_t i = 0; i + 4 <= t.rgba.size(); i += 4)
-      for (int c = 0; c < 3; ++c) albedo[c] = std::max<double>(albedo[c], t.rgba[i + c]);
+    albedo = brightest_texel(textures[m.albedo_texture]);
     texel = " (the albedo texture's brightest texel)";
   }
   for (int c = 0; c < 3; ++c) {
