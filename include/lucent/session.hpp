@@ -50,6 +50,7 @@ struct SessionOptions {
   bool specialize = true;                  ///< compile only the features the scene uses
   double pass_seconds = 0.25;              ///< target duration of one kernel launch
   /// Warnings of scene packing (skipped triangles, ...); null: "lucent: warning: ..." on stderr.
+  /// A session gives each warning about its scenes once, however often set_scene meets it.
   WarningSink on_warning;
 
   /// The defaults of the `lucent` command: device from LUCENT_DEVICE, kernel directory from

@@ -351,7 +351,7 @@ struct Renderer::Impl {
   double render_seconds = 0;
   bool last_cancelled = false;
 
-  std::set<std::string> energy_warned;  ///< the energy_gain_notes this session has given
+  std::set<std::string> notes_given;  ///< the warnings about its scenes this session has given
   std::atomic<bool> cancel_requested{false};
   const std::atomic<bool>* cancel_flag = nullptr;
   /// render_detail::CancelScopes alive: while one is, the calls are one operation, whose cancel a
@@ -464,24 +464,41 @@ struct Renderer::Impl {
 
   void set_scene(const Scene& s) {
     scene_detail::ScopedWarningSink sink(options.on_warning);
-    scene_detail::validate_scene(s);  // fields set directly may not have been checked
-    // once per session: an AOV render, a converge study's settings and an application's camera
-    // moves set the scene again (the warning came 4 times for a render with 3 AOVs)
-    for (const std::string& note : scene_detail::energy_gain_notes(s))
-      if (energy_warned.insert(note).second) scene_detail::warn(note);
+    // What the scene is warned of (validation, energy, packing, precision), each once per
+    // session: an AOV render, a converge study's settings and an application's camera moves set
+    // the scene again (a render with 3 AOVs said each 4 times). Collected, then given on.
+    std::vector<std::string> notes;
+    const std::function<void(const std::string&)> collect = [&notes](const std::string& m) {
+      notes.push_back(m);
+    };
+    auto give_notes = [&] {
+      for (const std::string& note : notes)
+        if (notes_given.insert(note).second) scene_detail::warn(note);
+    };
     std::vector<render_detail::DeviceLimits> limits;
-    for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
-    render_detail::check_host_memory(s, limits, limits.front().host_mem, limits.front().host_what);
-    for (const DeviceInfo& d : device_infos)
-      render_detail::check_precision_support(d, options.precision);
     auto t0 = clock_type::now();
     bool bvh_reused = false;
     const bool uploaded = workers.front()->dev.has_value();
-    render_detail::PackedScene next =
-        render_detail::pack_scene(s, uploaded ? &packed : nullptr, &bvh_reused);
-    if (options.precision == Precision::Float)
-      if (std::string note = render_detail::float_rounding_note(next); !note.empty())
-        scene_detail::warn(scene_detail::in_file(s.path, note));
+    render_detail::PackedScene next;
+    try {
+      scene_detail::ScopedWarningSink capture(collect);
+      scene_detail::validate_scene(s);  // fields set directly may not have been checked
+      for (const std::string& note : scene_detail::energy_gain_notes(s)) scene_detail::warn(note);
+      for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
+      render_detail::check_host_memory(s, limits, limits.front().host_mem,
+                                       limits.front().host_what);
+      for (const DeviceInfo& d : device_infos)
+        render_detail::check_precision_support(d, options.precision);
+      t0 = clock_type::now();
+      next = render_detail::pack_scene(s, uploaded ? &packed : nullptr, &bvh_reused);
+      if (options.precision == Precision::Float)
+        if (std::string note = render_detail::float_rounding_note(next); !note.empty())
+          scene_detail::warn(scene_detail::in_file(s.path, note));
+    } catch (...) {
+      give_notes();
+      throw;
+    }
+    give_notes();
     ++stats.scene_packs;
     if (!bvh_reused) {
       ++stats.bvh_builds;
