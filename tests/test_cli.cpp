@@ -298,6 +298,27 @@ TEST(Cli, ProgressLineAndTimeLimit) {
   EXPECT_EQ(r.out, "");
 }
 
+// --target-error with a --time that ends the render in its pilot: the summary says so and the
+// warning line names the time limit (it printed neither: the render looked complete, exit 0).
+TEST(Cli, AdaptiveStoppedInThePilotByTheTimeLimitSaysSo) {
+  std::string scene = plane_scene(0, 2);
+  std::string out = lucent::test::temp_dir() + "/a.exr";
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(out) +
+                            " --target-error 1e-4 --min-spp 64 --time 0.000001");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::regex_search(
+      r.err,
+      std::regex(out + ": adaptive: stopped in its pilot, \\d+ of \\d+ spp on average: no plan "
+                       "made, the error not estimated \\(target 0.0001\\)\n")))
+      << r.err;
+  EXPECT_TRUE(std::regex_search(
+      r.err, std::regex("lucent: warning: " + out +
+                        ": the time limit stopped the render in its pilot, at \\d+ of its \\d+ "
+                        "spp: no plan was made and the error is not estimated \\(target "
+                        "0.0001\\): raise --time\n$")))
+      << r.err;
+}
+
 // On a terminal the progress line is redrawn in place ('\r') and the summary starts a new line.
 // `script` (util-linux) gives the CLI a pseudo-terminal.
 TEST(Cli, ProgressLineOnATerminal) {

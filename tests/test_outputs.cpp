@@ -479,6 +479,44 @@ TEST(Outputs, SigintWritesThePartialImage) { interrupt_render(SIGINT, "SIGINT \\
 
 TEST(Outputs, SigtermWritesThePartialImage) { interrupt_render(SIGTERM, "SIGTERM", 143); }
 
+// SIGINT during an adaptive render's pilot: the last line says how far into its pilot it got.
+// It said "N of M spp", M the scene's integrator.spp (or --spp, only a cap for an adaptive
+// render): "740 of 64 spp (1156%)".
+TEST(Outputs, SigintInAnAdaptivePilotSaysHowFarItGot) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  lucent::test::write_file(scene, R"({
+    "film": {"width": 64, "height": 48},
+    "integrator": {"type": "path", "spp": 4},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
+  })");
+  std::string out = dir + "/partial.exr", err_path = dir + "/stderr";
+  const int status = interrupt_cli(
+      {"render", scene, "-o", out, "--target-error", "1e-6", "--min-spp", "1000000", "--spp",
+       "1000000", "--time", "120"},
+      err_path,
+      [](const std::string& err) { return err.find("Msamples/s  elapsed") != std::string::npos; },
+      SIGINT, 60);
+  std::string err = read_file(err_path);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(
+      err, m,
+      std::regex("lucent: interrupted by SIGINT \\(Ctrl-C\\): wrote " + out +
+                 " with (\\d+) spp on average, in its pilot of (\\d+) spp \\(no plan made\\)\n$")))
+      << err;
+  EXPECT_GE(std::stoll(m[1]), 1);
+  EXPECT_LT(std::stoll(m[1]), std::stoll(m[2]));
+  EXPECT_GE(std::stoll(m[2]), 1000000);
+  const lucent::RenderResult r = lucent::read_render(out);
+  std::uint64_t n = 0;
+  for (std::uint32_t c : r.samples) n += c;
+  EXPECT_GT(n, 0u);
+}
+
 // converge ends on SIGTERM (Slurm's at a job's time limit) as on SIGINT: the rungs done are in
 // the CSV, the exit status is 128 + the signal. Only SIGINT was caught: SIGTERM killed it with
 // nothing written.

@@ -596,6 +596,37 @@ TEST(AdaptivePlan, TargetShortfallIsReportedAbove1Point5TimesTheTarget) {
   EXPECT_EQ(lucent::target_shortfall(r), "");
 }
 
+// A render that a time limit stopped short of its plan: in the pilot the warning is always
+// given (no plan was made and nothing was estimated: the halves' difference may be 0, where only
+// one half has samples); after the pilot it names the time limit, not the plan's causes, when the
+// halves are above the limit. A cancelled render gets none (its last line says how far it got).
+TEST(AdaptivePlan, TargetShortfallNamesTheTimeLimit) {
+  RenderResult r;
+  r.mean.width = r.mean.height = 128;
+  r.target_error = 1e-3;
+  r.spp = 3;
+  r.planned_spp = 66;
+  r.pilot_incomplete = r.plan_incomplete = true;
+  EXPECT_EQ(lucent::target_shortfall(r),
+            "the time limit stopped the render in its pilot, at 3 of its 66 spp: no plan was "
+            "made and the error is not estimated (target 0.001): raise --time");
+  r.pilot_incomplete = false;
+  r.spp = 100;
+  r.planned_spp = 400;
+  r.halves_relmse = 1.4e-3;  // within 1.5 E: no warning
+  EXPECT_EQ(lucent::target_shortfall(r), "");
+  r.halves_relmse = 2.2e-3;
+  EXPECT_EQ(lucent::target_shortfall(r),
+            "the halves' difference estimates relMSE 0.0022, 2.2 times the target 0.001: the time "
+            "limit stopped the render at 100 of the 400 spp its plan asked for: raise --time");
+  r.cancelled = true;
+  EXPECT_EQ(lucent::target_shortfall(r), "");
+  r.cancelled = false;
+  r.pilot_incomplete = true;
+  r.cancelled = true;
+  EXPECT_EQ(lucent::target_shortfall(r), "");
+}
+
 // The weighing value: analytic on a 3 x 3 film of grey pixels (1, the same in the 3 channels
 // but for the blue channel's + 20) with a firefly at the centre (10): the centre gets its 8
 // neighbours' mean, 1; a corner keeps its own 1 (below its neighbours' (1 + 1 + 10) / 3). A pixel
@@ -822,6 +853,40 @@ TEST(Adaptive, MeanIsUnbiased) {
     if (m.emissive()) m.emission *= 1.02;
   RenderResult brighter = lucent::test::render(u, o);
   EXPECT_FALSE(lucent::compare_images(a, brighter).passed) << "the test has no power";
+}
+
+// A time limit that ends an adaptive render in its pilot: the result still says it is a target
+// render (target_error was set only once the pilot was done, so `lucent render --target-error E
+// --time T` stopped in the pilot printed no adaptive line and no warning, exit 0, as if complete),
+// that it stopped in the pilot and how far it got, and target_shortfall says so. A second call
+// without a limit completes the pilot and the plan.
+TEST(Adaptive, TimeLimitInThePilotIsReported) {
+  Scene s = adaptive_scene();
+  lucent::Renderer r(lucent::test::session_options());
+  r.set_scene(s);
+  lucent::AdaptiveOptions ao;
+  ao.target_error = 1e-3;
+  ao.min_spp = 8;
+  ao.max_seconds = 1e-9;  // one job, the first: part of the pilot
+  r.render_adaptive(ao);
+  RenderResult a = r.result();
+  EXPECT_FALSE(a.cancelled);
+  EXPECT_EQ(a.target_error, 1e-3);
+  EXPECT_TRUE(a.pilot_incomplete);
+  EXPECT_TRUE(a.plan_incomplete);
+  EXPECT_GE(a.planned_spp, 8u);  // both halves' pilot, and the calibration's
+  EXPECT_LT(a.spp, a.planned_spp);
+  EXPECT_EQ(lucent::target_shortfall(a).rfind("the time limit stopped the render in its pilot", 0),
+            0u)
+      << lucent::target_shortfall(a);
+
+  ao.max_seconds = 0;
+  r.render_adaptive(ao);
+  RenderResult b = r.result();
+  EXPECT_FALSE(b.pilot_incomplete);
+  EXPECT_FALSE(b.plan_incomplete);
+  EXPECT_EQ(b.spp, b.planned_spp);
+  EXPECT_GT(b.estimated_relmse, 0.0);
 }
 
 // The one-shot lucent::render with RenderOptions::target_error renders adaptively, as a

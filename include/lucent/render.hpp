@@ -93,6 +93,14 @@ struct RenderResult {
   /// calibrated plans of the last call predicted (0 when that call had a budget); 0 otherwise.
   double model_gain_a = 0, model_gain_b = 0;
   double planned_relmse = 0;
+  /// Adaptive renders: how far the last render_adaptive call got. planned_spp is the mean over
+  /// pixels of the samples its plans ask for (calibration samples included, as spp): the pilot's
+  /// while the pilot is not complete. pilot_incomplete: a time limit or a cancel stopped the render
+  /// in its pilot, so no plan was made and the estimates above read a partial pilot (the halves'
+  /// difference maybe none at all: 0). plan_incomplete: it stopped before every planned sample was
+  /// rendered (in the pilot or after). 0 and false for uniform renders and complete ones.
+  std::uint64_t planned_spp = 0;
+  bool pilot_incomplete = false, plan_incomplete = false;
   /// The key of the render's random numbers: the scene's integrator seed and the sampler's name
   /// ("sobol", "independent"), set by the kernel and reference renderers; sampler "" when unknown
   /// (an image read from a file that does not say). write_render_exr stores both (lucent.seed,
@@ -105,7 +113,9 @@ struct RenderResult {
 /// A render with a target error whose halves' estimate (halves_relmse) is above 1.5 times the
 /// target (widened on small films by twice that estimate's relative noise, sqrt(2 / (3 pixels)):
 /// 1.52 E at 128 x 128, 2.7 E at 2 x 2): one line saying so and what to do ("" otherwise, and
-/// for renders without a target).
+/// for renders without a target and cancelled ones). A render that a time limit stopped in its
+/// pilot always gets one (no plan was made, nothing estimated); one it stopped later names the
+/// time limit as the cause.
 /// The plan is made from a pilot, and a pilot that misses a scene's rare bright paths
 /// under-predicts (docs/rendering-model.md "Adaptive sampling"); the halves see what the whole
 /// render drew. Not a failure: the image is unbiased, only noisier than asked.

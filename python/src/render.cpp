@@ -403,6 +403,9 @@ py::dict result_state(const RenderResult& r) {
   d["model_gain_a"] = r.model_gain_a;
   d["model_gain_b"] = r.model_gain_b;
   d["planned_relmse"] = r.planned_relmse;
+  d["planned_spp"] = r.planned_spp;
+  d["pilot_incomplete"] = r.pilot_incomplete;
+  d["plan_incomplete"] = r.plan_incomplete;
   d["seed"] = r.seed;
   d["sampler"] = r.sampler;
   return d;
@@ -460,6 +463,9 @@ RenderResult result_from_state(const py::object& state) {
   r.model_gain_a = s.number("model_gain_a");
   r.model_gain_b = s.number("model_gain_b");
   r.planned_relmse = s.number("planned_relmse");
+  r.planned_spp = s.integer<std::uint64_t>("planned_spp");
+  r.pilot_incomplete = s.boolean("pilot_incomplete");
+  r.plan_incomplete = s.boolean("plan_incomplete");
   r.seed = s.integer<std::uint32_t>("seed");
   r.sampler = s.text("sampler");
   s.finish();
@@ -597,9 +603,18 @@ void bind_render(py::module_& m) {
                     "call)")
       .def_readonly("target_error", &RenderResult::target_error,
                     "the relMSE an adaptive render aimed at (0: not adaptive)")
+      .def_readonly("planned_spp", &RenderResult::planned_spp,
+                    "an adaptive render's planned samples per pixel, calibration included (the "
+                    "pilot's while the pilot is not complete; 0: not adaptive)")
+      .def_readonly("pilot_incomplete", &RenderResult::pilot_incomplete,
+                    "a time limit or a cancel stopped an adaptive render in its pilot (no plan "
+                    "made, nothing estimated)")
+      .def_readonly("plan_incomplete", &RenderResult::plan_incomplete,
+                    "a time limit or a cancel stopped an adaptive render before every planned "
+                    "sample was rendered")
       .def_property_readonly("target_shortfall", &lucent::target_shortfall,
-                             "a target render's warning when its halves' relMSE is above 1.5 "
-                             "times the target ('' otherwise)")
+                             "a target render's warning when a time limit stopped it in its pilot "
+                             "or its halves' relMSE is above 1.5 times the target ('' otherwise)")
       .def_readonly("seed", &RenderResult::seed,
                     "the seed of the render's random numbers (meaningful when sampler is set)")
       .def_readonly("sampler", &RenderResult::sampler,

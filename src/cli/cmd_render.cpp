@@ -169,6 +169,20 @@ std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_sp
       return buf;
     }
   }
+  if (r.target_error > 0) {
+    // adaptive: --spp is only a cap and the scene's spp means nothing to it ("740 of 64 spp
+    // (1156%)"); say where in its plan it stopped
+    if (r.pilot_incomplete)
+      std::snprintf(buf, sizeof buf, "%llu spp on average, in its pilot of %llu spp (no plan made)",
+                    static_cast<unsigned long long>(r.spp),
+                    static_cast<unsigned long long>(r.planned_spp));
+    else
+      std::snprintf(buf, sizeof buf, "%llu of the %llu spp its plan asked for on average (%.0f%%)",
+                    static_cast<unsigned long long>(r.spp),
+                    static_cast<unsigned long long>(r.planned_spp),
+                    r.planned_spp ? 100.0 * double(r.spp) / double(r.planned_spp) : 100.0);
+    return buf;
+  }
   if (target_spp > 0)
     std::snprintf(
         buf, sizeof buf, "%llu of %llu spp (%.0f%%)", static_cast<unsigned long long>(r.spp),
@@ -353,7 +367,13 @@ int render_with(const RenderArgs& a) {
         seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / seconds * 1e-6 : 0,
         seconds > 0 ? double(r.rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
         r.device.c_str(), device_shares(r.devices).c_str());
-  if (!a.quiet && r.target_error > 0)
+  if (!a.quiet && r.target_error > 0 && r.pilot_incomplete)  // (its estimates read a partial pilot)
+    std::fprintf(stderr,
+                 "%s: adaptive: stopped in its pilot, %llu of %llu spp on average: no plan made, "
+                 "the error not estimated (target %.3g)\n",
+                 one_line(a.output).c_str(), static_cast<unsigned long long>(r.spp),
+                 static_cast<unsigned long long>(r.planned_spp), r.target_error);
+  else if (!a.quiet && r.target_error > 0)
     std::fprintf(stderr,
                  "%s: adaptive: %llu spp on average, estimated relMSE %.3g (target %.3g; model "
                  "gains %.3g, %.3g), from the halves' difference %.3g\n",

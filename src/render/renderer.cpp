@@ -11,18 +11,39 @@
 namespace lucent {
 
 std::string target_shortfall(const RenderResult& r) {
+  if (!(r.target_error > 0) || r.cancelled) return "";
+  char line[400];
+  // a time limit stopped it in the pilot: no plan was made, and the estimates read a partial
+  // pilot (the halves' difference none at all where only one half had samples): the render
+  // ended without a word, exit 0, looking like a finished one
+  if (r.pilot_incomplete) {
+    std::snprintf(line, sizeof line,
+                  "the time limit stopped the render in its pilot, at %llu of its %llu spp: no "
+                  "plan was made and the error is not estimated (target %.3g): raise --time",
+                  static_cast<unsigned long long>(r.spp),
+                  static_cast<unsigned long long>(r.planned_spp), r.target_error);
+    return line;
+  }
   // 1.5 E, widened by twice the relative sd of the halves' estimate on a small film (a mean of
   // 3 npix terms of one degree of freedom each: sqrt(2 / (3 npix)))
   const double npix = std::max(1.0, double(r.mean.width) * double(r.mean.height));
   const double limit = 1.5 * r.target_error * (1 + 2 * std::sqrt(2 / (3 * npix)));
-  if (!(r.target_error > 0) || r.cancelled || !(r.halves_relmse > limit)) return "";
+  if (!(r.halves_relmse > limit)) return "";
   // %.3g: a tiny target made %.1f print hundreds of digits, and the line was cut short
-  char line[320];
-  std::snprintf(line, sizeof line,
-                "the halves' difference estimates relMSE %.3g, %.3g times the target %.3g (rare "
-                "bright samples that no pilot foresees, or the --spp cap): lower --target-error or "
-                "raise --spp; integrator.clamp trades such samples for bias",
-                r.halves_relmse, r.halves_relmse / r.target_error, r.target_error);
+  if (r.plan_incomplete)  // the time limit, not the plan (its advice named only the plan's causes)
+    std::snprintf(line, sizeof line,
+                  "the halves' difference estimates relMSE %.3g, %.3g times the target %.3g: the "
+                  "time limit stopped the render at %llu of the %llu spp its plan asked for: "
+                  "raise --time",
+                  r.halves_relmse, r.halves_relmse / r.target_error, r.target_error,
+                  static_cast<unsigned long long>(r.spp),
+                  static_cast<unsigned long long>(r.planned_spp));
+  else
+    std::snprintf(line, sizeof line,
+                  "the halves' difference estimates relMSE %.3g, %.3g times the target %.3g (rare "
+                  "bright samples that no pilot foresees, or the --spp cap): lower "
+                  "--target-error or raise --spp; integrator.clamp trades such samples for bias",
+                  r.halves_relmse, r.halves_relmse / r.target_error, r.target_error);
   return line;
 }
 

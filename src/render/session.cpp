@@ -843,11 +843,13 @@ struct Renderer::Impl {
   render_detail::Calibration calib[2];  // calib[h]: the gain of half h's plan
   double planned_relmse[2] = {0, 0};    // the calibrated plans' predictions (target renders)
   double adaptive_target = 0;
+  bool pilot_done = false;  // the last call's pilot was complete (its plans were made)
 
   void clear_adaptive() {
     adaptive = false;
     pilot = 0;
     adaptive_target = 0;
+    pilot_done = false;
     for (Half& h : halves) h = Half{};
     calib_pixels.clear();
     calibrated = false;
@@ -1037,6 +1039,11 @@ struct Renderer::Impl {
                            (planned() - call_start) / npix, o.max_seconds);
     };
     const double time_limit = o.max_seconds;
+    // this call's target, also when a time limit or a cancel stops it in the pilot (it was set
+    // after the pilot only: a render stopped there did not look adaptive at all, and `lucent
+    // render --target-error E --time T` said nothing of the target it had not reached)
+    adaptive_target = o.target_error;
+    pilot_done = false;
     Half& calib_half = halves[2];
     if (o.target_error > 0 && calib_half.plan.empty()) {
       // the calibration's pilot: `pilot` samples of stream C in each calibration pixel
@@ -1072,6 +1079,7 @@ struct Renderer::Impl {
       piloted = render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress);
     }
     if (!piloted) return progress();
+    pilot_done = true;
     for (int hi = 0; hi < 2; ++hi) {
       Half& h = halves[hi];
       if (h.piloted) continue;  // its samples are no longer only the pilot's
@@ -1109,7 +1117,6 @@ struct Renderer::Impl {
       }
     }
     calibrated = calibrated || o.target_error > 0;
-    adaptive_target = o.target_error;
     render_plans(cs, time_limit, launched_total, call_start, planned(), on_progress);
     return progress();
   }
@@ -1166,6 +1173,15 @@ struct Renderer::Impl {
         r.halves_relmse = render_detail::halves_relmse(a.sum, a.count, b.sum, b.count, &value);
       }
       r.target_error = adaptive_target;
+      // how far the plans got: a time limit or a cancel stops a render short of them
+      std::uint64_t planned_total = 0;
+      for (const Half& h : halves)
+        for (size_t i = 0; i < h.plan.size(); ++i) {
+          planned_total += h.plan[i];
+          if (h.launched[i] < h.plan[i]) r.plan_incomplete = true;
+        }
+      r.planned_spp = npix ? (planned_total + npix / 2) / npix : 0;  // rounded as spp is
+      r.pilot_incomplete = !pilot_done;
       if (calibrated) {
         r.model_gain_a = calib[0].gain;
         r.model_gain_b = calib[1].gain;
