@@ -873,6 +873,37 @@ TEST(Session, PlannedRelmseIsTheLastCallsPlan) {
   EXPECT_EQ(b.model_gain_a, t.model_gain_a);
 }
 
+// A call continues what an earlier call planned and did not render (here cancelled once its plan
+// was made), but within its own max_spp: a call with max_spp 16 after one with 4096 rendered the
+// earlier plan to its 4096 samples per pixel. Per half, a pixel ends at most at the larger of
+// what it had and the cap's half.
+TEST(Session, AdaptiveCallKeepsItsCapOverAnEarlierPlan) {
+  Renderer r = session();
+  r.set_scene(lucent::test::scene_from(kScene));
+  lucent::AdaptiveOptions ao;
+  ao.target_error = 1e-7;
+  ao.min_spp = 8;
+  ao.max_spp = 4096;
+  const std::uint64_t pilot_spp = 3 * 4;  // halves A, B and C (every pixel of a small film)
+  r.render_adaptive(ao, [&](const lucent::RenderProgress& p) {
+    if (p.samples_target > pilot_spp) r.cancel();  // the plan is made
+  });
+  const RenderResult a = r.result();
+  ASSERT_TRUE(a.cancelled);
+  ASSERT_FALSE(a.pilot_incomplete);
+  ASSERT_TRUE(a.plan_incomplete);
+  ASSERT_GT(a.planned_spp, 1000u);
+  ao.target_error = 1;
+  ao.max_spp = 16;
+  r.render_adaptive(ao);
+  const RenderResult b = r.result();
+  EXPECT_FALSE(b.cancelled);
+  EXPECT_FALSE(b.plan_incomplete);
+  ASSERT_EQ(a.samples.size(), b.samples.size());
+  for (std::size_t i = 0; i < a.samples.size(); ++i)
+    ASSERT_LE(b.samples[i], a.samples[i] + 16) << "pixel " << i;
+}
+
 // A pass's ray and non-finite counts are 64 bits: the kernel's 32-bit counters carry into a high
 // word. They wrapped: a pass of more than 2^32 rays (a 16-megapixel film at several samples per
 // pixel and deep paths) reported its rays modulo 2^32. Here each pass's counters start at

@@ -1109,8 +1109,13 @@ struct Renderer::Impl {
         render_detail::plan_halves(halves[0].pilot, halves[1].pilot, c, scene->film.width,
                                    scene->film.height, o.target_error, o.budget_spp, m, max_half);
     for (int hi = 0; hi < 2; ++hi) {
+      // what an earlier call planned and did not render (a time limit, a cancel) stays planned,
+      // but within this call's cap: a call with max_spp 64 after one with 100000 rendered the
+      // earlier plan to 100000 samples in a pixel. (Unbiased still: the cap is no sample's.)
+      Half& h = halves[hi];
       for (size_t i = 0; i < npix; ++i)
-        halves[hi].plan[i] = std::max(halves[hi].plan[i], plans.plan[hi].counts[i]);
+        h.plan[i] = std::max(std::min(h.plan[i], std::max(h.launched[i], max_half)),
+                             plans.plan[hi].counts[i]);
       if (o.target_error > 0) {
         calib[hi] = plans.calib[hi];
         planned_relmse[hi] = plans.plan[hi].predicted;
