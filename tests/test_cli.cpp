@@ -319,6 +319,20 @@ TEST(Cli, AdaptiveStoppedInThePilotByTheTimeLimitSaysSo) {
       << r.err;
 }
 
+// ... and one that ends it after its pilot, short of its plan: the summary line says so (it read
+// as a render that had completed its plan).
+TEST(Cli, AdaptiveStoppedByTheTimeLimitAfterItsPilotSaysSo) {
+  std::string scene = plane_scene(0, 2);
+  std::string out = lucent::test::temp_dir() + "/a.exr";
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(out) +
+                            " --target-error 1e-9 --min-spp 4 --spp 1000000 --time 0.3");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::regex_search(
+      r.err, std::regex(out + ": adaptive: \\d+ spp on average, .*; the time limit stopped it at "
+                              "\\d+ of the \\d+ spp its plan asked for\n")))
+      << r.err;
+}
+
 // On a terminal the progress line is redrawn in place ('\r') and the summary starts a new line.
 // `script` (util-linux) gives the CLI a pseudo-terminal.
 TEST(Cli, ProgressLineOnATerminal) {

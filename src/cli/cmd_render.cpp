@@ -367,6 +367,11 @@ int render_with(const RenderArgs& a) {
         seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / seconds * 1e-6 : 0,
         seconds > 0 ? double(r.rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
         r.device.c_str(), device_shares(r.devices).c_str());
+  // a time limit that ended the render before its plan did (a signal's last line says so)
+  std::string stopped_early;
+  if (r.plan_incomplete && !r.cancelled && !g_interrupted.load())
+    stopped_early = "; the time limit stopped it at " + std::to_string(r.spp) + " of the " +
+                    std::to_string(r.planned_spp) + " spp its plan asked for";
   if (!a.quiet && r.target_error > 0 && r.pilot_incomplete)  // (its estimates read a partial pilot)
     std::fprintf(stderr,
                  "%s: adaptive: stopped in its pilot, %llu of %llu spp on average: no plan made, "
@@ -376,10 +381,10 @@ int render_with(const RenderArgs& a) {
   else if (!a.quiet && r.target_error > 0)
     std::fprintf(stderr,
                  "%s: adaptive: %llu spp on average, estimated relMSE %.3g (target %.3g; model "
-                 "gains %.3g, %.3g), from the halves' difference %.3g\n",
+                 "gains %.3g, %.3g), from the halves' difference %.3g%s\n",
                  one_line(a.output).c_str(), static_cast<unsigned long long>(r.spp),
                  r.estimated_relmse, r.target_error, r.model_gain_a, r.model_gain_b,
-                 r.halves_relmse);
+                 r.halves_relmse, stopped_early.c_str());
   if (std::string s = lucent::target_shortfall(r); !s.empty())
     std::fprintf(stderr, "lucent: warning: %s: %s\n", one_line(a.output).c_str(), s.c_str());
   std::vector<std::string> missing_aovs;
