@@ -260,7 +260,13 @@ TEST(Converge, SettingSyntax) {
             "setting 'caustics+no-caustics': no-caustics and caustics set the same thing");
   // a number's knob as written, and the pilot's true range (it said min_spp, from 1)
   EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("adaptive+min-spp=-4"); }),
-            "setting min-spp=-4: expected an integer from 4 to 16777216");
+            "setting min-spp=-4: expected an integer from 4 to 16384");
+  // at most an adaptive render's most samples per pixel (16384), which a study cannot raise: the
+  // study failed at the setting, after rendering the reference and the settings before it
+  EXPECT_EQ(lucent::test::error_of(
+                [] { lucent::parse_converge_setting("target-error=1e-3+min-spp=20000"); }),
+            "setting min-spp=20000: expected an integer from 4 to 16384");
+  EXPECT_EQ(lucent::parse_converge_setting("adaptive+min-spp=16383").min_spp, 16383);
   EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("max-depth=0"); }),
             "setting max-depth=0: expected an integer from 1 to 100000");
 

@@ -225,8 +225,11 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
       no_value();
       s.adaptive = true;
     } else if (key == "min_spp") {
-      // (from 4: "min-spp=-4" said "an integer from 1", and under the spelling min_spp)
-      s.min_spp = parse_int(knob.substr(0, eq), value, 4, limits::kMaxSpp);
+      // (from 4: "min-spp=-4" said "an integer from 1", and under the spelling min_spp; to an
+      // adaptive render's most samples per pixel, which a study cannot raise: above it the
+      // study failed once it reached the setting, after the reference and the settings before
+      // it, with render_adaptive's "... <= max_spp, got 20000 and 16384")
+      s.min_spp = parse_int(knob.substr(0, eq), value, 4, int(AdaptiveOptions{}.max_spp));
     } else if (key == "target_error") {
       s.target_error = parse_number(knob, value, 0, true);
     } else if (key == "integrator") {
