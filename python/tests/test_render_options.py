@@ -2,6 +2,7 @@
 reference, and the image of the `lucent` command (a file of its own beside test_render.py: the two
 take about 10 s each on cold kernel caches, and one CTest entry per file keeps each under 20 s)."""
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -88,6 +89,19 @@ def test_samplers_clamp_and_adaptive(renderer, small_scene):
     # the shortfall warning says so exactly when the halves are above 1.5 times the target
     limit = 1.5 * 0.05 * (1 + 2 * math.sqrt(2 / (3 * r.width * r.height)))
     assert (r.target_shortfall != "") == (r.halves_relmse > limit)
+    # a complete render: its plan done, spp all it planned
+    assert not r.pilot_incomplete and not r.plan_incomplete and r.spp == r.planned_spp
+    # stopped by a time limit in its pilot: still a target render, and it says so (it had
+    # target_error 0 and no shortfall, like a finished uniform render); pickled with it
+    renderer.reset()
+    renderer.render_adaptive(target_error=0.05, min_spp=8, max_spp=256, max_seconds=1e-9)
+    r = renderer.result()
+    assert r.target_error == 0.05 and r.pilot_incomplete and r.plan_incomplete
+    assert r.spp < r.planned_spp
+    assert r.target_shortfall.startswith("the time limit stopped the render in its pilot")
+    back = pickle.loads(pickle.dumps(r))
+    assert (back.planned_spp, back.pilot_incomplete, back.plan_incomplete) == (
+        r.planned_spp, True, True)
     with pytest.raises(ValueError):
         renderer.render_adaptive()  # neither a target nor a budget
     with pytest.raises(ValueError):
