@@ -208,9 +208,11 @@ WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackE
       if (callback) {
         callback.get()(message_text(message));
       } else {
+        // stacklevel 1: the innermost Python frame, the line that called into lucent (warn is
+        // called from C++, not from a Python function of lucent's: 2 named the caller's caller)
         py::module_ lucent = py::module_::import("lucent");
         py::module_::import("warnings")
-            .attr("warn")(message_text(message), lucent.attr("LucentWarning"), 2);
+            .attr("warn")(message_text(message), lucent.attr("LucentWarning"), 1);
       }
     });
   };

@@ -1,8 +1,11 @@
 """The render session from Python: NumPy results without copies, progressive accumulation, what a
 change rebuilds (stats), AOVs, callbacks, the GIL, cancellation, and every error of the API."""
+import inspect
+import pathlib
 import re
 import threading
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -239,6 +242,24 @@ def test_warnings_of_packing(small_scene):
     assert len(got) == 1 and "skipped 1 degenerate or non-finite triangle" in got[0]
     with session() as r, pytest.warns(lucent.LucentWarning, match="degenerate"):
         r.set_scene(small_scene)
+
+
+def test_a_warning_names_the_line_that_called_lucent(small_scene):
+    """A LucentWarning is attributed to the line that called lucent (set_scene, load_scene), as a
+    warning of a Python function is to its caller: it named the caller's caller (stacklevel 2 from
+    C++, where no Python frame of lucent's is on the stack), or "sys:1" at a script's top level."""
+    add_degenerate_triangle(small_scene)
+    here = pathlib.Path(__file__).resolve()
+
+    def set_it(r):
+        line = inspect.currentframe().f_lineno + 1
+        r.set_scene(small_scene)
+        return line
+
+    with session() as r, warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        line = set_it(r)
+    assert [(pathlib.Path(w.filename).resolve(), w.lineno) for w in got] == [(here, line)]
 
 
 def test_session_options_and_devices(small_scene):
