@@ -290,6 +290,29 @@ TEST(Session, WarningsGoToTheSessionsSink) {
 
 // The kernel cache directory is the session's: "off" compiles, a directory is filled and then
 // read by the next session (where the driver keeps no cache of its own: PoCL with its cache off).
+// image_hash covers the kernel source of the session's program. A kernel directory whose build
+// failed, fixed and set again (kernel development in one session): the hash kept the first,
+// broken source's, so that the session's parts did not merge with those of a fresh session on the
+// same kernel (and a part of another kernel could claim it).
+TEST(Session, ImageHashIsThatOfTheKernelSourceBuilt) {
+  const fs::path dir = fs::path(lucent::test::temp_dir()) / "kernels";
+  fs::copy(lucent::test::source_path("kernels"), dir, fs::copy_options::recursive);
+  const fs::path main = dir / "megakernel.cl";
+  const std::string good = lucent::test::read_file(main.string());
+  ASSERT_FALSE(good.empty());
+  lucent::SessionOptions o = lucent::test::session_options();
+  o.kernel_dir = dir.string();
+  Scene scene = lucent::parse_scene(kScene, "session.json");
+  Renderer r(o);
+  lucent::test::write_file(main.string(), good + "\n#error broken on purpose\n");
+  EXPECT_NE(error_of([&] { r.set_scene(scene); }), "");
+  lucent::test::write_file(main.string(), good);  // fixed
+  r.set_scene(scene);
+  Renderer fresh(o);
+  fresh.set_scene(scene);
+  EXPECT_EQ(r.image_hash(), fresh.image_hash());
+}
+
 TEST(Session, CacheDirectoryIsAnOption) {
   lucent::test::ScopedEnv pocl_cache("POCL_KERNEL_CACHE", "0");
   Scene s = lucent::test::scene_from(kScene);

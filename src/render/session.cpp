@@ -90,6 +90,9 @@ struct Program {
   size_t work_group = kWorkGroupSize;  ///< render_detail::work_group_size for this kernel
   bool cache_hit = false;
   double build_seconds = 0;
+  /// FNV-1a of the kernel source it was built from (the embedded copy or kernel_dir's): part of
+  /// image_hash, so that parts rendered by different kernels do not merge
+  std::uint64_t source_hash = 0;
 };
 
 /// A pass output buffer's contents on the host, from `fetch` until the next `release`: on a
@@ -331,9 +334,6 @@ struct Renderer::Impl {
   /// rendering is refused until a set_scene succeeds; the accumulation stays readable.
   std::string stale;
   std::string build_options;
-  /// FNV-1a of the kernel source the session assembled (the embedded copy or kernel_dir's): part
-  /// of image_hash, so that parts rendered by different kernels do not merge
-  std::uint64_t kernel_source_hash = 0;
   size_t npix = 0;
 
   // the accumulation
@@ -417,6 +417,9 @@ struct Renderer::Impl {
         w.ctx.device.device.getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>().at(0),
         p.kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(w.ctx.device.device));
     p.cache_hit = info.cache_hit;
+    // the source this program was built from: a kernel directory's files may have changed since
+    // the session's first build (one that failed, then fixed: the first source's hash was kept)
+    p.source_hash = fnv1a(source.data(), source.size());
     if (!info.note.empty()) scene_detail::warn(info.note);
     if (info.cache_hit)
       ++stats.kernel_cache_loads;
@@ -528,7 +531,6 @@ struct Renderer::Impl {
         Program* previous_program = w.program;
         if (!w.programs.count(opts) && source.empty()) {
           source = detail::assemble_kernel_source("megakernel.cl", options.kernel_dir);
-          if (kernel_source_hash == 0) kernel_source_hash = fnv1a(source.data(), source.size());
         }
         cl_util::DeferredEntry entry;
         if (!w.programs.count(opts)) built = true;
@@ -1358,7 +1360,10 @@ std::uint64_t Renderer::image_hash() const {
   LC_SCENE_BUFFERS(LUCENT_HASH)
 #undef LUCENT_HASH
   add(m.build_options.data(), m.build_options.size());
-  add(&m.kernel_source_hash, sizeof m.kernel_source_hash);
+  // the kernel of the session's build options (after a failed set_scene a worker's program may be
+  // another's)
+  const std::uint64_t source_hash = m.workers.front()->programs.at(m.build_options).source_hash;
+  add(&source_hash, sizeof source_hash);
   return h;
 }
 std::uint64_t Renderer::spp() const { return impl_->done; }
