@@ -313,6 +313,45 @@ TEST(Session, ImageHashIsThatOfTheKernelSourceBuilt) {
   EXPECT_EQ(r.image_hash(), fresh.image_hash());
 }
 
+// A render's on_progress may read the session, not change it: set_scene from it replaced the
+// buffers and the accumulation under the render (with two devices a crash in the driver, with one
+// a render of 8 spp that returned holding none of them).
+TEST(Session, OnProgressMayReadTheSessionButNotChangeIt) {
+  lucent::SessionOptions o = lucent::test::session_options();
+  o.pass_seconds = 1e-6;  // one sample per pass: a callback after each
+  Renderer r(o);
+  Scene scene = lucent::parse_scene(kScene, "session.json");
+  r.set_scene(scene);
+  Scene moved = scene;
+  moved.camera.position.x += 1;
+  int calls = 0;
+  std::vector<std::string> errors;
+  r.render(8, [&](const lucent::RenderProgress& p) {
+    ++calls;
+    EXPECT_EQ(r.result().spp, p.accumulated);
+    EXPECT_EQ(r.spp(), p.accumulated);
+    errors.push_back(error_of([&] { r.set_scene(moved); }));
+    errors.push_back(error_of([&] { r.set_build_options(lucent::Precision::Float, true, true); }));
+    errors.push_back(error_of([&] { r.reset(); }));
+    errors.push_back(error_of([&] { r.render(1); }));
+    lucent::AdaptiveOptions a;
+    a.budget_spp = 8;
+    errors.push_back(error_of([&] { r.render_adaptive(a); }));
+  });
+  EXPECT_GE(calls, 1);
+  ASSERT_FALSE(errors.empty());
+  for (const std::string& e : errors)
+    EXPECT_NE(e.find("a render of this session is in progress"), std::string::npos) << e;
+  EXPECT_EQ(r.spp(), 8u);
+  Renderer fresh(o);
+  fresh.set_scene(scene);
+  fresh.render(8);
+  expect_same_samples(r.result(), fresh.result());
+  r.set_scene(moved);  // between calls: works
+  r.render(1);
+  EXPECT_EQ(r.spp(), 1u);
+}
+
 TEST(Session, CacheDirectoryIsAnOption) {
   lucent::test::ScopedEnv pocl_cache("POCL_KERNEL_CACHE", "0");
   Scene s = lucent::test::scene_from(kScene);

@@ -127,7 +127,9 @@ class Renderer {
   const Scene& scene() const;
 
   /// Adds `spp` samples per pixel to the accumulation (fewer when cancelled). `on_progress` is
-  /// called after each pass. Returns the progress at the end.
+  /// called after each pass; it may read the session (result(), spp(), stats()) and cancel() it,
+  /// while set_scene, set_build_options, reset and the render calls throw lucent::Error until the
+  /// render returned. Returns the progress at the end.
   RenderProgress render(std::uint64_t spp,
                         const std::function<void(const RenderProgress&)>& on_progress = {});
   /// Adds samples for about `seconds` (at least one pass).

@@ -350,6 +350,9 @@ struct Renderer::Impl {
   std::uint64_t light_paths = 0;
   double render_seconds = 0;
   bool last_cancelled = false;
+  /// A render call (render, render_for, render_adaptive) is in progress: its on_progress may read
+  /// the session (result, spp, stats) but not change it (check_not_rendering)
+  std::atomic<bool> rendering{false};
 
   std::set<std::string> notes_given;  ///< the warnings about its scenes this session has given
   std::atomic<bool> cancel_requested{false};
@@ -372,6 +375,29 @@ struct Renderer::Impl {
   }
 
   bool cancelled() const { return cancel_requested.load() || (cancel_flag && cancel_flag->load()); }
+
+  /// Refuses `call` during a render call of this session (from its on_progress callback, or
+  /// another thread): set_scene there replaced the buffers and the accumulation under the passes
+  /// still running (two devices: a crash in the driver; one: a render that claimed its samples
+  /// and held none).
+  void check_not_rendering(const char* call) const {
+    if (rendering.load()) throw rendering_error(call);
+  }
+  static Error rendering_error(const char* call) {
+    return Error(std::string(call) +
+                 ": a render of this session is in progress (a session runs one call at a time; "
+                 "its on_progress may read result(), spp() and stats(), or cancel())");
+  }
+  /// Marks a render call in progress while it lives (and refuses a render within a render).
+  struct RenderCall {
+    Impl& s;
+    RenderCall(Impl& impl, const char* call) : s(impl) {
+      if (s.rendering.exchange(true)) throw rendering_error(call);
+    }
+    ~RenderCall() { s.rendering = false; }
+    RenderCall(const RenderCall&) = delete;
+    RenderCall& operator=(const RenderCall&) = delete;
+  };
 
   void clear_accumulation(std::uint64_t first_sample) {
     std::fill(sum.begin(), sum.end(), 0.0);
@@ -776,6 +802,7 @@ struct Renderer::Impl {
   /// each takes the next range of sample indices when its pass is done.
   RenderProgress run(std::uint64_t target_spp, double time_limit,
                      const std::function<void(const RenderProgress&)>& on_progress) {
+    RenderCall call(*this, "render");
     if (!scene) throw Error("render: the session has no scene (call set_scene first)");
     check_not_stale("render");
     if (adaptive)
@@ -963,6 +990,7 @@ struct Renderer::Impl {
 
   RenderProgress run_adaptive(const AdaptiveOptions& o,
                               const std::function<void(const RenderProgress&)>& on_progress) {
+    RenderCall call(*this, "render_adaptive");
     if (!scene) throw Error("render_adaptive: the session has no scene (call set_scene first)");
     check_not_stale("render_adaptive");
     if (!(o.target_error > 0) == !(o.budget_spp > 0) || !std::isfinite(o.target_error) ||
@@ -1246,6 +1274,7 @@ std::vector<DeviceInfo> Renderer::devices() const { return impl_->device_infos; 
 const SessionOptions& Renderer::options() const { return impl_->options; }
 
 void Renderer::set_build_options(Precision precision, bool fast_math, bool specialize) {
+  impl_->check_not_rendering("set_build_options");
   if (precision != Precision::Float && precision != Precision::Double)  // (7 was taken as float)
     throw Error("set_build_options: unknown precision " +
                 std::to_string(static_cast<int>(precision)));
@@ -1265,7 +1294,10 @@ void Renderer::set_build_options(Precision precision, bool fast_math, bool speci
   }
 }
 
-void Renderer::set_scene(const Scene& scene) { impl_->set_scene(scene); }
+void Renderer::set_scene(const Scene& scene) {
+  impl_->check_not_rendering("set_scene");
+  impl_->set_scene(scene);
+}
 
 const Scene& Renderer::scene() const {
   if (!impl_->scene) throw Error("the session has no scene (call set_scene first)");
@@ -1300,6 +1332,7 @@ RenderProgress Renderer::render(std::uint64_t spp, double max_seconds,
 }
 
 void Renderer::reset(std::uint64_t first_sample) {
+  impl_->check_not_rendering("reset");
   if (first_sample > 0xffffffffull) throw Error("reset: the first sample index must be below 2^32");
   impl_->clear_accumulation(first_sample);
 }
