@@ -12,6 +12,7 @@
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
 #include "probe_launch.hpp"
+#include "reference/texture.hpp"
 #include "render/pack.hpp"
 #include "support.hpp"
 
@@ -214,3 +215,26 @@ TEST(TextureKernel, NonFiniteUvStaysInsideTheTexture) {
 }
 
 }  // namespace
+
+// The reference samples textures as the kernel does (src/reference/texture.cpp), non-finite uvs
+// included: they read uv 0 in that coordinate. The reference returned NaN for them (a NaN
+// converted to an integer texel index, and NaN weights), so that a scene the kernel rendered was
+// black in the reference.
+TEST(TextureKernel, ReferenceLookupMatchesTheKernelAtNonFiniteUvs) {
+  lucent::Scene s = three_textures();
+  const float nan = std::nanf(""), inf = INFINITY;
+  const std::vector<Query> q = {{1, nan, 0.3f}, {1, 0.7f, nan},  {1, inf, -inf},
+                                {0, nan, nan},  {0, 0.0f, 0.3f}, {1, 0.7f, 0.0f}};
+  std::vector<cl_float4> got = lookup(s, q);
+  for (size_t i = 0; i < q.size(); ++i) {
+    const glm::dvec3 ref = lucent::ref::texture_rgb(s.textures[q[i].texture], {q[i].u, q[i].v});
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_TRUE(std::isfinite(ref[c])) << "query " << i;
+      EXPECT_NEAR(ref[c], got[i].s[c], 1e-4) << "query " << i << " channel " << c;
+    }
+  }
+  // uv (NaN, 0.3) reads (0, 0.3), as a finite u of 0 does
+  const glm::dvec3 at_nan = lucent::ref::texture_rgb(s.textures[1], {nan, 0.3});
+  const glm::dvec3 at_zero = lucent::ref::texture_rgb(s.textures[1], {0.0, 0.3});
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(at_nan[c], at_zero[c]);
+}

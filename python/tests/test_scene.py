@@ -440,6 +440,35 @@ def test_dict_that_contains_itself_is_an_error():
         lucent.scene_from_dict(d)
 
 
+def textured_quad(small_scene):
+    """small_scene with its floor textured (a 2x2 texture) through uvs set from Python."""
+    s = small_scene
+    t = lucent.Texture()
+    t.rgba = np.full((2, 2, 4), 0.5, np.float32)
+    s.textures.append(t)
+    s.materials[1].albedo_texture = 0
+    s.uvs = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    for k in range(len(s.triangles)):
+        s.triangles[k].uv = s.triangles[k].v
+    return s
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), 1e300])
+def test_texture_coordinates_set_from_python_must_be_finite(renderer, small_scene, bad):
+    # add_mesh and the OBJ loader refuse such uvs; set from Python they were rendered: the
+    # reference's lookups were NaN (every sample of the floor dropped, a black floor), the
+    # kernel's read the texel at uv 0
+    s = textured_quad(small_scene)
+    uvs = np.array(s.uvs)
+    uvs[2] = [bad, 0.5]
+    s.uvs = uvs
+    match = r"/shapes/1 \(triangle 0\)/uv/1/0: must "
+    with pytest.raises(lucent.Error, match=match):
+        renderer.set_scene(s)
+    with pytest.raises(lucent.Error, match=match):
+        lucent.render_reference(s, spp=1)
+
+
 def test_scene_info_validates_the_scene(small_scene):
     # it packed the scene unchecked: a material index set from Python read past the list
     small_scene.spheres[0].material = 1000000

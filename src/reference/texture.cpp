@@ -18,6 +18,10 @@ dvec3 texture_rgb(const Texture& tex, dvec2 uv) {
     return dvec3(t[0], t[1], t[2]);
   };
   double u = uv.x - std::floor(uv.x), v = uv.y - std::floor(uv.y);
+  // as the kernel's texture_lookup: a NaN or infinite uv reads uv 0 (a NaN converted to long
+  // was undefined behaviour, and its weights made the lookup NaN)
+  if (!std::isfinite(u)) u = 0;
+  if (!std::isfinite(v)) v = 0;
   double x = u * tex.width - 0.5, y = (1 - v) * tex.height - 0.5;  // row 0 is the top
   double fx = std::floor(x), fy = std::floor(y);
   double ax = x - fx, ay = y - fy;

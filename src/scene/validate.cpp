@@ -314,6 +314,11 @@ void validate_mesh(const MeshShape& m, const Reporter& at) {
 
 namespace {
 
+// A texture coordinate the device can hold: finite, and within float range.
+bool finite_uv(const glm::dvec2& uv) {
+  return std::abs(uv.x) <= FLT_MAX && std::abs(uv.y) <= FLT_MAX;  // false for NaN
+}
+
 // The place of primitive `i` of a type: its shape entry's ("/shapes/3", "/shapes/1 (triangle
 // 12)" for the 13th triangle of a mesh), else "/<list>/<i>".
 std::string primitive_place(const Scene& s, ShapeType type, std::size_t i, const char* list,
@@ -396,6 +401,10 @@ void validate_scene(const Scene& s) {
       ok = ok && (!has_n || static_cast<std::size_t>(t.n[k]) < nn);
       ok = ok && (!has_uv || static_cast<std::size_t>(t.uv[k]) < nuv);
     }
+    // finite uvs, as add_mesh and the OBJ loader require: set from Python (Scene.uvs), a NaN or
+    // an infinite one made the reference's every lookup NaN (the surface black: each sample
+    // dropped) while the kernel read the texel at uv 0
+    for (int k = 0; k < 3 && ok && has_uv; ++k) ok = finite_uv(s.uvs[t.uv[k]]);
     // a finite vertex beyond the geometry range (non-finite ones are dropped by pack_scene)
     int far = -1;
     for (int k = 0; k < 3 && ok; ++k)
@@ -407,6 +416,8 @@ void validate_scene(const Scene& s) {
     for (int k = 0; k < 3; ++k) check_index(at.at("v").at(k), t.v[k], np, "positions");
     for (int k = 0; k < 3 && has_n; ++k) check_index(at.at("n").at(k), t.n[k], nn, "normals");
     for (int k = 0; k < 3 && has_uv; ++k) check_index(at.at("uv").at(k), t.uv[k], nuv, "uvs");
+    for (int k = 0; k < 3 && has_uv; ++k)
+      for (int c = 0; c < 2; ++c) check_finite(at.at("uv").at(k).at(c), s.uvs[t.uv[k]][c]);
     if (far >= 0) check_position(at.at("v").at(far), s.positions[t.v[far]]);
   }
 }
