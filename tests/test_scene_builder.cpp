@@ -598,6 +598,33 @@ TEST(SceneBuilder, TexturesFromMemory) {
 
 // A scene built in code is the scene its JSON twin loads to: same camera, materials, geometry
 // (transformed, mirrored), lights, shape entries; and the same image.
+// load_texture shares a file among the materials and meshes that name it, by the files the builder
+// loaded: a texture added from memory whose name is the file's path is not that file (it stood in
+// for it: the file's materials rendered the texture made in code), and an OBJ's map_Kd shares the
+// file a material of the builder loaded under another spelling.
+TEST(SceneBuilder, TexturesFromFilesAreSharedByFileNotByName) {
+  std::string dir = lucent::test::temp_dir();
+  const unsigned char px[] = {255, 0, 0};
+  const std::string png = dir + "/red.png";
+  ASSERT_NE(stbi_write_png(png.c_str(), 1, 1, 3, px, 3), 0);
+  SceneBuilder b("s");
+  // a tinted copy made in code, named after the file it came from
+  const int tinted = b.add_texture(lucent::texture_from_rgba(1, 1, {0, 0, 1, 1}, png));
+  const int file = b.load_texture(png);
+  EXPECT_NE(file, tinted);
+  ASSERT_EQ(b.scene().textures.size(), 2u);
+  EXPECT_EQ(b.scene().textures[file].rgba, (std::vector<float>{1, 0, 0, 1}));
+  EXPECT_EQ(b.load_texture(dir + "/./red.png"), file);  // the same file, spelled otherwise
+  lucent::test::write_file(dir + "/m.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd red.png\n");
+  lucent::test::write_file(dir + "/m.obj",
+                           "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+  lucent::ObjShape obj;
+  obj.file = dir + "/m.obj";
+  b.add_obj(obj);
+  EXPECT_EQ(b.scene().textures.size(), 2u);
+  EXPECT_EQ(b.scene().materials.back().albedo_texture, file);
+}
+
 TEST(SceneBuilder, EqualsTheSameSceneFromJson) {
   lucent::Scene from_json = lucent::parse_scene(R"({
     "camera": {"position": [0, 0.5, 4], "look_at": [0, 0.3, 0], "fov": 35, "aperture": 0.01},

@@ -108,8 +108,9 @@ class SceneBuilder {
   int material_index(const std::string& name, const std::string& pointer) const;
   std::string shape_place() const;
   Scene scene_;
-  /// The materials OBJ meshes made from MTL materials, by MTL library and material name
-  /// (scene_detail::ObjMaterials), for the meshes after them to share.
+  /// The materials OBJ meshes made from MTL materials, by MTL library and material name, and the
+  /// textures loaded from files, by canonical path (scene_detail::ObjMaterials), for the meshes
+  /// and materials after them to share.
   std::map<std::string, int> obj_materials_;
 };
 

@@ -32,26 +32,34 @@ class ScopedWarningSink {
 /// The scene materials OBJ meshes made from MTL materials, by "<canonical MTL path>\n<material
 /// name>", and their default material (key "obj:default"): a material is shared by the faces of
 /// meshes that use the same MTL material (the same OBJ loaded again, two OBJ files naming one
-/// library), never with another material of the same name (docs/obj-mtl.md).
+/// library), never with another material of the same name (docs/obj-mtl.md). It also holds the
+/// textures loaded from files, by texture_file_key(): SceneBuilder keeps one for its scene.
 using ObjMaterials = std::map<std::string, int>;
+
+/// The key of the texture file `path` in an ObjMaterials: its canonical path (where it can be
+/// computed) behind a NUL, which no path or material key holds.
+std::string texture_file_key(const std::string& path);
 
 /// Loads an OBJ file (and its MTL) into `scene`: positions, normals and UVs are transformed by
 /// `transform` (normals by its inverse transpose; a mirroring transform keeps faces' orientation)
 /// and appended to the scene's triangle list. When `material_override` >= 0 every face uses it;
 /// otherwise MTL materials become scene materials named "<obj file name>:<mtl name>" (made
 /// unique when another material has that name), reused through `known` (SceneBuilder's; null:
-/// this call's own), and faces without one use a default diffuse material. Missing MTL or texture
-/// files give a warning naming the file and fall back. Returns the MTL libraries the OBJ names that
-/// exist (none with a material override, which reads none): inputs of the scene, as its textures
-/// are. Throws lucent::Error naming the file (and line) of a parse error.
+/// this call's own, which shares the scene's textures by their paths), and faces without one use a
+/// default diffuse material. Missing MTL or texture files give a warning naming the file and fall
+/// back. Returns the MTL libraries the OBJ names that exist (none with a material override, which
+/// reads none): inputs of the scene, as its textures are. Throws lucent::Error naming the file (and
+/// line) of a parse error.
 std::vector<std::string> load_obj(Scene& scene, const std::string& path,
                                   const glm::dmat4& transform, int material_override,
                                   ObjMaterials* known = nullptr);
 
 /// Loads an image (PNG, JPG, BMP, TGA: 8-bit decoded from sRGB to linear; HDR, PFM, EXR kept
-/// linear) as a scene texture, reusing an already loaded one with the same path. Returns its
-/// index. Throws lucent::Error naming the file when it cannot be read.
-int load_texture(Scene& scene, const std::string& path);
+/// linear) as a scene texture, reusing an already loaded one with the same canonical path: the
+/// one `known` (SceneBuilder's) names, and records it there; without `known`, any of the scene's
+/// textures whose path is the file. Returns its index. Throws lucent::Error naming the file when
+/// it cannot be read.
+int load_texture(Scene& scene, const std::string& path, ObjMaterials* known = nullptr);
 
 /// Decodes a texture file's bytes (`path` names it in messages): what load_texture does after
 /// reading the file. Throws lucent::Error naming `path`.

@@ -243,7 +243,10 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
     scene.uvs.push_back({attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]});
 
   // faces
-  ObjMaterials own;
+  ObjMaterials own;  // without SceneBuilder's: the scene's textures are shared all the same
+  if (!known)
+    for (size_t i = 0; i < scene.textures.size(); ++i)
+      own.emplace(texture_file_key(scene.textures[i].path), static_cast<int>(i));
   obj::MaterialMapper mapper(scene, known ? *known : own, path, mats, reader.origin);
   size_t faces = 0, fanned_faces = 0;
   std::vector<glm::vec3> corners;

@@ -195,7 +195,7 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
            "); using Kd");
     } else {
       try {
-        m.albedo_texture = load_texture(scene_, p.string());
+        m.albedo_texture = load_texture(scene_, p.string(), &known_);
         m.albedo = glm::dvec3(1.0);
       } catch (const Error& e) {
         warn(std::string(e.what()) + " (map_Kd of " + where + "); using Kd");

@@ -68,7 +68,7 @@ int SceneBuilder::add_texture(Texture texture) {
 }
 
 int SceneBuilder::load_texture(const std::string& file) {
-  return scene_detail::load_texture(scene_, file);
+  return scene_detail::load_texture(scene_, file, &obj_materials_);
 }
 
 int SceneBuilder::add_material(const Material& material) {

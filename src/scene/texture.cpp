@@ -55,10 +55,25 @@ Texture decode_texture(const unsigned char* data, std::size_t size, const std::s
   return t;
 }
 
-int load_texture(Scene& scene, const std::string& path) {
-  std::string key = texture_key(path);
-  for (size_t i = 0; i < scene.textures.size(); ++i)
-    if (texture_key(scene.textures[i].path) == key) return static_cast<int>(i);
+std::string texture_file_key(const std::string& path) {
+  return std::string(1, '\0') + texture_key(path);
+}
+
+int load_texture(Scene& scene, const std::string& path, ObjMaterials* known) {
+  // by the files loaded before (SceneBuilder's): canonicalising every loaded texture's path again
+  // for each new one took 32 s (15 s of system time) for an OBJ of 1500 materials each with its
+  // own texture, and a texture added from memory (SceneBuilder::add_texture) whose name was the
+  // file's path stood in for the file
+  const std::string key = known ? texture_file_key(path) : texture_key(path);
+  if (known) {
+    auto it = known->find(key);
+    if (it != known->end() && it->second >= 0 &&
+        static_cast<size_t>(it->second) < scene.textures.size())
+      return it->second;
+  } else {
+    for (size_t i = 0; i < scene.textures.size(); ++i)
+      if (texture_key(scene.textures[i].path) == key) return static_cast<int>(i);
+  }
   const std::string bytes = io::read_file(path, image_detail::image_read_spec("texture"));
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   // the scene's textures together, as linear RGBA float, within the host limit: each is bounded,
@@ -79,7 +94,9 @@ int load_texture(Scene& scene, const std::string& path) {
                 sys::format_bytes(limit) + " (80% of " + what +
                 "): reduce the textures' resolution or number");
   scene.textures.push_back(decode_texture(data, bytes.size(), path));
-  return static_cast<int>(scene.textures.size() - 1);
+  const int index = static_cast<int>(scene.textures.size() - 1);
+  if (known) (*known)[key] = index;
+  return index;
 }
 
 }  // namespace lucent::scene_detail
