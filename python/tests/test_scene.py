@@ -469,6 +469,21 @@ def test_texture_coordinates_set_from_python_must_be_finite(renderer, small_scen
         lucent.render_reference(s, spp=1)
 
 
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -0.25])
+def test_texels_set_from_python_must_be_finite_and_non_negative(renderer, small_scene, bad):
+    # texture files and SceneBuilder.add_texture refuse such texels; set from Python they were
+    # rendered: a NaN texel made every sample that read it non-finite (a black floor), a
+    # negative one negative light
+    s = textured_quad(small_scene)
+    rgba = np.array(s.textures[0].rgba)
+    rgba[1, 0, 2] = bad
+    s.textures[0].rgba = rgba
+    with pytest.raises(lucent.Error, match=r"/textures/0/rgba/10: must be"):
+        renderer.set_scene(s)
+    with pytest.raises(lucent.Error, match=r"/textures/0/rgba/10: must be"):
+        lucent.render_reference(s, spp=1)
+
+
 def test_scene_info_validates_the_scene(small_scene):
     # it packed the scene unchecked: a material index set from Python read past the list
     small_scene.spheres[0].material = 1000000

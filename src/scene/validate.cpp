@@ -207,7 +207,7 @@ void validate_integrator(const Integrator& in, const Reporter& at) {
   check_range(at.at("dielectric_splits"), in.dielectric_splits, rules::kSplits);
 }
 
-void validate_texture_size(const Texture& t, const Reporter& at) {
+void validate_texture(const Texture& t, const Reporter& at) {
   if (t.width < 1) at.at("width").fail("must be >= 1, got " + std::to_string(t.width));
   if (t.height < 1) at.at("height").fail("must be >= 1, got " + std::to_string(t.height));
   std::size_t want = std::size_t(4) * std::size_t(t.width) * std::size_t(t.height);
@@ -215,10 +215,6 @@ void validate_texture_size(const Texture& t, const Reporter& at) {
     at.at("rgba").fail("must hold 4 x " + std::to_string(t.width) + " x " +
                        std::to_string(t.height) + " = " + std::to_string(want) + " floats, got " +
                        std::to_string(t.rgba.size()));
-}
-
-void validate_texture(const Texture& t, const Reporter& at) {
-  validate_texture_size(t, at);
   for (std::size_t i = 0; i < t.rgba.size(); ++i)  // the place is made only for a bad texel
     if (!(std::isfinite(t.rgba[i]) && t.rgba[i] >= 0))
       check_non_negative(at.at("rgba").at(i), t.rgba[i]);
@@ -357,8 +353,11 @@ void validate_scene(const Scene& s) {
     validate_film(rest, at);
   }
   validate_integrator(s.integrator, Reporter(file, "/integrator"));
+  // sizes and texels, as SceneBuilder::add_texture and texture files require: set from Python
+  // (Scene.textures), a NaN texel made every sample that read it non-finite (a black surface)
+  // and a negative one negative light
   for (std::size_t i = 0; i < s.textures.size(); ++i)
-    validate_texture_size(s.textures[i], Reporter(file, "/textures/" + std::to_string(i)));
+    validate_texture(s.textures[i], Reporter(file, "/textures/" + std::to_string(i)));
   for (std::size_t i = 0; i < s.materials.size(); ++i) {
     // names only serve messages and the scene file's references: a nameless one is named by
     // its index

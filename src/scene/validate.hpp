@@ -98,9 +98,8 @@ std::string scene_light_names();
 void validate_camera(const Camera& camera, const Reporter& at);
 void validate_film(const Film& film, const Reporter& at);
 void validate_integrator(const Integrator& integrator, const Reporter& at);
-/// Its size: width and height from 1, 4 floats per texel.
-void validate_texture_size(const Texture& texture, const Reporter& at);
-/// Its size, then every texel finite and non-negative.
+/// Its size (width and height from 1, 4 floats per texel), then every texel finite and
+/// non-negative.
 void validate_texture(const Texture& texture, const Reporter& at);
 /// The parameters every material has (name, type, emission, albedo texture), then its type's
 /// own, by the type's parameter table and its own check (scene/material_type.hpp).
