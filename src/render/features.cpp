@@ -134,9 +134,10 @@ bool light_sums_double(const DeviceInfo& device) { return device.fp64 && device.
 
 void check_precision_support(const DeviceInfo& device, Precision precision) {
   if (precision == Precision::Double && !device.fp64)
-    throw Error("--precision double: device '" + device.name +
-                "' has no double-precision floating point (cl_khr_fp64); use --precision float "
-                "or pick another device with --device");
+    // (the library's message: Python and C++ callers have no --precision option)
+    throw Error("double precision: device '" + device.name +
+                "' has no double-precision floating point (cl_khr_fp64); render in float "
+                "precision (--precision float) or on another device (--device)");
 }
 
 }  // namespace lucent::render_detail

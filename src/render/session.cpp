@@ -367,7 +367,11 @@ struct Renderer::Impl {
     if (!(options.pass_seconds > 0) || !std::isfinite(options.pass_seconds))
       throw Error("SessionOptions::pass_seconds must be a positive number of seconds, got " +
                   scene_detail::format_number(options.pass_seconds));
-    for (const DeviceInfo& d : select_devices(options.device, "device")) {
+    const std::vector<DeviceInfo> devices = select_devices(options.device, "device");
+    // double precision on a device without fp64: refused here, not at the first set_scene
+    for (const DeviceInfo& d : devices)
+      render_detail::check_precision_support(d, options.precision);
+    for (const DeviceInfo& d : devices) {
       workers.push_back(std::make_unique<Worker>(std::to_string(d.index)));
       device_infos.push_back(workers.back()->ctx.device.info);
     }
@@ -1278,6 +1282,9 @@ void Renderer::set_build_options(Precision precision, bool fast_math, bool speci
   if (precision != Precision::Float && precision != Precision::Double)  // (7 was taken as float)
     throw Error("set_build_options: unknown precision " +
                 std::to_string(static_cast<int>(precision)));
+  // (without a scene too: it was accepted, and refused at the next set_scene)
+  for (const DeviceInfo& d : impl_->device_infos)
+    render_detail::check_precision_support(d, precision);
   const SessionOptions before = impl_->options;
   impl_->options.precision = precision;
   impl_->options.fast_math = fast_math;
