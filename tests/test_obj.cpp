@@ -706,7 +706,49 @@ TEST(Obj, TextureOptionsKeepTheFileName) {
     EXPECT_EQ(m.albedo, glm::dvec3(1.0)) << "map_Kd " << maps[i];
   }
   EXPECT_EQ(w.count("'nothere.dds' not found"), 1) << w.dump();
-  EXPECT_EQ(w.all().size(), 1u) << w.dump();
+  // and the options that would change the look are named once (TextureOptionsThatChangeTheLook)
+  EXPECT_EQ(w.count("m.mtl: map_Kd options that lucent does not support are ignored: '-o 0.5' "
+                    "(line 3), '-s 2' (line 6), '-t 0.1 0.2' (line 9), '-o 0.5 0.5 0' (line 12) "
+                    "and 6 more (the image is mapped once per uv unit"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.all().size(), 2u) << w.dump();
+}
+
+// lucent reads a map_Kd image once per uv unit, repeating, as decoded: a model whose MTL tiles,
+// shifts or clamps its textures rendered otherwise than it asked, without a word. One warning
+// per MTL file names such options; those at their defaults, and those without an effect on a
+// colour map here, are not named.
+TEST(Obj, TextureOptionsThatChangeTheLookAreNamed) {
+  std::string dir = lucent::test::temp_dir();
+  const unsigned char px[] = {255, 255, 255, 0, 0, 0};
+  ASSERT_TRUE(stbi_write_png((dir + "/t.png").c_str(), 2, 1, 3, px, 6));
+  write(dir, "quiet.mtl",
+        "newmtl a\nmap_Kd -s 1 1 1 -o 0 0 -t 0 -mm 0 1 -clamp off -cc off -colorspace sRGB "
+        "-blendu off -boost 2 -texres 64 -imfchan r t.png\n"
+        "newmtl b\nmap_Ks -s 4 4 t.png\nmap_bump -bm 2 -clamp on t.png\n");
+  write(dir, "loud.mtl",
+        "newmtl a\nKd 1 1 1\n\nmap_Kd -mm 0.2 1 -colorspace linear t.png\n"
+        "newmtl b\nmap_Kd -mm 0 2 -s 1 3 t.png\n");
+  for (const char* lib : {"quiet", "loud"}) {
+    std::string path = write(dir, std::string(lib) + ".obj",
+                             std::string("mtllib ") + lib +
+                                 ".mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\n"
+                                 "usemtl b\nf 1 3 2\n");
+    CaptureWarnings w;
+    Scene s;
+    load(s, path);
+    if (std::string(lib) == "quiet") {
+      EXPECT_EQ(w.all().size(), 0u) << w.dump();
+    } else {
+      EXPECT_EQ(w.count("loud.mtl: map_Kd options that lucent does not support are ignored: "
+                        "'-mm 0.2 1' (line 4), '-colorspace linear' (line 4), '-mm 0 2' (line 6), "
+                        "'-s 1 3' (line 6) (the image"),
+                1)
+          << w.dump();
+      EXPECT_EQ(w.all().size(), 1u) << w.dump();
+    }
+  }
 }
 
 // A usemtl before the file's mtllib: tinyobjloader looks the name up when it reads the usemtl,

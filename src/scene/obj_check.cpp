@@ -405,9 +405,29 @@ constexpr TextureOption kTextureOptions[] = {
     {"-s", 3, Arg::Number},      {"-t", 3, Arg::Number},       {"-imfchan", 1, Arg::Word},
     {"-type", 1, Arg::Word},     {"-colorspace", 1, Arg::Word}};
 
+// An option of map_Kd whose arguments change what the texture looks like: lucent reads the
+// image once per uv unit, repeating, as decoded (docs/obj-mtl.md).
+bool changes_the_look(std::string_view name, const std::vector<std::string_view>& args) {
+  auto all = [&](double value) {  // every argument the given number (missing ones default)
+    for (std::string_view a : args)
+      if (std::strtod(std::string(a).c_str(), nullptr) != value) return false;
+    return true;
+  };
+  if (name == "-s") return !all(1);
+  if (name == "-o" || name == "-t") return !all(0);
+  if (name == "-mm")  // base 0, gain 1
+    return (args.size() > 0 && std::strtod(std::string(args[0]).c_str(), nullptr) != 0) ||
+           (args.size() > 1 && std::strtod(std::string(args[1]).c_str(), nullptr) != 1);
+  if (name == "-clamp" || name == "-cc") return args.empty() || args[0] != "off";
+  if (name == "-colorspace")  // tinyobjloader's: 8-bit images are decoded from sRGB
+    return args.empty() || (args[0] != "sRGB" && args[0] != "srgb");
+  return false;  // -blendu, -blendv, -boost, -texres, -bm, -imfchan, -type: no effect here
+}
+
 // Where the file name of a texture statement's `args` (the line after the tag and its space)
 // starts: after the options and their arguments. The last word is always (part of) the name.
-std::size_t texture_name_start(std::string_view args) {
+// `look`, if given, receives the options (with their arguments) that changes_the_look.
+std::size_t texture_name_start(std::string_view args, std::vector<std::string>* look = nullptr) {
   std::vector<Word> words;
   for (std::size_t i = 0; i < args.size();) {
     std::size_t b = args.find_first_not_of(" \t", i);
@@ -426,12 +446,19 @@ std::size_t texture_name_start(std::string_view args) {
       if (word(k) == o.name) option = &o;
     if (!option) break;
     ++k;
+    std::vector<std::string_view> taken;
     for (int n = 0; n < option->most && k + 1 < words.size(); ++n, ++k) {
       std::string_view a = word(k);
       bool fits = option->kind == Arg::Word ||
                   (option->kind == Arg::OnOff && (a == "on" || a == "off")) ||
                   (option->kind == Arg::Number && is_number(a));
       if (!fits) break;
+      taken.push_back(a);
+    }
+    if (look && changes_the_look(option->name, taken)) {
+      std::string text = option->name;
+      for (std::string_view a : taken) (text += ' ') += a;
+      look->push_back(text);
     }
   }
   return k < words.size() ? words[k].begin : args.size();
@@ -439,16 +466,20 @@ std::size_t texture_name_start(std::string_view args) {
 
 }  // namespace
 
-std::string strip_texture_options(const std::string& text) {
+std::string strip_texture_options(const std::string& text, std::vector<IgnoredOption>* ignored) {
   std::string out;
   std::size_t copied = 0;  // text before this offset is in `out`
-  for_each_line(text, [&](std::string_view line, long) {
+  for_each_line(text, [&](std::string_view line, long ln) {
     std::size_t b = line.find_first_not_of(" \t");
     if (b == std::string_view::npos) return;
     std::size_t e = line.find_first_of(" \t", b);
     if (e == std::string_view::npos || !texture_tag(line.substr(b, e - b))) return;
     std::string_view args = line.substr(e + 1);
-    std::size_t name = texture_name_start(args);
+    // map_Kd is the one map lucent reads: its options that would change the look are reported
+    std::vector<std::string> look;
+    const bool kd = line.substr(b, e - b) == "map_Kd" && ignored;
+    std::size_t name = texture_name_start(args, kd ? &look : nullptr);
+    for (std::string& o : look) ignored->push_back({ln, std::move(o)});
     if (args.find_first_not_of(" \t") >= name) return;  // no options
     const std::size_t at = static_cast<std::size_t>(args.data() - text.data());
     out.append(text, copied, at - copied);

@@ -52,8 +52,16 @@ void check_mtl_text(const std::string& path, const std::string& text);
 /// bump, ...: `-o u [v [w]]`, `-clamp on`, ...) removed, lucent using none of them. Each option
 /// takes the arguments that fit it, up to its count (tinyobjloader takes three numbers after
 /// -o, -s and -t, and `map_Kd -o 0.5 tex.png` lost its file name); the last word of a statement
-/// is always (part of) the file name. The lines are kept.
-std::string strip_texture_options(const std::string& text);
+/// is always (part of) the file name. The lines are kept. `ignored`, if given, receives each
+/// option of a map_Kd statement that would change the texture's look had lucent read it (`-s`,
+/// `-o`, `-t` other than their defaults, `-mm` other than 0 1, `-clamp on`, `-cc on`,
+/// `-colorspace` other than sRGB), with its arguments, and its line.
+struct IgnoredOption {
+  long line = 0;
+  std::string option;  ///< "-s 4 4"
+};
+std::string strip_texture_options(const std::string& text,
+                                  std::vector<IgnoredOption>* ignored = nullptr);
 
 /// A `newmtl` statement of an MTL file: the material's name as tinyobjloader reads it (the rest
 /// of the line, trailing spaces removed) and its line.
