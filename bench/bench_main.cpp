@@ -14,6 +14,7 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -325,18 +326,32 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
+    // a whole number in [lo, hi], or exit 2 naming the option ("abc" was read as 0 and clamped
+    // to 1, so --width abc measured 1-pixel frames without a word)
+    auto integer = [&](long lo, long hi) -> int {
+      const std::string v = next();
+      char* end = nullptr;
+      errno = 0;
+      long n = std::strtol(v.c_str(), &end, 10);
+      if (v.empty() || *end != '\0' || errno == ERANGE || n < lo || n > hi) {
+        std::fprintf(stderr, "lucent_bench: %s: '%s' is not a whole number from %ld to %ld\n",
+                     a.c_str(), v.c_str(), lo, hi);
+        std::exit(2);
+      }
+      return int(n);
+    };
     if (a == "--runs")
-      opt.runs = std::max(1, std::atoi(next().c_str()));
+      opt.runs = integer(1, 100000);
     else if (a == "--reps")
-      opt.reps = std::max(1, std::atoi(next().c_str()));
+      opt.reps = integer(1, 100000);
     else if (a == "--width")
-      opt.width = std::max(1, std::atoi(next().c_str()));
+      opt.width = integer(1, 16384);
     else if (a == "--height")
-      opt.height = std::max(1, std::atoi(next().c_str()));
+      opt.height = integer(1, 16384);
     else if (a == "--device")
       opt.device = next();
     else if (a == "--threads")
-      opt.threads = std::max(0, std::atoi(next().c_str()));
+      opt.threads = integer(0, 4096);
     else if (a == "--build-only")
       opt.build_only = true;
     else if (a == "--only")
@@ -346,11 +361,20 @@ int main(int argc, char** argv) {
     else if (a == "--reorder")
       opt.reorder = true;
     else if (a == "--leaf-block")
-      opt.leaf_block = std::max(1, std::atoi(next().c_str()));
+      opt.leaf_block = integer(1, 1 << 20);
     else if (a == "--max-leaf")
-      opt.max_leaf = std::max(1, std::atoi(next().c_str()));
-    else if (a == "--traversal-cost")
-      opt.traversal_cost = float(std::atof(next().c_str()));
+      opt.max_leaf = integer(1, 1 << 20);
+    else if (a == "--traversal-cost") {
+      const std::string v = next();
+      char* end = nullptr;
+      double c = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !(c >= 0 && c < 1e6)) {
+        std::fprintf(stderr, "lucent_bench: --traversal-cost: '%s' is not a number from 0\n",
+                     v.c_str());
+        return 2;
+      }
+      opt.traversal_cost = float(c);
+    }
 #ifdef LUCENT_BENCH_EMBREE
     else if (a == "--embree-quality") {
       std::string q = next();
@@ -366,6 +390,14 @@ int main(int argc, char** argv) {
       }
     } else if (a == "--embree-robust")
       opt.embree_robust = true;
+#else
+    else if (a == "--embree-quality" || a == "--embree-robust") {
+      std::fprintf(stderr,
+                   "lucent_bench: %s: this lucent_bench was built without Embree 3 (install "
+                   "libembree-dev, scripts/install-deps.sh --with-bench, and configure again)\n",
+                   a.c_str());
+      return 2;
+    }
 #endif
     else {
       std::fprintf(stderr,
