@@ -15,11 +15,12 @@ Two jobs, both from one lucent JSON scene:
       linear image mean.
 
 The subset of lucent's scene format translated (anything else is refused with a message):
-camera position/look_at/up/fov (vertical; no roll, no aperture); diffuse materials with an RGB
-albedo and optional emission; shapes sphere, mesh (OBJ with its MTL's Kd/Ke unless "material"
-overrides; the transform steps scale/rotate/translate/matrix) and triangles; lights point and
-environment (constant radiance). Emissive shapes become one-sided area lights (lucent emits from
-the front side: the side of (v1-v0)x(v2-v0), which is Mitsuba's face normal too).
+the path integrator (no clamp, MIS on); camera position/look_at/up/fov (vertical; no roll, no
+aperture); diffuse materials with an RGB albedo and optional emission; shapes sphere, mesh (OBJ
+with its MTL's Kd/Ke unless "material" overrides; the transform steps
+scale/rotate/translate/matrix) and triangles; lights point and environment (constant radiance).
+Emissive shapes become one-sided area lights (lucent emits from the front side: the side of
+(v1-v0)x(v2-v0), which is Mitsuba's face normal too).
 
 Equivalences (checked on the image means, see BENCHMARKS.md "Throughput against Mitsuba 3"):
   - max_depth: lucent counts path segments (1: emitters seen directly, 2: direct light); so does
@@ -323,6 +324,13 @@ def mitsuba_scene(args, tmpdir):
     scene_dir = os.path.dirname(os.path.abspath(args.scene))
     cam = scene.get("camera", {})
     check_camera(cam)
+    # Mitsuba renders a path tracer without clamping: a scene asking lucent for anything else
+    # would be compared against a different estimator
+    integ = scene.get("integrator", {})
+    if integ.get("type", "path") != "path":
+        fail("integrator %s is not translated (only path)" % integ["type"])
+    if integ.get("clamp", 0) or integ.get("mis", True) is False:
+        fail("integrator clamp and mis false are not translated")
     w, h = args.size
     d = {"type": "scene"}
     d["integrator"] = {"type": "path", "max_depth": args.max_depth}
