@@ -22,7 +22,8 @@
 #     rung reaches it, extrapolated from the top rung with the least-squares slope of relMSE
 #     against spp over all rungs (time: at the top rung's samples per second).
 #
-# Scenes: scenes/*.json; those that need ../shared assets are skipped when it is absent.
+# Scenes: scenes/*.json; those whose mesh or texture files are absent (the ../shared assets beside
+# the checkout, which the scenes name as ../../shared/...) are skipped.
 # Environment: LUCENT_DEVICE selects the device; BENCH_CONVERGE_SCENES="a b" limits the scenes;
 # BENCH_CONVERGE_KEEP=DIR keeps each scene's ladder CSV as DIR/SCENE.csv.
 set -euo pipefail
@@ -33,12 +34,28 @@ target=${2:-1e-3}
 ref_factor=${3:-8}
 max_seconds=${4:-90}
 lucent=$build/lucent
+for v in "TARGET $target" "REF_FACTOR $ref_factor" "MAX_SECONDS $max_seconds"; do
+  python3 -c 'import math, sys; v = float(sys.argv[1]); sys.exit(not (math.isfinite(v) and v > 0))' \
+    "${v#* }" 2>/dev/null ||
+    { echo "bench-converge: ${v% *} must be a positive number, got '${v#* }'" >&2; exit 2; }
+done
 [[ -x $lucent ]] || { echo "bench-converge: $lucent not found (build the lucent_cli target)" >&2; exit 1; }
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export LUCENT_CACHE_DIR=${LUCENT_CACHE_DIR:-$build/lucent-cache}
 export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$build/pocl-cache}
+
+# the files a scene names ("file", "texture") that are absent, resolved as lucent resolves them:
+# relative to the scene's directory (../shared beside this checkout, whatever /work/shared holds)
+missing_assets() {
+  local dir f
+  dir=$(dirname "$1")
+  { grep -o '"\(file\|texture\)": *"[^"]*"' "$1" || true; } | sed 's/.*: *"\(.*\)"$/\1/' | while read -r f; do
+    [[ $f == /* ]] || f=$(realpath -m "$dir/$f")
+    [[ -e $f ]] || echo "$f"
+  done
+}
 
 # pilot CSV -> "N* seconds_per_spp"
 plan() {
@@ -114,8 +131,9 @@ start=$(date +%s)
 for scene in "$root"/scenes/*.json; do
   name=$(basename "$scene" .json)
   if [[ -n ${BENCH_CONVERGE_SCENES:-} && " $BENCH_CONVERGE_SCENES " != *" $name "* ]]; then continue; fi
-  if grep -q '/shared/' "$scene" && [[ ! -d /work/shared && ! -d $root/../shared ]]; then
-    echo "| $name | (skipped: needs ../shared) | | | | | | | | | |"
+  missing=$(missing_assets "$scene")
+  if [[ -n $missing ]]; then
+    echo "| $name | (skipped: $(head -1 <<<"$missing") is absent) | | | | | | | | | |"
     continue
   fi
   film=$(grep -o '"width": *[0-9]*, *"height": *[0-9]*' "$scene" | sed 's/[^0-9,]//g; s/,/×/')

@@ -26,12 +26,12 @@ if ! command -v blender >/dev/null; then
   echo "bench-cycles: skipped: blender is not installed (apt-get install blender)"
   exit 0
 fi
-obj=""
-for d in /work/shared "$root/../shared"; do
-  [[ -f $d/assets/cornell-box/CornellBox-Original.obj ]] && obj=$d/assets/cornell-box/CornellBox-Original.obj && break
-done
-if [[ -z $obj ]]; then
-  echo "bench-cycles: skipped: ../shared/assets/cornell-box/CornellBox-Original.obj is absent"
+# the OBJ that lucent renders: the scene's mesh, relative to scenes/ (../shared beside the
+# checkout; a /work/shared elsewhere gave Cycles a mesh while lucent failed on its own)
+obj=$(grep -o '"file": *"[^"]*"' "$scene" | head -1 | sed 's/.*: *"\(.*\)"$/\1/')
+[[ $obj == /* ]] || obj=$(realpath -m "$root/scenes/$obj")
+if [[ ! -f $obj ]]; then
+  echo "bench-cycles: skipped: $obj is absent"
   exit 0
 fi
 [[ -x $lucent ]] || { echo "bench-cycles: $lucent not found (build the lucent_cli target)" >&2; exit 1; }

@@ -47,6 +47,12 @@ variant=${BENCH_MITSUBA_VARIANT:-llvm_ad_rgb}
 scenes=${BENCH_MITSUBA_SCENES:-cornell-box default dragon-box}
 helper=$root/bench/mitsuba/bench_mitsuba.py
 lucent=$build/lucent
+# SPP >= 2: lucent's CPU time is that of the run minus a 1-spp run, scaled by SPP / (SPP - 1)
+for v in "SPP $spp 2" "PAIRS $pairs 1" "SIZE $size 1"; do
+  read -r what val least <<<"$v"
+  [[ $val =~ ^[1-9][0-9]*$ ]] && ((val >= least)) ||
+    { echo "bench-mitsuba: $what must be a whole number of at least $least, got '$val'" >&2; exit 2; }
+done
 
 if ! python3 -c 'import mitsuba' >/dev/null 2>&1; then
   echo "bench-mitsuba: skipped: python3 cannot import mitsuba (pip install mitsuba)"

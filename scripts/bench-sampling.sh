@@ -17,8 +17,13 @@
 # arguments (e.g. "--width 160 --height 90"); BENCH_SAMPLING_CSV=DIR keeps the two CSVs of each
 # scene there (NAME.a.csv, NAME.b.csv).
 set -euo pipefail
+if [[ $# -lt 4 ]]; then
+  echo "usage: scripts/bench-sampling.sh BUILD_DIR REF_SPP LADDER SCENE..." >&2
+  exit 2
+fi
 build=$1 ref_spp=$2 ladder=$3
 shift 3
+[[ -x $build/lucent ]] || { echo "bench-sampling: $build/lucent not found (build the lucent_cli target)" >&2; exit 1; }
 target=${BENCH_SAMPLING_TARGET:-1e-3}
 settings=${BENCH_SAMPLING_SETTINGS:-sampler=independent,default,adaptive,clamp=2,adaptive+clamp=2}
 reversed=$(echo "$settings" | tr ',' '\n' | tac | paste -sd, -)

@@ -6,9 +6,10 @@
 #
 #   scripts/bench-scenes.sh [BUILD_DIR] [SPP] [RUNS]     (defaults: build, 16, 3)
 #
-# Scenes: scenes/*.json; those that need ../shared assets are skipped when /work/shared (or
-# ../shared beside the project) is absent. Environment: LUCENT_DEVICE selects the device;
-# LUCENT_BENCH_FLAGS adds render options (e.g. "--no-specialize" or "--fast-math").
+# Scenes: scenes/*.json; those whose mesh or texture files are absent (the ../shared assets beside
+# the checkout, which the scenes name as ../../shared/...) are skipped. Environment: LUCENT_DEVICE
+# selects the device; LUCENT_BENCH_FLAGS adds render options (e.g. "--no-specialize" or
+# "--fast-math").
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -16,6 +17,9 @@ build=${1:-$root/build}
 spp=${2:-16}
 runs=${3:-3}
 lucent=$build/lucent
+for v in "SPP $spp" "RUNS $runs"; do  # (RUNS 0 or a word printed a table of empty cells)
+  [[ ${v#* } =~ ^[1-9][0-9]*$ ]] || { echo "bench-scenes: ${v% *} must be a positive number, got '${v#* }'" >&2; exit 2; }
+done
 [[ -x $lucent ]] || { echo "bench-scenes: $lucent not found (build the lucent_cli target)" >&2; exit 1; }
 
 work=$(mktemp -d)
@@ -28,6 +32,17 @@ parse() {
 }
 min() { awk -v a="$1" -v b="$2" 'BEGIN { print (a == "" || b + 0 < a + 0) ? b : a }'; }
 
+# the files a scene names ("file", "texture") that are absent, resolved as lucent resolves them:
+# relative to the scene's directory (../shared beside this checkout, whatever /work/shared holds)
+missing_assets() {
+  local dir f
+  dir=$(dirname "$1")
+  { grep -o '"\(file\|texture\)": *"[^"]*"' "$1" || true; } | sed 's/.*: *"\(.*\)"$/\1/' | while read -r f; do
+    [[ $f == /* ]] || f=$(realpath -m "$dir/$f")
+    [[ -e $f ]] || echo "$f"
+  done
+}
+
 device=""
 echo "Machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores;" \
   "load average at start: $(cut -d' ' -f1-3 /proc/loadavg); $spp spp, best of $runs."
@@ -36,8 +51,9 @@ echo "| scene | film | spp | Msamples/s | Mrays/s | rays/sample | build cold (s)
 echo "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
 for scene in "$root"/scenes/*.json; do
   name=$(basename "$scene" .json)
-  if grep -q '/shared/' "$scene" && [[ ! -d /work/shared && ! -d $root/../shared ]]; then
-    echo "| $name | | | (skipped: needs ../shared) | | | | | |"
+  missing=$(missing_assets "$scene")
+  if [[ -n $missing ]]; then
+    echo "| $name | | | (skipped: $(head -1 <<<"$missing") is absent) | | | | | |"
     continue
   fi
   best_ms="" best_mr="" best_cold="" best_warm="" film="" peak_mem=""

@@ -12,10 +12,10 @@
 
 Deterministic: running it again gives the same bytes. Usage: scripts/make-assets.py [root]
 """
+import argparse
 import math
 import os
 import struct
-import sys
 import zlib
 
 
@@ -140,7 +140,11 @@ map_Kd ../textures/wood.png
 
 def main():
     default = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "assets")
-    root = sys.argv[1] if len(sys.argv) > 1 else default
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 usage="scripts/make-assets.py [root]")
+    ap.add_argument("root", nargs="?", default=default,
+                    help="the directory to write into (default: the checkout's assets/)")
+    root = ap.parse_args().root
     write_png(os.path.join(root, "textures", "checker.png"), 256, 256, checker)
     write_png(os.path.join(root, "textures", "wood.png"), 256, 256, wood)
     for rel, text in (("cube/cube.obj", CUBE_OBJ), ("cube/cube.mtl", CUBE_MTL),

@@ -12,6 +12,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build jobs="" work=/tmp/lucent-planted
 while [[ $# -gt 0 && "$1" == --* ]]; do
+  [[ $# -ge 2 ]] || { echo "planted-bugs: $1 needs a value" >&2; exit 2; }
   case "$1" in
     --build) build="$2"; shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
@@ -22,6 +23,10 @@ done
 [[ -n "$jobs" ]] || jobs="$(scripts/cpus.sh)"
 bugs=("$@")
 [[ ${#bugs[@]} -gt 0 ]] || bugs=(baseline 1 2 3 4 5 6 7)
+# every name checked before the first campaign (each one runs the whole suite for minutes)
+for bug in "${bugs[@]}"; do
+  [[ $bug =~ ^(baseline|[1-7])$ ]] || { echo "planted-bugs: unknown bug $bug (baseline, 1 ... 7)" >&2; exit 2; }
+done
 build="$(cd "$build" && pwd)"
 mkdir -p "$work"
 

@@ -8,11 +8,11 @@ scene as the device stores it at T: every coordinate (and the camera position) r
 float32(x + T) - T, so that rendering it near the origin shows what float storage alone changes.
 
 usage: scripts/precision-scenes.py OUTDIR [WIDTH]"""
+import argparse
 import json
 import math
 import os
 import struct
-import sys
 
 
 def base_scene(width):
@@ -100,8 +100,14 @@ def stored(scene, t):
 
 
 def main():
-    out = sys.argv[1]
-    width = int(sys.argv[2]) if len(sys.argv) > 2 else 48
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 usage="scripts/precision-scenes.py OUTDIR [WIDTH]")
+    ap.add_argument("outdir")
+    ap.add_argument("width", nargs="?", type=int, default=48, help="film width and height (48)")
+    args = ap.parse_args()
+    if args.width < 1:
+        ap.error("WIDTH must be a positive number of pixels, got %d" % args.width)
+    out, width = args.outdir, args.width
     os.makedirs(out, exist_ok=True)
     variants = {"origin": (1, 0), "scale-1e-4": (1e-4, 0), "scale-1e6": (1e6, 0),
                 "translate-1e4": (1, 1e4), "translate-1e5": (1, 1e5)}

@@ -17,14 +17,16 @@
 #                 scripts/test.sh runs the sanitizer stage with build/'s caches)
 #
 # The sanitizer build wants the environment scripts/test.sh gives it:
-#   ASAN_OPTIONS=detect_leaks=0 scripts/test-times.sh --build build-asan --caches build Prints the totals
-# and the top K by wall time and by CPU time. Needs python3 (measurement only, not the tests).
+#   ASAN_OPTIONS=detect_leaks=0:use_sigaltstack=0 UBSAN_OPTIONS=print_stacktrace=1 \
+#     scripts/test-times.sh --build build-asan --caches build
+# Prints the totals and the top K by wall time and by CPU time. Needs python3 (measurement only, not the tests).
 # A competing load is the caller's business, e.g.:
 #   taskset -c 0 sh -c 'while :; do :; done' & scripts/test-times.sh --wrap 'taskset -c 0' --jobs 1
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build jobs="" cold=0 wrap="" top=20 out="" filter="" caches=""
 while [[ $# -gt 0 ]]; do
+  if [[ $1 != --cold && $# -lt 2 ]]; then echo "test-times: $1 needs a value" >&2; exit 2; fi
   case "$1" in
     --build) build="$2"; shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
@@ -38,7 +40,12 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 [[ -n "$jobs" ]] || jobs="$(scripts/cpus.sh)"
+# (--jobs 0 started nothing and crashed in wait4; a word crashed in int())
+for v in "--jobs $jobs" "--top $top"; do
+  [[ ${v#* } =~ ^[1-9][0-9]*$ ]] || { echo "test-times: ${v% *} wants a positive number, got '${v#* }'" >&2; exit 2; }
+done
 build="$(cd "$build" && pwd)"
+if [[ -n "$caches" ]]; then mkdir -p "$caches"; fi
 caches="$(cd "${caches:-$build}" && pwd)"
 export POCL_CACHE_DIR="$caches/pocl-cache" LUCENT_CACHE_DIR="$caches/lucent-cache"
 if [[ "$cold" == 1 ]]; then rm -rf "$POCL_CACHE_DIR" "$LUCENT_CACHE_DIR"; fi

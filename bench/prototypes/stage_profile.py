@@ -27,11 +27,14 @@ STAGES = [
     ("hit point, normals, uv (interaction_from_hit)",
      ["interaction_from_hit", "_cl_atan2", "Sleef_asinf_u10", "Sleef_atan2f_u10"]),
     ("BSDF: material, eval, sample", ["bsdf_sample", "bsdf_eval", "bsdf_from_material"]),
-    ("light sampling and pdfs", ["light_sample", "light_pdf_area", "env_radiance"]),
-    ("random numbers (lc_rand)", ["lc_rand"]),
+    ("light sampling and pdfs", ["light_sample", "light_pdf", "env_radiance"]),
+    ("random numbers (lc_rand8, lc_rand2)", ["lc_rand8", "lc_rand2"]),
     ("camera ray and pixel filter", ["camera_generate_ray", "filter_sample", "Sleef_logf_u10"]),
+    # integrate() is a function of its own in every build (LC_POCL_NOINLINE): its own samples are
+    # the path loop's; PoCL names the work-group function _workgroup or _workgroup_fast
     ("rest of the kernel: path loop, MIS, frames, spawn, film write",
-     ["_pocl_kernel_lucent_render_workgroup"]),
+     ["integrate", "_pocl_kernel_lucent_render_workgroup",
+      "_pocl_kernel_lucent_render_workgroup_fast"]),
     ("host, per pass: accumulation, read-back", ["lucent::render", "__memmove_avx512_unaligned_erms"]),
 ]
 
