@@ -408,6 +408,16 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  const char* const names[] = {"stanford-bunny.obj", "dragon.obj", "generated bumpy torus"};
+  if (!opt.only.empty() && std::none_of(std::begin(names), std::end(names), [&](const char* n) {
+        return std::string(n).find(opt.only) != std::string::npos;
+      })) {
+    std::fprintf(stderr,
+                 "lucent_bench: --only %s matches none of stanford-bunny.obj, dragon.obj, "
+                 "generated bumpy torus\n",
+                 opt.only.c_str());
+    return 2;
+  }
   try {
     lucent::cl_util::Context ctx(opt.device);
     std::string load;
@@ -419,7 +429,7 @@ int main(int argc, char** argv) {
     auto wanted = [&](const std::string& name) {
       return opt.only.empty() || name.find(opt.only) != std::string::npos;
     };
-    for (const char* name : {"stanford-bunny.obj", "dragon.obj"}) {
+    for (const char* name : {names[0], names[1]}) {
       if (!wanted(name)) continue;
       std::vector<lc_triangle> tris;
       if (!load_obj(dir + name, tris)) {
@@ -429,9 +439,9 @@ int main(int argc, char** argv) {
       bench_mesh(name, tris, opt, ctx);
     }
     // 1000 x 500 x 2 = 1M triangles: a bumpy torus
-    if (wanted("generated bumpy torus")) {
+    if (wanted(names[2])) {
       auto torus = lucent::bvh::meshes::torus(1000, 500, 1.0f, 0.35f, 0.15f).triangles();
-      bench_mesh("generated bumpy torus", torus, opt, ctx);
+      bench_mesh(names[2], torus, opt, ctx);
     }
   } catch (const lucent::Error& e) {
     std::fprintf(stderr, "lucent_bench: %s\n", e.what());
