@@ -88,6 +88,9 @@ def loglog(x1, y1, x2, y2, y):
                     (math.log(x2) - math.log(x1)) / (math.log(y2) - math.log(y1)))
 
 def slope(xs, ys):
+    # nan below two distinct rungs (a ladder of 1 spp alone when the target needs less)
+    if len(set(xs)) < 2:
+        return float("nan")
     lx = [math.log(x) for x in xs]; ly = [math.log(y) for y in ys]
     mx, my = sum(lx) / len(lx), sum(ly) / len(ly)
     return sum((a - mx) * (b - my) for a, b in zip(lx, ly)) / sum((a - mx) ** 2 for a in lx)
@@ -152,7 +155,9 @@ for scene in "$root"/scenes/*.json; do
     --csv "$work/full.csv" -q >/dev/null 2>"$work/log" ||
     { echo "bench-converge: $name failed: $(tail -1 "$work/log")" >&2; exit 1; }
   if [[ -n ${BENCH_CONVERGE_KEEP:-} ]]; then mkdir -p "$BENCH_CONVERGE_KEEP" && cp "$work/full.csv" "$BENCH_CONVERGE_KEEP/$name.csv"; fi
-  echo "| $name | $film | $(analyse "$work/full.csv" "$ref_spp" "$capped" "$max_seconds") |"
+  # (a failing analysis stops here: in echo's arguments it printed a row of empty cells)
+  row=$(analyse "$work/full.csv" "$ref_spp" "$capped" "$max_seconds")
+  echo "| $name | $film | $row |"
 done
 echo
 echo "Total $(($(date +%s) - start)) s. Load average at the end: $(cut -d' ' -f1-3 /proc/loadavg)."

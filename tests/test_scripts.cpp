@@ -230,3 +230,34 @@ TEST(BenchScripts, CyclesSkipsWhenTheScenesMeshIsAbsent) {
             std::string::npos)
       << r.out;
 }
+
+// bench-converge.sh with a target that one sample per pixel reaches (a scaled-down run of the
+// BENCHMARKS.md command): the ladder is the 1-spp rung alone, and the least-squares slope over
+// one rung divided by zero; the row was printed with empty cells, a traceback on stderr, exit 0.
+// Here a stand-in lucent writes the pilot's and the ladder's CSVs.
+TEST(BenchScripts, ConvergeWithOneRungPrintsItsRow) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string build = dir + "/build";
+  fs::create_directories(build);
+  make_executable(build + "/lucent", R"(#!/bin/bash
+csv="" ladder=""
+while [[ $# -gt 0 ]]; do
+  case $1 in --csv) csv=$2; shift ;; --spp-ladder) ladder=$2; shift ;; esac
+  shift
+done
+echo setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse >"$csv"
+if [[ $ladder == 8 ]]; then echo default,8,0.1,1e6,0.01,0.001,0.0001 >>"$csv"
+else echo default,1,0.1,1e6,0.005,0.0015,0 >>"$csv"; fi
+)");
+  const std::string root = scratch_checkout(dir, {"bench-converge.sh"});
+  fs::remove(root + "/scenes/needs-mesh.json");
+  lucent::test::write_file(root + "/scenes/one.json",
+                           R"({"film": {"width": 8, "height": 4}, "shapes": []})");
+  ScriptRun r = run(root, "bash scripts/bench-converge.sh " + q(build) + " 1e-2 2 3");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("Traceback"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("| one | 8×4 | 64 | 1 | 0.0015 (0.00e+00) | 1 | 0.1 | 1.00 | nan | 0 | "
+                       "reached at the first rung |"),
+            std::string::npos)
+      << r.out;
+}
