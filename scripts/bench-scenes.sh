@@ -65,7 +65,8 @@ for scene in "$root"/scenes/*.json; do
       LUCENT_CACHE_DIR=$cache/lucent POCL_CACHE_DIR=$cache/pocl \
         "$lucent" render "$scene" --spp "$spp" ${LUCENT_BENCH_FLAGS:-} -o "$work/out.pfm" 2>"$log" >/dev/null ||
         { echo "bench-scenes: $name failed: $(tail -1 "$log")" >&2; exit 1; }
-      read -r ms mr build_s mem < <(parse "$log")
+      read -r ms mr build_s mem < <(parse "$log") ||
+        { echo "bench-scenes: $name: no summary line in lucent's output (-q in LUCENT_BENCH_FLAGS?)" >&2; exit 1; }
       peak_mem=$(awk -v a="$peak_mem" -v b="$mem" 'BEGIN { print (a == "" || b + 0 > a + 0) ? b : a }')
       film=$(sed -n 's/.*: \([0-9]*x[0-9]*\), .*/\1/p' "$log" | tail -1)
       device=$(sed -n 's/.* on \(.*\)$/\1/p' "$log" | tail -1)

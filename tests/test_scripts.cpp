@@ -261,3 +261,21 @@ else echo default,1,0.1,1e6,0.005,0.0015,0 >>"$csv"; fi
             std::string::npos)
       << r.out;
 }
+
+// bench-scenes.sh read lucent's summary line with `read`, which fails at an empty input: a run
+// whose output had no summary line (LUCENT_BENCH_FLAGS=-q, or a changed format) made the script
+// exit 1 after the table's header without a word.
+TEST(BenchScripts, ScenesSaysWhenLucentPrintedNoSummary) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string build = dir + "/build";
+  fs::create_directories(build);
+  make_executable(build + "/lucent", "#!/bin/sh\nexit 0\n");
+  const std::string root = scratch_checkout(dir, {"bench-scenes.sh"});
+  fs::remove(root + "/scenes/needs-mesh.json");
+  lucent::test::write_file(root + "/scenes/one.json",
+                           R"({"film": {"width": 8, "height": 4}, "shapes": []})");
+  ScriptRun r = run(root, "bash scripts/bench-scenes.sh " + q(build) + " 1 1");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("bench-scenes: one: no summary line in lucent's output"), std::string::npos)
+      << r.err;
+}
