@@ -30,6 +30,8 @@ if [[ $# -gt 0 && "$1" != "--" ]]; then
   shift
 fi
 [[ $# -gt 0 && "$1" == "--" ]] && shift
+# absolute (an absolute BUILD_DIR gave the caches "$PWD//abs/build/..." under the checkout)
+build="$(cd "$build" && pwd)"
 
 vendors="$(mktemp -d)"
 trap 'rm -rf "$vendors"' EXIT
@@ -46,8 +48,8 @@ if [[ -z "$name" ]]; then
 fi
 export LUCENT_DEVICE="$name"
 # the binaries of one runtime are not the other's: a cache of its own
-export LUCENT_CACHE_DIR="$PWD/$build/lucent-cache-intel"
-export POCL_CACHE_DIR="$PWD/$build/pocl-cache"
+export LUCENT_CACHE_DIR="$build/lucent-cache-intel"
+export POCL_CACHE_DIR="$build/pocl-cache"
 echo "test-intel-cpu: LUCENT_DEVICE='$name'"
 if [[ $# -gt 0 ]]; then
   exec "$@"

@@ -279,3 +279,23 @@ TEST(BenchScripts, ScenesSaysWhenLucentPrintedNoSummary) {
   EXPECT_NE(r.err.find("bench-scenes: one: no summary line in lucent's output"), std::string::npos)
       << r.err;
 }
+
+// test-intel-cpu.sh put its caches at "$PWD/$build/...": an absolute BUILD_DIR gave
+// "<checkout>//abs/build/lucent-cache-intel", a directory made under the checkout. Here a
+// stand-in lucent lists an Intel CPU device and the command after -- prints the caches.
+TEST(BenchScripts, IntelCpuCachesAreInTheBuildDirectory) {
+  const std::string dir = lucent::test::temp_dir();
+  fs::create_directories(dir + "/iocl");
+  lucent::test::write_file(dir + "/iocl/libintelocl.so", "");
+  const std::string build = dir + "/a build";
+  fs::create_directories(build);
+  make_executable(build + "/lucent",
+                  "#!/bin/sh\necho '  1  Intel(R) OpenCL   Some Xeon   CPU  (Intel(R) "
+                  "Corporation)'\n");
+  ScriptRun r = run(dir, "bash " + q(lucent::test::source_path("scripts/test-intel-cpu.sh")) + " " +
+                             q(dir + "/iocl") + " " + q(build) +
+                             " -- sh -c 'echo \"$LUCENT_CACHE_DIR|$POCL_CACHE_DIR\"'");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find(build + "/lucent-cache-intel|" + build + "/pocl-cache\n"), std::string::npos)
+      << r.out;
+}
