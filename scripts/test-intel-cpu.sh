@@ -51,7 +51,12 @@ export LUCENT_DEVICE="$name"
 export LUCENT_CACHE_DIR="$build/lucent-cache-intel"
 export POCL_CACHE_DIR="$build/pocl-cache"
 echo "test-intel-cpu: LUCENT_DEVICE='$name'"
+# not exec: the EXIT trap removes $vendors after the command (exec left it in TMPDIR every run)
+status=0
 if [[ $# -gt 0 ]]; then
-  exec "$@"
+  "$@" || status=$?
+else
+  ctest --test-dir "$build" --output-on-failure -j"${LUCENT_TEST_JOBS:-$(scripts/cpus.sh)}" ||
+    status=$?
 fi
-exec ctest --test-dir "$build" --output-on-failure -j"${LUCENT_TEST_JOBS:-$(scripts/cpus.sh)}"
+exit "$status"

@@ -281,21 +281,26 @@ TEST(BenchScripts, ScenesSaysWhenLucentPrintedNoSummary) {
 }
 
 // test-intel-cpu.sh put its caches at "$PWD/$build/...": an absolute BUILD_DIR gave
-// "<checkout>//abs/build/lucent-cache-intel", a directory made under the checkout. Here a
-// stand-in lucent lists an Intel CPU device and the command after -- prints the caches.
+// "<checkout>//abs/build/lucent-cache-intel", a directory made under the checkout; and its exec
+// of the command skipped the trap that removes its ICD directory. Here a stand-in lucent lists
+// an Intel CPU device and the command after -- prints the caches.
 TEST(BenchScripts, IntelCpuCachesAreInTheBuildDirectory) {
   const std::string dir = lucent::test::temp_dir();
   fs::create_directories(dir + "/iocl");
+  fs::create_directories(dir + "/tmp");
   lucent::test::write_file(dir + "/iocl/libintelocl.so", "");
   const std::string build = dir + "/a build";
   fs::create_directories(build);
   make_executable(build + "/lucent",
                   "#!/bin/sh\necho '  1  Intel(R) OpenCL   Some Xeon   CPU  (Intel(R) "
                   "Corporation)'\n");
-  ScriptRun r = run(dir, "bash " + q(lucent::test::source_path("scripts/test-intel-cpu.sh")) + " " +
+  ScriptRun r = run(dir, "TMPDIR=" + q(dir + "/tmp") + " bash " +
+                             q(lucent::test::source_path("scripts/test-intel-cpu.sh")) + " " +
                              q(dir + "/iocl") + " " + q(build) +
-                             " -- sh -c 'echo \"$LUCENT_CACHE_DIR|$POCL_CACHE_DIR\"'");
-  EXPECT_EQ(r.status, 0) << r.err;
+                             " -- sh -c 'echo \"$LUCENT_CACHE_DIR|$POCL_CACHE_DIR\"; exit 3'");
+  EXPECT_EQ(r.status, 3) << r.err;  // the command's own status
   EXPECT_NE(r.out.find(build + "/lucent-cache-intel|" + build + "/pocl-cache\n"), std::string::npos)
       << r.out;
+  // its ICD directory is removed (one was left in TMPDIR per run)
+  EXPECT_TRUE(fs::is_empty(dir + "/tmp"));
 }
