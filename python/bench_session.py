@@ -47,20 +47,22 @@ def child(cmd):
 
 
 def python_against_cli(cli, scene, spp, reps):
-    tmp = pathlib.Path(tempfile.mkdtemp())
     runs = {"cli": [], "python": []}
-    for rep in range(reps + 1):  # the first pair warms the kernel caches and is dropped
-        for who in ("cli", "python"):
-            if who == "cli":
-                cpu, text = child([cli, "render", scene, "-o", str(tmp / "a.exr"), "--spp",
-                                   str(spp)])
-                seconds = float(re.search(r"spp in ([0-9.]+) s", text).group(1))
-            else:
-                cpu, text = child([sys.executable, "-c", PY_RENDER, scene, str(spp),
-                                   str(tmp / "b.exr")])
-                seconds = float(re.search(r"render ([0-9.]+)", text).group(1))
-            if rep > 0:
-                runs[who].append((seconds, cpu))
+    # removed at the end (mkdtemp left both images behind on every run)
+    with tempfile.TemporaryDirectory() as tmpdir:
+        tmp = pathlib.Path(tmpdir)
+        for rep in range(reps + 1):  # the first pair warms the kernel caches and is dropped
+            for who in ("cli", "python"):
+                if who == "cli":
+                    cpu, text = child([cli, "render", scene, "-o", str(tmp / "a.exr"), "--spp",
+                                       str(spp)])
+                    seconds = float(re.search(r"spp in ([0-9.]+) s", text).group(1))
+                else:
+                    cpu, text = child([sys.executable, "-c", PY_RENDER, scene, str(spp),
+                                       str(tmp / "b.exr")])
+                    seconds = float(re.search(r"render ([0-9.]+)", text).group(1))
+                if rep > 0:
+                    runs[who].append((seconds, cpu))
     print(f"\n{scene}, {spp} spp, {reps} alternated runs each (median; min-max)")
     for who, r in runs.items():
         s = [x[0] for x in r]
@@ -112,6 +114,8 @@ def main():
     p.add_argument("--spp", type=int, default=64)
     p.add_argument("--reps", type=int, default=5)
     a = p.parse_args()
+    if a.spp < 1 or a.reps < 1:  # (--reps 0 ended in statistics.median of nothing)
+        p.error("--spp and --reps must be at least 1")
     print("load", open("/proc/loadavg").read().split()[:3], "device", lucent.list_devices()[0].name)
     python_against_cli(a.cli, a.scene, a.spp, a.reps)
     camera_move(16)
