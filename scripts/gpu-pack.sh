@@ -13,7 +13,10 @@
 #   scripts/gpu-pack.sh [--mitsuba]        then, on the GPU machine: bash scripts/gpu-run.sh STAGES
 set -euo pipefail
 cd "$(dirname "$0")/.."
-grep -qx '/.gpu/' .git/info/exclude 2>/dev/null || printf '/.gpu/\n/.whl/\n' >>.git/info/exclude
+# (git's path: in a worktree .git is a file, and '>>.git/info/exclude' stopped the script here)
+exclude=$(git rev-parse --git-path info/exclude)
+mkdir -p "$(dirname "$exclude")"
+grep -qx '/.gpu/' "$exclude" 2>/dev/null || printf '/.gpu/\n/.whl/\n' >>"$exclude"
 cmake --build build -j"$(nproc)" --target lucent_cli lucent_tests
 rm -rf .gpu && mkdir -p .gpu/bin .gpu/lib
 cp build/lucent build/tests/lucent_tests .gpu/bin/ && strip .gpu/bin/*
