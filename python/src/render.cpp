@@ -79,8 +79,8 @@ void bind_device_shares(py::module_& m, py::class_<T>& c) {
 /// - spp, first_sample and stats give the values the call began with, updated after each pass
 ///   of render(), render_for() and render_adaptive() (a copy that the rendering thread writes
 ///   under a mutex: the session's own counters change during passes, without the GIL);
-/// - scene and options raise, except while the call is stopped in its progress callback
-///   (between passes: nothing in the session changes then), from any thread;
+/// - scene, options and result() raise, except while the call is stopped in its progress
+///   callback (between passes: nothing in the session changes then), from any thread;
 /// - close() raises; once close() began, everything raises that the renderer is closed.
 /// `busy_`, `closed_` and `paused_` change with the GIL held, and are read with it: holding the
 /// GIL, a thread that sees no call in progress (or one paused in its callback) reads the session
@@ -227,6 +227,14 @@ class PyRenderer {
     call_interruptible(what, [&](Renderer& r, std::atomic<bool>&) { out = f(r, on_progress); });
     errors.rethrow();
     return out;
+  }
+
+  /// The accumulation: a call of its own, or, while a render is paused in its progress callback
+  /// (between passes, nothing in the session changes: Renderer::result() is safe there), read
+  /// with the GIL held, as scene and options are (a notebook's live preview was refused).
+  RenderResult result() {
+    if (busy_ && paused_) return get().result();
+    return call("result", [](Renderer& rr) { return rr.result(); });
   }
 
   /// Stops a render in progress after its current pass. Renderer::cancel() alone was lost when
@@ -763,9 +771,9 @@ void bind_render(py::module_& m) {
           py::arg("first_sample") = 0,
           "Drops the accumulation; the next sample index is first_sample.")
       .def(
-          "result",
-          [](PyRenderer& r) { return r.call("result", [](Renderer& rr) { return rr.result(); }); },
-          "The accumulation so far (a RenderResult; its arrays are this call's own).")
+          "result", [](PyRenderer& r) { return r.result(); },
+          "The accumulation so far (a RenderResult; its arrays are this call's own). Also from a "
+          "render's progress callback (between passes: a live preview).")
       .def_property_readonly(
           "spp", [](PyRenderer& r) { return r.counters().spp; },
           "Samples per pixel accumulated. spp, first_sample and stats can be read from any "
