@@ -119,7 +119,8 @@ class Renderer {
   /// Makes `scene` the session's scene (a copy is kept): packs it, builds or reuses the BVH and
   /// the kernel, uploads the buffers that changed. The accumulated samples are kept when nothing
   /// that changes the image changed (film display settings, the sample count), and dropped
-  /// otherwise. Throws lucent::Error for a scene it cannot render, first checking the whole scene
+  /// otherwise (the next sample index is then the last reset()'s first_sample, 0 by default).
+  /// Throws lucent::Error for a scene it cannot render, first checking the whole scene
   /// as SceneBuilder checks each element (its fields may have been set directly), with the place
   /// of the first problem ("scene.json: /shapes/1 (triangle 4)/v/2: must index one of ...").
   void set_scene(const Scene& scene);
