@@ -342,6 +342,25 @@ TEST(Parts, MergerAndPartsMisusedAreErrors) {
   EXPECT_EQ(parts.finish().merged.acc.count, (std::vector<std::uint32_t>{8}));
 }
 
+// Parts of two samplers (their headers say which) were refused only by their scene hashes, as
+// "another scene, camera, film, integrator setting, build option or kernel source", although
+// each header names its sampler: the merge names it now, as it names the seed. A part of lucent
+// before 24 Nov 2026 records no sampler, and merges with either.
+TEST(Parts, PartsOfTwoSamplersAreRefusedByName) {
+  lucent::RenderPart a = handmade_part({{0, 4}}, {0, 4}), b = handmade_part({{4, 8}}, {4, 8});
+  a.info.sampler = "sobol";
+  b.info.sampler = "independent";
+  lucent::PartMerger m;
+  m.add("a.exr", a);
+  EXPECT_EQ(error_of([&] { m.add("b.exr", b); }),
+            "b.exr: sampler independent differs from a.exr's sobol");
+  b.info.sampler.clear();  // an older part file
+  m.add("b.exr", b);
+  lucent::MergeReport r = m.finish();
+  EXPECT_EQ(r.merged.info.sampler, "sobol");
+  EXPECT_EQ(r.merged.info.samples, (std::vector<lucent::SampleRange>{{0, 8}}));
+}
+
 // A part's header may list many ranges (a merge of parts with gaps between them, or a file made
 // to hurt). The overlap check ran a loop over every pair of ranges: two crafted part files of
 // 0.5 MB each (4*10^4 interleaved ranges) took 1.7 s to merge, and ten times as many ranges

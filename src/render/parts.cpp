@@ -508,6 +508,11 @@ void PartMerger::check(const std::string& name, const PartInfo& info) {
   if (info.seed != first.seed)
     throw Error(name + ": seed " + std::to_string(info.seed) + " differs from " + fname + "'s " +
                 std::to_string(first.seed));
+  // (the scene hash covers the sampler too, but named it only as "another ... integrator
+  // setting"; a part file of lucent before 24 Nov 2026 records none)
+  if (!info.sampler.empty() && !first.sampler.empty() && info.sampler != first.sampler)
+    throw Error(name + ": sampler " + info.sampler + " differs from " + fname + "'s " +
+                first.sampler);
   if (info.integrator != first.integrator)
     throw Error(name + ": integrator " + info.integrator + " differs from " + fname + "'s " +
                 first.integrator);
