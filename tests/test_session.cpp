@@ -734,6 +734,52 @@ TEST(Session, SceneWithoutLightWarns) {
   EXPECT_EQ(warnings.all().size(), 0u) << warnings.dump();
 }
 
+// Lights that all send out nothing render a black image as well: zero intensities and
+// radiances, an environment map scaled by 0 or black in the channels its scale keeps. That was
+// silent (a reviewer's all-black map and zero point lights); a light that emits in any channel,
+// or any emissive shape, keeps the warning away.
+TEST(Session, SceneWhoseLightsEmitNothingWarns) {
+  const char* kMessage =
+      "every light of the scene emits nothing (an intensity, radiance or scale of 0, or a black "
+      "environment map): the image is black";
+  auto warnings_for = [&](const Scene& scene) {
+    Renderer r = session();  // a session says each warning once
+    lucent::test::CaptureWarnings warnings;
+    r.set_scene(scene);
+    return warnings.count(kMessage);
+  };
+  Scene base = lucent::test::scene_from(kScene);
+  base.lights[0].intensity = glm::dvec3(0);
+  lucent::Light env;
+  env.type = lucent::LightType::Environment;
+  base.lights.push_back(env);  // radiance 0
+  EXPECT_EQ(warnings_for(base), 1);
+
+  // a 2x1 map, red in one texel, green 0, blue 0 in both
+  lucent::Texture t;
+  t.path = "red.pfm";
+  t.width = 2;
+  t.height = 1;
+  t.rgba = {0, 0, 0, 1, 3, 0, 0, 1};
+  Scene mapped = base;
+  mapped.textures.push_back(t);
+  mapped.lights[1].type = lucent::LightType::EnvironmentMap;
+  mapped.lights[1].texture = 0;
+  mapped.lights[1].radiance = glm::dvec3(0, 1, 1);  // keeps green and blue only: black
+  EXPECT_EQ(warnings_for(mapped), 1);
+  mapped.lights[1].radiance = glm::dvec3(1, 0, 0);  // the red texel
+  EXPECT_EQ(warnings_for(mapped), 0);
+  mapped.textures[0].rgba[4] = 0;  // an all-black map, whatever its scale
+  EXPECT_EQ(warnings_for(mapped), 1);
+
+  Scene some = base;
+  some.lights[0].intensity = glm::dvec3(0, 0, 1e-30);
+  EXPECT_EQ(warnings_for(some), 0);
+  Scene shape = base;  // an emissive sphere is a light that emits
+  shape.materials[0].emission = glm::dvec3(1);
+  EXPECT_EQ(warnings_for(shape), 0);
+}
+
 // The camera and the scene are stored in float with either precision: a pixel spanning fewer
 // than 4 float steps at the look-at distance renders their rounding (at fov 1e-4 degrees a
 // reviewer's sphere silhouette came out in steps of whole pixels, its mean 13.9 standard errors
