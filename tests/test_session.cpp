@@ -12,6 +12,7 @@
 
 #include "cl/context.hpp"
 #include "cl/program_cache.hpp"
+#include "lucent/reference.hpp"
 #include "lucent/render.hpp"
 #include "lucent/scene_builder.hpp"
 #include "lucent/session.hpp"
@@ -728,6 +729,14 @@ TEST(Session, SceneWithoutLightWarns) {
               1)
         << warnings.dump();
   }
+  {  // the reference says so too (it was silent)
+    lucent::test::CaptureWarnings warnings;
+    dark.film.width = dark.film.height = 2;
+    lucent::ReferenceOptions ro;
+    ro.spp = 1;
+    lucent::render_reference(dark, ro);
+    EXPECT_EQ(warnings.count("the scene has no light"), 1) << warnings.dump();
+  }
   dark.integrator.type = lucent::IntegratorType::Albedo;
   lucent::test::CaptureWarnings warnings;
   r.set_scene(dark);
@@ -754,6 +763,15 @@ TEST(Session, SceneWhoseLightsEmitNothingWarns) {
   env.type = lucent::LightType::Environment;
   base.lights.push_back(env);  // radiance 0
   EXPECT_EQ(warnings_for(base), 1);
+  {  // and the reference (it was silent)
+    lucent::test::CaptureWarnings warnings;
+    Scene small = base;
+    small.film.width = small.film.height = 2;
+    lucent::ReferenceOptions ro;
+    ro.spp = 1;
+    lucent::render_reference(small, ro);
+    EXPECT_EQ(warnings.count(kMessage), 1) << warnings.dump();
+  }
 
   // a 2x1 map, red in one texel, green 0, blue 0 in both
   lucent::Texture t;

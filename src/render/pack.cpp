@@ -54,31 +54,6 @@ void put_normal(lc_triangle& t, const glm::dvec3& n) {
   t.ng_z = f(n.z);
 }
 
-/// Whether a light of Scene::lights can send out any light: a point light's intensity, an
-/// environment's radiance, an environment map's scale times its texels, in some channel.
-bool light_emits(const Scene& scene, const Light& l) {
-  switch (l.type) {
-    case LightType::Point:
-      return l.intensity.x > 0 || l.intensity.y > 0 || l.intensity.z > 0;
-    case LightType::Environment:
-      return l.radiance.x > 0 || l.radiance.y > 0 || l.radiance.z > 0;
-    case LightType::EnvironmentMap: {
-      if (l.texture < 0 || static_cast<size_t>(l.texture) >= scene.textures.size()) return false;
-      const Texture& t = scene.textures[static_cast<size_t>(l.texture)];
-      for (int c = 0; c < 3; ++c) {
-        if (!(l.radiance[c] > 0)) continue;
-        for (size_t i = static_cast<size_t>(c); i < t.rgba.size(); i += 4)
-          if (t.rgba[i] > 0) return true;
-      }
-      return false;
-    }
-    case LightType::Sphere:
-    case LightType::Triangle:
-      break;
-  }
-  return true;
-}
-
 }  // namespace
 
 bool set_triangle_normal(lc_triangle& t) {
@@ -379,22 +354,8 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   warn_camera_precision(scene, p);
   pack_lights(scene, p, std::move(power));
   // a light-transport integrator with nothing that emits renders a black image: said, not
-  // silently written (the AOVs need no light)
-  if (p.lights.empty() && !lucent::is_aov(scene.integrator.type))
-    scene_detail::warn(scene_detail::in_file(
-        scene.path,
-        "the scene has no light (no light entry, no emissive material): the image is "
-        "black"));
-  // lights that all send out nothing render black too (an intensity or a radiance of 0, a map
-  // scaled by 0 or all black), and were silent; emissive shapes (area lights, before the scene's
-  // lights in p.lights) always emit
-  else if (p.lights.size() == scene.lights.size() && !lucent::is_aov(scene.integrator.type) &&
-           std::none_of(scene.lights.begin(), scene.lights.end(),
-                        [&scene](const Light& l) { return light_emits(scene, l); }))
-    scene_detail::warn(scene_detail::in_file(
-        scene.path,
-        "every light of the scene emits nothing (an intensity, radiance or scale of 0, or a black "
-        "environment map): the image is black"));
+  // silently written
+  for (const std::string& note : scene_detail::light_notes(scene)) scene_detail::warn(note);
 
   for (const Texture& t : scene.textures) {
     lc_texture d{};

@@ -428,6 +428,59 @@ glm::dvec3 brightest_texel(const Texture& t) {
   return b;
 }
 
+namespace {
+
+/// Whether a light of Scene::lights can send out any light: a point light's intensity, an
+/// environment's radiance, an environment map's scale times its texels, in some channel.
+bool light_emits(const Scene& scene, const Light& l) {
+  switch (l.type) {
+    case LightType::Point:
+      return l.intensity.x > 0 || l.intensity.y > 0 || l.intensity.z > 0;
+    case LightType::Environment:
+      return l.radiance.x > 0 || l.radiance.y > 0 || l.radiance.z > 0;
+    case LightType::EnvironmentMap: {
+      if (l.texture < 0 || static_cast<size_t>(l.texture) >= scene.textures.size()) return false;
+      const Texture& t = scene.textures[static_cast<size_t>(l.texture)];
+      for (int c = 0; c < 3; ++c) {
+        if (!(l.radiance[c] > 0)) continue;
+        for (size_t i = static_cast<size_t>(c); i < t.rgba.size(); i += 4)
+          if (t.rgba[i] > 0) return true;
+      }
+      return false;
+    }
+    case LightType::Sphere:
+    case LightType::Triangle:
+      break;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::vector<std::string> light_notes(const Scene& s) {
+  if (is_aov(s.integrator.type)) return {};
+  auto emissive = [&s](int material) {
+    return material >= 0 && static_cast<std::size_t>(material) < s.materials.size() &&
+           s.materials[static_cast<std::size_t>(material)].emissive();
+  };
+  // a shape of an emissive material is an area light, which always emits
+  if (std::any_of(s.spheres.begin(), s.spheres.end(),
+                  [&](const Sphere& sp) { return emissive(sp.material); }) ||
+      std::any_of(s.triangles.begin(), s.triangles.end(),
+                  [&](const Triangle& t) { return emissive(t.material); }))
+    return {};
+  if (s.lights.empty())
+    return {in_file(s.path,
+                    "the scene has no light (no light entry, no emissive material): the image is "
+                    "black")};
+  if (std::none_of(s.lights.begin(), s.lights.end(),
+                   [&s](const Light& l) { return light_emits(s, l); }))
+    return {in_file(s.path,
+                    "every light of the scene emits nothing (an intensity, radiance or scale of "
+                    "0, or a black environment map): the image is black")};
+  return {};
+}
+
 std::vector<std::string> energy_gain_notes(const Scene& s) {
   std::vector<std::string> notes;
   if (is_aov(s.integrator.type)) return notes;  // nothing is reflected

@@ -129,6 +129,13 @@ void validate_scene(const Scene& scene);
 /// each once (Renderer::set_scene), the reference each time.
 std::vector<std::string> energy_gain_notes(const Scene& scene);
 
+/// A light-transport integrator's black image, said rather than silently rendered: "the scene
+/// has no light" (no light entry and no shape of an emissive material), or "every light of the
+/// scene emits nothing" (point intensities and environment radiances of 0, environment maps
+/// scaled by 0 or black in the channels their scale keeps; no emissive shape). None for the AOV
+/// integrators, which need no light. The session (pack_scene) and the reference give them.
+std::vector<std::string> light_notes(const Scene& scene);
+
 /// A texture's largest red, green and blue texels (0 for an empty one).
 glm::dvec3 brightest_texel(const Texture& texture);
 
