@@ -173,6 +173,35 @@ TEST(Outputs, WritesAreAtomicAndFollowSymlinks) {
 // Names near the file system's limit (255 bytes): one that fits is written (its temporary name
 // was its whole name plus a suffix, refused after the render: the image was lost), one that does
 // not is refused before rendering, as an AOV's would be.
+// An output that is a FIFO (or a link to one, or to a device) is refused before rendering: the
+// temporary file renamed into place replaced it with a regular file (as root, `-o n.png` with
+// n.png a link to /dev/null replaced /dev/null itself). Found by rendering to such a link.
+TEST(Outputs, NonRegularOutputsAreRefusedNotReplaced) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  const std::string fifo = dir + "/fifo.png";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  fs::create_symlink("fifo.png", dir + "/to-fifo.pfm");
+  for (const std::string& out : {fifo, dir + "/to-fifo.pfm"}) {
+    CommandResult r = run_cli("render " + q(scene) + " -o " + q(out) + " --quiet");
+    EXPECT_EQ(error_line(r), out +
+                                 ": is a pipe, not a regular file (outputs are written to a "
+                                 "temporary file renamed into place)");
+    EXPECT_TRUE(fs::is_fifo(fifo)) << out << ": the FIFO was replaced";
+  }
+  // the library's writer itself (Python's write_image, the kernel cache)
+  try {
+    lucent::io::write_file_atomic(dir + "/to-fifo.pfm", "data");
+    ADD_FAILURE() << "no error";
+  } catch (const lucent::Error& e) {
+    EXPECT_EQ(std::string(e.what()), dir +
+                                         "/to-fifo.pfm: is a pipe, not a regular file (outputs "
+                                         "are written to a temporary file renamed into place)");
+  }
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_TRUE(others(dir, {"scene.json", "fifo.png", "to-fifo.pfm"}).empty());
+}
+
 TEST(Outputs, LongNamesAreWrittenOrRefusedBeforeRendering) {
   std::string dir = lucent::test::temp_dir();
   if (::pathconf(dir.c_str(), _PC_NAME_MAX) != 255) GTEST_SKIP() << "names are not 255 bytes here";

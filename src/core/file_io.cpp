@@ -67,6 +67,16 @@ fs::path write_target(const std::string& path) {
   return target;
 }
 
+/// Refuses to write over `target` (where `path` leads) when it exists and is not a regular file:
+/// the temporary file renamed into place replaced a FIFO, a socket or a device node (a link to
+/// /dev/null run as root replaced the device with the image), and never wrote into it.
+void check_writable_kind(const std::string& path, const fs::path& target) {
+  struct stat st {};
+  if (::stat(target.c_str(), &st) != 0 || S_ISREG(st.st_mode) || S_ISDIR(st.st_mode)) return;
+  throw Error(path + ": is " + kind_of(st.st_mode) +
+              ", not a regular file (outputs are written to a temporary file renamed into place)");
+}
+
 // The temporary file a write of `name` into `dir` goes through: a hidden name beside it, of at
 // most 128 bytes of the name, so that a name near the file system's limit (255 bytes) has one
 // too (its whole name plus the suffix was refused, after the render).
@@ -165,6 +175,7 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
   if (fs::exists(out, ec) && ::access(out.c_str(), W_OK) != 0)
     throw Error(out + ": cannot write output (" + std::strerror(errno) + ")");
   const fs::path target = write_target(out);  // the directory the write will go to
+  check_writable_kind(out, target);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   const std::string name = target.filename().string();
   // the name itself, which only the final rename would refuse
@@ -207,6 +218,7 @@ void write_file_atomic(const std::string& path, const void* data, std::size_t si
   const std::string name = target.filename().string();
   if (name.empty() || name == "." || name == "..")
     throw Error(path + ": cannot write (not a file name)");
+  check_writable_kind(path, target);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   const std::string tmp = temp_path(dir, name).string();
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
