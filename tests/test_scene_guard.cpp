@@ -13,6 +13,7 @@
 
 #include "core/file_io.hpp"
 #include "lucent/error.hpp"
+#include "lucent/scene.hpp"
 #include "scene/validate.hpp"
 #include "support.hpp"
 
@@ -208,6 +209,31 @@ TEST(SceneGuard, PipedSceneFindsItsFilesFromTheCurrentDirectory) {
   EXPECT_EQ(r.err,
             "lucent: error: /dev/stdin: /shapes/0/file: tri.obj: cannot open OBJ file (No such "
             "file or directory)\n");
+}
+
+// A scene reached through a linked directory: "../x" in it is where the system finds it, beside
+// the directory the link points to (a lexical "link/.." made it beside the link: the scene opened,
+// its mesh did not). Found by loading scenes/textured.json through a link to scenes/.
+TEST(SceneGuard, DotDotAfterALinkedDirectoryIsTheLinkTargetsParent) {
+  namespace fs = std::filesystem;
+  std::string dir = lucent::test::temp_dir();
+  fs::create_directories(dir + "/project/scenes");
+  fs::create_directories(dir + "/elsewhere/deep");
+  lucent::test::write_file(dir + "/project/tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  lucent::test::write_file(dir + "/project/scenes/s.json",
+                           R"({"film": {"width": 4, "height": 4},
+    "integrator": {"type": "albedo", "spp": 1},
+    "shapes": [{"type": "mesh", "file": "../tri.obj"}]})");
+  fs::create_directory_symlink(dir + "/project/scenes", dir + "/elsewhere/deep/sc");
+  const std::string via_link = dir + "/elsewhere/deep/sc/s.json";
+  lucent::Scene scene;
+  ASSERT_NO_THROW(scene = lucent::load_scene(via_link));
+  ASSERT_EQ(scene.shapes.size(), 1u);
+  EXPECT_TRUE(fs::equivalent(scene.shapes[0].file, dir + "/project/tri.obj"))
+      << scene.shapes[0].file;
+  // without links the name stays as short as before
+  scene = lucent::load_scene(dir + "/project/scenes/./s.json");
+  EXPECT_EQ(scene.shapes[0].file, dir + "/project/tri.obj");
 }
 
 // A writer that holds a pipe open and sends nothing: the read gives up after the idle time.

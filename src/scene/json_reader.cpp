@@ -137,7 +137,22 @@ glm::dvec2 JsonReader::vec2(const json& j, const std::string& ptr) const {
 std::string JsonReader::resolve(const std::string& rel) const {
   fs::path p(rel);
   if (p.is_relative()) p = dir_ / p;
-  return p.lexically_normal().string();
+  // lexically_normal, except that a ".." after a symbolic link stays: the system resolves
+  // "link/.." in the link's target, so a scene reached through a linked directory found
+  // "../assets/x.obj" beside the link instead of beside the scene it reads
+  fs::path out;
+  std::error_code ec;
+  for (const fs::path& part : p) {
+    if (part.empty() || part == ".") continue;
+    if (part == ".." && out.has_relative_path() && out.filename() != ".." &&
+        !fs::is_symlink(out, ec)) {
+      out = out.parent_path();
+      continue;
+    }
+    if (part == ".." && out == out.root_path() && !out.empty()) continue;  // "/.." is "/"
+    out /= part;
+  }
+  return out.empty() ? "." : out.string();
 }
 
 }  // namespace lucent::scene_detail
