@@ -97,6 +97,21 @@ TEST(CliErrors, UnknownOptionIsNamed) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// A word that names no command is named, with the commands there are (it said "A subcommand is
+// required", as if none had been given). Found by running `lucent rendr`.
+TEST(CliErrors, UnknownCommandIsNamed) {
+  for (const char* word : {"frobnicate", "rendr"}) {
+    CommandResult r = run_cli(std::string(word) + " x.json");
+    EXPECT_EQ(expect_one_error_line(r),
+              std::string("unknown command ") + word +
+                  " (expected one of: render, devices, compare, info, cache, converge, merge) (see "
+                  "lucent --help)");
+    EXPECT_EQ(r.status, 2) << word;
+  }
+  // no command at all keeps CLI11's message
+  EXPECT_EQ(expect_one_error_line(run_cli("")), "A subcommand is required (see lucent --help)");
+}
+
 TEST(CliErrors, BadArgumentsAreParseErrors) {
   std::string scene = small_scene();
   std::string out = lucent::test::temp_dir() + "/o.png";

@@ -106,7 +106,10 @@ TEST(Outputs, FullDeviceIsAnErrorNamingThePath) {
   ::close(fd);
   // what the CLI prints to standard output is checked too
   std::string dir = lucent::test::temp_dir();
-  for (const std::string& args : {std::string("devices"), std::string("cache dir")}) {
+  // --help and --version too (they said nothing and exited 0)
+  for (const std::string& args :
+       {std::string("devices"), std::string("cache dir"), std::string("--help"),
+        std::string("--version"), std::string("render --help")}) {
     std::string cmd =
         std::string("'") + LUCENT_CLI_PATH + "' " + args + " >/dev/full 2>" + q(dir + "/err");
     int raw = std::system(cmd.c_str());

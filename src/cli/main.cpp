@@ -66,6 +66,27 @@ std::string non_finite_option(const CLI::App& app) {
   return "";
 }
 
+/// `status`, or 1 when what went to standard output (a table, a comparison, --help) could not be
+/// written (a full disk, a closed descriptor): one error line then.
+/// `earlier`: the errno of a write that already failed (std::cout flushed by std::endl).
+int stdout_written(int status, int earlier = 0) {
+  errno = 0;
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    const int err = errno ? errno : earlier;
+    std::fprintf(stderr, "lucent: error: standard output: cannot write (%s)\n",
+                 err ? std::strerror(err) : "write error");
+    return status == 0 ? 1 : status;
+  }
+  return status;
+}
+
+/// Prints --help or --version (CLI11 writes it to std::cout) and checks that it was written.
+int help_written(const CLI::App& app, const CLI::Error& e) {
+  errno = 0;
+  const int status = app.exit(e);
+  return stdout_written(status, std::ferror(stdout) ? errno : 0);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -83,11 +104,11 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
+    return help_written(app, e);  // (`lucent --help >/dev/full` said nothing, exit 0)
   } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
+    return help_written(app, e);
   } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
+    return help_written(app, e);
   } catch (const CLI::ParseError& e) {
     if (std::string bad = non_finite_option(app); !bad.empty()) {  // before CLI11's range text
       std::fprintf(stderr, "lucent: error: %s: must be a finite number (see lucent --help)\n",
@@ -103,6 +124,15 @@ int main(int argc, char** argv) {
           msg += " (a file whose name starts with '-' can be given as ./" + extra + ")";
         break;
       }
+    // a word that names no command: CLI11 says "A subcommand is required"
+    const std::vector<std::string> extras = app.remaining(true);
+    if (app.get_subcommands().empty() && !extras.empty() && !extras[0].empty() &&
+        extras[0][0] != '-') {
+      std::string names;
+      for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+        names += (names.empty() ? "" : ", ") + sub->get_name();
+      msg = "unknown command " + extras[0] + " (expected one of: " + names + ")";
+    }
     for (auto& c : msg)
       if (c == '\n') c = ' ';
     std::fprintf(stderr, "lucent: error: %s (see lucent --help)\n", one_line(msg).c_str());
@@ -141,12 +171,5 @@ int main(int argc, char** argv) {
                  one_line(e.what()).c_str());
     return 1;
   }
-  // what went to stdout (a table, a comparison) must have been written too
-  errno = 0;
-  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
-    std::fprintf(stderr, "lucent: error: standard output: cannot write (%s)\n",
-                 errno ? std::strerror(errno) : "write error");
-    return status == 0 ? 1 : status;
-  }
-  return status;
+  return stdout_written(status);
 }
