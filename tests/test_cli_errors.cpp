@@ -215,13 +215,24 @@ TEST(CliErrors, NoOpenClPlatform) {
 // PoCL cannot work without its cache directory: given a file, it fails every build with an empty
 // log; given a path that cannot be made, it lists no device. Both errors name the directory.
 TEST(CliErrors, UnusablePoclCacheDirIsNamed) {
-  {
-    lucent::test::ScopedEnv unset("POCL_CACHE_DIR", nullptr);
-    EXPECT_EQ(lucent::cl_util::pocl_cache_dir_problem(), "");
-  }
   const std::string dir = lucent::test::temp_dir();
   const std::string file = dir + "/a-file";
   lucent::test::write_file(file, "x");
+  {
+    // without POCL_CACHE_DIR, PoCL's own choice: $XDG_CACHE_HOME/pocl/kcache (one that could not
+    // be made said nothing: "no OpenCL device found on any platform")
+    lucent::test::ScopedEnv unset("POCL_CACHE_DIR", nullptr);
+    lucent::test::ScopedEnv kernel_cache("POCL_KERNEL_CACHE", nullptr);
+    {
+      lucent::test::ScopedEnv xdg("XDG_CACHE_HOME", dir.c_str());
+      EXPECT_EQ(lucent::cl_util::pocl_cache_dir(), dir + "/pocl/kcache");
+      EXPECT_EQ(lucent::cl_util::pocl_cache_dir_problem(), "");
+    }
+    lucent::test::ScopedEnv xdg("XDG_CACHE_HOME", file.c_str());
+    EXPECT_EQ(lucent::cl_util::pocl_cache_dir_problem(),
+              "PoCL's cache directory " + file + "/pocl/kcache (XDG_CACHE_HOME=" + file +
+                  ") cannot be created (" + file + " is not a directory)");
+  }
   struct Case {
     std::string value, problem;
   } cases[] = {
@@ -264,6 +275,13 @@ TEST(CliErrors, UnusablePoclCacheDirIsNamed) {
   EXPECT_FALSE(fs::exists(out));
   std::string msg = expect_one_error_line(run_cli("devices", "POCL_CACHE_DIR=" + q(file + "/sub")));
   EXPECT_NE(msg.find("POCL_CACHE_DIR=" + file + "/sub cannot be created (" + file +
+                     " is not a directory), which PoCL needs for its kernels"),
+            std::string::npos)
+      << msg;
+  msg = expect_one_error_line(
+      run_cli("devices", "unset POCL_CACHE_DIR POCL_KERNEL_CACHE; XDG_CACHE_HOME=" + q(file)));
+  EXPECT_NE(msg.find("PoCL's cache directory " + file + "/pocl/kcache (XDG_CACHE_HOME=" + file +
+                     ") cannot be created (" + file +
                      " is not a directory), which PoCL needs for its kernels"),
             std::string::npos)
       << msg;

@@ -1,11 +1,13 @@
 #include "cl/context.hpp"
 
 #include <sys/resource.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -113,26 +115,71 @@ std::string first_error_place(const std::string& log) {
   return "";
 }
 
+std::string pocl_cache_dir(std::string* origin) {
+  // as pocl_cache_init_topdir: POCL_CACHE_DIR, else $XDG_CACHE_HOME/pocl/kcache, else
+  // $HOME/.cache/pocl/kcache, else /tmp/pocl/kcache ("uncached" for "kcache" with
+  // POCL_KERNEL_CACHE off)
+  std::string from;
+  std::string dir;
+  if (const char* v = std::getenv("POCL_CACHE_DIR"); v && *v) {
+    dir = v;
+    from = "POCL_CACHE_DIR";
+  } else {
+    const char* cache = std::getenv("POCL_KERNEL_CACHE");
+    const std::string sub = cache && cache[0] != '1' ? "pocl/uncached" : "pocl/kcache";
+    const char* xdg = std::getenv("XDG_CACHE_HOME");
+    const char* home = std::getenv("HOME");
+    if (xdg && *xdg) {
+      dir = std::string(xdg) + "/" + sub;
+      from = "XDG_CACHE_HOME=" + std::string(xdg);
+    } else if (home) {
+      dir = std::string(home) + "/.cache/" + sub;
+      from = "HOME=" + std::string(home);
+    } else {
+      dir = "/tmp/" + sub;
+      from = "HOME unset";
+    }
+  }
+  if (origin) *origin = from;
+  return dir;
+}
+
 std::string pocl_cache_dir_problem() {
-  const char* v = std::getenv("POCL_CACHE_DIR");
-  if (!v || !*v) return "";
   namespace fs = std::filesystem;
-  const std::string name = std::string("POCL_CACHE_DIR=") + v;
+  // the directory PoCL uses, not only POCL_CACHE_DIR: an XDG_CACHE_HOME that was a file or
+  // read-only gave "no OpenCL device found on any platform" and nothing more
+  std::string origin;
+  const std::string dir = pocl_cache_dir(&origin);
+  const std::string name = origin == "POCL_CACHE_DIR"
+                               ? "POCL_CACHE_DIR=" + dir
+                               : "PoCL's cache directory " + dir + " (" + origin + ")";
   std::error_code ec;
-  fs::path p(v);
+  fs::path p(dir);
   // the directory itself, else the nearest ancestor that exists (PoCL creates the rest)
   while (!fs::exists(fs::symlink_status(p, ec)) && p.has_parent_path() && p != p.parent_path())
     p = p.parent_path();
   if (!fs::exists(p, ec)) return name + " cannot be created";
   if (!fs::is_directory(p, ec))
-    return name + (p == fs::path(v) ? " is not a directory"
-                                    : " cannot be created (" + p.string() + " is not a directory)");
+    return name + (p == fs::path(dir)
+                       ? " is not a directory"
+                       : " cannot be created (" + p.string() + " is not a directory)");
   if (::access(p.c_str(), W_OK | X_OK) != 0)
-    return name + (p == fs::path(v) ? " is not writable" : " cannot be created") + " (" +
+    return name + (p == fs::path(dir) ? " is not writable" : " cannot be created") + " (" +
            std::strerror(errno) + ")";
   // where permissions do not tell (root, /proc): make it as PoCL would (called on errors only)
-  if (p != fs::path(v) && !fs::create_directories(v, ec) && ec)
+  if (p != fs::path(dir) && !fs::create_directories(dir, ec) && ec)
     return name + " cannot be created (" + ec.message() + ")";
+  // a full disk: PoCL writes the kernel's source, bitcode and shared object there (a few MiB);
+  // its build failed with an empty log
+  struct statvfs fsinfo {};
+  if (::statvfs(dir.c_str(), &fsinfo) == 0) {
+    const double free_bytes = double(fsinfo.f_bavail) * double(fsinfo.f_frsize);
+    if (free_bytes < 16.0 * 1024 * 1024) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%.0f KiB", free_bytes / 1024.0);
+      return name + " has only " + buf + " free";
+    }
+  }
   return "";
 }
 

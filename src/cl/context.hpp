@@ -52,10 +52,18 @@ std::string map_source_places(const std::string& log, const std::string& source)
 /// (the session names the kernel directory in use instead of kernels/ when there is one).
 std::string first_error_place(const std::string& log);
 
-/// What keeps PoCL from using its kernel cache directory, POCL_CACHE_DIR when set: "" when
-/// nothing does (or the variable is unset), else e.g. "POCL_CACHE_DIR=/dev/null is not a
-/// directory". PoCL then lists no device or fails every build; those errors name it. Creates the
-/// directory, as PoCL would, when only trying tells whether it can be made.
+/// The directory PoCL keeps its kernels in, as PoCL chooses it: POCL_CACHE_DIR, else
+/// $XDG_CACHE_HOME/pocl/kcache, else $HOME/.cache/pocl/kcache, else /tmp/pocl/kcache
+/// (pocl/uncached with POCL_KERNEL_CACHE off). `origin`, when given: "POCL_CACHE_DIR",
+/// "XDG_CACHE_HOME=<value>", "HOME=<value>" or "HOME unset".
+std::string pocl_cache_dir(std::string* origin = nullptr);
+
+/// What keeps PoCL from using its kernel cache directory (POCL_CACHE_DIR when set, else as PoCL
+/// chooses it: $XDG_CACHE_HOME/pocl/kcache, $HOME/.cache/pocl/kcache): "" when nothing does,
+/// else e.g. "POCL_CACHE_DIR=/dev/null is not a directory", "PoCL's cache directory
+/// /ro/pocl/kcache (XDG_CACHE_HOME=/ro) cannot be created (Read-only file system)", "... has only
+/// 12 KiB free". PoCL then lists no device or fails every build; those errors name it. Creates
+/// the directory, as PoCL would, when only trying tells whether it can be made.
 std::string pocl_cache_dir_problem();
 
 /// Builds `source` (already assembled, with #line markers) for the context's device. On a build

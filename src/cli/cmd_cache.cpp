@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <string>
 
+#include "cl/context.hpp"
 #include "cl/program_cache.hpp"
 #include "cli/commands.hpp"
 #include "lucent/error.hpp"
@@ -38,10 +39,12 @@ int run_cache_command() {
   try {
     for (const cl_util::Device& d : cl_util::enumerate_devices())
       if (!cl_util::driver_program_cache(d).empty()) {
+        // (the directory PoCL uses: it said "default ~/.cache/pocl/kcache" whatever
+        // XDG_CACHE_HOME chose)
         std::printf(
-            "%s: kernels are cached by PoCL (POCL_CACHE_DIR, default ~/.cache/pocl/kcache), "
-            "not here; remove that directory to rebuild them from source\n",
-            d.info.name.c_str());
+            "%s: kernels are cached by PoCL in %s (POCL_CACHE_DIR), not here; remove that "
+            "directory to rebuild them from source\n",
+            d.info.name.c_str(), one_line(cl_util::pocl_cache_dir()).c_str());
         break;
       }
   } catch (const Error&) {
