@@ -5,8 +5,10 @@
 
 #include <atomic>
 #include <cctype>
+#include <clocale>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -196,6 +198,53 @@ std::vector<ConvergePoint> synthetic(const std::vector<double>& relmse,
     pts.push_back(p);
   }
   return pts;
+}
+// A process whose numbers are written with a decimal comma (a Python program that called
+// locale.setlocale(locale.LC_ALL, "") on a German system): the CSV, the SVG and the settings
+// keep the C locale's "0.5". The CSV held "0,25" in comma-separated fields, the SVG
+// x1="80,00", and "clamp=0.5" was refused. Found by running lucent.converge from Python under
+// de_DE.UTF-8. Skipped where no such locale is installed (LOCPATH may name a directory of one).
+TEST(Converge, NumbersIgnoreTheProcessLocale) {
+  const std::string before = std::setlocale(LC_NUMERIC, nullptr);
+  const char* comma = nullptr;
+  for (const char* name : {"de_DE.UTF-8", "de_DE.utf8", "fr_FR.UTF-8", "fr_FR.utf8", "de_DE",
+                           "fr_FR", "nl_NL.UTF-8", "ru_RU.UTF-8"})
+    if (std::setlocale(LC_NUMERIC, name) && std::string(std::localeconv()->decimal_point) == ",") {
+      comma = name;
+      break;
+    }
+  struct Restore {
+    std::string name;
+    ~Restore() { std::setlocale(LC_NUMERIC, name.c_str()); }
+  } restore{before};
+  if (!comma) GTEST_SKIP() << "no locale with a decimal comma is installed";
+  char probe[16];
+  std::snprintf(probe, sizeof probe, "%.1f", 0.5);
+  ASSERT_STREQ(probe, "0,5") << comma;
+
+  EXPECT_EQ(lucent::parse_converge_setting("clamp=0.5").clamp, 0.5);
+  EXPECT_EQ(lucent::parse_converge_setting("filter=gaussian:1.25").filter_radius, 1.25);
+  lucent::ConvergeResult r;
+  for (int i = 0; i < 3; ++i) {
+    lucent::ConvergePoint p;
+    p.setting = "default";
+    p.spp = 1u << i;
+    p.seconds = 0.25 * (i + 1);
+    p.samples_per_second = 1.5e6;
+    p.rmse = 0.5 / (i + 1);
+    p.relmse = 0.125 / (i + 1);
+    r.points.push_back(p);
+  }
+  r.fits.push_back(lucent::fit_convergence(r.points));
+  const std::string csv = lucent::convergence_csv(r);
+  EXPECT_NE(csv.find("default,1,0.25,1.5e+06,0.5,0.125,"), std::string::npos) << csv;
+  const std::string svg = lucent::convergence_svg(r, "t");
+  EXPECT_FALSE(std::regex_search(svg, std::regex("=\"[-0-9]+,[0-9]+\""))) << svg.substr(0, 400);
+  int paths = 0;
+  EXPECT_EQ(check_xml(svg, "path", &paths), "");
+  // this thread's locale is the process's again
+  std::snprintf(probe, sizeof probe, "%.1f", 0.5);
+  EXPECT_STREQ(probe, "0,5");
 }
 
 TEST(Converge, SettingSyntax) {

@@ -37,4 +37,13 @@ std::string one_line(const std::string& s) {
   return out;
 }
 
+CNumbers::CNumbers() {
+  static const locale_t c = ::newlocale(LC_ALL_MASK, "C", static_cast<locale_t>(nullptr));
+  if (c) previous_ = ::uselocale(c);
+}
+
+CNumbers::~CNumbers() {
+  if (previous_) ::uselocale(previous_);
+}
+
 }  // namespace lucent::io

@@ -13,6 +13,7 @@
 #include <optional>
 #include <sstream>
 
+#include "core/text.hpp"
 #include "image/plot_svg.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
@@ -59,6 +60,7 @@ double log_log_slope(const std::vector<double>& x, const std::vector<double>& y)
 
 /// A finite number >= lo (> lo when `strict`).
 double parse_number(const std::string& knob, const std::string& value, double lo, bool strict) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
   char* end = nullptr;
   double v = std::strtod(value.c_str(), &end);
   if (value.empty() || *end != '\0' || !std::isfinite(v) || (strict ? !(v > lo) : !(v >= lo)))
@@ -71,6 +73,7 @@ double parse_number(const std::string& knob, const std::string& value, double lo
 }
 
 std::string fmt(const char* f, double v) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
   char buf[64];
   std::snprintf(buf, sizeof buf, f, v);
   return buf;
@@ -135,6 +138,7 @@ void ConvergeSetting::apply(Scene& scene, RenderOptions& options) const {
 }
 
 ConvergeSetting parse_converge_setting(const std::string& text) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
   ConvergeSetting s;
   s.name = text;
   if (text.empty()) throw Error("empty setting (expected e.g. default, fast-math, max_depth=2)");
@@ -481,6 +485,7 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
 }
 
 std::string convergence_csv(const ConvergeResult& result) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
   std::string out =
       "setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s,"
       "reference_noise_relmse,estimated_relmse,halves_relmse\n";
@@ -540,10 +545,12 @@ plot::LogLogPlot convergence_plot(const ConvergeResult& result, const std::strin
 }  // namespace
 
 std::string convergence_svg(const ConvergeResult& result, const std::string& title) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
   return plot::log_log_svg(convergence_plot(result, title));
 }
 
 Image convergence_image(const ConvergeResult& result, const std::string& title) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
   return plot::log_log_image(convergence_plot(result, title));
 }
 

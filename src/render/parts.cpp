@@ -14,6 +14,7 @@
 #include <map>
 
 #include "core/file_io.hpp"
+#include "core/text.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/error.hpp"
 #include "lucent/limits.hpp"
@@ -39,6 +40,7 @@ const char* tonemap_name(ToneMap t) {
 }
 
 double parse_double(const std::string& path, const std::string& what, const std::string& s) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
   char* end = nullptr;
   const double v = std::strtod(s.c_str(), &end);
   if (s.empty() || *end != '\0' || !std::isfinite(v))
@@ -357,6 +359,7 @@ RenderResult part_result(const RenderPart& part) {
 }
 
 void write_render_part(const std::string& path, const RenderPart& part) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
   const PartInfo& info = part.info;
   const Accumulation& a = part.acc;
   const size_t npix = static_cast<size_t>(a.width) * a.height;

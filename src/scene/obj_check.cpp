@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "core/text.hpp"
 #include "lucent/error.hpp"
 #include "scene/obj_internal.hpp"
 
@@ -155,7 +156,10 @@ double number(std::string_view tok, const LineError& fail, const char* what) {
   double v = 0;
   auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
   if (ec == std::errc::result_out_of_range && ptr == t.data() + t.size()) {
-    v = std::strtod(std::string(t).c_str(), nullptr);  // tells overflow from underflow
+    {
+      io::CNumbers c_numbers;
+      v = std::strtod(std::string(t).c_str(), nullptr);  // tells overflow from underflow
+    }
     if (std::abs(v) <= 1.0) {
       check_tinyobj_arithmetic(tok, parts, fail, what);
       return 0.0;
@@ -408,6 +412,7 @@ constexpr TextureOption kTextureOptions[] = {
 // An option of map_Kd whose arguments change what the texture looks like: lucent reads the
 // image once per uv unit, repeating, as decoded (docs/obj-mtl.md).
 bool changes_the_look(std::string_view name, const std::vector<std::string_view>& args) {
+  io::CNumbers c_numbers;         // "0.5", whatever the process locale
   auto all = [&](double value) {  // every argument the given number (missing ones default)
     for (std::string_view a : args)
       if (std::strtod(std::string(a).c_str(), nullptr) != value) return false;
