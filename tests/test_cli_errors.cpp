@@ -182,6 +182,24 @@ TEST(CliErrors, UnknownOutputExtension) {
 
 // ocl-icd reads the ICDs to load from OCL_ICD_VENDORS when it is set: an empty directory hides
 // every driver, PoCL included (checked here through `lucent devices` first).
+// POCL_MAX_PTHREAD_COUNT that PoCL crashes with (a negative value: SIGSEGV; a huge one: SIGSEGV
+// or abort() when it cannot start the threads) is an error line before any OpenCL call; 0, a
+// word and sensible counts are PoCL's to read. Found by running `lucent devices` with -1.
+TEST(CliErrors, PoclThreadCountPoclCrashesWithIsRefused) {
+  for (const char* value : {"-1", "99999999999", "2147483648", "5000"}) {
+    CommandResult r = run_cli("devices", std::string("POCL_MAX_PTHREAD_COUNT=") + value);
+    EXPECT_EQ(expect_one_error_line(r),
+              std::string("POCL_MAX_PTHREAD_COUNT=") + value +
+                  ": PoCL crashes with a negative or huge thread count; give 1 to 4096, or unset "
+                  "it (one thread per CPU)");
+    EXPECT_EQ(r.status, 1) << value;
+  }
+  for (const char* value : {"0", "abc", "2", " 2", "0x7fffffff"}) {
+    lucent::test::ScopedEnv env("POCL_MAX_PTHREAD_COUNT", value);
+    EXPECT_EQ(lucent::cl_util::pocl_thread_count_problem(), "") << value;
+  }
+}
+
 TEST(CliErrors, NoOpenClPlatform) {
   std::string empty = lucent::test::temp_dir() + "/vendors";
   fs::create_directories(empty);

@@ -216,12 +216,31 @@ bool is_pocl(const DeviceInfo& device) {
   return device.platform.find(kPoclPlatform) != std::string::npos;
 }
 
+std::string pocl_thread_count_problem() {
+  const char* v = std::getenv("POCL_MAX_PTHREAD_COUNT");
+  if (!v || !*v) return "";
+  // PoCL reads it with atoi and starts that many threads when it initialises:
+  // a negative value (or one that wraps to it) crashed the process (SIGSEGV), 100000 aborted it
+  // ("PTHREAD ERROR in pthread_scheduler_init(): Resource temporarily unavailable")
+  errno = 0;
+  char* end = nullptr;
+  const long long n = std::strtoll(v, &end, 10);  // as atoi
+  if (end == v) return "";  // not a number: PoCL takes it as 0 and uses one thread
+  if (errno == ERANGE || n < 0 || n > kMaxPoclThreads)
+    return std::string("POCL_MAX_PTHREAD_COUNT=") + v +
+           ": PoCL crashes with a negative or huge thread count; give 1 to " +
+           std::to_string(kMaxPoclThreads) + ", or unset it (one thread per CPU)";
+  return "";
+}
+
 std::vector<Device> enumerate_devices() {
   // one enumeration at a time in the process: the ICD loader and PoCL initialise on the first
   // call, and sessions created at once from several threads crashed there (SIGSEGV) or saw no
   // platform
   static std::mutex mutex;
   std::lock_guard<std::mutex> lock(mutex);
+  // before PoCL reads it (it is read once, on the first call)
+  if (std::string problem = pocl_thread_count_problem(); !problem.empty()) throw Error(problem);
   std::vector<cl::Platform> platforms;
   try {
     cl::Platform::get(&platforms);

@@ -52,6 +52,14 @@ std::string map_source_places(const std::string& log, const std::string& source)
 /// (the session names the kernel directory in use instead of kernels/ when there is one).
 std::string first_error_place(const std::string& log);
 
+/// The most threads POCL_MAX_PTHREAD_COUNT may ask PoCL for.
+constexpr long long kMaxPoclThreads = 4096;
+
+/// "" unless POCL_MAX_PTHREAD_COUNT is a number PoCL crashes with (negative, or above
+/// kMaxPoclThreads: it starts that many threads, or wraps to a negative int); then the error
+/// enumerate_devices() throws before any OpenCL call.
+std::string pocl_thread_count_problem();
+
 /// The directory PoCL keeps its kernels in, as PoCL chooses it: POCL_CACHE_DIR, else
 /// $XDG_CACHE_HOME/pocl/kcache, else $HOME/.cache/pocl/kcache, else /tmp/pocl/kcache
 /// (pocl/uncached with POCL_KERNEL_CACHE off). `origin`, when given: "POCL_CACHE_DIR",
