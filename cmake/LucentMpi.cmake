@@ -19,6 +19,7 @@ if(NOT LUCENT_MPI STREQUAL "OFF")
     target_link_libraries(lucent_mpi PRIVATE lucent CLI11::CLI11 MPI::MPI_C)
     target_include_directories(lucent_mpi PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
     install(TARGETS lucent_mpi RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+    lucent_install_rpath(lucent_mpi ${CMAKE_INSTALL_BINDIR})
     message(STATUS "lucent-mpi: building against MPI ${MPI_C_VERSION} (${MPIEXEC_EXECUTABLE})")
   else()
     message(STATUS "lucent-mpi: no MPI found, not built (Debian: apt-get install libopenmpi-dev "
