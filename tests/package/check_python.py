@@ -8,6 +8,7 @@ import lucent
 prefix = pathlib.Path(sys.argv[1]).resolve()
 where = pathlib.Path(lucent.__file__).resolve()
 assert prefix in where.parents, f"imported {where}, not the module installed under {prefix}"
+assert lucent.__version__ == sys.argv[2], f"lucent.__version__ {lucent.__version__}, package {sys.argv[2]}"
 scene = lucent.scene_from_dict({
     "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov": 40},
     "film": {"width": 16, "height": 16},

@@ -6,6 +6,20 @@ execute_process(COMMAND ${CMAKE_COMMAND} --install ${BINARY_DIR} --prefix ${WORK
 if(rc)
   message(FATAL_ERROR "install failed: ${rc}")
 endif()
+# the installed programs run from the prefix (a shared lucent: they find liblucent there) and
+# report the package's version
+foreach(program lucent lucent-mpi)
+  if(program STREQUAL "lucent" OR EXISTS ${WORK_DIR}/prefix/bin/${program})
+    execute_process(COMMAND ${WORK_DIR}/prefix/bin/${program} --version WORKING_DIRECTORY ${WORK_DIR}
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err
+                    OUTPUT_STRIP_TRAILING_WHITESPACE)
+    if(rc OR NOT out STREQUAL "${program} ${VERSION}")
+      message(FATAL_ERROR "the installed ${program} --version: exit ${rc}, '${out}' ${err} (expected "
+                          "'${program} ${VERSION}')")
+    endif()
+  endif()
+endforeach()
+
 # The consumer is the README's CMake lines: it sets no C++ standard of its own. Configured at
 # C++14, the default of clang 14 (GCC 12's is C++17): lucent::lucent must bring C++17 itself.
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/package/consumer -B ${WORK_DIR}/build
@@ -35,7 +49,7 @@ if(PYTHON_EXECUTABLE AND PYTHON_INSTALL_DIR)
   endif()
   execute_process(COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${module_dir}
                           ${PYTHON_EXECUTABLE} ${SOURCE_DIR}/tests/package/check_python.py
-                          ${WORK_DIR}/prefix
+                          ${WORK_DIR}/prefix ${VERSION}
                   WORKING_DIRECTORY ${WORK_DIR} RESULT_VARIABLE rc)
   if(rc)
     message(FATAL_ERROR "importing the installed Python module failed: ${rc}")
