@@ -3,8 +3,18 @@
 # skips it.
 set(LUCENT_MPI AUTO CACHE STRING "Build lucent-mpi: AUTO (when MPI is found), ON or OFF")
 set_property(CACHE LUCENT_MPI PROPERTY STRINGS AUTO ON OFF)
-if(NOT LUCENT_MPI STREQUAL "OFF")
-  if(LUCENT_MPI STREQUAL "ON")
+# CMake's other spellings of a boolean mean ON and OFF too (-DLUCENT_MPI=NO was AUTO, and built
+# lucent-mpi; =1 or =TRUE was AUTO, and skipped it silently without MPI); anything else is refused
+string(TOUPPER "${LUCENT_MPI}" _lucent_mpi)
+if(_lucent_mpi MATCHES "^(ON|1|YES|Y|TRUE)$")
+  set(_lucent_mpi ON)
+elseif(_lucent_mpi MATCHES "^(OFF|0|NO|N|FALSE)$")
+  set(_lucent_mpi OFF)
+elseif(NOT _lucent_mpi STREQUAL "AUTO")
+  message(FATAL_ERROR "lucent: LUCENT_MPI is '${LUCENT_MPI}': AUTO, ON or OFF")
+endif()
+if(NOT _lucent_mpi STREQUAL "OFF")
+  if(_lucent_mpi STREQUAL "ON")
     find_package(MPI REQUIRED COMPONENTS C)
   else()
     find_package(MPI QUIET COMPONENTS C)
