@@ -46,16 +46,8 @@ trap 'rm -rf "$work"' EXIT
 export LUCENT_CACHE_DIR=${LUCENT_CACHE_DIR:-$build/lucent-cache}
 export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$build/pocl-cache}
 
-# the files a scene names ("file", "texture") that are absent, resolved as lucent resolves them:
-# relative to the scene's directory (../shared beside this checkout, whatever /work/shared holds)
-missing_assets() {
-  local dir f
-  dir=$(dirname "$1")
-  { grep -o '"\(file\|texture\)": *"[^"]*"' "$1" || true; } | sed 's/.*: *"\(.*\)"$/\1/' | while read -r f; do
-    [[ $f == /* ]] || f=$(realpath -m "$dir/$f")
-    [[ -e $f ]] || echo "$f"
-  done
-}
+# missing_assets SCENE: the absent files it names, where lucent looks for them
+source "$(dirname "${BASH_SOURCE[0]}")/missing-assets.sh"
 
 # pilot CSV -> "N* seconds_per_spp"
 plan() {

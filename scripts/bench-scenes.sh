@@ -32,16 +32,8 @@ parse() {
 }
 min() { awk -v a="$1" -v b="$2" 'BEGIN { print (a == "" || b + 0 < a + 0) ? b : a }'; }
 
-# the files a scene names ("file", "texture") that are absent, resolved as lucent resolves them:
-# relative to the scene's directory (../shared beside this checkout, whatever /work/shared holds)
-missing_assets() {
-  local dir f
-  dir=$(dirname "$1")
-  { grep -o '"\(file\|texture\)": *"[^"]*"' "$1" || true; } | sed 's/.*: *"\(.*\)"$/\1/' | while read -r f; do
-    [[ $f == /* ]] || f=$(realpath -m "$dir/$f")
-    [[ -e $f ]] || echo "$f"
-  done
-}
+# missing_assets SCENE: the absent files it names, where lucent looks for them
+source "$(dirname "${BASH_SOURCE[0]}")/missing-assets.sh"
 
 device=""
 echo "Machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores;" \

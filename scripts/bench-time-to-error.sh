@@ -21,16 +21,8 @@ only=" $* "
 mkdir -p "$out"
 delta="sampler=independent+no-caustics,no-caustics,caustics,adaptive+min-spp=8+no-caustics,no-caustics+clamp=10,caustics+clamp=10"
 plain="sampler=independent,default,adaptive+min-spp=8,clamp=10,adaptive+min-spp=8+clamp=10"
-# the files a scene names ("file", "texture") that are absent, relative to the scene's directory
-# as lucent resolves them (the ../shared assets beside this checkout)
-missing_assets() {
-  local dir f
-  dir=$(dirname "$1")
-  { grep -o '"\(file\|texture\)": *"[^"]*"' "$1" || true; } | sed 's/.*: *"\(.*\)"$/\1/' | while read -r f; do
-    [[ $f == /* ]] || f=$(realpath -m "$dir/$f")
-    [[ -e $f ]] || echo "$f"
-  done
-}
+# missing_assets SCENE: the absent files it names, where lucent looks for them
+source "$(dirname "${BASH_SOURCE[0]}")/missing-assets.sh"
 run() { # name scene ref_spp ladder settings args
   local name=$1 scene=$2 ref=$3 ladder=$4 settings=$5 args=$6
   [[ "$only" == "  " || "$only" == *" $name "* ]] || return 0

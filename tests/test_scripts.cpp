@@ -60,6 +60,9 @@ std::string scratch_checkout(const std::string& dir, std::initializer_list<const
   fs::create_directories(root + "/scenes");
   for (const char* s : scripts)
     fs::copy_file(lucent::test::source_path(std::string("scripts/") + s), root + "/scripts/" + s);
+  // sourced by the benchmark scripts
+  fs::copy_file(lucent::test::source_path("scripts/missing-assets.sh"),
+                root + "/scripts/missing-assets.sh");
   lucent::test::write_file(root + "/scenes/needs-mesh.json", R"({
   "film": {"width": 8, "height": 8},
   "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
