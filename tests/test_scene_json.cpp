@@ -394,6 +394,19 @@ TEST(SceneJson, MissingMeshAndTextureFiles) {
   }
 }
 
+// An empty file name was taken as the scene's directory: "": ".: is a directory, not a texture",
+// a message naming a file the scene does not name.
+TEST(SceneJson, EmptyFileNamesAreRefused) {
+  EXPECT_EQ(error_of(R"({"materials": {"m": {"type": "diffuse", "albedo": {"texture": ""}}}})"),
+            "scene.json: /materials/m/albedo/texture: must be a file name, got an empty string");
+  EXPECT_EQ(error_of(R"({"shapes": [{"type": "mesh", "file": ""}]})"),
+            "scene.json: /shapes/0/file: must be a file name, got an empty string");
+  EXPECT_EQ(error_of(R"({"lights": [{"type": "environment", "file": ""}]})"),
+            "scene.json: /lights/0/file: must be a file name, got an empty string");
+  EXPECT_EQ(error_of(R"({"lights": [{"type": "environment_map", "file": ""}]})"),
+            "scene.json: /lights/0/file: must be a file name, got an empty string");
+}
+
 // "\u0000" is valid JSON. A path holding one opened the file named by what precedes it
 // ("sky.pfm\u0000junk.exr" loaded sky.pfm, exit 0), and the messages that quoted it stopped there.
 TEST(SceneJson, StringsWithANulCharacterAreRefused) {

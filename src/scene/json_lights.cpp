@@ -36,7 +36,7 @@ void parse_light(const JsonReader& r, const json& j, const std::string& p, Scene
           r.fail(p + "/radiance", "give either radiance or file, not both");
         l.type = LightType::EnvironmentMap;
         l.radiance = glm::dvec3(j.contains("scale") ? r.number(j["scale"], p + "/scale") : 1.0);
-        std::string file = r.resolve(r.string(j["file"], p + "/file"));
+        std::string file = r.file_path(j["file"], p + "/file");
         try {
           l.texture = b.load_texture(file);
         } catch (const Error& e) {

@@ -31,10 +31,10 @@ Material parse_material(const JsonReader& r, const json& j, const std::string& p
     const json& v = j[param.key];
     if (param.kind == MaterialParam::ColourOrTexture && v.is_object()) {
       r.check_keys(v, pp, {"texture"});
-      std::string file = r.string(r.require(v, pp, "texture"), pp + "/texture");
+      std::string file = r.file_path(r.require(v, pp, "texture"), pp + "/texture");
       try {
         m.*param.colour = glm::dvec3(1.0);
-        m.albedo_texture = b.load_texture(r.resolve(file));
+        m.albedo_texture = b.load_texture(file);
       } catch (const Error& e) {
         r.fail(pp + "/texture", e.what());
       }

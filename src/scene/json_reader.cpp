@@ -134,6 +134,12 @@ glm::dvec2 JsonReader::vec2(const json& j, const std::string& ptr) const {
   return {number(j[0], ptr + "/0"), number(j[1], ptr + "/1")};
 }
 
+std::string JsonReader::file_path(const json& j, const std::string& ptr) const {
+  const std::string s = string(j, ptr);
+  if (s.empty()) fail(ptr, "must be a file name, got an empty string");
+  return resolve(s);
+}
+
 std::string JsonReader::resolve(const std::string& rel) const {
   fs::path p(rel);
   if (p.is_relative()) p = dir_ / p;

@@ -63,6 +63,9 @@ class JsonReader {
 
   /// A path of the scene file, relative to its directory unless absolute.
   std::string resolve(const std::string& rel) const;
+  /// A file name: a non-empty string (resolve("") named the scene's directory, "." in messages
+  /// such as ".: is a directory, not a texture"), resolved.
+  std::string file_path(const json& j, const std::string& ptr) const;
 
  private:
   std::string file_;

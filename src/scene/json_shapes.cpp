@@ -99,7 +99,7 @@ void parse_shape(const JsonReader& r, const json& j, const std::string& p, Scene
   if (name == "mesh") {
     r.check_keys(j, p, {"type", "file", "material", "transform"});
     ObjShape obj;
-    obj.file = r.resolve(r.string(r.require(j, p, "file"), p + "/file"));
+    obj.file = r.file_path(r.require(j, p, "file"), p + "/file");
     if (j.contains("material")) obj.material = r.string(j["material"], p + "/material");
     obj.transform = optional_transform(r, j, p);
     b.add_obj(obj);
