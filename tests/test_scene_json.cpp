@@ -394,6 +394,20 @@ TEST(SceneJson, MissingMeshAndTextureFiles) {
   }
 }
 
+// A mesh's "material": "" was taken as no material, the OBJ file's own used instead (an
+// obj:default diffuse for a file without MTL), where a sphere or a triangle list refuses it.
+TEST(SceneJson, EmptyMeshMaterialIsRefused) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_EQ(error_of(with_material(R"("shapes": [{"type": "mesh", "file": ")" + dir +
+                                   R"(/t.obj", "material": ""}])")),
+            "scene.json: /shapes/0/material: must name a material, got an empty string (leave it "
+            "out to use the OBJ file's materials)");
+  EXPECT_EQ(error_of(with_material(R"("shapes": [{"type": "sphere", "center": [0, 0, 0],
+                                      "radius": 1, "material": ""}])")),
+            "scene.json: /shapes/0/material: unknown material ''");
+}
+
 // An empty file name was taken as the scene's directory: "": ".: is a directory, not a texture",
 // a message naming a file the scene does not name.
 TEST(SceneJson, EmptyFileNamesAreRefused) {

@@ -100,7 +100,15 @@ void parse_shape(const JsonReader& r, const json& j, const std::string& p, Scene
     r.check_keys(j, p, {"type", "file", "material", "transform"});
     ObjShape obj;
     obj.file = r.file_path(r.require(j, p, "file"), p + "/file");
-    if (j.contains("material")) obj.material = r.string(j["material"], p + "/material");
+    if (j.contains("material")) {
+      // ObjShape's empty material means "the OBJ file's own": "" in a file would silently mean
+      // that too, where every other shape refuses it as an unknown material
+      obj.material = r.string(j["material"], p + "/material");
+      if (obj.material.empty())
+        r.fail(p + "/material",
+               "must name a material, got an empty string (leave it out to use the OBJ file's "
+               "materials)");
+    }
     obj.transform = optional_transform(r, j, p);
     b.add_obj(obj);
     return;
