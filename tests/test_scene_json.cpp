@@ -394,6 +394,19 @@ TEST(SceneJson, MissingMeshAndTextureFiles) {
   }
 }
 
+// "gamma" without "transfer": "gamma" changed nothing: the default srgb transfer was used.
+TEST(SceneJson, GammaNeedsTheGammaTransfer) {
+  EXPECT_EQ(error_of(R"({"film": {"gamma": 2.4}})"),
+            "scene.json: /film/gamma: only used with \"transfer\": \"gamma\" (the transfer is "
+            "srgb)");
+  EXPECT_EQ(error_of(R"({"film": {"transfer": "linear", "gamma": 1.8}})"),
+            "scene.json: /film/gamma: only used with \"transfer\": \"gamma\" (the transfer is "
+            "linear)");
+  EXPECT_EQ(
+      lucent::parse_scene(R"({"film": {"gamma": 1.8, "transfer": "gamma"}})", "s.json").film.gamma,
+      1.8);
+}
+
 // A mesh's "material": "" was taken as no material, the OBJ file's own used instead (an
 // obj:default diffuse for a file without MTL), where a sphere or a triangle list refuses it.
 TEST(SceneJson, EmptyMeshMaterialIsRefused) {

@@ -46,6 +46,11 @@ void parse_film(const JsonReader& r, const json& j, SceneBuilder& b) {
         t == "clamp" ? ToneMap::Clamp : (t == "reinhard" ? ToneMap::Reinhard : ToneMap::Aces);
   }
   b.set_film(f);
+  // gamma shapes the "gamma" transfer only: with srgb or linear it was ignored without a word
+  // (as an environment's scale without a file is refused); checked after the value itself
+  if (j.contains("gamma") && f.transfer != Transfer::Gamma)
+    r.fail(p + "/gamma", std::string("only used with \"transfer\": \"gamma\" (the transfer is ") +
+                             (f.transfer == Transfer::Srgb ? "srgb" : "linear") + ")");
 }
 
 void parse_integrator(const JsonReader& r, const json& j, SceneBuilder& b) {
