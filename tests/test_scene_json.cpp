@@ -82,7 +82,11 @@ TEST(SceneJson, WrongTypeNumberAndVector) {
   EXPECT_EQ(error_of(R"({"camera": {"position": [0, 1]}})"),
             "scene.json: /camera/position: must be an array of 3 numbers, got an array [0,1]");
   EXPECT_EQ(error_of(R"({"camera": {"position": [0, null, 1]}})"),
-            "scene.json: /camera/position/1: must be a number, got null null");
+            "scene.json: /camera/position/1: must be a number, got null");
+  EXPECT_EQ(error_of(R"({"integrator": {"spp": null}})"),
+            "scene.json: /integrator/spp: must be an integer, got null");
+  EXPECT_EQ(error_of(R"({"integrator": {"type": null}})"),
+            "scene.json: /integrator/type: must be a string, got null");
   EXPECT_EQ(error_of(R"({"materials": {"m": {"type": "diffuse", "albedo": "red"}}})"),
             "scene.json: /materials/m/albedo: must be an array of 3 numbers, got a string \"red\"");
 }

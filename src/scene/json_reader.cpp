@@ -35,6 +35,11 @@ std::string show(const json& j) {
   return s;
 }
 
+/// "a number 1.5", "a string \"x\"", ...: the type and the value (null is both: not "null null").
+std::string described(const json& j) {
+  return j.is_null() ? json_type_name(j) : json_type_name(j) + " " + show(j);
+}
+
 }  // namespace
 
 const json& JsonReader::require(const json& obj, const std::string& ptr, const char* key) const {
@@ -81,13 +86,13 @@ double JsonReader::number(const json& j, const std::string& ptr) const {
         s == "-Infinity")
       fail(ptr, "must be a finite number, got " + s);
   }
-  if (!j.is_number()) fail(ptr, "must be a number, got " + json_type_name(j) + " " + show(j));
+  if (!j.is_number()) fail(ptr, "must be a number, got " + described(j));
   return check_finite(at(ptr), j.get<double>());
 }
 
 long long JsonReader::integer(const json& j, const std::string& ptr, IntRange range) const {
   if (!j.is_number_integer() && !j.is_number_unsigned())
-    fail(ptr, "must be an integer, got " + json_type_name(j) + " " + show(j));
+    fail(ptr, "must be an integer, got " + described(j));
   // beyond the signed 64-bit range: reported as written, not wrapped around
   if (j.is_number_unsigned() && j.get<std::uint64_t>() > static_cast<std::uint64_t>(range.hi))
     fail_range(at(ptr), range, std::to_string(j.get<std::uint64_t>()));
@@ -102,7 +107,7 @@ bool JsonReader::boolean(const json& j, const std::string& ptr) const {
 }
 
 std::string JsonReader::string(const json& j, const std::string& ptr) const {
-  if (!j.is_string()) fail(ptr, "must be a string, got " + json_type_name(j) + " " + show(j));
+  if (!j.is_string()) fail(ptr, "must be a string, got " + described(j));
   std::string s = j.get<std::string>();
   // "\u0000" is valid JSON, but a path or a name ends there for the C functions that use it
   // ("a.pfm\u0000junk.exr" opened a.pfm), and messages would be cut short
@@ -125,7 +130,7 @@ std::string JsonReader::choice(const json& j, const std::string& ptr,
 
 glm::dvec3 JsonReader::vec3(const json& j, const std::string& ptr) const {
   if (!j.is_array() || j.size() != 3)
-    fail(ptr, "must be an array of 3 numbers, got " + json_type_name(j) + " " + show(j));
+    fail(ptr, "must be an array of 3 numbers, got " + described(j));
   return {number(j[0], ptr + "/0"), number(j[1], ptr + "/1"), number(j[2], ptr + "/2")};
 }
 
