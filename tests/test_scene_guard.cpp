@@ -61,7 +61,13 @@ TEST(SceneGuard, DeepNestingIsRefusedQuickly) {
     EXPECT_LT(s, 2.0);
     EXPECT_NE(msg.find("nested deeper than 64 levels"), std::string::npos) << msg.substr(0, 300);
     EXPECT_NE(msg.find("scene.json:1:"), std::string::npos) << msg.substr(0, 300);
+    // the depth the message says a scene needs: a matrix row is 7 containers deep (it said 6)
+    EXPECT_NE(msg.find("(a scene needs 7: "), std::string::npos) << msg.substr(0, 300);
   }
+  EXPECT_EQ(parse_error(R"({"materials": {"m": {"type": "diffuse"}}, "shapes": [{"type":
+      "triangles", "material": "m", "positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1,2],
+      "transform": [{"matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}]}]})"),
+            "");
   // 63 levels of arrays are only a schema error
   std::string ok = "{\"camera\": {\"position\": ";
   for (int i = 0; i < 61; ++i) ok += "[";

@@ -122,7 +122,7 @@ class StructureCheck : public nlohmann::json_sax<json> {
     if (static_cast<int>(frames_.size()) >= kMaxJsonDepth)
       fail(here(), pointer(),
            "nested deeper than " + std::to_string(kMaxJsonDepth) +
-               " levels (a scene needs 6: is this a scene file?)");
+               " levels (a scene needs 7: is this a scene file?)");
     frames_.push_back(Frame{object, -1, {}, {}});
     return true;
   }

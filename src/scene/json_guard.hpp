@@ -10,7 +10,8 @@ namespace lucent::scene_detail {
 
 /// A scene file's largest size (inline triangle lists make big scenes; meshes belong in OBJ).
 constexpr std::uint64_t kMaxSceneBytes = 256ull << 20;
-/// Deepest nesting of objects and arrays (the format itself needs 6).
+/// Deepest nesting of objects and arrays (the format itself needs 7: a transform matrix's row,
+/// in its step, in the transform, in a shape, in the shape list, in the scene).
 constexpr int kMaxJsonDepth = 64;
 
 /// The text of a scene file: a regular file or a pipe (e.g. /dev/stdin), at most
