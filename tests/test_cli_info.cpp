@@ -179,6 +179,38 @@ TEST(CliInfo, EmptyScene) {
       << m["kernel/build options"];
 }
 
+// The path integrator's knobs as the render uses them: info printed "clamp 5" and "glass splits 2"
+// for a whitted render, which reads neither, splits for a scene without glass, and no caustics
+// line at all (integrator.caustics is dropped without a mirror or glass surface).
+TEST(CliInfo, IntegratorKnobsSayWhenTheRenderLeavesThemUnused) {
+  std::string dir = lucent::test::temp_dir();
+  auto info = [&dir](const std::string& material, const std::string& args) {
+    lucent::test::write_file(dir + "/s.json", R"({"integrator": {"clamp": 5, "caustics": true},
+      "materials": {"m": {"type": ")" + material + R"("}},
+      "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+      "lights": [{"type": "point", "position": [0, 3, 3], "intensity": [1, 1, 1]}]})");
+    CommandResult r = run_cli("info '" + dir + "/s.json' " + args);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return parse_report(r.out);
+  };
+  std::map<std::string, std::string> m = info("dielectric", "");
+  EXPECT_EQ(m["clamp"], "5");
+  EXPECT_EQ(m["caustics"], "on");
+  EXPECT_EQ(m["glass splits"], "2");
+  m = info("dielectric", "--integrator whitted");
+  EXPECT_EQ(m["clamp"], "5 (unused: only the path integrator has it)");
+  EXPECT_EQ(m["caustics"], "off (asked for; only the path integrator has it)");
+  EXPECT_EQ(m["glass splits"], "2 (unused: only the path integrator has it)");
+  m = info("diffuse", "");
+  EXPECT_EQ(m["clamp"], "5");
+  EXPECT_EQ(m["caustics"], "off (asked for; no mirror or smooth glass surface in the scene)");
+  EXPECT_EQ(m["glass splits"], "2 (unused: no smooth glass in the scene)");
+  m = info("diffuse", "--no-caustics --dielectric-splits 0 --clamp 0");
+  EXPECT_EQ(m["clamp"], "off");
+  EXPECT_EQ(m["caustics"], "off");
+  EXPECT_EQ(m["glass splits"], "0");
+}
+
 // info needs no OpenCL device: it works with every driver hidden.
 TEST(CliInfo, NeedsNoOpenClPlatform) {
   std::string dir = lucent::test::temp_dir();

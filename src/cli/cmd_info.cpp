@@ -1,6 +1,7 @@
 // `lucent info SCENE`: what the scene holds (shapes, materials, textures, lights), the BVH built
 // over it and the kernel feature defines it would be compiled with. Needs no OpenCL device.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <string>
@@ -13,6 +14,7 @@
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
 #include "render/features.hpp"
+#include "render/integrator_knobs.hpp"
 #include "render/pack.hpp"
 
 namespace lucent::cli {
@@ -91,11 +93,38 @@ int run_info_command() {
   std::printf("filter        %s, radius %g\n", type_name(scene.film.filter.type),
               scene.film.filter.radius);
   std::printf("sampler       %s\n", type_name(scene.integrator.sampler));
-  if (scene.integrator.clamp > 0)
-    std::printf("clamp         %g\n", scene.integrator.clamp);
-  else
-    std::printf("clamp         off\n");
-  std::printf("glass splits  %d\n", scene.integrator.dielectric_splits);
+  // what the render does with the path integrator's knobs, not only what the scene says: a
+  // setting the render leaves unused says why (the kernel's features decide, as for the render)
+  using render_detail::IntegratorKnob;
+  const std::vector<std::string> features = render_detail::scene_features(scene, packed);
+  auto has = [&features](const char* f) {
+    return std::find(features.begin(), features.end(), f) != features.end();
+  };
+  auto why_unused = [&scene](IntegratorKnob knob, const char* otherwise) {
+    const char* why = render_detail::knob_ignored(scene.integrator.type, knob);
+    return std::string(why ? why : otherwise);
+  };
+  std::string clamp = "off", caustics = "off",
+              splits = std::to_string(scene.integrator.dielectric_splits);
+  if (scene.integrator.clamp > 0) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", scene.integrator.clamp);
+    clamp = buf;
+    if (!has("LC_HAS_CLAMP")) clamp += " (unused: " + why_unused(IntegratorKnob::Clamp, "") + ")";
+  }
+  if (scene.integrator.caustics)
+    caustics = has("LC_HAS_CAUSTICS")
+                   ? "on"
+                   : "off (asked for; " +
+                         why_unused(IntegratorKnob::Caustics,
+                                    "no mirror or smooth glass surface in the scene") +
+                         ")";
+  if (scene.integrator.dielectric_splits > 0 && !has("LC_HAS_SPLITTING"))
+    splits +=
+        " (unused: " + why_unused(IntegratorKnob::Splits, "no smooth glass in the scene") + ")";
+  std::printf("clamp         %s\n", clamp.c_str());
+  std::printf("caustics      %s\n", caustics.c_str());
+  std::printf("glass splits  %s\n", splits.c_str());
 
   // the shape list as written: its entries by type (OBJ files apart), then the primitives
   std::map<ShapeType, std::size_t> by_shape;
