@@ -621,6 +621,42 @@ TEST(SceneJson, DefaultsWhenKeysAreLeftOut) {
   EXPECT_TRUE(s.triangles.empty());
   // focus distance defaults to the distance to look_at: (0, 0, 5) -> origin
   EXPECT_DOUBLE_EQ(s.camera.focus_distance, 5.0);
+  // the defaults README.md's "Defaults" paragraph lists
+  expect_vec(s.camera.position, {0, 0, 5});
+  expect_vec(s.camera.look_at, {0, 0, 0});
+  expect_vec(s.camera.up, {0, 1, 0});
+  EXPECT_EQ(s.camera.fov_degrees, 45);
+  EXPECT_EQ(s.camera.roll_degrees, 0);
+  EXPECT_EQ(s.camera.aperture, 0);
+  EXPECT_EQ(s.film.filter.type, lucent::FilterType::Box);
+  EXPECT_EQ(s.film.transfer, lucent::Transfer::Srgb);
+  EXPECT_EQ(s.film.gamma, 2.2);
+  EXPECT_EQ(s.film.exposure, 0);
+  EXPECT_EQ(s.film.tonemap, lucent::ToneMap::Clamp);
+  EXPECT_EQ(s.integrator.max_depth, 8);
+  EXPECT_EQ(s.integrator.rr_depth, 4);
+  EXPECT_EQ(s.integrator.spp, 16);
+  EXPECT_EQ(s.integrator.seed, 0u);
+  EXPECT_TRUE(s.integrator.mis);
+  EXPECT_EQ(s.integrator.sampler, lucent::SamplerType::Sobol);
+  Scene m =
+      lucent::parse_scene(R"({"materials": {"d": {"type": "diffuse"}, "p": {"type": "plastic"},
+      "mi": {"type": "mirror"}, "g": {"type": "dielectric"}, "c": {"type": "conductor"},
+      "r": {"type": "rough_dielectric"}, "dm": {"type": "diffuse_mirror"}}})",
+                          "m.json");
+  auto mat = [&m](const char* name) { return m.materials[m.find_material(name)]; };
+  expect_vec(mat("d").albedo, glm::dvec3(0.8));
+  expect_vec(mat("p").albedo, glm::dvec3(0.8));
+  expect_vec(mat("dm").albedo, glm::dvec3(0.8));
+  expect_vec(mat("dm").specular, glm::dvec3(0.2));
+  expect_vec(mat("mi").specular, glm::dvec3(1));
+  expect_vec(mat("g").specular, glm::dvec3(1));
+  expect_vec(mat("r").specular, glm::dvec3(1));
+  expect_vec(mat("c").specular, glm::dvec3(0.9));
+  expect_vec(mat("p").specular, glm::dvec3(1));
+  for (const char* n : {"g", "p", "r"}) EXPECT_EQ(mat(n).ior, 1.5) << n;
+  for (const char* n : {"c", "p", "r"}) EXPECT_EQ(mat(n).roughness, 0.1) << n;
+  for (const lucent::Material& x : m.materials) expect_vec(x.emission, glm::dvec3(0));
   // a filter's default radius depends on its type
   EXPECT_EQ(
       lucent::parse_scene(R"({"film": {"filter": {"type": "box"}}})", "f.json").film.filter.radius,
