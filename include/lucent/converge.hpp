@@ -146,7 +146,8 @@ struct ConvergeResult {
 void check_convergence_options(const ConvergeOptions& options, const Scene* scene = nullptr);
 
 /// Renders every setting at every rung and compares each render with `reference` (which must
-/// have the scene's film size; its variance and samples may be empty). Throws lucent::Error.
+/// have the scene's film size; its variance and samples may be empty; a lucent render, whose
+/// `sampler` is set, must not have the scene's seed: see reference_seed()). Throws lucent::Error.
 ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference,
                                const ConvergeOptions& options);
 
