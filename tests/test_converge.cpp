@@ -385,6 +385,17 @@ TEST(Converge, FitOfSyntheticCurves) {
   // time (0.64 s), i.e. 128 spp
   EXPECT_NEAR(b15.floor_seconds, 1.28, 1e-9);
 
+  // the reference's share of the noise does not fall with time: only the render's own share is
+  // extrapolated. A reference of the top rung's spp (64) holds half the noise at that rung: the
+  // render's own noise there (0.5 / 64 / 2) equals the floor (0.5 * 0.5 / 64) at 0.64 s, 64 spp
+  // (the whole noise extrapolated said 1.28 s, 128 spp)
+  std::vector<ConvergePoint> half = synthetic(e15, e);
+  for (ConvergePoint& p : half) p.reference_noise_relmse = 0.5 * e.back();
+  ConvergeFit h = lucent::fit_convergence(half);
+  EXPECT_TRUE(h.biased);
+  EXPECT_NEAR(h.floor_seconds, 0.64, 1e-9);
+  EXPECT_NE(h.verdict.find("after ~0.64 s, ~64 spp"), std::string::npos) << h.verdict;
+
   // without variance estimates the tail slope decides
   std::vector<double> zero(5, 0.0);
   EXPECT_FALSE(lucent::fit_convergence(synthetic(e, zero)).biased);

@@ -103,8 +103,9 @@ struct ConvergeFit {
   static constexpr double kBiasRatio = 1.3;
   bool biased = false;
   double bias_relmse = 0;  ///< relMSE - noise_relmse at the last rung: the floor
-  /// Render time at which the noise (extrapolated as 1/t from the last rung) falls below the
-  /// floor: where the error stops decreasing. 0 when not biased.
+  /// Render time at which the render's own noise (noise_relmse less reference_noise_relmse at
+  /// the last rung, extrapolated as 1/t) falls below the floor: where the error stops
+  /// decreasing. 0 when not biased.
   double floor_seconds = 0;
   std::string verdict;  ///< one line, e.g. "unbiased" or "biased: error stops decreasing at ..."
 };

@@ -309,9 +309,12 @@ ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
     return f;
   }
   std::string where;
-  if (last.noise_relmse > 0 && f.bias_relmse > 0 && last.seconds > 0) {
-    // noise ~ c / t: it falls to the floor at t = noise * t_last / bias
-    double ratio = last.noise_relmse / f.bias_relmse;
+  // the render's own noise: the reference's share of noise_relmse does not fall with time
+  const double own_noise = std::max(0.0, last.noise_relmse - last.reference_noise_relmse);
+  if (own_noise > 0 && f.bias_relmse > 0 && last.seconds > 0) {
+    // noise ~ c / t: it falls to the floor at t = noise * t_last / bias (with the reference's
+    // share extrapolated too, a reference of the top rung's spp doubled the time and the spp)
+    double ratio = own_noise / f.bias_relmse;
     f.floor_seconds = last.seconds * ratio;
     if (f.floor_seconds < points.front().seconds)
       where = " (the bias dominates from the first rung on)";
