@@ -617,6 +617,22 @@ TEST(Converge, TimeToTheErrorOfASettingBelowItAtItsFirstRungIsABound) {
       r.out, std::regex("\n  target-error=1e-3\\+min-spp=8 +<= [0-9.]+ s  \\(x<=[0-9.]+ of "
                         "default; already below it at its first rung\\)\n")))
       << r.out;
+
+  // the bound as the first setting, the one the others are measured against: their ratios are
+  // lower bounds (they were printed as values, "x0.22 of target-error=..." for a setting at least
+  // 0.22 times as slow), and its own is 1 (it read "x<=1.00")
+  r = lucent::test::run_cli("converge '" + dir +
+                            "/t.json' --width 8 --height 8 --spp-ladder 1,2 --reference-spp 256 "
+                            "--settings target-error=1e-3+min-spp=8,default");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::regex_search(
+      r.out, std::regex("\n  target-error=1e-3\\+min-spp=8 +<= [0-9.]+ s  \\(x1.00 of "
+                        "target-error=1e-3\\+min-spp=8; already below it at its first rung\\)\n")))
+      << r.out;
+  EXPECT_TRUE(std::regex_search(
+      r.out,
+      std::regex("\n  default +[0-9.]+ s  \\(x>=[0-9.]+ of target-error=1e-3\\+min-spp=8\\)\n")))
+      << r.out;
 }
 
 // A setting whose knob the integrator it renders with does not read changes nothing, and the

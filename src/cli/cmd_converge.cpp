@@ -205,18 +205,37 @@ void print_time_to_common_error(const ConvergeResult& result) {
   std::printf("\ntime to relMSE %.3g (reached by every setting; interpolated on log-log axes):\n",
               common);
   double first = 0;
-  for (const ConvergeFit& f : result.fits) {
+  bool first_bound = false;
+  for (size_t k = 0; k < result.fits.size(); ++k) {
+    const ConvergeFit& f = result.fits[k];
     const std::vector<ConvergePoint>& pts = by_setting[f.setting];
     const double t = time_to_relmse(pts, common);
-    if (first == 0) first = t;
     // a setting already below the error at its first rung (a target-error setting is one render,
     // often far below it) reached it sooner than that rung's time, which only bounds it: it was
     // printed as the time to the error ("x10.88 of default" for a render 20 times below it)
     const bool bound = !pts.empty() && pts.front().relmse < common;
+    if (k == 0) first = t, first_bound = bound;
+    // the ratio to the first setting's time: a bound when one of the two times is (the first
+    // setting's bound made every other ratio a lower bound, printed as a value: "x0.22 of
+    // target-error=1e-3" for a setting at least 0.22 times as slow), none when both are
+    std::string ratio;
+    if (k == 0) {
+      ratio = "x1.00";
+    } else if (bound && first_bound) {
+      ratio = "x?";
+    } else {
+      char buf[48];
+      std::snprintf(buf, sizeof buf, "x%s%.2f",
+                    bound         ? "<="
+                    : first_bound ? ">="
+                                  : "",
+                    first > 0 ? t / first : 0.0);
+      ratio = buf;
+    }
     char time[48];
     std::snprintf(time, sizeof time, "%s%.3f", bound ? "<= " : "", t);
-    std::printf("  %-22s %12s s  (x%s%.2f of %s%s)\n", f.setting.c_str(), time, bound ? "<=" : "",
-                first > 0 ? t / first : 0.0, result.fits.front().setting.c_str(),
+    std::printf("  %-22s %12s s  (%s of %s%s)\n", f.setting.c_str(), time, ratio.c_str(),
+                result.fits.front().setting.c_str(),
                 bound ? "; already below it at its first rung" : "");
   }
 }
