@@ -950,6 +950,14 @@ TEST(Converge, CommandErrors) {
   lucent::test::CommandResult both =
       lucent::test::run_cli("converge '" + dir + "/t.json' --reference x.exr --reference-cpu");
   EXPECT_EQ(both.status, 2);
+  // --max-spp makes the default ladder: with a ladder given it was ignored without a word
+  for (const char* ladder : {"--spp-ladder 2", "--time-ladder 0.01"}) {
+    lucent::test::CommandResult max = lucent::test::run_cli(
+        "converge '" + dir + "/t.json' --max-spp 4 -q --reference-spp 4 " + ladder);
+    EXPECT_EQ(max.status, 2) << ladder << "\n" << max.out;
+    EXPECT_EQ(lucent::test::count_lines(max.err), 1) << max.err;
+    EXPECT_NE(max.err.find("excludes --max-spp"), std::string::npos) << max.err;
+  }
 }
 
 // The outputs (--csv, every --plot, --save-reference) never overwrite an input (the scene, the

@@ -180,7 +180,11 @@ CLI::App* add_converge_command(CLI::App& app) {
   spp->excludes(time);
   cmd->add_option("--max-spp", a.max_spp,
                   "Default ladder: powers of two from 1 to this (default 64)")
-      ->check(CLI::Range(1, limits::kMaxSpp / 16));  // the reference renders 16x the top rung
+      ->check(CLI::Range(1, limits::kMaxSpp / 16))  // the reference renders 16x the top rung
+      // a ladder given makes it meaningless (it was ignored without a word, and the reference's
+      // default spp followed the ladder given)
+      ->excludes(spp)
+      ->excludes(time);
   cmd->add_option("--width", a.width, "Image width (overrides the scene)")
       ->check(CLI::Range(1, limits::kMaxImageSize));
   cmd->add_option("--height", a.height, "Image height (overrides the scene)")
