@@ -711,6 +711,25 @@ TEST(Converge, ReferenceAtTheLaddersSeedIsRefused) {
   EXPECT_EQ(lucent::run_convergence(scene, independent_reference(scene), opt).points.size(), 1u);
 }
 
+// An adaptive setting's rung below the one before starts over, as a uniform rung does: it
+// continued the render, which had more samples already, and a ladder 8,4 reported 8 spp twice.
+TEST(Converge, AdaptiveRungBelowThePreviousStartsOver) {
+  lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
+  scene.film.width = scene.film.height = 8;
+  lucent::ConvergeOptions opt;
+  opt.render = lucent::test::render_options();
+  opt.spp_ladder = {8, 4, 8};
+  opt.settings = {lucent::parse_converge_setting("adaptive+min-spp=4"),
+                  lucent::parse_converge_setting("default")};
+  const lucent::ConvergeResult r =
+      lucent::run_convergence(scene, independent_reference(scene), opt);
+  ASSERT_EQ(r.points.size(), 6u);
+  for (size_t i = 0; i < 6; ++i) EXPECT_EQ(r.points[i].spp, opt.spp_ladder[i % 3]) << i;
+  // the 8-spp rungs are the same render, before and after the 4-spp one
+  EXPECT_EQ(r.points[0].relmse, r.points[2].relmse);
+  EXPECT_NE(r.points[0].relmse, r.points[1].relmse);
+}
+
 // A study on the caller's session: its cancel flag is the study's while it runs and the session's
 // own afterwards (the session once kept a pointer to the study's flag, which the caller may
 // destroy on return), and without a study flag the session's own stops the study.

@@ -452,6 +452,9 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
       } else if (setting.adaptive) {
         // the rungs' budgets rise: each continues the previous rung's render
         if (options.spp_ladder[i] < static_cast<int>(ao.min_spp)) continue;
+        // a rung below the previous one starts over, as a uniform rung does (it continued the
+        // render, which had more samples already: a ladder 16,8 reported 16 spp twice)
+        if (ao.budget_spp > 0 && options.spp_ladder[i] < ao.budget_spp) renderer->reset();
         ao.budget_spp = options.spp_ladder[i];
         renderer->render_adaptive(ao, options.render.on_progress);
       } else if (by_time) {
