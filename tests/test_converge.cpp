@@ -1111,3 +1111,41 @@ TEST(Converge, NonFiniteReferenceIsRefused) {
 }
 
 }  // namespace
+
+// Where the verdict is weak it says so (the converge review's measurements): against a reference
+// about as noisy as the rung, relMSE (which divides by the reference's noisy values) exceeds the
+// noise estimate, and an unbiased setting was called biased (error/noise 1.5 at a rung of 64 spp
+// against a reference of 16); and Sobol's stratified samples err less than variance / n says,
+// so an unbiased verdict on them can hide a bias (max_depth=4: "unbiased" with Sobol, biased
+// with independent samples).
+TEST(Converge, VerdictSaysWhereItIsWeak) {
+  lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
+  scene.film.width = 16;
+  scene.film.height = 12;
+  auto reference_of = [&](int spp) {
+    lucent::Scene ref_scene = scene;
+    ref_scene.integrator.seed = lucent::reference_seed(scene.integrator.seed);
+    ref_scene.integrator.spp = spp;
+    return lucent::test::render(ref_scene, lucent::test::render_options());
+  };
+  lucent::ConvergeOptions opt;
+  opt.render = lucent::test::render_options();
+  opt.spp_ladder = {4, 16};
+  opt.settings = {lucent::parse_converge_setting("default"),
+                  lucent::parse_converge_setting("sampler=independent")};
+  const std::string noisy_reference = "; the reference's own noise is ";
+  const std::string sobol = "; Sobol samples err less than their noise estimate";
+
+  lucent::ConvergeResult few = lucent::run_convergence(scene, reference_of(8), opt);
+  ASSERT_EQ(few.fits.size(), 2u);
+  for (const lucent::ConvergeFit& f : few.fits)
+    EXPECT_NE(f.verdict.find(noisy_reference), std::string::npos) << f.verdict;
+
+  lucent::ConvergeResult many = lucent::run_convergence(scene, reference_of(1024), opt);
+  ASSERT_EQ(many.fits.size(), 2u);
+  for (const lucent::ConvergeFit& f : many.fits)
+    EXPECT_EQ(f.verdict.find(noisy_reference), std::string::npos) << f.verdict;
+  ASSERT_FALSE(many.fits[0].biased) << many.fits[0].verdict;
+  EXPECT_NE(many.fits[0].verdict.find(sobol), std::string::npos) << many.fits[0].verdict;
+  EXPECT_EQ(many.fits[1].verdict.find(sobol), std::string::npos) << many.fits[1].verdict;
+}

@@ -72,8 +72,9 @@ struct ConvergePoint {
   double relmse = 0;  ///< as compare_images(): mean (A - R)^2 / (R^2 + 0.01)
   /// The relMSE that noise alone explains: mean over pixel-channels of (var_A / n_A + var_R /
   /// n_R) / (R^2 + 0.01), from the per-pixel sample variances of the render and the reference.
-  /// The expected relMSE of an unbiased setting; 0 when the render has fewer than 2 samples per
-  /// pixel (no variance estimate).
+  /// The expected relMSE of an unbiased setting of independent samples (Sobol's stratified
+  /// samples err less: for them it is an upper bound); 0 when the render has fewer than 2 samples
+  /// per pixel (no variance estimate).
   double noise_relmse = 0;
   /// The reference's own share of noise_relmse: mean over pixel-channels of var_R / n_R /
   /// (R^2 + 0.01) (0 without its variance); its expected contribution to relmse.
@@ -101,6 +102,11 @@ struct ConvergeFit {
   /// unbiased setting stays near 1: the measured error and the variance estimate come from the
   /// same samples, over every pixel-channel.
   static constexpr double kBiasRatio = 1.3;
+  /// run_convergence adds to the verdict that it is unreliable when the reference's own noise is
+  /// above this share of noise_relmse at the last rung (a reference about as noisy as the rung:
+  /// relMSE divides by its noisy values), and, for an unbiased verdict on Sobol samples, that
+  /// their noise estimate runs above their error (a bias can hide under it).
+  static constexpr double kReferenceShare = 1.0 / 3.0;
   bool biased = false;
   double bias_relmse = 0;  ///< relMSE - noise_relmse at the last rung: the floor
   /// Render time at which the render's own noise (noise_relmse less reference_noise_relmse at
