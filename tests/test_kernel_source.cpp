@@ -1,12 +1,18 @@
 // Kernel sources: embedded in the binary (the CLI works from any directory), loaded from
 // LUCENT_KERNEL_DIR when set, and a build failure shows the log with kernels/<file>:<line>.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cl/context.hpp"
@@ -168,7 +174,14 @@ TEST(KernelSource, MissingFileInKernelDir) {
   CommandResult r =
       render_plane("LUCENT_KERNEL_DIR='" + dir + "'", lucent::test::temp_dir() + "/o.pfm");
   EXPECT_EQ(r.status, 1);
-  EXPECT_EQ(r.err, "lucent: error: " + dir +
+  // the error names the #include that wants the file
+  std::vector<std::string> mk = lines_of(read_all(dir + "/megakernel.cl"));
+  int include_line = 0;
+  for (size_t i = 0; i < mk.size() && include_line == 0; ++i)
+    if (mk[i].rfind("#include \"util/math.cl\"", 0) == 0) include_line = static_cast<int>(i) + 1;
+  ASSERT_GT(include_line, 0) << "megakernel.cl no longer includes util/math.cl: update this test";
+  EXPECT_EQ(r.err, "lucent: error: " + dir + "/megakernel.cl:" + std::to_string(include_line) +
+                       ": #include \"util/math.cl\": " + dir +
                        "/util/math.cl: cannot read kernel source (kernel directory " + dir + ")\n");
 
   r = render_plane("LUCENT_KERNEL_DIR='" + dir + "/nowhere'", lucent::test::temp_dir() + "/o.pfm");
@@ -176,6 +189,58 @@ TEST(KernelSource, MissingFileInKernelDir) {
   EXPECT_EQ(r.err, "lucent: error: " + dir +
                        "/nowhere/megakernel.cl: cannot read kernel source (kernel directory " +
                        dir + "/nowhere)\n");
+}
+
+// A kernel directory's file that is not a regular text file is refused, naming it and what it is:
+// a directory was read as an empty file (the build then failed elsewhere, on the names it lacked),
+// a FIFO hung the render (until a writer came) and /dev/zero read until memory ran out. A missing
+// include names the place of the #include.
+TEST(KernelSource, KernelDirFilesMustBeRegularTextFiles) {
+  std::string dir = kernel_copy();
+  const std::string math = dir + "/util/math.cl", where = " (kernel directory " + dir + ")";
+  auto read = [&dir] { lucent::detail::read_kernel_file("util/math.cl", dir); };
+
+  fs::remove(math);
+  fs::create_directory(math);
+  EXPECT_EQ(lucent::test::error_of(read), math + ": is a directory, not a kernel source" + where);
+  fs::remove(math);
+
+  ASSERT_EQ(::mkfifo(math.c_str(), 0644), 0);
+  // a writer that opens the FIFO once a reader waits on it (never, when it is refused), so that a
+  // read that blocks ends instead of hanging the test
+  std::atomic<bool> done{false};
+  std::thread writer([&math, &done] {
+    auto t0 = std::chrono::steady_clock::now();
+    while (!done && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) {
+      int fd = ::open(math.c_str(), O_WRONLY | O_NONBLOCK);
+      if (fd >= 0) {
+        ::close(fd);
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  });
+  std::string fifo_error = lucent::test::error_of(read);
+  done = true;
+  writer.join();
+  EXPECT_EQ(fifo_error,
+            math + ": is a pipe, not a kernel source (only regular files are read)" + where);
+  fs::remove(math);
+
+  lucent::test::write_file(math, std::string("float x;\n\0", 11));
+  EXPECT_EQ(lucent::test::error_of(read).rfind(math + ": byte 10 is a NUL byte", 0), 0u)
+      << lucent::test::error_of(read);
+  lucent::test::write_file(math, std::string((16u << 20) + 1, ' '));
+  EXPECT_NE(lucent::test::error_of(read).find("more than the 16.0 MiB a kernel source may have"),
+            std::string::npos)
+      << lucent::test::error_of(read);
+
+  // an #include of a file that is not there: the including file and line, in the kernel directory
+  lucent::test::write_file(math, "/* math */\n#include \"util/nowhere.cl\"\n");
+  EXPECT_EQ(lucent::test::error_of(
+                [&dir] { lucent::detail::assemble_kernel_source("util/math.cl", dir); }),
+            math + ":2: #include \"util/nowhere.cl\": " + dir +
+                "/util/nowhere.cl: cannot read kernel source" + where);
 }
 
 /// Inserts `bad` as line `line` (1-based) of kernels/<file> in `dir`; line 0 appends it.

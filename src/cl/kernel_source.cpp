@@ -2,10 +2,11 @@
 
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
+#include <filesystem>
 #include <set>
 #include <sstream>
 
+#include "core/file_io.hpp"
 #include "lucent/error.hpp"
 #include "render/features.hpp"
 #include "shared/registry.h"
@@ -14,10 +15,23 @@ namespace lucent::detail {
 
 namespace {
 
+// `included_from`: "<file>:<line>" of the #include that names `path` ("" for the main file), so
+// that a file that cannot be read is reported with the place that wants it.
 void expand(const std::string& path, const std::string& kernel_dir, std::set<std::string>& seen,
-            std::ostringstream& out) {
+            std::ostringstream& out, const std::string& included_from = "") {
   if (!seen.insert(path).second) return;  // each file once (all headers are guarded anyway)
-  std::istringstream in(read_kernel_file(path, kernel_dir));
+  std::string text;
+  try {
+    text = read_kernel_file(path, kernel_dir);
+  } catch (const Error& e) {
+    if (included_from.empty()) throw;
+    throw Error(included_from + ": #include \"" + path + "\": " + e.what());
+  }
+  std::istringstream in(text);
+  // the place of a line for messages: the file in the kernel directory when sources come from one
+  // (the generated files never do)
+  const bool own = !kernel_dir.empty() && path.rfind("generated/", 0) != 0;
+  const std::string file = (own ? kernel_dir : std::string("kernels")) + "/" + path;
   out << "#line 1 \"kernels/" << path << "\"\n";
   std::string line;
   int number = 0;
@@ -32,9 +46,10 @@ void expand(const std::string& path, const std::string& kernel_dir, std::set<std
       auto q1 = line.find('"', p + 8);
       auto q2 = q1 == std::string::npos ? q1 : line.find('"', q1 + 1);
       if (q1 == std::string::npos || q2 == std::string::npos)
-        throw Error("kernels/" + path + ":" + std::to_string(number) +
+        throw Error(file + ":" + std::to_string(number) +
                     ": only #include \"file\" is supported in kernel sources");
-      expand(line.substr(q1 + 1, q2 - q1 - 1), kernel_dir, seen, out);
+      expand(line.substr(q1 + 1, q2 - q1 - 1), kernel_dir, seen, out,
+             file + ":" + std::to_string(number));
       out << "#line " << number + 1 << " \"kernels/" << path << "\"\n";
       continue;
     }
@@ -95,12 +110,22 @@ std::string read_kernel_file(const std::string& path, const std::string& kernel_
     throw Error("kernels/" + path + ": no such generated kernel source");
   }
   if (!kernel_dir.empty()) {
-    std::string full = kernel_dir + "/" + path;
-    std::ifstream f(full, std::ios::binary);
-    if (!f) throw Error(full + ": cannot read kernel source (kernel directory " + kernel_dir + ")");
-    std::ostringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
+    const std::string full = kernel_dir + "/" + path;
+    const std::string where = " (kernel directory " + kernel_dir + ")";
+    std::error_code ec;
+    if (!std::filesystem::exists(full, ec))
+      throw Error(full + ": cannot read kernel source" + where);
+    // bounded, regular files only, text: a directory there read as an empty file (the build
+    // then failed on names it lacked, elsewhere), a FIFO hung the render and /dev/zero ate memory
+    io::ReadSpec spec;
+    spec.what = "kernel source";
+    spec.max_bytes = 16u << 20;
+    spec.text = true;
+    try {
+      return io::read_file(full, spec);
+    } catch (const Error& e) {
+      throw Error(e.what() + where);
+    }
   }
   for (int i = 0; i < kEmbeddedKernelFileCount; ++i)
     if (path == kEmbeddedKernelFiles[i].path) return kEmbeddedKernelFiles[i].content;
