@@ -1,12 +1,18 @@
 // lucent's on-disk program cache: hits on a second build, keys on options, detects corrupt and
 // truncated entries and rebuilds them (the rebuilt program still runs).
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/file.h>
+#include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 #include <vector>
 
 #include "cl/kernel_source.hpp"
@@ -254,6 +260,52 @@ TEST(ProgramCache, CliClearsTheCache) {
   r = lucent::test::run_cli("cache clear", "POCL_KERNEL_CACHE=0 LUCENT_CACHE_DIR='" + dir + "'");
   EXPECT_EQ(r.out.find("kernels are cached by PoCL"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(dir + "/0123456789abcdef.bin"));
+}
+
+// A session waiting for another process's build lock stops waiting once its render is cancelled
+// (and builds without the lock): `lucent render` under `timeout` (one SIGTERM) waited 600 s for a
+// holder that had been stopped (Ctrl-Z) in its build, then rendered and wrote "interrupted".
+TEST(ProgramCache, CancelledSessionStopsWaitingForABuildLock) {
+  const lucent::Scene scene = lucent::test::scene_from(R"({
+    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
+    "film": {"width": 4, "height": 4},
+    "integrator": {"type": "albedo", "spp": 1},
+    "materials": {"m": {"type": "diffuse"}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]
+  })");
+  lucent::SessionOptions o = lucent::test::session_options();
+  if (o.cache_dir == "off") GTEST_SKIP() << "LUCENT_CACHE_DIR=off: no build locks";
+  // the lock's name (the key's hash, whatever the directory), from a first session's build
+  const std::string first = lucent::test::temp_dir(), second = lucent::test::temp_dir();
+  o.cache_dir = first;
+  lucent::Renderer(o).set_scene(scene);
+  std::string lock;
+  for (const auto& e : fs::directory_iterator(first))
+    if (e.path().extension() == ".lock") lock = e.path().filename().string();
+  ASSERT_FALSE(lock.empty());
+
+  // another process's lock, held until the session returns (at most 6 s)
+  int fd = ::open((second + "/" + lock).c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+  std::atomic<bool> done{false};
+  std::thread holder([fd, &done] {
+    auto t0 = std::chrono::steady_clock::now();
+    while (!done && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(6))
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ::close(fd);
+  });
+  o.cache_dir = second;
+  lucent::Renderer r(o);
+  std::atomic<bool> cancel{true};
+  r.set_cancel_flag(&cancel);
+  auto t0 = std::chrono::steady_clock::now();
+  std::string error = lucent::test::error_of([&] { r.set_scene(scene); });
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  done = true;
+  holder.join();
+  EXPECT_EQ(error, "");
+  EXPECT_LT(seconds, 4.0) << "waited for the lock although the render was cancelled";
 }
 
 }  // namespace

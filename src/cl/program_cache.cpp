@@ -141,17 +141,18 @@ void write_entry(const std::string& path, const std::string& key,
 /// An exclusive flock on `path` held while alive: processes that miss the same entry at the same
 /// time build it once (the others wait, then read what the first wrote) instead of each compiling
 /// it. Waits at most `max_wait` seconds (a holder stuck in a driver must not stall every other
-/// process), then builds without the lock; any failure to lock only costs a redundant build.
+/// process), or until `stop` returns true (the render was cancelled), then builds without the
+/// lock; any failure to lock only costs a redundant build.
 class BuildLock {
  public:
-  BuildLock(const std::string& path, double max_wait) {
+  BuildLock(const std::string& path, double max_wait, const std::function<bool()>& stop) {
     std::error_code ec;
     fs::create_directories(fs::path(path).parent_path(), ec);
     fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (fd_ < 0) return;
     auto t0 = std::chrono::steady_clock::now();
     while (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      if (errno != EWOULDBLOCK ||
+      if (errno != EWOULDBLOCK || (stop && stop()) ||
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > max_wait) {
         ::close(fd_);
         fd_ = -1;
@@ -235,7 +236,8 @@ void DeferredEntry::store(const cl::Program& program) {
 
 cl::Program build_program_cached(const Context& ctx, const std::string& source,
                                  const std::string& options, const std::string& cache_dir,
-                                 ProgramBuildInfo* info, DeferredEntry* deferred, bool entries) {
+                                 ProgramBuildInfo* info, DeferredEntry* deferred, bool entries,
+                                 const std::function<bool()>& stop) {
   auto t0 = std::chrono::steady_clock::now();
   ProgramBuildInfo local;
   ProgramBuildInfo& bi = info ? *info : local;
@@ -251,7 +253,7 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
   DeferredEntry entry;
   if (!dir.empty() && !entries) {
     const std::string file = dir + "/" + hex(fnv1a(key.data(), key.size())) + ".bin";
-    entry.lock_ = std::make_unique<BuildLock>(file + ".lock", 600);
+    entry.lock_ = std::make_unique<BuildLock>(file + ".lock", 600, stop);
   } else if (!dir.empty()) {
     bi.cache_file = dir + "/" + hex(fnv1a(key.data(), key.size())) + ".bin";
     std::string why;
@@ -273,7 +275,7 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
     cl::Program p;
     if (load(p)) return finish(p);
     // a miss: wait for another process that may be building this entry, then look again
-    entry.lock_ = std::make_unique<BuildLock>(bi.cache_file + ".lock", 600);
+    entry.lock_ = std::make_unique<BuildLock>(bi.cache_file + ".lock", 600, stop);
     if (load(p)) return finish(p);
     if (!why.empty()) {
       bi.note = (why.rfind(bi.cache_file, 0) == 0 ? why : bi.cache_file + ": " + why) + "; rebuilt";

@@ -16,6 +16,7 @@
 // leaves caching to such a driver (driver_program_cache) and stores an entry only for the others,
 // after the first launch (DeferredEntry), so that the entry also holds what the driver compiled
 // there: a hit then launches at once instead of compiling again.
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -59,7 +60,7 @@ class DeferredEntry {
  private:
   friend cl::Program build_program_cached(const Context&, const std::string&, const std::string&,
                                           const std::string&, ProgramBuildInfo*, DeferredEntry*,
-                                          bool);
+                                          bool, const std::function<bool()>&);
   std::string file_, key_;
   std::unique_ptr<BuildLock> lock_;
 };
@@ -69,10 +70,14 @@ class DeferredEntry {
 /// With `entries` false (a driver that caches its own builds) no entry is read or written, but
 /// the build still takes the entry's lock (held by `deferred` until store()), so that processes
 /// building the same program at once wait for the first and then build from the driver's cache.
+/// The wait for another process's lock (at most 600 s) ends early, building without the lock,
+/// once `stop` returns true (a cancelled render: a stopped or stuck holder kept an interrupted
+/// render waiting for the whole 600 s).
 cl::Program build_program_cached(const Context& ctx, const std::string& source,
                                  const std::string& options, const std::string& cache_dir,
                                  ProgramBuildInfo* info = nullptr,
-                                 DeferredEntry* deferred = nullptr, bool entries = true);
+                                 DeferredEntry* deferred = nullptr, bool entries = true,
+                                 const std::function<bool()>& stop = nullptr);
 
 /// Removes every cache entry of `dir`; returns how many files were removed (0 when `dir` does not
 /// exist). Throws lucent::Error when `dir` is not a directory or cannot be listed.

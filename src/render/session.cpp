@@ -433,7 +433,7 @@ struct Renderer::Impl {
       const bool entries = cl_util::driver_program_cache(w.ctx.device).empty();
       p.program = cl_util::build_program_cached(
           w.ctx, source, opts + render_detail::device_defines(w.ctx.device.info), cache_dir, &info,
-          &entry, entries);
+          &entry, entries, [this] { return cancelled(); });
     } catch (const Error& e) {
       // the place of a build error is "kernels/<file>:<line>": the file in the kernel directory
       // in use when the sources came from one
