@@ -351,11 +351,13 @@ void run_interruptible(const std::function<void()>& work, std::atomic<bool>& can
 
 namespace {
 
-/// The cache directory of a session whose cache_dir option is `dir` ("" when disabled).
+/// The cache directory of a session whose cache_dir option is `dir` ("" when disabled): "" is
+/// the default directory, as for Renderer(), which reads no environment variable unless asked
+/// (it read LUCENT_CACHE_DIR, so clear_cache() emptied another directory than the sessions'
+/// and removed none of their entries). The lucent command's: lucent.environment()["cache_dir"].
 FileText resolved_cache_dir(const FileText& given) {
-  const std::string& dir = given.bytes;
-  refuse_nul(dir, "cache_dir");
-  std::string d = dir.empty() ? SessionOptions::from_environment().cache_dir : dir;
+  const std::string& d = given.bytes;
+  refuse_nul(d, "cache_dir");
   if (d == "off") return {};
   return {d.empty() ? cl_util::default_program_cache_dir() : d};
 }
@@ -510,8 +512,9 @@ PYBIND11_MODULE(lucent, m) {
         "The `lucent` command's session defaults from LUCENT_DEVICE, LUCENT_KERNEL_DIR and "
         "LUCENT_CACHE_DIR, as keyword arguments for Renderer: Renderer(**lucent.environment()).");
   m.def("cache_dir", &resolved_cache_dir, py::arg("cache_dir") = "",
-        "The kernel binary cache directory a session with this cache_dir uses (\"\": "
-        "LUCENT_CACHE_DIR, else the default), or \"\" when disabled (\"off\").");
+        "The kernel binary cache directory a session with this cache_dir uses (\"\": the "
+        "default, as Renderer(); the lucent command's: lucent.environment()[\"cache_dir\"]), or "
+        "\"\" when disabled (\"off\").");
   m.def(
       "clear_cache",
       [](const FileText& dir) {

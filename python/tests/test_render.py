@@ -290,6 +290,12 @@ def test_kernel_cache_directory_is_an_option(tmp_path, small_scene, monkeypatch)
         assert (b.stats.kernel_cache_loads, b.stats.kernel_compiles) == (1, 0)
     assert lucent.cache_dir(str(tmp_path)) == str(tmp_path)
     assert lucent.cache_dir("off") == ""
+    # "" is the directory a Renderer() without cache_dir uses, whatever LUCENT_CACHE_DIR says
+    # (it was that variable's: clear_cache() emptied another directory than the sessions')
+    monkeypatch.setenv("LUCENT_CACHE_DIR", str(tmp_path / "env"))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert lucent.cache_dir() == str(tmp_path / "xdg" / "lucent")
+    assert lucent.cache_dir(lucent.environment()["cache_dir"]) == str(tmp_path / "env")
     assert lucent.clear_cache(str(tmp_path)) == 1
 
 
