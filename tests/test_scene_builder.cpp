@@ -293,7 +293,7 @@ std::vector<Case> cases() {
       {"index count", tri_json(tri_pos + R"("indices": [0, 1])"), mesh([](auto& t) {
          t.indices = {0, 1};
        }),
-       "scene.json: /shapes/0/indices: must be an array whose length is a multiple of 3"},
+       "scene.json: /shapes/0/indices: must be a non-empty array whose length is a multiple of 3"},
       {"no positions", tri_json(R"("positions": [], "indices": [])"), mesh([](auto& t) {
          t.positions.clear();
          t.indices.clear();

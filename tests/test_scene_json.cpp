@@ -194,8 +194,13 @@ TEST(SceneJson, TriangleListErrors) {
   };
   EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1,3])"),
             "scene.json: /shapes/0/indices/2: must be in [0, 2], got 3");
-  EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1])"),
-            "scene.json: /shapes/0/indices: must be an array whose length is a multiple of 3");
+  EXPECT_EQ(
+      tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1])"),
+      "scene.json: /shapes/0/indices: must be a non-empty array whose length is a multiple of 3");
+  // an empty index list made a shape of no triangle without a word
+  EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [])"),
+            "scene.json: /shapes/0/indices: must be a non-empty array whose length is a multiple "
+            "of 3");
   EXPECT_EQ(tri(R"("positions": [], "indices": [])"),
             "scene.json: /shapes/0/positions: must be a non-empty array of [x, y, z]");
   EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1,2],

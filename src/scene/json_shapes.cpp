@@ -70,9 +70,10 @@ MeshShape parse_triangles(const JsonReader& r, const json& j, const std::string&
   for (size_t i = 0; i < pos.size(); ++i)
     mesh.positions.push_back(r.vec3(pos[i], p + "/positions/" + std::to_string(i)));
   const json& idx = r.require(j, p, "indices");
-  if (!idx.is_array()) r.fail(p + "/indices", "must be an array whose length is a multiple of 3");
-  if (idx.size() % 3 != 0)  // before the indices: a short list is one error, not one per index
-    r.fail(p + "/indices", "must be an array whose length is a multiple of 3");
+  // before the indices: a short list is one error, not one per index (an empty one is refused
+  // with the mesh, after its positions: validate_mesh)
+  if (!idx.is_array() || idx.size() % 3 != 0)
+    r.fail(p + "/indices", "must be a non-empty array whose length is a multiple of 3");
   for (size_t i = 0; i < idx.size(); ++i)
     mesh.indices.push_back(static_cast<int>(
         r.integer(idx[i], p + "/indices/" + std::to_string(i), rules::vertex_index(pos.size()))));

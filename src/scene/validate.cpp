@@ -291,8 +291,9 @@ void validate_mesh(const MeshShape& m, const Reporter& at) {
   // (the places are made only for a bad element: meshes may be large)
   for (std::size_t i = 0; i < n; ++i)
     if (!finite(m.positions[i])) check_point(at.at("positions").at(i), m.positions[i]);
-  if (m.indices.size() % 3 != 0)
-    at.at("indices").fail("must be an array whose length is a multiple of 3");
+  // (an empty list made a shape of no triangle without a word)
+  if (m.indices.empty() || m.indices.size() % 3 != 0)
+    at.at("indices").fail("must be a non-empty array whose length is a multiple of 3");
   for (std::size_t i = 0; i < m.indices.size(); ++i)
     if (m.indices[i] < 0 || static_cast<std::size_t>(m.indices[i]) >= n)
       check_range(at.at("indices").at(i), m.indices[i], rules::vertex_index(n));
