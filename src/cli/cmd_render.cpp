@@ -139,7 +139,9 @@ std::vector<std::string> write_aovs(const RenderArgs& a, const lucent::Scene& sc
         missing.push_back(name);
         continue;
       }
-      lucent::write_image(path, aov.mean);
+      // with its var.*/n layers, as `--integrator NAME -o x.exr` writes it: without them
+      // `lucent compare` took a noisy AOV (ao) for an exact image
+      lucent::write_render_exr(path, aov);
     }
     if (!a.quiet) std::fprintf(stderr, "%s: %s AOV\n", one_line(path).c_str(), name.c_str());
   }
