@@ -200,6 +200,31 @@ TEST(KernelAnalytic, MirrorShowsKnownEmitter) {
         EXPECT_NEAR(r.mean.pixel(x, y)[c], expected[c], 1e-5) << x << "," << y;
 }
 
+// Whitted glass conserves energy: a dielectric's lobes weigh F and 1 - F. Two parallel glass
+// planes under a sky of 1, the camera between them at about 89 degrees off their normal: each ray
+// splits at every hit (F about 0.9 at this angle), every branch ends in the sky, so every pixel is
+// 1 (less the branches under 1e-9 that both integrators cut, and float rounding: 1e-5 allowed).
+// The kernel kept 32 pending rays and, past 31 hits in a row, dropped the reflected chain:
+// 0.945-0.989. It now leaves the heavier branch waiting and cuts branches under 1e-9, as the
+// reference does, which bounds the rays waiting (integrator/whitted.cl).
+TEST(KernelAnalytic, WhittedGlassBetweenParallelPlanesSumsToTheSky) {
+  const std::string scene = R"({
+    "camera": {"position": [0, 0, 0], "look_at": [1, 0, -0.02], "up": [0, 0, 1], "fov": 0.5},
+    "film": {"width": 8, "height": 8},
+    "integrator": {"type": "whitted", "max_depth": 100000},
+    "materials": {"g": {"type": "dielectric", "ior": 1.5}},
+    "shapes": [
+      {"type": "triangles", "material": "g", "indices": [0, 1, 2, 0, 2, 3],
+       "positions": [[-1e6, -1e6, -1], [1e6, -1e6, -1], [1e6, 1e6, -1], [-1e6, 1e6, -1]]},
+      {"type": "triangles", "material": "g", "indices": [0, 2, 1, 0, 3, 2],
+       "positions": [[-1e6, -1e6, 1], [1e6, -1e6, 1], [1e6, 1e6, 1], [-1e6, 1e6, 1]]}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]})";
+  RenderResult r = render_full(scene, 1);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.mean.pixel(x, y)[c], 1.0, 1e-5) << x << "," << y;
+}
+
 // White furnace: an albedo-1 diffuse sphere in a constant environment renders the environment's
 // value everywhere (unbounded depth, Russian roulette keeps it unbiased).
 TEST(KernelAnalytic, WhiteFurnace) {

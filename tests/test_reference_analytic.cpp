@@ -307,6 +307,30 @@ TEST(ReferenceAnalytic, MirrorShowsEmitter) {
     }
 }
 
+// Two parallel mirrors of reflectance 1 under a sky of 1, the camera between them looking 5.7
+// degrees off their normal: each ray bounces about 50000 times before it leaves their edge and
+// sees the sky, so every pixel is 1 (the scene's max_depth, 100000, is not reached). The
+// reference's Whitted integrator recursed once per bounce and overflowed its thread's stack here
+// (a crash); it now keeps its pending rays in a list.
+TEST(ReferenceAnalytic, WhittedChainOfFiftyThousandMirrorBounces) {
+  RenderResult r = render_ref(R"({
+    "camera": {"position": [0, 0, 0], "look_at": [0.1, 0, -1], "up": [0, 1, 0], "fov": 0.5},
+    "film": {"width": 4, "height": 4},
+    "integrator": {"type": "whitted", "max_depth": 100000},
+    "materials": {"m": {"type": "mirror", "reflectance": [1, 1, 1]}},
+    "shapes": [
+      {"type": "triangles", "material": "m", "indices": [0, 1, 2, 0, 2, 3],
+       "positions": [[-1e4, -1e4, -1], [1e4, -1e4, -1], [1e4, 1e4, -1], [-1e4, 1e4, -1]]},
+      {"type": "triangles", "material": "m", "indices": [0, 2, 1, 0, 3, 2],
+       "positions": [[-1e4, -1e4, 1], [1e4, -1e4, 1], [1e4, 1e4, 1], [-1e4, 1e4, 1]]}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]})",
+                              1);
+  EXPECT_GT(r.rays, 16u * 40000u);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.mean.pixel(x, y)[c], 1.0, 1e-9) << x << "," << y;
+}
+
 // Russian roulette (docs/rendering-model.md, "Integrators"): once a path has rr_depth segments it
 // survives with probability q = max(beta) while q < 1, its throughput divided by q. The camera
 // sees the emitter of MirrorShowsEmitter through a mirror of reflectance rho with RR from the

@@ -3,6 +3,8 @@
 // rays, a reflected and a transmitted ray with deterministic weights. Recursion stops after
 // max_depth segments; escaping rays return the environment radiance; area lights contribute only
 // where seen.
+#include <vector>
+
 #include "reference/integrator/integrator.hpp"
 
 namespace lucent::ref {
@@ -24,31 +26,44 @@ dvec3 diffuse_term(const Tracer& t, const Surface& s, const dvec3& albedo) {
   return albedo / kPi * sum;
 }
 
-dvec3 whitted(const Tracer& t, const Ray& ray, int depth, const dvec3& throughput) {
-  Hit hit;
-  if (!t.trace(ray, hit)) return t.escaped(ray.d);
-  Surface s = t.surface(ray, hit);
-  dvec3 L = t.emitted(s);
-  if (depth + 1 >= t.scene.integrator.max_depth) return L;
-  // branches too faint to matter are cut (the only departure from the exact recursion)
-  if (max3(throughput) < 1e-9) return L;
-  WhittedLobes lobes = t.bsdf(s)->whitted(-ray.d);
-  if (lobes.diffuse) L += diffuse_term(t, s, lobes.albedo);
-  if (lobes.reflect) {
-    const dvec3& w = lobes.reflect_weight;
-    L += w * whitted(t, Tracer::spawn(s, lobes.reflect_dir), depth + 1, throughput * w);
-  }
-  if (lobes.transmit) {
-    const dvec3& w = lobes.transmit_weight;
-    L += w * whitted(t, Tracer::spawn(s, lobes.transmit_dir), depth + 1, throughput * w);
-  }
-  return L;
-}
+/// A ray still to trace, with the weight its radiance has in the pixel.
+struct Branch {
+  Ray ray;
+  int depth;  // segments before this ray
+  dvec3 throughput;
+};
 
 }  // namespace
 
+// The recursion L = emitted + diffuse + w_r L(reflected) + w_t L(refracted), unrolled into a list
+// of pending branches: a chain of 100000 mirror bounces (two parallel mirrors at max_depth 100000)
+// overflowed the thread's stack when this recursed.
 dvec3 integrator_whitted(const Tracer& t, const Ray& ray, const Sampler&) {
-  return whitted(t, ray, 0, dvec3(1.0));
+  dvec3 L(0.0);
+  std::vector<Branch> pending{Branch{ray, 0, dvec3(1.0)}};
+  while (!pending.empty()) {
+    const Branch b = pending.back();
+    pending.pop_back();
+    Hit hit;
+    if (!t.trace(b.ray, hit)) {
+      L += b.throughput * t.escaped(b.ray.d);
+      continue;
+    }
+    Surface s = t.surface(b.ray, hit);
+    L += b.throughput * t.emitted(s);
+    if (b.depth + 1 >= t.scene.integrator.max_depth) continue;
+    // branches too faint to matter are cut (the only departure from the exact recursion)
+    if (max3(b.throughput) < 1e-9) continue;
+    WhittedLobes lobes = t.bsdf(s)->whitted(-b.ray.d);
+    if (lobes.diffuse) L += b.throughput * diffuse_term(t, s, lobes.albedo);
+    if (lobes.reflect)
+      pending.push_back(Branch{Tracer::spawn(s, lobes.reflect_dir), b.depth + 1,
+                               b.throughput * lobes.reflect_weight});
+    if (lobes.transmit)
+      pending.push_back(Branch{Tracer::spawn(s, lobes.transmit_dir), b.depth + 1,
+                               b.throughput * lobes.transmit_weight});
+  }
+  return L;
 }
 
 }  // namespace lucent::ref
