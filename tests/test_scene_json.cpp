@@ -2,10 +2,12 @@
 // problem (or line:column for syntax errors), and the full format parses to what it says.
 #include <gtest/gtest.h>
 
+#include <cfloat>
 #include <cmath>
 #include <glm/glm.hpp>
 #include <string>
 
+#include "lucent/reference.hpp"
 #include "support.hpp"
 
 namespace {
@@ -614,6 +616,21 @@ TEST(SceneJson, FullFormatParses) {
   expect_vec(s.lights[0].intensity, {10, 20, 30});
   EXPECT_EQ(s.lights[1].type, lucent::LightType::Environment);
   expect_vec(s.lights[1].radiance, {0.1, 0.2, 0.3});
+}
+
+// look_at's coordinates are floats, its distance from the camera need not be: the default focus
+// distance (the distance to look_at) was that distance, which the render then refused as
+// "/camera/focus_distance: must fit in a float", a key the scene does not have (and a pinhole
+// does not use). It is the largest float instead.
+TEST(SceneJson, LookAtFartherFromTheCameraThanTheLargestFloat) {
+  Scene s = lucent::parse_scene(
+      R"({"camera": {"position": [0, 0, 5], "look_at": [-3e38, -1e38, -3e38]},
+          "film": {"width": 2, "height": 2}, "integrator": {"spp": 1}})",
+      "far.json");
+  EXPECT_EQ(s.camera.focus_distance, double(FLT_MAX));
+  lucent::ReferenceOptions o;
+  o.spp = 1;
+  EXPECT_NO_THROW(lucent::render_reference(s, o));
 }
 
 TEST(SceneJson, DefaultsWhenKeysAreLeftOut) {
