@@ -8,6 +8,7 @@
 #include <string>
 
 #include "lucent/reference.hpp"
+#include "render/pack.hpp"
 #include "support.hpp"
 
 namespace {
@@ -621,16 +622,29 @@ TEST(SceneJson, FullFormatParses) {
 // look_at's coordinates are floats, its distance from the camera need not be: the default focus
 // distance (the distance to look_at) was that distance, which the render then refused as
 // "/camera/focus_distance: must fit in a float", a key the scene does not have (and a pinhole
-// does not use). It is the largest float instead.
+// does not use). The scene keeps 0 (the distance to look_at); the kernel's camera takes the
+// largest float.
 TEST(SceneJson, LookAtFartherFromTheCameraThanTheLargestFloat) {
   Scene s = lucent::parse_scene(
       R"({"camera": {"position": [0, 0, 5], "look_at": [-3e38, -1e38, -3e38]},
           "film": {"width": 2, "height": 2}, "integrator": {"spp": 1}})",
       "far.json");
-  EXPECT_EQ(s.camera.focus_distance, double(FLT_MAX));
+  EXPECT_EQ(s.camera.focus_distance, 0.0);
+  EXPECT_EQ(lucent::render_detail::pack_camera(s.camera, 2, 2).focus_distance, FLT_MAX);
   lucent::ReferenceOptions o;
   o.spp = 1;
   EXPECT_NO_THROW(lucent::render_reference(s, o));
+}
+
+// The default focus distance (0: the distance to look_at) follows a camera moved after the scene
+// was loaded, as it does in a scene built in code. Loading wrote the distance into the scene, so
+// a thin lens moved closer (README's camera-move example) stayed focused at the old distance.
+TEST(SceneJson, DefaultFocusFollowsAMovedCamera) {
+  Scene s = lucent::parse_scene(
+      R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "aperture": 0.1}})", "lens.json");
+  EXPECT_EQ(lucent::render_detail::pack_camera(s.camera, 2, 2).focus_distance, 5.0f);
+  s.camera.position.z = 2;
+  EXPECT_EQ(lucent::render_detail::pack_camera(s.camera, 2, 2).focus_distance, 2.0f);
 }
 
 TEST(SceneJson, DefaultsWhenKeysAreLeftOut) {
@@ -641,8 +655,8 @@ TEST(SceneJson, DefaultsWhenKeysAreLeftOut) {
   EXPECT_TRUE(s.materials.empty());
   EXPECT_TRUE(s.spheres.empty());
   EXPECT_TRUE(s.triangles.empty());
-  // focus distance defaults to the distance to look_at: (0, 0, 5) -> origin
-  EXPECT_DOUBLE_EQ(s.camera.focus_distance, 5.0);
+  // focus distance 0: the distance to look_at, whatever the camera's position when rendered
+  EXPECT_EQ(s.camera.focus_distance, 0.0);
   // the defaults README.md's "Defaults" paragraph lists
   expect_vec(s.camera.position, {0, 0, 5});
   expect_vec(s.camera.look_at, {0, 0, 0});

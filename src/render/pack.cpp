@@ -85,8 +85,12 @@ lc_camera pack_camera(const Camera& c, int width, int height) {
   cam.tan_half_fov = static_cast<float>(std::tan(glm::radians(c.fov_degrees) * 0.5));
   cam.aspect = static_cast<float>(width) / static_cast<float>(height);
   cam.lens_radius = static_cast<float>(c.aperture);
+  // 0: the distance to look_at, resolved here so that it follows a camera moved after loading.
+  // That distance may exceed a float where look_at's coordinates do not (a pinhole aimed at
+  // [-3e38, -1e38, -3e38]): the largest float then, a focal plane as far as infinity.
   cam.focus_distance = static_cast<float>(
-      c.focus_distance > 0 ? c.focus_distance : glm::length(c.look_at - c.position));
+      c.focus_distance > 0 ? c.focus_distance
+                           : std::min(glm::length(c.look_at - c.position), double(FLT_MAX)));
   return cam;
 }
 

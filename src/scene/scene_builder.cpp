@@ -3,8 +3,6 @@
 // element's place, then adds it.
 #include "lucent/scene_builder.hpp"
 
-#include <algorithm>
-#include <cfloat>
 #include <cmath>
 #include <utility>
 
@@ -190,13 +188,6 @@ void SceneBuilder::add_light(const Light& light) {
 }
 
 Scene SceneBuilder::build() {
-  Camera& c = scene_.camera;
-  // the distance to look_at, which may exceed a float where look_at's coordinates do not (a
-  // pinhole aimed at [-3e38, -1e38, -3e38] was refused as "/camera/focus_distance: must fit in a
-  // float", a key the scene did not have): the largest float then, a focal plane as far as
-  // infinity for the kernel's float camera
-  if (c.focus_distance <= 0)
-    c.focus_distance = std::min(glm::length(c.look_at - c.position), double(FLT_MAX));
   Scene out = std::move(scene_);
   scene_ = Scene{};
   obj_materials_.clear();
