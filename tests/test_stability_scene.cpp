@@ -264,6 +264,14 @@ TEST(StabilityInput, DegenerateAndNonFiniteTrianglesAreSkipped) {
       for (int c = 0; c < 3; ++c)
         worst = std::max(worst, double(std::abs(a.mean.pixel(x, y)[c] - b.mean.pixel(x, y)[c])));
   EXPECT_EQ(worst, 0.0);
+  // the reference drops them too, and says so as the kernel's pack does (it was silent)
+  CaptureWarnings ref_warnings;
+  dirty.film.width = dirty.film.height = 2;
+  lucent::ReferenceOptions ro;
+  ro.spp = 1;
+  lucent::render_reference(dirty, ro);
+  EXPECT_EQ(ref_warnings.count("skipped 8 degenerate or non-finite triangle(s)"), 1)
+      << ref_warnings.dump();
 }
 
 // Spheres with a NaN centre or radius (possible through the API only: the JSON loader rejects

@@ -51,6 +51,10 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
   render_detail::check_reference_host_memory(scene, caustics ? threads : 1);
   auto t0 = std::chrono::steady_clock::now();
   const ref::Tracer tracer(scene);
+  if (tracer.world.skipped_triangles > 0)  // as pack_scene says it of the kernel's
+    scene_detail::warn(scene_detail::in_file(
+        scene.path, "skipped " + std::to_string(tracer.world.skipped_triangles) +
+                        " degenerate or non-finite triangle(s)"));
   const ref::CameraModel camera(scene);
   std::unique_ptr<ref::LightTracer> light_tracer;
   if (caustics) light_tracer = std::make_unique<ref::LightTracer>(tracer, camera);

@@ -66,7 +66,10 @@ World::World(const Scene& s) : scene(s) {
     first += n;
     for (std::size_t i = 0; i < n; ++i) {
       Box b;
-      if (!ops.prepare(s, static_cast<int>(i), b)) continue;
+      if (!ops.prepare(s, static_cast<int>(i), b)) {
+        if (shape == Shape::Triangle) ++skipped_triangles;
+        continue;
+      }
       prims.push_back({shape, static_cast<int>(i), &ops});
       prim_boxes_.push_back(b);
     }

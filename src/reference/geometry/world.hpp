@@ -86,6 +86,8 @@ class World {
 
   const Scene& scene;
   std::vector<Prim> prims;
+  /// Triangles dropped as degenerate (zero area in double) or non-finite.
+  std::size_t skipped_triangles = 0;
 
   /// Closest hit with t in (0, tmax), ignoring primitive `skip` (if >= 0).
   bool intersect(const Ray& ray, double tmax, Hit& hit, int skip = -1) const;
