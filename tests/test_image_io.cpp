@@ -33,6 +33,24 @@ TEST(ImageIo, SrgbEncodingKnownValues) {
   EXPECT_EQ(encode_display(NAN, d), 0);
 }
 
+// An infinity from an array given to write_image is brighter than any finite value: white, as
+// 3e38 is (it was black), under every tone map; -inf is black, as every negative value is.
+TEST(ImageIo, PositiveInfinityEncodesAsWhite) {
+  for (lucent::ToneMap t :
+       {lucent::ToneMap::Clamp, lucent::ToneMap::Reinhard, lucent::ToneMap::Aces}) {
+    DisplaySettings d;
+    d.tonemap = t;
+    EXPECT_EQ(encode_display(3e38, d), 255);
+    EXPECT_EQ(encode_display(INFINITY, d), 255);
+    EXPECT_EQ(encode_display(-INFINITY, d), 0);
+    d.exposure = 1e30;
+    EXPECT_EQ(encode_display(INFINITY, d), 255);
+  }
+  DisplaySettings nan_exposure;  // (only the C++ API can make one): black, not lround(NaN)
+  nan_exposure.exposure = NAN;
+  EXPECT_EQ(encode_display(0.5, nan_exposure), 0);
+}
+
 TEST(ImageIo, GammaExposureAndToneMaps) {
   DisplaySettings g;
   g.transfer = lucent::Transfer::Gamma;

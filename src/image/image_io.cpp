@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "core/file_io.hpp"
 #include "image/image_probe.hpp"
@@ -104,9 +105,15 @@ std::string encode_png(const std::string& path, const Image& img, const DisplayS
 }  // namespace
 
 unsigned char encode_display(double v, const DisplaySettings& d) {
-  if (!std::isfinite(v)) v = 0;  // NaN/Inf never reach the film; guard the encoder anyway
+  // NaN/Inf never reach a render's film, but lucent::write_image and Python's write_image take
+  // any array: NaN has no brightness (black); +inf is brighter than any finite value and is
+  // encoded as one (it was black, next to a white 3e38), whatever the exposure (+inf times a
+  // scale that underflows to 0 was NaN)
+  if (std::isnan(v)) v = 0;
+  if (std::isinf(v) && v > 0) v = std::numeric_limits<double>::max();
   // (0 times an infinite scale is NaN: black stays black)
   v = v > 0 ? v * std::exp2(d.exposure) : 0.0;
+  if (std::isnan(v)) v = 0;
   v = tonemap(v, d.tonemap);
   v = std::clamp(v, 0.0, 1.0);
   switch (d.transfer) {
