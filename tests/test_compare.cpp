@@ -201,6 +201,21 @@ TEST(Compare, ExrRoundTripKeepsStatistics) {
   EXPECT_EQ(plain.rgb, a.mean.rgb);
 }
 
+// Counts above 2^24 (merged parts reach them) come back exactly: the UINT channel was read
+// through its float copy, which rounded 16777217 to 16777216 (and the image's spp with it) and
+// refused the largest counts, 4294967295 rounding to 2^32, as invalid.
+TEST(Compare, ExrRoundTripKeepsLargeSampleCounts) {
+  RenderResult a;
+  a.mean = lucent::Image{2, 2, std::vector<float>(12, 0.5f)};
+  a.variance = lucent::Image{2, 2, std::vector<float>(12, 0.25f)};
+  a.samples = {16777217u, 4294967295u, 123456789u, 1u};
+  std::string path = lucent::test::temp_dir() + "/large-n.exr";
+  lucent::write_render_exr(path, a);
+  RenderResult b = lucent::read_render(path);
+  EXPECT_EQ(b.samples, a.samples);
+  EXPECT_EQ(b.spp, 4294967295u);
+}
+
 // `lucent render --reference -o x.exr` writes the statistics layers; `lucent compare` prints the
 // metrics and exits 0 on PASS, 1 on FAIL; errors name the file.
 TEST(Compare, CommandLine) {

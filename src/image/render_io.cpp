@@ -151,13 +151,20 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
     for (size_t i = 0; i < n; ++i) r.variance.rgb[i * 3 + c] = exr.planes[var[c]][i];
   r.samples.resize(n);
   std::uint32_t most = 0;
+  // lucent writes n as UINT: read it exactly (its float copy rounds counts above 2^24, which
+  // merged parts reach: 16777217 read back as 16777216)
+  const bool exact = exr.uint_planes[cnt].size() == n;
   for (size_t i = 0; i < n; ++i) {
-    // a count is a non-negative integer: anything else (NaN, negative, huge) is a corrupt file
-    const float v = exr.planes[cnt][i];
-    if (!(v >= 0.0f && v < 4294967296.0f))
-      throw Error(path + ": channel n: pixel " + std::to_string(i % w) + ", " +
-                  std::to_string(i / w) + " has an invalid sample count " + std::to_string(v));
-    r.samples[i] = static_cast<std::uint32_t>(v);
+    if (exact) {
+      r.samples[i] = exr.uint_planes[cnt][i];
+    } else {
+      // a count is a non-negative integer: anything else (NaN, negative, huge) is a corrupt file
+      const float v = exr.planes[cnt][i];
+      if (!(v >= 0.0f && v < 4294967296.0f))
+        throw Error(path + ": channel n: pixel " + std::to_string(i % w) + ", " +
+                    std::to_string(i / w) + " has an invalid sample count " + std::to_string(v));
+      r.samples[i] = static_cast<std::uint32_t>(v);
+    }
     most = std::max(most, r.samples[i]);
   }
   r.spp = most;
