@@ -100,8 +100,8 @@ struct Sphere {
 /// One triangle of the scene's single, world-space triangle list.
 struct Triangle {
   int v[3] = {0, 0, 0};      ///< indices into Scene::positions
-  int n[3] = {-1, -1, -1};   ///< indices into Scene::normals, -1 when absent
-  int uv[3] = {-1, -1, -1};  ///< indices into Scene::uvs, -1 when absent
+  int n[3] = {-1, -1, -1};   ///< indices into Scene::normals, all three -1 when absent
+  int uv[3] = {-1, -1, -1};  ///< indices into Scene::uvs, all three -1 when absent
   int material = 0;
 };
 

@@ -886,7 +886,7 @@ void bind_scene(py::module_& m) {
 
   py::class_<Triangle> triangle(m, "Triangle",
                                 "Indices into Scene.positions (v), .normals (n) and .uvs (uv); "
-                                "-1: absent.");
+                                "n or uv (-1, -1, -1): absent.");
   triangle.def(py::init<>()).def_readwrite("material", &Triangle::material);
   triple_property(triangle, "v", &Triangle::v);
   triple_property(triangle, "n", &Triangle::n);

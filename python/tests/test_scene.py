@@ -516,3 +516,45 @@ def test_out_of_memory_in_array_fields_is_raised_not_reported_as_a_wrong_shape(s
 def test_array_fields_refuse_strings_that_look_like_numbers():
     with pytest.raises(TypeError, match="positions: expected numbers"):
         lucent.Scene().positions = [["1", "2", "3e400"]]
+
+
+def with_normals(small_scene, normals):
+    """small_scene with its floor's vertex normals set from Python (the floor faces +y)."""
+    s = small_scene
+    s.normals = normals
+    for k in range(len(s.triangles)):
+        s.triangles[k].n = s.triangles[k].v
+    return s
+
+
+@pytest.mark.parametrize("bad", [float("inf"), -float("inf"), 1e39])
+def test_normals_set_from_python_must_fit_in_a_float(small_scene, bad):
+    # add_mesh and the OBJ loader refuse non-finite normals and store unit ones; set from Python
+    # an infinite normal, or one beyond float range, made the kernel's shading normal NaN: the
+    # floor rendered black (mean 0.0035 instead of 0.055) with no non-finite sample counted
+    normals = np.tile([0.0, 1.0, 0.0], (4, 1))
+    normals[2, 1] = bad
+    s = with_normals(small_scene, normals)
+    with pytest.raises(lucent.Error, match=r"/shapes/1 \(triangle 0\)/n/1/1: must "):
+        lucent.scene_info(s)
+    s.normals = np.tile([0.0, 2.0, 0.0], (4, 1))  # any finite length: normalized when shading
+    assert lucent.scene_info(s)["triangles"] == 2
+
+
+@pytest.mark.parametrize("field, indices", [("n", (0, 1, -1)), ("n", (-2, -2, -2)),
+                                            ("uv", (-1, 0, 1)), ("uv", (-1, -1, -3))])
+def test_normal_and_uv_indices_are_three_or_none(small_scene, field, indices):
+    # normals (uvs) are used when all three indices are given: some given and some not, or an
+    # index below -1, ignored them without a word
+    s = with_normals(small_scene, np.tile([0.0, 1.0, 0.0], (4, 1)))
+    s.uvs = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    setattr(s.triangles[1], field, indices)
+    what = "normals" if field == "n" else "uvs"
+    with pytest.raises(lucent.Error,
+                       match=r"/shapes/1 \(triangle 1\)/%s: must be three indices of the scene's "
+                       r"%s or -1 for all three \(none\), got \(%d, %d, %d\)$"
+                       % ((field, what) + indices)):
+        lucent.scene_info(s)
+    setattr(s.triangles[1], field, (-1, -1, -1))
+    assert lucent.scene_info(s)["triangles"] == 2
+

@@ -316,6 +316,24 @@ bool finite_uv(const glm::dvec2& uv) {
   return std::abs(uv.x) <= FLT_MAX && std::abs(uv.y) <= FLT_MAX;  // false for NaN
 }
 
+// A shading normal the device can hold: finite, and within float range.
+bool float_normal(const glm::dvec3& n) {
+  return std::abs(n.x) <= FLT_MAX && std::abs(n.y) <= FLT_MAX && std::abs(n.z) <= FLT_MAX;
+}
+
+// A triangle's normal or uv indices: three indices, or -1 for all three (none).
+bool all_or_none(const int (&ix)[3]) {
+  const bool all = ix[0] >= 0 && ix[1] >= 0 && ix[2] >= 0;
+  return all || (ix[0] == -1 && ix[1] == -1 && ix[2] == -1);
+}
+
+void check_all_or_none(const Reporter& at, const int (&ix)[3], const char* what) {
+  if (!all_or_none(ix))
+    at.fail("must be three indices of the scene's " + std::string(what) +
+            " or -1 for all three (none), got (" + std::to_string(ix[0]) + ", " +
+            std::to_string(ix[1]) + ", " + std::to_string(ix[2]) + ")");
+}
+
 // The place of primitive `i` of a type: its shape entry's ("/shapes/3", "/shapes/1 (triangle
 // 12)" for the 13th triangle of a mesh), else "/<list>/<i>".
 std::string primitive_place(const Scene& s, ShapeType type, std::size_t i, const char* list,
@@ -405,6 +423,13 @@ void validate_scene(const Scene& s) {
     // an infinite one made the reference's every lookup NaN (the surface black: each sample
     // dropped) while the kernel read the texel at uv 0
     for (int k = 0; k < 3 && ok && has_uv; ++k) ok = finite_uv(s.uvs[t.uv[k]]);
+    // normals too (add_mesh and the OBJ loader require finite ones and store them unit
+    // length): set from Python (Scene.normals), an infinite one, or one beyond float range,
+    // made the kernel's shading normal NaN, the surface black without a non-finite sample
+    for (int k = 0; k < 3 && ok && has_n; ++k) ok = float_normal(s.normals[t.n[k]]);
+    // some indices given and some not (0, 1, -1), or one below -1: the triangle's normals or
+    // uvs were ignored without a word (they are used when all three are given)
+    ok = ok && all_or_none(t.n) && all_or_none(t.uv);
     // a finite vertex beyond the geometry range (non-finite ones are dropped by pack_scene)
     int far = -1;
     for (int k = 0; k < 3 && ok; ++k)
@@ -414,10 +439,14 @@ void validate_scene(const Scene& s) {
     const Reporter at(file, primitive_place(s, ShapeType::Triangle, i, "triangles", "triangle"));
     check_index(at.at("material"), t.material, nm, "materials");
     for (int k = 0; k < 3; ++k) check_index(at.at("v").at(k), t.v[k], np, "positions");
+    check_all_or_none(at.at("n"), t.n, "normals");
+    check_all_or_none(at.at("uv"), t.uv, "uvs");
     for (int k = 0; k < 3 && has_n; ++k) check_index(at.at("n").at(k), t.n[k], nn, "normals");
     for (int k = 0; k < 3 && has_uv; ++k) check_index(at.at("uv").at(k), t.uv[k], nuv, "uvs");
     for (int k = 0; k < 3 && has_uv; ++k)
       for (int c = 0; c < 2; ++c) check_finite(at.at("uv").at(k).at(c), s.uvs[t.uv[k]][c]);
+    for (int k = 0; k < 3 && has_n; ++k)
+      for (int c = 0; c < 3; ++c) check_finite(at.at("n").at(k).at(c), s.normals[t.n[k]][c]);
     if (far >= 0) check_position(at.at("v").at(far), s.positions[t.v[far]]);
   }
 }
