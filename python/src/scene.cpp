@@ -112,6 +112,57 @@ py::class_<V> bind_vector_type(py::module_& m, const char* name) {
   return c;
 }
 
+/// `arg` as an integer of type I: TypeError unless it is an integer (an int, a NumPy integer:
+/// operator.index; not a bool, as for triangle indices), ValueError "<what> must be an integer
+/// in [lo, hi], got <value>" for one outside I, of any size (never wrapped or clamped). A C++
+/// integer member bound as is refused such a value with pybind11's TypeError "incompatible
+/// function arguments", several lines that named neither the field nor its range.
+template <class I>
+I integer_value(const IntArg& arg, const std::string& what) {
+  py::handle v = arg.value;
+  py::object i = py::isinstance<py::bool_>(v)
+                     ? py::object()
+                     : py::reinterpret_steal<py::object>(PyNumber_Index(v.ptr()));
+  if (!i) {
+    PyErr_Clear();
+    throw py::type_error(what + " must be an integer, got " + py::repr(v).cast<std::string>());
+  }
+  int overflow = 0;
+  const long long x = PyLong_AsLongLongAndOverflow(i.ptr(), &overflow);
+  if (x == -1 && PyErr_Occurred()) throw py::error_already_set();
+  using L = std::numeric_limits<I>;
+  if (overflow > 0 && !L::is_signed) {  // 2**63 .. 2**64 - 1
+    const unsigned long long u = PyLong_AsUnsignedLongLong(i.ptr());
+    if (PyErr_Occurred())
+      PyErr_Clear();
+    else if (u <= static_cast<unsigned long long>(L::max()))
+      return static_cast<I>(u);
+  } else if (overflow == 0 && (x < 0 ? L::is_signed && x >= static_cast<long long>(L::min())
+                                     : static_cast<unsigned long long>(x) <=
+                                           static_cast<unsigned long long>(L::max()))) {
+    return static_cast<I>(x);
+  }
+  const std::string lo =
+      L::is_signed ? "-" + range_bound(static_cast<std::uint64_t>(-(L::min() + 1)) + 1) : "0";
+  std::string shown;
+  try {
+    shown = py::repr(i).cast<std::string>();
+  } catch (py::error_already_set&) {  // an int past sys.get_int_max_str_digits()
+    shown = "an integer too long to show";
+  }
+  throw py::value_error(what + " must be an integer in [" + lo + ", " +
+                        range_bound(static_cast<std::uint64_t>(L::max())) + "], got " + shown);
+}
+
+/// An integer member (integer_value's checks, naming the class and the member).
+template <class C, class I>
+void int_property(py::class_<C>& c, const char* name, I C::*member, const char* doc = "") {
+  const std::string what = c.attr("__name__").template cast<std::string>() + "." + name;
+  c.def_property(
+      name, [member](const C& o) { return o.*member; },
+      [member, what](C& o, const IntArg& v) { o.*member = integer_value<I>(v, what); }, doc);
+}
+
 /// A property holding text from files (FileText: a file name, a name in an MTL file).
 template <class C>
 void text_property(py::class_<C>& c, const char* name, std::string C::*member,
@@ -827,11 +878,11 @@ void bind_scene(py::module_& m) {
 
   py::class_<Film> film(m, "Film", "Image size, pixel filter and display settings.");
   film.def(py::init<>())
-      .def_readwrite("width", &Film::width)
-      .def_readwrite("height", &Film::height)
       .def_readwrite("filter", &Film::filter)
       .def_readwrite("gamma", &Film::gamma)
       .def_readwrite("exposure", &Film::exposure);
+  int_property(film, "width", &Film::width);
+  int_property(film, "height", &Film::height);
   enum_property(film, "transfer", &Film::transfer);
   enum_property(film, "tonemap", &Film::tonemap);
   def_pickle(film);
@@ -839,26 +890,25 @@ void bind_scene(py::module_& m) {
   py::class_<Integrator> integrator(m, "Integrator",
                                     "type: an integrator or AOV name (INTEGRATORS).");
   integrator.def(py::init<>())
-      .def_readwrite("max_depth", &Integrator::max_depth)
-      .def_readwrite("rr_depth", &Integrator::rr_depth)
-      .def_readwrite("spp", &Integrator::spp)
-      .def_readwrite("seed", &Integrator::seed)
       .def_readwrite("ao_distance", &Integrator::ao_distance)
       .def_readwrite("mis", &Integrator::mis)
       .def_readwrite("clamp", &Integrator::clamp,
                      "the largest sample contribution (0: off); biased, lower variance")
       .def_readwrite("caustics", &Integrator::caustics,
-                     "path: caustic paths by light tracing (pinhole and thin-lens cameras)")
-      .def_readwrite("dielectric_splits", &Integrator::dielectric_splits,
-                     "path: smooth-glass vertices per camera path at which both lobes are "
-                     "followed (0 .. 4; default 2; 0: off)");
+                     "path: caustic paths by light tracing (pinhole and thin-lens cameras)");
+  int_property(integrator, "max_depth", &Integrator::max_depth);
+  int_property(integrator, "rr_depth", &Integrator::rr_depth);
+  int_property(integrator, "spp", &Integrator::spp);
+  int_property(integrator, "seed", &Integrator::seed);
+  int_property(integrator, "dielectric_splits", &Integrator::dielectric_splits,
+               "path: smooth-glass vertices per camera path at which both lobes are "
+               "followed (0 .. 4; default 2; 0: off)");
   enum_property(integrator, "type", &Integrator::type);
   enum_property(integrator, "sampler", &Integrator::sampler);
   def_pickle(integrator);
 
   py::class_<Material> material(m, "Material", "type: MATERIAL_TYPES; README, \"materials\".");
   material.def(py::init<>())
-      .def_readwrite("albedo_texture", &Material::albedo_texture, "index into Scene.textures or -1")
       .def_readwrite("ior", &Material::ior)
       .def_readwrite("roughness", &Material::roughness)
       .def_property_readonly("emissive", &Material::emissive)
@@ -866,6 +916,8 @@ void bind_scene(py::module_& m) {
         return "<lucent.Material " + py::repr(file_text(mt.name)).cast<std::string>() + " " +
                enum_name(mt.type) + ">";
       });
+  int_property(material, "albedo_texture", &Material::albedo_texture,
+               "index into Scene.textures or -1");
   text_property(material, "name", &Material::name);
   vec_property(material, "albedo", &Material::albedo);
   vec_property(material, "emission", &Material::emission);
@@ -875,27 +927,29 @@ void bind_scene(py::module_& m) {
 
   py::class_<Sphere> sphere(m, "Sphere");
   sphere.def(py::init<>())
-      .def(py::init([](py::handle center, double radius, int material) {
-             return Sphere{to_vec<glm::dvec3>(center), radius, material};
+      .def(py::init([](py::handle center, double radius, const IntArg& material) {
+             return Sphere{to_vec<glm::dvec3>(center), radius,
+                           integer_value<int>(material, "Sphere.material")};
            }),
            py::arg("center"), py::arg("radius"), py::arg("material") = 0)
-      .def_readwrite("radius", &Sphere::radius)
-      .def_readwrite("material", &Sphere::material, "index into Scene.materials");
+      .def_readwrite("radius", &Sphere::radius);
+  int_property(sphere, "material", &Sphere::material, "index into Scene.materials");
   vec_property(sphere, "center", &Sphere::center);
   def_pickle(sphere);
 
   py::class_<Triangle> triangle(m, "Triangle",
                                 "Indices into Scene.positions (v), .normals (n) and .uvs (uv); "
                                 "n or uv (-1, -1, -1): absent.");
-  triangle.def(py::init<>()).def_readwrite("material", &Triangle::material);
+  triangle.def(py::init<>());
+  int_property(triangle, "material", &Triangle::material);
   triple_property(triangle, "v", &Triangle::v);
   triple_property(triangle, "n", &Triangle::n);
   triple_property(triangle, "uv", &Triangle::uv);
   def_pickle(triangle);
 
   py::class_<Light> light(m, "Light", "An explicit light: point, environment or environment_map.");
-  light.def(py::init<>())
-      .def_readwrite("texture", &Light::texture, "environment map: index into Scene.textures");
+  light.def(py::init<>());
+  int_property(light, "texture", &Light::texture, "environment map: index into Scene.textures");
   vec_property(light, "position", &Light::position);
   vec_property(light, "intensity", &Light::intensity, "point: W/sr");
   vec_property(light, "radiance", &Light::radiance, "environment radiance, or the map's scale");
@@ -919,9 +973,9 @@ void bind_scene(py::module_& m) {
       "One entry of the scene's shape list as given (for messages and statistics): type, the "
       "OBJ file of a mesh, its first sphere or triangle and their count, and the MTL libraries "
       "the OBJ file named that exist (inputs of the scene).");
+  int_property(shape_entry, "first", &ShapeEntry::first);
+  int_property(shape_entry, "count", &ShapeEntry::count);
   shape_entry.def(py::init<>())
-      .def_readwrite("first", &ShapeEntry::first)
-      .def_readwrite("count", &ShapeEntry::count)
       .def_property(
           "libraries",
           [](const ShapeEntry& e) {

@@ -558,3 +558,38 @@ def test_normal_and_uv_indices_are_three_or_none(small_scene, field, indices):
     setattr(s.triangles[1], field, (-1, -1, -1))
     assert lucent.scene_info(s)["triangles"] == 2
 
+
+@pytest.mark.parametrize("obj, field, lo, hi", [
+    (lucent.Film(), "width", "-2**31", "2**31 - 1"),
+    (lucent.Integrator(), "seed", "0", "2**32 - 1"),
+    (lucent.Integrator(), "max_depth", "-2**31", "2**31 - 1"),
+    (lucent.Material(), "albedo_texture", "-2**31", "2**31 - 1"),
+    (lucent.Sphere(), "material", "-2**31", "2**31 - 1"),
+    (lucent.Triangle(), "material", "-2**31", "2**31 - 1"),
+    (lucent.Light(), "texture", "-2**31", "2**31 - 1"),
+    (lucent.ShapeEntry(), "first", "0", "2**64 - 1"),
+])
+def test_integer_fields_out_of_range_are_value_errors_naming_the_field(obj, field, lo, hi):
+    # as README says of every number out of its range: a ValueError naming it and its range.
+    # These were pybind11's TypeError "incompatible function arguments", several lines naming
+    # neither the field nor its range
+    name = type(obj).__name__
+    before = getattr(obj, field)
+    for big in (2 ** 64, -2 ** 70, 10 ** 30):
+        with pytest.raises(ValueError) as e:
+            setattr(obj, field, big)
+        assert str(e.value) == "%s.%s must be an integer in [%s, %s], got %d" % (name, field, lo,
+                                                                                  hi, big)
+    with pytest.raises(TypeError, match=r"^%s\.%s must be an integer, got 2\.0$" % (name, field)):
+        setattr(obj, field, 2.0)
+    with pytest.raises(TypeError, match="must be an integer, got True"):
+        setattr(obj, field, True)
+    assert getattr(obj, field) == before  # unchanged by a refused assignment
+    setattr(obj, field, np.int16(3))
+    assert getattr(obj, field) == 3
+
+
+def test_sphere_material_argument_is_checked_as_the_field():
+    with pytest.raises(ValueError, match=r"^Sphere\.material must be an integer in \[-2\*\*31, "):
+        lucent.Sphere((0, 0, 0), 1, 2 ** 40)
+    assert lucent.Sphere((0, 0, 0), 1, np.int64(2)).material == 2
