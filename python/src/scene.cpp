@@ -871,7 +871,9 @@ void bind_scene(py::module_& m) {
   vec_property(camera, "up", &Camera::up);
   def_pickle(camera);
 
-  py::class_<Filter> filter(m, "Filter", "Pixel filter: type (FILTER_TYPES) and radius in pixels.");
+  py::class_<Filter> filter(m, "Filter",
+                            "Pixel filter: type (FILTER_TYPES) and radius in pixels (0.5; setting "
+                            "type keeps it: a scene file's tent and gaussian default to 1.5).");
   filter.def(py::init<>()).def_readwrite("radius", &Filter::radius);
   enum_property(filter, "type", &Filter::type);
   def_pickle(filter);
@@ -907,7 +909,12 @@ void bind_scene(py::module_& m) {
   enum_property(integrator, "sampler", &Integrator::sampler);
   def_pickle(integrator);
 
-  py::class_<Material> material(m, "Material", "type: MATERIAL_TYPES; README, \"materials\".");
+  py::class_<Material> material(
+      m, "Material",
+      "type: MATERIAL_TYPES; README, \"materials\". specular is the scene format's reflectance "
+      "(mirror, diffuse_mirror) and tint (dielectric, rough_dielectric). Material() has albedo "
+      "0.8, specular 1, ior 1.5, roughness 0.1 whatever its type: not a type's defaults of the "
+      "scene format (a conductor's specular 0.9, a diffuse_mirror's reflectance 0.2).");
   material.def(py::init<>())
       .def_readwrite("ior", &Material::ior)
       .def_readwrite("roughness", &Material::roughness)

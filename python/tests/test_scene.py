@@ -593,3 +593,21 @@ def test_sphere_material_argument_is_checked_as_the_field():
     with pytest.raises(ValueError, match=r"^Sphere\.material must be an integer in \[-2\*\*31, "):
         lucent.Sphere((0, 0, 0), 1, 2 ** 40)
     assert lucent.Sphere((0, 0, 0), 1, np.int64(2)).material == 2
+
+
+def test_python_values_start_from_the_struct_defaults_not_the_types(small_scene):
+    # README's Python section: setting a type changes nothing else (the scene format's per-type
+    # defaults, a conductor's specular 0.9, a diffuse_mirror's reflectance 0.2, a gaussian's
+    # radius 1.5, are not applied)
+    m = lucent.Material()
+    m.type = "conductor"
+    assert m.specular == (1, 1, 1)
+    f = lucent.Filter()
+    f.type = "gaussian"
+    assert f.radius == 0.5
+    m.type = "diffuse_mirror"
+    m.name = "dm"
+    small_scene.materials[0] = m
+    with pytest.raises(lucent.Error, match=r"/materials/dm/reflectance/0: albedo \+ reflectance "
+                                           r"must be <= 1 .* 0\.8 \+ 1 = 1\.8 in red"):
+        lucent.scene_info(small_scene)
