@@ -25,7 +25,8 @@ TEST(CliInfo, SceneAndBvhStatistics) {
   lucent::write_image(dir + "/tex.png", tex);
   std::string scene = dir + "/scene.json";
   lucent::test::write_file(scene, R"({
-    "film": {"width": 40, "height": 30},
+    "film": {"width": 40, "height": 30, "transfer": "gamma", "gamma": 1.8, "exposure": -1.5,
+             "tonemap": "aces"},
     "integrator": {"type": "direct", "max_depth": 3, "spp": 9, "seed": 5},
     "materials": {
       "white": {"type": "diffuse", "albedo": [0.8, 0.8, 0.8]},
@@ -61,6 +62,8 @@ TEST(CliInfo, SceneAndBvhStatistics) {
   EXPECT_EQ(m["integrator"], "direct, max_depth 3, spp 9, seed 5");
 
   EXPECT_EQ(m["filter"], "box, radius 0.5");
+  // what the 8-bit outputs apply (it was not shown)
+  EXPECT_EQ(m["display"], "gamma 1.8, exposure -1.5, tonemap aces");
   // the shape list's entries by type, then the primitives they made
   EXPECT_EQ(m["shapes"], "6");
   EXPECT_EQ(m["shapes/sphere"], "3");

@@ -29,6 +29,14 @@ enum class FilterType { LC_FILTER_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
 enum class Transfer { Srgb, Gamma, Linear };
 enum class ToneMap { Clamp, Reinhard, Aces };
 
+/// The scene format's names of the display settings ("srgb", "reinhard", ...).
+inline const char* transfer_name(Transfer t) {
+  return t == Transfer::Srgb ? "srgb" : t == Transfer::Gamma ? "gamma" : "linear";
+}
+inline const char* tonemap_name(ToneMap t) {
+  return t == ToneMap::Clamp ? "clamp" : t == ToneMap::Reinhard ? "reinhard" : "aces";
+}
+
 struct Filter {
   FilterType type = FilterType::Box;
   double radius = 0.5;  ///< in pixels

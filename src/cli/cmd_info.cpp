@@ -93,6 +93,11 @@ int run_info_command() {
   std::printf("filter        %s, radius %g\n", type_name(scene.film.filter.type),
               scene.film.filter.radius);
   std::printf("sampler       %s\n", type_name(scene.integrator.sampler));
+  // what the 8-bit outputs apply (README, "film")
+  const Film& film = scene.film;
+  std::printf("display       %s", transfer_name(film.transfer));
+  if (film.transfer == Transfer::Gamma) std::printf(" %g", film.gamma);
+  std::printf(", exposure %g, tonemap %s\n", film.exposure, tonemap_name(film.tonemap));
   // what the render does with the path integrator's knobs, not only what the scene says: a
   // setting the render leaves unused says why (the kernel's features decide, as for the render)
   using render_detail::IntegratorKnob;

@@ -32,13 +32,6 @@ constexpr const char* kFormat = "lucent-part 1";
 constexpr const char* kPlanes[2] = {"sum", "sumsq"};
 constexpr const char* kRgb[3] = {"R", "G", "B"};
 
-const char* transfer_name(Transfer t) {
-  return t == Transfer::Srgb ? "srgb" : t == Transfer::Gamma ? "gamma" : "linear";
-}
-const char* tonemap_name(ToneMap t) {
-  return t == ToneMap::Clamp ? "clamp" : t == ToneMap::Reinhard ? "reinhard" : "aces";
-}
-
 double parse_double(const std::string& path, const std::string& what, const std::string& s) {
   io::CNumbers c_numbers;  // "0.5", whatever the process locale
   char* end = nullptr;
