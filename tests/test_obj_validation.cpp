@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <glm/gtc/matrix_transform.hpp>
 #include <string>
@@ -161,8 +162,34 @@ TEST(ObjValidation, HugePolygonsAreRefusedQuickly) {
   for (int i = 1; i <= 1100; ++i) face += " " + std::to_string(i);
   auto t0 = std::chrono::steady_clock::now();
   EXPECT_EQ(obj_error(text + face + "\n"),
-            "m.obj:1101: face has 1100 corners, more than the 1024 lucent triangulates");
+            "m.obj:1101: face has 1100 corners, more than the 255 tinyobjloader can hold");
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
+}
+
+// tinyobjloader keeps a face's corner count in an unsigned char: a polygon of 256 to 1024
+// corners passed the check (then 1024 corners) and came back from tinyobjloader with its count
+// wrapped, refused as "m.obj: inconsistent face list" (300 corners) or "m.obj: a face has 0
+// corners" (256), naming no line. Found by loading a 300-corner star polygon. A polygon of 255
+// corners, the most tinyobjloader holds, still loads, its area whole.
+TEST(ObjValidation, PolygonsBeyondTinyobjloadersCornerCountAreRefusedWithTheirLine) {
+  auto polygon = [](int n) {
+    std::string text;
+    for (int i = 0; i < n; ++i) {
+      const double a = 2 * 3.14159265358979 * i / n, r = i % 2 ? 1.0 : 0.5;  // a star
+      text +=
+          "v " + std::to_string(r * std::cos(a)) + " " + std::to_string(r * std::sin(a)) + " 0\n";
+    }
+    text += "f";
+    for (int i = 1; i <= n; ++i) text += " " + std::to_string(i);
+    return text + "\n";
+  };
+  EXPECT_EQ(obj_error(kTri + "f 1 2 3\n" + polygon(300)),
+            "m.obj:305: face has 300 corners, more than the 255 tinyobjloader can hold");
+  EXPECT_EQ(obj_error(polygon(256)),
+            "m.obj:257: face has 256 corners, more than the 255 tinyobjloader can hold");
+  Scene s;
+  ASSERT_EQ(obj_error(polygon(255), "", glm::dmat4(1.0), &s), "");
+  EXPECT_EQ(s.triangles.size(), 253u);
 }
 
 TEST(ObjValidation, MtlNumbersAreChecked) {

@@ -97,7 +97,7 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<glm::vec3>& p, boo
     if (q[j] == q[a] || q[j] == q[b] || q[j] == q[c]) return false;
     return turn(a, b, j) >= 0 && turn(b, c, j) >= 0 && turn(c, a, j) >= 0;
   };
-  // at most 1024 corners (the OBJ check), but each ear is tested against the corners left: a
+  // at most 255 corners (the OBJ check), but each ear is tested against the corners left: a
   // budget keeps a pathological polygon from taking seconds
   long budget = 16L * n * n;  // a convex polygon takes about n^2 / 2
   while (idx.size() > 3) {

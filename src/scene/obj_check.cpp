@@ -310,7 +310,7 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
     if (tag != "f") return;
     if (corners > kMaxFaceVertices)
       fail("face has " + std::to_string(corners) + " corners, more than the " +
-           std::to_string(kMaxFaceVertices) + " lucent triangulates");
+           std::to_string(kMaxFaceVertices) + " tinyobjloader can hold");
     if (corners >= 3) out.triangles += corners - 2;
     if (static_cast<std::uint64_t>(out.triangles) > kMaxTriangles)
       fail("more than " + std::to_string(kMaxTriangles) + " triangles in one OBJ file");

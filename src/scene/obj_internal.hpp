@@ -22,8 +22,10 @@ constexpr std::uint64_t kMaxObjBytes = 1ull << 30;
 constexpr std::uint64_t kMaxMtlBytes = 64ull << 20;
 /// Most triangles one OBJ file may produce (67 million: several GiB of scene and BVH).
 constexpr std::uint64_t kMaxTriangles = 1ull << 26;
-/// Most corners of one polygon: tinyobjloader's ear clipping takes cubic time in it.
-constexpr int kMaxFaceVertices = 1024;
+/// Most corners of one polygon: tinyobjloader stores a face's corner count in an unsigned char
+/// (mesh_t::num_face_vertices), so a polygon of 256 to 1024 corners came back with its count
+/// wrapped (300 as 44) and was refused as "inconsistent face list", without a line.
+constexpr int kMaxFaceVertices = 255;
 
 /// What the check of an OBJ file's text counted.
 struct TextCounts {
