@@ -154,6 +154,27 @@ TEST(ObjValidation, AbsurdIndicesAreErrors) {
   EXPECT_EQ(s.triangles.size(), 1u);
 }
 
+// "f 1/ 2/ 3/ 4/1" passed the check (an empty texture coordinate taken as none), but
+// tinyobjloader's atoi skipped the space after "1/" and read the next corner's vertex index as its
+// texture coordinate: the quad loaded with UVs 2, 3, 4 and 1 without a word, and "f 1/ 2/ 3/ 4"
+// (vt 4 of 3) was refused as "a face index is out of range" naming no line. Found by loading
+// faces with trailing slashes. A corner ending with a slash is now an error naming its line.
+TEST(ObjValidation, CornersEndingWithASlashAreErrors) {
+  const std::string quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n";
+  EXPECT_EQ(obj_error(quad + "f 1/ 2/ 3/ 4/1\n"),
+            "m.obj:9: face: '1/' ends with a slash (the forms are v, v/vt, v//vn and v/vt/vn)");
+  EXPECT_EQ(obj_error(quad + "f 1/1 2/2 3/ 4\n"),
+            "m.obj:9: face: '3/' ends with a slash (the forms are v, v/vt, v//vn and v/vt/vn)");
+  EXPECT_EQ(obj_error(quad + "vn 0 0 1\nf 1/1/ 2/2/1 3/3/1\n"),
+            "m.obj:10: face: '1/1/' ends with a slash (the forms are v, v/vt, v//vn and v/vt/vn)");
+  EXPECT_EQ(obj_error(quad + "f 1// 2 3\n"),
+            "m.obj:9: face: '1//' ends with a slash (the forms are v, v/vt, v//vn and v/vt/vn)");
+  // the four forms, mixed in one face, still load
+  Scene s;
+  ASSERT_EQ(obj_error(quad + "vn 0 0 1\nf 1 2/2 3//1 4/4/1\n", "", glm::dmat4(1.0), &s), "");
+  EXPECT_EQ(s.triangles.size(), 2u);
+}
+
 TEST(ObjValidation, HugePolygonsAreRefusedQuickly) {
   std::string text;
   for (int i = 0; i < 1100; ++i)

@@ -283,7 +283,13 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
       for (int k = 0; k < np; ++k) {
         if (parts[k].empty()) {
           if (k == 0) fail(std::string(element) + ": '" + str(t) + "' has no vertex index");
-          continue;  // "1//3": no texture coordinate
+          // "1//3": no texture coordinate. A slash with nothing after it ("1/", "1//", "1/2/")
+          // is no form of the grammar: tinyobjloader's atoi skipped the space after "1/" and
+          // took the next corner's vertex index as this corner's texture coordinate
+          if (k == np - 1)
+            fail(std::string(element) + ": '" + str(t) + "' ends with a slash (the forms are v, " +
+                 "v/vt, v//vn and v/vt/vn)");
+          continue;
         }
         std::int64_t idx = 0;
         std::string_view p = parts[k];
