@@ -147,7 +147,10 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   // are moved back by one)
   const bool head = use_mtl && counts.usemtl_before_mtllib && !counts.libraries.empty();
   const std::string first_line = head ? "mtllib libraries\n" : "";
-  JoinedText joined(first_line, text);
+  // "f 1 2 3 # top": tinyobjloader reads the comment as an index; a copy without it (only then)
+  const std::string uncommented =
+      counts.element_comments ? obj::blank_element_comments(text) : std::string();
+  JoinedText joined(first_line, counts.element_comments ? uncommented : text);
   std::istream in(&joined);
   obj::MtlReader reader(fs::path(path).parent_path(), counts.libraries, use_mtl);
   tinyobj::attrib_t attrib;

@@ -269,6 +269,11 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
                                        : nullptr;
     if (!element) return;
     int corners = 0;
+    if (rest.find('#') != std::string_view::npos) {  // a word starting with '#' ends the line
+      std::string_view probe = rest;
+      for (std::string_view t; !(t = raw_token(probe)).empty();)
+        if (t[0] == '#') out.element_comments = true;
+    }
     for (std::string_view t; !(t = token(rest)).empty(); ++corners) {
       // v, v/vt, v//vn or v/vt/vn
       std::string_view parts[3];
@@ -329,6 +334,22 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
   out.vertices = count[0];
   out.texcoords = count[1];
   out.normals = count[2];
+  return out;
+}
+
+std::string blank_element_comments(const std::string& text) {
+  std::string out = text;
+  for_each_line(text, [&](std::string_view rest, long) {
+    const std::string_view tag = token(rest);
+    if (tag != "f" && tag != "l" && tag != "p") return;
+    for (std::string_view t; !(t = raw_token(rest)).empty();) {
+      if (t[0] != '#') continue;
+      const std::size_t from = static_cast<std::size_t>(t.data() - text.data());
+      const std::size_t to = static_cast<std::size_t>(rest.data() + rest.size() - text.data());
+      std::fill(out.begin() + from, out.begin() + to, ' ');
+      return;
+    }
+  });
   return out;
 }
 

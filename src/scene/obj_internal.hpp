@@ -35,6 +35,9 @@ struct TextCounts {
   std::vector<std::string> libraries;
   /// A `usemtl` comes before the first `mtllib`.
   bool usemtl_before_mtllib = false;
+  /// An f, l or p element ends with a comment ("f 1 2 3 # top"): tinyobjloader would read the
+  /// '#' as an index (see blank_element_comments).
+  bool element_comments = false;
 };
 
 /// Checks an OBJ file's text before tinyobjloader sees it: every number of a v, vn and vt line
@@ -44,6 +47,11 @@ struct TextCounts {
 /// and at most kMaxTriangles triangles; notes the MTL libraries. Throws
 /// lucent::Error("<path>:<line>: ...").
 TextCounts check_obj_text(const std::string& path, const std::string& text);
+
+/// `text` with the comments at the end of its f, l and p lines ("f 1 2 3 # top") turned into
+/// spaces (the lines and their offsets kept): tinyobjloader reads every word of such a line as an
+/// index, and refused the '#' as a malformed face.
+std::string blank_element_comments(const std::string& text);
 
 /// Checks the numbers of an MTL file's statements that carry them (Ka, Kd, Ks, Ke, Tf, Ns, Ni,
 /// d, Tr, illum, ...): finite, within float range, colours not negative. Throws
