@@ -111,6 +111,35 @@ TEST(Obj, QuadsAndNgonsAreTriangulatedKeepingAreaAndOrientation) {
       << w.dump();
 }
 
+// "f 1 2 3 3" (a triangle written as a quad, as some exporters do) was fanned into a triangle and
+// a degenerate one, with two warnings that did not fit it: "1 polygon(s) that cut themselves or
+// have no area were split as fans" and, at render, "skipped 1 degenerate triangle(s)". Found by
+// loading quads with a repeated corner. A corner at the position of the one before it is left
+// out before the polygon is triangulated.
+TEST(Obj, RepeatedCornersAreLeftOutWithoutAWarning) {
+  std::string dir = lucent::test::temp_dir();
+  std::string path = write(dir, "dup.obj",
+                           "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                           "f 1/1 2/2 3/3 3/3\n"  // a triangle (area 1)
+                           "f 1 1 2 3 4\n"        // a quad (area 2)
+                           "f 4 1 2 2 3 4\n"      // the quad, first and last corner the same
+                           "f 1 2 3 4 1\n");      // and once more
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  EXPECT_TRUE(w.all().empty()) << w.dump();
+  ASSERT_EQ(s.triangles.size(), 1u + 2u + 2u + 2u);
+  EXPECT_NEAR(area(s, s.triangles[0]), 1.0, 1e-12);
+  double total = 0;
+  for (const Triangle& t : s.triangles) {
+    EXPECT_GT(area(s, t), 0.5 - 1e-12);
+    EXPECT_GT(geometric_normal(s, t).z, 0);
+    total += area(s, t);
+  }
+  EXPECT_NEAR(total, 1.0 + 3 * 2.0, 1e-12);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(s.triangles[0].uv[k], k);
+}
+
 TEST(Obj, NegativeIndicesAreRelativeToTheVerticesSoFar) {
   std::string dir = lucent::test::temp_dir();
   std::string a = write(dir, "abs.obj",

@@ -61,6 +61,19 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<glm::vec3>& p, boo
   };
   if (n < 3) return out;
   if (n == 3) return {{0, 1, 2}};
+  // a corner at the position of the one before it adds no edge ("f 1 2 3 3", a triangle written
+  // as a quad): without it the polygon is one of fewer corners, not one that "has no area"
+  std::vector<int> distinct;
+  for (int i = 0; i < n; ++i)
+    if (distinct.empty() || p[i] != p[distinct.back()]) distinct.push_back(i);
+  while (distinct.size() > 1 && p[distinct.back()] == p[distinct.front()]) distinct.pop_back();
+  if (distinct.size() >= 3 && static_cast<int>(distinct.size()) < n) {
+    std::vector<glm::vec3> fewer;
+    for (int i : distinct) fewer.push_back(p[i]);
+    for (const std::array<int, 3>& t : triangulate(fewer, fanned))
+      out.push_back({distinct[t[0]], distinct[t[1]], distinct[t[2]]});
+    return out;
+  }
   glm::dvec3 normal(0.0);  // Newell's: twice the polygon's vector area
   for (int i = 0; i < n; ++i) normal += glm::cross(glm::dvec3(p[i]), glm::dvec3(p[(i + 1) % n]));
   const glm::dvec3 an = glm::abs(normal);
