@@ -140,6 +140,28 @@ TEST(Obj, RepeatedCornersAreLeftOutWithoutAWarning) {
   for (int k = 0; k < 3; ++k) EXPECT_EQ(s.triangles[0].uv[k], k);
 }
 
+// A pentagram (corners 1 3 5 2 4 of a pentagon) has ears, so ear clipping ran to its end, and
+// the last three corners, taken without a test, made a triangle facing the other way: the polygon
+// cuts itself, but there was no warning, while docs/obj-mtl.md promises one for such polygons.
+// Found by loading self-intersecting polygons. Now it is fanned and said, as when no ear is left.
+TEST(Obj, SelfIntersectingPolygonsThatClipBackwardsAreFannedAndSaid) {
+  std::string dir = lucent::test::temp_dir();
+  std::string text;
+  for (int k = 0; k < 5; ++k) {
+    const double a = 2 * 3.14159265358979 * k / 5 + 3.14159265358979 / 2;
+    text += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\n";
+  }
+  std::string path = write(dir, "star.obj", text + "f 1 3 5 2 4\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  EXPECT_EQ(s.triangles.size(), 3u);
+  EXPECT_EQ(w.count("1 polygon(s) that cut themselves or have no area were split as fans"), 1)
+      << w.dump();
+  // fanned from its first corner
+  for (size_t i = 0; i < s.triangles.size(); ++i) EXPECT_EQ(s.triangles[i].v[0], 0);
+}
+
 TEST(Obj, NegativeIndicesAreRelativeToTheVerticesSoFar) {
   std::string dir = lucent::test::temp_dir();
   std::string a = write(dir, "abs.obj",

@@ -138,6 +138,16 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<glm::vec3>& p, boo
     out.push_back({idx[(ear + m - 1) % m], idx[ear], idx[(ear + 1) % m]});
     idx.erase(idx.begin() + ear);
   }
+  // the last three corners are no ear: in a polygon that cuts itself (a pentagram) they can wind
+  // the other way, a triangle facing backwards without a word. Such a polygon is fanned, and said.
+  if (turn(idx[0], idx[1], idx[2]) < 0) {
+    *fanned = true;
+    out.clear();
+    idx.resize(n);
+    for (int i = 0; i < n; ++i) idx[i] = i;
+    fan(idx);
+    return out;
+  }
   out.push_back({idx[0], idx[1], idx[2]});
   return out;
 }
