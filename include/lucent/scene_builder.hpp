@@ -64,6 +64,11 @@ Texture texture_from_rgba(int width, int height, std::vector<float> rgba, std::s
 Texture texture_from_srgb8(int width, int height, int channels,
                            const std::vector<std::uint8_t>& data, std::string name = "");
 
+/// A material of `type` with the scene format's defaults for the type's parameters (a
+/// conductor's specular 0.9, a diffuse_mirror's reflectance 0.2: README, "materials"), no
+/// emission. A default-constructed Material keeps the struct's defaults whatever its type.
+Material material_of_type(MaterialType type, std::string name = "");
+
 /// A point light: `intensity` in W/sr.
 Light point_light(const glm::dvec3& position, const glm::dvec3& intensity);
 /// A constant environment of `radiance`.

@@ -11,6 +11,7 @@
 
 #include "common.hpp"
 #include "lucent/error.hpp"
+#include "lucent/types.hpp"
 #include "render/features.hpp"
 #include "render/pack.hpp"
 #include "scene/json_guard.hpp"
@@ -871,10 +872,20 @@ void bind_scene(py::module_& m) {
   vec_property(camera, "up", &Camera::up);
   def_pickle(camera);
 
-  py::class_<Filter> filter(m, "Filter",
-                            "Pixel filter: type (FILTER_TYPES) and radius in pixels (0.5; setting "
-                            "type keeps it: a scene file's tent and gaussian default to 1.5).");
-  filter.def(py::init<>()).def_readwrite("radius", &Filter::radius);
+  py::class_<Filter> filter(
+      m, "Filter",
+      "Pixel filter: type (FILTER_TYPES) and radius in pixels. Filter() is a box of 0.5, and "
+      "setting type keeps the radius; Filter(type) has the type's default radius, as a scene "
+      "file gives it (tent and gaussian 1.5).");
+  filter.def(py::init<>())
+      .def(py::init([](const std::string& type) {
+             Filter f;
+             f.type = parse_enum<FilterType>(type);
+             f.radius = lucent::default_filter_radius(f.type);
+             return f;
+           }),
+           py::arg("type"))
+      .def_readwrite("radius", &Filter::radius);
   enum_property(filter, "type", &Filter::type);
   def_pickle(filter);
 
@@ -912,10 +923,15 @@ void bind_scene(py::module_& m) {
   py::class_<Material> material(
       m, "Material",
       "type: MATERIAL_TYPES; README, \"materials\". specular is the scene format's reflectance "
-      "(mirror, diffuse_mirror) and tint (dielectric, rough_dielectric). Material() has albedo "
-      "0.8, specular 1, ior 1.5, roughness 0.1 whatever its type: not a type's defaults of the "
-      "scene format (a conductor's specular 0.9, a diffuse_mirror's reflectance 0.2).");
+      "(mirror, diffuse_mirror) and tint (dielectric, rough_dielectric). Material(type, name='') "
+      "has the type's defaults of the scene format (a conductor's specular 0.9, a "
+      "diffuse_mirror's reflectance 0.2); Material() has albedo 0.8, specular 1, ior 1.5, "
+      "roughness 0.1, and setting its type changes nothing else.");
   material.def(py::init<>())
+      .def(py::init([](const std::string& type, const FileText& name) {
+             return material_of_type(parse_enum<MaterialType>(type), name.bytes);
+           }),
+           py::arg("type"), py::arg("name") = FileText{})
       .def_readwrite("ior", &Material::ior)
       .def_readwrite("roughness", &Material::roughness)
       .def_property_readonly("emissive", &Material::emissive)

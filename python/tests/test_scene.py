@@ -611,3 +611,25 @@ def test_python_values_start_from_the_struct_defaults_not_the_types(small_scene)
     with pytest.raises(lucent.Error, match=r"/materials/dm/reflectance/0: albedo \+ reflectance "
                                            r"must be <= 1 .* 0\.8 \+ 1 = 1\.8 in red"):
         lucent.scene_info(small_scene)
+
+
+@pytest.mark.parametrize("type_name", lucent.MATERIAL_TYPES)
+def test_material_of_a_type_has_the_scene_formats_defaults(type_name):
+    # Material(type) is the material a scene file gives for {"type": type_name} alone (it did not
+    # exist: Material() has the struct's defaults whatever its type, see the test above)
+    from_file = lucent.scene_from_dict({"materials": {"m": {"type": type_name}}}).materials[0]
+    made = lucent.Material(type_name, "m")
+    assert made.type == type_name and made.name == "m"
+    for field in ("albedo", "specular", "emission"):
+        assert tuple(getattr(made, field)) == tuple(getattr(from_file, field)), field
+    for field in ("ior", "roughness", "albedo_texture"):
+        assert getattr(made, field) == getattr(from_file, field), field
+    with pytest.raises(ValueError, match="unknown material type 'bogus'"):
+        lucent.Material("bogus")
+
+
+@pytest.mark.parametrize("type_name", lucent.FILTER_TYPES)
+def test_filter_of_a_type_has_the_scene_formats_radius(type_name):
+    from_file = lucent.scene_from_dict({"film": {"filter": {"type": type_name}}}).film.filter
+    made = lucent.Filter(type_name)
+    assert made.type == type_name and made.radius == from_file.radius

@@ -16,17 +16,13 @@ void parse_materials(const JsonReader& r, const json& j, SceneBuilder& b) {
 Material parse_material(const JsonReader& r, const json& j, const std::string& p,
                         const std::string& name, SceneBuilder& b) {
   r.check_object(j, p);
-  Material m;
-  m.name = name;
-  m.type = r.type<MaterialType>(r.require(j, p, "type"), p + "/type");
+  Material m = material_of_type(r.type<MaterialType>(r.require(j, p, "type"), p + "/type"), name);
   const MaterialTypeDef& def = material_type_def(m.type);
   std::vector<const char*> keys = {"type", "emission"};
   for (const MaterialParam& param : def.params) keys.push_back(param.key);
   r.check_keys(j, p, keys);
   for (const MaterialParam& param : def.params) {
     const std::string pp = p + "/" + param.key;
-    if (param.colour) m.*param.colour = param.default_colour;
-    if (param.number) m.*param.number = param.default_number;
     if (!j.contains(param.key)) continue;
     const json& v = j[param.key];
     if (param.kind == MaterialParam::ColourOrTexture && v.is_object()) {

@@ -8,6 +8,7 @@
 
 #include "lucent/error.hpp"
 #include "scene/loaders.hpp"
+#include "scene/material_type.hpp"
 #include "scene/validate.hpp"
 
 namespace lucent {
@@ -18,6 +19,17 @@ int Scene::find_material(const std::string& name) const {
   for (size_t i = 0; i < materials.size(); ++i)
     if (materials[i].name == name) return static_cast<int>(i);
   return -1;
+}
+
+Material material_of_type(MaterialType type, std::string name) {
+  Material m;
+  m.name = std::move(name);
+  m.type = type;
+  for (const scene_detail::MaterialParam& param : scene_detail::material_type_def(type).params) {
+    if (param.colour) m.*param.colour = param.default_colour;
+    if (param.number) m.*param.number = param.default_number;
+  }
+  return m;
 }
 
 Light point_light(const glm::dvec3& position, const glm::dvec3& intensity) {
