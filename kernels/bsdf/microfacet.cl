@@ -4,11 +4,16 @@
 #ifndef LUCENT_BSDF_MICROFACET_CL
 #define LUCENT_BSDF_MICROFACET_CL
 
+/* h a unit vector. t = cos^2 (a2 + tan^2) = sin^2 + a2 cos^2, with sin^2 from h's tangential
+ * components: as 1 - cos^2 (c2 (a2 - 1) + 1) it cancelled near the peak, where sin^2 is of the
+ * order of a2, and at alpha = 1e-3 (roughness 0) D came out up to 44% off next to the mirror
+ * direction (a float cos^2 near 1 resolves sin^2 to 6e-8 only; tests/test_kernel_bsdf.cpp,
+ * GgxEvalMatchesReferenceAtSmallRoughness). */
 static inline float ggx_d(float3 h, float alpha) {
   float c2 = h.z * h.z;
   if (c2 <= 0.0f) return 0.0f;
   float a2 = alpha * alpha;
-  float t = c2 * (a2 - 1.0f) + 1.0f; /* = cos^2 (a2 + tan^2) */
+  float t = (h.x * h.x + h.y * h.y) + a2 * c2;
   return a2 / (LC_PI * t * t);
 }
 
