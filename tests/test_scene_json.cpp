@@ -178,7 +178,7 @@ TEST(SceneJson, OtherDomainErrors) {
   EXPECT_EQ(error_of(R"({"materials": {"m": {"type": "conductor", "roughness": 1.5}}})"),
             "scene.json: /materials/m/roughness: must be in [0, 1], got 1.5");
   EXPECT_EQ(error_of(R"({"materials": {"m": {"type": "dielectric", "ior": 0}}})"),
-            "scene.json: /materials/m/ior: must be in [1e-06, 1e+06], got 0");
+            "scene.json: /materials/m/ior: must be in [0.05, 20], got 0");
   EXPECT_EQ(error_of(R"({"materials": {"": {"type": "diffuse"}}})"),
             "scene.json: /materials/: material names must not be empty");
   EXPECT_EQ(error_of(R"({"lights": [{"type": "environment", "radiance": [1, 1, 1]},
