@@ -866,6 +866,12 @@ TEST(Session, FloatRoundingLargeAgainstTheSceneWarns) {
   for (glm::dvec3& p : far.positions) p.x += 1e3;
   far.spheres[0].center.x += 1e3;
   EXPECT_EQ(warnings_for(far, lucent::Precision::Float), 0);
+  // a sphere of non-finite centre is never hit: it counted as a coordinate of inf ("offset by
+  // their rounding, up to inf here"), the Python review's find
+  Scene odd = plain;
+  odd.spheres.push_back(odd.spheres[0]);
+  odd.spheres.back().center.x = INFINITY;
+  EXPECT_EQ(warnings_for(odd, lucent::Precision::Float), 0);
 }
 
 // A material colour above 1 reflects more light than it receives: a diffuse albedo of 2 rendered

@@ -150,7 +150,10 @@ std::string float_rounding_note(const PackedScene& packed) {
     sizes.push_back(edge);
   }
   for (const lc_sphere& sp : packed.spheres) {
-    if (!(sp.radius > 0) || !std::isfinite(sp.radius)) continue;  // never hit
+    // never hit (a non-finite centre counted as an infinite coordinate: "up to inf here")
+    if (!(sp.radius > 0) || !std::isfinite(sp.radius) || !std::isfinite(sp.center[0]) ||
+        !std::isfinite(sp.center[1]) || !std::isfinite(sp.center[2]))
+      continue;
     for (int c = 0; c < 3; ++c)
       largest = std::max(largest, std::abs(double(sp.center[c])) + sp.radius);
     if (i++ % stride == 0) sizes.push_back(2.0 * sp.radius);
