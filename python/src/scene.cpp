@@ -164,6 +164,25 @@ void int_property(py::class_<C>& c, const char* name, I C::*member, const char* 
       [member, what](C& o, const IntArg& v) { o.*member = integer_value<I>(v, what); }, doc);
 }
 
+/// A bool member that takes True, False or a NumPy bool only (TypeError "<Class>.<name> must be
+/// True or False, got ..."): pybind11's caster took anything with a truth value, so
+/// `integrator.mis = "no"` or `= 0.5` turned MIS on without a word.
+template <class C>
+void bool_property(py::class_<C>& c, const char* name, bool C::*member, const char* doc = "") {
+  const std::string what = c.attr("__name__").template cast<std::string>() + "." + name;
+  c.def_property(
+      name, [member](const C& o) { return o.*member; },
+      [member, what](C& o, py::object v) {
+        const bool numpy_bool = std::string(Py_TYPE(v.ptr())->tp_name) == "numpy.bool_" ||
+                                std::string(Py_TYPE(v.ptr())->tp_name) == "numpy.bool";
+        if (!py::isinstance<py::bool_>(v) && !numpy_bool)
+          throw py::type_error(what + " must be True or False, got " +
+                               py::repr(v).cast<std::string>());
+        o.*member = v.cast<bool>();
+      },
+      doc);
+}
+
 /// A property holding text from files (FileText: a file name, a name in an MTL file).
 template <class C>
 void text_property(py::class_<C>& c, const char* name, std::string C::*member,
@@ -904,11 +923,11 @@ void bind_scene(py::module_& m) {
                                     "type: an integrator or AOV name (INTEGRATORS).");
   integrator.def(py::init<>())
       .def_readwrite("ao_distance", &Integrator::ao_distance)
-      .def_readwrite("mis", &Integrator::mis)
       .def_readwrite("clamp", &Integrator::clamp,
-                     "the largest sample contribution (0: off); biased, lower variance")
-      .def_readwrite("caustics", &Integrator::caustics,
-                     "path: caustic paths by light tracing (pinhole and thin-lens cameras)");
+                     "the largest sample contribution (0: off); biased, lower variance");
+  bool_property(integrator, "mis", &Integrator::mis);
+  bool_property(integrator, "caustics", &Integrator::caustics,
+                "path: caustic paths by light tracing (pinhole and thin-lens cameras)");
   int_property(integrator, "max_depth", &Integrator::max_depth);
   int_property(integrator, "rr_depth", &Integrator::rr_depth);
   int_property(integrator, "spp", &Integrator::spp);

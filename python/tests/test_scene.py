@@ -633,3 +633,16 @@ def test_filter_of_a_type_has_the_scene_formats_radius(type_name):
     from_file = lucent.scene_from_dict({"film": {"filter": {"type": type_name}}}).film.filter
     made = lucent.Filter(type_name)
     assert made.type == type_name and made.radius == from_file.radius
+
+
+@pytest.mark.parametrize("field", ["mis", "caustics"])
+def test_bool_fields_take_only_bools(field):
+    # pybind11's bool caster took anything with a truth value: mis = "no" turned MIS on
+    i = lucent.Integrator()
+    for v in (True, False, np.bool_(True)):
+        setattr(i, field, v)
+        assert getattr(i, field) == bool(v)
+    for v in ("no", 0.5, None, 1):
+        with pytest.raises(TypeError, match=rf"Integrator\.{field} must be True or False, got "):
+            setattr(i, field, v)
+    assert getattr(i, field) is True
