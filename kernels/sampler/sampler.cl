@@ -32,8 +32,8 @@ static inline float2 lc_rand2(const lc_rng* r, lc_uint dim) {
  * shuffles and eight scrambles take the instructions of one, their chains of multiplications
  * overlapped. */
 static inline uint8 lc_sobol_pairs4(lc_uint pixel, lc_uint sample, lc_uint pair, lc_uint seed) {
-  uint4 x = (uint4)(pixel), y = (uint4)(pair) + (uint4)(0u, 1u, 2u, 3u);
-  uint4 z = (uint4)(seed), w = (uint4)(0x50b01u);
+  uint4 x = (uint4)(LC_FOLD(pixel)), y = LC_FOLD((uint4)(pair) + (uint4)(0u, 1u, 2u, 3u));
+  uint4 z = (uint4)(LC_FOLD(seed)), w = (uint4)(0x50b01u);
   LC_PCG4D(x, y, z, w)
   uint4 i = (uint4)(lc_reverse_bits(sample)); /* the shuffled index, as in lc_sobol_pair */
   LC_OWEN_HASH(i, x)
