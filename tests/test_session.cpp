@@ -212,6 +212,22 @@ TEST(Session, SampleIndicesStopAt2To32) {
             "set_build_options: unknown precision 7");
 }
 
+// A pixel's sample count is 32-bit: an accumulation holds at most 2^32 - 1 samples per pixel. All
+// of [0, 2^32) was accepted and wrapped every count to 0 (pixels without samples: a black image).
+TEST(Session, PixelCountsStopBelow2To32) {
+  Renderer r = session();
+  r.set_scene(lucent::test::scene_from(kScene));
+  const std::uint64_t end = std::uint64_t(1) << 32;
+  EXPECT_EQ(lucent::test::error_of([&] { r.render(end, 0.05); }),
+            "render: 4294967296 samples per pixel on top of the accumulation's 0 exceed 2^32 - 1, "
+            "the most a pixel's sample count holds");
+  EXPECT_EQ(r.spp(), 0u) << "nothing rendered";
+  lucent::RenderProgress p = r.render(end - 1, 0.05);  // a time limit stops it long before
+  EXPECT_GE(p.samples_done, 1u);
+  EXPECT_THROW(r.render(end - p.samples_done), lucent::Error);
+  EXPECT_EQ(r.spp(), p.samples_done);
+}
+
 TEST(Session, RenderForRendersAtLeastOnePass) {
   Renderer r = session();
   r.set_scene(lucent::test::scene_from(kScene));

@@ -127,7 +127,9 @@ class Renderer {
   /// The session's scene. Throws lucent::Error when none was set.
   const Scene& scene() const;
 
-  /// Adds `spp` samples per pixel to the accumulation (fewer when cancelled). `on_progress` is
+  /// Adds `spp` samples per pixel to the accumulation (fewer when cancelled); throws
+  /// lucent::Error when they would pass sample index 2^32 (the sampler's range) or 2^32 - 1
+  /// samples per pixel in the accumulation (its 32-bit counts). `on_progress` is
   /// called after each pass; it may read the session (result(), spp(), stats()) and cancel() it,
   /// while set_scene, set_build_options, reset and the render calls throw lucent::Error until the
   /// render returned. Returns the progress at the end.

@@ -821,11 +821,19 @@ struct Renderer::Impl {
       throw Error("render: " + std::to_string(target_spp > 0 ? target_spp : 1) +
                   " samples from sample index " + std::to_string(start_index) +
                   " go past 2^32, the sampler's range (samples would repeat)");
+    // the per-pixel counts are 32-bit: an accumulation holds at most 2^32 - 1 samples per pixel
+    // (all of [0, 2^32) wrapped every count to 0: pixels without samples, a black image)
+    const std::uint64_t count_max = 0xffffffffull;
+    if (done >= count_max || (target_spp > 0 && target_spp > count_max - done))
+      throw Error("render: " + std::to_string(target_spp > 0 ? target_spp : 1) +
+                  " samples per pixel on top of the accumulation's " + std::to_string(done) +
+                  " exceed 2^32 - 1, the most a pixel's sample count holds");
+    // the samples this call may launch: a time-limited render stops at either limit
+    const std::uint64_t room = std::min(index_end - start_index, count_max - done);
     auto next = [&](Worker& w, Job& job) {
       if (target_spp > 0 && started >= target_spp) return false;
-      if (start_index + started >= index_end) return false;  // a time-limited render stops there
-      job.n = static_cast<std::uint32_t>(
-          std::min<std::uint64_t>(w.pass_spp, index_end - start_index - started));
+      if (started >= room) return false;
+      job.n = static_cast<std::uint32_t>(std::min<std::uint64_t>(w.pass_spp, room - started));
       if (target_spp > 0)
         job.n = static_cast<std::uint32_t>(std::min<std::uint64_t>(job.n, target_spp - started));
       job.begin = start_index + started;
