@@ -316,4 +316,54 @@ std::string bounced_caustic_scene(bool caustics, int max_depth, const std::strin
          more + light + "}";
 }
 
+std::string glass_lamp_box_scene(int width, int height, const std::string& filter, int max_depth) {
+  return R"({
+    "camera": {"position": [0, 1, 3.5], "look_at": [0, 1, 0], "up": [0, 1, 0], "fov": 40},
+    "film": {"width": )" +
+         std::to_string(width) + R"(, "height": )" + std::to_string(height) + R"(, "filter": )" +
+         filter + R"(},
+    "integrator": {"type": "path", "max_depth": )" +
+         std::to_string(max_depth) + R"(, "caustics": true, "sampler": "independent"},
+    "materials": {"wall": {"type": "diffuse", "albedo": [0.8, 0.8, 0.8]},
+                  "glass": {"type": "dielectric", "ior": 1.5}},
+    "shapes": [
+      {"type": "triangles", "material": "wall", "indices": [0,2,1, 0,3,2],
+       "positions": [[-1,0,-1],[1,0,-1],[1,0,1],[-1,0,1]]},
+      {"type": "triangles", "material": "wall", "indices": [0,1,2, 0,2,3],
+       "positions": [[-1,0,-1],[1,0,-1],[1,2,-1],[-1,2,-1]]},
+      {"type": "triangles", "material": "wall", "indices": [0,1,2, 0,2,3],
+       "positions": [[-1,0,-1],[-1,0,1],[-1,2,1],[-1,2,-1]]},
+      {"type": "triangles", "material": "wall", "indices": [0,2,1, 0,3,2],
+       "positions": [[1,0,-1],[1,0,1],[1,2,1],[1,2,-1]]},
+      {"type": "sphere", "center": [0, 1, 0], "radius": 0.4, "material": "glass"}],
+    "lights": [{"type": "point", "position": [0, 1, 0], "intensity": [5, 5, 5]}]
+  })";
+}
+
+double ensemble_variance_ratio(const std::function<RenderResult(int)>& render, int R, int channel) {
+  std::vector<std::vector<double>> means;
+  std::vector<double> reported;
+  for (int k = 0; k < R; ++k) {
+    const RenderResult r = render(k);
+    const size_t npix = r.samples.size();
+    if (means.empty()) {
+      means.assign(npix, {});
+      reported.assign(npix, 0.0);
+    }
+    for (size_t i = 0; i < npix; ++i) {
+      means[i].push_back(r.mean.rgb[i * 3 + channel]);
+      reported[i] += r.samples[i] ? r.variance.rgb[i * 3 + channel] / r.samples[i] / R : 0.0;
+    }
+  }
+  double emp = 0, rep = 0;
+  for (size_t i = 0; i < means.size(); ++i) {
+    double m = 0, m2 = 0;
+    for (double v : means[i]) m += v / R;
+    for (double v : means[i]) m2 += (v - m) * (v - m);
+    emp += m2 / (R - 1);
+    rep += reported[i];
+  }
+  return emp / rep;
+}
+
 }  // namespace lucent::test

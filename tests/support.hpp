@@ -168,4 +168,19 @@ inline constexpr const char* kMirrorWall = R"(, {"type": "triangles", "material"
 inline constexpr const char* kFloorBesideTheMirrorWall =
     R"({"position": [2, 0, 1], "look_at": [2, 0, 0], "up": [0, 1, 0], "fov": 50})";
 
+/// A point light inside a glass sphere (radius 0.4, ior 1.5) in an open diffuse box (albedo 0.8:
+/// floor, back and side walls 2 units wide and high), seen from the open front through a
+/// `width` x `height` film with `filter` (a JSON object). With caustics every light reaching the
+/// walls has passed the glass, so the whole image is light-traced, and a light path connects to
+/// the camera at each wall it bounces off (up to max_depth - 2 connections), often several times
+/// within one wide filter's reach.
+std::string glass_lamp_box_scene(int width, int height, const std::string& filter, int max_depth);
+
+/// The variance check of an ensemble of renders: `render(k)` for k = 0 .. R - 1 must be independent
+/// renders of one scene. Returns the empirical variance of the pixel means across the renders
+/// (ddof 1) over the mean reported variance of the mean (variance / samples), each summed over
+/// the pixels, in channel `channel`: about 1 when the reported variance is right.
+double ensemble_variance_ratio(const std::function<RenderResult(int)>& render, int R,
+                               int channel = 1);
+
 }  // namespace lucent::test

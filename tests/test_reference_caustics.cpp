@@ -392,3 +392,30 @@ TEST(ReferenceCaustics, SphereLightCausticThroughFrostedGlassMatchesPathTracing)
 }
 
 }  // namespace
+
+namespace {
+
+// The reference's variance counts a light path's connections that land in one pixel together:
+// it sums the path's shares per pixel before squaring (render.cpp). The ensemble check of
+// KernelCaustics.VarianceOfAPathsConnectionsInOnePixel (test_kernel_caustics.cpp) on the same
+// scene: R = 400 renders (seeds 1000 ..), 2x2 film, tent radius 2, max_depth 6; the empirical
+// over the reported variance of the pixel means must be 1 within 0.4 (relative sd of the ratio
+// sqrt(2 / (R - 1)) = 0.071 for Gaussian means, so about 5 sd with room for heavier tails).
+// Before the per-pixel sums: 5.3.
+TEST(ReferenceCaustics, VarianceOfAPathsConnectionsInOnePixel) {
+  lucent::Scene scene = lucent::test::scene_from(
+      lucent::test::glass_lamp_box_scene(2, 2, R"({"type": "tent", "radius": 2})", 6));
+  const int R = 400, spp = 16;
+  lucent::ReferenceOptions o;
+  o.spp = spp;
+  o.threads = 1;
+  const double ratio = lucent::test::ensemble_variance_ratio(
+      [&](int k) {
+        scene.integrator.seed = 1000u + static_cast<std::uint32_t>(k);
+        return lucent::render_reference(scene, o);
+      },
+      R);
+  EXPECT_NEAR(ratio, 1.0, 0.4) << "empirical over reported variance of the pixel means";
+}
+
+}  // namespace

@@ -65,8 +65,8 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
   std::atomic<int> next_row{0};
   std::atomic<std::uint64_t> nonfinite{0}, rays{0}, light_paths{0};
   std::atomic<bool> cancelled{false};
-  // per thread: the sum and the sum of squares of the light paths' contributions per pixel and
-  // channel (a light path gives a pixel at most one contribution c_jp)
+  // per thread: the sum and the sum of squares of the light paths' values per pixel and channel
+  // (a light path's value at a pixel: the sum of its connections' shares there)
   std::vector<std::vector<double>> light_sum(caustics ? threads : 0),
       light_sq(caustics ? threads : 0);
 
@@ -114,15 +114,28 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
           splats.clear();
           light_tracer->trace(rng, splats);
           ++my_paths;
-          for (const ref::Splat& sp : splats) {
-            if (!square_fits_float(sp.c)) {
-              ++my_nonfinite;
-              continue;
+          // a share whose square does not fit a float is left out and counted
+          const auto kept = std::remove_if(splats.begin(), splats.end(), [](const ref::Splat& sp) {
+            return !square_fits_float(sp.c);
+          });
+          my_nonfinite += static_cast<std::uint64_t>(splats.end() - kept);
+          splats.erase(kept, splats.end());
+          // The path's value at a pixel is the sum X of its shares there, one per connection
+          // whose filter reaches the pixel (a path connects at every non-delta vertex from y_2
+          // on, and wide filters or small films put several of them in one pixel): the sum of
+          // squares takes X^2, cross terms included. Grouped by pixel in their order, so that
+          // each pixel's sum adds the same shares in the same order as one by one.
+          std::stable_sort(
+              splats.begin(), splats.end(),
+              [](const ref::Splat& a, const ref::Splat& b) { return a.pixel < b.pixel; });
+          for (size_t g = 0; g < splats.size();) {
+            const int pixel = splats[g].pixel;
+            glm::dvec3 X(0.0);
+            for (; g < splats.size() && splats[g].pixel == pixel; ++g) {
+              X += splats[g].c;
+              for (int c = 0; c < 3; ++c) light_sum[thread][pixel * 3 + c] += splats[g].c[c];
             }
-            for (int c = 0; c < 3; ++c) {
-              light_sum[thread][sp.pixel * 3 + c] += sp.c[c];
-              light_sq[thread][sp.pixel * 3 + c] += sp.c[c] * sp.c[c];
-            }
+            for (int c = 0; c < 3; ++c) light_sq[thread][pixel * 3 + c] += X[c] * X[c];
           }
         }
     }
