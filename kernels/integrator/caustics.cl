@@ -54,16 +54,71 @@ static inline void lc_atomic_add_float(volatile __global float* p, float v) {
 }
 #endif
 
+/* The light path's last connections (LC_CAUSTICS_HISTORY of them at most, in a ring): their film
+ * positions and contributions c, for the cross terms of the sums of squares. A light path's value
+ * at a pixel is the sum X = sum_k x_k of its connections' shares there (a path connects at every
+ * non-delta vertex from y_2 on, and a wide filter or a small film puts several of them in one
+ * pixel); the variance needs X^2, so share k adds x_k^2 + 2 x_k sum_{j<k} x_j, with the earlier
+ * shares x_j recomputed from their film positions by the same filter density. A connection more
+ * than LC_CAUSTICS_HISTORY connections back is forgotten: its cross terms are missing (the
+ * variance of a path with more connections than that is slightly low; docs/rendering-model.md). */
+#ifndef LC_CAUSTICS_HISTORY
+#define LC_CAUSTICS_HISTORY 16
+#endif
+#if LC_CAUSTICS_HISTORY < 1 || LC_CAUSTICS_HISTORY > 32
+#error "LC_CAUSTICS_HISTORY: 1 to 32 (a bit mask of them in caustics_splat)"
+#endif
+typedef struct {
+  float fx[LC_CAUSTICS_HISTORY], fy[LC_CAUSTICS_HISTORY];
+  float3 c[LC_CAUSTICS_HISTORY];
+  lc_uint n; /* connections splatted so far; the last min(n, LC_CAUSTICS_HISTORY) are kept */
+} lc_caustics_history;
+
+/* The earlier connections whose filter may share a pixel with one at (fx, fy) (each within 2 r
+ * of it on both axes), as a bit mask: usually none, and then the splat needs no cross terms. */
+static inline lc_uint caustics_history_near(const lc_caustics_history* h, float r, float fx,
+                                            float fy) {
+  lc_uint near = 0;
+  const lc_uint n = min(h->n, (lc_uint)LC_CAUSTICS_HISTORY);
+  for (lc_uint j = 0; j < n; ++j)
+    if (fabs(h->fx[j] - fx) <= 2.0f * r && fabs(h->fy[j] - fy) <= 2.0f * r) near |= 1u << j;
+  return near;
+}
+
+/* The sum of the earlier connections' shares (those in `near`) at the pixel of centre (cx, cy):
+ * those that caustics_splat kept (a share whose square is not a finite float was dropped; where
+ * the sums are floats, also one that the sum of squares could not take then, which is not
+ * recomputed). */
+static inline float3 caustics_history_at(const lc_caustics_history* h, lc_uint near, lc_uint filter,
+                                         float r, float cx, float cy) {
+  float3 sum = (float3)(0.0f);
+  for (lc_uint j = 0; j < (lc_uint)LC_CAUSTICS_HISTORY; ++j) {
+    const lc_uint rest = near >> j; /* j < 32: a defined shift */
+    if (!rest) break;
+    if (!(rest & 1u)) continue;
+    float dx = h->fx[j] - cx, dy = h->fy[j] - cy;
+    if (fabs(dx) > r || fabs(dy) > r) continue; /* beyond every filter's support */
+    float w = filter_density(filter, r, dx, dy);
+    if (!(w > 0.0f)) continue;
+    float3 v = h->c[j] * w;
+    if (lc_isfinite3(v * v)) sum += v;
+  }
+  return sum;
+}
+
 /* Adds contribution c (before the filter) at film position (fx, fy) to every pixel whose filter
- * reaches it, and its square to the sums of squares. Returns the number of pixel shares dropped:
- * a share (c times the filter's density there) whose square overflows a float, as the reference
- * judges each pixel's share, or, where the light sums are floats (no LC_LIGHT_DOUBLE), that would
- * take the pixel's float sum of squares past FLT_MAX (a few splats of 1e19 on one pixel in one
- * pass made its variance infinite). That second test reads the sum before the atomic adds:
- * work-items that race there may still pass it together, near 3.4e38. In double a pass's sums
- * keep every share the first test keeps, as the reference's do. */
+ * reaches it, and to the sums of squares the share's square plus twice its product with the
+ * earlier connections' shares in the same pixel (history h; the connection is then added to it).
+ * Returns the number of pixel shares dropped: a share (c times the filter's density there) whose
+ * square overflows a float, as the reference judges each pixel's share, or, where the light sums
+ * are floats (no LC_LIGHT_DOUBLE), that would take the pixel's float sum of squares past FLT_MAX (a
+ * few splats of 1e19 on one pixel in one pass made its variance infinite). That second test reads
+ * the sum before the atomic adds: work-items that race there may still pass it together,
+ * near 3.4e38. In double a pass's sums keep every share the first test keeps, as the reference's
+ * do. */
 static inline lc_uint caustics_splat(const lc_scene* s, float fx, float fy, float3 c,
-                                     __global lc_lsum4* light_sum, __global lc_lsum4* light_sumsq) {
+                                     __global lc_lsum4* light_sum, __global lc_lsum4* light_sumsq,
+                                     lc_caustics_history* h) {
   __global const lc_params* P = s->params;
   const float r = P->filter_radius;
   const int W = (int)P->width, H = (int)P->height;
@@ -72,6 +127,7 @@ static inline lc_uint caustics_splat(const lc_scene* s, float fx, float fy, floa
   int x0 = max(0, (int)ceil(fx - r - 0.5f)), x1 = min(W - 1, (int)floor(fx + r - 0.5f));
   int y0 = max(0, (int)ceil(fy - r - 0.5f)), y1 = min(H - 1, (int)floor(fy + r - 0.5f));
   lc_uint dropped = 0;
+  const lc_uint near = caustics_history_near(h, r, fx, fy);
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
       float w = filter_density(P->filter, r, fx - ((float)x + 0.5f), fy - ((float)y + 0.5f));
@@ -79,16 +135,22 @@ static inline lc_uint caustics_splat(const lc_scene* s, float fx, float fy, floa
       float3 v = c * w, v2 = v * v;
       volatile __global lc_lsum* a = (volatile __global lc_lsum*)&light_sum[y * W + x];
       volatile __global lc_lsum* b = (volatile __global lc_lsum*)&light_sumsq[y * W + x];
-#ifdef LC_LIGHT_DOUBLE
       if (!lc_isfinite3(v2)) {
-#else
-      if (!lc_isfinite3(v2) || !lc_isfinite3((float3)(b[0], b[1], b[2]) + v2)) {
-#endif
         ++dropped;
         continue;
       }
-      /* a share's square of floats is exact in double */
+      /* x_k^2 + 2 x_k sum_{j<k} x_j (a share's square of floats is exact in double) */
       lc_lsum3 lv = lc_lsum3_from(v), lv2 = lv * lv;
+      if (near)
+        lv2 += (lc_lsum)2 * lv *
+               lc_lsum3_from(
+                   caustics_history_at(h, near, P->filter, r, (float)x + 0.5f, (float)y + 0.5f));
+#ifndef LC_LIGHT_DOUBLE
+      if (!lc_isfinite3(lv2) || !lc_isfinite3((float3)(b[0], b[1], b[2]) + lv2)) {
+        ++dropped;
+        continue;
+      }
+#endif
       lc_atomic_add_lsum(a + 0, lv.x);
       lc_atomic_add_lsum(a + 1, lv.y);
       lc_atomic_add_lsum(a + 2, lv.z);
@@ -96,6 +158,11 @@ static inline lc_uint caustics_splat(const lc_scene* s, float fx, float fy, floa
       lc_atomic_add_lsum(b + 1, lv2.y);
       lc_atomic_add_lsum(b + 2, lv2.z);
     }
+  const lc_uint k = h->n % (lc_uint)LC_CAUSTICS_HISTORY;
+  h->fx[k] = fx;
+  h->fy[k] = fy;
+  h->c[k] = c;
+  ++h->n;
   return dropped;
 }
 
@@ -110,7 +177,7 @@ static inline lc_uint caustics_splat(const lc_scene* s, float fx, float fy, floa
 static inline lc_uint caustics_connect(const lc_scene* s, lc_ray ray, const lc_interaction* surf,
                                        const lc_bsdf* b_light, float lu, float lv, float3 beta,
                                        __global lc_lsum4* light_sum, __global lc_lsum4* light_sumsq,
-                                       lc_uint* rays) {
+                                       lc_caustics_history* h, lc_uint* rays) {
   const lc_real3 x = surf->p;
   __global const lc_params* P = s->params;
   __global const lc_camera* cam = &P->camera;
@@ -150,7 +217,7 @@ static inline lc_uint caustics_connect(const lc_scene* s, lc_ray ray, const lc_i
   float pitch = 2.0f * cam->tan_half_fov / (float)P->height;
   float3 c = beta * f * (cos_x / ((float)(dist * dist) * pitch * pitch * cos_c * cos_c * cos_c));
   if (!lc_isfinite3(c)) return 1u;
-  return caustics_splat(s, fx, fy, c, light_sum, light_sumsq);
+  return caustics_splat(s, fx, fy, c, light_sum, light_sumsq, h);
 }
 
 /* The light path of the camera sample rng (random numbers from LC_DIM_LIGHT_PATH). Returns the
@@ -168,6 +235,8 @@ static LC_POCL_NOINLINE lc_uint caustics_light_path(const lc_scene* s, const lc_
   if (!light_emit(s, ue.z, (float4)(ue.x, ue.y, ud.x, ud.y), &ray, &beta)) return 0;
   const float beta0 = lc_max3(beta);
   lc_uint nonfinite = 0;
+  lc_caustics_history h;
+  h.n = 0;
   int caustic = 0; /* 1 once the lobe sampled at y_1 was a delta one */
   /* scattering vertices 1 .. max_depth - 1: the camera path's segment limit */
   for (lc_uint i = 1; i < P->max_depth; ++i) {
@@ -184,7 +253,7 @@ static LC_POCL_NOINLINE lc_uint caustics_light_path(const lc_scene* s, const lc_
     float4 ua = uv.lo, ub = uv.hi;
     if (caustic && !(bsdf_lobes(&b) & LC_BSDF_DELTA))
       nonfinite +=
-          caustics_connect(s, ray, &surf, &b, ua.x, ua.y, beta, light_sum, light_sumsq, rays);
+          caustics_connect(s, ray, &surf, &b, ua.x, ua.y, beta, light_sum, light_sumsq, &h, rays);
     /* a light path goes on after a delta lobe at y_1, through any lobes after it */
     lc_frame fr = frame_from(it.ns);
     float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
