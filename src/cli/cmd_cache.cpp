@@ -17,8 +17,9 @@ std::string g_action;
 CLI::App* add_cache_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "cache",
-      "Manage the kernel binary cache (LUCENT_CACHE_DIR, default ~/.cache/lucent; unused on PoCL "
-      "while POCL_KERNEL_CACHE is on, PoCL's own cache serving instead)");
+      "Manage the kernel binary cache (LUCENT_CACHE_DIR, default $XDG_CACHE_HOME/lucent or "
+      "~/.cache/lucent; unused on PoCL while POCL_KERNEL_CACHE is on, PoCL's own cache serving "
+      "instead)");
   cmd->add_option("action", g_action,
                   "clear: remove every cached program; dir: print the directory")
       ->required()

@@ -427,8 +427,10 @@ CLI::App* add_render_command(CLI::App& app) {
   CLI::App* render = app.add_subcommand("render", "Render a JSON scene to an image");
   render->add_option("scene", ra.scene, "Scene file (JSON)")->required();
   render
-      ->add_option("-o,--output", ra.output,
-                   "Output image: .png (8-bit sRGB), .pfm or .exr (linear)")
+      ->add_option(
+          "-o,--output", ra.output,
+          "Output image: .png (8-bit, the film's transfer, exposure and tone map), .pfm or .exr "
+          "(linear)")
       ->required();
   render
       ->add_option("--spp", ra.spp,
