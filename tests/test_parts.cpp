@@ -875,6 +875,47 @@ TEST(Parts, MpiFailingRankEndsTheJobWithoutOutput) {
   EXPECT_NE(r.err.find("are missing (a rank stopped early)"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(out));
 }
+// A command line lucent-mpi cannot parse is one line and status 2, as for `lucent`: CLI11's own
+// exit printed two lines and exited 105, 106 or 109, a --time of nan passed the parser and ended
+// in a rank's MPI_Abort, and one of inf was refused naming 1.8e308 in 300 digits.
+TEST(Parts, MpiCommandLineErrorsAreOneLine) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  const std::string out = dir + "/mpi.exr";
+  // one process, without mpirun: MPI's singleton start (mpirun adds its own report of the status)
+  const std::string prog =
+      "env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+      "OMPI_MCA_btl_vader_single_copy_mechanism=none '" +
+      std::string(LUCENT_MPI_PATH) + "' ";
+  const std::pair<std::string, std::string> cases[] = {
+      {q(scene) + " -o " + q(out) + " --time nan", "--time: must be a finite number"},
+      {q(scene) + " -o " + q(out) + " --time inf", "--time: must be a finite number"},
+      {q(scene) + " -o " + q(out) + " --time 2e7", "--time: must be in (0, 1e7] seconds, got 2e7"},
+      {q(scene) + " -o " + q(out) + " --time -1", "--time: must be in (0, 1e7] seconds, got -1"},
+      {q(scene) + " -o " + q(out) + " --bogus", "--bogus"},
+      {q(scene) + " -o " + q(out) + " --spp 0", "--spp"},
+      {q(scene), "--output is required"}};
+  for (const auto& [args, says] : cases) {
+    CommandResult r = run_shell("timeout 60 " + prog + args, dir);
+    EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("lucent-mpi: error: ", 0), 0u) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find("(see lucent-mpi --help)\n"), std::string::npos) << args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out)) << args;
+  }
+  CommandResult help = run_shell("timeout 60 " + prog + "--help", dir);
+  EXPECT_EQ(help.status, 0) << help.err;
+  EXPECT_NE(help.out.find("--time"), std::string::npos) << help.out;
+  EXPECT_EQ(help.err, "");
+  // a valid time still renders
+  CommandResult ok =
+      run_shell("timeout 60 " + prog + q(scene) + " -q --spp 2 --time 1e7 -o " + q(out), dir);
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_TRUE(fs::exists(out));
+}
+
 // lucent-mpi's output may not be a file the scene reads (an environment map here): rank 0 wrote
 // over it, as `lucent render` refuses to.
 TEST(Parts, MpiRefusesToOverwriteWhatTheSceneReads) {

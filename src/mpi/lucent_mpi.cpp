@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -235,8 +236,17 @@ int main(int argc, char** argv) {
   app.add_option("-o,--output", a.output, "Output: .exr (a part file), .png or .pfm")->required();
   app.add_option("--spp", a.spp, "Samples per pixel in all (default: the scene's)")
       ->check(CLI::Range(1, lucent::limits::kMaxSpp));
-  app.add_option("--time", a.time_limit, "Each rank stops after this many seconds")
-      ->check(CLI::PositiveNumber);
+  // as `lucent render --time`: a finite number of seconds up to 1e7 (CLI::PositiveNumber let NaN
+  // through to a rank's MPI_Abort, and refused inf naming 1.8e308 in 300 digits)
+  app.add_option("--time", a.time_limit, "Each rank stops after this many seconds (at most 1e7)")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            double v = 0;
+            if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v))
+              return "must be a finite number of seconds, got " + text;
+            return v > 0 && v <= 1e7 ? "" : "must be in (0, 1e7] seconds, got " + text;
+          },
+          "SECONDS"));
   app.add_option("--width", a.width, "Image width")
       ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
   app.add_option("--height", a.height, "Image height")
@@ -257,10 +267,20 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     failed = 1;
     code = e.get_exit_code();
-    if (g_rank == 0)
-      parse_status = app.exit(e);
-    else
+    if (g_rank != 0) {
       message = e.what();
+    } else if (code == 0) {
+      parse_status = app.exit(e);  // --help, --version: stdout, status 0
+    } else {
+      // one line and status 2, as `lucent` says it (CLI11's own exit printed two lines and
+      // exited 105, 106 or 109)
+      std::string what = e.what();
+      for (char& c : what)
+        if (c == '\n') c = ' ';
+      std::fprintf(stderr, "lucent-mpi: error: %s (see lucent-mpi --help)\n",
+                   one_line(what).c_str());
+      parse_status = 2;
+    }
   }
   int root_failed = failed, any_failed = 0;
   MPI_Bcast(&root_failed, 1, MPI_INT, 0, MPI_COMM_WORLD);
