@@ -74,8 +74,7 @@ __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
   lc_uint gid = (lc_uint)get_global_id(0);
   lc_uint width = params->width, height = params->height;
   lc_rng rng;
-  rng.sampler = params->sampler;
-  lc_uint first, count;
+  lc_uint pixel, first, count;
 #ifdef LC_HAS_CAUSTICS
   lc_uint light_base = 0u; /* the light sums' first element for this work-item's stream */
   int trace_light = 1;
@@ -83,28 +82,28 @@ __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
   if (params->work_items > 0u) {
     if (gid >= params->work_items) return;
     uint4 e = work[gid];
-    rng.pixel = e.x;
+    pixel = e.x;
     first = e.y;
     count = e.z;
-    rng.seed = lc_stream_seed(params->seed, e.w);
+    lc_rng_init(&rng, pixel, lc_stream_seed(params->seed, e.w), params->sampler);
 #ifdef LC_HAS_CAUSTICS
     trace_light = e.w < 2u;
     light_base = trace_light ? e.w * width * height : 0u;
 #endif
   } else {
     if (gid >= width * height) return;
-    rng.pixel = gid;
+    pixel = gid;
     first = params->sample_offset;
     count = params->samples_per_pass;
-    rng.seed = params->seed;
+    lc_rng_init(&rng, pixel, params->seed, params->sampler);
   }
   lc_scene s = LC_SCENE_FROM_KERNEL_ARGS;
 
-  lc_uint px = rng.pixel % width, py = rng.pixel / width;
+  lc_uint px = pixel % width, py = pixel / width;
   lc_accum3 sum = (lc_accum3)(0.0f), sumsq = (lc_accum3)(0.0f);
   lc_uint accepted = 0, nonfinite = 0, rays = 0;
   for (lc_uint k = 0; k < count; ++k) {
-    rng.sample = first + k;
+    lc_rng_set_sample(&rng, first + k);
     float2 uf = lc_rand2(&rng, LC_DIM_FILTER);
     float2 off = filter_sample(params->filter, params->filter_radius, uf.x, uf.y);
 #ifdef LC_HAS_THIN_LENS

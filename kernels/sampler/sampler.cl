@@ -9,14 +9,28 @@
 #ifndef LUCENT_SAMPLER_SAMPLER_CL
 #define LUCENT_SAMPLER_SAMPLER_CL
 
+/* A camera sample's random-number state: its sample index and the folded words (LC_FOLD,
+ * shared/rng.h) of its pixel, sample index and seed, folded once per sample (lc_rng_init,
+ * lc_rng_set_sample) rather than at each number. */
 typedef struct {
-  lc_uint pixel, sample, seed, sampler;
+  lc_uint kpixel, sample, ksample, kseed, sampler;
 } lc_rng;
+
+static inline void lc_rng_init(lc_rng* r, lc_uint pixel, lc_uint seed, lc_uint sampler) {
+  r->kpixel = LC_FOLD(pixel);
+  r->kseed = LC_FOLD(seed);
+  r->sampler = sampler;
+  r->sample = r->ksample = 0u;
+}
+static inline void lc_rng_set_sample(lc_rng* r, lc_uint sample) {
+  r->sample = sample;
+  r->ksample = LC_FOLD(sample);
+}
 
 /* Numbers dim and dim + 1 (dim even). */
 #define LC_SAMPLER_PAIR(ID, Name, value, name, feature, file) \
   if (LC_ENABLED(feature) && r->sampler == LC_SAMPLER_##ID)   \
-    lc_##file##_pair(r->pixel, r->sample, dim >> 1, r->seed, w);
+    lc_##file##_pair_k(r->kpixel, r->sample, r->ksample, dim >> 1, r->kseed, w);
 static inline float2 lc_rand2(const lc_rng* r, lc_uint dim) {
   lc_uint w[2] = {0u, 0u};
   LC_SAMPLER_TYPES(LC_SAMPLER_PAIR)
@@ -31,9 +45,11 @@ static inline float2 lc_rand2(const lc_rng* r, lc_uint dim) {
 /* Sobol: lc_sobol_pair with rng.h's word operations on vectors (lane k: pair + k): the four keys,
  * shuffles and eight scrambles take the instructions of one, their chains of multiplications
  * overlapped. */
-static inline uint8 lc_sobol_pairs4(lc_uint pixel, lc_uint sample, lc_uint pair, lc_uint seed) {
-  uint4 x = (uint4)(LC_FOLD(pixel)), y = LC_FOLD((uint4)(pair) + (uint4)(0u, 1u, 2u, 3u));
-  uint4 z = (uint4)(LC_FOLD(seed)), w = (uint4)(0x50b01u);
+static inline uint8 lc_sobol_pairs4(lc_uint kpixel, lc_uint sample, lc_uint ksample, lc_uint pair,
+                                    lc_uint kseed) {
+  uint4 x = (uint4)(kpixel), y = LC_FOLD((uint4)(pair) + (uint4)(0u, 1u, 2u, 3u));
+  uint4 z = (uint4)(kseed), w = (uint4)(0x50b01u);
+  (void)ksample;
   LC_PCG4D(x, y, z, w)
   uint4 i = (uint4)(lc_reverse_bits(sample)); /* the shuffled index, as in lc_sobol_pair */
   LC_OWEN_HASH(i, x)
@@ -48,18 +64,19 @@ static inline uint8 lc_sobol_pairs4(lc_uint pixel, lc_uint sample, lc_uint pair,
 }
 
 /* Independent: two quads, scalar (in uint2 lanes they measured 2% slower). */
-static inline uint8 lc_independent_pairs4(lc_uint pixel, lc_uint sample, lc_uint pair,
-                                          lc_uint seed) {
+static inline uint8 lc_independent_pairs4(lc_uint kpixel, lc_uint sample, lc_uint ksample,
+                                          lc_uint pair, lc_uint kseed) {
   lc_uint a[4], c[4];
-  lc_independent_quad(pixel, sample, pair >> 1, seed, a);
-  lc_independent_quad(pixel, sample, (pair >> 1) + 1u, seed, c);
+  (void)sample;
+  lc_independent_quad_k(kpixel, ksample, pair >> 1, kseed, a);
+  lc_independent_quad_k(kpixel, ksample, (pair >> 1) + 1u, kseed, c);
   return (uint8)(a[0], a[1], a[2], a[3], c[0], c[1], c[2], c[3]);
 }
 
 /* Numbers dim .. dim + 7 (dim a multiple of 4): one bounce's, or a light path vertex's. */
 #define LC_SAMPLER_PAIRS4(ID, Name, value, name, feature, file) \
   if (LC_ENABLED(feature) && r->sampler == LC_SAMPLER_##ID)     \
-    q = lc_##file##_pairs4(r->pixel, r->sample, dim >> 1, r->seed);
+    q = lc_##file##_pairs4(r->kpixel, r->sample, r->ksample, dim >> 1, r->kseed);
 static inline float8 lc_rand8(const lc_rng* r, lc_uint dim) {
   uint8 q = (uint8)(0u);
   LC_SAMPLER_TYPES(LC_SAMPLER_PAIRS4)

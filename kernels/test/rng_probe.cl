@@ -13,10 +13,8 @@ __kernel void probe_rng(__global const uint4* query, uint sampler, __global floa
   size_t i = get_global_id(0);
   uint4 q = query[i];
   lc_rng r;
-  r.pixel = q.x;
-  r.sample = q.y;
-  r.seed = q.w;
-  r.sampler = sampler;
+  lc_rng_init(&r, q.x, q.w, sampler);
+  lc_rng_set_sample(&r, q.y);
   vstore8(lc_rand8(&r, q.z), 0, out + 10 * i);
   vstore2(lc_rand2(&r, q.z), 0, out + 10 * i + 8);
 }
