@@ -19,6 +19,7 @@
 #include "render/cancel_scope.hpp"
 #include "render/device_scene.hpp"
 #include "render/resources.hpp"
+#include "stability_scene.hpp"
 #include "support.hpp"
 #include "support/test_meshes.hpp"
 
@@ -888,6 +889,29 @@ TEST(Session, FloatRoundingLargeAgainstTheSceneWarns) {
   odd.spheres.push_back(odd.spheres[0]);
   odd.spheres.back().center.x = INFINITY;
   EXPECT_EQ(warnings_for(odd, lucent::Precision::Float), 0);
+}
+
+// In float precision the triangle test's products of three coordinate differences underflow in a
+// tiny scene (a Cornell box scaled by 1e-15 rendered half as bright, by 1e-16 black, without a
+// word; double renders it right): a warning says so below a size of 1e-10, in float only.
+TEST(Session, FloatTinySceneWarns) {
+  const std::string what = "in float precision, the intersection tests multiply coordinate";
+  auto warnings_for = [&](double scale, lucent::Precision precision) {
+    Scene s = lucent::test::map_positions(lucent::test::scene_from(kScene),
+                                          [&](glm::dvec3 p) { return scale * p; });
+    for (auto& sp : s.spheres) sp.radius *= scale;
+    Renderer r = session();
+    r.set_build_options(precision, false, true);
+    lucent::test::CaptureWarnings warnings;
+    r.set_scene(s);
+    int n = 0;
+    for (const std::string& w : warnings.all()) n += w.find(what) != std::string::npos;
+    return n;
+  };
+  EXPECT_EQ(warnings_for(1e-12, lucent::Precision::Float), 1);
+  EXPECT_EQ(warnings_for(1e-12, lucent::Precision::Double), 0);
+  EXPECT_EQ(warnings_for(1e-8, lucent::Precision::Float), 0);
+  EXPECT_EQ(warnings_for(1, lucent::Precision::Float), 0);
 }
 
 // A material colour above 1 reflects more light than it receives: a diffuse albedo of 2 rendered

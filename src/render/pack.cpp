@@ -129,7 +129,9 @@ static void warn_camera_precision(const Scene& scene, const PackedScene& p) {
 }
 
 std::string float_rounding_note(const PackedScene& packed) {
-  double largest = 0;  // the largest coordinate magnitude of a primitive
+  constexpr double kTinySceneSize = 1e-10;  // the diagonal of the scene's bounds, below which
+                                            // float's products underflow (see below)
+  double largest = 0;                       // the largest coordinate magnitude of a primitive
   std::vector<double> sizes;
   const size_t n = packed.triangles.size() + packed.spheres.size();
   const size_t stride = std::max<size_t>(1, n / 100000);  // a sample of at most ~1e5 sizes
@@ -169,6 +171,21 @@ std::string float_rounding_note(const PackedScene& packed) {
     diagonal += e * e;
   }
   diagonal = std::sqrt(diagonal);
+  // the triangle test's depth is a product of three coordinate differences between the ray's
+  // origin and the vertices (kernels/geom/triangle.cl: T), about size^3, which leaves float's
+  // normal range (1.2e-38) below a size of 2.3e-13: a Cornell box scaled by 1e-13 in float gave
+  // wrong distances, by 1e-15 half its brightness, by 1e-16 a black image; double renders them
+  // right. 1e-10: a margin of 100 for rays meeting primitives at a hundredth of the scene's size.
+  if (diagonal > 0 && diagonal < kTinySceneSize) {
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "in float precision, the intersection tests multiply coordinate differences "
+                  "whose products fall below float's range in a scene this small (size %.3g, "
+                  "below %.0e): primitives may be missed and the image too dark or black; use "
+                  "--precision double or scale the scene up",
+                  diagonal, kTinySceneSize);
+    return buf;
+  }
   // offsets beyond 1/8 of the small features (a huge ground triangle under small objects), or
   // coordinates 1000 times the scene's size (a scene far from the origin: its offsets and the
   // rounding of its hit points, a thousandth of its size, let rays out of closed shells at

@@ -44,7 +44,9 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous = nullptr
 /// percentile of primitive sizes: a triangle's longest edge, a sphere's diameter) or when its
 /// coordinates reach 1000 times the size of its bounds, "" otherwise.
 /// A ground triangle of 1e6 under a sphere of 0.01 rendered 16% too dark, a box of size 2 at 1e4
-/// leaked light along its inner edges; --precision double renders both right.
+/// leaked light along its inner edges; --precision double renders both right. Also when the
+/// scene's bounds are smaller than 1e-10 across: the triangle test's products of three coordinate
+/// differences underflow float (a Cornell box at 1e-16 rendered black, at 1e-15 half as bright).
 std::string float_rounding_note(const PackedScene& packed);
 
 /// The light table (src/render/lights.cpp): the scene's point and environment lights after the
