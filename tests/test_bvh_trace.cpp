@@ -746,3 +746,46 @@ TEST_F(BvhTrace, AxisAlignedCubeRaysInFacePlanes) {
 }
 
 }  // namespace
+
+namespace {
+
+// Coincident triangles (every centroid and box the same: the build splits them by count alone)
+// around the leaf limits (4 per block, 16 per leaf) and by the thousand: a ray through the
+// triangle hits it, closest hit and any-hit, and one that passes outside misses (targets within
+// 1e-6 of an edge are not judged).
+TEST_F(BvhTrace, CoincidentTriangles) {
+  for (int n : {4, 5, 16, 17, 64, 3000}) {
+    Scene s;
+    for (int i = 0; i < n; ++i) {
+      lc_triangle t{};
+      const float v[9] = {0, 0, 0.5f, 1, 0, 0.5f, 0, 1, 0.5f};
+      std::memcpy(t.v0, v, 12), std::memcpy(t.v1, v + 3, 12), std::memcpy(t.v2, v + 6, 12);
+      t.light = LC_INVALID;
+      s.tris.push_back(t);
+    }
+    Bvh b = lucent::bvh::build(s.tris, s.spheres);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<TraceRay> rays;
+    std::vector<int> expect;  // 1 hit, 0 miss, -1 not judged
+    for (int i = 0; i < 4000; ++i) {
+      const D3 o{u(rng), u(rng), -1.0}, p{u(rng) * 1.2 - 0.1, u(rng) * 1.2 - 0.1, 0.5};
+      rays.push_back(make_ray(o, p - o, (i & 1) ? 2.0f : INFINITY));
+      const double m = std::min({p.x, p.y, 1 - p.x - p.y});
+      expect.push_back(m > 1e-6 ? 1 : (m < -1e-6 ? 0 : -1));
+    }
+    for (bool any : {false, true}) {
+      auto h = trace(s, b, rays, any);
+      std::size_t bad = 0, hits = 0;
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        hits += h[i].prim != LC_INVALID;
+        if (expect[i] >= 0 && (h[i].prim != LC_INVALID) != (expect[i] == 1)) ++bad;
+        if (!any && h[i].prim != LC_INVALID) EXPECT_NEAR(h[i].t, 1.5 / rays[i].d[2], 1e-5) << n;
+      }
+      EXPECT_EQ(bad, 0u) << n << " triangles, any-hit " << any;
+      EXPECT_GT(hits, rays.size() / 4) << n;
+    }
+  }
+}
+
+}  // namespace
