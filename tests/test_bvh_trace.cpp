@@ -780,7 +780,9 @@ TEST_F(BvhTrace, CoincidentTriangles) {
       for (std::size_t i = 0; i < rays.size(); ++i) {
         hits += h[i].prim != LC_INVALID;
         if (expect[i] >= 0 && (h[i].prim != LC_INVALID) != (expect[i] == 1)) ++bad;
-        if (!any && h[i].prim != LC_INVALID) EXPECT_NEAR(h[i].t, 1.5 / rays[i].d[2], 1e-5) << n;
+        if (!any && h[i].prim != LC_INVALID) {
+          EXPECT_NEAR(h[i].t, 1.5 / rays[i].d[2], 1e-5) << n;
+        }
       }
       EXPECT_EQ(bad, 0u) << n << " triangles, any-hit " << any;
       EXPECT_GT(hits, rays.size() / 4) << n;
