@@ -46,12 +46,20 @@ static inline int light_sphere_sample(const lc_scene* s, __global const lc_light
   ls->L = lc_load3(L->p.sphere.radiance);
   ls->pdf = L->pdf_select / (2.0f * LC_PI * one_minus_cosmax);
   /* q is known to the sphere's ulps only (sphere_point_error), and so is where the shadow ray
-   * meets the light itself: stop short of it by a few of them too. A floor 0.5 under a sphere
-   * light of radius 4000 (ulps of 2.4e-4) lost a tenth of its light to the light's own surface
-   * with the relative margin alone. The margin lets through only an occluder within those few
-   * ulps of the light's surface, which float cannot tell from the surface anyway. */
-  ls->rel_margin =
-      fmax((lc_real)LC_SHADOW_REL_MARGIN, LC_REAL(4.0) * lc_max3r(sphere_point_error(c, r)) / dist);
+   * meets the light itself: stop short of it by a few of them, along the ray (over cos_l, as a
+   * triangle light does), never by less than 4 of them (a floor 0.5 under a sphere light of
+   * radius 4000, ulps of 2.4e-4, lost a tenth of its light to the light's own surface with a
+   * relative margin alone) nor, grazing, by more than the other lights' 2e-4 of dist. That fixed
+   * 2e-4 let through an occluder within it of the light: a lamp of radius 600 poking 0.27 through
+   * a ceiling, lit 80 away, showed 0.016 more of itself, +6% of its direct light (the
+   * smallpt-style room 0.8% bright with walls of triangles). Such an occluder within the few
+   * ulps is let through: float cannot tell it from the surface anyway. */
+  const lc_real ulps = LC_REAL(4.0) * lc_max3r(sphere_point_error(c, r));
+  const lc_real cos_l = -dot(ls->wi, n);
+  const lc_real along = ulps + LC_REAL(16.0) * LC_REAL_U * (lc_max3r(fabs(p)) + dist);
+  ls->rel_margin = fmax(ulps / dist, cos_l > LC_REAL(0.0) ? fmin((lc_real)LC_SHADOW_REL_MARGIN,
+                                                                 along / (cos_l * dist))
+                                                          : (lc_real)LC_SHADOW_REL_MARGIN);
   return 1;
 }
 
