@@ -964,10 +964,22 @@ TEST(Session, SphereLightCutThinAgainstFloatRoundingWarns) {
   const char* hanging = R"({"type": "sphere", "center": [50, 70, 81.6], "radius": 5,
                             "material": "lamp"})";
   EXPECT_EQ(warnings_for(room(poking, true), lucent::Precision::Float), 1);
-  EXPECT_EQ(warnings_for(room(poking, true), lucent::Precision::Double), 0);
+  EXPECT_EQ(warnings_for(room(poking, true), lucent::Precision::Double), 0);  // +0.5%, z 2
   EXPECT_EQ(warnings_for(room(hanging, true), lucent::Precision::Float), 0);
   // the ceiling a quad of +-100 around the room: offsets of 2.4e-4, the lamp's own margin 2.4e-3
   EXPECT_EQ(warnings_for(room(poking, false), lucent::Precision::Float), 0);
+  // walls of radius 1e6: the ceiling's centre, stored in float, moves it 0.025 up (its spacing
+  // there is 1/16), and the lamp's cut part from 0.27 to 0.295: 9.5% bright in double as well
+  // (image-mean z 38), which double's own note says
+  Scene wide = room(poking, true);
+  for (lucent::Sphere& sp : wide.spheres)
+    if (sp.radius == 1e5) {
+      for (int k = 0; k < 3; ++k)
+        if (std::abs(sp.center[k]) > 5e4) sp.center[k] += (sp.center[k] > 0 ? 9e5 : -9e5);
+      sp.radius = 1e6;
+    }
+  EXPECT_EQ(warnings_for(wide, lucent::Precision::Double), 1);
+  EXPECT_EQ(warnings_for(wide, lucent::Precision::Float), 1);
 }
 
 // A material colour above 1 reflects more light than it receives: a diffuse albedo of 2 rendered

@@ -231,7 +231,7 @@ double point_triangle_distance(const glm::dvec3& c, const glm::dvec3& a, const g
 
 }  // namespace
 
-std::string float_emitter_cut_note(const PackedScene& packed) {
+std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic) {
   // at most ~2e7 sphere-primitive tests: the first emitters only in a scene of very many
   const size_t prims = packed.triangles.size() + packed.spheres.size();
   const size_t most_emitters = std::max<size_t>(1, size_t(20000000) / std::max<size_t>(1, prims));
@@ -251,7 +251,10 @@ std::string float_emitter_cut_note(const PackedScene& packed) {
     const glm::dvec3 ce(E.center[0], E.center[1], E.center[2]);
     const double re = E.radius;
     // the shadow rays' margin short of the emitter, 4 of its point error bounds (light/sphere.cl)
-    const double own = (coord(E.center) + re) * std::ldexp(1.0, -19);
+    // (in double: the rounding of the stored coordinates, float in both precisions, which moved
+    // the ceiling of the room below with walls of radius 1e6 by 0.025, 9.5% bright in double)
+    const int own_exp = float_arithmetic ? -19 : -24, cutter_exp = float_arithmetic ? -20 : -24;
+    const double own = (coord(E.center) + re) * std::ldexp(1.0, own_exp);
     auto consider = [&](double h, double cutter) {  // h: the thinner part's depth
       const double m = std::max(own, cutter);
       if (h > 0 && m / h > worst) {
@@ -269,7 +272,7 @@ std::string float_emitter_cut_note(const PackedScene& packed) {
       if (!(d > std::abs(re - rs)) || !(d < re + rs)) continue;  // the surfaces do not cross
       // the plane of the crossing circle, x from ce towards cs: E's parts have depths re -+ x
       const double x = ((d - rs) * (d + rs) + re * re) / (2 * d);
-      consider(re - std::abs(x), (coord(S.center) + rs) * std::ldexp(1.0, -20));
+      consider(re - std::abs(x), (coord(S.center) + rs) * std::ldexp(1.0, cutter_exp));
     }
     for (const lc_triangle& t : packed.triangles) {
       const glm::dvec3 a(t.v0[0], t.v0[1], t.v0[2]), b(t.v1[0], t.v1[1], t.v1[2]),
@@ -288,20 +291,32 @@ std::string float_emitter_cut_note(const PackedScene& packed) {
       const double len = glm::length(n);
       if (!(len > 0)) continue;
       const double s = std::abs(glm::dot(ce - a, n / len));  // the plane cuts a cap of re - s
-      consider(re - s, std::max({coord(t.v0), coord(t.v1), coord(t.v2)}) * std::ldexp(1.0, -20));
+      consider(re - s,
+               std::max({coord(t.v0), coord(t.v1), coord(t.v2)}) * std::ldexp(1.0, cutter_exp));
     }
   }
   // the part's error is about 3% of m / h in the image (a lamp of radius 600 poking 0.27 through
   // a smallpt ceiling sphere of 1e5: m / h 0.7, 1.2% bright; poking 2: 0.1, 0.3%)
   if (!(worst > 1.0 / 16)) return "";
-  char buf[640];
-  std::snprintf(buf, sizeof buf,
-                "in float precision, a sphere light (radius %.3g) is cut by another surface into "
-                "a part only %.2g thick, and rays near it are offset by their rounding, up to "
-                "%.2g here: how much of the light shows may be wrong (a smallpt-style lamp poking "
-                "0.27 into a wall of radius 1e5 rendered 1.2%% bright); use --precision double, "
-                "walls of triangles instead of huge spheres, or a light farther from the cut",
-                worst_r, worst_h, worst_m);
+  char buf[720];
+  if (float_arithmetic)
+    std::snprintf(buf, sizeof buf,
+                  "in float precision, a sphere light (radius %.3g) is cut by another surface into "
+                  "a part only %.2g thick, and rays near it are offset by their rounding, up to "
+                  "%.2g here: how much of the light shows may be wrong (a smallpt-style lamp "
+                  "poking 0.27 into a wall of radius 1e5 rendered 1.2%% bright); use --precision "
+                  "double, walls of triangles instead of huge spheres, or a light farther from "
+                  "the cut",
+                  worst_r, worst_h, worst_m);
+  else
+    std::snprintf(buf, sizeof buf,
+                  "a sphere light (radius %.3g) is cut by another surface into a part only %.2g "
+                  "thick, and the scene's coordinates, stored in float in either precision, are "
+                  "rounded by up to %.2g there: how much of the light shows may be wrong (a "
+                  "smallpt-style lamp poking 0.27 into a wall of radius 1e6 rendered 9.5%% "
+                  "bright); use walls of triangles instead of huge spheres or move the cut nearer "
+                  "the origin",
+                  worst_r, worst_h, worst_m);
   return buf;
 }
 

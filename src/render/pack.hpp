@@ -49,13 +49,15 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous = nullptr
 /// differences underflow float (a Cornell box at 1e-16 rendered black, at 1e-15 half as bright).
 std::string float_rounding_note(const PackedScene& packed);
 
-/// In float precision, a sphere light cut by another surface (a sphere's or a triangle's) into a
-/// thin part: a warning's text when the larger of the two primitives' rounding (the cutter's
-/// spawn offsets, the light's shadow-ray margin of 4 point error bounds) exceeds 1/16 of that
-/// part's depth, "" otherwise. smallpt's lamp (radius 600) pokes 0.27 through a ceiling sphere
-/// of radius 1e5 whose offsets are 0.19: it rendered 2% bright (1.2% once the light's own margin
-/// was bounded) without a word. The first emitters only where emitters x primitives pass 2e7.
-std::string float_emitter_cut_note(const PackedScene& packed);
+/// A sphere light cut by another surface (a sphere's or a triangle's) into a thin part: a
+/// warning's text when the larger of the two primitives' rounding exceeds 1/16 of that part's
+/// depth, "" otherwise. With float arithmetic that rounding is the cutter's spawn offsets and the
+/// light's shadow-ray margin (4 point error bounds): smallpt's lamp (radius 600) pokes 0.27
+/// through a ceiling sphere of radius 1e5 whose offsets are 0.19, and rendered 2% bright (1.2%
+/// once the light's own margin was bounded) without a word. With double arithmetic it is the
+/// rounding of the coordinates stored in float (2^-24 of them): walls of radius 1e6 moved the
+/// ceiling by 0.025, 9.5% bright. The first emitters only where emitters x primitives pass 2e7.
+std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic);
 
 /// The light table (src/render/lights.cpp): the scene's point and environment lights after the
 /// area lights that pack_scene added for emissive shapes (`area_power`: their powers), each light's

@@ -524,12 +524,13 @@ struct Renderer::Impl {
         render_detail::check_precision_support(d, options.precision);
       t0 = clock_type::now();
       next = render_detail::pack_scene(s, uploaded ? &packed : nullptr, &bvh_reused);
-      if (options.precision == Precision::Float) {
+      if (options.precision == Precision::Float)
         if (std::string note = render_detail::float_rounding_note(next); !note.empty())
           scene_detail::warn(scene_detail::in_file(s.path, note));
-        if (std::string note = render_detail::float_emitter_cut_note(next); !note.empty())
-          scene_detail::warn(scene_detail::in_file(s.path, note));
-      }
+      if (std::string note =
+              render_detail::emitter_cut_note(next, options.precision == Precision::Float);
+          !note.empty())
+        scene_detail::warn(scene_detail::in_file(s.path, note));
     } catch (...) {
       give_notes();
       throw;
