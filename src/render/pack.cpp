@@ -320,6 +320,56 @@ std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic) {
   return buf;
 }
 
+std::string point_light_note(const PackedScene& packed, bool float_arithmetic) {
+  // at most ~2e7 light-primitive distances: the first point lights only in a scene of very many
+  const size_t prims = packed.triangles.size() + packed.spheres.size();
+  const size_t most_lights = std::max<size_t>(1, size_t(20000000) / std::max<size_t>(1, prims));
+  auto coord = [](const float* v) {
+    return std::max({std::abs(double(v[0])), std::abs(double(v[1])), std::abs(double(v[2]))});
+  };
+  const int surface_exp = float_arithmetic ? -20 : -24;  // spawn offsets, or storage alone
+  size_t lights = 0;
+  double worst = 0, worst_h = 0, worst_m = 0;
+  for (const lc_light& l : packed.lights) {
+    if (l.type != LC_LIGHT_POINT || lights++ >= most_lights) continue;
+    const float* pos = l.p.point.position;
+    const glm::dvec3 p(pos[0], pos[1], pos[2]);
+    double h = INFINITY, cutter = 0;  // the nearest surface's distance and coordinates there
+    for (const lc_sphere& sp : packed.spheres) {
+      if (!(sp.radius > 0) || !std::isfinite(sp.radius)) continue;
+      const double d = std::abs(
+          glm::length(glm::dvec3(sp.center[0], sp.center[1], sp.center[2]) - p) - sp.radius);
+      if (d < h) h = d, cutter = coord(sp.center) + sp.radius;
+    }
+    for (const lc_triangle& t : packed.triangles) {
+      const glm::dvec3 a(t.v0[0], t.v0[1], t.v0[2]), b(t.v1[0], t.v1[1], t.v1[2]),
+          c(t.v2[0], t.v2[1], t.v2[2]);
+      bool apart = false;  // the triangle's bounds farther than the nearest surface so far
+      for (int k = 0; k < 3 && !apart; ++k)
+        apart = std::min({a[k], b[k], c[k]}) > p[k] + h || std::max({a[k], b[k], c[k]}) < p[k] - h;
+      if (apart) continue;
+      const double d = point_triangle_distance(p, a, b, c);
+      if (d < h) h = d, cutter = std::max({coord(t.v0), coord(t.v1), coord(t.v2)});
+    }
+    // the light's position, stored in float, and the surface's rounding there
+    const double m =
+        std::max(coord(pos) * std::ldexp(1.0, -24), cutter * std::ldexp(1.0, surface_exp));
+    if (h > 0 && std::isfinite(h) && m / h > worst) worst = m / h, worst_h = h, worst_m = m;
+  }
+  if (!(worst > 1.0 / 256)) return "";
+  char buf[600];
+  std::snprintf(buf, sizeof buf,
+                "a point light lies %.2g from a surface, and the coordinates there are rounded by "
+                "up to %.2g (%s), %.2g of that distance: the light it casts near it may be wrong "
+                "(a light 0.01 above a floor at 1e4 from the origin was, pixel by pixel); move "
+                "the light farther from the surface or the scene nearer the origin",
+                worst_h, worst_m,
+                float_arithmetic ? "float precision's offsets and the stored floats"
+                                 : "the coordinates are stored in float in either precision",
+                worst);
+  return buf;
+}
+
 PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bvh_reused) {
   // what the kernel's 32-bit indices can reach, before anything is built: the BVH's leaf blocks
   // (one per primitive at worst) and the texels (a texture's offset and offset + y w + x are
