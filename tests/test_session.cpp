@@ -998,6 +998,22 @@ TEST(Session, PointLightCloseToASurfaceAgainstTheRoundingWarns) {
             0);
 }
 
+// Caustics reach a pixel through its filter only: with a near-delta filter (radius 1e-3) they
+// vanished from an image that looked complete, without a word (the film review). Not said for
+// a radius of 0.5, nor without a surface that makes caustics (the light paths are dropped).
+TEST(Session, CausticsWithATinyFilterWarn) {
+  const std::string what = "integrator.caustics with a filter radius of";
+  Scene s = lucent::test::scene_from(kScene);
+  s.integrator.caustics = true;
+  s.film.filter.radius = 1e-3;
+  EXPECT_EQ(warnings_containing(s, lucent::Precision::Float, what), 0);  // nothing makes caustics
+  s.materials[0].type = lucent::MaterialType::Dielectric;
+  s.materials[0].specular = glm::dvec3(1.0);
+  EXPECT_EQ(warnings_containing(s, lucent::Precision::Float, what), 1);
+  s.film.filter.radius = 0.5;
+  EXPECT_EQ(warnings_containing(s, lucent::Precision::Float, what), 0);
+}
+
 // A material colour above 1 reflects more light than it receives: a diffuse albedo of 2 rendered
 // a white furnace 1.73, without a word (diffuse_mirror refuses such values; the others warn),
 // and so does an albedo texture's texel (a PFM of 2s rendered 2.12). Once per session (a render

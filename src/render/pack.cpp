@@ -525,6 +525,17 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     for (const lc_triangle& t : p.triangles) any = any || delta(t.material);
     if (!any) P.flags &= ~LC_FLAG_CAUSTICS;
   }
+  // light paths reach a pixel through its filter only: a filter of a tiny radius (accepted, a
+  // near-delta filter) takes almost none of them, and makes the few it takes huge (its density
+  // 1/(4 r^2) or more), which the non-finite rule drops: the caustics vanished from an image that
+  // looked complete (the film review)
+  if ((P.flags & LC_FLAG_CAUSTICS) && scene.film.filter.radius < 0.05)
+    scene_detail::warn(scene_detail::in_file(
+        scene.path, "integrator.caustics with a filter radius of " +
+                        scene_detail::format_number(scene.film.filter.radius) +
+                        " pixels: light paths reach a pixel through its filter only, so few "
+                        "of them count and the caustics are faint or missing; use a radius of at "
+                        "least 0.5"));
 
   const bool reuse = previous && same_geometry(*previous, p);
   if (bvh_reused) *bvh_reused = reuse;
