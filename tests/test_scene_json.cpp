@@ -134,6 +134,9 @@ TEST(SceneJson, MissingFields) {
             "scene.json: /shapes/0: missing required field 'indices'");
   EXPECT_EQ(error_of(R"({"lights": [{"type": "point", "intensity": [1, 1, 1]}]})"),
             "scene.json: /lights/0: missing required field 'position'");
+  // an environment takes radiance or file: the message names both (it named radiance alone)
+  EXPECT_EQ(error_of(R"({"lights": [{"type": "environment"}]})"),
+            "scene.json: /lights/0: missing required field 'radiance' (or 'file', a map)");
   EXPECT_EQ(error_of(R"({"shapes": [{"center": [0, 0, 0]}]})"),
             "scene.json: /shapes/0: missing required field 'type'");
 }

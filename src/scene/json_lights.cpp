@@ -44,7 +44,10 @@ void parse_light(const JsonReader& r, const json& j, const std::string& p, Scene
         }
       } else {
         if (j.contains("scale")) r.fail(p + "/scale", "only allowed with file");
-        l.radiance = r.vec3(r.require(j, p, "radiance"), p + "/radiance");
+        // either key will do: the message names both (it named radiance alone)
+        if (!j.contains("radiance"))
+          r.fail(p, "missing required field 'radiance' (or 'file', a map)");
+        l.radiance = r.vec3(j["radiance"], p + "/radiance");
       }
       break;
     case LightType::Sphere:  // emissive shapes: refused by check_light_type above
