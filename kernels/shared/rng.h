@@ -53,7 +53,8 @@
 #define LC_DIM_RR 6u           /* pair with the next: Russian roulette                */
 #define LC_DIM_LIGHT_TEXEL 7u  /* across an env. map's texel (down: LC_DIM_LIGHT_UV+1) */
 /* The light path of a camera sample (integrator.caustics, docs/rendering-model.md): from
- * LC_DIM_LIGHT_PATH, +0,+1 point on the light, +2 light selection, +4,+5 emitted direction; then
+ * LC_DIM_LIGHT_PATH, +0,+1 point on the light, +2 light selection, +4,+5 emitted direction (the
+ * kernel's point light, which has no point to draw, takes its direction from +0,+1); then
  * 8 per scattering vertex i = 1, 2, ... from LC_DIM_LIGHT_PATH + 8 i with the offsets above
  * (+0,+1 the lens point of the vertex's connection to a thin-lens camera, +3 lobe, +4,+5 BSDF
  * direction, +6 Russian roulette). */
