@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -373,6 +374,29 @@ TEST(Resources, AddressSpaceLimitBoundsTheHost) {
             std::string::npos)
       << r.err;
   EXPECT_FALSE(lucent::test::read_file(dir + "/o.png").size() > 0);
+}
+
+// Short of memory at the end of a render, the EXR encoder (tinyexr, which does not check its
+// allocations) wrote through a null pointer: a part file's render (--samples) under an
+// address-space limit that its render fits ended in SIGSEGV without a word (the resources
+// review). The memory the encoder needs is now asked for first: one error line, status 1, no
+// file. Where this machine's limits let the render be refused up front instead, there is
+// nothing to check (skipped).
+TEST(Resources, ExrWriteShortOfMemoryIsAnErrorNotACrash) {
+  if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer cannot run under ulimit -v";
+  std::string dir = lucent::test::temp_dir();
+  auto r = lucent::test::run_cli("render " + q(lucent::test::source_path("scenes/whitted.json")) +
+                                     " -o " + q(dir + "/p.exr") +
+                                     " --width 2048 --height 2048 --integrator path --samples 0:1",
+                                 ulimit_v("2000000"));
+  if (r.err.find("more than the limit") != std::string::npos)
+    GTEST_SKIP() << "refused before the render here: " << r.err;
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("p.exr: cannot encode EXR: not enough memory for its encoder"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/p.exr"));
 }
 
 // The work-group size is 64 where the device and the kernel allow it, else the largest power of

@@ -51,6 +51,25 @@ io::ReadSpec part_read_spec() {
 
 std::string save_exr_to_memory(const std::string& path, const EXRImage& image,
                                const EXRHeader& header) {
+  // tinyexr does not check its allocations: short of memory (ulimit -v), its encoder wrote
+  // through a null pointer, and a part file's render ended in SIGSEGV after it had rendered (the
+  // resources review). Its peak is about twice the encoded file (its chunks, then the file in one
+  // block), and this function's copy a third; the encoded file is at most the raw pixels plus
+  // ZIP's few bytes per block. That much memory is asked for first and given back: where it
+  // cannot be had, a clear error instead of the crash.
+  std::uint64_t raw = 0;
+  for (int c = 0; c < header.num_channels; ++c)
+    raw += std::uint64_t(header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF ? 2 : 4) *
+           std::uint64_t(image.width) * std::uint64_t(image.height);
+  const std::uint64_t need = 3 * (raw + raw / 64) + (std::uint64_t(1) << 20);
+  if (void* probe = need <= SIZE_MAX ? std::malloc(static_cast<std::size_t>(need)) : nullptr) {
+    std::free(probe);
+  } else {
+    char mib[32];
+    std::snprintf(mib, sizeof mib, "%.0f", double(need) / (1 << 20));
+    throw Error(path + ": cannot encode EXR: not enough memory for its encoder (about " + mib +
+                " MiB; the address-space limit, ulimit -v, or the machine's memory)");
+  }
   unsigned char* memory = nullptr;
   const char* err = nullptr;
   size_t n = SaveEXRImageToMemory(&image, &header, &memory, &err);
