@@ -385,10 +385,10 @@ TEST(Resources, AddressSpaceLimitBoundsTheHost) {
 TEST(Resources, ExrWriteShortOfMemoryIsAnErrorNotACrash) {
   if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer cannot run under ulimit -v";
   std::string dir = lucent::test::temp_dir();
-  auto r = lucent::test::run_cli("render " + q(lucent::test::source_path("scenes/whitted.json")) +
-                                     " -o " + q(dir + "/p.exr") +
-                                     " --width 2048 --height 2048 --integrator path --samples 0:1",
-                                 ulimit_v("2000000"));
+  auto r = lucent::test::run_cli(
+      "render " + q(lucent::test::source_path("scenes/whitted.json")) + " -o " + q(dir + "/p.exr") +
+          " --width 2048 --height 2048 --integrator path --samples 0:1 -q",
+      ulimit_v("2000000"));
   if (r.err.find("more than the limit") != std::string::npos)
     GTEST_SKIP() << "refused before the render here: " << r.err;
   EXPECT_EQ(r.status, 1) << r.err;
