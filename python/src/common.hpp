@@ -214,6 +214,23 @@ V to_vec(py::handle o) {
   return v;
 }
 
+/// An integer argument's value (int_value): its sign and magnitude, `fits` false beyond 64 bits
+/// (either sign); `index` is the int itself (operator.index of the argument), for messages.
+struct IntValue {
+  bool fits = false, negative = false;
+  std::uint64_t magnitude = 0;
+  py::object index;
+};
+
+/// `arg` as an int (what operator.index takes: an int, a NumPy integer; a bool only when
+/// `allow_bool`): TypeError "<what> must be an integer, got <repr>" otherwise. The one
+/// conversion of int_argument and of the scene structs' integer fields.
+IntValue int_value(const IntArg& arg, const std::string& what, bool allow_bool);
+
+/// repr() of an int for messages ("an integer too long to show" past
+/// sys.get_int_max_str_digits()).
+std::string int_repr(py::handle value);
+
 /// `arg` as an integer in [lo, hi], the one check of the integer arguments of the session's
 /// methods (and render_reference's): TypeError naming `what` unless it is an integer (an int, a
 /// NumPy integer: what operator.index takes, not a float or a str); ValueError

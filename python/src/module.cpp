@@ -98,41 +98,50 @@ std::string range_bound(std::uint64_t n) {
   return std::to_string(n);
 }
 
-std::uint64_t int_argument(const IntArg& arg, const char* what, std::uint64_t lo, std::uint64_t hi,
-                           const char* note) {
-  const auto shown = [](py::handle v) {
-    try {
-      return py::repr(v).cast<std::string>();
-    } catch (py::error_already_set&) {  // an int past sys.get_int_max_str_digits()
-      return std::string("an integer too long to show");
-    }
-  };
-  py::object i = py::reinterpret_steal<py::object>(PyNumber_Index(arg.value.ptr()));
-  if (!i) {
+std::string int_repr(py::handle value) {
+  try {
+    return py::repr(value).cast<std::string>();
+  } catch (py::error_already_set&) {  // an int past sys.get_int_max_str_digits()
+    return "an integer too long to show";
+  }
+}
+
+IntValue int_value(const IntArg& arg, const std::string& what, bool allow_bool) {
+  py::handle v = arg.value;
+  IntValue out;
+  if (allow_bool || !py::isinstance<py::bool_>(v))
+    out.index = py::reinterpret_steal<py::object>(PyNumber_Index(v.ptr()));
+  if (!out.index) {
     PyErr_Clear();
-    throw py::type_error(std::string(what) + " must be an integer, got " + shown(arg.value));
+    throw py::type_error(what + " must be an integer, got " + int_repr(v));
   }
   int overflow = 0;
-  const long long x = PyLong_AsLongLongAndOverflow(i.ptr(), &overflow);
+  const long long x = PyLong_AsLongLongAndOverflow(out.index.ptr(), &overflow);
   if (x == -1 && PyErr_Occurred()) throw py::error_already_set();
-  bool in_range = false;
-  std::uint64_t v = 0;
-  if (overflow > 0) {  // 2**63 and more: within 64 bits?
-    const unsigned long long u = PyLong_AsUnsignedLongLong(i.ptr());
+  if (overflow == 0) {
+    out.fits = true;
+    out.negative = x < 0;
+    out.magnitude =
+        x < 0 ? static_cast<std::uint64_t>(-(x + 1)) + 1 : static_cast<std::uint64_t>(x);
+  } else if (overflow > 0) {  // 2**63 and more: within 64 bits?
+    const unsigned long long u = PyLong_AsUnsignedLongLong(out.index.ptr());
     if (PyErr_Occurred()) {
       PyErr_Clear();
     } else {
-      v = u;
-      in_range = v >= lo && v <= hi;
+      out.fits = true;
+      out.magnitude = u;
     }
-  } else if (overflow == 0 && x >= 0) {
-    v = static_cast<std::uint64_t>(x);
-    in_range = v >= lo && v <= hi;
   }
-  if (!in_range)
+  return out;
+}
+
+std::uint64_t int_argument(const IntArg& arg, const char* what, std::uint64_t lo, std::uint64_t hi,
+                           const char* note) {
+  const IntValue v = int_value(arg, what, /*allow_bool=*/true);
+  if (!v.fits || v.negative || v.magnitude < lo || v.magnitude > hi)
     throw py::value_error(std::string(what) + " must be an integer in [" + range_bound(lo) + ", " +
-                          range_bound(hi) + "]" + note + ", got " + shown(i));
-  return v;
+                          range_bound(hi) + "]" + note + ", got " + int_repr(v.index));
+  return v.magnitude;
 }
 
 void refuse_nul(const std::string& text, const char* what) {

@@ -120,39 +120,18 @@ py::class_<V> bind_vector_type(py::module_& m, const char* name) {
 /// function arguments", several lines that named neither the field nor its range.
 template <class I>
 I integer_value(const IntArg& arg, const std::string& what) {
-  py::handle v = arg.value;
-  py::object i = py::isinstance<py::bool_>(v)
-                     ? py::object()
-                     : py::reinterpret_steal<py::object>(PyNumber_Index(v.ptr()));
-  if (!i) {
-    PyErr_Clear();
-    throw py::type_error(what + " must be an integer, got " + py::repr(v).cast<std::string>());
-  }
-  int overflow = 0;
-  const long long x = PyLong_AsLongLongAndOverflow(i.ptr(), &overflow);
-  if (x == -1 && PyErr_Occurred()) throw py::error_already_set();
   using L = std::numeric_limits<I>;
-  if (overflow > 0 && !L::is_signed) {  // 2**63 .. 2**64 - 1
-    const unsigned long long u = PyLong_AsUnsignedLongLong(i.ptr());
-    if (PyErr_Occurred())
-      PyErr_Clear();
-    else if (u <= static_cast<unsigned long long>(L::max()))
-      return static_cast<I>(u);
-  } else if (overflow == 0 && (x < 0 ? L::is_signed && x >= static_cast<long long>(L::min())
-                                     : static_cast<unsigned long long>(x) <=
-                                           static_cast<unsigned long long>(L::max()))) {
-    return static_cast<I>(x);
-  }
-  const std::string lo =
-      L::is_signed ? "-" + range_bound(static_cast<std::uint64_t>(-(L::min() + 1)) + 1) : "0";
-  std::string shown;
-  try {
-    shown = py::repr(i).cast<std::string>();
-  } catch (py::error_already_set&) {  // an int past sys.get_int_max_str_digits()
-    shown = "an integer too long to show";
-  }
-  throw py::value_error(what + " must be an integer in [" + lo + ", " +
-                        range_bound(static_cast<std::uint64_t>(L::max())) + "], got " + shown);
+  const IntValue v = int_value(arg, what, /*allow_bool=*/false);
+  // the magnitude of the type's lowest value (2**31 for an int)
+  const std::uint64_t lowest = L::is_signed ? static_cast<std::uint64_t>(-(L::min() + 1)) + 1 : 0;
+  if (v.fits &&
+      (v.negative ? v.magnitude <= lowest : v.magnitude <= static_cast<std::uint64_t>(L::max())))
+    return v.negative ? static_cast<I>(-static_cast<long long>(v.magnitude - 1) - 1)
+                      : static_cast<I>(v.magnitude);
+  throw py::value_error(what + " must be an integer in [" +
+                        (L::is_signed ? "-" + range_bound(lowest) : std::string("0")) + ", " +
+                        range_bound(static_cast<std::uint64_t>(L::max())) + "], got " +
+                        int_repr(v.index));
 }
 
 /// An integer member (integer_value's checks, naming the class and the member).
