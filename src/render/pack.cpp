@@ -128,6 +128,61 @@ static void warn_camera_precision(const Scene& scene, const PackedScene& p) {
   scene_detail::warn(scene_detail::in_file(scene.path, buf));
 }
 
+namespace {
+
+/// The largest magnitude of a stored point's coordinates.
+double max_abs3(const float* v) {
+  return std::max({std::abs(double(v[0])), std::abs(double(v[1])), std::abs(double(v[2]))});
+}
+
+/// A sphere that rays can hit: a finite centre and a positive finite radius (pack_scene keeps
+/// the others, never hit).
+bool hittable(const lc_sphere& sp) {
+  return sp.radius > 0 && std::isfinite(sp.radius) && std::isfinite(sp.center[0]) &&
+         std::isfinite(sp.center[1]) && std::isfinite(sp.center[2]);
+}
+
+/// Whether the bounds of the triangle (a, b, c) lie farther than r from the point p on an axis.
+bool bounds_apart(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
+                  const glm::dvec3& p, double r) {
+  for (int k = 0; k < 3; ++k)
+    if (std::min({a[k], b[k], c[k]}) > p[k] + r || std::max({a[k], b[k], c[k]}) < p[k] - r)
+      return true;
+  return false;
+}
+
+/// How many lights the checks below compare with every primitive: at most ~2e7 tests, so the
+/// first lights only in a scene of very many (at least one).
+size_t most_against_every_primitive(const PackedScene& packed) {
+  const size_t prims = packed.triangles.size() + packed.spheres.size();
+  return std::max<size_t>(1, size_t(20000000) / std::max<size_t>(1, prims));
+}
+
+/// The distance from the point c to the triangle (a, b, d), in double.
+double point_triangle_distance(const glm::dvec3& c, const glm::dvec3& a, const glm::dvec3& b,
+                               const glm::dvec3& d) {
+  const glm::dvec3 n = glm::cross(b - a, d - a);
+  const double len = glm::length(n);
+  auto segment = [&](const glm::dvec3& p, const glm::dvec3& q) {
+    const glm::dvec3 e = q - p;
+    const double ee = glm::dot(e, e);
+    const double t = ee > 0 ? std::clamp(glm::dot(c - p, e) / ee, 0.0, 1.0) : 0.0;
+    return glm::length(c - (p + t * e));
+  };
+  const double edges = std::min({segment(a, b), segment(b, d), segment(d, a)});
+  if (!(len > 0)) return edges;
+  const glm::dvec3 u = n / len;
+  const double s = glm::dot(c - a, u);
+  const glm::dvec3 f =
+      c - s * u;  // c's foot on the plane: inside when on the inner side of all edges
+  if (glm::dot(glm::cross(b - a, f - a), u) >= 0 && glm::dot(glm::cross(d - b, f - b), u) >= 0 &&
+      glm::dot(glm::cross(a - d, f - d), u) >= 0)
+    return std::abs(s);
+  return edges;
+}
+
+}  // namespace
+
 std::string float_rounding_note(const PackedScene& packed) {
   constexpr double kTinySceneSize = 1e-10;  // the diagonal of the scene's bounds, below which
                                             // float's products underflow (see below)
@@ -153,9 +208,7 @@ std::string float_rounding_note(const PackedScene& packed) {
   }
   for (const lc_sphere& sp : packed.spheres) {
     // never hit (a non-finite centre counted as an infinite coordinate: "up to inf here")
-    if (!(sp.radius > 0) || !std::isfinite(sp.radius) || !std::isfinite(sp.center[0]) ||
-        !std::isfinite(sp.center[1]) || !std::isfinite(sp.center[2]))
-      continue;
+    if (!hittable(sp)) continue;
     for (int c = 0; c < 3; ++c)
       largest = std::max(largest, std::abs(double(sp.center[c])) + sp.radius);
     if (i++ % stride == 0) sizes.push_back(2.0 * sp.radius);
@@ -204,49 +257,13 @@ std::string float_rounding_note(const PackedScene& packed) {
   return buf;
 }
 
-namespace {
-
-/// The distance from the point c to the triangle (a, b, d), in double.
-double point_triangle_distance(const glm::dvec3& c, const glm::dvec3& a, const glm::dvec3& b,
-                               const glm::dvec3& d) {
-  const glm::dvec3 n = glm::cross(b - a, d - a);
-  const double len = glm::length(n);
-  auto segment = [&](const glm::dvec3& p, const glm::dvec3& q) {
-    const glm::dvec3 e = q - p;
-    const double ee = glm::dot(e, e);
-    const double t = ee > 0 ? std::clamp(glm::dot(c - p, e) / ee, 0.0, 1.0) : 0.0;
-    return glm::length(c - (p + t * e));
-  };
-  const double edges = std::min({segment(a, b), segment(b, d), segment(d, a)});
-  if (!(len > 0)) return edges;
-  const glm::dvec3 u = n / len;
-  const double s = glm::dot(c - a, u);
-  const glm::dvec3 f =
-      c - s * u;  // c's foot on the plane: inside when on the inner side of all edges
-  if (glm::dot(glm::cross(b - a, f - a), u) >= 0 && glm::dot(glm::cross(d - b, f - b), u) >= 0 &&
-      glm::dot(glm::cross(a - d, f - d), u) >= 0)
-    return std::abs(s);
-  return edges;
-}
-
-}  // namespace
-
 std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic) {
-  // at most ~2e7 sphere-primitive tests: the first emitters only in a scene of very many
-  const size_t prims = packed.triangles.size() + packed.spheres.size();
-  const size_t most_emitters = std::max<size_t>(1, size_t(20000000) / std::max<size_t>(1, prims));
+  const size_t most_emitters = most_against_every_primitive(packed);
   size_t emitters = 0;
   double worst = 0, worst_h = 0, worst_m = 0, worst_r = 0;
-  auto coord = [](const float* v) {
-    return std::max({std::abs(double(v[0])), std::abs(double(v[1])), std::abs(double(v[2]))});
-  };
-  auto usable = [](const lc_sphere& sp) {
-    return sp.radius > 0 && std::isfinite(sp.radius) && std::isfinite(sp.center[0]) &&
-           std::isfinite(sp.center[1]) && std::isfinite(sp.center[2]);
-  };
   for (size_t e = 0; e < packed.spheres.size() && emitters < most_emitters; ++e) {
     const lc_sphere& E = packed.spheres[e];
-    if (E.light == LC_INVALID || !usable(E)) continue;
+    if (E.light == LC_INVALID || !hittable(E)) continue;
     ++emitters;
     const glm::dvec3 ce(E.center[0], E.center[1], E.center[2]);
     const double re = E.radius;
@@ -254,7 +271,7 @@ std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic) {
     // (in double: the rounding of the stored coordinates, float in both precisions, which moved
     // the ceiling of the room below with walls of radius 1e6 by 0.025, 9.5% bright in double)
     const int own_exp = float_arithmetic ? -19 : -24, cutter_exp = float_arithmetic ? -20 : -24;
-    const double own = (coord(E.center) + re) * std::ldexp(1.0, own_exp);
+    const double own = (max_abs3(E.center) + re) * std::ldexp(1.0, own_exp);
     auto consider = [&](double h, double cutter) {  // h: the thinner part's depth
       const double m = std::max(own, cutter);
       if (h > 0 && m / h > worst) {
@@ -266,23 +283,18 @@ std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic) {
     };
     for (size_t i = 0; i < packed.spheres.size(); ++i) {
       const lc_sphere& S = packed.spheres[i];
-      if (i == e || !usable(S)) continue;
+      if (i == e || !hittable(S)) continue;
       const glm::dvec3 cs(S.center[0], S.center[1], S.center[2]);
       const double rs = S.radius, d = glm::length(cs - ce);
       if (!(d > std::abs(re - rs)) || !(d < re + rs)) continue;  // the surfaces do not cross
       // the plane of the crossing circle, x from ce towards cs: E's parts have depths re -+ x
       const double x = ((d - rs) * (d + rs) + re * re) / (2 * d);
-      consider(re - std::abs(x), (coord(S.center) + rs) * std::ldexp(1.0, cutter_exp));
+      consider(re - std::abs(x), (max_abs3(S.center) + rs) * std::ldexp(1.0, cutter_exp));
     }
     for (const lc_triangle& t : packed.triangles) {
       const glm::dvec3 a(t.v0[0], t.v0[1], t.v0[2]), b(t.v1[0], t.v1[1], t.v1[2]),
           c(t.v2[0], t.v2[1], t.v2[2]);
-      // a quick rejection: the triangle's bounds miss the sphere's
-      bool apart = false;
-      for (int k = 0; k < 3 && !apart; ++k)
-        apart =
-            std::min({a[k], b[k], c[k]}) > ce[k] + re || std::max({a[k], b[k], c[k]}) < ce[k] - re;
-      if (apart) continue;
+      if (bounds_apart(a, b, c, ce, re)) continue;  // the triangle's bounds miss the sphere's
       // inside the sphere entirely: it cuts no part of its surface
       if (glm::length(a - ce) < re && glm::length(b - ce) < re && glm::length(c - ce) < re)
         continue;
@@ -291,8 +303,8 @@ std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic) {
       const double len = glm::length(n);
       if (!(len > 0)) continue;
       const double s = std::abs(glm::dot(ce - a, n / len));  // the plane cuts a cap of re - s
-      consider(re - s,
-               std::max({coord(t.v0), coord(t.v1), coord(t.v2)}) * std::ldexp(1.0, cutter_exp));
+      consider(re - s, std::max({max_abs3(t.v0), max_abs3(t.v1), max_abs3(t.v2)}) *
+                           std::ldexp(1.0, cutter_exp));
     }
   }
   // the part's error is about 3% of m / h in the image (a lamp of radius 600 poking 0.27 through
@@ -321,12 +333,7 @@ std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic) {
 }
 
 std::string point_light_note(const PackedScene& packed, bool float_arithmetic) {
-  // at most ~2e7 light-primitive distances: the first point lights only in a scene of very many
-  const size_t prims = packed.triangles.size() + packed.spheres.size();
-  const size_t most_lights = std::max<size_t>(1, size_t(20000000) / std::max<size_t>(1, prims));
-  auto coord = [](const float* v) {
-    return std::max({std::abs(double(v[0])), std::abs(double(v[1])), std::abs(double(v[2]))});
-  };
+  const size_t most_lights = most_against_every_primitive(packed);
   const int surface_exp = float_arithmetic ? -20 : -24;  // spawn offsets, or storage alone
   size_t lights = 0;
   double worst = 0, worst_h = 0, worst_m = 0;
@@ -336,24 +343,21 @@ std::string point_light_note(const PackedScene& packed, bool float_arithmetic) {
     const glm::dvec3 p(pos[0], pos[1], pos[2]);
     double h = INFINITY, cutter = 0;  // the nearest surface's distance and coordinates there
     for (const lc_sphere& sp : packed.spheres) {
-      if (!(sp.radius > 0) || !std::isfinite(sp.radius)) continue;
+      if (!hittable(sp)) continue;
       const double d = std::abs(
           glm::length(glm::dvec3(sp.center[0], sp.center[1], sp.center[2]) - p) - sp.radius);
-      if (d < h) h = d, cutter = coord(sp.center) + sp.radius;
+      if (d < h) h = d, cutter = max_abs3(sp.center) + sp.radius;
     }
     for (const lc_triangle& t : packed.triangles) {
       const glm::dvec3 a(t.v0[0], t.v0[1], t.v0[2]), b(t.v1[0], t.v1[1], t.v1[2]),
           c(t.v2[0], t.v2[1], t.v2[2]);
-      bool apart = false;  // the triangle's bounds farther than the nearest surface so far
-      for (int k = 0; k < 3 && !apart; ++k)
-        apart = std::min({a[k], b[k], c[k]}) > p[k] + h || std::max({a[k], b[k], c[k]}) < p[k] - h;
-      if (apart) continue;
+      if (bounds_apart(a, b, c, p, h)) continue;  // farther than the nearest surface so far
       const double d = point_triangle_distance(p, a, b, c);
-      if (d < h) h = d, cutter = std::max({coord(t.v0), coord(t.v1), coord(t.v2)});
+      if (d < h) h = d, cutter = std::max({max_abs3(t.v0), max_abs3(t.v1), max_abs3(t.v2)});
     }
     // the light's position, stored in float, and the surface's rounding there
     const double m =
-        std::max(coord(pos) * std::ldexp(1.0, -24), cutter * std::ldexp(1.0, surface_exp));
+        std::max(max_abs3(pos) * std::ldexp(1.0, -24), cutter * std::ldexp(1.0, surface_exp));
     if (h > 0 && std::isfinite(h) && m / h > worst) worst = m / h, worst_h = h, worst_m = m;
   }
   if (!(worst > 1.0 / 256)) return "";
