@@ -311,14 +311,13 @@ void validate_mesh(const MeshShape& m, const Reporter& at) {
 
 namespace {
 
-// A texture coordinate the device can hold: finite, and within float range.
-bool finite_uv(const glm::dvec2& uv) {
-  return std::abs(uv.x) <= FLT_MAX && std::abs(uv.y) <= FLT_MAX;  // false for NaN
-}
-
-// A shading normal the device can hold: finite, and within float range.
-bool float_normal(const glm::dvec3& n) {
-  return std::abs(n.x) <= FLT_MAX && std::abs(n.y) <= FLT_MAX && std::abs(n.z) <= FLT_MAX;
+// A vector the device can hold (a texture coordinate, a shading normal): finite, and within
+// float range.
+template <int N>
+bool fits_float(const glm::vec<N, double>& v) {
+  for (int c = 0; c < N; ++c)
+    if (!(std::abs(v[c]) <= FLT_MAX)) return false;  // NaN too
+  return true;
 }
 
 // A triangle's normal or uv indices: three indices, or -1 for all three (none).
@@ -422,11 +421,11 @@ void validate_scene(const Scene& s) {
     // finite uvs, as add_mesh and the OBJ loader require: set from Python (Scene.uvs), a NaN or
     // an infinite one made the reference's every lookup NaN (the surface black: each sample
     // dropped) while the kernel read the texel at uv 0
-    for (int k = 0; k < 3 && ok && has_uv; ++k) ok = finite_uv(s.uvs[t.uv[k]]);
+    for (int k = 0; k < 3 && ok && has_uv; ++k) ok = fits_float(s.uvs[t.uv[k]]);
     // normals too (add_mesh and the OBJ loader require finite ones and store them unit
     // length): set from Python (Scene.normals), an infinite one, or one beyond float range,
     // made the kernel's shading normal NaN, the surface black without a non-finite sample
-    for (int k = 0; k < 3 && ok && has_n; ++k) ok = float_normal(s.normals[t.n[k]]);
+    for (int k = 0; k < 3 && ok && has_n; ++k) ok = fits_float(s.normals[t.n[k]]);
     // some indices given and some not (0, 1, -1), or one below -1: the triangle's normals or
     // uvs were ignored without a word (they are used when all three are given)
     ok = ok && all_or_none(t.n) && all_or_none(t.uv);
