@@ -3,6 +3,7 @@
 // that must end in one line and a non-zero exit within seconds and bounded memory. The limits are
 // shrunk (DeviceLimits, ScopedLimitOverride) so that small scenes stand for huge ones.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/session.hpp"
@@ -376,27 +378,98 @@ TEST(Resources, AddressSpaceLimitBoundsTheHost) {
   EXPECT_FALSE(lucent::test::read_file(dir + "/o.png").size() > 0);
 }
 
+/// In a death test's child: write_render_exr of a 2048x2048 render with the address space
+/// capped; exits 3 after printing its lucent::Error, 0 when the write succeeded.
+[[noreturn]] void write_exr_under_cap(const std::string& path) {
+  const int w = 2048, h = 2048;
+  const size_t n = size_t(w) * h;
+  lucent::RenderResult r;
+  r.mean = lucent::Image{w, h, std::vector<float>(n * 3, 0.5f)};
+  r.variance = lucent::Image{w, h, std::vector<float>(n * 3, 0.25f)};
+  r.samples.assign(n, 4);
+  // what the process maps now, plus the planes write_render_exr makes (24 bytes a pixel)
+  // and 32 MiB: the encoder's twice 28 bytes a pixel cannot be had
+  std::uint64_t vm_kib = 0;
+  std::FILE* f = std::fopen("/proc/self/status", "r");
+  char line[256];
+  while (f && std::fgets(line, sizeof line, f))
+    if (std::sscanf(line, "VmSize: %lu", &vm_kib) == 1) break;
+  if (f) std::fclose(f);
+  rlimit cap{};
+  cap.rlim_cur = cap.rlim_max = vm_kib * 1024 + n * 24 + (32u << 20);
+  if (vm_kib == 0 || setrlimit(RLIMIT_AS, &cap) != 0) std::exit(2);
+  try {
+    lucent::write_render_exr(path, r);
+  } catch (const lucent::Error& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    std::exit(3);
+  }
+  std::exit(0);
+}
+
 // Short of memory at the end of a render, the EXR encoder (tinyexr, which does not check its
 // allocations) wrote through a null pointer: a part file's render (--samples) under an
 // address-space limit that its render fits ended in SIGSEGV without a word (the resources
-// review). The memory the encoder needs is now asked for first: one error line, status 1, no
-// file. Where this machine's limits let the render be refused up front instead, there is
-// nothing to check (skipped).
-TEST(Resources, ExrWriteShortOfMemoryIsAnErrorNotACrash) {
+// review). The memory the encoder needs is now asked for first: an error, no file. (Run in a
+// child whose address space is capped just above what it holds with the image's planes.)
+TEST(Resources, ExrEncoderShortOfMemoryIsAnErrorNotACrash) {
+  if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer cannot run under an address-space cap";
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const std::string path = lucent::test::temp_dir() + "/p.exr";
+  EXPECT_EXIT(write_exr_under_cap(path), testing::ExitedWithCode(3),
+              "p.exr: cannot encode EXR: not enough memory for its encoder");
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+// Writing an output takes memory of its own after the render: a part file about 278 bytes a
+// pixel at most (its sums, their 32-bit words, planes and the EXR encoder), against the
+// session's 160. Under an address-space limit that the session's estimate fit, the render
+// ran and its write then failed (the render lost) or crashed. It is now refused before
+// rendering, naming the write.
+TEST(Resources, OutputTooLargeToWriteIsRefusedBeforeRendering) {
   if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer cannot run under ulimit -v";
   std::string dir = lucent::test::temp_dir();
-  auto r = lucent::test::run_cli(
-      "render " + q(lucent::test::source_path("scenes/whitted.json")) + " -o " + q(dir + "/p.exr") +
-          " --width 2048 --height 2048 --integrator path --samples 0:1 -q",
-      ulimit_v("2000000"));
-  if (r.err.find("more than the limit") != std::string::npos)
-    GTEST_SKIP() << "refused before the render here: " << r.err;
+  lucent::test::write_file(dir + "/s.json", grid_scene(2, 4));
+  auto t0 = std::chrono::steady_clock::now();
+  auto r = lucent::test::run_cli("render " + q(dir + "/s.json") + " -o " + q(dir + "/p.exr") +
+                                     " --width 2048 --height 2048 --samples 0:1 -q",
+                                 ulimit_v("1000000"));
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_LT(seconds, 10);
   EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find("p.exr: cannot encode EXR: not enough memory for its encoder"),
+  EXPECT_NE(r.err.find("s.json: rendering needs about 1.1 GiB of host memory, more than the limit "
+                       "of 781.2 MiB (80% of the address-space limit (ulimit -v)); the largest "
+                       "part is writing "),
             std::string::npos)
       << r.err;
+  EXPECT_NE(r.err.find("p.exr (2048x2048) (906.5 MiB): reduce the film size"), std::string::npos)
+      << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/p.exr"));
+}
+
+// What an application keeps beside a session (SessionOptions::reserved_host_bytes: `lucent
+// render` declares its outputs there) counts in the session's estimate.
+TEST(Resources, SessionCountsWhatTheApplicationReserves) {
+  Scene s = lucent::load_scene(textured_scene_file(64, 64, 32));
+  s.path = "t.json";
+  DeviceLimits lim;
+  lim.host_mem = 8 << 20;
+  ScopedLimitOverride o(lim);
+  lucent::SessionOptions so = lucent::test::session_options();
+  so.reserved_host_bytes = 10 << 20;
+  {
+    lucent::Renderer r(so);
+    const std::string msg = error_of([&] { r.set_scene(s); });
+    EXPECT_EQ(msg.rfind("t.json: rendering needs about ", 0), 0u) << msg;
+    EXPECT_NE(msg.find("the largest part is what the application keeps beside the session (its "
+                       "outputs, as it declared them) (10.0 MiB): reduce the film size"),
+              std::string::npos)
+        << msg;
+  }
+  so.reserved_host_bytes = 1 << 20;
+  lucent::Renderer r(so);
+  EXPECT_EQ(error_of([&] { r.set_scene(s); }), "");
 }
 
 // The work-group size is 64 where the device and the kernel allow it, else the largest power of

@@ -80,6 +80,10 @@ RenderResult part_result(const RenderPart& part);
 /// Writes a part file (an OpenEXR: the render's R, G, B, var.*, n layers, which `lucent compare`
 /// reads, plus the raw double sums and the header as attributes; docs/parts.md), atomically.
 void write_render_part(const std::string& path, const RenderPart& part);
+/// The host memory write_render_part allocates for a width x height part, beside the part
+/// itself (its planes, the sums' 32-bit words and the EXR encoder), at most: for a front end's
+/// check before it renders.
+std::uint64_t part_write_bytes(int width, int height);
 /// Reads a part file; throws lucent::Error naming the file and what is wrong.
 RenderPart read_render_part(const std::string& path);
 /// Reads only a part file's header.

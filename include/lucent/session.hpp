@@ -49,6 +49,11 @@ struct SessionOptions {
   bool fast_math = false;                  ///< -cl-fast-relaxed-math (default: IEEE math)
   bool specialize = true;                  ///< compile only the features the scene uses
   double pass_seconds = 0.25;              ///< target duration of one kernel launch
+  /// Host memory the application holds beside the session while the session lives (an output
+  /// being written, another result kept), in bytes: added to the estimate by which set_scene and
+  /// render_adaptive refuse, before rendering, a film too large for the host's memory, so that a
+  /// render is not lost to its write. `lucent render` declares its outputs here.
+  std::uint64_t reserved_host_bytes = 0;
   /// Warnings of scene packing (skipped triangles, ...); null: "lucent: warning: ..." on stderr.
   /// A session gives each warning about its scenes once, however often set_scene meets it.
   WarningSink on_warning;

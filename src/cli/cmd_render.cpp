@@ -29,6 +29,7 @@
 #include "lucent/parts.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/types.hpp"
+#include "render/resources.hpp"
 #include "render/sample_stats.hpp"
 
 namespace lucent::cli {
@@ -260,6 +261,39 @@ int render_with(const RenderArgs& a) {
   lucent::cli::apply_sampling_options(a.sampling, scene);
   if (range) lucent::check_part_scene(scene, a.scene);
 
+  // The outputs' memory, counted before rendering: a render refused up front rather than lost to
+  // its write (the resources review: a part file's write took 2.5 times the session's estimate).
+  // Without AOVs the session is gone before the output is written; with them it lives on.
+  const int fw = scene.film.width, fh = scene.film.height;
+  const std::uint64_t npix = std::uint64_t(fw) * std::uint64_t(fh);
+  const std::string film = std::to_string(fw) + "x" + std::to_string(fh);
+  // a RenderResult's mean, variance and counts; an accumulation's sums, squares and counts
+  const std::uint64_t result_bytes = npix * (6 * sizeof(float) + sizeof(std::uint32_t));
+  const std::uint64_t acc_bytes = npix * (6 * sizeof(double) + sizeof(std::uint32_t));
+  const std::uint64_t write_bytes =
+      range ? lucent::part_write_bytes(fw, fh)
+            : (lucent::io::lower_extension(a.output) == ".exr"
+                   ? lucent::image_detail::render_exr_write_bytes(fw, fh, true)
+                   : lucent::image_detail::image_write_bytes(a.output, fw, fh));
+  std::uint64_t reserved = 0;                              // beside a live session
+  std::vector<lucent::render_detail::MemoryPart> outputs;  // after it (checked with the scene)
+  if (!a.aovs.empty()) {
+    // the main image's write, then each AOV's result and file
+    reserved = write_bytes;
+    for (const std::string& name : a.aovs)
+      reserved =
+          std::max(reserved,
+                   name == "variance"
+                       ? lucent::image_detail::image_write_bytes(aov_path(a.output, name), fw, fh)
+                       : result_bytes + lucent::image_detail::render_exr_write_bytes(fw, fh, true));
+  } else {
+    if (range) reserved = acc_bytes;  // the part's copy of the sums, made before the session goes
+    const std::string kept = range ? "the part's sums of the " + film + " film"
+                                   : "the result images of the " + film + " film";
+    outputs = {{kept, range ? acc_bytes : result_bytes, "the film size"},
+               {"writing " + one_line(a.output) + " (" + film + ")", write_bytes, "the film size"}};
+  }
+
   lucent::RenderOptions opt;
   opt.spp = a.spp;
   opt.time_limit = a.time_limit;
@@ -288,6 +322,16 @@ int render_with(const RenderArgs& a) {
       printed = true;
     };
   }
+  // before any device is opened or kernel built: the session's estimate without its devices'
+  // parts (set_scene checks it again with them), then the outputs'
+  if (!a.reference) {
+    std::string what;
+    const std::uint64_t limit = lucent::render_detail::host_memory_allowed(&what);
+    lucent::render_detail::check_host_memory(scene, {}, limit, what,
+                                             lucent::render_detail::reserved_part(reserved));
+  }
+  if (!outputs.empty()) lucent::render_detail::check_output_host_memory(scene, outputs);
+
   lucent::RenderResult r;
   std::optional<lucent::Renderer> renderer;
   double wall = 0;  // of the kernel render (several devices: their passes overlap)
@@ -301,6 +345,7 @@ int render_with(const RenderArgs& a) {
     so.precision = opt.precision;
     so.fast_math = opt.fast_math;
     so.specialize = opt.specialize;
+    so.reserved_host_bytes = reserved;
     renderer.emplace(so);
     renderer->set_cancel_flag(&g_interrupted);
     try {
@@ -345,9 +390,17 @@ int render_with(const RenderArgs& a) {
                                   scene.film.tonemap};
   // every sample non-finite: nothing written (a part keeps its counts, and is written)
   if (!range) lucent::render_detail::check_some_sample_finite(a.output, r.nonfinite, r.samples);
-  if (range)
-    lucent::write_render_part(a.output, lucent::make_part(*renderer, *range, a.scene));
-  else if (lucent::io::lower_extension(a.output) == ".exr") {
+  // the session is not needed again without AOVs: its memory goes before the write's (a part
+  // is taken from it first)
+  if (a.aovs.empty() && !range) renderer.reset();
+  if (range) {
+    r.mean = {};  // (not written: the part's sums are; the rest of r says how it went)
+    r.variance = {};
+    r.samples = {};
+    const lucent::RenderPart part = lucent::make_part(*renderer, *range, a.scene);
+    renderer.reset();  // its sums, images and device buffers, before the write's own memory
+    lucent::write_render_part(a.output, part);
+  } else if (lucent::io::lower_extension(a.output) == ".exr") {
     // with var.R/G/B and n layers (docs/compare.md), and the key of its random numbers
     // (RenderResult::seed, sampler), by which `lucent converge` refuses a reference that would
     // replay its ladder's samples

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <memory>
 
+#include "core/file_io.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/error.hpp"
 
@@ -49,19 +50,31 @@ io::ReadSpec part_read_spec() {
   return spec;
 }
 
-std::string save_exr_to_memory(const std::string& path, const EXRImage& image,
-                               const EXRHeader& header) {
+std::uint64_t exr_encoder_bytes(std::uint64_t raw) {
+  return 2 * (raw + raw / 64) + (std::uint64_t(1) << 20);
+}
+
+namespace {
+
+struct FreeDeleter {
+  void operator()(unsigned char* p) const { std::free(p); }
+};
+using ExrBlock = std::unique_ptr<unsigned char, FreeDeleter>;
+
+/// tinyexr's encoded file, in its own block of `*size` bytes.
+ExrBlock encode_exr(const std::string& path, const EXRImage& image, const EXRHeader& header,
+                    std::size_t* size) {
   // tinyexr does not check its allocations: short of memory (ulimit -v), its encoder wrote
   // through a null pointer, and a part file's render ended in SIGSEGV after it had rendered (the
   // resources review). Its peak is about twice the encoded file (its chunks, then the file in one
-  // block), and this function's copy a third; the encoded file is at most the raw pixels plus
-  // ZIP's few bytes per block. That much memory is asked for first and given back: where it
-  // cannot be had, a clear error instead of the crash.
+  // block); the encoded file is at most the raw pixels plus ZIP's few bytes per block. That much
+  // memory is asked for first and given back: where it cannot be had, a clear error instead of
+  // the crash.
   std::uint64_t raw = 0;
   for (int c = 0; c < header.num_channels; ++c)
     raw += std::uint64_t(header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF ? 2 : 4) *
            std::uint64_t(image.width) * std::uint64_t(image.height);
-  const std::uint64_t need = 3 * (raw + raw / 64) + (std::uint64_t(1) << 20);
+  const std::uint64_t need = exr_encoder_bytes(raw);
   if (void* probe = need <= SIZE_MAX ? std::malloc(static_cast<std::size_t>(need)) : nullptr) {
     std::free(probe);
   } else {
@@ -72,14 +85,26 @@ std::string save_exr_to_memory(const std::string& path, const EXRImage& image,
   }
   unsigned char* memory = nullptr;
   const char* err = nullptr;
-  size_t n = SaveEXRImageToMemory(&image, &header, &memory, &err);
-  if (n == 0 || !memory) {
-    std::free(memory);
-    throw Error(path + ": cannot encode EXR: " + exr_message(err));
-  }
-  std::string out(reinterpret_cast<const char*>(memory), n);
-  std::free(memory);
-  return out;
+  *size = SaveEXRImageToMemory(&image, &header, &memory, &err);
+  ExrBlock block(memory);
+  if (*size == 0 || !block) throw Error(path + ": cannot encode EXR: " + exr_message(err));
+  return block;
+}
+
+}  // namespace
+
+std::string save_exr_to_memory(const std::string& path, const EXRImage& image,
+                               const EXRHeader& header) {
+  std::size_t size = 0;
+  ExrBlock block = encode_exr(path, image, header, &size);
+  return std::string(reinterpret_cast<const char*>(block.get()), size);
+}
+
+void write_exr(const std::string& path, const EXRImage& image, const EXRHeader& header) {
+  // written from tinyexr's block: a copy of the file was a third of the encoder's peak
+  std::size_t size = 0;
+  ExrBlock block = encode_exr(path, image, header, &size);
+  io::write_file_atomic(path, block.get(), size);
 }
 
 double srgb_to_linear(double c) {

@@ -57,7 +57,7 @@ std::string encode_pfm(const Image& img) {
   return out;
 }
 
-std::string encode_exr(const std::string& path, const Image& img) {
+void write_exr_image(const std::string& path, const Image& img) {
   // tinyexr wants planar channels in B, G, R order
   EXRHeader header;
   InitEXRHeader(&header);
@@ -86,7 +86,7 @@ std::string encode_exr(const std::string& path, const Image& img) {
   header.pixel_types = types.data();
   header.requested_pixel_types = types.data();
   header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
-  return image_detail::save_exr_to_memory(path, image, header);
+  image_detail::write_exr(path, image, header);
 }
 
 std::string encode_png(const std::string& path, const Image& img, const DisplaySettings& display) {
@@ -129,21 +129,34 @@ unsigned char encode_display(double v, const DisplaySettings& d) {
   return static_cast<unsigned char>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
 }
 
+namespace image_detail {
+
+std::uint64_t image_write_bytes(const std::string& path, int width, int height) {
+  const std::uint64_t npix = std::uint64_t(std::max(width, 0)) * std::uint64_t(std::max(height, 0));
+  const std::string ext = extension(path);
+  // EXR: three float planes and the encoder; PFM: the file; PNG: the 8-bit pixels, and
+  // stb_image_write's filtered rows, its deflate buffer (grown by doubling, so up to twice the
+  // pixels), the file and this side's copy of it
+  if (ext == "exr") return npix * 3 * sizeof(float) + exr_encoder_bytes(npix * 3 * sizeof(float));
+  if (ext == "pfm") return npix * 3 * sizeof(float) + 64;
+  return npix * 3 * 6 + (std::uint64_t(1) << 16);
+}
+
+}  // namespace image_detail
+
 void write_image(const std::string& path, const Image& img, const DisplaySettings& display) {
   if (img.width <= 0 || img.height <= 0 ||
       img.rgb.size() != static_cast<size_t>(img.width) * img.height * 3)
     throw Error(path + ": refusing to write an empty or inconsistent image");
   std::string ext = extension(path);
-  std::string bytes;
   if (ext == "pfm")
-    bytes = encode_pfm(img);
+    io::write_file_atomic(path, encode_pfm(img));
   else if (ext == "exr")
-    bytes = encode_exr(path, img);
+    write_exr_image(path, img);
   else if (ext == "png")
-    bytes = encode_png(path, img, display);
+    io::write_file_atomic(path, encode_png(path, img, display));
   else
     throw Error(path + ": unknown output format '." + ext + "' (use .png, .pfm or .exr)");
-  io::write_file_atomic(path, bytes);
 }
 
 Image read_image(const std::string& path) {

@@ -133,6 +133,19 @@ io::ReadSpec part_read_spec();
 std::string save_exr_to_memory(const std::string& path, const EXRImage& image,
                                const EXRHeader& header);
 
+/// Encodes `image` as OpenEXR and writes it to `path` (io::write_file_atomic, from tinyexr's own
+/// buffer: no copy of the file); throws lucent::Error("<path>: cannot encode EXR: ...").
+void write_exr(const std::string& path, const EXRImage& image, const EXRHeader& header);
+
+/// The host memory write_exr's encoder takes at most for `raw` bytes of pixels (its chunks, then
+/// the file in one block; ZIP adds a few bytes per block to data it cannot compress).
+std::uint64_t exr_encoder_bytes(std::uint64_t raw);
+
+/// The host memory lucent::write_image allocates for a width x height image written to `path`
+/// (by its extension), beside the image itself, at most: the encoded file and the encoder's own
+/// buffers (PNG through stb_image_write, EXR's planes and tinyexr).
+std::uint64_t image_write_bytes(const std::string& path, int width, int height);
+
 /// What a render EXR may carry beyond write_render_exr's layers: UINT channels (name, width *
 /// height values) and string attributes (name, value).
 struct ExrExtras {
@@ -142,6 +155,24 @@ struct ExrExtras {
 
 /// write_render_exr() with extra channels and attributes.
 void write_render_exr(const std::string& path, const RenderResult& r, const ExrExtras& extras);
+
+/// A render's images as planes (width * height values each), for write_render_planes: the mean
+/// (R, G, B) and, where variance and samples are all set, the statistics (var.R, var.G, var.B,
+/// n). Pointers only: the caller's arrays are written without a copy.
+struct RenderPlanes {
+  int width = 0, height = 0;
+  const float* mean[3] = {nullptr, nullptr, nullptr};
+  const float* variance[3] = {nullptr, nullptr, nullptr};
+  const std::uint32_t* samples = nullptr;
+};
+
+/// write_render_exr() of planes the caller holds.
+void write_render_planes(const std::string& path, const RenderPlanes& r, const ExrExtras& extras);
+
+/// The host memory write_render_exr takes beside its RenderResult at width x height: its planes
+/// and the encoder (with the statistics' layers when `stats`, and `extra_uint_channels` more).
+std::uint64_t render_exr_write_bytes(int width, int height, bool stats,
+                                     int extra_uint_channels = 0);
 
 /// read_render() on a file's bytes: an EXR with lucent's layers (mean, var.R/G/B, n), or any
 /// image decode_image reads (variance and samples left empty).

@@ -31,42 +31,59 @@ void write_render_exr(const std::string& path, const RenderResult& r, const ExrE
   const int w = r.mean.width, h = r.mean.height;
   const size_t n = static_cast<size_t>(w) * h;
   if (r.mean.rgb.size() != n * 3) throw Error(path + ": cannot write EXR: inconsistent image");
+  const bool stats = r.variance.rgb.size() == n * 3 && r.samples.size() == n;
+  // the images are interleaved RGB; EXR's channels are planes
+  std::vector<float> planes((stats ? 6 : 3) * n);
+  RenderPlanes p;
+  p.width = w;
+  p.height = h;
+  for (int c = 0; c < 3; ++c) {
+    float* mean = planes.data() + size_t(c) * n;
+    for (size_t i = 0; i < n; ++i) mean[i] = r.mean.rgb[i * 3 + c];
+    p.mean[c] = mean;
+    if (!stats) continue;
+    float* var = planes.data() + size_t(3 + c) * n;
+    for (size_t i = 0; i < n; ++i) var[i] = r.variance.rgb[i * 3 + c];
+    p.variance[c] = var;
+  }
+  if (stats) p.samples = r.samples.data();
+  write_render_planes(path, p, extras);
+}
+
+std::uint64_t render_exr_write_bytes(int width, int height, bool stats, int extra_uint_channels) {
+  const std::uint64_t npix = std::uint64_t(std::max(width, 0)) * std::uint64_t(std::max(height, 0));
+  const std::uint64_t floats = stats ? 6 : 3;
+  const std::uint64_t channels = floats + (stats ? 1 : 0) + std::uint64_t(extra_uint_channels);
+  return npix * floats * sizeof(float) + exr_encoder_bytes(npix * channels * 4);
+}
+
+void write_render_planes(const std::string& path, const RenderPlanes& r, const ExrExtras& extras) {
+  const int w = r.width, h = r.height;
+  const size_t n = static_cast<size_t>(std::max(w, 0)) * static_cast<size_t>(std::max(h, 0));
   // (a 0x0 image made a file that read_render refused: "empty data window")
   if (n == 0) throw Error(path + ": cannot write EXR: the image has no pixels");
-  const bool stats = r.variance.rgb.size() == n * 3 && r.samples.size() == n;
-  // the mean (B G R), then the statistics (n var.B var.G var.R) and the extras, sorted below
-  std::vector<std::string> names = {"B", "G", "R"};
-  std::vector<std::vector<float>> planes;
-  for (int c = 2; c >= 0; --c) {
-    planes.emplace_back(n);
-    for (size_t i = 0; i < n; ++i) planes.back()[i] = r.mean.rgb[i * 3 + c];
-  }
-  std::vector<unsigned int> counts;
-  if (stats) {
-    names.insert(names.end(), {"n", "var.B", "var.G", "var.R"});
-    counts.assign(r.samples.begin(), r.samples.end());
-    for (int c = 2; c >= 0; --c) {
-      planes.emplace_back(n);
-      for (size_t i = 0; i < n; ++i) planes.back()[i] = r.variance.rgb[i * 3 + c];
-    }
-  }
+  for (const float* m : r.mean)
+    if (!m) throw Error(path + ": cannot write EXR: inconsistent image");
+  const bool stats = r.samples && r.variance[0] && r.variance[1] && r.variance[2];
   struct Channel {
     std::string name;
     unsigned char* data;
     int type;
   };
-  std::vector<Channel> channels;
-  for (size_t k = 0, p = 0; k < names.size(); ++k) {
-    if (names[k] == "n")
-      channels.push_back(
-          {names[k], reinterpret_cast<unsigned char*>(counts.data()), TINYEXR_PIXELTYPE_UINT});
-    else
-      channels.push_back({names[k], reinterpret_cast<unsigned char*>(planes[p++].data()),
-                          TINYEXR_PIXELTYPE_FLOAT});
-  }
+  auto bytes = [](const void* data) {
+    return reinterpret_cast<unsigned char*>(const_cast<void*>(data));
+  };
+  // the mean, then the statistics and the extras, sorted below
+  std::vector<Channel> channels = {{"R", bytes(r.mean[0]), TINYEXR_PIXELTYPE_FLOAT},
+                                   {"G", bytes(r.mean[1]), TINYEXR_PIXELTYPE_FLOAT},
+                                   {"B", bytes(r.mean[2]), TINYEXR_PIXELTYPE_FLOAT}};
+  if (stats)
+    channels.insert(channels.end(), {{"n", bytes(r.samples), TINYEXR_PIXELTYPE_UINT},
+                                     {"var.R", bytes(r.variance[0]), TINYEXR_PIXELTYPE_FLOAT},
+                                     {"var.G", bytes(r.variance[1]), TINYEXR_PIXELTYPE_FLOAT},
+                                     {"var.B", bytes(r.variance[2]), TINYEXR_PIXELTYPE_FLOAT}});
   for (const auto& [name, data] : extras.uint_channels)
-    channels.push_back({name, reinterpret_cast<unsigned char*>(const_cast<std::uint32_t*>(data)),
-                        TINYEXR_PIXELTYPE_UINT});
+    channels.push_back({name, bytes(data), TINYEXR_PIXELTYPE_UINT});
   // OpenEXR wants the channels sorted by name
   std::sort(channels.begin(), channels.end(),
             [](const Channel& a, const Channel& b) { return a.name < b.name; });
@@ -104,7 +121,7 @@ void write_render_exr(const std::string& path, const RenderResult& r, const ExrE
   header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
   header.num_custom_attributes = static_cast<int>(attributes.size());
   header.custom_attributes = attributes.empty() ? nullptr : attributes.data();
-  io::write_file_atomic(path, save_exr_to_memory(path, image, header));
+  write_exr(path, image, header);
 }
 
 }  // namespace image_detail

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -155,7 +156,8 @@ int run(const Args& a) {
   if (!a.device.empty()) so.device = a.device;
   so.precision = lucent::parse_precision(a.precision);
   so.fast_math = a.fast_math;
-  lucent::Renderer renderer(so);
+  std::optional<lucent::Renderer> session(std::in_place, so);
+  lucent::Renderer& renderer = *session;
   renderer.set_cancel_flag(&g_stop);
   renderer.set_scene(scene);
   renderer.reset(range.begin);
@@ -173,6 +175,7 @@ int run(const Args& a) {
   renderer.render(range.end - range.begin, a.time_limit, progress);
   if (root && !a.quiet && last > 0 && tty) std::fprintf(stderr, "\n");
   lucent::RenderPart part = lucent::make_part(renderer, range, a.scene);
+  session.reset();  // its sums and device buffers: the part is what is sent, merged and written
 
   if (!root) {
     send_part(part);

@@ -351,6 +351,14 @@ RenderResult part_result(const RenderPart& part) {
   return r;
 }
 
+std::uint64_t part_write_bytes(int width, int height) {
+  const std::uint64_t npix = std::uint64_t(std::max(width, 0)) * std::uint64_t(std::max(height, 0));
+  // write_render_part's twelve 32-bit words and six float planes; the encoder's input is those
+  // and the counts: 19 channels of 4 bytes
+  return npix * (12 * sizeof(std::uint32_t) + 6 * sizeof(float)) +
+         image_detail::exr_encoder_bytes(npix * 19 * 4);
+}
+
 void write_render_part(const std::string& path, const RenderPart& part) {
   io::CNumbers c_numbers;  // "0.5", whatever the process locale
   const PartInfo& info = part.info;
@@ -362,27 +370,45 @@ void write_render_part(const std::string& path, const RenderPart& part) {
     throw Error(path +
                 ": cannot write part: part files do not hold light-traced caustics "
                 "(integrator.caustics); render the scene without --samples A:B");
-  // each double as two UINT channels: its high and low 32 bits (EXR has no 64-bit pixel type)
-  std::vector<std::vector<std::uint32_t>> words;
+  // each double as two UINT channels: its high and low 32 bits (EXR has no 64-bit pixel type);
+  // one block for the twelve, and one for the mean and variance planes read_render shows, made
+  // here from the sums (no RenderResult copy of the images)
+  std::vector<std::uint32_t> words(12 * npix);
+  std::vector<float> planes(6 * npix);
+  image_detail::RenderPlanes shown;
+  shown.width = a.width;
+  shown.height = a.height;
+  shown.samples = a.count.data();
+  for (int c = 0; c < 3; ++c) {
+    float* mean = planes.data() + size_t(c) * npix;
+    float* var = planes.data() + size_t(3 + c) * npix;
+    for (size_t i = 0; i < npix; ++i) {
+      const double n = a.count[i], s = a.sum[i * 3 + c], s2 = a.sumsq[i * 3 + c];
+      mean[i] = static_cast<float>(n > 0 ? s / n : 0);
+      var[i] = static_cast<float>(render_detail::sample_variance(s, s2, n));
+    }
+    shown.mean[c] = mean;
+    shown.variance[c] = var;
+  }
   image_detail::ExrExtras extras;
   for (int plane = 0; plane < 2; ++plane) {
     const std::vector<double>& src = plane == 0 ? a.sum : a.sumsq;
     for (int c = 0; c < 3; ++c) {
-      std::vector<std::uint32_t> hi(npix), lo(npix);
+      std::uint32_t* hi = words.data() + size_t(plane * 6 + c * 2) * npix;
+      std::uint32_t* lo = hi + npix;
       for (size_t i = 0; i < npix; ++i) {
         std::uint64_t bits;
         std::memcpy(&bits, &src[i * 3 + c], sizeof bits);
         hi[i] = static_cast<std::uint32_t>(bits >> 32);
         lo[i] = static_cast<std::uint32_t>(bits);
       }
-      words.push_back(std::move(hi));
-      words.push_back(std::move(lo));
     }
   }
   for (int plane = 0, k = 0; plane < 2; ++plane)
     for (int c = 0; c < 3; ++c)
       for (bool high : {true, false})
-        extras.uint_channels.emplace_back(channel_name(plane, c, high), words[k++].data());
+        extras.uint_channels.emplace_back(channel_name(plane, c, high),
+                                          words.data() + size_t(k++) * npix);
   char gamma[64], exposure[64], seconds[64];
   std::snprintf(gamma, sizeof gamma, "%.17g", info.display.gamma);
   std::snprintf(exposure, sizeof exposure, "%.17g", info.display.exposure);
@@ -405,7 +431,7 @@ void write_render_part(const std::string& path, const RenderPart& part) {
   };
   // read_render's seed and sampler (what converge checks a reference by)
   if (!info.sampler.empty()) extras.attributes.emplace_back("lucent.sampler", info.sampler);
-  image_detail::write_render_exr(path, part_result(part), extras);
+  image_detail::write_render_planes(path, shown, extras);
 }
 
 namespace {

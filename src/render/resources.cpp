@@ -111,6 +111,47 @@ ScopedCounterStart::ScopedCounterStart(std::uint32_t start) { g_counter_start = 
 ScopedCounterStart::~ScopedCounterStart() { g_counter_start = 0; }
 std::uint32_t counter_start() { return g_counter_start.load(); }
 
+namespace {
+
+struct PackedSizes {
+  std::uint64_t ntri = 0, nsph = 0, tri_bytes = 0, sph_bytes = 0, tex_bytes = 0;
+};
+
+// the packed scene (pack.cpp): a triangle and its attributes, a sphere, a texel as float4, and
+// an environment map's sampling table (a float per texel)
+PackedSizes packed_sizes(const Scene& scene) {
+  PackedSizes z;
+  z.ntri = scene.triangles.size();
+  z.nsph = scene.spheres.size();
+  z.tri_bytes = z.ntri * (sizeof(lc_triangle) + sizeof(lc_triangle_attr));
+  z.sph_bytes = z.nsph * sizeof(lc_sphere);
+  for (const Texture& t : scene.textures)
+    z.tex_bytes += std::uint64_t(t.width) * std::uint64_t(t.height) * sizeof(lc_float4);
+  for (const Light& l : scene.lights)
+    if (l.type == LightType::EnvironmentMap && l.texture >= 0 &&
+        size_t(l.texture) < scene.textures.size()) {
+      const Texture& t = scene.textures[size_t(l.texture)];
+      z.tex_bytes += (std::uint64_t(t.width) * std::uint64_t(t.height) + 1) * sizeof(float);
+    }
+  return z;
+}
+
+}  // namespace
+
+std::vector<MemoryPart> scene_host_parts(const Scene& scene) {
+  const PackedSizes z = packed_sizes(scene);
+  return {{"the " + std::to_string(z.ntri) + " triangles", z.tri_bytes, "the number of triangles"},
+          {"the " + std::to_string(z.nsph) + " spheres", z.sph_bytes, "the number of spheres"},
+          {"the texels of the " + std::to_string(scene.textures.size()) + " textures", z.tex_bytes,
+           "the textures' resolution"}};
+}
+
+std::vector<MemoryPart> reserved_part(std::uint64_t reserved) {
+  if (reserved == 0) return {};
+  return {{"what the application keeps beside the session (its outputs, as it declared them)",
+           reserved, "the film size"}};
+}
+
 std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                                              const std::vector<DeviceLimits>& devices) {
   const std::uint64_t npix = std::uint64_t(scene.film.width) * std::uint64_t(scene.film.height);
@@ -128,20 +169,9 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
   if (caustics)
     parts.push_back({"the caustics light sums of the " + film + " film", npix * 6 * sizeof(double),
                      "the film size, or render without caustics"});
-  // the packed scene (pack.cpp): a triangle and its attributes, a sphere, a texel as float4, and
-  // an environment map's sampling table (a float per texel)
-  const std::uint64_t ntri = scene.triangles.size(), nsph = scene.spheres.size();
-  const std::uint64_t tri_bytes = ntri * (sizeof(lc_triangle) + sizeof(lc_triangle_attr));
-  const std::uint64_t sph_bytes = nsph * sizeof(lc_sphere);
-  std::uint64_t tex_bytes = 0;
-  for (const Texture& t : scene.textures)
-    tex_bytes += std::uint64_t(t.width) * std::uint64_t(t.height) * sizeof(lc_float4);
-  for (const Light& l : scene.lights)
-    if (l.type == LightType::EnvironmentMap && l.texture >= 0 &&
-        size_t(l.texture) < scene.textures.size()) {
-      const Texture& t = scene.textures[size_t(l.texture)];
-      tex_bytes += (std::uint64_t(t.width) * std::uint64_t(t.height) + 1) * sizeof(float);
-    }
+  const PackedSizes z = packed_sizes(scene);
+  const std::uint64_t ntri = z.ntri, nsph = z.nsph, sph_bytes = z.sph_bytes,
+                      tex_bytes = z.tex_bytes;
   // the BVH: the build's primitive references (32 bytes), binary nodes (at most 2 per primitive)
   // and primitive indices; then the wide tree's leaf blocks (about one per 2 primitives) and
   // nodes (about one per 4)
@@ -151,11 +181,7 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
   const std::uint64_t bvh_tree = leaf_bytes + node_bytes;
   const std::uint64_t bvh_bytes =
       nprim * (32 + 2 * sizeof(bvh::Node2) + sizeof(lc_uint)) + bvh_tree;
-  parts.push_back(
-      {"the " + std::to_string(ntri) + " triangles", tri_bytes, "the number of triangles"});
-  parts.push_back({"the " + std::to_string(nsph) + " spheres", sph_bytes, "the number of spheres"});
-  parts.push_back({"the texels of the " + std::to_string(scene.textures.size()) + " textures",
-                   tex_bytes, "the textures' resolution"});
+  for (MemoryPart& p : scene_host_parts(scene)) parts.push_back(std::move(p));
   parts.push_back({"the BVH of " + std::to_string(nprim) + " primitives", bvh_bytes,
                    "the number of triangles and spheres"});
   // on a CPU device each large buffer takes whole huge pages (device_scene.cpp)
@@ -203,9 +229,21 @@ void check_host_parts(const Scene& scene, const std::vector<MemoryPart>& parts,
 }  // namespace
 
 void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
-                       std::uint64_t host_limit, const std::string& limit_what) {
+                       std::uint64_t host_limit, const std::string& limit_what,
+                       const std::vector<MemoryPart>& extra) {
   if (host_limit == 0) return;
-  check_host_parts(scene, estimate_host_memory(scene, devices), host_limit, limit_what);
+  std::vector<MemoryPart> parts = estimate_host_memory(scene, devices);
+  parts.insert(parts.end(), extra.begin(), extra.end());
+  check_host_parts(scene, parts, host_limit, limit_what);
+}
+
+void check_output_host_memory(const Scene& scene, const std::vector<MemoryPart>& outputs) {
+  std::string what;
+  const std::uint64_t limit = host_memory_allowed(&what);
+  if (limit == 0) return;
+  std::vector<MemoryPart> parts = scene_host_parts(scene);
+  parts.insert(parts.end(), outputs.begin(), outputs.end());
+  check_host_parts(scene, parts, limit, what);
 }
 
 std::uint64_t host_memory_allowed(std::string* what) { return sys::host_memory_allowed(what); }
@@ -240,9 +278,11 @@ std::uint64_t adaptive_host_bytes(std::uint64_t npix, bool caustics) {
 
 void check_adaptive_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
                                 bool caustics, std::uint64_t host_limit,
-                                const std::string& limit_what) {
+                                const std::string& limit_what,
+                                const std::vector<MemoryPart>& extra) {
   if (host_limit == 0) return;
   std::vector<MemoryPart> parts = estimate_host_memory(scene, devices);
+  parts.insert(parts.end(), extra.begin(), extra.end());
   const std::uint64_t npix = std::uint64_t(scene.film.width) * std::uint64_t(scene.film.height);
   parts.push_back({"the halves, pilots and plans of adaptive sampling for the " +
                        film_size(scene.film.width, scene.film.height) + " film",

@@ -109,10 +109,24 @@ struct MemoryPart {
 std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                                              const std::vector<DeviceLimits>& devices);
 
-/// Throws lucent::Error when the estimate exceeds `host_limit` (0: no check), naming the largest
-/// part and the limit (80% of `limit_what`).
+/// The application's part of an estimate: what it declared it holds beside the session
+/// (SessionOptions::reserved_host_bytes; none when 0).
+std::vector<MemoryPart> reserved_part(std::uint64_t reserved);
+
+/// Throws lucent::Error when the estimate, with `extra` parts, exceeds `host_limit` (0: no
+/// check), naming the largest part and the limit (80% of `limit_what`).
 void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
-                       std::uint64_t host_limit, const std::string& limit_what = "physical memory");
+                       std::uint64_t host_limit, const std::string& limit_what = "physical memory",
+                       const std::vector<MemoryPart>& extra = {});
+
+/// What the scene description itself holds on the host (its triangles, spheres and texels, about
+/// as large as their packed copies), as parts of an estimate.
+std::vector<MemoryPart> scene_host_parts(const Scene& scene);
+
+/// Before rendering, for a front end that writes its outputs after the session is gone: throws
+/// lucent::Error as check_host_memory does when the scene description and `outputs` (what
+/// writing keeps and allocates) exceed host_memory_allowed().
+void check_output_host_memory(const Scene& scene, const std::vector<MemoryPart>& outputs);
 
 /// Before the CPU reference (render_reference) allocates: its accumulation and result images, the
 /// scene's BVH, and with caustics one set of light sums per thread (`threads`), against
@@ -133,7 +147,8 @@ std::uint64_t adaptive_host_bytes(std::uint64_t npix, bool caustics);
 /// check_host_memory with an adaptive render's memory added (adaptive_host_bytes).
 void check_adaptive_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
                                 bool caustics, std::uint64_t host_limit,
-                                const std::string& limit_what = "physical memory");
+                                const std::string& limit_what = "physical memory",
+                                const std::vector<MemoryPart>& extra = {});
 
 /// The film buffers of a device: the pass's sums and sums of squares (double4 per pixel with
 /// `fp64`, else float4), the work list (uint4 per pixel), and the light paths' sums and sums of

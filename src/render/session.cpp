@@ -518,8 +518,8 @@ struct Renderer::Impl {
       scene_detail::validate_scene(s);  // fields set directly may not have been checked
       for (const std::string& note : scene_detail::energy_gain_notes(s)) scene_detail::warn(note);
       for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
-      render_detail::check_host_memory(s, limits, limits.front().host_mem,
-                                       limits.front().host_what);
+      render_detail::check_host_memory(s, limits, limits.front().host_mem, limits.front().host_what,
+                                       render_detail::reserved_part(options.reserved_host_bytes));
       for (const DeviceInfo& d : device_infos)
         render_detail::check_precision_support(d, options.precision);
       t0 = clock_type::now();
@@ -1030,9 +1030,9 @@ struct Renderer::Impl {
             "first)");
       std::vector<render_detail::DeviceLimits> limits;
       for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
-      render_detail::check_adaptive_host_memory(*scene, limits,
-                                                (packed.params.flags & LC_FLAG_CAUSTICS) != 0,
-                                                limits.front().host_mem, limits.front().host_what);
+      render_detail::check_adaptive_host_memory(
+          *scene, limits, (packed.params.flags & LC_FLAG_CAUSTICS) != 0, limits.front().host_mem,
+          limits.front().host_what, render_detail::reserved_part(options.reserved_host_bytes));
       adaptive = true;
       pilot = m;
       for (int hi = 0; hi < 2; ++hi) {
