@@ -184,6 +184,77 @@ TEST(Resources, PeakHostMemoryOfALargeFilmIsWithinTheEstimate) {
   EXPECT_GE(large - small, 0.6 * growth) << large << " " << small << " " << growth;
 }
 
+/// A scene of `n` separate small triangles scattered in a 10-unit cube (an OBJ "soup": the BVH's
+/// leaves hold one triangle each), written to dir/soup<n>.json; returns its path.
+std::string soup_scene(const std::string& dir, int n) {
+  std::string obj;
+  obj.reserve(size_t(n) * 110);
+  std::uint32_t state = 12345;
+  auto next = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return double(state >> 8) / double(1 << 24) * 10.0;
+  };
+  char line[128];
+  for (int i = 0; i < n; ++i) {
+    const double x = next(), y = next(), z = next();
+    std::snprintf(line, sizeof line, "v %.5f %.5f %.5f\nv %.5f %.5f %.5f\nv %.5f %.5f %.5f\n", x, y,
+                  z, x + 0.01, y, z, x, y + 0.01, z);
+    obj += line;
+  }
+  for (int i = 0; i < n; ++i) {
+    std::snprintf(line, sizeof line, "f %d %d %d\n", 3 * i + 1, 3 * i + 2, 3 * i + 3);
+    obj += line;
+  }
+  const std::string name = "soup" + std::to_string(n);
+  lucent::test::write_file(dir + "/" + name + ".obj", obj);
+  lucent::test::write_file(dir + "/" + name + ".json",
+                           R"({"camera": {"position": [5, 5, -20], "look_at": [5, 5, 5]},
+    "film": {"width": 16, "height": 16},
+    "integrator": {"type": "path", "spp": 1},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "lights": [{"type": "point", "position": [5, 5, -10], "intensity": [100, 100, 100]}],
+    "shapes": [{"type": "mesh", "file": ")" +
+                               name + R"(.obj", "material": "m"}]})");
+  return dir + "/" + name + ".json";
+}
+
+// The same for a mesh: a soup of 300,000 separate triangles against one of 3,000. It took 57%
+// more than estimated (the resources review, at 10^6): the estimate counted a BVH leaf block per
+// two primitives where a soup has one per primitive, and not the scene description that the
+// application and the session each hold (nor did glibc give back the OBJ loader's freed arrays).
+TEST(Resources, PeakHostMemoryOfALargeMeshIsWithinTheEstimate) {
+  if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer's own memory is in the peak";
+  const std::string dir = lucent::test::temp_dir();
+  auto peak_mib = [&](const std::string& scene) {
+    auto r = lucent::test::run_cli("render " + q(scene) + " -o " + q(dir + "/o.pfm"));
+    EXPECT_EQ(r.status, 0) << r.err;
+    const size_t at = r.err.find("peak host memory ");
+    EXPECT_NE(at, std::string::npos) << r.err;
+    return at == std::string::npos ? 0.0 : std::atof(r.err.c_str() + at + 17);
+  };
+  const std::string small_scene = soup_scene(dir, 3000), large_scene = soup_scene(dir, 300000);
+  peak_mib(small_scene);  // builds the kernel (a compiler's memory is not the mesh's)
+  const double small = peak_mib(small_scene), large = peak_mib(large_scene);
+  const lucent::DeviceInfo info = lucent::select_device();
+  DeviceLimits device;
+  device.device = info.name;
+  device.host_unified = info.type == "CPU";
+  device.fp64 = info.fp64;
+  device.light_double = info.fp64 && info.int64_atomics;
+  auto estimate = [&](const std::string& scene) {
+    std::uint64_t bytes = 0;
+    for (const MemoryPart& p :
+         lucent::render_detail::estimate_host_memory(lucent::load_scene(scene), {device}))
+      bytes += p.bytes;
+    return double(bytes) / 1048576.0;
+  };
+  const double growth = estimate(large_scene) - estimate(small_scene);
+  EXPECT_LE(large - small, growth) << "peak " << large << " MiB against " << small
+                                   << " MiB; estimated growth " << growth << " MiB";
+  // and the mesh's memory is there: the estimate is not a wide overestimate
+  EXPECT_GE(large - small, 0.6 * growth) << large << " " << small << " " << growth;
+}
+
 // Over the host limit: one line naming the total, the limit, the largest part and what to reduce.
 TEST(Resources, HostLimitNamesTheCulprit) {
   Scene s = lucent::test::scene_from(grid_scene(2, 4));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <initializer_list>
+#include <type_traits>
 
 #include "bvh/bvh.hpp"
 #include "core/host_memory.hpp"
@@ -138,12 +139,23 @@ PackedSizes packed_sizes(const Scene& scene) {
 
 }  // namespace
 
+std::uint64_t description_bytes(const Scene& scene) {
+  // what the vectors hold (their capacities: a loader's growth leaves up to twice the size)
+  auto held = [](const auto& v) {
+    return std::uint64_t(v.capacity()) * sizeof(typename std::decay_t<decltype(v)>::value_type);
+  };
+  std::uint64_t b = held(scene.materials) + held(scene.spheres) + held(scene.positions) +
+                    held(scene.normals) + held(scene.uvs) + held(scene.triangles) +
+                    held(scene.lights) + held(scene.textures) + held(scene.shapes);
+  for (const Texture& t : scene.textures) b += held(t.rgba);
+  return b;
+}
+
 std::vector<MemoryPart> scene_host_parts(const Scene& scene) {
-  const PackedSizes z = packed_sizes(scene);
-  return {{"the " + std::to_string(z.ntri) + " triangles", z.tri_bytes, "the number of triangles"},
-          {"the " + std::to_string(z.nsph) + " spheres", z.sph_bytes, "the number of spheres"},
-          {"the texels of the " + std::to_string(scene.textures.size()) + " textures", z.tex_bytes,
-           "the textures' resolution"}};
+  return {{"the scene description (" + std::to_string(scene.triangles.size()) + " triangles, " +
+               std::to_string(scene.positions.size()) + " vertices, " +
+               std::to_string(scene.textures.size()) + " textures)",
+           description_bytes(scene), "the number of triangles or the textures' resolution"}};
 }
 
 std::vector<MemoryPart> reserved_part(std::uint64_t reserved) {
@@ -169,19 +181,29 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
   if (caustics)
     parts.push_back({"the caustics light sums of the " + film + " film", npix * 6 * sizeof(double),
                      "the film size, or render without caustics"});
+  // the scene description: the application's, and the session's copy of it (Renderer::scene)
+  MemoryPart description = scene_host_parts(scene).front();
+  description.what += ", the application's and the session's copy";
+  description.bytes *= 2;
+  parts.push_back(description);
   const PackedSizes z = packed_sizes(scene);
   const std::uint64_t ntri = z.ntri, nsph = z.nsph, sph_bytes = z.sph_bytes,
                       tex_bytes = z.tex_bytes;
   // the BVH: the build's primitive references (32 bytes), binary nodes (at most 2 per primitive)
-  // and primitive indices; then the wide tree's leaf blocks (about one per 2 primitives) and
+  // and primitive indices; then the wide tree's leaf blocks (at most one per primitive: a soup
+  // of separate triangles has leaves of one, a mesh about one block per 2 or 3 primitives) and
   // nodes (about one per 4)
   const std::uint64_t nprim = ntri + nsph;
-  const std::uint64_t leaf_bytes = (nprim / 2 + 1) * sizeof(lc_bvh_leaf);
+  const std::uint64_t leaf_bytes = (nprim + 1) * sizeof(lc_bvh_leaf);
   const std::uint64_t node_bytes = (nprim / 4 + 1) * sizeof(lc_bvh_node);
   const std::uint64_t bvh_tree = leaf_bytes + node_bytes;
   const std::uint64_t bvh_bytes =
       nprim * (32 + 2 * sizeof(bvh::Node2) + sizeof(lc_uint)) + bvh_tree;
-  for (MemoryPart& p : scene_host_parts(scene)) parts.push_back(std::move(p));
+  parts.push_back(
+      {"the " + std::to_string(ntri) + " triangles", z.tri_bytes, "the number of triangles"});
+  parts.push_back({"the " + std::to_string(nsph) + " spheres", sph_bytes, "the number of spheres"});
+  parts.push_back({"the texels of the " + std::to_string(scene.textures.size()) + " textures",
+                   tex_bytes, "the textures' resolution"});
   parts.push_back({"the BVH of " + std::to_string(nprim) + " primitives", bvh_bytes,
                    "the number of triangles and spheres"});
   // on a CPU device each large buffer takes whole huge pages (device_scene.cpp)

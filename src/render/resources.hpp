@@ -119,8 +119,10 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
                        std::uint64_t host_limit, const std::string& limit_what = "physical memory",
                        const std::vector<MemoryPart>& extra = {});
 
-/// What the scene description itself holds on the host (its triangles, spheres and texels, about
-/// as large as their packed copies), as parts of an estimate.
+/// What the scene description's arrays hold on the host (their capacities), in bytes.
+std::uint64_t description_bytes(const Scene& scene);
+
+/// The scene description (description_bytes) as the parts of an estimate.
 std::vector<MemoryPart> scene_host_parts(const Scene& scene);
 
 /// Before rendering, for a front end that writes its outputs after the session is gone: throws

@@ -17,6 +17,7 @@
 #include "cl/context.hpp"
 #include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
+#include "core/host_memory.hpp"
 #include "lucent/error.hpp"
 #include "lucent/types.hpp"
 #include "render/adaptive.hpp"
@@ -635,6 +636,7 @@ struct Renderer::Impl {
     build_options = opts;
     npix = n;
     scene = s;
+    sys::return_free_memory();  // the BVH build's and the previous scene's arrays
     if (!keep) {
       sum.assign(npix * 3, 0.0);
       sumsq.assign(npix * 3, 0.0);

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/host_memory.hpp"
 #include "lucent/error.hpp"
 #include "lucent/scene.hpp"
 #include "scene/json_guard.hpp"
@@ -119,8 +120,13 @@ fs::path scene_dir(const std::string& path) {
 }  // namespace
 
 Scene load_scene(const std::string& path) {
-  const std::string text = scene_detail::read_scene_text(path);  // bounded; pipes allowed
-  return parse_scene_in(text, path, scene_dir(path));
+  Scene scene;
+  {
+    const std::string text = scene_detail::read_scene_text(path);  // bounded; pipes allowed
+    scene = parse_scene_in(text, path, scene_dir(path));
+  }
+  sys::return_free_memory();  // the text and the loaders' arrays, freed in many pieces
+  return scene;
 }
 
 namespace scene_detail {
