@@ -99,4 +99,40 @@ TEST(ProgramCacheLock, LockOnlyBuildsTakeTurns) {
     EXPECT_EQ(e.path().extension(), ".lock") << e.path();
 }
 
+// A lock file removed while a builder waits on it (by `cache clear`, or by an eviction that took
+// the free lock an instant before the builder did) is opened again: the builder that waited on the
+// removed file must not build beside one that locked the new file, but wait for it and read its
+// entry.
+TEST(ProgramCacheLock, ALockRemovedUnderAWaitingBuilderIsOpenedAgain) {
+  const std::string dir = lucent::test::temp_dir() + "/cache";
+  const std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
+  const std::string options = "-cl-std=CL1.2 -D LC_PROGRAM_CACHE_REMOVED_LOCK_TEST";
+  lucent::cl_util::Context first_ctx(""), waiter_ctx(""), second_ctx("");
+  // a first builder holds the lock (deferred: until it stores or drops its entry)
+  auto first = std::make_unique<lucent::cl_util::DeferredEntry>();
+  ProgramBuildInfo first_info, waiter_info, second_info;
+  lucent::cl_util::build_program_cached(first_ctx, src, options, dir, &first_info, first.get());
+  ASSERT_TRUE(first->pending());
+  std::string waiter_error;
+  std::thread waiter([&] {
+    waiter_error = lucent::test::error_of([&] {
+      lucent::cl_util::build_program_cached(waiter_ctx, src, options, dir, &waiter_info);
+    });
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the waiter waits on the lock
+  std::filesystem::remove(first_info.cache_file + ".lock");
+  // a second builder locks a new file of that name and builds; the first gives up unstored
+  lucent::cl_util::DeferredEntry second;
+  cl::Program p =
+      lucent::cl_util::build_program_cached(second_ctx, src, options, dir, &second_info, &second);
+  ASSERT_TRUE(second.pending());
+  first.reset();
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  second.store(p);
+  waiter.join();
+  EXPECT_EQ(waiter_error, "");
+  EXPECT_FALSE(second_info.cache_hit);
+  EXPECT_TRUE(waiter_info.cache_hit) << "the waiter built beside the second builder";
+}
+
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -136,29 +137,49 @@ void write_entry(const std::string& path, const std::string& key,
   }
 }
 
+// Whether `fd` is still the file at `path`: a lock file may be removed (`cache clear`, an
+// eviction) while another process waits on it or has just opened it.
+bool still_at(int fd, const std::string& path) {
+  struct stat open_file, named;
+  return ::fstat(fd, &open_file) == 0 && ::stat(path.c_str(), &named) == 0 &&
+         open_file.st_ino == named.st_ino && open_file.st_dev == named.st_dev;
+}
+
 }  // namespace
 
 /// An exclusive flock on `path` held while alive: processes that miss the same entry at the same
 /// time build it once (the others wait, then read what the first wrote) instead of each compiling
 /// it. Waits at most `max_wait` seconds (a holder stuck in a driver must not stall every other
 /// process), or until `stop` returns true (the render was cancelled), then builds without the
-/// lock; any failure to lock only costs a redundant build.
+/// lock; any failure to lock only costs a redundant build. A lock file removed while this process
+/// opened it or waited on it is opened again: two builders locking two files of one name would
+/// both build.
 class BuildLock {
  public:
   BuildLock(const std::string& path, double max_wait, const std::function<bool()>& stop) {
     std::error_code ec;
     fs::create_directories(fs::path(path).parent_path(), ec);
-    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0) return;
     auto t0 = std::chrono::steady_clock::now();
-    while (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      if (errno != EWOULDBLOCK || (stop && stop()) ||
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > max_wait) {
-        ::close(fd_);
-        fd_ = -1;
-        return;
+    auto give_up = [&] {
+      return (stop && stop()) ||
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >
+                 max_wait;
+    };
+    for (;;) {
+      fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+      if (fd_ < 0) return;
+      while (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+        if (errno != EWOULDBLOCK || give_up()) {
+          ::close(fd_);
+          fd_ = -1;
+          return;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      if (still_at(fd_, path)) return;
+      ::close(fd_);
+      fd_ = -1;
+      if (give_up()) return;
     }
   }
   ~BuildLock() {
