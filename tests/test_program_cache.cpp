@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -27,6 +28,16 @@ using lucent::cl_util::ProgramBuildInfo;
 struct CacheDir {
   std::string dir = lucent::test::temp_dir() + "/cache";
 };
+
+// A file of `bytes` bytes named as the cache names entry `i`, last used `hours_ago` hours ago.
+std::string old_entry(const std::string& dir, unsigned i, size_t bytes, int hours_ago) {
+  char name[32];
+  std::snprintf(name, sizeof name, "/%016x.bin", i);
+  fs::create_directories(dir);
+  lucent::test::write_file(dir + name, std::string(bytes, 'x'));
+  fs::last_write_time(dir + name, fs::file_time_type::clock::now() - std::chrono::hours(hours_ago));
+  return dir + name;
+}
 
 // Runs the layout probe kernel: a built program that really works returns sizeof(lc_material).
 unsigned run_probe(lucent::cl_util::Context& ctx, cl::Program& p) {
@@ -260,6 +271,131 @@ TEST(ProgramCache, CliClearsTheCache) {
   r = lucent::test::run_cli("cache clear", "POCL_KERNEL_CACHE=0 LUCENT_CACHE_DIR='" + dir + "'");
   EXPECT_EQ(r.out.find("kernels are cached by PoCL"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(dir + "/0123456789abcdef.bin"));
+}
+
+// Past the limit, the least recently used entries go first, with their build locks (unless held),
+// never the entry kept (the one just written), and nothing the cache did not write.
+TEST(ProgramCache, EvictsTheLeastRecentlyUsedEntries) {
+  const std::string dir = lucent::test::temp_dir() + "/cache";
+  std::vector<std::string> e;
+  for (unsigned i = 0; i < 5; ++i)
+    e.push_back(old_entry(dir, i, 100000, 5 - int(i)));  // e[0] oldest
+  for (int i : {0, 1, 4}) lucent::test::write_file(e[i] + ".lock", "");
+  const std::string tmp = dir + "/.0000000000000000.bin.tmp-1-0";
+  for (const std::string& other : {dir + "/weights.bin", dir + "/0000000000ABCDEF.bin", tmp}) {
+    lucent::test::write_file(other, std::string(300000, 'y'));
+    fs::last_write_time(other, fs::file_time_type::clock::now() - std::chrono::hours(9));
+  }
+  lucent::cl_util::ProgramCacheUsage usage = lucent::cl_util::program_cache_usage(dir);
+  EXPECT_EQ(usage.programs, 5);
+  EXPECT_EQ(usage.bytes, 500000u);
+
+  EXPECT_EQ(lucent::cl_util::evict_program_cache(dir, 0), 0) << "0: no limit";
+  EXPECT_EQ(lucent::cl_util::evict_program_cache(dir, 500000), 0) << "at the limit";
+  EXPECT_EQ(lucent::test::error_of([] { lucent::cl_util::evict_program_cache("/etc/passwd", 1); }),
+            "");
+  EXPECT_EQ(lucent::cl_util::program_cache_usage(dir).programs, 5);
+
+  // e[1]'s lock is held by a builder: it stays
+  int fd = ::open((e[1] + ".lock").c_str(), O_RDWR | O_CLOEXEC);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+  EXPECT_EQ(lucent::cl_util::evict_program_cache(dir, 250000, e[4]), 3);
+  ::close(fd);
+  for (int i : {0, 1, 2}) EXPECT_FALSE(fs::exists(e[i])) << i;
+  for (int i : {3, 4}) EXPECT_TRUE(fs::exists(e[i])) << i;
+  EXPECT_FALSE(fs::exists(e[0] + ".lock"));
+  EXPECT_TRUE(fs::exists(e[1] + ".lock")) << "a held lock was removed";
+  EXPECT_TRUE(fs::exists(e[4] + ".lock")) << "the lock of an entry still there was removed";
+  for (const std::string& other : {dir + "/weights.bin", dir + "/0000000000ABCDEF.bin", tmp})
+    EXPECT_TRUE(fs::exists(other)) << other;
+  usage = lucent::cl_util::program_cache_usage(dir);
+  EXPECT_EQ(usage.programs, 2);
+  EXPECT_EQ(usage.bytes, 200000u);
+
+  // the entry kept stays even when it is the oldest and alone over the limit; free locks of
+  // entries gone go at the next eviction
+  EXPECT_EQ(lucent::cl_util::evict_program_cache(dir, 1, e[3]), 1);
+  EXPECT_TRUE(fs::exists(e[3]));
+  EXPECT_FALSE(fs::exists(e[4]));
+  EXPECT_FALSE(fs::exists(e[1] + ".lock"));
+  EXPECT_FALSE(fs::exists(e[4] + ".lock"));
+}
+
+// LUCENT_CACHE_MAX_MB: MiB, fractions allowed, 0 for no limit; what is not a size warns once and
+// keeps the default.
+TEST(ProgramCache, LimitFromTheEnvironment) {
+  const std::uint64_t kDefault = 256ull << 20;
+  {
+    lucent::test::ScopedEnv unset("LUCENT_CACHE_MAX_MB", nullptr);
+    EXPECT_EQ(lucent::cl_util::program_cache_max_bytes(), kDefault);
+  }
+  const struct {
+    const char* value;
+    std::uint64_t bytes;
+  } good[] = {{"", kDefault},       {"0", 0},   {"1", 1u << 20}, {"1.5", 3u << 19},
+              {"4096", 1ull << 32}, {"1e-9", 1}};
+  for (const auto& g : good) {
+    lucent::test::ScopedEnv env("LUCENT_CACHE_MAX_MB", g.value);
+    lucent::test::CaptureWarnings warnings;
+    EXPECT_EQ(lucent::cl_util::program_cache_max_bytes(), g.bytes) << "'" << g.value << "'";
+    EXPECT_EQ(warnings.all().size(), 0u) << "'" << g.value << "'";
+  }
+  for (const char* bad : {"lots", "-1", "12MB", "nan", "inf", "1,5"}) {
+    lucent::test::ScopedEnv env("LUCENT_CACHE_MAX_MB", bad);
+    lucent::test::CaptureWarnings warnings;
+    EXPECT_EQ(lucent::cl_util::program_cache_max_bytes(), kDefault) << bad;
+    ASSERT_EQ(warnings.all().size(), 1u) << bad;
+    EXPECT_EQ(warnings.all()[0], std::string("LUCENT_CACHE_MAX_MB='") + bad +
+                                     "' is not a size in MiB (a number, 0 for no limit); the "
+                                     "kernel cache keeps its default limit of 256 MiB");
+  }
+}
+
+// Writing an entry evicts past LUCENT_CACHE_MAX_MB, least recently used first, where a load is a
+// use; 0 keeps everything.
+TEST(ProgramCache, WritesEvictLeastRecentlyUsedEntries) {
+  CacheDir cache;
+  lucent::cl_util::Context ctx{lucent::test::device()};
+  const std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
+  ProgramBuildInfo a, hit, b, again;
+  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2 -D LC_EVICT_A", cache.dir, &a);
+  ASSERT_TRUE(fs::exists(a.cache_file));
+  const auto size_a = fs::file_size(a.cache_file);
+  // three old entries of 1 MiB, and `a` older still, then loaded: a use
+  std::vector<std::string> old;
+  for (unsigned i = 0; i < 3; ++i) old.push_back(old_entry(cache.dir, i, 1u << 20, 3 - int(i)));
+  fs::last_write_time(a.cache_file, fs::file_time_type::clock::now() - std::chrono::hours(10));
+  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2 -D LC_EVICT_A", cache.dir, &hit);
+  ASSERT_TRUE(hit.cache_hit);
+
+  // a limit of 1.5 MiB more than four entries like `a`: writing `b` removes two old entries
+  const std::string limit = std::to_string(1.5 + 4.0 * double(size_a) / (1 << 20));
+  {
+    lucent::test::ScopedEnv env("LUCENT_CACHE_MAX_MB", limit.c_str());
+    cl::Program p = lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2 -D LC_EVICT_B",
+                                                          cache.dir, &b);
+    EXPECT_EQ(run_probe(ctx, p), 64u);
+  }
+  EXPECT_FALSE(b.cache_hit);
+  EXPECT_TRUE(fs::exists(b.cache_file));
+  EXPECT_TRUE(fs::exists(a.cache_file)) << "the entry just loaded was evicted";
+  EXPECT_FALSE(fs::exists(old[0]));
+  EXPECT_FALSE(fs::exists(old[1]));
+  EXPECT_TRUE(fs::exists(old[2]));
+  lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2 -D LC_EVICT_A", cache.dir, &again);
+  EXPECT_TRUE(again.cache_hit);
+
+  // 0: no limit, however small the last one was
+  for (unsigned i = 3; i < 6; ++i) old.push_back(old_entry(cache.dir, i, 1u << 20, 20));
+  ProgramBuildInfo c;
+  {
+    lucent::test::ScopedEnv env("LUCENT_CACHE_MAX_MB", "0");
+    lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2 -D LC_EVICT_C", cache.dir, &c);
+  }
+  EXPECT_FALSE(c.cache_hit);
+  for (size_t i = 2; i < old.size(); ++i) EXPECT_TRUE(fs::exists(old[i])) << i;
+  EXPECT_EQ(lucent::cl_util::program_cache_usage(cache.dir).programs, 7);
 }
 
 // A session waiting for another process's build lock stops waiting once its render is cancelled

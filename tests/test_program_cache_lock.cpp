@@ -135,4 +135,43 @@ TEST(ProgramCacheLock, ALockRemovedUnderAWaitingBuilderIsOpenedAgain) {
   EXPECT_TRUE(waiter_info.cache_hit) << "the waiter built beside the second builder";
 }
 
+// Evictions racing loads of the entry they remove: each load that loses the race rebuilds (and
+// writes the entry again); none fails or gets a program that does not run.
+TEST(ProgramCacheLock, EvictionsRacingLoadsCostRebuilds) {
+  const std::string dir = lucent::test::temp_dir() + "/cache";
+  const std::string src = lucent::detail::assemble_kernel_source("test/layout_probe.cl");
+  const std::string options = "-cl-std=CL1.2 -D LC_PROGRAM_CACHE_EVICTION_RACE_TEST";
+  std::atomic<bool> done{false};
+  std::atomic<int> hits{0}, builds{0}, evicted{0}, loaders{kBuilders - 1};
+  std::vector<std::string> errors = run_builders([&](lucent::cl_util::Context& ctx, int i) {
+    if (i == 0) {  // the evictor: everything it can, every few milliseconds
+      while (!done) {
+        evicted += lucent::cl_util::evict_program_cache(dir, 1);
+        std::this_thread::sleep_for(std::chrono::milliseconds(3));
+      }
+      return;
+    }
+    auto t0 = std::chrono::steady_clock::now();
+    while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(1500)) {
+      ProgramBuildInfo info;
+      cl::Program p = lucent::cl_util::build_program_cached(ctx, src, options, dir, &info);
+      cl::Kernel k(p, "lucent_layout_probe");
+      cl::Buffer out(ctx.context, CL_MEM_WRITE_ONLY, 4096);
+      k.setArg(0, out);
+      ctx.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1), cl::NullRange);
+      unsigned v = 0;
+      ctx.queue.enqueueReadBuffer(out, CL_TRUE, 0, sizeof v, &v);
+      if (v != 64u) throw std::runtime_error("the program does not run: " + std::to_string(v));
+      if (!info.note.empty()) throw std::runtime_error("a damaged entry: " + info.note);
+      ++(info.cache_hit ? hits : builds);
+    }
+    if (--loaders == 0) done = true;
+  });
+  done = true;
+  for (int i = 0; i < kBuilders; ++i) EXPECT_EQ(errors[i], "") << "builder " << i;
+  EXPECT_GT(evicted.load(), 1);
+  EXPECT_GT(builds.load(), 1) << "no load lost a race with an eviction";
+  EXPECT_GT(hits.load(), 0);
+}
+
 }  // namespace

@@ -43,7 +43,7 @@ struct SessionOptions {
   /// from there instead (kernel development without rebuilding).
   std::string kernel_dir;
   /// Directory of the kernel binary cache; "" means $XDG_CACHE_HOME/lucent or ~/.cache/lucent,
-  /// "off" disables the cache.
+  /// "off" disables the cache. Its size limit is LUCENT_CACHE_MAX_MB's (default 256 MiB; README).
   std::string cache_dir;
   Precision precision = Precision::Float;  ///< Double: rays and geometry in double (needs fp64)
   bool fast_math = false;                  ///< -cl-fast-relaxed-math (default: IEEE math)

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -118,7 +119,7 @@ void warn_once(const std::string& message) {
   if (said.insert(message).second) scene_detail::warn(message);
 }
 
-void write_entry(const std::string& path, const std::string& key,
+bool write_entry(const std::string& path, const std::string& key,
                  const std::vector<unsigned char>& binary) {
   std::uint64_t key_len = key.size(), bin_len = binary.size();
   std::uint64_t checksum = fnv1a(binary.data(), binary.size());
@@ -130,10 +131,12 @@ void write_entry(const std::string& path, const std::string& key,
   bytes.append(reinterpret_cast<const char*>(binary.data()), binary.size());
   try {
     io::write_file_atomic(path, bytes);  // readers never see a half-written entry
+    return true;
   } catch (const Error& e) {
     warn_once(std::string(e.what()) +
               "; the kernel cache is not updated (kernels are built "
               "again next time)");
+    return false;
   }
 }
 
@@ -245,7 +248,9 @@ void DeferredEntry::store(const cl::Program& program) {
   if (!file_.empty()) {
     try {
       auto bins = program.getInfo<CL_PROGRAM_BINARIES>();
-      if (bins.size() == 1 && !bins[0].empty()) write_entry(file_, key_, bins[0]);
+      if (bins.size() == 1 && !bins[0].empty() && write_entry(file_, key_, bins[0]))
+        evict_program_cache(fs::path(file_).parent_path().string(), program_cache_max_bytes(),
+                            file_);
     } catch (const cl::Error&) {
       // some drivers cannot return binaries: no cache, no harm
     }
@@ -287,6 +292,8 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
         p = cl::Program(ctx.context, {ctx.device.device}, bins);
         p.build({ctx.device.device}, options.c_str());
         bi.cache_hit = true;
+        // a use: the entry's mtime orders evictions (fails harmlessly once it is removed)
+        ::utimensat(AT_FDCWD, bi.cache_file.c_str(), nullptr, 0);
         return true;
       } catch (const cl::Error&) {
         why = "the driver rejected the binary";
@@ -326,22 +333,119 @@ bool cache_file_name(std::string name) {
                      [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
 }
 
-}  // namespace
-
-int clear_program_cache(const std::string& dir) {
-  if (dir.empty()) return 0;
-  int n = 0;
+// The files of the cache directory `dir` that the cache wrote (none when `dir` does not exist).
+// A file, or a directory that cannot be listed, is an error (it said "removed 0" for
+// LUCENT_CACHE_DIR=/etc/passwd).
+std::vector<fs::directory_entry> cache_files(const std::string& dir) {
+  std::vector<fs::directory_entry> files;
   std::error_code ec;
-  // a directory that does not exist holds nothing; a file, or one that cannot be listed, is an
-  // error (it said "removed 0" for LUCENT_CACHE_DIR=/etc/passwd)
-  if (!fs::exists(dir, ec) && !ec) return 0;
+  if (dir.empty() || (!fs::exists(dir, ec) && !ec)) return files;
   if (!fs::is_directory(dir, ec))
     throw Error(dir + ": not a directory (the kernel cache, LUCENT_CACHE_DIR)");
   fs::directory_iterator it(dir, ec);
   if (ec) throw Error(dir + ": cannot list the kernel cache (" + ec.message() + ")");
-  for (auto& e : it) {
+  for (; it != fs::directory_iterator(); it.increment(ec))
+    if (cache_file_name(it->path().filename().string())) files.push_back(*it);
+  return files;
+}
+
+// An entry, "<key>.bin" (not a lock, not a write's temporary).
+bool is_entry(const fs::directory_entry& e) {
+  return e.path().extension() == ".bin" && e.path().filename().string()[0] != '.';
+}
+
+// Removes the lock file `path` unless a process holds it (one that opened it and waits for it
+// sees that it is gone: BuildLock).
+void remove_unused_lock(const std::string& path) {
+  int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
+  if (fd < 0) return;
+  if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && still_at(fd, path)) ::unlink(path.c_str());
+  ::close(fd);
+}
+
+}  // namespace
+
+std::uint64_t program_cache_max_bytes() {
+  const double fallback_mb = 256;
+  const char* v = std::getenv("LUCENT_CACHE_MAX_MB");
+  if (!v || !*v) return static_cast<std::uint64_t>(fallback_mb) << 20;
+  char* end = nullptr;
+  double mb = std::strtod(v, &end);
+  if (end == v || *end != '\0' || !std::isfinite(mb) || mb < 0) {
+    warn_once(std::string("LUCENT_CACHE_MAX_MB='") + v +
+              "' is not a size in MiB (a number, 0 for no limit); the kernel cache keeps its "
+              "default limit of 256 MiB");
+    mb = fallback_mb;
+  }
+  if (mb == 0) return 0;
+  // at least one byte (a tiny limit is not "no limit"), and no overflow
+  return static_cast<std::uint64_t>(std::clamp(mb * 1048576.0, 1.0, 1e18));
+}
+
+ProgramCacheUsage program_cache_usage(const std::string& dir) {
+  ProgramCacheUsage usage;
+  for (const fs::directory_entry& e : cache_files(dir)) {
+    std::error_code ec;
+    if (!is_entry(e) || !e.is_regular_file(ec)) continue;
+    const std::uintmax_t bytes = e.file_size(ec);
+    if (ec) continue;  // removed meanwhile
+    ++usage.programs;
+    usage.bytes += bytes;
+  }
+  return usage;
+}
+
+int evict_program_cache(const std::string& dir, std::uint64_t max_bytes, const std::string& keep) {
+  if (max_bytes == 0) return 0;
+  std::vector<fs::directory_entry> files;
+  try {
+    files = cache_files(dir);
+  } catch (const Error&) {
+    return 0;  // a cache that cannot be listed stays as it is: it only costs disk
+  }
+  struct Entry {
+    fs::file_time_type used;
+    std::uint64_t bytes;
+    fs::path path;
+  };
+  std::vector<Entry> entries;
+  std::uint64_t total = 0;
+  for (const fs::directory_entry& e : files) {
+    std::error_code ec, time_ec, size_ec;
+    if (!is_entry(e) || !e.is_regular_file(ec)) continue;
+    Entry entry{e.last_write_time(time_ec), e.file_size(size_ec), e.path()};
+    if (time_ec || size_ec) continue;  // removed meanwhile
+    total += entry.bytes;
+    entries.push_back(entry);
+  }
+  if (total <= max_bytes) return 0;
+  std::sort(entries.begin(), entries.end(),
+            [](const Entry& a, const Entry& b) { return a.used < b.used; });
+  const fs::path kept = fs::path(keep).filename();
+  int removed = 0;
+  for (const Entry& e : entries) {
+    if (total <= max_bytes) break;
+    if (e.path.filename() == kept) continue;
+    std::error_code ec;
+    if (fs::remove(e.path, ec)) ++removed;
+    total -= e.bytes;  // gone either way (another process may have removed it first)
+  }
+  // then the build locks of entries that are gone, evicted or not (one held is a build underway)
+  for (const fs::directory_entry& e : files) {
+    const std::string lock = e.path().string();
+    std::error_code ec;
+    if (e.path().extension() == ".lock" &&
+        !fs::exists(lock.substr(0, lock.size() - std::strlen(".lock")), ec) && !ec)
+      remove_unused_lock(lock);
+  }
+  return removed;
+}
+
+int clear_program_cache(const std::string& dir) {
+  int n = 0;
+  for (const fs::directory_entry& e : cache_files(dir)) {
     const std::string name = e.path().filename().string();
-    if (!cache_file_name(name)) continue;
+    std::error_code ec;
     if (e.path().extension() == ".lock") {
       fs::remove(e.path(), ec);  // build locks: not entries, not counted
       continue;

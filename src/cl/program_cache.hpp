@@ -8,6 +8,11 @@
 // the CLI's default is LUCENT_CACHE_DIR, "off" disabling it); "" disables the cache.
 // A miss is built under an exclusive lock on <entry>.lock, so that processes missing the same
 // entry at once (a parallel test run on cold caches) compile it once and the others read it.
+// The cache is bounded: after writing an entry it removes the least recently used others (a load
+// renews an entry's mtime) while the entries hold more than LUCENT_CACHE_MAX_MB
+// (program_cache_max_bytes), with their build locks when no process holds them. A removal racing
+// a load costs a rebuild: a reader that opened the entry reads it whole, one that comes later
+// misses it, and a lock file removed under a waiting builder is noticed (BuildLock).
 //
 // Drivers that cache their own builds: PoCL keeps every program it builds and every work-group
 // function it compiles at a launch (POCL_CACHE_DIR, while POCL_KERNEL_CACHE is on, its default),
@@ -16,6 +21,7 @@
 // leaves caching to such a driver (driver_program_cache) and stores an entry only for the others,
 // after the first launch (DeferredEntry), so that the entry also holds what the driver compiled
 // there: a hit then launches at once instead of compiling again.
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -78,6 +84,27 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
                                  ProgramBuildInfo* info = nullptr,
                                  DeferredEntry* deferred = nullptr, bool entries = true,
                                  const std::function<bool()>& stop = nullptr);
+
+/// The cache's size limit in bytes, from LUCENT_CACHE_MAX_MB (MiB, a fraction allowed): 256 MiB
+/// when unset or empty, 0 (no limit) for "0"; any other value that is not a number of 0 or more
+/// warns once and keeps the default.
+std::uint64_t program_cache_max_bytes();
+
+struct ProgramCacheUsage {
+  int programs = 0;         ///< entries ("<key>.bin")
+  std::uint64_t bytes = 0;  ///< their total size
+};
+
+/// What the entries of `dir` hold (nothing when `dir` does not exist). Throws lucent::Error when
+/// `dir` is not a directory or cannot be listed.
+ProgramCacheUsage program_cache_usage(const std::string& dir);
+
+/// While the entries of `dir` hold more than `max_bytes` (0: no limit), removes the least
+/// recently used (oldest mtime) but `keep` (a path, "" for none), and then the build locks of
+/// entries that are gone, each one only when no process holds it. Only files the cache writes are
+/// touched; failures are ignored. Returns the number of entries removed.
+int evict_program_cache(const std::string& dir, std::uint64_t max_bytes,
+                        const std::string& keep = "");
 
 /// Removes every cache entry of `dir`; returns how many files were removed (0 when `dir` does not
 /// exist). Throws lucent::Error when `dir` is not a directory or cannot be listed.
