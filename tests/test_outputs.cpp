@@ -108,8 +108,8 @@ TEST(Outputs, FullDeviceIsAnErrorNamingThePath) {
   std::string dir = lucent::test::temp_dir();
   // --help and --version too (they said nothing and exited 0)
   for (const std::string& args :
-       {std::string("devices"), std::string("cache dir"), std::string("--help"),
-        std::string("--version"), std::string("render --help")}) {
+       {std::string("devices"), std::string("cache dir"), std::string("cache info"),
+        std::string("--help"), std::string("--version"), std::string("render --help")}) {
     std::string cmd =
         std::string("'") + LUCENT_CLI_PATH + "' " + args + " >/dev/full 2>" + q(dir + "/err");
     int raw = std::system(cmd.c_str());

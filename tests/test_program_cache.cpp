@@ -398,6 +398,42 @@ TEST(ProgramCache, WritesEvictLeastRecentlyUsedEntries) {
   EXPECT_EQ(lucent::cl_util::program_cache_usage(cache.dir).programs, 7);
 }
 
+// `lucent cache info`: the directory, the number and size of the entries (nothing else the
+// directory holds), the limit.
+TEST(ProgramCache, CliReportsTheCacheSize) {
+  const std::string dir = lucent::test::temp_dir() + "/clicache";
+  const std::string env = "LUCENT_CACHE_DIR='" + dir + "' ";
+  auto r = lucent::test::run_cli("cache info", env);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("directory: " + dir + "\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("programs: 0, 0 bytes\n"), std::string::npos) << r.out;
+  old_entry(dir, 1, 1000, 1);
+  old_entry(dir, 2, 2072, 2);
+  lucent::test::write_file(dir + "/0000000000000001.bin.lock", "");
+  lucent::test::write_file(dir + "/.0000000000000003.bin.tmp-1-0", std::string(500, 'x'));
+  lucent::test::write_file(dir + "/weights.bin", std::string(700, 'x'));
+  r = lucent::test::run_cli("cache info", env);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("programs: 2, 3072 bytes (3.0 KiB)\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("limit: 256.0 MiB (LUCENT_CACHE_MAX_MB"), std::string::npos) << r.out;
+  r = lucent::test::run_cli("cache info", env + "LUCENT_CACHE_MAX_MB=0.5");
+  EXPECT_NE(r.out.find("limit: 512.0 KiB (LUCENT_CACHE_MAX_MB"), std::string::npos) << r.out;
+  r = lucent::test::run_cli("cache info", env + "LUCENT_CACHE_MAX_MB=0");
+  EXPECT_NE(r.out.find("limit: none (LUCENT_CACHE_MAX_MB"), std::string::npos) << r.out;
+  r = lucent::test::run_cli("cache info", env + "LUCENT_CACHE_MAX_MB=big");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("limit: 256.0 MiB (LUCENT_CACHE_MAX_MB"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("LUCENT_CACHE_MAX_MB='big' is not a size in MiB"), std::string::npos)
+      << r.err;
+  r = lucent::test::run_cli("cache info", "LUCENT_CACHE_DIR=off");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("directory: (disabled)\n"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("programs:"), std::string::npos) << r.out;
+  r = lucent::test::run_cli("cache info", "LUCENT_CACHE_DIR=/etc/passwd");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("/etc/passwd: not a directory"), std::string::npos) << r.err;
+}
+
 // A session waiting for another process's build lock stops waiting once its render is cancelled
 // (and builds without the lock): `lucent render` under `timeout` (one SIGTERM) waited 600 s for a
 // holder that had been stopped (Ctrl-Z) in its build, then rendered and wrote "interrupted".
