@@ -89,7 +89,7 @@ class PyRenderer {
  public:
   PyRenderer(const std::string& device, const FileText& kernel_dir, const FileText& cache_dir,
              const std::string& precision, bool fast_math, bool specialize, double pass_seconds,
-             py::object on_warning)
+             const IntArg& reserved_host_bytes, py::object on_warning)
       : warning_errors_(std::make_shared<CallbackErrors>()) {
     check_callable(on_warning, "on_warning");
     refuse_nul(device, "device");
@@ -106,6 +106,8 @@ class PyRenderer {
     o.fast_math = fast_math;
     o.specialize = specialize;
     o.pass_seconds = pass_seconds;
+    o.reserved_host_bytes = int_argument(reserved_host_bytes, "reserved_host_bytes", 0,
+                                         std::numeric_limits<std::uint64_t>::max());
     WarningSink sink = python_warning_sink(SharedObject(std::move(on_warning)), warning_errors_);
     o.on_warning = [this, sink](const std::string& message) {
       WithChain chain(caller_chain_);  // on a device thread, the chain of the call's caller
@@ -649,14 +651,17 @@ void bind_render(py::module_& m) {
   bind_session_devices<Renderer>(renderer);
   renderer
       .def(py::init<const std::string&, const FileText&, const FileText&, const std::string&, bool,
-                    bool, double, py::object>(),
+                    bool, double, const IntArg&, py::object>(),
            py::kw_only(), py::arg("device") = "", py::arg("kernel_dir") = "",
            py::arg("cache_dir") = "", py::arg("precision") = "float", py::arg("fast_math") = false,
            py::arg("specialize") = true, py::arg("pass_seconds") = 0.25,
-           py::arg("on_warning") = py::none(),
+           py::arg("reserved_host_bytes") = 0, py::arg("on_warning") = py::none(),
            "device: an index from list_devices() or a name substring (\"\": the first GPU, else "
            "the first CPU); kernel_dir: \"\" for the embedded kernels; cache_dir: \"\" for the "
-           "default, \"off\" for none; precision: \"float\" or \"double\"; on_warning(message): "
+           "default, \"off\" for none; precision: \"float\" or \"double\"; reserved_host_bytes: "
+           "host memory the application holds beside the session (its outputs, other results), "
+           "added to the estimate by which set_scene() refuses a film too large; "
+           "on_warning(message): "
            "warnings of scene packing (None: warnings.warn with LucentWarning).")
       .def_property_readonly(
           "device", [](PyRenderer& r) { return r.get().device(); },
@@ -674,6 +679,7 @@ void bind_render(py::module_& m) {
             d["fast_math"] = o.fast_math;
             d["specialize"] = o.specialize;
             d["pass_seconds"] = o.pass_seconds;
+            d["reserved_host_bytes"] = o.reserved_host_bytes;
             return d;
           },
           "The session's options, as a dict. Like scene, raises while "

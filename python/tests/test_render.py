@@ -416,6 +416,22 @@ def test_integer_arguments_take_any_integer_and_refuse_the_rest(renderer, small_
     assert "spp: int" in renderer.render.__doc__ and "first_sample: int = 0" in renderer.reset.__doc__
 
 
+def test_reserved_host_bytes_counts_in_the_memory_check(small_scene):
+    """What the application declares it holds beside the session is added to the estimate by
+    which set_scene refuses a film too large for the host (here a petabyte: always refused)."""
+    with session(reserved_host_bytes=2**50) as r:
+        assert r.options["reserved_host_bytes"] == 2**50
+        with pytest.raises(lucent.Error, match="the largest part is what the application keeps "
+                           r"beside the session \(its outputs, as it declared them\)"):
+            r.set_scene(small_scene)
+    with session(reserved_host_bytes=1 << 20) as r:
+        r.set_scene(small_scene)  # a mebibyte more: fine
+    with pytest.raises(ValueError, match=r"^reserved_host_bytes must be an integer in \[0, "):
+        session(reserved_host_bytes=-1)
+    with pytest.raises(TypeError, match="^reserved_host_bytes must be an integer, got 1.5"):
+        session(reserved_host_bytes=1.5)
+
+
 def test_session_option_errors():
     with pytest.raises(lucent.Error, match="no such device"):
         session(device="no such device at all")
