@@ -835,6 +835,29 @@ TEST(Parts, MpiTwoRanksRenderTheOneProcessImage) {
   EXPECT_LT(max_relative_difference(mpi.acc, one.acc), 1e-5);
 }
 
+// Rank 0 merges the parts and writes the image after every rank has rendered: a write the
+// host's memory cannot hold (a 2048x2048 part file, under an address-space limit the session
+// fits) is refused before rendering, naming the write, instead of failing after the job's work.
+TEST(Parts, MpiOutputTooLargeToWriteIsRefusedBeforeRendering) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  if (lucent::test::kAddressSanitizer)
+    GTEST_SKIP() << "AddressSanitizer cannot run under ulimit -v";
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  const std::string out = dir + "/mpi.exr";
+  CommandResult r =
+      run_shell("ulimit -v 1500000; timeout 60 env " +
+                    mpirun("-np 1 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) +
+                           " --width 2048 --height 2048 --spp 1 -o " + q(out)),
+                dir);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("lucent-mpi: error: rank 0 of 1 ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the largest part is writing "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("mpi.exr (2048x2048) (906.5 MiB): reduce the film size"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(Parts, MpiFailingRankEndsTheJobWithoutOutput) {
   if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
   std::string dir = lucent::test::temp_dir();

@@ -21,10 +21,12 @@
 
 #include "core/file_io.hpp"
 #include "core/text.hpp"
+#include "image/image_probe.hpp"
 #include "lucent/limits.hpp"
 #include "lucent/lucent.hpp"
 #include "lucent/parts.hpp"
 #include "lucent/types.hpp"
+#include "render/resources.hpp"
 #include "scene/loaders.hpp"
 
 namespace {
@@ -152,7 +154,25 @@ int run(const Args& a) {
   };
   const lucent::SampleRange range = share(g_rank);
 
+  // memory beside the session: each rank's part, copied from it before it goes; then on rank 0
+  // its part, the merge, a part received and the write (refused now rather than after the render)
+  const int fw = scene.film.width, fh = scene.film.height;
+  const std::uint64_t npix = std::uint64_t(fw) * std::uint64_t(fh);
+  const std::uint64_t part_bytes = npix * (6 * sizeof(double) + sizeof(std::uint32_t));
+  if (root) {
+    const std::string film = std::to_string(fw) + "x" + std::to_string(fh);
+    const std::uint64_t write = lucent::io::lower_extension(a.output) == ".exr"
+                                    ? lucent::part_write_bytes(fw, fh)
+                                    : npix * (6 * sizeof(float) + sizeof(std::uint32_t)) +
+                                          lucent::image_detail::image_write_bytes(a.output, fw, fh);
+    lucent::render_detail::check_output_host_memory(
+        scene, {{"rank 0's part, the merged sums and a part received of the " + film + " film",
+                 3 * part_bytes, "the film size"},
+                {"writing " + one_line(a.output) + " (" + film + ")", write, "the film size"}});
+  }
+
   lucent::SessionOptions so = lucent::SessionOptions::from_environment();
+  so.reserved_host_bytes = part_bytes;
   if (!a.device.empty()) so.device = a.device;
   so.precision = lucent::parse_precision(a.precision);
   so.fast_math = a.fast_math;
