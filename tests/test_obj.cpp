@@ -475,6 +475,22 @@ TEST(Obj, TransformMovesPositionsAndNormalsByTheInverseTranspose) {
   EXPECT_LT(glm::dot(naive, ng), 0.99) << "the test transform must tell the two apart";
 }
 
+// A flat mesh stretched by 1e300 across its plane's normal: its normals become [0, 0, 1e-300]
+// before they are normalised, a direction whose squared length underflows to 0. They were
+// dropped as zero (the triangle lost its normals); now they are +z.
+TEST(Obj, NormalsShrunkByTheTransformKeepTheirDirection) {
+  std::string dir = lucent::test::temp_dir();
+  std::string path =
+      write(dir, "flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n");
+  Scene s;
+  load(s, path, glm::scale(glm::dmat4(1.0), glm::dvec3(1, 1, 1e300)));
+  ASSERT_EQ(s.triangles.size(), 1u);
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_GE(s.triangles[0].n[k], 0);
+    EXPECT_LT(glm::length(s.normals[s.triangles[0].n[k]] - glm::dvec3(0, 0, 1)), 1e-15);
+  }
+}
+
 // A unit cube around the origin, faces counter-clockwise from outside, with outward normals and
 // per-face UVs equal to two of the corner's coordinates + 0.5.
 const char* kCube =

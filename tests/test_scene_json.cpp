@@ -2,6 +2,7 @@
 // problem (or line:column for syntax errors), and the full format parses to what it says.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <glm/glm.hpp>
@@ -637,6 +638,55 @@ TEST(SceneJson, LookAtFartherFromTheCameraThanTheLargestFloat) {
   lucent::ReferenceOptions o;
   o.spp = 1;
   EXPECT_NO_THROW(lucent::render_reference(s, o));
+}
+
+// A tiny direction is a direction: an up of [0, 1e-170, 0] (or look_at 1e-170 from the camera,
+// a rotation axis or a mesh normal of that size) has a squared length that underflows to 0, and
+// was refused as "/camera/up: must be a non-zero vector" (glm::normalize made it NaN). Now the
+// camera is the one with up [0, 1, 0], to the bit, in the kernel's packed camera and in the
+// reference's image.
+TEST(SceneJson, TinyDirectionsAreDirections) {
+  auto scene = [](const std::string& camera, const std::string& axis, const std::string& normal) {
+    return lucent::parse_scene(R"({"camera": )" + camera + R"(,
+        "film": {"width": 6, "height": 4}, "integrator": {"spp": 2},
+        "materials": {"m": {"type": "diffuse"}},
+        "lights": [{"type": "point", "position": [0, 3, 3], "intensity": [5, 5, 5]}],
+        "shapes": [{"type": "sphere", "center": [0.3, 0, 0], "radius": 1, "material": "m"},
+                   {"type": "triangles", "material": "m", "positions": [[0,0,0],[1,0,0],[0,1,0]],
+                    "indices": [0, 1, 2], "normals": [)" +
+                                   normal + "," + normal + "," + normal + R"(],
+                    "transform": [{"rotate": {"axis": )" +
+                                   axis + R"(, "degrees": 30}}]}]})",
+                               "tiny.json");
+  };
+  const Scene want = scene(R"({"position": [0, 0, 5], "look_at": [0, 0, 4], "up": [0, 1, 0]})",
+                           "[0, 0, 1]", "[0, 0, 1]");
+  for (const char* camera :
+       {R"({"position": [0, 0, 5], "look_at": [0, 0, 4], "up": [0, 1e-170, 0]})",
+        R"({"position": [0, 0, 1e-170], "look_at": [0, 0, 0]})"}) {
+    SCOPED_TRACE(camera);
+    Scene s;
+    ASSERT_NO_THROW(s = scene(camera, "[0, 0, 1e-170]", "[0, 0, 1e-170]"));
+    const lc_camera a = lucent::render_detail::pack_camera(s.camera, 6, 4);
+    const lc_camera b = lucent::render_detail::pack_camera(want.camera, 6, 4);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(a.right[k], b.right[k]);
+      EXPECT_EQ(a.up[k], b.up[k]);
+      EXPECT_EQ(a.forward[k], b.forward[k]);
+    }
+    ASSERT_EQ(s.normals.size(), want.normals.size());
+    for (std::size_t i = 0; i < s.normals.size(); ++i) EXPECT_EQ(s.normals[i], want.normals[i]);
+    ASSERT_EQ(s.positions.size(), want.positions.size());
+    for (std::size_t i = 0; i < s.positions.size(); ++i)
+      EXPECT_EQ(s.positions[i], want.positions[i]);
+    if (s.camera.position == want.camera.position) {  // the same pinhole: the same image
+      lucent::ReferenceOptions o;
+      o.threads = 1;
+      const std::vector<float> image = lucent::render_reference(want, o).mean.rgb;
+      EXPECT_GT(*std::max_element(image.begin(), image.end()), 0.0f);
+      EXPECT_EQ(lucent::render_reference(s, o).mean.rgb, image);
+    }
+  }
 }
 
 // The default focus distance (0: the distance to look_at) follows a camera moved after the scene

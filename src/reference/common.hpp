@@ -28,6 +28,16 @@ inline double max_abs(const dvec3& v) {
   return std::max(std::abs(v.x), std::max(std::abs(v.y), std::abs(v.z)));
 }
 
+/// v / |v| for any finite v other than 0 (0 stays 0), scaled first by the power of two of its
+/// largest component: glm::normalize made [0, 1e-170, 0] NaN (its squared length underflows to
+/// 0). The scaling is exact: where glm::normalize has no underflow, the same bits.
+inline dvec3 unit(const dvec3& v) {
+  double m = max_abs(v);
+  if (!(m > 0) || !std::isfinite(m)) return v;
+  int e = std::ilogb(m);
+  return glm::normalize(dvec3(std::ldexp(v.x, -e), std::ldexp(v.y, -e), std::ldexp(v.z, -e)));
+}
+
 inline bool finite(const dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }

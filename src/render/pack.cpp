@@ -68,8 +68,9 @@ bool set_triangle_normal(lc_triangle& t) {
 
 lc_camera pack_camera(const Camera& c, int width, int height) {
   lc_camera cam{};
-  glm::dvec3 fwd = glm::normalize(c.look_at - c.position);
-  glm::dvec3 right = glm::normalize(glm::cross(fwd, c.up));
+  // unit(): a tiny up or look_at - position (1e-170) is a direction like any other
+  glm::dvec3 fwd = scene_detail::unit(c.look_at - c.position);
+  glm::dvec3 right = scene_detail::unit(glm::cross(fwd, scene_detail::unit(c.up)));
   glm::dvec3 up = glm::cross(right, fwd);
   if (c.roll_degrees != 0) {
     // counter-clockwise as seen looking along forward: right turns towards up

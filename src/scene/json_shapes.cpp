@@ -33,7 +33,7 @@ glm::dmat4 parse_transform(const JsonReader& r, const json& j, const std::string
       glm::dvec3 axis = r.vec3(r.require(rj, sp + "/rotate", "axis"), sp + "/rotate/axis");
       check_nonzero(r.at(sp + "/rotate/axis"), axis);
       double deg = r.number(r.require(rj, sp + "/rotate", "degrees"), sp + "/rotate/degrees");
-      s = glm::rotate(glm::dmat4(1.0), glm::radians(deg), glm::normalize(axis));
+      s = glm::rotate(glm::dmat4(1.0), glm::radians(deg), unit(axis));
     } else if (step.contains("translate")) {
       s = glm::translate(glm::dmat4(1.0), r.vec3(step["translate"], sp + "/translate"));
     } else if (step.contains("matrix")) {

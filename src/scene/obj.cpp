@@ -261,9 +261,10 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   for (long i = 0; i < nn; ++i) {
     glm::dvec3 n = nxf * glm::dvec3(attrib.normals[3 * i], attrib.normals[3 * i + 1],
                                     attrib.normals[3 * i + 2]);
-    double len = glm::length(n);
+    glm::dvec3 u = unit(n);
+    double len = glm::length(u);  // 1, or 0 or not finite for a normal that has no direction
     normal_ok[i] = len > 0 && std::isfinite(len);
-    scene.normals.push_back(normal_ok[i] ? n / len : glm::dvec3(0.0));
+    scene.normals.push_back(normal_ok[i] ? u : glm::dvec3(0.0));
   }
   for (long i = 0; i < nt; ++i)
     scene.uvs.push_back({attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]});

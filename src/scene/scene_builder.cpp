@@ -136,11 +136,7 @@ void SceneBuilder::add_mesh(const MeshShape& mesh) {
               scene_detail::format_number(m) + ","));
     scene_.positions.push_back(w);
   }
-  for (const glm::dvec3& n : mesh.normals) {
-    glm::dvec3 t = nxf * n;
-    double len = glm::length(t);
-    scene_.normals.push_back(len > 0 ? t / len : t);
-  }
+  for (const glm::dvec3& n : mesh.normals) scene_.normals.push_back(scene_detail::unit(nxf * n));
   for (const glm::dvec2& uv : mesh.uvs) scene_.uvs.push_back(uv);
   ShapeEntry entry{ShapeType::Triangle, "", scene_.triangles.size(), mesh.indices.size() / 3, {}};
   for (std::size_t i = 0; i < mesh.indices.size(); i += 3) {

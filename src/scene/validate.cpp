@@ -70,6 +70,13 @@ double max_abs(const glm::dvec3& v) {
   return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
 }
 
+glm::dvec3 unit(const glm::dvec3& v) {
+  const double m = max_abs(v);
+  if (!(m > 0) || !std::isfinite(m)) return v;
+  const int e = std::ilogb(m);
+  return glm::normalize(glm::dvec3(std::ldexp(v.x, -e), std::ldexp(v.y, -e), std::ldexp(v.z, -e)));
+}
+
 std::string beyond_geometry_range(const std::string& what) {
   return what + " is beyond lucent's geometry range (coordinates of magnitude at most " +
          format_number(limits::kMaxCoordinate) +
@@ -89,7 +96,7 @@ void check_colour(const Reporter& at, const glm::dvec3& c) {
 
 void check_nonzero(const Reporter& at, const glm::dvec3& v) {
   check_point(at, v);
-  if (glm::length(v) == 0) at.fail("must be a non-zero vector");
+  if (max_abs(v) == 0) at.fail("must be a non-zero vector");
 }
 
 void check_scale(const Reporter& at, const glm::dvec3& s) {
@@ -164,8 +171,8 @@ void validate_camera(const Camera& c, const Reporter& at) {
   check_non_negative(at.at("aperture"), c.aperture);
   check_non_negative(at.at("focus_distance"), c.focus_distance);
   glm::dvec3 forward = c.look_at - c.position;
-  if (glm::length(forward) == 0) at.at("look_at").fail("must differ from the camera position");
-  if (glm::length(glm::cross(glm::normalize(forward), glm::normalize(c.up))) < 1e-9)
+  if (max_abs(forward) == 0) at.at("look_at").fail("must differ from the camera position");
+  if (glm::length(glm::cross(unit(forward), unit(c.up))) < 1e-9)
     at.at("up").fail("must not be parallel to the viewing direction");
   // The kernel aims a lens ray at the focal plane in float from its point on the lens: from a
   // lens 1e8 times wider than the focus distance the aim is off by more than the scene, and

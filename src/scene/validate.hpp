@@ -73,6 +73,11 @@ void check_between(const Reporter& at, double v, double lo, double hi);  ///< fi
 void check_point(const Reporter& at, const glm::dvec3& v);               ///< finite components
 /// The largest magnitude of v's components (what limits::kMaxCoordinate bounds).
 double max_abs(const glm::dvec3& v);
+/// v / |v| for any finite v other than 0 (0 stays 0): v is first scaled by the power of two of
+/// its largest component, so that the squares of tiny components cannot underflow (the length of
+/// [0, 1e-170, 0] was 0: glm::normalize made it NaN, and the checks refused it as zero). The
+/// scaling is exact: where glm::normalize has no underflow, the same bits.
+glm::dvec3 unit(const glm::dvec3& v);
 /// A position in the scene: finite components of magnitude <= limits::kMaxCoordinate.
 void check_position(const Reporter& at, const glm::dvec3& v);
 /// "<subject> is beyond lucent's geometry range (...)": the message for a coordinate beyond

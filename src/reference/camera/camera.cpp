@@ -8,8 +8,8 @@ namespace lucent::ref {
 CameraModel::CameraModel(const Scene& scene) : filter_(scene.film.filter) {
   const Camera& c = scene.camera;
   pos_ = c.position;
-  fwd_ = glm::normalize(c.look_at - c.position);
-  dvec3 right = glm::normalize(glm::cross(fwd_, c.up));
+  fwd_ = unit(c.look_at - c.position);  // unit(): tiny vectors (1e-170) are directions too
+  dvec3 right = unit(glm::cross(fwd_, unit(c.up)));
   dvec3 up = glm::cross(right, fwd_);
   // roll: right and up turn counter-clockwise as seen looking along forward, i.e. right moves
   // towards up
