@@ -78,6 +78,20 @@ TEST(KernelBsdf, FresnelDielectricKnownValues) {
   for (int i = 14; i < 20; ++i) EXPECT_NEAR(out[i].s[0], 0.0, 1e-6);
 }
 
+// ior 1 is no interface: F = 0 exactly and cos_t = cos_i at every angle, grazing included (the
+// reference's 1 - (1 - cos_i^2) / eta^2 left 3e-11 at cos 1e-6 and total reflection below 1e-8;
+// the kernel's eta^2 - 1 + cos_i^2 gives cos_i^2 exactly, and sqrt of a square its root).
+TEST(KernelBsdf, FresnelAtIorOneIsZero) {
+  std::vector<cl_float2> in;
+  for (float c : {1.0f, 0.5f, 1e-2f, 1e-4f, 1e-6f, 1e-8f, 1e-12f, 1e-18f})
+    in.push_back({{c, 1.0f}});
+  std::vector<cl_float2> out = probe().map<cl_float2>("probe_fresnel", in);
+  for (size_t i = 0; i < in.size(); ++i) {
+    EXPECT_EQ(out[i].s[0], 0.0f) << "cos " << in[i].s[0];
+    EXPECT_EQ(out[i].s[1], in[i].s[0]) << "cos " << in[i].s[0];
+  }
+}
+
 // lc_unit_circle (util/math.cl: a quarter-turn reduction and Taylor polynomials, where PoCL's
 // sinpi and cospi took twice the instructions) against cos and sin in double, at every u that
 // the samplers give (multiples of 2^-24) below 2^-4 and near the octant boundaries, and 2^18

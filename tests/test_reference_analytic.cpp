@@ -13,6 +13,8 @@
 
 #include "lucent/compare.hpp"
 #include "lucent/reference.hpp"
+#include "reference/bsdf/bsdf.hpp"
+#include "reference/bsdf/parts.hpp"
 #include "support.hpp"
 
 namespace {
@@ -243,6 +245,49 @@ TEST(ReferenceAnalytic, FresnelDielectric) {
   for (double c : {0.1, 0.4, 0.8}) {
     double cos_t = std::sqrt(1 - (1 - c * c) / (1.33 * 1.33));
     EXPECT_NEAR(fresnel_dielectric(c, 1.33), fresnel_dielectric(cos_t, 1 / 1.33), 1e-12);
+  }
+}
+
+// ior 1 is no interface: F = 0 at every angle, exactly. cos_t^2 was 1 - (1 - cos_i^2) / eta^2,
+// which lost cos_i^2 to rounding near grazing: F 3e-11 at cos 1e-6, total reflection (F = 1)
+// below 1e-8. A plastic of roughness 0 (GGX alpha 1e-3) multiplies F by its grazing peak, D G2 /
+// (4 cos_o cos_i) ~ 1e14 at cos 1e-6: its f at the mirror direction was 15000 times its analytic
+// albedo / pi. Elsewhere the formula keeps its values (against long double, to 1e-12)
+// and refraction at ior 1 goes straight on.
+TEST(ReferenceAnalytic, IorOneReflectsNothing) {
+  using lucent::reference::fresnel_dielectric;
+  for (double c : {1.0, 0.5, 0.1, 1e-3, 1e-6, 1e-8, 1e-9, 1e-12, 1e-100})
+    EXPECT_EQ(fresnel_dielectric(c, 1.0), 0.0) << "cos " << c;
+  for (double eta : {0.05, 0.5, 1 / 1.5, 0.99, 1.01, 1.5, 20.0})
+    for (double c : {1.0, 0.9, 0.5, 0.2, 0.05, 1e-3, 1e-6}) {
+      long double ci = c, e = eta, s2 = (1 - ci * ci) / (e * e);
+      if (s2 >= 1) {
+        EXPECT_EQ(fresnel_dielectric(c, eta), 1.0) << "cos " << c << " eta " << eta;
+        continue;
+      }
+      long double ct = std::sqrt(1 - s2), rs = (ci - e * ct) / (ci + e * ct),
+                  rp = (e * ci - ct) / (e * ci + ct);
+      EXPECT_NEAR(fresnel_dielectric(c, eta), double(0.5 * (rs * rs + rp * rp)), 1e-12)
+          << "cos " << c << " eta " << eta;
+    }
+
+  lucent::Material m;
+  m.type = lucent::MaterialType::Plastic;
+  m.albedo = glm::dvec3(0.5);
+  m.specular = glm::dvec3(1.0);
+  m.roughness = 0;
+  m.ior = 1;
+  const auto plastic = lucent::ref::make_bsdf(lucent::Scene{}, m, lucent::ref::ShadingPoint{});
+  for (double co : {0.5, 1e-2, 1e-4, 1e-6, 1e-9}) {
+    const glm::dvec3 wo(std::sqrt(1 - co * co), 0, co);
+    for (const glm::dvec3& wi : {glm::dvec3(-wo.x, 0, co), glm::dvec3(-wo.x, 1e-3, co),
+                                 glm::dvec3(0, 0, 1), glm::dvec3(0.6, 0, 0.8)}) {
+      const glm::dvec3 w = glm::normalize(wi);
+      EXPECT_DOUBLE_EQ(plastic->eval(wo, w).y, 0.5 / lucent::ref::kPi * w.z)
+          << "cos_o " << co << ", wi (" << w.x << ", " << w.y << ", " << w.z << ")";
+    }
+    const glm::dvec3 through = lucent::ref::refract(wo, glm::dvec3(0, 0, 1), co, 1.0);
+    EXPECT_LT(glm::length(through + wo), 1e-15) << "cos_o " << co;
   }
 }
 

@@ -10,9 +10,13 @@ namespace lucent {
 
 double reference::fresnel_dielectric(double cos_i, double eta) {
   cos_i = std::clamp(cos_i, 0.0, 1.0);
-  double sin2_t = (1 - cos_i * cos_i) / (eta * eta);
-  if (sin2_t >= 1) return 1;  // total internal reflection
-  double cos_t = std::sqrt(1 - sin2_t);
+  // eta^2 cos_t^2 = eta^2 - 1 + cos_i^2 (Snell), which at eta = 1 is cos_i^2 exactly, so cos_t
+  // = cos_i and F = 0 (as the kernel writes it). cos_t^2 = 1 - (1 - cos_i^2) / eta^2 lost cos_i^2
+  // in 1 - cos_i^2: at ior 1, F was 3e-11 at cos 1e-6 (a plastic of roughness 0 reflected that
+  // times its huge grazing GGX peak), and below cos 1e-8 it was total reflection.
+  double k = eta * eta - 1 + cos_i * cos_i;
+  if (k <= 0) return 1;  // total internal reflection
+  double cos_t = std::sqrt(k) / eta;
   // amplitude ratios divided through by the incident index
   double rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
   double rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);

@@ -12,7 +12,8 @@ namespace lucent::ref {
 /// cos_o = wo . m > 0), eta = n_transmitted / n_incident; undefined under total internal
 /// reflection.
 inline dvec3 refract(const dvec3& wo, const dvec3& m, double cos_o, double eta) {
-  double cos_t = std::sqrt(std::max(0.0, 1 - (1 - cos_o * cos_o) / (eta * eta)));
+  // Snell as fresnel_dielectric writes it: at eta = 1, cos_t = cos_o and wi = -wo exactly
+  double cos_t = std::sqrt(std::max(0.0, eta * eta - 1 + cos_o * cos_o)) / eta;
   return glm::normalize(-wo / eta + (cos_o / eta - cos_t) * m);
 }
 
