@@ -89,6 +89,9 @@ TEST(SceneGuard, DuplicateKeysNameBothPlaces) {
   // escaped quotes inside a key do not confuse the place
   EXPECT_EQ(after_path(parse_error(R"({"a\"b": 1, "a\"b": 2})")),
             ":1:13: /a\"b: duplicate key (first at 1:2)");
+  // a JSON pointer (RFC 6901): '~' in a key is "~0", '/' is "~1"
+  EXPECT_EQ(after_path(parse_error(R"({"materials": {"a/b~": {}, "a/b~": {}}})")),
+            ":1:28: /materials/a~1b~0: duplicate material name 'a/b~' (first at 1:16)");
   // the same key in two different objects is fine
   EXPECT_EQ(parse_error(R"({"film": {"width": 8}, "camera": {"fov": 30}})"), "");
 }

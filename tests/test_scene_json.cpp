@@ -6,10 +6,13 @@
 #include <cfloat>
 #include <cmath>
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "lucent/reference.hpp"
+#include "lucent/scene_builder.hpp"
 #include "render/pack.hpp"
+#include "scene/validate.hpp"
 #include "support.hpp"
 
 namespace {
@@ -122,6 +125,48 @@ TEST(SceneJson, UnknownKeys) {
   EXPECT_STARTS_WITH(error_of(with_material(R"("shapes": [{"type": "sphere", "center": [0,0,0],
                                                "radus": 1, "material": "m"}])")),
                      "scene.json: /shapes/0/radus: unknown key (allowed: ");
+}
+
+// The place is a JSON pointer (RFC 6901): a key's '~' is written "~0" and its '/' "~1". Keys were
+// written raw, so the material "a/b" was reported as "/materials/a/b/ior", a pointer to the
+// member "b" of a material "a". Each message's pointer leads back to the element in the file.
+TEST(SceneJson, PointersEscapeSlashAndTilde) {
+  auto pointer_of = [](const std::string& json) {
+    const std::string e = error_of(json);
+    const std::size_t a = std::string("scene.json: ").size(), b = e.find(": ", a);
+    EXPECT_EQ(e.substr(0, a), "scene.json: ") << e;
+    const std::string p = e.substr(a, b - a);
+    EXPECT_TRUE(nlohmann::json::parse(json).contains(nlohmann::json::json_pointer(p))) << e;
+    return p;
+  };
+  EXPECT_EQ(pointer_of(R"({"materials": {"a/b~1": {"type": "dielectric", "ior": 0}}})"),
+            "/materials/a~1b~01/ior");
+  EXPECT_EQ(pointer_of(R"({"materials": {"~/": {"type": "diffuse", "ro/ugh": 0}}})"),
+            "/materials/~0~1/ro~1ugh");
+  EXPECT_EQ(pointer_of(R"({"camera": {"up/": [0, 1, 0]}})"), "/camera/up~1");
+  EXPECT_EQ(pointer_of(with_transform(R"([{"sh/ear": [1, 0, 0]}])")),
+            "/shapes/0/transform/0/sh~1ear");
+  // a built scene's names too (SceneBuilder::add_material and validate_scene)
+  lucent::Material m;
+  m.name = "wood/oak";
+  m.ior = 0;
+  m.type = lucent::MaterialType::Dielectric;
+  lucent::SceneBuilder b("built");
+  try {
+    b.add_material(m);
+    ADD_FAILURE() << "ior 0 accepted";
+  } catch (const lucent::Error& e) {
+    EXPECT_STARTS_WITH(e.what(), "built: /materials/wood~1oak/ior: must be in [");
+  }
+  Scene s;
+  s.path = "built";
+  s.materials.push_back(m);
+  try {
+    lucent::scene_detail::validate_scene(s);
+    ADD_FAILURE() << "ior 0 accepted";
+  } catch (const lucent::Error& e) {
+    EXPECT_STARTS_WITH(e.what(), "built: /materials/wood~1oak/ior: must be in [");
+  }
 }
 
 TEST(SceneJson, MissingFields) {

@@ -752,7 +752,7 @@ nlohmann::json to_json(py::handle o, const std::string& path, const std::string&
         return fail("keys must be strings, got " + py::repr(item.first).cast<std::string>());
       std::string key;
       if (!utf8_text(item.first, key)) return fail("a key " + not_unicode(item.first));
-      j[key] = to_json(item.second, path + "/" + key, label, depth + 1);
+      j[key] = to_json(item.second, path + "/" + scene_detail::pointer_key(key), label, depth + 1);
     }
     return j;
   }

@@ -222,6 +222,16 @@ def test_dict_values_json_cannot_hold(value, message):
         lucent.scene_from_dict({"camera": {"fov": value}})
 
 
+def test_dict_paths_escape_slash_and_tilde_in_keys():
+    # JSON pointers (RFC 6901): '~' as ~0, '/' as ~1; the key "a/b" was written as two levels
+    with pytest.raises(lucent.Error) as e:
+        lucent.scene_from_dict({"materials": {"a/b~": {"type": object()}}})
+    assert one_line(e).startswith("./<dict>: /materials/a~1b~0/type: cannot be written as JSON")
+    with pytest.raises(lucent.Error) as e:
+        lucent.scene_from_dict({"materials": {"a/b": {"type": "dielectric", "ior": 0}}})
+    assert one_line(e).startswith("./<dict>: /materials/a~1b/ior: must be in [")
+
+
 def test_dict_keys_must_be_strings():
     with pytest.raises(lucent.Error, match="keys must be strings"):
         lucent.scene_from_dict({"camera": {1: 2}})

@@ -8,6 +8,7 @@
 
 #include "core/file_io.hpp"
 #include "lucent/error.hpp"
+#include "scene/validate.hpp"
 
 namespace lucent::scene_detail {
 
@@ -104,7 +105,8 @@ class StructureCheck : public nlohmann::json_sax<json> {
 
   std::string pointer() const {
     std::string p;
-    for (const Frame& f : frames_) p += "/" + (f.object ? f.key : std::to_string(f.index));
+    for (const Frame& f : frames_)
+      p += "/" + (f.object ? pointer_key(f.key) : std::to_string(f.index));
     return p.empty() ? "/" : p;
   }
 

@@ -10,7 +10,8 @@ namespace lucent::scene_detail {
 void parse_materials(const JsonReader& r, const json& j, SceneBuilder& b) {
   r.check_object(j, "/materials");
   for (auto it = j.begin(); it != j.end(); ++it)
-    b.add_material(parse_material(r, it.value(), "/materials/" + it.key(), it.key(), b));
+    b.add_material(
+        parse_material(r, it.value(), "/materials/" + pointer_key(it.key()), it.key(), b));
 }
 
 Material parse_material(const JsonReader& r, const json& j, const std::string& p,

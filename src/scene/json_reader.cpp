@@ -73,7 +73,7 @@ void JsonReader::check_keys(const json& obj, const std::string& ptr,
     if (!ok) {
       std::string list;
       for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-      fail(ptr + "/" + it.key(), "unknown key (allowed: " + list + ")");
+      fail(ptr + "/" + pointer_key(it.key()), "unknown key (allowed: " + list + ")");
     }
   }
 }

@@ -48,7 +48,7 @@ glm::dmat4 parse_transform(const JsonReader& r, const json& j, const std::string
       }
       check_affine(r.at(mp), s);
     } else {
-      r.fail(sp + "/" + step.begin().key(),
+      r.fail(sp + "/" + pointer_key(step.begin().key()),
              "unknown transform step (allowed: scale, rotate, translate, matrix)");
     }
     m = s * m;  // steps apply in order

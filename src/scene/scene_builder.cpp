@@ -84,7 +84,7 @@ int SceneBuilder::load_texture(const std::string& file) {
 }
 
 int SceneBuilder::add_material(const Material& material) {
-  Reporter at(scene_.path, "/materials/" + material.name);
+  const Reporter at = Reporter(scene_.path, "/materials").at(material.name);
   scene_detail::validate_material(material, scene_.textures, at);
   if (scene_.find_material(material.name) >= 0)
     at.fail("there is already a material named '" + material.name + "'");

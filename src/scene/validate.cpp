@@ -18,6 +18,12 @@ std::string in_file(const std::string& file, const std::string& what) {
   return file.empty() ? what : file + ": " + what;
 }
 
+std::string pointer_key(const std::string& key) {
+  std::string out;
+  for (char c : key) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+  return out;
+}
+
 void Reporter::fail(const std::string& what) const {
   const std::string& ptr = pointer_.empty() ? std::string("/") : pointer_;
   throw Error(in_file(file_, ptr + ": " + what));
@@ -388,7 +394,7 @@ void validate_scene(const Scene& s) {
     // its index
     Material m = s.materials[i];
     if (m.name.empty()) m.name = std::to_string(i);
-    validate_material(m, s.textures, Reporter(file, "/materials/" + m.name));
+    validate_material(m, s.textures, Reporter(file, "/materials").at(m.name));
   }
   for (std::size_t i = 0; i < s.lights.size(); ++i)
     validate_light(s.lights[i], s.textures.size(), Reporter(file, "/lights/" + std::to_string(i)));

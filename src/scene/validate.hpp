@@ -20,6 +20,10 @@
 
 namespace lucent::scene_detail {
 
+/// `key` as a reference token of a JSON pointer (RFC 6901): '~' written "~0" and '/' "~1", so that
+/// a key holding a '/' (a material "wood/oak") is not read as two levels.
+std::string pointer_key(const std::string& key);
+
 /// The place of a value: the scene's file (or a built scene's name) and the JSON pointer of the
 /// value in it. fail() throws lucent::Error "<file>: <pointer>: <what>" ("<pointer>: <what>" when
 /// the scene has no name).
@@ -27,8 +31,8 @@ class Reporter {
  public:
   Reporter(std::string file, std::string pointer)
       : file_(std::move(file)), pointer_(std::move(pointer)) {}
-  /// The member `key` of this object, or the element `index` of this array.
-  Reporter at(const std::string& key) const { return {file_, pointer_ + "/" + key}; }
+  /// The member `key` of this object (escaped: pointer_key), or the element `index` of this array.
+  Reporter at(const std::string& key) const { return {file_, pointer_ + "/" + pointer_key(key)}; }
   Reporter at(std::size_t index) const { return at(std::to_string(index)); }
   const std::string& file() const { return file_; }
   const std::string& pointer() const { return pointer_; }
