@@ -224,7 +224,7 @@ struct IntValue {
 
 /// `arg` as an int (what operator.index takes: an int, a NumPy integer; a bool only when
 /// `allow_bool`): TypeError "<what> must be an integer, got <repr>" otherwise. The one
-/// conversion of int_argument and of the scene structs' integer fields.
+/// conversion of int_argument, of the scene structs' integer fields and of triangle indices.
 IntValue int_value(const IntArg& arg, const std::string& what, bool allow_bool);
 
 /// repr() of an int for messages ("an integer too long to show" past

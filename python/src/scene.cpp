@@ -113,6 +113,24 @@ py::class_<V> bind_vector_type(py::module_& m, const char* name) {
   return c;
 }
 
+/// The magnitude of I's lowest value (2**31 for an int, 0 for an unsigned type).
+template <class I>
+constexpr std::uint64_t lowest_magnitude() {
+  using L = std::numeric_limits<I>;
+  return L::is_signed ? static_cast<std::uint64_t>(-(L::min() + 1)) + 1 : 0;
+}
+
+/// The integer `v` (int_value) as an I, or nothing when it is beyond I's range.
+template <class I>
+std::optional<I> narrowed(const IntValue& v) {
+  if (!v.fits ||
+      v.magnitude > (v.negative ? lowest_magnitude<I>()
+                                : static_cast<std::uint64_t>(std::numeric_limits<I>::max())))
+    return std::nullopt;
+  return v.negative ? static_cast<I>(-static_cast<long long>(v.magnitude - 1) - 1)
+                    : static_cast<I>(v.magnitude);
+}
+
 /// `arg` as an integer of type I: TypeError unless it is an integer (an int, a NumPy integer:
 /// operator.index; not a bool, as for triangle indices), ValueError "<what> must be an integer
 /// in [lo, hi], got <value>" for one outside I, of any size (never wrapped or clamped). A C++
@@ -122,12 +140,8 @@ template <class I>
 I integer_value(const IntArg& arg, const std::string& what) {
   using L = std::numeric_limits<I>;
   const IntValue v = int_value(arg, what, /*allow_bool=*/false);
-  // the magnitude of the type's lowest value (2**31 for an int)
-  const std::uint64_t lowest = L::is_signed ? static_cast<std::uint64_t>(-(L::min() + 1)) + 1 : 0;
-  if (v.fits &&
-      (v.negative ? v.magnitude <= lowest : v.magnitude <= static_cast<std::uint64_t>(L::max())))
-    return v.negative ? static_cast<I>(-static_cast<long long>(v.magnitude - 1) - 1)
-                      : static_cast<I>(v.magnitude);
+  if (const std::optional<I> x = narrowed<I>(v)) return *x;
+  const std::uint64_t lowest = lowest_magnitude<I>();
   throw py::value_error(what + " must be an integer in [" +
                         (L::is_signed ? "-" + range_bound(lowest) : std::string("0")) + ", " +
                         range_bound(static_cast<std::uint64_t>(L::max())) + "], got " +
@@ -192,17 +206,17 @@ void triple_property(py::class_<C>& c, const char* name, int (C::*member)[3]) {
           throw py::value_error("expected 3 indices, got " + py::repr(s).cast<std::string>());
         int v[3];
         for (int i = 0; i < 3; ++i) {
-          py::object e = s[static_cast<std::size_t>(i)];
-          // Python and NumPy integers (operator.index), not booleans
-          if (py::isinstance<py::bool_>(e) || !py::hasattr(e, "__index__"))
+          const std::string what = "index " + std::to_string(i);
+          IntValue x;
+          try {  // Python and NumPy integers (operator.index), not booleans
+            x = int_value(IntArg{s[static_cast<std::size_t>(i)]}, what, /*allow_bool=*/false);
+          } catch (const py::type_error&) {
             throw py::type_error("expected 3 integer indices, got " +
                                  py::repr(s).cast<std::string>());
-          const long long x = py::reinterpret_steal<py::int_>(PyNumber_Index(e.ptr()))
-                                  .cast<long long>();  // overflow raises
-          if (x < std::numeric_limits<int>::min() || x > std::numeric_limits<int>::max())
-            throw py::value_error("index " + std::to_string(i) +
-                                  " out of range: " + std::to_string(x));
-          v[i] = static_cast<int>(x);
+          }
+          const std::optional<int> n = narrowed<int>(x);
+          if (!n) throw py::value_error(what + " out of range: " + int_repr(x.index));
+          v[i] = *n;
         }
         for (int i = 0; i < 3; ++i) (o.*member)[i] = v[i];
       });

@@ -510,6 +510,13 @@ def test_indices_take_numpy_integers_and_refuse_the_rest():
         t.v = (True, 1, 2)
     with pytest.raises(ValueError, match="index 0 out of range"):
         t.v = (2 ** 40, 0, 0)
+    # beyond 64 bits, or NumPy's unsigned: the same ValueError (it was RuntimeError "Unable to
+    # cast Python instance to C++ type"), through the integer fields' int_value
+    for big in (2 ** 64, -2 ** 63 - 1, np.uint64(2 ** 64 - 1)):
+        with pytest.raises(ValueError, match=f"^index 1 out of range: {int(big)}$"):
+            t.n = (0, big, 0)
+    with pytest.raises(ValueError, match="^index 2 out of range: an integer too long to show$"):
+        t.uv = (0, 0, 10 ** 5000)
     assert t.v == (0, 1, 2)  # unchanged by a refused assignment
 
 
