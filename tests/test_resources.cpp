@@ -243,14 +243,15 @@ TEST(Resources, PeakHostMemoryOfALargeMeshIsWithinTheEstimate) {
   device.light_double = info.fp64 && info.int64_atomics;
   auto estimate = [&](const std::string& scene) {
     std::uint64_t bytes = 0;
+    // (one description: lucent render gives its scene to the session, set_scene(Scene&&))
     for (const MemoryPart& p :
-         lucent::render_detail::estimate_host_memory(lucent::load_scene(scene), {device}))
+         lucent::render_detail::estimate_host_memory(lucent::load_scene(scene), {device}, 1))
       bytes += p.bytes;
     return double(bytes) / 1048576.0;
   };
   const double growth = estimate(large_scene) - estimate(small_scene);
-  EXPECT_LE(large - small, growth) << "peak " << large << " MiB against " << small
-                                   << " MiB; estimated growth " << growth << " MiB";
+  EXPECT_LE(large - small, 1.1 * growth) << "peak " << large << " MiB against " << small
+                                         << " MiB; estimated growth " << growth << " MiB";
   // and the mesh's memory is there: the estimate is not a wide overestimate
   EXPECT_GE(large - small, 0.6 * growth) << large << " " << small << " " << growth;
 }

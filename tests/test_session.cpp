@@ -92,6 +92,32 @@ TEST(Session, CameraChangeRebuildsNothing) {
   EXPECT_FALSE(same_image(before, r.result()));
 }
 
+// set_scene(Scene&&) takes the scene instead of copying it (a large mesh or texture is held once):
+// the session's scene is the one given, the caller's is left empty, and the image is the one a
+// copied scene renders. Refused, it leaves the caller's scene as it was.
+TEST(Session, TakenSceneIsHeldOnceAndRendersTheSame) {
+  const Scene s = lucent::test::scene_from(kScene);
+  Renderer copied = session();
+  copied.set_scene(s);
+  copied.render(2);
+  Renderer taken = session();
+  Scene given = s;
+  taken.set_scene(std::move(given));
+  EXPECT_TRUE(given.triangles.empty() && given.positions.empty() && given.spheres.empty());
+  EXPECT_EQ(taken.scene().triangles.size(), s.triangles.size());
+  EXPECT_EQ(taken.scene().positions, s.positions);
+  taken.render(2);
+  EXPECT_TRUE(same_image(copied.result(), taken.result()));
+  // refused (a triangle indexing a vertex that is not there): untouched
+  Scene bad = s;
+  bad.triangles[0].v[2] = 99;
+  const std::string msg = error_of([&] { taken.set_scene(std::move(bad)); });
+  EXPECT_NE(msg.find("must index one of the"), std::string::npos) << msg;
+  EXPECT_EQ(bad.triangles.size(), s.triangles.size());
+  EXPECT_EQ(bad.positions, s.positions);
+  EXPECT_EQ(taken.scene().triangles[0].v[2], s.triangles[0].v[2]) << "the session keeps its scene";
+}
+
 // A material's parameters are data: its buffer is uploaded again, nothing is rebuilt. A
 // material of a type the kernel was not built with needs a kernel build, still not a BVH.
 TEST(Session, MaterialChangesUploadDataOrBuildTheKernelButNeverTheBvh) {

@@ -129,6 +129,11 @@ class Renderer {
   /// as SceneBuilder checks each element (its fields may have been set directly), with the place
   /// of the first problem ("scene.json: /shapes/1 (triangle 4)/v/2: must index one of ...").
   void set_scene(const Scene& scene);
+  /// set_scene() that takes the scene instead of copying it: its arrays (a large mesh's
+  /// vertices, a texture's texels) are then held once, by the session, not also by the caller.
+  /// On success `scene` is left empty (read it back with scene()); when this throws, `scene` is
+  /// untouched.
+  void set_scene(Scene&& scene);
   /// The session's scene. Throws lucent::Error when none was set.
   const Scene& scene() const;
 

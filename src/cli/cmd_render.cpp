@@ -118,8 +118,7 @@ std::string aov_path(const std::string& output, const std::string& name) {
 /// session (the BVH is reused, only the AOV kernel is built); returns the names of those not
 /// written. The variance AOV is the main render's, so an interrupted render writes it too; the
 /// others need renders of their own, which an interrupt skips (the AOVs written so far stay).
-std::vector<std::string> write_aovs(const RenderArgs& a, const lucent::Scene& scene,
-                                    lucent::Renderer* renderer,
+std::vector<std::string> write_aovs(const RenderArgs& a, lucent::Renderer* renderer,
                                     const lucent::RenderResult& main_result) {
   std::vector<std::string> missing;
   for (const std::string& name : a.aovs) {
@@ -130,9 +129,9 @@ std::vector<std::string> write_aovs(const RenderArgs& a, const lucent::Scene& sc
       missing.push_back(name);
       continue;
     } else {
-      lucent::Scene s = scene;
+      lucent::Scene s = renderer->scene();  // (the main scene, or the last AOV's: its type)
       s.integrator.type = lucent::cli::parse_integrator(name);
-      renderer->set_scene(s);
+      renderer->set_scene(std::move(s));
       renderer->reset();
       renderer->render(std::max<std::uint64_t>(1, main_result.spp));
       lucent::RenderResult aov = renderer->result();
@@ -328,10 +327,14 @@ int render_with(const RenderArgs& a) {
     std::string what;
     const std::uint64_t limit = lucent::render_detail::host_memory_allowed(&what);
     lucent::render_detail::check_host_memory(scene, {}, limit, what,
-                                             lucent::render_detail::reserved_part(reserved));
+                                             lucent::render_detail::reserved_part(reserved), 1);
   }
   if (!outputs.empty()) lucent::render_detail::check_output_host_memory(scene, outputs);
 
+  // the session takes the scene (its meshes and textures are not held twice): what is read of it
+  // after the render, first
+  const lucent::Film film_settings = scene.film;
+  const std::uint64_t scene_spp = std::uint64_t(scene.integrator.spp);
   lucent::RenderResult r;
   std::optional<lucent::Renderer> renderer;
   double wall = 0;  // of the kernel render (several devices: their passes overlap)
@@ -349,9 +352,9 @@ int render_with(const RenderArgs& a) {
     renderer.emplace(so);
     renderer->set_cancel_flag(&g_interrupted);
     try {
-      renderer->set_scene(scene);
-      std::uint64_t spp = a.spp > 0 ? static_cast<std::uint64_t>(a.spp)
-                                    : (a.time_limit > 0 ? 0 : scene.integrator.spp);
+      renderer->set_scene(std::move(scene));
+      std::uint64_t spp =
+          a.spp > 0 ? static_cast<std::uint64_t>(a.spp) : (a.time_limit > 0 ? 0 : scene_spp);
       if (range) {
         renderer->reset(range->begin);
         spp = range->end - range->begin;
@@ -386,8 +389,8 @@ int render_with(const RenderArgs& a) {
     return 128 + g_signal;
   }
 
-  lucent::DisplaySettings display{scene.film.transfer, scene.film.gamma, scene.film.exposure,
-                                  scene.film.tonemap};
+  lucent::DisplaySettings display{film_settings.transfer, film_settings.gamma,
+                                  film_settings.exposure, film_settings.tonemap};
   // every sample non-finite: nothing written (a part keeps its counts, and is written)
   if (!range) lucent::render_detail::check_some_sample_finite(a.output, r.nonfinite, r.samples);
   // the session is not needed again without AOVs: its memory goes before the write's (a part
@@ -417,9 +420,8 @@ int render_with(const RenderArgs& a) {
         stderr,
         "%s: %dx%d, %llu spp in %.3f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak host "
         "memory %.0f MiB) on %s%s\n",
-        one_line(a.output).c_str(), scene.film.width, scene.film.height,
-        static_cast<unsigned long long>(r.spp), seconds,
-        seconds > 0 ? double(r.spp) * scene.film.width * scene.film.height / seconds * 1e-6 : 0,
+        one_line(a.output).c_str(), fw, fh, static_cast<unsigned long long>(r.spp), seconds,
+        seconds > 0 ? double(r.spp) * double(npix) / seconds * 1e-6 : 0,
         seconds > 0 ? double(r.rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
         r.device.c_str(), device_shares(r.devices).c_str());
   // a time limit that ended the render before its plan did (a signal's last line says so)
@@ -443,11 +445,10 @@ int render_with(const RenderArgs& a) {
   if (std::string s = lucent::target_shortfall(r); !s.empty())
     std::fprintf(stderr, "lucent: warning: %s: %s\n", one_line(a.output).c_str(), s.c_str());
   std::vector<std::string> missing_aovs;
-  if (!a.reference) missing_aovs = write_aovs(a, scene, &*renderer, r);
+  if (!a.reference) missing_aovs = write_aovs(a, &*renderer, r);
   if (r.cancelled || g_interrupted.load()) {
     const int sig = g_signal ? static_cast<int>(g_signal) : SIGINT;
-    std::uint64_t target = a.spp > 0 ? std::uint64_t(a.spp)
-                                     : (a.time_limit > 0 ? 0 : std::uint64_t(scene.integrator.spp));
+    std::uint64_t target = a.spp > 0 ? std::uint64_t(a.spp) : (a.time_limit > 0 ? 0 : scene_spp);
     if (range) target = range->end - range->begin;
     std::string aovs;  // the AOVs asked for and not written
     for (const std::string& name : missing_aovs)

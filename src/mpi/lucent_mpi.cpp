@@ -179,7 +179,7 @@ int run(const Args& a) {
   std::optional<lucent::Renderer> session(std::in_place, so);
   lucent::Renderer& renderer = *session;
   renderer.set_cancel_flag(&g_stop);
-  renderer.set_scene(scene);
+  renderer.set_scene(std::move(scene));  // held once, by the session
   renderer.reset(range.begin);
   const bool tty = isatty(STDERR_FILENO);
   double last = -10;

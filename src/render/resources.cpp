@@ -151,13 +151,6 @@ std::uint64_t description_bytes(const Scene& scene) {
   return b;
 }
 
-std::vector<MemoryPart> scene_host_parts(const Scene& scene) {
-  return {{"the scene description (" + std::to_string(scene.triangles.size()) + " triangles, " +
-               std::to_string(scene.positions.size()) + " vertices, " +
-               std::to_string(scene.textures.size()) + " textures)",
-           description_bytes(scene), "the number of triangles or the textures' resolution"}};
-}
-
 std::vector<MemoryPart> reserved_part(std::uint64_t reserved) {
   if (reserved == 0) return {};
   return {{"what the application keeps beside the session (its outputs, as it declared them)",
@@ -165,7 +158,8 @@ std::vector<MemoryPart> reserved_part(std::uint64_t reserved) {
 }
 
 std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
-                                             const std::vector<DeviceLimits>& devices) {
+                                             const std::vector<DeviceLimits>& devices,
+                                             int description_copies) {
   const std::uint64_t npix = std::uint64_t(scene.film.width) * std::uint64_t(scene.film.height);
   const std::string film = film_size(scene.film.width, scene.film.height);
   std::vector<MemoryPart> parts;
@@ -181,21 +175,24 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
   if (caustics)
     parts.push_back({"the caustics light sums of the " + film + " film", npix * 6 * sizeof(double),
                      "the film size, or render without caustics"});
-  // the scene description: the application's, and the session's copy of it (Renderer::scene)
-  MemoryPart description = scene_host_parts(scene).front();
-  description.what += ", the application's and the session's copy";
-  description.bytes *= 2;
-  parts.push_back(description);
+  // the scene description: the application's, and the session's copy of it (Renderer::scene),
+  // or only the session's where it took the application's
+  parts.push_back({"the scene description (" + std::to_string(scene.triangles.size()) +
+                       " triangles, " + std::to_string(scene.positions.size()) + " vertices, " +
+                       std::to_string(scene.textures.size()) + " textures)" +
+                       (description_copies > 1 ? ", the application's and the session's copy" : ""),
+                   description_bytes(scene) * std::uint64_t(std::max(description_copies, 0)),
+                   "the number of triangles or the textures' resolution"});
   const PackedSizes z = packed_sizes(scene);
   const std::uint64_t ntri = z.ntri, nsph = z.nsph, sph_bytes = z.sph_bytes,
                       tex_bytes = z.tex_bytes;
   // the BVH: the build's primitive references (32 bytes), binary nodes (at most 2 per primitive)
   // and primitive indices; then the wide tree's leaf blocks (at most one per primitive: a soup
   // of separate triangles has leaves of one, a mesh about one block per 2 or 3 primitives) and
-  // nodes (about one per 4)
+  // nodes (a soup 0.29 per primitive, the dragon 0.06: counted as one per 3)
   const std::uint64_t nprim = ntri + nsph;
   const std::uint64_t leaf_bytes = (nprim + 1) * sizeof(lc_bvh_leaf);
-  const std::uint64_t node_bytes = (nprim / 4 + 1) * sizeof(lc_bvh_node);
+  const std::uint64_t node_bytes = (nprim / 3 + 1) * sizeof(lc_bvh_node);
   const std::uint64_t bvh_tree = leaf_bytes + node_bytes;
   const std::uint64_t bvh_bytes =
       nprim * (32 + 2 * sizeof(bvh::Node2) + sizeof(lc_uint)) + bvh_tree;
@@ -252,9 +249,9 @@ void check_host_parts(const Scene& scene, const std::vector<MemoryPart>& parts,
 
 void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
                        std::uint64_t host_limit, const std::string& limit_what,
-                       const std::vector<MemoryPart>& extra) {
+                       const std::vector<MemoryPart>& extra, int description_copies) {
   if (host_limit == 0) return;
-  std::vector<MemoryPart> parts = estimate_host_memory(scene, devices);
+  std::vector<MemoryPart> parts = estimate_host_memory(scene, devices, description_copies);
   parts.insert(parts.end(), extra.begin(), extra.end());
   check_host_parts(scene, parts, host_limit, limit_what);
 }
@@ -263,9 +260,7 @@ void check_output_host_memory(const Scene& scene, const std::vector<MemoryPart>&
   std::string what;
   const std::uint64_t limit = host_memory_allowed(&what);
   if (limit == 0) return;
-  std::vector<MemoryPart> parts = scene_host_parts(scene);
-  parts.insert(parts.end(), outputs.begin(), outputs.end());
-  check_host_parts(scene, parts, limit, what);
+  check_host_parts(scene, outputs, limit, what);
 }
 
 std::uint64_t host_memory_allowed(std::string* what) { return sys::host_memory_allowed(what); }
@@ -300,10 +295,10 @@ std::uint64_t adaptive_host_bytes(std::uint64_t npix, bool caustics) {
 
 void check_adaptive_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
                                 bool caustics, std::uint64_t host_limit,
-                                const std::string& limit_what,
-                                const std::vector<MemoryPart>& extra) {
+                                const std::string& limit_what, const std::vector<MemoryPart>& extra,
+                                int description_copies) {
   if (host_limit == 0) return;
-  std::vector<MemoryPart> parts = estimate_host_memory(scene, devices);
+  std::vector<MemoryPart> parts = estimate_host_memory(scene, devices, description_copies);
   parts.insert(parts.end(), extra.begin(), extra.end());
   const std::uint64_t npix = std::uint64_t(scene.film.width) * std::uint64_t(scene.film.height);
   parts.push_back({"the halves, pilots and plans of adaptive sampling for the " +

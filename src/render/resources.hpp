@@ -103,11 +103,14 @@ struct MemoryPart {
 };
 
 /// What rendering `scene` will allocate on the host, estimated before packing: the film's
-/// accumulation and result images, the packed triangles, spheres and texels, the BVH (its build
-/// and the tree), and per device the pass read-back (and, for devices whose memory is the host's,
-/// their buffers). `devices` lists the limits of each device of the session.
+/// accumulation and result images, the scene description (`description_copies` of it: 2 where
+/// the application keeps its own beside the session's copy, 1 where the session took it), the
+/// packed triangles, spheres and texels, the BVH (its build and the tree), and per device the pass
+/// read-back (and, for devices whose memory is the host's, their buffers). `devices` lists the
+/// limits of each device of the session.
 std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
-                                             const std::vector<DeviceLimits>& devices);
+                                             const std::vector<DeviceLimits>& devices,
+                                             int description_copies = 2);
 
 /// The application's part of an estimate: what it declared it holds beside the session
 /// (SessionOptions::reserved_host_bytes; none when 0).
@@ -117,17 +120,14 @@ std::vector<MemoryPart> reserved_part(std::uint64_t reserved);
 /// check), naming the largest part and the limit (80% of `limit_what`).
 void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
                        std::uint64_t host_limit, const std::string& limit_what = "physical memory",
-                       const std::vector<MemoryPart>& extra = {});
+                       const std::vector<MemoryPart>& extra = {}, int description_copies = 2);
 
 /// What the scene description's arrays hold on the host (their capacities), in bytes.
 std::uint64_t description_bytes(const Scene& scene);
 
-/// The scene description (description_bytes) as the parts of an estimate.
-std::vector<MemoryPart> scene_host_parts(const Scene& scene);
-
-/// Before rendering, for a front end that writes its outputs after the session is gone: throws
-/// lucent::Error as check_host_memory does when the scene description and `outputs` (what
-/// writing keeps and allocates) exceed host_memory_allowed().
+/// Before rendering, for a front end that writes its outputs after the session (which took the
+/// scene: set_scene(Scene&&)) is gone: throws lucent::Error as check_host_memory does, naming
+/// `scene`, when `outputs` (what writing keeps and allocates) exceed host_memory_allowed().
 void check_output_host_memory(const Scene& scene, const std::vector<MemoryPart>& outputs);
 
 /// Before the CPU reference (render_reference) allocates: its accumulation and result images, the
@@ -150,7 +150,8 @@ std::uint64_t adaptive_host_bytes(std::uint64_t npix, bool caustics);
 void check_adaptive_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
                                 bool caustics, std::uint64_t host_limit,
                                 const std::string& limit_what = "physical memory",
-                                const std::vector<MemoryPart>& extra = {});
+                                const std::vector<MemoryPart>& extra = {},
+                                int description_copies = 2);
 
 /// The film buffers of a device: the pass's sums and sums of squares (double4 per pixel with
 /// `fp64`, else float4), the work list (uint4 per pixel), and the light paths' sums and sums of

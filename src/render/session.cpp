@@ -329,6 +329,7 @@ struct Renderer::Impl {
   std::string cache_dir;
 
   std::optional<Scene> scene;
+  bool scene_taken = false;  // set_scene(Scene&&): the application holds no copy of its own
   render_detail::PackedScene packed;  // what the device buffers hold
   /// A set_scene failed after it had begun to change the devices: their buffers match neither
   /// `packed` nor `scene`. They were dropped (the next set_scene uploads everything), and
@@ -496,7 +497,9 @@ struct Renderer::Impl {
                   stale);
   }
 
-  void set_scene(const Scene& s) {
+  /// `take`, when not null, is `s` itself, given to the session (moved in on success) instead
+  /// of copied.
+  void set_scene(const Scene& s, Scene* take = nullptr) {
     scene_detail::ScopedWarningSink sink(options.on_warning);
     // What the scene is warned of (validation, energy, packing, precision), each once per
     // session: an AOV render, a converge study's settings and an application's camera moves set
@@ -520,7 +523,8 @@ struct Renderer::Impl {
       for (const std::string& note : scene_detail::energy_gain_notes(s)) scene_detail::warn(note);
       for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
       render_detail::check_host_memory(s, limits, limits.front().host_mem, limits.front().host_what,
-                                       render_detail::reserved_part(options.reserved_host_bytes));
+                                       render_detail::reserved_part(options.reserved_host_bytes),
+                                       take ? 1 : 2);
       for (const DeviceInfo& d : device_infos)
         render_detail::check_precision_support(d, options.precision);
       t0 = clock_type::now();
@@ -635,7 +639,11 @@ struct Renderer::Impl {
     packed = std::move(next);
     build_options = opts;
     npix = n;
-    scene = s;
+    if (take)
+      scene = std::move(*take);
+    else
+      scene = s;
+    scene_taken = take != nullptr;
     sys::return_free_memory();  // the BVH build's and the previous scene's arrays
     if (!keep) {
       sum.assign(npix * 3, 0.0);
@@ -1034,7 +1042,8 @@ struct Renderer::Impl {
       for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
       render_detail::check_adaptive_host_memory(
           *scene, limits, (packed.params.flags & LC_FLAG_CAUSTICS) != 0, limits.front().host_mem,
-          limits.front().host_what, render_detail::reserved_part(options.reserved_host_bytes));
+          limits.front().host_what, render_detail::reserved_part(options.reserved_host_bytes),
+          scene_taken ? 1 : 2);
       adaptive = true;
       pilot = m;
       for (int hi = 0; hi < 2; ++hi) {
@@ -1303,7 +1312,13 @@ void Renderer::set_build_options(Precision precision, bool fast_math, bool speci
   impl_->options.fast_math = fast_math;
   impl_->options.specialize = specialize;
   try {
-    if (impl_->scene) impl_->set_scene(Scene(*impl_->scene));
+    if (impl_->scene) {
+      // a copy (two descriptions while it packs, as the estimate counts a copied scene); the
+      // application still holds its own or not, as before
+      const bool taken = impl_->scene_taken;
+      impl_->set_scene(Scene(*impl_->scene));
+      impl_->scene_taken = taken;
+    }
   } catch (...) {
     // refused (a device without fp64, a kernel that does not build): the options stay those
     // the session's programs were built with
@@ -1317,6 +1332,11 @@ void Renderer::set_build_options(Precision precision, bool fast_math, bool speci
 void Renderer::set_scene(const Scene& scene) {
   impl_->check_not_rendering("set_scene");
   impl_->set_scene(scene);
+}
+
+void Renderer::set_scene(Scene&& scene) {
+  impl_->check_not_rendering("set_scene");
+  impl_->set_scene(scene, &scene);
 }
 
 const Scene& Renderer::scene() const {
