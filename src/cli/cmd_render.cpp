@@ -195,6 +195,46 @@ std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_sp
   return buf;
 }
 
+/// The outputs' memory, counted before rendering: a render refused up front rather than lost to
+/// its write (the resources review: a part file's write took 2.5 times the session's estimate).
+/// Without AOVs the session is gone before the output is written (`after`, checked on its own);
+/// with them it lives on, and the writes are declared beside it (`beside`).
+struct OutputMemory {
+  std::uint64_t beside = 0;
+  std::vector<lucent::render_detail::MemoryPart> after;
+};
+
+OutputMemory output_memory(const RenderArgs& a, int fw, int fh, bool part) {
+  const std::uint64_t npix = std::uint64_t(fw) * std::uint64_t(fh);
+  const std::string film = std::to_string(fw) + "x" + std::to_string(fh);
+  // a RenderResult's mean, variance and counts; an accumulation's sums, squares and counts
+  const std::uint64_t result_bytes = npix * (6 * sizeof(float) + sizeof(std::uint32_t));
+  const std::uint64_t acc_bytes = npix * (6 * sizeof(double) + sizeof(std::uint32_t));
+  const std::uint64_t write_bytes =
+      part ? lucent::part_write_bytes(fw, fh)
+           : (lucent::io::lower_extension(a.output) == ".exr"
+                  ? lucent::image_detail::render_exr_write_bytes(fw, fh, true)
+                  : lucent::image_detail::image_write_bytes(a.output, fw, fh));
+  OutputMemory m;
+  if (!a.aovs.empty()) {
+    // the main image's write, then each AOV's result and file
+    m.beside = write_bytes;
+    for (const std::string& name : a.aovs)
+      m.beside =
+          std::max(m.beside,
+                   name == "variance"
+                       ? lucent::image_detail::image_write_bytes(aov_path(a.output, name), fw, fh)
+                       : result_bytes + lucent::image_detail::render_exr_write_bytes(fw, fh, true));
+    return m;
+  }
+  if (part) m.beside = acc_bytes;  // the part's copy of the sums, made before the session goes
+  const std::string kept = part ? "the part's sums of the " + film + " film"
+                                : "the result images of the " + film + " film";
+  m.after = {{kept, part ? acc_bytes : result_bytes, "the film size"},
+             {"writing " + one_line(a.output) + " (" + film + ")", write_bytes, "the film size"}};
+  return m;
+}
+
 int render_with(const RenderArgs& a) {
   // options the reference does not honour: refused, rather than silently ignored (it runs on the
   // CPU, in double precision, with its own code: the kernel's device and build options mean
@@ -260,38 +300,8 @@ int render_with(const RenderArgs& a) {
   lucent::cli::apply_sampling_options(a.sampling, scene);
   if (range) lucent::check_part_scene(scene, a.scene);
 
-  // The outputs' memory, counted before rendering: a render refused up front rather than lost to
-  // its write (the resources review: a part file's write took 2.5 times the session's estimate).
-  // Without AOVs the session is gone before the output is written; with them it lives on.
-  const int fw = scene.film.width, fh = scene.film.height;
-  const std::uint64_t npix = std::uint64_t(fw) * std::uint64_t(fh);
-  const std::string film = std::to_string(fw) + "x" + std::to_string(fh);
-  // a RenderResult's mean, variance and counts; an accumulation's sums, squares and counts
-  const std::uint64_t result_bytes = npix * (6 * sizeof(float) + sizeof(std::uint32_t));
-  const std::uint64_t acc_bytes = npix * (6 * sizeof(double) + sizeof(std::uint32_t));
-  const std::uint64_t write_bytes =
-      range ? lucent::part_write_bytes(fw, fh)
-            : (lucent::io::lower_extension(a.output) == ".exr"
-                   ? lucent::image_detail::render_exr_write_bytes(fw, fh, true)
-                   : lucent::image_detail::image_write_bytes(a.output, fw, fh));
-  std::uint64_t reserved = 0;                              // beside a live session
-  std::vector<lucent::render_detail::MemoryPart> outputs;  // after it (checked with the scene)
-  if (!a.aovs.empty()) {
-    // the main image's write, then each AOV's result and file
-    reserved = write_bytes;
-    for (const std::string& name : a.aovs)
-      reserved =
-          std::max(reserved,
-                   name == "variance"
-                       ? lucent::image_detail::image_write_bytes(aov_path(a.output, name), fw, fh)
-                       : result_bytes + lucent::image_detail::render_exr_write_bytes(fw, fh, true));
-  } else {
-    if (range) reserved = acc_bytes;  // the part's copy of the sums, made before the session goes
-    const std::string kept = range ? "the part's sums of the " + film + " film"
-                                   : "the result images of the " + film + " film";
-    outputs = {{kept, range ? acc_bytes : result_bytes, "the film size"},
-               {"writing " + one_line(a.output) + " (" + film + ")", write_bytes, "the film size"}};
-  }
+  const OutputMemory memory =
+      output_memory(a, scene.film.width, scene.film.height, range.has_value());
 
   lucent::RenderOptions opt;
   opt.spp = a.spp;
@@ -326,10 +336,10 @@ int render_with(const RenderArgs& a) {
   if (!a.reference) {
     std::string what;
     const std::uint64_t limit = lucent::render_detail::host_memory_allowed(&what);
-    lucent::render_detail::check_host_memory(scene, {}, limit, what,
-                                             lucent::render_detail::reserved_part(reserved), 1);
+    lucent::render_detail::check_host_memory(
+        scene, {}, limit, what, lucent::render_detail::reserved_part(memory.beside), 1);
   }
-  if (!outputs.empty()) lucent::render_detail::check_output_host_memory(scene, outputs);
+  if (!memory.after.empty()) lucent::render_detail::check_output_host_memory(scene, memory.after);
 
   // the session takes the scene (its meshes and textures are not held twice): what is read of it
   // after the render, first
@@ -348,7 +358,7 @@ int render_with(const RenderArgs& a) {
     so.precision = opt.precision;
     so.fast_math = opt.fast_math;
     so.specialize = opt.specialize;
-    so.reserved_host_bytes = reserved;
+    so.reserved_host_bytes = memory.beside;
     renderer.emplace(so);
     renderer->set_cancel_flag(&g_interrupted);
     try {
@@ -420,8 +430,10 @@ int render_with(const RenderArgs& a) {
         stderr,
         "%s: %dx%d, %llu spp in %.3f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak host "
         "memory %.0f MiB) on %s%s\n",
-        one_line(a.output).c_str(), fw, fh, static_cast<unsigned long long>(r.spp), seconds,
-        seconds > 0 ? double(r.spp) * double(npix) / seconds * 1e-6 : 0,
+        one_line(a.output).c_str(), film_settings.width, film_settings.height,
+        static_cast<unsigned long long>(r.spp), seconds,
+        seconds > 0 ? double(r.spp) * film_settings.width * film_settings.height / seconds * 1e-6
+                    : 0,
         seconds > 0 ? double(r.rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
         r.device.c_str(), device_shares(r.devices).c_str());
   // a time limit that ended the render before its plan did (a signal's last line says so)
