@@ -5,11 +5,13 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <streambuf>
 
 #include "core/file_io.hpp"
+#include "core/host_memory.hpp"
 #include "lucent/error.hpp"
 #include "scene/loaders.hpp"
 #include "scene/obj_internal.hpp"
@@ -152,6 +154,60 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<glm::vec3>& p, boo
   return out;
 }
 
+/// The capacity grow_for gives a vector of `capacity` that must hold `need`.
+std::uint64_t grown_capacity(std::uint64_t capacity, std::uint64_t need) {
+  return capacity >= need ? capacity : std::max(need, capacity + capacity / 2);
+}
+
+/// Makes room in `v` for `more` elements at once: one allocation per mesh, by at least half again
+/// (amortised over many meshes), and never the slack of doubling for one large mesh.
+template <typename T>
+void grow_for(std::vector<T>& v, std::size_t more) {
+  v.reserve(std::size_t(grown_capacity(v.capacity(), v.size() + more)));
+}
+
+/// Before tinyobjloader reads `path`: the scene's meshes so far and this one must stay within the
+/// host limit while it loads (the file's text, tinyobjloader's arrays: 12 bytes a vertex or
+/// normal, 8 a texture coordinate, 12 a corner; and the scene's own: 24, 24, 16 and 40 a
+/// triangle), and the scene's vertices and triangles within the int indices of its triangles.
+/// Each OBJ file is bounded, not their number: twelve copies of a 10^6-triangle soup under a 2
+/// GB limit loaded for 14 s and ended in a bare "out of memory".
+void check_mesh_memory(const Scene& scene, const std::string& path, std::uint64_t text_bytes,
+                       const obj::TextCounts& c) {
+  const std::uint64_t v = std::uint64_t(c.vertices), n = std::uint64_t(c.normals),
+                      t = std::uint64_t(c.texcoords), tri = std::uint64_t(c.triangles);
+  constexpr std::uint64_t kMaxIndex = std::uint64_t(std::numeric_limits<int>::max());
+  if (scene.positions.size() + v > kMaxIndex || scene.normals.size() + n > kMaxIndex ||
+      scene.uvs.size() + t > kMaxIndex || scene.triangles.size() + tri > kMaxIndex / 2)
+    throw Error(path + ": with this mesh the scene has more than " + std::to_string(kMaxIndex) +
+                " vertices, normals or texture coordinates, or " + std::to_string(kMaxIndex / 2) +
+                " triangles: reduce the meshes' size or number");
+  // the scene's arrays as they are held, and as they grow to take this mesh (grow_for: the old
+  // block and the new one at once)
+  std::uint64_t held = 0, grown = 0;
+  auto add = [&](std::uint64_t capacity, std::uint64_t size, std::uint64_t more,
+                 std::uint64_t bytes) {
+    held += capacity * bytes;
+    grown += grown_capacity(capacity, size + more) * bytes;
+  };
+  add(scene.positions.capacity(), scene.positions.size(), v, sizeof(glm::dvec3));
+  add(scene.normals.capacity(), scene.normals.size(), n, sizeof(glm::dvec3));
+  add(scene.uvs.capacity(), scene.uvs.size(), t, sizeof(glm::dvec2));
+  add(scene.triangles.capacity(), scene.triangles.size(), tri, sizeof(Triangle));
+  // tinyobjloader's arrays (floats, and an index triple per corner: a polygon of k corners is
+  // k - 2 triangles, so at most 3 corners a triangle)
+  const std::uint64_t reading = text_bytes + 4 * (3 * v + 3 * n + 2 * t) + 12 * 3 * tri;
+  const std::uint64_t need = held + grown + reading;
+  std::string what;
+  const std::uint64_t limit = sys::host_memory_allowed(&what);
+  if (limit > 0 && need > limit)
+    throw Error(path + ": with this mesh (" + std::to_string(tri) +
+                " triangles) the scene's meshes need about " + sys::format_bytes(need) +
+                " while it is read (" + sys::format_bytes(grown) +
+                " after), more than the limit of " + sys::format_bytes(limit) + " (80% of " + what +
+                "): reduce the meshes' size or number");
+}
+
 }  // namespace
 
 std::vector<std::string> load_obj(Scene& scene, const std::string& path,
@@ -163,6 +219,7 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   spec.text = true;
   const std::string text = io::read_file(path, spec);
   const obj::TextCounts counts = obj::check_obj_text(path, text);  // before tinyobjloader
+  check_mesh_memory(scene, path, text.size(), counts);
   const bool use_mtl = material_override < 0;
   // tinyobjloader looks a usemtl name up when it reads the statement, in the libraries read so
   // far: the reader reads all of the file's libraries at the first mtllib, and when a usemtl
@@ -243,6 +300,11 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   const int vbase = static_cast<int>(scene.positions.size());
   const int nbase = static_cast<int>(scene.normals.size());
   const int tbase = static_cast<int>(scene.uvs.size());
+  // room for the mesh at once (growing by doubling held up to three times the vertices at once)
+  grow_for(scene.positions, std::size_t(nv));
+  grow_for(scene.normals, std::size_t(nn));
+  grow_for(scene.uvs, std::size_t(nt));
+  grow_for(scene.triangles, std::size_t(counts.triangles));
   for (long i = 0; i < nv; ++i) {
     glm::dvec3 p(attrib.vertices[3 * i], attrib.vertices[3 * i + 1], attrib.vertices[3 * i + 2]);
     glm::dvec3 w = glm::dvec3(transform * glm::dvec4(p, 1.0));
