@@ -532,6 +532,22 @@ PYBIND11_MODULE(lucent, m) {
       py::arg("cache_dir") = "",
       "Removes every cached kernel program from that directory (only the files the cache "
       "wrote); returns how many.");
+  m.def(
+      "cache_info",
+      [](const FileText& dir) {
+        const FileText resolved = resolved_cache_dir(dir);
+        const cl_util::ProgramCacheUsage usage = cl_util::program_cache_usage(resolved.bytes);
+        py::dict d;
+        d["directory"] = file_text(resolved.bytes);
+        d["programs"] = usage.programs;
+        d["bytes"] = usage.bytes;
+        d["limit_bytes"] = cl_util::program_cache_max_bytes();
+        return d;
+      },
+      py::arg("cache_dir") = "",
+      "What `lucent cache info` prints, as a dict: the directory (\"\" when disabled), the "
+      "number of cached programs, their size in bytes, and the limit the cache keeps them under "
+      "(LUCENT_CACHE_MAX_MB; 0: none).");
 
   bind_scene(m);
   bind_render(m);

@@ -296,7 +296,14 @@ def test_kernel_cache_directory_is_an_option(tmp_path, small_scene, monkeypatch)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     assert lucent.cache_dir() == str(tmp_path / "xdg" / "lucent")
     assert lucent.cache_dir(lucent.environment()["cache_dir"]) == str(tmp_path / "env")
+    info = lucent.cache_info(str(tmp_path))
+    assert (info["directory"], info["programs"]) == (str(tmp_path), 1)
+    assert info["bytes"] == sum(f.stat().st_size for f in tmp_path.glob("*.bin"))
+    monkeypatch.setenv("LUCENT_CACHE_MAX_MB", "64")
+    assert lucent.cache_info(str(tmp_path))["limit_bytes"] == 64 << 20
     assert lucent.clear_cache(str(tmp_path)) == 1
+    assert lucent.cache_info(str(tmp_path))["programs"] == 0
+    assert lucent.cache_info("off")["directory"] == ""
 
 
 # --- errors -------------------------------------------------------------------------------
