@@ -443,6 +443,11 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     return static_cast<lc_uint>(p.lights.size() - 1);
   };
 
+  // as large as they will be: growing by doubling copied a 10^6-triangle mesh's arrays about
+  // twice over, into fresh pages, at every set_scene (a camera move included)
+  p.spheres.reserve(scene.spheres.size());
+  p.triangles.reserve(scene.triangles.size());
+  p.tri_attrs.reserve(scene.triangles.size());
   for (const Sphere& s : scene.spheres) {
     lc_sphere d{};
     put3(d.center, s.center);
