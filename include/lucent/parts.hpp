@@ -112,11 +112,16 @@ class PartMerger {
   void add_header(const std::string& name, const PartInfo& info);
   /// check(), then adds the part.
   void add(const std::string& name, const RenderPart& part);
+  /// add(), taking the part: a first part becomes the sum without being copied (a film's sums
+  /// held once, not twice: `lucent render --checkpoint` merges beside its session).
+  void add(const std::string& name, RenderPart&& part);
   bool empty() const { return names_.empty(); }
-  /// The merged part and its coverage.
+  /// The merged part and its coverage. The sum is moved out: call it once.
   MergeReport finish();
 
  private:
+  void check_part(const std::string& name, const RenderPart& part);
+
   std::vector<std::string> names_;
   std::vector<PartInfo> infos_;
   RenderPart total_;

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <utility>
 
 #include "core/file_io.hpp"
 #include "core/text.hpp"
@@ -560,7 +561,7 @@ void PartMerger::add_header(const std::string& name, const PartInfo& info) {
   infos_.push_back(info);
 }
 
-void PartMerger::add(const std::string& name, const RenderPart& part) {
+void PartMerger::check_part(const std::string& name, const RenderPart& part) {
   // headers or parts, not both: after add_header there is no sum to add to (it read empty
   // vectors as a full film's)
   if (!names_.empty() && total_.info.width == 0)
@@ -569,14 +570,27 @@ void PartMerger::add(const std::string& name, const RenderPart& part) {
                 "parts, not both");
   check(name, part.info);
   const Accumulation& a = part.acc;
-  const size_t npix = static_cast<size_t>(a.width) * a.height;
   if (a.width <= 0 || a.height <= 0 || !sums_fit_film(a) || a.width != part.info.width ||
       a.height != part.info.height)
     throw Error(name + ": inconsistent part (film and accumulation sizes differ)");
   check_counts(name, part.info, a);  // a part of lucent-mpi's ranks, or of a library caller
+}
+
+void PartMerger::add(const std::string& name, RenderPart&& part) {
+  if (!names_.empty()) return add(name, static_cast<const RenderPart&>(part));
+  check_part(name, part);
+  names_.push_back(name);
+  infos_.push_back(part.info);
+  total_ = std::move(part);
+}
+
+void PartMerger::add(const std::string& name, const RenderPart& part) {
+  check_part(name, part);
   if (names_.empty()) {
     total_ = part;
   } else {
+    const Accumulation& a = part.acc;
+    const size_t npix = static_cast<size_t>(a.width) * a.height;
     Accumulation& t = total_.acc;
     for (size_t i = 0; i < npix; ++i)
       if (std::uint64_t(t.count[i]) + a.count[i] > 0xffffffffull)
@@ -608,7 +622,8 @@ MergeReport PartMerger::finish() {
   if (total_.info.width == 0)
     throw Error("merge: no parts added (add_header() checks headers, add() adds parts)");
   MergeReport r;
-  r.merged = total_;
+  r.merged = std::move(total_);  // (not copied: a film's sums)
+  total_ = RenderPart{};
   r.order = names_;
   // missing: [0, the highest end requested) less what was rendered
   const std::uint64_t end =
