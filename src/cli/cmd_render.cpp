@@ -105,8 +105,12 @@ struct RenderArgs {
   std::string precision;  ///< "" : float
   bool no_specialize = false;
   lucent::cli::SamplingArgs sampling;  ///< --sampler, --clamp, --target-error, --min-spp
-  std::string samples;  ///< "A:B": a part file of sample indices [A, B) (lucent/parts.hpp)
+  std::string samples;          ///< "A:B": a part file of sample indices [A, B) (lucent/parts.hpp)
+  std::string checkpoint;       ///< a part file of the samples so far, resumed from when present
+  double checkpoint_every = 0;  ///< seconds between checkpoints; 0: not given (the default)
 };
+
+constexpr double kDefaultCheckpointSeconds = 300;
 
 /// <output stem>.<name>.exr beside the main output.
 std::string aov_path(const std::string& output, const std::string& name) {
@@ -195,6 +199,179 @@ std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_sp
   return buf;
 }
 
+/// --checkpoint FILE: the samples rendered so far, written every --checkpoint-every seconds as a
+/// part file of the samples [0, K) (docs/parts.md, "Checkpoints"), so that a render killed
+/// outright (SIGKILL, the OOM killer, a power loss, a crashed driver) loses at most that much. A
+/// render started with the file present resumes from it: it renders the samples [K, N) only, and
+/// its image is that of [0, N), the one the render without a stop gives (the same sample
+/// indices, summed in another order). The file is removed once the output is written.
+class Checkpoint {
+ public:
+  Checkpoint(std::string path, std::string scene_path, double every)
+      : path_(std::move(path)), scene_(std::move(scene_path)), every_(every) {}
+
+  /// Before the session: reads the checkpoint when there is one, so that a file that is not a
+  /// part, or a corrupt one, is refused before a device is opened.
+  void read() {
+    std::error_code ec;
+    if (std::filesystem::exists(path_, ec)) old_ = lucent::read_render_part(path_);
+    held_ = first_sample();
+  }
+  bool resumed() const { return old_.has_value(); }
+  /// K: the samples per pixel the checkpoint holds, where this render starts.
+  std::uint64_t first_sample() const {
+    return old_ && !old_->info.samples.empty() ? old_->info.samples.back().end : 0;
+  }
+
+  /// After set_scene, before rendering: refuses a checkpoint of another image (PartMerger's
+  /// checks: film, seed, sampler, integrator, lucent's version, scene hash), one that is not of
+  /// the samples [0, K), or one holding more samples than `target` (N; 0: a time limit alone).
+  void check(const lucent::Renderer& renderer, std::uint64_t target) {
+    target_ = target;
+    last_ = std::chrono::steady_clock::now();
+    if (!old_) return;
+    const std::vector<lucent::SampleRange>& have = old_->info.samples;
+    if (have.size() > 1 || (have.size() == 1 && have[0].begin != 0))
+      throw lucent::Error(path_ + ": holds samples " + lucent::ranges_text(have) +
+                          ", not a checkpoint's [0, K) (a part of `lucent render --samples`?)");
+    lucent::PartMerger merger;  // (the session's part holds no sample yet)
+    merger.add_header(scene_, lucent::make_part(renderer, requested(renderer), scene_).info);
+    merger.check(path_, old_->info);
+    if (target > 0 && first_sample() > target)
+      throw lucent::Error(path_ + ": holds " + std::to_string(first_sample()) +
+                          " samples per pixel, more than the " + std::to_string(target) +
+                          " this render asks for (--spp or the scene's integrator.spp)");
+  }
+
+  /// From on_progress, after each pass: writes the checkpoint when --checkpoint-every seconds
+  /// have passed since the last one ended and the session has new samples.
+  void on_pass(const lucent::Renderer& renderer) {
+    const double since =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_).count();
+    if (since < every_ || renderer.spp() == saved_spp_) return;
+    std::optional<lucent::RenderPart> part;
+    try {
+      part = whole(renderer);
+    } catch (const lucent::Error&) {
+      // several devices: a pass can end before an earlier one, and the samples are not one range
+      // until that one has (Renderer::accumulation refuses them): the next pass writes it
+      return;
+    }
+    if (save(*part)) saved_spp_ = renderer.spp();
+  }
+
+  /// The samples [0, K + the session's): the checkpoint's and the session's, added.
+  lucent::RenderPart whole(const lucent::Renderer& renderer) const {
+    lucent::RenderPart part = lucent::make_part(renderer, requested(renderer), scene_);
+    if (!old_) return part;
+    lucent::PartMerger merger;
+    merger.add(scene_, std::move(part));  // (moved: the film's sums are not copied)
+    merger.add(path_, *old_);
+    return merger.finish().merged;
+  }
+
+  /// Writes `part` to the checkpoint, atomically; a failure (a full disk) is a warning: the
+  /// render goes on, and the previous checkpoint stays as it was.
+  bool save(const lucent::RenderPart& part) {
+    bool ok = true;
+    try {
+      lucent::write_render_part(path_, part);
+    } catch (const lucent::Error& e) {
+      std::fprintf(stderr, "lucent: warning: checkpoint not written: %s\n",
+                   one_line(e.what()).c_str());
+      ok = false;
+    }
+    if (ok) held_ = part.info.samples.empty() ? 0 : part.info.samples.back().end;
+    last_ = std::chrono::steady_clock::now();
+    return ok;
+  }
+
+  /// The render asked for is done: N samples (a time limit alone: its time), not stopped.
+  bool complete(const lucent::Renderer& renderer, bool stopped) const {
+    return !stopped && (target_ == 0 || first_sample() + renderer.spp() >= target_);
+  }
+  /// The samples per pixel the file holds ([0, held())): read, or last written.
+  std::uint64_t held() const { return held_; }
+
+  /// The checkpoint's part, no longer needed (its samples are in a whole() part).
+  void drop() { old_.reset(); }
+
+  /// After the output was written: the render is complete, its checkpoint of no further use.
+  void remove() const {
+    std::error_code ec;
+    if (!std::filesystem::remove(path_, ec) && ec)
+      std::fprintf(stderr, "lucent: warning: %s: checkpoint not removed (%s)\n",
+                   one_line(path_).c_str(), ec.message().c_str());
+  }
+
+  const std::string& path() const { return path_; }
+
+ private:
+  /// [0, N), or with a time limit alone the samples so far ([0, K + the session's))
+  lucent::SampleRange requested(const lucent::Renderer& renderer) const {
+    return {0, std::max(target_, renderer.first_sample() + renderer.spp())};
+  }
+
+  std::string path_, scene_;
+  double every_;
+  std::uint64_t target_ = 0;
+  std::optional<lucent::RenderPart> old_;  ///< the checkpoint resumed from
+  std::chrono::steady_clock::time_point last_;
+  std::uint64_t saved_spp_ = 0;  ///< the session's samples per pixel in the last checkpoint
+  std::uint64_t held_ = 0;
+};
+
+/// After a render with a checkpoint, while the session lives: an unfinished render's samples go
+/// to the checkpoint, which stays for the next run to resume from; a resumed render's result
+/// becomes the image of the checkpoint's samples and the session's (the session is gone then).
+bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer,
+                       lucent::RenderResult& r) {
+  const bool complete = ck.complete(*renderer, r.cancelled || g_interrupted.load());
+  if (complete && !ck.resumed()) return true;  // the session's result is the image
+  lucent::RenderPart all;
+  try {
+    all = ck.whole(*renderer);
+  } catch (const lucent::Error& e) {
+    if (ck.resumed()) throw;  // (the session's samples alone are not the image)
+    // (a device's failed pass left a gap: the image is written, the last checkpoint stays)
+    std::fprintf(stderr, "lucent: warning: checkpoint not written: %s\n",
+                 one_line(e.what()).c_str());
+    return false;
+  }
+  if (!complete && !all.info.samples.empty()) ck.save(all);  // (stopped before its first sample)
+  if (!ck.resumed()) return complete;
+  // the session's sums and images, and the checkpoint's, before the image's own memory
+  renderer.reset();
+  ck.drop();
+  r.mean = {};
+  r.variance = {};
+  r.samples = {};
+  lucent::RenderResult m = lucent::part_result(all);
+  all = {};
+  r.mean = std::move(m.mean);
+  r.variance = std::move(m.variance);
+  r.samples = std::move(m.samples);
+  r.spp = m.spp;  // (the render's totals: the checkpoint's samples too)
+  r.nonfinite = m.nonfinite;
+  r.rays = m.rays;
+  r.seconds = m.seconds;
+  return complete;
+}
+
+/// Before rendering, with a checkpoint: checks it against the session, starts the session after
+/// its samples and makes `spp` (N) the samples left; false when none is.
+bool resume_from(Checkpoint& ck, lucent::Renderer& renderer, std::uint64_t& spp, bool quiet) {
+  ck.check(renderer, spp);
+  const std::uint64_t first = ck.first_sample();
+  renderer.reset(first);  // (as --samples first:N does)
+  if (ck.resumed() && !quiet)
+    std::fprintf(stderr, "lucent: resuming from %s, which holds samples [0, %llu)\n",
+                 one_line(ck.path()).c_str(), static_cast<unsigned long long>(first));
+  if (spp == 0) return true;  // a time limit alone: as long again
+  spp -= first;
+  return spp > 0;
+}
+
 /// The outputs' memory, counted before rendering: a render refused up front rather than lost to
 /// its write (the resources review: a part file's write took 2.5 times the session's estimate).
 /// Without AOVs the session is gone before the output is written (`after`, checked on its own);
@@ -204,7 +381,7 @@ struct OutputMemory {
   std::vector<lucent::render_detail::MemoryPart> after;
 };
 
-OutputMemory output_memory(const RenderArgs& a, int fw, int fh, bool part) {
+OutputMemory output_memory(const RenderArgs& a, int fw, int fh, bool part, bool resumed) {
   const std::uint64_t npix = std::uint64_t(fw) * std::uint64_t(fh);
   const std::string film = std::to_string(fw) + "x" + std::to_string(fh);
   // a RenderResult's mean, variance and counts; an accumulation's sums, squares and counts
@@ -216,6 +393,15 @@ OutputMemory output_memory(const RenderArgs& a, int fw, int fh, bool part) {
                   ? lucent::image_detail::render_exr_write_bytes(fw, fh, true)
                   : lucent::image_detail::image_write_bytes(a.output, fw, fh));
   OutputMemory m;
+  if (!a.checkpoint.empty()) {
+    // beside the session: a checkpoint's part (the session's sums, added to a resumed render's
+    // checkpoint, itself held throughout) and the write of its file; after it, a resumed render's
+    // image is made from that part (--checkpoint is refused with --aov and --samples)
+    m.beside = (resumed ? 2 : 1) * acc_bytes + lucent::part_write_bytes(fw, fh);
+    if (resumed)
+      m.after.push_back({"the sums of the checkpoint and this render (" + film + ")", acc_bytes,
+                         "the film size"});
+  }
   if (!a.aovs.empty()) {
     // the main image's write, then each AOV's result and file
     m.beside = write_bytes;
@@ -227,11 +413,12 @@ OutputMemory output_memory(const RenderArgs& a, int fw, int fh, bool part) {
                        : result_bytes + lucent::image_detail::render_exr_write_bytes(fw, fh, true));
     return m;
   }
-  if (part) m.beside = acc_bytes;  // the part's copy of the sums, made before the session goes
+  if (part) m.beside += acc_bytes;  // the part's copy of the sums, made before the session goes
   const std::string kept = part ? "the part's sums of the " + film + " film"
                                 : "the result images of the " + film + " film";
-  m.after = {{kept, part ? acc_bytes : result_bytes, "the film size"},
-             {"writing " + one_line(a.output) + " (" + film + ")", write_bytes, "the film size"}};
+  m.after.push_back({kept, part ? acc_bytes : result_bytes, "the film size"});
+  m.after.push_back(
+      {"writing " + one_line(a.output) + " (" + film + ")", write_bytes, "the film size"});
   return m;
 }
 
@@ -266,9 +453,30 @@ int render_with(const RenderArgs& a) {
     if (lucent::io::lower_extension(a.output) != ".exr")
       throw lucent::Error(a.output + ": --samples writes a part file: use an .exr output");
   }
+  if (a.checkpoint_every > 0 && a.checkpoint.empty())
+    throw lucent::Error(
+        "--checkpoint-every is how often --checkpoint writes: it does nothing "
+        "without it");
+  if (!a.checkpoint.empty()) {
+    // a checkpoint is a part of the samples [0, K): renders that are not one range of samples
+    // (adaptive, the reference's pixel by pixel), or whose session lives on (AOVs) or is a part
+    const std::pair<bool, const char*> unsupported[] = {
+        {range.has_value(), "--samples"},
+        {a.reference, "--reference"},
+        {!a.aovs.empty(), "--aov"},
+        {a.sampling.target_error > 0, "--target-error"}};
+    for (const auto& [given, name] : unsupported)
+      if (given) throw lucent::Error(std::string("--checkpoint is not supported with ") + name);
+    if (lucent::io::lower_extension(a.checkpoint) != ".exr")
+      throw lucent::Error(a.checkpoint + ": --checkpoint writes a part file: use an .exr name");
+    if (lucent::io::same_file(a.checkpoint, a.output))
+      throw lucent::Error(a.checkpoint +
+                          ": is the output too: give --checkpoint a file of its own");
+  }
   lucent::io::check_output_path(a.output, {a.scene});
   for (const std::string& name : a.aovs)
     lucent::io::check_output_path(aov_path(a.output, name), {a.scene, a.output});
+  if (!a.checkpoint.empty()) lucent::io::check_output_path(a.checkpoint, {a.scene, a.output});
   // from here on a stop signal lets the render end its pass and write what it has
   for (int sig : kStopSignals) std::signal(sig, on_stop_signal);
   std::signal(SIGPIPE, SIG_IGN);  // a closed stderr pipe must not cost the image
@@ -279,6 +487,7 @@ int render_with(const RenderArgs& a) {
     lucent::io::check_output_path(a.output, inputs);
     for (const std::string& name : a.aovs)
       lucent::io::check_output_path(aov_path(a.output, name), inputs);
+    if (!a.checkpoint.empty()) lucent::io::check_output_path(a.checkpoint, inputs);
   }
   if (g_interrupted.load()) {
     std::fprintf(stderr, "lucent: interrupted by %s before rendering: nothing written\n",
@@ -299,9 +508,23 @@ int render_with(const RenderArgs& a) {
   if (a.rr_depth > 0) scene.integrator.rr_depth = a.rr_depth;
   lucent::cli::apply_sampling_options(a.sampling, scene);
   if (range) lucent::check_part_scene(scene, a.scene);
+  std::optional<Checkpoint> checkpoint;
+  if (!a.checkpoint.empty()) {
+    try {
+      lucent::check_part_scene(scene, a.scene);
+    } catch (const lucent::Error&) {
+      throw lucent::Error(a.scene +
+                          ": integrator.caustics: a checkpoint (a part file) cannot hold "
+                          "light-traced caustics yet; render without --checkpoint, or with "
+                          "--no-caustics");
+    }
+    checkpoint.emplace(a.checkpoint, a.scene,
+                       a.checkpoint_every > 0 ? a.checkpoint_every : kDefaultCheckpointSeconds);
+    checkpoint->read();
+  }
 
-  const OutputMemory memory =
-      output_memory(a, scene.film.width, scene.film.height, range.has_value());
+  const OutputMemory memory = output_memory(a, scene.film.width, scene.film.height,
+                                            range.has_value(), checkpoint && checkpoint->resumed());
 
   lucent::RenderOptions opt;
   opt.spp = a.spp;
@@ -331,6 +554,12 @@ int render_with(const RenderArgs& a) {
       printed = true;
     };
   }
+  std::optional<lucent::Renderer> renderer;
+  if (checkpoint)  // after each pass: the progress line, then the checkpoint when one is due
+    opt.on_progress = [&, print = std::move(opt.on_progress)](const lucent::RenderProgress& p) {
+      if (print) print(p);
+      checkpoint->on_pass(*renderer);
+    };
   // before any device is opened or kernel built: the session's estimate without its devices'
   // parts (set_scene checks it again with them), then the outputs'
   if (!a.reference) {
@@ -346,7 +575,6 @@ int render_with(const RenderArgs& a) {
   const lucent::Film film_settings = scene.film;
   const std::uint64_t scene_spp = std::uint64_t(scene.integrator.spp);
   lucent::RenderResult r;
-  std::optional<lucent::Renderer> renderer;
   double wall = 0;  // of the kernel render (several devices: their passes overlap)
   if (a.reference) {
     lucent::ReferenceOptions ro;
@@ -369,11 +597,12 @@ int render_with(const RenderArgs& a) {
         renderer->reset(range->begin);
         spp = range->end - range->begin;
       }
+      const bool samples_left = !checkpoint || resume_from(*checkpoint, *renderer, spp, a.quiet);
       auto t0 = std::chrono::steady_clock::now();
       if (a.sampling.target_error > 0)
         renderer->render_adaptive(lucent::cli::adaptive_options(a.sampling, a.spp, a.time_limit),
                                   opt.on_progress);
-      else
+      else if (samples_left)
         renderer->render(spp, a.time_limit, opt.on_progress);
       wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       r = renderer->result();
@@ -389,6 +618,8 @@ int render_with(const RenderArgs& a) {
     }
   }
   if (printed && tty) std::fprintf(stderr, "\n");
+  // a resumed render's image is that of the checkpoint's samples and the session's
+  const bool checkpoint_done = checkpoint && finish_checkpoint(*checkpoint, renderer, r);
   // interrupted before its first sample (an adaptive render's pilot, the reference's first
   // pixel): no image to write; it wrote a black one claiming "0 of 256 spp". A part keeps its
   // (empty) range, and is written.
@@ -420,6 +651,12 @@ int render_with(const RenderArgs& a) {
     lucent::write_render_exr(a.output, r);
   } else
     lucent::write_image(a.output, r.mean, display);
+  if (checkpoint_done)
+    checkpoint->remove();
+  else if (checkpoint && checkpoint->held() > 0)
+    std::fprintf(
+        stderr, "lucent: %s holds samples [0, %llu): the same command resumes the render\n",
+        one_line(checkpoint->path()).c_str(), static_cast<unsigned long long>(checkpoint->held()));
   if (r.nonfinite > 0)
     std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
                  static_cast<unsigned long long>(r.nonfinite));
@@ -547,6 +784,15 @@ CLI::App* add_render_command(CLI::App& app) {
   render->add_option("--samples", ra.samples,
                      "Render only the sample indices [A, B) (A:B) and write their raw "
                      "accumulation to an .exr part file for `lucent merge`");
+  render->add_option("--checkpoint", ra.checkpoint,
+                     "Write the samples rendered so far to this .exr part file every "
+                     "--checkpoint-every seconds, and resume from it when it exists; removed "
+                     "once the output is written (docs/parts.md, \"Checkpoints\")");
+  render
+      ->add_option("--checkpoint-every", ra.checkpoint_every,
+                   "Seconds between two checkpoints (default 300)")
+      ->check(lucent::cli::positive_real())
+      ->check(lucent::cli::real_range(0.0, 1e7));
   render->add_flag("--reference", ra.reference,
                    "Render with the scalar CPU reference integrator instead of the kernel");
   lucent::cli::add_sampling_options(render, ra.sampling, true);
