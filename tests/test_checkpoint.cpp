@@ -1,0 +1,294 @@
+// Checkpoints (`lucent render --checkpoint FILE`, docs/parts.md, "Checkpoints"): a render killed
+// with SIGKILL after a checkpoint, then run again, writes the image of the render that was never
+// stopped; the checkpoint in between is a part file of exactly the samples [0, K) it claims; a
+// checkpoint of another image is refused with one line, and so are the renders it cannot hold.
+//
+// Equality: the resumed image adds the checkpoint's sums and the second run's, where the single
+// render added its passes in one sequence; the sample indices are the same, so the images agree
+// to the rounding of those sums (double on a device with fp64, float pass sums without: within
+// 1e-5 relative), while a checkpoint off by one sample differs by the noise (~10%, as
+// Parts.CommandLinePartsMergeIntoTheSingleRender measures).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "lucent/compare.hpp"
+#include "lucent/image.hpp"
+#include "lucent/parts.hpp"
+#include "support.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using lucent::test::CommandResult;
+using lucent::test::run_cli;
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+/// A diffuse sphere and a plane under a point light and a sky: every pixel noisy, 12x10.
+std::string noisy_scene(const std::string& dir, const std::string& name = "scene.json",
+                        double radius = 0.5) {
+  std::string path = dir + "/" + name;
+  lucent::test::write_file(path, R"({
+    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
+    "film": {"width": 12, "height": 10},
+    "integrator": {"type": "path", "spp": 8, "seed": 3},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.25, 0.5, 0.75]}},
+    "shapes": [{"type": "triangles", "material": "m",
+                "positions": [[-10,-10,0],[10,-10,0],[10,10,0],[-10,10,0]], "indices": [0,1,2, 0,2,3]},
+               {"type": "sphere", "center": [0.3, 0.2, 0.5], "radius": )" +
+                                     std::to_string(radius) + R"(, "material": "m"}],
+    "lights": [{"type": "point", "position": [0.7, 0.4, 2.0], "intensity": [20, 20, 20]},
+               {"type": "environment", "radiance": [0.3, 0.3, 0.3]}]
+  })");
+  return path;
+}
+
+/// Largest relative difference between two renders' pixel means; their sample counts must be
+/// equal.
+double max_relative_difference(const lucent::RenderResult& a, const lucent::RenderResult& b) {
+  EXPECT_EQ(a.samples, b.samples);
+  EXPECT_EQ(a.mean.rgb.size(), b.mean.rgb.size());
+  double worst = 0;
+  for (size_t i = 0; i < a.mean.rgb.size() && i < b.mean.rgb.size(); ++i) {
+    const double x = a.mean.rgb[i], y = b.mean.rgb[i];
+    const double scale = std::max(std::abs(x), std::abs(y));
+    if (scale > 0) worst = std::max(worst, std::abs(x - y) / scale);
+  }
+  return worst;
+}
+
+/// The same for two parts' sums.
+double max_relative_difference(const lucent::Accumulation& a, const lucent::Accumulation& b) {
+  EXPECT_EQ(a.count, b.count);
+  double worst = 0;
+  for (size_t i = 0; i < a.sum.size() && i < b.sum.size(); ++i) {
+    const double scale = std::max(std::abs(a.sum[i]), std::abs(b.sum[i]));
+    if (scale > 0) worst = std::max(worst, std::abs(a.sum[i] - b.sum[i]) / scale);
+  }
+  return worst;
+}
+
+/// Starts `lucent args...` (stdout and stderr to /dev/null), waits until `path` exists (at most
+/// 60 s, for a loaded machine), kills it with SIGKILL and reaps it. False (with a failure) when
+/// it ended before the file appeared.
+bool kill_once_written(const std::vector<std::string>& args, const std::string& path) {
+  pid_t pid = ::fork();
+  EXPECT_GE(pid, 0);
+  if (pid == 0) {
+    int null = ::open("/dev/null", O_RDWR);
+    if (null < 0) ::_exit(126);
+    ::dup2(null, 0);
+    ::dup2(null, 1);
+    ::dup2(null, 2);
+    std::vector<char*> argv{const_cast<char*>("lucent")};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(LUCENT_CLI_PATH, argv.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < end && !fs::exists(path)) {
+    if (::waitpid(pid, &status, WNOHANG) == pid) {
+      ADD_FAILURE() << "lucent ended (status " << status << ") before writing " << path;
+      return false;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, &status, 0);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL)
+      << "lucent was not killed (status " << status << "): the render ended first";
+  return WIFSIGNALED(status);
+}
+
+// (a) and (b): killed with SIGKILL once its first checkpoint exists, the render run again
+// resumes from the checkpoint and writes the image of the uninterrupted render; the checkpoint
+// in between holds exactly the samples [0, K) it claims, and is removed at the end.
+TEST(Checkpoint, KilledRenderResumesToTheUninterruptedImage) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string ck = dir + "/ck.exr", out = dir + "/out.exr", full = dir + "/full.exr";
+  // ~1.5 s of rendering on an idle core (12x10 at 6 Msamples/s): passes aim at 0.25 s, so the
+  // checkpoint every 0.2 s first appears a fraction of the way in
+  const std::string spp = "100000";
+  ASSERT_TRUE(kill_once_written(
+      {"render", scene, "--spp", spp, "-o", out, "--checkpoint", ck, "--checkpoint-every", "0.2"},
+      ck));
+  EXPECT_FALSE(fs::exists(out));
+  // (b) a part file of the samples [0, K), each of them in every pixel, and those samples: the
+  // part of --samples 0:K
+  const lucent::RenderPart part = lucent::read_render_part(ck);
+  ASSERT_EQ(part.info.samples.size(), 1u);
+  const std::uint64_t k = part.info.samples[0].end;
+  EXPECT_EQ(part.info.samples[0].begin, 0u);
+  EXPECT_GT(k, 0u);
+  EXPECT_LT(k, 100000u);
+  EXPECT_EQ(part.info.requested, (std::vector<lucent::SampleRange>{{0, 100000}}));
+  const std::string same = dir + "/same.exr";
+  ASSERT_EQ(
+      run_cli("render " + q(scene) + " -q --samples 0:" + std::to_string(k) + " -o " + q(same))
+          .status,
+      0);
+  EXPECT_LT(max_relative_difference(part.acc, lucent::read_render_part(same).acc), 1e-5);
+
+  // (a) the same command again: samples [K, N) only, the image of [0, N)
+  CommandResult r = run_cli("render " + q(scene) + " --spp " + spp + " -o " + q(out) +
+                            " --checkpoint " + q(ck) + " --checkpoint-every 0.2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("lucent: resuming from " + ck + ", which holds samples [0, " +
+                       std::to_string(k) + ")"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(ck));  // done with
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --spp " + spp + " -o " + q(full)).status, 0);
+  const lucent::RenderResult resumed = lucent::read_render(out), single = lucent::read_render(full);
+  EXPECT_EQ(resumed.samples, std::vector<std::uint32_t>(120, 100000u));
+  EXPECT_LT(max_relative_difference(resumed, single), 1e-5);
+}
+
+// A checkpoint of part of the samples, or of all of them (a render killed after its last
+// checkpoint, before its output): the image equals the single render's, and the checkpoint goes.
+// A part of --samples 0:K is a checkpoint; one sample more or less is another image.
+TEST(Checkpoint, ResumedImageEqualsTheSingleRender) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string full = dir + "/full.exr", ck = dir + "/ck.exr";
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --spp 64 -o " + q(full)).status, 0);
+  const lucent::RenderResult single = lucent::read_render(full);
+  for (const char* k : {"3", "64"}) {
+    SCOPED_TRACE(k);
+    ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:" + k + " -o " + q(ck)).status, 0);
+    const std::string out = dir + "/out" + k + ".exr";
+    CommandResult r =
+        run_cli("render " + q(scene) + " -q --spp 64 --checkpoint " + q(ck) + " -o " + q(out));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_FALSE(fs::exists(ck));
+    EXPECT_LT(max_relative_difference(lucent::read_render(out), single), 1e-5);
+  }
+  // a PNG output too (the 8-bit image of the same means)
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:5 -o " + q(ck)).status, 0);
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --spp 64 -o " + q(dir + "/single.png")).status, 0);
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --spp 64 --checkpoint " + q(ck) + " -o " +
+                    q(dir + "/resumed.png"))
+                .status,
+            0);
+  // (within one 8-bit level, 0.0087 in linear at most: float pass sums, without fp64, may round a
+  // value across a step)
+  const lucent::Image a = lucent::read_image(dir + "/resumed.png"),
+                      b = lucent::read_image(dir + "/single.png");
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  for (size_t i = 0; i < a.rgb.size(); ++i) EXPECT_NEAR(a.rgb[i], b.rgb[i], 0.009) << i;
+}
+
+// SIGTERM: the output of the samples so far is written, and the checkpoint holds them too (it
+// stays, for the next run), as the line before the last says.
+TEST(Checkpoint, SigtermKeepsTheCheckpoint) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string ck = dir + "/ck.exr", out = dir + "/out.exr", err = dir + "/err";
+  // SIGTERM once the progress line shows the render loop running
+  const std::string script = "'" + std::string(LUCENT_CLI_PATH) + "' render " + q(scene) +
+                             " --spp 16000000 -o " + q(out) + " --checkpoint " + q(ck) + " 2>" +
+                             q(err) + " </dev/null & pid=$!; for i in $(seq 600); do grep -q " +
+                             "Msamples/s " + q(err) + " && break; sleep 0.1; done; kill -TERM " +
+                             "$pid; wait $pid";
+  const int raw = std::system(("bash -c " + q(script)).c_str());
+  const std::string text = lucent::test::read_file(err);
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 143) << text;
+  const lucent::PartInfo info = lucent::read_part_info(ck);
+  ASSERT_EQ(info.samples.size(), 1u) << text;
+  const std::uint64_t k = info.samples[0].end;
+  EXPECT_EQ(lucent::read_render(out).samples, std::vector<std::uint32_t>(120, std::uint32_t(k)));
+  EXPECT_NE(text.find("lucent: " + ck + " holds samples [0, " + std::to_string(k) +
+                      "): the same command resumes the render"),
+            std::string::npos)
+      << text;
+}
+
+// (c) a checkpoint of another image (seed, scene, film), of other samples or of more than the
+// render asks for: one line naming it, status 1, no output, the checkpoint untouched.
+TEST(Checkpoint, CheckpointOfAnotherRenderIsRefused) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string other = noisy_scene(dir, "other.json", 0.6);
+  const std::string ck = dir + "/ck.exr", later = dir + "/later.exr", out = dir + "/out.png";
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:4 -o " + q(ck)).status, 0);
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 4:8 -o " + q(later)).status, 0);
+  const std::string bytes = lucent::test::read_file(ck);
+  const struct {
+    std::string args, error;
+  } cases[] = {
+      {q(scene) + " --seed 9 --checkpoint " + q(ck),
+       ck + ": seed 3 differs from " + scene + "'s 9"},
+      {q(other) + " --checkpoint " + q(ck), ck + ": scene hash "},
+      {q(scene) + " --width 13 --checkpoint " + q(ck),
+       ck + ": film 12x10 differs from " + scene + "'s 13x10"},
+      {q(scene) + " --spp 2 --checkpoint " + q(ck),
+       ck + ": holds 4 samples per pixel, more than the 2 this render asks for"},
+      {q(scene) + " --checkpoint " + q(later),
+       later + ": holds samples [4, 8), not a checkpoint's [0, K)"},
+      {q(scene) + " --checkpoint " + q(scene + ".exr"), ""},  // (none yet: a fresh render)
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.args);
+    CommandResult r = run_cli("render " + c.args + " -q -o " + q(out));
+    if (c.error.empty()) {
+      EXPECT_EQ(r.status, 0) << r.err;
+      fs::remove(out);
+      continue;
+    }
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("lucent: error: " + c.error, 0), 0u) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  EXPECT_EQ(lucent::test::read_file(ck), bytes);
+}
+
+// (d) what a checkpoint cannot hold, or options that do nothing: one line, nothing written.
+TEST(Checkpoint, UnsupportedCombinationsAreRefused) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string ck = q(dir + "/ck.exr"), out = dir + "/out.exr";
+  const struct {
+    std::string args, error;
+    int status;
+  } cases[] = {
+      {"--checkpoint " + ck + " --aov albedo", "--checkpoint is not supported with --aov", 1},
+      {"--checkpoint " + ck + " --target-error 0.01",
+       "--checkpoint is not supported with --target-error", 1},
+      {"--checkpoint " + ck + " --reference", "--checkpoint is not supported with --reference", 1},
+      {"--checkpoint " + ck + " --samples 0:4", "--checkpoint is not supported with --samples", 1},
+      {"--checkpoint " + ck + " --caustics",
+       scene + ": integrator.caustics: a checkpoint (a part file) cannot hold light-traced "
+               "caustics",
+       1},
+      {"--checkpoint-every 5", "--checkpoint-every is how often --checkpoint writes", 1},
+      {"--checkpoint " + q(dir + "/ck.png"), dir + "/ck.png: --checkpoint writes a part file", 1},
+      {"--checkpoint " + q(out), out + ": is the output too", 1},
+      {"--checkpoint " + ck + " --checkpoint-every 0", "--checkpoint-every: must be a positive", 2},
+      {"--checkpoint " + ck + " --checkpoint-every 2e7", "--checkpoint-every: must be in", 2},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.args);
+    CommandResult r = run_cli("render " + q(scene) + " -q -o " + q(out) + " " + c.args);
+    EXPECT_EQ(r.status, c.status);
+    EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("lucent: error: " + c.error, 0), 0u) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_FALSE(fs::exists(dir + "/ck.exr"));
+  }
+}
+
+}  // namespace
