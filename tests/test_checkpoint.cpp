@@ -14,8 +14,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -119,9 +121,17 @@ TEST(Checkpoint, KilledRenderResumesToTheUninterruptedImage) {
   const std::string dir = lucent::test::temp_dir();
   const std::string scene = noisy_scene(dir);
   const std::string ck = dir + "/ck.exr", out = dir + "/out.exr", full = dir + "/full.exr";
-  // ~1.5 s of rendering on an idle core (12x10 at 6 Msamples/s): passes aim at 0.25 s, so the
-  // checkpoint every 0.2 s first appears a fraction of the way in
-  const std::string spp = "100000";
+  // about 1.5 s of rendering on this device (a CPU core: 12x10 at 100000 spp; a GPU ~100 times
+  // more), measured by a render of 0.5 s: passes aim at 0.25 s, so the checkpoint every 0.2 s
+  // first appears a fraction of the way in
+  CommandResult cal = run_cli("render " + q(scene) + " --time 0.5 -o " + q(dir + "/cal.exr"));
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  const size_t at = cal.err.find(" Msamples/s");
+  ASSERT_NE(at, std::string::npos) << cal.err;
+  const double rate = std::atof(cal.err.substr(cal.err.rfind('(', at) + 1).c_str()) * 1e6;
+  const std::uint64_t n =
+      std::clamp<std::uint64_t>(std::uint64_t(rate * 1.5 / 120), 20000, std::uint64_t(1) << 24);
+  const std::string spp = std::to_string(n);
   ASSERT_TRUE(kill_once_written(
       {"render", scene, "--spp", spp, "-o", out, "--checkpoint", ck, "--checkpoint-every", "0.2"},
       ck));
@@ -133,8 +143,8 @@ TEST(Checkpoint, KilledRenderResumesToTheUninterruptedImage) {
   const std::uint64_t k = part.info.samples[0].end;
   EXPECT_EQ(part.info.samples[0].begin, 0u);
   EXPECT_GT(k, 0u);
-  EXPECT_LT(k, 100000u);
-  EXPECT_EQ(part.info.requested, (std::vector<lucent::SampleRange>{{0, 100000}}));
+  EXPECT_LT(k, n);
+  EXPECT_EQ(part.info.requested, (std::vector<lucent::SampleRange>{{0, n}}));
   const std::string same = dir + "/same.exr";
   ASSERT_EQ(
       run_cli("render " + q(scene) + " -q --samples 0:" + std::to_string(k) + " -o " + q(same))
@@ -153,7 +163,7 @@ TEST(Checkpoint, KilledRenderResumesToTheUninterruptedImage) {
   EXPECT_FALSE(fs::exists(ck));  // done with
   ASSERT_EQ(run_cli("render " + q(scene) + " -q --spp " + spp + " -o " + q(full)).status, 0);
   const lucent::RenderResult resumed = lucent::read_render(out), single = lucent::read_render(full);
-  EXPECT_EQ(resumed.samples, std::vector<std::uint32_t>(120, 100000u));
+  EXPECT_EQ(resumed.samples, std::vector<std::uint32_t>(120, std::uint32_t(n)));
   EXPECT_LT(max_relative_difference(resumed, single), 1e-5);
 }
 
