@@ -29,7 +29,11 @@
  * integrator.caustics each camera sample also traces a light path that adds to light_sum and
  * light_sumsq, any pixel's (integrator/caustics.cl): a uniform pass's to elements [0, W H), a
  * work list's stream s < 2 to elements [s W H, (s + 1) W H) (the adaptive halves' separate light
- * estimates); stream 2, the calibration's, traces none.
+ * estimates); stream 2, the calibration's, traces none. Work-item i also writes the sum and the
+ * sum of squares of its light paths' totals (a path's shares over all pixels) after the items'
+ * sums, to out_sum[items + i] and out_sumsq[items + i] (items: the work list's entries or W H),
+ * for the host to add up: the image mean's light part, whose variance no pixel's variance shows
+ * (a path's splats correlate the pixels; docs/compare.md).
  * vec_type_hint(float4): one work-item is one path, written with vector types; an OpenCL compiler
  * that packs work-items into SIMD lanes (Intel's CPU runtime does when its cost model says so)
  * should not. Intel's CPU runtime 2026.2 packed them for small kernels (the AOV integrators) and
@@ -102,6 +106,9 @@ __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
   lc_uint px = pixel % width, py = pixel / width;
   lc_accum3 sum = (lc_accum3)(0.0f), sumsq = (lc_accum3)(0.0f);
   lc_uint accepted = 0, nonfinite = 0, rays = 0;
+#ifdef LC_HAS_CAUSTICS
+  lc_accum3 total_sum = (lc_accum3)(0.0f), total_sumsq = (lc_accum3)(0.0f);
+#endif
   for (lc_uint k = 0; k < count; ++k) {
     lc_rng_set_sample(&rng, first + k);
     float2 uf = lc_rand2(&rng, LC_DIM_FILTER);
@@ -115,9 +122,14 @@ __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
                                      (float)py + 0.5f + off.y, width, height, ul.x, ul.y);
     float3 L = integrate(&s, ray, &rng, &rays);
 #ifdef LC_HAS_CAUSTICS
-    if ((params->flags & LC_FLAG_CAUSTICS) && trace_light)
-      nonfinite +=
-          caustics_light_path(&s, &rng, light_sum + light_base, light_sumsq + light_base, &rays);
+    if ((params->flags & LC_FLAG_CAUSTICS) && trace_light) {
+      lc_lsum3 total;
+      nonfinite += caustics_light_path(&s, &rng, light_sum + light_base, light_sumsq + light_base,
+                                       &total, &rays);
+      lc_accum3 t = lc_accum3_from(total);
+      total_sum += t;
+      total_sumsq += t * t;
+    }
 #endif
     /* a sample whose square overflows float counts as non-finite too: an infinite sum of squares
      * made the variance infinite, sent every pixel of an adaptive render to its cap and wrote part
@@ -139,6 +151,13 @@ __kernel __attribute__((vec_type_hint(float4))) void lucent_render(
   }
   out_sum[gid] = (lc_accum4)(sum, (lc_accum)accepted);
   out_sumsq[gid] = (lc_accum4)(sumsq, (lc_accum)0.0f);
+#ifdef LC_HAS_CAUSTICS
+  if (params->flags & LC_FLAG_CAUSTICS) {
+    const lc_uint items = params->work_items > 0u ? params->work_items : width * height;
+    out_sum[items + gid] = (lc_accum4)(total_sum, (lc_accum)0.0f);
+    out_sumsq[items + gid] = (lc_accum4)(total_sumsq, (lc_accum)0.0f);
+  }
+#endif
   if (nonfinite) lc_count64(counters, LC_COUNTER_NONFINITE, LC_COUNTER_NONFINITE_HIGH, nonfinite);
   lc_count64(counters, LC_COUNTER_RAYS, LC_COUNTER_RAYS_HIGH, rays);
 }

@@ -288,6 +288,61 @@ TEST(Compare, RendersKeepTheirSeedThroughExr) {
   }
 }
 
+// Caustics renders carry the image mean's light part (RenderResult::light_mean_variance) through
+// write_render_exr and read_render as the attribute lucent.light_mean_var, exactly (six doubles
+// in %.17g): the kernel's, the reference's and one made by hand; a render without caustics has
+// none and writes none. A malformed attribute is a one-line error naming the file.
+TEST(Compare, LightMeanVarianceRoundTripsThroughExr) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::Scene scene = lucent::test::scene_from(
+      lucent::test::glass_lamp_box_scene(4, 3, R"({"type": "gaussian", "radius": 2})", 6));
+  lucent::RenderOptions ko;
+  ko.spp = 4;
+  lucent::ReferenceOptions ro;
+  ro.spp = 4;
+  RenderResult made = constant_image(4, 3, 0.5f);
+  made.variance = made.mean;
+  made.samples.assign(12, 4);
+  made.light_mean_variance = lucent::LightMeanVariance{{1.0 / 3, 2e-300, 0}, {0.1, 7e22, 1e-7}};
+  for (const RenderResult& r :
+       {lucent::test::render(scene, ko), lucent::render_reference(scene, ro), made}) {
+    ASSERT_TRUE(r.light_mean_variance) << r.device;
+    EXPECT_GT(r.light_mean_variance->paths[1], 0.0) << r.device;
+    lucent::write_render_exr(dir + "/r.exr", r);
+    RenderResult back = lucent::read_render(dir + "/r.exr");
+    ASSERT_TRUE(back.light_mean_variance) << r.device;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(back.light_mean_variance->paths[c], r.light_mean_variance->paths[c]) << r.device;
+      EXPECT_EQ(back.light_mean_variance->pixels[c], r.light_mean_variance->pixels[c]) << r.device;
+    }
+  }
+  scene.integrator.caustics = false;
+  const RenderResult plain = lucent::test::render(scene, ko);
+  EXPECT_FALSE(plain.light_mean_variance);
+  lucent::write_render_exr(dir + "/p.exr", plain);
+  EXPECT_FALSE(lucent::read_render(dir + "/p.exr").light_mean_variance);
+
+  for (const std::string bad :
+       {"1 2 3 4 5", "1 2 3 4 5 6 7", "1 2 3 4 5 x", "1 2 3 -4 5 6", "1 2 3 nan 5 6",
+        "1 2 3 inf 5 6", "1,2,3,4,5,6", "", "1 2 3 4 5 6\n7"}) {
+    lucent::image_detail::ExrExtras extras;
+    extras.attributes = {{"lucent.light_mean_var", bad}};
+    lucent::image_detail::write_render_exr(dir + "/bad.exr", made, extras);
+    try {
+      lucent::read_render(dir + "/bad.exr");
+      ADD_FAILURE() << "lucent.light_mean_var '" << bad << "' was read";
+    } catch (const lucent::Error& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(dir + "/bad.exr: attribute lucent.light_mean_var: expected 6 finite "
+                                 "numbers >= 0",
+                           0),
+                0u)
+          << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+}
+
 // A display image (PNG: tone-mapped, encoded, clipped) against a linear render compares the
 // display transform: refused in either order, one line naming the display image. Two display
 // images stay comparable (a tolerance test without variances).

@@ -132,12 +132,13 @@ TEST(Resources, HostEstimateCoversThePackedScene) {
   EXPECT_GE(part(parts, "the scene's buffers on device 'cpu'"), tris + tree);
   for (const MemoryPart& p : parts) EXPECT_EQ(p.what.find("caustics"), std::string::npos);
   // caustics: the light sums in doubles, and four more float4 read-back buffers per device (two
-  // films each: an adaptive work list's halves)
+  // films each: an adaptive work list's halves), and the pass sums twice as long (the light
+  // paths' totals after them)
   s.integrator.type = lucent::IntegratorType::Path;
   s.integrator.caustics = true;
   parts = lucent::render_detail::estimate_host_memory(s, {gpu, cpu});
   EXPECT_EQ(part(parts, "the caustics light sums of the 32x32 film"), 32u * 32 * 48);
-  EXPECT_EQ(part(parts, "the buffers of device 'gpu'"), 32u * 32 * 96);
+  EXPECT_EQ(part(parts, "the buffers of device 'gpu'"), 32u * 32 * 128);
 }
 
 // What a render really takes on the host stays within the estimate the limits are checked
@@ -360,10 +361,11 @@ TEST(Resources, DeviceLimitsNameTheBuffer) {
   d.global_mem = 13 << 20;
   EXPECT_EQ(error_of([&] { lucent::render_detail::check_device_memory(s, packed, d); }), "");
   // with caustics the light paths' sums and sums of squares take two more buffers of two films
-  // each (an adaptive work list's halves A and B)
+  // each (an adaptive work list's halves A and B), and the sums and sums of squares are twice as
+  // long (the light paths' totals after them): 4 x 8 + 4 MiB
   packed.params.flags |= LC_FLAG_CAUSTICS;
   msg = error_of([&] { lucent::render_detail::check_device_memory(s, packed, d); });
-  EXPECT_EQ(msg.rfind("s.json: the scene and film buffers need 28.0 MiB on device 'Tiny GPU'", 0),
+  EXPECT_EQ(msg.rfind("s.json: the scene and film buffers need 36.0 MiB on device 'Tiny GPU'", 0),
             0u)
       << msg;
 }

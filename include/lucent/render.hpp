@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,19 @@ struct RenderOptions {
   int min_spp = 0;  ///< adaptive: the pilot per pixel; 0: AdaptiveOptions' default
 };
 
+/// integrator.caustics: the light-traced part of the image mean (the mean over the N pixels, per
+/// channel), for compare's image-mean test (docs/compare.md, "The test"). A light path splats
+/// into many pixels, so the pixels' light parts are correlated: `paths` is that part's variance
+/// from each light path's total (its shares summed over all pixels, over N) taken as one sample,
+/// var(total) / paths; `pixels` is what the variance layer holds of it, the light part's variance
+/// of each pixel's mean summed over the pixels as if they were independent, over N^2. The image
+/// mean's variance is then sum(var / n) / N^2 - pixels + paths. write_render_exr stores both
+/// (the attribute lucent.light_mean_var) and read_render reads them back.
+struct LightMeanVariance {
+  double paths[3] = {0, 0, 0};
+  double pixels[3] = {0, 0, 0};
+};
+
 struct RenderResult {
   Image mean;                          ///< per-pixel mean radiance
   Image variance;                      ///< per-pixel sample variance (of one sample)
@@ -108,6 +122,9 @@ struct RenderResult {
   /// reference rendered at its ladder's own seed.
   std::uint32_t seed = 0;
   std::string sampler;
+  /// integrator.caustics: the light-traced part of the image mean's variance (LightMeanVariance);
+  /// absent without caustics, and from images that do not carry it.
+  std::optional<LightMeanVariance> light_mean_variance;
 };
 
 /// A render with a target error whose halves' estimate (halves_relmse) is above 1.5 times the

@@ -72,6 +72,9 @@ typedef struct {
   float fx[LC_CAUSTICS_HISTORY], fy[LC_CAUSTICS_HISTORY];
   float3 c[LC_CAUSTICS_HISTORY];
   lc_uint n; /* connections splatted so far; the last min(n, LC_CAUSTICS_HISTORY) are kept */
+  /* the path's total: every share added to the light sums, over all pixels (its contribution to
+   * the film's sum, the image mean's light part; megakernel.cl) */
+  lc_lsum3 total;
 } lc_caustics_history;
 
 /* The earlier connections whose filter may share a pixel with one at (fx, fy) (each within 2 r
@@ -151,6 +154,7 @@ static inline lc_uint caustics_splat(const lc_scene* s, float fx, float fy, floa
         continue;
       }
 #endif
+      h->total += lv;
       lc_atomic_add_lsum(a + 0, lv.x);
       lc_atomic_add_lsum(a + 1, lv.y);
       lc_atomic_add_lsum(a + 2, lv.z);
@@ -221,12 +225,15 @@ static inline lc_uint caustics_connect(const lc_scene* s, lc_ray ray, const lc_i
 }
 
 /* The light path of the camera sample rng (random numbers from LC_DIM_LIGHT_PATH). Returns the
- * number of non-finite contributions it dropped. Out of line on PoCL's CPU device
- * (LC_POCL_NOINLINE, util/math.cl). */
+ * number of non-finite contributions it dropped, and in *total the sum of the shares it added to
+ * the light sums (all pixels). Out of line on PoCL's CPU device (LC_POCL_NOINLINE, util/math.cl).
+ */
 static LC_POCL_NOINLINE lc_uint caustics_light_path(const lc_scene* s, const lc_rng* rng,
                                                     __global lc_lsum4* light_sum,
-                                                    __global lc_lsum4* light_sumsq, lc_uint* rays) {
+                                                    __global lc_lsum4* light_sumsq, lc_lsum3* total,
+                                                    lc_uint* rays) {
   __global const lc_params* P = s->params;
+  *total = (lc_lsum3)(0.0f);
   if (P->max_depth < 3u) return 0; /* a caustic path has at least 3 segments */
   float8 u0 = lc_rand8(rng, LC_DIM_LIGHT_PATH);
   float4 ue = u0.lo, ud = u0.hi;
@@ -237,6 +244,7 @@ static LC_POCL_NOINLINE lc_uint caustics_light_path(const lc_scene* s, const lc_
   lc_uint nonfinite = 0;
   lc_caustics_history h;
   h.n = 0;
+  h.total = (lc_lsum3)(0.0f);
   int caustic = 0; /* 1 once the lobe sampled at y_1 was a delta one */
   /* scattering vertices 1 .. max_depth - 1: the camera path's segment limit */
   for (lc_uint i = 1; i < P->max_depth; ++i) {
@@ -282,6 +290,7 @@ static LC_POCL_NOINLINE lc_uint caustics_light_path(const lc_scene* s, const lc_
       beta /= q;
     }
   }
+  *total = h.total;
   return nonfinite;
 }
 

@@ -374,6 +374,41 @@ py::array_t<float> image_copy(const Image& image) {
   return a;
 }
 
+/// RenderResult::light_mean_variance as Python sees it: None, or {"paths": (R, G, B), "pixels":
+/// (R, G, B)}.
+py::object light_mean_variance_object(const std::optional<LightMeanVariance>& v) {
+  if (!v) return py::none();
+  py::dict d;
+  d["paths"] = py::make_tuple(v->paths[0], v->paths[1], v->paths[2]);
+  d["pixels"] = py::make_tuple(v->pixels[0], v->pixels[1], v->pixels[2]);
+  return d;
+}
+
+/// The same back from a pickled state (None, or that dict of finite numbers >= 0).
+std::optional<LightMeanVariance> light_mean_variance_from(py::handle v, const std::string& where) {
+  if (v.is_none()) return std::nullopt;
+  StateReader s(v, where);
+  LightMeanVariance m;
+  auto three = [&](const char* key, double(&out)[3]) {
+    py::object t = s.get(key);
+    bool ok = py::isinstance<py::tuple>(t) && py::len(t) == 3;
+    for (int c = 0; ok && c < 3; ++c) {
+      py::object x = t[py::int_(c)];
+      ok = !py::isinstance<py::bool_>(x) &&
+           (py::isinstance<py::float_>(x) || py::isinstance<py::int_>(x));
+      if (ok) out[c] = x.cast<double>();
+      ok = ok && std::isfinite(out[c]) && out[c] >= 0;
+    }
+    if (!ok)
+      s.fail(key,
+             "expected a tuple of 3 finite numbers >= 0, got " + py::repr(t).cast<std::string>());
+  };
+  three("paths", m.paths);
+  three("pixels", m.pixels);
+  s.finish();
+  return m;
+}
+
 /// A RenderResult's pickled state: its fields by attribute name, the images and counts as NumPy
 /// arrays (variance and samples None when the result has none), read back strictly (state.hpp).
 py::dict result_state(const RenderResult& r) {
@@ -418,6 +453,7 @@ py::dict result_state(const RenderResult& r) {
   d["plan_incomplete"] = r.plan_incomplete;
   d["seed"] = r.seed;
   d["sampler"] = r.sampler;
+  d["light_mean_variance"] = light_mean_variance_object(r.light_mean_variance);
   return d;
 }
 
@@ -478,6 +514,7 @@ RenderResult result_from_state(const py::object& state) {
   r.plan_incomplete = s.boolean("plan_incomplete");
   r.seed = s.integer<std::uint32_t>("seed");
   r.sampler = s.text("sampler");
+  r.light_mean_variance = s.nested("light_mean_variance", &light_mean_variance_from);
   s.finish();
   return r;
 }
@@ -630,6 +667,13 @@ void bind_render(py::module_& m) {
       .def_readonly("sampler", &RenderResult::sampler,
                     "the render's sampler ('sobol', 'independent'); '' when unknown (an image "
                     "that did not say); write_render_exr stores both")
+      .def_property_readonly(
+          "light_mean_variance",
+          [](const RenderResult& r) { return light_mean_variance_object(r.light_mean_variance); },
+          "integrator.caustics: the image mean's light part, {'paths': (R, G, B), 'pixels': (R, G, "
+          "B)}: its variance from the light paths' totals, and its share of the variance layer "
+          "summed over the pixels, each over the pixel count squared (compare's image-mean test "
+          "uses both); None without caustics or when unknown")
       .def_readonly("rays", &RenderResult::rays)
       .def_readonly("seconds", &RenderResult::seconds)
       .def_readonly("build_seconds", &RenderResult::build_seconds)

@@ -236,6 +236,26 @@ def test_a_render_result_round_trips_exactly(renderer, small_scene, name, round_
     assert a.variance is None and a.samples is None and a.spp == 7 and a.mean.shape == (2, 3, 3)
 
 
+@pytest.mark.parametrize("name, round_trip", round_trips())
+def test_a_caustics_result_keeps_its_light_mean_variance(renderer, small_dict, name, round_trip):
+    """A render with caustics carries the image mean's light part (its variance from the light
+    paths' totals, and its share of the variance layer), a render without none; both come back
+    exactly."""
+    small_dict["integrator"]["caustics"] = True
+    small_dict["integrator"]["max_depth"] = 6
+    small_dict["materials"]["w"] = {"type": "dielectric", "ior": 1.5}
+    small_dict["lights"][0]["position"] = [0, 1.5, 0]  # over the glass sphere
+    renderer.set_scene(lucent.scene_from_dict(small_dict))
+    renderer.render(4)
+    res = renderer.result()
+    v = res.light_mean_variance
+    assert list(v) == ["paths", "pixels"] and all(x > 0 for x in v["paths"] + v["pixels"])
+    c = round_trip(res)
+    assert c.light_mean_variance == v
+    assert res.__getstate__()["light_mean_variance"] == v
+    assert lucent.RenderResult(res.mean, res.variance, res.samples).light_mean_variance is None
+
+
 @pytest.mark.parametrize("key, value, message", [
     ("mean", np.zeros((12, 16)), "/mean: expected a (N, N, 3) array of float32, got a (12, 16) "
                                  "array of float64"),
@@ -256,6 +276,12 @@ def test_a_render_result_round_trips_exactly(renderer, small_scene, name, round_
     ("mean", np.empty((2 ** 31, 0, 3), np.float32), "got a (2147483648, 0, 3) array"),
     ("mean", np.empty((2 ** 32 + 2, 0, 3), np.float32), "got a (4294967298, 0, 3) array"),
     ("mean", np.empty((0, 2 ** 31, 3), np.float32), "got a (0, 2147483648, 3) array"),
+    ("light_mean_variance", {"paths": (1.0, 2.0), "pixels": (0.0, 0.0, 0.0)},
+     "/light_mean_variance/paths: expected a tuple of 3 finite numbers >= 0, got (1.0, 2.0)"),
+    ("light_mean_variance", {"paths": (1.0, 2.0, 3.0), "pixels": (0.0, -1.0, 0.0)},
+     "/light_mean_variance/pixels: expected a tuple of 3 finite numbers >= 0"),
+    ("light_mean_variance", {"paths": (1.0, 2.0, 3.0)}, "/light_mean_variance/pixels: missing"),
+    ("light_mean_variance", [1.0] * 6, "/light_mean_variance: expected a dict, got list"),
 ])
 def test_a_corrupted_result_state_raises_value_error(renderer, small_scene, key, value, message):
     renderer.set_scene(small_scene)

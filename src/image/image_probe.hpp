@@ -153,6 +153,12 @@ struct ExrExtras {
   std::vector<std::pair<std::string, std::string>> attributes;
 };
 
+/// The attribute lucent.light_mean_var of RenderResult::light_mean_variance: its paths and its
+/// pixels (R G B each), six numbers in decimal (docs/compare.md), and back: throws lucent::Error
+/// "<path>: attribute lucent.light_mean_var: ..." unless the text is six finite numbers >= 0.
+std::string light_mean_var_attribute(const LightMeanVariance& v);
+LightMeanVariance parse_light_mean_var(const std::string& path, const std::string& text);
+
 /// write_render_exr() with extra channels and attributes.
 void write_render_exr(const std::string& path, const RenderResult& r, const ExrExtras& extras);
 

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -22,10 +24,48 @@ void write_render_exr(const std::string& path, const RenderResult& r) {
   image_detail::ExrExtras extras;
   if (!r.sampler.empty())
     extras.attributes = {{"lucent.seed", std::to_string(r.seed)}, {"lucent.sampler", r.sampler}};
+  if (r.light_mean_variance)
+    extras.attributes.emplace_back("lucent.light_mean_var",
+                                   image_detail::light_mean_var_attribute(*r.light_mean_variance));
   image_detail::write_render_exr(path, r, extras);
 }
 
 namespace image_detail {
+
+std::string light_mean_var_attribute(const LightMeanVariance& v) {
+  std::string s;
+  char buf[32];
+  for (const double* part : {v.paths, v.pixels})
+    for (int c = 0; c < 3; ++c) {
+      std::snprintf(buf, sizeof buf, "%.17g", part[c]);
+      s += (s.empty() ? "" : " ") + std::string(buf);
+    }
+  return s;
+}
+
+LightMeanVariance parse_light_mean_var(const std::string& path, const std::string& text) {
+  LightMeanVariance v;
+  double* const values[6] = {&v.paths[0],  &v.paths[1],  &v.paths[2],
+                             &v.pixels[0], &v.pixels[1], &v.pixels[2]};
+  const char* p = text.c_str();
+  int k = 0;
+  for (; k < 6; ++k) {
+    char* end = nullptr;
+    const double x = std::strtod(p, &end);
+    if (end == p || (*end != ' ' && *end != '\0') || !(x >= 0) || !std::isfinite(x)) break;
+    *values[k] = x;
+    p = end;
+  }
+  while (*p == ' ') ++p;
+  if (k == 6 && *p == '\0') return v;
+  std::string shown = text.substr(0, 80) + (text.size() > 80 ? "..." : "");
+  for (char& ch : shown)
+    if (static_cast<unsigned char>(ch) < 0x20) ch = '?';  // one line
+  throw Error(path +
+              ": attribute lucent.light_mean_var: expected 6 finite numbers >= 0 (the image "
+              "mean's light-path and per-pixel light variances, R G B each), got '" +
+              shown + "'");
+}
 
 void write_render_exr(const std::string& path, const RenderResult& r, const ExrExtras& extras) {
   const int w = r.mean.width, h = r.mean.height;
@@ -157,6 +197,10 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
         parse_attribute_u64(path, "lucent.seed", seed->second, 0xffffffffu));
     r.sampler = sampler->second;
   }
+  // caustics: the image mean's light part (RenderResult::light_mean_variance)
+  auto light = exr.attributes.find("lucent.light_mean_var");
+  if (light != exr.attributes.end())
+    r.light_mean_variance = parse_light_mean_var(path, light->second);
   r.mean = Image{w, h, std::vector<float>(n * 3)};
   for (int c = 0; c < 3; ++c)
     for (size_t i = 0; i < n; ++i) r.mean.rgb[i * 3 + c] = exr.planes[rgb[c]][i];

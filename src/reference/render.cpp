@@ -19,6 +19,7 @@
 #include "reference/integrator/integrator.hpp"
 #include "reference/integrator/light_tracer.hpp"
 #include "render/resources.hpp"
+#include "render/sample_stats.hpp"
 #include "scene/loaders.hpp"
 #include "scene/validate.hpp"
 
@@ -69,6 +70,9 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
   // (a light path's value at a pixel: the sum of its connections' shares there)
   std::vector<std::vector<double>> light_sum(caustics ? threads : 0),
       light_sq(caustics ? threads : 0);
+  // per thread: the sums of the light paths' totals (a path's shares over all pixels) and of
+  // their squares, for the image mean's light part (RenderResult::light_mean_variance)
+  std::vector<render_detail::LightTotals> light_totals(caustics ? threads : 0);
 
   auto worker = [&](int thread) {
     ref::reset_ray_count();
@@ -128,6 +132,7 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
           std::stable_sort(
               splats.begin(), splats.end(),
               [](const ref::Splat& a, const ref::Splat& b) { return a.pixel < b.pixel; });
+          glm::dvec3 total(0.0);
           for (size_t g = 0; g < splats.size();) {
             const int pixel = splats[g].pixel;
             glm::dvec3 X(0.0);
@@ -136,6 +141,11 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
               for (int c = 0; c < 3; ++c) light_sum[thread][pixel * 3 + c] += splats[g].c[c];
             }
             for (int c = 0; c < 3; ++c) light_sq[thread][pixel * 3 + c] += X[c] * X[c];
+            total += X;
+          }
+          for (int c = 0; c < 3; ++c) {
+            light_totals[thread].sum[c] += total[c];
+            light_totals[thread].sumsq[c] += total[c] * total[c];
           }
         }
     }
@@ -153,26 +163,40 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
   // that variance / n stays the variance of the pixel's mean. N counts the light paths traced
   // (all N = W H spp unless cancelled); pixels without camera samples stay empty.
   const double N = static_cast<double>(light_paths);
-  for (size_t t = 1; t < light_sum.size(); ++t)
+  for (size_t t = 1; t < light_sum.size(); ++t) {
     for (size_t j = 0; j < npix * 3; ++j) {
       light_sum[0][j] += light_sum[t][j];
       light_sq[0][j] += light_sq[t][j];
     }
+    for (int c = 0; c < 3; ++c) {
+      light_totals[0].sum[c] += light_totals[t].sum[c];
+      light_totals[0].sumsq[c] += light_totals[t].sumsq[c];
+    }
+  }
 
   RenderResult r;
   r.mean = Image{W, H, std::vector<float>(npix * 3)};
   r.variance = Image{W, H, std::vector<float>(npix * 3)};
+  LightMeanVariance lmv;  // the image mean's light part (its variances)
   for (size_t i = 0; i < npix; ++i)
     for (int c = 0; c < 3; ++c) {
       double m = mean[i * 3 + c], var = count[i] > 1 ? m2[i * 3 + c] / (count[i] - 1) : 0.0;
       if (caustics && N > 0 && count[i] > 0) {
         const double lm = light_sum[0][i * 3 + c] / N;
         m += lm;
-        if (N > 1) var += count[i] * std::max(0.0, light_sq[0][i * 3 + c] / N - lm * lm) / (N - 1);
+        if (N > 1) {
+          const double lvar = std::max(0.0, light_sq[0][i * 3 + c] / N - lm * lm) / (N - 1);
+          var += count[i] * lvar;
+          lmv.pixels[c] += lvar / (double(npix) * double(npix));  // var / n holds it
+        }
       }
       r.mean.rgb[i * 3 + c] = static_cast<float>(m);
       r.variance.rgb[i * 3 + c] = static_cast<float>(var);
     }
+  if (caustics && N > 1) {
+    render_detail::light_paths_variance(light_totals[0], light_paths, double(npix), lmv.paths);
+    r.light_mean_variance = render_detail::finite_or_none(lmv);
+  }
   r.samples = std::move(count);
   r.spp = static_cast<std::uint64_t>(spp);
   r.nonfinite = nonfinite;

@@ -209,13 +209,13 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
                           tex_bytes, leaf_bytes, node_bytes})
     scene_buffers += host_block_bytes(b);
   for (const DeviceLimits& d : devices) {
-    // the device's pass sums (double4 with fp64, else float4) and with caustics its light
-    // sums (double4 with fp64 and 64-bit atomics, else float4: two films each, an adaptive work
-    // list's halves A and B)
+    // the device's pass sums (double4 with fp64, else float4; with caustics twice as many, the
+    // light paths' totals after them) and with caustics its light sums (double4 with fp64 and
+    // 64-bit atomics, else float4: two films each, an adaptive work list's halves A and B)
     const std::uint64_t sum_elem = d.fp64 ? sizeof(cl_double4) : sizeof(cl_float4);
     const std::uint64_t light_elem = d.light_double ? sizeof(cl_double4) : sizeof(cl_float4);
     const std::uint64_t light_bufs = (caustics ? 4 : 0) * npix * light_elem;
-    const std::uint64_t film_bufs = 2 * npix * sum_elem + light_bufs;
+    const std::uint64_t film_bufs = (caustics ? 4 : 2) * npix * sum_elem + light_bufs;
     // a CPU device's buffers are host memory: the film's (and the work list), and the scene's;
     // its pass results are mapped there (session.cpp). Another device's results are read back
     // into host copies as large as its buffers (h_sum, h_sumsq, and with caustics h_light,
@@ -312,9 +312,10 @@ std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics
                                             bool light_double) {
   const std::uint64_t npix = std::uint64_t(width) * std::uint64_t(height);
   const std::string film = film_size(width, height);
-  // session.cpp's Worker: the work list, the pass sums (double4 with fp64), and the light paths'
-  // sums (one element each without caustics; double4 with fp64 and 64-bit atomics)
-  const std::uint64_t sum = fp64 ? sizeof(cl_double4) : sizeof(cl_float4);
+  // session.cpp's Worker: the work list, the pass sums (double4 with fp64; with caustics the
+  // light paths' totals after them, twice the elements), and the light paths' sums (one element
+  // each without caustics; double4 with fp64 and 64-bit atomics)
+  const std::uint64_t sum = (caustics ? 2 : 1) * (fp64 ? sizeof(cl_double4) : sizeof(cl_float4));
   const std::uint64_t light = light_double ? sizeof(cl_double4) : sizeof(cl_float4);
   std::vector<MemoryPart> parts = {
       {"film sample sums (" + film + ")", npix * sum, "the film size"},

@@ -3,11 +3,14 @@
 // files, an adaptive render's halves, its calibration and its light paths): from running sums
 // and sums of squares, never from stored samples.
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "lucent/error.hpp"
+#include "lucent/render.hpp"
 
 namespace lucent::render_detail {
 
@@ -44,6 +47,30 @@ inline double pooled_variance(double sum_a, double sumsq_a, double n_a, double s
   if (n_b > 0) ss += std::max(0.0, sumsq_b - sum_b * (sum_b / n_b));
   const double dof = n_a + n_b - double(n_a > 0) - double(n_b > 0);
   return dof > 0 ? ss / dof : 0;
+}
+
+/// integrator.caustics: per channel, the sums of the light paths' totals (a path's shares added
+/// over all pixels: its contribution to the film's sum) and of their squares (megakernel.cl).
+struct LightTotals {
+  double sum[3] = {0, 0, 0}, sumsq[3] = {0, 0, 0};
+};
+
+/// The variance of the image mean's light part, per channel, from `paths` light paths' totals on
+/// a film of `npix` pixels (LightMeanVariance::paths): a total over npix is one
+/// path's contribution to the image mean, and the light part its mean over the paths.
+inline void light_paths_variance(const LightTotals& t, std::uint64_t paths, double npix,
+                                 double out[3]) {
+  const double n = double(paths);
+  for (int c = 0; c < 3; ++c)
+    out[c] = paths > 1 ? sample_variance(t.sum[c], t.sumsq[c], n) / n / (npix * npix) : 0;
+}
+
+/// `v` when all its numbers are finite, else none (a float device's sums of squares of the
+/// light paths' totals can overflow: compare then takes the pixels as independent).
+inline std::optional<LightMeanVariance> finite_or_none(const LightMeanVariance& v) {
+  for (int c = 0; c < 3; ++c)
+    if (!std::isfinite(v.paths[c]) || !std::isfinite(v.pixels[c])) return std::nullopt;
+  return v;
 }
 
 }  // namespace lucent::render_detail

@@ -208,6 +208,10 @@ struct Worker {
   double sumsq_at(size_t k, int c) const {
     return accum_double ? h_sumsq[k].s[c] : h_sumsq_f[k].s[c];
   }
+  /// Caustics: channel c of the sum and the sum of squares of item k's light paths' totals, in a
+  /// pass of `items` items (after the items' sums, megakernel.cl).
+  double total_at(size_t items, size_t k, int c) const { return sum_at(items + k, c); }
+  double totalsq_at(size_t items, size_t k, int c) const { return sumsq_at(items + k, c); }
   /// Bytes of one element of the light sums (b_light, b_lightsq).
   size_t light_bytes() const { return light_double ? sizeof(cl_double4) : sizeof(cl_float4); }
   /// Component c of the last pass's light sum and sum of squares of element k.
@@ -289,12 +293,13 @@ struct Worker {
     }
     q.enqueueNDRangeKernel(program->kernel, cl::NullRange, cl::NDRange(global_size(items)),
                            cl::NDRange(program->work_group));
+    const size_t ns = light ? 2 * items : items;  // and the light paths' totals
     if (accum_double) {
-      h_sum.fetch(q, b_sum, items, map_results);
-      h_sumsq.fetch(q, b_sumsq, items, map_results);
+      h_sum.fetch(q, b_sum, ns, map_results);
+      h_sumsq.fetch(q, b_sumsq, ns, map_results);
     } else {
-      h_sum_f.fetch(q, b_sum, items, map_results);
-      h_sumsq_f.fetch(q, b_sumsq, items, map_results);
+      h_sum_f.fetch(q, b_sum, ns, map_results);
+      h_sumsq_f.fetch(q, b_sumsq, ns, map_results);
     }
     if (light && light_double) {
       h_light.fetch(q, b_light, nl, map_results);
@@ -350,6 +355,7 @@ struct Renderer::Impl {
   // squares per pixel, and the number of light paths
   std::vector<double> light_sum, light_sumsq;
   std::uint64_t light_paths = 0;
+  render_detail::LightTotals light_totals;  // the light paths' totals, for the image mean
   double render_seconds = 0;
   bool last_cancelled = false;
   /// A render call (render, render_for, render_adaptive) is in progress: its on_progress may read
@@ -412,6 +418,7 @@ struct Renderer::Impl {
     std::fill(light_sum.begin(), light_sum.end(), 0.0);
     std::fill(light_sumsq.begin(), light_sumsq.end(), 0.0);
     light_paths = 0;
+    light_totals = {};
     first = first_sample;
     done = nonfinite = rays = 0;
     end_index = first_sample;
@@ -598,8 +605,10 @@ struct Renderer::Impl {
           w.release_results();
           w.npix = n;
           w.b_work = cl::Buffer(w.ctx.context, CL_MEM_READ_ONLY, n * sizeof(cl_uint4));
-          w.b_sum = w.result_buffer(CL_MEM_WRITE_ONLY, n * w.sum_bytes());
-          w.b_sumsq = w.result_buffer(CL_MEM_WRITE_ONLY, n * w.sum_bytes());
+          // with caustics the light paths' totals follow the items' sums (megakernel.cl)
+          const size_t ns = light ? 2 * n : n;
+          w.b_sum = w.result_buffer(CL_MEM_WRITE_ONLY, ns * w.sum_bytes());
+          w.b_sumsq = w.result_buffer(CL_MEM_WRITE_ONLY, ns * w.sum_bytes());
           w.b_counters =
               cl::Buffer(w.ctx.context, CL_MEM_READ_WRITE, LC_COUNTER_COUNT * sizeof(lc_uint));
           const size_t nl = light ? n : 1;  // an adaptive render doubles it (ensure_light)
@@ -671,6 +680,8 @@ struct Renderer::Impl {
         for (int c = 0; c < 3; ++c) {
           light_sum[i * 3 + c] += w.light_at(i, c);
           light_sumsq[i * 3 + c] += w.lightsq_at(i, c);
+          light_totals.sum[c] += w.total_at(npix, i, c);
+          light_totals.sumsq[c] += w.totalsq_at(npix, i, c);
         }
       light_paths += std::uint64_t(n) * npix;
     }
@@ -882,6 +893,7 @@ struct Renderer::Impl {
     // caustics (A and B only): the half's light paths' splat sums and their number
     std::vector<double> light_sum, light_sumsq;
     std::uint64_t light_paths = 0;
+    render_detail::LightTotals light_totals;
     render_detail::Pilot pilot;
     bool piloted = false;
   };
@@ -984,7 +996,13 @@ struct Renderer::Impl {
           }
           h.count[i] += static_cast<std::uint32_t>(w.sum_at(k, 3));
           h.launched[i] += e.s[2];
-          if (!h.light_sum.empty()) h.light_paths += e.s[2];  // one per camera sample
+          if (!h.light_sum.empty()) {
+            h.light_paths += e.s[2];  // one per camera sample
+            for (int c = 0; c < 3; ++c) {
+              h.light_totals.sum[c] += w.total_at(job.entries.size(), k, c);
+              h.light_totals.sumsq[c] += w.totalsq_at(job.entries.size(), k, c);
+            }
+          }
           samples += e.s[2];
         }
         for (int hi = 0; hi < 2; ++hi) {  // the halves' light splats, anywhere on the film
@@ -1059,6 +1077,7 @@ struct Renderer::Impl {
         h.light_sum.assign(caustics ? npix * 3 : 0, 0.0);
         h.light_sumsq.assign(caustics ? npix * 3 : 0, 0.0);
         h.light_paths = 0;
+        h.light_totals = {};
       }
       const int width = scene->film.width, height = scene->film.height;
       const int stride = render_detail::calibration_stride(width, height);
@@ -1197,6 +1216,7 @@ struct Renderer::Impl {
       const double ga = calibrated ? calib[0].gain : 1, gb = calibrated ? calib[1].gain : 1;
       const bool caustics = !a.light_sum.empty();
       std::vector<double> mean_var(npix * 3, 0.0);  // the variance of each pixel's mean
+      LightMeanVariance lmv;                        // caustics: the image mean's light part
       for (size_t i = 0; i < npix; ++i) {
         render_detail::combine_halves(&a.sum[i * 3], &a.sumsq[i * 3], a.count[i], &b.sum[i * 3],
                                       &b.sumsq[i * 3], b.count[i], &r.mean.rgb[i * 3],
@@ -1210,6 +1230,7 @@ struct Renderer::Impl {
                                           r.samples[i], &r.mean.rgb[i * 3], &r.variance.rgb[i * 3],
                                           light_var);
         if (r.samples[i] == 0) continue;
+        for (int c = 0; c < 3; ++c) lmv.pixels[c] += light_var[c];
         // var / n is s^2 (1/n_A + 1/n_B) / 4; the calibrated model's is s^2 (g_A/n_A + g_B/n_B) / 4
         const double na = a.count[i], nb = b.count[i];
         const double gain =
@@ -1230,6 +1251,18 @@ struct Renderer::Impl {
           if (b.light_paths) sb[k] += b.count[k / 3] * b.light_sum[k] / double(b.light_paths);
         }
         r.halves_relmse = render_detail::halves_relmse(sa, a.count, sb, b.count, &value);
+        // the light part is the halves' average (add_light_halves), as their variances combine
+        double va[3], vb[3];
+        render_detail::light_paths_variance(a.light_totals, a.light_paths, double(npix), va);
+        render_detail::light_paths_variance(b.light_totals, b.light_paths, double(npix), vb);
+        const bool both = a.light_paths > 0 && b.light_paths > 0;
+        for (int c = 0; c < 3; ++c) {
+          lmv.paths[c] = both ? (va[c] + vb[c]) / 4 : va[c] + vb[c];
+          lmv.pixels[c] /= double(npix) * double(npix);
+        }
+        // (a half of one path has no variance: then none is known)
+        if (a.light_paths != 1 && b.light_paths != 1 && (a.light_paths || b.light_paths))
+          r.light_mean_variance = render_detail::finite_or_none(lmv);
       } else {
         r.halves_relmse = render_detail::halves_relmse(a.sum, a.count, b.sum, b.count, &value);
       }
@@ -1251,6 +1284,7 @@ struct Renderer::Impl {
         if (adaptive_target > 0) r.planned_relmse = (planned_relmse[0] + planned_relmse[1]) / 4;
       }
     } else {
+      LightMeanVariance lmv;  // caustics: the image mean's light part
       for (size_t i = 0; i < npix; ++i) {
         double n = count[i];
         for (int c = 0; c < 3; ++c) {
@@ -1264,10 +1298,16 @@ struct Renderer::Impl {
                 render_detail::sample_variance(light_sum[i * 3 + c], light_sumsq[i * 3 + c], N) / N;
             mean += lm;
             var += n * lvar;
+            if (n > 0) lmv.pixels[c] += lvar;  // var / n holds it
           }
           r.mean.rgb[i * 3 + c] = static_cast<float>(mean);
           r.variance.rgb[i * 3 + c] = static_cast<float>(var);
         }
+      }
+      if (light_paths > 1) {
+        render_detail::light_paths_variance(light_totals, light_paths, double(npix), lmv.paths);
+        for (double& p : lmv.pixels) p /= double(npix) * double(npix);
+        r.light_mean_variance = render_detail::finite_or_none(lmv);
       }
     }
     r.spp = done;
