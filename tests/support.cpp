@@ -366,4 +366,13 @@ double ensemble_variance_ratio(const std::function<RenderResult(int)>& render, i
   return emp / rep;
 }
 
+double mean_image_mean_z2(const std::function<RenderResult(int)>& render, int pairs, int channel) {
+  double sum = 0;
+  for (int k = 0; k < pairs; ++k) {
+    const double z = compare_images(render(2 * k), render(2 * k + 1)).mean_z[channel];
+    sum += z * z;
+  }
+  return sum / pairs;
+}
+
 }  // namespace lucent::test

@@ -183,4 +183,10 @@ std::string glass_lamp_box_scene(int width, int height, const std::string& filte
 double ensemble_variance_ratio(const std::function<RenderResult(int)>& render, int R,
                                int channel = 1);
 
+/// The image-mean test on pairs of independent renders: compares render(2 k) with render(2 k + 1)
+/// for k = 0 .. pairs - 1 (compare_images) and returns the mean of the image-mean z^2 in channel
+/// `channel`: about 1 when the image mean's standard error is right (z standard normal).
+double mean_image_mean_z2(const std::function<RenderResult(int)>& render, int pairs,
+                          int channel = 0);
+
 }  // namespace lucent::test

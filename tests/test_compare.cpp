@@ -343,6 +343,39 @@ TEST(Compare, LightMeanVarianceRoundTripsThroughExr) {
   }
 }
 
+// The image mean's variance with caustics: per image, the pixels' sum of var / n over N^2, less
+// the light part's share of it (pixels), plus the light part from the paths' totals (paths); an
+// image without light_mean_variance counts its pixels as independent, and the report says which.
+TEST(Compare, ImageMeanVarianceTakesTheLightPartFromThePaths) {
+  RenderResult a = constant_image(2, 1, 1.0f), b = constant_image(2, 1, 0.0f);
+  for (RenderResult* r : {&a, &b}) {
+    r->variance = constant_image(2, 1, 8.0f).mean;  // var / n = 2 per pixel: 4 / N^2 = 1
+    r->samples = {4, 4};
+  }
+  CompareOptions o;
+  o.abs_epsilon = o.rel_epsilon = 0;
+  CompareResult plain = lucent::compare_images(a, b, o);
+  EXPECT_DOUBLE_EQ(plain.mean_z[0], 1.0 / std::sqrt(2.0));
+  EXPECT_FALSE(plain.light_paths_a || plain.light_paths_b);
+  EXPECT_EQ(plain.summary().find("light paths"), std::string::npos);
+
+  a.light_mean_variance = lucent::LightMeanVariance{{3, 3, 3}, {0.5, 0.5, 2}};
+  CompareResult one = lucent::compare_images(a, b, o);
+  // A: 1 - 0.5 + 3 = 3.5 (blue: 1 - 2 clamps at 0, + 3), B: 1
+  EXPECT_DOUBLE_EQ(one.mean_z[0], 1.0 / std::sqrt(4.5));
+  EXPECT_DOUBLE_EQ(one.mean_z[2], 1.0 / std::sqrt(4.0));
+  EXPECT_TRUE(one.light_paths_a);
+  EXPECT_FALSE(one.light_paths_b);
+  EXPECT_NE(one.summary().find("light paths' totals in A (B's pixels taken as independent"),
+            std::string::npos)
+      << one.summary();
+
+  b.light_mean_variance = lucent::LightMeanVariance{{0, 0, 0}, {1, 1, 1}};
+  CompareResult both = lucent::compare_images(a, b, o);
+  EXPECT_DOUBLE_EQ(both.mean_z[0], 1.0 / std::sqrt(3.5));
+  EXPECT_NE(both.summary().find("light paths' totals in A and B"), std::string::npos);
+}
+
 // A display image (PNG: tone-mapped, encoded, clipped) against a linear render compares the
 // display transform: refused in either order, one line naming the display image. Two display
 // images stay comparable (a tolerance test without variances).

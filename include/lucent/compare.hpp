@@ -43,6 +43,9 @@ struct CompareResult {
   double mean_z[3] = {0, 0, 0};                         ///< z of the difference of the image means
   double mean_z_threshold = 0;
   bool mean_test_passed = true;
+  /// The image-mean test took image A's (B's) light-traced part from its light paths' totals
+  /// (RenderResult::light_mean_variance, caustics); otherwise from its pixels, as independent.
+  bool light_paths_a = false, light_paths_b = false;
   double rmse = 0;              ///< sqrt(mean over pixel-channels of (A - B)^2)
   double relmse = 0;            ///< mean of (A - B)^2 / (B^2 + 0.01)
   double max_abs_error = 0;     ///< largest |A - B|

@@ -115,6 +115,10 @@ void bind_image(py::module_& m) {
       .def_property_readonly("mean_z", [](const CompareResult& c) { return triple(c.mean_z); })
       .def_readonly("mean_z_threshold", &CompareResult::mean_z_threshold)
       .def_readonly("mean_test_passed", &CompareResult::mean_test_passed)
+      .def_readonly("light_paths_a", &CompareResult::light_paths_a,
+                    "the image-mean test took A's light-traced part (caustics) from its light "
+                    "paths' totals (RenderResult.light_mean_variance), not from its pixels")
+      .def_readonly("light_paths_b", &CompareResult::light_paths_b)
       .def_readonly("rmse", &CompareResult::rmse)
       .def_readonly("relmse", &CompareResult::relmse)
       .def_readonly("max_abs_error", &CompareResult::max_abs_error)

@@ -240,7 +240,7 @@ def test_a_render_result_round_trips_exactly(renderer, small_scene, name, round_
 def test_a_caustics_result_keeps_its_light_mean_variance(renderer, small_dict, name, round_trip):
     """A render with caustics carries the image mean's light part (its variance from the light
     paths' totals, and its share of the variance layer), a render without none; both come back
-    exactly."""
+    exactly, and compare() takes it from either."""
     small_dict["integrator"]["caustics"] = True
     small_dict["integrator"]["max_depth"] = 6
     small_dict["materials"]["w"] = {"type": "dielectric", "ior": 1.5}
@@ -253,6 +253,8 @@ def test_a_caustics_result_keeps_its_light_mean_variance(renderer, small_dict, n
     c = round_trip(res)
     assert c.light_mean_variance == v
     assert res.__getstate__()["light_mean_variance"] == v
+    cmp = lucent.compare(res, c)
+    assert cmp.light_paths_a and cmp.light_paths_b
     assert lucent.RenderResult(res.mean, res.variance, res.samples).light_mean_variance is None
 
 

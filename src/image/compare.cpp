@@ -45,6 +45,17 @@ double z_score(double d, double var_eps) {
   return d / std::sqrt(var_eps);
 }
 
+/// The variance of image r's mean in channel c, from `pixels`, the sum of its pixels' variances
+/// of the mean over N^2 (as if independent). With caustics (r.light_mean_variance) the light part
+/// is correlated between pixels: its share of `pixels` is replaced by its variance from the light
+/// paths' totals, so that the camera part counts per pixel and the light part once, as a whole.
+double image_mean_variance(const RenderResult& r, double pixels, int c) {
+  if (!r.light_mean_variance) return pixels;
+  const LightMeanVariance& l = *r.light_mean_variance;
+  // (the float variance layers round; a pixel of n < 2 counts 0 above, its light part too)
+  return std::max(0.0, pixels - l.pixels[c]) + l.paths[c];
+}
+
 void check_layers(const RenderResult& r, const char* which) {
   size_t npix = static_cast<size_t>(r.mean.width) * r.mean.height;
   if (r.mean.rgb.size() != npix * 3)
@@ -119,13 +130,14 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
   double per_test = -std::expm1(std::log1p(-o.alpha) / static_cast<double>(r.tested));
   r.z_threshold = normal_two_sided_critical(per_test);
 
-  double sq = 0, rel = 0, sum_var[3] = {0, 0, 0};
+  double sq = 0, rel = 0, sum_var_a[3] = {0, 0, 0}, sum_var_b[3] = {0, 0, 0};
   for (size_t i = 0; i < npix; ++i) {
     bool pixel_ok = true;
     for (int c = 0; c < 3; ++c) {
       double va = a.mean.rgb[i * 3 + c], vb = b.mean.rgb[i * 3 + c];
       double d = va - vb;
-      double var = variance_of_mean(a, i, c) + variance_of_mean(b, i, c);
+      const double var_a = variance_of_mean(a, i, c), var_b = variance_of_mean(b, i, c);
+      double var = var_a + var_b;
       double eps = o.abs_epsilon + o.rel_epsilon * std::max(std::abs(va), std::abs(vb));
       double z = z_score(d, var + eps * eps);
       r.z.rgb[i * 3 + c] = static_cast<float>(z);
@@ -143,7 +155,8 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
       }
       r.mean_a[c] += va;
       r.mean_b[c] += vb;
-      sum_var[c] += var;
+      sum_var_a[c] += var_a;
+      sum_var_b[c] += var_b;
       sq += d * d;
       rel += d * d / (vb * vb + 0.01);
       r.max_abs_error = std::max(r.max_abs_error, std::isfinite(d) ? std::abs(d) : INFINITY);
@@ -158,12 +171,16 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
 
   r.mean_z_threshold = normal_two_sided_critical(-std::expm1(std::log1p(-o.alpha) / 3));
   r.mean_test_passed = true;
+  r.light_paths_a = a.light_mean_variance.has_value();
+  r.light_paths_b = b.light_mean_variance.has_value();
   for (int c = 0; c < 3; ++c) {
     r.mean_a[c] /= n;
     r.mean_b[c] /= n;
     double eps =
         o.abs_epsilon + o.rel_epsilon * std::max(std::abs(r.mean_a[c]), std::abs(r.mean_b[c]));
-    r.mean_z[c] = z_score(r.mean_a[c] - r.mean_b[c], sum_var[c] / (n * n) + eps * eps);
+    const double var = image_mean_variance(a, sum_var_a[c] / (n * n), c) +
+                       image_mean_variance(b, sum_var_b[c] / (n * n), c);
+    r.mean_z[c] = z_score(r.mean_a[c] - r.mean_b[c], var + eps * eps);
     if (o.image_mean_test && !(std::abs(r.mean_z[c]) <= r.mean_z_threshold))
       r.mean_test_passed = false;
   }
@@ -183,6 +200,12 @@ std::string CompareResult::summary() const {
   std::snprintf(buf, sizeof buf, "image-mean z  %.3f %.3f %.3f (threshold %.3f)%s\n", mean_z[0],
                 mean_z[1], mean_z[2], mean_z_threshold, mean_test_passed ? "" : "  FAIL");
   s += buf;
+  if (light_paths_a || light_paths_b) {
+    s += "image-mean var camera part per pixel, light part from the light paths' totals in ";
+    s += light_paths_a && light_paths_b ? "A and B\n"
+         : light_paths_a ? "A (B's pixels taken as independent: no lucent.light_mean_var)\n"
+                         : "B (A's pixels taken as independent: no lucent.light_mean_var)\n";
+  }
   std::snprintf(buf, sizeof buf, "RMSE          %.6g\nrelMSE        %.6g\nmax abs error %.6g\n",
                 rmse, relmse, max_abs_error);
   s += buf;
