@@ -376,14 +376,13 @@ TEST(KernelCaustics, AdaptiveImageMeanZOfRendersDifferingInSeedIsStandardNormal)
 // The image mean's light part, from the kernel's and the reference's light paths: the variance
 // from the paths' totals and the per-pixel part, each the mean over 200 renders (8x8, gaussian
 // radius 3, 4 spp) of its estimate. Both estimate the same number where the light paths are
-// sampled alike: Russian roulette off (rr_depth 100; the kernel's starts a vertex earlier, which
-// the model leaves open, and raised the kernel's variance 8%). A z-test of the two means with
-// the renders' spread (about 8% a render: 0.6% a mean), |z| <= 4. Measured: 0.002447 and
-// 0.002445 (paths).
+// sampled alike, Russian roulette included (the default rr_depth 4: the kernel's light paths
+// started it a vertex earlier than the reference's, which the model leaves open, and their
+// variance was 8% above; both now start once the path has rr_depth segments). A z-test of the
+// two means with the renders' spread (about 8% a render: 0.6% a mean), |z| <= 4.
 TEST(KernelCaustics, LightMeanVarianceAgreesWithTheReference) {
   lucent::Scene scene = lucent::test::scene_from(
       lucent::test::glass_lamp_box_scene(8, 8, R"({"type": "gaussian", "radius": 3})", 6));
-  scene.integrator.rr_depth = 100;
   lucent::Renderer r(lucent::test::session_options());
   r.set_scene(scene);
   lucent::ReferenceOptions o;
