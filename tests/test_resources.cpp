@@ -141,6 +141,26 @@ TEST(Resources, HostEstimateCoversThePackedScene) {
   EXPECT_EQ(part(parts, "the buffers of device 'gpu'"), 32u * 32 * 128);
 }
 
+/// The CLI's peak host memory in MiB for `args` (its summary line), after checking it succeeded.
+double peak_host_mib(const std::string& args) {
+  auto r = lucent::test::run_cli(args);
+  EXPECT_EQ(r.status, 0) << r.err;
+  const size_t at = r.err.find("peak host memory ");
+  EXPECT_NE(at, std::string::npos) << r.err;
+  return at == std::string::npos ? 0.0 : std::atof(r.err.c_str() + at + 17);
+}
+
+/// The limits of the device the CLI renders on, as the session takes them (memory sizes aside).
+DeviceLimits this_device() {
+  const lucent::DeviceInfo info = lucent::select_device();
+  DeviceLimits device;
+  device.device = info.name;
+  device.host_unified = info.type == "CPU";
+  device.fp64 = info.fp64;
+  device.light_double = info.fp64 && info.int64_atomics;
+  return device;
+}
+
 // What a render really takes on the host stays within the estimate the limits are checked
 // against: the CLI's peak host memory (getrusage) for a 2048x2048 film, less that of a 16x16
 // film of the same scene, against the estimate's growth over those pixels plus the PFM written
@@ -154,21 +174,12 @@ TEST(Resources, PeakHostMemoryOfALargeFilmIsWithinTheEstimate) {
   lucent::test::write_file(dir + "/s.json", grid_scene(2, 16));
   auto peak_mib = [&](int film) {
     const std::string size = std::to_string(film);
-    auto r = lucent::test::run_cli("render " + q(dir + "/s.json") + " -o " + q(dir + "/o.pfm") +
-                                   " --width " + size + " --height " + size);
-    EXPECT_EQ(r.status, 0) << r.err;
-    const size_t at = r.err.find("peak host memory ");
-    EXPECT_NE(at, std::string::npos) << r.err;
-    return at == std::string::npos ? 0.0 : std::atof(r.err.c_str() + at + 17);
+    return peak_host_mib("render " + q(dir + "/s.json") + " -o " + q(dir + "/o.pfm") + " --width " +
+                         size + " --height " + size);
   };
   peak_mib(16);  // builds the kernel (a compiler's memory is not the film's)
   const double small = peak_mib(16), large = peak_mib(2048);
-  const lucent::DeviceInfo info = lucent::select_device();
-  DeviceLimits device;
-  device.device = info.name;
-  device.host_unified = info.type == "CPU";
-  device.fp64 = info.fp64;
-  device.light_double = info.fp64 && info.int64_atomics;
+  const DeviceLimits device = this_device();
   auto estimate = [&](int film) {
     Scene sc = lucent::test::scene_from(grid_scene(2, film));
     std::uint64_t bytes = 0;
@@ -257,21 +268,12 @@ TEST(Resources, PeakHostMemoryOfALargeMeshIsWithinTheEstimate) {
   if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer's own memory is in the peak";
   const std::string dir = lucent::test::temp_dir();
   auto peak_mib = [&](const std::string& scene) {
-    auto r = lucent::test::run_cli("render " + q(scene) + " -o " + q(dir + "/o.pfm"));
-    EXPECT_EQ(r.status, 0) << r.err;
-    const size_t at = r.err.find("peak host memory ");
-    EXPECT_NE(at, std::string::npos) << r.err;
-    return at == std::string::npos ? 0.0 : std::atof(r.err.c_str() + at + 17);
+    return peak_host_mib("render " + q(scene) + " -o " + q(dir + "/o.pfm"));
   };
   const std::string small_scene = soup_scene(dir, 3000), large_scene = soup_scene(dir, 300000);
   peak_mib(small_scene);  // builds the kernel (a compiler's memory is not the mesh's)
   const double small = peak_mib(small_scene), large = peak_mib(large_scene);
-  const lucent::DeviceInfo info = lucent::select_device();
-  DeviceLimits device;
-  device.device = info.name;
-  device.host_unified = info.type == "CPU";
-  device.fp64 = info.fp64;
-  device.light_double = info.fp64 && info.int64_atomics;
+  const DeviceLimits device = this_device();
   auto estimate = [&](const std::string& scene) {
     std::uint64_t bytes = 0;
     // (one description: lucent render gives its scene to the session, set_scene(Scene&&))
