@@ -116,6 +116,14 @@ TEST(CliInfo, SceneAndBvhStatistics) {
   EXPECT_NE(m["BVH/build time"].find(" ms"), std::string::npos);
   EXPECT_GT(std::stod(m["BVH/SAH cost"]), 0.0);
 
+  // the host memory lucent render checks before rendering on a CPU device: its total, and the
+  // film's part (40x30 pixels of 80 bytes: 93.75 KiB), as render/resources.cpp estimates them
+  EXPECT_NE(m["host memory"].find(" estimated for a render on a CPU device"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("  93.75 KiB   the accumulation and result images of the 40x30 film\n"),
+            std::string::npos)
+      << r.out;
+
   // the same numbers as the library's build of the same scene
   lucent::Scene s = lucent::load_scene(scene);
   lucent::render_detail::PackedScene packed = lucent::render_detail::pack_scene(s);

@@ -16,6 +16,7 @@
 #include "render/features.hpp"
 #include "render/integrator_knobs.hpp"
 #include "render/pack.hpp"
+#include "render/resources.hpp"
 
 namespace lucent::cli {
 
@@ -55,6 +56,32 @@ void print_counts(const std::map<E, std::size_t>& counts) {
     auto it = counts.find(e.value);
     std::printf("  %-19s %zu\n", e.name, it == counts.end() ? std::size_t(0) : it->second);
   }
+}
+
+/// The estimate `lucent render` checks before rendering on PoCL's CPU device (its buffers are host
+/// memory), part by part, against what lucent allows itself (render/resources.hpp); the output's
+/// write comes on top (docs/reliability.md, "Resources").
+void print_memory(const Scene& scene) {
+  render_detail::DeviceLimits cpu;
+  cpu.device = "CPU";
+  cpu.host_unified = cpu.fp64 = cpu.light_double = true;
+  // (one description: lucent render gives its scene to the session)
+  std::vector<render_detail::MemoryPart> parts =
+      render_detail::estimate_host_memory(scene, {cpu}, 1);
+  std::stable_sort(parts.begin(), parts.end(),
+                   [](const auto& a, const auto& b) { return a.bytes > b.bytes; });
+  std::uint64_t total = 0;
+  for (const render_detail::MemoryPart& p : parts) total += p.bytes;
+  std::string what;
+  const std::uint64_t limit = render_detail::host_memory_allowed(&what);
+  std::printf("\nhost memory   %s estimated for a render on a CPU device",
+              format_bytes(total).c_str());
+  if (limit > 0)
+    std::printf(" (lucent allows itself %s: 80%% of %s)", format_bytes(limit).c_str(),
+                what.c_str());
+  std::printf("\n");
+  for (const render_detail::MemoryPart& p : parts)
+    if (p.bytes > 0) std::printf("  %-10s  %s\n", format_bytes(p.bytes).c_str(), p.what.c_str());
 }
 
 }  // namespace
@@ -189,6 +216,7 @@ int run_info_command() {
   // (--no-specialize: every feature, as the build options below and Python's scene_info say)
   std::string defines = render_detail::feature_defines(scene, packed, options.specialize);
   if (!defines.empty() && defines[0] == ' ') defines.erase(0, 1);
+  print_memory(scene);
   std::printf("\nkernel\n");
   std::string kernel_dir = SessionOptions::from_environment().kernel_dir;
   std::printf("  sources             %s\n", kernel_dir.empty() ? "embedded" : kernel_dir.c_str());
