@@ -14,6 +14,7 @@
 #include "lucent/types.hpp"
 #include "render/features.hpp"
 #include "render/pack.hpp"
+#include "render/resources.hpp"
 #include "scene/json_guard.hpp"
 #include "scene/loaders.hpp"
 #include "scene/validate.hpp"
@@ -853,6 +854,25 @@ py::dict scene_info(const Scene& scene, const std::string& precision, bool fast_
   d["precision"] = precision_name(options.precision);
   d["fast_math"] = fast_math;
   d["build_options"] = render_detail::build_options(copy, packed, options);
+  // what a session's set_scene checks before rendering on a CPU device (the scene held twice:
+  // the application's and the session's copy), as `lucent info` prints it
+  render_detail::DeviceLimits cpu;
+  cpu.device = "CPU";
+  cpu.host_unified = cpu.fp64 = cpu.light_double = true;
+  py::list parts;
+  std::uint64_t total = 0;
+  for (const render_detail::MemoryPart& p : render_detail::estimate_host_memory(copy, {cpu})) {
+    py::dict part;
+    part["what"] = p.what;
+    part["bytes"] = p.bytes;
+    parts.append(part);
+    total += p.bytes;
+  }
+  py::dict memory;
+  memory["bytes"] = total;
+  memory["limit_bytes"] = render_detail::host_memory_allowed();
+  memory["parts"] = parts;
+  d["host_memory"] = memory;
   return d;
 }
 
@@ -1082,7 +1102,9 @@ void bind_scene(py::module_& m) {
         py::arg("on_warning") = py::none(),
         "What `lucent info` prints, as a dict: counts (triangles, skipped_triangles, lights by "
         "type, ...), the BVH's statistics, the kernel's feature defines and full build options "
-        "for these settings. Packs the scene and builds its BVH; needs no device.");
+        "for these settings, and host_memory: what set_scene estimates for a CPU device (bytes, "
+        "parts) and the limit it checks against (limit_bytes; 0: unknown). Packs the scene and "
+        "builds its BVH; needs no device.");
   m.def(
       "scene_from_dict",
       [](py::dict d, const std::filesystem::path& base_dir, const FileText& name,

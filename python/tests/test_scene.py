@@ -410,6 +410,13 @@ def test_scene_info_matches_the_cli(tmp_path, small_dict):
                    "LC_HAS_SPHERE_LIGHTS", "LC_HAS_DIFFUSE", "LC_HAS_INTEGRATOR_PATH"):
         assert define in info["feature_defines"], define
     assert "LC_HAS_MIRROR" not in info["feature_defines"]
+    # what set_scene checks before rendering on a CPU device: the film's part is 80 bytes a pixel
+    memory = info["host_memory"]
+    film = small_dict["film"]
+    film_part = next(p for p in memory["parts"] if p["what"].startswith("the accumulation"))
+    assert film_part["bytes"] == film["width"] * film["height"] * 80
+    assert memory["bytes"] == sum(p["bytes"] for p in memory["parts"]) > film_part["bytes"]
+    assert memory["limit_bytes"] >= 0
     double = lucent.scene_info(scene, precision="double", fast_math=True, specialize=False)
     assert "-D LC_DOUBLE" in double["build_options"]
     assert "-cl-fast-relaxed-math" in double["build_options"]
