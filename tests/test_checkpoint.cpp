@@ -301,4 +301,25 @@ TEST(Checkpoint, UnsupportedCombinationsAreRefused) {
   }
 }
 
+// The output under another spelling of the checkpoint's name (./out.exr, out.exr: libstdc++'s
+// weakly_canonical made one absolute and left the other relative) is refused; it was accepted,
+// and the finished render removed its output as its checkpoint (status 0, no image).
+TEST(Checkpoint, OutputUnderAnotherNameIsRefusedNeverRemoved) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string in_dir = "cd " + q(dir) + " &&";
+  for (const auto& [out, ck] : std::vector<std::pair<std::string, std::string>>{
+           {"./out.exr", "out.exr"}, {"out.exr", "./out.exr"}, {"out.exr", "sub/../out.exr"}}) {
+    SCOPED_TRACE(out + " " + ck);
+    fs::create_directories(dir + "/sub");
+    CommandResult r =
+        run_cli("render scene.json -q -o " + q(out) + " --checkpoint " + q(ck), in_dir);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(r.err, "lucent: error: " + ck +
+                         ": is the output too: give --checkpoint a file of "
+                         "its own\n");
+    EXPECT_FALSE(fs::exists(dir + "/out.exr"));
+  }
+}
+
 }  // namespace

@@ -216,6 +216,7 @@ class Checkpoint {
     std::error_code ec;
     if (std::filesystem::exists(path_, ec)) old_ = lucent::read_render_part(path_);
     held_ = first_sample();
+    ours_ = old_.has_value();
   }
   bool resumed() const { return old_.has_value(); }
   /// K: the samples per pixel the checkpoint holds, where this render starts.
@@ -282,6 +283,7 @@ class Checkpoint {
       ok = false;
     }
     if (ok) held_ = part.info.samples.empty() ? 0 : part.info.samples.back().end;
+    ours_ = ours_ || ok;
     last_ = std::chrono::steady_clock::now();
     return ok;
   }
@@ -297,7 +299,10 @@ class Checkpoint {
   void drop() { old_.reset(); }
 
   /// After the output was written: the render is complete, its checkpoint of no further use.
+  /// Only a file this render resumed from or wrote: none may be there, or another's (a file
+  /// that the output's name reached by another path was removed as the checkpoint).
   void remove() const {
+    if (!ours_) return;
     std::error_code ec;
     if (!std::filesystem::remove(path_, ec) && ec)
       std::fprintf(stderr, "lucent: warning: %s: checkpoint not removed (%s)\n",
@@ -319,6 +324,7 @@ class Checkpoint {
   std::chrono::steady_clock::time_point last_;
   std::uint64_t saved_spp_ = 0;  ///< the session's samples per pixel in the last checkpoint
   std::uint64_t held_ = 0;
+  bool ours_ = false;  ///< the file at path_ is this render's: resumed from, or written
 };
 
 /// After a render with a checkpoint, while the session lives: an unfinished render's samples go

@@ -194,9 +194,23 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
 bool same_file(const std::string& a, const std::string& b) {
   std::error_code ec;
   if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec) && !ec;
-  fs::path ca = fs::weakly_canonical(a, ec);
-  if (ec) return false;
-  fs::path cb = fs::weakly_canonical(b, ec);
+  // a path not there yet: where a write of it goes (through a link to a file not yet written),
+  // made absolute first (libstdc++'s weakly_canonical left "out.exr" relative, when no part of
+  // it exists, and made "./out.exr" absolute: the two were different files, and `lucent render
+  // -o ./out.exr --checkpoint out.exr` removed its output as the finished checkpoint)
+  auto where = [&ec](const std::string& p) {
+    fs::path t;
+    try {
+      t = write_target(p);
+    } catch (const Error&) {
+      t = p;  // (a loop of links: as given)
+    }
+    t = fs::absolute(t, ec);
+    return ec ? fs::path() : fs::weakly_canonical(t, ec);
+  };
+  const fs::path ca = where(a);
+  if (ec || ca.empty()) return false;
+  const fs::path cb = where(b);
   return !ec && ca == cb;
 }
 
