@@ -624,6 +624,11 @@ int render_with(const RenderArgs& a) {
     }
   }
   if (printed && tty) std::fprintf(stderr, "\n");
+  // this run's samples, rays and time (a resumed render's result becomes the totals of its
+  // checkpoint and this run, below): the summary's rates are this run's
+  const std::uint64_t run_spp = r.spp, run_rays = r.rays;
+  const double run_seconds = r.seconds;
+  const std::uint64_t resumed_spp = checkpoint ? checkpoint->first_sample() : 0;
   // a resumed render's image is that of the checkpoint's samples and the session's
   const bool checkpoint_done = checkpoint && finish_checkpoint(*checkpoint, renderer, r);
   // interrupted before its first sample (an adaptive render's pilot, the reference's first
@@ -666,18 +671,24 @@ int render_with(const RenderArgs& a) {
   if (r.nonfinite > 0)
     std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
                  static_cast<unsigned long long>(r.nonfinite));
-  // one device: its pass time; several: the wall time of the render, when they overlapped
-  double seconds = r.devices.size() > 1 ? wall : r.seconds;
+  // one device: its pass time; several: the wall time of the render, when they overlapped. A
+  // resumed render: this run's time and rates (its spp counts the checkpoint's samples too,
+  // which it names: dividing them by this run's wall time gave thousands of Msamples/s)
+  double seconds = r.devices.size() > 1 ? wall : run_seconds;
+  std::string resumed_note;
+  if (resumed_spp > 0)
+    resumed_note =
+        " (" + std::to_string(resumed_spp) + " of them from " + one_line(checkpoint->path()) + ")";
   if (!a.quiet)
     std::fprintf(
         stderr,
-        "%s: %dx%d, %llu spp in %.3f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak host "
-        "memory %.0f MiB) on %s%s\n",
+        "%s: %dx%d, %llu spp%s in %.3f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak "
+        "host memory %.0f MiB) on %s%s\n",
         one_line(a.output).c_str(), film_settings.width, film_settings.height,
-        static_cast<unsigned long long>(r.spp), seconds,
-        seconds > 0 ? double(r.spp) * film_settings.width * film_settings.height / seconds * 1e-6
+        static_cast<unsigned long long>(r.spp), resumed_note.c_str(), seconds,
+        seconds > 0 ? double(run_spp) * film_settings.width * film_settings.height / seconds * 1e-6
                     : 0,
-        seconds > 0 ? double(r.rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
+        seconds > 0 ? double(run_rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
         r.device.c_str(), device_shares(r.devices).c_str());
   // a time limit that ended the render before its plan did (a signal's last line says so)
   std::string stopped_early;
