@@ -344,7 +344,11 @@ bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer
                  one_line(e.what()).c_str());
     return false;
   }
-  if (!complete && !all.info.samples.empty()) ck.save(all);  // (stopped before its first sample)
+  // (stopped before its first sample: nothing to write; right after a periodic checkpoint, or
+  // before a resumed run's first pass: the file holds these samples already, and writing them
+  // again took seconds in which a second Ctrl-C lost the output)
+  if (!complete && !all.info.samples.empty() && all.info.samples.back().end != ck.held())
+    ck.save(all);
   if (!ck.resumed()) return complete;
   // the session's sums and images, and the checkpoint's, before the image's own memory
   renderer.reset();
