@@ -417,3 +417,42 @@ TEST(KernelCaustics, LightMeanVarianceAgreesWithTheReference) {
 }
 
 }  // namespace
+
+namespace {
+
+// RenderResult::light_mean_variance's `pixels` (Q) is the light part's share of what compare
+// reads of the variance layer, sum over the pixels of var / n over N^2, where compare counts a
+// pixel of n < 2 as 0 (variance_of_mean): Q must leave those pixels out too, or compare's
+// max(0, sum - Q) takes their light part off the other pixels' camera part. On the lamp in glass
+// no camera path reaches the light (the camera part is exactly 0), so var / n is the light part
+// alone and Q must equal compare's sum: at 4 spp to the float layers' rounding (relative 1e-5),
+// at 1 spp (n = 1 everywhere: compare reads nothing) exactly 0. Kernel and reference. It held
+// the pixels of n = 1 (Q > 0 at 1 spp) before.
+TEST(KernelCaustics, LightMeanVariancePixelsIsWhatCompareReadsOfTheVarianceLayer) {
+  lucent::Scene scene = lucent::test::scene_from(
+      lucent::test::glass_lamp_box_scene(8, 8, R"({"type": "gaussian", "radius": 3})", 6));
+  lucent::Renderer r(lucent::test::session_options());
+  r.set_scene(scene);
+  for (int spp : {1, 4}) {
+    r.reset();
+    r.render(spp);
+    lucent::ReferenceOptions o;
+    o.spp = spp;
+    o.threads = 2;
+    for (const lucent::RenderResult& res : {r.result(), lucent::render_reference(scene, o)}) {
+      ASSERT_TRUE(res.light_mean_variance) << res.device << ", " << spp << " spp";
+      const double N = double(res.samples.size());
+      for (int c = 0; c < 3; ++c) {
+        double read = 0;  // what compare reads: var / n of the pixels of n >= 2
+        for (size_t i = 0; i < res.samples.size(); ++i)
+          if (res.samples[i] >= 2) read += double(res.variance.rgb[i * 3 + c]) / res.samples[i];
+        read /= N * N;
+        const double q = res.light_mean_variance->pixels[c];
+        EXPECT_NEAR(q, read, 1e-5 * read) << res.device << ", " << spp << " spp, channel " << c;
+        EXPECT_GT(res.light_mean_variance->paths[c], 0.0) << res.device << ", " << spp << " spp";
+      }
+    }
+  }
+}
+
+}  // namespace

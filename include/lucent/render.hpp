@@ -68,8 +68,9 @@ struct RenderOptions {
 /// into many pixels, so the pixels' light parts are correlated: `paths` is that part's variance
 /// from each light path's total (its shares summed over all pixels, over N) taken as one sample,
 /// var(total) / paths; `pixels` is what the variance layer holds of it, the light part's variance
-/// of each pixel's mean summed over the pixels as if they were independent, over N^2. The image
-/// mean's variance is then sum(var / n) / N^2 - pixels + paths. write_render_exr stores both
+/// of each pixel's mean summed over the pixels as if they were independent, over N^2, over the
+/// pixels of n >= 2 only (compare reads a pixel of n < 2 as variance 0). The image mean's
+/// variance is then sum(var / n) / N^2 - pixels + paths. write_render_exr stores both
 /// (the attribute lucent.light_mean_var) and read_render reads them back.
 struct LightMeanVariance {
   double paths[3] = {0, 0, 0};

@@ -187,7 +187,8 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
         if (N > 1) {
           const double lvar = std::max(0.0, light_sq[0][i * 3 + c] / N - lm * lm) / (N - 1);
           var += count[i] * lvar;
-          lmv.pixels[c] += lvar / (double(npix) * double(npix));  // var / n holds it
+          // var / n holds it, where compare reads var (a pixel of n < 2 counts 0 there)
+          if (count[i] >= 2) lmv.pixels[c] += lvar / (double(npix) * double(npix));
         }
       }
       r.mean.rgb[i * 3 + c] = static_cast<float>(m);

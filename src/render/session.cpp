@@ -1230,7 +1230,9 @@ struct Renderer::Impl {
                                           r.samples[i], &r.mean.rgb[i * 3], &r.variance.rgb[i * 3],
                                           light_var);
         if (r.samples[i] == 0) continue;
-        for (int c = 0; c < 3; ++c) lmv.pixels[c] += light_var[c];
+        // compare reads a pixel of n < 2 as variance 0, its light part too: Q leaves it out
+        if (r.samples[i] >= 2)
+          for (int c = 0; c < 3; ++c) lmv.pixels[c] += light_var[c];
         // var / n is s^2 (1/n_A + 1/n_B) / 4; the calibrated model's is s^2 (g_A/n_A + g_B/n_B) / 4
         const double na = a.count[i], nb = b.count[i];
         const double gain =
@@ -1298,7 +1300,8 @@ struct Renderer::Impl {
                 render_detail::sample_variance(light_sum[i * 3 + c], light_sumsq[i * 3 + c], N) / N;
             mean += lm;
             var += n * lvar;
-            if (n > 0) lmv.pixels[c] += lvar;  // var / n holds it
+            // var / n holds it, where compare reads var (a pixel of n < 2 counts 0 there)
+            if (n >= 2) lmv.pixels[c] += lvar;
           }
           r.mean.rgb[i * 3 + c] = static_cast<float>(mean);
           r.variance.rgb[i * 3 + c] = static_cast<float>(var);
