@@ -373,6 +373,44 @@ TEST(KernelCaustics, AdaptiveImageMeanZOfRendersDifferingInSeedIsStandardNormal)
   EXPECT_NEAR(z2, 1.0, 0.5) << "mean image-mean z^2 of 300 pairs";
 }
 
+// The same with the camera part present: caustics off and a point light outside the glass, so
+// every pixel's value is the camera samples' (budget 16, pilot 4, at most 64, independent
+// sampler). Each half's count is planned from the other half's pilot; a variance of one sample
+// pooled over both halves read that pilot, correlated with the count it weighs (combine_halves),
+// and var / n fell short of the spread of the renders: the ratio of the pixel means' empirical
+// variance over 600 renders to the mean var / n was 1.36 (image-mean z^2 of 300 pairs 1.39,
+// within 1 +- 0.5). With each half's own variance: 1.01 (z^2 1.01); 1.00-1.03 over 3 seeds and 3
+// light positions, so the ratio's tolerance 1 +- 0.1 fails the pooled variance by > 10 of those
+// spreads, and z^2 keeps the image-mean test's 1 +- 0.5.
+TEST(KernelCaustics, AdaptiveCameraVarianceOfRendersDifferingInSeedIsTheirSpread) {
+  std::string json =
+      lucent::test::glass_lamp_box_scene(8, 8, R"({"type": "gaussian", "radius": 3})", 6);
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const size_t at = json.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    json.replace(at, from.size(), to);
+  };
+  replace(R"("caustics": true)", R"("caustics": false)");
+  replace(R"("lights": [)",
+          R"("lights": [{"type": "point", "position": [0.8, 0.2, 0.8], "intensity": [3, 3, 3]}, )");
+  lucent::Scene scene = lucent::test::scene_from(json);
+  lucent::Renderer r(lucent::test::session_options());
+  lucent::AdaptiveOptions o;
+  o.budget_spp = 16;
+  o.min_spp = 4;
+  o.max_spp = 64;
+  const auto render = [&](int k) {
+    scene.integrator.seed = 3000u + static_cast<std::uint32_t>(k);
+    r.set_scene(scene);
+    r.render_adaptive(o);
+    return r.result();
+  };
+  EXPECT_NEAR(lucent::test::ensemble_variance_ratio(render, 600, 0), 1.0, 0.1)
+      << "the pixel means' spread over 600 renders / their mean var / n";
+  EXPECT_NEAR(lucent::test::mean_image_mean_z2(render, 300), 1.0, 0.5)
+      << "mean image-mean z^2 of 300 pairs";
+}
+
 // The image mean's light part, from the kernel's and the reference's light paths: the variance
 // from the paths' totals and the per-pixel part, each the mean over 200 renders (8x8, gaussian
 // radius 3, 4 spp) of its estimate. Both estimate the same number where the light paths are

@@ -340,11 +340,16 @@ TEST(AdaptivePlan, CombinedVarianceIsThatOfTheAverageOfTheHalves) {
   const double sa[3] = {4, 4, 4}, qa[3] = {10, 10, 10}, sb[3] = {12, 12, 12}, qb[3] = {40, 40, 40};
   float mean[3], var[3];
   std::uint32_t n;
-  lucent::render_detail::combine_halves(sa, qa, 2, sb, qb, 4, mean, var, &n);
+  double half_var[2][3];
+  lucent::render_detail::combine_halves(sa, qa, 2, sb, qb, 4, mean, var, &n, half_var);
   EXPECT_EQ(n, 6u);
   EXPECT_FLOAT_EQ(mean[0], 2.5f);  // (2 + 3) / 2, not the pooled 16 / 6
-  // pooled s^2 = (2 + 4) / (6 - 2) = 1.5; var(mean) = s^2 (1/2 + 1/4) / 4; var = n var(mean)
-  EXPECT_FLOAT_EQ(var[0] / 6, static_cast<float>(1.5 * (0.5 + 0.25) / 4));
+  // each half's own s^2 (not one pooled over both, (2 + 4) / (6 - 2) = 1.5: a half's count is
+  // planned from the other half's pilot, which a pooled s^2 would read): s_A^2 = 2, s_B^2 = 4/3;
+  // var(mean) = (s_A^2 / 2 + s_B^2 / 4) / 4; var = n var(mean)
+  EXPECT_DOUBLE_EQ(half_var[0][0], 1.0);
+  EXPECT_DOUBLE_EQ(half_var[1][0], 1.0 / 3);
+  EXPECT_FLOAT_EQ(var[0] / 6, static_cast<float>((1.0 + 1.0 / 3) / 4));
   // one sample per half, {1} and {3} (a render stopped by --time in its pilot): their variance,
   // s^2 = (1 - 2)^2 + (3 - 2)^2 = 2 over 1 degree of freedom, not 0 (every pixel exact)
   const double s1[3] = {1, 1, 1}, q1[3] = {1, 1, 1}, s3[3] = {3, 3, 3}, q3[3] = {9, 9, 9};

@@ -280,22 +280,29 @@ double halves_relmse(const std::vector<double>& sum_a, const std::vector<std::ui
 
 void combine_halves(const double* sum_a, const double* sumsq_a, std::uint32_t n_a,
                     const double* sum_b, const double* sumsq_b, std::uint32_t n_b, float mean[3],
-                    float var[3], std::uint32_t* n) {
+                    float var[3], std::uint32_t* n, double half_var[2][3]) {
   *n = n_a + n_b;
   for (int c = 0; c < 3; ++c) {
     const double ma = n_a ? sum_a[c] / n_a : 0, mb = n_b ? sum_b[c] / n_b : 0;
     double m = n_a && n_b ? 0.5 * (ma + mb) : (n_a ? ma : mb);
-    // one sample in each half (a render stopped by --time in its pilot): no degree of freedom
-    // within the halves, so their two samples' variance, the halves estimating one mean (it was
-    // 0, which claimed every pixel exact)
+    // one sample's variance from both halves: only where a half has no degree of freedom of its
+    // own. One sample in each half (a render stopped by --time in its pilot): their two
+    // samples' variance, the halves estimating one mean (it was 0, which claimed every pixel
+    // exact)
     const double s2 = n_a == 1 && n_b == 1
                           ? sample_variance(sum_a[c] + sum_b[c], sumsq_a[c] + sumsq_b[c], 2)
                           : pooled_variance(sum_a[c], sumsq_a[c], n_a, sum_b[c], sumsq_b[c], n_b);
-    double v = 0;
-    if (n_a && n_b)
-      v = double(*n) * s2 * (1.0 / n_a + 1.0 / n_b) / 4;
-    else
-      v = s2;
+    // each half's variance of one sample from its own samples: half A's count was planned from
+    // B's pilot, so a variance pooled over both halves reads B's pilot samples, which are
+    // correlated with n_A (a pilot that missed the bright paths plans few samples and lowers the
+    // pooled variance exactly where s^2 / n_A is large): var / n was 0.74-0.91 of the mean's
+    // variance (render/adaptive.hpp). A half's own variance is independent of its count.
+    const double sa = n_a >= 2 ? sample_variance(sum_a[c], sumsq_a[c], n_a) : s2;
+    const double sb = n_b >= 2 ? sample_variance(sum_b[c], sumsq_b[c], n_b) : s2;
+    const double va = n_a ? sa / n_a : 0, vb = n_b ? sb / n_b : 0;  // of each half's mean
+    // the variance of the mean: (va + vb) / 4 for the average, the one half's alone otherwise
+    const double v = n_a && n_b ? double(*n) * (va + vb) / 4 : double(*n) * (va + vb);
+    if (half_var) half_var[0][c] = va, half_var[1][c] = vb;
     mean[c] = static_cast<float>(m);
     var[c] = static_cast<float>(v);
   }

@@ -1218,12 +1218,11 @@ struct Renderer::Impl {
       std::vector<double> mean_var(npix * 3, 0.0);  // the variance of each pixel's mean
       LightMeanVariance lmv;                        // caustics: the image mean's light part
       for (size_t i = 0; i < npix; ++i) {
+        double half_var[2][3];  // each half's variance of its camera mean, from its own samples
         render_detail::combine_halves(&a.sum[i * 3], &a.sumsq[i * 3], a.count[i], &b.sum[i * 3],
                                       &b.sumsq[i * 3], b.count[i], &r.mean.rgb[i * 3],
-                                      &r.variance.rgb[i * 3], &r.samples[i]);
+                                      &r.variance.rgb[i * 3], &r.samples[i], half_var);
         double light_var[3] = {0, 0, 0};  // of the light part (caustics), not scaled by gains
-        const double camera_var[3] = {r.variance.rgb[i * 3], r.variance.rgb[i * 3 + 1],
-                                      r.variance.rgb[i * 3 + 2]};
         if (caustics)
           render_detail::add_light_halves(&a.light_sum[i * 3], &a.light_sumsq[i * 3], a.light_paths,
                                           &b.light_sum[i * 3], &b.light_sumsq[i * 3], b.light_paths,
@@ -1233,12 +1232,12 @@ struct Renderer::Impl {
         // compare reads a pixel of n < 2 as variance 0, its light part too: Q leaves it out
         if (r.samples[i] >= 2)
           for (int c = 0; c < 3; ++c) lmv.pixels[c] += light_var[c];
-        // var / n is s^2 (1/n_A + 1/n_B) / 4; the calibrated model's is s^2 (g_A/n_A + g_B/n_B) / 4
-        const double na = a.count[i], nb = b.count[i];
-        const double gain =
-            na > 0 && nb > 0 ? (ga / na + gb / nb) / (1 / na + 1 / nb) : (na > 0 ? ga : gb);
+        // the camera part's var / n is (V_A + V_B) / 4 (V_h = s_h^2 / n_h, combine_halves); the
+        // calibrated model's is (g_A V_A + g_B V_B) / 4, one half's g_h V_h alone
+        const bool both = a.count[i] > 0 && b.count[i] > 0;
         for (int c = 0; c < 3; ++c)
-          mean_var[i * 3 + c] = gain * camera_var[c] / r.samples[i] + light_var[c];
+          mean_var[i * 3 + c] =
+              (ga * half_var[0][c] + gb * half_var[1][c]) / (both ? 4 : 1) + light_var[c];
       }
       // errors weighed by each pixel's value from its neighbours (render/adaptive.hpp)
       const std::vector<double> value = render_detail::neighbour_values(
