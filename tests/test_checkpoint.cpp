@@ -11,6 +11,7 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -199,6 +200,40 @@ TEST(Checkpoint, ResumedImageEqualsTheSingleRender) {
                       b = lucent::read_image(dir + "/single.png");
   ASSERT_EQ(a.rgb.size(), b.rgb.size());
   for (size_t i = 0; i < a.rgb.size(); ++i) EXPECT_NEAR(a.rgb[i], b.rgb[i], 0.009) << i;
+}
+
+// Two renders given one checkpoint wrote over each other's samples (each run's work lost to the
+// other's next write): a render holds <checkpoint>.lock while it runs, and a second one is
+// refused with one line, before it reads the file, writing nothing. The lock goes with the
+// finished render's checkpoint.
+TEST(Checkpoint, ACheckpointInUseIsRefused) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string ck = dir + "/ck.exr", out = dir + "/out.exr";
+  {
+    // another render's lock, as a running one holds it
+    const int fd = ::open((ck + ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+    CommandResult r =
+        run_cli("render " + q(scene) + " -q --spp 8 --checkpoint " + q(ck) + " -o " + q(out));
+    ::close(fd);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("ck.exr: another render is using this checkpoint (" + ck +
+                         ".lock is locked): give each render a checkpoint of its own"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_FALSE(fs::exists(ck));
+  }
+  // free again: the render runs, and leaves neither its checkpoint nor the lock
+  CommandResult r =
+      run_cli("render " + q(scene) + " -q --spp 8 --checkpoint " + q(ck) + " -o " + q(out));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(ck));
+  EXPECT_FALSE(fs::exists(ck + ".lock"));
 }
 
 // SIGTERM: the output of the samples so far is written, and the checkpoint holds them too (it

@@ -2,6 +2,7 @@
 // the image: outputs checked before rendering, written atomically, stop signals honoured
 // (SIGINT, SIGTERM, SIGHUP: what was rendered is written, exit 128 + the signal).
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -205,6 +206,39 @@ std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_sp
 /// render started with the file present resumes from it: it renders the samples [K, N) only, and
 /// its image is that of [0, N), the one the render without a stop gives (the same sample
 /// indices, summed in another order). The file is removed once the output is written.
+/// An exclusive lock on `<checkpoint>.lock` for the render's life (flock: a killed render's goes
+/// with it): two renders given one checkpoint wrote over each other's samples, and each run's
+/// work was lost to the other's next write (the checkpoint review).
+class CheckpointLock {
+ public:
+  explicit CheckpointLock(const std::string& checkpoint) : path_(checkpoint + ".lock") {
+    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0)
+      throw lucent::Error(path_ + ": cannot create the checkpoint's lock (" + std::strerror(errno) +
+                          ")");
+    if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
+    const int e = errno;
+    ::close(fd_);
+    fd_ = -1;
+    if (e == EWOULDBLOCK)
+      throw lucent::Error(checkpoint + ": another render is using this checkpoint (" + path_ +
+                          " is locked): give each render a checkpoint of its own");
+    throw lucent::Error(path_ + ": cannot lock the checkpoint (" + std::strerror(e) + ")");
+  }
+  CheckpointLock(const CheckpointLock&) = delete;
+  CheckpointLock& operator=(const CheckpointLock&) = delete;
+  ~CheckpointLock() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  /// With the checkpoint, once the output is written (while held: a render that opened it
+  /// meanwhile locks a file no longer there, as one that finds none creates its own).
+  void remove() const { ::unlink(path_.c_str()); }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+};
+
 class Checkpoint {
  public:
   Checkpoint(std::string path, std::string scene_path, double every)
@@ -213,6 +247,7 @@ class Checkpoint {
   /// Before the session: reads the checkpoint when there is one, so that a file that is not a
   /// part, or a corrupt one, is refused before a device is opened.
   void read() {
+    lock_.emplace(path_);  // first: the file read is no other render's work in progress
     std::error_code ec;
     if (std::filesystem::exists(path_, ec)) old_ = lucent::read_render_part(path_);
     held_ = first_sample();
@@ -302,6 +337,7 @@ class Checkpoint {
   /// Only a file this render resumed from or wrote: none may be there, or another's (a file
   /// that the output's name reached by another path was removed as the checkpoint).
   void remove() const {
+    if (lock_) lock_->remove();
     if (!ours_) return;
     std::error_code ec;
     if (!std::filesystem::remove(path_, ec) && ec)
@@ -325,6 +361,7 @@ class Checkpoint {
   std::uint64_t saved_spp_ = 0;  ///< the session's samples per pixel in the last checkpoint
   std::uint64_t held_ = 0;
   bool ours_ = false;  ///< the file at path_ is this render's: resumed from, or written
+  std::optional<CheckpointLock> lock_;
 };
 
 /// After a render with a checkpoint, while the session lives: an unfinished render's samples go
