@@ -57,38 +57,6 @@ std::string encode_pfm(const Image& img) {
   return out;
 }
 
-void write_exr_image(const std::string& path, const Image& img) {
-  // tinyexr wants planar channels in B, G, R order
-  EXRHeader header;
-  InitEXRHeader(&header);
-  EXRImage image;
-  InitEXRImage(&image);
-  size_t n = static_cast<size_t>(img.width) * img.height;
-  std::vector<float> planes[3];
-  for (int c = 0; c < 3; ++c) {
-    planes[c].resize(n);
-    for (size_t i = 0; i < n; ++i) planes[c][i] = img.rgb[i * 3 + c];
-  }
-  float* ptrs[3] = {planes[2].data(), planes[1].data(), planes[0].data()};
-  image.images = reinterpret_cast<unsigned char**>(ptrs);
-  image.num_channels = 3;
-  image.width = img.width;
-  image.height = img.height;
-  header.num_channels = 3;
-  std::vector<EXRChannelInfo> infos(3);
-  const char* names[3] = {"B", "G", "R"};
-  for (int c = 0; c < 3; ++c) {
-    std::memset(&infos[c], 0, sizeof(EXRChannelInfo));
-    std::strncpy(infos[c].name, names[c], 255);
-  }
-  header.channels = infos.data();
-  std::vector<int> types(3, TINYEXR_PIXELTYPE_FLOAT);
-  header.pixel_types = types.data();
-  header.requested_pixel_types = types.data();
-  header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
-  image_detail::write_exr(path, image, header);
-}
-
 std::string encode_png(const std::string& path, const Image& img, const DisplaySettings& display) {
   std::vector<unsigned char> bytes(img.rgb.size());
   for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = encode_display(img.rgb[i], display);
@@ -152,7 +120,7 @@ void write_image(const std::string& path, const Image& img, const DisplaySetting
   if (ext == "pfm")
     io::write_file_atomic(path, encode_pfm(img));
   else if (ext == "exr")
-    write_exr_image(path, img);
+    image_detail::write_image_exr(path, img, nullptr, nullptr, {});  // the mean layers alone
   else if (ext == "png")
     io::write_file_atomic(path, encode_png(path, img, display));
   else

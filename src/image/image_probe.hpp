@@ -172,6 +172,12 @@ struct RenderPlanes {
   const std::uint32_t* samples = nullptr;
 };
 
+/// An EXR of `mean` (R, G, B) and, with `variance` and `samples` (width * height counts), the
+/// statistics' layers, as write_render_exr writes them (lucent::write_image's EXR is the mean
+/// alone); the images must hold width * height RGB pixels.
+void write_image_exr(const std::string& path, const Image& mean, const Image* variance,
+                     const std::uint32_t* samples, const ExrExtras& extras);
+
 /// write_render_exr() of planes the caller holds.
 void write_render_planes(const std::string& path, const RenderPlanes& r, const ExrExtras& extras);
 

@@ -68,25 +68,32 @@ LightMeanVariance parse_light_mean_var(const std::string& path, const std::strin
 }
 
 void write_render_exr(const std::string& path, const RenderResult& r, const ExrExtras& extras) {
-  const int w = r.mean.width, h = r.mean.height;
-  const size_t n = static_cast<size_t>(w) * h;
+  const size_t n = static_cast<size_t>(r.mean.width) * r.mean.height;
   if (r.mean.rgb.size() != n * 3) throw Error(path + ": cannot write EXR: inconsistent image");
   const bool stats = r.variance.rgb.size() == n * 3 && r.samples.size() == n;
+  write_image_exr(path, r.mean, stats ? &r.variance : nullptr, stats ? r.samples.data() : nullptr,
+                  extras);
+}
+
+void write_image_exr(const std::string& path, const Image& mean, const Image* variance,
+                     const std::uint32_t* samples, const ExrExtras& extras) {
+  const size_t n = static_cast<size_t>(mean.width) * mean.height;
+  const bool stats = variance && samples;
   // the images are interleaved RGB; EXR's channels are planes
   std::vector<float> planes((stats ? 6 : 3) * n);
   RenderPlanes p;
-  p.width = w;
-  p.height = h;
+  p.width = mean.width;
+  p.height = mean.height;
   for (int c = 0; c < 3; ++c) {
-    float* mean = planes.data() + size_t(c) * n;
-    for (size_t i = 0; i < n; ++i) mean[i] = r.mean.rgb[i * 3 + c];
-    p.mean[c] = mean;
+    float* m = planes.data() + size_t(c) * n;
+    for (size_t i = 0; i < n; ++i) m[i] = mean.rgb[i * 3 + c];
+    p.mean[c] = m;
     if (!stats) continue;
     float* var = planes.data() + size_t(3 + c) * n;
-    for (size_t i = 0; i < n; ++i) var[i] = r.variance.rgb[i * 3 + c];
+    for (size_t i = 0; i < n; ++i) var[i] = variance->rgb[i * 3 + c];
     p.variance[c] = var;
   }
-  if (stats) p.samples = r.samples.data();
+  if (stats) p.samples = samples;
   write_render_planes(path, p, extras);
 }
 
