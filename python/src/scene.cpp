@@ -856,12 +856,10 @@ py::dict scene_info(const Scene& scene, const std::string& precision, bool fast_
   d["build_options"] = render_detail::build_options(copy, packed, options);
   // what a session's set_scene checks before rendering on a CPU device (the scene held twice:
   // the application's and the session's copy), as `lucent info` prints it
-  render_detail::DeviceLimits cpu;
-  cpu.device = "CPU";
-  cpu.host_unified = cpu.fp64 = cpu.light_double = true;
   py::list parts;
   std::uint64_t total = 0;
-  for (const render_detail::MemoryPart& p : render_detail::estimate_host_memory(copy, {cpu})) {
+  for (const render_detail::MemoryPart& p :
+       render_detail::estimate_host_memory(copy, {render_detail::DeviceLimits::cpu()})) {
     py::dict part;
     part["what"] = p.what;
     part["bytes"] = p.bytes;

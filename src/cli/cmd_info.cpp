@@ -62,12 +62,9 @@ void print_counts(const std::map<E, std::size_t>& counts) {
 /// memory), part by part, against what lucent allows itself (render/resources.hpp); the output's
 /// write comes on top (docs/reliability.md, "Resources").
 void print_memory(const Scene& scene) {
-  render_detail::DeviceLimits cpu;
-  cpu.device = "CPU";
-  cpu.host_unified = cpu.fp64 = cpu.light_double = true;
   // (one description: lucent render gives its scene to the session)
   std::vector<render_detail::MemoryPart> parts =
-      render_detail::estimate_host_memory(scene, {cpu}, 1);
+      render_detail::estimate_host_memory(scene, {render_detail::DeviceLimits::cpu()}, 1);
   std::stable_sort(parts.begin(), parts.end(),
                    [](const auto& a, const auto& b) { return a.bytes > b.bytes; });
   std::uint64_t total = 0;

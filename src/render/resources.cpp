@@ -76,6 +76,13 @@ DeviceLimits DeviceLimits::of(const cl_util::Device& device) {
   return d;
 }
 
+DeviceLimits DeviceLimits::cpu() {
+  DeviceLimits d;
+  d.device = "CPU";
+  d.host_unified = d.fp64 = d.light_double = true;
+  return d;
+}
+
 ScopedLimitOverride::ScopedLimitOverride(const DeviceLimits& limits) {
   delete g_override;
   g_override = new DeviceLimits(limits);

@@ -36,6 +36,9 @@ struct DeviceLimits {
   /// The limits of an OpenCL device, with host_mem = host_memory_limit(), each lowered to the
   /// override's where it sets one (ScopedLimitOverride).
   static DeviceLimits of(const cl_util::Device& device);
+  /// A CPU device as PoCL's (buffers in host memory, fp64 and 64-bit atomics), named "CPU", no
+  /// memory sizes: what `lucent info` and Python's scene_info estimate for, opening no device.
+  static DeviceLimits cpu();
 };
 
 /// For tests: while alive, DeviceLimits::of lowers every limit to the override's non-zero ones,
