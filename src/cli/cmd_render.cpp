@@ -431,9 +431,8 @@ struct OutputMemory {
 OutputMemory output_memory(const RenderArgs& a, int fw, int fh, bool part, bool resumed) {
   const std::uint64_t npix = std::uint64_t(fw) * std::uint64_t(fh);
   const std::string film = std::to_string(fw) + "x" + std::to_string(fh);
-  // a RenderResult's mean, variance and counts; an accumulation's sums, squares and counts
-  const std::uint64_t result_bytes = npix * (6 * sizeof(float) + sizeof(std::uint32_t));
-  const std::uint64_t acc_bytes = npix * (6 * sizeof(double) + sizeof(std::uint32_t));
+  const std::uint64_t result_bytes = npix * lucent::render_detail::kResultPixelBytes;
+  const std::uint64_t acc_bytes = npix * lucent::render_detail::kAccumulationPixelBytes;
   const std::uint64_t write_bytes =
       part ? lucent::part_write_bytes(fw, fh)
            : (lucent::io::lower_extension(a.output) == ".exr"

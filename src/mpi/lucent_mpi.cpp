@@ -158,12 +158,12 @@ int run(const Args& a) {
   // its part, the merge, a part received and the write (refused now rather than after the render)
   const int fw = scene.film.width, fh = scene.film.height;
   const std::uint64_t npix = std::uint64_t(fw) * std::uint64_t(fh);
-  const std::uint64_t part_bytes = npix * (6 * sizeof(double) + sizeof(std::uint32_t));
+  const std::uint64_t part_bytes = npix * lucent::render_detail::kAccumulationPixelBytes;
   if (root) {
     const std::string film = std::to_string(fw) + "x" + std::to_string(fh);
     const std::uint64_t write = lucent::io::lower_extension(a.output) == ".exr"
                                     ? lucent::part_write_bytes(fw, fh)
-                                    : npix * (6 * sizeof(float) + sizeof(std::uint32_t)) +
+                                    : npix * lucent::render_detail::kResultPixelBytes +
                                           lucent::image_detail::image_write_bytes(a.output, fw, fh);
     lucent::render_detail::check_output_host_memory(
         scene, {{"rank 0's part, the merged sums and a part received of the " + film + " film",

@@ -173,9 +173,7 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
   // session.cpp: double sums and sums of squares (3 + 3) and a sample count per pixel; the
   // result's mean and variance (3 + 3 floats) and sample counts
   parts.push_back({"the accumulation and result images of the " + film + " film",
-                   npix * (6 * sizeof(double) + sizeof(std::uint32_t) + 6 * sizeof(float) +
-                           sizeof(std::uint32_t)),
-                   "the film size"});
+                   npix * (kAccumulationPixelBytes + kResultPixelBytes), "the film size"});
   // caustics: the light paths' sums and sums of squares (3 + 3 doubles per pixel); an upper
   // bound (pack_scene drops caustics from a scene without a delta surface)
   const bool caustics = scene.integrator.caustics && scene.integrator.type == IntegratorType::Path;

@@ -98,6 +98,12 @@ std::uint32_t counter_start();
 std::size_t work_group_size(std::size_t preferred, std::size_t device_max, std::size_t item_max,
                             std::size_t kernel_max);
 
+/// Host bytes per pixel of an accumulation (double sums and sums of squares, 3 + 3, and a sample
+/// count: Accumulation, a part's sums) and of a RenderResult's images (mean and variance as
+/// floats, 3 + 3, and the counts).
+constexpr std::uint64_t kAccumulationPixelBytes = 6 * sizeof(double) + sizeof(std::uint32_t);
+constexpr std::uint64_t kResultPixelBytes = 6 * sizeof(float) + sizeof(std::uint32_t);
+
 /// One part of an estimate: what it is, its size, and what to reduce when it is too large.
 struct MemoryPart {
   std::string what;  ///< "film accumulation (16384x16384)", "texture texels", ...
