@@ -40,6 +40,23 @@ struct Probe {
     lucent::test::launch_probe(ctx.queue, k, in.size());
     return lucent::test::read_back<Out>(ctx.queue, bout, in.size());
   }
+
+  /// probe_bsdf_eval: the BSDF of `mat` (f in xyz, pdf in w) for each pair wos[i], wis[i], on the
+  /// `front` side.
+  std::vector<cl_float4> eval(const lc_material& mat, const std::vector<cl_float4>& wos,
+                              const std::vector<cl_float4>& wis, int front) {
+    cl::Buffer bmat(ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(lc_material),
+                    const_cast<lc_material*>(&mat));
+    cl::Buffer bwo(ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                   wos.size() * sizeof(cl_float4), const_cast<cl_float4*>(wos.data()));
+    cl::Buffer bwi(ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                   wis.size() * sizeof(cl_float4), const_cast<cl_float4*>(wis.data()));
+    cl::Buffer bout(ctx.context, CL_MEM_WRITE_ONLY, wis.size() * sizeof(cl_float4));
+    cl::Kernel k(program, "probe_bsdf_eval");
+    lucent::test::set_args(k, 0, bmat, bwo, bwi, bout, cl_int(front));
+    lucent::test::launch_probe(ctx.queue, k, wis.size());
+    return lucent::test::read_back<cl_float4>(ctx.queue, bout, wis.size());
+  }
 };
 
 Probe& probe() {
@@ -269,15 +286,7 @@ void chi_square(const ChiSquareCase& tc) {
           dirs.push_back({{float(r * std::cos(phi)), float(r * std::sin(phi)), float(z), 0.0f}});
           wos.push_back(wo);
         }
-  cl::Buffer bwo2(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                  wos.size() * sizeof(cl_float4), wos.data());
-  cl::Buffer bwi2(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                  dirs.size() * sizeof(cl_float4), dirs.data());
-  cl::Buffer bout(p.ctx.context, CL_MEM_WRITE_ONLY, dirs.size() * sizeof(cl_float4));
-  cl::Kernel ke(p.program, "probe_bsdf_eval");
-  lucent::test::set_args(ke, 0, bmat, bwo2, bwi2, bout, cl_int(tc.front));
-  lucent::test::launch_probe(p.ctx.queue, ke, dirs.size());
-  std::vector<cl_float4> ev = lucent::test::read_back<cl_float4>(p.ctx.queue, bout, dirs.size());
+  std::vector<cl_float4> ev = p.eval(tc.mat, wos, dirs, tc.front);
   // solid angle of a sub-cell in (z, phi): dz dphi
   const double dA = (zspan / NT / SUB) * (2 * M_PI / NP / SUB);
   std::vector<double> expected(NT * NP, 0.0);
@@ -333,14 +342,8 @@ void chi_square(const ChiSquareCase& tc) {
       some_wi.push_back({{wi[i].s[0], wi[i].s[1], wi[i].s[2], float(i)}});
       some_wo.push_back(wo);
     }
-  cl::Buffer b3(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                some_wi.size() * sizeof(cl_float4), some_wi.data());
-  cl::Buffer b4(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                some_wo.size() * sizeof(cl_float4), some_wo.data());
-  cl::Buffer b5(p.ctx.context, CL_MEM_WRITE_ONLY, some_wi.size() * sizeof(cl_float4));
-  lucent::test::set_args(ke, 1, b4, b3, b5);
-  lucent::test::launch_probe(p.ctx.queue, ke, some_wi.size());
-  std::vector<cl_float4> fe = lucent::test::read_back<cl_float4>(p.ctx.queue, b5, some_wi.size());
+  // (the sample's index rides in wi's w, which the kernel does not read)
+  std::vector<cl_float4> fe = p.eval(tc.mat, some_wo, some_wi, tc.front);
   for (size_t i = 0; i < fe.size(); ++i) {
     int idx = int(some_wi[i].s[3]);
     for (int c = 0; c < 3; ++c) {
@@ -447,19 +450,7 @@ TEST(KernelBsdf, GgxEvalMatchesReferenceAtSmallRoughness) {
           wos.push_back({{float(wo.x), float(wo.y), float(wo.z), 0.0f}});
           wis.push_back({{float(wi.x), float(wi.y), float(wi.z), 0.0f}});
         }
-      Probe& p = probe();
-      cl::Buffer bmat(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(lc_material),
-                      &mat);
-      cl::Buffer bwo(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                     wos.size() * sizeof(cl_float4), wos.data());
-      cl::Buffer bwi(p.ctx.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                     wis.size() * sizeof(cl_float4), wis.data());
-      cl::Buffer bout(p.ctx.context, CL_MEM_WRITE_ONLY, wis.size() * sizeof(cl_float4));
-      cl::Kernel ke(p.program, "probe_bsdf_eval");
-      lucent::test::set_args(ke, 0, bmat, bwo, bwi, bout, cl_int(lobe.front));
-      lucent::test::launch_probe(p.ctx.queue, ke, wis.size());
-      const std::vector<cl_float4> f =
-          lucent::test::read_back<cl_float4>(p.ctx.queue, bout, wis.size());
+      const std::vector<cl_float4> f = probe().eval(mat, wos, wis, lobe.front);
       double sum_kernel = 0, sum_ref = 0, worst = 0;
       for (size_t i = 0; i < f.size(); ++i) {
         const dvec3 o(wos[i].s[0], wos[i].s[1], wos[i].s[2]);
