@@ -257,12 +257,12 @@ TEST(RenderAnalytic, BrightSamplesAreKeptWhileTheirSquareFitsAFloat) {
   }
 }
 
-// The same for an emitting quad with an opaque quad 1e-4 under it: the floor below is black.
-// Shadow rays towards every light's surface stopped 2e-4 of their length short of it, so the
-// cover, 1e-4 / 2 of the distance in front of the lamp, let its light through (mean 0.49). A
-// triangle light now bounds that margin by its own rounding (light/triangle.cl).
-TEST(RenderAnalytic, CoverJustUnderAnEmittingQuadHidesIt) {
-  const char* scene = R"({
+/// The brightest pixel of a floor under `lamp` (a shape of material "lamp", whose lowest point is
+/// at height 2), with an opaque white quad of half-width `cover` at 1.9999 between them: 0 when the
+/// cover hides the lamp (16x16, `spp` samples, max_depth 4).
+double brightest_under_a_covered_lamp(const std::string& lamp, double cover, int spp) {
+  const std::string c = std::to_string(cover);
+  const std::string scene = R"({
     "camera": {"position": [0, 1, 4], "look_at": [0, 0.5, 0], "fov": 45},
     "film": {"width": 16, "height": 16},
     "integrator": {"type": "path", "max_depth": 4},
@@ -271,15 +271,27 @@ TEST(RenderAnalytic, CoverJustUnderAnEmittingQuadHidesIt) {
     "shapes": [
       {"type": "triangles", "material": "white", "indices": [0,2,1, 0,3,2],
        "positions": [[-5,0,-5],[5,0,-5],[5,0,5],[-5,0,5]]},
-      {"type": "triangles", "material": "lamp", "indices": [0,1,2, 0,2,3],
-       "positions": [[-1,2,-1],[1,2,-1],[1,2,1],[-1,2,1]]},
+      )" + lamp + R"(,
       {"type": "triangles", "material": "white", "indices": [0,1,2, 0,2,3],
-       "positions": [[-2,1.9999,-2],[2,1.9999,-2],[2,1.9999,2],[-2,1.9999,2]]}]
+       "positions": [[-)" + c +
+                            ",1.9999,-" + c + "],[" + c + ",1.9999,-" + c + "],[" + c + ",1.9999," +
+                            c + "],[-" + c + ",1.9999," + c + R"(]]}]
   })";
-  lucent::RenderResult r = lucent::test::render_json(scene, 8, false);
+  lucent::RenderResult r = lucent::test::render_json(scene, spp, false);
   double brightest = 0;
   for (float v : r.mean.rgb) brightest = std::max(brightest, double(v));
-  EXPECT_EQ(brightest, 0.0);
+  return brightest;
+}
+
+// The same for an emitting quad with an opaque quad 1e-4 under it: the floor below is black.
+// Shadow rays towards every light's surface stopped 2e-4 of their length short of it, so the
+// cover, 1e-4 / 2 of the distance in front of the lamp, let its light through (mean 0.49). A
+// triangle light now bounds that margin by its own rounding (light/triangle.cl).
+TEST(RenderAnalytic, CoverJustUnderAnEmittingQuadHidesIt) {
+  EXPECT_EQ(brightest_under_a_covered_lamp(R"({"type": "triangles", "material": "lamp",
+       "indices": [0,1,2, 0,2,3], "positions": [[-1,2,-1],[1,2,-1],[1,2,1],[-1,2,1]]})",
+                                           2, 8),
+            0.0);
 }
 
 // The same for a sphere light: a lamp of radius 10 whose lowest point is 1e-4 above an opaque
@@ -289,23 +301,10 @@ TEST(RenderAnalytic, CoverJustUnderAnEmittingQuadHidesIt) {
 // floor showed 0.016 more of itself, +0.8% on the room's image. A sphere light now bounds that
 // margin by its own rounding along the ray, as a triangle light does (light/sphere.cl).
 TEST(RenderAnalytic, CoverJustUnderASphereLightHidesIt) {
-  const char* scene = R"({
-    "camera": {"position": [0, 1, 4], "look_at": [0, 0.5, 0], "fov": 45},
-    "film": {"width": 16, "height": 16},
-    "integrator": {"type": "path", "max_depth": 4},
-    "materials": {"white": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]},
-                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [10, 10, 10]}},
-    "shapes": [
-      {"type": "triangles", "material": "white", "indices": [0,2,1, 0,3,2],
-       "positions": [[-5,0,-5],[5,0,-5],[5,0,5],[-5,0,5]]},
-      {"type": "sphere", "center": [0, 12, 0], "radius": 10, "material": "lamp"},
-      {"type": "triangles", "material": "white", "indices": [0,1,2, 0,2,3],
-       "positions": [[-40,1.9999,-40],[40,1.9999,-40],[40,1.9999,40],[-40,1.9999,40]]}]
-  })";
-  lucent::RenderResult r = lucent::test::render_json(scene, 64, false);
-  double brightest = 0;
-  for (float v : r.mean.rgb) brightest = std::max(brightest, double(v));
-  EXPECT_EQ(brightest, 0.0);
+  EXPECT_EQ(
+      brightest_under_a_covered_lamp(
+          R"({"type": "sphere", "center": [0, 12, 0], "radius": 10, "material": "lamp"})", 40, 64),
+      0.0);
 }
 
 // A diffuse floor (albedo 0.5) under a sky of radiance 1, whose map also holds a 3x3 sun of 1e12
