@@ -626,6 +626,40 @@ TEST(Obj, MtlMaterialsMapToLucentMaterials) {
   EXPECT_COLOUR(lamp.albedo, 0.78, 0.78, 0.78);
 }
 
+// Some exporters write the illumination model as a decimal ("illum 2.0"; Blender's importer
+// reads it, tinyobjloader's atoi reads 2): lucent refused the file. A decimal that is not a whole
+// number (which atoi would truncate) is still refused.
+TEST(Obj, IllumWrittenAsAWholeDecimalIsRead) {
+  std::string dir = lucent::test::temp_dir();
+  const std::string mtl = write(dir, "d.mtl",
+                                "newmtl shiny\nKd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nillum 2.0\n"
+                                "newmtl glass\nillum 7.000\n"
+                                "newmtl matte\nKd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nillum 1.\n");
+  std::string obj =
+      "mtllib d.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl shiny\nf 1 2 3\n"
+      "usemtl glass\nf 1 2 3\nusemtl matte\nf 1 2 3\n";
+  std::string path = write(dir, "d.obj", obj);
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  EXPECT_TRUE(w.all().empty()) << w.dump();
+  EXPECT_EQ(material_named(s, "d.obj:shiny").type, MaterialType::Plastic);
+  EXPECT_EQ(material_named(s, "d.obj:glass").type, MaterialType::Dielectric);
+  EXPECT_EQ(material_named(s, "d.obj:matte").type, MaterialType::Diffuse);
+
+  for (const char* bad : {"2.5", "1e1", "2.0x", ".5"}) {
+    write(dir, "d.mtl", std::string("newmtl shiny\nillum ") + bad + "\n");
+    Scene s2;
+    try {
+      load(s2, path);
+      ADD_FAILURE() << bad;
+    } catch (const lucent::Error& e) {
+      EXPECT_EQ(std::string(e.what()),
+                mtl + ":2: illum line: '" + bad + "' is not an illumination model (0 to 10)");
+    }
+  }
+}
+
 TEST(Obj, MaterialOverrideIgnoresTheMtl) {
   std::string dir = lucent::test::temp_dir();
   write(dir, "m.mtl", "newmtl red\nKd 1 0 0\nmap_Kd nothere.png\n");

@@ -388,6 +388,12 @@ void check_mtl_text(const std::string& path, const std::string& text) {
       std::string_view t = token(rest);
       int v = -1;
       auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+      // "illum 2.0" (some exporters write a decimal; tinyobjloader's atoi reads 2): a point and
+      // zeros only, since atoi would read "2.5" as 2 and "1e1" as 1
+      if (ec == std::errc() && ptr < t.data() + t.size() && *ptr == '.') {
+        ++ptr;
+        while (ptr < t.data() + t.size() && *ptr == '0') ++ptr;
+      }
       if (ec != std::errc() || ptr != t.data() + t.size() || v < 0 || v > 10)
         fail("illum line: '" + str(t) + "' is not an illumination model (0 to 10)");
     }
