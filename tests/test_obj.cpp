@@ -338,6 +338,69 @@ TEST(Obj, UsemtlAppliesPerFaceAcrossGroups) {
   EXPECT_EQ(unknown_faces, 1);
 }
 
+// A material name is the rest of its line, trimmed, for newmtl and usemtl alike (as Blender and
+// assimp read both): tinyobjloader's newmtl kept the whole line but its usemtl read the first
+// word, so "usemtl my mat" selected 'my' (or the default material, quoting 'my'), 3ds Max's
+// names with spaces could not be used. A '#' on a newmtl line is part of the name; a usemtl
+// whose whole name is not defined selects the name before its comment, as before.
+TEST(Obj, MaterialNamesWithSpacesAreSelectedWhole) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "m.mtl",
+        "newmtl my mat\nKd 1 0 0\n"      // 'my mat'
+        "newmtl my\nKd 0 1 0\n"          // 'my'
+        "newmtl   padded  \nKd 0 0 1\n"  // 'padded': tinyobjloader kept the leading spaces
+        "newmtl red # note\nKd 1 1 0\n"  // 'red # note'
+        "newmtl plain\nKd 0 1 1\n");
+  std::string path = write(dir, "names.obj",
+                           "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                           "usemtl my mat\nf 1 2 3\n"  // before the mtllib (an alias and a head)
+                           "mtllib m.mtl\n"
+                           "usemtl my\nf 1 3 2\n"
+                           "usemtl \t my mat  \nf 2 1 3 # a comment ends the face\n"
+                           "usemtl padded\nf 2 3 1\n"
+                           "usemtl red # note\nf 3 1 2\n"
+                           "usemtl plain # the name before the comment\nf 3 2 1\n"
+                           "usemtl red\nf 1 2 3\n"  // no such name
+                           "usemtl my other mat\nf 1 2 3\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), 8u);
+  auto name = [&](int i) { return s.materials[s.triangles[i].material].name; };
+  EXPECT_EQ(name(0), "names.obj:my mat");
+  EXPECT_EQ(s.materials[s.triangles[0].material].albedo, glm::dvec3(1, 0, 0));
+  EXPECT_EQ(name(1), "names.obj:my");
+  EXPECT_EQ(name(2), "names.obj:my mat");
+  EXPECT_EQ(name(3), "names.obj:padded");
+  EXPECT_EQ(s.materials[s.triangles[3].material].albedo, glm::dvec3(0, 0, 1));
+  EXPECT_EQ(name(4), "names.obj:red # note");
+  EXPECT_EQ(name(5), "names.obj:plain");
+  EXPECT_EQ(name(6), "obj:default");
+  EXPECT_EQ(name(7), "obj:default");
+  EXPECT_EQ(
+      w.count(path + ": usemtl 'red' names no material of the MTL file (the MTL file defines 'red "
+                     "# note': a '#' on a newmtl line is part of the name, not a comment); faces "
+                     "use the default material"),
+      1)
+      << w.dump();
+  EXPECT_EQ(w.count(path + ": usemtl 'my other mat' names no material of the MTL file; faces use "
+                           "the default material"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.all().size(), 2u) << w.dump();
+
+  // without a library, the warning quotes the whole name
+  std::string none = write(dir, "none.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl my mat\nf 1 2 3\n");
+  CaptureWarnings w2;
+  Scene s2;
+  load(s2, none);
+  EXPECT_EQ(w2.count(none + ": usemtl 'my mat' but the file names no material library (mtllib); "
+                            "faces use the default material"),
+            1)
+      << w2.dump();
+  EXPECT_EQ(w2.all().size(), 1u) << w2.dump();
+}
+
 TEST(Obj, TexturesAreRelativeToTheMtlFileAndMissingOnesWarn) {
   std::string dir = lucent::test::temp_dir();
   std::filesystem::create_directories(dir + "/lib/tex");

@@ -227,12 +227,17 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   // are moved back by one)
   const bool head = use_mtl && counts.usemtl_before_mtllib && !counts.libraries.empty();
   const std::string first_line = head ? "mtllib libraries\n" : "";
-  // "f 1 2 3 # top": tinyobjloader reads the comment as an index; a copy without it (only then)
-  const std::string uncommented =
-      counts.element_comments ? obj::blank_element_comments(text) : std::string();
-  JoinedText joined(first_line, counts.element_comments ? uncommented : text);
+  // "f 1 2 3 # top": tinyobjloader reads the comment as an index; "usemtl my mat": it reads the
+  // first word. A copy without the comments, and naming such materials by alias (only then)
+  const bool edit = counts.element_comments || !counts.usemtl_names.empty();
+  std::string edited;
+  if (counts.element_comments) edited = obj::blank_element_comments(text);
+  if (!counts.usemtl_names.empty())
+    edited = obj::alias_usemtl(counts.element_comments ? edited : text, counts.usemtl_names);
+  JoinedText joined(first_line, edit ? edited : text);
   std::istream in(&joined);
-  obj::MtlReader reader(fs::path(path).parent_path(), counts.libraries, use_mtl);
+  obj::MtlReader reader(fs::path(path).parent_path(), counts.libraries, use_mtl,
+                        counts.usemtl_names);
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> mats;
@@ -285,10 +290,23 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
       if (!use_mtl || !reader.missing.empty() || !reader.unreadable.empty()) continue;
       size_t a = w.find('\''), b = w.rfind('\'');
       std::string name = (a != std::string::npos && b > a) ? w.substr(a + 1, b - a - 1) : w;
+      for (size_t k = 0; k < counts.usemtl_names.size(); ++k)
+        if (name == obj::usemtl_alias(k)) name = counts.usemtl_names[k];
+      // "newmtl red # note" defines 'red # note', which "usemtl red" does not name
+      std::string hint;
+      for (const tinyobj::material_t& m : mats) {
+        if (m.name.size() <= name.size() + 1 || m.name.compare(0, name.size(), name) != 0 ||
+            (m.name[name.size()] != ' ' && m.name[name.size()] != '\t') ||
+            obj::trim(m.name.substr(name.size()))[0] != '#')
+          continue;
+        hint = " (the MTL file defines '" + m.name +
+               "': a '#' on a newmtl line is part of the name, not a comment)";
+        break;
+      }
       warn(path + ": usemtl '" + name +
            (counts.libraries.empty() ? "' but the file names no material library (mtllib)"
                                      : "' names no material of the MTL file") +
-           "; faces use the default material");
+           hint + "; faces use the default material");
       continue;
     }
     warn(path + ": " + w);

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -178,7 +179,38 @@ double number(std::string_view tok, const LineError& fail, const char* what) {
 
 const char* const kKinds[3] = {"vertex", "texture coordinate", "normal"};
 
+// The first character of usemtl_alias's names: a control character, in no exporter's names.
+constexpr char kAliasMark = '\x1f';
+
 }  // namespace
+
+std::string trim(const std::string& s) {
+  const std::size_t b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return {};
+  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
+}
+
+std::string usemtl_alias(std::size_t k) { return kAliasMark + std::to_string(k); }
+
+std::string alias_usemtl(const std::string& text, const std::vector<std::string>& names) {
+  std::map<std::string, std::size_t> index;
+  for (std::size_t k = 0; k < names.size(); ++k) index.emplace(names[k], k);
+  std::string out;
+  out.reserve(text.size());
+  std::size_t copied = 0;  // text before this offset is in `out`
+  for_each_line(text, [&](std::string_view line, long) {
+    const std::size_t b = std::min(line.find_first_not_of(" \t"), line.size());
+    if (line.substr(b, 6) != "usemtl") return;
+    auto it = index.find(trim(std::string(line.substr(b + 6))));
+    if (it == index.end()) return;
+    const std::size_t at = static_cast<std::size_t>(line.data() - text.data());
+    out.append(text, copied, at - copied);
+    out += "usemtl " + usemtl_alias(it->second);
+    copied = at + line.size();
+  });
+  out.append(text, copied, std::string::npos);
+  return out;
+}
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;
@@ -199,13 +231,22 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
   long wanted_line[3] = {0, 0, 0};
   TextCounts out;
   bool mtllib_seen = false;
-  std::set<std::string> libraries;
+  std::set<std::string> libraries, usemtl_names;
   for_each_line(text, [&](std::string_view rest, long ln) {
     const LineError fail(path, ln);
     // usemtl and mtllib as tinyobjloader tells them: "usemtl" starts the line, "mtllib" and a
     // space or tab start it
     const std::string_view line = rest.substr(std::min(rest.find_first_not_of(" \t"), rest.size()));
-    if (line.substr(0, 6) == "usemtl" && !mtllib_seen) out.usemtl_before_mtllib = true;
+    if (line.substr(0, 6) == "usemtl") {
+      if (!mtllib_seen) out.usemtl_before_mtllib = true;
+      // the name is the rest of the line, as newmtl's; tinyobjloader reads the first word
+      const std::string name = trim(std::string(line.substr(6)));
+      const std::string word = name.substr(0, name.find_first_of(" \t"));
+      if ((name != word || (!word.empty() && word[0] == kAliasMark)) &&
+          usemtl_names.insert(name).second)
+        out.usemtl_names.push_back(name);
+      return;
+    }
     if (line.size() > 6 && line.substr(0, 6) == "mtllib" && (line[6] == ' ' || line[6] == '\t')) {
       mtllib_seen = true;
       std::vector<std::string> names(1);
@@ -535,10 +576,11 @@ std::vector<MtlName> mtl_material_names(const std::string& text) {
     if (b == std::string_view::npos || line.compare(b, 6, "newmtl") != 0 || b + 6 >= line.size() ||
         (line[b + 6] != ' ' && line[b + 6] != '\t'))
       return;
-    std::string_view name = line.substr(b + 7);
-    std::size_t last = name.find_last_not_of(" \t");
-    if (last == std::string_view::npos) return;  // "newmtl" and spaces: no statement
-    out.push_back({std::string(name.substr(0, last + 1)), ln});
+    // tinyobjloader keeps what follows "newmtl" and one space, spaces in front included; the
+    // reader trims them (MtlReader::read)
+    const std::string name = trim(std::string(line.substr(b + 7)));
+    if (name.empty()) return;  // "newmtl" and spaces: no statement
+    out.push_back({name, ln});
   });
   return out;
 }

@@ -38,7 +38,20 @@ struct TextCounts {
   /// An f, l or p element ends with a comment ("f 1 2 3 # top"): tinyobjloader would read the
   /// '#' as an index (see blank_element_comments).
   bool element_comments = false;
+  /// The names of the usemtl statements that tinyobjloader does not read whole, each once, in
+  /// order: a name is the rest of the line, trimmed ("usemtl my mat", "usemtl red # note"), where
+  /// tinyobjloader reads the first word. The text it reads names them by alias (alias_usemtl).
+  std::vector<std::string> usemtl_names;
 };
+
+/// The name that stands for usemtl_names[k] in the OBJ text tinyobjloader reads: one word, which
+/// starts with a control character no material name has (a usemtl naming such a word is aliased
+/// too).
+std::string usemtl_alias(std::size_t k);
+
+/// `text` with each usemtl statement naming one of `names` (TextCounts::usemtl_names) made
+/// "usemtl <usemtl_alias(k)>" (the lines kept).
+std::string alias_usemtl(const std::string& text, const std::vector<std::string>& names);
 
 /// Checks an OBJ file's text before tinyobjloader sees it: every number of a v, vn and vt line
 /// (present, a number, finite, within float range), every index of an f, l and p element (an
@@ -73,13 +86,16 @@ struct IgnoredOption {
 std::string strip_texture_options(const std::string& text,
                                   std::vector<IgnoredOption>* ignored = nullptr);
 
-/// A `newmtl` statement of an MTL file: the material's name as tinyobjloader reads it (the rest
-/// of the line, trailing spaces removed) and its line.
+/// A `newmtl` statement of an MTL file: the material's name (the rest of the line, trimmed: a '#'
+/// is part of it, as tinyobjloader, Blender and assimp read it) and its line.
 struct MtlName {
   std::string name;
   long line = 0;
 };
 std::vector<MtlName> mtl_material_names(const std::string& text);
+
+/// `s` without the spaces and tabs at its ends.
+std::string trim(const std::string& s);
 
 /// Line (1-based) of the `n`-th (0-based) statement `tag` of `text`, or 0.
 long line_of_statement(const std::string& text, const char* tag, std::int64_t n);
@@ -101,9 +117,14 @@ std::vector<std::string> lines_of(const std::string& text);
 /// read.
 class MtlReader : public tinyobj::MaterialReader {
  public:
-  /// `names`: the OBJ's libraries (TextCounts::libraries).
-  MtlReader(std::filesystem::path dir, std::vector<std::string> names, bool enabled)
-      : dir_(std::move(dir)), names_(std::move(names)), enabled_(enabled) {}
+  /// `names`: the OBJ's libraries (TextCounts::libraries); `usemtl_names`: the names its text
+  /// gives by alias (TextCounts::usemtl_names), added to the material map when read.
+  MtlReader(std::filesystem::path dir, std::vector<std::string> names, bool enabled,
+            std::vector<std::string> usemtl_names = {})
+      : dir_(std::move(dir)),
+        names_(std::move(names)),
+        usemtl_names_(std::move(usemtl_names)),
+        enabled_(enabled) {}
 
   bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                   std::map<std::string, int>* map, std::string* warn, std::string* err) override;
@@ -120,8 +141,12 @@ class MtlReader : public tinyobj::MaterialReader {
   bool read(const std::string& path, std::vector<tinyobj::material_t>* materials,
             std::map<std::string, int>* map);
 
+  /// Adds the aliases of usemtl_names_ to `map` (each name whole, else before its comment).
+  void add_aliases(std::map<std::string, int>* map) const;
+
   std::filesystem::path dir_;
   std::vector<std::string> names_;
+  std::vector<std::string> usemtl_names_;
   bool enabled_;
   bool done_ = false;
   /// each material name's first definition: library and line

@@ -51,7 +51,25 @@ bool MtlReader::operator()(const std::string&, std::vector<tinyobj::material_t>*
     if (!seen.insert(ec ? p.string() : canonical.string()).second) continue;
     if (!read(p.string(), materials, map)) break;
   }
+  add_aliases(map);
   return true;
+}
+
+void MtlReader::add_aliases(std::map<std::string, int>* map) const {
+  for (std::size_t k = 0; k < usemtl_names_.size(); ++k) {
+    const std::string& name = usemtl_names_[k];
+    auto it = map->find(name);
+    // "usemtl red # note" where no material has that whole name: the name before the comment,
+    // as tinyobjloader read it (its first word) before names could have spaces
+    for (std::size_t hash = name.find('#'); it == map->end() && hash != std::string::npos;
+         hash = name.find('#', hash + 1)) {
+      if (hash == 0 || (name[hash - 1] != ' ' && name[hash - 1] != '\t')) continue;
+      const std::string before = trim(name.substr(0, hash));
+      if (!before.empty()) it = map->find(before);
+      break;
+    }
+    if (it != map->end()) (*map)[usemtl_alias(k)] = it->second;
+  }
 }
 
 bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* materials,
@@ -81,7 +99,8 @@ bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* 
     return false;
   }
   // a name defined again (in this library or an earlier one): tinyobjloader keeps the first
-  for (const MtlName& m : mtl_material_names(text)) {
+  const std::vector<MtlName> names = mtl_material_names(text);
+  for (const MtlName& m : names) {
     auto [first, added] = defined_.insert({m.name, {path, m.line}});
     if (added) continue;
     const auto& [first_path, first_line] = first->second;
@@ -107,7 +126,18 @@ bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* 
   size_t before = materials->size();
   std::string mtl_warn, mtl_err;
   tinyobj::LoadMtl(map, materials, &in, &mtl_warn, &mtl_err);
-  for (size_t i = before; i < materials->size(); ++i) origin.push_back(path);
+  for (size_t i = before; i < materials->size(); ++i) {
+    origin.push_back(path);
+    // tinyobjloader keeps the spaces after "newmtl " ("newmtl  red" is " red"): a name is trimmed
+    // as usemtl's is (the first definition of a name keeps it)
+    tinyobj::material_t& m = (*materials)[i];
+    const std::string trimmed = trim(m.name);
+    if (trimmed == m.name) continue;
+    auto it = map->find(m.name);
+    if (it != map->end() && it->second == static_cast<int>(i)) map->erase(it);
+    m.name = trimmed;
+    map->emplace(trimmed, static_cast<int>(i));
+  }
   for (const std::string& w : lines_of(mtl_warn + mtl_err)) warnings.push_back(path + ": " + w);
   return true;
 }
