@@ -689,6 +689,67 @@ TEST(Obj, MtlMaterialsMapToLucentMaterials) {
   EXPECT_COLOUR(lamp.albedo, 0.78, 0.78, 0.78);
 }
 
+// A transparent material (a dielectric) takes Tf, the transmission filter, as its tint: lucent
+// made every one clear, ignoring Tf without a word. A grey Tf other than 1 (Tf 0 0 0, a default
+// some exporters write on every material; McGuire's Cornell boxes' Tf 0.10 on glass, meaning one
+// minus the light let through) and the spectral form are said and taken as clear; a map_Kd,
+// which a dielectric cannot use, is said too. Tf on an opaque material has no effect.
+TEST(Obj, TransparentMaterialsTakeTfAsTint) {
+  std::string dir = lucent::test::temp_dir();
+  const std::string mtl =
+      write(dir, "t.mtl",
+            "newmtl green glass\nd 0.5\nTf 0.2 0.9 0.4\n"               // line 1
+            "newmtl kt\nillum 7\nKt 0.5 0.6 0.7\n"                      // 4
+            "newmtl max\nillum 2\nTr 0.3\nTf 1 1 1\n"                   // 7
+            "newmtl plain\nillum 4\n"                                   // 11
+            "newmtl black\nillum 6\nTf 0 0 0\n"                         // 13
+            "newmtl spectral\nd 0.2\nTf spectral glass.rfl\n"           // 16
+            "newmtl poly\nillum 4\nKd 0.5 0.5 0.5\nmap_Kd skin.png\n"   // 19
+            "newmtl opaque\nKd 0.5 0.5 0.5\nKs 0.1 0.1 0.1\nillum 2\n"  // 23
+            "Tf 0.1 0.2 0.3\n"
+            "newmtl water\nKs 0.3 0.3 0.3\nTf 0.10 0.10 0.10\nillum 7\n");  // 28
+  const char* names[] = {"green glass", "kt",   "max",    "plain", "black",
+                         "spectral",    "poly", "opaque", "water"};
+  std::string obj = "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n";
+  for (const char* n : names) obj += std::string("usemtl ") + n + "\nf 1 2 3\n";
+  std::string path = write(dir, "t.obj", obj);
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), 9u);
+  for (const char* n : names) {
+    const Material& m = material_named(s, std::string("t.obj:") + n);
+    EXPECT_EQ(m.type, std::string(n) == "opaque" ? MaterialType::Plastic : MaterialType::Dielectric)
+        << n;
+  }
+  EXPECT_COLOUR(material_named(s, "t.obj:green glass").specular, 0.2, 0.9, 0.4);
+  EXPECT_COLOUR(material_named(s, "t.obj:kt").specular, 0.5, 0.6, 0.7);
+  EXPECT_COLOUR(material_named(s, "t.obj:max").specular, 1, 1, 1);
+  EXPECT_COLOUR(material_named(s, "t.obj:plain").specular, 1, 1, 1) << "no Tf: clear";
+  EXPECT_COLOUR(material_named(s, "t.obj:black").specular, 1, 1, 1);
+  EXPECT_COLOUR(material_named(s, "t.obj:spectral").specular, 1, 1, 1);
+  EXPECT_COLOUR(material_named(s, "t.obj:poly").specular, 1, 1, 1);
+  EXPECT_COLOUR(material_named(s, "t.obj:opaque").specular, 0.1, 0.1, 0.1) << "Ks, not Tf";
+  EXPECT_COLOUR(material_named(s, "t.obj:water").specular, 1, 1, 1);
+  EXPECT_EQ(w.count(mtl + ":15: material 'black' (transparent: illum 6): Tf 0 0 0 is grey, which "
+                          "readers take as the light let through or as one minus it; taken as "
+                          "clear (tint 1): a Tf of unequal channels is the tint"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.count(mtl + ":30: material 'water' (transparent: illum 7): Tf 0.1 0.1 0.1 is grey"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.count(mtl + ":18: material 'spectral' (transparent: opacity 0.2 (d or Tr)): only Tf "
+                          "with numbers is read (not the spectral and xyz forms); tint 1"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.count(mtl + ":19: material 'poly' (transparent: illum 4) becomes a dielectric, which "
+                          "has no texture: its map_Kd 'skin.png' is ignored (Tf gives its tint)"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.all().size(), 4u) << w.dump();
+}
+
 // Some exporters write the illumination model as a decimal ("illum 2.0"; Blender's importer
 // reads it, tinyobjloader's atoi reads 2): lucent refused the file. A decimal that is not a whole
 // number (which atoi would truncate) is still refused.

@@ -354,7 +354,8 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   if (!known)
     for (size_t i = 0; i < scene.textures.size(); ++i)
       own.emplace(texture_file_key(scene.textures[i].path), static_cast<int>(i));
-  obj::MaterialMapper mapper(scene, known ? *known : own, path, mats, reader.origin);
+  obj::MaterialMapper mapper(scene, known ? *known : own, path, mats, reader.origin,
+                             reader.definition);
   size_t faces = 0, fanned_faces = 0;
   std::vector<glm::vec3> corners;
   for (const auto& s : shapes) {

@@ -573,7 +573,18 @@ std::vector<MtlName> mtl_material_names(const std::string& text) {
   std::vector<MtlName> out;
   for_each_line(text, [&](std::string_view line, long ln) {
     std::size_t b = line.find_first_not_of(" \t");
-    if (b == std::string_view::npos || line.compare(b, 6, "newmtl") != 0 || b + 6 >= line.size() ||
+    if (b == std::string_view::npos) return;
+    // Tf and Kt as tinyobjloader tells them (both are its transmittance)
+    if ((line.compare(b, 2, "Tf") == 0 || line.compare(b, 2, "Kt") == 0) && b + 2 < line.size() &&
+        (line[b + 2] == ' ' || line[b + 2] == '\t')) {
+      if (out.empty()) return;  // before any newmtl: tinyobjloader's unnamed material
+      std::string_view rest = line.substr(b + 2);
+      const std::string_view first = token(rest);
+      out.back().tf_line = ln;
+      out.back().tf_numbers = first != "spectral" && first != "xyz";
+      return;
+    }
+    if (line.compare(b, 6, "newmtl") != 0 || b + 6 >= line.size() ||
         (line[b + 6] != ' ' && line[b + 6] != '\t'))
       return;
     // tinyobjloader keeps what follows "newmtl" and one space, spaces in front included; the

@@ -87,10 +87,15 @@ std::string strip_texture_options(const std::string& text,
                                   std::vector<IgnoredOption>* ignored = nullptr);
 
 /// A `newmtl` statement of an MTL file: the material's name (the rest of the line, trimmed: a '#'
-/// is part of it, as tinyobjloader, Blender and assimp read it) and its line.
+/// is part of it, as tinyobjloader, Blender and assimp read it) and its line, and what of its
+/// statements lucent needs beyond tinyobjloader's material_t.
 struct MtlName {
   std::string name;
   long line = 0;
+  /// its last Tf (or Kt) statement's line, 0 when it has none; `tf_numbers`: that statement
+  /// gives numbers (not the `spectral` or `xyz` forms, which tinyobjloader reads as zeros)
+  long tf_line = 0;
+  bool tf_numbers = false;
 };
 std::vector<MtlName> mtl_material_names(const std::string& text);
 
@@ -133,6 +138,7 @@ class MtlReader : public tinyobj::MaterialReader {
   std::vector<std::string> missing;     ///< libraries that do not exist
   std::vector<std::string> unreadable;  ///< libraries that exist but cannot be read (messages)
   std::vector<std::string> origin;      ///< the library of each material, by index
+  std::vector<MtlName> definition;      ///< each material's newmtl statement and more, by index
   std::vector<std::string> warnings;    ///< the libraries' own warnings, prefixed with their path
   std::string error;                    ///< the first malformed library's error
 
@@ -158,14 +164,14 @@ class MaterialMapper {
  public:
   MaterialMapper(Scene& scene, ObjMaterials& known, const std::string& obj_path,
                  const std::vector<tinyobj::material_t>& mats,
-                 const std::vector<std::string>& origin);
+                 const std::vector<std::string>& origin, const std::vector<MtlName>& definition);
 
   /// The scene material of MTL material `id` (created on first use), or the default one.
   int get(int id);
   int default_material();
 
  private:
-  int convert(const tinyobj::material_t& t, const std::string& mtl_path);
+  int convert(const tinyobj::material_t& t, const std::string& mtl_path, const MtlName& def);
   /// `name` when no material has it, else with the OBJ file's parent directories in front
   /// ("b/model.obj:paint"), else with "#2", "#3", ... after it.
   std::string free_name(const std::string& name, bool with_path) const;
@@ -175,6 +181,7 @@ class MaterialMapper {
   std::filesystem::path obj_path_;  ///< canonical
   const std::vector<tinyobj::material_t>& mats_;
   const std::vector<std::string>& origin_;
+  const std::vector<MtlName>& definition_;
   std::vector<int> index_;
   int default_ = -1;
   std::set<std::string> warned_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <locale>
 #include <set>
 #include <sstream>
 
@@ -128,6 +129,8 @@ bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* 
   tinyobj::LoadMtl(map, materials, &in, &mtl_warn, &mtl_err);
   for (size_t i = before; i < materials->size(); ++i) {
     origin.push_back(path);
+    // one material per newmtl, in order (a file without any: one unnamed material)
+    definition.push_back(i - before < names.size() ? names[i - before] : MtlName{});
     // tinyobjloader keeps the spaces after "newmtl " ("newmtl  red" is " red"): a name is trimmed
     // as usemtl's is (the first definition of a name keeps it)
     tinyobj::material_t& m = (*materials)[i];
@@ -144,8 +147,14 @@ bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* 
 
 MaterialMapper::MaterialMapper(Scene& scene, ObjMaterials& known, const std::string& obj_path,
                                const std::vector<tinyobj::material_t>& mats,
-                               const std::vector<std::string>& origin)
-    : scene_(scene), known_(known), mats_(mats), origin_(origin), index_(mats.size(), -1) {
+                               const std::vector<std::string>& origin,
+                               const std::vector<MtlName>& definition)
+    : scene_(scene),
+      known_(known),
+      mats_(mats),
+      origin_(origin),
+      definition_(definition),
+      index_(mats.size(), -1) {
   std::error_code ec;
   obj_path_ = fs::weakly_canonical(obj_path, ec);
   if (ec) obj_path_ = obj_path;
@@ -153,7 +162,7 @@ MaterialMapper::MaterialMapper(Scene& scene, ObjMaterials& known, const std::str
 
 int MaterialMapper::get(int id) {
   if (id < 0 || id >= static_cast<int>(mats_.size())) return default_material();
-  if (index_[id] < 0) index_[id] = convert(mats_[id], origin_[id]);
+  if (index_[id] < 0) index_[id] = convert(mats_[id], origin_[id], definition_[id]);
   return index_[id];
 }
 
@@ -194,7 +203,8 @@ int MaterialMapper::default_material() {
   return default_;
 }
 
-int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl_path) {
+int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl_path,
+                            const MtlName& def) {
   // the same MTL material (library by canonical path, and name) made before: by this OBJ loaded
   // again, or another naming the same library
   std::error_code ec;
@@ -216,6 +226,40 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
     m.type = MaterialType::Dielectric;
     m.ior = ior;
     m.specular = glm::dvec3(1.0);
+    // why it is transparent, for the warnings
+    std::ostringstream why;
+    why.imbue(std::locale::classic());  // "0.5", whatever the global locale
+    if (t.dissolve < 1)
+      why << "opacity " << t.dissolve << " (d or Tr)";
+    else
+      why << "illum " << illum;
+    const std::string at = mtl_path + ":" + std::to_string(def.tf_line) + ": material '" + t.name +
+                           "' (transparent: " + why.str() + ")";
+    // Tf, the transmission filter, is the tint of the light that passes (the MTL specification;
+    // 3ds Max writes its filter colour). A grey Tf other than 1 has two readings: the fraction
+    // let through (the specification), or one minus it (3ds Max's import and G3D, for which
+    // McGuire's Cornell boxes write Tf 0.10 on their glass and water); some exporters write
+    // Tf 0 0 0 on every material. Every grey Tf seen on a transparent material meant clear
+    const glm::dvec3 tf = rgb(t.transmittance);
+    if (def.tf_line > 0 && !def.tf_numbers) {
+      warn(at + ": only Tf with numbers is read (not the spectral and xyz forms); tint 1");
+    } else if (def.tf_line > 0 && tf.x == tf.y && tf.y == tf.z) {
+      if (tf.x != 1) {
+        std::ostringstream g;
+        g.imbue(std::locale::classic());
+        g << tf.x;
+        warn(at + ": Tf " + g.str() + " " + g.str() + " " + g.str() +
+             " is grey, which readers take as the light let through or as one minus it; taken "
+             "as clear (tint 1): a Tf of unequal channels is the tint");
+      }
+    } else if (def.tf_line > 0) {
+      m.specular = tf;
+    }
+    if (!t.diffuse_texname.empty())
+      warn(mtl_path + ":" + std::to_string(def.line) + ": material '" + t.name +
+           "' (transparent: " + why.str() +
+           ") becomes a dielectric, which has no texture: its map_Kd '" + t.diffuse_texname +
+           "' is ignored (Tf gives its tint)");
   } else if ((illum == 3 || illum == 5) && has_ks && max3(kd) <= 0.01 &&
              t.diffuse_texname.empty()) {
     m.type = MaterialType::Mirror;
