@@ -375,6 +375,7 @@ TEST(Session, OnProgressMayReadTheSessionButNotChangeIt) {
     EXPECT_EQ(r.result().spp, p.accumulated);
     EXPECT_EQ(r.spp(), p.accumulated);
     errors.push_back(error_of([&] { r.set_scene(moved); }));
+    errors.push_back(error_of([&] { r.set_camera(moved.camera); }));
     errors.push_back(error_of([&] { r.set_build_options(lucent::Precision::Float, true, true); }));
     errors.push_back(error_of([&] { r.reset(); }));
     errors.push_back(error_of([&] { r.render(1); }));

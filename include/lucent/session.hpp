@@ -5,14 +5,17 @@
 //   renderer.set_scene(lucent::load_scene("scenes/default.json"));
 //   renderer.render(64);                        // adds 64 samples per pixel
 //   lucent::RenderResult r = renderer.result();
-//   scene.camera.position.x += 1;               // a new camera: no BVH or kernel rebuild
-//   renderer.set_scene(scene);
+//   lucent::Camera camera = renderer.scene().camera;
+//   camera.position.x += 1;                     // a new camera: nothing packed or built again
+//   renderer.set_camera(camera);
 //   renderer.render_for(2.0);                   // about two seconds of samples
 //
 // set_scene() packs the scene and builds what it needs, reusing what it can: the BVH when the
 // geometry is unchanged, the kernel when its build options are (they change with the types the
 // scene uses and the session's precision and math mode), the device buffers whose contents are
-// unchanged. stats() counts what was built. No OpenCL type appears in this header.
+// unchanged. set_camera() changes the camera alone without packing the scene again (a camera
+// move of a large scene: an interactive viewer, a turntable). stats() counts what was built.
+// No OpenCL type appears in this header.
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -65,9 +68,10 @@ struct SessionOptions {
 
 /// What a session has built and done, for tools that want to know what a change cost.
 /// scene_packs, bvh_builds and kernel_reuses count set_scene() calls (set_build_options() with a
-/// scene makes one); the other counters and the times count work on the devices, summed over the
-/// session's devices: with two devices a new program is two builds, a buffer written is written
-/// to each (two uploads), and each device's passes count.
+/// scene makes one, and so does a set_camera() that cannot keep the kernel); camera_moves counts
+/// set_camera() calls that packed nothing; the other counters and the times count work on the
+/// devices, summed over the session's devices: with two devices a new program is two builds, a
+/// buffer written is written to each (two uploads), and each device's passes count.
 struct SessionStats {
   std::uint64_t scene_packs = 0;         ///< set_scene() calls that packed a scene
   std::uint64_t bvh_builds = 0;          ///< BVH builds (not counted when the geometry was reused)
@@ -76,6 +80,8 @@ struct SessionStats {
   /// set_scene() calls that kept the session's program: no device built or loaded one (one per
   /// call, whatever the number of devices)
   std::uint64_t kernel_reuses = 0;
+  /// set_camera() calls that changed the camera without packing the scene (no scene_packs)
+  std::uint64_t camera_moves = 0;
   /// scene buffers written to each device: the first set_scene writes every buffer that holds
   /// data (an empty one is not counted), a later one the buffers whose contents changed
   std::uint64_t buffer_uploads = 0;
@@ -134,6 +140,19 @@ class Renderer {
   /// On success `scene` is left empty (read it back with scene()); when this throws, `scene` is
   /// untouched.
   void set_scene(Scene&& scene);
+  /// Moves the camera of the session's scene: what set_scene() of that scene with `camera`
+  /// does (the same image, bit for bit; the same errors, at "/camera"; its warnings, each once per
+  /// session; the accumulation dropped unless the camera is the same), without packing the scene
+  /// again: the camera is packed into the launch parameters, and on a scene lit by an environment
+  /// the light table is built again when the camera's distance to its look-at changes it (a few
+  /// lights, the environment map's texel CDF); nothing else is packed, built or uploaded
+  /// (stats().camera_moves counts such calls). Falls back to a whole set_scene() (counted as one)
+  /// where it cannot: a camera that changes the kernel (an aperture from or to 0 with
+  /// specialisation: the lens code), or after a set_scene() that failed. The film, integrator and
+  /// everything else stay the scene's: change them through set_scene() (a film size also changes
+  /// the session's buffers). Throws lucent::Error without a scene, for an invalid camera (the
+  /// session unchanged) or during a render.
+  void set_camera(const Camera& camera);
   /// The session's scene. Throws lucent::Error when none was set.
   const Scene& scene() const;
 

@@ -120,6 +120,16 @@ DeviceScene::Upload DeviceScene::update(const cl_util::Context& ctx, const Packe
   return up;
 }
 
+DeviceScene::Upload DeviceScene::update_lights(const cl_util::Context& ctx,
+                                               const PackedScene& previous,
+                                               const std::vector<lc_light>& now_lights,
+                                               const std::vector<float>& now_cdf) {
+  Upload up;
+  update_buffer(ctx, lights, previous.lights, now_lights, up);
+  update_buffer(ctx, light_cdf, previous.light_cdf, now_cdf, up);
+  return up;
+}
+
 DeviceScene::DeviceScene(const cl_util::Context& ctx, const PackedScene& p)
     :
 #define LUCENT_UPLOAD(name, type, ...) name(make_buffer(ctx, p.name)),

@@ -28,6 +28,11 @@ struct DeviceScene {
   Upload update(const cl_util::Context& ctx, const PackedScene& previous,
                 const PackedScene& packed);
 
+  /// update() of the light table alone (Renderer::set_camera): the lights and light_cdf buffers
+  /// from `previous`'s to `lights` and `light_cdf`.
+  Upload update_lights(const cl_util::Context& ctx, const PackedScene& previous,
+                       const std::vector<lc_light>& lights, const std::vector<float>& light_cdf);
+
   /// Sets kernel arguments first .. first + kArgCount - 1; returns the next argument index.
   int set_args(cl::Kernel& kernel, int first = 0) const;
 };

@@ -60,7 +60,7 @@ void append_env_map_cdf(const Texture& t, std::vector<float>& cdf) {
 
 }  // namespace
 
-void pack_lights(const Scene& scene, PackedScene& p, std::vector<double> power) {
+double environment_radius(const Camera& camera, const PackedScene& p) {
   // Radius of the region that matters, for the power of environment lights: the scene's
   // bounding radius, but no more than the camera's distance to what it looks at (a ground sphere
   // of radius 1000 would otherwise make the sky outweigh every point light a thousandfold).
@@ -71,8 +71,12 @@ void pack_lights(const Scene& scene, PackedScene& p, std::vector<double> power) 
     glm::dvec3 d(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
     radius = std::max(1e-6, 0.5 * glm::length(d));
   }
-  double view = glm::length(scene.camera.look_at - scene.camera.position);
+  double view = glm::length(camera.look_at - camera.position);
   if (view > 0 && std::isfinite(view)) radius = std::min(radius, view);
+  return radius;
+}
+
+void pack_lights(const Scene& scene, PackedScene& p, std::vector<double> power, double radius) {
   for (const Light& l : scene.lights) {
     lc_light d{};
     d.type = static_cast<lc_uint>(l.type);

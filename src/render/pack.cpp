@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 
@@ -102,8 +103,7 @@ lc_camera pack_camera(const Camera& c, int width, int height) {
 // double, does not). Said when a pixel spans fewer than 4 steps. The distance is the look-at's,
 // or the scene's bounds' when they are farther (a look-at 1 ahead of a camera 5000 from what it
 // sees warned).
-static void warn_camera_precision(const Scene& scene, const PackedScene& p) {
-  const Camera& c = scene.camera;
+static void warn_camera_precision(const Scene& scene, const Camera& c, const PackedScene& p) {
   double to_bounds = 0;  // from the camera to the nearest point of the scene's bounds
   for (int i = 0; i < 3; ++i) {
     const double out =
@@ -564,8 +564,9 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     std::copy(bvh.bmax, bvh.bmax + 3, p.bounds_max);
   }
 
-  warn_camera_precision(scene, p);
-  pack_lights(scene, p, std::move(power));
+  warn_camera_precision(scene, scene.camera, p);
+  p.area_power = power;  // (repack_camera builds the light table again from them)
+  pack_lights(scene, p, std::move(power), environment_radius(scene.camera, p));
   // a light-transport integrator with nothing that emits renders a black image: said, not
   // silently written
   for (const std::string& note : scene_detail::light_notes(scene)) scene_detail::warn(note);
@@ -585,6 +586,34 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   P.num_lights = static_cast<lc_uint>(p.lights.size());
   P.num_nodes = static_cast<lc_uint>(p.nodes.size());
   return p;
+}
+
+CameraPacking repack_camera(const Scene& scene, const PackedScene& packed, const Camera& camera) {
+  CameraPacking c;
+  c.params = packed.params;
+  c.params.camera = pack_camera(camera, scene.film.width, scene.film.height);
+  warn_camera_precision(scene, camera, packed);
+  // the light table follows the camera only through environment lights' power, and only when
+  // the camera's distance to its look-at bounds their radius: built again then (an environment
+  // map's texel CDF included, the same bits), as pack_scene builds it, from the area lights' kept
+  // powers
+  const double radius = environment_radius(camera, packed);
+  if (packed.params.env_light < 0 || radius == environment_radius(scene.camera, packed)) return c;
+  PackedScene t;
+  t.params = c.params;
+  t.lights.assign(packed.lights.begin(),
+                  packed.lights.begin() + static_cast<std::ptrdiff_t>(packed.area_power.size()));
+  pack_lights(scene, t, packed.area_power, radius);
+  const bool same =
+      t.lights.size() == packed.lights.size() && t.light_cdf.size() == packed.light_cdf.size() &&
+      std::memcmp(t.lights.data(), packed.lights.data(), t.lights.size() * sizeof(lc_light)) == 0 &&
+      std::memcmp(t.light_cdf.data(), packed.light_cdf.data(),
+                  t.light_cdf.size() * sizeof(float)) == 0;
+  if (same) return c;
+  c.lights_changed = true;
+  c.lights = std::move(t.lights);
+  c.light_cdf = std::move(t.light_cdf);
+  return c;
 }
 
 }  // namespace lucent::render_detail

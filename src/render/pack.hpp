@@ -22,6 +22,10 @@ struct PackedScene {
   bvh::BuildStats bvh_stats;
   float bounds_min[3] = {0, 0, 0}, bounds_max[3] = {0, 0, 0};  ///< scene bounds (0 when empty)
   std::size_t skipped_triangles = 0;  ///< degenerate or non-finite, left out with a warning
+  /// The powers of the area lights (the first entries of `lights`, emissive shapes in scene
+  /// order), kept so that repack_camera can build the light table again for another camera
+  /// without packing the shapes again.
+  std::vector<double> area_power;
 };
 
 /// Sets t.ng_x, ng_y, ng_z to the unit normal of (v1 - v0) x (v2 - v0) of t's float vertices,
@@ -68,10 +72,35 @@ std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic);
 /// primitives pass 2e7.
 std::string point_light_note(const PackedScene& packed, bool float_arithmetic);
 
+/// The radius of the region over which pack_lights reckons an environment light's power: the
+/// bounding radius of `packed`'s primitives (1 without any), but no more than `camera`'s distance
+/// to what it looks at. The one part of the light table that follows the camera.
+double environment_radius(const Camera& camera, const PackedScene& packed);
+
 /// The light table (src/render/lights.cpp): the scene's point and environment lights after the
 /// area lights that pack_scene added for emissive shapes (`area_power`: their powers), each light's
 /// selection probability and the light_cdf buffer (selection CDF, then each environment map's
-/// texel CDF). Sets params.env_light.
-void pack_lights(const Scene& scene, PackedScene& packed, std::vector<double> area_power);
+/// texel CDF), environment lights weighed over `env_radius` (environment_radius). Sets
+/// params.env_light.
+void pack_lights(const Scene& scene, PackedScene& packed, std::vector<double> area_power,
+                 double env_radius);
+
+/// What a packing holds that depends on the camera, for `camera` in place of scene.camera
+/// (Renderer::set_camera): everything else of pack_scene(scene) is the same for any camera (the
+/// film, whose size sets the aspect ratio and the session's buffers, is the scene's).
+struct CameraPacking {
+  lc_params params{};  ///< packed.params with the new camera
+  /// The light table for the new camera, when it differs from packed's (environment lights
+  /// weighed over a new environment_radius); else lights_changed is false and both are empty.
+  bool lights_changed = false;
+  std::vector<lc_light> lights;
+  std::vector<float> light_cdf;
+};
+
+/// The camera-dependent part of pack_scene for `camera`, from `packed` = pack_scene(scene) without
+/// packing the shapes again: in the bits pack_scene(scene with `camera`) gives. Gives the camera
+/// warning pack_scene gives (a pixel finer than float's steps) through scene_detail::warn. The
+/// camera must have been validated (scene_detail::validate_camera).
+CameraPacking repack_camera(const Scene& scene, const PackedScene& packed, const Camera& camera);
 
 }  // namespace lucent::render_detail

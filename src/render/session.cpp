@@ -666,6 +666,116 @@ struct Renderer::Impl {
     }
   }
 
+  /// Renderer::set_camera: set_scene() of the session's scene with `camera`, without packing it
+  /// again where only the launch parameters (and the light table an environment light weighs by
+  /// the camera) change. Nothing of the session changes before the camera passed the checks.
+  void set_camera(const Camera& camera) {
+    if (!scene) throw Error("set_camera: the session has no scene (call set_scene first)");
+    scene_detail::ScopedWarningSink sink(options.on_warning);
+    // the session's warnings, each once, as set_scene gives them
+    std::vector<std::string> notes;
+    const std::function<void(const std::string&)> collect = [&notes](const std::string& m) {
+      notes.push_back(m);
+    };
+    auto give_notes = [&] {
+      for (const std::string& note : notes)
+        if (notes_given.insert(note).second) scene_detail::warn(note);
+    };
+    {
+      scene_detail::ScopedWarningSink capture(collect);
+      try {
+        // set_scene's check of the camera, at its place in the scene ("scene.json: /camera/fov:
+        // ..."); the rest of the scene passed it when it was set
+        scene_detail::validate_camera(camera, scene_detail::Reporter(scene->path, "/camera"));
+      } catch (...) {
+        give_notes();
+        throw;
+      }
+    }
+    // the kernel's build options with the new camera (an aperture turns the lens code on): read
+    // with the camera put in the held scene for the call, which changes nothing else
+    RenderOptions ro;
+    ro.precision = options.precision;
+    ro.fast_math = options.fast_math;
+    ro.specialize = options.specialize;
+    std::string opts;
+    {
+      const Camera kept = scene->camera;
+      scene->camera = camera;
+      try {
+        opts = render_detail::build_options(*scene, packed, ro);
+      } catch (...) {
+        scene->camera = kept;
+        throw;
+      }
+      scene->camera = kept;
+    }
+    if (!stale.empty() || opts != build_options) {
+      // another kernel, or devices that hold no scene since a set_scene failed: the whole
+      // set_scene, of the held scene moved out and back (not copied: a large mesh is held once)
+      Scene s = std::move(*scene);
+      const Camera kept = s.camera;
+      const bool taken = scene_taken;
+      s.camera = camera;
+      try {
+        set_scene(s, &s);
+      } catch (...) {
+        s.camera = kept;  // set_scene left `s` as it was
+        scene = std::move(s);
+        throw;
+      }
+      scene_taken = taken;
+      return;
+    }
+    render_detail::CameraPacking next;
+    {
+      scene_detail::ScopedWarningSink capture(collect);
+      try {
+        next = render_detail::repack_camera(*scene, packed, camera);
+      } catch (...) {
+        give_notes();
+        throw;
+      }
+    }
+    give_notes();
+    const bool keep =
+        !next.lights_changed && std::memcmp(&next.params, &packed.params, sizeof(lc_params)) == 0;
+    if (next.lights_changed) {
+      std::string device;
+      try {
+        for (auto& w : workers) {
+          device = w->ctx.device.info.name;
+          const render_detail::DeviceScene::Upload up =
+              w->dev->update_lights(w->ctx, packed, next.lights, next.light_cdf);
+          stats.buffer_uploads += up.buffers;
+          stats.bytes_uploaded += up.bytes;
+          if (render_detail::upload_fault())
+            throw cl::Error(CL_MEM_OBJECT_ALLOCATION_FAILURE,
+                            "clCreateBuffer (injected by a test)");
+          w->set_args();  // a buffer may have been made again
+        }
+      } catch (const cl::Error& e) {
+        const std::string what =
+            render_detail::resource_error(e, render_detail::ClStage::Upload, scene->path, device);
+        drop_device_scenes(what);
+        throw Error(what);
+      } catch (const std::exception& e) {
+        drop_device_scenes(e.what());
+        throw;
+      }
+      packed.lights = std::move(next.lights);
+      packed.light_cdf = std::move(next.light_cdf);
+    }
+    // the launch parameters go to the devices with each pass (Worker::launch)
+    packed.params = next.params;
+    scene->camera = camera;
+    ++stats.camera_moves;
+    if (!keep) {
+      clear_accumulation(first);
+      for (auto& w : workers) w->pass_spp = 1;
+    }
+  }
+
   /// Adds one pass's sums to the accumulation.
   void accumulate(const Worker& w, std::uint32_t n) {
     for (size_t i = 0; i < npix; ++i) {
@@ -1379,6 +1489,11 @@ void Renderer::set_scene(const Scene& scene) {
 void Renderer::set_scene(Scene&& scene) {
   impl_->check_not_rendering("set_scene");
   impl_->set_scene(scene, &scene);
+}
+
+void Renderer::set_camera(const Camera& camera) {
+  impl_->check_not_rendering("set_camera");
+  impl_->set_camera(camera);
 }
 
 const Scene& Renderer::scene() const {
