@@ -25,6 +25,7 @@ namespace {
   X(kernel_compiles)               \
   X(kernel_cache_loads)            \
   X(kernel_reuses)                 \
+  X(camera_moves)                  \
   X(buffer_uploads)                \
   X(bytes_uploaded) X(passes) X(pack_seconds) X(bvh_seconds) X(build_seconds) X(render_seconds)
 
@@ -746,6 +747,16 @@ void bind_render(py::module_& m) {
           py::arg("scene"),
           "Makes a copy of `scene` the session's scene; keeps the BVH, the kernel and the "
           "accumulation when it can (see Renderer).")
+      .def(
+          "set_camera",
+          [](PyRenderer& r, const Camera& camera) {
+            const Camera copy = camera;  // (as set_scene's copy of its scene)
+            r.call("set_camera", [&](Renderer& rr) { rr.set_camera(copy); });
+          },
+          py::arg("camera"),
+          "Moves the camera of the session's scene: what set_scene() of the scene with `camera` "
+          "does (the same image, errors and warnings), without packing the scene again "
+          "(stats.camera_moves). The film, integrator and the rest stay the scene's.")
       .def_property_readonly(
           "scene", [](PyRenderer& r) { return Scene(r.read("scene").scene()); },
           "A copy of the session's scene. Raises lucent.Error while another thread's call "

@@ -72,6 +72,50 @@ def test_camera_change_rebuilds_neither_bvh_nor_kernel(renderer, small_scene):
     assert s2.buffer_uploads == s1.buffer_uploads + 1
 
 
+def test_set_camera_moves_the_camera_without_packing(renderer, small_scene):
+    """set_camera renders what a fresh session of the moved scene renders, bit for bit, packs
+    and uploads nothing (stats.camera_moves counts it), and refuses a bad camera with
+    set_scene's message, keeping the session's camera and samples."""
+    renderer.set_scene(small_scene)
+    renderer.render(2)
+    s0 = renderer.stats
+    camera = renderer.scene.camera
+    camera.position = (0.5, 1.2, 4.5)
+    renderer.set_camera(camera)
+    assert renderer.spp == 0, "a new camera drops the accumulation"
+    s1 = renderer.stats
+    assert s1.camera_moves == s0.camera_moves + 1
+    assert (s1.scene_packs, s1.bvh_builds, kernel_builds(s1), s1.buffer_uploads,
+            s1.bytes_uploaded) == (s0.scene_packs, s0.bvh_builds, kernel_builds(s0),
+                                   s0.buffer_uploads, s0.bytes_uploaded)
+    assert tuple(renderer.scene.camera.position) == (0.5, 1.2, 4.5)
+    renderer.render(3)
+    moved = renderer.result()
+    small_scene.camera = camera
+    with session() as fresh:
+        fresh.set_scene(small_scene)
+        fresh.render(3)
+        expected = fresh.result()
+    assert np.array_equal(moved.mean, expected.mean)
+    assert np.array_equal(moved.variance, expected.variance)
+    assert np.array_equal(moved.samples, expected.samples)
+
+    bad = renderer.scene.camera
+    bad.fov_degrees = 180
+    bad_scene = renderer.scene
+    bad_scene.camera = bad
+    with session() as other:
+        with pytest.raises(lucent.Error) as by_scene:
+            other.set_scene(bad_scene)
+    with pytest.raises(lucent.Error) as by_camera:
+        renderer.set_camera(bad)
+    assert str(by_camera.value) == str(by_scene.value)
+    assert "/camera/fov: must be in (0, 180) degrees, got 180" in str(by_camera.value)
+    assert renderer.scene.camera.fov_degrees == camera.fov_degrees and renderer.spp == 3
+    with pytest.raises(TypeError):
+        renderer.set_camera(small_scene)
+
+
 def test_stats_count_calls_once_and_buffers_per_device(small_scene):
     """scene_packs and kernel_reuses count set_scene calls, once whatever the number of devices;
     kernel builds and buffer uploads count work on each device, and a first upload counts every

@@ -222,6 +222,7 @@ def session_calls(r, scene):
     return {"render": lambda: r.render(1), "render_for": lambda: r.render_for(0.01),
             "render_adaptive": lambda: r.render_adaptive(budget_spp=4, min_spp=4),
             "set_scene": lambda: r.set_scene(scene), "set_build_options": r.set_build_options,
+            "set_camera": lambda: r.set_camera(scene.camera),
             "reset": r.reset, "result": r.result, "close": r.close,
             "converge": lambda: lucent.converge(scene, reference, renderer=r, spp_ladder=[1])}
 
