@@ -241,6 +241,26 @@ TEST(SessionCamera, FallsBackToSetSceneWhereItMust) {
   EXPECT_TRUE(same_image(r.result(), fresh_render(with_camera(s, moved), 2)));
 }
 
+// Without specialisation the kernel holds the lens code whatever the camera: a lens is a move
+// like any other.
+TEST(SessionCamera, LensWithoutSpecialisationIsAMove) {
+  const Scene s = base_scene();
+  lucent::SessionOptions o = lucent::test::session_options();
+  o.specialize = false;
+  Renderer r(o);
+  r.set_scene(s);
+  Camera lens = s.camera;
+  lens.aperture = 0.05;
+  r.set_camera(lens);
+  EXPECT_EQ(r.stats().scene_packs, 1u);
+  EXPECT_EQ(r.stats().camera_moves, 1u);
+  r.render(2);
+  Renderer fresh(o);
+  fresh.set_scene(with_camera(s, lens));
+  fresh.render(2);
+  EXPECT_TRUE(same_image(r.result(), fresh.result()));
+}
+
 // A move that fails while it writes the light table (an allocation failing, simulated) leaves
 // the devices without a scene, as a failed set_scene does: rendering is refused until a call
 // succeeds, and the next set_camera (a whole set_scene then) renders the moved scene.

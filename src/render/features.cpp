@@ -32,6 +32,18 @@ const std::vector<std::string>& all_features() {
   return all;
 }
 
+namespace {
+
+/// The one camera feature: the thin-lens code (LC_OTHER_FEATURES' lens). Every camera field that
+/// scene_features reads goes through here, and so through camera_features_differ.
+bool camera_has_lens(const Camera& c) { return c.aperture > 0; }
+
+}  // namespace
+
+bool camera_features_differ(const Camera& a, const Camera& b) {
+  return camera_has_lens(a) != camera_has_lens(b);
+}
+
 std::vector<std::string> scene_features(const Scene& scene, const PackedScene& packed) {
   // which type of each list the scene uses, by enum value
   bool shape[LC_SHAPE_COUNT] = {}, material[LC_MAT_COUNT] = {}, light[LC_LIGHT_COUNT] = {};
@@ -67,7 +79,7 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
     split_lobes =
         split_lobes || (used[i] && scene_detail::material_type_def(scene.materials[i].type).splits);
   const bool splitting = packed.params.splits > 0 && split_lobes;
-  const bool other[] = {smooth,  uvs && textured, textured, scene.camera.aperture > 0,
+  const bool other[] = {smooth,  uvs && textured, textured, camera_has_lens(scene.camera),
                         clamped, caustics,        splitting};
 #define LUCENT_COUNT(feature, what) +1
   static_assert(sizeof(other) / sizeof(other[0]) == 0 LC_OTHER_FEATURES(LUCENT_COUNT),

@@ -21,6 +21,11 @@ const std::vector<std::string>& all_features();
 /// data needs.
 std::vector<std::string> scene_features(const Scene& scene, const PackedScene& packed);
 
+/// Whether scene_features can differ between two cameras of the same scene. The features read
+/// the camera only through this (a lens: aperture > 0), so that Renderer::set_camera knows
+/// without scanning a large packing again that a move keeps the kernel.
+bool camera_features_differ(const Camera& a, const Camera& b);
+
 /// OpenCL build options (" -D LC_HAS_..." ...) for the scene's features, or for all of them.
 std::string feature_defines(const Scene& scene, const PackedScene& packed, bool specialize = true);
 
