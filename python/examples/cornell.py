@@ -29,14 +29,16 @@ first = renderer.result()
 print(f"first:  {first.spp} spp in {first.seconds:.2f} s on {first.device}")
 print("       ", renderer.stats)
 
-scene.camera.position.x += 0.3  # a new camera: only the launch parameters change
-renderer.set_scene(scene)
+camera = scene.camera
+camera.position.x += 0.3  # a new camera: only the launch parameters change
+renderer.set_camera(camera)
 renderer.render(args.spp)
 second = renderer.result()
 stats = renderer.stats
 print(f"second: {second.spp} spp in {second.seconds:.2f} s")
 print("       ", stats)
 assert stats.bvh_builds == 1 and stats.kernel_compiles + stats.kernel_cache_loads == 1
+assert stats.scene_packs == 1 and stats.camera_moves == 1, "the move packed nothing"
 
 lucent.write_image(args.out / "cornell-1.png", first, film=scene.film)
 lucent.write_image(args.out / "cornell-2.png", second, film=scene.film)
