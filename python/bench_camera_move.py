@@ -1,5 +1,7 @@
-"""Benchmark (BENCHMARKS.md, "Python bindings", a camera move): in one session, a camera move by
-set_scene (the scene again, its camera changed) against one by set_camera, alternated.
+"""A camera move by set_scene against one by set_camera, in one session, alternated.
+
+The benchmark of BENCHMARKS.md, "Python bindings" (a camera move). set_scene is given the scene
+again with its camera changed; set_camera the camera alone.
 
     PYTHONPATH=build/python python3 python/bench_camera_move.py /tmp/soup/soup.json [--rounds 6]
 
@@ -10,6 +12,7 @@ the scene (Python threads may change it while the call runs), timed on its own a
 """
 import argparse
 import statistics
+import sys
 import time
 
 import lucent
@@ -29,7 +32,10 @@ def main():
     if a.rounds < 1:
         p.error("--rounds must be at least 1")
     print("load", open("/proc/loadavg").read().split()[:3], "device", lucent.list_devices()[0].name)
-    scene = lucent.load_scene(a.scene)
+    try:
+        scene = lucent.load_scene(a.scene)
+    except lucent.Error as e:  # one line, not a traceback
+        sys.exit(f"bench_camera_move.py: {e}")
     r = lucent.Renderer(**lucent.environment())
     t_first = timed(lambda: r.set_scene(scene))
     r.render(1)
