@@ -691,7 +691,8 @@ void bind_render(py::module_& m) {
       m, "Renderer",
       "A render session: one device and one scene, rendered progressively. set_scene() packs "
       "the scene and builds only what changed (a camera move rebuilds neither the BVH nor the "
-      "kernel: see stats). Environment variables are not read: pass **lucent.environment() for "
+      "kernel, and set_camera() packs nothing again: see stats). Environment variables are not "
+      "read: pass **lucent.environment() for "
       "the `lucent` command's defaults.");
   bind_session_devices<Renderer>(renderer);
   renderer
