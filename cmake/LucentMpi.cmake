@@ -20,7 +20,10 @@ if(NOT _lucent_mpi STREQUAL "OFF")
     find_package(MPI QUIET COMPONENTS C)
   endif()
   if(MPI_C_FOUND)
-    add_executable(lucent_mpi ${CMAKE_CURRENT_SOURCE_DIR}/src/mpi/lucent_mpi.cpp)
+    # the checkpoints are `lucent render --checkpoint`'s (src/cli/checkpoint.cpp, compiled again:
+    # the CLI's code is not in the library)
+    add_executable(lucent_mpi ${CMAKE_CURRENT_SOURCE_DIR}/src/mpi/lucent_mpi.cpp
+                              ${CMAKE_CURRENT_SOURCE_DIR}/src/cli/checkpoint.cpp)
     lucent_glue_target(lucent_mpi)
     set_target_properties(lucent_mpi PROPERTIES OUTPUT_NAME lucent-mpi)
     target_compile_options(lucent_mpi PRIVATE -Wall -Wextra)

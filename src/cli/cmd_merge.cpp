@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/commands.hpp"
 #include "core/file_io.hpp"
 #include "lucent/error.hpp"
 #include "lucent/parts.hpp"

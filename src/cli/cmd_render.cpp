@@ -1,8 +1,6 @@
 // `lucent render SCENE -o OUT`: renders a JSON scene with the kernel (or the reference) and writes
 // the image: outputs checked before rendering, written atomically, stop signals honoured
 // (SIGINT, SIGTERM, SIGHUP: what was rendered is written, exit 128 + the signal).
-#include <fcntl.h>
-#include <sys/file.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -10,17 +8,16 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
-#include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "cli/checkpoint.hpp"
 #include "cli/commands.hpp"
 #include "core/file_io.hpp"
 #include "image/image_probe.hpp"
@@ -111,8 +108,6 @@ struct RenderArgs {
   double checkpoint_every = 0;  ///< seconds between checkpoints; 0: not given (the default)
 };
 
-constexpr double kDefaultCheckpointSeconds = 300;
-
 /// <output stem>.<name>.exr beside the main output.
 std::string aov_path(const std::string& output, const std::string& name) {
   std::filesystem::path p(output);
@@ -200,225 +195,6 @@ std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_sp
   return buf;
 }
 
-/// --checkpoint FILE: the samples rendered so far, written every --checkpoint-every seconds as a
-/// part file of the samples [0, K) (docs/parts.md, "Checkpoints"), so that a render killed
-/// outright (SIGKILL, the OOM killer, a power loss, a crashed driver) loses at most that much. A
-/// render started with the file present resumes from it: it renders the samples [K, N) only, and
-/// its image is that of [0, N), the one the render without a stop gives (the same sample
-/// indices, summed in another order). The file is removed once the output is written.
-/// An exclusive lock on `<checkpoint>.lock` for the render's life (flock: a killed render's goes
-/// with it): two renders given one checkpoint wrote over each other's samples, and each run's
-/// work was lost to the other's next write (the checkpoint review).
-class CheckpointLock {
- public:
-  explicit CheckpointLock(const std::string& checkpoint) : path_(checkpoint + ".lock") {
-    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0)
-      throw lucent::Error(path_ + ": cannot create the checkpoint's lock (" + std::strerror(errno) +
-                          ")");
-    if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
-    const int e = errno;
-    ::close(fd_);
-    fd_ = -1;
-    if (e == EWOULDBLOCK)
-      throw lucent::Error(checkpoint + ": another render is using this checkpoint (" + path_ +
-                          " is locked): give each render a checkpoint of its own");
-    throw lucent::Error(path_ + ": cannot lock the checkpoint (" + std::strerror(e) + ")");
-  }
-  CheckpointLock(const CheckpointLock&) = delete;
-  CheckpointLock& operator=(const CheckpointLock&) = delete;
-  ~CheckpointLock() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  /// With the checkpoint, once the output is written (while held: a render that opened it
-  /// meanwhile locks a file no longer there, as one that finds none creates its own).
-  void remove() const { ::unlink(path_.c_str()); }
-
- private:
-  std::string path_;
-  int fd_ = -1;
-};
-
-class Checkpoint {
- public:
-  Checkpoint(std::string path, std::string scene_path, double every)
-      : path_(std::move(path)), scene_(std::move(scene_path)), every_(every) {}
-
-  /// Before the session: reads the checkpoint when there is one, so that a file that is not a
-  /// part, or a corrupt one, is refused before a device is opened.
-  void read() {
-    lock_.emplace(path_);  // first: the file read is no other render's work in progress
-    std::error_code ec;
-    if (std::filesystem::exists(path_, ec)) old_ = lucent::read_render_part(path_);
-    held_ = first_sample();
-    ours_ = old_.has_value();
-  }
-  bool resumed() const { return old_.has_value(); }
-  /// K: the samples per pixel the checkpoint holds, where this render starts.
-  std::uint64_t first_sample() const {
-    return old_ && !old_->info.samples.empty() ? old_->info.samples.back().end : 0;
-  }
-
-  /// After set_scene, before rendering: refuses a checkpoint of another image (PartMerger's
-  /// checks: film, seed, sampler, integrator, lucent's version, scene hash), one that is not of
-  /// the samples [0, K), or one holding more samples than `target` (N; 0: a time limit alone).
-  void check(const lucent::Renderer& renderer, std::uint64_t target) {
-    target_ = target;
-    last_ = std::chrono::steady_clock::now();
-    if (!old_) return;
-    const std::vector<lucent::SampleRange>& have = old_->info.samples;
-    if (have.size() > 1 || (have.size() == 1 && have[0].begin != 0))
-      throw lucent::Error(path_ + ": holds samples " + lucent::ranges_text(have) +
-                          ", not a checkpoint's [0, K) (a part of `lucent render --samples`?)");
-    lucent::PartMerger merger;  // (the session's part holds no sample yet)
-    merger.add_header(scene_, lucent::make_part(renderer, requested(renderer), scene_).info);
-    merger.check(path_, old_->info);
-    if (target > 0 && first_sample() > target)
-      throw lucent::Error(path_ + ": holds " + std::to_string(first_sample()) +
-                          " samples per pixel, more than the " + std::to_string(target) +
-                          " this render asks for (--spp or the scene's integrator.spp)");
-  }
-
-  /// From on_progress, after each pass: writes the checkpoint when --checkpoint-every seconds
-  /// have passed since the last one ended and the session has new samples.
-  void on_pass(const lucent::Renderer& renderer) {
-    const double since =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_).count();
-    if (since < every_ || renderer.spp() == saved_spp_) return;
-    std::optional<lucent::RenderPart> part;
-    try {
-      part = whole(renderer);
-    } catch (const lucent::Error&) {
-      // several devices: a pass can end before an earlier one, and the samples are not one range
-      // until that one has (Renderer::accumulation refuses them): the next pass writes it
-      return;
-    }
-    if (save(*part)) saved_spp_ = renderer.spp();
-  }
-
-  /// The samples [0, K + the session's): the checkpoint's and the session's, added.
-  lucent::RenderPart whole(const lucent::Renderer& renderer) const {
-    lucent::RenderPart part = lucent::make_part(renderer, requested(renderer), scene_);
-    if (!old_) return part;
-    lucent::PartMerger merger;
-    merger.add(scene_, std::move(part));  // (moved: the film's sums are not copied)
-    merger.add(path_, *old_);
-    return merger.finish().merged;
-  }
-
-  /// Writes `part` to the checkpoint, atomically; a failure (a full disk) is a warning: the
-  /// render goes on, and the previous checkpoint stays as it was.
-  bool save(const lucent::RenderPart& part) {
-    bool ok = true;
-    try {
-      lucent::write_render_part(path_, part);
-    } catch (const lucent::Error& e) {
-      std::fprintf(stderr, "lucent: warning: checkpoint not written: %s\n",
-                   one_line(e.what()).c_str());
-      ok = false;
-    }
-    if (ok) held_ = part.info.samples.empty() ? 0 : part.info.samples.back().end;
-    ours_ = ours_ || ok;
-    last_ = std::chrono::steady_clock::now();
-    return ok;
-  }
-
-  /// The render asked for is done: N samples (a time limit alone: its time), not stopped.
-  bool complete(const lucent::Renderer& renderer, bool stopped) const {
-    return !stopped && (target_ == 0 || first_sample() + renderer.spp() >= target_);
-  }
-  /// The samples per pixel the file holds ([0, held())): read, or last written.
-  std::uint64_t held() const { return held_; }
-
-  /// The checkpoint's part, no longer needed (its samples are in a whole() part).
-  void drop() { old_.reset(); }
-
-  /// After the output was written: the render is complete, its checkpoint of no further use.
-  /// Only a file this render resumed from or wrote: none may be there, or another's (a file
-  /// that the output's name reached by another path was removed as the checkpoint).
-  void remove() const {
-    if (lock_) lock_->remove();
-    if (!ours_) return;
-    std::error_code ec;
-    if (!std::filesystem::remove(path_, ec) && ec)
-      std::fprintf(stderr, "lucent: warning: %s: checkpoint not removed (%s)\n",
-                   one_line(path_).c_str(), ec.message().c_str());
-  }
-
-  const std::string& path() const { return path_; }
-
- private:
-  /// [0, N), or with a time limit alone the samples so far ([0, K + the session's))
-  lucent::SampleRange requested(const lucent::Renderer& renderer) const {
-    return {0, std::max(target_, renderer.first_sample() + renderer.spp())};
-  }
-
-  std::string path_, scene_;
-  double every_;
-  std::uint64_t target_ = 0;
-  std::optional<lucent::RenderPart> old_;  ///< the checkpoint resumed from
-  std::chrono::steady_clock::time_point last_;
-  std::uint64_t saved_spp_ = 0;  ///< the session's samples per pixel in the last checkpoint
-  std::uint64_t held_ = 0;
-  bool ours_ = false;  ///< the file at path_ is this render's: resumed from, or written
-  std::optional<CheckpointLock> lock_;
-};
-
-/// After a render with a checkpoint, while the session lives: an unfinished render's samples go
-/// to the checkpoint, which stays for the next run to resume from; a resumed render's result
-/// becomes the image of the checkpoint's samples and the session's (the session is gone then).
-bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer,
-                       lucent::RenderResult& r) {
-  const bool complete = ck.complete(*renderer, r.cancelled || g_interrupted.load());
-  if (complete && !ck.resumed()) return true;  // the session's result is the image
-  lucent::RenderPart all;
-  try {
-    all = ck.whole(*renderer);
-  } catch (const lucent::Error& e) {
-    if (ck.resumed()) throw;  // (the session's samples alone are not the image)
-    // (a device's failed pass left a gap: the image is written, the last checkpoint stays)
-    std::fprintf(stderr, "lucent: warning: checkpoint not written: %s\n",
-                 one_line(e.what()).c_str());
-    return false;
-  }
-  // (stopped before its first sample: nothing to write; right after a periodic checkpoint, or
-  // before a resumed run's first pass: the file holds these samples already, and writing them
-  // again took seconds in which a second Ctrl-C lost the output)
-  if (!complete && !all.info.samples.empty() && all.info.samples.back().end != ck.held())
-    ck.save(all);
-  if (!ck.resumed()) return complete;
-  // the session's sums and images, and the checkpoint's, before the image's own memory
-  renderer.reset();
-  ck.drop();
-  r.mean = {};
-  r.variance = {};
-  r.samples = {};
-  lucent::RenderResult m = lucent::part_result(all);
-  all = {};
-  r.mean = std::move(m.mean);
-  r.variance = std::move(m.variance);
-  r.samples = std::move(m.samples);
-  r.spp = m.spp;  // (the render's totals: the checkpoint's samples too)
-  r.nonfinite = m.nonfinite;
-  r.rays = m.rays;
-  r.seconds = m.seconds;
-  return complete;
-}
-
-/// Before rendering, with a checkpoint: checks it against the session, starts the session after
-/// its samples and makes `spp` (N) the samples left; false when none is.
-bool resume_from(Checkpoint& ck, lucent::Renderer& renderer, std::uint64_t& spp, bool quiet) {
-  ck.check(renderer, spp);
-  const std::uint64_t first = ck.first_sample();
-  renderer.reset(first);  // (as --samples first:N does)
-  if (ck.resumed() && !quiet)
-    std::fprintf(stderr, "lucent: resuming from %s, which holds samples [0, %llu)\n",
-                 one_line(ck.path()).c_str(), static_cast<unsigned long long>(first));
-  if (spp == 0) return true;  // a time limit alone: as long again
-  spp -= first;
-  return spp > 0;
-}
-
 /// The outputs' memory, counted before rendering: a render refused up front rather than lost to
 /// its write (the resources review: a part file's write took 2.5 times the session's estimate).
 /// Without AOVs the session is gone before the output is written (`after`, checked on its own);
@@ -443,7 +219,7 @@ OutputMemory output_memory(const RenderArgs& a, int fw, int fh, bool part, bool 
     // beside the session: a checkpoint's part (the session's sums, added to a resumed render's
     // checkpoint, itself held throughout) and the write of its file; after it, a resumed render's
     // image is made from that part (--checkpoint is refused with --aov and --samples)
-    m.beside = (resumed ? 2 : 1) * acc_bytes + lucent::part_write_bytes(fw, fh);
+    m.beside = checkpoint_beside_bytes(fw, fh, resumed);
     if (resumed)
       m.after.push_back({"the sums of the checkpoint and this render (" + film + ")", acc_bytes,
                          "the film size"});
@@ -670,7 +446,8 @@ int render_with(const RenderArgs& a) {
   const double run_seconds = r.seconds;
   const std::uint64_t resumed_spp = checkpoint ? checkpoint->first_sample() : 0;
   // a resumed render's image is that of the checkpoint's samples and the session's
-  const bool checkpoint_done = checkpoint && finish_checkpoint(*checkpoint, renderer, r);
+  const bool checkpoint_done = checkpoint && finish_checkpoint(*checkpoint, renderer, r,
+                                                               r.cancelled || g_interrupted.load());
   // interrupted before its first sample (an adaptive render's pilot, the reference's first
   // pixel): no image to write; it wrote a black one claiming "0 of 256 spp". A part keeps its
   // (empty) range, and is written.

@@ -1,0 +1,199 @@
+// Checkpoints (checkpoint.hpp): the lock, the file's life (read, checked, written after a pass,
+// removed), and the image of a resumed render.
+#include "cli/checkpoint.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <utility>
+#include <vector>
+
+#include "core/text.hpp"
+#include "lucent/types.hpp"
+#include "render/resources.hpp"
+
+namespace lucent::cli {
+
+using io::one_line;
+
+CheckpointLock::CheckpointLock(const std::string& checkpoint) : path_(checkpoint + ".lock") {
+  fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0)
+    throw lucent::Error(path_ + ": cannot create the checkpoint's lock (" + std::strerror(errno) +
+                        ")");
+  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
+  const int e = errno;
+  ::close(fd_);
+  fd_ = -1;
+  if (e == EWOULDBLOCK)
+    throw lucent::Error(checkpoint + ": another render is using this checkpoint (" + path_ +
+                        " is locked): give each render a checkpoint of its own");
+  throw lucent::Error(path_ + ": cannot lock the checkpoint (" + std::strerror(e) + ")");
+}
+
+CheckpointLock::~CheckpointLock() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void CheckpointLock::remove() const { ::unlink(path_.c_str()); }
+
+Checkpoint::Checkpoint(std::string path, std::string scene_path, double every, std::string program,
+                       std::uint64_t begin)
+    : path_(std::move(path)),
+      scene_(std::move(scene_path)),
+      program_(std::move(program)),
+      every_(every),
+      begin_(begin),
+      held_(begin) {}
+
+void Checkpoint::read() {
+  lock_.emplace(path_);  // first: the file read is no other render's work in progress
+  std::error_code ec;
+  if (std::filesystem::exists(path_, ec)) old_ = lucent::read_render_part(path_);
+  held_ = first_sample();
+  ours_ = old_.has_value();
+}
+
+std::uint64_t Checkpoint::first_sample() const {
+  return old_ && !old_->info.samples.empty() ? old_->info.samples.back().end : begin_;
+}
+
+void Checkpoint::check(const lucent::Renderer& renderer, std::uint64_t target) {
+  target_ = target;
+  last_ = std::chrono::steady_clock::now();
+  if (!old_) return;
+  const std::vector<lucent::SampleRange>& have = old_->info.samples;
+  if (have.size() > 1 || (have.size() == 1 && have[0].begin != begin_))
+    throw lucent::Error(path_ + ": holds samples " + lucent::ranges_text(have) +
+                        ", not a checkpoint's [" + std::to_string(begin_) +
+                        ", K) (a part of `lucent render --samples`?)");
+  lucent::PartMerger merger;  // (the session's part holds no sample yet)
+  merger.add_header(scene_, lucent::make_part(renderer, requested(renderer), scene_).info);
+  merger.check(path_, old_->info);
+  if (target > 0 && first_sample() > target)
+    throw lucent::Error(path_ + ": holds " + std::to_string(first_sample() - begin_) +
+                        " samples per pixel, more than the " + std::to_string(target - begin_) +
+                        " this render asks for (--spp or the scene's integrator.spp)");
+}
+
+void Checkpoint::on_pass(const lucent::Renderer& renderer) {
+  const double since =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - last_).count();
+  if (since < every_ || renderer.spp() == saved_spp_) return;
+  std::optional<lucent::RenderPart> part;
+  try {
+    part = whole(renderer);
+  } catch (const lucent::Error&) {
+    // several devices: a pass can end before an earlier one, and the samples are not one range
+    // until that one has (Renderer::accumulation refuses them): the next pass writes it
+    return;
+  }
+  if (save(*part)) saved_spp_ = renderer.spp();
+}
+
+lucent::RenderPart Checkpoint::whole(const lucent::Renderer& renderer) const {
+  lucent::RenderPart part = lucent::make_part(renderer, requested(renderer), scene_);
+  if (!old_) return part;
+  lucent::PartMerger merger;
+  merger.add(scene_, std::move(part));  // (moved: the film's sums are not copied)
+  merger.add(path_, *old_);
+  return merger.finish().merged;
+}
+
+bool Checkpoint::save(const lucent::RenderPart& part) {
+  bool ok = true;
+  try {
+    lucent::write_render_part(path_, part);
+  } catch (const lucent::Error& e) {
+    std::fprintf(stderr, "%s: warning: checkpoint not written: %s\n", program_.c_str(),
+                 one_line(e.what()).c_str());
+    ok = false;
+  }
+  if (ok) held_ = part.info.samples.empty() ? begin_ : part.info.samples.back().end;
+  ours_ = ours_ || ok;
+  last_ = std::chrono::steady_clock::now();
+  return ok;
+}
+
+bool Checkpoint::complete(const lucent::Renderer& renderer, bool stopped) const {
+  return !stopped && (target_ == 0 || first_sample() + renderer.spp() >= target_);
+}
+
+void Checkpoint::remove() const {
+  if (lock_) lock_->remove();
+  if (!ours_) return;
+  std::error_code ec;
+  if (!std::filesystem::remove(path_, ec) && ec)
+    std::fprintf(stderr, "%s: warning: %s: checkpoint not removed (%s)\n", program_.c_str(),
+                 one_line(path_).c_str(), ec.message().c_str());
+}
+
+lucent::SampleRange Checkpoint::requested(const lucent::Renderer& renderer) const {
+  return {begin_, std::max(target_, renderer.first_sample() + renderer.spp())};
+}
+
+bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer,
+                       lucent::RenderResult& r, bool stopped) {
+  const bool complete = ck.complete(*renderer, stopped);
+  if (complete && !ck.resumed()) return true;  // the session's result is the image
+  lucent::RenderPart all;
+  try {
+    all = ck.whole(*renderer);
+  } catch (const lucent::Error& e) {
+    if (ck.resumed()) throw;  // (the session's samples alone are not the image)
+    // (a device's failed pass left a gap: the image is written, the last checkpoint stays)
+    std::fprintf(stderr, "%s: warning: checkpoint not written: %s\n", ck.program().c_str(),
+                 one_line(e.what()).c_str());
+    return false;
+  }
+  // (stopped before its first sample: nothing to write; right after a periodic checkpoint, or
+  // before a resumed run's first pass: the file holds these samples already, and writing them
+  // again took seconds in which a second Ctrl-C lost the output)
+  if (!complete && !all.info.samples.empty() && all.info.samples.back().end != ck.held())
+    ck.save(all);
+  if (!ck.resumed()) return complete;
+  // the session's sums and images, and the checkpoint's, before the image's own memory
+  renderer.reset();
+  ck.drop();
+  r.mean = {};
+  r.variance = {};
+  r.samples = {};
+  lucent::RenderResult m = lucent::part_result(all);
+  all = {};
+  r.mean = std::move(m.mean);
+  r.variance = std::move(m.variance);
+  r.samples = std::move(m.samples);
+  r.spp = m.spp;  // (the render's totals: the checkpoint's samples too)
+  r.nonfinite = m.nonfinite;
+  r.rays = m.rays;
+  r.seconds = m.seconds;
+  return complete;
+}
+
+bool resume_from(Checkpoint& ck, lucent::Renderer& renderer, std::uint64_t& spp, bool quiet) {
+  const std::uint64_t begin = ck.begin();
+  ck.check(renderer, spp == 0 ? 0 : begin + spp);
+  const std::uint64_t first = ck.first_sample();
+  renderer.reset(first);  // (as --samples first:N does)
+  if (ck.resumed() && !quiet)
+    std::fprintf(stderr, "%s: resuming from %s, which holds samples [%llu, %llu)\n",
+                 ck.program().c_str(), one_line(ck.path()).c_str(),
+                 static_cast<unsigned long long>(begin), static_cast<unsigned long long>(first));
+  if (spp == 0) return true;  // a time limit alone: as long again
+  spp = begin + spp - first;
+  return spp > 0;
+}
+
+std::uint64_t checkpoint_beside_bytes(int width, int height, bool resumed) {
+  const std::uint64_t acc_bytes =
+      std::uint64_t(width) * std::uint64_t(height) * lucent::render_detail::kAccumulationPixelBytes;
+  return (resumed ? 2 : 1) * acc_bytes + lucent::part_write_bytes(width, height);
+}
+
+}  // namespace lucent::cli
