@@ -21,6 +21,7 @@
 #include <fstream>
 #include <functional>
 #include <string>
+#include <tuple>
 
 #include "lucent/compare.hpp"
 #include "lucent/image.hpp"
@@ -993,6 +994,167 @@ TEST(Parts, MpiSigtermToMpirunWritesWhatTheRanksRendered) {
   EXPECT_LT(info.samples[1].end, 16000000u);
   EXPECT_NE(text.find("lucent-mpi: interrupted: " + out + " holds samples [0, "), std::string::npos)
       << text;
+}
+
+/// The names in `dir` that contain `part`.
+std::vector<std::string> names_with(const std::string& dir, const std::string& part) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find(part) != std::string::npos) names.push_back(name);
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+/// The lines of `err` that lucent-mpi printed (mpirun adds its own reports).
+int lucent_mpi_lines(const std::string& err) {
+  int n = 0;
+  for (size_t at = 0; (at = err.find("lucent-mpi:", at)) != std::string::npos; ++at)
+    n += at == 0 || err[at - 1] == '\n';
+  return n;
+}
+
+// --checkpoint (docs/parts.md, "Checkpoints of lucent-mpi"): a render that is not stopped writes
+// the image of the run without it, and leaves no checkpoint, lock or temporary file behind.
+TEST(Parts, MpiCheckpointCompleteRunLeavesNoCheckpoint) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string prog = "-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " --spp 8";
+  CommandResult r = run_shell(
+      mpirun(prog + " -o " + q(dir + "/with.exr") + " --checkpoint " + q(dir + "/ck.exr")), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(names_with(dir, "ck."), std::vector<std::string>{}) << r.err;
+  r = run_shell(mpirun(prog + " -o " + q(dir + "/without.exr")), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const lucent::RenderPart with = lucent::read_render_part(dir + "/with.exr");
+  const lucent::RenderPart without = lucent::read_render_part(dir + "/without.exr");
+  EXPECT_EQ(with.info.samples, (std::vector<lucent::SampleRange>{{0, 8}}));
+  EXPECT_LT(max_relative_difference(with.acc, without.acc), 1e-5);
+}
+
+// A rank's checkpoint needs its part and the part file's write beside the session, as `lucent
+// render --checkpoint` counts them: at 2048x2048 (1.1 GiB), under an address-space limit that the
+// render without a checkpoint fits, the rank refuses before rendering instead of failing its first
+// checkpoint write.
+TEST(Parts, MpiCheckpointMemoryIsCountedBeforeRendering) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  if (lucent::test::kAddressSanitizer)
+    GTEST_SKIP() << "AddressSanitizer cannot run under ulimit -v";
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string out = dir + "/mpi.png";
+  CommandResult r = run_shell("ulimit -v 1500000; timeout 60 env " +
+                                  mpirun("-np 1 '" + std::string(LUCENT_MPI_PATH) + "' " +
+                                         q(scene) + " --width 2048 --height 2048 --spp 1 -o " +
+                                         q(out) + " --checkpoint " + q(dir + "/ck.exr")),
+                              dir);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("lucent-mpi: error: rank 0 of 1 ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the largest part is what the application keeps beside the session (its "
+                       "outputs, as it declared them) (1.1 GiB)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(dir + "/ck.rank0-of-1.exr"));
+}
+
+// A job stopped by SIGTERM (Slurm's at its time limit) keeps each rank's checkpoint of its own
+// range; the same command resumes every rank where its checkpoint ends and writes the image of the
+// uninterrupted run. Another number of ranks, or a checkpoint of another seed, is refused with one
+// line before rendering, writing nothing.
+TEST(Parts, MpiCheckpointStoppedRunResumesToTheUninterruptedImage) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string ck = dir + "/ck.exr", out = dir + "/out.exr", full = dir + "/full.exr";
+  const std::string ck0 = dir + "/ck.rank0-of-2.exr", ck1 = dir + "/ck.rank1-of-2.exr";
+  // about 1.2 s of rendering per rank for two ranks sharing this device (12x10: a CPU's rate
+  // measured by a render of 0.5 s); the checkpoints every 0.2 s appear a fraction of the way in
+  CommandResult cal = run_cli("render " + q(scene) + " --time 0.5 -o " + q(dir + "/cal.exr"));
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  const size_t at = cal.err.find(" Msamples/s");
+  ASSERT_NE(at, std::string::npos) << cal.err;
+  const double rate = std::atof(cal.err.substr(cal.err.rfind('(', at) + 1).c_str()) * 1e6;
+  const std::uint64_t n =
+      std::clamp<std::uint64_t>(std::uint64_t(rate * 1.2 / 120), 20000, std::uint64_t(1) << 24);
+  auto command = [&](int ranks, const std::string& extra) {
+    return mpirun("-np " + std::to_string(ranks) + " '" + std::string(LUCENT_MPI_PATH) + "' " +
+                  q(scene) + " --spp " + std::to_string(n) + " -o " + q(out) + " --checkpoint " +
+                  q(ck) + " --checkpoint-every 0.2" + extra);
+  };
+  // SIGTERM to the ranks (mpirun's children; mpirun itself passes it on a second later) once
+  // both checkpoints exist
+  const std::string script = dir + "/stop.sh";
+  lucent::test::write_file(
+      script, command(2, "") + " 2>" + q(dir + "/stop.err") + " </dev/null & pid=$!\n" +
+                  "for i in $(seq 600); do [ -e " + q(ck0) + " ] && [ -e " + q(ck1) +
+                  " ] && break; kill -0 $pid 2>/dev/null || break; sleep 0.05; done\n" +
+                  "kill -TERM $(pgrep -P $pid)\nwait $pid\n");
+  const int raw = std::system(("bash " + q(script)).c_str());
+  const std::string text = lucent::test::read_file(dir + "/stop.err");
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) != 0) << text;
+  ASSERT_TRUE(fs::exists(ck0) && fs::exists(ck1)) << text;
+  const lucent::PartInfo info0 = lucent::read_part_info(ck0), info1 = lucent::read_part_info(ck1);
+  ASSERT_EQ(info0.samples.size(), 1u) << text;
+  ASSERT_EQ(info1.samples.size(), 1u) << text;
+  const std::uint64_t k0 = info0.samples[0].end, k1 = info1.samples[0].end;
+  EXPECT_EQ(info0.samples[0].begin, 0u);
+  EXPECT_EQ(info1.samples[0].begin, n / 2);
+  EXPECT_EQ(info0.requested, (std::vector<lucent::SampleRange>{{0, n / 2}}));
+  EXPECT_EQ(info1.requested, (std::vector<lucent::SampleRange>{{n / 2, n}}));
+  EXPECT_TRUE(k0 < n / 2 || k1 < n) << "the render ended before the stop";
+  EXPECT_NE(text.find("lucent-mpi: the checkpoints " + dir +
+                      "/ck.rank<r>-of-2.exr hold samples [0, " + std::to_string(k0) + "), [" +
+                      std::to_string(n / 2) + ", " + std::to_string(k1) + ") of [0, " +
+                      std::to_string(n) + "): the same command with 2 ranks resumes the render"),
+            std::string::npos)
+      << text;
+
+  // refused before rendering: one line, the checkpoints, the output and the directory as they were
+  const std::string bytes0 = lucent::test::read_file(ck0), bytes1 = lucent::test::read_file(ck1);
+  const std::string output = lucent::test::read_file(out);
+  const std::vector<std::string> files = names_with(dir, "ck.");
+  for (const auto& [ranks, extra, says] : std::vector<std::tuple<int, std::string, std::string>>{
+           {3, "",
+            "-of-2.exr: a checkpoint of a run of 2 ranks, this one has 3: resume it with "
+            "mpirun -np 2, or remove " +
+                dir + "/ck.rank*-of-2.exr to start again"},
+           {2, " --seed 9", "ck.rank0-of-2.exr: seed 3 differs from " + scene + "'s 9"}}) {
+    SCOPED_TRACE(std::to_string(ranks) + extra);
+    CommandResult r = run_shell("timeout 60 env " + command(ranks, extra), dir);
+    EXPECT_NE(r.status, 0);
+    EXPECT_EQ(lucent_mpi_lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("lucent-mpi: error: rank 0 of " + std::to_string(ranks) + " ("),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_EQ(names_with(dir, "ck."), files);  // (no lock, no checkpoint of this run)
+    EXPECT_EQ(lucent::test::read_file(ck0), bytes0);
+    EXPECT_EQ(lucent::test::read_file(ck1), bytes1);
+    EXPECT_EQ(lucent::test::read_file(out), output);
+  }
+
+  // the same command: each rank resumes its range, and the checkpoints go
+  CommandResult r = run_shell(command(2, ""), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  if (k0 > 0) {
+    EXPECT_NE(r.err.find("lucent-mpi: rank 0 of 2: resuming from " + ck0 +
+                         ", which holds samples [0, " + std::to_string(k0) + ")"),
+              std::string::npos)
+        << r.err;
+  }
+  EXPECT_EQ(names_with(dir, "ck."), std::vector<std::string>{}) << r.err;
+  ASSERT_EQ(run_shell(mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) +
+                             " -q --spp " + std::to_string(n) + " -o " + q(full)),
+                      dir)
+                .status,
+            0);
+  const lucent::RenderPart resumed = lucent::read_render_part(out);
+  const lucent::RenderPart single = lucent::read_render_part(full);
+  EXPECT_EQ(resumed.info.samples, (std::vector<lucent::SampleRange>{{0, n}}));
+  EXPECT_LT(max_relative_difference(resumed.acc, single.acc), 1e-5);
 }
 #else
 TEST(Parts, MpiTwoRanksRenderTheOneProcessImage) {

@@ -5,20 +5,26 @@
 // and writes OUT atomically. A rank that fails prints one line naming it and ends the job with
 // MPI_Abort: nothing is written. SIGINT, SIGTERM and SIGHUP stop every rank after its current
 // pass; what they rendered is merged and written (an .exr records the ranges it holds).
+// --checkpoint CK: each rank keeps a checkpoint of its own range, CK with ".rank<r>-of-<K>" before
+// its extension (src/cli/checkpoint.hpp, as `lucent render --checkpoint`), resumed by the same
+// command with the same number of ranks (docs/parts.md, "Checkpoints of lucent-mpi").
 #include <mpi.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "cli/checkpoint.hpp"
 #include "core/file_io.hpp"
 #include "core/text.hpp"
 #include "image/image_probe.hpp"
@@ -44,15 +50,38 @@ extern "C" void on_stop_signal(int sig) {
 
 int g_rank = 0, g_size = 1;
 
-/// One line naming the rank, then the whole job ends: no rank writes anything after this.
-[[noreturn]] void fail(const std::string& what) {
+/// "lucent-mpi: error: rank 1 of 4 (node17): WHAT".
+void print_failure(const std::string& what) {
   char host[256] = "?";
   gethostname(host, sizeof host - 1);
   std::fprintf(stderr, "lucent-mpi: error: rank %d of %d (%s): %s\n", g_rank, g_size, host,
                one_line(what).c_str());
   std::fflush(stderr);
+}
+
+/// One line naming the rank, then the whole job ends: no rank writes anything after this.
+[[noreturn]] void fail(const std::string& what) {
+  print_failure(what);
   MPI_Abort(MPI_COMM_WORLD, 1);
   std::_Exit(1);  // not reached
+}
+
+/// A step every rank takes, whose failure on any rank stops them all: the lowest failing rank
+/// prints its line (as fail() does) and every rank gets true, to end with status 1. One line,
+/// where a check that fails on every rank (a checkpoint of another seed) printed one per rank
+/// before the first MPI_Abort ended the job.
+bool refused(const std::function<void()>& step) {
+  std::string what;
+  int mine = g_size, first = g_size;
+  try {
+    step();
+  } catch (const std::exception& e) {
+    what = e.what();
+    mine = g_rank;
+  }
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (first == g_rank) print_failure(what);
+  return first < g_size;
 }
 
 struct Args {
@@ -61,7 +90,60 @@ struct Args {
   long long seed = -1;
   double time_limit = 0;
   bool fast_math = false, quiet = false;
+  std::string checkpoint;       ///< CK: each rank's checkpoint is rank_checkpoint(CK, r, K)
+  double checkpoint_every = 0;  ///< seconds; 0: not given
 };
+
+/// Rank r of K's checkpoint: CK's name with ".rank<r>-of-<K>" before its extension
+/// (ck.exr: ck.rank3-of-8.exr), beside it. K is in the name: a run with another number of ranks
+/// splits the samples otherwise, and finds the other run's files by it (other_rank_count).
+std::string rank_checkpoint(const std::string& ck, int rank, int ranks) {
+  const std::filesystem::path p(ck);
+  return (p.parent_path() / (p.stem().string() + ".rank" + std::to_string(rank) + "-of-" +
+                             std::to_string(ranks) + p.extension().string()))
+      .string();
+}
+
+/// "ck.rank<r>-of-4.exr": the names of the K ranks' checkpoints, for messages.
+std::string rank_checkpoints(const std::string& ck, int ranks) {
+  const std::filesystem::path p(ck);
+  return (p.parent_path() /
+          (p.stem().string() + ".rank<r>-of-" + std::to_string(ranks) + p.extension().string()))
+      .string();
+}
+
+/// Refuses the checkpoints of a run with another number of ranks beside CK (its ranks' shares
+/// are other ranges, which this run's ranks cannot resume): "ck.rank0-of-2.exr: a checkpoint of
+/// a run of 2 ranks, ...". Rank 0's check, before any rank locks or reads its own.
+void refuse_other_rank_counts(const std::string& ck, int ranks) {
+  const std::filesystem::path p(ck);
+  const std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : ".";
+  const std::string head = p.stem().string() + ".rank", ext = p.extension().string();
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= head.size() + ext.size() || name.compare(0, head.size(), head) != 0 ||
+        name.compare(name.size() - ext.size(), ext.size(), ext) != 0)
+      continue;
+    // "<r>-of-<k>" between them, digits only
+    const std::string mid = name.substr(head.size(), name.size() - head.size() - ext.size());
+    const size_t of = mid.find("-of-");
+    auto digits = [](const std::string& t) {
+      return !t.empty() && t.size() < 10 &&
+             std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    if (of == std::string::npos || !digits(mid.substr(0, of)) || !digits(mid.substr(of + 4)))
+      continue;
+    const int k = std::stoi(mid.substr(of + 4));
+    if (k == ranks) continue;
+    const std::string base =
+        (p.parent_path() / (p.stem().string() + ".rank*-of-" + std::to_string(k) + ext)).string();
+    throw lucent::Error((p.parent_path() / name).string() + ": a checkpoint of a run of " +
+                        std::to_string(k) + " ranks, this one has " + std::to_string(ranks) +
+                        ": resume it with mpirun -np " + std::to_string(k) + ", or remove " + base +
+                        " to start again");
+  }
+}
 
 // What travels from a rank to rank 0 besides its sums: the part's header.
 struct Header {
@@ -154,13 +236,47 @@ int run(const Args& a) {
   };
   const lucent::SampleRange range = share(g_rank);
 
-  // memory beside the session: each rank's part, copied from it before it goes; then on rank 0
-  // its part, the merge, a part received and the write (refused now rather than after the render)
+  // --checkpoint: the arguments, this rank's file (not the output, nor an input) and, on rank 0,
+  // no checkpoints of another rank count; then each rank locks and reads its own. Each step is
+  // agreed by all ranks: one line, and nothing locked or written when the first refuses.
+  std::optional<lucent::cli::Checkpoint> ck;
+  const std::string ck_path =
+      a.checkpoint.empty() ? "" : rank_checkpoint(a.checkpoint, g_rank, g_size);
+  if (refused([&] {
+        if (a.checkpoint_every > 0 && a.checkpoint.empty())
+          throw lucent::Error(
+              "--checkpoint-every is how often --checkpoint writes: it does nothing without it");
+        if (a.checkpoint.empty()) return;
+        if (lucent::io::lower_extension(a.checkpoint) != ".exr")
+          throw lucent::Error(a.checkpoint + ": --checkpoint writes part files: use an .exr name");
+        if (lucent::io::same_file(ck_path, a.output))
+          throw lucent::Error(ck_path + ": is the output too: give --checkpoint a name of its own");
+        std::vector<std::string> inputs = lucent::scene_detail::scene_inputs(a.scene, scene);
+        inputs.push_back(a.scene);
+        inputs.push_back(a.output);
+        lucent::io::check_output_path(ck_path, inputs);
+        if (root) refuse_other_rank_counts(a.checkpoint, g_size);
+      }))
+    return 1;
+  if (!a.checkpoint.empty() && refused([&] {
+        ck.emplace(
+            ck_path, a.scene,
+            a.checkpoint_every > 0 ? a.checkpoint_every : lucent::cli::kDefaultCheckpointSeconds,
+            "lucent-mpi: rank " + std::to_string(g_rank) + " of " + std::to_string(g_size),
+            range.begin);
+        ck->read();
+      }))
+    return 1;
+
+  // memory beside the session: each rank's part, copied from it before it goes (with a
+  // checkpoint: the checkpoint's part and its write, as `lucent render --checkpoint` counts them);
+  // then on rank 0 its part, the merge, a part received and the write (refused now rather than
+  // after the render), and on the other ranks with a checkpoint their part and its last write
   const int fw = scene.film.width, fh = scene.film.height;
   const std::uint64_t npix = std::uint64_t(fw) * std::uint64_t(fh);
   const std::uint64_t part_bytes = npix * lucent::render_detail::kAccumulationPixelBytes;
+  const std::string film = std::to_string(fw) + "x" + std::to_string(fh);
   if (root) {
-    const std::string film = std::to_string(fw) + "x" + std::to_string(fh);
     const std::uint64_t write = lucent::io::lower_extension(a.output) == ".exr"
                                     ? lucent::part_write_bytes(fw, fh)
                                     : npix * lucent::render_detail::kResultPixelBytes +
@@ -169,10 +285,18 @@ int run(const Args& a) {
         scene, {{"rank 0's part, the merged sums and a part received of the " + film + " film",
                  3 * part_bytes, "the film size"},
                 {"writing " + one_line(a.output) + " (" + film + ")", write, "the film size"}});
+  } else if (ck) {
+    lucent::render_detail::check_output_host_memory(
+        scene, {{"rank " + std::to_string(g_rank) + "'s part of the " + film + " film", part_bytes,
+                 "the film size"},
+                {"writing " + one_line(ck_path) + " (" + film + ")",
+                 lucent::part_write_bytes(fw, fh), "the film size"}});
   }
 
   lucent::SessionOptions so = lucent::SessionOptions::from_environment();
-  so.reserved_host_bytes = part_bytes;
+  so.reserved_host_bytes =
+      ck ? std::max(part_bytes, lucent::cli::checkpoint_beside_bytes(fw, fh, ck->resumed()))
+         : part_bytes;
   if (!a.device.empty()) so.device = a.device;
   so.precision = lucent::parse_precision(a.precision);
   so.fast_math = a.fast_math;
@@ -181,24 +305,47 @@ int run(const Args& a) {
   renderer.set_cancel_flag(&g_stop);
   renderer.set_scene(std::move(scene));  // held once, by the session
   renderer.reset(range.begin);
+  // a checkpoint of another image, of other samples (another --spp) or of more than the rank's
+  // share: refused before rendering; else the rank starts after its samples
+  std::uint64_t todo = range.end - range.begin;
+  if (ck && refused([&] { lucent::cli::resume_from(*ck, renderer, todo, a.quiet); })) return 1;
+  const std::uint64_t resumed = ck ? ck->first_sample() - range.begin : 0;
   const bool tty = isatty(STDERR_FILENO);
   double last = -10;
   auto progress = [&](const lucent::RenderProgress& p) {
+    if (ck) ck->on_pass(renderer);
     if (!root || a.quiet || p.elapsed < 1.0 || (!tty && p.elapsed - last < 2.0)) return;
     last = p.elapsed;
+    // rank 0's share, its checkpoint's samples counted
+    const std::uint64_t done = resumed + p.samples_done, all = range.end - range.begin;
     std::fprintf(stderr, "%srank 0 of %d: %5.1f%%  %llu of %llu spp  %.2f Msamples/s%s",
-                 tty ? "\r" : "", g_size, 100.0 * double(p.samples_done) / double(p.samples_target),
-                 static_cast<unsigned long long>(p.samples_done),
-                 static_cast<unsigned long long>(p.samples_target), p.samples_per_second * 1e-6,
-                 tty ? "   " : "\n");
+                 tty ? "\r" : "", g_size, 100.0 * double(done) / double(all),
+                 static_cast<unsigned long long>(done), static_cast<unsigned long long>(all),
+                 p.samples_per_second * 1e-6, tty ? "   " : "\n");
   };
-  renderer.render(range.end - range.begin, a.time_limit, progress);
+  if (todo > 0) renderer.render(todo, a.time_limit, progress);
   if (root && !a.quiet && last > 0 && tty) std::fprintf(stderr, "\n");
-  lucent::RenderPart part = lucent::make_part(renderer, range, a.scene);
+  // with a checkpoint: the render is complete when every rank's is; until then each rank's
+  // samples go to its checkpoint, before they are sent (a SIGKILL that follows a SIGTERM during
+  // the merge or the output's write loses nothing)
+  int complete = ck ? ck->complete(renderer, g_stop.load()) : 1, all_complete = 1;
+  MPI_Allreduce(&complete, &all_complete, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  lucent::RenderPart part = ck ? ck->whole(renderer) : lucent::make_part(renderer, range, a.scene);
   session.reset();  // its sums and device buffers: the part is what is sent, merged and written
+  if (ck) {
+    ck->drop();
+    if (!all_complete && !part.info.samples.empty() && part.info.samples.back().end != ck->held())
+      ck->save(part);
+  }
+  // every rank's checkpoint goes once rank 0 has written the output of a complete render
+  auto finish = [&](int written) {
+    MPI_Bcast(&written, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (ck && written && all_complete) ck->remove();
+  };
 
   if (!root) {
     send_part(part);
+    finish(0);
     return 0;
   }
   lucent::PartMerger merger;
@@ -213,6 +360,7 @@ int run(const Args& a) {
   }
   lucent::MergeReport m = merger.finish();
   lucent::write_merged(a.output, m.merged);
+  finish(1);
   if (!a.quiet)
     std::fprintf(stderr, "%s: %dx%d, samples %s from %d ranks (%.2f s of kernel time in all)\n",
                  one_line(a.output).c_str(), m.merged.info.width, m.merged.info.height,
@@ -221,6 +369,13 @@ int run(const Args& a) {
     std::fprintf(stderr,
                  "lucent-mpi: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
                  static_cast<unsigned long long>(m.merged.info.nonfinite));
+  if (ck && !all_complete)
+    std::fprintf(stderr,
+                 "lucent-mpi: the checkpoints %s hold samples %s of [0, %llu): the same "
+                 "command with %d ranks resumes the render\n",
+                 one_line(rank_checkpoints(a.checkpoint, g_size)).c_str(),
+                 lucent::ranges_text(m.merged.info.samples).c_str(),
+                 static_cast<unsigned long long>(n), g_size);
   if (g_stop.load()) {
     std::fprintf(stderr, "lucent-mpi: interrupted: %s holds samples %s of [0, %llu)\n",
                  one_line(a.output).c_str(), lucent::ranges_text(m.merged.info.samples).c_str(),
@@ -261,15 +416,16 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, lucent::limits::kMaxSpp));
   // as `lucent render --time`: a finite number of seconds up to 1e7 (CLI::PositiveNumber let NaN
   // through to a rank's MPI_Abort, and refused inf naming 1.8e308 in 300 digits)
+  const CLI::Validator seconds(
+      [](std::string& text) -> std::string {
+        double v = 0;
+        if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v))
+          return "must be a finite number of seconds, got " + text;
+        return v > 0 && v <= 1e7 ? "" : "must be in (0, 1e7] seconds, got " + text;
+      },
+      "SECONDS");
   app.add_option("--time", a.time_limit, "Each rank stops after this many seconds (at most 1e7)")
-      ->check(CLI::Validator(
-          [](std::string& text) -> std::string {
-            double v = 0;
-            if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v))
-              return "must be a finite number of seconds, got " + text;
-            return v > 0 && v <= 1e7 ? "" : "must be in (0, 1e7] seconds, got " + text;
-          },
-          "SECONDS"));
+      ->check(seconds);
   app.add_option("--width", a.width, "Image width")
       ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
   app.add_option("--height", a.height, "Image height")
@@ -281,6 +437,13 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"float", "double"}));
   app.add_flag("--fast-math", a.fast_math, "Build the kernel with -cl-fast-relaxed-math");
   app.add_flag("-q,--quiet", a.quiet, "No progress line or summary");
+  app.add_option("--checkpoint", a.checkpoint,
+                 "Each rank writes the samples it rendered so far to CK.rank<r>-of-<K>.exr every "
+                 "--checkpoint-every seconds, and resumes from it when it exists; removed once "
+                 "the output is written (docs/parts.md, \"Checkpoints of lucent-mpi\")");
+  app.add_option("--checkpoint-every", a.checkpoint_every,
+                 "Seconds between two checkpoints (default 300)")
+      ->check(seconds);
   // the ranks agree on whether the arguments parse: a rank that ended alone on a parse error
   // (different arguments per rank, mpirun's A : B) left rank 0 waiting for its part for ever
   int failed = 0, parse_status = 0, code = 0;
