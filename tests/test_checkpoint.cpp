@@ -382,4 +382,24 @@ TEST(Checkpoint, SummaryRatesAreThisRunsOwn) {
   }
 }
 
+// A render killed while it wrote its checkpoint (SIGKILL, the OOM killer) left the write's
+// temporary file, as large as the checkpoint, for ever. The next render that holds the checkpoint's
+// lock removes the temporary files of its checkpoint's writes, and no other file.
+TEST(Checkpoint, TemporaryFilesOfAKilledWriteAreRemoved) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string ck = dir + "/ck.exr", out = dir + "/out.exr";
+  const std::vector<std::string> stale = {".ck.exr.tmp-123456-0", ".ck.exr.tmp-7-12"};
+  const std::vector<std::string> kept = {".ck.exr.tmp-12x-0", ".ck.exr.tmp-",   ".ck.exr.tmp-1-",
+                                         ".out.exr.tmp-7-0",  "ck.exr.tmp-7-0", ".ck.exr.tmp-1-2.x",
+                                         ".ck.exr.bak"};
+  for (const std::string& name : stale) lucent::test::write_file(dir + "/" + name, "partial");
+  for (const std::string& name : kept) lucent::test::write_file(dir + "/" + name, "other");
+  CommandResult r =
+      run_cli("render " + q(scene) + " -q --spp 8 -o " + q(out) + " --checkpoint " + q(ck));
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const std::string& name : stale) EXPECT_FALSE(fs::exists(dir + "/" + name)) << name;
+  for (const std::string& name : kept) EXPECT_TRUE(fs::exists(dir + "/" + name)) << name;
+}
+
 }  // namespace

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/file_io.hpp"
 #include "core/text.hpp"
 #include "lucent/types.hpp"
 #include "render/resources.hpp"
@@ -54,6 +55,9 @@ Checkpoint::Checkpoint(std::string path, std::string scene_path, double every, s
 
 void Checkpoint::read() {
   lock_.emplace(path_);  // first: the file read is no other render's work in progress
+  // a checkpoint write killed half-way (SIGKILL, the OOM killer) left its temporary file, as large
+  // as the checkpoint, for ever: no other render writes this checkpoint while the lock is held
+  lucent::io::remove_stale_temporaries(path_);
   std::error_code ec;
   if (std::filesystem::exists(path_, ec)) old_ = lucent::read_render_part(path_);
   held_ = first_sample();

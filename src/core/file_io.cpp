@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
@@ -78,12 +79,26 @@ void check_writable_kind(const std::string& path, const fs::path& target) {
 }
 
 // The temporary file a write of `name` into `dir` goes through: a hidden name beside it, of at
-// most 128 bytes of the name, so that a name near the file system's limit (255 bytes) has one
-// too (its whole name plus the suffix was refused, after the render).
+// most kTempNameBytes of the name, so that a name near the file system's limit (255 bytes) has
+// one too (its whole name plus the suffix was refused, after the render).
+constexpr size_t kTempNameBytes = 128;
 fs::path temp_path(const fs::path& dir, const std::string& name) {
   static std::atomic<unsigned> counter{0};
-  return dir / ("." + name.substr(0, 128) + ".tmp-" + std::to_string(::getpid()) + "-" +
+  return dir / ("." + name.substr(0, kTempNameBytes) + ".tmp-" + std::to_string(::getpid()) + "-" +
                 std::to_string(counter++));
+}
+
+// Whether `file` is a name temp_path(dir, name) gives: ".<name>.tmp-<digits>-<digits>".
+bool is_temp_name(const std::string& file, const std::string& name) {
+  const std::string head = "." + name + ".tmp-";
+  if (file.compare(0, head.size(), head) != 0) return false;
+  const std::string tail = file.substr(head.size());
+  const size_t dash = tail.find('-');
+  auto digits = [](const std::string& t) {
+    return !t.empty() &&
+           std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  return dash != std::string::npos && digits(tail.substr(0, dash)) && digits(tail.substr(dash + 1));
 }
 
 }  // namespace
@@ -224,6 +239,23 @@ void write_all(int fd, const void* data, std::size_t size, const std::string& pa
     p += n;
     size -= static_cast<std::size_t>(n);
   }
+}
+
+int remove_stale_temporaries(const std::string& path) {
+  std::error_code ec;
+  const fs::path target = write_target(path);
+  const std::string name = target.filename().string();
+  if (name.empty() || name == "." || name == ".." || name.size() > kTempNameBytes) return 0;
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  int removed = 0;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code type_ec;
+    if (!is_temp_name(it->path().filename().string(), name) || !it->is_regular_file(type_ec))
+      continue;
+    std::error_code rm_ec;
+    removed += fs::remove(it->path(), rm_ec) ? 1 : 0;
+  }
+  return removed;
 }
 
 void write_file_atomic(const std::string& path, const void* data, std::size_t size) {
