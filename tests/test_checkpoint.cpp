@@ -402,4 +402,37 @@ TEST(Checkpoint, TemporaryFilesOfAKilledWriteAreRemoved) {
   for (const std::string& name : kept) EXPECT_TRUE(fs::exists(dir + "/" + name)) << name;
 }
 
+// The progress line of a resumed render counts its checkpoint's samples ("20 + 1234 spp") and
+// its percentage is of the whole render; it counted this run's samples alone.
+TEST(Checkpoint, ProgressOfAResumedRenderCountsTheCheckpoint) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string ck = dir + "/ck.exr", out = dir + "/out.exr";
+  // about 1.5 s of rendering after a checkpoint of a quarter of the samples (the progress line
+  // starts after 1 s)
+  CommandResult cal = run_cli("render " + q(scene) + " --time 0.5 -o " + q(dir + "/cal.exr"));
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  const size_t at = cal.err.find(" Msamples/s");
+  ASSERT_NE(at, std::string::npos) << cal.err;
+  const double rate = std::atof(cal.err.substr(cal.err.rfind('(', at) + 1).c_str()) * 1e6;
+  const std::uint64_t n =
+      std::clamp<std::uint64_t>(std::uint64_t(rate * 2 / 120), 20000, std::uint64_t(1) << 24);
+  const std::uint64_t k = n / 4;
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:" + std::to_string(k) + " -o " + q(ck))
+                .status,
+            0);
+  CommandResult r = run_cli("render " + q(scene) + " --spp " + std::to_string(n) + " -o " + q(out) +
+                            " --checkpoint " + q(ck));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string head = "%  " + std::to_string(k) + " + ";
+  const size_t line = r.err.find(head);
+  ASSERT_NE(line, std::string::npos) << r.err;
+  // "NN.N%  K + D spp": at least the checkpoint's share of the render
+  const size_t start =
+      r.err.rfind('\n', line) == std::string::npos ? 0 : r.err.rfind('\n', line) + 1;
+  const double percent = std::atof(r.err.substr(start, line - start).c_str());
+  EXPECT_GE(percent, 100.0 * double(k) / double(n) - 0.05) << r.err;
+  EXPECT_NE(r.err.find(" spp  ", line), std::string::npos) << r.err;
+}
+
 }  // namespace

@@ -358,6 +358,9 @@ int render_with(const RenderArgs& a) {
   const bool tty = isatty(STDERR_FILENO);
   double last_print = -10;
   bool printed = false;
+  // a resumed render: the checkpoint's samples, which its progress line counts ("413 + 1200 spp",
+  // its percentage of the whole render; it said "1200 spp", 40% where the image was at 80%)
+  const std::uint64_t resumed_from = checkpoint ? checkpoint->first_sample() : 0;
   if (!a.quiet) {
     opt.on_progress = [&](const lucent::RenderProgress& p) {
       if (p.elapsed < 1.0) return;  // short renders stay silent
@@ -366,12 +369,22 @@ int render_with(const RenderArgs& a) {
       double frac = p.samples_target > 0 ? double(p.samples_done) / double(p.samples_target)
                                          : (p.time_limit > 0 ? p.elapsed / p.time_limit : 0);
       frac = std::min(1.0, frac);
-      double eta = frac > 0 ? p.elapsed * (1 - frac) / frac : 0;
-      std::fprintf(stderr, "%s%5.1f%%  %llu spp  %.2f Msamples/s  elapsed %s  ETA %s%s%s",
-                   tty ? "\r" : "", 100 * frac, static_cast<unsigned long long>(p.samples_done),
-                   p.samples_per_second * 1e-6, format_duration(p.elapsed).c_str(),
-                   format_duration(eta).c_str(), device_shares(p.devices).c_str(),
-                   tty ? "   " : "\n");
+      double eta = frac > 0 ? p.elapsed * (1 - frac) / frac : 0;  // (this run's rate)
+      double shown = frac;
+      char spp[64];
+      if (resumed_from > 0) {
+        if (p.samples_target > 0)
+          shown = std::min(
+              1.0, double(resumed_from + p.samples_done) / double(resumed_from + p.samples_target));
+        std::snprintf(spp, sizeof spp, "%llu + %llu", static_cast<unsigned long long>(resumed_from),
+                      static_cast<unsigned long long>(p.samples_done));
+      } else {
+        std::snprintf(spp, sizeof spp, "%llu", static_cast<unsigned long long>(p.samples_done));
+      }
+      std::fprintf(stderr, "%s%5.1f%%  %s spp  %.2f Msamples/s  elapsed %s  ETA %s%s%s",
+                   tty ? "\r" : "", 100 * shown, spp, p.samples_per_second * 1e-6,
+                   format_duration(p.elapsed).c_str(), format_duration(eta).c_str(),
+                   device_shares(p.devices).c_str(), tty ? "   " : "\n");
       std::fflush(stderr);
       printed = true;
     };
