@@ -1058,6 +1058,23 @@ TEST(Parts, MpiCheckpointMemoryIsCountedBeforeRendering) {
       << r.err;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_FALSE(fs::exists(dir + "/ck.rank0-of-1.exr"));
+
+  // the ranks other than 0 keep their part and write their checkpoint after the session: refused
+  // before rendering too (ulimit 1.2 GB: 937.5 MiB allowed, rank 0's merge and PNG fit), with one
+  // line where each of them printed its own, and before any lock is taken
+  r = run_shell("ulimit -v 1200000; timeout 60 env " +
+                    mpirun("-np 3 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) +
+                           " --width 2048 --height 2048 --spp 3 -o " + q(out) + " --checkpoint " +
+                           q(dir + "/ck.exr")),
+                dir);
+  EXPECT_NE(r.status, 0);
+  EXPECT_EQ(lucent_mpi_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("lucent-mpi: error: rank 1 of 3 ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the largest part is writing " + dir + "/ck.rank1-of-3.exr (2048x2048)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(names_with(dir, "-of-3"), std::vector<std::string>{});
 }
 
 // A job stopped by SIGTERM (Slurm's at its time limit) keeps each rank's checkpoint of its own

@@ -96,7 +96,7 @@ struct Args {
 
 /// Rank r of K's checkpoint: CK's name with ".rank<r>-of-<K>" before its extension
 /// (ck.exr: ck.rank3-of-8.exr), beside it. K is in the name: a run with another number of ranks
-/// splits the samples otherwise, and finds the other run's files by it (other_rank_count).
+/// splits the samples otherwise, and finds the other run's files by it (refuse_other_rank_counts).
 std::string rank_checkpoint(const std::string& ck, int rank, int ranks) {
   const std::filesystem::path p(ck);
   return (p.parent_path() / (p.stem().string() + ".rank" + std::to_string(rank) + "-of-" +
@@ -258,6 +258,38 @@ int run(const Args& a) {
         if (root) refuse_other_rank_counts(a.checkpoint, g_size);
       }))
     return 1;
+  // memory beside the session: each rank's part, copied from it before it goes (with a
+  // checkpoint: the checkpoint's part and its write, as `lucent render --checkpoint` counts them);
+  // then on rank 0 its part, the merge, a part received and the write (refused now rather than
+  // after the render), and on the other ranks with a checkpoint their part and its last write
+  // (agreed, as the checkpoint's checks: every rank refusing printed a line each; before the
+  // checkpoints are locked, so that a refusal leaves no file)
+  const int fw = scene.film.width, fh = scene.film.height;
+  const std::uint64_t npix = std::uint64_t(fw) * std::uint64_t(fh);
+  const std::uint64_t part_bytes = npix * lucent::render_detail::kAccumulationPixelBytes;
+  const std::string film = std::to_string(fw) + "x" + std::to_string(fh);
+  if (refused([&] {
+        if (root) {
+          const std::uint64_t write =
+              lucent::io::lower_extension(a.output) == ".exr"
+                  ? lucent::part_write_bytes(fw, fh)
+                  : npix * lucent::render_detail::kResultPixelBytes +
+                        lucent::image_detail::image_write_bytes(a.output, fw, fh);
+          lucent::render_detail::check_output_host_memory(
+              scene,
+              {{"rank 0's part, the merged sums and a part received of the " + film + " film",
+                3 * part_bytes, "the film size"},
+               {"writing " + one_line(a.output) + " (" + film + ")", write, "the film size"}});
+        } else if (!a.checkpoint.empty()) {
+          lucent::render_detail::check_output_host_memory(
+              scene, {{"rank " + std::to_string(g_rank) + "'s part of the " + film + " film",
+                       part_bytes, "the film size"},
+                      {"writing " + one_line(ck_path) + " (" + film + ")",
+                       lucent::part_write_bytes(fw, fh), "the film size"}});
+        }
+      }))
+    return 1;
+
   if (!a.checkpoint.empty() && refused([&] {
         ck.emplace(
             ck_path, a.scene,
@@ -267,31 +299,6 @@ int run(const Args& a) {
         ck->read();
       }))
     return 1;
-
-  // memory beside the session: each rank's part, copied from it before it goes (with a
-  // checkpoint: the checkpoint's part and its write, as `lucent render --checkpoint` counts them);
-  // then on rank 0 its part, the merge, a part received and the write (refused now rather than
-  // after the render), and on the other ranks with a checkpoint their part and its last write
-  const int fw = scene.film.width, fh = scene.film.height;
-  const std::uint64_t npix = std::uint64_t(fw) * std::uint64_t(fh);
-  const std::uint64_t part_bytes = npix * lucent::render_detail::kAccumulationPixelBytes;
-  const std::string film = std::to_string(fw) + "x" + std::to_string(fh);
-  if (root) {
-    const std::uint64_t write = lucent::io::lower_extension(a.output) == ".exr"
-                                    ? lucent::part_write_bytes(fw, fh)
-                                    : npix * lucent::render_detail::kResultPixelBytes +
-                                          lucent::image_detail::image_write_bytes(a.output, fw, fh);
-    lucent::render_detail::check_output_host_memory(
-        scene, {{"rank 0's part, the merged sums and a part received of the " + film + " film",
-                 3 * part_bytes, "the film size"},
-                {"writing " + one_line(a.output) + " (" + film + ")", write, "the film size"}});
-  } else if (ck) {
-    lucent::render_detail::check_output_host_memory(
-        scene, {{"rank " + std::to_string(g_rank) + "'s part of the " + film + " film", part_bytes,
-                 "the film size"},
-                {"writing " + one_line(ck_path) + " (" + film + ")",
-                 lucent::part_write_bytes(fw, fh), "the film size"}});
-  }
 
   lucent::SessionOptions so = lucent::SessionOptions::from_environment();
   so.reserved_host_bytes =
