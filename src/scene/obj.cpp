@@ -3,12 +3,19 @@
 // world-space triangle list, MTL materials mapped by obj_mtl.cpp (docs/obj-mtl.md).
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <set>
 #include <sstream>
 #include <streambuf>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
 
 #include "core/file_io.hpp"
 #include "core/host_memory.hpp"
@@ -24,10 +31,15 @@ using obj::lines_of;
 
 namespace {
 
-// Serves `head`, then `body`, to tinyobjloader without copying them.
-class JoinedText : public std::streambuf {
+// Serves `head`, then `body`, to tinyobjloader without copying them, a window at a time, and
+// gives the whole pages of `body` it has read back to the system as it goes (Linux:
+// madvise(MADV_DONTNEED) makes them zeros, like writing zeros to them, which the owner of a
+// string may do): the text need not be held whole beside tinyobjloader's arrays, which grow as
+// the text is read (a 10^6-triangle soup: 98 MiB of text and about 200 MiB of arrays). `body`
+// is spent: what was read of it is zeros.
+class SpentText : public std::streambuf {
  public:
-  JoinedText(const std::string& head, const std::string& body) : body_(body) {
+  SpentText(const std::string& head, std::string& body) : body_(body) {
     char* h = const_cast<char*>(head.data());
     setg(h, h, h + head.size());
   }
@@ -35,16 +47,33 @@ class JoinedText : public std::streambuf {
  protected:
   int_type underflow() override {
     if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
-    if (in_body_ || body_.empty()) return traits_type::eof();
-    in_body_ = true;
-    char* b = const_cast<char*>(body_.data());
-    setg(b, b, b + body_.size());
+    if (next_ >= body_.size()) return traits_type::eof();
+    release(next_);  // tinyobjloader reads forward only (it never puts a character back)
+    char* b = &body_[0] + next_;
+    const std::size_t n = std::min(std::size_t(obj::kTextWindow), body_.size() - next_);
+    setg(b, b, b + n);
+    next_ += n;
     return traits_type::to_int_type(*gptr());
   }
 
  private:
-  const std::string& body_;
-  bool in_body_ = false;
+  /// Gives back the whole pages of body_ before offset `end`.
+  void release(std::size_t end) {
+#if defined(__linux__)
+    static const std::uintptr_t page = std::uintptr_t(::sysconf(_SC_PAGESIZE));
+    const std::uintptr_t base = reinterpret_cast<std::uintptr_t>(body_.data());
+    const std::uintptr_t from = (base + released_ + page - 1) / page * page;
+    const std::uintptr_t to = (base + end) / page * page;
+    if (to > from && ::madvise(reinterpret_cast<void*>(from), to - from, MADV_DONTNEED) == 0)
+      released_ = to - base;
+#else
+    (void)end;
+#endif
+  }
+
+  std::string& body_;
+  std::size_t next_ = 0;      // body_ before this offset has been served
+  std::size_t released_ = 0;  // body_ before this offset has been given back
 };
 
 /// The triangles of a planar polygon (its corners' positions, in order), as index triples into
@@ -154,6 +183,24 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<glm::vec3>& p, boo
   return out;
 }
 
+/// Frees what `v` holds (clear() keeps its capacity).
+template <typename T>
+void release(std::vector<T>& v) {
+  std::vector<T>().swap(v);
+}
+
+/// ":<line>" of the OBJ file's vertex `i` (0-based), or "" when it cannot be found: the file is
+/// read again, the text tinyobjloader read having been given back as it was read (only an error
+/// needs the line).
+std::string vertex_line(const std::string& path, const io::ReadSpec& spec, long i) {
+  long line = 0;
+  try {
+    line = obj::line_of_statement(io::read_file(path, spec), "v", i);
+  } catch (const Error&) {
+  }
+  return line > 0 ? ":" + std::to_string(line) : "";
+}
+
 /// The capacity grow_for gives a vector of `capacity` that must hold `need`.
 std::uint64_t grown_capacity(std::uint64_t capacity, std::uint64_t need) {
   return capacity >= need ? capacity : std::max(need, capacity + capacity / 2);
@@ -166,12 +213,44 @@ void grow_for(std::vector<T>& v, std::size_t more) {
   v.reserve(std::size_t(grown_capacity(v.capacity(), v.size() + more)));
 }
 
+}  // namespace
+
+namespace obj {
+
+MeshLoadBytes mesh_load_bytes(const Scene& scene, std::uint64_t text_bytes, const TextCounts& c) {
+  const std::uint64_t v = std::uint64_t(c.vertices), n = std::uint64_t(c.normals),
+                      t = std::uint64_t(c.texcoords), tri = std::uint64_t(c.triangles);
+  // the scene's arrays as they are held, and as they grow to take this mesh (grow_for: the old
+  // block and the new one at once)
+  MeshLoadBytes b;
+  auto add = [&](std::uint64_t capacity, std::uint64_t size, std::uint64_t more,
+                 std::uint64_t bytes) {
+    b.held += capacity * bytes;
+    b.grown += grown_capacity(capacity, size + more) * bytes;
+  };
+  add(scene.positions.capacity(), scene.positions.size(), v, sizeof(glm::dvec3));
+  add(scene.normals.capacity(), scene.normals.size(), n, sizeof(glm::dvec3));
+  add(scene.uvs.capacity(), scene.uvs.size(), t, sizeof(glm::dvec2));
+  add(scene.triangles.capacity(), scene.triangles.size(), tri, sizeof(Triangle));
+  const std::uint64_t reading =
+      std::max(c.usemtl_names.empty() ? text_bytes : 2 * text_bytes, c.reading_bytes);
+  // tinyobjloader's arrays as it leaves them: floats with up to as much again unused, each
+  // corner's indices (12 bytes) and each element's corner count, material and smoothing group
+  const std::uint64_t left =
+      8 * (3 * v + 3 * n + 2 * t) + 12 * std::uint64_t(c.corners) + 9 * std::uint64_t(c.elements);
+  b.need = b.held + std::max(reading, b.grown + left);
+  return b;
+}
+
+}  // namespace obj
+
+namespace {
+
 /// Before tinyobjloader reads `path`: the scene's meshes so far and this one must stay within the
-/// host limit while it loads (the file's text, tinyobjloader's arrays: 12 bytes a vertex or
-/// normal, 8 a texture coordinate, 12 a corner; and the scene's own: 24, 24, 16 and 40 a
-/// triangle), and the scene's vertices and triangles within the int indices of its triangles.
-/// Each OBJ file is bounded, not their number: twelve copies of a 10^6-triangle soup under a 2
-/// GB limit loaded for 14 s and ended in a bare "out of memory".
+/// host limit while it loads (obj::mesh_load_bytes), and the scene's vertices and triangles
+/// within the int indices of its triangles. Each OBJ file is bounded, not their number: twelve
+/// copies of a 10^6-triangle soup under a 2 GB limit loaded for 14 s and ended in a bare "out of
+/// memory".
 void check_mesh_memory(const Scene& scene, const std::string& path, std::uint64_t text_bytes,
                        const obj::TextCounts& c) {
   const std::uint64_t v = std::uint64_t(c.vertices), n = std::uint64_t(c.normals),
@@ -182,28 +261,13 @@ void check_mesh_memory(const Scene& scene, const std::string& path, std::uint64_
     throw Error(path + ": with this mesh the scene has more than " + std::to_string(kMaxIndex) +
                 " vertices, normals or texture coordinates, or " + std::to_string(kMaxIndex / 2) +
                 " triangles: reduce the meshes' size or number");
-  // the scene's arrays as they are held, and as they grow to take this mesh (grow_for: the old
-  // block and the new one at once)
-  std::uint64_t held = 0, grown = 0;
-  auto add = [&](std::uint64_t capacity, std::uint64_t size, std::uint64_t more,
-                 std::uint64_t bytes) {
-    held += capacity * bytes;
-    grown += grown_capacity(capacity, size + more) * bytes;
-  };
-  add(scene.positions.capacity(), scene.positions.size(), v, sizeof(glm::dvec3));
-  add(scene.normals.capacity(), scene.normals.size(), n, sizeof(glm::dvec3));
-  add(scene.uvs.capacity(), scene.uvs.size(), t, sizeof(glm::dvec2));
-  add(scene.triangles.capacity(), scene.triangles.size(), tri, sizeof(Triangle));
-  // tinyobjloader's arrays (floats, and an index triple per corner: a polygon of k corners is
-  // k - 2 triangles, so at most 3 corners a triangle)
-  const std::uint64_t reading = text_bytes + 4 * (3 * v + 3 * n + 2 * t) + 12 * 3 * tri;
-  const std::uint64_t need = held + grown + reading;
+  const obj::MeshLoadBytes b = obj::mesh_load_bytes(scene, text_bytes, c);
   std::string what;
   const std::uint64_t limit = sys::host_memory_allowed(&what);
-  if (limit > 0 && need > limit)
+  if (limit > 0 && b.need > limit)
     throw Error(path + ": with this mesh (" + std::to_string(tri) +
-                " triangles) the scene's meshes need about " + sys::format_bytes(need) +
-                " while it is read (" + sys::format_bytes(grown) +
+                " triangles) the scene's meshes need about " + sys::format_bytes(b.need) +
+                " while it is read (" + sys::format_bytes(b.grown) +
                 " after), more than the limit of " + sys::format_bytes(limit) + " (80% of " + what +
                 "): reduce the meshes' size or number");
 }
@@ -217,7 +281,7 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   spec.what = "OBJ file";
   spec.max_bytes = obj::kMaxObjBytes;
   spec.text = true;
-  const std::string text = io::read_file(path, spec);
+  std::string text = io::read_file(path, spec);
   const obj::TextCounts counts = obj::check_obj_text(path, text);  // before tinyobjloader
   check_mesh_memory(scene, path, text.size(), counts);
   const bool use_mtl = material_override < 0;
@@ -228,14 +292,12 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   const bool head = use_mtl && counts.usemtl_before_mtllib && !counts.libraries.empty();
   const std::string first_line = head ? "mtllib libraries\n" : "";
   // "f 1 2 3 # top": tinyobjloader reads the comment as an index; "usemtl my mat": it reads the
-  // first word. A copy without the comments, and naming such materials by alias (only then)
-  const bool edit = counts.element_comments || !counts.usemtl_names.empty();
-  std::string edited;
-  if (counts.element_comments) edited = obj::blank_element_comments(text);
-  if (!counts.usemtl_names.empty())
-    edited = obj::alias_usemtl(counts.element_comments ? edited : text, counts.usemtl_names);
-  JoinedText joined(first_line, edit ? edited : text);
-  std::istream in(&joined);
+  // first word. The comments blanked (in place), and such materials named by alias (a copy, that
+  // replaces the text)
+  if (counts.element_comments) obj::blank_element_comments(text);
+  if (!counts.usemtl_names.empty()) text = obj::alias_usemtl(text, counts.usemtl_names);
+  SpentText spent(first_line, text);  // the text is spent as tinyobjloader reads it
+  std::istream in(&spent);
   obj::MtlReader reader(fs::path(path).parent_path(), counts.libraries, use_mtl,
                         counts.usemtl_names);
   tinyobj::attrib_t attrib;
@@ -245,6 +307,10 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   // polygons as they are: lucent triangulates them (triangulate() above)
   bool ok = tinyobj::LoadObj(&attrib, &shapes, &mats, &twarn, &terr, &in, &reader,
                              /*triangulate=*/false, /*default_vcols_fallback=*/false);
+  std::string().swap(text);  // spent
+  // tinyobjloader's faces were a small array each, freed in many pieces that glibc keeps (37 MiB
+  // for a 10^6-triangle soup): given back before the scene's arrays grow
+  sys::return_free_memory();
   if (head) {
     twarn = obj::shift_line_numbers(twarn, 1);
     terr = obj::shift_line_numbers(terr, 1);
@@ -312,31 +378,36 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
     warn(path + ": " + w);
   }
 
-  // vertices
+  // The scene's arrays are filled in the order that holds the least at once: normals and texture
+  // coordinates, each array of tinyobjloader's freed once converted; the faces, each shape's
+  // arrays freed once converted; the positions last (the faces' polygons read tinyobjloader's).
+  // The vertices are checked first, so that an error comes before any face is converted.
   const glm::dmat3 nxf = glm::transpose(glm::inverse(glm::dmat3(transform)));
   const bool mirrored = glm::determinant(glm::dmat3(transform)) < 0;
   const int vbase = static_cast<int>(scene.positions.size());
   const int nbase = static_cast<int>(scene.normals.size());
   const int tbase = static_cast<int>(scene.uvs.size());
+  auto world = [&](long i) {
+    const glm::dvec3 p(attrib.vertices[3 * i], attrib.vertices[3 * i + 1],
+                       attrib.vertices[3 * i + 2]);
+    return glm::dvec3(transform * glm::dvec4(p, 1.0));
+  };
+  for (long i = 0; i < nv; ++i) {
+    // a vertex (after the transform) beyond the geometry range is refused: the kernel's float
+    // arithmetic would make it vanish (lucent/limits.hpp)
+    const glm::dvec3 w = world(i);
+    if (!(max_abs(w) <= limits::kMaxCoordinate)) {
+      std::ostringstream where;
+      where << "vertex " << i + 1 << " (" << w.x << ", " << w.y << ", " << w.z << ")"
+            << (transform == glm::dmat4(1.0) ? "" : " after the transform");
+      throw Error(path + vertex_line(path, spec, i) + ": " + beyond_geometry_range(where.str()));
+    }
+  }
   // room for the mesh at once (growing by doubling held up to three times the vertices at once)
   grow_for(scene.positions, std::size_t(nv));
   grow_for(scene.normals, std::size_t(nn));
   grow_for(scene.uvs, std::size_t(nt));
   grow_for(scene.triangles, std::size_t(counts.triangles));
-  for (long i = 0; i < nv; ++i) {
-    glm::dvec3 p(attrib.vertices[3 * i], attrib.vertices[3 * i + 1], attrib.vertices[3 * i + 2]);
-    glm::dvec3 w = glm::dvec3(transform * glm::dvec4(p, 1.0));
-    // a vertex (after the transform) beyond the geometry range is refused: the kernel's float
-    // arithmetic would make it vanish (lucent/limits.hpp)
-    if (!(max_abs(w) <= limits::kMaxCoordinate)) {
-      std::ostringstream where;
-      where << "vertex " << i + 1 << " (" << w.x << ", " << w.y << ", " << w.z << ")"
-            << (transform == glm::dmat4(1.0) ? "" : " after the transform");
-      throw Error(path + ":" + std::to_string(obj::line_of_statement(text, "v", i)) + ": " +
-                  beyond_geometry_range(where.str()));
-    }
-    scene.positions.push_back(w);
-  }
   std::vector<bool> normal_ok(nn);
   for (long i = 0; i < nn; ++i) {
     glm::dvec3 n = nxf * glm::dvec3(attrib.normals[3 * i], attrib.normals[3 * i + 1],
@@ -346,8 +417,10 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
     normal_ok[i] = len > 0 && std::isfinite(len);
     scene.normals.push_back(normal_ok[i] ? u : glm::dvec3(0.0));
   }
+  release(attrib.normals);
   for (long i = 0; i < nt; ++i)
     scene.uvs.push_back({attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]});
+  release(attrib.texcoords);
 
   // faces
   ObjMaterials own;  // without SceneBuilder's: the scene's textures are shared all the same
@@ -358,19 +431,25 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
                              reader.definition);
   size_t faces = 0, fanned_faces = 0;
   std::vector<glm::vec3> corners;
-  for (const auto& s : shapes) {
+  std::vector<std::array<int, 3>> tris;
+  for (auto& s : shapes) {
     size_t first = 0;  // the face's first index
     for (size_t f = 0; f < s.mesh.num_face_vertices.size(); ++f) {
       const unsigned int fv = s.mesh.num_face_vertices[f];
       const tinyobj::index_t* face = &s.mesh.indices[first];
       first += fv;
-      corners.clear();
-      for (unsigned int k = 0; k < fv; ++k) {
-        const float* v = &attrib.vertices[3 * size_t(face[k].vertex_index)];
-        corners.emplace_back(v[0], v[1], v[2]);
-      }
       bool fanned = false;
-      for (const std::array<int, 3>& tri : triangulate(corners, &fanned)) {
+      if (fv > 3) {
+        corners.clear();
+        for (unsigned int k = 0; k < fv; ++k) {
+          const float* v = &attrib.vertices[3 * size_t(face[k].vertex_index)];
+          corners.emplace_back(v[0], v[1], v[2]);
+        }
+        tris = triangulate(corners, &fanned);
+      } else {
+        tris.assign(1, {0, 1, 2});  // a triangle is itself (as triangulate() makes it)
+      }
+      for (const std::array<int, 3>& tri : tris) {
         const tinyobj::index_t idx[3] = {face[tri[0]], face[tri[1]], face[tri[2]]};
         Triangle t;
         bool has_n = true, has_uv = true;
@@ -396,7 +475,10 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
       }
       fanned_faces += fanned;
     }
+    s.mesh = tinyobj::mesh_t();  // converted: its index arrays are freed
   }
+  for (long i = 0; i < nv; ++i) scene.positions.push_back(world(i));
+  release(attrib.vertices);
   if (faces == 0) warn(path + ": no faces");
   if (fanned_faces > 0)
     warn(path + ": " + std::to_string(fanned_faces) +

@@ -232,7 +232,16 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
   TextCounts out;
   bool mtllib_seen = false;
   std::set<std::string> libraries, usemtl_names;
+  // the text not yet given back (the lines from here on, the window being read and a page) and
+  // the arrays of the lines before: the most of it is TextCounts::reading_bytes
+  auto reading = [&](std::uint64_t left) {
+    const std::uint64_t bytes =
+        std::min<std::uint64_t>(left + 2 * kTextWindow, text.size()) +
+        tinyobj_bytes(count[0], count[2], count[1], out.elements, out.corners);
+    out.reading_bytes = std::max(out.reading_bytes, bytes);
+  };
   for_each_line(text, [&](std::string_view rest, long ln) {
+    reading(std::uint64_t(text.size() - std::size_t(rest.data() - text.data())));
     const LineError fail(path, ln);
     // usemtl and mtllib as tinyobjloader tells them: "usemtl" starts the line, "mtllib" and a
     // space or tab start it
@@ -359,6 +368,8 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
         }
       }
     }
+    ++out.elements;
+    out.corners += corners;
     if (tag != "f") return;
     if (corners > kMaxFaceVertices)
       fail("face has " + std::to_string(corners) + " corners, more than the " +
@@ -367,6 +378,7 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
     if (static_cast<std::uint64_t>(out.triangles) > kMaxTriangles)
       fail("more than " + std::to_string(kMaxTriangles) + " triangles in one OBJ file");
   });
+  reading(0);
   for (int k = 0; k < 3; ++k)
     if (wanted[k] > count[k])
       LineError(path, wanted_line[k])(
@@ -378,8 +390,9 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
   return out;
 }
 
-std::string blank_element_comments(const std::string& text) {
-  std::string out = text;
+void blank_element_comments(std::string& text) {
+  // in place (spaces end no line, so the lines found stay as they are): a copy would hold the
+  // text twice while tinyobjloader reads it
   for_each_line(text, [&](std::string_view rest, long) {
     const std::string_view tag = token(rest);
     if (tag != "f" && tag != "l" && tag != "p") return;
@@ -387,11 +400,10 @@ std::string blank_element_comments(const std::string& text) {
       if (t[0] != '#') continue;
       const std::size_t from = static_cast<std::size_t>(t.data() - text.data());
       const std::size_t to = static_cast<std::size_t>(rest.data() + rest.size() - text.data());
-      std::fill(out.begin() + from, out.begin() + to, ' ');
+      std::fill(text.begin() + from, text.begin() + to, ' ');
       return;
     }
   });
-  return out;
 }
 
 void check_mtl_text(const std::string& path, const std::string& text) {

@@ -4,6 +4,7 @@
 // (obj_mtl.cpp).
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -27,9 +28,35 @@ constexpr std::uint64_t kMaxTriangles = 1ull << 26;
 /// wrapped (300 as 44) and was refused as "inconsistent face list", without a line.
 constexpr int kMaxFaceVertices = 255;
 
+/// The text is served to tinyobjloader a window at a time, and each window given back (to the
+/// system) once read (obj.cpp).
+constexpr std::uint64_t kTextWindow = 1ull << 20;
+
+/// The host memory tinyobjloader's arrays take while it reads vertices, normals, texture
+/// coordinates, elements (f, l and p statements) and their corners: an upper bound of what it
+/// was measured to hold at once (peak resident memory, tinyobjloader 2.0.0rc10: a 400,000-
+/// triangle soup 88 MB against 101 here, a 200x200 grid of triangles 76 against 85, of quads 47
+/// against 56, of quads with normals and texture coordinates 51 against 62). A vertex or normal
+/// is 12 bytes of floats in an array that doubles as it grows; an element is an entry of 32
+/// bytes in its list and an array of its corners of its own (48 bytes for three, about 24 a
+/// corner more for a polygon); a corner is 12 bytes of indices, doubled as they grow, and copied
+/// once more when its shape is done.
+inline std::uint64_t tinyobj_bytes(std::int64_t vertices, std::int64_t normals,
+                                   std::int64_t texcoords, std::int64_t elements,
+                                   std::int64_t corners) {
+  return std::uint64_t(16 * (vertices + normals) + 12 * texcoords + 96 * elements + 36 * corners +
+                       24 * std::max<std::int64_t>(corners - 3 * elements, 0));
+}
+
 /// What the check of an OBJ file's text counted.
 struct TextCounts {
   std::int64_t vertices = 0, normals = 0, texcoords = 0, triangles = 0;
+  /// f, l and p statements, and their corners
+  std::int64_t elements = 0, corners = 0;
+  /// The most that tinyobjloader's arrays (tinyobj_bytes) and the text not yet given back
+  /// (kTextWindow) hold at once while it reads the text: the text read so far and the arrays
+  /// made of it, at each line.
+  std::uint64_t reading_bytes = 0;
   /// The names of the `mtllib` statements, in order, each once (split as tinyobjloader splits
   /// them: at spaces, `\ ` escaping one; a word starting with '#' ends the list)
   std::vector<std::string> libraries;
@@ -43,6 +70,16 @@ struct TextCounts {
   /// tinyobjloader reads the first word. The text it reads names them by alias (alias_usemtl).
   std::vector<std::string> usemtl_names;
 };
+
+/// The host memory that loading an OBJ file holds at once (obj.cpp, load_obj), in order, never
+/// all together: the text (twice while a copy names materials by alias); the text not yet read
+/// and tinyobjloader's arrays (TextCounts::reading_bytes); tinyobjloader's arrays as it leaves
+/// them and the scene's arrays grown to take the mesh (the old blocks and the new ones). `held`:
+/// the scene's arrays before; `grown`: after; `need`: the most at once, those held included.
+struct MeshLoadBytes {
+  std::uint64_t held = 0, grown = 0, need = 0;
+};
+MeshLoadBytes mesh_load_bytes(const Scene& scene, std::uint64_t text_bytes, const TextCounts& c);
 
 /// The name that stands for usemtl_names[k] in the OBJ text tinyobjloader reads: one word, which
 /// starts with a control character no material name has (a usemtl naming such a word is aliased
@@ -61,10 +98,10 @@ std::string alias_usemtl(const std::string& text, const std::vector<std::string>
 /// lucent::Error("<path>:<line>: ...").
 TextCounts check_obj_text(const std::string& path, const std::string& text);
 
-/// `text` with the comments at the end of its f, l and p lines ("f 1 2 3 # top") turned into
-/// spaces (the lines and their offsets kept): tinyobjloader reads every word of such a line as an
+/// Turns the comments at the end of `text`'s f, l and p lines ("f 1 2 3 # top") into spaces, in
+/// place (the lines and their offsets kept): tinyobjloader reads every word of such a line as an
 /// index, and refused the '#' as a malformed face.
-std::string blank_element_comments(const std::string& text);
+void blank_element_comments(std::string& text);
 
 /// Checks the numbers of an MTL file's statements that carry them (Ka, Kd, Ks, Ke, Tf, Ns, Ni,
 /// d, Tr, illum, ...): finite, within float range, colours not negative. Throws
