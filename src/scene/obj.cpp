@@ -59,7 +59,7 @@ class SpentText : public std::streambuf {
  private:
   /// Gives back the whole pages of body_ before offset `end`.
   void release(std::size_t end) {
-#if defined(__linux__)
+#if defined(__linux__)  // obj::kTextGivenBack
     static const std::uintptr_t page = std::uintptr_t(::sysconf(_SC_PAGESIZE));
     const std::uintptr_t base = reinterpret_cast<std::uintptr_t>(body_.data());
     const std::uintptr_t from = (base + released_ + page - 1) / page * page;

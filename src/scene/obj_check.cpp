@@ -235,9 +235,10 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
   // the text not yet given back (the lines from here on, the window being read and a page) and
   // the arrays of the lines before: the most of it is TextCounts::reading_bytes
   auto reading = [&](std::uint64_t left) {
+    const std::uint64_t held =
+        kTextGivenBack ? std::min<std::uint64_t>(left + 2 * kTextWindow, text.size()) : text.size();
     const std::uint64_t bytes =
-        std::min<std::uint64_t>(left + 2 * kTextWindow, text.size()) +
-        tinyobj_bytes(count[0], count[2], count[1], out.elements, out.corners);
+        held + tinyobj_bytes(count[0], count[2], count[1], out.elements, out.corners);
     out.reading_bytes = std::max(out.reading_bytes, bytes);
   };
   for_each_line(text, [&](std::string_view rest, long ln) {

@@ -29,8 +29,14 @@ constexpr std::uint64_t kMaxTriangles = 1ull << 26;
 constexpr int kMaxFaceVertices = 255;
 
 /// The text is served to tinyobjloader a window at a time, and each window given back (to the
-/// system) once read (obj.cpp).
+/// system) once read (obj.cpp), where the system allows it (Linux: madvise); elsewhere the text
+/// stays whole until tinyobjloader is done.
 constexpr std::uint64_t kTextWindow = 1ull << 20;
+#if defined(__linux__)
+constexpr bool kTextGivenBack = true;
+#else
+constexpr bool kTextGivenBack = false;
+#endif
 
 /// The host memory tinyobjloader's arrays take while it reads vertices, normals, texture
 /// coordinates, elements (f, l and p statements) and their corners: an upper bound of what it
