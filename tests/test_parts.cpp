@@ -1034,6 +1034,31 @@ TEST(Parts, MpiCheckpointCompleteRunLeavesNoCheckpoint) {
   EXPECT_LT(max_relative_difference(with.acc, without.acc), 1e-5);
 }
 
+// mpirun's A : B gives ranks arguments of their own: --checkpoint on some ranks only is refused
+// with one line before anything is written or locked. The ranks with a checkpoint take collective
+// steps that the others skip, and such a job hung for ever (here: until the timeout, status 124).
+TEST(Parts, MpiCheckpointOnSomeRanksOnlyIsRefused) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string out = dir + "/out.exr";
+  const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " --spp 8 -o " +
+                           q(out),
+                    with = prog + " --checkpoint " + q(dir + "/ck.exr");
+  for (const std::string& ranks :
+       {"-np 1 " + with + " : -np 1 " + prog, "-np 1 " + prog + " : -np 2 " + with}) {
+    SCOPED_TRACE(ranks);
+    CommandResult r = run_shell("timeout 20 env " + mpirun(ranks), dir);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(lucent_mpi_lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("lucent-mpi: error: rank 0 of "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("another rank has "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("give every rank the same --checkpoint"), std::string::npos) << r.err;
+    EXPECT_EQ(names_with(dir, "ck."), std::vector<std::string>{});
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
 // A rank's checkpoint needs its part and the part file's write beside the session, as `lucent
 // render --checkpoint` counts them: at 2048x2048 (1.1 GiB), under an address-space limit that the
 // render without a checkpoint fits, the rank refuses before rendering instead of failing its first

@@ -242,7 +242,18 @@ int run(const Args& a) {
   std::optional<lucent::cli::Checkpoint> ck;
   const std::string ck_path =
       a.checkpoint.empty() ? "" : rank_checkpoint(a.checkpoint, g_rank, g_size);
+  // whether every rank has --checkpoint (mpirun's A : B gives ranks arguments of their own): the
+  // ranks with one take collective steps that the others skip, and a job with it on rank 0
+  // alone hung in them for ever
+  int with_ck = a.checkpoint.empty() ? 0 : 1, all_ck = 0, any_ck = 0;
+  MPI_Allreduce(&with_ck, &all_ck, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(&with_ck, &any_ck, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
   if (refused([&] {
+        if (all_ck != any_ck)
+          throw lucent::Error(
+              std::string("--checkpoint: rank ") + std::to_string(g_rank) +
+              (with_ck ? " has one, another rank has none" : " has none, another rank has one") +
+              " (mpirun's A : B): give every rank the same --checkpoint");
         if (a.checkpoint_every > 0 && a.checkpoint.empty())
           throw lucent::Error(
               "--checkpoint-every is how often --checkpoint writes: it does nothing without it");
