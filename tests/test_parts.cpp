@@ -1059,6 +1059,45 @@ TEST(Parts, MpiCheckpointOnSomeRanksOnlyIsRefused) {
   }
 }
 
+// A rank whose checkpoint write fails (a full disk; here a file size limit on rank 1 alone, under
+// the 10 MB of its 400x400 checkpoint) warns and goes on; rank 0's last line names the samples the
+// checkpoints hold, not the output's (it said they held rank 1's samples, in no file).
+TEST(Parts, MpiCheckpointFailedWriteIsNotClaimed) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string limited = dir + "/limited.sh";
+  // (SIGXFSZ ignored: a write past the limit fails with EFBIG instead of ending the rank)
+  lucent::test::write_file(limited, "trap '' XFSZ\nulimit -f 6000\nexec \"$@\"\n");
+  const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) +
+                           " --width 400 --height 400 --spp 16000000 --time 1 -o " +
+                           q(dir + "/out.exr") + " --checkpoint " + q(dir + "/ck.exr");
+  // --time stops both ranks far short of their shares: each writes its checkpoint
+  CommandResult r = run_shell(
+      "timeout 60 env " + mpirun("-np 1 " + prog + " : -np 1 bash " + q(limited) + " " + prog),
+      dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("lucent-mpi: rank 1 of 2: warning: checkpoint not written: " + dir +
+                       "/ck.rank1-of-2.exr: cannot write (File too large)"),
+            std::string::npos)
+      << r.err;
+  ASSERT_TRUE(fs::exists(dir + "/ck.rank0-of-2.exr")) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/ck.rank1-of-2.exr")) << r.err;
+  const lucent::PartInfo out = lucent::read_part_info(dir + "/out.exr");
+  ASSERT_EQ(out.samples.size(), 2u) << r.err;
+  EXPECT_EQ(out.samples[1].begin, 8000000u);
+  const lucent::PartInfo ck0 = lucent::read_part_info(dir + "/ck.rank0-of-2.exr");
+  ASSERT_EQ(ck0.samples.size(), 1u) << r.err;
+  EXPECT_NE(
+      r.err.find("lucent-mpi: the checkpoints " + dir + "/ck.rank<r>-of-2.exr hold samples " +
+                 lucent::range_text(ck0.samples[0]) +
+                 " of [0, 16000000) (not all of the output's " + lucent::ranges_text(out.samples) +
+                 ": a checkpoint was not written): the same command with 2 ranks resumes "
+                 "the render"),
+      std::string::npos)
+      << r.err;
+}
+
 // A rank's checkpoint needs its part and the part file's write beside the session, as `lucent
 // render --checkpoint` counts them: at 2048x2048 (1.1 GiB), under an address-space limit that the
 // render without a checkpoint fits, the rank refuses before rendering instead of failing its first

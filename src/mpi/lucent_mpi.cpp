@@ -355,6 +355,14 @@ int run(const Args& a) {
     if (!all_complete && !part.info.samples.empty() && part.info.samples.back().end != ck->held())
       ck->save(part);
   }
+  // where each rank's checkpoint ends now, for rank 0's last line: a rank whose write failed (a
+  // full disk: a warning, the render goes on) holds fewer samples than it sent, and the line said
+  // the checkpoints held the output's samples
+  std::vector<std::uint64_t> held(root ? g_size : 0);
+  if (ck) {
+    const std::uint64_t mine = ck->held();
+    MPI_Gather(&mine, 1, MPI_UINT64_T, held.data(), 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+  }
   // every rank's checkpoint goes once rank 0 has written the output of a complete render
   auto finish = [&](int written) {
     MPI_Bcast(&written, 1, MPI_INT, 0, MPI_COMM_WORLD);
@@ -387,13 +395,29 @@ int run(const Args& a) {
     std::fprintf(stderr,
                  "lucent-mpi: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
                  static_cast<unsigned long long>(m.merged.info.nonfinite));
-  if (ck && !all_complete)
+  if (ck && !all_complete) {
+    std::vector<lucent::SampleRange> kept;  // [B_r, held_r) of each rank, adjacent ones joined
+    for (int r = 0; r < g_size; ++r) {
+      const lucent::SampleRange s = {share(r).begin, held[r]};
+      if (s.end <= s.begin) continue;
+      if (!kept.empty() && kept.back().end == s.begin)
+        kept.back().end = s.end;
+      else
+        kept.push_back(s);
+    }
+    const std::string kept_text =
+        kept.empty() ? "no samples" : "samples " + lucent::ranges_text(kept);
+    const std::string short_of = kept == m.merged.info.samples
+                                     ? ""
+                                     : " (not all of the output's " +
+                                           lucent::ranges_text(m.merged.info.samples) +
+                                           ": a checkpoint was not written)";
     std::fprintf(stderr,
-                 "lucent-mpi: the checkpoints %s hold samples %s of [0, %llu): the same "
-                 "command with %d ranks resumes the render\n",
-                 one_line(rank_checkpoints(a.checkpoint, g_size)).c_str(),
-                 lucent::ranges_text(m.merged.info.samples).c_str(),
-                 static_cast<unsigned long long>(n), g_size);
+                 "lucent-mpi: the checkpoints %s hold %s of [0, %llu)%s: the same command with %d "
+                 "ranks resumes the render\n",
+                 one_line(rank_checkpoints(a.checkpoint, g_size)).c_str(), kept_text.c_str(),
+                 static_cast<unsigned long long>(n), short_of.c_str(), g_size);
+  }
   if (g_stop.load()) {
     std::fprintf(stderr, "lucent-mpi: interrupted: %s holds samples %s of [0, %llu)\n",
                  one_line(a.output).c_str(), lucent::ranges_text(m.merged.info.samples).c_str(),
