@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/file_io.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/image.hpp"
 #include "lucent/parts.hpp"
@@ -400,6 +401,28 @@ TEST(Checkpoint, TemporaryFilesOfAKilledWriteAreRemoved) {
   ASSERT_EQ(r.status, 0) << r.err;
   for (const std::string& name : stale) EXPECT_FALSE(fs::exists(dir + "/" + name)) << name;
   for (const std::string& name : kept) EXPECT_TRUE(fs::exists(dir + "/" + name)) << name;
+}
+
+// remove_stale_temporaries removes only the regular files a write of its checkpoint makes: not a
+// symbolic link of such a name (it followed links, and removed one that led to a regular file),
+// nor a directory; names with glob and regex characters are matched as they are.
+TEST(Checkpoint, StaleTemporariesAreOnlyTheWritesOwnFiles) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string name = "c[k]*.+(1)?.exr", ck = dir + "/" + name;
+  lucent::test::write_file(dir + "/precious.exr", "someone's");
+  const std::string stale = "." + name + ".tmp-12-0";
+  lucent::test::write_file(dir + "/" + stale, "partial");
+  fs::create_symlink("precious.exr", dir + "/." + name + ".tmp-13-0");
+  fs::create_symlink("nowhere.exr", dir + "/." + name + ".tmp-14-0");
+  fs::create_directory(dir + "/." + name + ".tmp-15-0");
+  lucent::test::write_file(dir + "/.ck.exr.tmp-16-0", "another name's");  // ([k]* as a glob)
+  EXPECT_EQ(lucent::io::remove_stale_temporaries(ck), 1);
+  EXPECT_FALSE(fs::exists(dir + "/" + stale));
+  EXPECT_TRUE(fs::is_symlink(dir + "/." + name + ".tmp-13-0"));
+  EXPECT_TRUE(fs::is_symlink(dir + "/." + name + ".tmp-14-0"));
+  EXPECT_TRUE(fs::is_directory(dir + "/." + name + ".tmp-15-0"));
+  EXPECT_TRUE(fs::exists(dir + "/.ck.exr.tmp-16-0"));
+  EXPECT_EQ(lucent::test::read_file(dir + "/precious.exr"), "someone's");
 }
 
 // The progress line of a resumed render counts its checkpoint's samples ("20 + 1234 spp") and

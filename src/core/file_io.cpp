@@ -249,8 +249,12 @@ int remove_stale_temporaries(const std::string& path) {
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   int removed = 0;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    // the entry itself, not where it leads: write_file_atomic makes regular files, and a
+    // symbolic link of that name is someone else's (is_regular_file followed it, and removed a
+    // link to a regular file)
     std::error_code type_ec;
-    if (!is_temp_name(it->path().filename().string(), name) || !it->is_regular_file(type_ec))
+    if (!is_temp_name(it->path().filename().string(), name) ||
+        !fs::is_regular_file(it->symlink_status(type_ec)))
       continue;
     std::error_code rm_ec;
     removed += fs::remove(it->path(), rm_ec) ? 1 : 0;

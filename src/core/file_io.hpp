@@ -38,7 +38,8 @@ inline void write_file_atomic(const std::string& path, const std::string& bytes)
 
 /// Removes the temporary files that write_file_atomic(path) leaves behind when it is killed in
 /// the middle of a write (SIGKILL, the OOM killer, a power loss): the names it gives them beside
-/// `path`'s target, ".<name>.tmp-<pid>-<n>", and no other file. For a caller that alone writes
+/// `path`'s target, ".<name>.tmp-<pid>-<n>", regular files (not a directory or a symbolic link of
+/// such a name), and no other file. For a caller that alone writes
 /// `path` (the holder of a checkpoint's lock): a write in progress goes through such a file too.
 /// A name over 128 bytes is left alone (its temporary files carry only its first 128 bytes,
 /// which another name may share). Returns how many were removed; failures are ignored.
