@@ -403,6 +403,51 @@ TEST(Checkpoint, TemporaryFilesOfAKilledWriteAreRemoved) {
   for (const std::string& name : kept) EXPECT_TRUE(fs::exists(dir + "/" + name)) << name;
 }
 
+// A checkpoint given as a symbolic link is the file it leads to, which its writes replace: locked
+// there (a lock per name let a render given the link and one given the target write one file, and
+// remove each other's write in progress as a stale temporary), and removed there once the output
+// is written (the link was removed, and the finished checkpoint stayed for a later render of the
+// target to resume from).
+TEST(Checkpoint, ASymbolicLinkIsTheCheckpointItLeadsTo) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string real = dir + "/real/ck.exr", link = dir + "/link.exr", out = dir + "/out.exr";
+  fs::create_directory(dir + "/real");
+  fs::create_symlink("real/ck.exr", link);
+  const std::string live = dir + "/real/.ck.exr.tmp-999999-0";  // the other render's write
+  lucent::test::write_file(live, "in progress");
+  {
+    // another render given the target holds its lock
+    const int fd = ::open((real + ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+    CommandResult r =
+        run_cli("render " + q(scene) + " -q --spp 8 --checkpoint " + q(link) + " -o " + q(out));
+    ::close(fd);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("link.exr: another render is using this checkpoint (" + real +
+                         ".lock is locked)"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_TRUE(fs::exists(live));
+    EXPECT_FALSE(fs::exists(link + ".lock"));
+  }
+  fs::remove(live);
+  fs::remove(real + ".lock");
+  // a checkpoint of [0, 4) at the target: resumed through the link, then removed there
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:4 -o " + q(real)).status, 0);
+  CommandResult r =
+      run_cli("render " + q(scene) + " --spp 8 --checkpoint " + q(link) + " -o " + q(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("resuming from " + link + ", which holds samples [0, 4)"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(", 8 spp (4 of them from " + link + ")"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(real)) << "the finished checkpoint stayed";
+  EXPECT_FALSE(fs::exists(real + ".lock"));
+  EXPECT_TRUE(fs::is_symlink(link)) << "the link is the user's";
+}
+
 // remove_stale_temporaries removes only the regular files a write of its checkpoint makes: not a
 // symbolic link of such a name (it followed links, and removed one that led to a regular file),
 // nor a directory; names with glob and regex characters are matched as they are.

@@ -23,7 +23,11 @@ namespace lucent::cli {
 
 using io::one_line;
 
-CheckpointLock::CheckpointLock(const std::string& checkpoint) : path_(checkpoint + ".lock") {
+// beside the file the checkpoint's writes replace: a checkpoint given as a symbolic link and as
+// its target is one checkpoint (two locks, one per name, let two renders write it and remove each
+// other's write in progress as a stale temporary file)
+CheckpointLock::CheckpointLock(const std::string& checkpoint)
+    : path_(lucent::io::write_target_path(checkpoint) + ".lock") {
   fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd_ < 0)
     throw lucent::Error(path_ + ": cannot create the checkpoint's lock (" + std::strerror(errno) +
@@ -132,8 +136,15 @@ bool Checkpoint::complete(const lucent::Renderer& renderer, bool stopped) const 
 void Checkpoint::remove() const {
   if (lock_) lock_->remove();
   if (!ours_) return;
+  // the file written, where a symbolic link leads (removing the link left the checkpoint, for a
+  // later render of its target to resume from); the link stays, and a next run writes through it
   std::error_code ec;
-  if (!std::filesystem::remove(path_, ec) && ec)
+  std::string file = path_;
+  try {
+    file = lucent::io::write_target_path(path_);
+  } catch (const lucent::Error&) {
+  }
+  if (!std::filesystem::remove(file, ec) && ec)
     std::fprintf(stderr, "%s: warning: %s: checkpoint not removed (%s)\n", program_.c_str(),
                  one_line(path_).c_str(), ec.message().c_str());
 }

@@ -19,7 +19,8 @@ constexpr double kDefaultCheckpointSeconds = 300;
 
 /// An exclusive lock on `<checkpoint>.lock` for the render's life (flock: a killed render's goes
 /// with it): two renders given one checkpoint wrote over each other's samples, and each run's
-/// work was lost to the other's next write (the checkpoint review).
+/// work was lost to the other's next write (the checkpoint review). A checkpoint that is a
+/// symbolic link is locked where it leads (`<target>.lock`), as the file its writes replace.
 class CheckpointLock {
  public:
   explicit CheckpointLock(const std::string& checkpoint);

@@ -241,6 +241,8 @@ void write_all(int fd, const void* data, std::size_t size, const std::string& pa
   }
 }
 
+std::string write_target_path(const std::string& path) { return write_target(path).string(); }
+
 int remove_stale_temporaries(const std::string& path) {
   std::error_code ec;
   const fs::path target = write_target(path);

@@ -36,6 +36,10 @@ inline void write_file_atomic(const std::string& path, const std::string& bytes)
   write_file_atomic(path, bytes.data(), bytes.size());
 }
 
+/// The file that write_file_atomic(path) replaces: `path`, or where its chain of symbolic links
+/// ends (existing or not). Throws lucent::Error for a loop of links.
+std::string write_target_path(const std::string& path);
+
 /// Removes the temporary files that write_file_atomic(path) leaves behind when it is killed in
 /// the middle of a write (SIGKILL, the OOM killer, a power loss): the names it gives them beside
 /// `path`'s target, ".<name>.tmp-<pid>-<n>", regular files (not a directory or a symbolic link of
