@@ -148,10 +148,13 @@ class Renderer {
   /// lights, the environment map's texel CDF); nothing else is packed, built or uploaded
   /// (stats().camera_moves counts such calls). Falls back to a whole set_scene() (counted as one)
   /// where it cannot: a camera that changes the kernel (an aperture from or to 0 with
-  /// specialisation: the lens code), or after a set_scene() that failed. The film, integrator and
-  /// everything else stay the scene's: change them through set_scene() (a film size also changes
-  /// the session's buffers). Throws lucent::Error without a scene, for an invalid camera (the
-  /// session unchanged) or during a render.
+  /// specialisation: the lens code), or after a set_scene() or set_camera() that failed part-way
+  /// and left the devices without a scene (render() refuses until a call succeeds). A set_scene()
+  /// refused before it changed the devices (a bad scene) leaves the previous scene, whose camera
+  /// this moves as any other. The film, integrator and everything else stay the scene's: change
+  /// them through set_scene() (a film size also changes the session's buffers). Throws
+  /// lucent::Error without a scene, for an invalid camera (the session unchanged) or during a
+  /// render.
   void set_camera(const Camera& camera);
   /// The session's scene. Throws lucent::Error when none was set.
   const Scene& scene() const;
