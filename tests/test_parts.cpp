@@ -1059,6 +1059,33 @@ TEST(Parts, MpiCheckpointOnSomeRanksOnlyIsRefused) {
   }
 }
 
+// Another --spp moves the ranks' shares: rank 1's checkpoint no longer starts at its share and is
+// refused, with one line. Rank 0, whose checkpoint still fits its share, said first that it was
+// resuming from it (a line for a render that never ran): that is said once every rank agreed.
+TEST(Parts, MpiCheckpointRefusedResumeIsOneLine) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  auto command = [&](const std::string& spp) {
+    return mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " --spp " + spp +
+                  " --time 0.5 -o " + q(dir + "/out.exr") + " --checkpoint " + q(dir + "/ck.exr"));
+  };
+  // --time stops both ranks far short of their shares: each writes its checkpoint
+  CommandResult r = run_shell(command("16000000"), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_TRUE(fs::exists(dir + "/ck.rank0-of-2.exr") && fs::exists(dir + "/ck.rank1-of-2.exr"))
+      << r.err;
+  const std::string bytes1 = lucent::test::read_file(dir + "/ck.rank1-of-2.exr");
+  r = run_shell("timeout 60 env " + command("12000000"), dir);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(lucent_mpi_lines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.find("resuming"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("lucent-mpi: error: rank 1 of 2 ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("ck.rank1-of-2.exr: holds samples [8000000, "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("not a checkpoint's [6000000, K)"), std::string::npos) << r.err;
+  EXPECT_EQ(lucent::test::read_file(dir + "/ck.rank1-of-2.exr"), bytes1);
+}
+
 // A rank whose checkpoint write fails (a full disk; here a file size limit on rank 1 alone, under
 // the 10 MB of its 400x400 checkpoint) warns and goes on; rank 0's last line names the samples the
 // checkpoints hold, not the output's (it said they held rank 1's samples, in no file).

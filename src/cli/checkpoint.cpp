@@ -191,15 +191,20 @@ bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer
   return complete;
 }
 
+void say_resumed(const Checkpoint& ck) {
+  if (!ck.resumed()) return;
+  std::fprintf(stderr, "%s: resuming from %s, which holds samples [%llu, %llu)\n",
+               ck.program().c_str(), one_line(ck.path()).c_str(),
+               static_cast<unsigned long long>(ck.begin()),
+               static_cast<unsigned long long>(ck.first_sample()));
+}
+
 bool resume_from(Checkpoint& ck, lucent::Renderer& renderer, std::uint64_t& spp, bool quiet) {
   const std::uint64_t begin = ck.begin();
   ck.check(renderer, spp == 0 ? 0 : begin + spp);
   const std::uint64_t first = ck.first_sample();
   renderer.reset(first);  // (as --samples first:N does)
-  if (ck.resumed() && !quiet)
-    std::fprintf(stderr, "%s: resuming from %s, which holds samples [%llu, %llu)\n",
-                 ck.program().c_str(), one_line(ck.path()).c_str(),
-                 static_cast<unsigned long long>(begin), static_cast<unsigned long long>(first));
+  if (!quiet) say_resumed(ck);
   if (spp == 0) return true;  // a time limit alone: as long again
   spp = begin + spp - first;
   return spp > 0;

@@ -112,8 +112,12 @@ bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer
                        lucent::RenderResult& r, bool stopped);
 
 /// Before rendering, with a checkpoint: checks it against the session, starts the session after
-/// its samples and makes `spp` (N - B) the samples left; false when none is.
+/// its samples and makes `spp` (N - B) the samples left; false when none is. Says so (say_resumed)
+/// unless `quiet`.
 bool resume_from(Checkpoint& ck, lucent::Renderer& renderer, std::uint64_t& spp, bool quiet);
+
+/// "<program>: resuming from <path>, which holds samples [B, K)", when the checkpoint was read.
+void say_resumed(const Checkpoint& ck);
 
 /// The host memory a checkpoint needs beside the session, for a width x height film: a
 /// checkpoint's part (the session's sums, added to a resumed render's checkpoint, itself held

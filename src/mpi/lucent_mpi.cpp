@@ -326,7 +326,11 @@ int run(const Args& a) {
   // a checkpoint of another image, of other samples (another --spp) or of more than the rank's
   // share: refused before rendering; else the rank starts after its samples
   std::uint64_t todo = range.end - range.begin;
-  if (ck && refused([&] { lucent::cli::resume_from(*ck, renderer, todo, a.quiet); })) return 1;
+  if (ck && refused([&] { lucent::cli::resume_from(*ck, renderer, todo, /*quiet=*/true); }))
+    return 1;
+  // said once every rank has accepted its checkpoint: a rank said it resumed, then another rank's
+  // refusal ended the job
+  if (ck && !a.quiet) lucent::cli::say_resumed(*ck);
   const std::uint64_t resumed = ck ? ck->first_sample() - range.begin : 0;
   const bool tty = isatty(STDERR_FILENO);
   double last = -10;
