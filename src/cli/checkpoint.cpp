@@ -80,7 +80,9 @@ void Checkpoint::check(const lucent::Renderer& renderer, std::uint64_t target) {
   if (have.size() > 1 || (have.size() == 1 && have[0].begin != begin_))
     throw lucent::Error(path_ + ": holds samples " + lucent::ranges_text(have) +
                         ", not a checkpoint's [" + std::to_string(begin_) +
-                        ", K) (a part of `lucent render --samples`?)");
+                        ", K) (a part of `lucent render --samples`, or a lucent-mpi rank's "
+                        "checkpoint: of another rank, or of another --spp, which moves the ranks' "
+                        "shares?)");
   lucent::PartMerger merger;  // (the session's part holds no sample yet)
   merger.add_header(scene_, lucent::make_part(renderer, requested(renderer), scene_).info);
   merger.check(path_, old_->info);
