@@ -41,12 +41,12 @@ inline void write_file_atomic(const std::string& path, const std::string& bytes)
 std::string write_target_path(const std::string& path);
 
 /// Removes the temporary files that write_file_atomic(path) leaves behind when it is killed in
-/// the middle of a write (SIGKILL, the OOM killer, a power loss): the names it gives them beside
-/// `path`'s target, ".<name>.tmp-<pid>-<n>", regular files (not a directory or a symbolic link of
-/// such a name), and no other file. For a caller that alone writes
-/// `path` (the holder of a checkpoint's lock): a write in progress goes through such a file too.
-/// A name over 128 bytes is left alone (its temporary files carry only its first 128 bytes,
-/// which another name may share). Returns how many were removed; failures are ignored.
+/// the middle of a write (SIGKILL, the OOM killer, a power loss): the regular files of the names
+/// it gives them beside `path`'s target, ".<name>.tmp-<pid>-<n>" (not a directory or a symbolic
+/// link of such a name), and no other file. For a caller that alone writes `path` (the holder of
+/// a checkpoint's lock): a write in progress goes through such a file too. A name over 128 bytes
+/// is left alone (its temporary files carry only its first 128 bytes, which another name may
+/// share). Returns how many were removed; failures are ignored.
 int remove_stale_temporaries(const std::string& path);
 
 /// Writes all `size` bytes to the open descriptor `fd` (retrying short writes and EINTR);
