@@ -200,7 +200,7 @@ TEST(BvhBuild, NonFinitePrimitivesStayOutAndTheOthersKeepTheirBoxes) {
       EXPECT_GE(nd.bmax[0], s.center[0] + s.radius) << "sphere at " << s.center[0];
     }
   // only NaN: an empty tree
-  EXPECT_TRUE(lucent::bvh::build_binary({}, {sphere(nan, 1)}).nodes.empty());
+  EXPECT_TRUE(lucent::bvh::build_binary({}, std::vector<lc_sphere>{sphere(nan, 1)}).nodes.empty());
 }
 
 TEST(BvhBuild, OnePrimitiveIsARootLeaf) {

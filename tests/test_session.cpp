@@ -3,9 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <functional>
+#include <iterator>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -1285,12 +1289,11 @@ TEST(Session, CancelBetweenTheCallsOfAScopeStopsTheNext) {
   EXPECT_EQ(r.spp(), 3u);
 }
 
-// A CPU device's scene buffers of 1 MiB or more live in host blocks of whole huge pages
-// (device_scene.cpp), each freed when its buffer is deleted; LUCENT_HUGE_PAGES=0 copies them as
-// before, and both render the same images, also after the mesh moved (the new contents written
-// into the blocks in place). An icosphere of 20,480 triangles: its triangles and their
-// attributes (1.25 MiB each) take such blocks.
-TEST(Session, LargeSceneBuffersOfACpuDeviceLiveInHugePageBlocks) {
+namespace {
+
+/// An icosphere of 20,480 triangles under a point light: its triangles and their attributes
+/// (1.25 MiB each) are arrays of 1 MiB or more, which live in host blocks (core/host_blocks.hpp).
+Scene icosphere_scene() {
   const lucent::bvh::meshes::IndexedMesh ico = lucent::bvh::meshes::icosphere(5);
   lucent::SceneBuilder b;
   lucent::Film film;
@@ -1308,44 +1311,160 @@ TEST(Session, LargeSceneBuffersOfACpuDeviceLiveInHugePageBlocks) {
   mesh.material = "m";
   b.add_mesh(mesh);
   b.add_light(lucent::point_light({2, 3, 4}, {30, 30, 30}));
-  const Scene scene = b.build();
-  ASSERT_EQ(scene.triangles.size(), 20480u);
+  return b.build();
+}
 
-  // the mesh moved: buffers of the same sizes, written into the blocks in place
-  Scene moved = scene;
-  for (glm::dvec3& p : moved.positions) p.x += 0.25;
+/// Waits for the host blocks alive to come back to `n` (a buffer's block is released by its
+/// destructor callback, which the driver may run late); returns how many are alive.
+int blocks_back_to(int n) {
+  for (int i = 0; i < 100 && lucent::render_detail::huge_page_blocks() != n; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  return lucent::render_detail::huge_page_blocks();
+}
 
+/// The host blocks that one packing of `s` holds.
+int blocks_of_a_packing(const Scene& s) {
   const int before = lucent::render_detail::huge_page_blocks();
-  RenderResult huge, huge_moved;
+  const lucent::render_detail::PackedScene packed = lucent::render_detail::pack_scene(s);
+  return lucent::render_detail::huge_page_blocks() - before;
+}
+
+}  // namespace
+
+// A CPU device's scene buffers of 1 MiB or more are the packed arrays themselves: buffers made
+// with CL_MEM_USE_HOST_PTR over the arrays' host blocks, not copies. They were copied into
+// blocks of their own, so that a large mesh's packed scene was held twice (a 10^6-triangle soup:
+// 346 MB twice). A buffer holds its block: the packing may be freed first, the buffer still
+// reads it (AddressSanitizer would see a use after free), and the block goes with the buffer.
+TEST(Session, CpuDeviceBuffersAreThePackedArrays) {
+  lucent::cl_util::Context ctx{lucent::test::device()};
+  if (!lucent::render_detail::buffers_in_host_memory(ctx.device.device))
+    GTEST_SKIP() << "not a CPU device: " << ctx.device.info.name;
+  const int before = lucent::render_detail::huge_page_blocks();
+  auto packed = std::make_unique<lucent::render_detail::PackedScene>(
+      lucent::render_detail::pack_scene(icosphere_scene()));
+  ASSERT_GE(packed->triangles.size() * sizeof(lc_triangle),
+            lucent::render_detail::kHugePageMinBuffer);
+  ASSERT_GE(packed->tri_attrs.size() * sizeof(lc_triangle_attr),
+            lucent::render_detail::kHugePageMinBuffer);
+  const int held = lucent::render_detail::huge_page_blocks() - before;
+  auto dev = std::make_unique<lucent::render_detail::DeviceScene>(ctx, *packed);
+  EXPECT_EQ(dev->triangles.getInfo<CL_MEM_HOST_PTR>(),
+            static_cast<void*>(packed->triangles.data()));
+  EXPECT_EQ(dev->tri_attrs.getInfo<CL_MEM_HOST_PTR>(),
+            static_cast<void*>(packed->tri_attrs.data()));
+  EXPECT_EQ(lucent::render_detail::huge_page_blocks() - before, held) << "no block of their own";
+
+  const std::vector<lc_triangle> triangles(packed->triangles.begin(), packed->triangles.end());
+  packed.reset();
+  EXPECT_EQ(lucent::render_detail::huge_page_blocks() - before, 2) << "the buffers hold theirs";
+  std::vector<lc_triangle> read(triangles.size());
+  ctx.queue.enqueueReadBuffer(dev->triangles, CL_TRUE, 0, read.size() * sizeof(lc_triangle),
+                              read.data());
+  EXPECT_EQ(std::memcmp(read.data(), triangles.data(), read.size() * sizeof(lc_triangle)), 0);
+  dev.reset();
+  ctx.queue.finish();
+  EXPECT_EQ(blocks_back_to(before), before);
+}
+
+// set_scene on a CPU device: the arrays that did not change keep their storage (the buffers
+// share it), those that changed get buffers over the new arrays. Materials, then the light,
+// then the geometry (the triangles move, their attributes stay), an injected upload failure,
+// and the first scene again: each renders, bit for bit, what a fresh session renders, and the
+// session holds the host blocks of one packing, not of two (a kept buffer over the previous
+// array while the session held the new, equal one). LUCENT_HUGE_PAGES=0 (no huge-page advice)
+// renders the same.
+TEST(Session, SetSceneSequencesOnSharedBuffersRenderAsAFreshSession) {
+  const Scene first = icosphere_scene();
+  Scene materials = first;
+  materials.materials[0].albedo = glm::dvec3(0.8, 0.3, 0.2);
+  Scene light = materials;
+  light.lights[0].position = glm::dvec3(-2, 3, 4);
+  Scene moved = light;
+  for (glm::dvec3& p : moved.positions) p.x += 0.25;
+  struct Step {
+    const char* what;
+    const Scene* scene;
+    bool fault;
+  };
+  const Step steps[] = {{"first", &first, false}, {"materials", &materials, false},
+                        {"light", &light, false}, {"moved", &moved, false},
+                        {"fault", &first, true},  {"moved again", &moved, false}};
+  const int before = lucent::render_detail::huge_page_blocks();
+  const int one = blocks_of_a_packing(first);
+  ASSERT_GE(one, 2) << "the triangles and their attributes at least";
+  EXPECT_EQ(blocks_of_a_packing(moved), one);
+  std::vector<RenderResult> fresh;
+  for (const Step& st : steps) {
+    Renderer f = session();
+    f.set_scene(*st.scene);
+    f.render(3);
+    fresh.push_back(f.result());
+  }
+  EXPECT_FALSE(same_image(fresh[0], fresh[1])) << "the materials changed";
+  EXPECT_FALSE(same_image(fresh[1], fresh[2])) << "the light moved";
+  EXPECT_FALSE(same_image(fresh[2], fresh[3])) << "the mesh moved";
+  ASSERT_EQ(blocks_back_to(before), before);
   {
     Renderer r = session();
-    r.set_scene(scene);
-    r.render(4);
-    huge = r.result();
-    const lucent::DeviceInfo d = r.devices().at(0);  // devices() returns a copy
-    if (d.type != "CPU") GTEST_SKIP() << "not a CPU device: " << d.name;
-    EXPECT_EQ(lucent::render_detail::huge_page_blocks() - before, 2)
-        << "the triangles and their attributes";
-    r.set_scene(moved);
-    r.render(4);
-    huge_moved = r.result();
-    EXPECT_EQ(lucent::render_detail::huge_page_blocks() - before, 2);
+    const bool cpu = r.devices().at(0).type == "CPU";
+    for (size_t i = 0; i < std::size(steps); ++i) {
+      const Step& st = steps[i];
+      if (st.fault) {
+        lucent::render_detail::ScopedUploadFault fault;
+        Scene other = moved;
+        other.materials[0].albedo = glm::dvec3(0.1, 0.9, 0.1);
+        EXPECT_NE(error_of([&] { r.set_scene(other); }), "");
+        EXPECT_NE(error_of([&] { r.render(1); }), "") << "the devices hold no scene";
+      }
+      r.set_scene(*st.scene);
+      r.render(3);
+      EXPECT_TRUE(same_image(r.result(), fresh[i])) << st.what;
+      if (cpu) {
+        EXPECT_EQ(blocks_back_to(before + one), before + one) << st.what;
+      }
+    }
   }
-  // freed with the session's buffers (by their destructor callbacks, which may run late)
-  for (int i = 0; i < 100 && lucent::render_detail::huge_page_blocks() != before; ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  EXPECT_EQ(lucent::render_detail::huge_page_blocks(), before);
+  EXPECT_EQ(blocks_back_to(before), before) << "freed with the session";
 
   lucent::test::ScopedEnv off("LUCENT_HUGE_PAGES", "0");
-  auto copied = [&](const Scene& sc) {
-    Renderer r = session();
-    r.set_scene(sc);
-    r.render(4);
-    EXPECT_EQ(lucent::render_detail::huge_page_blocks(), before);
-    return r.result();
-  };
-  EXPECT_TRUE(same_image(huge, copied(scene)));
-  EXPECT_TRUE(same_image(huge_moved, copied(moved)));
-  EXPECT_FALSE(same_image(huge, huge_moved)) << "the mesh moved";
-  EXPECT_GT(huge.mean.pixel(8, 6)[0], 0.0f) << "the sphere is lit";
+  Renderer r = session();
+  r.set_scene(moved);
+  r.render(3);
+  EXPECT_TRUE(same_image(r.result(), fresh[3]));
+}
+
+// Two CPU devices in one session ("0,0": two contexts) make buffers over the same arrays, read
+// only: the session holds one packing's blocks, and after set_scene both render the new scene
+// (the samples of a one-device render, up to float summation order).
+TEST(Session, TwoCpuDevicesShareThePackedArrays) {
+  lucent::SessionOptions o = lucent::test::session_options();
+  std::string one_device = std::to_string(lucent::select_device(o.device).index);
+  o.device = one_device + "," + one_device;
+  o.pass_seconds = 1e-4;  // many small passes, so that both devices take some
+  const Scene first = icosphere_scene();
+  Scene moved_scene = first;
+  for (glm::dvec3& p : moved_scene.positions) p.y += 0.25;
+  const Scene& moved = moved_scene;
+  const int before = lucent::render_detail::huge_page_blocks();
+  const int one = blocks_of_a_packing(first);
+  {
+    Renderer both(o);
+    ASSERT_EQ(both.devices().size(), 2u);
+    const bool cpu = both.devices().at(0).type == "CPU";
+    for (const Scene* sc : {&first, &moved}) {
+      both.set_scene(*sc);
+      lucent::RenderProgress p = both.render(16);
+      EXPECT_GT(p.devices[0].samples, 0u);
+      EXPECT_GT(p.devices[1].samples, 0u);
+      if (cpu) {
+        EXPECT_EQ(blocks_back_to(before + one), before + one);
+      }
+      Renderer single = session();
+      single.set_scene(*sc);
+      single.render(16);
+      expect_same_samples(both.result(), single.result());
+    }
+  }
+  EXPECT_EQ(blocks_back_to(before), before);
 }

@@ -4,13 +4,16 @@
 // to a whole set_scene where the kernel or the devices' buffers need one.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "lucent/scene_builder.hpp"
 #include "lucent/session.hpp"
+#include "render/device_scene.hpp"
 #include "render/pack.hpp"
 #include "render/resources.hpp"
 #include "support.hpp"
@@ -144,6 +147,48 @@ TEST(SessionCamera, EnvironmentLightTableFollowsTheCamera) {
   EXPECT_EQ(r.stats().buffer_uploads, moved.buffer_uploads);
   r.render(2);
   EXPECT_TRUE(same_image(r.result(), fresh_render(with_camera(s, around), 2)));
+}
+
+// The same with a large environment map (512 x 512: its texels, 4 MiB, and its light table,
+// 1 MiB, are host blocks that a CPU device's buffers share, core/host_blocks.hpp): a move that
+// changes the table makes buffers over the new arrays, and the session holds one light table,
+// not the previous one beside it (a kept buffer over the array the session replaced).
+TEST(SessionCamera, LargeLightTableIsHeldOnce) {
+  Scene s = base_scene();
+  lucent::Texture t;
+  t.width = t.height = 512;
+  t.rgba.reserve(size_t(t.width) * t.height * 4);
+  for (int i = 0; i < t.width * t.height; ++i)
+    t.rgba.insert(t.rgba.end(), {0.2f + float(i % 7) * 0.1f, 0.3f, 0.2f + float(i % 5) * 0.1f, 1});
+  s.textures.push_back(t);
+  s.lights.push_back(lucent::environment_map(static_cast<int>(s.textures.size()) - 1, 0.5));
+  Camera nearer = s.camera;
+  nearer.position = {0, 1, 2};
+  const lucent::render_detail::PackedScene a = lucent::render_detail::pack_scene(s);
+  const lucent::render_detail::PackedScene b =
+      lucent::render_detail::pack_scene(with_camera(s, nearer));
+  ASSERT_GE(a.light_cdf.size() * sizeof(float), lucent::render_detail::kHugePageMinBuffer);
+  ASSERT_NE(a.light_cdf, b.light_cdf) << "the test's premise: the light table changes";
+  Camera around = nearer;
+  around.position = {2, 1, 0};  // the same distance: the table stays
+
+  const int before = lucent::render_detail::huge_page_blocks();
+  Renderer r = session();
+  r.set_scene(s);
+  r.render(1);
+  const bool cpu = r.devices().at(0).type == "CPU";
+  const int held = lucent::render_detail::huge_page_blocks() - before;
+  for (const Camera& c : {nearer, around, s.camera}) {
+    r.set_camera(c);
+    r.render(2);
+    EXPECT_TRUE(same_image(r.result(), fresh_render(with_camera(s, c), 2)));
+    // (a released buffer's block goes with its destructor callback, which may run late)
+    for (int i = 0; i < 100 && lucent::render_detail::huge_page_blocks() - before != held; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (cpu) {
+      EXPECT_EQ(lucent::render_detail::huge_page_blocks() - before, held);
+    }
+  }
 }
 
 // A bad camera is refused with set_scene's message, at the same place; the session keeps its

@@ -4,9 +4,23 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/host_blocks.hpp"
 #include "shared/types.h"
 
 namespace lucent::bvh {
+
+/// A read-only view of the primitives of a std::vector or a sys::HostVector (the packed scene's).
+template <class T>
+struct Span {
+  const T* ptr = nullptr;
+  std::size_t n = 0;
+  Span() = default;
+  template <class A>
+  Span(const std::vector<T, A>& v) : ptr(v.data()), n(v.size()) {}  // NOLINT: implicit
+  std::size_t size() const { return n; }
+  bool empty() const { return n == 0; }
+  const T& operator[](std::size_t i) const { return ptr[i]; }
+};
 
 struct BuildOptions {
   /// A leaf is forced to split above this many primitives (clamped to 1..LC_BVH_LEAF_MAX).
@@ -60,27 +74,28 @@ struct Bvh2 {
 
 /// The tree the kernel walks: wide nodes and leaf blocks (kernels/shared/types.h), depth-first.
 struct Bvh {
-  std::vector<lc_bvh_node> nodes;  ///< nodes[0] is the root; empty when there is no primitive
+  /// nodes[0] is the root; empty when there is no primitive. (Host vectors, as the packed scene's
+  /// arrays: pack_scene moves them there.)
+  sys::HostVector<lc_bvh_node> nodes;
   /// Leaf blocks, in the order the collapse meets the leaves; they hold the primitive references
   /// (triangle index, or sphere index | LC_PRIM_SPHERE_BIT).
-  std::vector<lc_bvh_leaf> leaves;
+  sys::HostVector<lc_bvh_leaf> leaves;
   float bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0};  ///< bounds of the scene (0 when empty)
   BuildStats stats;
 };
 
 /// Builds the binary SAH tree over `triangles` then `spheres`.
-Bvh2 build_binary(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere>& spheres,
+Bvh2 build_binary(Span<lc_triangle> triangles, Span<lc_sphere> spheres,
                   const BuildOptions& options = {});
 
 /// Collapses a binary tree built over `triangles` (then spheres) into wide nodes: each wide node
 /// is made from an interior binary node, opened, and takes as its children (at most LC_BVH_WIDTH)
 /// the descendants that give the wide tree the least SAH cost (bvh_wide.cpp). Each leaf becomes
 /// 1 to 4 consecutive leaf blocks holding the vertices of its triangles.
-Bvh collapse(const Bvh2& binary, const std::vector<lc_triangle>& triangles);
+Bvh collapse(const Bvh2& binary, Span<lc_triangle> triangles);
 
 /// build_binary, then collapse.
-Bvh build(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere>& spheres,
-          const BuildOptions& options = {});
+Bvh build(Span<lc_triangle> triangles, Span<lc_sphere> spheres, const BuildOptions& options = {});
 
 /// SAH cost of a binary tree (same convention as BuildStats::sah_cost).
 double sah_cost(const std::vector<Node2>& nodes);

@@ -48,8 +48,7 @@ double sah_cost(const std::vector<Node2>& nodes) {
   return cost;
 }
 
-Bvh2 build_binary(const std::vector<lc_triangle>& tris, const std::vector<lc_sphere>& spheres,
-                  const BuildOptions& options_in) {
+Bvh2 build_binary(Span<lc_triangle> tris, Span<lc_sphere> spheres, const BuildOptions& options_in) {
   auto t0 = std::chrono::steady_clock::now();
   BuildOptions options = options_in;
   options.max_leaf_size = std::min(std::max(options.max_leaf_size, 1), int(LC_BVH_LEAF_MAX));
@@ -179,8 +178,7 @@ Bvh2 build_binary(const std::vector<lc_triangle>& tris, const std::vector<lc_sph
   return out;
 }
 
-Bvh build(const std::vector<lc_triangle>& triangles, const std::vector<lc_sphere>& spheres,
-          const BuildOptions& options) {
+Bvh build(Span<lc_triangle> triangles, Span<lc_sphere> spheres, const BuildOptions& options) {
   Bvh2 b = build_binary(triangles, spheres, options);
   double binary_seconds = b.stats.seconds;
   auto t0 = std::chrono::steady_clock::now();

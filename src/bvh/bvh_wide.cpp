@@ -117,7 +117,7 @@ class OptimalCollapse {
 
 }  // namespace
 
-Bvh collapse(const Bvh2& b, const std::vector<lc_triangle>& triangles) {
+Bvh collapse(const Bvh2& b, Span<lc_triangle> triangles) {
   Bvh out;
   out.stats = b.stats;
   out.stats.binary_nodes = b.stats.nodes;

@@ -24,7 +24,7 @@ constexpr double kLattice = 16777216.0;  // 2^24
 
 /// Appends the lattice CDF of the weights `w` (non-negative, summing to `total` > 0): entry i is
 /// the running sum rounded to the lattice, kept non-decreasing; the last is 1.
-void append_lattice_cdf(const std::vector<double>& w, double total, std::vector<float>& cdf) {
+void append_lattice_cdf(const std::vector<double>& w, double total, sys::HostVector<float>& cdf) {
   double run = 0;
   std::uint32_t prev = 0;
   for (size_t i = 0; i < w.size(); ++i) {
@@ -41,7 +41,7 @@ void append_lattice_cdf(const std::vector<double>& w, double total, std::vector<
 /// The texel CDF of an environment map (luminance x sin(theta), n + 1 entries from 0 to 1, on
 /// the lattice), appended to `cdf`. A texel whose share is below a lattice step may get
 /// none: light sampling then never picks it, its pdf is 0, and BSDF sampling alone covers it.
-void append_env_map_cdf(const Texture& t, std::vector<float>& cdf) {
+void append_env_map_cdf(const Texture& t, sys::HostVector<float>& cdf) {
   std::vector<double> w(static_cast<size_t>(t.width) * t.height);
   double total_w = 0;
   for (int y = 0; y < t.height; ++y) {

@@ -571,6 +571,8 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   // silently written
   for (const std::string& note : scene_detail::light_notes(scene)) scene_detail::warn(note);
 
+  // reserved: a large array's capacity is the block it holds (and a CPU device shares)
+  p.texels.reserve(static_cast<std::size_t>(texels));
   for (const Texture& t : scene.textures) {
     lc_texture d{};
     d.offset = static_cast<lc_uint>(p.texels.size());

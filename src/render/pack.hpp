@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "bvh/bvh.hpp"
+#include "core/host_blocks.hpp"
 #include "lucent/scene.hpp"
 #include "render/features.hpp"
 #include "shared/types.h"
@@ -16,7 +17,9 @@ inline double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.
 
 struct PackedScene {
   lc_params params{};
-#define LUCENT_PACKED_BUFFER(name, type, ...) std::vector<type> name;
+  // host vectors: a large one's storage is a host block, which a CPU device's buffer shares
+  // (device_scene.hpp's read_only_buffer): the scene's arrays are held once on such a device
+#define LUCENT_PACKED_BUFFER(name, type, ...) sys::HostVector<type> name;
   LC_SCENE_BUFFERS(LUCENT_PACKED_BUFFER)
 #undef LUCENT_PACKED_BUFFER
   bvh::BuildStats bvh_stats;
@@ -93,8 +96,8 @@ struct CameraPacking {
   /// The light table for the new camera, when it differs from packed's (environment lights
   /// weighed over a new environment_radius); else lights_changed is false and both are empty.
   bool lights_changed = false;
-  std::vector<lc_light> lights;
-  std::vector<float> light_cdf;
+  sys::HostVector<lc_light> lights;
+  sys::HostVector<float> light_cdf;
 };
 
 /// The camera-dependent part of pack_scene for `camera`, from `packed` = pack_scene(scene) without

@@ -563,6 +563,8 @@ struct Renderer::Impl {
     const size_t n = static_cast<size_t>(s.film.width) * s.film.height;
     for (const render_detail::DeviceLimits& l : limits)
       render_detail::check_device_memory(s, next, l);
+    // which buffers differ from what the devices hold, compared once for all of them
+    const unsigned changes = uploaded ? render_detail::scene_changes(packed, next) : ~0u;
     std::string device;  // the one being set up, and what it does, for messages
     render_detail::ClStage stage = render_detail::ClStage::Upload;
     bool touched = false;
@@ -593,7 +595,7 @@ struct Renderer::Impl {
           LC_SCENE_BUFFERS(LUCENT_BYTES)
 #undef LUCENT_BYTES
         } else {
-          render_detail::DeviceScene::Upload up = w.dev->update(w.ctx, packed, next);
+          render_detail::DeviceScene::Upload up = w.dev->update(w.ctx, changes, next);
           stats.buffer_uploads += up.buffers;
           stats.bytes_uploaded += up.bytes;
         }
@@ -645,6 +647,9 @@ struct Renderer::Impl {
     }
     if (!built) ++stats.kernel_reuses;  // once per call, whatever the number of devices
     stale.clear();
+    // the arrays that did not change keep the storage that the CPU devices' buffers share (the
+    // others' buffers were made over next's): the scene's arrays are held once
+    if (uploaded) render_detail::keep_unchanged_storage(packed, next, changes);
     packed = std::move(next);
     build_options = opts;
     npix = n;
@@ -743,12 +748,14 @@ struct Renderer::Impl {
     const bool keep =
         !next.lights_changed && std::memcmp(&next.params, &packed.params, sizeof(lc_params)) == 0;
     if (next.lights_changed) {
+      // the array that did not change keeps its storage, which the CPU devices' buffers share
+      const unsigned changes = render_detail::light_changes(packed, next.lights, next.light_cdf);
       std::string device;
       try {
         for (auto& w : workers) {
           device = w->ctx.device.info.name;
           const render_detail::DeviceScene::Upload up =
-              w->dev->update_lights(w->ctx, packed, next.lights, next.light_cdf);
+              w->dev->update_lights(w->ctx, changes, next.lights, next.light_cdf);
           stats.buffer_uploads += up.buffers;
           stats.bytes_uploaded += up.bytes;
           if (render_detail::upload_fault())
@@ -765,8 +772,10 @@ struct Renderer::Impl {
         drop_device_scenes(e.what());
         throw;
       }
-      packed.lights = std::move(next.lights);
-      packed.light_cdf = std::move(next.light_cdf);
+      if (changes & render_detail::kBufferBit(render_detail::lights_index))
+        packed.lights = std::move(next.lights);
+      if (changes & render_detail::kBufferBit(render_detail::light_cdf_index))
+        packed.light_cdf = std::move(next.light_cdf);
     }
     // the launch parameters go to the devices with each pass (Worker::launch)
     packed.params = next.params;

@@ -12,10 +12,10 @@ namespace lucent::bvh {
 
 namespace {
 
-template <class T>
-cl::Buffer upload(const cl_util::Context& ctx, const std::vector<T>& v) {
-  // made as the renderer's (huge pages on a CPU device when large, render/device_scene.cpp), which
-  // copy the data; OpenCL refuses empty buffers: keep one zeroed element
+template <class T, class A>
+cl::Buffer upload(const cl_util::Context& ctx, const std::vector<T, A>& v) {
+  // made as the renderer's (on a CPU device, when large, over the array's host block or a copy
+  // in a new one, render/device_scene.cpp); OpenCL refuses empty buffers: keep one zeroed element
   const T zero{};
   return v.empty() ? render_detail::read_only_buffer(ctx, &zero, sizeof(T))
                    : render_detail::read_only_buffer(ctx, v.data(), v.size() * sizeof(T));

@@ -1,0 +1,100 @@
+#include "core/host_blocks.hpp"
+
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <unordered_map>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+namespace lucent::sys {
+
+namespace {
+
+struct Block {
+  std::size_t bytes = 0;  ///< what it holds (a multiple of kHugePageBytes)
+  int refs = 0;
+};
+
+/// The live blocks by address. Never destroyed: an OpenCL driver may release a buffer, and with
+/// it a block, from its own thread as the process exits.
+struct Registry {
+  std::mutex mutex;
+  std::unordered_map<const void*, Block> blocks;
+  std::uint64_t bytes = 0;
+};
+Registry& registry() {
+  static Registry* r = new Registry;
+  return *r;
+}
+
+bool huge_pages_wanted() {
+  const char* e = std::getenv("LUCENT_HUGE_PAGES");
+  return !(e && std::strcmp(e, "0") == 0);
+}
+
+}  // namespace
+
+std::uint64_t host_block_bytes(std::uint64_t bytes) {
+  if (bytes < kHugePageMinBuffer) return bytes;
+  return (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+}
+
+void* allocate_host_block(std::size_t bytes) {
+  const std::size_t size = host_block_bytes(bytes);
+  void* p = std::aligned_alloc(kHugePageBytes, size);
+  if (!p) return nullptr;
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  // before the first touch, so that the pages are huge as they are faulted in; advice only:
+  // refused, the block keeps ordinary pages
+  if (huge_pages_wanted()) madvise(p, size, MADV_HUGEPAGE);
+#endif
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  try {
+    r.blocks.emplace(p, Block{size, 1});
+  } catch (...) {
+    std::free(p);
+    return nullptr;
+  }
+  r.bytes += size;
+  return p;
+}
+
+bool retain_host_block(const void* p, std::size_t bytes) {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  auto it = r.blocks.find(p);
+  if (it == r.blocks.end() || it->second.bytes < bytes) return false;
+  ++it->second.refs;
+  return true;
+}
+
+void release_host_block(void* p) {
+  if (!p) return;
+  Registry& r = registry();
+  {
+    std::lock_guard<std::mutex> lock(r.mutex);
+    auto it = r.blocks.find(p);
+    if (it == r.blocks.end()) std::abort();  // not a block: a bug, not a case to go on with
+    if (--it->second.refs > 0) return;
+    r.bytes -= it->second.bytes;
+    r.blocks.erase(it);
+  }
+  std::free(p);
+}
+
+int host_blocks() {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  return static_cast<int>(r.blocks.size());
+}
+
+std::uint64_t host_block_total() {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  return r.bytes;
+}
+
+}  // namespace lucent::sys
