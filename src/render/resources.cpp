@@ -122,7 +122,7 @@ std::uint32_t counter_start() { return g_counter_start.load(); }
 namespace {
 
 struct PackedSizes {
-  std::uint64_t ntri = 0, nsph = 0, tri_bytes = 0, sph_bytes = 0, tex_bytes = 0;
+  std::uint64_t ntri = 0, nsph = 0, sph_bytes = 0, tex_bytes = 0;
 };
 
 // the packed scene (pack.cpp): a triangle and its attributes, a sphere, a texel as float4, and
@@ -131,7 +131,6 @@ PackedSizes packed_sizes(const Scene& scene) {
   PackedSizes z;
   z.ntri = scene.triangles.size();
   z.nsph = scene.spheres.size();
-  z.tri_bytes = z.ntri * (sizeof(lc_triangle) + sizeof(lc_triangle_attr));
   z.sph_bytes = z.nsph * sizeof(lc_sphere);
   for (const Texture& t : scene.textures)
     z.tex_bytes += std::uint64_t(t.width) * std::uint64_t(t.height) * sizeof(lc_float4);
@@ -191,28 +190,32 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
   const PackedSizes z = packed_sizes(scene);
   const std::uint64_t ntri = z.ntri, nsph = z.nsph, sph_bytes = z.sph_bytes,
                       tex_bytes = z.tex_bytes;
-  // the BVH: the build's primitive references (32 bytes), binary nodes (at most 2 per primitive)
-  // and primitive indices; then the wide tree's leaf blocks (at most one per primitive: a soup
-  // of separate triangles has leaves of one, a mesh about one block per 2 or 3 primitives) and
-  // nodes (a soup 0.29 per primitive, the dragon 0.06: counted as one per 3)
+  // the BVH: the build's primitive references (32 bytes), binary nodes (at most 2 per primitive,
+  // twice: the scratch tree and its depth-first copy are held together as it is flattened,
+  // bvh_build.cpp), primitive indices and kept flags; then the wide tree's leaf blocks (at most one
+  // per primitive: a soup of separate triangles has leaves of one, a mesh about one block per 2 or
+  // 3 primitives) and nodes (a soup 0.29 per primitive, the dragon 0.06: counted as one per 3)
   const std::uint64_t nprim = ntri + nsph;
   const std::uint64_t leaf_bytes = (nprim + 1) * sizeof(lc_bvh_leaf);
   const std::uint64_t node_bytes = (nprim / 3 + 1) * sizeof(lc_bvh_node);
   const std::uint64_t bvh_tree = leaf_bytes + node_bytes;
   const std::uint64_t bvh_bytes =
-      nprim * (32 + 2 * sizeof(bvh::Node2) + sizeof(lc_uint)) + bvh_tree;
-  parts.push_back(
-      {"the " + std::to_string(ntri) + " triangles", z.tri_bytes, "the number of triangles"});
-  parts.push_back({"the " + std::to_string(nsph) + " spheres", sph_bytes, "the number of spheres"});
+      nprim * (32 + 4 * sizeof(bvh::Node2) + sizeof(lc_uint) + 1) + bvh_tree;
+  // the packed arrays: each of 1 MiB or more takes whole huge pages (core/host_blocks.hpp). A CPU
+  // device's scene buffers are those arrays themselves (device_scene.hpp's read_only_buffer), so
+  // they are counted once whatever the devices; another device's are in its own memory.
+  parts.push_back({"the " + std::to_string(ntri) + " triangles",
+                   host_block_bytes(ntri * sizeof(lc_triangle)) +
+                       host_block_bytes(ntri * sizeof(lc_triangle_attr)),
+                   "the number of triangles"});
+  parts.push_back({"the " + std::to_string(nsph) + " spheres", host_block_bytes(sph_bytes),
+                   "the number of spheres"});
   parts.push_back({"the texels of the " + std::to_string(scene.textures.size()) + " textures",
-                   tex_bytes, "the textures' resolution"});
-  parts.push_back({"the BVH of " + std::to_string(nprim) + " primitives", bvh_bytes,
-                   "the number of triangles and spheres"});
-  // on a CPU device each large buffer takes whole huge pages (device_scene.cpp)
-  std::uint64_t scene_buffers = 0;
-  for (std::uint64_t b : {ntri * sizeof(lc_triangle), ntri * sizeof(lc_triangle_attr), sph_bytes,
-                          tex_bytes, leaf_bytes, node_bytes})
-    scene_buffers += host_block_bytes(b);
+                   host_block_bytes(tex_bytes), "the textures' resolution"});
+  parts.push_back(
+      {"the BVH of " + std::to_string(nprim) + " primitives",
+       bvh_bytes - bvh_tree + host_block_bytes(leaf_bytes) + host_block_bytes(node_bytes),
+       "the number of triangles and spheres"});
   for (const DeviceLimits& d : devices) {
     // the device's pass sums (double4 with fp64, else float4; with caustics twice as many, the
     // light paths' totals after them) and with caustics its light sums (double4 with fp64 and
@@ -221,18 +224,15 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
     const std::uint64_t light_elem = d.light_double ? sizeof(cl_double4) : sizeof(cl_float4);
     const std::uint64_t light_bufs = (caustics ? 4 : 0) * npix * light_elem;
     const std::uint64_t film_bufs = (caustics ? 4 : 2) * npix * sum_elem + light_bufs;
-    // a CPU device's buffers are host memory: the film's (and the work list), and the scene's;
-    // its pass results are mapped there (session.cpp). Another device's results are read back
-    // into host copies as large as its buffers (h_sum, h_sumsq, and with caustics h_light,
-    // h_lightsq).
+    // a CPU device's buffers are host memory: the film's (and the work list), and the scene's
+    // (the packed arrays, counted above); its pass results are mapped there (session.cpp).
+    // Another device's results are read back into host copies as large as its buffers (h_sum,
+    // h_sumsq, and with caustics h_light, h_lightsq).
     std::uint64_t bytes = film_bufs;
     if (d.host_unified) bytes += npix * sizeof(cl_uint4);
     parts.push_back({"the buffers of device '" + d.device + "' for the " + film + " film" +
                          (d.host_unified ? " (host memory)" : ""),
                      bytes, "the film size"});
-    if (d.host_unified)
-      parts.push_back({"the scene's buffers on device '" + d.device + "' (host memory)",
-                       scene_buffers, "the number of triangles or the textures' resolution"});
   }
   return parts;
 }
