@@ -32,32 +32,41 @@ void parallel_for(std::size_t n, unsigned threads, F f) {
   for (auto& t : pool) t.join();
 }
 
+double node_area(const Node2& n) {
+  double d[3];
+  for (int a = 0; a < 3; ++a) d[a] = std::max(0.0, double(n.bmax[a]) - n.bmin[a]);
+  return 2 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
+}
+
+double sah_term(const Node2& n, double root) {
+  return node_area(n) / root * (n.count ? double(n.count) : 1.0);
+}
+
 }  // namespace
 
 double sah_cost(const std::vector<Node2>& nodes) {
   if (nodes.empty()) return 0;
-  auto area = [](const Node2& n) {
-    double d[3];
-    for (int a = 0; a < 3; ++a) d[a] = std::max(0.0, double(n.bmax[a]) - n.bmin[a]);
-    return 2 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
-  };
-  double root = area(nodes[0]);
+  double root = node_area(nodes[0]);
   if (root <= 0) return 0;
   double cost = 0;
-  for (const auto& n : nodes) cost += area(n) / root * (n.count ? double(n.count) : 1.0);
+  for (const auto& n : nodes) cost += sah_term(n, root);
   return cost;
 }
 
-Bvh2 build_binary(Span<lc_triangle> tris, Span<lc_sphere> spheres, const BuildOptions& options_in) {
-  auto t0 = std::chrono::steady_clock::now();
+namespace detail {
+
+ScratchBuild build_scratch(Span<lc_triangle> tris, Span<lc_sphere> spheres,
+                           const BuildOptions& options_in, unsigned& threads) {
+  ScratchBuild out;
+  out.start = std::chrono::steady_clock::now();
   BuildOptions options = options_in;
   options.max_leaf_size = std::min(std::max(options.max_leaf_size, 1), int(LC_BVH_LEAF_MAX));
-  Bvh2 out;
   const std::size_t nt = tris.size(), n = nt + spheres.size();
   out.stats.primitives = n;
+  threads = 1;
   if (n == 0) return out;
-  unsigned threads = options.threads > 0 ? static_cast<unsigned>(options.threads)
-                                         : std::max(1u, std::thread::hardware_concurrency());
+  threads = options.threads > 0 ? static_cast<unsigned>(options.threads)
+                                : std::max(1u, std::thread::hardware_concurrency());
 
   // primitive bounds, and the root's bounds and centroid bounds, one slice per thread. A
   // primitive whose bounds are not finite (a NaN sphere, which validate_scene allows: it is never
@@ -121,11 +130,50 @@ Bvh2 build_binary(Span<lc_triangle> tris, Span<lc_sphere> spheres, const BuildOp
     refs.resize(k);
     if (k == 0) return out;
   }
+  std::vector<char>().swap(kept);
 
-  detail::ScratchTree tree =
-      detail::build_sah_tree(refs, box, cbox, options, threads, !spheres.empty());
-  const std::size_t count = tree.count;
-  const Node2* tmp = tree.nodes.get();
+  out.tree = build_sah_tree(refs, box, cbox, options, threads, !spheres.empty());
+  // the references' order is all that is left of them (32 bytes a primitive: gone before the
+  // tree is flattened or collapsed)
+  out.prim_refs.resize(refs.size());
+  parallel_for(refs.size(), threads, [&](std::size_t b, std::size_t e, unsigned) {
+    for (std::size_t i = b; i < e; ++i) out.prim_refs[i] = refs[i].id();
+  });
+  std::vector<PrimRef>().swap(refs);
+  out.stats.nodes = out.tree.count;
+  out.stats.max_depth = out.tree.max_depth;
+  return out;
+}
+
+double scratch_sah_cost(const Node2* nodes) {
+  const double root = node_area(nodes[0]);
+  if (root <= 0) return 0;
+  // the root, then each interior node's children in the order the depth-first copy places them
+  // (its padding node adds 0)
+  double cost = sah_term(nodes[0], root);
+  std::vector<lc_uint> stack{0};
+  while (!stack.empty()) {
+    const Node2& s = nodes[stack.back()];
+    stack.pop_back();
+    if (s.count != 0) continue;
+    cost += sah_term(nodes[s.left_first], root);
+    cost += sah_term(nodes[s.left_first + 1], root);
+    stack.push_back(s.left_first + 1);
+    stack.push_back(s.left_first);
+  }
+  return cost;
+}
+
+}  // namespace detail
+
+Bvh2 build_binary(Span<lc_triangle> tris, Span<lc_sphere> spheres, const BuildOptions& options) {
+  unsigned threads = 1;
+  detail::ScratchBuild sb = detail::build_scratch(tris, spheres, options, threads);
+  Bvh2 out;
+  out.stats = sb.stats;
+  if (sb.tree.count == 0) return out;
+  const std::size_t count = sb.tree.count;
+  const Node2* tmp = sb.tree.nodes.get();
 
   // flatten depth-first: a node's children are adjacent and its left subtree follows them. Node 1
   // is padding (an empty box, never referenced) so that every sibling pair starts at an even
@@ -139,10 +187,7 @@ Bvh2 build_binary(Span<lc_triangle> tris, Span<lc_sphere> spheres, const BuildOp
     pad.left_first = 0;
     pad.count = 0;
   }
-  out.prim_refs.resize(refs.size());
-  parallel_for(refs.size(), threads, [&](std::size_t b, std::size_t e, unsigned) {
-    for (std::size_t i = b; i < e; ++i) out.prim_refs[i] = refs[i].id();
-  });
+  out.prim_refs = std::move(sb.prim_refs);
   struct Item {
     lc_uint src, dst;
   };
@@ -162,29 +207,47 @@ Bvh2 build_binary(Span<lc_triangle> tris, Span<lc_sphere> spheres, const BuildOp
     }
   }
 
-  BuildStats& st = out.stats;
-  st.nodes = count;  // the padding node left out
-  st.max_depth = tree.max_depth;
+  BuildStats& st = out.stats;  // nodes: the padding node left out
   for (const auto& nd : out.nodes)
     if (nd.count) {
       ++st.leaves;
       st.max_leaf_size = std::max<std::size_t>(st.max_leaf_size, nd.count);
     }
-  st.mean_leaf_size = double(refs.size()) / double(st.leaves);
-  st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  st.mean_leaf_size = double(out.prim_refs.size()) / double(st.leaves);
+  st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sb.start).count();
   st.sah_cost = sah_cost(out.nodes);  // not part of the build time
   st.binary_nodes = st.nodes;
   st.binary_max_depth = st.max_depth;
   return out;
 }
 
+// The scratch tree collapsed directly: its depth-first copy (build_binary's) would sit beside it,
+// and the binary tree beside the whole wide tree; the collapse hands back the scratch tree's
+// pages as it leaves them behind. The wide tree is the same as collapse(build_binary(...)).
 Bvh build(Span<lc_triangle> triangles, Span<lc_sphere> spheres, const BuildOptions& options) {
-  Bvh2 b = build_binary(triangles, spheres, options);
-  double binary_seconds = b.stats.seconds;
-  auto t0 = std::chrono::steady_clock::now();
-  Bvh out = collapse(b, triangles);
+  unsigned threads = 1;
+  detail::ScratchBuild sb = detail::build_scratch(triangles, spheres, options, threads);
+  if (sb.tree.count == 0) {
+    Bvh2 empty;
+    empty.stats = sb.stats;
+    empty.stats.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - sb.start).count();
+    return collapse(empty, triangles);
+  }
+  const double binary_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - sb.start).count();
+  BuildStats st = sb.stats;
+  st.sah_cost = detail::scratch_sah_cost(sb.tree.nodes.get());  // not part of the build time
+  const auto t_sah = std::chrono::steady_clock::now();
+  st.binary_nodes = st.nodes;
+  st.binary_max_depth = st.max_depth;
+  // slots: the scratch tree's node indices stay below 2n - 1
+  const std::size_t flat_size = st.nodes + (st.nodes > 1 ? 1 : 0);  // with its padding node
+  Bvh out = detail::collapse_nodes(sb.tree.nodes.get(), 2 * sb.prim_refs.size() - 1, flat_size,
+                                   sb.prim_refs, st, triangles, &sb.tree.nodes);
   out.stats.seconds =
-      binary_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      binary_seconds +
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_sah).count();
   return out;
 }
 

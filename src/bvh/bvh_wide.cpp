@@ -14,6 +14,7 @@
 #include <string>
 
 #include "bvh/bvh.hpp"
+#include "bvh/sah_builder.hpp"
 #include "lucent/error.hpp"
 
 namespace lucent::bvh {
@@ -33,20 +34,28 @@ double area(const Node2& n) {
 // plus one per sphere (as the SAH build counts them); one test of a wide node and one leaf block
 // take about the same instructions on AVX2. cost(x, k), the least cost of binary subtree x in at
 // most k child slots, is x as one child (a leaf, or a wide node made by opening x) or, for k >= 2,
-// x opened with its two children sharing the k slots. Solved bottom-up; only each node's choices
-// (9 bytes) are kept, the costs live on the recursion, which the binary depth bounds
-// (LC_BVH_MAX_DEPTH).
+// x opened with its two children sharing the k slots. Solved bottom-up; only each interior node's
+// choices (9 bytes, kept by the index of its children's pair: a leaf has none) are kept, the costs
+// live on the recursion, which the binary depth bounds (LC_BVH_MAX_DEPTH).
 class OptimalCollapse {
  public:
-  explicit OptimalCollapse(const Bvh2& b) : b_(b), split_(b.nodes.size()) { solve(0); }
+  // nodes: the binary tree (root 0), of `slots` nodes at most
+  OptimalCollapse(const Node2* nodes, std::size_t slots, const std::vector<lc_uint>& prim_refs)
+      : nodes_(nodes), prim_refs_(prim_refs), split_(slots / 2 + 1) {
+    solve(0);
+  }
+
+  /// The leaf blocks of the tree: one per 4 primitives of each leaf, rounded up.
+  std::size_t blocks() const { return blocks_; }
 
   // The binary nodes that become the children of the wide node made from interior node x, in
   // the binary tree's order; returns how many (2 to LC_BVH_WIDTH).
   int children(lc_uint x, lc_uint* out) const {
     int n = 0;
-    const Node2& bn = b_.nodes[x];
-    collect(bn.left_first, split_[x][0], out, n);
-    collect(bn.left_first + 1, LC_BVH_WIDTH - split_[x][0], out, n);
+    const Node2& bn = nodes_[x];
+    const Split& sp = split_[bn.left_first / 2];
+    collect(bn.left_first, sp[0], out, n);
+    collect(bn.left_first + 1, LC_BVH_WIDTH - sp[0], out, n);
     return n;
   }
 
@@ -66,7 +75,7 @@ class OptimalCollapse {
   double leaf_cost(const Node2& n) const {
     std::size_t tri = 0, sph = 0;
     for (lc_uint i = 0; i < n.count; ++i)
-      ++((b_.prim_refs[n.left_first + i] & LC_PRIM_SPHERE_BIT) ? sph : tri);
+      ++((prim_refs_[n.left_first + i] & LC_PRIM_SPHERE_BIT) ? sph : tri);
     return double((tri + 3) / 4 + sph);
   }
 
@@ -79,16 +88,18 @@ class OptimalCollapse {
   }
 
   Costs solve(lc_uint x) {
-    const Node2& n = b_.nodes[x];
-    Split& sp = split_[x];
-    std::fill(std::begin(sp.a), std::end(sp.a), 0);
+    const Node2& n = nodes_[x];
     Costs out;
     out.c[0] = 0;
     if (n.count > 0) {
+      blocks_ += (n.count + 3) / 4;
       std::fill(out.c + 1, out.c + LC_BVH_WIDTH + 1, area(n) * leaf_cost(n));
       return out;
     }
     const Costs l = solve(n.left_first), r = solve(n.left_first + 1);
+    // children pairs start at distinct even (depth-first copy) or odd (scratch tree) indices
+    Split& sp = split_[n.left_first / 2];
+    std::fill(std::begin(sp.a), std::end(sp.a), 0);
     const double as_node = area(n) + shared(l, r, LC_BVH_WIDTH, sp.a[0]);
     out.c[1] = as_node;
     for (int k = 2; k <= LC_BVH_WIDTH; ++k) {
@@ -101,33 +112,39 @@ class OptimalCollapse {
   }
 
   void collect(lc_uint x, int k, lc_uint* out, int& n) const {
-    const unsigned char a = k >= 2 ? split_[x][k] : 0;
+    const Node2& bn = nodes_[x];
+    const unsigned char a = k >= 2 && bn.count == 0 ? split_[bn.left_first / 2][k] : 0;
     if (a == 0) {
       out[n++] = x;
       return;
     }
-    const Node2& bn = b_.nodes[x];
     collect(bn.left_first, a, out, n);
     collect(bn.left_first + 1, k - a, out, n);
   }
 
-  const Bvh2& b_;
+  const Node2* nodes_;
+  const std::vector<lc_uint>& prim_refs_;
   std::vector<Split> split_;
+  std::size_t blocks_ = 0;
 };
 
 }  // namespace
 
-Bvh collapse(const Bvh2& b, Span<lc_triangle> triangles) {
+namespace detail {
+
+Bvh collapse_nodes(const Node2* nodes, std::size_t slots, std::size_t flat_size,
+                   const std::vector<lc_uint>& prim_refs, const BuildStats& stats,
+                   Span<lc_triangle> triangles, ScratchNodes* release) {
   Bvh out;
-  out.stats = b.stats;
-  out.stats.binary_nodes = b.stats.nodes;
-  out.stats.binary_max_depth = b.stats.max_depth;
+  out.stats = stats;
+  out.stats.binary_nodes = stats.nodes;
+  out.stats.binary_max_depth = stats.max_depth;
   out.stats.nodes = 0;
   out.stats.max_depth = 0;
-  if (b.nodes.empty()) return out;
+  if (slots == 0) return out;
   // a leaf's blocks start at most at prim_refs.size() - 1 (one block per primitive at worst)
-  if (b.prim_refs.size() > std::size_t(LC_BVH_LEAF_FIRST_MASK) + 1)
-    throw Error("scene: " + std::to_string(b.prim_refs.size()) +
+  if (prim_refs.size() > std::size_t(LC_BVH_LEAF_FIRST_MASK) + 1)
+    throw Error("scene: " + std::to_string(prim_refs.size()) +
                 " primitives, more than the BVH can reference (" +
                 std::to_string(std::size_t(LC_BVH_LEAF_FIRST_MASK) + 1) + ")");
   auto add_leaf = [&](const Node2& c) {
@@ -141,7 +158,7 @@ Bvh collapse(const Bvh2& b, Span<lc_triangle> triangles) {
           l.prim[j] = LC_INVALID;
           continue;
         }
-        lc_uint ref = b.prim_refs[c.left_first + i];
+        lc_uint ref = prim_refs[c.left_first + i];
         l.prim[j] = ref;
         if (ref & LC_PRIM_SPHERE_BIT) continue;
         if (ref >= triangles.size())
@@ -157,32 +174,38 @@ Bvh collapse(const Bvh2& b, Span<lc_triangle> triangles) {
     }
     return LC_BVH_LEAF_BIT | ((blocks - 1) << LC_BVH_LEAF_COUNT_SHIFT) | first;
   };
-  const Node2& root = b.nodes[0];
+  const Node2& root = nodes[0];
   for (int a = 0; a < 3; ++a) out.bmin[a] = root.bmin[a], out.bmax[a] = root.bmax[a];
 
   struct Item {
     lc_uint binary, wide, depth;
   };
-  const OptimalCollapse optimal(b);
+  const OptimalCollapse optimal(nodes, slots, prim_refs);
   std::vector<Item> stack{{0, 0, 1}};
-  out.nodes.reserve(b.nodes.size() / 2 + 1);
+  // (as many as the depth-first copy's size gives, scratch tree or not: the same block)
+  out.nodes.reserve(flat_size / 2 + 1);
   // every binary leaf becomes one wide leaf of ceil(count / 4) blocks: reserved exactly (a guess
   // of one block per 2 primitives grew by doubling where sparse primitives get a block each, and
   // held 1.5 times the blocks for a moment: a million small spheres peaked 20% above the host
   // memory estimate, resources.cpp)
-  std::size_t blocks = 0;
-  for (const Node2& n : b.nodes) blocks += (n.count + 3) / 4;
-  out.leaves.reserve(blocks);
+  out.leaves.reserve(optimal.blocks());
   out.nodes.emplace_back();
-  std::size_t leaves = 0, max_leaf = 0;
+  std::size_t leaves = 0, max_leaf = 0, steps = 0;
   while (!stack.empty()) {
+    // what is left to read lies at and after the binary nodes on the stack (a node's descendants
+    // follow it): the pages before them go back
+    if (release && ++steps % 64 == 0) {
+      lc_uint low = stack.back().binary;
+      for (const Item& s : stack) low = std::min(low, s.binary);
+      release->release_below(low);
+    }
     Item it = stack.back();
     stack.pop_back();
     out.stats.max_depth = std::max<std::size_t>(out.stats.max_depth, it.depth);
     // the binary nodes that become this node's children
     lc_uint kids[LC_BVH_WIDTH];
     int n = 0;
-    const Node2& bn = b.nodes[it.binary];
+    const Node2& bn = nodes[it.binary];
     if (bn.count > 0) {  // a root leaf: the only child of the root
       kids[n++] = it.binary;
     } else {
@@ -191,7 +214,7 @@ Bvh collapse(const Bvh2& b, Span<lc_triangle> triangles) {
     // children that are interior nodes get consecutive node indices
     lc_uint next = static_cast<lc_uint>(out.nodes.size());
     int interior = 0;
-    for (int k = 0; k < n; ++k) interior += b.nodes[kids[k]].count == 0;
+    for (int k = 0; k < n; ++k) interior += nodes[kids[k]].count == 0;
     out.nodes.resize(out.nodes.size() + interior);
     lc_bvh_node& w = out.nodes[it.wide];
     for (int k = 0; k < LC_BVH_WIDTH; ++k) {
@@ -204,7 +227,7 @@ Bvh collapse(const Bvh2& b, Span<lc_triangle> triangles) {
         w.pad[k] = 0;
         continue;
       }
-      const Node2& c = b.nodes[kids[k]];
+      const Node2& c = nodes[kids[k]];
       for (int a = 0; a < 3; ++a) {
         w.bounds[2 * a][k] = c.bmin[a];
         w.bounds[2 * a + 1][k] = c.bmax[a];
@@ -225,8 +248,15 @@ Bvh collapse(const Bvh2& b, Span<lc_triangle> triangles) {
   out.stats.nodes = out.nodes.size();
   out.stats.leaves = leaves;
   out.stats.max_leaf_size = max_leaf;
-  out.stats.mean_leaf_size = leaves ? double(b.prim_refs.size()) / double(leaves) : 0;
+  out.stats.mean_leaf_size = leaves ? double(prim_refs.size()) / double(leaves) : 0;
   return out;
+}
+
+}  // namespace detail
+
+Bvh collapse(const Bvh2& b, Span<lc_triangle> triangles) {
+  return detail::collapse_nodes(b.nodes.data(), b.nodes.size(), b.nodes.size(), b.prim_refs,
+                                b.stats, triangles, nullptr);
 }
 
 }  // namespace lucent::bvh

@@ -8,8 +8,68 @@
 #include <condition_variable>
 #include <mutex>
 #include <thread>
+#if defined(__unix__) || defined(__APPLE__)
+#include <sys/mman.h>
+#include <unistd.h>
+#define LUCENT_SCRATCH_MMAP 1
+#endif
 
 namespace lucent::bvh::detail {
+
+ScratchNodes::ScratchNodes(std::size_t n) : bytes_(std::max<std::size_t>(1, n) * sizeof(Node2)) {
+#ifdef LUCENT_SCRATCH_MMAP
+  void* m = ::mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (m != MAP_FAILED) {
+    p_ = static_cast<Node2*>(m);
+    mapped_ = true;
+    return;
+  }
+#endif
+  p_ = new Node2[bytes_ / sizeof(Node2)];
+}
+
+ScratchNodes::~ScratchNodes() { free_all(); }
+
+ScratchNodes::ScratchNodes(ScratchNodes&& o) noexcept
+    : p_(o.p_), bytes_(o.bytes_), released_(o.released_), mapped_(o.mapped_) {
+  o.p_ = nullptr;
+}
+
+ScratchNodes& ScratchNodes::operator=(ScratchNodes&& o) noexcept {
+  if (this != &o) {
+    free_all();
+    p_ = o.p_, bytes_ = o.bytes_, released_ = o.released_, mapped_ = o.mapped_;
+    o.p_ = nullptr;
+  }
+  return *this;
+}
+
+void ScratchNodes::free_all() {
+  if (!p_) return;
+#ifdef LUCENT_SCRATCH_MMAP
+  if (mapped_) {
+    ::munmap(p_, bytes_);
+    p_ = nullptr;
+    return;
+  }
+#endif
+  delete[] p_;
+  p_ = nullptr;
+}
+
+void ScratchNodes::release_below(std::size_t i) {
+#ifdef LUCENT_SCRATCH_MMAP
+  if (!mapped_) return;
+  static const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  // in steps of 1 MiB or more: one system call per few thousand nodes
+  const std::size_t upto = std::min(i * sizeof(Node2), bytes_) / page * page;
+  if (upto < released_ + (std::size_t(1) << 20)) return;
+  ::madvise(reinterpret_cast<char*>(p_) + released_, upto - released_, MADV_DONTNEED);
+  released_ = upto;
+#else
+  (void)i;
+#endif
+}
 
 namespace {
 
@@ -117,7 +177,7 @@ class Builder {
         threads_(threads),
         traversal_cost_(options.traversal_cost),
         block_(static_cast<std::size_t>(std::max(1, options.leaf_block))) {
-    nodes_.reset(new Node2[std::max<std::size_t>(1, 2 * refs.size() - 1)]);
+    nodes_ = ScratchNodes(2 * refs.size() - 1);
   }
 
   // Builds the tree over refs_, whose bounds and centroid bounds are given; returns the number
@@ -133,7 +193,7 @@ class Builder {
     return 1 + 2 * interior_.load();
   }
 
-  std::unique_ptr<Node2[]> release_nodes() { return std::move(nodes_); }
+  ScratchNodes release_nodes() { return std::move(nodes_); }
 
   // intersection cost of n primitives of which s spheres: the kernel tests the triangles by
   // blocks of block_, the spheres one by one
@@ -351,7 +411,7 @@ class Builder {
   unsigned threads_;
   float traversal_cost_;
   std::size_t block_;
-  std::unique_ptr<Node2[]> nodes_;  // scratch tree (2n - 1 slots, not zeroed)
+  ScratchNodes nodes_;  // scratch tree (2n - 1 slots, not zeroed)
   std::atomic<std::size_t> interior_{0};
   std::atomic<std::size_t> max_depth_{0};
   std::mutex mutex_;

@@ -190,17 +190,20 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
   const PackedSizes z = packed_sizes(scene);
   const std::uint64_t ntri = z.ntri, nsph = z.nsph, sph_bytes = z.sph_bytes,
                       tex_bytes = z.tex_bytes;
-  // the BVH: the build's primitive references (32 bytes), binary nodes (at most 2 per primitive,
-  // twice: the scratch tree and its depth-first copy are held together as it is flattened,
-  // bvh_build.cpp), primitive indices and kept flags; then the wide tree's leaf blocks (at most one
-  // per primitive: a soup of separate triangles has leaves of one, a mesh about one block per 2 or
-  // 3 primitives) and nodes (a soup 0.29 per primitive, the dragon 0.06: counted as one per 3)
+  // the BVH (bvh_build.cpp, bvh_wide.cpp): the build's primitive references (32 bytes) and scratch
+  // binary tree (at most 2 nodes per primitive), then the tree collapsed directly while its pages
+  // go back, beside the primitive indices and the collapse's choices (9 bytes per interior node)
+  // and the growing wide tree: its leaf blocks (at most one per primitive: a soup of separate
+  // triangles has leaves of one, a mesh about one block per 2 or 3 primitives) and nodes (a soup
+  // 0.29 per primitive, the dragon 0.06: counted as one per 3). The second phase is the larger:
+  // the scratch tree, indices and choices are counted beside the whole wide tree (a 10^6-triangle
+  // soup peaked at 251 bytes a primitive, counted 322; the scratch tree's depth-first copy, no
+  // longer made, took 323)
   const std::uint64_t nprim = ntri + nsph;
   const std::uint64_t leaf_bytes = (nprim + 1) * sizeof(lc_bvh_leaf);
   const std::uint64_t node_bytes = (nprim / 3 + 1) * sizeof(lc_bvh_node);
   const std::uint64_t bvh_tree = leaf_bytes + node_bytes;
-  const std::uint64_t bvh_bytes =
-      nprim * (32 + 4 * sizeof(bvh::Node2) + sizeof(lc_uint) + 1) + bvh_tree;
+  const std::uint64_t bvh_bytes = nprim * (2 * sizeof(bvh::Node2) + sizeof(lc_uint) + 9) + bvh_tree;
   // the packed arrays: each of 1 MiB or more takes whole huge pages (core/host_blocks.hpp). A CPU
   // device's scene buffers are those arrays themselves (device_scene.hpp's read_only_buffer), so
   // they are counted once whatever the devices; another device's are in its own memory.
