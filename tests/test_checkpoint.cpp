@@ -57,6 +57,22 @@ std::string noisy_scene(const std::string& dir, const std::string& name = "scene
   return path;
 }
 
+/// A lamp filling the left of a 500x400 view, its edge slanted, nothing else: every sample of a
+/// pixel off the edge is the same, so that its part file compresses to 80 KB, where its PFM takes
+/// 2.4 MB (a pixel on the edge differs with its samples).
+std::string flat_scene(const std::string& dir) {
+  std::string path = dir + "/flat.json";
+  lucent::test::write_file(path, R"({
+    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
+    "film": {"width": 500, "height": 400},
+    "integrator": {"type": "path", "spp": 16, "seed": 3},
+    "materials": {"lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1, 0.5, 0.25]}},
+    "shapes": [{"type": "triangles", "material": "lamp",
+                "positions": [[-10,-10,0],[0.3,-10,0],[0.9,10,0],[-10,10,0]], "indices": [0,1,2, 0,2,3]}]
+  })");
+  return path;
+}
+
 /// Largest relative difference between two renders' pixel means; their sample counts must be
 /// equal.
 double max_relative_difference(const lucent::RenderResult& a, const lucent::RenderResult& b) {
@@ -503,6 +519,67 @@ TEST(Checkpoint, ProgressOfAResumedRenderCountsTheCheckpoint) {
   const double percent = std::atof(r.err.substr(start, line - start).c_str());
   EXPECT_GE(percent, 100.0 * double(k) / double(n) - 0.05) << r.err;
   EXPECT_NE(r.err.find(" spp  ", line), std::string::npos) << r.err;
+}
+
+// The output's write fails after a complete render (a full disk; here a file size limit of 1.5 MB,
+// which the 2.4 MB PFM exceeds and the 80 KB checkpoint does not): the samples go to the
+// checkpoint, all of them (it held none: the default --checkpoint-every is 300 s, and a render
+// that ran that long lost up to 300 s of work), and two lines say so. The same command then
+// renders nothing and writes the image of the uninterrupted render.
+TEST(Checkpoint, FailedOutputWriteKeepsTheSamplesInTheCheckpoint) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = flat_scene(dir);
+  const std::string ck = dir + "/ck.exr", out = dir + "/out.pfm", full = dir + "/full.pfm";
+  // (first: the kernel caches are filled, whose files the limit would refuse)
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q -o " + q(full)).status, 0);
+  // (bash's unit, KiB: sh's may be 512 bytes)
+  const std::string limited = dir + "/limited.sh";
+  lucent::test::write_file(limited, "ulimit -f 1500\nexec \"$@\"\n");
+  CommandResult r = run_cli("render " + q(scene) + " -q -o " + q(out) + " --checkpoint " + q(ck),
+                            "bash " + q(limited));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(r.err, "lucent: error: " + out + ": cannot write (File too large)\nlucent: " + ck +
+                       " holds all the samples, [0, 16): the same command writes the output\n");
+  EXPECT_FALSE(fs::exists(out));
+  ASSERT_TRUE(fs::exists(ck)) << r.err;
+  EXPECT_EQ(lucent::read_part_info(ck).samples, (std::vector<lucent::SampleRange>{{0, 16}}));
+
+  r = run_cli("render " + q(scene) + " -o " + q(out) + " --checkpoint " + q(ck));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("lucent: resuming from " + ck + ", which holds samples [0, 16)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(", 16 spp (16 of them from " + ck + ") in 0.000 s ("), std::string::npos)
+      << r.err;  // (nothing rendered)
+  EXPECT_FALSE(fs::exists(ck));
+  EXPECT_FALSE(fs::exists(ck + ".lock"));
+  const lucent::Image resumed = lucent::read_image(out), single = lucent::read_image(full);
+  ASSERT_EQ(resumed.rgb.size(), single.rgb.size());
+  double worst = 0;
+  for (size_t i = 0; i < resumed.rgb.size(); ++i) {
+    const double x = resumed.rgb[i], y = single.rgb[i];
+    if (std::max(std::abs(x), std::abs(y)) > 0)
+      worst = std::max(worst, std::abs(x - y) / std::max(std::abs(x), std::abs(y)));
+  }
+  EXPECT_LT(worst, 1e-5);
+
+  // a checkpoint over the limit too (a noisy image's: its doubles do not compress): a warning
+  // says so, and the last line that no file holds the samples
+  const std::string noisy = noisy_scene(dir);
+  const std::string size = " --width 500 --height 400 --spp 2";
+  ASSERT_EQ(run_cli("render " + q(noisy) + " -q" + size + " -o " + q(full)).status, 0);
+  const std::string noisy_out = dir + "/noisy.pfm";
+  r = run_cli(
+      "render " + q(noisy) + " -q" + size + " -o " + q(noisy_out) + " --checkpoint " + q(ck),
+      "bash " + q(limited));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(r.err,
+            "lucent: error: " + noisy_out + ": cannot write (File too large)\n" +
+                "lucent: warning: checkpoint not written: " + ck +
+                ": cannot write (File too large)\nlucent: no checkpoint holds the samples (" + ck +
+                " not written): the same command renders them again\n");
+  EXPECT_FALSE(fs::exists(noisy_out));
+  EXPECT_FALSE(fs::exists(ck));
 }
 
 }  // namespace

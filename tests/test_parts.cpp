@@ -1130,6 +1130,66 @@ TEST(Parts, MpiCheckpointFailedWriteIsNotClaimed) {
       << r.err;
 }
 
+// Rank 0's write of the output fails after a complete render (a full disk; here a file size limit
+// on rank 0 alone, which the 2.4 MB PFM exceeds and the 80 KB checkpoints of this flat image do
+// not): every rank's checkpoint then holds its whole share (they held none: the default
+// --checkpoint-every is 300 s, up to which every rank's work was lost), rank 0 says so after one
+// line for the output, and the same command renders nothing and writes the uninterrupted image.
+TEST(Parts, MpiCheckpointFailedOutputWriteKeepsEveryRanksSamples) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  const std::string dir = lucent::test::temp_dir();
+  // a lamp filling the left of the view, its edge slanted (a pixel on it differs with its
+  // samples), nothing else: every other pixel's samples are the same, and its sums compress
+  const std::string scene = dir + "/flat.json";
+  lucent::test::write_file(scene, R"({
+    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
+    "film": {"width": 500, "height": 400},
+    "integrator": {"type": "path", "spp": 16, "seed": 3},
+    "materials": {"lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1, 0.5, 0.25]}},
+    "shapes": [{"type": "triangles", "material": "lamp",
+                "positions": [[-10,-10,0],[0.3,-10,0],[0.9,10,0],[-10,10,0]], "indices": [0,1,2, 0,2,3]}]
+  })");
+  const std::string ck = dir + "/ck.exr", out = dir + "/out.pfm", full = dir + "/full.pfm";
+  const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " -q -o ";
+  // (first: the kernel caches are filled, whose files the limit would refuse)
+  CommandResult r = run_shell("timeout 60 env " + mpirun("-np 2 " + prog + q(full)), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string limited = dir + "/limited.sh";
+  // (SIGXFSZ ignored: a write past the limit fails with EFBIG instead of ending the rank)
+  lucent::test::write_file(limited, "trap '' XFSZ\nulimit -f 1500\nexec \"$@\"\n");
+  const std::string with = prog + q(out) + " --checkpoint " + q(ck);
+  r = run_shell(
+      "timeout 60 env " + mpirun("-np 1 bash " + q(limited) + " " + with + " : -np 1 " + with),
+      dir);
+  EXPECT_NE(r.status, 0) << r.err;
+  EXPECT_EQ(lucent_mpi_lines(r.err), 2) << r.err;
+  EXPECT_NE(r.err.find("lucent-mpi: error: rank 0 of 2 ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("): " + out + ": cannot write (File too large)\n"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("lucent-mpi: the checkpoints " + dir +
+                       "/ck.rank<r>-of-2.exr hold samples [0, 16) of [0, 16): the same command "
+                       "with 2 ranks writes the output\n"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  ASSERT_TRUE(fs::exists(dir + "/ck.rank0-of-2.exr") && fs::exists(dir + "/ck.rank1-of-2.exr"))
+      << r.err;
+  EXPECT_EQ(lucent::read_part_info(dir + "/ck.rank0-of-2.exr").samples,
+            (std::vector<lucent::SampleRange>{{0, 8}}));
+  EXPECT_EQ(lucent::read_part_info(dir + "/ck.rank1-of-2.exr").samples,
+            (std::vector<lucent::SampleRange>{{8, 16}}));
+
+  // the same command: nothing rendered (each rank's checkpoint holds its share), the output
+  // written, the checkpoints gone
+  r = run_shell("timeout 60 env " + mpirun("-np 2 " + with), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(names_with(dir, "ck."), std::vector<std::string>{}) << r.err;
+  const lucent::Image resumed = lucent::read_image(out), single = lucent::read_image(full);
+  ASSERT_EQ(resumed.rgb.size(), single.rgb.size());
+  for (size_t i = 0; i < resumed.rgb.size(); ++i)
+    ASSERT_NEAR(resumed.rgb[i], single.rgb[i], 1e-5 * std::abs(single.rgb[i])) << i;
+}
+
 // A rank's checkpoint needs its part and the part file's write beside the session, as `lucent
 // render --checkpoint` counts them: at 2048x2048 (1.1 GiB), under an address-space limit that the
 // render without a checkpoint fits, the rank refuses before rendering instead of failing its first

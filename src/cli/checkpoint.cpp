@@ -131,6 +131,11 @@ bool Checkpoint::save(const lucent::RenderPart& part) {
   return ok;
 }
 
+bool Checkpoint::save_new(const lucent::RenderPart& part) {
+  const std::uint64_t end = part.info.samples.empty() ? begin_ : part.info.samples.back().end;
+  return end == held_ || save(part);
+}
+
 bool Checkpoint::complete(const lucent::Renderer& renderer, bool stopped) const {
   return !stopped && (target_ == 0 || first_sample() + renderer.spp() >= target_);
 }
@@ -156,7 +161,8 @@ lucent::SampleRange Checkpoint::requested(const lucent::Renderer& renderer) cons
 }
 
 bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer,
-                       lucent::RenderResult& r, bool stopped) {
+                       lucent::RenderResult& r, bool stopped,
+                       std::optional<lucent::RenderPart>& kept) {
   const bool complete = ck.complete(*renderer, stopped);
   if (complete && !ck.resumed()) return true;  // the session's result is the image
   lucent::RenderPart all;
@@ -172,8 +178,7 @@ bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer
   // (stopped before its first sample: nothing to write; right after a periodic checkpoint, or
   // before a resumed run's first pass: the file holds these samples already, and writing them
   // again took seconds in which a second Ctrl-C lost the output)
-  if (!complete && !all.info.samples.empty() && all.info.samples.back().end != ck.held())
-    ck.save(all);
+  if (!complete && !all.info.samples.empty()) ck.save_new(all);
   if (!ck.resumed()) return complete;
   // the session's sums and images, and the checkpoint's, before the image's own memory
   renderer.reset();
@@ -182,6 +187,9 @@ bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer
   r.variance = {};
   r.samples = {};
   lucent::RenderResult m = lucent::part_result(all);
+  // a complete render's samples, for the checkpoint should the output's write fail (the memory
+  // counted after the session holds them: "the sums of the checkpoint and this render")
+  if (complete) kept = std::move(all);
   all = {};
   r.mean = std::move(m.mean);
   r.variance = std::move(m.variance);
@@ -191,6 +199,40 @@ bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer
   r.rays = m.rays;
   r.seconds = m.seconds;
   return complete;
+}
+
+void keep_samples_of_failed_output(Checkpoint& ck, bool complete,
+                                   std::optional<lucent::RenderPart>& kept,
+                                   std::optional<lucent::Renderer>& renderer) {
+  if (complete && !kept && renderer) {
+    try {
+      kept = ck.whole(*renderer);
+    } catch (const lucent::Error& e) {
+      std::fprintf(stderr, "%s: warning: checkpoint not written: %s\n", ck.program().c_str(),
+                   one_line(e.what()).c_str());
+    }
+  }
+  renderer.reset();  // (its sums are in the part: its memory, before the write's)
+  const bool all = complete && kept && ck.save_new(*kept);
+  kept.reset();
+  say_kept(ck, all);
+}
+
+void say_kept(const Checkpoint& ck, bool all) {
+  const unsigned long long begin = ck.begin(), held = ck.held();
+  if (held == begin)
+    std::fprintf(stderr,
+                 "%s: no checkpoint holds the samples (%s not written): the same command "
+                 "renders them again\n",
+                 ck.program().c_str(), one_line(ck.path()).c_str());
+  else if (all)
+    std::fprintf(stderr,
+                 "%s: %s holds all the samples, [%llu, %llu): the same command writes the "
+                 "output\n",
+                 ck.program().c_str(), one_line(ck.path()).c_str(), begin, held);
+  else
+    std::fprintf(stderr, "%s: %s holds samples [%llu, %llu): the same command resumes the render\n",
+                 ck.program().c_str(), one_line(ck.path()).c_str(), begin, held);
 }
 
 void say_resumed(const Checkpoint& ck) {

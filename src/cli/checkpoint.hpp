@@ -71,6 +71,9 @@ class Checkpoint {
   /// Writes `part` to the checkpoint, atomically; a failure (a full disk) is a warning: the
   /// render goes on, and the previous checkpoint stays as it was.
   bool save(const lucent::RenderPart& part);
+  /// save(), unless the file holds the part's samples already (written by the last checkpoint,
+  /// or read); true when the file holds them after it.
+  bool save_new(const lucent::RenderPart& part);
 
   /// The render asked for is done: N samples (a time limit alone: its time), not stopped.
   bool complete(const lucent::Renderer& renderer, bool stopped) const;
@@ -107,9 +110,30 @@ class Checkpoint {
 /// After a render with a checkpoint, while the session lives: an unfinished render's samples go
 /// to the checkpoint, which stays for the next run to resume from; a resumed render's result
 /// becomes the image of the checkpoint's samples and the session's (the session is gone then).
-/// `stopped`: a stop signal or a cancel ended the render. True when the render is complete.
+/// `stopped`: a stop signal or a cancel ended the render. True when the render is complete; a
+/// complete resumed render's part (of all its samples) is then moved to `kept`, for
+/// keep_samples_of_failed_output, until the output is written.
 bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer,
-                       lucent::RenderResult& r, bool stopped);
+                       lucent::RenderResult& r, bool stopped,
+                       std::optional<lucent::RenderPart>& kept);
+
+/// The output's write failed (a full disk, a directory removed) after a render with a checkpoint:
+/// its samples go to the checkpoint unless the file holds them already (a stopped render's,
+/// which finish_checkpoint wrote), so that the same command writes the output without rendering
+/// them again; a complete render's checkpoint otherwise held only the samples of its last
+/// periodic write, up to --checkpoint-every seconds short. The samples: `kept` (a resumed
+/// render's, from finish_checkpoint), else the session's while it lives. Then one line says where
+/// they are: "lucent: ck.exr holds all the samples, [0, 64): the same command writes the output".
+/// `complete`: finish_checkpoint's answer (a stopped render's samples are in the file already).
+void keep_samples_of_failed_output(Checkpoint& ck, bool complete,
+                                   std::optional<lucent::RenderPart>& kept,
+                                   std::optional<lucent::Renderer>& renderer);
+
+/// The line that says what the checkpoint holds after a run that did not end complete, or whose
+/// output was not written: "<program>: ck.exr holds samples [0, 27171): the same command resumes
+/// the render" (`all`: every sample of the render, "... holds all the samples, [0, 64): the same
+/// command writes the output"); "... no checkpoint holds ..." when the file holds none.
+void say_kept(const Checkpoint& ck, bool all);
 
 /// Before rendering, with a checkpoint: checks it against the session, starts the session after
 /// its samples and makes `spp` (N - B) the samples left; false when none is. Says so (say_resumed)

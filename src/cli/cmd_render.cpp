@@ -244,6 +244,27 @@ OutputMemory output_memory(const RenderArgs& a, int fw, int fh, bool part, bool 
   return m;
 }
 
+/// Writes the output: a part (--samples, taken from the session, which goes before the write's
+/// memory), an .exr with var.R/G/B and n layers (docs/compare.md) and the key of its random
+/// numbers (RenderResult::seed, sampler), by which `lucent converge` refuses a reference that
+/// would replay its ladder's samples, or an image.
+void write_output(const RenderArgs& a, const std::optional<lucent::SampleRange>& range,
+                  std::optional<lucent::Renderer>& renderer, lucent::RenderResult& r,
+                  const lucent::DisplaySettings& display) {
+  if (range) {
+    r.mean = {};  // (not written: the part's sums are; the rest of r says how it went)
+    r.variance = {};
+    r.samples = {};
+    const lucent::RenderPart part = lucent::make_part(*renderer, *range, a.scene);
+    renderer.reset();  // its sums, images and device buffers, before the write's own memory
+    lucent::write_render_part(a.output, part);
+  } else if (lucent::io::lower_extension(a.output) == ".exr") {
+    lucent::write_render_exr(a.output, r);
+  } else {
+    lucent::write_image(a.output, r.mean, display);
+  }
+}
+
 int render_with(const RenderArgs& a) {
   // options the reference does not honour: refused, rather than silently ignored (it runs on the
   // CPU, in double precision, with its own code: the kernel's device and build options mean
@@ -458,9 +479,12 @@ int render_with(const RenderArgs& a) {
   const std::uint64_t run_spp = r.spp, run_rays = r.rays;
   const double run_seconds = r.seconds;
   const std::uint64_t resumed_spp = checkpoint ? checkpoint->first_sample() : 0;
-  // a resumed render's image is that of the checkpoint's samples and the session's
-  const bool checkpoint_done = checkpoint && finish_checkpoint(*checkpoint, renderer, r,
-                                                               r.cancelled || g_interrupted.load());
+  // a resumed render's image is that of the checkpoint's samples and the session's; its part is
+  // kept until the output is written
+  std::optional<lucent::RenderPart> kept;
+  const bool checkpoint_done =
+      checkpoint &&
+      finish_checkpoint(*checkpoint, renderer, r, r.cancelled || g_interrupted.load(), kept);
   // interrupted before its first sample (an adaptive render's pilot, the reference's first
   // pixel): no image to write; it wrote a black one claiming "0 of 256 spp". A part keeps its
   // (empty) range, and is written.
@@ -476,28 +500,29 @@ int render_with(const RenderArgs& a) {
   // every sample non-finite: nothing written (a part keeps its counts, and is written)
   if (!range) lucent::render_detail::check_some_sample_finite(a.output, r.nonfinite, r.samples);
   // the session is not needed again without AOVs: its memory goes before the write's (a part
-  // is taken from it first)
-  if (a.aovs.empty() && !range) renderer.reset();
-  if (range) {
-    r.mean = {};  // (not written: the part's sums are; the rest of r says how it went)
-    r.variance = {};
-    r.samples = {};
-    const lucent::RenderPart part = lucent::make_part(*renderer, *range, a.scene);
-    renderer.reset();  // its sums, images and device buffers, before the write's own memory
-    lucent::write_render_part(a.output, part);
-  } else if (lucent::io::lower_extension(a.output) == ".exr") {
-    // with var.R/G/B and n layers (docs/compare.md), and the key of its random numbers
-    // (RenderResult::seed, sampler), by which `lucent converge` refuses a reference that would
-    // replay its ladder's samples
-    lucent::write_render_exr(a.output, r);
-  } else
-    lucent::write_image(a.output, r.mean, display);
+  // is taken from it first). A complete render's with a checkpoint stays until the output is
+  // written: its samples go to the checkpoint should the write fail (the part and its write
+  // were counted beside the session, and its result images and the output's write take less)
+  if (a.aovs.empty() && !range && !checkpoint_done) renderer.reset();
+  try {
+    write_output(a, range, renderer, r, display);
+  } catch (const lucent::Error& e) {
+    if (!checkpoint) throw;
+    // a full disk, a directory removed: the samples since the last checkpoint went with the
+    // session (up to --checkpoint-every seconds of work), and the checkpoint held an unfinished
+    // render although every sample was rendered
+    if (!e.details().empty()) std::fprintf(stderr, "%s\n", e.details().c_str());
+    std::fprintf(stderr, "lucent: error: %s\n", one_line(e.what()).c_str());
+    r = {};  // (its images: the part's write needs the memory)
+    keep_samples_of_failed_output(*checkpoint, checkpoint_done, kept, renderer);
+    return 1;
+  }
+  if (a.aovs.empty()) renderer.reset();
+  kept.reset();
   if (checkpoint_done)
     checkpoint->remove();
   else if (checkpoint && checkpoint->held() > 0)
-    std::fprintf(
-        stderr, "lucent: %s holds samples [0, %llu): the same command resumes the render\n",
-        one_line(checkpoint->path()).c_str(), static_cast<unsigned long long>(checkpoint->held()));
+    say_kept(*checkpoint, false);
   if (r.nonfinite > 0)
     std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
                  static_cast<unsigned long long>(r.nonfinite));

@@ -356,21 +356,29 @@ int run(const Args& a) {
   session.reset();  // its sums and device buffers: the part is what is sent, merged and written
   if (ck) {
     ck->drop();
-    if (!all_complete && !part.info.samples.empty() && part.info.samples.back().end != ck->held())
-      ck->save(part);
+    if (!all_complete && !part.info.samples.empty()) ck->save_new(part);
   }
   // where each rank's checkpoint ends now, for rank 0's last line: a rank whose write failed (a
   // full disk: a warning, the render goes on) holds fewer samples than it sent, and the line said
   // the checkpoints held the output's samples
   std::vector<std::uint64_t> held(root ? g_size : 0);
-  if (ck) {
+  auto gather_held = [&] {
     const std::uint64_t mine = ck->held();
     MPI_Gather(&mine, 1, MPI_UINT64_T, held.data(), 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
-  }
-  // every rank's checkpoint goes once rank 0 has written the output of a complete render
+  };
+  if (ck) gather_held();
+  // every rank's checkpoint goes once rank 0 has written the output of a complete render. When
+  // its write failed (a full disk, a directory removed), a complete render's samples go to the
+  // checkpoints instead, each rank's whole share (they held those of the last periodic write, up
+  // to --checkpoint-every seconds of every rank's work short): the same command then renders
+  // nothing and writes the output. (`written` and all_complete are every rank's.)
   auto finish = [&](int written) {
     MPI_Bcast(&written, 1, MPI_INT, 0, MPI_COMM_WORLD);
     if (ck && written && all_complete) ck->remove();
+    if (ck && !written && all_complete) {
+      if (!part.info.samples.empty()) ck->save_new(part);
+      gather_held();
+    }
   };
 
   if (!root) {
@@ -389,17 +397,9 @@ int run(const Args& a) {
     }
   }
   lucent::MergeReport m = merger.finish();
-  lucent::write_merged(a.output, m.merged);
-  finish(1);
-  if (!a.quiet)
-    std::fprintf(stderr, "%s: %dx%d, samples %s from %d ranks (%.2f s of kernel time in all)\n",
-                 one_line(a.output).c_str(), m.merged.info.width, m.merged.info.height,
-                 lucent::ranges_text(m.merged.info.samples).c_str(), g_size, m.merged.info.seconds);
-  if (m.merged.info.nonfinite > 0)
-    std::fprintf(stderr,
-                 "lucent-mpi: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
-                 static_cast<unsigned long long>(m.merged.info.nonfinite));
-  if (ck && !all_complete) {
+  // what the checkpoints hold, after a stop or a failed write: "lucent-mpi: the checkpoints
+  // ck.rank<r>-of-2.exr hold samples [0, 2210), [4000, 6114) of [0, 8000): ..."
+  auto say_kept = [&](const std::vector<lucent::SampleRange>& output) {
     std::vector<lucent::SampleRange> kept;  // [B_r, held_r) of each rank, adjacent ones joined
     for (int r = 0; r < g_size; ++r) {
       const lucent::SampleRange s = {share(r).begin, held[r]};
@@ -411,17 +411,41 @@ int run(const Args& a) {
     }
     const std::string kept_text =
         kept.empty() ? "no samples" : "samples " + lucent::ranges_text(kept);
-    const std::string short_of = kept == m.merged.info.samples
+    const std::string short_of = kept == output
                                      ? ""
-                                     : " (not all of the output's " +
-                                           lucent::ranges_text(m.merged.info.samples) +
+                                     : " (not all of the output's " + lucent::ranges_text(output) +
                                            ": a checkpoint was not written)";
+    const bool all = kept == std::vector<lucent::SampleRange>{{0, n}};
     std::fprintf(stderr,
                  "lucent-mpi: the checkpoints %s hold %s of [0, %llu)%s: the same command with %d "
-                 "ranks resumes the render\n",
+                 "ranks %s\n",
                  one_line(rank_checkpoints(a.checkpoint, g_size)).c_str(), kept_text.c_str(),
-                 static_cast<unsigned long long>(n), short_of.c_str(), g_size);
+                 static_cast<unsigned long long>(n), short_of.c_str(), g_size,
+                 all ? "writes the output" : "resumes the render");
+  };
+  try {
+    lucent::write_merged(a.output, m.merged);
+  } catch (const lucent::Error& e) {
+    if (!ck) throw;
+    // one line for the output, then the ranks keep their samples in their checkpoints (rank 0
+    // its own part: the merged sums go first, for its write's memory)
+    print_failure(e.what());
+    const std::vector<lucent::SampleRange> output = m.merged.info.samples;
+    m = {};
+    finish(0);
+    say_kept(output);
+    return 1;
   }
+  finish(1);
+  if (!a.quiet)
+    std::fprintf(stderr, "%s: %dx%d, samples %s from %d ranks (%.2f s of kernel time in all)\n",
+                 one_line(a.output).c_str(), m.merged.info.width, m.merged.info.height,
+                 lucent::ranges_text(m.merged.info.samples).c_str(), g_size, m.merged.info.seconds);
+  if (m.merged.info.nonfinite > 0)
+    std::fprintf(stderr,
+                 "lucent-mpi: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
+                 static_cast<unsigned long long>(m.merged.info.nonfinite));
+  if (ck && !all_complete) say_kept(m.merged.info.samples);
   if (g_stop.load()) {
     std::fprintf(stderr, "lucent-mpi: interrupted: %s holds samples %s of [0, %llu)\n",
                  one_line(a.output).c_str(), lucent::ranges_text(m.merged.info.samples).c_str(),
