@@ -1015,6 +1015,50 @@ int lucent_mpi_lines(const std::string& err) {
   return n;
 }
 
+// A stop signal during the kernel build is an interruption, as for `lucent render`
+// (Outputs.SigtermDuringTheKernelBuildIsAnInterruption): PoCL's LLVM handles the signal too while
+// it builds, and the build fails, which ended the job through MPI_Abort ("kernel build failed",
+// status 1). The kernel caches off (PoCL's in an empty directory each time: a build the signal
+// did not fail fills it), the build takes about a second here (a whole LLVM compilation): SIGTERM
+// to the ranks 0, 40 or 80 ms after both locked their checkpoints (their handlers are installed
+// then; a rank killed in MPI_Init could hang mpirun), before their sessions open a device, comes
+// before rendering on a machine ten times faster than this one too, during the device's opening
+// or the build; wherever it comes there, the outcome is the same: every rank ends, one line
+// ("interrupted by SIGTERM before rendering: nothing written"), status 143, no output.
+TEST(Parts, MpiSigtermDuringTheKernelBuildIsAnInterruption) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string script = dir + "/stop.sh", err = dir + "/mpi.err";
+  const std::string lock0 = dir + "/ck.rank0-of-2.exr.lock",
+                    lock1 = dir + "/ck.rank1-of-2.exr.lock";
+  for (int ms = 0; ms <= 80; ms += 40) {
+    SCOPED_TRACE(std::to_string(ms) + " ms");
+    for (const std::string& name : names_with(dir, "ck.")) fs::remove(dir + "/" + name);
+    lucent::test::write_file(
+        script, "timeout 60 env POCL_CACHE_DIR=" + q(dir + "/pocl" + std::to_string(ms)) +
+                    " LUCENT_CACHE_DIR=off " +
+                    mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) +
+                           " --spp 16000000 -o " + q(dir + "/mpi.exr") + " --checkpoint " +
+                           q(dir + "/ck.exr")) +
+                    " 2>" + q(err) + " </dev/null & pid=$!\n" + "for i in $(seq 3000); do [ -e " +
+                    q(lock0) + " ] && [ -e " + q(lock1) + " ] && break; sleep 0.01; done\nsleep " +
+                    std::to_string(ms / 1000.0) +
+                    "\nkill -TERM $(pgrep -P $(pgrep -P $pid))\nwait $pid\n");
+    const int raw = std::system(("bash " + q(script)).c_str());
+    const std::string text = lucent::test::read_file(err);
+    ASSERT_TRUE(WIFEXITED(raw)) << text;
+    EXPECT_EQ(WEXITSTATUS(raw), 143) << text;
+    EXPECT_EQ(text.find("lucent-mpi: error:"), std::string::npos) << text;
+    EXPECT_EQ(text.find("kernel build failed"), std::string::npos) << text;
+    EXPECT_NE(text.find("interrupted by SIGTERM before rendering: nothing written"),
+              std::string::npos)
+        << text;
+    EXPECT_EQ(lucent_mpi_lines(text), 1) << text;
+    EXPECT_EQ(names_with(dir, "mpi.exr"), std::vector<std::string>{});
+  }
+}
+
 // --checkpoint (docs/parts.md, "Checkpoints of lucent-mpi"): a render that is not stopped writes
 // the image of the run without it, and leaves no checkpoint, lock or temporary file behind.
 TEST(Parts, MpiCheckpointCompleteRunLeavesNoCheckpoint) {

@@ -84,6 +84,25 @@ bool refused(const std::function<void()>& step) {
   return first < g_size;
 }
 
+const char* signal_name(int sig) {
+  return sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "SIGINT (Ctrl-C)";
+}
+
+/// Whether a rank has a stop signal, agreed by all ranks: its number (the highest any rank has),
+/// else 0. The lowest stopped rank says so, in one line.
+int stopped_before_rendering() {
+  const int mine = g_stop.load() ? (g_signal ? int(g_signal) : SIGINT) : 0;
+  int sig = 0, first = g_size;
+  const int rank = mine ? g_rank : g_size;
+  MPI_Allreduce(&mine, &sig, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(&rank, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (first == g_rank)
+    std::fprintf(stderr,
+                 "lucent-mpi: rank %d of %d: interrupted by %s before rendering: nothing written\n",
+                 g_rank, g_size, signal_name(mine));
+  return sig;
+}
+
 struct Args {
   std::string scene, output, device, precision = "float";
   int spp = 0, width = 0, height = 0;
@@ -321,7 +340,18 @@ int run(const Args& a) {
   std::optional<lucent::Renderer> session(std::in_place, so);
   lucent::Renderer& renderer = *session;
   renderer.set_cancel_flag(&g_stop);
-  renderer.set_scene(std::move(scene));  // held once, by the session
+  try {
+    renderer.set_scene(std::move(scene));  // held once, by the session
+  } catch (const lucent::Error&) {
+    // a stop signal during the kernel build: PoCL's LLVM handles it too (it removes its
+    // temporary files, then passes it on), and the build fails. That is the interruption, as
+    // `lucent render` reports it, not a build error (it ended the job through MPI_Abort, "kernel
+    // build failed", exit 1)
+    if (!g_stop.load()) throw;
+  }
+  // a rank stopped before rendering ends the job, every rank with 128 + the signal: nothing was
+  // rendered, and a rank that went on alone would wait for the others for ever
+  if (const int sig = stopped_before_rendering(); sig > 0) return 128 + sig;
   renderer.reset(range.begin);
   // a checkpoint of another image, of other samples (another --spp) or of more than the rank's
   // share: refused before rendering; else the rank starts after its samples
