@@ -1234,6 +1234,42 @@ TEST(Parts, MpiCheckpointFailedOutputWriteKeepsEveryRanksSamples) {
     ASSERT_NEAR(resumed.rgb[i], single.rgb[i], 1e-5 * std::abs(single.rgb[i])) << i;
 }
 
+// The checkpoints of another number of ranks are refused, and the line names what to remove to
+// start again: the checkpoints, their locks and the hidden temporary files of a write killed
+// half-way, which a run of that count removes and this one does not ("ck.rank*-of-2.exr" left
+// the last two for ever). Removing what it names leaves none of the old run's files, and the
+// render runs.
+TEST(Parts, MpiCheckpointOfAnotherRankCountNamesAllItsFiles) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  for (const char* name : {"ck.rank0-of-2.exr", "ck.rank0-of-2.exr.lock", "ck.rank1-of-2.exr",
+                           "ck.rank1-of-2.exr.lock", ".ck.rank1-of-2.exr.tmp-4242-0"})
+    lucent::test::write_file(dir + "/" + name, "the old run's");
+  const std::string command =
+      mpirun("-np 1 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " -q --spp 8 -o " +
+             q(dir + "/out.exr") + " --checkpoint " + q(dir + "/ck.exr"));
+  CommandResult r = run_shell("timeout 60 env " + command, dir);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(lucent_mpi_lines(r.err), 1) << r.err;
+  const std::string head =
+                        ": a checkpoint of a run of 2 ranks, this one has 1: resume it with "
+                        "mpirun -np 2, or remove ",
+                    tail = " to start again";
+  const size_t at = r.err.find(head), end = r.err.find(tail);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  ASSERT_NE(end, std::string::npos) << r.err;
+  std::string patterns = r.err.substr(at + head.size(), end - at - head.size());
+  EXPECT_EQ(patterns, dir + "/ck.rank*-of-2.exr* and " + dir + "/.ck.rank*-of-2.exr.tmp-*");
+  if (const size_t and_at = patterns.find(" and "); and_at != std::string::npos)
+    patterns.replace(and_at, 5, " ");
+  ASSERT_EQ(std::system(("bash -c " + q("rm -f -- " + patterns)).c_str()), 0);
+  EXPECT_EQ(names_with(dir, "-of-2"), std::vector<std::string>{});
+  r = run_shell("timeout 60 env " + command, dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/out.exr"));
+}
+
 // A rank's checkpoint needs its part and the part file's write beside the session, as `lucent
 // render --checkpoint` counts them: at 2048x2048 (1.1 GiB), under an address-space limit that the
 // render without a checkpoint fits, the rank refuses before rendering instead of failing its first
@@ -1347,7 +1383,8 @@ TEST(Parts, MpiCheckpointStoppedRunResumesToTheUninterruptedImage) {
            {3, "",
             "-of-2.exr: a checkpoint of a run of 2 ranks, this one has 3: resume it with "
             "mpirun -np 2, or remove " +
-                dir + "/ck.rank*-of-2.exr to start again"},
+                dir + "/ck.rank*-of-2.exr* and " + dir +
+                "/.ck.rank*-of-2.exr.tmp-* to start again"},
            {2, " --seed 9", "ck.rank0-of-2.exr: seed 3 differs from " + scene + "'s 9"}}) {
     SCOPED_TRACE(std::to_string(ranks) + extra);
     CommandResult r = run_shell("timeout 60 env " + command(ranks, extra), dir);

@@ -155,12 +155,16 @@ void refuse_other_rank_counts(const std::string& ck, int ranks) {
       continue;
     const int k = std::stoi(mid.substr(of + 4));
     if (k == ranks) continue;
-    const std::string base =
-        (p.parent_path() / (p.stem().string() + ".rank*-of-" + std::to_string(k) + ext)).string();
+    // the files to remove: the checkpoints and their locks (ck.rank*-of-2.exr*), and the
+    // temporary files of a write killed half-way (.ck.rank*-of-2.exr.tmp-*, hidden, which a
+    // run of 2 ranks removes but this one cannot: "ck.rank*-of-2.exr" left both for ever)
+    const std::string base = p.stem().string() + ".rank*-of-" + std::to_string(k) + ext;
+    const std::string files = (p.parent_path() / (base + "*")).string() + " and " +
+                              (p.parent_path() / ("." + base + ".tmp-*")).string();
     throw lucent::Error((p.parent_path() / name).string() + ": a checkpoint of a run of " +
                         std::to_string(k) + " ranks, this one has " + std::to_string(ranks) +
-                        ": resume it with mpirun -np " + std::to_string(k) + ", or remove " + base +
-                        " to start again");
+                        ": resume it with mpirun -np " + std::to_string(k) + ", or remove " +
+                        files + " to start again");
   }
 }
 
