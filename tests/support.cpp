@@ -6,7 +6,9 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -373,6 +375,72 @@ double mean_image_mean_z2(const std::function<RenderResult(int)>& render, int pa
     sum += z * z;
   }
   return sum / pairs;
+}
+
+namespace {
+
+/// A field of /proc/self/status, in KiB ("VmRSS:"), or -1.
+long status_kib(const char* key) {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind(key, 0) == 0) return std::atol(line.c_str() + std::string(key).size());
+  return -1;
+}
+
+}  // namespace
+
+double child_peak_bytes(const std::function<bool()>& work) {
+  int fds[2];
+  if (::pipe(fds) != 0) return -1;
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    return -1;
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    double added = -1;
+    if (std::ofstream("/proc/self/clear_refs") << "5") {
+      const long before = status_kib("VmRSS:");
+      try {
+        if (work()) added = 1024.0 * double(status_kib("VmHWM:") - before);
+      } catch (...) {
+      }
+    }
+    const ssize_t w = ::write(fds[1], &added, sizeof added);
+    ::_exit(w == sizeof added ? 0 : 1);
+  }
+  ::close(fds[1]);
+  double added = -1;
+  if (::read(fds[0], &added, sizeof added) != sizeof added) added = -1;
+  ::close(fds[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return added;
+}
+
+std::string soup_obj_text(int n) {
+  std::string obj;
+  obj.reserve(size_t(n) * 110);
+  std::uint32_t state = 12345;
+  auto next = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return double(state >> 8) / double(1 << 24) * 10.0;
+  };
+  char line[128];
+  for (int i = 0; i < n; ++i) {
+    const double x = next(), y = next(), z = next();
+    std::snprintf(line, sizeof line, "v %.5f %.5f %.5f\nv %.5f %.5f %.5f\nv %.5f %.5f %.5f\n", x, y,
+                  z, x + 0.01, y, z, x, y + 0.01, z);
+    obj += line;
+  }
+  for (int i = 0; i < n; ++i) {
+    std::snprintf(line, sizeof line, "f %d %d %d\n", 3 * i + 1, 3 * i + 2, 3 * i + 3);
+    obj += line;
+  }
+  return obj;
 }
 
 }  // namespace lucent::test

@@ -105,6 +105,15 @@ std::map<std::string, std::string> parse_report(const std::string& out);
 /// Number of lines in `s` that are not empty.
 int count_lines(const std::string& s);
 
+/// The peak resident memory that `work` adds, in bytes, measured in a child process (forked; its
+/// peak reset first through /proc/self/clear_refs, then VmHWM less the VmRSS before `work`); -1
+/// when it cannot be measured or `work` returns false (or throws).
+double child_peak_bytes(const std::function<bool()>& work);
+
+/// The text of an OBJ file of `n` separate small triangles scattered in a 10-unit cube (a "soup":
+/// the BVH's leaves hold one triangle each), the same for the same `n`.
+std::string soup_obj_text(int n);
+
 /// z threshold of a two-sided test at family-wise significance alpha over m tests (Sidak).
 double sidak_z(double alpha, int m);
 

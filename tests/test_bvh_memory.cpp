@@ -5,12 +5,8 @@
 // collapses the scratch tree directly and hands its pages back as it goes (BENCHMARKS.md, "Peak
 // host memory").
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdint>
-#include <cstdlib>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -18,15 +14,6 @@
 #include "support.hpp"
 
 namespace {
-
-/// A field of /proc/self/status, in KiB ("VmRSS:"), or -1.
-long status_kib(const char* key) {
-  std::ifstream f("/proc/self/status");
-  std::string line;
-  while (std::getline(f, line))
-    if (line.rfind(key, 0) == 0) return std::atol(line.c_str() + std::string(key).size());
-  return -1;
-}
 
 /// `n` small separate triangles scattered in a box: leaves of one triangle, the most nodes and
 /// leaf blocks a primitive.
@@ -46,33 +33,14 @@ std::vector<lc_triangle> soup(std::size_t n) {
   return tris;
 }
 
-/// The peak resident memory that bvh::build over `tris` adds, in bytes (its peak reset before the
-/// build: /proc/self/clear_refs), measured in a child process; -1 when it cannot be measured.
+/// The peak resident memory that bvh::build over `tris` adds, in bytes, measured in a child
+/// process; -1 when it cannot be measured.
 double build_peak_bytes(const std::vector<lc_triangle>& tris) {
-  int fds[2];
-  if (::pipe(fds) != 0) return -1;
-  const pid_t pid = ::fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    ::close(fds[0]);
-    double added = -1;
-    if (std::ofstream("/proc/self/clear_refs") << "5") {
-      const long before = status_kib("VmRSS:");
-      lucent::bvh::BuildOptions o;
-      o.threads = 2;
-      const lucent::bvh::Bvh b = lucent::bvh::build(tris, {}, o);
-      if (!b.nodes.empty()) added = 1024.0 * double(status_kib("VmHWM:") - before);
-    }
-    const ssize_t w = ::write(fds[1], &added, sizeof added);
-    ::_exit(w == sizeof added ? 0 : 1);
-  }
-  ::close(fds[1]);
-  double added = -1;
-  if (::read(fds[0], &added, sizeof added) != sizeof added) added = -1;
-  ::close(fds[0]);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return added;
+  return lucent::test::child_peak_bytes([&] {
+    lucent::bvh::BuildOptions o;
+    o.threads = 2;
+    return !lucent::bvh::build(tris, {}, o).nodes.empty();
+  });
 }
 
 }  // namespace

@@ -4,13 +4,8 @@
 // scene's: a 10^6-triangle soup took 344 MiB at its peak where the check counted 274 (and the
 // scene keeps 107).
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
-#include <fstream>
 #include <string>
 
 #include "lucent/scene.hpp"
@@ -19,43 +14,10 @@
 
 namespace {
 
-/// A field of /proc/self/status, in KiB ("VmRSS:"), or -1.
-long status_kib(const char* key) {
-  std::ifstream f("/proc/self/status");
-  std::string line;
-  while (std::getline(f, line))
-    if (line.rfind(key, 0) == 0) return std::atol(line.c_str() + std::string(key).size());
-  return -1;
-}
-
-/// The peak resident memory that load_scene(`scene`) adds, in bytes, measured in a child process
-/// (its peak reset before the load: /proc/self/clear_refs), or -1 when it cannot be measured.
+/// The peak resident memory that load_scene(`scene`) adds, in bytes, measured in a child process,
+/// or -1 when it cannot be measured.
 double load_peak_bytes(const std::string& scene) {
-  int fds[2];
-  if (::pipe(fds) != 0) return -1;
-  const pid_t pid = ::fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    ::close(fds[0]);
-    double added = -1;
-    if (std::ofstream("/proc/self/clear_refs") << "5") {
-      const long before = status_kib("VmRSS:");
-      try {
-        const lucent::Scene s = lucent::load_scene(scene);
-        added = 1024.0 * double(status_kib("VmHWM:") - before);
-      } catch (...) {
-      }
-    }
-    const ssize_t w = ::write(fds[1], &added, sizeof added);
-    ::_exit(w == sizeof added ? 0 : 1);
-  }
-  ::close(fds[1]);
-  double added = -1;
-  if (::read(fds[0], &added, sizeof added) != sizeof added) added = -1;
-  ::close(fds[0]);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return added;
+  return lucent::test::child_peak_bytes([&] { return !lucent::load_scene(scene).path.empty(); });
 }
 
 }  // namespace
@@ -68,24 +30,7 @@ TEST(ObjMemory, PeakOfALargeMeshIsWithinTheLoadersCount) {
   if (lucent::test::kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer's memory is in the peak";
   const std::string dir = lucent::test::temp_dir();
   const int n = 200000;
-  std::string obj;
-  obj.reserve(size_t(n) * 110);
-  std::uint32_t state = 12345;
-  auto next = [&state] {
-    state = state * 1664525u + 1013904223u;
-    return double(state >> 8) / double(1 << 24) * 10.0;
-  };
-  char line[128];
-  for (int i = 0; i < n; ++i) {
-    const double x = next(), y = next(), z = next();
-    std::snprintf(line, sizeof line, "v %.5f %.5f %.5f\nv %.5f %.5f %.5f\nv %.5f %.5f %.5f\n", x, y,
-                  z, x + 0.01, y, z, x, y + 0.01, z);
-    obj += line;
-  }
-  for (int i = 0; i < n; ++i) {
-    std::snprintf(line, sizeof line, "f %d %d %d\n", 3 * i + 1, 3 * i + 2, 3 * i + 3);
-    obj += line;
-  }
+  std::string obj = lucent::test::soup_obj_text(n);
   lucent::test::write_file(dir + "/soup.obj", obj);
   lucent::test::write_file(dir + "/soup.json",
                            R"({"camera": {"position": [5, 5, -20], "look_at": [5, 5, 5]},

@@ -200,24 +200,7 @@ TEST(Resources, PeakHostMemoryOfALargeFilmIsWithinTheEstimate) {
 /// A scene of `n` separate small triangles scattered in a 10-unit cube (an OBJ "soup": the BVH's
 /// leaves hold one triangle each), written to dir/soup<n>.json; returns its path.
 std::string soup_scene(const std::string& dir, int n) {
-  std::string obj;
-  obj.reserve(size_t(n) * 110);
-  std::uint32_t state = 12345;
-  auto next = [&state] {
-    state = state * 1664525u + 1013904223u;
-    return double(state >> 8) / double(1 << 24) * 10.0;
-  };
-  char line[128];
-  for (int i = 0; i < n; ++i) {
-    const double x = next(), y = next(), z = next();
-    std::snprintf(line, sizeof line, "v %.5f %.5f %.5f\nv %.5f %.5f %.5f\nv %.5f %.5f %.5f\n", x, y,
-                  z, x + 0.01, y, z, x, y + 0.01, z);
-    obj += line;
-  }
-  for (int i = 0; i < n; ++i) {
-    std::snprintf(line, sizeof line, "f %d %d %d\n", 3 * i + 1, 3 * i + 2, 3 * i + 3);
-    obj += line;
-  }
+  const std::string obj = lucent::test::soup_obj_text(n);
   const std::string name = "soup" + std::to_string(n);
   lucent::test::write_file(dir + "/" + name + ".obj", obj);
   lucent::test::write_file(dir + "/" + name + ".json",
