@@ -504,28 +504,41 @@ struct Renderer::Impl {
                   stale);
   }
 
+  /// What a set_scene or set_camera call is warned of (validation, energy, packing, precision),
+  /// collected while it runs (collect(), the sink of a ScopedWarningSink), then given on, each
+  /// once per session: an AOV render, a converge study's settings and an application's camera
+  /// moves set the scene again (a render with 3 AOVs said each 4 times).
+  class CallNotes {
+   public:
+    explicit CallNotes(std::set<std::string>& given) : given_(given) {}
+    CallNotes(const CallNotes&) = delete;
+    CallNotes& operator=(const CallNotes&) = delete;
+    const std::function<void(const std::string&)>& collect() const { return collect_; }
+    void give() const {
+      for (const std::string& note : notes_)
+        if (given_.insert(note).second) scene_detail::warn(note);
+    }
+
+   private:
+    std::set<std::string>& given_;
+    std::vector<std::string> notes_;
+    const std::function<void(const std::string&)> collect_ = [this](const std::string& m) {
+      notes_.push_back(m);
+    };
+  };
+
   /// `take`, when not null, is `s` itself, given to the session (moved in on success) instead
   /// of copied.
   void set_scene(const Scene& s, Scene* take = nullptr) {
     scene_detail::ScopedWarningSink sink(options.on_warning);
-    // What the scene is warned of (validation, energy, packing, precision), each once per
-    // session: an AOV render, a converge study's settings and an application's camera moves set
-    // the scene again (a render with 3 AOVs said each 4 times). Collected, then given on.
-    std::vector<std::string> notes;
-    const std::function<void(const std::string&)> collect = [&notes](const std::string& m) {
-      notes.push_back(m);
-    };
-    auto give_notes = [&] {
-      for (const std::string& note : notes)
-        if (notes_given.insert(note).second) scene_detail::warn(note);
-    };
+    CallNotes notes(notes_given);
     std::vector<render_detail::DeviceLimits> limits;
     auto t0 = clock_type::now();
     bool bvh_reused = false;
     const bool uploaded = workers.front()->dev.has_value();
     render_detail::PackedScene next;
     try {
-      scene_detail::ScopedWarningSink capture(collect);
+      scene_detail::ScopedWarningSink capture(notes.collect());
       scene_detail::validate_scene(s);  // fields set directly may not have been checked
       for (const std::string& note : scene_detail::energy_gain_notes(s)) scene_detail::warn(note);
       for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
@@ -543,10 +556,10 @@ struct Renderer::Impl {
         if (std::string note = note_of(next, options.precision == Precision::Float); !note.empty())
           scene_detail::warn(scene_detail::in_file(s.path, note));
     } catch (...) {
-      give_notes();
+      notes.give();
       throw;
     }
-    give_notes();
+    notes.give();
     ++stats.scene_packs;
     if (!bvh_reused) {
       ++stats.bvh_builds;
@@ -677,23 +690,15 @@ struct Renderer::Impl {
   void set_camera(const Camera& camera) {
     if (!scene) throw Error("set_camera: the session has no scene (call set_scene first)");
     scene_detail::ScopedWarningSink sink(options.on_warning);
-    // the session's warnings, each once, as set_scene gives them
-    std::vector<std::string> notes;
-    const std::function<void(const std::string&)> collect = [&notes](const std::string& m) {
-      notes.push_back(m);
-    };
-    auto give_notes = [&] {
-      for (const std::string& note : notes)
-        if (notes_given.insert(note).second) scene_detail::warn(note);
-    };
+    CallNotes notes(notes_given);  // the session's warnings, each once, as set_scene gives them
     {
-      scene_detail::ScopedWarningSink capture(collect);
+      scene_detail::ScopedWarningSink capture(notes.collect());
       try {
         // set_scene's check of the camera, at its place in the scene ("scene.json: /camera/fov:
         // ..."); the rest of the scene passed it when it was set
         scene_detail::validate_camera(camera, scene_detail::Reporter(scene->path, "/camera"));
       } catch (...) {
-        give_notes();
+        notes.give();
         throw;
       }
     }
@@ -736,15 +741,15 @@ struct Renderer::Impl {
     }
     render_detail::CameraPacking next;
     {
-      scene_detail::ScopedWarningSink capture(collect);
+      scene_detail::ScopedWarningSink capture(notes.collect());
       try {
         next = render_detail::repack_camera(*scene, packed, camera);
       } catch (...) {
-        give_notes();
+        notes.give();
         throw;
       }
     }
-    give_notes();
+    notes.give();
     const bool keep =
         !next.lights_changed && std::memcmp(&next.params, &packed.params, sizeof(lc_params)) == 0;
     if (next.lights_changed) {
