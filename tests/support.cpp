@@ -421,6 +421,14 @@ double child_peak_bytes(const std::function<bool()>& work) {
   return added;
 }
 
+double cli_samples_per_second(const std::string& scene, const std::string& out) {
+  const CommandResult cal = run_cli("render '" + scene + "' --time 0.5 -o '" + out + "'");
+  const size_t at = cal.err.find(" Msamples/s");
+  const size_t open = at == std::string::npos ? at : cal.err.rfind('(', at);
+  if (cal.status != 0 || open == std::string::npos) return -1;
+  return std::atof(cal.err.c_str() + open + 1) * 1e6;
+}
+
 std::string soup_obj_text(int n) {
   std::string obj;
   obj.reserve(size_t(n) * 110);

@@ -105,6 +105,10 @@ std::map<std::string, std::string> parse_report(const std::string& out);
 /// Number of lines in `s` that are not empty.
 int count_lines(const std::string& s);
 
+/// The samples per second of `lucent render SCENE --time 0.5 -o OUT` (its summary line), to size
+/// a test's render for this machine; -1 when the render fails or prints no rate.
+double cli_samples_per_second(const std::string& scene, const std::string& out);
+
 /// The peak resident memory that `work` adds, in bytes, measured in a child process (forked; its
 /// peak reset first through /proc/self/clear_refs, then VmHWM less the VmRSS before `work`); -1
 /// when it cannot be measured or `work` returns false (or throws).
