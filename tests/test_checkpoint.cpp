@@ -57,22 +57,6 @@ std::string noisy_scene(const std::string& dir, const std::string& name = "scene
   return path;
 }
 
-/// A lamp filling the left of a 500x400 view, its edge slanted, nothing else: every sample of a
-/// pixel off the edge is the same, so that its part file compresses to 80 KB, where its PFM takes
-/// 2.4 MB (a pixel on the edge differs with its samples).
-std::string flat_scene(const std::string& dir) {
-  std::string path = dir + "/flat.json";
-  lucent::test::write_file(path, R"({
-    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
-    "film": {"width": 500, "height": 400},
-    "integrator": {"type": "path", "spp": 16, "seed": 3},
-    "materials": {"lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1, 0.5, 0.25]}},
-    "shapes": [{"type": "triangles", "material": "lamp",
-                "positions": [[-10,-10,0],[0.3,-10,0],[0.9,10,0],[-10,10,0]], "indices": [0,1,2, 0,2,3]}]
-  })");
-  return path;
-}
-
 /// Largest relative difference between two renders' pixel means; their sample counts must be
 /// equal.
 double max_relative_difference(const lucent::RenderResult& a, const lucent::RenderResult& b) {
@@ -522,7 +506,7 @@ TEST(Checkpoint, ProgressOfAResumedRenderCountsTheCheckpoint) {
 // renders nothing and writes the image of the uninterrupted render.
 TEST(Checkpoint, FailedOutputWriteKeepsTheSamplesInTheCheckpoint) {
   const std::string dir = lucent::test::temp_dir();
-  const std::string scene = flat_scene(dir);
+  const std::string scene = lucent::test::flat_lamp_scene(dir);
   const std::string ck = dir + "/ck.exr", out = dir + "/out.pfm", full = dir + "/full.pfm";
   // (first: the kernel caches are filled, whose files the limit would refuse)
   ASSERT_EQ(run_cli("render " + q(scene) + " -q -o " + q(full)).status, 0);

@@ -1191,17 +1191,7 @@ TEST(Parts, MpiCheckpointFailedOutputWriteKeepsEveryRanksSamples) {
   // them; the sanitizer build runs the other lucent-mpi entries, which take the same paths)
   if (lucent::test::kAddressSanitizer) GTEST_SKIP() << "slow under AddressSanitizer";
   const std::string dir = lucent::test::temp_dir();
-  // a lamp filling the left of the view, its edge slanted (a pixel on it differs with its
-  // samples), nothing else: every other pixel's samples are the same, and its sums compress
-  const std::string scene = dir + "/flat.json";
-  lucent::test::write_file(scene, R"({
-    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
-    "film": {"width": 500, "height": 400},
-    "integrator": {"type": "path", "spp": 16, "seed": 3},
-    "materials": {"lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1, 0.5, 0.25]}},
-    "shapes": [{"type": "triangles", "material": "lamp",
-                "positions": [[-10,-10,0],[0.3,-10,0],[0.9,10,0],[-10,10,0]], "indices": [0,1,2, 0,2,3]}]
-  })");
+  const std::string scene = lucent::test::flat_lamp_scene(dir);  // 80 KB parts, 2.4 MB PFMs
   const std::string ck = dir + "/ck.exr", out = dir + "/out.pfm", full = dir + "/full.pfm";
   const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " -q -o ";
   // (first: the kernel caches are filled, whose files the limit would refuse)
