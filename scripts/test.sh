@@ -3,7 +3,7 @@
 # With LUCENT_SANITIZE=1 (CI sets it) the suite then runs again on an AddressSanitizer +
 # UndefinedBehaviorSanitizer build in build-asan/ (built by clang when it is installed), and, when
 # clang with libFuzzer is installed (scripts/install-deps.sh --with-fuzz), each fuzz target runs
-# for LUCENT_FUZZ_SECONDS (default 10; 0 skips it) in build-fuzz/ (scripts/fuzz.sh).
+# for LUCENT_FUZZ_SECONDS (default 5; 0 skips it) in build-fuzz/ (scripts/fuzz.sh).
 #
 # Sized for a slow, shared machine (docs/testing.md): as many builds and tests at a time as there
 # are CPUs this process may really use (scripts/cpus.sh: the affinity mask and the cgroup CPU
@@ -71,11 +71,11 @@ if [[ "${LUCENT_SANITIZE:-0}" == "1" ]]; then
     timed "sanitizer tests" ctest --test-dir build-asan --output-on-failure -j"$jobs"
 fi
 
-if [[ "${LUCENT_SANITIZE:-0}" == "1" && "${LUCENT_FUZZ_SECONDS:-10}" != "0" ]]; then
-  echo "test: fuzz smoke run (${LUCENT_FUZZ_SECONDS:-10} s per target)"
+if [[ "${LUCENT_SANITIZE:-0}" == "1" && "${LUCENT_FUZZ_SECONDS:-5}" != "0" ]]; then
+  echo "test: fuzz smoke run (${LUCENT_FUZZ_SECONDS:-5} s per target)"
   export FUZZ_JOBS="$jobs"
   # a smoke run: the targets build, start and take their seeds; -O0 halves to thirds their build
   # (third_party.cpp 18 -> 7 s) at the cost of executions, which 10 s do not need
   FUZZ_FLAGS="${FUZZ_FLAGS:--O0 -g1}" \
-    timed "fuzz smoke run" scripts/fuzz.sh --if-available "${LUCENT_FUZZ_SECONDS:-10}"
+    timed "fuzz smoke run" scripts/fuzz.sh --if-available "${LUCENT_FUZZ_SECONDS:-5}"
 fi

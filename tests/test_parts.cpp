@@ -797,12 +797,24 @@ TEST(Parts, SlurmArrayScriptsRenderAndMerge) {
 }
 
 #ifdef LUCENT_MPI_PATH
+/// How long mpirun leaves the other ranks once one has exited with a non-zero status or been
+/// signalled (odls_base_sigkill_timeout).
+enum class Grace {
+  /// none: the job's ranks exit together (lucent-mpi's ranks agree on their status and finalize
+  /// before they exit), and mpirun's default would only add 2 s (a second before SIGTERM, one
+  /// before SIGKILL) to every run that exits non-zero
+  none,
+  /// mpirun's default second: what a stopped rank has to write its checkpoint and part
+  mpirun_default,
+};
+
 /// mpirun with the settings a test needs: root allowed (containers), no CMA single copy (ptrace
 /// is often restricted in containers), oversubscription of the 2-core machine.
-std::string mpirun(const std::string& args) {
+std::string mpirun(const std::string& args, Grace grace = Grace::none) {
   return std::string(
              "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
-             "OMPI_MCA_btl_vader_single_copy_mechanism=none '") +
+             "OMPI_MCA_btl_vader_single_copy_mechanism=none ") +
+         (grace == Grace::none ? "OMPI_MCA_odls_base_sigkill_timeout=0 " : "") + "'" +
          LUCENT_MPIEXEC + "' --oversubscribe " + args;
 }
 
@@ -977,7 +989,8 @@ TEST(Parts, MpiSigtermToMpirunWritesWhatTheRanksRendered) {
   // in the background; SIGTERM to mpirun once rank 0's progress line shows its render running
   const std::string script = dir + "/stop.sh";
   lucent::test::write_file(script, mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " +
-                                          q(scene) + " --spp 16000000 -o " + q(out)) +
+                                              q(scene) + " --spp 16000000 -o " + q(out),
+                                          Grace::mpirun_default) +
                                        " 2>" + q(err) +
                                        " </dev/null & pid=$!\nfor i in $(seq 600); do grep -q " +
                                        "'rank 0 of 2:' " + q(err) +
@@ -1045,8 +1058,9 @@ TEST(Parts, MpiSigtermDuringTheKernelBuildIsAnInterruption) {
         script, "timeout 60 env POCL_CACHE_DIR=" + q(dir + "/pocl" + std::to_string(ms)) +
                     " LUCENT_CACHE_DIR=off " +
                     mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) +
-                           " --spp 16000000 -o " + q(dir + "/mpi.exr") + " --checkpoint " +
-                           q(dir + "/ck.exr")) +
+                               " --spp 16000000 -o " + q(dir + "/mpi.exr") + " --checkpoint " +
+                               q(dir + "/ck.exr"),
+                           Grace::mpirun_default) +
                     " 2>" + q(err) + " </dev/null & pid=$!\n" + "for i in $(seq 3000); do [ -e " +
                     q(lock0) + " ] && [ -e " + q(lock1) + " ] && break; sleep 0.01; done\nsleep " +
                     std::to_string(ms / 1000.0) +
@@ -1330,10 +1344,11 @@ TEST(Parts, MpiCheckpointStoppedRunResumesToTheUninterruptedImage) {
   const double rate = lucent::test::cli_samples_per_second(scene, dir + "/cal.exr");
   ASSERT_GT(rate, 0) << "the calibration render failed";
   std::uint64_t n = 0;
-  auto command = [&](int ranks, const std::string& extra) {
+  auto command = [&](int ranks, const std::string& extra, Grace grace = Grace::none) {
     return mpirun("-np " + std::to_string(ranks) + " '" + std::string(LUCENT_MPI_PATH) + "' " +
-                  q(scene) + " --spp " + std::to_string(n) + " -o " + q(out) + " --checkpoint " +
-                  q(ck) + " --checkpoint-every 0.2" + extra);
+                      q(scene) + " --spp " + std::to_string(n) + " -o " + q(out) +
+                      " --checkpoint " + q(ck) + " --checkpoint-every 0.2" + extra,
+                  grace);
   };
   // SIGTERM to the ranks (mpirun's children; mpirun itself passes it on a second later) once
   // both checkpoints exist. A machine faster than at the calibration can finish first: tried
@@ -1344,8 +1359,9 @@ TEST(Parts, MpiCheckpointStoppedRunResumesToTheUninterruptedImage) {
     n = std::clamp<std::uint64_t>(std::uint64_t(rate * 1.0 / 120) << attempt, 20000,
                                   std::uint64_t(1) << 24);
     lucent::test::write_file(
-        script, command(2, "") + " 2>" + q(dir + "/stop.err") + " </dev/null & pid=$!\n" +
-                    "for i in $(seq 600); do [ -e " + q(ck0) + " ] && [ -e " + q(ck1) +
+        script, command(2, "", Grace::mpirun_default) + " 2>" + q(dir + "/stop.err") +
+                    " </dev/null & pid=$!\n" + "for i in $(seq 600); do [ -e " + q(ck0) +
+                    " ] && [ -e " + q(ck1) +
                     " ] && break; kill -0 $pid 2>/dev/null || break; sleep 0.05; done\n" +
                     "kill -TERM $(pgrep -P $pid)\nwait $pid\n");
     const int raw = std::system(("bash " + q(script)).c_str());
