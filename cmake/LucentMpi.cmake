@@ -25,6 +25,11 @@ if(NOT _lucent_mpi STREQUAL "OFF")
     add_executable(lucent_mpi ${CMAKE_CURRENT_SOURCE_DIR}/src/mpi/lucent_mpi.cpp
                               ${CMAKE_CURRENT_SOURCE_DIR}/src/cli/checkpoint.cpp)
     lucent_glue_target(lucent_mpi)
+    # it parses arguments and passes parts (the library does the work): -O1 compiles it in 6.5 s
+    # instead of 10.5 s at -O3 (CLI11's inline functions, as for the CLI above)
+    if(NOT LUCENT_SANITIZE)
+      target_compile_options(lucent_mpi PRIVATE $<$<NOT:$<CONFIG:Debug>>:-O1>)
+    endif()
     set_target_properties(lucent_mpi PROPERTIES OUTPUT_NAME lucent-mpi)
     target_compile_options(lucent_mpi PRIVATE -Wall -Wextra)
     # the C API only: no deprecated C++ bindings (their symbols are in another library)
