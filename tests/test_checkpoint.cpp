@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "core/file_io.hpp"
+#include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/image.hpp"
 #include "lucent/parts.hpp"
@@ -116,6 +117,14 @@ bool kill_once_written(const std::vector<std::string>& args, const std::string& 
   return WIFSIGNALED(status);
 }
 
+/// The compression of the OpenEXR file at `path` (TINYEXR_COMPRESSIONTYPE_*).
+int compression_of(const std::string& path) {
+  const std::string bytes = lucent::test::read_file(path);
+  return lucent::image_detail::probe_image(reinterpret_cast<const unsigned char*>(bytes.data()),
+                                           bytes.size(), path, 1 << 24)
+      .compression;
+}
+
 // (a) and (b): killed with SIGKILL once its first checkpoint exists, the render run again
 // resumes from the checkpoint and writes the image of the uninterrupted render; the checkpoint
 // in between holds exactly the samples [0, K) it claims, and is removed at the end.
@@ -150,6 +159,10 @@ TEST(Checkpoint, KilledRenderResumesToTheUninterruptedImage) {
           .status,
       0);
   EXPECT_LT(max_relative_difference(part.acc, lucent::read_render_part(same).acc), 1e-5);
+  // the checkpoint in PIZ (written in half ZIP's time: the render waits for it), the part of
+  // --samples in ZIP (read in half PIZ's time)
+  EXPECT_EQ(compression_of(ck), TINYEXR_COMPRESSIONTYPE_PIZ);
+  EXPECT_EQ(compression_of(same), TINYEXR_COMPRESSIONTYPE_ZIP);
 
   // (a) the same command again: samples [K, N) only, the image of [0, N)
   CommandResult r = run_cli("render " + q(scene) + " --spp " + spp + " -o " + q(out) +

@@ -119,7 +119,9 @@ lucent::RenderPart Checkpoint::whole(const lucent::Renderer& renderer) const {
 bool Checkpoint::save(const lucent::RenderPart& part) {
   bool ok = true;
   try {
-    lucent::write_render_part(path_, part);
+    // PIZ: a render pauses for the write (and a stopped job's SIGKILL may follow soon), and reads
+    // the file once
+    lucent::write_render_part(path_, part, lucent::PartCompression::piz);
   } catch (const lucent::Error& e) {
     std::fprintf(stderr, "%s: warning: checkpoint not written: %s\n", program_.c_str(),
                  one_line(e.what()).c_str());

@@ -43,6 +43,13 @@ io::ReadSpec image_read_spec(const char* what) {
   return spec;
 }
 
+std::uint64_t exr_decode_bytes_per_pixel(const Probe& p) {
+  const std::uint64_t channels = std::uint64_t(std::max(p.channels, 0));
+  // at least the 128 bytes counted for any OpenEXR before (another tool's, decoded to RGBA)
+  const bool uncompressed = p.compression == TINYEXR_COMPRESSIONTYPE_NONE;
+  return std::max<std::uint64_t>(128, (uncompressed ? 15 : 13) * channels + 40);
+}
+
 io::ReadSpec part_read_spec() {
   io::ReadSpec spec;
   spec.what = "part file";

@@ -465,6 +465,8 @@ class Checker {
            std::to_string(h) + ")");
     size(p, u64(w), u64(h));
     if (header.num_channels <= 0) fail("OpenEXR header has no channels");
+    p.channels = header.num_channels;
+    p.compression = header.compression_type;
     u64 bytes_per_pixel = 0;
     for (int c = 0; c < header.num_channels; ++c)
       bytes_per_pixel += header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF ? 2 : 4;

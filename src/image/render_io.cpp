@@ -165,7 +165,7 @@ void write_render_planes(const std::string& path, const RenderPlanes& r, const E
   header.channels = infos.data();
   header.pixel_types = types.data();
   header.requested_pixel_types = types.data();
-  header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
+  header.compression_type = extras.piz ? TINYEXR_COMPRESSIONTYPE_PIZ : TINYEXR_COMPRESSIONTYPE_ZIP;
   header.num_custom_attributes = static_cast<int>(attributes.size());
   header.custom_attributes = attributes.empty() ? nullptr : attributes.data();
   write_exr(path, image, header);
@@ -244,10 +244,11 @@ RenderResult read_render(const std::string& path, Format* format) {
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   const Probe p = probe_image(data, bytes.size(), path, kMaxImagePixels);
   if (format) *format = p.format;
-  // decoding holds the file and, per pixel, the decoded planes and the result's images: about
-  // 128 bytes a pixel for an OpenEXR (lucent's seven channels, tinyexr's buffers, mean, variance
-  // and counts), 32 for the others (two 16384x16384 PNGs took 9.4 GB in compare)
-  check_decode_memory(path, "image", p, p.format == Format::Exr ? 128 : 32, bytes.size());
+  // decoding holds the file and, per pixel, the decoded planes and the result's images: for an
+  // OpenEXR by its channels (exr_decode_bytes_per_pixel), 32 bytes for the others (two
+  // 16384x16384 PNGs took 9.4 GB in compare)
+  check_decode_memory(path, "image", p,
+                      p.format == Format::Exr ? exr_decode_bytes_per_pixel(p) : 32, bytes.size());
   return read_render_memory(data, bytes.size(), path);
 }
 

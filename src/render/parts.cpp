@@ -360,7 +360,8 @@ std::uint64_t part_write_bytes(int width, int height) {
          image_detail::exr_encoder_bytes(npix * 19 * 4);
 }
 
-void write_render_part(const std::string& path, const RenderPart& part) {
+void write_render_part(const std::string& path, const RenderPart& part,
+                       PartCompression compression) {
   io::CNumbers c_numbers;  // "0.5", whatever the process locale
   const PartInfo& info = part.info;
   const Accumulation& a = part.acc;
@@ -432,6 +433,7 @@ void write_render_part(const std::string& path, const RenderPart& part) {
   };
   // read_render's seed and sampler (what converge checks a reference by)
   if (!info.sampler.empty()) extras.attributes.emplace_back("lucent.sampler", info.sampler);
+  extras.piz = compression == PartCompression::piz;
   image_detail::write_render_planes(path, shown, extras);
 }
 
@@ -470,14 +472,14 @@ RenderPart read_render_part(const std::string& path) {
   if (bytes.size() < 4 || std::memcmp(bytes.data(), "\x76\x2f\x31\x01", 4) != 0)
     throw Error(path + ": not a lucent part file (not an OpenEXR file)");
   {
-    // what decoding takes, checked before it allocates: about 256 bytes per pixel (the decoded
-    // channels, their float and integer copies, the sums in double), and the file itself
+    // what decoding takes, checked before it allocates, and the file itself
     EXRHeader header;
     image_detail::Probe probe =
         image_detail::probe_exr(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(),
                                 path, image_detail::kMaxImagePixels, header);
     FreeEXRHeader(&header);
-    image_detail::check_decode_memory(path, "part", probe, 256, bytes.size());
+    image_detail::check_decode_memory(
+        path, "part", probe, image_detail::exr_decode_bytes_per_pixel(probe), bytes.size());
   }
   image_detail::ExrChannels exr =
       image_detail::read_exr_channels(reinterpret_cast<const unsigned char*>(bytes.data()),
