@@ -739,8 +739,8 @@ TEST(Obj, TransparentMaterialsTakeTfAsTint) {
   EXPECT_EQ(w.count(mtl + ":30: material 'water' (transparent: illum 7): Tf 0.1 0.1 0.1 is grey"),
             1)
       << w.dump();
-  EXPECT_EQ(w.count(mtl + ":18: material 'spectral' (transparent: opacity 0.2 (d or Tr)): only Tf "
-                          "with numbers is read (not the spectral and xyz forms); tint 1"),
+  EXPECT_EQ(w.count(mtl + ":18: material 'spectral' (transparent: opacity 0.2 (d or Tr)): Tf "
+                          "spectral (a curve) is not read; tint 1"),
             1)
       << w.dump();
   EXPECT_EQ(w.count(mtl + ":19: material 'poly' (transparent: illum 4) becomes a dielectric, which "
@@ -748,6 +748,50 @@ TEST(Obj, TransparentMaterialsTakeTfAsTint) {
             1)
       << w.dump();
   EXPECT_EQ(w.all().size(), 4u) << w.dump();
+}
+
+// The MTL specification's other colour forms, which tinyobjloader read as zeros without a word
+// ("Kd xyz 0.3 0.4 0.5" gave Kd 0 0.3 0.4): "xyz x y z" is CIE XYZ, put in linear sRGB (D65),
+// one number meaning x = y = z, a colour outside sRGB's gamut clamped with a warning; "spectral
+// file" (a reflectance curve) is not read, with a warning, as if the statement were absent.
+TEST(Obj, ColourFormsXyzAndSpectral) {
+  std::string dir = lucent::test::temp_dir();
+  const std::string mtl = write(dir, "c.mtl",
+                                "newmtl xyz\nKd xyz 0.3 0.4 0.5\nKs xyz 0.2\nillum 2\n"  // line 1
+                                "newmtl curve\nKd spectral red.rfl 1.0\n"                // 5
+                                "newmtl none\nillum 1\n"                                 // 7
+                                "newmtl vivid\nKd xyz 0.1 0.5 0.1\n"                     // 9
+                                "newmtl glass\nd 0.5\nTf xyz 0.4 0.3 0.2\n");            // 11
+  const char* names[] = {"xyz", "curve", "none", "vivid", "glass"};
+  std::string obj = "mtllib c.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n";
+  for (const char* n : names) obj += std::string("usemtl ") + n + "\nf 1 2 3\n";
+  std::string path = write(dir, "c.obj", obj);
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), 5u);
+  // XYZ to linear sRGB (IEC 61966-2-1's matrix), computed apart: 0.3 * (3.2404542, -0.9692660,
+  // 0.0556434) + 0.4 * (-1.5371385, 1.8760108, -0.2040259) + ...
+  const Material& xyz = material_named(s, "c.obj:xyz");
+  EXPECT_EQ(xyz.type, MaterialType::Plastic);
+  EXPECT_COLOUR(xyz.albedo, 0.10801516, 0.48040252, 0.46369526);
+  EXPECT_COLOUR(xyz.specular, 0.2 * 1.2047843, 0.2 * 0.9483008, 0.2 * 0.9088427);
+  // as a material without Kd
+  EXPECT_COLOUR(material_named(s, "c.obj:curve").albedo, material_named(s, "c.obj:none").albedo.x,
+                material_named(s, "c.obj:none").albedo.y, material_named(s, "c.obj:none").albedo.z);
+  // red: 0.32404542 - 0.76856925 - 0.04985314 < 0
+  EXPECT_COLOUR(material_named(s, "c.obj:vivid").albedo, 0, 0.8452344, 0.00927391);
+  EXPECT_EQ(material_named(s, "c.obj:glass").type, MaterialType::Dielectric);
+  EXPECT_COLOUR(material_named(s, "c.obj:glass").specular, 0.73533385, 0.18340804, 0.17249463);
+  EXPECT_EQ(w.count(mtl + ":6: material 'curve': Kd spectral (a curve in 'red.rfl') is not read: "
+                          "the material's Kd is 0 0 0, as without the statement"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.count(mtl + ":10: material 'vivid': Kd xyz 0.1 0.5 0.1 is outside the sRGB gamut: "
+                          "its negative channels are taken as 0 (Kd 0 0.8452344 0.00927391)"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.all().size(), 2u) << w.dump();
 }
 
 // Some exporters write the illumination model as a decimal ("illum 2.0"; Blender's importer

@@ -246,14 +246,20 @@ TEST(ObjValidation, MtlNumbersAreChecked) {
       {"Ns inf", "m.mtl:2: Ns line: 'inf' is not a finite number"},
       {"Ni", "m.mtl:2: Ni line has no number"},
       {"illum 99", "m.mtl:2: illum line: '99' is not an illumination model (0 to 10)"},
+      {"Kd xyz 0.5 0.5", "m.mtl:2: Kd xyz line has 2 numbers, needs 1 or 3"},
+      {"Ks xyz 0.5 -1 0.5", "m.mtl:2: Ks line: '-1' is negative"},
+      {"Kd xyz nan", "m.mtl:2: Kd line: 'nan' is not a finite number"},
+      {"Kd spectral", "m.mtl:2: Kd spectral line has no file name"},
+      {"Ke spectral x.rfl inf", "m.mtl:2: Ke line: 'inf' is not a finite number"},
   };
   for (const Case& c : cases) {
     std::string err = obj_error(obj, "newmtl a\n" + c.line + "\n");
     EXPECT_NE(err.find(c.error), std::string::npos) << c.line << ": " << err;
     EXPECT_EQ(err.find('\n'), std::string::npos) << err;
   }
-  // forms tinyobjloader does not read are left alone; valid libraries load
+  // the spectral and xyz forms (read_colour_forms); valid libraries load
   EXPECT_EQ(obj_error(obj, "newmtl a\nKd spectral x.rfl\nKd 0.5 0.5 0.5\nNs 10\nillum 2\n"), "");
+  EXPECT_EQ(obj_error(obj, "newmtl a\nKd xyz 0.5\nKs xyz 0.1 0.2 0.1\nKe spectral x.rfl 2\n"), "");
 }
 
 TEST(ObjValidation, TransformBeyondFloatRangeIsAnError) {

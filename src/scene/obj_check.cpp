@@ -425,13 +425,25 @@ void check_mtl_text(const std::string& path, const std::string& text) {
     if (colour) {
       std::string_view probe = rest;
       std::string_view first = token(probe);
-      if (first == "spectral" || first == "xyz") return;  // forms tinyobjloader does not read
+      // the forms tinyobjloader does not read (read_colour_forms): "spectral file [factor]",
+      // "xyz x [y z]"
+      if (first == "spectral") {
+        if (token(probe).empty()) fail(name + " spectral line has no file name");
+        std::string_view factor = token(probe);
+        if (!factor.empty()) number(factor, fail, name.c_str());
+        return;
+      }
+      const bool xyz = first == "xyz";
+      if (xyz) rest = probe;
       int n = 0;
       for (std::string_view t; !(t = token(rest)).empty(); ++n) {
         double v = number(t, fail, name.c_str());
         if (v < 0) fail(name + " line: '" + str(t) + "' is negative");
       }
-      if (n != 3)
+      if (xyz && n != 1 && n != 3)
+        fail(name + " xyz line has " + std::to_string(n) + " number" + (n == 1 ? "" : "s") +
+             ", needs 1 or 3");
+      if (!xyz && n != 3)
         fail(name + " line has " + std::to_string(n) + " number" + (n == 1 ? "" : "s") +
              ", needs 3");
     } else if (scalar) {
@@ -582,6 +594,76 @@ std::string strip_texture_options(const std::string& text, std::vector<IgnoredOp
   return out;
 }
 
+std::string read_colour_forms(const std::string& path, const std::string& text,
+                              std::vector<std::string>* warnings) {
+  if (text.find("xyz") == std::string::npos && text.find("spectral") == std::string::npos)
+    return text;
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
+  std::string out;
+  out.reserve(text.size());
+  std::size_t copied = 0;  // text before this offset is in `out`
+  std::string material;    // the newmtl before the line, for the warnings
+  for_each_line(text, [&](std::string_view line, long ln) {
+    std::string_view rest = line;
+    const std::string_view tag = token(rest);
+    if (tag == "newmtl") {
+      material = trim(std::string(rest));
+      return;
+    }
+    static const char* const colours[] = {"Ka", "Kd", "Ks", "Ke", "Kt", "Tf"};
+    if (std::none_of(std::begin(colours), std::end(colours),
+                     [&](const char* c) { return tag == c; }))
+      return;
+    std::string_view args = rest;
+    const std::string_view form = token(args);
+    // Tf spectral stays: a transparent material is warned of it, and clear (MaterialMapper)
+    if (form != "xyz" && (form != "spectral" || tag == "Tf" || tag == "Kt")) return;
+    const std::size_t at = static_cast<std::size_t>(line.data() - text.data());
+    out.append(text, copied, at - copied);
+    copied = at + line.size();
+    const std::string where = path + ":" + std::to_string(ln) + ": material '" + material + "': ";
+    if (form == "spectral") {
+      // the statement left out (Ka is not read at all)
+      if (tag != "Ka")
+        warnings->push_back(where + std::string(tag) + " spectral (a curve in '" +
+                            std::string(token(args)) + "') is not read: the material's " +
+                            std::string(tag) + " is 0 0 0, as without the statement");
+      return;
+    }
+    // CIE XYZ, to linear sRGB (D65); one number is x = y = z (the MTL specification)
+    double v[3] = {0, 0, 0};
+    int n = 0;
+    for (std::string_view t; n < 3 && !(t = token(args)).empty(); ++n)
+      v[n] = std::strtod(std::string(t).c_str(), nullptr);  // (checked by check_mtl_text)
+    if (n == 1) v[1] = v[2] = v[0];
+    const double m[3][3] = {{3.2404542, -1.5371385, -0.4985314},
+                            {-0.9692660, 1.8760108, 0.0415560},
+                            {0.0556434, -0.2040259, 1.0572252}};
+    double rgb[3];
+    bool clamped = false;
+    for (int c = 0; c < 3; ++c) {
+      rgb[c] = m[c][0] * v[0] + m[c][1] * v[1] + m[c][2] * v[2];
+      if (rgb[c] < 0) {
+        clamped = true;
+        rgb[c] = 0;
+      }
+    }
+    char numbers[96];
+    std::snprintf(numbers, sizeof numbers, " %.9g %.9g %.9g", rgb[0], rgb[1], rgb[2]);
+    out += std::string(tag) + numbers;
+    if (clamped) {
+      char given[96];
+      std::snprintf(given, sizeof given, "%.9g %.9g %.9g", v[0], v[1], v[2]);
+      warnings->push_back(where + std::string(tag) + " xyz " + given +
+                          " is outside the sRGB gamut: its negative channels are taken as 0 (" +
+                          std::string(tag) + numbers + ")");
+    }
+  });
+  if (copied == 0) return text;
+  out.append(text, copied, std::string::npos);
+  return out;
+}
+
 std::vector<MtlName> mtl_material_names(const std::string& text) {
   std::vector<MtlName> out;
   for_each_line(text, [&](std::string_view line, long ln) {
@@ -594,7 +676,7 @@ std::vector<MtlName> mtl_material_names(const std::string& text) {
       std::string_view rest = line.substr(b + 2);
       const std::string_view first = token(rest);
       out.back().tf_line = ln;
-      out.back().tf_numbers = first != "spectral" && first != "xyz";
+      out.back().tf_numbers = first != "spectral";  // (the xyz form is numbers by now)
       return;
     }
     if (line.compare(b, 6, "newmtl") != 0 || b + 6 >= line.size() ||

@@ -136,11 +136,21 @@ struct MtlName {
   std::string name;
   long line = 0;
   /// its last Tf (or Kt) statement's line, 0 when it has none; `tf_numbers`: that statement
-  /// gives numbers (not the `spectral` or `xyz` forms, which tinyobjloader reads as zeros)
+  /// gives numbers (not the `spectral` form, which tinyobjloader reads as zeros; the `xyz`
+  /// form is put in numbers first, read_colour_forms)
   long tf_line = 0;
   bool tf_numbers = false;
 };
 std::vector<MtlName> mtl_material_names(const std::string& text);
+
+/// `text` (an MTL file's, checked by check_mtl_text) with the colour statements that
+/// tinyobjloader would read as zeros put in numbers, line for line: `xyz x [y z]` (CIE XYZ) as
+/// linear sRGB (D65; one number is x = y = z), negative channels taken as 0 with a warning;
+/// `Ka`/`Kd`/`Ks`/`Ke spectral file [factor]` left out (0 0 0, tinyobjloader's default), with a
+/// warning (for Kd, Ks, Ke). `Tf` and
+/// `Kt spectral` stay (MaterialMapper warns of them on a transparent material).
+std::string read_colour_forms(const std::string& path, const std::string& text,
+                              std::vector<std::string>* warnings);
 
 /// `s` without the spaces and tabs at its ends.
 std::string trim(const std::string& s);

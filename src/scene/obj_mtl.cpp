@@ -99,6 +99,7 @@ bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* 
     error = e.what();
     return false;
   }
+  text = read_colour_forms(path, text, &warnings);
   // a name defined again (in this library or an earlier one): tinyobjloader keeps the first
   const std::vector<MtlName> names = mtl_material_names(text);
   for (const MtlName& m : names) {
@@ -242,7 +243,7 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
     // Tf 0 0 0 on every material. Every grey Tf seen on a transparent material meant clear
     const glm::dvec3 tf = rgb(t.transmittance);
     if (def.tf_line > 0 && !def.tf_numbers) {
-      warn(at + ": only Tf with numbers is read (not the spectral and xyz forms); tint 1");
+      warn(at + ": Tf spectral (a curve) is not read; tint 1");
     } else if (def.tf_line > 0 && tf.x == tf.y && tf.y == tf.z) {
       if (tf.x != 1) {
         std::ostringstream g;
