@@ -41,6 +41,16 @@ std::string write(const std::string& dir, const std::string& name, const std::st
   return dir + "/" + name;
 }
 
+/// An OBJ file `name` in `dir` that loads the library `mtllib` and gives each material of
+/// `materials` one triangle, in order; its path.
+std::string one_face_per_material(const std::string& dir, const std::string& name,
+                                  const std::string& mtllib,
+                                  const std::vector<const char*>& materials) {
+  std::string obj = "mtllib " + mtllib + "\nv 0 0 0\nv 1 0 0\nv 1 1 0\n";
+  for (const char* n : materials) obj += std::string("usemtl ") + n + "\nf 1 2 3\n";
+  return write(dir, name, obj);
+}
+
 glm::dvec3 pos(const Scene& s, const Triangle& t, int k) { return s.positions[t.v[k]]; }
 glm::dvec3 geometric_normal(const Scene& s, const Triangle& t) {
   return glm::cross(pos(s, t, 1) - pos(s, t, 0), pos(s, t, 2) - pos(s, t, 0));
@@ -57,6 +67,8 @@ std::array<std::array<double, 3>, 3> corners(const Scene& s, const Triangle& t) 
 
 // tinyobjloader reads numbers as float: compare colours to single precision
 #define EXPECT_COLOUR(a, ...) EXPECT_NEAR(glm::length((a)-glm::dvec3(__VA_ARGS__)), 0.0, 1e-6) << #a
+// `text` was warned once (a CaptureWarnings `w`)
+#define EXPECT_WARNED_ONCE(w, text) EXPECT_EQ((w).count(text), 1) << (w).dump()
 
 const Material& material_named(const Scene& s, const std::string& name) {
   int i = s.find_material(name);
@@ -708,11 +720,9 @@ TEST(Obj, TransparentMaterialsTakeTfAsTint) {
             "newmtl opaque\nKd 0.5 0.5 0.5\nKs 0.1 0.1 0.1\nillum 2\n"  // 23
             "Tf 0.1 0.2 0.3\n"
             "newmtl water\nKs 0.3 0.3 0.3\nTf 0.10 0.10 0.10\nillum 7\n");  // 28
-  const char* names[] = {"green glass", "kt",   "max",    "plain", "black",
-                         "spectral",    "poly", "opaque", "water"};
-  std::string obj = "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n";
-  for (const char* n : names) obj += std::string("usemtl ") + n + "\nf 1 2 3\n";
-  std::string path = write(dir, "t.obj", obj);
+  const std::vector<const char*> names = {"green glass", "kt",   "max",    "plain", "black",
+                                          "spectral",    "poly", "opaque", "water"};
+  const std::string path = one_face_per_material(dir, "t.obj", "t.mtl", names);
   CaptureWarnings w;
   Scene s;
   load(s, path);
@@ -731,22 +741,19 @@ TEST(Obj, TransparentMaterialsTakeTfAsTint) {
   EXPECT_COLOUR(material_named(s, "t.obj:poly").specular, 1, 1, 1);
   EXPECT_COLOUR(material_named(s, "t.obj:opaque").specular, 0.1, 0.1, 0.1) << "Ks, not Tf";
   EXPECT_COLOUR(material_named(s, "t.obj:water").specular, 1, 1, 1);
-  EXPECT_EQ(w.count(mtl + ":15: material 'black' (transparent: illum 6): Tf 0 0 0 is grey, which "
-                          "readers take as the light let through or as one minus it; taken as "
-                          "clear (tint 1): a Tf of unequal channels is the tint"),
-            1)
-      << w.dump();
-  EXPECT_EQ(w.count(mtl + ":30: material 'water' (transparent: illum 7): Tf 0.1 0.1 0.1 is grey"),
-            1)
-      << w.dump();
-  EXPECT_EQ(w.count(mtl + ":18: material 'spectral' (transparent: opacity 0.2 (d or Tr)): Tf "
-                          "spectral (a curve) is not read; tint 1"),
-            1)
-      << w.dump();
-  EXPECT_EQ(w.count(mtl + ":19: material 'poly' (transparent: illum 4) becomes a dielectric, which "
-                          "has no texture: its map_Kd 'skin.png' is ignored (Tf gives its tint)"),
-            1)
-      << w.dump();
+  EXPECT_WARNED_ONCE(w, mtl +
+                            ":15: material 'black' (transparent: illum 6): Tf 0 0 0 is grey, which "
+                            "readers take as the light let through or as one minus it; taken as "
+                            "clear (tint 1): a Tf of unequal channels is the tint");
+  EXPECT_WARNED_ONCE(w,
+                     mtl + ":30: material 'water' (transparent: illum 7): Tf 0.1 0.1 0.1 is grey");
+  EXPECT_WARNED_ONCE(w, mtl +
+                            ":18: material 'spectral' (transparent: opacity 0.2 (d or Tr)): Tf "
+                            "spectral (a curve) is not read; tint 1");
+  EXPECT_WARNED_ONCE(w,
+                     mtl +
+                         ":19: material 'poly' (transparent: illum 4) becomes a dielectric, which "
+                         "has no texture: its map_Kd 'skin.png' is ignored (Tf gives its tint)");
   EXPECT_EQ(w.all().size(), 4u) << w.dump();
 }
 
@@ -762,10 +769,8 @@ TEST(Obj, ColourFormsXyzAndSpectral) {
                                 "newmtl none\nillum 1\n"                                 // 7
                                 "newmtl vivid\nKd xyz 0.1 0.5 0.1\n"                     // 9
                                 "newmtl glass\nd 0.5\nTf xyz 0.4 0.3 0.2\n");            // 11
-  const char* names[] = {"xyz", "curve", "none", "vivid", "glass"};
-  std::string obj = "mtllib c.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n";
-  for (const char* n : names) obj += std::string("usemtl ") + n + "\nf 1 2 3\n";
-  std::string path = write(dir, "c.obj", obj);
+  const std::string path =
+      one_face_per_material(dir, "c.obj", "c.mtl", {"xyz", "curve", "none", "vivid", "glass"});
   CaptureWarnings w;
   Scene s;
   load(s, path);
@@ -783,14 +788,12 @@ TEST(Obj, ColourFormsXyzAndSpectral) {
   EXPECT_COLOUR(material_named(s, "c.obj:vivid").albedo, 0, 0.8452344, 0.00927391);
   EXPECT_EQ(material_named(s, "c.obj:glass").type, MaterialType::Dielectric);
   EXPECT_COLOUR(material_named(s, "c.obj:glass").specular, 0.73533385, 0.18340804, 0.17249463);
-  EXPECT_EQ(w.count(mtl + ":6: material 'curve': Kd spectral (a curve in 'red.rfl') is not read: "
-                          "the material's Kd is 0 0 0, as without the statement"),
-            1)
-      << w.dump();
-  EXPECT_EQ(w.count(mtl + ":10: material 'vivid': Kd xyz 0.1 0.5 0.1 is outside the sRGB gamut: "
-                          "its negative channels are taken as 0 (Kd 0 0.8452344 0.00927391)"),
-            1)
-      << w.dump();
+  EXPECT_WARNED_ONCE(w, mtl +
+                            ":6: material 'curve': Kd spectral (a curve in 'red.rfl') is not read: "
+                            "the material's Kd is 0 0 0, as without the statement");
+  EXPECT_WARNED_ONCE(w, mtl +
+                            ":10: material 'vivid': Kd xyz 0.1 0.5 0.1 is outside the sRGB gamut: "
+                            "its negative channels are taken as 0 (Kd 0 0.8452344 0.00927391)");
   EXPECT_EQ(w.all().size(), 2u) << w.dump();
 }
 
