@@ -757,18 +757,18 @@ TEST(Obj, TransparentMaterialsTakeTfAsTint) {
   EXPECT_EQ(w.all().size(), 4u) << w.dump();
 }
 
-// The MTL specification's other colour forms, which tinyobjloader read as zeros without a word
-// ("Kd xyz 0.3 0.4 0.5" gave Kd 0 0.3 0.4): "xyz x y z" is CIE XYZ, put in linear sRGB (D65),
-// one number meaning x = y = z, a colour outside sRGB's gamut clamped with a warning; "spectral
-// file" (a reflectance curve) is not read, with a warning, as if the statement were absent.
+// The MTL specification's other colour forms, which tinyobjloader misread without a word ("Kd xyz
+// 0.3 0.4 0.5" gave Kd 0 0.3 0.4): "xyz x y z" is CIE XYZ, put in linear sRGB (D65), one number
+// meaning x = y = z, a colour outside sRGB's gamut clamped with a warning; "spectral file" (a
+// reflectance curve) is not read, with a warning: the colour is 0 0 0.
 TEST(Obj, ColourFormsXyzAndSpectral) {
   std::string dir = lucent::test::temp_dir();
   const std::string mtl = write(dir, "c.mtl",
                                 "newmtl xyz\nKd xyz 0.3 0.4 0.5\nKs xyz 0.2\nillum 2\n"  // line 1
                                 "newmtl curve\nKd spectral red.rfl 1.0\n"                // 5
                                 "newmtl none\nillum 1\n"                                 // 7
-                                "newmtl vivid\nKd xyz 0.1 0.5 0.1\n"                     // 9
-                                "newmtl glass\nd 0.5\nTf xyz 0.4 0.3 0.2\n");            // 11
+                                "newmtl vivid\nnewmtl\nKd xyz 0.1 0.5 0.1\n"             // 9
+                                "newmtl glass\nd 0.5\nTf xyz 0.4 0.3 0.2\n");            // 12
   const std::string path =
       one_face_per_material(dir, "c.obj", "c.mtl", {"xyz", "curve", "none", "vivid", "glass"});
   CaptureWarnings w;
@@ -781,20 +781,28 @@ TEST(Obj, ColourFormsXyzAndSpectral) {
   EXPECT_EQ(xyz.type, MaterialType::Plastic);
   EXPECT_COLOUR(xyz.albedo, 0.10801516, 0.48040252, 0.46369526);
   EXPECT_COLOUR(xyz.specular, 0.2 * 1.2047843, 0.2 * 0.9483008, 0.2 * 0.9088427);
-  // as a material without Kd
-  EXPECT_COLOUR(material_named(s, "c.obj:curve").albedo, material_named(s, "c.obj:none").albedo.x,
-                material_named(s, "c.obj:none").albedo.y, material_named(s, "c.obj:none").albedo.z);
+  EXPECT_COLOUR(material_named(s, "c.obj:curve").albedo, 0, 0, 0);
+  EXPECT_COLOUR(material_named(s, "c.obj:none").albedo, 0, 0, 0) << "(as without Kd)";
   // red: 0.32404542 - 0.76856925 - 0.04985314 < 0
   EXPECT_COLOUR(material_named(s, "c.obj:vivid").albedo, 0, 0.8452344, 0.00927391);
   EXPECT_EQ(material_named(s, "c.obj:glass").type, MaterialType::Dielectric);
   EXPECT_COLOUR(material_named(s, "c.obj:glass").specular, 0.73533385, 0.18340804, 0.17249463);
   EXPECT_WARNED_ONCE(w, mtl +
-                            ":6: material 'curve': Kd spectral (a curve in 'red.rfl') is not read: "
-                            "the material's Kd is 0 0 0, as without the statement");
+                            ":6: material 'curve': Kd spectral (a curve in 'red.rfl') is not "
+                            "read: the material's Kd is 0 0 0");
+  // (the bare "newmtl" on line 10 is no statement: the line is still vivid's)
   EXPECT_WARNED_ONCE(w, mtl +
-                            ":10: material 'vivid': Kd xyz 0.1 0.5 0.1 is outside the sRGB gamut: "
+                            ":11: material 'vivid': Kd xyz 0.1 0.5 0.1 is outside the sRGB gamut: "
                             "its negative channels are taken as 0 (Kd 0 0.8452344 0.00927391)");
   EXPECT_EQ(w.all().size(), 2u) << w.dump();
+
+  // a spectral Kd beside a map_Kd that is missing: the material keeps its Kd, 0 0 0 as the
+  // warning says (tinyobjloader gives 0.6 to a map_Kd without a Kd in a file where no material
+  // had one: the statement was left out before)
+  write(dir, "t.mtl", "newmtl tex\nKd spectral red.rfl\nmap_Kd no.png\n");
+  Scene t;
+  load(t, one_face_per_material(dir, "t.obj", "t.mtl", {"tex"}));
+  EXPECT_COLOUR(material_named(t, "t.obj:tex").albedo, 0, 0, 0);
 }
 
 // Some exporters write the illumination model as a decimal ("illum 2.0"; Blender's importer

@@ -247,6 +247,7 @@ TEST(ObjValidation, MtlNumbersAreChecked) {
       {"Ni", "m.mtl:2: Ni line has no number"},
       {"illum 99", "m.mtl:2: illum line: '99' is not an illumination model (0 to 10)"},
       {"Kd xyz 0.5 0.5", "m.mtl:2: Kd xyz line has 2 numbers, needs 1 or 3"},
+      {"Ke xyz 2e38 0 0", "m.mtl:2: Ke xyz line: the colour is out of range for a float in sRGB"},
       {"Ks xyz 0.5 -1 0.5", "m.mtl:2: Ks line: '-1' is negative"},
       {"Kd xyz nan", "m.mtl:2: Kd line: 'nan' is not a finite number"},
       {"Kd spectral", "m.mtl:2: Kd spectral line has no file name"},

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <glm/glm.hpp>
 #include <map>
 #include <regex>
 #include <set>
@@ -407,6 +408,19 @@ void blank_element_comments(std::string& text) {
   });
 }
 
+namespace {
+
+/// A colour given as CIE XYZ (one to three numbers; one is x = y = z, the MTL specification) in
+/// linear sRGB (D65, IEC 61966-2-1's matrix); its negative channels are left negative.
+glm::dvec3 xyz_to_srgb(const double* v, int n) {
+  const double x = v[0], y = n == 1 ? v[0] : v[1], z = n == 1 ? v[0] : v[2];
+  return {3.2404542 * x - 1.5371385 * y - 0.4985314 * z,
+          -0.9692660 * x + 1.8760108 * y + 0.0415560 * z,
+          0.0556434 * x - 0.2040259 * y + 1.0572252 * z};
+}
+
+}  // namespace
+
 void check_mtl_text(const std::string& path, const std::string& text) {
   for_each_line(text, [&](std::string_view rest, long ln) {
     const LineError fail(path, ln);
@@ -436,13 +450,22 @@ void check_mtl_text(const std::string& path, const std::string& text) {
       const bool xyz = first == "xyz";
       if (xyz) rest = probe;
       int n = 0;
+      double given[3] = {0, 0, 0};
       for (std::string_view t; !(t = token(rest)).empty(); ++n) {
         double v = number(t, fail, name.c_str());
         if (v < 0) fail(name + " line: '" + str(t) + "' is negative");
+        if (n < 3) given[n] = v;
       }
       if (xyz && n != 1 && n != 3)
         fail(name + " xyz line has " + std::to_string(n) + " number" + (n == 1 ? "" : "s") +
              ", needs 1 or 3");
+      // (the matrix multiplies by up to 3.24: "Kd xyz 2e38 0 0" is 6.5e38 in sRGB, which
+      // tinyobjloader's float cannot hold)
+      if (xyz) {
+        const glm::dvec3 rgb = xyz_to_srgb(given, n);
+        if (std::max({rgb.x, rgb.y, rgb.z}) > double(FLT_MAX))
+          fail(name + " xyz line: the colour is out of range for a float in sRGB");
+      }
       if (!xyz && n != 3)
         fail(name + " line has " + std::to_string(n) + " number" + (n == 1 ? "" : "s") +
              ", needs 3");
@@ -607,7 +630,8 @@ std::string read_colour_forms(const std::string& path, const std::string& text,
     std::string_view rest = line;
     const std::string_view tag = token(rest);
     if (tag == "newmtl") {
-      material = trim(std::string(rest));
+      // ("newmtl" alone is no statement: the lines after it are the previous material's)
+      if (std::string name = trim(std::string(rest)); !name.empty()) material = name;
       return;
     }
     static const char* const colours[] = {"Ka", "Kd", "Ks", "Ke", "Kt", "Tf"};
@@ -623,35 +647,27 @@ std::string read_colour_forms(const std::string& path, const std::string& text,
     copied = at + line.size();
     const std::string where = path + ":" + std::to_string(ln) + ": material '" + material + "': ";
     if (form == "spectral") {
-      // the statement left out (Ka is not read at all)
-      if (tag != "Ka")
+      // 0 0 0 in its place (as without the statement, but for a map_Kd: tinyobjloader gives one
+      // without a Kd 0.6, in a file where no material had a Kd, which a missing image shows)
+      out += std::string(tag) + " 0 0 0";
+      if (tag != "Ka")  // (not read at all)
         warnings->push_back(where + std::string(tag) + " spectral (a curve in '" +
                             std::string(token(args)) + "') is not read: the material's " +
-                            std::string(tag) + " is 0 0 0, as without the statement");
+                            std::string(tag) + " is 0 0 0");
       return;
     }
-    // CIE XYZ, to linear sRGB (D65); one number is x = y = z (the MTL specification)
     double v[3] = {0, 0, 0};
     int n = 0;
     for (std::string_view t; n < 3 && !(t = token(args)).empty(); ++n)
       v[n] = std::strtod(std::string(t).c_str(), nullptr);  // (checked by check_mtl_text)
+    const glm::dvec3 srgb = xyz_to_srgb(v, n);
     if (n == 1) v[1] = v[2] = v[0];
-    const double m[3][3] = {{3.2404542, -1.5371385, -0.4985314},
-                            {-0.9692660, 1.8760108, 0.0415560},
-                            {0.0556434, -0.2040259, 1.0572252}};
-    double rgb[3];
-    bool clamped = false;
-    for (int c = 0; c < 3; ++c) {
-      rgb[c] = m[c][0] * v[0] + m[c][1] * v[1] + m[c][2] * v[2];
-      if (rgb[c] < 0) {
-        clamped = true;
-        rgb[c] = 0;
-      }
-    }
+    const bool clamped = std::min({srgb.x, srgb.y, srgb.z}) < 0;
+    const glm::dvec3 rgb = glm::max(srgb, glm::dvec3(0.0));
     char numbers[96];
-    std::snprintf(numbers, sizeof numbers, " %.9g %.9g %.9g", rgb[0], rgb[1], rgb[2]);
+    std::snprintf(numbers, sizeof numbers, " %.9g %.9g %.9g", rgb.x, rgb.y, rgb.z);
     out += std::string(tag) + numbers;
-    if (clamped) {
+    if (clamped && tag != "Ka") {
       char given[96];
       std::snprintf(given, sizeof given, "%.9g %.9g %.9g", v[0], v[1], v[2]);
       warnings->push_back(where + std::string(tag) + " xyz " + given +
