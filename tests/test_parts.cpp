@@ -558,6 +558,60 @@ TEST(Parts, ReadingAPartStaysWithinTheReadersCount) {
   }
 }
 
+// A part file keeps its sums bit for bit in both compressions (PIZ, a checkpoint's, handles the
+// 32-bit words as pairs of 16-bit values), and checks them: its attribute lucent.checksum. A PIZ
+// chunk has no check of its own (ZIP's has Adler-32), so a damaged one that still decoded gave
+// other sums without a word; a damaged file now reads as its sums or is refused in one line.
+TEST(Parts, PartFilesKeepAndCheckTheirSums) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::Scene scene = lucent::load_scene(noisy_scene(dir));
+  scene.film.width = 64;
+  scene.film.height = 48;
+  lucent::Renderer renderer(lucent::test::session_options());
+  renderer.set_scene(scene);
+  const lucent::RenderPart part = render_range(renderer, 0, 4);
+  for (lucent::PartCompression c : {lucent::PartCompression::zip, lucent::PartCompression::piz}) {
+    SCOPED_TRACE(c == lucent::PartCompression::zip ? "ZIP" : "PIZ");
+    const std::string path = dir + "/p.exr";
+    lucent::write_render_part(path, part, c);
+    const lucent::RenderPart back = lucent::read_render_part(path);
+    EXPECT_TRUE(bit_equal(back.acc.sum, part.acc.sum));
+    EXPECT_TRUE(bit_equal(back.acc.sumsq, part.acc.sumsq));
+    EXPECT_EQ(back.acc.count, part.acc.count);
+
+    // the checksum of other sums
+    const std::string bytes = lucent::test::read_file(path);
+    const size_t at = bytes.find(std::string("lucent.checksum\0string\0", 23));
+    ASSERT_NE(at, std::string::npos);
+    std::string other = bytes;
+    char& digit = other[at + 23 + 4];  // (after the value's 4-byte size)
+    digit = digit == '0' ? '1' : '0';
+    lucent::test::write_file(path, other);
+    EXPECT_EQ(error_of([&] { lucent::read_render_part(path); }),
+              path + ": part file is damaged: its samples do not match its checksum");
+
+    // one byte of the pixel data changed, at 40 places in the file's second half: refused, or
+    // the same sums (a byte that decodes the same)
+    int refused = 0, same = 0;
+    for (size_t k = bytes.size() / 2; k < bytes.size(); k += bytes.size() / 80) {
+      std::string damaged = bytes;
+      damaged[k] = static_cast<char>(damaged[k] ^ 0x5a);
+      lucent::test::write_file(path, damaged);
+      try {
+        const lucent::RenderPart r = lucent::read_render_part(path);
+        EXPECT_TRUE(bit_equal(r.acc.sum, part.acc.sum) && bit_equal(r.acc.sumsq, part.acc.sumsq) &&
+                    r.acc.count == part.acc.count)
+            << "byte " << k << ": other sums read without an error";
+        ++same;
+      } catch (const lucent::Error& e) {
+        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+        ++refused;
+      }
+    }
+    EXPECT_GT(refused, 0);
+  }
+}
+
 TEST(Parts, DamagedPartFilesAreOneLineErrors) {
   const std::string dir = lucent::test::temp_dir();
   const std::string scene = noisy_scene(dir);

@@ -77,8 +77,6 @@ RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
 /// The part's mean, variance and counts as a RenderResult (as Renderer::result() computes them).
 RenderResult part_result(const RenderPart& part);
 
-/// Writes a part file (an OpenEXR: the render's R, G, B, var.*, n layers, which `lucent compare`
-/// reads, plus the raw double sums and the header as attributes; docs/parts.md), atomically.
 /// How write_render_part compresses the file's channels (both lossless). Measured on a part of
 /// scenes/default.json at 1920x1080 (tinyexr 1.0.1, zlib): ZIP wrote 81 MB in 2.7 s and is read
 /// in 1.1 s; PIZ 77 MB in 1.2 s, read in 2.0 s; a flat image's ZIP file is smaller (500x400: 81
@@ -87,12 +85,17 @@ enum class PartCompression {
   zip,  ///< the default: the quickest read, for files that are kept and merged
   piz,  ///< a checkpoint's: a render waits for its writes, and reads it once
 };
+
+/// Writes a part file (an OpenEXR: the render's R, G, B, var.*, n layers, which `lucent compare`
+/// reads, plus the raw double sums and the header as attributes, with a checksum of the sums;
+/// docs/parts.md), atomically.
 void write_render_part(const std::string& path, const RenderPart& part,
                        PartCompression compression = PartCompression::zip);
 /// The host memory write_render_part allocates for a width x height part, beside the part
 /// itself (its planes, the sums' 32-bit words and the EXR encoder), at most: for a front end's
 /// check before it renders.
-std::uint64_t part_write_bytes(int width, int height);
+std::uint64_t part_write_bytes(int width, int height,
+                               PartCompression compression = PartCompression::zip);
 /// Reads a part file; throws lucent::Error naming the file and what is wrong.
 RenderPart read_render_part(const std::string& path);
 /// Reads only a part file's header.

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <new>
 #include <utility>
 #include <vector>
 
@@ -125,6 +126,11 @@ bool Checkpoint::save(const lucent::RenderPart& part) {
   } catch (const lucent::Error& e) {
     std::fprintf(stderr, "%s: warning: checkpoint not written: %s\n", program_.c_str(),
                  one_line(e.what()).c_str());
+    ok = false;
+  } catch (const std::bad_alloc&) {
+    // (the encoder's buffers, under an address-space limit tighter than the count)
+    std::fprintf(stderr, "%s: warning: checkpoint not written: %s: out of memory\n",
+                 program_.c_str(), one_line(path_).c_str());
     ok = false;
   }
   if (ok) held_ = part.info.samples.empty() ? begin_ : part.info.samples.back().end;
@@ -259,7 +265,8 @@ bool resume_from(Checkpoint& ck, lucent::Renderer& renderer, std::uint64_t& spp,
 std::uint64_t checkpoint_beside_bytes(int width, int height, bool resumed) {
   const std::uint64_t acc_bytes =
       std::uint64_t(width) * std::uint64_t(height) * lucent::render_detail::kAccumulationPixelBytes;
-  return (resumed ? 2 : 1) * acc_bytes + lucent::part_write_bytes(width, height);
+  return (resumed ? 2 : 1) * acc_bytes +
+         lucent::part_write_bytes(width, height, lucent::PartCompression::piz);
 }
 
 }  // namespace lucent::cli

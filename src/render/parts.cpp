@@ -120,6 +120,25 @@ std::string hex64(std::uint64_t v) {
   return buf;
 }
 
+/// A check of a part's samples, its attribute lucent.checksum: the bits of every sum, sum of
+/// squares and count, chained through a multiply and a shift. A PIZ chunk (a checkpoint's) has no
+/// check of its own, unlike ZIP's Adler-32: a damaged one that still decodes gave other sums.
+std::uint64_t sums_checksum(const Accumulation& a) {
+  std::uint64_t h = 0x9e3779b97f4a7c15ull;
+  auto mix = [&h](std::uint64_t w) {
+    h = (h ^ w) * 0x100000001b3ull;
+    h ^= h >> 29;
+  };
+  for (const std::vector<double>* v : {&a.sum, &a.sumsq})
+    for (const double d : *v) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &d, sizeof bits);
+      mix(bits);
+    }
+  for (const std::uint32_t n : a.count) mix(n);
+  return h;
+}
+
 PartInfo info_from_attributes(const std::string& path,
                               const std::map<std::string, std::string>& attrs, int width,
                               int height) {
@@ -352,12 +371,16 @@ RenderResult part_result(const RenderPart& part) {
   return r;
 }
 
-std::uint64_t part_write_bytes(int width, int height) {
+std::uint64_t part_write_bytes(int width, int height, PartCompression compression) {
   const std::uint64_t npix = std::uint64_t(std::max(width, 0)) * std::uint64_t(std::max(height, 0));
   // write_render_part's twelve 32-bit words and six float planes; the encoder's input is those
-  // and the counts: 19 channels of 4 bytes
+  // and the counts: 19 channels of 4 bytes. tinyexr's PIZ encoder holds, for each chunk of 32
+  // lines beside its output, its input, twice its size of blocks and a temporary copy, and 2 MB
+  // of Huffman tables: films of few lines (16384 x 32: about 200 MB) took more than the rest
+  const std::uint64_t piz_chunk = std::uint64_t(std::max(width, 0)) * 32 * 19 * 4;
   return npix * (12 * sizeof(std::uint32_t) + 6 * sizeof(float)) +
-         image_detail::exr_encoder_bytes(npix * 19 * 4);
+         image_detail::exr_encoder_bytes(npix * 19 * 4) +
+         (compression == PartCompression::piz ? 4 * piz_chunk + (std::uint64_t(2) << 20) : 0);
 }
 
 void write_render_part(const std::string& path, const RenderPart& part,
@@ -430,6 +453,7 @@ void write_render_part(const std::string& path, const RenderPart& part,
       {"lucent.seconds", seconds},
       {"lucent.display", std::string(transfer_name(info.display.transfer)) + "," + gamma + "," +
                              exposure + "," + tonemap_name(info.display.tonemap)},
+      {"lucent.checksum", hex64(sums_checksum(a))},
   };
   // read_render's seed and sampler (what converge checks a reference by)
   if (!info.sampler.empty()) extras.attributes.emplace_back("lucent.sampler", info.sampler);
@@ -514,6 +538,10 @@ RenderPart read_render_part(const std::string& path) {
     }
   }
   a.count = uint_channel("n");
+  // (a part file written before 30 Nov 2026 has none)
+  if (auto sum = exr.attributes.find("lucent.checksum");
+      sum != exr.attributes.end() && sum->second != hex64(sums_checksum(a)))
+    throw Error(path + ": part file is damaged: its samples do not match its checksum");
   check_counts(path, p.info, a);
   a.spp = total(p.info.samples);
   a.nonfinite = p.info.nonfinite;
