@@ -898,7 +898,10 @@ enum class Grace {
   /// before they exit), and mpirun's default would only add 2 s (a second before SIGTERM, one
   /// before SIGKILL) to every run that exits non-zero
   none,
-  /// mpirun's default second: what a stopped rank has to write its checkpoint and part
+  /// mpirun's default second: what the ranks have to stop, write and finalize when mpirun
+  /// itself is signalled (it passes the signal on, then kills them). A test that signals the
+  /// ranks needs none: they agree on the stop and finalize together, so the first to exit
+  /// leaves nothing to write
   mpirun_default,
 };
 
@@ -1152,9 +1155,8 @@ TEST(Parts, MpiSigtermDuringTheKernelBuildIsAnInterruption) {
         script, "timeout 60 env POCL_CACHE_DIR=" + q(dir + "/pocl" + std::to_string(ms)) +
                     " LUCENT_CACHE_DIR=off " +
                     mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) +
-                               " --spp 16000000 -o " + q(dir + "/mpi.exr") + " --checkpoint " +
-                               q(dir + "/ck.exr"),
-                           Grace::mpirun_default) +
+                           " --spp 16000000 -o " + q(dir + "/mpi.exr") + " --checkpoint " +
+                           q(dir + "/ck.exr")) +
                     " 2>" + q(err) + " </dev/null & pid=$!\n" + "for i in $(seq 3000); do [ -e " +
                     q(lock0) + " ] && [ -e " + q(lock1) + " ] && break; sleep 0.01; done\nsleep " +
                     std::to_string(ms / 1000.0) +
@@ -1438,11 +1440,10 @@ TEST(Parts, MpiCheckpointStoppedRunResumesToTheUninterruptedImage) {
   const double rate = lucent::test::cli_samples_per_second(scene, dir + "/cal.exr");
   ASSERT_GT(rate, 0) << "the calibration render failed";
   std::uint64_t n = 0;
-  auto command = [&](int ranks, const std::string& extra, Grace grace = Grace::none) {
+  auto command = [&](int ranks, const std::string& extra) {
     return mpirun("-np " + std::to_string(ranks) + " '" + std::string(LUCENT_MPI_PATH) + "' " +
-                      q(scene) + " --spp " + std::to_string(n) + " -o " + q(out) +
-                      " --checkpoint " + q(ck) + " --checkpoint-every 0.2" + extra,
-                  grace);
+                  q(scene) + " --spp " + std::to_string(n) + " -o " + q(out) + " --checkpoint " +
+                  q(ck) + " --checkpoint-every 0.2" + extra);
   };
   // SIGTERM to the ranks (mpirun's children; mpirun itself passes it on a second later) once
   // both checkpoints exist. A machine faster than at the calibration can finish first: tried
@@ -1453,9 +1454,8 @@ TEST(Parts, MpiCheckpointStoppedRunResumesToTheUninterruptedImage) {
     n = std::clamp<std::uint64_t>(std::uint64_t(rate * 1.0 / 120) << attempt, 20000,
                                   std::uint64_t(1) << 24);
     lucent::test::write_file(
-        script, command(2, "", Grace::mpirun_default) + " 2>" + q(dir + "/stop.err") +
-                    " </dev/null & pid=$!\n" + "for i in $(seq 600); do [ -e " + q(ck0) +
-                    " ] && [ -e " + q(ck1) +
+        script, command(2, "") + " 2>" + q(dir + "/stop.err") + " </dev/null & pid=$!\n" +
+                    "for i in $(seq 600); do [ -e " + q(ck0) + " ] && [ -e " + q(ck1) +
                     " ] && break; kill -0 $pid 2>/dev/null || break; sleep 0.05; done\n" +
                     "kill -TERM $(pgrep -P $pid)\nwait $pid\n");
     const int raw = std::system(("bash " + q(script)).c_str());
