@@ -3,14 +3,32 @@
 #include <cmath>
 
 #include "common.hpp"
+#include "core/file_io.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
+#include "lucent/parts.hpp"
 
 namespace lucent::python {
 
 namespace {
 
 py::tuple triple(const double v[3]) { return py::make_tuple(v[0], v[1], v[2]); }
+
+/// Sample ranges as a list of (begin, end) tuples, [begin, end).
+py::list range_list(const std::vector<SampleRange>& ranges) {
+  py::list out;
+  for (const SampleRange& r : ranges) out.append(py::make_tuple(r.begin, r.end));
+  return out;
+}
+
+/// What merge_parts gives Python: the merged image and what the parts held.
+struct MergedParts {
+  RenderResult result;
+  PartInfo info;
+  std::vector<SampleRange> missing;
+  std::uint32_t min_spp = 0, max_spp = 0;
+  double mean_spp = 0;
+};
 
 /// The display settings of `film` (a Film or None: the defaults), each overridden when given.
 DisplaySettings display_settings(const Film* film, py::object transfer, py::object gamma,
@@ -93,6 +111,113 @@ void bind_image(py::module_& m) {
       py::arg("path"),
       "Reads an image as a RenderResult: an EXR with variances and counts, or any image "
       "read_image() reads (variance and samples None).");
+
+  py::class_<PartInfo>(m, "PartInfo", "A part file's header (docs/parts.md).")
+      .def_readonly("width", &PartInfo::width)
+      .def_readonly("height", &PartInfo::height)
+      .def_readonly("scene_hash", &PartInfo::scene_hash,
+                    "the hash of what makes the image (scene, camera, film, integrator, ...)")
+      .def_readonly("seed", &PartInfo::seed)
+      .def_readonly("sampler", &PartInfo::sampler)
+      .def_readonly("integrator", &PartInfo::integrator)
+      .def_readonly("version", &PartInfo::version, "lucent's version that rendered it")
+      .def_readonly("scene", &PartInfo::scene, "the scene file (informative)")
+      .def_property_readonly(
+          "samples", [](const PartInfo& i) { return range_list(i.samples); },
+          "the sample ranges rendered: a list of (begin, end), [begin, end)")
+      .def_property_readonly(
+          "requested", [](const PartInfo& i) { return range_list(i.requested); },
+          "the sample ranges asked for")
+      .def_readonly("nonfinite", &PartInfo::nonfinite)
+      .def_readonly("rays", &PartInfo::rays)
+      .def_readonly("seconds", &PartInfo::seconds, "kernel seconds, summed over merged parts")
+      .def("__repr__", [](const PartInfo& i) {
+        return "<lucent.PartInfo " + std::to_string(i.width) + "x" + std::to_string(i.height) +
+               ", samples " + ranges_text(i.samples) + ">";
+      });
+  m.def(
+      "read_part_info",
+      [](const std::filesystem::path& path) {
+        std::string p = path.string();
+        refuse_nul(p, "path");
+        ReleaseGil release;
+        return read_part_info(p);
+      },
+      py::arg("path"), "Reads a part file's header (its pixels are not read).");
+
+  py::class_<MergedParts>(m, "MergedParts", "What merge_parts() made.")
+      .def_readonly("result", &MergedParts::result,
+                    "the merged image (a RenderResult: mean, variance, samples, ...)")
+      .def_readonly("info", &MergedParts::info, "its header (a PartInfo)")
+      .def_property_readonly(
+          "missing", [](const MergedParts& m) { return range_list(m.missing); },
+          "the sample ranges the parts do not hold, of `expect` (or of [0, the highest end a "
+          "part asked for))")
+      .def_readonly("min_spp", &MergedParts::min_spp, "finite samples per pixel, the fewest")
+      .def_readonly("mean_spp", &MergedParts::mean_spp)
+      .def_readonly("max_spp", &MergedParts::max_spp)
+      .def("__repr__", [](const MergedParts& m) {
+        return "<lucent.MergedParts " + std::to_string(m.info.width) + "x" +
+               std::to_string(m.info.height) + ", samples " + ranges_text(m.info.samples) +
+               (m.missing.empty() ? "" : ", missing " + ranges_text(m.missing)) + ">";
+      });
+  m.def(
+      "merge_parts",
+      [](const std::vector<std::filesystem::path>& paths,
+         std::optional<std::filesystem::path> output,
+         std::optional<std::pair<std::uint64_t, std::uint64_t>> expect, bool complete) {
+        std::vector<std::string> inputs;
+        for (const auto& p : paths) {
+          inputs.push_back(p.string());
+          refuse_nul(inputs.back(), "paths");
+        }
+        if (inputs.empty()) throw py::value_error("merge_parts: no part files given");
+        const std::string out = output ? output->string() : std::string();
+        refuse_nul(out, "output");
+        SampleRange want;
+        if (expect) {
+          want = {expect->first, expect->second};
+          if (!(want.begin < want.end) || want.end > (std::uint64_t(1) << 32))
+            throw py::value_error("expect must be (begin, end) with begin < end <= 2**32, got (" +
+                                  std::to_string(want.begin) + ", " + std::to_string(want.end) +
+                                  ")");
+        }
+        ReleaseGil release;
+        // as `lucent merge`: the output checked before any part is read
+        if (!out.empty()) {
+          for (const std::string& in : inputs)
+            if (io::same_file(out, in))
+              throw Error(out + ": is an input of the merge; refusing to overwrite it");
+          io::check_output_path(out, inputs);
+        }
+        MergeReport r = merge_render_parts(inputs);
+        if (expect) {
+          for (const SampleRange& s : r.merged.info.samples)
+            if (s.begin < want.begin || s.end > want.end)
+              throw Error("merge: the parts hold samples " + ranges_text(r.merged.info.samples) +
+                          ", outside expect " + range_text(want));
+          r.missing = missing_ranges(r.merged.info.samples, want);
+        }
+        if (complete && !r.missing.empty())
+          throw Error("merge: samples " + ranges_text(r.missing) + " are missing (complete)");
+        if (!out.empty()) write_merged(out, r.merged);
+        MergedParts m;
+        m.result = part_result(r.merged);
+        m.info = r.merged.info;
+        m.missing = r.missing;
+        m.min_spp = r.min_spp;
+        m.max_spp = r.max_spp;
+        m.mean_spp = r.mean_spp;
+        return m;
+      },
+      py::arg("paths"), py::kw_only(), py::arg("output") = py::none(),
+      py::arg("expect") = py::none(), py::arg("complete") = false,
+      "Merges part files (Renderer.write_part, `lucent render --samples A:B`) into the image of "
+      "their samples, exactly as `lucent merge` does: they must be of one image (film, seed, "
+      "integrator, scene hash) with disjoint ranges, added in ascending order of their first "
+      "sample whatever order they are given in. output: also writes it (.exr: a part file, "
+      "mergeable again; .png; .pfm). expect=(begin, end): the samples the parts should hold "
+      "together; complete=True raises when some are missing.");
 
   py::class_<CompareResult>(m, "CompareResult",
                             "The per-pixel z-test of two images (docs/compare.md).")

@@ -10,6 +10,7 @@
 #include "common.hpp"
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
+#include "lucent/parts.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/session.hpp"
 #include "state.hpp"
@@ -832,6 +833,32 @@ void bind_render(py::module_& m) {
           },
           py::arg("first_sample") = 0,
           "Drops the accumulation; the next sample index is first_sample.")
+      .def(
+          "write_part",
+          [](PyRenderer& r, const std::filesystem::path& path, const std::string& compression) {
+            const std::string p = path.string();
+            refuse_nul(p, "path");
+            PartCompression c = PartCompression::zip;
+            if (compression == "piz")
+              c = PartCompression::piz;
+            else if (compression != "zip")
+              throw py::value_error("compression must be 'zip' or 'piz', got '" + compression +
+                                    "'");
+            r.call("write_part", [&](Renderer& rr) {
+              const std::string scene_path = rr.scene().path;  // (raises without a scene)
+              if (rr.spp() == 0)
+                throw Error(p + ": the session holds no samples to write (render first)");
+              const SampleRange range{rr.first_sample(), rr.first_sample() + rr.spp()};
+              write_render_part(p, make_part(rr, range, scene_path), c);
+            });
+          },
+          py::arg("path"), py::arg("compression") = "zip",
+          "Writes the accumulation, samples [first_sample, first_sample + spp), as a part file "
+          "(docs/parts.md; `lucent render --samples A:B` writes the same): parts of disjoint "
+          "ranges of one scene merge into the image of their union, exactly (merge_parts, "
+          "`lucent merge`). compression: 'zip' (the default) or 'piz' (written in half the "
+          "time, read in twice it). Refused for a session without samples, an adaptive render "
+          "and light-traced caustics.")
       .def(
           "result", [](PyRenderer& r) { return r.result(); },
           "The accumulation so far (a RenderResult; its arrays are this call's own). Also from a "
