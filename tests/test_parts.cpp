@@ -519,6 +519,22 @@ TEST(Parts, ReadingAPartChecksItsMemoryFirst) {
   EXPECT_NE(msg.find("is larger than the memory limit of 1.0 KiB"), std::string::npos) << msg;
 }
 
+/// Samples [0, spp) of noisy_scene at width x height, as a part.
+lucent::RenderPart noisy_part(const std::string& dir, int width, int height, std::uint64_t spp) {
+  lucent::Scene scene = lucent::load_scene(noisy_scene(dir));
+  scene.film.width = width;
+  scene.film.height = height;
+  lucent::Renderer renderer(lucent::test::session_options());
+  renderer.set_scene(scene);
+  return render_range(renderer, 0, spp);
+}
+
+constexpr lucent::PartCompression kCompressions[] = {lucent::PartCompression::zip,
+                                                     lucent::PartCompression::piz};
+const char* name_of(lucent::PartCompression c) {
+  return c == lucent::PartCompression::zip ? "ZIP" : "PIZ";
+}
+
 // What reading a 640x480 part file takes, measured in a child process, against what the readers
 // count before they decode it (image_detail::exr_decode_bytes_per_pixel, and the file):
 // read_render_part, and read_render (`lucent compare` and `converge --reference` given a part),
@@ -527,16 +543,11 @@ TEST(Parts, ReadingAPartChecksItsMemoryFirst) {
 TEST(Parts, ReadingAPartStaysWithinTheReadersCount) {
   if (lucent::test::kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer's memory is in the peak";
   const std::string dir = lucent::test::temp_dir();
-  lucent::Scene scene = lucent::load_scene(noisy_scene(dir));
-  scene.film.width = 640;
-  scene.film.height = 480;
-  lucent::Renderer renderer(lucent::test::session_options());
-  renderer.set_scene(scene);
-  const lucent::RenderPart part = render_range(renderer, 0, 1);
+  const lucent::RenderPart part = noisy_part(dir, 640, 480, 1);
   const std::string path = dir + "/p.exr";
   const double mib = 1048576.0;
-  for (lucent::PartCompression c : {lucent::PartCompression::zip, lucent::PartCompression::piz}) {
-    SCOPED_TRACE(c == lucent::PartCompression::zip ? "ZIP" : "PIZ");
+  for (lucent::PartCompression c : kCompressions) {
+    SCOPED_TRACE(name_of(c));
     lucent::write_render_part(path, part, c);
     const std::string bytes = lucent::test::read_file(path);
     const lucent::image_detail::Probe p = lucent::image_detail::probe_image(
@@ -564,14 +575,9 @@ TEST(Parts, ReadingAPartStaysWithinTheReadersCount) {
 // other sums without a word; a damaged file now reads as its sums or is refused in one line.
 TEST(Parts, PartFilesKeepAndCheckTheirSums) {
   const std::string dir = lucent::test::temp_dir();
-  lucent::Scene scene = lucent::load_scene(noisy_scene(dir));
-  scene.film.width = 64;
-  scene.film.height = 48;
-  lucent::Renderer renderer(lucent::test::session_options());
-  renderer.set_scene(scene);
-  const lucent::RenderPart part = render_range(renderer, 0, 4);
-  for (lucent::PartCompression c : {lucent::PartCompression::zip, lucent::PartCompression::piz}) {
-    SCOPED_TRACE(c == lucent::PartCompression::zip ? "ZIP" : "PIZ");
+  const lucent::RenderPart part = noisy_part(dir, 64, 48, 4);
+  for (lucent::PartCompression c : kCompressions) {
+    SCOPED_TRACE(name_of(c));
     const std::string path = dir + "/p.exr";
     lucent::write_render_part(path, part, c);
     const lucent::RenderPart back = lucent::read_render_part(path);
