@@ -906,7 +906,8 @@ enum class Grace {
   none,
   /// mpirun's default second: what the ranks have to stop, write and finalize when mpirun
   /// itself is signalled (it passes the signal on, then kills them). A test that signals the
-  /// ranks needs none: they agree on the stop and finalize together, so the first to exit
+  /// ranks needs none: they agree on the stop and finalize together (Open MPI's MPI_Finalize
+  /// fences the ranks by default; the MPI standard does not promise it), so the first to exit
   /// leaves nothing to write
   mpirun_default,
 };
@@ -1451,7 +1452,7 @@ TEST(Parts, MpiCheckpointStoppedRunResumesToTheUninterruptedImage) {
                   q(scene) + " --spp " + std::to_string(n) + " -o " + q(out) + " --checkpoint " +
                   q(ck) + " --checkpoint-every 0.2" + extra);
   };
-  // SIGTERM to the ranks (mpirun's children; mpirun itself passes it on a second later) once
+  // SIGTERM to the ranks (mpirun's children) once
   // both checkpoints exist. A machine faster than at the calibration can finish first: tried
   // again with twice the samples, up to 3 times
   const std::string script = dir + "/stop.sh";

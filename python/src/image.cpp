@@ -121,7 +121,9 @@ void bind_image(py::module_& m) {
       .def_readonly("sampler", &PartInfo::sampler)
       .def_readonly("integrator", &PartInfo::integrator)
       .def_readonly("version", &PartInfo::version, "lucent's version that rendered it")
-      .def_readonly("scene", &PartInfo::scene, "the scene file (informative)")
+      .def_property_readonly(
+          "scene", [](const PartInfo& i) { return FileText{i.scene}; },
+          "the scene file (informative)")
       .def_property_readonly(
           "samples", [](const PartInfo& i) { return range_list(i.samples); },
           "the sample ranges rendered: a list of (begin, end), [begin, end)")
@@ -139,7 +141,6 @@ void bind_image(py::module_& m) {
       "read_part_info",
       [](const std::filesystem::path& path) {
         std::string p = path.string();
-        refuse_nul(p, "path");
         ReleaseGil release;
         return read_part_info(p);
       },
@@ -164,21 +165,25 @@ void bind_image(py::module_& m) {
   m.def(
       "merge_parts",
       [](const std::vector<std::filesystem::path>& paths,
-         std::optional<std::filesystem::path> output,
-         std::optional<std::pair<std::uint64_t, std::uint64_t>> expect, bool complete) {
+         std::optional<std::filesystem::path> output, py::object expect, bool complete) {
         std::vector<std::string> inputs;
-        for (const auto& p : paths) {
-          inputs.push_back(p.string());
-          refuse_nul(inputs.back(), "paths");
-        }
+        for (const auto& p : paths) inputs.push_back(p.string());
         if (inputs.empty()) throw py::value_error("merge_parts: no part files given");
         const std::string out = output ? output->string() : std::string();
-        refuse_nul(out, "output");
+        // what the parts hold together (many parts of at most 2**24 samples each)
         SampleRange want;
-        if (expect) {
-          want = {expect->first, expect->second};
-          if (!(want.begin < want.end) || want.end > (std::uint64_t(1) << 32))
-            throw py::value_error("expect must be (begin, end) with begin < end <= 2**32, got (" +
+        const bool expecting = !expect.is_none();
+        if (expecting) {
+          const py::tuple t =
+              py::isinstance<py::tuple>(expect) ? expect.cast<py::tuple>() : py::tuple();
+          if (t.size() != 2)
+            throw py::type_error("expect must be a tuple (begin, end), got " +
+                                 py::repr(expect).cast<std::string>());
+          const std::uint64_t top = std::uint64_t(1) << 32;
+          want = {int_argument(IntArg{t[0]}, "expect begin", 0, top - 1),
+                  int_argument(IntArg{t[1]}, "expect end", 1, top)};
+          if (want.begin >= want.end)
+            throw py::value_error("expect must be (begin, end) with begin < end, got (" +
                                   std::to_string(want.begin) + ", " + std::to_string(want.end) +
                                   ")");
         }
@@ -191,7 +196,7 @@ void bind_image(py::module_& m) {
           io::check_output_path(out, inputs);
         }
         MergeReport r = merge_render_parts(inputs);
-        if (expect) {
+        if (expecting) {
           for (const SampleRange& s : r.merged.info.samples)
             if (s.begin < want.begin || s.end > want.end)
               throw Error("merge: the parts hold samples " + ranges_text(r.merged.info.samples) +

@@ -8,11 +8,13 @@
 #include <optional>
 
 #include "common.hpp"
+#include "core/file_io.hpp"
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
 #include "lucent/parts.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/session.hpp"
+#include "scene/loaders.hpp"
 #include "state.hpp"
 
 namespace lucent::python {
@@ -835,30 +837,53 @@ void bind_render(py::module_& m) {
           "Drops the accumulation; the next sample index is first_sample.")
       .def(
           "write_part",
-          [](PyRenderer& r, const std::filesystem::path& path, const std::string& compression) {
+          [](PyRenderer& r, const std::filesystem::path& path, py::object requested,
+             const std::string& compression) {
             const std::string p = path.string();
-            refuse_nul(p, "path");
             PartCompression c = PartCompression::zip;
             if (compression == "piz")
               c = PartCompression::piz;
             else if (compression != "zip")
               throw py::value_error("compression must be 'zip' or 'piz', got '" + compression +
                                     "'");
+            if (io::lower_extension(p) != ".exr")
+              throw Error(p + ": write_part writes a part file: use an .exr name");
+            std::optional<SampleRange> asked;
+            if (!requested.is_none()) {
+              const py::tuple t =
+                  py::isinstance<py::tuple>(requested) ? requested.cast<py::tuple>() : py::tuple();
+              if (t.size() != 2)
+                throw py::type_error("requested must be a tuple (begin, end), got " +
+                                     py::repr(requested).cast<std::string>());
+              asked = SampleRange{
+                  int_argument(IntArg{t[0]}, "requested begin", 0, kSampleIndices - 1, kSampleNote),
+                  int_argument(IntArg{t[1]}, "requested end", 1, kSampleIndices, kSampleNote)};
+              if (asked->begin >= asked->end)
+                throw py::value_error("requested must be (begin, end) with begin < end, got (" +
+                                      std::to_string(asked->begin) + ", " +
+                                      std::to_string(asked->end) + ")");
+            }
             r.call("write_part", [&](Renderer& rr) {
-              const std::string scene_path = rr.scene().path;  // (raises without a scene)
+              const Scene& scene = rr.scene();  // (raises without a scene)
+              // not over the scene or a file it reads (a part written over scene.json)
+              io::check_output_path(p, scene_detail::scene_inputs(scene.path, scene));
               if (rr.spp() == 0)
                 throw Error(p + ": the session holds no samples to write (render first)");
-              const SampleRange range{rr.first_sample(), rr.first_sample() + rr.spp()};
-              write_render_part(p, make_part(rr, range, scene_path), c);
+              const SampleRange rendered{rr.first_sample(), rr.first_sample() + rr.spp()};
+              write_render_part(p, make_part(rr, asked.value_or(rendered), scene.path), c);
             });
           },
-          py::arg("path"), py::arg("compression") = "zip",
+          py::arg("path"), py::kw_only(), py::arg("requested") = py::none(),
+          py::arg("compression") = "zip",
           "Writes the accumulation, samples [first_sample, first_sample + spp), as a part file "
-          "(docs/parts.md; `lucent render --samples A:B` writes the same): parts of disjoint "
-          "ranges of one scene merge into the image of their union, exactly (merge_parts, "
-          "`lucent merge`). compression: 'zip' (the default) or 'piz' (written in half the "
-          "time, read in twice it). Refused for a session without samples, an adaptive render "
-          "and light-traced caustics.")
+          "(.exr, docs/parts.md): parts of disjoint ranges of one scene merge into the image of "
+          "their union, exactly (merge_parts, `lucent merge`). requested=(begin, end): the range "
+          "the render was asked for, recorded as `lucent render --samples A:B` does, so that a "
+          "render cut short (a time limit, cancel()) leaves the rest missing in merge_parts; by "
+          "default the samples rendered. compression: 'zip' (the default) or 'piz' (written in "
+          "half the time, read in twice it). Refused for a session without samples, an "
+          "adaptive render, light-traced caustics, a requested range that does not hold the "
+          "samples, and a path that is the scene or one of its files.")
       .def(
           "result", [](PyRenderer& r) { return r.result(); },
           "The accumulation so far (a RenderResult; its arrays are this call's own). Also from a "

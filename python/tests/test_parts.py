@@ -51,16 +51,44 @@ def test_missing_and_overlapping_ranges(small_scene, tmp_path):
     merged = lucent.merge_parts([a], expect=(0, 12))
     assert merged.missing == [(4, 12)]
     assert "missing [4, 12)" in repr(merged)
+    # refused before the output is written
+    out = tmp_path / "m.exr"
     with pytest.raises(lucent.Error, match=r"samples \[4, 12\) are missing \(complete\)"):
-        lucent.merge_parts([a], expect=(0, 12), complete=True)
+        lucent.merge_parts([a], output=out, expect=(0, 12), complete=True)
     with pytest.raises(lucent.Error, match=r"outside expect \[0, 2\)"):
-        lucent.merge_parts([a], expect=(0, 2))
-    # the output is checked before any part is read, and never one of them
+        lucent.merge_parts([a], output=out, expect=(0, 2))
+    assert not out.exists()
+    # the output is checked before any part is read (here one that does not exist), and is never
+    # one of them
+    with pytest.raises(lucent.Error, match=r"unknown output format '\.jpg'"):
+        lucent.merge_parts([tmp_path / "none.exr"], output=tmp_path / "m.jpg")
     with pytest.raises(lucent.Error, match="is an input of the merge"):
         lucent.merge_parts([a], output=a)
-    with pytest.raises(lucent.Error, match=r"unknown output format '\.jpg'"):
-        lucent.merge_parts([a], output=tmp_path / "m.jpg")
-    assert not (tmp_path / "m.jpg").exists()
+    # expect's bounds are named
+    with pytest.raises(ValueError, match=r"expect begin must be an integer in \[0, "):
+        lucent.merge_parts([a], expect=(-1, 4))
+    with pytest.raises(ValueError, match=r"expect end must be an integer in \[1, "):
+        lucent.merge_parts([a], expect=(0, 2**64))
+    with pytest.raises(TypeError, match=r"expect must be a tuple \(begin, end\)"):
+        lucent.merge_parts([a], expect=[0, 4])
+
+
+def test_a_render_cut_short_records_the_range_it_was_asked_for(small_scene, tmp_path):
+    part = tmp_path / "p.exr"
+    with session() as r:
+        r.set_scene(small_scene)
+        r.reset(first_sample=8)
+        r.render(4)  # (as if a time limit had stopped a render of [8, 16))
+        r.write_part(part, requested=(8, 16))
+        assert lucent.read_part_info(part).samples == [(8, 12)]
+        assert lucent.read_part_info(part).requested == [(8, 16)]
+        assert lucent.merge_parts([part]).missing == [(0, 8), (12, 16)]
+        # a range that does not hold the samples rendered
+        with pytest.raises(lucent.Error, match=r"lie outside the requested \[0, 10\)"):
+            r.write_part(tmp_path / "q.exr", requested=(0, 10))
+        with pytest.raises(ValueError, match="requested must be"):
+            r.write_part(tmp_path / "q.exr", requested=(9, 9))
+    assert not (tmp_path / "q.exr").exists()
 
 
 def test_refusals(small_scene, tmp_path):
@@ -73,7 +101,21 @@ def test_refusals(small_scene, tmp_path):
         r.render(1)
         with pytest.raises(ValueError, match="compression must be 'zip' or 'piz', got 'lzw'"):
             r.write_part(tmp_path / "p.exr", compression="lzw")
-    assert not (tmp_path / "p.exr").exists()
+        with pytest.raises(lucent.Error, match="write_part writes a part file: use an .exr name"):
+            r.write_part(tmp_path / "p.png")
+    assert not (tmp_path / "p.exr").exists() and not (tmp_path / "p.png").exists()
+    # never over a file the scene reads (an environment map in OpenEXR)
+    sky = tmp_path / "sky.exr"
+    lucent.write_image(sky, np.full((4, 8, 3), 0.5, np.float32))
+    d = {"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+         "film": {"width": 8, "height": 6},
+         "lights": [{"type": "environment", "file": "sky.exr"}]}
+    with session() as r:
+        r.set_scene(lucent.scene_from_dict(d, base_dir=str(tmp_path)))
+        r.render(1)
+        with pytest.raises(lucent.Error, match="sky.exr"):
+            r.write_part(sky)
+    np.testing.assert_array_equal(lucent.read_image(sky), np.full((4, 8, 3), 0.5, np.float32))
     with pytest.raises(ValueError, match="no part files given"):
         lucent.merge_parts([])
     with pytest.raises(ValueError, match=r"expect must be \(begin, end\)"):
