@@ -768,13 +768,14 @@ TEST(Obj, ColourFormsXyzAndSpectral) {
                                 "newmtl curve\nKd spectral red.rfl 1.0\n"                // 5
                                 "newmtl none\nillum 1\n"                                 // 7
                                 "newmtl vivid\nnewmtl\nKd xyz 0.1 0.5 0.1\n"             // 9
-                                "newmtl glass\nd 0.5\nTf xyz 0.4 0.3 0.2\n");            // 12
-  const std::string path =
-      one_face_per_material(dir, "c.obj", "c.mtl", {"xyz", "curve", "none", "vivid", "glass"});
+                                "newmtl glass\nd 0.5\nTf xyz 0.4 0.3 0.2\n"              // 12
+                                "newmtl kt curve\nd 0.5\nKt spectral k.rfl\n");          // 15
+  const std::string path = one_face_per_material(
+      dir, "c.obj", "c.mtl", {"xyz", "curve", "none", "vivid", "glass", "kt curve"});
   CaptureWarnings w;
   Scene s;
   load(s, path);
-  ASSERT_EQ(s.triangles.size(), 5u);
+  ASSERT_EQ(s.triangles.size(), 6u);
   // XYZ to linear sRGB (IEC 61966-2-1's matrix), computed apart: 0.3 * (3.2404542, -0.9692660,
   // 0.0556434) + 0.4 * (-1.5371385, 1.8760108, -0.2040259) + ...
   const Material& xyz = material_named(s, "c.obj:xyz");
@@ -794,7 +795,12 @@ TEST(Obj, ColourFormsXyzAndSpectral) {
   EXPECT_WARNED_ONCE(w, mtl +
                             ":11: material 'vivid': Kd xyz 0.1 0.5 0.1 is outside the sRGB gamut: "
                             "its negative channels are taken as 0 (Kd 0 0.8452344 0.00927391)");
-  EXPECT_EQ(w.all().size(), 2u) << w.dump();
+  // a transparent material's Kt spectral: clear, and the warning names Kt (it said Tf)
+  EXPECT_COLOUR(material_named(s, "c.obj:kt curve").specular, 1, 1, 1);
+  EXPECT_WARNED_ONCE(w, mtl +
+                            ":17: material 'kt curve' (transparent: opacity 0.5 (d or Tr)): Kt "
+                            "spectral (a curve) is not read; tint 1");
+  EXPECT_EQ(w.all().size(), 3u) << w.dump();
 
   // a spectral Kd beside a map_Kd that is missing: the material keeps its Kd, 0 0 0 as the
   // warning says (tinyobjloader gives 0.6 to a map_Kd without a Kd in a file where no material

@@ -692,6 +692,7 @@ std::vector<MtlName> mtl_material_names(const std::string& text) {
       std::string_view rest = line.substr(b + 2);
       const std::string_view first = token(rest);
       out.back().tf_line = ln;
+      out.back().tf_tag = std::string(line.substr(b, 2));
       out.back().tf_numbers = first != "spectral";  // (the xyz form is numbers by now)
       return;
     }
@@ -702,7 +703,10 @@ std::vector<MtlName> mtl_material_names(const std::string& text) {
     // reader trims them (MtlReader::read)
     const std::string name = trim(std::string(line.substr(b + 7)));
     if (name.empty()) return;  // "newmtl" and spaces: no statement
-    out.push_back({name, ln});
+    MtlName m;
+    m.name = name;
+    m.line = ln;
+    out.push_back(std::move(m));
   });
   return out;
 }

@@ -135,10 +135,11 @@ std::string strip_texture_options(const std::string& text,
 struct MtlName {
   std::string name;
   long line = 0;
-  /// its last Tf (or Kt) statement's line, 0 when it has none; `tf_numbers`: that statement
-  /// gives numbers (not the `spectral` form, which tinyobjloader reads as zeros; the `xyz`
-  /// form is put in numbers first, read_colour_forms)
+  /// its last Tf (or Kt) statement's line, 0 when it has none, and its tag (for messages);
+  /// `tf_numbers`: that statement gives numbers (not the `spectral` form, which tinyobjloader
+  /// misreads; the `xyz` form is put in numbers first, read_colour_forms)
   long tf_line = 0;
+  std::string tf_tag;
   bool tf_numbers = false;
 };
 std::vector<MtlName> mtl_material_names(const std::string& text);

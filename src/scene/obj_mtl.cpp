@@ -243,7 +243,7 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
     // Tf 0 0 0 on every material. Every grey Tf seen on a transparent material meant clear
     const glm::dvec3 tf = rgb(t.transmittance);
     if (def.tf_line > 0 && !def.tf_numbers) {
-      warn(at + ": Tf spectral (a curve) is not read; tint 1");
+      warn(at + ": " + def.tf_tag + " spectral (a curve) is not read; tint 1");
     } else if (def.tf_line > 0 && tf.x == tf.y && tf.y == tf.z) {
       if (tf.x != 1) {
         std::ostringstream g;
