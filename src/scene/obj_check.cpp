@@ -410,6 +410,14 @@ void blank_element_comments(std::string& text) {
 
 namespace {
 
+/// The MTL statements that give a colour (three numbers, or the xyz and spectral forms).
+constexpr const char* kColourTags[] = {"Ka", "Kd", "Ks", "Ke", "Kt", "Tf"};
+
+bool colour_tag(std::string_view tag) {
+  return std::any_of(std::begin(kColourTags), std::end(kColourTags),
+                     [&](const char* c) { return tag == c; });
+}
+
 /// A colour given as CIE XYZ (one to three numbers; one is x = y = z, the MTL specification) in
 /// linear sRGB (D65, IEC 61966-2-1's matrix); its negative channels are left negative.
 glm::dvec3 xyz_to_srgb(const double* v, int n) {
@@ -429,12 +437,11 @@ void check_mtl_text(const std::string& path, const std::string& text) {
     if (tag != "newmtl")
       for (std::string_view probe = rest, t; !(t = raw_token(probe)).empty();)
         check_exponent(t, fail);
-    static const char* const colours[] = {"Ka", "Kd", "Ks", "Ke", "Kt", "Tf"};
     static const char* const scalars[] = {"Ns", "Ni", "d",   "Tr",    "Pr",    "Pm",
                                           "Ps", "Pc", "Pcr", "aniso", "anisor"};
     std::string name(tag);
-    bool colour = false, scalar = false;
-    for (const char* c : colours) colour = colour || tag == c;
+    const bool colour = colour_tag(tag);
+    bool scalar = false;
     for (const char* s : scalars) scalar = scalar || tag == s;
     if (colour) {
       std::string_view probe = rest;
@@ -634,10 +641,7 @@ std::string read_colour_forms(const std::string& path, const std::string& text,
       if (std::string name = trim(std::string(rest)); !name.empty()) material = name;
       return;
     }
-    static const char* const colours[] = {"Ka", "Kd", "Ks", "Ke", "Kt", "Tf"};
-    if (std::none_of(std::begin(colours), std::end(colours),
-                     [&](const char* c) { return tag == c; }))
-      return;
+    if (!colour_tag(tag)) return;
     std::string_view args = rest;
     const std::string_view form = token(args);
     // Tf spectral stays: a transparent material is warned of it, and clear (MaterialMapper)
