@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "lucent/image.hpp"
+#include "lucent/parts.hpp"
 #include "lucent/render.hpp"
 #include "lucent/scene.hpp"
 
@@ -237,6 +238,12 @@ std::string int_repr(py::handle value);
 /// "<what> must be an integer in [lo, hi]<note>, got <value>" for any integer outside, negative
 /// or beyond 64 bits alike (never clamped).
 std::uint64_t int_argument(const IntArg& arg, const char* what, std::uint64_t lo, std::uint64_t hi,
+                           const char* note = "");
+
+/// A sample range given as a tuple (begin, end), [begin, end) with begin < end <= `top`:
+/// TypeError "<what> must be a tuple (begin, end), got ..." for anything else than a 2-tuple,
+/// ValueError naming "<what> begin" or "<what> end" (int_argument) or the order.
+SampleRange range_argument(py::handle arg, const char* what, std::uint64_t top,
                            const char* note = "");
 
 /// `n` as messages write a range's bound: 2**k or 2**k - 1 from 2**16 on, else in decimal.

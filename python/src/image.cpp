@@ -173,20 +173,7 @@ void bind_image(py::module_& m) {
         // what the parts hold together (many parts of at most 2**24 samples each)
         SampleRange want;
         const bool expecting = !expect.is_none();
-        if (expecting) {
-          const py::tuple t =
-              py::isinstance<py::tuple>(expect) ? expect.cast<py::tuple>() : py::tuple();
-          if (t.size() != 2)
-            throw py::type_error("expect must be a tuple (begin, end), got " +
-                                 py::repr(expect).cast<std::string>());
-          const std::uint64_t top = std::uint64_t(1) << 32;
-          want = {int_argument(IntArg{t[0]}, "expect begin", 0, top - 1),
-                  int_argument(IntArg{t[1]}, "expect end", 1, top)};
-          if (want.begin >= want.end)
-            throw py::value_error("expect must be (begin, end) with begin < end, got (" +
-                                  std::to_string(want.begin) + ", " + std::to_string(want.end) +
-                                  ")");
-        }
+        if (expecting) want = range_argument(expect, "expect", std::uint64_t(1) << 32);
         ReleaseGil release;
         // as `lucent merge`: the output checked before any part is read
         if (!out.empty()) {

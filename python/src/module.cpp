@@ -144,6 +144,21 @@ std::uint64_t int_argument(const IntArg& arg, const char* what, std::uint64_t lo
   return v.magnitude;
 }
 
+SampleRange range_argument(py::handle arg, const char* what, std::uint64_t top, const char* note) {
+  const py::tuple t =
+      py::isinstance<py::tuple>(arg) ? py::reinterpret_borrow<py::tuple>(arg) : py::tuple();
+  if (t.size() != 2)
+    throw py::type_error(std::string(what) + " must be a tuple (begin, end), got " +
+                         py::repr(arg).cast<std::string>());
+  const std::string name(what);
+  const SampleRange r{int_argument(IntArg{t[0]}, (name + " begin").c_str(), 0, top - 1, note),
+                      int_argument(IntArg{t[1]}, (name + " end").c_str(), 1, top, note)};
+  if (r.begin >= r.end)
+    throw py::value_error(name + " must be (begin, end) with begin < end, got (" +
+                          std::to_string(r.begin) + ", " + std::to_string(r.end) + ")");
+  return r;
+}
+
 void refuse_nul(const std::string& text, const char* what) {
   if (text.find('\0') != std::string::npos)
     throw py::value_error(std::string(what) + ": embedded null character in '" + visible_nul(text) +

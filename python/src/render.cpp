@@ -849,20 +849,8 @@ void bind_render(py::module_& m) {
             if (io::lower_extension(p) != ".exr")
               throw Error(p + ": write_part writes a part file: use an .exr name");
             std::optional<SampleRange> asked;
-            if (!requested.is_none()) {
-              const py::tuple t =
-                  py::isinstance<py::tuple>(requested) ? requested.cast<py::tuple>() : py::tuple();
-              if (t.size() != 2)
-                throw py::type_error("requested must be a tuple (begin, end), got " +
-                                     py::repr(requested).cast<std::string>());
-              asked = SampleRange{
-                  int_argument(IntArg{t[0]}, "requested begin", 0, kSampleIndices - 1, kSampleNote),
-                  int_argument(IntArg{t[1]}, "requested end", 1, kSampleIndices, kSampleNote)};
-              if (asked->begin >= asked->end)
-                throw py::value_error("requested must be (begin, end) with begin < end, got (" +
-                                      std::to_string(asked->begin) + ", " +
-                                      std::to_string(asked->end) + ")");
-            }
+            if (!requested.is_none())
+              asked = range_argument(requested, "requested", kSampleIndices, kSampleNote);
             r.call("write_part", [&](Renderer& rr) {
               const Scene& scene = rr.scene();  // (raises without a scene)
               // not over the scene or a file it reads (a part written over scene.json)
