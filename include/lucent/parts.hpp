@@ -6,6 +6,7 @@
 // accumulation of their union; merging adds them in ascending sample order, so a merge does not
 // depend on the order its inputs are given in. File format: docs/parts.md.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -143,6 +144,18 @@ class PartMerger {
 /// overlapping ranges), then reads and adds the parts in ascending order of their first sample
 /// (one part in memory at a time besides the sum).
 MergeReport merge_render_parts(const std::vector<std::string>& paths);
+
+/// Before a merge reads its parts (`lucent merge`'s -o, Python's merge_parts output=): `output`
+/// is none of them, and has a format write_merged writes and a place that can be written; throws
+/// lucent::Error naming it otherwise.
+void check_merge_output(const std::string& output, const std::vector<std::string>& parts);
+
+/// After a merge: the parts' samples lie within `expect` (when given), whose ranges they miss
+/// replace `report.missing`; with `complete`, none may be missing. Throws lucent::Error naming
+/// the options as `expect_name` and `complete_name` ("--expect", "--complete").
+void check_merge_coverage(MergeReport& report, const std::optional<SampleRange>& expect,
+                          bool complete, const std::string& expect_name,
+                          const std::string& complete_name);
 
 /// Writes a merged part in the format of `path`'s extension: .exr (a part file, which can be
 /// merged again), .png (8-bit, the parts' display settings), .pfm (the mean). Atomic.

@@ -3,7 +3,6 @@
 #include <cmath>
 
 #include "common.hpp"
-#include "core/file_io.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/parts.hpp"
@@ -171,27 +170,13 @@ void bind_image(py::module_& m) {
         if (inputs.empty()) throw py::value_error("merge_parts: no part files given");
         const std::string out = output ? output->string() : std::string();
         // what the parts hold together (many parts of at most 2**24 samples each)
-        SampleRange want;
-        const bool expecting = !expect.is_none();
-        if (expecting) want = range_argument(expect, "expect", std::uint64_t(1) << 32);
+        std::optional<SampleRange> want;
+        if (!expect.is_none()) want = range_argument(expect, "expect", std::uint64_t(1) << 32);
         ReleaseGil release;
         // as `lucent merge`: the output checked before any part is read
-        if (!out.empty()) {
-          for (const std::string& in : inputs)
-            if (io::same_file(out, in))
-              throw Error(out + ": is an input of the merge; refusing to overwrite it");
-          io::check_output_path(out, inputs);
-        }
+        if (!out.empty()) check_merge_output(out, inputs);
         MergeReport r = merge_render_parts(inputs);
-        if (expecting) {
-          for (const SampleRange& s : r.merged.info.samples)
-            if (s.begin < want.begin || s.end > want.end)
-              throw Error("merge: the parts hold samples " + ranges_text(r.merged.info.samples) +
-                          ", outside expect " + range_text(want));
-          r.missing = missing_ranges(r.merged.info.samples, want);
-        }
-        if (complete && !r.missing.empty())
-          throw Error("merge: samples " + ranges_text(r.missing) + " are missing (complete)");
+        check_merge_coverage(r, want, complete, "expect", "complete");
         if (!out.empty()) write_merged(out, r.merged);
         MergedParts m;
         m.result = part_result(r.merged);

@@ -4,11 +4,11 @@
 // are missing and the effective samples per pixel, and writes OUT atomically.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "core/file_io.hpp"
 #include "lucent/error.hpp"
 #include "lucent/parts.hpp"
 
@@ -51,30 +51,16 @@ CLI::App* add_merge_command(CLI::App& app) {
 
 int run_merge_command() {
   MergeArgs& a = merge_args();
-  for (const std::string& in : a.parts)
-    if (io::same_file(a.output, in))
-      throw Error(a.output + ": is an input of the merge; refusing to overwrite it");
-  // the format (.exr, .png, .pfm, as write_merged writes) and a place that can be written, before
-  // reading any part
-  io::check_output_path(a.output, a.parts);
-  SampleRange expect;
+  check_merge_output(a.output, a.parts);
+  std::optional<SampleRange> expect;
   // what the parts hold together: many parts of at most 2^24 samples each (the per-part limit)
   if (!a.expect.empty()) expect = parse_sample_range(a.expect, "--expect", false);
   MergeReport r = merge_render_parts(a.parts);
   const PartInfo& info = r.merged.info;
-  if (!a.expect.empty()) {
-    for (const SampleRange& s : info.samples)
-      if (s.begin < expect.begin || s.end > expect.end)
-        throw Error("merge: the parts hold samples " + ranges_text(info.samples) +
-                    ", outside --expect " + range_text(expect));
-    r.missing = missing_ranges(info.samples, expect);
-  }
-  if (!r.missing.empty()) {
-    if (a.complete)
-      throw Error("merge: samples " + ranges_text(r.missing) + " are missing (--complete)");
+  check_merge_coverage(r, expect, a.complete, "--expect", "--complete");
+  if (!r.missing.empty())
     std::fprintf(stderr, "lucent: warning: samples %s are missing: the image has fewer samples\n",
                  ranges_text(r.missing).c_str());
-  }
   write_merged(a.output, r.merged);
   if (!a.quiet) {
     std::fprintf(stderr, "%s: %dx%d, %zu part(s), samples %s\n", one_line(a.output).c_str(),

@@ -675,6 +675,30 @@ MergeReport PartMerger::finish() {
   return r;
 }
 
+void check_merge_output(const std::string& output, const std::vector<std::string>& parts) {
+  for (const std::string& in : parts)
+    if (io::same_file(output, in))
+      throw Error(output + ": is an input of the merge; refusing to overwrite it");
+  // the format (.exr, .png, .pfm, as write_merged writes) and a place that can be written
+  io::check_output_path(output, parts);
+}
+
+void check_merge_coverage(MergeReport& report, const std::optional<SampleRange>& expect,
+                          bool complete, const std::string& expect_name,
+                          const std::string& complete_name) {
+  const std::vector<SampleRange>& samples = report.merged.info.samples;
+  if (expect) {
+    for (const SampleRange& s : samples)
+      if (s.begin < expect->begin || s.end > expect->end)
+        throw Error("merge: the parts hold samples " + ranges_text(samples) + ", outside " +
+                    expect_name + " " + range_text(*expect));
+    report.missing = missing_ranges(samples, *expect);
+  }
+  if (complete && !report.missing.empty())
+    throw Error("merge: samples " + ranges_text(report.missing) + " are missing (" + complete_name +
+                ")");
+}
+
 MergeReport merge_render_parts(const std::vector<std::string>& paths) {
   if (paths.empty()) throw Error("merge: no part files given");
   struct Entry {
