@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -137,6 +138,10 @@ bool Checkpoint::save(const lucent::RenderPart& part) {
   ours_ = ours_ || ok;
   last_ = std::chrono::steady_clock::now();
   return ok;
+}
+
+const char* signal_name(int sig) {
+  return sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "SIGINT (Ctrl-C)";
 }
 
 bool Checkpoint::save_new(const lucent::RenderPart& part) {

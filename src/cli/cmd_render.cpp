@@ -47,10 +47,6 @@ extern "C" void on_stop_signal(int sig) {
 
 const int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
-const char* signal_name(int sig) {
-  return sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "SIGINT (Ctrl-C)";
-}
-
 std::string format_duration(double s) {
   char buf[32];
   if (s < 60) {

@@ -84,10 +84,6 @@ bool refused(const std::function<void()>& step) {
   return first < g_size;
 }
 
-const char* signal_name(int sig) {
-  return sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "SIGINT (Ctrl-C)";
-}
-
 /// Whether a rank has a stop signal, agreed by all ranks: its number (the highest any rank has),
 /// else 0. The lowest stopped rank says so, in one line.
 int stopped_before_rendering() {
@@ -99,7 +95,7 @@ int stopped_before_rendering() {
   if (first == g_rank)
     std::fprintf(stderr,
                  "lucent-mpi: rank %d of %d: interrupted by %s before rendering: nothing written\n",
-                 g_rank, g_size, signal_name(mine));
+                 g_rank, g_size, lucent::cli::signal_name(mine));
   return sig;
 }
 
