@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -13,8 +14,10 @@
 #include <string>
 #include <vector>
 
+#include "core/host_blocks.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
+#include "lucent/parts.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/session.hpp"
 #include "render/pack.hpp"
@@ -300,6 +303,57 @@ TEST(Resources, HostLimitNamesTheCulprit) {
       error_of([&] { lucent::render_detail::check_host_memory(s, {d}, std::uint64_t(8) << 30); }),
       "");
   EXPECT_EQ(error_of([&] { lucent::render_detail::check_host_memory(s, {d}, 0); }), "");
+}
+
+// Byte counts saturate instead of wrapping: a film of 2147352580x536903681 pixels (2^60 + 4) was
+// counted as 3783 bytes, passed the check and aborted in PoCL; 2^30 x 2^30 counted 0 bytes; and an
+// application's reservation near 2^64 wrapped the total below the limit. Every film too large for
+// 64 bits of bytes, alone or with the reservation, is refused by the check, as is every film in
+// between (the count never falls as the film grows).
+TEST(Resources, HostCountsSaturateInsteadOfWrapping) {
+  Scene s = lucent::test::scene_from(grid_scene(2, 4));
+  s.path = "huge.json";
+  DeviceLimits cpu;
+  cpu.device = "cpu";
+  cpu.host_unified = true;
+  const std::uint64_t limit = std::uint64_t(16) << 30;
+  auto refused = [&](int w, int h, const std::vector<MemoryPart>& extra = {}) {
+    s.film.width = w;
+    s.film.height = h;
+    return error_of(
+        [&] { lucent::render_detail::check_host_memory(s, {cpu}, limit, "memory", extra); });
+  };
+  for (auto [w, h] : {std::pair{2147352580, 536903681}, std::pair{1073741824, 1073741824},
+                      std::pair{2147483647, 2147483647}, std::pair{65536, 65536}}) {
+    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+    const std::string msg = refused(w, h);
+    EXPECT_EQ(msg.rfind("huge.json: rendering needs about ", 0), 0u) << msg;
+    EXPECT_NE(msg.find("reduce the film size"), std::string::npos) << msg;
+    std::uint64_t largest = 0;
+    for (const MemoryPart& p : lucent::render_detail::estimate_host_memory(s, {cpu}))
+      largest = std::max(largest, p.bytes);
+    EXPECT_GE(largest, std::uint64_t(w) * std::uint64_t(h)) << "a byte or more per pixel";
+  }
+  // the adaptive render's and the reference's counts, and the device buffers'
+  s.film.width = 2147352580;
+  s.film.height = 536903681;
+  EXPECT_NE(error_of([&] {
+              lucent::render_detail::check_adaptive_host_memory(s, {cpu}, true, limit, "memory",
+                                                                {});
+            }),
+            "");
+  EXPECT_GE(lucent::render_detail::adaptive_host_bytes(std::uint64_t(1) << 62, true),
+            std::uint64_t(1) << 62);
+  for (const MemoryPart& p :
+       lucent::render_detail::film_device_buffers(2147352580, 536903681, true, true, true))
+    EXPECT_GE(p.bytes, std::uint64_t(1) << 60) << p.what;
+  EXPECT_GE(lucent::part_write_bytes(2147352580, 536903681, lucent::PartCompression::piz),
+            std::uint64_t(1) << 60);
+  // a reservation near 2^64 with a small film
+  for (const std::uint64_t reserved :
+       {std::uint64_t(1) << 63, ~std::uint64_t(0) - 99, ~std::uint64_t(0)})
+    EXPECT_NE(refused(16, 16, lucent::render_detail::reserved_part(reserved)), "") << reserved;
+  EXPECT_EQ(lucent::sys::host_block_bytes(~std::uint64_t(0) - 5), ~std::uint64_t(0));
 }
 
 // Before upload, per device: each buffer against the largest allocation, by its registry

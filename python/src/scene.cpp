@@ -857,17 +857,16 @@ py::dict scene_info(const Scene& scene, const std::string& precision, bool fast_
   // what a session's set_scene checks before rendering on a CPU device (the scene held twice:
   // the application's and the session's copy), as `lucent info` prints it
   py::list parts;
-  std::uint64_t total = 0;
-  for (const render_detail::MemoryPart& p :
-       render_detail::estimate_host_memory(copy, {render_detail::DeviceLimits::cpu()})) {
+  const std::vector<render_detail::MemoryPart> estimate =
+      render_detail::estimate_host_memory(copy, {render_detail::DeviceLimits::cpu()});
+  for (const render_detail::MemoryPart& p : estimate) {
     py::dict part;
     part["what"] = p.what;
     part["bytes"] = p.bytes;
     parts.append(part);
-    total += p.bytes;
   }
   py::dict memory;
-  memory["bytes"] = total;
+  memory["bytes"] = render_detail::total_bytes(estimate);
   memory["limit_bytes"] = render_detail::host_memory_allowed();
   memory["parts"] = parts;
   d["host_memory"] = memory;

@@ -6,6 +6,7 @@ import os
 import pickle
 import re
 import subprocess
+import warnings
 
 import numpy as np
 import pytest
@@ -507,6 +508,27 @@ def test_scene_info_validates_the_scene(small_scene):
     with pytest.raises(lucent.Error,
                        match="/shapes/0/material: must index one of the scene.s 2 materials"):
         lucent.scene_info(small_scene)
+
+
+def test_memory_counts_of_huge_films_saturate_and_are_refused(small_scene):
+    """A film of 2147352580x536903681 pixels (2^60 + 4) was counted as 3783 bytes: its byte counts
+    wrapped 64 bits, set_scene passed the memory check and PoCL aborted the interpreter. Counts now
+    stop at 2^64 - 1: the total is never below a part, and set_scene refuses the film."""
+    for width, height in ((2147352580, 536903681), (1073741824, 1073741824),
+                          (2147483647, 2147483647)):
+        small_scene.film.width, small_scene.film.height = width, height
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", lucent.LucentWarning)  # the camera's float steps
+            memory = lucent.scene_info(small_scene)["host_memory"]
+            assert memory["bytes"] >= max(p["bytes"] for p in memory["parts"]) >= width * height
+            r = lucent.Renderer()
+            with pytest.raises(lucent.Error, match="rendering needs about .*: reduce the film size"):
+                r.set_scene(small_scene)
+    # an application's reservation near 2^64 no longer wraps the total below the limit
+    small_scene.film.width, small_scene.film.height = 16, 12
+    for reserved in (2 ** 63, 2 ** 64 - 100, 2 ** 64 - 1):
+        with pytest.raises(lucent.Error, match="what the application keeps beside the session"):
+            lucent.Renderer(reserved_host_bytes=reserved).set_scene(small_scene)
 
 
 def test_indices_take_numpy_integers_and_refuse_the_rest():

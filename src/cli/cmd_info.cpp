@@ -67,8 +67,7 @@ void print_memory(const Scene& scene) {
       render_detail::estimate_host_memory(scene, {render_detail::DeviceLimits::cpu()}, 1);
   std::stable_sort(parts.begin(), parts.end(),
                    [](const auto& a, const auto& b) { return a.bytes > b.bytes; });
-  std::uint64_t total = 0;
-  for (const render_detail::MemoryPart& p : parts) total += p.bytes;
+  const std::uint64_t total = render_detail::total_bytes(parts);
   std::string what;
   const std::uint64_t limit = render_detail::host_memory_allowed(&what);
   std::printf("\nhost memory   %s estimated for a render on a CPU device",

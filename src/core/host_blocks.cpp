@@ -38,6 +38,7 @@ bool huge_pages_wanted() {
 
 std::uint64_t host_block_bytes(std::uint64_t bytes) {
   if (bytes < kHugePageMinBuffer) return bytes;
+  if (bytes > ~std::uint64_t(0) - kHugePageBytes) return ~std::uint64_t(0);  // a saturated count
   return (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
 }
 

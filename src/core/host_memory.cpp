@@ -74,6 +74,16 @@ std::uint64_t host_memory_allowed(std::string* what) {
 
 void set_host_limit_override(std::uint64_t bytes) { g_host_override = bytes; }
 
+std::uint64_t bytes_mul(std::uint64_t a, std::uint64_t b) {
+  std::uint64_t r;
+  return __builtin_mul_overflow(a, b, &r) ? ~std::uint64_t(0) : r;
+}
+
+std::uint64_t bytes_add(std::uint64_t a, std::uint64_t b) {
+  std::uint64_t r;
+  return __builtin_add_overflow(a, b, &r) ? ~std::uint64_t(0) : r;
+}
+
 std::string format_bytes(std::uint64_t bytes) {
   char buf[64];
   const double b = double(bytes);

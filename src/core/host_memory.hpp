@@ -33,6 +33,12 @@ void set_host_limit_override(std::uint64_t bytes);
 /// (an OBJ soup of 10^6 triangles left 70 MB of the loader's arrays).
 void return_free_memory();
 
+/// Byte counts for the memory checks: a * b and a + b, or the largest count where they overflow.
+/// A film's pixels reach 2^62 (two 31-bit sides), so a count in bytes can pass 64 bits: wrapped,
+/// a 2147352580x536903681 film counted 3783 bytes and passed the check.
+std::uint64_t bytes_mul(std::uint64_t a, std::uint64_t b);
+std::uint64_t bytes_add(std::uint64_t a, std::uint64_t b);
+
 /// Bytes as "12.3 GiB", "512.0 MiB", "96.0 KiB", "100 bytes".
 std::string format_bytes(std::uint64_t bytes);
 

@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "core/file_io.hpp"
+#include "core/host_memory.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/error.hpp"
 
@@ -58,7 +59,7 @@ io::ReadSpec part_read_spec() {
 }
 
 std::uint64_t exr_encoder_bytes(std::uint64_t raw) {
-  return 2 * (raw + raw / 64) + (std::uint64_t(1) << 20);
+  return sys::bytes_add(sys::bytes_mul(2, sys::bytes_add(raw, raw / 64)), std::uint64_t(1) << 20);
 }
 
 namespace {

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "core/file_io.hpp"
+#include "core/host_memory.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
@@ -105,9 +106,11 @@ std::uint64_t image_write_bytes(const std::string& path, int width, int height) 
   // EXR: three float planes and the encoder; PFM: the file; PNG: the 8-bit pixels, and
   // stb_image_write's filtered rows, its deflate buffer (grown by doubling, so up to twice the
   // pixels), the file and this side's copy of it
-  if (ext == "exr") return npix * 3 * sizeof(float) + exr_encoder_bytes(npix * 3 * sizeof(float));
-  if (ext == "pfm") return npix * 3 * sizeof(float) + 64;
-  return npix * 3 * 6 + (std::uint64_t(1) << 16);
+  // (saturated counts, sys::bytes_mul: a film's pixels reach 2^62)
+  const std::uint64_t floats = sys::bytes_mul(npix, 3 * sizeof(float));
+  if (ext == "exr") return sys::bytes_add(floats, exr_encoder_bytes(floats));
+  if (ext == "pfm") return sys::bytes_add(floats, 64);
+  return sys::bytes_add(sys::bytes_mul(npix, 3 * 6), std::uint64_t(1) << 16);
 }
 
 }  // namespace image_detail

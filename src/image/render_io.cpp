@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/file_io.hpp"
+#include "core/host_memory.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
@@ -101,7 +102,8 @@ std::uint64_t render_exr_write_bytes(int width, int height, bool stats, int extr
   const std::uint64_t npix = std::uint64_t(std::max(width, 0)) * std::uint64_t(std::max(height, 0));
   const std::uint64_t floats = stats ? 6 : 3;
   const std::uint64_t channels = floats + (stats ? 1 : 0) + std::uint64_t(extra_uint_channels);
-  return npix * floats * sizeof(float) + exr_encoder_bytes(npix * channels * 4);
+  return sys::bytes_add(sys::bytes_mul(npix, floats * sizeof(float)),
+                        exr_encoder_bytes(sys::bytes_mul(npix, channels * 4)));
 }
 
 void write_render_planes(const std::string& path, const RenderPlanes& r, const ExrExtras& extras) {

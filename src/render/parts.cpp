@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "core/file_io.hpp"
+#include "core/host_memory.hpp"
 #include "core/text.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/error.hpp"
@@ -378,9 +379,10 @@ std::uint64_t part_write_bytes(int width, int height, PartCompression compressio
   // lines beside its output, its input, twice its size of blocks and a temporary copy, and 2 MB
   // of Huffman tables: films of few lines (16384 x 32: about 200 MB) took more than the rest
   const std::uint64_t piz_chunk = std::uint64_t(std::max(width, 0)) * 32 * 19 * 4;
-  return npix * (12 * sizeof(std::uint32_t) + 6 * sizeof(float)) +
-         image_detail::exr_encoder_bytes(npix * 19 * 4) +
-         (compression == PartCompression::piz ? 4 * piz_chunk + (std::uint64_t(2) << 20) : 0);
+  return sys::bytes_add(
+      sys::bytes_add(sys::bytes_mul(npix, 12 * sizeof(std::uint32_t) + 6 * sizeof(float)),
+                     image_detail::exr_encoder_bytes(sys::bytes_mul(npix, 19 * 4))),
+      compression == PartCompression::piz ? 4 * piz_chunk + (std::uint64_t(2) << 20) : 0);
 }
 
 void write_render_part(const std::string& path, const RenderPart& part,

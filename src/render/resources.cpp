@@ -13,6 +13,8 @@
 
 namespace lucent::render_detail {
 
+using sys::bytes_add;
+using sys::bytes_mul;
 using sys::host_memory;
 using sys::HostMemory;
 
@@ -48,13 +50,13 @@ const MemoryPart& largest(const std::vector<MemoryPart>& parts) {
       [](const MemoryPart& a, const MemoryPart& b) { return a.bytes < b.bytes; });
 }
 
-std::uint64_t total(const std::vector<MemoryPart>& parts) {
+}  // namespace
+
+std::uint64_t total_bytes(const std::vector<MemoryPart>& parts) {
   std::uint64_t t = 0;
-  for (const MemoryPart& p : parts) t += p.bytes;
+  for (const MemoryPart& p : parts) t = bytes_add(t, p.bytes);
   return t;
 }
-
-}  // namespace
 
 bool buffers_in_host_memory(const cl::Device& device) {
   return (device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
@@ -172,12 +174,13 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
   // session.cpp: double sums and sums of squares (3 + 3) and a sample count per pixel; the
   // result's mean and variance (3 + 3 floats) and sample counts
   parts.push_back({"the accumulation and result images of the " + film + " film",
-                   npix * (kAccumulationPixelBytes + kResultPixelBytes), "the film size"});
+                   bytes_mul(npix, kAccumulationPixelBytes + kResultPixelBytes), "the film size"});
   // caustics: the light paths' sums and sums of squares (3 + 3 doubles per pixel); an upper
   // bound (pack_scene drops caustics from a scene without a delta surface)
   const bool caustics = scene.integrator.caustics && scene.integrator.type == IntegratorType::Path;
   if (caustics)
-    parts.push_back({"the caustics light sums of the " + film + " film", npix * 6 * sizeof(double),
+    parts.push_back({"the caustics light sums of the " + film + " film",
+                     bytes_mul(npix, 6 * sizeof(double)),
                      "the film size, or render without caustics"});
   // the scene description: the application's, and the session's copy of it (Renderer::scene),
   // or only the session's where it took the application's
@@ -225,14 +228,15 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
     // 64-bit atomics, else float4: two films each, an adaptive work list's halves A and B)
     const std::uint64_t sum_elem = d.fp64 ? sizeof(cl_double4) : sizeof(cl_float4);
     const std::uint64_t light_elem = d.light_double ? sizeof(cl_double4) : sizeof(cl_float4);
-    const std::uint64_t light_bufs = (caustics ? 4 : 0) * npix * light_elem;
-    const std::uint64_t film_bufs = (caustics ? 4 : 2) * npix * sum_elem + light_bufs;
+    const std::uint64_t light_bufs = bytes_mul(npix, (caustics ? 4 : 0) * light_elem);
+    const std::uint64_t film_bufs =
+        bytes_add(bytes_mul(npix, (caustics ? 4 : 2) * sum_elem), light_bufs);
     // a CPU device's buffers are host memory: the film's (and the work list), and the scene's
     // (the packed arrays, counted above); its pass results are mapped there (session.cpp).
     // Another device's results are read back into host copies as large as its buffers (h_sum,
     // h_sumsq, and with caustics h_light, h_lightsq).
     std::uint64_t bytes = film_bufs;
-    if (d.host_unified) bytes += npix * sizeof(cl_uint4);
+    if (d.host_unified) bytes = bytes_add(bytes, bytes_mul(npix, sizeof(cl_uint4)));
     parts.push_back({"the buffers of device '" + d.device + "' for the " + film + " film" +
                          (d.host_unified ? " (host memory)" : ""),
                      bytes, "the film size"});
@@ -244,7 +248,7 @@ namespace {
 
 void check_host_parts(const Scene& scene, const std::vector<MemoryPart>& parts,
                       std::uint64_t host_limit, const std::string& limit_what) {
-  const std::uint64_t need = total(parts);
+  const std::uint64_t need = total_bytes(parts);
   if (need <= host_limit) return;
   const MemoryPart& big = largest(parts);
   throw Error(scene_name(scene) + ": rendering needs about " + format_bytes(need) +
@@ -283,7 +287,7 @@ void check_reference_host_memory(const Scene& scene, int threads) {
   std::vector<MemoryPart> parts = estimate_host_memory(scene, {});
   for (MemoryPart& p : parts)
     if (p.what.rfind("the caustics light sums", 0) == 0) {
-      p.bytes *= std::uint64_t(std::max(threads, 1));
+      p.bytes = bytes_mul(p.bytes, std::uint64_t(std::max(threads, 1)));
       p.what += ", one per thread (" + std::to_string(threads) + ")";
       p.reduce = "the film size or the reference's threads, or render without caustics";
     }
@@ -298,7 +302,7 @@ std::uint64_t adaptive_host_bytes(std::uint64_t npix, bool caustics) {
   const std::uint64_t pilot = 7 * sizeof(double) + sizeof(std::uint32_t);
   std::uint64_t per_pixel = 3 * half + 2 * pilot + 12 * sizeof(double);
   if (caustics) per_pixel += 2 * 6 * sizeof(double);
-  return npix * per_pixel;
+  return bytes_mul(npix, per_pixel);
 }
 
 void check_adaptive_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
@@ -326,13 +330,13 @@ std::vector<MemoryPart> film_device_buffers(int width, int height, bool caustics
   const std::uint64_t sum = (caustics ? 2 : 1) * (fp64 ? sizeof(cl_double4) : sizeof(cl_float4));
   const std::uint64_t light = light_double ? sizeof(cl_double4) : sizeof(cl_float4);
   std::vector<MemoryPart> parts = {
-      {"film sample sums (" + film + ")", npix * sum, "the film size"},
-      {"film sums of squares (" + film + ")", npix * sum, "the film size"},
-      {"film work list (" + film + ")", npix * sizeof(cl_uint4), "the film size"}};
+      {"film sample sums (" + film + ")", bytes_mul(npix, sum), "the film size"},
+      {"film sums of squares (" + film + ")", bytes_mul(npix, sum), "the film size"},
+      {"film work list (" + film + ")", bytes_mul(npix, sizeof(cl_uint4)), "the film size"}};
   const std::uint64_t nl = caustics ? 2 * npix : 1;  // an adaptive work list's halves A and B
-  parts.push_back({"caustics light sums (" + film + ")", nl * light,
+  parts.push_back({"caustics light sums (" + film + ")", bytes_mul(nl, light),
                    caustics ? "the film size, or render without caustics" : "the film size"});
-  parts.push_back({"caustics light sums of squares (" + film + ")", nl * light,
+  parts.push_back({"caustics light sums of squares (" + film + ")", bytes_mul(nl, light),
                    caustics ? "the film size, or render without caustics" : "the film size"});
   return parts;
 }
@@ -358,7 +362,8 @@ void check_device_memory(const Scene& scene, const PackedScene& packed,
                 format_bytes(big.bytes) + ", more than the " + format_bytes(limits.max_alloc) +
                 " " + device + " allows per buffer (CL_DEVICE_MAX_MEM_ALLOC_SIZE): reduce " +
                 big.reduce);
-  const std::uint64_t need = total(parts) + sizeof(lc_params) + LC_COUNTER_COUNT * sizeof(lc_uint);
+  const std::uint64_t need =
+      bytes_add(total_bytes(parts), sizeof(lc_params) + LC_COUNTER_COUNT * sizeof(lc_uint));
   if (limits.global_mem > 0 && need > limits.global_mem)
     throw Error(scene_name(scene) + ": the scene and film buffers need " + format_bytes(need) +
                 " on " + device + ", more than its " + format_bytes(limits.global_mem) +

@@ -111,6 +111,9 @@ struct MemoryPart {
   std::string reduce;  ///< "the film size", ...
 };
 
+/// The parts' bytes together, saturated at the largest count (sys::bytes_add) rather than wrapped.
+std::uint64_t total_bytes(const std::vector<MemoryPart>& parts);
+
 /// What rendering `scene` will allocate on the host, estimated before packing: the film's
 /// accumulation and result images, the scene description (`description_copies` of it: 2 where
 /// the application keeps its own beside the session's copy, 1 where the session took it), the
