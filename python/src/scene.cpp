@@ -39,6 +39,25 @@ std::string format_number(double v) {
   return s.str();
 }
 
+/// The object a setter assigns to, taken from `self` after the value was converted. Converting
+/// can run Python code (__float__, __index__, a sequence's __getitem__, __array__), and that code
+/// can change the scene list the object is an element of, which moves the element to a copy
+/// (scene_list.hpp): a `C&` taken as the setter's first argument, before its value was converted,
+/// pointed where the element had been, and the edit went into freed memory or another scene's
+/// element. Every setter of the scene's classes takes `py::handle self` and calls this last.
+template <class C>
+C& assigned(py::handle self) {
+  return self.cast<C&>();
+}
+
+/// A number member (what def_readwrite gives, with the object taken after the number).
+template <class C, class D>
+void number_property(py::class_<C>& c, const char* name, D C::*member, const char* doc = "") {
+  c.def_property(
+      name, [member](const C& o) { return o.*member; },
+      [member](py::handle self, D v) { assigned<C>(self).*member = v; }, doc);
+}
+
 /// A vector member: reading gives the vector itself (`camera.position.x += 1` changes the
 /// camera), assigning takes any sequence of numbers.
 template <class C, class V>
@@ -46,7 +65,11 @@ void vec_property(py::class_<C>& c, const char* name, V C::*member, const char* 
   c.def_property(name,
                  py::cpp_function([member](C& o) -> V& { return o.*member; },
                                   py::return_value_policy::reference_internal),
-                 py::cpp_function([member](C& o, py::handle v) { o.*member = to_vec<V>(v); }), doc);
+                 py::cpp_function([member](py::handle self, py::handle v) {
+                   const V x = to_vec<V>(v);
+                   assigned<C>(self).*member = x;
+                 }),
+                 doc);
 }
 
 /// Vec3 / Vec2: glm vectors with x, y, (z), indexing, iteration, comparison with sequences and
@@ -60,16 +83,16 @@ py::class_<V> bind_vector_type(py::module_& m, const char* name) {
     return v[static_cast<int>(i)];
   };
   py::class_<V> c(m, name);
-  c.def(py::init([](py::sequence s) { return to_vec<V>(s); }), py::arg("values"))
-      .def_readwrite("x", &V::x)
-      .def_readwrite("y", &V::y)
-      .def("__len__", [](const V&) { return N; })
+  c.def(py::init([](py::sequence s) { return to_vec<V>(s); }), py::arg("values"));
+  number_property(c, "x", &V::x);
+  number_property(c, "y", &V::y);
+  c.def("__len__", [](const V&) { return N; })
       .def("__getitem__", get)
       .def("__setitem__",
-           [](V& v, py::ssize_t i, double value) {
+           [](py::handle self, py::ssize_t i, double value) {
              if (i < 0) i += N;
              if (i < 0 || i >= N) throw py::index_error(std::string("index out of range"));
-             v[static_cast<int>(i)] = value;
+             assigned<V>(self)[static_cast<int>(i)] = value;
            })
       .def("__iter__",
            [](const V& v) {
@@ -78,21 +101,24 @@ py::class_<V> bind_vector_type(py::module_& m, const char* name) {
              return py::iter(l);
            })
       .def("__eq__",
-           [](const V& v, py::object other) {
-             if (py::isinstance<V>(other)) return v == other.cast<V>();
+           [](py::handle self, py::object other) {
+             if (py::isinstance<V>(other)) return assigned<V>(self) == other.cast<V>();
              if (!py::isinstance<py::sequence>(other) || py::isinstance<py::str>(other) ||
                  py::len(other) != static_cast<std::size_t>(N))
                return false;
+             // the other side's numbers first (their conversion can move this vector, as a
+             // setter's value can: assigned())
              py::sequence s = py::reinterpret_borrow<py::sequence>(other);
+             V w;
              for (int i = 0; i < N; ++i) {
                py::object e = s[static_cast<std::size_t>(i)];
                // a number that is not real (complex) compares unequal rather than raising
                if (!PyNumber_Check(e.ptr()) || !py::hasattr(e, "__float__") ||
                    py::isinstance<py::str>(e))
                  return false;
-               if (py::float_(e).cast<double>() != v[i]) return false;
+               w[i] = py::float_(e).cast<double>();
              }
-             return true;
+             return assigned<V>(self) == w;
            })
       .def(
           "__array__",
@@ -108,7 +134,7 @@ py::class_<V> bind_vector_type(py::module_& m, const char* name) {
         for (int i = 0; i < N; ++i) s += (i ? ", " : "") + format_number(v[i]);
         return s + ")";
       });
-  if constexpr (N == 3) c.def_readwrite("z", &V::z);
+  if constexpr (N == 3) number_property(c, "z", &V::z);
   c.attr("__hash__") = py::none();
   py::implicitly_convertible<py::sequence, V>();
   return c;
@@ -155,7 +181,11 @@ void int_property(py::class_<C>& c, const char* name, I C::*member, const char* 
   const std::string what = c.attr("__name__").template cast<std::string>() + "." + name;
   c.def_property(
       name, [member](const C& o) { return o.*member; },
-      [member, what](C& o, const IntArg& v) { o.*member = integer_value<I>(v, what); }, doc);
+      [member, what](py::handle self, const IntArg& v) {
+        const I x = integer_value<I>(v, what);
+        assigned<C>(self).*member = x;
+      },
+      doc);
 }
 
 /// A bool member that takes True, False or a NumPy bool only (TypeError "<Class>.<name> must be
@@ -166,13 +196,13 @@ void bool_property(py::class_<C>& c, const char* name, bool C::*member, const ch
   const std::string what = c.attr("__name__").template cast<std::string>() + "." + name;
   c.def_property(
       name, [member](const C& o) { return o.*member; },
-      [member, what](C& o, py::object v) {
+      [member, what](py::handle self, py::object v) {
         const bool numpy_bool = std::string(Py_TYPE(v.ptr())->tp_name) == "numpy.bool_" ||
                                 std::string(Py_TYPE(v.ptr())->tp_name) == "numpy.bool";
         if (!py::isinstance<py::bool_>(v) && !numpy_bool)
           throw py::type_error(what + " must be True or False, got " +
                                py::repr(v).cast<std::string>());
-        o.*member = v.cast<bool>();
+        assigned<C>(self).*member = v.cast<bool>();
       },
       doc);
 }
@@ -183,7 +213,7 @@ void text_property(py::class_<C>& c, const char* name, std::string C::*member,
                    const char* doc = "") {
   c.def_property(
       name, [member](const C& o) { return FileText{o.*member}; },
-      [member](C& o, const FileText& v) { o.*member = v.bytes; }, doc);
+      [member](py::handle self, const FileText& v) { assigned<C>(self).*member = v.bytes; }, doc);
 }
 
 /// A property holding an enum by its registry name.
@@ -191,7 +221,10 @@ template <class C, class E>
 void enum_property(py::class_<C>& c, const char* name, E C::*member) {
   c.def_property(
       name, [member](const C& o) { return std::string(enum_name(o.*member)); },
-      [member](C& o, const std::string& v) { o.*member = parse_enum<E>(v); });
+      [member](py::handle self, const std::string& v) {
+        const E x = parse_enum<E>(v);
+        assigned<C>(self).*member = x;
+      });
 }
 
 /// int[3] members (triangle indices) as tuples.
@@ -202,7 +235,7 @@ void triple_property(py::class_<C>& c, const char* name, int (C::*member)[3]) {
       [member](const C& o) {
         return py::make_tuple((o.*member)[0], (o.*member)[1], (o.*member)[2]);
       },
-      [member](C& o, py::sequence s) {
+      [member](py::handle self, py::sequence s) {
         if (s.size() != 3)
           throw py::value_error("expected 3 indices, got " + py::repr(s).cast<std::string>());
         int v[3];
@@ -219,6 +252,7 @@ void triple_property(py::class_<C>& c, const char* name, int (C::*member)[3]) {
           if (!n) throw py::value_error(what + " out of range: " + int_repr(x.index));
           v[i] = *n;
         }
+        C& o = assigned<C>(self);
         for (int i = 0; i < 3; ++i) (o.*member)[i] = v[i];
       });
 }
@@ -253,7 +287,10 @@ void vector_array_property(py::class_<Scene>& c, const char* name, std::vector<V
   constexpr int D = V::length();
   c.def_property(
       name, [member](const Scene& s) { return vectors_array(s.*member); },
-      [member, name](Scene& s, py::handle value) { s.*member = vectors_from<V>(value, name); },
+      [member, name](py::handle self, py::handle value) {
+        std::vector<V> x = vectors_from<V>(value, name);
+        assigned<Scene>(self).*member = std::move(x);
+      },
       (std::string(name) + ": an (N, " + std::to_string(D) +
        ") float64 array (a read-only copy; assign to change)")
           .c_str());
@@ -271,11 +308,12 @@ py::array_t<float> texture_texels(const Texture& t) {
 }
 
 /// Sets a texture's texels, width and height from an (H, W, 4) array of numbers (H, W >= 1).
-void set_texture_texels(Texture& t, py::handle value) {
+void set_texture_texels(py::handle self, py::handle value) {
   require_numbers(value, "rgba");
   auto a = array_or_null<CArray<float>>(value);
   if (!a || a.ndim() != 3 || a.shape(2) != 4 || a.shape(0) < 1 || a.shape(1) < 1)
     throw py::value_error("rgba: expected an array of shape (H, W, 4)");
+  Texture& t = assigned<Texture>(self);  // after the conversion
   t.height = static_cast<int>(a.shape(0));
   t.width = static_cast<int>(a.shape(1));
   t.rgba.assign(a.data(), a.data() + a.size());
@@ -891,11 +929,11 @@ void bind_scene(py::module_& m) {
   def_pickle(vec2);
 
   py::class_<Camera> camera(m, "Camera", "Pinhole or thin-lens camera (README, \"camera\").");
-  camera.def(py::init<>())
-      .def_readwrite("fov_degrees", &Camera::fov_degrees, "vertical field of view")
-      .def_readwrite("roll_degrees", &Camera::roll_degrees)
-      .def_readwrite("aperture", &Camera::aperture, "thin-lens radius (0: pinhole)")
-      .def_readwrite("focus_distance", &Camera::focus_distance, "0: the distance to look_at");
+  camera.def(py::init<>());
+  number_property(camera, "fov_degrees", &Camera::fov_degrees, "vertical field of view");
+  number_property(camera, "roll_degrees", &Camera::roll_degrees);
+  number_property(camera, "aperture", &Camera::aperture, "thin-lens radius (0: pinhole)");
+  number_property(camera, "focus_distance", &Camera::focus_distance, "0: the distance to look_at");
   vec_property(camera, "position", &Camera::position);
   vec_property(camera, "look_at", &Camera::look_at);
   vec_property(camera, "up", &Camera::up);
@@ -913,16 +951,15 @@ void bind_scene(py::module_& m) {
              f.radius = lucent::default_filter_radius(f.type);
              return f;
            }),
-           py::arg("type"))
-      .def_readwrite("radius", &Filter::radius);
+           py::arg("type"));
+  number_property(filter, "radius", &Filter::radius);
   enum_property(filter, "type", &Filter::type);
   def_pickle(filter);
 
   py::class_<Film> film(m, "Film", "Image size, pixel filter and display settings.");
-  film.def(py::init<>())
-      .def_readwrite("filter", &Film::filter)
-      .def_readwrite("gamma", &Film::gamma)
-      .def_readwrite("exposure", &Film::exposure);
+  film.def(py::init<>()).def_readwrite("filter", &Film::filter);
+  number_property(film, "gamma", &Film::gamma);
+  number_property(film, "exposure", &Film::exposure);
   int_property(film, "width", &Film::width);
   int_property(film, "height", &Film::height);
   enum_property(film, "transfer", &Film::transfer);
@@ -931,10 +968,10 @@ void bind_scene(py::module_& m) {
 
   py::class_<Integrator> integrator(m, "Integrator",
                                     "type: an integrator or AOV name (INTEGRATORS).");
-  integrator.def(py::init<>())
-      .def_readwrite("ao_distance", &Integrator::ao_distance)
-      .def_readwrite("clamp", &Integrator::clamp,
-                     "the largest sample contribution (0: off); biased, lower variance");
+  integrator.def(py::init<>());
+  number_property(integrator, "ao_distance", &Integrator::ao_distance);
+  number_property(integrator, "clamp", &Integrator::clamp,
+                  "the largest sample contribution (0: off); biased, lower variance");
   bool_property(integrator, "mis", &Integrator::mis);
   bool_property(integrator, "caustics", &Integrator::caustics,
                 "path: caustic paths by light tracing (pinhole and thin-lens cameras)");
@@ -961,13 +998,13 @@ void bind_scene(py::module_& m) {
              return material_of_type(parse_enum<MaterialType>(type), name.bytes);
            }),
            py::arg("type"), py::arg("name") = FileText{})
-      .def_readwrite("ior", &Material::ior)
-      .def_readwrite("roughness", &Material::roughness)
       .def_property_readonly("emissive", &Material::emissive)
       .def("__repr__", [](const Material& mt) {
         return "<lucent.Material " + py::repr(file_text(mt.name)).cast<std::string>() + " " +
                enum_name(mt.type) + ">";
       });
+  number_property(material, "ior", &Material::ior);
+  number_property(material, "roughness", &Material::roughness);
   int_property(material, "albedo_texture", &Material::albedo_texture,
                "index into Scene.textures or -1");
   text_property(material, "name", &Material::name);
@@ -983,8 +1020,8 @@ void bind_scene(py::module_& m) {
              return Sphere{to_vec<glm::dvec3>(center), radius,
                            integer_value<int>(material, "Sphere.material")};
            }),
-           py::arg("center"), py::arg("radius"), py::arg("material") = 0)
-      .def_readwrite("radius", &Sphere::radius);
+           py::arg("center"), py::arg("radius"), py::arg("material") = 0);
+  number_property(sphere, "radius", &Sphere::radius);
   int_property(sphere, "material", &Sphere::material, "index into Scene.materials");
   vec_property(sphere, "center", &Sphere::center);
   def_pickle(sphere);
@@ -1035,7 +1072,8 @@ void bind_scene(py::module_& m) {
             for (const std::string& l : e.libraries) out.push_back({l});
             return out;
           },
-          [](ShapeEntry& e, const std::vector<FileText>& libraries) {
+          [](py::handle self, const std::vector<FileText>& libraries) {
+            ShapeEntry& e = assigned<ShapeEntry>(self);
             e.libraries.clear();
             for (const FileText& l : libraries) e.libraries.push_back(l.bytes);
           });

@@ -104,13 +104,26 @@ inline std::size_t wrap_index(py::ssize_t i, std::size_t n, const char* what) {
   return static_cast<std::size_t>(i);
 }
 
-/// The indices a slice selects in a sequence of n, in the slice's order.
-inline std::vector<std::size_t> slice_indices(const py::slice& s, std::size_t n) {
-  py::ssize_t start = 0, stop = 0, step = 0, length = 0;
-  if (!s.compute(static_cast<py::ssize_t>(n), &start, &stop, &step, &length))
-    throw py::error_already_set();
-  std::vector<std::size_t> out(static_cast<std::size_t>(length));
-  for (py::ssize_t k = 0; k < length; ++k) out[k] = static_cast<std::size_t>(start + k * step);
+/// What a slice selects in a list: its first index and step, and the indices in its order.
+struct Selection {
+  py::ssize_t start = 0, step = 1;
+  std::vector<std::size_t> indices;
+};
+
+/// The elements slice `s` selects in `v`. Its bounds are converted first (__index__, which can run
+/// Python code that changes v), then fitted to v's length at that point, as a Python list does
+/// (PySlice_Unpack, then PySlice_AdjustIndices): a length read before the conversion gave indices
+/// past the end of a list that the conversion shortened.
+template <class T>
+Selection slice_indices(const py::slice& s, const std::vector<T>& v) {
+  Selection out;
+  py::ssize_t stop = 0;
+  if (PySlice_Unpack(s.ptr(), &out.start, &stop, &out.step) < 0) throw py::error_already_set();
+  const py::ssize_t length =
+      PySlice_AdjustIndices(static_cast<py::ssize_t>(v.size()), &out.start, &stop, out.step);
+  out.indices.resize(static_cast<std::size_t>(length));
+  for (py::ssize_t k = 0; k < length; ++k)
+    out.indices[k] = static_cast<std::size_t>(out.start + k * out.step);
   return out;
 }
 
@@ -185,7 +198,7 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
       .def("__getitem__",
            [](const V& v, const py::slice& s) {
              V out;
-             for (std::size_t i : list_detail::slice_indices(s, v.size())) out.push_back(v[i]);
+             for (std::size_t i : list_detail::slice_indices(s, v).indices) out.push_back(v[i]);
              return out;
            })
       .def("__setitem__",
@@ -202,10 +215,9 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
           [](V& v, const py::slice& s, const py::iterable& items) {
             V values;
             for (py::handle h : items) values.push_back(h.cast<T>());
-            const std::vector<std::size_t> at = list_detail::slice_indices(s, v.size());
-            py::ssize_t start = 0, stop = 0, step = 0, length = 0;
-            s.compute(static_cast<py::ssize_t>(v.size()), &start, &stop, &step, &length);
-            if (step != 1) {  // an extended slice: one value per selected element
+            const list_detail::Selection sel = list_detail::slice_indices(s, v);
+            const std::vector<std::size_t>& at = sel.indices;
+            if (sel.step != 1) {  // an extended slice: one value per selected element
               if (values.size() != at.size())
                 throw py::value_error("attempt to assign sequence of size " +
                                       std::to_string(values.size()) +
@@ -221,7 +233,7 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
               return;
             }
             // [start, start + length) replaced by the values, whatever their number
-            const std::size_t first = static_cast<std::size_t>(start), count = at.size();
+            const std::size_t first = static_cast<std::size_t>(sel.start), count = at.size();
             const std::ptrdiff_t shift =
                 static_cast<std::ptrdiff_t>(values.size()) - static_cast<std::ptrdiff_t>(count);
             change(
@@ -252,8 +264,9 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
            })
       .def("__delitem__",
            [](V& v, const py::slice& s) {
+             const list_detail::Selection sel = list_detail::slice_indices(s, v);
              std::vector<char> gone(v.size(), 0);
-             for (std::size_t i : list_detail::slice_indices(s, v.size())) gone[i] = 1;
+             for (std::size_t i : sel.indices) gone[i] = 1;
              list_detail::erase(v, gone);
            })
       .def(

@@ -7,6 +7,8 @@ list reallocated: edits were lost, reads returned garbage, writes crashed the in
 these tests with AddressSanitizer, which reports any access to freed memory."""
 import random
 
+import numpy as np
+
 import pytest
 
 import lucent
@@ -200,3 +202,153 @@ def test_scene_renders_after_its_lists_changed_under_references():
     w.albedo = (0.9, 0.1, 0.1)
     lucent.scene_info(s)  # validates: every index in range
     assert tuple(s.materials[0].albedo) == pytest.approx((0.9, 0.1, 0.1))
+
+
+class Hostile:
+    """A number whose conversion (__float__, __index__) runs Python code that empties a scene list
+    and fills another scene's list of the same type, which takes the freed memory: a setter that
+    took its element before converting its value wrote into the other scene (or freed memory)."""
+
+    def __init__(self, value, victim, other, make):
+        self.value, self.victim, self.other, self.make = value, victim, other, make
+
+    def strike(self):
+        if self.victim is not None:
+            self.victim.clear()
+            self.other.extend([self.make() for _ in range(8)])
+            self.victim = None
+
+    def __float__(self):
+        self.strike()
+        return float(self.value)
+
+    def __index__(self):
+        self.strike()
+        return int(self.value)
+
+
+class HostileArray(Hostile):
+    def __array__(self, dtype=None, copy=None):
+        self.strike()
+        return np.full((2, 3, 4), self.value, dtype=np.float32)
+
+
+class HostileSequence(Hostile):
+    def __len__(self):
+        return 3
+
+    def __getitem__(self, i):
+        if i >= 3:
+            raise IndexError(i)
+        self.strike()
+        return self.value
+
+
+def sphere():
+    return lucent.Sphere((7, 7, 7), 2.0, 1)
+
+
+def light():
+    l = lucent.Light()
+    l.position = (7, 7, 7)
+    return l
+
+
+def shape():
+    e = lucent.ShapeEntry()
+    e.first = 7
+    e.libraries = ["x.mtl"]
+    return e
+
+
+# (list, a new element, the edit through a reference with a value that strikes, what the edited
+# element then reads); the value is 5
+EDITS = [
+    ("spheres", sphere, lambda e, h: setattr(e, "radius", h), lambda e: e.radius),
+    ("spheres", sphere, lambda e, h: setattr(e, "material", h), lambda e: e.material),
+    ("spheres", sphere, lambda e, h: setattr(e, "center", (h, 0, 0)), lambda e: e.center.x),
+    ("spheres", sphere, lambda e, h: setattr(e.center, "y", h), lambda e: e.center.y),
+    ("spheres", sphere, lambda e, h: e.center.__setitem__(2, h), lambda e: e.center.z),
+    ("materials", lambda: material("m"), lambda e, h: setattr(e, "ior", h), lambda e: e.ior),
+    ("materials", lambda: material("m"), lambda e, h: setattr(e, "albedo_texture", h),
+     lambda e: e.albedo_texture),
+    ("materials", lambda: material("m"), lambda e, h: setattr(e, "albedo", (0, h, 0)),
+     lambda e: e.albedo.y),
+    ("triangles", lucent.Triangle, lambda e, h: setattr(e, "material", h), lambda e: e.material),
+    ("lights", light, lambda e, h: setattr(e, "position", (0, 0, h)), lambda e: e.position.z),
+    ("shapes", shape, lambda e, h: setattr(e, "first", h), lambda e: e.first),
+]
+
+
+@pytest.mark.parametrize("name,make,edit,read", EDITS)
+def test_an_edit_whose_value_changes_the_list_reaches_the_element_it_named(name, make, edit,
+                                                                           read):
+    """The value is converted before the element is taken: the edit lands on the element, which
+    the conversion removed from its list (a copy the reference keeps), and never in the other
+    scene that reused the memory. The sanitizer build reports any write to freed memory."""
+    scene, other = lucent.Scene(), lucent.Scene()
+    victim = getattr(scene, name)
+    victim.append(make())
+    element = victim[0]
+    edit(element, Hostile(5, victim, getattr(other, name), make))
+    assert len(victim) == 0
+    assert read(element) == 5
+    fresh = make()
+    for e in getattr(other, name):
+        assert read(e) == read(fresh), "the edit went to another scene's element"
+
+
+def test_sequence_and_array_values_are_converted_before_the_element_is_taken():
+    scene, other = lucent.Scene(), lucent.Scene()
+    scene.triangles.append(lucent.Triangle())
+    t = scene.triangles[0]
+    t.v = HostileSequence(4, scene.triangles, other.triangles, lucent.Triangle)
+    assert t.v == (4, 4, 4) and len(scene.triangles) == 0
+    assert all(e.v == lucent.Triangle().v for e in other.triangles)
+
+    def texture():
+        x = lucent.Texture()
+        x.rgba = np.zeros((1, 1, 4), np.float32)
+        return x
+
+    scene.textures.append(texture())
+    x = scene.textures[0]
+    x.rgba = HostileArray(0.5, scene.textures, other.textures, texture)
+    assert (x.height, x.width) == (2, 3) and float(x.rgba[1, 2, 3]) == 0.5
+    assert all((e.height, e.width) == (1, 1) for e in other.textures)
+
+    scene.shapes.append(shape())
+    e = scene.shapes[0]
+    e.libraries = HostileSequence("y.mtl", scene.shapes, other.shapes, shape)
+    assert e.libraries == ["y.mtl"] * 3
+    assert all(s.libraries == ["x.mtl"] for s in other.shapes)
+    # a comparison reads the vector after converting the other side
+    scene.spheres.append(sphere())
+    c = scene.spheres[0].center
+    assert c == (Hostile(7, scene.spheres, other.spheres, sphere), 7, 7)
+
+
+def test_slice_bounds_are_converted_before_the_list_is_measured():
+    """A slice's bounds (__index__) can change the list: it is measured after them, as a Python
+    list is. With the length read first, reads, deletions and assignments went past the end."""
+    other = lucent.Scene()
+
+    def filled():
+        lst = lucent.MaterialList()
+        lst.extend([material(f"n{i}") for i in range(6)])
+        return lst
+
+    def bound(lst):
+        return Hostile(1, lst, other.materials, lambda: material("o"))
+
+    lst = filled()
+    assert len(lst[bound(lst):5]) == 0
+    lst = filled()
+    del lst[bound(lst):5:2]
+    assert len(lst) == 0
+    lst = filled()
+    lst[bound(lst):5] = [material("a")]
+    assert [m.name for m in lst] == ["a"]
+    lst = filled()
+    with pytest.raises(ValueError, match="extended slice of size 0"):
+        lst[bound(lst):5:2] = [material("a")]
