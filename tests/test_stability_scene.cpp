@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -294,17 +295,26 @@ TEST(StabilityInput, DegenerateAndNonFiniteTrianglesAreSkipped) {
 
 // Spheres with a NaN centre or radius (possible through the API only: the JSON loader rejects
 // non-finite numbers) are never hit: no crash, no NaN, the image of the scene without them (same
-// seed: bit for bit). pack_scene gives no warning for them (it does for triangles).
+// seed: bit for bit), with one warning as for non-finite triangles (there was none).
 TEST(StabilityInput, NonFiniteSpheresAreNeverHit) {
   Scene clean = scene_from(lucent::test::stability_scene_json());
   Scene dirty = clean;
+  const std::size_t first = dirty.spheres.size();
   lucent::Sphere sp;
   sp.center = dvec3(std::nan(""), 0, 0);
   dirty.spheres.push_back(sp);
   sp.center = dvec3(0, 0.5, 0);
   sp.radius = std::nan("");
   dirty.spheres.push_back(sp);
-  RenderResult a = render(clean, 64, 5), b = render(dirty, 64, 5);
+  sp.radius = std::numeric_limits<double>::infinity();
+  dirty.spheres.push_back(sp);
+  RenderResult a = render(clean, 64, 5);
+  CaptureWarnings warnings;
+  RenderResult b = render(dirty, 64, 5);
+  EXPECT_EQ(warnings.count("/spheres/" + std::to_string(first) +
+                           ": 3 sphere(s) with a non-finite centre or radius, never hit"),
+            1)
+      << warnings.dump();
   EXPECT_CLEAN(a);
   EXPECT_CLEAN(b);
   CompareResult cmp = lucent::compare_images(a, b);

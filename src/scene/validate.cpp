@@ -404,12 +404,17 @@ void validate_scene(const Scene& s) {
     if (s.lights[i].type != LightType::Point && ++envs > 1)
       Reporter(file, "/lights/" + std::to_string(i)).fail("only one environment light is allowed");
   const std::size_t nm = s.materials.size();
+  std::size_t never_hit = 0, first_never_hit = 0;
   for (std::size_t i = 0; i < s.spheres.size(); ++i) {
-    // (a NaN centre or radius is allowed: such a sphere is never hit, tests/test_stability_scene;
-    // a finite one beyond the geometry range would vanish as silently, so it is an error, and so
-    // is a radius <= 0, which the loader refuses: from Python a negative one rendered the sphere
-    // inside out, its normals pointing in)
+    // (a NaN or infinite centre or radius is allowed, with a warning, as a non-finite triangle
+    // is: such a sphere is never hit, tests/test_stability_scene; a finite one beyond the
+    // geometry range would vanish silently, so it is an error, and so is a radius <= 0, which the
+    // loader refuses: from Python a negative one rendered the sphere inside out, its normals
+    // pointing in)
     const Sphere& sp = s.spheres[i];
+    if (!finite(sp.center) || !std::isfinite(sp.radius)) {
+      if (never_hit++ == 0) first_never_hit = i;
+    }
     const bool in_range = !(sphere_reach(sp.center, sp.radius) > limits::kMaxCoordinate);
     if (sp.material >= 0 && static_cast<std::size_t>(sp.material) < nm && in_range &&
         !(sp.radius <= 0))
@@ -419,6 +424,10 @@ void validate_scene(const Scene& s) {
     if (sp.radius <= 0) at.at("radius").fail("must be > 0, got " + format_number(sp.radius));
     if (finite(sp.center) && std::isfinite(sp.radius)) check_sphere_reach(at, sp.center, sp.radius);
   }
+  if (never_hit > 0)
+    warn(in_file(file, primitive_place(s, ShapeType::Sphere, first_never_hit, "spheres", "sphere") +
+                           ": " + std::to_string(never_hit) +
+                           " sphere(s) with a non-finite centre or radius, never hit"));
   const std::size_t np = s.positions.size(), nn = s.normals.size(), nuv = s.uvs.size();
   for (std::size_t i = 0; i < s.triangles.size(); ++i) {
     const Triangle& t = s.triangles[i];
