@@ -22,6 +22,7 @@
 #include "lucent/compare.hpp"
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
+#include "lucent/limits.hpp"
 #include "lucent/session.hpp"
 #include "support.hpp"
 
@@ -346,6 +347,29 @@ TEST(Converge, DefaultLadder) {
   const std::vector<int> top = lucent::default_spp_ladder(std::numeric_limits<int>::max());
   EXPECT_EQ(top.size(), 32u);
   EXPECT_EQ(top.back(), std::numeric_limits<int>::max());
+}
+
+// The library refuses the ladders the command line refuses (lucent::limits: 1 .. 2^24 spp, up to
+// 1e7 s): a caller of the API gave a rung of 2^31 - 1 spp or 1e300 s, which ran until killed.
+TEST(Converge, LaddersBeyondTheLimitsAreRefused) {
+  lucent::ConvergeOptions opt;
+  opt.spp_ladder = {1, lucent::limits::kMaxSpp};
+  EXPECT_NO_THROW(lucent::check_convergence_options(opt));
+  for (int bad : {0, lucent::limits::kMaxSpp + 1, std::numeric_limits<int>::max()}) {
+    opt.spp_ladder = {1, bad};
+    EXPECT_EQ(lucent::test::error_of([&] { lucent::check_convergence_options(opt); }),
+              "converge: spp ladder values must be in [1, 16777216], got " + std::to_string(bad));
+  }
+  opt.spp_ladder.clear();
+  opt.time_ladder = {0.5, 1e7};
+  EXPECT_NO_THROW(lucent::check_convergence_options(opt));
+  for (double bad : {0.0, -1.0, 1.0001e7, 1e300, std::numeric_limits<double>::infinity(),
+                     std::numeric_limits<double>::quiet_NaN()}) {
+    opt.time_ladder = {0.5, bad};
+    const std::string msg = lucent::test::error_of([&] { lucent::check_convergence_options(opt); });
+    EXPECT_EQ(msg.rfind("converge: time ladder values must be in (0, 1e7] seconds, got ", 0), 0u)
+        << msg;
+  }
 }
 
 TEST(Converge, FitOfSyntheticCurves) {

@@ -9,6 +9,9 @@ namespace lucent::limits {
 inline constexpr int kMaxImageSize = 16384;
 /// Samples per pixel: 1 .. kMaxSpp.
 inline constexpr int kMaxSpp = 1 << 24;
+/// A time limit (render --time, --checkpoint-every, converge's time ladder): at most kMaxSeconds
+/// (about 116 days).
+inline constexpr double kMaxSeconds = 1e7;
 /// Integrator max_depth and rr_depth: 1 .. kMaxDepth path segments.
 inline constexpr int kMaxDepth = 100000;
 /// integrator.dielectric_splits: 0 .. kMaxDielectricSplits smooth-glass vertices per camera path

@@ -11,6 +11,7 @@
 #include "core/file_io.hpp"
 #include "lucent/converge.hpp"
 #include "lucent/error.hpp"
+#include "lucent/limits.hpp"
 #include "lucent/parts.hpp"
 #include "lucent/reference.hpp"
 #include "lucent/session.hpp"
@@ -973,8 +974,8 @@ void bind_render(py::module_& m) {
   m.def(
       "converge",
       [](const Scene& scene, py::handle reference, const std::vector<std::string>& settings,
-         std::optional<std::vector<int>> spp_ladder, std::optional<std::vector<double>> time_ladder,
-         py::object renderer, py::object on_point) {
+         std::optional<std::vector<IntArg>> spp_ladder,
+         std::optional<std::vector<double>> time_ladder, py::object renderer, py::object on_point) {
         check_callable(on_point, "on_point");
         if (!renderer.is_none() && !py::isinstance<PyRenderer>(renderer))
           throw py::type_error("renderer must be a lucent.Renderer or None, got " +
@@ -983,16 +984,19 @@ void bind_render(py::module_& m) {
           throw py::value_error("give spp_ladder or time_ladder, not both");
         ConvergeOptions o;
         o.settings = parse_settings(settings);
+        // the command line's limits (lucent converge --spp-ladder, --time-ladder)
         if (time_ladder)
           o.time_ladder = *time_ladder;
+        else if (spp_ladder)
+          for (const IntArg& s : *spp_ladder)
+            o.spp_ladder.push_back(
+                static_cast<int>(int_argument(s, "spp_ladder values", 1, limits::kMaxSpp, "")));
         else
-          o.spp_ladder = spp_ladder ? *spp_ladder : default_spp_ladder(64);
-        for (int s : o.spp_ladder)
-          if (s < 1)
-            throw py::value_error("spp_ladder values must be >= 1, got " + std::to_string(s));
+          o.spp_ladder = default_spp_ladder(64);
         for (double t : o.time_ladder)
-          if (!(t > 0) || !std::isfinite(t))
-            throw py::value_error("time_ladder values must be finite and > 0 seconds");
+          if (!(t > 0 && t <= limits::kMaxSeconds))
+            throw py::value_error("time_ladder values must be in (0, 1e7] seconds, got " +
+                                  py::repr(py::float_(t)).cast<std::string>());
         RenderResult ref = render_result_from(reference, "reference");
         Scene copy = scene;
         CallbackErrors errors;

@@ -237,10 +237,18 @@ def test_converge_by_time_and_errors(small_scene):
             lucent.converge(small_scene, reference, settings=["default", "default"], renderer=r)
         with pytest.raises(ValueError, match="not both"):
             lucent.converge(small_scene, reference, spp_ladder=[1], time_ladder=[1], renderer=r)
-        with pytest.raises(ValueError, match="spp_ladder values must be >= 1"):
-            lucent.converge(small_scene, reference, spp_ladder=[0], renderer=r)
-        with pytest.raises(ValueError, match="time_ladder values"):
-            lucent.converge(small_scene, reference, time_ladder=[-1], renderer=r)
+        # the command line's limits (a rung of 2^31 - 1 spp or 1e300 s ran until killed); every
+        # value refused before anything renders
+        for bad in (0, 2 ** 24 + 1, 2 ** 31 - 1, 2 ** 40, -1):
+            with pytest.raises(ValueError, match=r"spp_ladder values must be an integer in "
+                                                 r"\[1, 2\*\*24\], got " + str(bad)):
+                lucent.converge(small_scene, reference, spp_ladder=[1, bad], renderer=r)
+        with pytest.raises(TypeError, match="spp_ladder values must be an integer"):
+            lucent.converge(small_scene, reference, spp_ladder=[1.5], renderer=r)
+        for bad in (-1, 0, 1e7 * 1.0001, 1e300, math.inf, math.nan):
+            with pytest.raises(ValueError, match=r"time_ladder values must be in \(0, 1e7\] "
+                                                 r"seconds, got " + re.escape(repr(bad))):
+                lucent.converge(small_scene, reference, time_ladder=[0.01, bad], renderer=r)
         with pytest.raises(lucent.Error, match="ladder is empty"):
             lucent.converge(small_scene, reference, spp_ladder=[], renderer=r)
         # an adaptive setting with no rung at its pilot rendered nothing, and was dropped

@@ -30,7 +30,7 @@ CHILD = textwrap.dedent("""
         elif mode == "converge":
             reference = lucent.RenderResult(r.result().mean)
             print("rendering", flush=True)
-            lucent.converge(scene, reference, spp_ladder=[10 ** 8], renderer=r)
+            lucent.converge(scene, reference, spp_ladder=[2 ** 24], renderer=r)
         else:
             # the reference stops after the rows under way: many short rows
             scene.film.height = 100000

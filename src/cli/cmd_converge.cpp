@@ -176,7 +176,7 @@ CLI::App* add_converge_command(CLI::App& app) {
   auto* time = cmd->add_option("--time-ladder", a.time_ladder, "Seconds of rendering per rung")
                    ->delimiter(',')
                    ->check(lucent::cli::positive_real())
-                   ->check(lucent::cli::real_range(0.0, 1e7));  // as render's --time
+                   ->check(lucent::cli::real_range(0.0, lucent::limits::kMaxSeconds));
   spp->excludes(time);
   cmd->add_option("--max-spp", a.max_spp,
                   "Default ladder: powers of two from 1 to this (default 64)")

@@ -356,11 +356,18 @@ void check_convergence_options(const ConvergeOptions& options, const Scene* scen
     throw Error("converge: the ladder is empty");
   int largest = 0;
   for (int s : options.spp_ladder) {
-    if (s < 1) throw Error("converge: spp ladder values must be >= 1, got " + std::to_string(s));
+    if (s < 1 || s > limits::kMaxSpp)
+      throw Error("converge: spp ladder values must be in [1, " + std::to_string(limits::kMaxSpp) +
+                  "], got " + std::to_string(s));
     largest = std::max(largest, s);
   }
   for (double t : options.time_ladder)
-    if (!(t > 0)) throw Error("converge: time ladder values must be > 0 seconds");
+    if (!(t > 0 && t <= limits::kMaxSeconds)) {
+      char got[32];
+      std::snprintf(got, sizeof got, "%g", t);
+      throw Error(std::string("converge: time ladder values must be in (0, 1e7] seconds, got ") +
+                  got);
+    }
   for (const ConvergeSetting& setting : options.settings) {
     if ((setting.adaptive || setting.target_error > 0) && by_time)
       throw Error("converge: setting " + setting.name + " is adaptive: use an spp ladder");
