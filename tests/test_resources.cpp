@@ -4,13 +4,17 @@
 // shrunk (DeviceLimits, ScopedLimitOverride) so that small scenes stand for huge ones.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -22,6 +26,7 @@
 #include "lucent/session.hpp"
 #include "render/pack.hpp"
 #include "render/resources.hpp"
+#include "scene/json_guard.hpp"
 #include "support.hpp"
 
 namespace {
@@ -215,6 +220,140 @@ std::string soup_scene(const std::string& dir, int n) {
     "shapes": [{"type": "mesh", "file": ")" +
                                name + R"(.obj", "material": "m"}]})");
   return dir + "/" + name + ".json";
+}
+
+/// A scene of `n` inline positions "[0,0,0]" (the densest mesh text: 8 bytes a vertex) and one
+/// triangle, rendered from afar at 16x16.
+std::string dense_json(std::size_t n) {
+  std::string text = R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+    "film": {"width": 16, "height": 16}, "integrator": {"type": "path", "spp": 1},
+    "materials": {"m": {"type": "diffuse"}},
+    "lights": [{"type": "point", "position": [0, 0, 3], "intensity": [1, 1, 1]}],
+    "shapes": [{"type": "triangles", "material": "m", "indices": [0, 1, 2], "positions": [)";
+  text.reserve(text.size() + 8 * n + 64);
+  text += "[0,0,0],[1,0,0],[0,1,0]";
+  for (std::size_t i = 3; i < n; ++i) text += ",[0,0,0]";
+  return text + "]}]}";
+}
+
+// A scene's JSON text is counted before it is parsed (scene_detail::json_load_bytes): a document
+// beyond the host limit is refused in one line, before its values are allocated. A 248 MB scene
+// under `ulimit -v` 4 GiB (the format allows 256 MiB) ran out of memory while it loaded and ended
+// in std::terminate (SIGABRT).
+TEST(Resources, JsonSceneBeyondTheHostLimitIsRefusedBeforeParsing) {
+  const std::string text = dense_json(100000);  // 800 KB of text, 400,000 values
+  DeviceLimits lim;
+  lim.host_mem = 16 << 20;
+  {
+    ScopedLimitOverride o(lim);
+    const std::string msg = error_of([&] { lucent::parse_scene(text, "dense.json"); });
+    EXPECT_EQ(msg.rfind("dense.json: loading this scene's 400", 0), 0u) << msg;
+    EXPECT_NE(msg.find(" JSON values needs about "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("more than the limit of 16.0 MiB"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("reduce the scene's inline arrays"), std::string::npos) << msg;
+  }
+  lim.host_mem = 64 << 20;
+  ScopedLimitOverride o(lim);
+  EXPECT_EQ(lucent::parse_scene(text, "dense.json").positions.size(), 100000u);
+}
+
+/// The peak resident memory that `f` adds, in MiB, measured in a forked child (getrusage's high
+/// mark against the child's resident set when it starts); -1 when the child fails.
+double child_peak_growth_mib(const std::function<void()>& f) {
+  int fds[2];
+  if (pipe(fds) != 0) return -1;
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(fds[0]);
+    long pages[2] = {0, 0};
+    if (FILE* statm = std::fopen("/proc/self/statm", "r")) {
+      if (std::fscanf(statm, "%ld %ld", &pages[0], &pages[1]) != 2) pages[1] = 0;
+      std::fclose(statm);
+    }
+    double growth = -1;
+    try {
+      f();
+      struct rusage ru;
+      getrusage(RUSAGE_SELF, &ru);
+      growth =
+          (double(ru.ru_maxrss) * 1024.0 - double(pages[1]) * sysconf(_SC_PAGESIZE)) / 1048576.0;
+    } catch (...) {
+    }
+    if (write(fds[1], &growth, sizeof growth) != sizeof growth) _exit(1);
+    _exit(0);
+  }
+  close(fds[1]);
+  double growth = -1;
+  if (read(fds[0], &growth, sizeof growth) != sizeof growth) growth = -1;
+  close(fds[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return growth;
+}
+
+// What loading an inline mesh really takes stays within that count (measured: 22-24 bytes of
+// peak per byte of such text; counted 1.3-1.4 times that), and is not a wide overestimate. Not
+// under AddressSanitizer, whose shadow memory and quarantine are in the peak.
+TEST(Resources, PeakHostMemoryOfAnInlineMeshIsWithinTheCount) {
+  if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer's own memory is in the peak";
+  const std::string text = dense_json(500000);
+  std::uint64_t counted = 0;
+  {
+    // the count check_json_structure makes, read back from its refusal under a 1-byte limit
+    DeviceLimits lim;
+    lim.host_mem = 1;
+    ScopedLimitOverride o(lim);
+    const std::string msg = error_of([&] { lucent::parse_scene(text, "dense.json"); });
+    const size_t at = msg.find("needs about ");
+    ASSERT_NE(at, std::string::npos) << msg;
+    counted = std::uint64_t(std::atof(msg.c_str() + at + 12) * 1048576.0);
+    ASSERT_NE(msg.find(" MiB of host memory", at), std::string::npos) << msg;
+  }
+  // the text is the caller's before the load: the child's peak is the load's own
+  const double peak = child_peak_growth_mib([&] { lucent::parse_scene(text, "dense.json"); });
+  const double count = double(counted) / 1048576.0 - double(text.size()) / 1048576.0;
+  EXPECT_GT(peak, 0.0);
+  std::printf("inline mesh: load peak %.1f MiB, counted %.1f MiB\n", peak, count);
+  EXPECT_LE(peak, count) << "peak " << peak << " MiB against a count of " << count << " MiB";
+  EXPECT_GE(peak, 0.6 * count) << "peak " << peak << " MiB against a count of " << count << " MiB";
+}
+
+// release_json frees a parsed document without allocating. In a child process whose address
+// space is then nearly full, it returns, where the document's own destructor (which first moves
+// a container's elements into a vector as large as the container) ends it in std::terminate.
+TEST(Resources, JsonDocumentIsFreedWithoutAllocating) {
+  if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer reserves address space: no RLIMIT_AS";
+  auto child = [](bool release) {
+    const pid_t pid = fork();
+    if (pid == 0) {
+      nlohmann::json doc = nlohmann::json::array();
+      for (int i = 0; i < 4000000; ++i) doc.push_back(i);
+      long pages = 0;
+      if (FILE* f = std::fopen("/proc/self/statm", "r")) {
+        if (std::fscanf(f, "%ld", &pages) != 1) pages = 0;
+        std::fclose(f);
+      }
+      if (pages <= 0) _exit(3);
+      // 8 MB beyond what the process has mapped: far less than the 64 MB the destructor's
+      // vector of 4,000,000 elements takes
+      const rlim_t size = rlim_t(pages) * rlim_t(sysconf(_SC_PAGESIZE)) + (8 << 20);
+      const struct rlimit rl = {size, size};
+      if (setrlimit(RLIMIT_AS, &rl) != 0) _exit(4);
+      if (release)
+        lucent::scene_detail::release_json(doc);
+      else
+        nlohmann::json(std::move(doc));  // the destructor
+      _exit(doc.is_null() ? 0 : 5);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return status;
+  };
+  const int released = child(true);
+  EXPECT_TRUE(WIFEXITED(released) && WEXITSTATUS(released) == 0) << released;
+  const int destroyed = child(false);
+  EXPECT_TRUE(WIFSIGNALED(destroyed) && WTERMSIG(destroyed) == SIGABRT)
+      << "the control: nlohmann's destructor allocates (status " << destroyed << ")";
 }
 
 // Each OBJ file is bounded, and so are all of a scene's meshes together: as they load, the

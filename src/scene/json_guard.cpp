@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/file_io.hpp"
+#include "core/host_memory.hpp"
 #include "lucent/error.hpp"
 #include "scene/validate.hpp"
 
@@ -50,12 +51,18 @@ class StructureCheck : public nlohmann::json_sax<json> {
   StructureCheck(const std::string& text, const std::string& path, const char** last)
       : text_(text), path_(path), last_(last) {}
 
+  /// What the text holds, for json_load_bytes.
+  std::uint64_t values = 0, containers = 0, string_bytes = 0;
+
   bool null() override { return value(); }
   bool boolean(bool) override { return value(); }
   bool number_integer(number_integer_t) override { return value(); }
   bool number_unsigned(number_unsigned_t) override { return value(); }
   bool number_float(number_float_t, const string_t&) override { return value(); }
-  bool string(string_t&) override { return value(); }
+  bool string(string_t& s) override {
+    string_bytes += s.size();
+    return value();
+  }
   bool binary(binary_t&) override { return value(); }
   bool start_object(std::size_t) override { return open(true); }
   bool start_array(std::size_t) override { return open(false); }
@@ -63,6 +70,7 @@ class StructureCheck : public nlohmann::json_sax<json> {
   bool end_array() override { return close(); }
 
   bool key(string_t& k) override {
+    string_bytes += k.size();
     Frame& f = frames_.back();
     const std::size_t at = key_start();
     auto [it, fresh] = f.keys.emplace(k, at);
@@ -115,12 +123,14 @@ class StructureCheck : public nlohmann::json_sax<json> {
   }
 
   bool value() {
+    ++values;
     if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
     return true;
   }
 
   bool open(bool object) {
     value();
+    ++containers;
     if (static_cast<int>(frames_.size()) >= kMaxJsonDepth)
       fail(here(), pointer(),
            "nested deeper than " + std::to_string(kMaxJsonDepth) +
@@ -164,11 +174,50 @@ std::string read_scene_text(const std::string& path) {
   return io::read_file(path, spec);
 }
 
+std::uint64_t json_load_bytes(std::uint64_t text_bytes, std::uint64_t values,
+                              std::uint64_t containers, std::uint64_t string_bytes) {
+  // a value: its slot, twice over while its array grows (32), and what a number becomes in the
+  // scene (a double of a position, an index of a triangle, with their arrays' growth: 16); a
+  // container: its std::vector or std::map and the allocations' overhead; a string or key: its
+  // characters beside the std::string counted in its slot
+  return sys::bytes_add(sys::bytes_add(text_bytes, sys::bytes_mul(values, 48)),
+                        sys::bytes_add(sys::bytes_mul(containers, 64), 2 * string_bytes));
+}
+
 void check_json_structure(const std::string& text, const std::string& path) {
   const char* last = text.data();
   StructureCheck check(text, path, &last);
   TrackingIterator first{text.data(), &last}, end{text.data() + text.size(), &last};
   json::sax_parse(first, end, &check);
+  std::string what;
+  const std::uint64_t limit = sys::host_memory_allowed(&what);
+  const std::uint64_t need =
+      json_load_bytes(text.size(), check.values, check.containers, check.string_bytes);
+  if (limit > 0 && need > limit)
+    throw Error(path + ": loading this scene's " + std::to_string(check.values) +
+                " JSON values needs about " + sys::format_bytes(need) +
+                " of host memory, more than the limit of " + sys::format_bytes(limit) +
+                " (80% of " + what + "): reduce the scene's inline arrays");
+}
+
+void release_json(json& document) {
+  // post-order: a container's elements are emptied first, then removed from the back one by one
+  // (pop_back and erase free and never allocate), so that each destructor meets an empty
+  // container or a scalar (depth is at most kMaxJsonDepth: check_json_structure)
+  if (document.is_array()) {
+    json::array_t& a = document.get_ref<json::array_t&>();
+    while (!a.empty()) {
+      release_json(a.back());
+      a.pop_back();
+    }
+  } else if (document.is_object()) {
+    json::object_t& o = document.get_ref<json::object_t&>();
+    while (!o.empty()) {
+      release_json(o.begin()->second);
+      o.erase(o.begin());
+    }
+  }
+  document = nullptr;
 }
 
 }  // namespace lucent::scene_detail

@@ -65,10 +65,17 @@ Scene build_scene(const json& root, const std::string& path, const fs::path& dir
 
 /// parse_scene, with the relative file names taken from `dir`.
 Scene parse_scene_in(const std::string& text, const std::string& path, const fs::path& dir) {
-  scene_detail::check_json_structure(text, path);  // nesting depth, duplicate keys
+  scene_detail::check_json_structure(text, path);  // nesting depth, duplicate keys, memory
+  // the document is built in place and freed by release_json, also when an exception leaves
+  // (json::parse builds into a local of its own, which its destructor frees by allocating)
   json root;
+  struct Release {
+    json& document;
+    ~Release() { scene_detail::release_json(document); }
+  } release{root};
   try {
-    root = json::parse(text);
+    nlohmann::detail::json_sax_dom_parser<json> dom(root);
+    json::sax_parse(text, &dom);
   } catch (const json::parse_error& e) {
     std::string what = e.what();
     auto pos = what.find("syntax error");
