@@ -156,6 +156,7 @@ MaterialMapper::MaterialMapper(Scene& scene, ObjMaterials& known, const std::str
       origin_(origin),
       definition_(definition),
       index_(mats.size(), -1) {
+  for (const Material& m : scene.materials) names_.insert(m.name);
   std::error_code ec;
   obj_path_ = fs::weakly_canonical(obj_path, ec);
   if (ec) obj_path_ = obj_path;
@@ -173,7 +174,7 @@ std::string MaterialMapper::free_name(const std::string& name, bool with_path) c
   fs::path dir = obj_path_.parent_path();
   for (;;) {
     std::string candidate = with_path ? prefix + ":" + name : name;
-    if (scene_.find_material(candidate) < 0) return candidate;
+    if (!names_.count(candidate)) return candidate;
     if (!with_path || dir.empty() || dir == dir.parent_path()) break;
     prefix = (dir.filename() / prefix).generic_string();
     if (dir.parent_path() == dir.root_path()) prefix = dir.root_path().generic_string() + prefix;
@@ -182,7 +183,7 @@ std::string MaterialMapper::free_name(const std::string& name, bool with_path) c
   const std::string base = with_path ? obj_path_.filename().string() + ":" + name : name;
   for (int n = 2;; ++n) {
     std::string candidate = base + "#" + std::to_string(n);
-    if (scene_.find_material(candidate) < 0) return candidate;
+    if (!names_.count(candidate)) return candidate;
   }
 }
 
@@ -197,6 +198,7 @@ int MaterialMapper::default_material() {
       m.type = MaterialType::Diffuse;
       m.albedo = glm::dvec3(0.8);
       scene_.materials.push_back(m);
+      names_.insert(m.name);
       default_ = static_cast<int>(scene_.materials.size() - 1);
       known_[kDefaultMaterial] = default_;
     }
@@ -314,6 +316,7 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
   }
 
   scene_.materials.push_back(m);
+  names_.insert(m.name);
   known_[key] = static_cast<int>(scene_.materials.size() - 1);
   return known_[key];
 }

@@ -86,16 +86,24 @@ int SceneBuilder::load_texture(const std::string& file) {
 int SceneBuilder::add_material(const Material& material) {
   const Reporter at = Reporter(scene_.path, "/materials").at(material.name);
   scene_detail::validate_material(material, scene_.textures, at);
-  if (scene_.find_material(material.name) >= 0)
+  if (material_names_.count(material.name))
     at.fail("there is already a material named '" + material.name + "'");
-  scene_.materials.push_back(material);
-  return static_cast<int>(scene_.materials.size() - 1);
+  const int index = static_cast<int>(scene_.materials.size());
+  material_names_.emplace(material.name, index);  // first: may throw, before the list changes
+  try {
+    scene_.materials.push_back(material);
+  } catch (...) {
+    material_names_.erase(material.name);
+    throw;
+  }
+  return index;
 }
 
 int SceneBuilder::material_index(const std::string& name, const std::string& pointer) const {
-  int index = scene_.find_material(name);
-  if (index < 0) Reporter(scene_.path, pointer).fail("unknown material '" + name + "'");
-  return index;
+  const auto it = material_names_.find(name);
+  if (it == material_names_.end())
+    Reporter(scene_.path, pointer).fail("unknown material '" + name + "'");
+  return it->second;
 }
 
 std::string SceneBuilder::shape_place() const {
@@ -182,6 +190,9 @@ void SceneBuilder::add_obj(const ObjShape& obj) {
     scene_.textures.resize(textures);
     at.at("file").fail(e.what());  // "<scene>: /shapes/2/file: <obj>:<line>: ..."
   }
+  // the materials the MTL libraries made (first of a name wins, as Scene::find_material's)
+  for (std::size_t i = materials; i < scene_.materials.size(); ++i)
+    material_names_.emplace(scene_.materials[i].name, static_cast<int>(i));
   entry.count = scene_.triangles.size() - entry.first;
   scene_.shapes.push_back(entry);
 }
@@ -199,6 +210,7 @@ Scene SceneBuilder::build() {
   Scene out = std::move(scene_);
   scene_ = Scene{};
   obj_materials_.clear();
+  material_names_.clear();
   scene_.path = out.path;
   return out;
 }
