@@ -443,6 +443,15 @@ int render_with(const RenderArgs& a) {
     renderer->set_cancel_flag(&g_interrupted);
     try {
       renderer->set_scene(std::move(scene));
+      // a stop signal during set_scene (its kernel build, where the build did not fail; its BVH):
+      // nothing rendered, and a render call takes at least one pass, which rendered the whole
+      // image after the signal and wrote it as "1 of 64 spp"
+      if (g_interrupted.load()) {
+        if (printed && tty) std::fprintf(stderr, "\n");
+        std::fprintf(stderr, "lucent: interrupted by %s before rendering: nothing written\n",
+                     signal_name(g_signal));
+        return 128 + g_signal;
+      }
       std::uint64_t spp =
           a.spp > 0 ? static_cast<std::uint64_t>(a.spp) : (a.time_limit > 0 ? 0 : scene_spp);
       if (range) {
