@@ -678,6 +678,17 @@ TEST(Outputs, SigintStopsTheReferenceWithinAPixel) {
   ASSERT_EQ(r.samples.size(), 8u);
   EXPECT_GT(r.samples[0], 0u);
   EXPECT_LT(r.samples[7], 16777216u);
+  // the summary gives the samples rendered, their mean per pixel and their rate (it gave the
+  // 16777216 spp asked for, and a rate made of them)
+  std::uint64_t total = 0;
+  for (std::uint32_t n : r.samples) total += n;
+  std::smatch sm;
+  ASSERT_TRUE(std::regex_search(
+      err, sm, std::regex(out + ": 8x1, ([0-9]+) spp in ([0-9.]+) s \\(([0-9.]+) Msamples/s")))
+      << err;
+  EXPECT_EQ(std::stoull(sm[1]), total / 8) << err;
+  const double seconds = std::stod(sm[2]), rate = std::stod(sm[3]);
+  EXPECT_NEAR(rate, double(total) / seconds * 1e-6, 0.006 + 0.002 * rate) << err;
 }
 
 }  // namespace

@@ -539,15 +539,24 @@ int render_with(const RenderArgs& a) {
   if (resumed_spp > 0)
     resumed_note =
         " (" + std::to_string(resumed_spp) + " of them from " + one_line(checkpoint->path()) + ")";
+  // the reference's pixels hold all, some or none of their samples when it is stopped: its spp
+  // is their mean, its rate their total (it gave the spp asked for, and a rate made of them)
+  std::uint64_t shown_spp = r.spp;
+  double run_samples = double(run_spp) * film_settings.width * film_settings.height;
+  if (a.reference && !r.samples.empty()) {
+    std::uint64_t total = 0;
+    for (const std::uint32_t n : r.samples) total += n;
+    shown_spp = total / r.samples.size();
+    run_samples = double(total);
+  }
   if (!a.quiet)
     std::fprintf(
         stderr,
         "%s: %dx%d, %llu spp%s in %.3f s (%.2f Msamples/s, %.2f Mrays/s, build %.2f s, peak "
         "host memory %.0f MiB) on %s%s\n",
         one_line(a.output).c_str(), film_settings.width, film_settings.height,
-        static_cast<unsigned long long>(r.spp), resumed_note.c_str(), seconds,
-        seconds > 0 ? double(run_spp) * film_settings.width * film_settings.height / seconds * 1e-6
-                    : 0,
+        static_cast<unsigned long long>(shown_spp), resumed_note.c_str(), seconds,
+        seconds > 0 ? run_samples / seconds * 1e-6 : 0,
         seconds > 0 ? double(run_rays) / seconds * 1e-6 : 0, r.build_seconds, peak_host_mib(),
         r.device.c_str(), device_shares(r.devices).c_str());
   // a time limit that ended the render before its plan did (a signal's last line says so)
