@@ -11,6 +11,7 @@
 #include "cli/commands.hpp"
 #include "lucent/error.hpp"
 #include "lucent/parts.hpp"
+#include "render/sample_stats.hpp"
 
 namespace lucent::cli {
 
@@ -68,8 +69,9 @@ int run_merge_command() {
     std::fprintf(stderr, "effective samples per pixel (finite): min %u, mean %.2f, max %u\n",
                  r.min_spp, r.mean_spp, r.max_spp);
     if (info.nonfinite > 0)
-      std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
-                   static_cast<unsigned long long>(info.nonfinite));
+      std::fprintf(
+          stderr, "lucent: warning: %s\n",
+          lucent::render_detail::nonfinite_warning(info.nonfinite, r.merged.acc.count).c_str());
   }
   return 0;
 }

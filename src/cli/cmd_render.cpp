@@ -529,8 +529,8 @@ int render_with(const RenderArgs& a) {
   else if (checkpoint && checkpoint->held() > 0)
     say_kept(*checkpoint, false);
   if (r.nonfinite > 0)
-    std::fprintf(stderr, "lucent: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
-                 static_cast<unsigned long long>(r.nonfinite));
+    std::fprintf(stderr, "lucent: warning: %s\n",
+                 lucent::render_detail::nonfinite_warning(r.nonfinite, r.samples).c_str());
   // one device: its pass time; several: the wall time of the render, when they overlapped. A
   // resumed render: this run's time and rates (its spp counts the checkpoint's samples too,
   // which it names: dividing them by this run's wall time gave thousands of Msamples/s)

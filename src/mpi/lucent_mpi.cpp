@@ -33,6 +33,7 @@
 #include "lucent/parts.hpp"
 #include "lucent/types.hpp"
 #include "render/resources.hpp"
+#include "render/sample_stats.hpp"
 #include "scene/loaders.hpp"
 
 namespace {
@@ -472,9 +473,10 @@ int run(const Args& a) {
                  one_line(a.output).c_str(), m.merged.info.width, m.merged.info.height,
                  lucent::ranges_text(m.merged.info.samples).c_str(), g_size, m.merged.info.seconds);
   if (m.merged.info.nonfinite > 0)
-    std::fprintf(stderr,
-                 "lucent-mpi: warning: %llu non-finite sample(s) (NaN or Inf) were dropped\n",
-                 static_cast<unsigned long long>(m.merged.info.nonfinite));
+    std::fprintf(
+        stderr, "lucent-mpi: warning: %s\n",
+        lucent::render_detail::nonfinite_warning(m.merged.info.nonfinite, m.merged.acc.count)
+            .c_str());
   if (ck && !all_complete) say_kept(m.merged.info.samples);
   if (g_stop.load()) {
     std::fprintf(stderr, "lucent-mpi: interrupted: %s holds samples %s of [0, %llu)\n",

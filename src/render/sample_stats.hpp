@@ -31,6 +31,19 @@ inline void check_some_sample_finite(const std::string& path, std::uint64_t nonf
                 "radiance or intensity above about 1.8e19?)");
 }
 
+/// The warning of `nonfinite` dropped samples (without "lucent: warning: "), with the pixels they
+/// left without any sample, which are black (and which `compare` refuses), of `counts` when given.
+inline std::string nonfinite_warning(std::uint64_t nonfinite,
+                                     const std::vector<std::uint32_t>& counts) {
+  std::size_t empty = 0;
+  for (const std::uint32_t n : counts) empty += n == 0;
+  std::string s = std::to_string(nonfinite) +
+                  " non-finite sample(s) (NaN or Inf, or a square beyond a float's range) were "
+                  "dropped";
+  if (empty > 0) s += "; " + std::to_string(empty) + " pixel(s) hold no sample and are black";
+  return s;
+}
+
 /// The unbiased variance of one sample, from n samples' sum and sum of squares; 0 below 2 samples
 /// (and never negative: the sums' rounding can make it so).
 inline double sample_variance(double sum, double sumsq, double n) {
