@@ -401,8 +401,9 @@ TEST(ImageIo, PizExrReadsAndDamagedHuffmanTablesAreRefused) {
             at + "a run of zero code lengths passes the last symbol of its Huffman table");
 }
 
-// A single-channel OpenEXR file (Y, or one channel of any name) is grey; one without R, G, B or
-// Y among several channels is an error naming the file.
+// A single-channel OpenEXR file (Y, or one channel of any name but R, G or B) is grey; one with
+// some of R, G and B has the others 0; one without R, G, B or Y among several channels is an
+// error naming the file.
 TEST(ImageIo, GreyExrIsGreyAndOtherChannelsAreRefused) {
   auto value = [](int, int x, int y) { return 0.5f * float(x) + float(y); };
   const std::string dir = lucent::test::temp_dir();
@@ -420,6 +421,21 @@ TEST(ImageIo, GreyExrIsGreyAndOtherChannelsAreRefused) {
     ADD_FAILURE() << "read an image without colour channels";
   } catch (const lucent::Error& e) {
     EXPECT_EQ(std::string(e.what()), dir + "/uv.exr: OpenEXR file has no R, G, B or Y channels");
+  }
+  // some of R, G and B: the others are 0, as OpenEXR's RGBA reader fills them (a file of R
+  // alone came out grey, R copied into G and B; R and G together were refused)
+  for (const std::vector<std::string>& names :
+       {std::vector<std::string>{"R"}, {"G", "R"}, {"B"}, {"B", "G"}}) {
+    write_exr(dir + "/some.exr", 5, 3, names, value);
+    const lucent::Image some = lucent::read_image(dir + "/some.exr");
+    ASSERT_EQ(some.rgb.size(), 5u * 3u * 3u);
+    for (int c = 0; c < 3; ++c) {
+      const bool has =
+          std::find(names.begin(), names.end(), std::string(1, "RGB"[c])) != names.end();
+      for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 5; ++x)
+          ASSERT_EQ(some.pixel(x, y)[c], has ? value(0, x, y) : 0.0f) << names[0] << " " << c;
+    }
   }
   // luminance/chroma is a colour image: read from Y alone it came out grey, without a word
   write_exr(dir + "/ryby.exr", 5, 3, {"BY", "RY", "Y"}, value);

@@ -251,7 +251,9 @@ Decoded decode_image(const unsigned char* data, std::size_t size, const std::str
   if (p.format == Format::Exr) {
     ExrChannels exr = read_exr_channels(data, size, path, max_pixels);
     int src[3] = {exr.find("R"), exr.find("G"), exr.find("B")};
-    if (src[0] < 0 || src[1] < 0 || src[2] < 0) {
+    // some of R, G and B: the others are 0, as OpenEXR's RGBA reader fills them (a file of R
+    // alone was read as grey)
+    if (src[0] < 0 && src[1] < 0 && src[2] < 0) {
       // a single channel (Y, or anything else) is grey; luminance with chroma (Y, RY, BY: a
       // colour image) is not, and its colour would be lost
       if (exr.find("RY") >= 0 || exr.find("BY") >= 0)
@@ -266,7 +268,8 @@ Decoded decode_image(const unsigned char* data, std::size_t size, const std::str
     allocate(exr.width, exr.height);
     const size_t n = static_cast<size_t>(exr.width) * exr.height;
     for (size_t i = 0; i < n; ++i)
-      for (int c = 0; c < 3; ++c) out.pixels[i * channels + c] = exr.planes[src[c]][i];
+      for (int c = 0; c < 3; ++c)
+        out.pixels[i * channels + c] = src[c] >= 0 ? exr.planes[src[c]][i] : 0.0f;
     return out;
   }
 
