@@ -258,6 +258,12 @@ TEST(ObjValidation, MtlNumbersAreChecked) {
     EXPECT_NE(err.find(c.error), std::string::npos) << c.line << ": " << err;
     EXPECT_EQ(err.find('\n'), std::string::npos) << err;
   }
+  // a value the scene refuses is named by the MTL file, the material's line and its statement:
+  // the error came at render time as "s.json: /materials/m.obj:a/ior: ...", a place of no file
+  const std::string glass = obj_error(obj, "# glass\nnewmtl a\nillum 7\nNi 1000\n");
+  EXPECT_NE(glass.find("/m.mtl:2: material 'a': ior (Ni): must be in [0.05, 20], got 1000"),
+            std::string::npos)
+      << glass;
   // the spectral and xyz forms (read_colour_forms); valid libraries load
   EXPECT_EQ(obj_error(obj, "newmtl a\nKd spectral x.rfl\nKd 0.5 0.5 0.5\nNs 10\nillum 2\n"), "");
   EXPECT_EQ(obj_error(obj, "newmtl a\nKd xyz 0.5\nKs xyz 0.1 0.2 0.1\nKe spectral x.rfl 2\n"), "");

@@ -227,6 +227,9 @@ class MaterialMapper {
 
  private:
   int convert(const tinyobj::material_t& t, const std::string& mtl_path, const MtlName& def);
+  /// Throws lucent::Error "<mtl>:<line>: material '<name>': ior (Ni): must be ..." when the
+  /// material converted from MTL material `def` fails the scene's checks (validate_material).
+  void check_converted(const Material& m, const std::string& mtl_path, const MtlName& def) const;
   /// `name` when no material has it, else with the OBJ file's parent directories in front
   /// ("b/model.obj:paint"), else with "#2", "#3", ... after it.
   std::string free_name(const std::string& name, bool with_path) const;

@@ -11,6 +11,7 @@
 #include "lucent/error.hpp"
 #include "scene/loaders.hpp"
 #include "scene/obj_internal.hpp"
+#include "scene/validate.hpp"
 
 namespace lucent::scene_detail::obj {
 
@@ -187,6 +188,33 @@ std::string MaterialMapper::free_name(const std::string& name, bool with_path) c
   }
 }
 
+void MaterialMapper::check_converted(const Material& m, const std::string& mtl_path,
+                                     const MtlName& def) const {
+  // the scene's checks (validate_material), named by the MTL file, the material's line and the
+  // statement a value came from: validate_scene reported "s.json: /materials/m.obj:red/ior: must
+  // be in [0.05, 20], got 1000", a place of no file
+  const std::string head = "material '" + def.name + "'";
+  try {
+    validate_material(m, scene_.textures, Reporter("", head));
+  } catch (const Error& e) {
+    // "material 'red'/ior: must be ..." -> "ior (Ni): must be ..."; "/albedo/1" -> "albedo/1 (Kd)"
+    const std::string what = e.what();
+    const std::size_t at = what.find(head);
+    std::string rest = at == std::string::npos ? what : what.substr(at + head.size());
+    const std::size_t colon = rest.find(": ");
+    std::string key = rest.substr(0, colon),
+                tail = colon == std::string::npos ? "" : rest.substr(colon);
+    static const std::pair<const char*, const char*> kFrom[] = {
+        {"/ior", "Ni"},  {"/albedo", "Kd"},   {"/specular", "Ks"}, {"/reflectance", "Ks"},
+        {"/tint", "Tf"}, {"/emission", "Ke"}, {"/roughness", "Ns"}};
+    for (const auto& [name, tag] : kFrom)
+      if (key.substr(0, key.find('/', 1)) == name) key += std::string(" (") + tag + ")";
+    if (!key.empty() && key[0] == '/') key.erase(0, 1);
+    throw Error(mtl_path + ":" + std::to_string(def.line) + ": " + head +
+                (key.empty() ? "" : ": " + key) + tail);
+  }
+}
+
 int MaterialMapper::default_material() {
   if (default_ < 0) {
     auto it = known_.find(kDefaultMaterial);
@@ -315,6 +343,7 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
            "); ignored (lucent does not use " + key + ")");
   }
 
+  check_converted(m, mtl_path, def);
   scene_.materials.push_back(m);
   names_.insert(m.name);
   known_[key] = static_cast<int>(scene_.materials.size() - 1);
