@@ -404,7 +404,7 @@ TEST(Compare, DisplayImageAgainstALinearOneIsRefused) {
 // An input image holding a NaN or an infinity (a PFM can) is an error in that file, not a
 // difference between renders: one line naming the file, the pixel and the channel, exit 1 as
 // every error, and no PASS/FAIL report (it printed FAIL with "max |z| inf", as if the renders
-// disagreed). A NaN in a variance layer too.
+// disagreed). A NaN in a variance layer too, and a negative variance.
 TEST(Compare, NonFiniteInputIsAnInputError) {
   const std::string dir = lucent::test::temp_dir();
   lucent::Image img{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)};
@@ -416,10 +416,15 @@ TEST(Compare, NonFiniteInputIsAnInputError) {
   v.samples.assign(64, 16);
   v.variance.rgb[(7 * 8 + 7) * 3 + 2] = NAN;
   lucent::write_render_exr(dir + "/var.exr", v);
+  // a negative variance (none is) was taken as 0
+  v.variance.rgb[(7 * 8 + 7) * 3 + 2] = 0.1f;
+  v.variance.rgb[(2 * 8 + 1) * 3 + 0] = -0.5f;
+  lucent::write_render_exr(dir + "/neg.exr", v);
   const std::pair<std::string, std::string> cases[] = {
       {"nan.pfm nan.pfm", "nan.pfm: pixel (4, 3) channel G is not finite (nan)"},
       {"ok.pfm nan.pfm", "nan.pfm: pixel (4, 3) channel G is not finite (nan)"},
-      {"var.exr ok.pfm", "var.exr: pixel (7, 7) channel var.B is not finite (nan)"}};
+      {"var.exr ok.pfm", "var.exr: pixel (7, 7) channel var.B is not finite (nan)"},
+      {"ok.pfm neg.exr", "neg.exr: pixel (1, 2) channel var.R is negative (-0.5)"}};
   for (const auto& [args, want] : cases) {
     const size_t space = args.find(' ');
     auto r = lucent::test::run_cli("compare '" + dir + "/" + args.substr(0, space) + "' '" + dir +

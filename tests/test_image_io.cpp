@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "fuzz_common.hpp"
+#include "lucent/compare.hpp"
 #include "support.hpp"
 
 namespace {
@@ -399,6 +400,23 @@ TEST(ImageIo, PizExrReadsAndDamagedHuffmanTablesAreRefused) {
   short_run[huffman + 4 + 20] = static_cast<char>(0xEC);
   EXPECT_EQ(error_of(short_run),
             at + "a run of zero code lengths passes the last symbol of its Huffman table");
+}
+
+// An OpenEXR file's n layer in float (not lucent's UINT) holds whole counts: 16.5, a negative or
+// a NaN count is an error naming the file, the pixel and the value (16.5 was read as 16).
+TEST(ImageIo, FloatSampleCountsAreWholeNumbers) {
+  const std::string dir = lucent::test::temp_dir();
+  for (const float bad : {16.5f, -1.0f, std::nanf("")}) {
+    write_exr(
+        dir + "/n.exr", 4, 2, {"B", "G", "R", "n", "var.B", "var.G", "var.R"},
+        [bad](int c, int x, int y) { return c == 3 ? (x == 2 && y == 1 ? bad : 16.0f) : 0.25f; });
+    const std::string err = lucent::test::error_of([&] { lucent::read_render(dir + "/n.exr"); });
+    EXPECT_EQ(err.rfind(dir + "/n.exr: channel n: pixel 2, 1 has an invalid sample count ", 0), 0u)
+        << bad << ": " << err;
+  }
+  write_exr(dir + "/n.exr", 4, 2, {"B", "G", "R", "n", "var.B", "var.G", "var.R"},
+            [](int c, int, int) { return c == 3 ? 16.0f : 0.25f; });
+  EXPECT_EQ(lucent::read_render(dir + "/n.exr").samples, std::vector<std::uint32_t>(8, 16));
 }
 
 // A single-channel OpenEXR file (Y, or one channel of any name but R, G or B) is grey; one with

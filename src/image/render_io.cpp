@@ -232,7 +232,7 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
     } else {
       // a count is a non-negative integer: anything else (NaN, negative, huge) is a corrupt file
       const float v = exr.planes[cnt][i];
-      if (!(v >= 0.0f && v < 4294967296.0f))
+      if (!(v >= 0.0f && v < 4294967296.0f) || v != std::floor(v))
         throw Error(path + ": channel n: pixel " + std::to_string(i % w) + ", " +
                     std::to_string(i / w) + " has an invalid sample count " + std::to_string(v));
       r.samples[i] = static_cast<std::uint32_t>(v);
