@@ -1145,7 +1145,13 @@ void bind_scene(py::module_& m) {
       [](py::dict d, const std::filesystem::path& base_dir, const FileText& name,
          py::object on_warning) {
         std::string label = (base_dir / name.bytes).string();
-        std::string text = to_json(d, "", label).dump();
+        // (the document freed without allocating: scene_detail::release_json)
+        nlohmann::json document = to_json(d, "", label);
+        std::string text;
+        {
+          const scene_detail::JsonRelease release(document);
+          text = document.dump();
+        }
         return with_warnings(std::move(on_warning), [&] { return parse_scene(text, label); });
       },
       py::arg("d"), py::arg("base_dir") = ".", py::arg("name") = "<dict>",

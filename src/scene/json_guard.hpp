@@ -40,6 +40,18 @@ std::uint64_t json_load_bytes(std::uint64_t text_bytes, std::uint64_t values,
 /// inside a noexcept destructor, and the program ended in std::terminate (SIGABRT).
 void release_json(nlohmann::json& document);
 
+/// release_json of a document when the scope ends, also when an exception leaves it.
+class JsonRelease {
+ public:
+  explicit JsonRelease(nlohmann::json& document) : document_(document) {}
+  ~JsonRelease() { release_json(document_); }
+  JsonRelease(const JsonRelease&) = delete;
+  JsonRelease& operator=(const JsonRelease&) = delete;
+
+ private:
+  nlohmann::json& document_;
+};
+
 /// "<line>:<col>" (1-based) of the byte at `offset` in `text`.
 std::string line_col_at(const std::string& text, std::size_t offset);
 

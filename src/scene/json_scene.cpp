@@ -69,10 +69,7 @@ Scene parse_scene_in(const std::string& text, const std::string& path, const fs:
   // the document is built in place and freed by release_json, also when an exception leaves
   // (json::parse builds into a local of its own, which its destructor frees by allocating)
   json root;
-  struct Release {
-    json& document;
-    ~Release() { scene_detail::release_json(document); }
-  } release{root};
+  const scene_detail::JsonRelease release(root);
   try {
     nlohmann::detail::json_sax_dom_parser<json> dom(root);
     json::sax_parse(text, &dom);
