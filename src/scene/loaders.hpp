@@ -6,6 +6,7 @@
 #include <glm/glm.hpp>
 #include <map>
 #include <string>
+#include <unordered_map>
 
 #include "lucent/scene.hpp"
 
@@ -48,11 +49,14 @@ std::string texture_file_key(const std::string& path);
 /// this call's own, which shares the scene's textures by their paths), and faces without one use a
 /// default diffuse material. Missing MTL or texture files give a warning naming the file and fall
 /// back. Returns the MTL libraries the OBJ names that exist (none with a material override, which
-/// reads none): inputs of the scene, as its textures are. Throws lucent::Error naming the file (and
-/// line) of a parse error.
+/// reads none): inputs of the scene, as its textures are. `names`: the scene's materials by name
+/// (SceneBuilder's), to which the new materials are added; null: made from the scene's list when
+/// a new material needs a free name. Throws lucent::Error naming the file (and line) of a parse
+/// error.
 std::vector<std::string> load_obj(Scene& scene, const std::string& path,
                                   const glm::dmat4& transform, int material_override,
-                                  ObjMaterials* known = nullptr);
+                                  ObjMaterials* known = nullptr,
+                                  std::unordered_map<std::string, int>* names = nullptr);
 
 /// Loads an image (PNG, JPG, BMP, TGA: 8-bit decoded from sRGB to linear; HDR, PFM, EXR kept
 /// linear) as a scene texture, reusing an already loaded one with the same canonical path: the

@@ -276,7 +276,8 @@ void check_mesh_memory(const Scene& scene, const std::string& path, std::uint64_
 
 std::vector<std::string> load_obj(Scene& scene, const std::string& path,
                                   const glm::dmat4& transform, int material_override,
-                                  ObjMaterials* known) {
+                                  ObjMaterials* known,
+                                  std::unordered_map<std::string, int>* names) {
   io::ReadSpec spec;
   spec.what = "OBJ file";
   spec.max_bytes = obj::kMaxObjBytes;
@@ -427,7 +428,7 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   if (!known)
     for (size_t i = 0; i < scene.textures.size(); ++i)
       own.emplace(texture_file_key(scene.textures[i].path), static_cast<int>(i));
-  obj::MaterialMapper mapper(scene, known ? *known : own, path, mats, reader.origin,
+  obj::MaterialMapper mapper(scene, known ? *known : own, names, path, mats, reader.origin,
                              reader.definition);
   size_t faces = 0, fanned_faces = 0;
   std::vector<glm::vec3> corners;

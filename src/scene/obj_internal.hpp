@@ -10,7 +10,7 @@
 #include <map>
 #include <set>
 #include <string>
-#include <unordered_set>
+#include <unordered_map>
 #include <vector>
 
 #include "lucent/scene.hpp"
@@ -217,8 +217,8 @@ class MtlReader : public tinyobj::MaterialReader {
 /// Creates scene materials from MTL materials on first use (docs/obj-mtl.md).
 class MaterialMapper {
  public:
-  MaterialMapper(Scene& scene, ObjMaterials& known, const std::string& obj_path,
-                 const std::vector<tinyobj::material_t>& mats,
+  MaterialMapper(Scene& scene, ObjMaterials& known, std::unordered_map<std::string, int>* names,
+                 const std::string& obj_path, const std::vector<tinyobj::material_t>& mats,
                  const std::vector<std::string>& origin, const std::vector<MtlName>& definition);
 
   /// The scene material of MTL material `id` (created on first use), or the default one.
@@ -232,7 +232,11 @@ class MaterialMapper {
   void check_converted(const Material& m, const std::string& mtl_path, const MtlName& def) const;
   /// `name` when no material has it, else with the OBJ file's parent directories in front
   /// ("b/model.obj:paint"), else with "#2", "#3", ... after it.
-  std::string free_name(const std::string& name, bool with_path) const;
+  std::string free_name(const std::string& name, bool with_path);
+  /// The scene's materials by name: load_obj's `names`, or made from the list when first needed.
+  std::unordered_map<std::string, int>& names();
+  /// Adds material `m` to the scene and its name to names(); returns its index.
+  int add(const Material& m);
 
   Scene& scene_;
   ObjMaterials& known_;
@@ -243,9 +247,12 @@ class MaterialMapper {
   std::vector<int> index_;
   int default_ = -1;
   std::set<std::string> warned_;
-  /// The scene's material names (free_name's lookups: a search of the list for each new name
-  /// made an MTL library of N materials take N^2 / 2 comparisons, 80,000 of them 13.7 s).
-  std::unordered_set<std::string> names_;
+  /// free_name's lookups (a search of the list for each new name made an MTL library of N
+  /// materials take N^2 / 2 comparisons: 80,000 of them loaded in 9.4 s; a set made from the
+  /// whole list by each OBJ load made K meshes of a scene of N materials take K N)
+  std::unordered_map<std::string, int>* names_;
+  std::unordered_map<std::string, int> own_names_;
+  bool own_made_ = false;
 };
 
 }  // namespace lucent::scene_detail::obj

@@ -147,7 +147,9 @@ bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* 
   return true;
 }
 
-MaterialMapper::MaterialMapper(Scene& scene, ObjMaterials& known, const std::string& obj_path,
+MaterialMapper::MaterialMapper(Scene& scene, ObjMaterials& known,
+                               std::unordered_map<std::string, int>* names,
+                               const std::string& obj_path,
                                const std::vector<tinyobj::material_t>& mats,
                                const std::vector<std::string>& origin,
                                const std::vector<MtlName>& definition)
@@ -156,8 +158,8 @@ MaterialMapper::MaterialMapper(Scene& scene, ObjMaterials& known, const std::str
       mats_(mats),
       origin_(origin),
       definition_(definition),
-      index_(mats.size(), -1) {
-  for (const Material& m : scene.materials) names_.insert(m.name);
+      index_(mats.size(), -1),
+      names_(names) {
   std::error_code ec;
   obj_path_ = fs::weakly_canonical(obj_path, ec);
   if (ec) obj_path_ = obj_path;
@@ -169,13 +171,30 @@ int MaterialMapper::get(int id) {
   return index_[id];
 }
 
-std::string MaterialMapper::free_name(const std::string& name, bool with_path) const {
+std::unordered_map<std::string, int>& MaterialMapper::names() {
+  if (names_) return *names_;
+  if (!own_made_) {
+    for (std::size_t i = 0; i < scene_.materials.size(); ++i)
+      own_names_.emplace(scene_.materials[i].name, static_cast<int>(i));  // the first wins
+    own_made_ = true;
+  }
+  return own_names_;
+}
+
+int MaterialMapper::add(const Material& m) {
+  const int index = static_cast<int>(scene_.materials.size());
+  scene_.materials.push_back(m);
+  names().emplace(m.name, index);
+  return index;
+}
+
+std::string MaterialMapper::free_name(const std::string& name, bool with_path) {
   // "model.obj:paint", then "b/model.obj:paint", "a/b/model.obj:paint", ... the whole path
   std::string prefix = with_path ? obj_path_.filename().string() : "";
   fs::path dir = obj_path_.parent_path();
   for (;;) {
     std::string candidate = with_path ? prefix + ":" + name : name;
-    if (!names_.count(candidate)) return candidate;
+    if (!names().count(candidate)) return candidate;
     if (!with_path || dir.empty() || dir == dir.parent_path()) break;
     prefix = (dir.filename() / prefix).generic_string();
     if (dir.parent_path() == dir.root_path()) prefix = dir.root_path().generic_string() + prefix;
@@ -184,7 +203,7 @@ std::string MaterialMapper::free_name(const std::string& name, bool with_path) c
   const std::string base = with_path ? obj_path_.filename().string() + ":" + name : name;
   for (int n = 2;; ++n) {
     std::string candidate = base + "#" + std::to_string(n);
-    if (!names_.count(candidate)) return candidate;
+    if (!names().count(candidate)) return candidate;
   }
 }
 
@@ -225,9 +244,7 @@ int MaterialMapper::default_material() {
       m.name = free_name(kDefaultMaterial, false);
       m.type = MaterialType::Diffuse;
       m.albedo = glm::dvec3(0.8);
-      scene_.materials.push_back(m);
-      names_.insert(m.name);
-      default_ = static_cast<int>(scene_.materials.size() - 1);
+      default_ = add(m);
       known_[kDefaultMaterial] = default_;
     }
   }
@@ -344,9 +361,7 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
   }
 
   check_converted(m, mtl_path, def);
-  scene_.materials.push_back(m);
-  names_.insert(m.name);
-  known_[key] = static_cast<int>(scene_.materials.size() - 1);
+  known_[key] = add(m);
   return known_[key];
 }
 

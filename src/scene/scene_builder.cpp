@@ -177,22 +177,30 @@ void SceneBuilder::add_obj(const ObjShape& obj) {
                     normals = scene_.normals.size(), uvs = scene_.uvs.size(),
                     triangles = scene_.triangles.size(), textures = scene_.textures.size();
   const scene_detail::ObjMaterials obj_materials = obj_materials_;
-  try {
-    entry.libraries =
-        scene_detail::load_obj(scene_, obj.file, obj.transform, material, &obj_materials_);
-  } catch (const Error& e) {
+  auto roll_back = [&] {
     obj_materials_ = obj_materials;
+    for (std::size_t i = materials; i < scene_.materials.size(); ++i) {
+      const auto it = material_names_.find(scene_.materials[i].name);
+      if (it != material_names_.end() && it->second == static_cast<int>(i))
+        material_names_.erase(it);
+    }
     scene_.materials.resize(materials);
     scene_.positions.resize(positions);
     scene_.normals.resize(normals);
     scene_.uvs.resize(uvs);
     scene_.triangles.resize(triangles);
     scene_.textures.resize(textures);
+  };
+  try {
+    entry.libraries = scene_detail::load_obj(scene_, obj.file, obj.transform, material,
+                                             &obj_materials_, &material_names_);
+  } catch (const Error& e) {
+    roll_back();
     at.at("file").fail(e.what());  // "<scene>: /shapes/2/file: <obj>:<line>: ..."
+  } catch (...) {                  // std::bad_alloc: the builder as it was too
+    roll_back();
+    throw;
   }
-  // the materials the MTL libraries made (first of a name wins, as Scene::find_material's)
-  for (std::size_t i = materials; i < scene_.materials.size(); ++i)
-    material_names_.emplace(scene_.materials[i].name, static_cast<int>(i));
   entry.count = scene_.triangles.size() - entry.first;
   scene_.shapes.push_back(entry);
 }
