@@ -39,7 +39,8 @@ std::string format_number(double v) {
   return s.str();
 }
 
-/// The object a setter assigns to, taken from `self` after the value was converted. Converting
+/// The object a setter assigns to (or a method reads), taken from `self` after the value (or an
+/// index, or the other side of a comparison) was converted. Converting
 /// can run Python code (__float__, __index__, a sequence's __getitem__, __array__), and that code
 /// can change the scene list the object is an element of, which moves the element to a copy
 /// (scene_list.hpp): a `C&` taken as the setter's first argument, before its value was converted,
@@ -77,10 +78,11 @@ void vec_property(py::class_<C>& c, const char* name, V C::*member, const char* 
 template <class V>
 py::class_<V> bind_vector_type(py::module_& m, const char* name) {
   constexpr int N = V::length();
-  auto get = [](const V& v, py::ssize_t i) {
+  // (the vector read after the index is converted: assigned())
+  auto get = [](py::handle self, py::ssize_t i) {
     if (i < 0) i += N;
     if (i < 0 || i >= N) throw py::index_error(std::string("index out of range"));
-    return v[static_cast<int>(i)];
+    return assigned<V>(self)[static_cast<int>(i)];
   };
   py::class_<V> c(m, name);
   c.def(py::init([](py::sequence s) { return to_vec<V>(s); }), py::arg("values"));

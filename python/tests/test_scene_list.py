@@ -322,10 +322,17 @@ def test_sequence_and_array_values_are_converted_before_the_element_is_taken():
     e.libraries = HostileSequence("y.mtl", scene.shapes, other.shapes, shape)
     assert e.libraries == ["y.mtl"] * 3
     assert all(s.libraries == ["x.mtl"] for s in other.shapes)
-    # a comparison reads the vector after converting the other side
+    # a comparison reads the vector after converting the other side, and an index after
+    # converting it (the other scene's elements differ, so that a stale read shows)
+    def far_sphere():
+        return lucent.Sphere((1, 1, 1), 2.0, 1)
+
     scene.spheres.append(sphere())
     c = scene.spheres[0].center
-    assert c == (Hostile(7, scene.spheres, other.spheres, sphere), 7, 7)
+    assert c == (Hostile(7, scene.spheres, other.spheres, far_sphere), 7, 7)
+    scene.spheres.append(sphere())
+    c = scene.spheres[0].center
+    assert c[Hostile(1, scene.spheres, other.spheres, far_sphere)] == 7
 
 
 def test_slice_bounds_are_converted_before_the_list_is_measured():
