@@ -47,6 +47,78 @@ struct ErrorLocator : nlohmann::json_sax<json> {
   }
 };
 
+/// Builds a JSON document into `root` in place, so that release_json frees it, also the part built
+/// when an exception leaves (json::parse builds into a local of its own, whose destructor frees
+/// it by allocating). nlohmann's own builder, detail::json_sax_dom_parser, is not public: its
+/// template parameters changed in 3.12. A syntax error or a number out of range is thrown as the
+/// parser's own exception (json::parse_error, json::out_of_range), as json::parse throws it.
+class DocumentBuilder : public nlohmann::json_sax<json> {
+ public:
+  explicit DocumentBuilder(json& root) : root_(root) {}
+  bool null() override { return put(nullptr); }
+  bool boolean(bool v) override { return put(v); }
+  bool number_integer(number_integer_t v) override { return put(v); }
+  bool number_unsigned(number_unsigned_t v) override { return put(v); }
+  bool number_float(number_float_t v, const string_t&) override { return put(v); }
+  bool string(string_t& v) override { return put(std::move(v)); }
+  bool binary(binary_t& v) override { return put(json::binary(std::move(v))); }
+  bool start_object(std::size_t) override {
+    stack_.push_back(place(json::object()));
+    return true;
+  }
+  bool start_array(std::size_t) override {
+    stack_.push_back(place(json::array()));
+    return true;
+  }
+  bool end_object() override { return pop(); }
+  bool end_array() override { return pop(); }
+  bool key(string_t& k) override {
+    // (check_json_structure refused duplicate keys)
+    member_ = &stack_.back()->get_ref<json::object_t&>()[k];
+    return true;
+  }
+  bool parse_error(std::size_t, const std::string& token,
+                   const nlohmann::detail::exception& e) override {
+    if (const auto* p = dynamic_cast<const json::parse_error*>(&e)) throw *p;
+    if (const auto* o = dynamic_cast<const json::out_of_range*>(&e)) throw *o;
+    error_ = std::string(e.what()) + " (at '" + token + "')";
+    return false;
+  }
+  /// The error of a parse that returned false without an exception of the parser's types.
+  const std::string& error() const { return error_; }
+
+ private:
+  /// The new value's place: the root, the end of the array being read, or the member whose key
+  /// came last.
+  json* place(json&& v) {
+    if (stack_.empty()) {
+      root_ = std::move(v);
+      return &root_;
+    }
+    json& parent = *stack_.back();
+    if (parent.is_array()) {
+      json::array_t& a = parent.get_ref<json::array_t&>();
+      a.push_back(std::move(v));
+      return &a.back();
+    }
+    *member_ = std::move(v);
+    return member_;
+  }
+  bool put(json&& v) {
+    place(std::move(v));
+    return true;
+  }
+  bool pop() {
+    stack_.pop_back();
+    return true;
+  }
+
+  json& root_;
+  std::vector<json*> stack_;  ///< the open objects and arrays (at most kMaxJsonDepth)
+  json* member_ = nullptr;
+  std::string error_ = "invalid JSON";
+};
+
 /// The scene in `root`: its sections in a fixed order (materials before the shapes naming them).
 /// Relative file names are taken from `dir`.
 Scene build_scene(const json& root, const std::string& path, const fs::path& dir) {
@@ -67,12 +139,11 @@ Scene build_scene(const json& root, const std::string& path, const fs::path& dir
 Scene parse_scene_in(const std::string& text, const std::string& path, const fs::path& dir) {
   scene_detail::check_json_structure(text, path);  // nesting depth, duplicate keys, memory
   // the document is built in place and freed by release_json, also when an exception leaves
-  // (json::parse builds into a local of its own, which its destructor frees by allocating)
   json root;
   const scene_detail::JsonRelease release(root);
   try {
-    nlohmann::detail::json_sax_dom_parser<json> dom(root);
-    json::sax_parse(text, &dom);
+    DocumentBuilder builder(root);
+    if (!json::sax_parse(text, &builder)) throw Error(path + ": invalid JSON: " + builder.error());
   } catch (const json::parse_error& e) {
     std::string what = e.what();
     auto pos = what.find("syntax error");
