@@ -23,6 +23,7 @@
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
 #include "lucent/version.hpp"
+#include "render/part_channels.hpp"
 #include "render/resources.hpp"
 #include "render/sample_stats.hpp"
 
@@ -492,24 +493,9 @@ PartInfo read_part_info(const std::string& path) {
   return info_from_attributes(path, attrs, probe.width, probe.height);
 }
 
-RenderPart read_render_part(const std::string& path) {
-  check_part_file_size(path);
-  const std::string bytes = io::read_file(path, image_detail::part_read_spec());
-  if (bytes.size() < 4 || std::memcmp(bytes.data(), "\x76\x2f\x31\x01", 4) != 0)
-    throw Error(path + ": not a lucent part file (not an OpenEXR file)");
-  {
-    // what decoding takes, checked before it allocates, and the file itself
-    EXRHeader header;
-    image_detail::Probe probe =
-        image_detail::probe_exr(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(),
-                                path, image_detail::kMaxImagePixels, header);
-    FreeEXRHeader(&header);
-    image_detail::check_decode_memory(
-        path, "part", probe, image_detail::exr_decode_bytes_per_pixel(probe), bytes.size());
-  }
-  image_detail::ExrChannels exr =
-      image_detail::read_exr_channels(reinterpret_cast<const unsigned char*>(bytes.data()),
-                                      bytes.size(), path, image_detail::kMaxImagePixels);
+namespace render_detail {
+
+RenderPart part_from_channels(const image_detail::ExrChannels& exr, const std::string& path) {
   RenderPart p;
   p.info = info_from_attributes(path, exr.attributes, exr.width, exr.height);
   const size_t npix = static_cast<size_t>(exr.width) * exr.height;
@@ -550,6 +536,29 @@ RenderPart read_render_part(const std::string& path) {
   a.rays = p.info.rays;
   a.seconds = p.info.seconds;
   return p;
+}
+
+}  // namespace render_detail
+
+RenderPart read_render_part(const std::string& path) {
+  check_part_file_size(path);
+  const std::string bytes = io::read_file(path, image_detail::part_read_spec());
+  if (bytes.size() < 4 || std::memcmp(bytes.data(), "\x76\x2f\x31\x01", 4) != 0)
+    throw Error(path + ": not a lucent part file (not an OpenEXR file)");
+  {
+    // what decoding takes, checked before it allocates, and the file itself
+    EXRHeader header;
+    image_detail::Probe probe =
+        image_detail::probe_exr(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(),
+                                path, image_detail::kMaxImagePixels, header);
+    FreeEXRHeader(&header);
+    image_detail::check_decode_memory(
+        path, "part", probe, image_detail::exr_decode_bytes_per_pixel(probe), bytes.size());
+  }
+  const image_detail::ExrChannels exr =
+      image_detail::read_exr_channels(reinterpret_cast<const unsigned char*>(bytes.data()),
+                                      bytes.size(), path, image_detail::kMaxImagePixels);
+  return render_detail::part_from_channels(exr, path);
 }
 
 void PartMerger::check(const std::string& name, const PartInfo& info) {
