@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <regex>
@@ -32,6 +33,16 @@ using lucent::test::CommandResult;
 using lucent::test::run_cli;
 
 std::string q(const std::string& s) { return "'" + s + "'"; }
+
+/// `s` as a regular expression that matches it literally (a path in a pattern).
+std::string regex_text(const std::string& s) {
+  std::string out;
+  for (const char c : s) {
+    if (std::strchr(".^$|()[]{}*+?\\", c)) out += '\\';
+    out += c;
+  }
+  return out;
+}
 
 using lucent::test::read_file;
 
@@ -389,8 +400,8 @@ TEST(Outputs, RenderWithoutAFiniteSampleWritesNothing) {
     EXPECT_EQ(r.status, 1);
     // (the scene's first radiance beyond a float's squares is named before rendering)
     EXPECT_EQ(r.err, "lucent: warning: " + scene +
-                         ": /materials/hot/emission: 1e+30 is above 1.84e+19, where a sample's "
-                         "square overflows a float: the kernel drops such samples as non-finite "
+                         ": material 'hot': emission 1e+30 is above 1.84e+19, where a sample's "
+                         "square overflows a float: such samples are dropped as non-finite "
                          "(lower it and raise film.exposure)\n"
                          "lucent: error: " +
                          dir + "/" + name +
@@ -505,7 +516,7 @@ void interrupt_render(int sig, const char* name, int status_expected) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(
       err, m,
-      std::regex(std::string("lucent: interrupted by ") + name + ": wrote " + out +
+      std::regex(std::string("lucent: interrupted by ") + name + ": wrote " + regex_text(out) +
                  " with (\\d+) spp after [0-9.]+ of 120 s \\(AOVs not "
                  "written: albedo\\)\n$")))
       << err;
@@ -553,7 +564,7 @@ TEST(Outputs, SigintInAnAdaptivePilotSaysHowFarItGot) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(
       err, m,
-      std::regex("lucent: interrupted by SIGINT \\(Ctrl-C\\): wrote " + out +
+      std::regex("lucent: interrupted by SIGINT \\(Ctrl-C\\): wrote " + regex_text(out) +
                  " with (\\d+) spp on average, in its pilot of (\\d+) spp \\(no plan made\\)\n$")))
       << err;
   EXPECT_GE(std::stoll(m[1]), 1);
@@ -684,7 +695,7 @@ TEST(Outputs, SigintStopsTheReferenceWithinAPixel) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(
       err, m,
-      std::regex("lucent: interrupted by SIGINT \\(Ctrl-C\\): wrote " + out +
+      std::regex("lucent: interrupted by SIGINT \\(Ctrl-C\\): wrote " + regex_text(out) +
                  " with ([0-9.]+)% of its 16777216 spp per pixel \\(([0-9.]+)% of the pixels "
                  "have samples, the others are black\\)\n$")))
       << err;
@@ -700,7 +711,8 @@ TEST(Outputs, SigintStopsTheReferenceWithinAPixel) {
   for (std::uint32_t n : r.samples) total += n;
   std::smatch sm;
   ASSERT_TRUE(std::regex_search(
-      err, sm, std::regex(out + ": 8x1, ([0-9]+) spp in ([0-9.]+) s \\(([0-9.]+) Msamples/s")))
+      err, sm,
+      std::regex(regex_text(out) + ": 8x1, ([0-9]+) spp in ([0-9.]+) s \\(([0-9.]+) Msamples/s")))
       << err;
   EXPECT_EQ(std::stoull(sm[1]), total / 8) << err;
   const double seconds = std::stod(sm[2]), rate = std::stod(sm[3]);

@@ -315,34 +315,46 @@ TEST(Resources, PeakHostMemoryOfAnInlineMeshIsWithinTheCount) {
   EXPECT_GT(peak, 0.0);
   std::printf("inline mesh: load peak %.1f MiB, counted %.1f MiB\n", peak, count);
   EXPECT_LE(peak, count) << "peak " << peak << " MiB against a count of " << count << " MiB";
-  EXPECT_GE(peak, 0.6 * count) << "peak " << peak << " MiB against a count of " << count << " MiB";
+  EXPECT_GE(peak, 0.4 * count) << "peak " << peak << " MiB against a count of " << count << " MiB";
 }
 
-// release_json frees a parsed document without allocating. In a child process whose address
-// space is then nearly full, it returns, where the document's own destructor (which first moves
-// a container's elements into a vector as large as the container) ends it in std::terminate.
+// release_json frees a parsed document without allocating. In a child process whose memory is
+// then exhausted (an address-space limit, and every block malloc still gives taken), it returns,
+// where the document's own destructor (which first moves a container's elements into a vector as
+// large as the container) ends the child in std::terminate.
 TEST(Resources, JsonDocumentIsFreedWithoutAllocating) {
   if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer reserves address space: no RLIMIT_AS";
   auto child = [](bool release) {
     const pid_t pid = fork();
     if (pid == 0) {
+      const struct rlimit no_core = {0, 0};
+      setrlimit(RLIMIT_CORE, &no_core);
+      if (FILE* null = std::freopen("/dev/null", "w", stderr)) (void)null;  // "terminate called"
       nlohmann::json doc = nlohmann::json::array();
       for (int i = 0; i < 4000000; ++i) doc.push_back(i);
+      std::vector<void*> ballast;
+      ballast.reserve(std::size_t(1) << 20);
       long pages = 0;
       if (FILE* f = std::fopen("/proc/self/statm", "r")) {
         if (std::fscanf(f, "%ld", &pages) != 1) pages = 0;
         std::fclose(f);
       }
       if (pages <= 0) _exit(3);
-      // 8 MB beyond what the process has mapped: far less than the 64 MB the destructor's
-      // vector of 4,000,000 elements takes
       const rlim_t size = rlim_t(pages) * rlim_t(sysconf(_SC_PAGESIZE)) + (8 << 20);
       const struct rlimit rl = {size, size};
       if (setrlimit(RLIMIT_AS, &rl) != 0) _exit(4);
+      // what is left, taken: new mappings up to the limit, and the heap's free blocks
+      for (const std::size_t block :
+           {std::size_t(1) << 20, std::size_t(1) << 16, std::size_t(1) << 12})
+        while (ballast.size() < ballast.capacity()) {
+          void* p = std::malloc(block);
+          if (!p) break;
+          ballast.push_back(p);
+        }
       if (release)
         lucent::scene_detail::release_json(doc);
       else
-        nlohmann::json(std::move(doc));  // the destructor
+        nlohmann::json(std::move(doc));  // the destructor (64 MB for its stack of elements)
       _exit(doc.is_null() ? 0 : 5);
     }
     int status = 0;
@@ -468,6 +480,9 @@ TEST(Resources, HostCountsSaturateInsteadOfWrapping) {
     const std::string msg = refused(w, h);
     EXPECT_EQ(msg.rfind("huge.json: rendering needs about ", 0), 0u) << msg;
     EXPECT_NE(msg.find("reduce the film size"), std::string::npos) << msg;
+    // a saturated count is no figure (it printed 17179869184.0 GiB)
+    if (w == 2147483647)
+      EXPECT_NE(msg.find("needs about 16.0 EiB or more of host memory"), std::string::npos) << msg;
     std::uint64_t largest = 0;
     for (const MemoryPart& p : lucent::render_detail::estimate_host_memory(s, {cpu}))
       largest = std::max(largest, p.bytes);

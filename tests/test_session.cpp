@@ -791,6 +791,52 @@ TEST(Session, SceneWithoutLightWarns) {
   EXPECT_EQ(warnings.all().size(), 0u) << warnings.dump();
 }
 
+// An emission or environment radiance above sqrt(FLT_MAX) (about 1.84e19) makes samples whose
+// square overflows a float, which the kernel and the reference drop: the scene's first such
+// radiance is named before either renders (the lamp's pixels came out black, with a count of
+// non-finite samples and no word of why). A point light's intensity is not: it reaches a pixel
+// divided by a squared distance (1e20 at 1000 renders without a dropped sample).
+TEST(Session, RadianceBeyondFloatSquaresWarns) {
+  Scene s = lucent::test::scene_from(kScene);
+  s.film.width = s.film.height = 2;
+  const std::string hot =
+      "/lights/0/radiance 1e+20 is above 1.84e+19, where a sample's square "
+      "overflows a float: such samples are dropped as non-finite (lower it "
+      "and raise film.exposure)";
+  lucent::Light sky;
+  sky.type = lucent::LightType::Environment;
+  sky.radiance = glm::dvec3(1e20, 1, 1);
+  s.lights.insert(s.lights.begin(), sky);
+  Renderer r = session();
+  lucent::ReferenceOptions ro;
+  ro.spp = 1;
+  {
+    lucent::test::CaptureWarnings warnings;
+    r.set_scene(s);
+    EXPECT_EQ(warnings.count(hot), 1) << warnings.dump();
+  }
+  {
+    lucent::test::CaptureWarnings warnings;
+    lucent::render_reference(s, ro);
+    EXPECT_EQ(warnings.count(hot), 1) << warnings.dump();
+  }
+  s.lights[0].radiance = glm::dvec3(1e19, 1, 1);  // below: nothing said
+  s.materials[0].emission = glm::dvec3(0, 2e19, 0);
+  {
+    lucent::test::CaptureWarnings warnings;
+    r.set_scene(s);
+    EXPECT_EQ(warnings.count("material '" + s.materials[0].name + "': emission 2e+19 is above"), 1)
+        << warnings.dump();
+  }
+  s.materials[0].emission = glm::dvec3(0);
+  s.lights.erase(s.lights.begin());
+  for (lucent::Light& l : s.lights)
+    if (l.type == lucent::LightType::Point) l.intensity = glm::dvec3(1e20);
+  lucent::test::CaptureWarnings warnings;
+  r.set_scene(s);
+  EXPECT_EQ(warnings.count("is above 1.84e+19"), 0) << warnings.dump();
+}
+
 // Lights that all send out nothing render a black image as well: zero intensities and
 // radiances, an environment map scaled by 0 or black in the channels its scale keeps. That was
 // silent (a reviewer's all-black map and zero point lights); a light that emits in any channel,

@@ -528,9 +528,13 @@ int render_with(const RenderArgs& a) {
     checkpoint->remove();
   else if (checkpoint && checkpoint->held() > 0)
     say_kept(*checkpoint, false);
+  // (a stopped render's pixels without a sample may be the ones it never reached)
   if (r.nonfinite > 0)
     std::fprintf(stderr, "lucent: warning: %s\n",
-                 lucent::render_detail::nonfinite_warning(r.nonfinite, r.samples).c_str());
+                 lucent::render_detail::nonfinite_warning(
+                     r.nonfinite,
+                     r.cancelled || g_interrupted.load() ? std::vector<std::uint32_t>{} : r.samples)
+                     .c_str());
   // one device: its pass time; several: the wall time of the render, when they overlapped. A
   // resumed render: this run's time and rates (its spp counts the checkpoint's samples too,
   // which it names: dividing them by this run's wall time gave thousands of Msamples/s)
@@ -539,11 +543,12 @@ int render_with(const RenderArgs& a) {
   if (resumed_spp > 0)
     resumed_note =
         " (" + std::to_string(resumed_spp) + " of them from " + one_line(checkpoint->path()) + ")";
-  // the reference's pixels hold all, some or none of their samples when it is stopped: its spp
-  // is their mean, its rate their total (it gave the spp asked for, and a rate made of them)
+  // a stopped reference's pixels hold all, some or none of their samples: its spp is their mean,
+  // its rate their total (it gave the spp asked for, and a rate made of them). (Not a complete
+  // one's: its counts leave out the samples it dropped as non-finite.)
   std::uint64_t shown_spp = r.spp;
   double run_samples = double(run_spp) * film_settings.width * film_settings.height;
-  if (a.reference && !r.samples.empty()) {
+  if (a.reference && (r.cancelled || g_interrupted.load()) && !r.samples.empty()) {
     std::uint64_t total = 0;
     for (const std::uint32_t n : r.samples) total += n;
     shown_spp = total / r.samples.size();

@@ -85,6 +85,8 @@ std::uint64_t bytes_add(std::uint64_t a, std::uint64_t b) {
 }
 
 std::string format_bytes(std::uint64_t bytes) {
+  // a saturated count (bytes_mul, bytes_add): not a figure
+  if (bytes == ~std::uint64_t(0)) return "16.0 EiB or more";
   char buf[64];
   const double b = double(bytes);
   if (bytes >= (1ull << 30))

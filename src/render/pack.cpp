@@ -375,43 +375,6 @@ std::string point_light_note(const PackedScene& packed, bool float_arithmetic) {
   return buf;
 }
 
-namespace {
-
-/// Warns of the first emission, intensity or radiance above sqrt(FLT_MAX), about 1.8e19: the
-/// kernel drops a sample whose square overflows a float (its sums of squares would be infinite),
-/// so such a light's directly seen pixels rendered black with a count of non-finite samples, and
-/// nothing said why. (The reference, in double, renders them.)
-void warn_of_radiance_beyond_float_squares(const Scene& scene) {
-  const double most = std::sqrt(double(FLT_MAX));
-  auto beyond = [most](const glm::dvec3& c) {
-    return std::max({c.x, c.y, c.z}) > most ? std::max({c.x, c.y, c.z}) : 0.0;
-  };
-  std::string place;
-  double value = 0;
-  for (const Material& m : scene.materials)
-    if ((value = beyond(m.emission)) > 0) {
-      place = "/materials/" + scene_detail::pointer_key(m.name) + "/emission";
-      break;
-    }
-  for (std::size_t i = 0; place.empty() && i < scene.lights.size(); ++i) {
-    const Light& l = scene.lights[i];
-    if ((value = beyond(l.type == LightType::Point ? l.intensity : l.radiance)) > 0)
-      place = "/lights/" + std::to_string(i) +
-              (l.type == LightType::Point         ? "/intensity"
-               : l.type == LightType::Environment ? "/radiance"
-                                                  : "/scale");
-  }
-  if (place.empty()) return;
-  char buf[256];
-  std::snprintf(buf, sizeof buf,
-                "%s: %.3g is above %.3g, where a sample's square overflows a float: the kernel "
-                "drops such samples as non-finite (lower it and raise film.exposure)",
-                place.c_str(), value, most);
-  scene_detail::warn(scene_detail::in_file(scene.path, buf));
-}
-
-}  // namespace
-
 PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bvh_reused) {
   // what the kernel's 32-bit indices can reach, before anything is built: the BVH's leaf blocks
   // (one per primitive at worst) and the texels (a texture's offset and offset + y w + x are
@@ -463,7 +426,6 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
 
   if (scene.materials.empty() && (!scene.spheres.empty() || !scene.triangles.empty()))
     throw Error(scene_detail::in_file(scene.path, "shapes need at least one material"));
-  warn_of_radiance_beyond_float_squares(scene);
   for (const Material& m : scene.materials) {
     lc_material d;
     std::fill(std::begin(d.p.words), std::end(d.p.words), 0.0f);
@@ -608,6 +570,7 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   // a light-transport integrator with nothing that emits renders a black image: said, not
   // silently written
   for (const std::string& note : scene_detail::light_notes(scene)) scene_detail::warn(note);
+  for (const std::string& note : scene_detail::radiance_notes(scene)) scene_detail::warn(note);
 
   // reserved: a large array's capacity is the block it holds (and a CPU device shares)
   p.texels.reserve(static_cast<std::size_t>(texels));

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "lucent/error.hpp"
@@ -530,6 +531,30 @@ std::vector<std::string> light_notes(const Scene& s) {
                     "every light of the scene emits nothing (an intensity, radiance or scale of "
                     "0, or a black environment map): the image is black")};
   return {};
+}
+
+std::vector<std::string> radiance_notes(const Scene& s) {
+  const double most = std::sqrt(double(FLT_MAX));
+  auto largest = [](const glm::dvec3& c) { return std::max({c.x, c.y, c.z}); };
+  std::string what;
+  double value = 0;
+  for (const Material& m : s.materials)
+    if ((value = largest(m.emission)) > most) {
+      what = "material '" + m.name + "': emission";  // (an MTL material has no JSON place)
+      break;
+    }
+  for (std::size_t i = 0; what.empty() && i < s.lights.size(); ++i) {
+    const Light& l = s.lights[i];
+    if (l.type != LightType::Point && (value = largest(l.radiance)) > most)
+      what = "/lights/" + std::to_string(i) +
+             (l.type == LightType::Environment ? "/radiance" : "/scale");
+  }
+  if (what.empty()) return {};
+  char buf[64];
+  std::snprintf(buf, sizeof buf, " %.3g is above %.3g", value, most);
+  return {in_file(s.path, what + buf +
+                              ", where a sample's square overflows a float: such samples are "
+                              "dropped as non-finite (lower it and raise film.exposure)")};
 }
 
 std::vector<std::string> energy_gain_notes(const Scene& s) {

@@ -145,6 +145,13 @@ std::vector<std::string> energy_gain_notes(const Scene& scene);
 /// integrators, which need no light. The session (pack_scene) and the reference give them.
 std::vector<std::string> light_notes(const Scene& scene);
 
+/// The first emission or environment radiance (or map scale) above sqrt(FLT_MAX), about 1.84e19,
+/// as a warning: the kernel and the reference drop a sample whose square overflows a float (the
+/// image's variances are floats), so such a light's directly seen pixels rendered black, with a
+/// count of non-finite samples and no word of why. (A point light's intensity is not seen
+/// directly: it reaches a pixel divided by a squared distance.)
+std::vector<std::string> radiance_notes(const Scene& scene);
+
 /// A texture's largest red, green and blue texels (0 for an empty one).
 glm::dvec3 brightest_texel(const Texture& texture);
 
