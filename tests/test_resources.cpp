@@ -292,7 +292,7 @@ double child_peak_growth_mib(const std::function<void()>& f) {
 }
 
 // What loading an inline mesh really takes stays within that count (measured: 22-24 bytes of
-// peak per byte of such text; counted 1.3-1.4 times that), and is not a wide overestimate. Not
+// peak per byte of such text; counted 1.3-1.5 times that), and is not a wide overestimate. Not
 // under AddressSanitizer, whose shadow memory and quarantine are in the peak.
 TEST(Resources, PeakHostMemoryOfAnInlineMeshIsWithinTheCount) {
   if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer's own memory is in the peak";

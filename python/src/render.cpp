@@ -993,6 +993,7 @@ void bind_render(py::module_& m) {
                 static_cast<int>(int_argument(s, "spp_ladder values", 1, limits::kMaxSpp, "")));
         else
           o.spp_ladder = default_spp_ladder(64);
+        static_assert(limits::kMaxSeconds == 1e7, "the message below says (0, 1e7]");
         for (double t : o.time_ladder)
           if (!(t > 0 && t <= limits::kMaxSeconds))
             throw py::value_error("time_ladder values must be in (0, 1e7] seconds, got " +

@@ -802,12 +802,18 @@ nlohmann::json to_json(py::handle o, const std::string& path, const std::string&
   }
   if (py::isinstance<py::dict>(o)) {
     nlohmann::json j = nlohmann::json::object();
-    for (auto item : py::reinterpret_borrow<py::dict>(o)) {
-      if (!py::isinstance<py::str>(item.first))
-        return fail("keys must be strings, got " + py::repr(item.first).cast<std::string>());
-      std::string key;
-      if (!utf8_text(item.first, key)) return fail("a key " + not_unicode(item.first));
-      j[key] = to_json(item.second, path + "/" + scene_detail::pointer_key(key), label, depth + 1);
+    try {  // (a part built when an exception leaves is freed without allocating: release_json)
+      for (auto item : py::reinterpret_borrow<py::dict>(o)) {
+        if (!py::isinstance<py::str>(item.first))
+          return fail("keys must be strings, got " + py::repr(item.first).cast<std::string>());
+        std::string key;
+        if (!utf8_text(item.first, key)) return fail("a key " + not_unicode(item.first));
+        j[key] =
+            to_json(item.second, path + "/" + scene_detail::pointer_key(key), label, depth + 1);
+      }
+    } catch (...) {
+      scene_detail::release_json(j);
+      throw;
     }
     return j;
   }
@@ -817,8 +823,13 @@ nlohmann::json to_json(py::handle o, const std::string& path, const std::string&
       py::isinstance<glm::dvec3>(o) || py::isinstance<glm::dvec2>(o)) {
     nlohmann::json j = nlohmann::json::array();
     std::size_t i = 0;
-    for (auto item : o)
-      j.push_back(to_json(item, path + "/" + std::to_string(i++), label, depth + 1));
+    try {
+      for (auto item : o)
+        j.push_back(to_json(item, path + "/" + std::to_string(i++), label, depth + 1));
+    } catch (...) {
+      scene_detail::release_json(j);
+      throw;
+    }
     return j;
   }
   return fail("cannot be written as JSON: " + py::repr(o).cast<std::string>());

@@ -194,7 +194,8 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
   ExrChannels exr = read_exr_channels(data, size, path, kMaxImagePixels);
   const int rgb[3] = {exr.find("R"), exr.find("G"), exr.find("B")};
   if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) {
-    // not our layout (a luminance-only EXR, say): the general reader makes it grey or refuses
+    // not our layout (a luminance-only EXR, or one of some of R, G and B, say): the general
+    // reader makes it grey, fills the missing colour channels with 0, or refuses
     // (its channels go first: the memory check counted one decoding, not two at once)
     exr = ExrChannels{};
     Decoded d = decode_image(data, size, path, 3, kMaxImagePixels);

@@ -361,6 +361,7 @@ void check_convergence_options(const ConvergeOptions& options, const Scene* scen
                   "], got " + std::to_string(s));
     largest = std::max(largest, s);
   }
+  static_assert(limits::kMaxSeconds == 1e7, "the message below says (0, 1e7]");
   for (double t : options.time_ladder)
     if (!(t > 0 && t <= limits::kMaxSeconds)) {
       char got[32];

@@ -30,7 +30,7 @@ void check_json_structure(const std::string& text, const std::string& path);
 /// (nlohmann::json: a 16-byte slot per value, an allocation per array and object, growing arrays
 /// twice their size) and the scene's arrays the numbers become. Dense inline meshes peaked at
 /// 22-24 times their text (24 MB of "[0,0,0]" positions: 571 MB): counted per value and per
-/// container, 1.3-1.4 times that.
+/// container, 1.3-1.5 times that.
 std::uint64_t json_load_bytes(std::uint64_t text_bytes, std::uint64_t values,
                               std::uint64_t containers, std::uint64_t string_bytes);
 
