@@ -256,11 +256,20 @@ TEST(ProgramCache, CliClearsTheCache) {
   // mistake, ".", lost every *.bin file in it)
   lucent::test::write_file(dir + "/weights.bin", "keep");
   lucent::test::write_file(dir + "/0123456789ABCDEF.bin", "keep");
+  // nor a directory of an entry's name (an empty one was removed and counted as a program)
+  fs::create_directories(dir + "/0000000000000000.bin");
+  fs::create_directories(dir + "/fedcba9876543210.bin");
+  lucent::test::write_file(dir + "/fedcba9876543210.bin/data.txt", "keep");
+  r = lucent::test::run_cli("cache info", "LUCENT_CACHE_DIR='" + dir + "'");
+  EXPECT_NE(r.out.find("programs: 1"), std::string::npos) << r.out;
   r = lucent::test::run_cli("cache clear", "LUCENT_CACHE_DIR='" + dir + "'");
   EXPECT_EQ(r.status, 0);
-  EXPECT_NE(r.out.find("removed 2"), std::string::npos) << r.out;
+  // as many as info counted: the entry (its write's temporary file went too, uncounted)
+  EXPECT_NE(r.out.find("removed 1 "), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(dir + "/weights.bin"));
   EXPECT_TRUE(fs::exists(dir + "/0123456789ABCDEF.bin"));
+  EXPECT_TRUE(fs::is_directory(dir + "/0000000000000000.bin"));
+  EXPECT_TRUE(fs::exists(dir + "/fedcba9876543210.bin/data.txt"));
   EXPECT_FALSE(fs::exists(dir + "/0123456789abcdef.bin.lock"));
   EXPECT_FALSE(fs::exists(dir + "/.0123456789abcdef.bin.tmp-12-0"));
   // on PoCL with its cache on, where sessions leave caching to PoCL, it says so

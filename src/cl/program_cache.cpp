@@ -446,14 +446,18 @@ int clear_program_cache(const std::string& dir) {
   for (const fs::directory_entry& e : cache_files(dir)) {
     const std::string name = e.path().filename().string();
     std::error_code ec;
+    // only files the cache writes: a directory or a link of such a name is not one (a directory
+    // "0000000000000000.bin" was removed and counted as a program, which info did not count)
+    if (!e.is_regular_file(ec) || e.is_symlink(ec)) continue;
     if (e.path().extension() == ".lock") {
-      fs::remove(e.path(), ec);  // build locks: not entries, not counted
-      continue;
+      remove_unused_lock(e.path().string());  // build locks: not entries, not counted; one held
+      continue;                               // is a build underway (as eviction leaves it)
     }
-    // entries, and the temporary files of writes that were interrupted
-    if (e.path().extension() == ".bin" || name.find(".bin.tmp") != std::string::npos) {
+    // entries, counted as info counts them, and the temporary files of interrupted writes
+    if (is_entry(e)) {
+      if (fs::remove(e.path(), ec)) ++n;
+    } else if (name.find(".bin.tmp") != std::string::npos) {
       fs::remove(e.path(), ec);
-      if (!ec) ++n;
     }
   }
   return n;
