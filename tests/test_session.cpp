@@ -763,6 +763,25 @@ TEST(Session, AdaptiveDeviceSharesCountEverySample) {
   EXPECT_EQ(res.devices[0].samples, p.accumulated);
 }
 
+// A moved-from Renderer holds no session: its methods throw lucent::Error (spp() and every other
+// call dereferenced a null pointer, SIGSEGV), and the Renderer it moved to renders.
+TEST(Session, MovedFromRendererThrows) {
+  Renderer a = session();
+  a.set_scene(lucent::test::scene_from(kScene));
+  Renderer b(std::move(a));
+  const std::string moved = "this lucent::Renderer was moved from: it holds no session";
+  EXPECT_EQ(lucent::test::error_of([&] { (void)a.spp(); }), moved);
+  EXPECT_EQ(lucent::test::error_of([&] { a.render(1); }), moved);
+  EXPECT_EQ(lucent::test::error_of([&] { (void)a.result(); }), moved);
+  EXPECT_EQ(lucent::test::error_of([&] { a.set_scene(lucent::test::scene_from(kScene)); }), moved);
+  EXPECT_EQ(lucent::test::error_of([&] { a.cancel(); }), moved);
+  b.render(1);
+  EXPECT_EQ(b.spp(), 1u);
+  a = std::move(b);  // assigned again, it renders
+  a.render(1);
+  EXPECT_EQ(a.spp(), 2u);
+}
+
 // A light-transport render of a scene with nothing that emits is black: a warning says so (it
 // was silent). The AOVs need no light and get none.
 TEST(Session, SceneWithoutLightWarns) {

@@ -221,6 +221,8 @@ class Renderer {
  private:
   friend class render_detail::CancelScope;
   struct Impl;
+  /// The session; throws lucent::Error on a moved-from Renderer.
+  Impl& impl() const;
   std::unique_ptr<Impl> impl_;
 };
 

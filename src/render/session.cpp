@@ -1459,80 +1459,86 @@ struct Renderer::Impl {
 };
 
 Renderer::Renderer(SessionOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+
+Renderer::Impl& Renderer::impl() const {
+  // (a moved-from Renderer: its methods dereferenced a null pointer)
+  if (!impl_) throw Error("this lucent::Renderer was moved from: it holds no session");
+  return *impl_;
+}
 Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 
-const DeviceInfo& Renderer::device() const { return impl_->device_infos.front(); }
-std::vector<DeviceInfo> Renderer::devices() const { return impl_->device_infos; }
-const SessionOptions& Renderer::options() const { return impl_->options; }
+const DeviceInfo& Renderer::device() const { return impl().device_infos.front(); }
+std::vector<DeviceInfo> Renderer::devices() const { return impl().device_infos; }
+const SessionOptions& Renderer::options() const { return impl().options; }
 
 void Renderer::set_build_options(Precision precision, bool fast_math, bool specialize) {
-  impl_->check_not_rendering("set_build_options");
+  impl().check_not_rendering("set_build_options");
   if (precision != Precision::Float && precision != Precision::Double)  // (7 was taken as float)
     throw Error("set_build_options: unknown precision " +
                 std::to_string(static_cast<int>(precision)));
   // (without a scene too: it was accepted, and refused at the next set_scene)
-  for (const DeviceInfo& d : impl_->device_infos)
+  for (const DeviceInfo& d : impl().device_infos)
     render_detail::check_precision_support(d, precision);
-  const SessionOptions before = impl_->options;
-  impl_->options.precision = precision;
-  impl_->options.fast_math = fast_math;
-  impl_->options.specialize = specialize;
+  const SessionOptions before = impl().options;
+  impl().options.precision = precision;
+  impl().options.fast_math = fast_math;
+  impl().options.specialize = specialize;
   try {
-    if (impl_->scene) {
+    if (impl().scene) {
       // a copy (two descriptions while it packs, as the estimate counts a copied scene); the
       // application still holds its own or not, as before
-      const bool taken = impl_->scene_taken;
-      impl_->set_scene(Scene(*impl_->scene));
-      impl_->scene_taken = taken;
+      const bool taken = impl().scene_taken;
+      impl().set_scene(Scene(*impl().scene));
+      impl().scene_taken = taken;
     }
   } catch (...) {
     // refused (a device without fp64, a kernel that does not build): the options stay those
     // the session's programs were built with
-    impl_->options.precision = before.precision;
-    impl_->options.fast_math = before.fast_math;
-    impl_->options.specialize = before.specialize;
+    impl().options.precision = before.precision;
+    impl().options.fast_math = before.fast_math;
+    impl().options.specialize = before.specialize;
     throw;
   }
 }
 
 void Renderer::set_scene(const Scene& scene) {
-  impl_->check_not_rendering("set_scene");
-  impl_->set_scene(scene);
+  impl().check_not_rendering("set_scene");
+  impl().set_scene(scene);
 }
 
 void Renderer::set_scene(Scene&& scene) {
-  impl_->check_not_rendering("set_scene");
-  impl_->set_scene(scene, &scene);
+  impl().check_not_rendering("set_scene");
+  impl().set_scene(scene, &scene);
 }
 
 void Renderer::set_camera(const Camera& camera) {
-  impl_->check_not_rendering("set_camera");
-  impl_->set_camera(camera);
+  impl().check_not_rendering("set_camera");
+  impl().set_camera(camera);
 }
 
 const Scene& Renderer::scene() const {
-  if (!impl_->scene) throw Error("the session has no scene (call set_scene first)");
-  return *impl_->scene;
+  if (!impl().scene) throw Error("the session has no scene (call set_scene first)");
+  return *impl().scene;
 }
 
 RenderProgress Renderer::render(std::uint64_t spp,
                                 const std::function<void(const RenderProgress&)>& on_progress) {
   if (spp == 0) throw Error("render: the number of samples per pixel must be positive");
-  return impl_->run(spp, 0, on_progress);
+  return impl().run(spp, 0, on_progress);
 }
 
 RenderProgress Renderer::render_for(double seconds,
                                     const std::function<void(const RenderProgress&)>& on_progress) {
   if (!(seconds > 0) || !std::isfinite(seconds))
     throw Error("render_for: the time must be a positive number of seconds");
-  return impl_->run(0, seconds, on_progress);
+  return impl().run(0, seconds, on_progress);
 }
 
 RenderProgress Renderer::render_adaptive(
     const AdaptiveOptions& options, const std::function<void(const RenderProgress&)>& on_progress) {
-  return impl_->run_adaptive(options, on_progress);
+  return impl().run_adaptive(options, on_progress);
 }
 
 RenderProgress Renderer::render(std::uint64_t spp, double max_seconds,
@@ -1541,19 +1547,19 @@ RenderProgress Renderer::render(std::uint64_t spp, double max_seconds,
     throw Error("render: give a number of samples per pixel, a time limit or both");
   if (!(max_seconds >= 0) || !std::isfinite(max_seconds))
     throw Error("render: the time limit must be a non-negative number of seconds");
-  return impl_->run(spp, max_seconds, on_progress);
+  return impl().run(spp, max_seconds, on_progress);
 }
 
 void Renderer::reset(std::uint64_t first_sample) {
-  impl_->check_not_rendering("reset");
+  impl().check_not_rendering("reset");
   if (first_sample > 0xffffffffull) throw Error("reset: the first sample index must be below 2^32");
-  impl_->clear_accumulation(first_sample);
+  impl().clear_accumulation(first_sample);
 }
 
-RenderResult Renderer::result() const { return impl_->result(); }
+RenderResult Renderer::result() const { return impl().result(); }
 
 Accumulation Renderer::accumulation() const {
-  const Impl& m = *impl_;
+  const Impl& m = impl();
   if (!m.scene) throw Error("accumulation: the session has no scene (call set_scene first)");
   // an adaptive render's samples are in its halves, per-pixel counts of two streams, which a
   // contiguous range of sample indices cannot describe (this returned zero sums claiming them)
@@ -1587,7 +1593,7 @@ Accumulation Renderer::accumulation() const {
 }
 
 std::uint64_t Renderer::image_hash() const {
-  const Impl& m = *impl_;
+  const Impl& m = impl();
   if (!m.scene) throw Error("image_hash: the session has no scene (call set_scene first)");
   std::uint64_t h = 14695981039346656037ull;  // FNV-1a, 64 bits
   auto add = [&h](const void* data, size_t size) {
@@ -1612,12 +1618,12 @@ std::uint64_t Renderer::image_hash() const {
   add(&source_hash, sizeof source_hash);
   return h;
 }
-std::uint64_t Renderer::spp() const { return impl_->done; }
-std::uint64_t Renderer::first_sample() const { return impl_->first; }
-void Renderer::cancel() { impl_->cancel_requested = true; }
-void Renderer::set_cancel_flag(const std::atomic<bool>* flag) { impl_->cancel_flag = flag; }
-const std::atomic<bool>* Renderer::cancel_flag() const { return impl_->cancel_flag; }
-SessionStats Renderer::stats() const { return impl_->stats; }
+std::uint64_t Renderer::spp() const { return impl().done; }
+std::uint64_t Renderer::first_sample() const { return impl().first; }
+void Renderer::cancel() { impl().cancel_requested = true; }
+void Renderer::set_cancel_flag(const std::atomic<bool>* flag) { impl().cancel_flag = flag; }
+const std::atomic<bool>* Renderer::cancel_flag() const { return impl().cancel_flag; }
+SessionStats Renderer::stats() const { return impl().stats; }
 
 namespace render_detail {
 
