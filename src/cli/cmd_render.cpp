@@ -628,10 +628,13 @@ CLI::App* add_render_command(CLI::App& app) {
       ->required();
   render
       ->add_option("--spp", ra.spp,
-                   "Samples per pixel (default: the scene's integrator.spp; with --target-error "
-                   "the most per pixel, default 16384)")
+                   "Samples per pixel (default: the scene's integrator.spp; with --time alone, as "
+                   "many as the time allows; with --target-error the most per pixel, default "
+                   "16384)")
       ->check(CLI::Range(1, lucent::limits::kMaxSpp));
-  render->add_option("--time", ra.time_limit, "Stop after this many seconds of rendering")
+  render
+      ->add_option("--time", ra.time_limit,
+                   "Stop after this many seconds of rendering (alone: render until then)")
       ->check(lucent::cli::positive_real())
       ->check(lucent::cli::real_range(0.0, lucent::limits::kMaxSeconds));
   render->add_option("--width", ra.width, "Image width (overrides the scene)")

@@ -526,7 +526,10 @@ int main(int argc, char** argv) {
         return v > 0 && v <= 1e7 ? "" : "must be in (0, 1e7] seconds, got " + text;
       },
       "SECONDS");
-  app.add_option("--time", a.time_limit, "Each rank stops after this many seconds (at most 1e7)")
+  app.add_option("--time", a.time_limit,
+                 "Each rank stops after this many seconds (at most 1e7) short of its share of "
+                 "--spp or the scene's spp (unlike lucent render --time alone, which renders "
+                 "until then: the ranks share a fixed number of samples)")
       ->check(seconds);
   app.add_option("--width", a.width, "Image width")
       ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
