@@ -664,6 +664,8 @@ TEST(Parts, DamagedPartFilesAreOneLineErrors) {
       {"lucent.display", "srgb,", "srgx,", "attribute lucent.display: unknown transfer 'srgx'"},
       {"lucent.display", ",clamp", ",clamq", "attribute lucent.display: unknown tone map 'clamq'"},
       {"lucent.display", "srgb,", "srgb;", "attribute lucent.display: invalid 'srgb;"},
+      // trailing characters (the scan stopped at them: 'clampX' read as clamp)
+      {"lucent.display", "2,0,clamp", ",0,clampX", "attribute lucent.display: invalid 'srgb,"},
       {"lucent.seconds", "0.", "-.", "attribute lucent.seconds: negative time '-."},
       // names of no integrator or sampler (they were read as given)
       {"lucent.integrator", "path", "patz",

@@ -194,9 +194,11 @@ PartInfo info_from_attributes(const std::string& path,
   const std::string& d = get("display");
   char transfer[16] = {0}, tonemap[16] = {0};
   double gamma = 0, exposure = 0;
-  if (std::sscanf(d.c_str(), "%15[a-z],%lf,%lf,%15[a-z]", transfer, &gamma, &exposure, tonemap) !=
-          4 ||
-      !std::isfinite(gamma) || !(gamma > 0) || !std::isfinite(exposure))
+  int end = 0;  // the whole value (trailing characters, 'clampX', were ignored)
+  if (std::sscanf(d.c_str(), "%15[a-z],%lf,%lf,%15[a-z]%n", transfer, &gamma, &exposure, tonemap,
+                  &end) != 4 ||
+      static_cast<std::size_t>(end) != d.size() || !std::isfinite(gamma) || !(gamma > 0) ||
+      !std::isfinite(exposure))
     throw Error(path + ": attribute lucent.display: invalid '" + d + "'");
   const std::string t = transfer, m = tonemap;
   if (t != "srgb" && t != "gamma" && t != "linear")
