@@ -15,11 +15,11 @@
 #include "core/file_io.hpp"
 #include "core/host_memory.hpp"
 #include "image/image_probe.hpp"
+#include "image/part_sums.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
-#include "lucent/parts.hpp"
-#include "render/part_channels.hpp"
+#include "render/sample_stats.hpp"
 
 namespace lucent {
 
@@ -208,14 +208,7 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
   // the checksum covers, not from its display channels, which it does not (a damaged PIZ chunk
   // of a checkpoint read as a mean of 1.5e24, which compare reported as a difference). The same
   // values for an intact file: the display channels are written from the sums.
-  if (exr.attributes.count("lucent.checksum")) {
-    RenderResult part = part_result(render_detail::part_from_channels(exr, path));
-    part.spp = 0;  // as below: the most samples of a pixel
-    for (const std::uint32_t count : part.samples)
-      part.spp = std::max<std::uint64_t>(part.spp, count);
-    if (part.sampler.empty()) part.seed = 0;
-    return part;
-  }
+  const bool part = exr.attributes.count("lucent.checksum") > 0;
   // the key of its random numbers, when a lucent render wrote it (write_render_exr)
   auto seed = exr.attributes.find("lucent.seed"), sampler = exr.attributes.find("lucent.sampler");
   if (seed != exr.attributes.end() && sampler != exr.attributes.end()) {
@@ -227,6 +220,22 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
   auto light = exr.attributes.find("lucent.light_mean_var");
   if (light != exr.attributes.end())
     r.light_mean_variance = parse_light_mean_var(path, light->second);
+  if (part) {
+    // mean and variance as write_render_part wrote them from the sums (part_result's)
+    const PartSums s = part_sums_from_channels(exr, path);
+    r.mean = Image{w, h, std::vector<float>(n * 3)};
+    r.variance = Image{w, h, std::vector<float>(n * 3)};
+    for (size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) {
+        const double count = s.count[i], sum = s.sum[i * 3 + c], sumsq = s.sumsq[i * 3 + c];
+        r.mean.rgb[i * 3 + c] = static_cast<float>(count > 0 ? sum / count : 0);
+        r.variance.rgb[i * 3 + c] =
+            static_cast<float>(render_detail::sample_variance(sum, sumsq, count));
+      }
+    r.samples = s.count;
+    r.spp = r.samples.empty() ? 0 : *std::max_element(r.samples.begin(), r.samples.end());
+    return r;
+  }
   r.mean = Image{w, h, std::vector<float>(n * 3)};
   for (int c = 0; c < 3; ++c)
     for (size_t i = 0; i < n; ++i) r.mean.rgb[i * 3 + c] = exr.planes[rgb[c]][i];

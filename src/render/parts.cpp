@@ -18,12 +18,12 @@
 #include "core/host_memory.hpp"
 #include "core/text.hpp"
 #include "image/image_probe.hpp"
+#include "image/part_sums.hpp"
 #include "lucent/error.hpp"
 #include "lucent/limits.hpp"
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
 #include "lucent/version.hpp"
-#include "render/part_channels.hpp"
 #include "render/resources.hpp"
 #include "render/sample_stats.hpp"
 
@@ -31,9 +31,9 @@ namespace lucent {
 
 namespace {
 
+using image_detail::hex64;
+
 constexpr const char* kFormat = "lucent-part 1";
-constexpr const char* kPlanes[2] = {"sum", "sumsq"};
-constexpr const char* kRgb[3] = {"R", "G", "B"};
 
 double parse_double(const std::string& path, const std::string& what, const std::string& s) {
   io::CNumbers c_numbers;  // "0.5", whatever the process locale
@@ -116,29 +116,9 @@ bool overlap(const std::vector<SampleRange>& a, const std::vector<SampleRange>& 
   return false;
 }
 
-std::string hex64(std::uint64_t v) {
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016" PRIx64, v);
-  return buf;
-}
-
-/// A check of a part's samples, its attribute lucent.checksum: the bits of every sum, sum of
-/// squares and count, chained through a multiply and a shift. A PIZ chunk (a checkpoint's) has no
-/// check of its own, unlike ZIP's Adler-32: a damaged one that still decodes gave other sums.
+/// The checksum of an accumulation's sums (image_detail::part_sums_checksum).
 std::uint64_t sums_checksum(const Accumulation& a) {
-  std::uint64_t h = 0x9e3779b97f4a7c15ull;
-  auto mix = [&h](std::uint64_t w) {
-    h = (h ^ w) * 0x100000001b3ull;
-    h ^= h >> 29;
-  };
-  for (const std::vector<double>* v : {&a.sum, &a.sumsq})
-    for (const double d : *v) {
-      std::uint64_t bits;
-      std::memcpy(&bits, &d, sizeof bits);
-      mix(bits);
-    }
-  for (const std::uint32_t n : a.count) mix(n);
-  return h;
+  return image_detail::part_sums_checksum(a.sum, a.sumsq, a.count);
 }
 
 PartInfo info_from_attributes(const std::string& path,
@@ -215,7 +195,7 @@ PartInfo info_from_attributes(const std::string& path,
 }
 
 std::string channel_name(int plane, int c, bool high) {
-  return std::string(kPlanes[plane]) + "." + kRgb[c] + (high ? ".hi" : ".lo");
+  return image_detail::part_channel_name(plane, c, high);
 }
 
 /// Whether an accumulation's sums and counts have its film's size (a part made by hand may not:
@@ -495,43 +475,21 @@ PartInfo read_part_info(const std::string& path) {
   return info_from_attributes(path, attrs, probe.width, probe.height);
 }
 
-namespace render_detail {
+namespace {
 
+/// The part in `exr` (the channels and attributes of the part file `path`): its header, and its
+/// sums, sums of squares and counts (checked against the checksum, and the counts against the
+/// ranges).
 RenderPart part_from_channels(const image_detail::ExrChannels& exr, const std::string& path) {
   RenderPart p;
   p.info = info_from_attributes(path, exr.attributes, exr.width, exr.height);
-  const size_t npix = static_cast<size_t>(exr.width) * exr.height;
+  image_detail::PartSums sums = image_detail::part_sums_from_channels(exr, path);
   Accumulation& a = p.acc;
   a.width = exr.width;
   a.height = exr.height;
-  a.sum.resize(npix * 3);
-  a.sumsq.resize(npix * 3);
-  auto uint_channel = [&](const std::string& name) -> const std::vector<std::uint32_t>& {
-    const int k = exr.find(name.c_str());
-    if (k < 0 || exr.uint_planes[k].size() != npix)
-      throw Error(path + ": part file has no UINT channel " + name);
-    return exr.uint_planes[k];
-  };
-  for (int plane = 0; plane < 2; ++plane) {
-    std::vector<double>& dst = plane == 0 ? a.sum : a.sumsq;
-    for (int c = 0; c < 3; ++c) {
-      const std::vector<std::uint32_t>& hi = uint_channel(channel_name(plane, c, true));
-      const std::vector<std::uint32_t>& lo = uint_channel(channel_name(plane, c, false));
-      for (size_t i = 0; i < npix; ++i) {
-        const std::uint64_t bits = (std::uint64_t(hi[i]) << 32) | lo[i];
-        std::memcpy(&dst[i * 3 + c], &bits, sizeof(double));
-        if (!std::isfinite(dst[i * 3 + c]) || (plane == 1 && dst[i * 3 + c] < 0))
-          throw Error(path + ": channel " + channel_name(plane, c, true) + ": pixel " +
-                      std::to_string(i % a.width) + ", " + std::to_string(i / a.width) +
-                      " holds an invalid sum");
-      }
-    }
-  }
-  a.count = uint_channel("n");
-  // (a part file written before 30 Nov 2026 has none)
-  if (auto sum = exr.attributes.find("lucent.checksum");
-      sum != exr.attributes.end() && sum->second != hex64(sums_checksum(a)))
-    throw Error(path + ": part file is damaged: its samples do not match its checksum");
+  a.sum = std::move(sums.sum);
+  a.sumsq = std::move(sums.sumsq);
+  a.count = std::move(sums.count);
   check_counts(path, p.info, a);
   a.spp = total(p.info.samples);
   a.nonfinite = p.info.nonfinite;
@@ -540,7 +498,7 @@ RenderPart part_from_channels(const image_detail::ExrChannels& exr, const std::s
   return p;
 }
 
-}  // namespace render_detail
+}  // namespace
 
 RenderPart read_render_part(const std::string& path) {
   check_part_file_size(path);
@@ -560,7 +518,7 @@ RenderPart read_render_part(const std::string& path) {
   const image_detail::ExrChannels exr =
       image_detail::read_exr_channels(reinterpret_cast<const unsigned char*>(bytes.data()),
                                       bytes.size(), path, image_detail::kMaxImagePixels);
-  return render_detail::part_from_channels(exr, path);
+  return part_from_channels(exr, path);
 }
 
 void PartMerger::check(const std::string& name, const PartInfo& info) {

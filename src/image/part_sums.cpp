@@ -1,0 +1,78 @@
+#include "image/part_sums.hpp"
+
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "lucent/error.hpp"
+
+namespace lucent::image_detail {
+
+namespace {
+constexpr const char* kPlanes[2] = {"sum", "sumsq"};
+constexpr const char* kRgb[3] = {"R", "G", "B"};
+}  // namespace
+
+std::string part_channel_name(int plane, int c, bool high) {
+  return std::string(kPlanes[plane]) + "." + kRgb[c] + (high ? ".hi" : ".lo");
+}
+
+std::uint64_t part_sums_checksum(const std::vector<double>& sum, const std::vector<double>& sumsq,
+                                 const std::vector<std::uint32_t>& count) {
+  std::uint64_t h = 0x9e3779b97f4a7c15ull;
+  auto mix = [&h](std::uint64_t w) {
+    h = (h ^ w) * 0x100000001b3ull;
+    h ^= h >> 29;
+  };
+  for (const std::vector<double>* v : {&sum, &sumsq})
+    for (const double d : *v) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &d, sizeof bits);
+      mix(bits);
+    }
+  for (const std::uint32_t n : count) mix(n);
+  return h;
+}
+
+std::string hex64(std::uint64_t v) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016" PRIx64, v);
+  return buf;
+}
+
+PartSums part_sums_from_channels(const ExrChannels& exr, const std::string& path) {
+  const size_t npix = static_cast<size_t>(exr.width) * exr.height;
+  PartSums p;
+  p.sum.resize(npix * 3);
+  p.sumsq.resize(npix * 3);
+  auto uint_channel = [&](const std::string& name) -> const std::vector<std::uint32_t>& {
+    const int k = exr.find(name.c_str());
+    if (k < 0 || exr.uint_planes[k].size() != npix)
+      throw Error(path + ": part file has no UINT channel " + name);
+    return exr.uint_planes[k];
+  };
+  for (int plane = 0; plane < 2; ++plane) {
+    std::vector<double>& dst = plane == 0 ? p.sum : p.sumsq;
+    for (int c = 0; c < 3; ++c) {
+      const std::vector<std::uint32_t>& hi = uint_channel(part_channel_name(plane, c, true));
+      const std::vector<std::uint32_t>& lo = uint_channel(part_channel_name(plane, c, false));
+      for (size_t i = 0; i < npix; ++i) {
+        const std::uint64_t bits = (std::uint64_t(hi[i]) << 32) | lo[i];
+        std::memcpy(&dst[i * 3 + c], &bits, sizeof(double));
+        if (!std::isfinite(dst[i * 3 + c]) || (plane == 1 && dst[i * 3 + c] < 0))
+          throw Error(path + ": channel " + part_channel_name(plane, c, true) + ": pixel " +
+                      std::to_string(i % exr.width) + ", " + std::to_string(i / exr.width) +
+                      " holds an invalid sum");
+      }
+    }
+  }
+  p.count = uint_channel("n");
+  if (auto sum = exr.attributes.find("lucent.checksum");
+      sum != exr.attributes.end() &&
+      sum->second != hex64(part_sums_checksum(p.sum, p.sumsq, p.count)))
+    throw Error(path + ": part file is damaged: its samples do not match its checksum");
+  return p;
+}
+
+}  // namespace lucent::image_detail
