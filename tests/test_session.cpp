@@ -848,6 +848,15 @@ TEST(Session, RadianceBeyondFloatSquaresWarns) {
         << warnings.dump();
   }
   s.materials[0].emission = glm::dvec3(0);
+  // a map: its scale times its brightest texel (1e10 x 4e9)
+  s.textures.push_back(lucent::texture_from_rgba(2, 1, {1, 1, 1, 1, 1, 4e9f, 1, 1}));
+  s.lights[0] = lucent::environment_map(static_cast<int>(s.textures.size()) - 1, 1e10);
+  {
+    lucent::test::CaptureWarnings warnings;
+    r.set_scene(s);
+    EXPECT_EQ(warnings.count("/lights/0/scale (times the map's brightest texel) 4e+19 is above"), 1)
+        << warnings.dump();
+  }
   s.lights.erase(s.lights.begin());
   for (lucent::Light& l : s.lights)
     if (l.type == lucent::LightType::Point) l.intensity = glm::dvec3(1e20);

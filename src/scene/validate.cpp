@@ -545,9 +545,18 @@ std::vector<std::string> radiance_notes(const Scene& s) {
     }
   for (std::size_t i = 0; what.empty() && i < s.lights.size(); ++i) {
     const Light& l = s.lights[i];
-    if (l.type != LightType::Point && (value = largest(l.radiance)) > most)
-      what = "/lights/" + std::to_string(i) +
-             (l.type == LightType::Environment ? "/radiance" : "/scale");
+    if (l.type == LightType::Environment && (value = largest(l.radiance)) > most)
+      what = "/lights/" + std::to_string(i) + "/radiance";
+    if (l.type != LightType::EnvironmentMap || l.texture < 0 ||
+        static_cast<std::size_t>(l.texture) >= s.textures.size())
+      continue;
+    // a map: its scale times its brightest texel, channel by channel
+    const std::vector<float>& rgba = s.textures[static_cast<std::size_t>(l.texture)].rgba;
+    value = 0;
+    for (std::size_t k = 0; k + 3 < rgba.size(); k += 4)
+      for (int c = 0; c < 3; ++c) value = std::max(value, l.radiance[c] * double(rgba[k + c]));
+    if (value > most)
+      what = "/lights/" + std::to_string(i) + "/scale (times the map's brightest texel)";
   }
   if (what.empty()) return {};
   char buf[64];

@@ -145,7 +145,8 @@ std::vector<std::string> energy_gain_notes(const Scene& scene);
 /// integrators, which need no light. The session (pack_scene) and the reference give them.
 std::vector<std::string> light_notes(const Scene& scene);
 
-/// The first emission or environment radiance (or map scale) above sqrt(FLT_MAX), about 1.84e19,
+/// The first emission or environment radiance (or a map's scale times its brightest texel) above
+/// sqrt(FLT_MAX), about 1.84e19,
 /// as a warning: the kernel and the reference drop a sample whose square overflows a float (the
 /// image's variances are floats), so such a light's directly seen pixels rendered black, with a
 /// count of non-finite samples and no word of why. (A point light's intensity is not seen
