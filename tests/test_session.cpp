@@ -956,6 +956,38 @@ TEST(Session, CameraFinerThanFloatWarns) {
   EXPECT_EQ(warnings_for(40, 1e8, false), 0);
 }
 
+// A surface within a few float steps of the camera: the camera's stored (float) position may fall
+// on it or past it, with either precision, and the surface is not seen. A wall 0.0002 in front of
+// a camera at x = 1e4 (floats 0.001 apart there) was sky in both precisions, without a word,
+// where the reference sees the wall. Said now; not for the wall at 0.5, nor for a camera at the
+// origin, nor for one far outside the scene's bounds.
+TEST(Session, SurfaceWithinFloatStepsOfTheCameraWarns) {
+  const std::string what = "camera: a surface lies within ";
+  auto warnings_for = [&](double x, double gap, const char* precision) {
+    char json[1024];
+    std::snprintf(json, sizeof json, R"({
+      "camera": {"position": [%.17g, 0, 0], "look_at": [%.17g, 0, 0], "up": [0, 1, 0], "fov": 60},
+      "film": {"width": 8, "height": 8},
+      "materials": {"wall": {"type": "diffuse", "albedo": [0.3, 0.3, 0.3]}},
+      "shapes": [{"type": "triangles", "material": "wall",
+                  "positions": [[%.17g, -50, -50], [%.17g, 50, -50], [%.17g, 50, 50], [%.17g, -50, 50]],
+                  "indices": [0, 1, 2, 0, 2, 3]}],
+      "lights": [{"type": "environment", "radiance": [1, 1, 1]}]})",
+                  x, x - 200, x - gap, x - gap, x - gap, x - gap);
+    lucent::SessionOptions o = lucent::test::session_options();
+    o.precision = lucent::parse_precision(precision);
+    Renderer r(o);
+    lucent::test::CaptureWarnings warnings;
+    r.set_scene(lucent::test::scene_from(json));
+    return warnings.count(what);
+  };
+  EXPECT_EQ(warnings_for(10000.0004, 0.0002, "float"), 1);
+  EXPECT_EQ(warnings_for(10000.0004, 0.0002, "double"), 1);
+  EXPECT_EQ(warnings_for(10000.0004, 0.5, "float"), 0);
+  EXPECT_EQ(warnings_for(0.0004, 0.0002, "float"), 0);
+  EXPECT_EQ(warnings_for(10000.0004, -1e3, "float"), 0);  // the wall far behind the camera
+}
+
 // In float precision, rays leave surfaces offset by their rounding, which scales with their
 // primitive's coordinates: a warning says when that is large against the scene's small features
 // (a ground triangle of 1e6 under a sphere of 0.01 rendered 16% too dark, image-mean z -84

@@ -103,7 +103,48 @@ lc_camera pack_camera(const Camera& c, int width, int height) {
 // double, does not). Said when a pixel spans fewer than 4 steps. The distance is the look-at's,
 // or the scene's bounds' when they are farther (a look-at 1 ahead of a camera 5000 from what it
 // sees warned).
+/// Whether a stored surface (a triangle's plane within its bounds, a sphere) lies within `reach`
+/// of point `o`.
+static bool surface_within(const PackedScene& p, const glm::dvec3& o, double reach) {
+  for (const lc_triangle& t : p.triangles) {
+    bool inside = true;
+    for (int a = 0; a < 3 && inside; ++a) {
+      const double lo = std::min({t.v0[a], t.v1[a], t.v2[a]}),
+                   hi = std::max({t.v0[a], t.v1[a], t.v2[a]});
+      inside = o[a] >= lo - reach && o[a] <= hi + reach;
+    }
+    if (inside && std::abs(t.ng_x * (o.x - t.v0[0]) + t.ng_y * (o.y - t.v0[1]) +
+                           t.ng_z * (o.z - t.v0[2])) <= reach)
+      return true;
+  }
+  for (const lc_sphere& s : p.spheres)
+    if (std::abs(glm::length(o - glm::dvec3(s.center[0], s.center[1], s.center[2])) - s.radius) <=
+        reach)
+      return true;
+  return false;
+}
+
 static void warn_camera_precision(const Scene& scene, const Camera& c, const PackedScene& p) {
+  // a surface within a few float steps of the camera: the camera's rounding can put it on the
+  // surface or past it, with either precision (a wall 0.0002 in front of a camera at 1e4, where
+  // floats are 0.001 apart, was not seen: the camera rounded onto its plane). Checked only when
+  // the camera is that near the scene's bounds.
+  double at = 0, outside = 0;
+  for (int i = 0; i < 3; ++i) {
+    at = std::max(at, std::abs(c.position[i]));
+    outside = std::max({outside, p.bounds_min[i] - c.position[i], c.position[i] - p.bounds_max[i]});
+  }
+  const double apart = at * std::ldexp(1.0, -23), reach = 4 * apart;
+  if (reach > 0 && outside <= reach && surface_within(p, c.position, reach)) {
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "camera: a surface lies within %.3g of the camera, at coordinates up to %.3g "
+                  "where floats are up to %.3g apart: with either precision the camera's stored "
+                  "position may fall on the surface or past it, which is then not seen; move the "
+                  "camera away from it or the scene nearer the origin",
+                  reach, at, apart);
+    scene_detail::warn(scene_detail::in_file(scene.path, buf));
+  }
   double to_bounds = 0;  // from the camera to the nearest point of the scene's bounds
   for (int i = 0; i < 3; ++i) {
     const double out =
