@@ -413,7 +413,7 @@ TEST(CliErrors, RealOptionsBeyondAFloatNameTheOption) {
   // converge's --time-ladder is bounded as render's --time is
   CommandResult r = run_cli(converge + "--time-ladder 1e8");
   EXPECT_EQ(expect_one_error_line(r),
-            "--time-ladder: must be in [0, 1e+07], got 1e8 (see lucent "
+            "--time-ladder: must be in (0, 1e7] seconds, got 1e8 (see lucent "
             "--help)");
   // and converge's settings
   r = run_cli(converge + "--settings default,clamp=1e300");

@@ -368,8 +368,8 @@ TEST(Outputs, NonFiniteOptionsAreRefused) {
       {"--target-error x", "--target-error: must be a number, got x"},
       {"--clamp -0.5", "--clamp: must be 0 or more, got -0.5"},
       {"--dielectric-splits 5", "--dielectric-splits: Value 5 not in range 0 to 4"},
-      {"--time -3", "--time: must be a positive number, got -3"},
-      {"--time 1e8", "--time: must be in [0, 1e+07], got 1e8"}};
+      {"--time -3", "--time: must be in (0, 1e7] seconds, got -3"},
+      {"--time 1e8", "--time: must be in (0, 1e7] seconds, got 1e8"}};
   for (const auto& [opt, want] : bad)
     EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o " + q(out) + " " + opt)),
               std::string(want) + " (see lucent --help)");

@@ -343,6 +343,16 @@ constexpr std::uint64_t kSampleIndices = std::uint64_t(1) << 32;
 constexpr const char* kSampleNote = " (the sampler's sample indices are 32-bit)";
 constexpr std::uint64_t kMaxAdaptiveSpp = std::numeric_limits<std::uint32_t>::max();
 
+/// A time limit: as checked_seconds, and at most the command line's 1e7 s (--time; a render_for
+/// of 1e8 s ran until killed).
+double checked_time_limit(double s, const char* what) {
+  static_assert(limits::kMaxSeconds == 1e7, "the message says 1e7");
+  if (!(s >= 0) || !(s <= limits::kMaxSeconds))
+    throw py::value_error(std::string(what) + " must be a finite number in [0, 1e7] seconds, got " +
+                          format_field(s));
+  return s;
+}
+
 double checked_seconds(double s, const char* what) {
   if (!(s >= 0) || !std::isfinite(s))
     throw py::value_error(std::string(what) + " must be a finite number >= 0, got " +
@@ -771,7 +781,7 @@ void bind_render(py::module_& m) {
           "render",
           [](PyRenderer& r, const IntArg& spp_arg, double seconds, py::object progress) {
             const std::uint64_t spp = int_argument(spp_arg, "spp", 0, kSampleIndices, kSampleNote);
-            seconds = checked_seconds(seconds, "seconds");
+            seconds = checked_time_limit(seconds, "seconds");
             if (spp == 0 && seconds == 0)
               throw py::value_error(
                   "render: give spp > 0, seconds > 0 or both, got spp=0 and "
@@ -806,7 +816,7 @@ void bind_render(py::module_& m) {
                   "to even, " +
                   std::to_string(pilot) + "), got min_spp=" + std::to_string(o.min_spp) +
                   " and max_spp=" + std::to_string(o.max_spp));
-            o.max_seconds = checked_seconds(max_seconds, "max_seconds");
+            o.max_seconds = checked_time_limit(max_seconds, "max_seconds");
             return r.render_adaptive(o, std::move(progress));
           },
           py::arg("target_error") = 0.0, py::arg("budget_spp") = 0.0, py::arg("min_spp") = 64,
@@ -820,8 +830,8 @@ void bind_render(py::module_& m) {
       .def(
           "render_for",
           [](PyRenderer& r, double seconds, py::object progress) {
-            if (!(seconds > 0) || !std::isfinite(seconds))
-              throw py::value_error("seconds must be a finite number > 0, got " +
+            if (!(seconds > 0) || !(seconds <= limits::kMaxSeconds))
+              throw py::value_error("seconds must be a finite number in (0, 1e7], got " +
                                     format_field(seconds));
             return r.render("render_for", 0, seconds, std::move(progress));
           },

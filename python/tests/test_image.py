@@ -120,6 +120,12 @@ def test_compare_arrays_without_variance():
     b[1, 2, 0] = np.nextafter(np.float32(1), np.float32(2))
     c = lucent.compare(a, b, abs_epsilon=0, rel_epsilon=0)
     assert not c.passed and c.failed_channels == 1 and c.max_z == math.inf
+    # alpha in the command line's and the library's range (0.7 passed here, then the library
+    # refused it as a lucent.Error)
+    for bad in (0, 1e-13, 0.7, 1, math.nan):
+        with pytest.raises(ValueError, match=r"alpha must be in \[1e-12, 0.5\]"):
+            lucent.compare(a, a, alpha=bad)
+    assert lucent.compare(a, a, alpha=0.5).passed
 
 
 def test_image_errors(tmp_path):

@@ -175,8 +175,7 @@ CLI::App* add_converge_command(CLI::App& app) {
                   ->check(CLI::Range(1, limits::kMaxSpp));
   auto* time = cmd->add_option("--time-ladder", a.time_ladder, "Seconds of rendering per rung")
                    ->delimiter(',')
-                   ->check(lucent::cli::positive_real())
-                   ->check(lucent::cli::real_range(0.0, lucent::limits::kMaxSeconds));
+                   ->check(lucent::cli::seconds_limit());
   spp->excludes(time);
   cmd->add_option("--max-spp", a.max_spp,
                   "Default ladder: powers of two from 1 to this (default 64)")

@@ -635,8 +635,7 @@ CLI::App* add_render_command(CLI::App& app) {
   render
       ->add_option("--time", ra.time_limit,
                    "Stop after this many seconds of rendering (alone: render until then)")
-      ->check(lucent::cli::positive_real())
-      ->check(lucent::cli::real_range(0.0, lucent::limits::kMaxSeconds));
+      ->check(lucent::cli::seconds_limit());
   render->add_option("--width", ra.width, "Image width (overrides the scene)")
       ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
   render->add_option("--height", ra.height, "Image height (overrides the scene)")
@@ -685,8 +684,7 @@ CLI::App* add_render_command(CLI::App& app) {
   render
       ->add_option("--checkpoint-every", ra.checkpoint_every,
                    "Seconds between two checkpoints (default 300)")
-      ->check(lucent::cli::positive_real())
-      ->check(lucent::cli::real_range(0.0, lucent::limits::kMaxSeconds));
+      ->check(lucent::cli::seconds_limit());
   render->add_flag("--reference", ra.reference,
                    "Render with the scalar CPU reference integrator instead of the kernel");
   lucent::cli::add_sampling_options(render, ra.sampling, true);

@@ -10,6 +10,7 @@
 
 #include "cl/program_cache.hpp"
 #include "lucent/error.hpp"
+#include "lucent/limits.hpp"
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
 
@@ -51,6 +52,12 @@ CLI::Validator real_range(double lo, double hi) {
   char what[96];
   std::snprintf(what, sizeof what, "must be in [%g, %g]", lo, hi);
   return real_check([lo, hi](double v) { return v >= lo && v <= hi; }, what, "REAL");
+}
+
+CLI::Validator seconds_limit() {
+  static_assert(limits::kMaxSeconds == 1e7, "the message says (0, 1e7]");
+  return real_check([](double v) { return v > 0 && v <= limits::kMaxSeconds; },
+                    "must be in (0, 1e7] seconds", "SECONDS");
 }
 
 CLI::Validator positive_real() {
