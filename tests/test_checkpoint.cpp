@@ -333,7 +333,8 @@ TEST(Checkpoint, UnsupportedCombinationsAreRefused) {
       {"--checkpoint-every 5", "--checkpoint-every is how often --checkpoint writes", 1},
       {"--checkpoint " + q(dir + "/ck.png"), dir + "/ck.png: --checkpoint writes a part file", 1},
       {"--checkpoint " + q(out), out + ": is the output too", 1},
-      {"--checkpoint " + ck + " --checkpoint-every 0", "--checkpoint-every: must be a positive", 2},
+      {"--checkpoint " + ck + " --checkpoint-every 0",
+       "--checkpoint-every: must be in (0, 1e7] seconds, got 0", 2},
       {"--checkpoint " + ck + " --checkpoint-every 2e7", "--checkpoint-every: must be in", 2},
   };
   for (const auto& c : cases) {
