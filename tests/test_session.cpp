@@ -22,6 +22,7 @@
 #include "lucent/session.hpp"
 #include "render/cancel_scope.hpp"
 #include "render/device_scene.hpp"
+#include "render/pack.hpp"
 #include "render/resources.hpp"
 #include "stability_scene.hpp"
 #include "support.hpp"
@@ -826,12 +827,11 @@ TEST(Session, RadianceBeyondFloatSquaresWarns) {
   sky.type = lucent::LightType::Environment;
   sky.radiance = glm::dvec3(1e20, 1, 1);
   s.lights.insert(s.lights.begin(), sky);
-  Renderer r = session();
   lucent::ReferenceOptions ro;
   ro.spp = 1;
   {
     lucent::test::CaptureWarnings warnings;
-    r.set_scene(s);
+    lucent::render_detail::pack_scene(s);  // (its warnings: no kernel built)
     EXPECT_EQ(warnings.count(hot), 1) << warnings.dump();
   }
   {
@@ -843,7 +843,7 @@ TEST(Session, RadianceBeyondFloatSquaresWarns) {
   s.materials[0].emission = glm::dvec3(0, 2e19, 0);
   {
     lucent::test::CaptureWarnings warnings;
-    r.set_scene(s);
+    lucent::render_detail::pack_scene(s);  // (its warnings: no kernel built)
     EXPECT_EQ(warnings.count("material '" + s.materials[0].name + "': emission 2e+19 is above"), 1)
         << warnings.dump();
   }
@@ -853,7 +853,7 @@ TEST(Session, RadianceBeyondFloatSquaresWarns) {
   s.lights[0] = lucent::environment_map(static_cast<int>(s.textures.size()) - 1, 1e10);
   {
     lucent::test::CaptureWarnings warnings;
-    r.set_scene(s);
+    lucent::render_detail::pack_scene(s);  // (its warnings: no kernel built)
     EXPECT_EQ(warnings.count("/lights/0/scale (times the map's brightest texel) 4e+19 is above"), 1)
         << warnings.dump();
   }
@@ -861,7 +861,7 @@ TEST(Session, RadianceBeyondFloatSquaresWarns) {
   for (lucent::Light& l : s.lights)
     if (l.type == lucent::LightType::Point) l.intensity = glm::dvec3(1e20);
   lucent::test::CaptureWarnings warnings;
-  r.set_scene(s);
+  lucent::render_detail::pack_scene(s);  // (its warnings: no kernel built)
   EXPECT_EQ(warnings.count("is above 1.84e+19"), 0) << warnings.dump();
 }
 
@@ -963,7 +963,7 @@ TEST(Session, CameraFinerThanFloatWarns) {
 // origin, nor for one far outside the scene's bounds.
 TEST(Session, SurfaceWithinFloatStepsOfTheCameraWarns) {
   const std::string what = "camera: a surface lies within ";
-  auto warnings_for = [&](double x, double gap, const char* precision) {
+  auto warnings_for = [&](double x, double gap) {
     char json[1024];
     std::snprintf(json, sizeof json, R"({
       "camera": {"position": [%.17g, 0, 0], "look_at": [%.17g, 0, 0], "up": [0, 1, 0], "fov": 60},
@@ -974,18 +974,15 @@ TEST(Session, SurfaceWithinFloatStepsOfTheCameraWarns) {
                   "indices": [0, 1, 2, 0, 2, 3]}],
       "lights": [{"type": "environment", "radiance": [1, 1, 1]}]})",
                   x, x - 200, x - gap, x - gap, x - gap, x - gap);
-    lucent::SessionOptions o = lucent::test::session_options();
-    o.precision = lucent::parse_precision(precision);
-    Renderer r(o);
+    // (pack_scene's warning, the same for either precision: no kernel is built)
     lucent::test::CaptureWarnings warnings;
-    r.set_scene(lucent::test::scene_from(json));
+    lucent::render_detail::pack_scene(lucent::test::scene_from(json));
     return warnings.count(what);
   };
-  EXPECT_EQ(warnings_for(10000.0004, 0.0002, "float"), 1);
-  EXPECT_EQ(warnings_for(10000.0004, 0.0002, "double"), 1);
-  EXPECT_EQ(warnings_for(10000.0004, 0.5, "float"), 0);
-  EXPECT_EQ(warnings_for(0.0004, 0.0002, "float"), 0);
-  EXPECT_EQ(warnings_for(10000.0004, -1e3, "float"), 0);  // the wall far behind the camera
+  EXPECT_EQ(warnings_for(10000.0004, 0.0002), 1);
+  EXPECT_EQ(warnings_for(10000.0004, 0.5), 0);
+  EXPECT_EQ(warnings_for(0.0004, 0.0002), 0);
+  EXPECT_EQ(warnings_for(10000.0004, -1e3), 0);  // the wall far behind the camera
 }
 
 // In float precision, rays leave surfaces offset by their rounding, which scales with their
