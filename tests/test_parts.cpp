@@ -1006,6 +1006,17 @@ TEST(Parts, MpiFailingRankEndsTheJobWithoutOutput) {
   EXPECT_NE(r.err.find("lucent-mpi: error: rank 1 of 2 ("), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("no-such-device"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
+  // every rank without its device: one line, the lowest rank's (each rank printed its own)
+  r = run_shell(mpirun("-np 2 -x LUCENT_DEVICE=no-such-device " + prog), dir);
+  EXPECT_EQ(r.status, 1) << r.err;
+  // (mpirun adds its own report of the exit status)
+  size_t lines = 0;
+  for (size_t at = r.err.find("lucent-mpi:"); at != std::string::npos;
+       at = r.err.find("lucent-mpi:", at + 1))
+    ++lines;
+  EXPECT_EQ(lines, 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("lucent-mpi: error: rank 0 of 2 (", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(out));
   for (const auto& entry : fs::directory_iterator(dir))
     EXPECT_EQ(entry.path().filename().string().find("mpi.exr"), std::string::npos)
         << "a temporary output was left: " << entry.path();

@@ -338,7 +338,10 @@ int run(const Args& a) {
   if (!a.device.empty()) so.device = a.device;
   so.precision = lucent::parse_precision(a.precision);
   so.fast_math = a.fast_math;
-  std::optional<lucent::Renderer> session(std::in_place, so);
+  // the device opened by every rank, agreed: one line naming the lowest rank that cannot (every
+  // rank of a job given another machine's --device printed its own, each racing MPI_Abort)
+  std::optional<lucent::Renderer> session;
+  if (refused([&] { session.emplace(so); })) return 1;
   lucent::Renderer& renderer = *session;
   renderer.set_cancel_flag(&g_stop);
   try {
