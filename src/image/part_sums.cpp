@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "lucent/error.hpp"
+#include "render/sample_stats.hpp"
 
 namespace lucent::image_detail {
 
@@ -39,6 +40,22 @@ std::string hex64(std::uint64_t v) {
   char buf[17];
   std::snprintf(buf, sizeof buf, "%016" PRIx64, v);
   return buf;
+}
+
+void part_image(int width, int height, const std::vector<double>& sum,
+                const std::vector<double>& sumsq, const std::vector<std::uint32_t>& count,
+                Image& mean, Image& variance) {
+  const size_t npix = static_cast<size_t>(width) * height;
+  mean = Image{width, height, std::vector<float>(npix * 3)};
+  variance = Image{width, height, std::vector<float>(npix * 3)};
+  for (size_t i = 0; i < npix; ++i) {
+    const double n = count[i];
+    for (int c = 0; c < 3; ++c) {
+      const double s = sum[i * 3 + c], s2 = sumsq[i * 3 + c];
+      mean.rgb[i * 3 + c] = static_cast<float>(n > 0 ? s / n : 0);
+      variance.rgb[i * 3 + c] = static_cast<float>(render_detail::sample_variance(s, s2, n));
+    }
+  }
 }
 
 PartSums part_sums_from_channels(const ExrChannels& exr, const std::string& path) {

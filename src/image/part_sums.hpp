@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "image/image_probe.hpp"
+#include "lucent/image.hpp"
 
 namespace lucent::image_detail {
 
@@ -28,6 +29,13 @@ struct PartSums {
   std::vector<double> sum, sumsq;    ///< 3 per pixel, row 0 at the top
   std::vector<std::uint32_t> count;  ///< per pixel
 };
+
+/// A part's image from its sums: each pixel's mean and the variance of one of its samples, per
+/// channel, in floats (what part_result gives, read_render reads from a part file, and
+/// write_render_part's display channels hold).
+void part_image(int width, int height, const std::vector<double>& sum,
+                const std::vector<double>& sumsq, const std::vector<std::uint32_t>& count,
+                Image& mean, Image& variance);
 
 /// The sums, sums of squares and counts of the part file `path` from its decoded channels: each
 /// sum finite, each sum of squares >= 0, and all of them matching lucent.checksum where the file

@@ -19,7 +19,6 @@
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
-#include "render/sample_stats.hpp"
 
 namespace lucent {
 
@@ -222,17 +221,9 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
     r.light_mean_variance = parse_light_mean_var(path, light->second);
   if (part) {
     // mean and variance as write_render_part wrote them from the sums (part_result's)
-    const PartSums s = part_sums_from_channels(exr, path);
-    r.mean = Image{w, h, std::vector<float>(n * 3)};
-    r.variance = Image{w, h, std::vector<float>(n * 3)};
-    for (size_t i = 0; i < n; ++i)
-      for (int c = 0; c < 3; ++c) {
-        const double count = s.count[i], sum = s.sum[i * 3 + c], sumsq = s.sumsq[i * 3 + c];
-        r.mean.rgb[i * 3 + c] = static_cast<float>(count > 0 ? sum / count : 0);
-        r.variance.rgb[i * 3 + c] =
-            static_cast<float>(render_detail::sample_variance(sum, sumsq, count));
-      }
-    r.samples = s.count;
+    PartSums s = part_sums_from_channels(exr, path);
+    part_image(w, h, s.sum, s.sumsq, s.count, r.mean, r.variance);
+    r.samples = std::move(s.count);
     r.spp = r.samples.empty() ? 0 : *std::max_element(r.samples.begin(), r.samples.end());
     return r;
   }

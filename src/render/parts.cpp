@@ -330,22 +330,11 @@ RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
 
 RenderResult part_result(const RenderPart& part) {
   const Accumulation& a = part.acc;
-  const size_t npix = static_cast<size_t>(a.width) * a.height;
   if (!sums_fit_film(a))
     throw Error("part_result: inconsistent part (film and accumulation sizes differ)");
   RenderResult r;
-  r.mean = Image{a.width, a.height, std::vector<float>(npix * 3)};
-  r.variance = Image{a.width, a.height, std::vector<float>(npix * 3)};
+  image_detail::part_image(a.width, a.height, a.sum, a.sumsq, a.count, r.mean, r.variance);
   r.samples = a.count;
-  for (size_t i = 0; i < npix; ++i) {
-    const double n = a.count[i];
-    for (int c = 0; c < 3; ++c) {
-      const double s = a.sum[i * 3 + c], s2 = a.sumsq[i * 3 + c];
-      const double mean = n > 0 ? s / n : 0;
-      r.mean.rgb[i * 3 + c] = static_cast<float>(mean);
-      r.variance.rgb[i * 3 + c] = static_cast<float>(render_detail::sample_variance(s, s2, n));
-    }
-  }
   r.spp = total(part.info.samples);
   r.seed = part.info.seed;
   r.sampler = part.info.sampler;
