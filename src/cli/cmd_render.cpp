@@ -441,17 +441,18 @@ int render_with(const RenderArgs& a) {
     so.reserved_host_bytes = memory.beside;
     renderer.emplace(so);
     renderer->set_cancel_flag(&g_interrupted);
+    auto interrupted_before_rendering = [&] {
+      if (printed && tty) std::fprintf(stderr, "\n");
+      std::fprintf(stderr, "lucent: interrupted by %s before rendering: nothing written\n",
+                   signal_name(g_signal));
+      return 128 + g_signal;
+    };
     try {
       renderer->set_scene(std::move(scene));
       // a stop signal during set_scene (its kernel build, where the build did not fail; its BVH):
       // nothing rendered, and a render call takes at least one pass, which rendered the whole
       // image after the signal and wrote it as "1 of 64 spp"
-      if (g_interrupted.load()) {
-        if (printed && tty) std::fprintf(stderr, "\n");
-        std::fprintf(stderr, "lucent: interrupted by %s before rendering: nothing written\n",
-                     signal_name(g_signal));
-        return 128 + g_signal;
-      }
+      if (g_interrupted.load()) return interrupted_before_rendering();
       std::uint64_t spp =
           a.spp > 0 ? static_cast<std::uint64_t>(a.spp) : (a.time_limit > 0 ? 0 : scene_spp);
       if (range) {
@@ -472,10 +473,7 @@ int render_with(const RenderArgs& a) {
       // temporary files, then passes it on), and the build fails. That is the interruption,
       // not a build error (it was reported as "kernel build failed", exit 1).
       if (!g_interrupted.load()) throw;
-      if (printed && tty) std::fprintf(stderr, "\n");
-      std::fprintf(stderr, "lucent: interrupted by %s before rendering: nothing written\n",
-                   signal_name(g_signal));
-      return 128 + g_signal;
+      return interrupted_before_rendering();
     }
   }
   if (printed && tty) std::fprintf(stderr, "\n");
