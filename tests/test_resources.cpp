@@ -257,6 +257,19 @@ TEST(Resources, JsonSceneBeyondTheHostLimitIsRefusedBeforeParsing) {
   EXPECT_EQ(lucent::parse_scene(text, "dense.json").positions.size(), 100000u);
 }
 
+/// This process's mapped size and resident set, in pages (/proc/self/statm); 0, 0 when unknown.
+struct StatmPages {
+  long size = 0, resident = 0;
+};
+StatmPages statm_pages() {
+  StatmPages p;
+  if (FILE* statm = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(statm, "%ld %ld", &p.size, &p.resident) != 2) p = {};
+    std::fclose(statm);
+  }
+  return p;
+}
+
 /// The peak resident memory that `f` adds, in MiB, measured in a forked child (getrusage's high
 /// mark against the child's resident set when it starts); -1 when the child fails.
 double child_peak_growth_mib(const std::function<void()>& f) {
@@ -265,18 +278,14 @@ double child_peak_growth_mib(const std::function<void()>& f) {
   const pid_t pid = fork();
   if (pid == 0) {
     close(fds[0]);
-    long pages[2] = {0, 0};
-    if (FILE* statm = std::fopen("/proc/self/statm", "r")) {
-      if (std::fscanf(statm, "%ld %ld", &pages[0], &pages[1]) != 2) pages[1] = 0;
-      std::fclose(statm);
-    }
+    const long resident = statm_pages().resident;
     double growth = -1;
     try {
       f();
       struct rusage ru;
       getrusage(RUSAGE_SELF, &ru);
       growth =
-          (double(ru.ru_maxrss) * 1024.0 - double(pages[1]) * sysconf(_SC_PAGESIZE)) / 1048576.0;
+          (double(ru.ru_maxrss) * 1024.0 - double(resident) * sysconf(_SC_PAGESIZE)) / 1048576.0;
     } catch (...) {
     }
     if (write(fds[1], &growth, sizeof growth) != sizeof growth) _exit(1);
@@ -334,11 +343,7 @@ TEST(Resources, JsonDocumentIsFreedWithoutAllocating) {
       for (int i = 0; i < 4000000; ++i) doc.push_back(i);
       std::vector<void*> ballast;
       ballast.reserve(std::size_t(1) << 20);
-      long pages = 0;
-      if (FILE* f = std::fopen("/proc/self/statm", "r")) {
-        if (std::fscanf(f, "%ld", &pages) != 1) pages = 0;
-        std::fclose(f);
-      }
+      const long pages = statm_pages().size;
       if (pages <= 0) _exit(3);
       const rlim_t size = rlim_t(pages) * rlim_t(sysconf(_SC_PAGESIZE)) + (8 << 20);
       const struct rlimit rl = {size, size};
@@ -481,8 +486,9 @@ TEST(Resources, HostCountsSaturateInsteadOfWrapping) {
     EXPECT_EQ(msg.rfind("huge.json: rendering needs about ", 0), 0u) << msg;
     EXPECT_NE(msg.find("reduce the film size"), std::string::npos) << msg;
     // a saturated count is no figure (it printed 17179869184.0 GiB)
-    if (w == 2147483647)
+    if (w == 2147483647) {
       EXPECT_NE(msg.find("needs about 16.0 EiB or more of host memory"), std::string::npos) << msg;
+    }
     std::uint64_t largest = 0;
     for (const MemoryPart& p : lucent::render_detail::estimate_host_memory(s, {cpu}))
       largest = std::max(largest, p.bytes);
