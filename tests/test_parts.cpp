@@ -23,6 +23,7 @@
 #include <string>
 #include <tuple>
 
+#include "cl/kernel_source.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/image.hpp"
@@ -1104,7 +1105,10 @@ TEST(Parts, MpiRefusesToOverwriteWhatTheSceneReads) {
     "lights": [{"type": "environment", "file": "sky.pfm"}]})");
   CommandResult r = run_shell(
       mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " -o " + q(env)), dir);
-  EXPECT_NE(r.status, 0);
+  // refused by rank 0 alone, agreed by the ranks: one line and status 1
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(r.err.rfind("lucent-mpi: error: rank 0 of 2 (", 0), 0u) << r.err;
+  EXPECT_EQ(r.err.find("MPI_ABORT"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find(": is an input of this render ("), std::string::npos) << r.err;
   EXPECT_EQ(lucent::test::read_file(env), before);
 }
@@ -1159,6 +1163,52 @@ int lucent_mpi_lines(const std::string& err) {
   for (size_t at = 0; (at = err.find("lucent-mpi:", at)) != std::string::npos; ++at)
     n += at == 0 || err[at - 1] == '\n';
   return n;
+}
+
+// Errors before rendering are agreed by the ranks: one line naming the lowest failing rank,
+// status 1, no output. A scene no rank can read (the commonest mistake), too many ranks for the
+// samples and a kernel that does not build (an error injected into a copy of the kernel sources,
+// LUCENT_KERNEL_DIR) printed one line per rank, then Open MPI's report of MPI_Abort (eight lines),
+// and the build failure's line referred to a "build log above" that no rank printed.
+TEST(Parts, MpiSceneErrorsAreOneLine) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir), out = dir + "/mpi.exr";
+  const std::string kernels = dir + "/kernels";
+  for (int i = 0; i < lucent::detail::kEmbeddedKernelFileCount; ++i) {
+    const auto& f = lucent::detail::kEmbeddedKernelFiles[i];
+    fs::create_directories((fs::path(kernels) / f.path).parent_path());
+    lucent::test::write_file((fs::path(kernels) / f.path).string(),
+                             f.content + std::string(f.path == std::string("megakernel.cl")
+                                                         ? "\nlucent_injected_error here;\n"
+                                                         : ""));
+  }
+  const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' ";
+  const std::pair<std::string, std::string> cases[] = {
+      {q(dir + "/none.json") + " -o " + q(out), "none.json: cannot open scene file"},
+      {q(scene) + " --spp 1 -o " + q(out), "2 ranks for 1 samples per pixel"},
+      {"-x LUCENT_KERNEL_DIR=" + q(kernels) + " " + prog + q(scene) + " -o " + q(out),
+       "megakernel.cl:"}};
+  for (const auto& [args, says] : cases) {
+    const bool env = args.rfind("-x ", 0) == 0;  // mpirun's option, then the program
+    CommandResult r =
+        run_shell("timeout 60 env " + mpirun("-np 2 " + (env ? "" : prog) + args), dir);
+    EXPECT_EQ(r.status, 1) << args << "\n" << r.err;
+    EXPECT_EQ(lucent_mpi_lines(r.err), 1) << args << "\n" << r.err;
+    const size_t line = r.err.find("lucent-mpi: error: rank 0 of 2 (");
+    ASSERT_NE(line, std::string::npos) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(says, line), std::string::npos) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.find("MPI_ABORT"), std::string::npos) << args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out)) << args;
+    if (env) {  // the build log its line refers to ("build log above"), once, as lucent says it
+      EXPECT_NE(r.err.find("(build log above)"), std::string::npos) << r.err;
+      const size_t log = r.err.find("kernel build log:\n");
+      EXPECT_LT(log, line) << r.err;
+      EXPECT_EQ(r.err.find("kernel build log:", log + 1), std::string::npos) << r.err;
+      EXPECT_NE(r.err.find("unknown type name 'lucent_injected_error'", log), std::string::npos)
+          << r.err;
+    }
+  }
 }
 
 // A stop signal during the kernel build is an interruption, as for `lucent render`

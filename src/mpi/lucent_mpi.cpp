@@ -2,8 +2,10 @@
 // sample indices [N r / K, N (r + 1) / K) of the N samples per pixel, then rank 0 receives the
 // ranks' raw accumulations in rank order (ascending sample ranges), adds them with
 // lucent::PartMerger (the code of `lucent merge`, so the image is the merge of the ranks' parts)
-// and writes OUT atomically. A rank that fails prints one line naming it and ends the job with
-// MPI_Abort: nothing is written. SIGINT, SIGTERM and SIGHUP stop every rank after its current
+// and writes OUT atomically. Failures before rendering (the scene, the device, the kernel build,
+// the checkpoints) are agreed by the ranks: the lowest failing rank prints one line naming it,
+// every rank exits 1. A rank that fails later prints one line and ends the job with MPI_Abort.
+// Either way nothing is written. SIGINT, SIGTERM and SIGHUP stop every rank after its current
 // pass; what they rendered is merged and written (an .exr records the ranges it holds).
 // --checkpoint CK: each rank keeps a checkpoint of its own range, CK with ".rank<r>-of-<K>" before
 // its extension (src/cli/checkpoint.hpp, as `lucent render --checkpoint`), resumed by the same
@@ -52,17 +54,20 @@ extern "C" void on_stop_signal(int sig) {
 int g_rank = 0, g_size = 1;
 
 /// "lucent-mpi: error: rank 1 of 4 (node17): WHAT".
-void print_failure(const std::string& what) {
+/// `details`: the error's own lines (lucent::Error::details(): a kernel build's log, which the
+/// line refers to as "build log above"), printed before the line as `lucent` prints them.
+void print_failure(const std::string& what, const std::string& details = "") {
   char host[256] = "?";
   gethostname(host, sizeof host - 1);
+  if (!details.empty()) std::fprintf(stderr, "%s\n", details.c_str());
   std::fprintf(stderr, "lucent-mpi: error: rank %d of %d (%s): %s\n", g_rank, g_size, host,
                one_line(what).c_str());
   std::fflush(stderr);
 }
 
 /// One line naming the rank, then the whole job ends: no rank writes anything after this.
-[[noreturn]] void fail(const std::string& what) {
-  print_failure(what);
+[[noreturn]] void fail(const std::string& what, const std::string& details = "") {
+  print_failure(what, details);
   MPI_Abort(MPI_COMM_WORLD, 1);
   std::_Exit(1);  // not reached
 }
@@ -72,16 +77,20 @@ void print_failure(const std::string& what) {
 /// where a check that fails on every rank (a checkpoint of another seed) printed one per rank
 /// before the first MPI_Abort ended the job.
 bool refused(const std::function<void()>& step) {
-  std::string what;
+  std::string what, details;
   int mine = g_size, first = g_size;
   try {
     step();
+  } catch (const lucent::Error& e) {
+    what = e.what();
+    details = e.details();
+    mine = g_rank;
   } catch (const std::exception& e) {
     what = e.what();
     mine = g_rank;
   }
   MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  if (first == g_rank) print_failure(what);
+  if (first == g_rank) print_failure(what, details);
   return first < g_size;
 }
 
@@ -237,19 +246,28 @@ lucent::RenderPart receive_part(int from, const lucent::PartInfo& mine,
 
 int run(const Args& a) {
   const bool root = g_rank == 0;
-  if (root) lucent::io::check_output_path(a.output, {a.scene});
-  lucent::Scene scene = lucent::load_scene(a.scene);
-  if (a.width > 0) scene.film.width = a.width;
-  if (a.height > 0) scene.film.height = a.height;
-  if (a.seed >= 0) scene.integrator.seed = static_cast<std::uint32_t>(a.seed);
-  // nor a file the scene reads (a texture or mesh: rank 0 replaced it)
-  if (root)
-    lucent::io::check_output_path(a.output, lucent::scene_detail::scene_inputs(a.scene, scene));
-  lucent::check_part_scene(scene, a.scene);
-  const std::uint64_t n = a.spp > 0 ? std::uint64_t(a.spp) : scene.integrator.spp;
-  if (n < std::uint64_t(g_size))
-    throw lucent::Error(std::to_string(g_size) + " ranks for " + std::to_string(n) +
-                        " samples per pixel: use at most one rank per sample");
+  // the scene, the output and the shares, agreed by all ranks: one line, status 1 (a scene no
+  // rank could read, the commonest mistake, printed one line per rank and Open MPI's MPI_Abort
+  // report)
+  lucent::Scene scene;
+  std::uint64_t n = 0;
+  if (refused([&] {
+        if (root) lucent::io::check_output_path(a.output, {a.scene});
+        scene = lucent::load_scene(a.scene);
+        if (a.width > 0) scene.film.width = a.width;
+        if (a.height > 0) scene.film.height = a.height;
+        if (a.seed >= 0) scene.integrator.seed = static_cast<std::uint32_t>(a.seed);
+        // nor a file the scene reads (a texture or mesh: rank 0 replaced it)
+        if (root)
+          lucent::io::check_output_path(a.output,
+                                        lucent::scene_detail::scene_inputs(a.scene, scene));
+        lucent::check_part_scene(scene, a.scene);
+        n = a.spp > 0 ? std::uint64_t(a.spp) : scene.integrator.spp;
+        if (n < std::uint64_t(g_size))
+          throw lucent::Error(std::to_string(g_size) + " ranks for " + std::to_string(n) +
+                              " samples per pixel: use at most one rank per sample");
+      }))
+    return 1;
   // rank r's share of the samples [0, n)
   auto share = [&](int r) {
     return lucent::SampleRange{n * std::uint64_t(r) / g_size, n * std::uint64_t(r + 1) / g_size};
@@ -344,15 +362,20 @@ int run(const Args& a) {
   if (refused([&] { session.emplace(so); })) return 1;
   lucent::Renderer& renderer = *session;
   renderer.set_cancel_flag(&g_stop);
-  try {
-    renderer.set_scene(std::move(scene));  // held once, by the session
-  } catch (const lucent::Error&) {
-    // a stop signal during the kernel build: PoCL's LLVM handles it too (it removes its
-    // temporary files, then passes it on), and the build fails. That is the interruption, as
-    // `lucent render` reports it, not a build error (it ended the job through MPI_Abort, "kernel
-    // build failed", exit 1)
-    if (!g_stop.load()) throw;
-  }
+  // agreed as well: a scene the session refuses or a kernel that does not build fails on every
+  // rank, which printed one line each and Open MPI's MPI_Abort report
+  if (refused([&] {
+        try {
+          renderer.set_scene(std::move(scene));  // held once, by the session
+        } catch (const lucent::Error&) {
+          // a stop signal during the kernel build: PoCL's LLVM handles it too (it removes its
+          // temporary files, then passes it on), and the build fails. That is the interruption,
+          // as `lucent render` reports it, not a build error (it ended the job through
+          // MPI_Abort, "kernel build failed", exit 1)
+          if (!g_stop.load()) throw;
+        }
+      }))
+    return 1;
   // a rank stopped before rendering ends the job, every rank with 128 + the signal: nothing was
   // rendered, and a rank that went on alone would wait for the others for ever
   if (const int sig = stopped_before_rendering(); sig > 0) return 128 + sig;
@@ -591,6 +614,8 @@ int main(int argc, char** argv) {
   int status = 0;
   try {
     status = run(a);
+  } catch (const lucent::Error& e) {
+    fail(e.what(), e.details());
   } catch (const std::exception& e) {
     fail(e.what());
   }
