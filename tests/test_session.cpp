@@ -53,6 +53,15 @@ Renderer session() {
   return Renderer(o);
 }
 
+/// A session with the full kernel (every feature: the program many tests share, at `precision`),
+/// for tests of set_scene's warnings, which do not depend on the kernel: a specialised kernel for
+/// each variant of a scene cost those tests a cold kernel build each (1-2 s of CPU) in CI.
+Renderer full_kernel_session(lucent::Precision precision = lucent::Precision::Float) {
+  Renderer r = session();
+  r.set_build_options(precision, false, false);
+  return r;
+}
+
 bool same_image(const RenderResult& a, const RenderResult& b) {
   return a.mean.rgb == b.mean.rgb && a.variance.rgb == b.variance.rgb && a.samples == b.samples;
 }
@@ -788,7 +797,7 @@ TEST(Session, MovedFromRendererThrows) {
 TEST(Session, SceneWithoutLightWarns) {
   Scene dark = lucent::test::scene_from(kScene);
   dark.lights.clear();
-  Renderer r = session();
+  Renderer r = full_kernel_session();
   {
     lucent::test::CaptureWarnings warnings;
     r.set_scene(dark);
@@ -874,7 +883,7 @@ TEST(Session, SceneWhoseLightsEmitNothingWarns) {
       "every light of the scene emits nothing (an intensity, radiance or scale of 0, or a black "
       "environment map): the image is black";
   auto warnings_for = [&](const Scene& scene) {
-    Renderer r = session();  // a session says each warning once
+    Renderer r = full_kernel_session();  // a session says each warning once
     lucent::test::CaptureWarnings warnings;
     r.set_scene(scene);
     return warnings.count(kMessage);
@@ -993,8 +1002,7 @@ TEST(Session, SurfaceWithinFloatStepsOfTheCameraWarns) {
 // both right, nor for this test's scene.
 /// The warnings containing `what` that a new session gives for scene s at `precision`.
 int warnings_containing(const Scene& s, lucent::Precision precision, const std::string& what) {
-  Renderer r = session();
-  r.set_build_options(precision, false, true);
+  Renderer r = full_kernel_session(precision);
   lucent::test::CaptureWarnings warnings;
   r.set_scene(s);
   int n = 0;
@@ -1154,7 +1162,7 @@ TEST(Session, CausticsWithATinyFilterWarn) {
 // with 3 AOVs said it 4 times); not for colours of 1, not for plastic's specular colour (a
 // Fresnel term's factor: its surface stays below 1), not for the AOV integrators.
 TEST(Session, MaterialsThatGainEnergyWarn) {
-  Renderer r = session();
+  Renderer r = full_kernel_session();
   Scene s = lucent::test::scene_from(kScene);
   const std::string tail =
       " is above 1: the surface reflects more light than it receives (each bounce gains energy, "
@@ -1169,7 +1177,7 @@ TEST(Session, MaterialsThatGainEnergyWarn) {
     EXPECT_EQ(warnings.all().size(), 1u) << warnings.dump();
   }
   auto warnings_for = [&](const Scene& scene) {
-    Renderer fresh = session();
+    Renderer fresh = full_kernel_session();
     lucent::test::CaptureWarnings warnings;
     fresh.set_scene(scene);
     return warnings.all();
