@@ -26,9 +26,17 @@ using lucent::Scene;
 struct Both {
   RenderResult kernel, reference;
   CompareResult cmp;
+  /// Whether the reference rendered the samples asked for, which the test's power is sized for.
+  bool statistics = true;
 };
 
 using lucent::test::scene_from;
+
+// Under AddressSanitizer (CI's second stage, which looks for memory errors) the reference, whose
+// instrumented scalar code is most of these tests' time there (PathCausticsSeenInAMirror: 8.5 s
+// against 1.7 s in Release), renders a quarter of the samples, and the z-test, sized for the
+// whole count, is left to the release build: the same code runs, the verdict is Release's.
+constexpr bool kStatistics = !lucent::test::kAddressSanitizer;
 
 Both render_both(Scene scene, int spp, const CompareOptions& options = {}) {
   Both b;
@@ -37,17 +45,19 @@ Both render_both(Scene scene, int spp, const CompareOptions& options = {}) {
   b.kernel = lucent::test::render(scene, ko);
   scene.integrator.seed ^= 0x9e3779b9u;  // independent samples
   lucent::ReferenceOptions ro;
-  ro.spp = spp;
+  ro.spp = kStatistics ? spp : std::max(1, spp / 4);
+  b.statistics = ro.spp == spp;
   b.reference = lucent::render_reference(scene, ro);
   b.cmp = lucent::compare_images(b.kernel, b.reference, options);
   return b;
 }
 
-#define EXPECT_AGREE(b)                                                                \
-  do {                                                                                 \
-    EXPECT_TRUE((b).cmp.passed) << "A = kernel, B = reference\n" << (b).cmp.summary(); \
-    EXPECT_EQ((b).kernel.nonfinite, 0u);                                               \
-    EXPECT_EQ((b).reference.nonfinite, 0u);                                            \
+#define EXPECT_AGREE(b)                                                                  \
+  do {                                                                                   \
+    if ((b).statistics)                                                                  \
+      EXPECT_TRUE((b).cmp.passed) << "A = kernel, B = reference\n" << (b).cmp.summary(); \
+    EXPECT_EQ((b).kernel.nonfinite, 0u);                                                 \
+    EXPECT_EQ((b).reference.nonfinite, 0u);                                              \
   } while (0)
 
 /// A 32x32 scene around a floor quad with the given materials, shapes and lights (JSON snippets).
@@ -703,6 +713,7 @@ TEST(KernelVsReference, LargeSphereFloorUnderSphereLight) {
 
 // Negative control: the same scene with the floor's albedo 3% lower in the reference must fail.
 TEST(KernelVsReference, DetectsAThreePercentAlbedoChange) {
+  if (!kStatistics) GTEST_SKIP() << "the test's power is checked in the release build";
   Scene s = scene_from(scene_json(R"({"type": "path", "max_depth": 5})", kDiffuseMats, kSpheres,
                                   std::string(kPointLights) + ", " + kEnv));
   lucent::RenderOptions ko;
