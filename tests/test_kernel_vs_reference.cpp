@@ -54,8 +54,9 @@ Both render_both(Scene scene, int spp, const CompareOptions& options = {}) {
 
 #define EXPECT_AGREE(b)                                                                  \
   do {                                                                                   \
-    if ((b).statistics)                                                                  \
+    if ((b).statistics) {                                                                \
       EXPECT_TRUE((b).cmp.passed) << "A = kernel, B = reference\n" << (b).cmp.summary(); \
+    }                                                                                    \
     EXPECT_EQ((b).kernel.nonfinite, 0u);                                                 \
     EXPECT_EQ((b).reference.nonfinite, 0u);                                              \
   } while (0)

@@ -110,7 +110,7 @@ def test_refusals(small_scene, tmp_path):
     d = {"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
          "film": {"width": 8, "height": 6},
          "lights": [{"type": "environment", "file": "sky.exr"}]}
-    with session() as r:
+    with session(specialize=False) as r:  # the full kernel, which other tests build too
         r.set_scene(lucent.scene_from_dict(d, base_dir=str(tmp_path)))
         r.render(1)
         with pytest.raises(lucent.Error, match="sky.exr"):

@@ -173,14 +173,14 @@ def test_a_round_tripped_scene_renders_the_same_image(rich_scene):
     """Bit-identical images at a fixed seed, each scene in a session of its own; the textures
     matter to the image (a zeroed one changes it), so their texels were carried over."""
     s = rich_scene
-    s.integrator.caustics = False  # a shorter kernel build
+    s.integrator.caustics = False  # no light paths: a shorter render
     s.integrator.seed = 7
     s.textures[1].rgba = np.random.default_rng(3).random((3, 6, 4), dtype=np.float32)
     images = []
     changed = s.copy()
     changed.textures[0].rgba = np.zeros((4, 5, 4))
     for scene in (s, pickled(s, 2), pickled(s, pickle.HIGHEST_PROTOCOL), changed):
-        with session() as r:
+        with session(specialize=False) as r:
             r.set_scene(scene)
             r.render(2)
             result = r.result()
@@ -193,8 +193,10 @@ def test_a_round_tripped_scene_renders_the_same_image(rich_scene):
 
 
 def render_here(scene):
-    """Renders `scene` in a session of its own (in a worker process, or here)."""
-    with session() as r:
+    """Renders `scene` in a session of its own (in a worker process, or here), with the full
+    kernel: these tests are of the scene's round trip, and the full kernel is the program many
+    tests share (a specialised one per scene cost CI a cold kernel build each)."""
+    with session(specialize=False) as r:
         r.set_scene(scene)
         r.render(2)
         return r.result()
@@ -245,6 +247,7 @@ def test_a_caustics_result_keeps_its_light_mean_variance(renderer, small_dict, n
     small_dict["integrator"]["max_depth"] = 6
     small_dict["materials"]["w"] = {"type": "dielectric", "ior": 1.5}
     small_dict["lights"][0]["position"] = [0, 1.5, 0]  # over the glass sphere
+    renderer.set_build_options(specialize=False)  # (the shared full kernel, as render_here)
     renderer.set_scene(lucent.scene_from_dict(small_dict))
     renderer.render(4)
     res = renderer.result()

@@ -53,6 +53,7 @@ def test_python_render_equals_the_cli_render(tmp_path, small_dict):
 
 def test_samplers_clamp_and_adaptive(renderer, small_scene):
     """The sampling knobs of the CLI (--sampler, --clamp, --target-error) from Python."""
+    renderer.set_build_options(specialize=False)  # the full kernel, which other tests build too
     images = {}
     for name in lucent.SAMPLERS:
         small_scene.integrator.sampler = name
@@ -111,6 +112,7 @@ def test_samplers_clamp_and_adaptive(renderer, small_scene):
 def test_caustics_from_python(renderer, small_dict):
     """integrator.caustics: a point light's caustic through a mirror appears only with it, and
     what light tracing cannot do is refused with lucent.Error."""
+    renderer.set_build_options(specialize=False)  # the full kernel, which other tests build too
     small_dict["materials"]["mirror"] = {"type": "mirror"}
     small_dict["shapes"].append({"type": "sphere", "center": [-1.5, 1, 0], "radius": 1,
                                  "material": "mirror"})

@@ -134,6 +134,7 @@ def test_scene_built_in_code_renders(renderer):
 
 
 def test_diffuse_mirror_from_python(renderer, small_dict):
+    renderer.set_build_options(specialize=False)  # the full kernel, which other tests build too
     # reflectance is Material.specular, as for mirror; the albedo AOV is albedo + reflectance
     m = lucent.Material()
     m.type = "diffuse_mirror"
