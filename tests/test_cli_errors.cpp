@@ -379,6 +379,42 @@ TEST(CliErrors, CausticsRefusalsAreOneLine) {
   EXPECT_TRUE(fs::exists(dir + "/a.exr"));
 }
 
+// Integer options are plain decimal: CLI11 read a leading zero as octal and took 0x and 0b
+// prefixes, so `--spp 010` rendered 8 samples per pixel without a word, and `--spp 0b11` was
+// refused as "Value 0b11 not in range 1 to 16777216". Now a usage error (exit 2) naming the
+// option and the value, before anything is read or written, for every command's integers
+// (converge's ladder elements too); 0 and negative numbers still reach the range checks.
+TEST(CliErrors, IntegerOptionsArePlainDecimal) {
+  const std::string scene = small_scene();
+  const std::string dir = lucent::test::temp_dir();
+  const std::string render = "render " + q(scene) + " -o " + q(dir + "/o.pfm") + " ";
+  const std::string tail =
+      ": integers are plain decimal digits, without a leading zero or a base prefix (0x, 0b) "
+      "(see lucent --help)";
+  const std::pair<std::string, std::string> cases[] = {
+      {render + "--spp 010", "--spp 010"},
+      {render + "--spp 0x10", "--spp 0x10"},
+      {render + "--spp 0b11", "--spp 0b11"},
+      {render + "--spp +16", "--spp +16"},
+      {render + "--width 08", "--width 08"},
+      {render + "--seed 00", "--seed 00"},
+      {render + "--max-depth 1e2", "--max-depth 1e2"},
+      {render + "--target-error 0.1 --min-spp 010", "--min-spp 010"},
+      {"converge " + q(scene) + " --spp-ladder 1,010 --reference-spp 4", "--spp-ladder 010"}};
+  for (const auto& [args, bad] : cases) {
+    CommandResult r = run_cli(args);
+    EXPECT_EQ(expect_one_error_line(r), bad + tail) << args;
+    EXPECT_EQ(r.status, 2) << args;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+  // a range's own message stays for decimal values; 0 and 10 are decimal
+  EXPECT_EQ(expect_one_error_line(run_cli(render + "--spp 0")),
+            "--spp: Value 0 not in range 1 to 16777216 (see lucent --help)");
+  CommandResult ok = run_cli(render + "-q --spp 10 --seed 0");
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_EQ(lucent::read_image(dir + "/o.pfm").width, 8);
+}
+
 // A real option beyond a float's range is reported against the option, not against the scene
 // file it would have been written into ("scene.json: /integrator/clamp: must fit in a float"
 // for --clamp 1e300), as a usage error (exit 2) before anything is read: every real option of

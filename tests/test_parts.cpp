@@ -1072,6 +1072,10 @@ TEST(Parts, MpiCommandLineErrorsAreOneLine) {
       {q(scene) + " -o " + q(out) + " --time -1", "--time: must be in (0, 1e7] seconds, got -1"},
       {q(scene) + " -o " + q(out) + " --bogus", "--bogus"},
       {q(scene) + " -o " + q(out) + " --spp 0", "--spp"},
+      // integers are plain decimal (CLI11 read 010 as octal 8, 0b11 as binary)
+      {q(scene) + " -o " + q(out) + " --spp 010",
+       "--spp 010: integers are plain decimal digits, without a leading zero or a base prefix"},
+      {q(scene) + " -o " + q(out) + " --width 0b11", "--width 0b11: integers are plain decimal"},
       {q(scene), "--output is required"}};
   for (const auto& [args, says] : cases) {
     CommandResult r = run_shell("timeout 60 " + prog + args, dir);

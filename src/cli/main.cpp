@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/integer_options.hpp"
 #include "core/text.hpp"
 #include "lucent/lucent.hpp"
 
@@ -110,6 +111,11 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return help_written(app, e);
   } catch (const CLI::ParseError& e) {
+    if (std::string bad = lucent::cli::non_decimal_option(app); !bad.empty()) {  // (0b11: range)
+      std::fprintf(stderr, "lucent: error: %s: %s (see lucent --help)\n", one_line(bad).c_str(),
+                   lucent::cli::kDecimalIntegers);
+      return 2;
+    }
     if (std::string bad = non_finite_option(app); !bad.empty()) {  // before CLI11's range text
       std::fprintf(stderr, "lucent: error: %s: must be a finite number (see lucent --help)\n",
                    one_line(bad).c_str());
@@ -141,6 +147,12 @@ int main(int argc, char** argv) {
   if (std::string bad = non_finite_option(app); !bad.empty()) {
     std::fprintf(stderr, "lucent: error: %s: must be a finite number (see lucent --help)\n",
                  one_line(bad).c_str());
+    return 2;
+  }
+  // (CLI11 read --spp 010 as octal 8)
+  if (std::string bad = lucent::cli::non_decimal_option(app); !bad.empty()) {
+    std::fprintf(stderr, "lucent: error: %s: %s (see lucent --help)\n", one_line(bad).c_str(),
+                 lucent::cli::kDecimalIntegers);
     return 2;
   }
 

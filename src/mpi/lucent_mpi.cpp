@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "cli/checkpoint.hpp"
+#include "cli/integer_options.hpp"
 #include "core/file_io.hpp"
 #include "core/text.hpp"
 #include "image/image_probe.hpp"
@@ -581,17 +582,24 @@ int main(int argc, char** argv) {
   std::string message;
   try {
     app.parse(argc, argv);
+    // (CLI11 read --spp 010 as octal 8)
+    if (const std::string bad = lucent::cli::non_decimal_option(app); !bad.empty())
+      throw CLI::ValidationError(bad + ": " + lucent::cli::kDecimalIntegers);
   } catch (const CLI::ParseError& e) {
     failed = 1;
     code = e.get_exit_code();
+    // an integer that is not plain decimal is named as such (0b11 was "not in range")
+    const std::string bad = lucent::cli::non_decimal_option(app);
+    const std::string said =
+        bad.empty() ? std::string(e.what()) : bad + ": " + lucent::cli::kDecimalIntegers;
     if (g_rank != 0) {
-      message = e.what();
+      message = said;
     } else if (code == 0) {
       parse_status = app.exit(e);  // --help, --version: stdout, status 0
     } else {
       // one line and status 2, as `lucent` says it (CLI11's own exit printed two lines and
       // exited 105, 106 or 109)
-      std::string what = e.what();
+      std::string what = said;
       for (char& c : what)
         if (c == '\n') c = ' ';
       std::fprintf(stderr, "lucent-mpi: error: %s (see lucent-mpi --help)\n",

@@ -1,0 +1,43 @@
+#pragma once
+// Integer options as a user means them, for `lucent` and `lucent-mpi` alike. CLI11 reads an
+// integer with a leading zero as octal and takes 0x and 0b prefixes: `--spp 010` rendered 8
+// samples per pixel without a word, and `--spp 0b11` was refused as "not in range 1 to 16777216".
+#include <CLI/CLI.hpp>
+#include <sstream>
+#include <string>
+
+namespace lucent::cli {
+
+/// What an integer option's value must be, for the error line.
+inline constexpr const char kDecimalIntegers[] =
+    "integers are plain decimal digits, without a leading zero or a base prefix (0x, 0b)";
+
+/// Whether `text` is an integer in plain decimal: an optional '-', then 0 or digits that do not
+/// start with 0.
+inline bool plain_decimal(const std::string& text) {
+  const size_t start = !text.empty() && text[0] == '-' ? 1 : 0;
+  if (text.size() == start || text.find_first_not_of("0123456789", start) != std::string::npos)
+    return false;
+  return text[start] != '0' || text.size() == start + 1;
+}
+
+/// The first integer option (CLI11's type INT or UINT; each element of a comma-separated list)
+/// given a value that is not plain decimal, as "--name value" ("" when none).
+inline std::string non_decimal_option(const CLI::App& app) {
+  std::vector<const CLI::App*> apps{&app};
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    apps.push_back(sub);
+  for (const CLI::App* a : apps)
+    for (const CLI::Option* o : a->get_options()) {
+      if (o->get_type_name().find("INT") == std::string::npos) continue;
+      for (const std::string& all : o->results()) {
+        std::string value;
+        std::istringstream items(all);
+        while (std::getline(items, value, ','))
+          if (!plain_decimal(value)) return o->get_name() + " " + value;
+      }
+    }
+  return "";
+}
+
+}  // namespace lucent::cli
