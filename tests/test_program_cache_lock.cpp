@@ -152,6 +152,15 @@ TEST(ProgramCacheLock, EvictionsRacingLoadsCostRebuilds) {
       }
       return;
     }
+    // the last loader to end, by an error too, ends the evictor (a loader that threw left it
+    // running, and the test hung in join)
+    struct LastLoaderEndsTheEvictor {
+      std::atomic<int>& loaders;
+      std::atomic<bool>& done;
+      ~LastLoaderEndsTheEvictor() {
+        if (--loaders == 0) done = true;
+      }
+    } last{loaders, done};
     // 1.5 s of loads after the loader's first program: a cold build alone took 1.7 s on a loaded
     // CI machine, and a window counted from the start then held one build and no load at all
     std::optional<std::chrono::steady_clock::time_point> t0;
@@ -169,7 +178,6 @@ TEST(ProgramCacheLock, EvictionsRacingLoadsCostRebuilds) {
       ++(info.cache_hit ? hits : builds);
       if (!t0) t0 = std::chrono::steady_clock::now();
     }
-    if (--loaders == 0) done = true;
   });
   done = true;
   for (int i = 0; i < kBuilders; ++i) EXPECT_EQ(errors[i], "") << "builder " << i;

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace lucent::cli {
 
@@ -22,19 +23,24 @@ inline bool plain_decimal(const std::string& text) {
 }
 
 /// The first integer option (CLI11's type INT or UINT; each element of a comma-separated list)
-/// given a value that is not plain decimal, as "--name value" ("" when none).
+/// given a value that is not plain decimal, as "--name value" ("--name ''" for an empty one; ""
+/// when none). The type is the name's part before the validators' descriptions ("INT:INT in [1 -
+/// 16777216]"): a real option checked by CLI::Range(0, 1) shows "FLOAT:INT in [0 - 1]".
 inline std::string non_decimal_option(const CLI::App& app) {
   std::vector<const CLI::App*> apps{&app};
   for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
     apps.push_back(sub);
   for (const CLI::App* a : apps)
     for (const CLI::Option* o : a->get_options()) {
-      if (o->get_type_name().find("INT") == std::string::npos) continue;
+      const std::string type = o->get_type_name();
+      const std::string base = type.substr(0, type.find(':'));
+      if (base != "INT" && base != "UINT") continue;
       for (const std::string& all : o->results()) {
+        if (all.empty()) return o->get_name() + " ''";
         std::string value;
         std::istringstream items(all);
         while (std::getline(items, value, ','))
-          if (!plain_decimal(value)) return o->get_name() + " " + value;
+          if (!plain_decimal(value)) return o->get_name() + " " + (value.empty() ? "''" : value);
       }
     }
   return "";
