@@ -200,6 +200,26 @@ TEST(CliErrors, PoclThreadCountPoclCrashesWithIsRefused) {
   }
 }
 
+// An empty POCL_CACHE_DIR made PoCL abort on its assertion (pocl_cache_init_topdir) in every
+// command that opens a device, and in Python: one error line now, before any OpenCL call (the
+// adversarial tester's find). A directory is PoCL's to use.
+TEST(CliErrors, EmptyPoclCacheDirIsRefused) {
+  const std::string scene = small_scene();
+  const std::string out = lucent::test::temp_dir() + "/o.pfm";
+  const std::string says =
+      "POCL_CACHE_DIR is set but empty, which PoCL aborts on: unset it or name a directory";
+  for (const std::string& args : {std::string("devices"), "render " + q(scene) + " -o " + q(out)}) {
+    CommandResult r = run_cli(args, "POCL_CACHE_DIR=");
+    EXPECT_EQ(expect_one_error_line(r), says) << args;
+    EXPECT_EQ(r.status, 1) << args;
+  }
+  EXPECT_FALSE(fs::exists(out));
+  lucent::test::ScopedEnv env("POCL_CACHE_DIR", "");
+  EXPECT_EQ(lucent::cl_util::pocl_empty_cache_dir_problem(), says);
+  lucent::test::ScopedEnv dir("POCL_CACHE_DIR", (lucent::test::temp_dir() + "/pocl").c_str());
+  EXPECT_EQ(lucent::cl_util::pocl_empty_cache_dir_problem(), "");
+}
+
 TEST(CliErrors, NoOpenClPlatform) {
   std::string empty = lucent::test::temp_dir() + "/vendors";
   fs::create_directories(empty);
@@ -413,6 +433,27 @@ TEST(CliErrors, IntegerOptionsArePlainDecimal) {
   CommandResult ok = run_cli(render + "-q --spp 10 --seed 0");
   EXPECT_EQ(ok.status, 0) << ok.err;
   EXPECT_EQ(lucent::read_image(dir + "/o.pfm").width, 8);
+}
+
+// An empty name was taken as no name: `render --integrator ''` rendered the scene's own
+// integrator (exit 0), and so did info; --sampler '' and --device '' likewise. A usage error now
+// (the adversarial tester's find).
+TEST(CliErrors, EmptyNamesAreRefused) {
+  const std::string scene = small_scene();
+  const std::string dir = lucent::test::temp_dir();
+  const std::string render = "render " + q(scene) + " -o " + q(dir + "/o.pfm") + " ";
+  for (const auto& [args, option] :
+       {std::pair<std::string, std::string>{render + "--integrator ''", "--integrator"},
+        {render + "--sampler ''", "--sampler"},
+        {render + "--device ''", "--device"},
+        {"info " + q(scene) + " --integrator ''", "--integrator"},
+        {"info " + q(scene) + " --sampler ''", "--sampler"},
+        {"converge " + q(scene) + " --spp-ladder 1,2 --device ''", "--device"}}) {
+    CommandResult r = run_cli(args);
+    EXPECT_EQ(expect_one_error_line(r), option + ": must not be empty (see lucent --help)") << args;
+    EXPECT_EQ(r.status, 2) << args;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
 }
 
 // A real option beyond a float's range is reported against the option, not against the scene

@@ -233,6 +233,12 @@ std::string pocl_thread_count_problem() {
   return "";
 }
 
+std::string pocl_empty_cache_dir_problem() {
+  const char* v = std::getenv("POCL_CACHE_DIR");
+  if (!v || *v) return "";
+  return "POCL_CACHE_DIR is set but empty, which PoCL aborts on: unset it or name a directory";
+}
+
 std::vector<Device> enumerate_devices() {
   // one enumeration at a time in the process: the ICD loader and PoCL initialise on the first
   // call, and sessions created at once from several threads crashed there (SIGSEGV) or saw no
@@ -241,6 +247,7 @@ std::vector<Device> enumerate_devices() {
   std::lock_guard<std::mutex> lock(mutex);
   // before PoCL reads it (it is read once, on the first call)
   if (std::string problem = pocl_thread_count_problem(); !problem.empty()) throw Error(problem);
+  if (std::string problem = pocl_empty_cache_dir_problem(); !problem.empty()) throw Error(problem);
   std::vector<cl::Platform> platforms;
   try {
     cl::Platform::get(&platforms);

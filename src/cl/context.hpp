@@ -60,6 +60,11 @@ constexpr long long kMaxPoclThreads = 4096;
 /// enumerate_devices() throws before any OpenCL call.
 std::string pocl_thread_count_problem();
 
+/// "" unless POCL_CACHE_DIR is set but empty, which PoCL aborts on when it initialises (an
+/// assertion in pocl_cache_init_topdir: `lucent devices` ended with SIGABRT, and so did the
+/// Python interpreter); then the error enumerate_devices() throws before any OpenCL call.
+std::string pocl_empty_cache_dir_problem();
+
 /// The directory PoCL keeps its kernels in, as PoCL chooses it: POCL_CACHE_DIR, else
 /// $XDG_CACHE_HOME/pocl/kcache, else $HOME/.cache/pocl/kcache, else /tmp/pocl/kcache
 /// (pocl/uncached with POCL_KERNEL_CACHE off). `origin`, when given: "POCL_CACHE_DIR",

@@ -190,7 +190,8 @@ CLI::App* add_converge_command(CLI::App& app) {
       ->check(CLI::Range(1, limits::kMaxImageSize));
   cmd->add_option("--device", a.device,
                   "OpenCL device: index or name substring, a comma-separated list of them or "
-                  "'all' to share the renders (env LUCENT_DEVICE)");
+                  "'all' to share the renders (env LUCENT_DEVICE)")
+      ->check(non_empty());
   cmd->add_flag("-q,--quiet", a.quiet,
                 "Print only the slopes (and, with several settings, the time each takes to the "
                 "common error)");

@@ -88,7 +88,8 @@ CLI::App* add_info_command(CLI::App& app) {
   cmd->add_option("scene", info_args().scene, "Scene file (JSON)")->required();
   cmd->add_option("--integrator", info_args().integrator,
                   "Show the scene with this integrator (as render --integrator): " +
-                      type_names<IntegratorType>());
+                      type_names<IntegratorType>())
+      ->check(non_empty());
   cmd->add_option("--precision", info_args().precision,
                   "Show the build options for this precision: float (default) or double")
       ->check(CLI::IsMember({"float", "double"}));

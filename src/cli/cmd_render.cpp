@@ -638,13 +638,17 @@ CLI::App* add_render_command(CLI::App& app) {
       ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
   render->add_option("--height", ra.height, "Image height (overrides the scene)")
       ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
-  render->add_option("--device", ra.device,
-                     "OpenCL device: index or name substring, a comma-separated list of them or "
-                     "'all' to share the render (env LUCENT_DEVICE)");
+  render
+      ->add_option("--device", ra.device,
+                   "OpenCL device: index or name substring, a comma-separated list of them or "
+                   "'all' to share the render (env LUCENT_DEVICE)")
+      ->check(lucent::cli::non_empty());
   render->add_option("--seed", ra.seed, "Random seed (overrides the scene)")
       ->check(CLI::Range(0LL, static_cast<long long>(lucent::limits::kMaxSeed)));
-  render->add_option("--integrator", ra.integrator,
-                     "Override the integrator: " + lucent::type_names<lucent::IntegratorType>());
+  render
+      ->add_option("--integrator", ra.integrator,
+                   "Override the integrator: " + lucent::type_names<lucent::IntegratorType>())
+      ->check(lucent::cli::non_empty());
   render
       ->add_option("--max-depth", ra.max_depth,
                    "Most path segments: 1 shows the emitters the camera sees, 2 adds direct "

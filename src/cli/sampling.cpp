@@ -12,7 +12,8 @@ namespace lucent::cli {
 void add_sampling_options(CLI::App* cmd, SamplingArgs& a, bool adaptive) {
   cmd->add_option("--sampler", a.sampler,
                   "Random numbers: " + type_names<SamplerType>() +
-                      " (overrides integrator.sampler; default sobol)");
+                      " (overrides integrator.sampler; default sobol)")
+      ->check(non_empty());
   cmd->add_option("--clamp", a.clamp,
                   "Largest contribution of a path vertex after a scattering (overrides "
                   "integrator.clamp; 0: off; biased when it binds)")
