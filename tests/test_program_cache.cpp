@@ -108,6 +108,13 @@ TEST(ProgramCache, HitsMissesAndRebuildsCorruptEntries) {
   EXPECT_EQ(lucent::test::error_of([] { lucent::cl_util::clear_program_cache("/etc/passwd"); }),
             "/etc/passwd: not a directory (the kernel cache, LUCENT_CACHE_DIR)");
   EXPECT_EQ(lucent::cl_util::clear_program_cache(cache.dir + "/none"), 0);
+  // and so is one below a file (it was "removed 0", as for a cache not made yet)
+  EXPECT_EQ(lucent::test::error_of([] { lucent::cl_util::clear_program_cache("/etc/passwd/sub"); }),
+            "/etc/passwd/sub: cannot be the kernel cache (LUCENT_CACHE_DIR): /etc/passwd is not a "
+            "directory");
+  EXPECT_EQ(lucent::test::error_of([] { lucent::cl_util::program_cache_usage("/etc/passwd/a/b"); }),
+            "/etc/passwd/a/b: cannot be the kernel cache (LUCENT_CACHE_DIR): /etc/passwd is not a "
+            "directory");
   EXPECT_GE(lucent::cl_util::clear_program_cache(cache.dir), 2);
   ProgramBuildInfo h;
   lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", cache.dir, &h);

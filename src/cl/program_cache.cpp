@@ -339,7 +339,20 @@ bool cache_file_name(std::string name) {
 std::vector<fs::directory_entry> cache_files(const std::string& dir) {
   std::vector<fs::directory_entry> files;
   std::error_code ec;
-  if (dir.empty() || (!fs::exists(dir, ec) && !ec)) return files;
+  if (dir.empty()) return files;
+  if (!fs::exists(dir, ec) && !ec) {
+    // a cache not made yet is empty, unless it cannot be made: a path below a file said "removed
+    // 0 cached program(s)" and "programs: 0", where the one naming the file was an error
+    for (fs::path p = fs::path(dir).parent_path(); !p.empty() && p != p.parent_path();
+         p = p.parent_path())
+      if (fs::exists(p, ec)) {
+        if (!fs::is_directory(p, ec))
+          throw Error(dir + ": cannot be the kernel cache (LUCENT_CACHE_DIR): " + p.string() +
+                      " is not a directory");
+        break;
+      }
+    return files;
+  }
   if (!fs::is_directory(dir, ec))
     throw Error(dir + ": not a directory (the kernel cache, LUCENT_CACHE_DIR)");
   fs::directory_iterator it(dir, ec);
