@@ -436,8 +436,8 @@ TEST(CliErrors, IntegerOptionsArePlainDecimal) {
 }
 
 // An empty name was taken as no name: `render --integrator ''` rendered the scene's own
-// integrator (exit 0), and so did info; --sampler '' and --device '' likewise. A usage error now
-// (the adversarial tester's find).
+// integrator (exit 0), and so did info; --sampler '' and --device '' likewise, and the paths and
+// ranges below. A usage error now (the adversarial tester's and the review's finds).
 TEST(CliErrors, EmptyNamesAreRefused) {
   const std::string scene = small_scene();
   const std::string dir = lucent::test::temp_dir();
@@ -448,7 +448,18 @@ TEST(CliErrors, EmptyNamesAreRefused) {
         {render + "--device ''", "--device"},
         {"info " + q(scene) + " --integrator ''", "--integrator"},
         {"info " + q(scene) + " --sampler ''", "--sampler"},
-        {"converge " + q(scene) + " --spp-ladder 1,2 --device ''", "--device"}}) {
+        {"converge " + q(scene) + " --spp-ladder 1,2 --device ''", "--device"},
+        // paths and ranges: --checkpoint '' rendered without checkpoints (exit 0), --samples ''
+        // the whole image instead of a part, converge --reference '' rendered a reference,
+        // --csv '' and --save-reference '' wrote nothing, merge --expect '' took the default,
+        // compare --zmap '' wrote no map
+        {render + "--checkpoint ''", "--checkpoint"},
+        {render + "--samples ''", "--samples"},
+        {"converge " + q(scene) + " --spp-ladder 1,2 --reference ''", "--reference"},
+        {"converge " + q(scene) + " --spp-ladder 1,2 --reference-spp 4 --csv ''", "--csv"},
+        {"converge " + q(scene) + " --spp-ladder 1,2 --save-reference ''", "--save-reference"},
+        {"merge " + q(dir + "/p.exr") + " -o " + q(dir + "/m.exr") + " --expect ''", "--expect"},
+        {"compare " + q(scene) + " " + q(scene) + " --zmap ''", "--zmap"}}) {
     CommandResult r = run_cli(args);
     EXPECT_EQ(expect_one_error_line(r), option + ": must not be empty (see lucent --help)") << args;
     EXPECT_EQ(r.status, 2) << args;

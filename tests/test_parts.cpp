@@ -1071,6 +1071,9 @@ TEST(Parts, MpiCommandLineErrorsAreOneLine) {
       {q(scene) + " -o " + q(out) + " --spp 010",
        "--spp 010: integers are plain decimal digits, without a leading zero or a base prefix"},
       {q(scene) + " -o " + q(out) + " --width 0b11", "--width 0b11: integers are plain decimal"},
+      // an empty --device fell back to LUCENT_DEVICE, an empty --checkpoint to none
+      {q(scene) + " -o " + q(out) + " --device ''", "--device: must not be empty"},
+      {q(scene) + " -o " + q(out) + " --checkpoint ''", "--checkpoint: must not be empty"},
       {q(scene), "--output is required"}};
   for (const auto& [args, says] : cases) {
     CommandResult r = run_shell("timeout 60 " + prog + args, dir);
@@ -1081,6 +1084,16 @@ TEST(Parts, MpiCommandLineErrorsAreOneLine) {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
     EXPECT_FALSE(fs::exists(out)) << args;
   }
+  // an empty POCL_CACHE_DIR, on which PoCL aborts in the singleton's daemon (orted probes the
+  // OpenCL devices): refused before MPI_Init, one line (it was orted's assertion, then Open MPI's
+  // reports of a failed MPI_Init)
+  CommandResult cache = run_shell(
+      "timeout 60 env POCL_CACHE_DIR= " + prog + q(scene) + " -o " + q(out) + " --spp 2", dir);
+  EXPECT_EQ(cache.status, 1) << cache.err;
+  EXPECT_EQ(cache.err,
+            "lucent-mpi: error: POCL_CACHE_DIR is set but empty, which PoCL aborts on: unset it "
+            "or name a directory\n");
+  EXPECT_FALSE(fs::exists(out));
   CommandResult help = run_shell("timeout 60 " + prog + "--help", dir);
   EXPECT_EQ(help.status, 0) << help.err;
   EXPECT_NE(help.out.find("--time"), std::string::npos) << help.out;

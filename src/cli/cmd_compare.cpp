@@ -48,7 +48,8 @@ CLI::App* add_compare_command(CLI::App& app) {
       ->check(lucent::cli::non_negative_real());
   cmd->add_flag("--no-mean-test", a.no_mean_test, "Skip the test of the image means");
   cmd->add_option("--zmap", a.zmap,
-                  "Write the per-pixel z values (signed, per channel) to this .exr or .pfm file");
+                  "Write the per-pixel z values (signed, per channel) to this .exr or .pfm file")
+      ->check(non_empty());
   return cmd;
 }
 

@@ -143,12 +143,14 @@ CLI::App* add_converge_command(CLI::App& app) {
   cmd->add_option("scene", a.scene, "Scene file (JSON)")->required();
   cmd->add_option("--csv", a.csv,
                   "Write setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s,"
-                  "reference_noise_relmse,estimated_relmse,halves_relmse");
+                  "reference_noise_relmse,estimated_relmse,halves_relmse")
+      ->check(non_empty());
   cmd->add_option("--plot", a.plots,
                   "Write a plot of relMSE against time (log-log): .svg, or .png (raster); may be "
                   "given more than once");
   auto* ref = cmd->add_option("--reference", a.reference,
-                              "Reference image (.exr with var.*/n layers, .pfm, ...)");
+                              "Reference image (.exr with var.*/n layers, .pfm, ...)")
+                  ->check(non_empty());
   auto* ref_spp = cmd->add_option("--reference-spp", a.reference_spp,
                                   "Render the reference with this many spp (default: 16 x the "
                                   "largest rung, at least 256; 1024 with --time-ladder)")
@@ -158,7 +160,8 @@ CLI::App* add_converge_command(CLI::App& app) {
   ref->excludes(ref_spp)->excludes(ref_cpu);
   auto* save_ref =
       cmd->add_option("--save-reference", a.save_reference,
-                      "Write the rendered reference to this .exr (reuse it with --reference)");
+                      "Write the rendered reference to this .exr (reuse it with --reference)")
+          ->check(non_empty());
   // a reference given is not rendered: there would be nothing to save (it was silently ignored)
   ref->excludes(save_ref);
   cmd->add_option("--settings", a.settings,

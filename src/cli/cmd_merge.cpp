@@ -45,7 +45,8 @@ CLI::App* add_merge_command(CLI::App& app) {
   cmd->add_option("--expect", a.expect,
                   "A:B, the sample indices the parts should hold together: ranges missing from "
                   "it are reported (default: [0, the highest end a part asked for), which cannot "
-                  "see a last part that was never written)");
+                  "see a last part that was never written)")
+      ->check(non_empty());
   cmd->add_flag("-q,--quiet", a.quiet, "Print only warnings and errors");
   return cmd;
 }

@@ -676,13 +676,17 @@ CLI::App* add_render_command(CLI::App& app) {
                        lucent::cli::joined(lucent::cli::aov_names()))
       ->delimiter(',')
       ->check(CLI::IsMember(lucent::cli::aov_names()));
-  render->add_option("--samples", ra.samples,
-                     "Render only the sample indices [A, B) (A:B) and write their raw "
-                     "accumulation to an .exr part file for `lucent merge`");
-  render->add_option("--checkpoint", ra.checkpoint,
-                     "Write the samples rendered so far to this .exr part file every "
-                     "--checkpoint-every seconds, and resume from it when it exists; removed "
-                     "once the output is written (docs/parts.md, \"Checkpoints\")");
+  render
+      ->add_option("--samples", ra.samples,
+                   "Render only the sample indices [A, B) (A:B) and write their raw "
+                   "accumulation to an .exr part file for `lucent merge`")
+      ->check(lucent::cli::non_empty());
+  render
+      ->add_option("--checkpoint", ra.checkpoint,
+                   "Write the samples rendered so far to this .exr part file every "
+                   "--checkpoint-every seconds, and resume from it when it exists; removed "
+                   "once the output is written (docs/parts.md, \"Checkpoints\")")
+      ->check(lucent::cli::non_empty());
   render
       ->add_option("--checkpoint-every", ra.checkpoint_every,
                    "Seconds between two checkpoints (default 300)")

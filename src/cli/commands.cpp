@@ -54,11 +54,6 @@ CLI::Validator real_range(double lo, double hi) {
   return real_check([lo, hi](double v) { return v >= lo && v <= hi; }, what, "REAL");
 }
 
-CLI::Validator non_empty() {
-  return CLI::Validator(
-      [](std::string& text) -> std::string { return text.empty() ? "must not be empty" : ""; }, "");
-}
-
 CLI::Validator seconds_limit() {
   static_assert(limits::kMaxSeconds == 1e7, "the message says (0, 1e7]");
   return real_check([](double v) { return v > 0 && v <= limits::kMaxSeconds; },

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/option_checks.hpp"
 #include "core/text.hpp"
 #include "lucent/render.hpp"
 #include "lucent/scene.hpp"
@@ -40,9 +41,6 @@ CLI::Validator positive_real();
 CLI::Validator non_negative_real();
 /// lo <= value <= hi, as "must be in [1e-12, 0.5], got 0" (CLI::Range prints "%f": 0.000000).
 CLI::Validator real_range(double lo, double hi);
-/// A name (an integrator, a sampler, a device): not empty. An empty value was taken as no value:
-/// `--integrator ''` rendered the scene's own integrator without a word.
-CLI::Validator non_empty();
 /// A time in seconds: in (0, lucent::limits::kMaxSeconds], "must be in (0, 1e7] seconds" (as
 /// lucent-mpi's --time says it).
 CLI::Validator seconds_limit();

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "cli/integer_options.hpp"
+#include "cli/option_checks.hpp"
 #include "core/text.hpp"
 #include "lucent/lucent.hpp"
 

@@ -26,8 +26,9 @@
 #include <string>
 #include <vector>
 
+#include "cl/context.hpp"
 #include "cli/checkpoint.hpp"
-#include "cli/integer_options.hpp"
+#include "cli/option_checks.hpp"
 #include "core/file_io.hpp"
 #include "core/text.hpp"
 #include "image/image_probe.hpp"
@@ -530,6 +531,13 @@ int run(const Args& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // before MPI_Init: an MPI singleton's daemon (orted) probes OpenCL devices through hwloc, and
+  // PoCL aborts on an empty POCL_CACHE_DIR there (mpirun itself does so before any rank starts)
+  if (const std::string problem = lucent::cl_util::pocl_empty_cache_dir_problem();
+      !problem.empty()) {
+    std::fprintf(stderr, "lucent-mpi: error: %s\n", problem.c_str());
+    return 1;
+  }
   MPI_Init(&argc, &argv);
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &g_size);
@@ -564,7 +572,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
   app.add_option("--seed", a.seed, "Random seed")
       ->check(CLI::Range(0LL, static_cast<long long>(lucent::limits::kMaxSeed)));
-  app.add_option("--device", a.device, "OpenCL device(s) of every rank (env LUCENT_DEVICE)");
+  app.add_option("--device", a.device, "OpenCL device(s) of every rank (env LUCENT_DEVICE)")
+      ->check(lucent::cli::non_empty());
   app.add_option("--precision", a.precision, "float or double")
       ->check(CLI::IsMember({"float", "double"}));
   app.add_flag("--fast-math", a.fast_math, "Build the kernel with -cl-fast-relaxed-math");
@@ -572,7 +581,8 @@ int main(int argc, char** argv) {
   app.add_option("--checkpoint", a.checkpoint,
                  "Each rank writes the samples it rendered so far to CK.rank<r>-of-<K>.exr every "
                  "--checkpoint-every seconds, and resumes from it when it exists; removed once "
-                 "the output is written (docs/parts.md, \"Checkpoints of lucent-mpi\")");
+                 "the output is written (docs/parts.md, \"Checkpoints of lucent-mpi\")")
+      ->check(lucent::cli::non_empty());
   app.add_option("--checkpoint-every", a.checkpoint_every,
                  "Seconds between two checkpoints (default 300)")
       ->check(seconds);

@@ -1,13 +1,20 @@
 #pragma once
-// Integer options as a user means them, for `lucent` and `lucent-mpi` alike. CLI11 reads an
+// Option values as a user means them, for `lucent` and `lucent-mpi` alike. CLI11 reads an
 // integer with a leading zero as octal and takes 0x and 0b prefixes: `--spp 010` rendered 8
 // samples per pixel without a word, and `--spp 0b11` was refused as "not in range 1 to 16777216".
+// An empty string was taken as no value: `--checkpoint ''` rendered without checkpoints, exit 0.
 #include <CLI/CLI.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
 namespace lucent::cli {
+
+/// A name or a path (an integrator, a device, a checkpoint, an output): not empty.
+inline CLI::Validator non_empty() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string { return text.empty() ? "must not be empty" : ""; }, "");
+}
 
 /// What an integer option's value must be, for the error line.
 inline constexpr const char kDecimalIntegers[] =
