@@ -47,24 +47,30 @@ int cmd_devices() {
 /// "--name value" ("" when none): CLI11's range checks let NaN through (every comparison with it
 /// is false), and a NaN --time would never end a render.
 std::string non_finite_option(const CLI::App& app) {
-  std::vector<const CLI::App*> apps{&app};
-  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
-    apps.push_back(sub);
-  for (const CLI::App* a : apps)
-    for (const CLI::Option* o : a->get_options()) {
-      if (o->get_type_name().find("FLOAT") == std::string::npos) continue;
-      for (const std::string& all : o->results()) {
-        std::string value;
-        std::istringstream items(all);
-        while (std::getline(items, value, ',')) {
-          char* end = nullptr;
-          double v = std::strtod(value.c_str(), &end);
-          if (end != value.c_str() && *end == '\0' && !std::isfinite(v))
-            return o->get_name() + " " + value;
-        }
-      }
-    }
-  return "";
+  return lucent::cli::first_bad_value(
+      app, [](const std::string& type) { return type.find("FLOAT") != std::string::npos; },
+      [](const std::string& value) {
+        char* end = nullptr;
+        const double v = std::strtod(value.c_str(), &end);
+        return end != value.c_str() && *end == '\0' && !std::isfinite(v);
+      });
+}
+
+/// The usage error of an option value that CLI11 took but no user means (an integer that is not
+/// plain decimal: CLI11 read --spp 010 as octal 8; a real that is not finite), printed, or false.
+/// Checked whether or not the parse failed: with 0b11, CLI11's own range error came first.
+bool refused_option_value(const CLI::App& app) {
+  if (std::string bad = lucent::cli::non_decimal_option(app); !bad.empty()) {
+    std::fprintf(stderr, "lucent: error: %s: %s (see lucent --help)\n", one_line(bad).c_str(),
+                 lucent::cli::kDecimalIntegers);
+    return true;
+  }
+  if (std::string bad = non_finite_option(app); !bad.empty()) {
+    std::fprintf(stderr, "lucent: error: %s: must be a finite number (see lucent --help)\n",
+                 one_line(bad).c_str());
+    return true;
+  }
+  return false;
 }
 
 /// `status`, or 1 when what went to standard output (a table, a comparison, --help) could not be
@@ -111,16 +117,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return help_written(app, e);
   } catch (const CLI::ParseError& e) {
-    if (std::string bad = lucent::cli::non_decimal_option(app); !bad.empty()) {  // (0b11: range)
-      std::fprintf(stderr, "lucent: error: %s: %s (see lucent --help)\n", one_line(bad).c_str(),
-                   lucent::cli::kDecimalIntegers);
-      return 2;
-    }
-    if (std::string bad = non_finite_option(app); !bad.empty()) {  // before CLI11's range text
-      std::fprintf(stderr, "lucent: error: %s: must be a finite number (see lucent --help)\n",
-                   one_line(bad).c_str());
-      return 2;
-    }
+    if (refused_option_value(app)) return 2;  // before CLI11's range text
     std::string msg = e.what();
     // CLI11 reports a missing argument before an unexpected one: name the unknown option first
     for (const std::string& extra : app.remaining(true))
@@ -144,17 +141,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "lucent: error: %s (see lucent --help)\n", one_line(msg).c_str());
     return 2;
   }
-  if (std::string bad = non_finite_option(app); !bad.empty()) {
-    std::fprintf(stderr, "lucent: error: %s: must be a finite number (see lucent --help)\n",
-                 one_line(bad).c_str());
-    return 2;
-  }
-  // (CLI11 read --spp 010 as octal 8)
-  if (std::string bad = lucent::cli::non_decimal_option(app); !bad.empty()) {
-    std::fprintf(stderr, "lucent: error: %s: %s (see lucent --help)\n", one_line(bad).c_str(),
-                 lucent::cli::kDecimalIntegers);
-    return 2;
-  }
+  if (refused_option_value(app)) return 2;
 
   int status = 1;
   try {

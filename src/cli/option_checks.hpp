@@ -29,28 +29,43 @@ inline bool plain_decimal(const std::string& text) {
   return text[start] != '0' || text.size() == start + 1;
 }
 
-/// The first integer option (CLI11's type INT or UINT; each element of a comma-separated list)
-/// given a value that is not plain decimal, as "--name value" ("--name ''" for an empty one; ""
-/// when none). The type is the name's part before the validators' descriptions ("INT:INT in [1 -
-/// 16777216]"): a real option checked by CLI::Range(0, 1) shows "FLOAT:INT in [0 - 1]".
-inline std::string non_decimal_option(const CLI::App& app) {
+/// The first value given to an option of `app` or its subcommands whose CLI11 type name
+/// (get_type_name(): the type, then the validators' descriptions) `typed` accepts, that `bad`
+/// finds wrong, as "--name value" ("--name ''" for an empty one; "" when none). Each element of a
+/// comma-separated list is a value; an empty result is one empty value.
+template <class Typed, class Bad>
+std::string first_bad_value(const CLI::App& app, Typed typed, Bad bad) {
   std::vector<const CLI::App*> apps{&app};
   for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
     apps.push_back(sub);
   for (const CLI::App* a : apps)
     for (const CLI::Option* o : a->get_options()) {
-      const std::string type = o->get_type_name();
-      const std::string base = type.substr(0, type.find(':'));
-      if (base != "INT" && base != "UINT") continue;
+      if (!typed(o->get_type_name())) continue;
       for (const std::string& all : o->results()) {
-        if (all.empty()) return o->get_name() + " ''";
         std::string value;
         std::istringstream items(all);
-        while (std::getline(items, value, ','))
-          if (!plain_decimal(value)) return o->get_name() + " " + (value.empty() ? "''" : value);
+        bool any = false;
+        while (std::getline(items, value, ',') || (!any && all.empty())) {
+          any = true;
+          if (bad(value)) return o->get_name() + " " + (value.empty() ? "''" : value);
+        }
       }
     }
   return "";
+}
+
+/// The first integer option (CLI11's type INT or UINT) given a value that is not plain decimal,
+/// as first_bad_value says it. The type is the name's part before the validators' descriptions
+/// ("INT:INT in [1 - 16777216]"): a real option checked by CLI::Range(0, 1) shows "FLOAT:INT in
+/// [0 - 1]".
+inline std::string non_decimal_option(const CLI::App& app) {
+  return first_bad_value(
+      app,
+      [](const std::string& type) {
+        const std::string base = type.substr(0, type.find(':'));
+        return base == "INT" || base == "UINT";
+      },
+      [](const std::string& value) { return !plain_decimal(value); });
 }
 
 }  // namespace lucent::cli
