@@ -14,6 +14,7 @@
 #include <map>
 #include <sstream>
 
+#include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/session.hpp"
@@ -73,6 +74,17 @@ RenderResult render(const Scene& scene, RenderOptions options) {
   if (options.kernel_dir.empty()) options.kernel_dir = env.kernel_dir;
   if (options.cache_dir.empty()) options.cache_dir = env.cache_dir;
   return lucent::render(scene, options);
+}
+
+std::string kernel_copy() {
+  std::string dir = temp_dir() + "/kernels";
+  for (int i = 0; i < lucent::detail::kEmbeddedKernelFileCount; ++i) {
+    const auto& f = lucent::detail::kEmbeddedKernelFiles[i];
+    std::filesystem::path p = std::filesystem::path(dir) / f.path;
+    std::filesystem::create_directories(p.parent_path());
+    write_file(p.string(), f.content);
+  }
+  return dir;
 }
 
 std::string temp_dir() {

@@ -37,6 +37,9 @@ CommandResult run_cli(const std::string& args, const std::string& env = "");
 
 /// A fresh directory under the build tree, removed at the end of the test program.
 std::string temp_dir();
+/// Writes the kernel sources this build embeds into a fresh directory and returns it (for
+/// LUCENT_KERNEL_DIR: a kernel with an injected error, another source).
+std::string kernel_copy();
 
 /// Writes `text` to `path`.
 void write_file(const std::string& path, const std::string& text);

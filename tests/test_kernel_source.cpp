@@ -46,17 +46,7 @@ std::string read_all(const std::string& path) {
   return ss.str();
 }
 
-/// Writes the kernel sources this build embeds into a fresh directory and returns it.
-std::string kernel_copy() {
-  std::string dir = lucent::test::temp_dir() + "/kernels";
-  for (int i = 0; i < lucent::detail::kEmbeddedKernelFileCount; ++i) {
-    const auto& f = lucent::detail::kEmbeddedKernelFiles[i];
-    fs::path p = fs::path(dir) / f.path;
-    fs::create_directories(p.parent_path());
-    lucent::test::write_file(p.string(), f.content);
-  }
-  return dir;
-}
+using lucent::test::kernel_copy;
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;

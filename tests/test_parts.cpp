@@ -23,7 +23,6 @@
 #include <string>
 #include <tuple>
 
-#include "cl/kernel_source.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/image.hpp"
@@ -1193,15 +1192,8 @@ TEST(Parts, MpiSceneErrorsAreOneLine) {
   if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
   const std::string dir = lucent::test::temp_dir();
   const std::string scene = noisy_scene(dir), out = dir + "/mpi.exr";
-  const std::string kernels = dir + "/kernels";
-  for (int i = 0; i < lucent::detail::kEmbeddedKernelFileCount; ++i) {
-    const auto& f = lucent::detail::kEmbeddedKernelFiles[i];
-    fs::create_directories((fs::path(kernels) / f.path).parent_path());
-    lucent::test::write_file((fs::path(kernels) / f.path).string(),
-                             f.content + std::string(f.path == std::string("megakernel.cl")
-                                                         ? "\nlucent_injected_error here;\n"
-                                                         : ""));
-  }
+  const std::string kernels = lucent::test::kernel_copy();
+  std::ofstream(kernels + "/megakernel.cl", std::ios::app) << "\nlucent_injected_error here;\n";
   const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' ";
   const std::pair<std::string, std::string> cases[] = {
       {q(dir + "/none.json") + " -o " + q(out), "none.json: cannot open scene file"},
