@@ -664,12 +664,14 @@ TEST(SceneBuilder, MaterialNamesFollowTheList) {
   EXPECT_EQ(b.add_material(material("bad.obj:blue", lucent::MaterialType::Diffuse)), 2);
   // the same OBJ again shares its material; another file's material of that name is made
   // unique beside the one a material of the builder holds
-  b.add_obj(obj = lucent::ObjShape{dir + "/m.obj"});
+  obj.file = dir + "/m.obj";
+  b.add_obj(obj);
   EXPECT_EQ(b.scene().materials.size(), 3u);
   std::filesystem::create_directories(dir + "/sub");
   lucent::test::write_file(dir + "/sub/bad.obj",
                            "mtllib ../m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl blue\nf 1 2 3\n");
-  b.add_obj(lucent::ObjShape{dir + "/sub/bad.obj"});
+  obj.file = dir + "/sub/bad.obj";
+  b.add_obj(obj);
   ASSERT_EQ(b.scene().materials.size(), 4u);
   EXPECT_EQ(b.scene().materials[3].name, "sub/bad.obj:blue");
   b.add_sphere({{0, 0, 0}, 1, "bad.obj:blue"});
