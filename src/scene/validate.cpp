@@ -550,11 +550,8 @@ std::vector<std::string> radiance_notes(const Scene& s) {
     if (l.type != LightType::EnvironmentMap || l.texture < 0 ||
         static_cast<std::size_t>(l.texture) >= s.textures.size())
       continue;
-    // a map: its scale times its brightest texel, channel by channel
-    const std::vector<float>& rgba = s.textures[static_cast<std::size_t>(l.texture)].rgba;
-    value = 0;
-    for (std::size_t k = 0; k + 3 < rgba.size(); k += 4)
-      for (int c = 0; c < 3; ++c) value = std::max(value, l.radiance[c] * double(rgba[k + c]));
+    // a map: its scale times its brightest texel, channel by channel (scales are >= 0)
+    value = largest(l.radiance * brightest_texel(s.textures[static_cast<std::size_t>(l.texture)]));
     if (value > most)
       what = "/lights/" + std::to_string(i) + "/scale (times the map's brightest texel)";
   }
