@@ -326,7 +326,12 @@ TEST(Converge, SettingSyntax) {
         "clamp=-1", "clamp=x", "clamp", "target-error=0", "target-error=nan", "adaptive+min-spp=2",
         "min-spp=8", "adaptive+target-error=1e-3", "integrator=bogus", "mis=1", "caustics=1",
         // two knobs setting one thing: the last one won without a word
-        "caustics+no-caustics", "clamp=1+clamp=2", "float+double", "mis+no_mis"}) {
+        "caustics+no-caustics", "clamp=1+clamp=2", "float+double", "mis+no_mis",
+        // numbers in plain decimal, as the command line's (strtol and strtod took these), and
+        // no empty knob (a trailing + was dropped)
+        "max_depth=03", "max_depth= 3", "max_depth=+3", "splits=0x1", "clamp=0x10", "clamp= 1",
+        "target-error=0x1p-10", "filter=tent:0x1", "filter=box: 1", "max_depth=3+", "+mis",
+        "mis++fast-math"}) {
     try {
       lucent::parse_converge_setting(bad);
       ADD_FAILURE() << "accepted '" << bad << "'";
@@ -936,6 +941,18 @@ TEST(Converge, CommandErrors) {
       "converge '" + dir + "/t.json' --settings default,default --spp-ladder 2");
   EXPECT_EQ(twice.status, 1);
   EXPECT_NE(twice.err.find("twice"), std::string::npos) << twice.err;
+  // the same setting in two spellings rendered twice
+  lucent::test::CommandResult spelt = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --settings max_depth=3,max-depth=3 --spp-ladder 2");
+  EXPECT_EQ(spelt.status, 1);
+  EXPECT_EQ(spelt.err,
+            "lucent: error: --settings: 'max-depth=3' is the same setting as 'max_depth=3'\n");
+  spelt = lucent::test::run_cli(
+      "converge '" + dir + "/t.json' --settings clamp=1+no-mis,no_mis+clamp=1.0 --spp-ladder 2");
+  EXPECT_EQ(spelt.status, 1);
+  EXPECT_NE(spelt.err.find("'no_mis+clamp=1.0' is the same setting as 'clamp=1+no-mis'"),
+            std::string::npos)
+      << spelt.err;
 
   // a reference of another size names the file
   lucent::test::CommandResult size = lucent::test::run_cli(

@@ -250,7 +250,12 @@ TEST(Parts, OverlapsAndMismatchesAreOneLineErrors) {
   EXPECT_EQ(error_line(run_cli("render " + q(scene) + " --samples 5:5 -o " + q(out))),
             "--samples '5:5': need 0 <= A < B <= 4294967296");
   EXPECT_EQ(error_line(run_cli("render " + q(scene) + " --samples 3 -o " + q(out))),
-            "--samples '3': expected A:B, the sample indices [A, B)");
+            "--samples '3': expected A:B, the sample indices [A, B) in decimal");
+  // plain decimal, as the integer options (010:020 read 10:20 where --spp 010 is refused)
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " --samples 010:020 -o " + q(out))),
+            "--samples '010:020': expected A:B, the sample indices [A, B) in decimal");
+  EXPECT_EQ(error_line(run_cli("merge --expect 0:08 " + a + " -o " + q(out))),
+            "--expect '0:08': expected A:B, the sample indices [A, B) in decimal");
   EXPECT_EQ(error_line(run_cli("render " + q(scene) + " --samples 0:4 -o " + q(dir + "/x.png"))),
             dir + "/x.png: --samples writes a part file: use an .exr output");
   EXPECT_EQ(error_line(run_cli("render " + q(scene) + " --samples 0:4 --spp 4 -o " + q(out))),
@@ -1060,8 +1065,12 @@ TEST(Parts, MpiCommandLineErrorsAreOneLine) {
       "OMPI_MCA_btl_vader_single_copy_mechanism=none '" +
       std::string(LUCENT_MPI_PATH) + "' ";
   const std::pair<std::string, std::string> cases[] = {
-      {q(scene) + " -o " + q(out) + " --time nan", "--time: must be a finite number"},
-      {q(scene) + " -o " + q(out) + " --time inf", "--time: must be a finite number"},
+      {q(scene) + " -o " + q(out) + " --time nan", "--time nan: must be a finite number"},
+      {q(scene) + " -o " + q(out) + " --time inf", "--time inf: must be a finite number"},
+      // reals are plain decimal (CLI11 took 0x10 as 16)
+      {q(scene) + " -o " + q(out) + " --time 0x10", "--time 0x10: reals are decimal numbers"},
+      {q(scene) + " -o " + q(out) + " --checkpoint-every ' 5'",
+       "--checkpoint-every ' 5': reals are decimal numbers"},
       {q(scene) + " -o " + q(out) + " --time 2e7", "--time: must be in (0, 1e7] seconds, got 2e7"},
       {q(scene) + " -o " + q(out) + " --time -1", "--time: must be in (0, 1e7] seconds, got -1"},
       {q(scene) + " -o " + q(out) + " --bogus", "--bogus"},

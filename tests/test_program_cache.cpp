@@ -357,14 +357,16 @@ TEST(ProgramCache, LimitFromTheEnvironment) {
     EXPECT_EQ(lucent::cl_util::program_cache_max_bytes(), g.bytes) << "'" << g.value << "'";
     EXPECT_EQ(warnings.all().size(), 0u) << "'" << g.value << "'";
   }
-  for (const char* bad : {"lots", "-1", "12MB", "nan", "inf", "1,5"}) {
+  // (plain decimal, as the command line's numbers: strtod took "0x10" and " 16")
+  for (const char* bad : {"lots", "-1", "12MB", "nan", "inf", "1,5", "0x10", " 16", "16 "}) {
     lucent::test::ScopedEnv env("LUCENT_CACHE_MAX_MB", bad);
     lucent::test::CaptureWarnings warnings;
     EXPECT_EQ(lucent::cl_util::program_cache_max_bytes(), kDefault) << bad;
     ASSERT_EQ(warnings.all().size(), 1u) << bad;
-    EXPECT_EQ(warnings.all()[0], std::string("LUCENT_CACHE_MAX_MB='") + bad +
-                                     "' is not a size in MiB (a number, 0 for no limit); the "
-                                     "kernel cache keeps its default limit of 256 MiB");
+    EXPECT_EQ(warnings.all()[0],
+              std::string("LUCENT_CACHE_MAX_MB='") + bad +
+                  "' is not a size in MiB (a decimal number, 0 for no limit); the "
+                  "kernel cache keeps its default limit of 256 MiB");
   }
 }
 

@@ -61,6 +61,10 @@ struct ConvergeSetting {
 /// Parses one setting (syntax above). Throws lucent::Error naming the knob that is wrong.
 ConvergeSetting parse_converge_setting(const std::string& text);
 
+/// Parses a list of settings, refusing one given twice however it is spelt ("max_depth=3" and
+/// "max-depth=3", "clamp=1" and "clamp=1.0": the same renders twice). Throws lucent::Error.
+std::vector<ConvergeSetting> parse_converge_settings(const std::vector<std::string>& texts);
+
 /// One rung of the ladder: one render of one setting, compared with the reference.
 struct ConvergePoint {
   std::string setting;

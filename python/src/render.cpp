@@ -361,18 +361,12 @@ double checked_seconds(double s, const char* what) {
 }
 
 std::vector<ConvergeSetting> parse_settings(const std::vector<std::string>& names) {
-  std::vector<ConvergeSetting> out;
-  for (const std::string& n : names) {
-    refuse_nul(n, "settings");
-    for (const ConvergeSetting& s : out)
-      if (s.name == n) throw Error("settings: '" + n + "' is given twice");
-    try {
-      out.push_back(parse_converge_setting(n));
-    } catch (const Error& e) {
-      throw Error(std::string("settings: ") + e.what());
-    }
+  for (const std::string& n : names) refuse_nul(n, "settings");
+  try {
+    return parse_converge_settings(names);
+  } catch (const Error& e) {
+    throw Error(std::string("settings: ") + e.what());
   }
-  return out;
 }
 
 std::string result_repr(const RenderResult& r) {

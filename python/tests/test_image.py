@@ -241,6 +241,11 @@ def test_converge_by_time_and_errors(small_scene):
             lucent.converge(small_scene, reference, settings=["max_depth=0"], renderer=r)
         with pytest.raises(lucent.Error, match="given twice"):
             lucent.converge(small_scene, reference, settings=["default", "default"], renderer=r)
+        # the same setting in another spelling rendered twice
+        same = "'max-depth=2' is the same setting as 'max_depth=2'"
+        with pytest.raises(lucent.Error, match=same):
+            lucent.converge(small_scene, reference, settings=["max_depth=2", "max-depth=2"],
+                            renderer=r)
         with pytest.raises(ValueError, match="not both"):
             lucent.converge(small_scene, reference, spp_ladder=[1], time_ladder=[1], renderer=r)
         # the command line's limits (a rung of 2^31 - 1 spp or 1e300 s ran until killed); every

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/file_io.hpp"
+#include "core/text.hpp"
 #include "lucent/error.hpp"
 #include "lucent/version.hpp"
 #include "scene/loaders.hpp"
@@ -382,12 +383,13 @@ std::uint64_t program_cache_max_bytes() {
   const double fallback_mb = 256;
   const char* v = std::getenv("LUCENT_CACHE_MAX_MB");
   if (!v || !*v) return static_cast<std::uint64_t>(fallback_mb) << 20;
-  char* end = nullptr;
-  double mb = std::strtod(v, &end);
-  if (end == v || *end != '\0' || !std::isfinite(mb) || mb < 0) {
-    warn_once(std::string("LUCENT_CACHE_MAX_MB='") + v +
-              "' is not a size in MiB (a number, 0 for no limit); the kernel cache keeps its "
-              "default limit of 256 MiB");
+  // plain decimal, as the command line's numbers (strtod took "0x10" and " 16")
+  double mb = io::plain_decimal_real(v) ? std::strtod(v, nullptr) : -1;
+  if (!std::isfinite(mb) || mb < 0) {
+    warn_once(
+        std::string("LUCENT_CACHE_MAX_MB='") + v +
+        "' is not a size in MiB (a decimal number, 0 for no limit); the kernel cache keeps its "
+        "default limit of 256 MiB");
     mb = fallback_mb;
   }
   if (mb == 0) return 0;

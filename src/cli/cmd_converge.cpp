@@ -13,7 +13,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -268,14 +267,10 @@ int run_converge_command() {
   check_outputs(a, inputs);
 
   ConvergeOptions opt;
-  std::set<std::string> seen;
-  for (const std::string& s : a.settings) {
-    if (!seen.insert(s).second) throw Error("--settings: '" + s + "' is given twice");
-    try {
-      opt.settings.push_back(parse_converge_setting(s));
-    } catch (const Error& e) {
-      throw Error(std::string("--settings: ") + e.what());
-    }
+  try {
+    opt.settings = parse_converge_settings(a.settings);
+  } catch (const Error& e) {
+    throw Error(std::string("--settings: ") + e.what());
   }
   if (opt.settings.empty()) opt.settings.push_back(ConvergeSetting{});
   opt.time_ladder = a.time_ladder;

@@ -43,34 +43,13 @@ int cmd_devices() {
   return 0;
 }
 
-/// The first floating-point option given a value that is not a finite number, as
-/// "--name value" ("" when none): CLI11's range checks let NaN through (every comparison with it
-/// is false), and a NaN --time would never end a render.
-std::string non_finite_option(const CLI::App& app) {
-  return lucent::cli::first_bad_value(
-      app, [](const std::string& type) { return type.find("FLOAT") != std::string::npos; },
-      [](const std::string& value) {
-        char* end = nullptr;
-        const double v = std::strtod(value.c_str(), &end);
-        return end != value.c_str() && *end == '\0' && !std::isfinite(v);
-      });
-}
-
-/// The usage error of an option value that CLI11 took but no user means (an integer that is not
-/// plain decimal: CLI11 read --spp 010 as octal 8; a real that is not finite), printed, or false.
-/// Checked whether or not the parse failed: with 0b11, CLI11's own range error came first.
+/// The usage error of an option value that CLI11 took but no user means
+/// (lucent::cli::refused_value), printed, or false.
 bool refused_option_value(const CLI::App& app) {
-  if (std::string bad = lucent::cli::non_decimal_option(app); !bad.empty()) {
-    std::fprintf(stderr, "lucent: error: %s: %s (see lucent --help)\n", one_line(bad).c_str(),
-                 lucent::cli::kDecimalIntegers);
-    return true;
-  }
-  if (std::string bad = non_finite_option(app); !bad.empty()) {
-    std::fprintf(stderr, "lucent: error: %s: must be a finite number (see lucent --help)\n",
-                 one_line(bad).c_str());
-    return true;
-  }
-  return false;
+  const std::string bad = lucent::cli::refused_value(app);
+  if (bad.empty()) return false;
+  std::fprintf(stderr, "lucent: error: %s (see lucent --help)\n", one_line(bad).c_str());
+  return true;
 }
 
 /// `status`, or 1 when what went to standard output (a table, a comparison, --help) could not be

@@ -3,10 +3,16 @@
 // integer with a leading zero as octal and takes 0x and 0b prefixes: `--spp 010` rendered 8
 // samples per pixel without a word, and `--spp 0b11` was refused as "not in range 1 to 16777216".
 // An empty string was taken as no value: `--checkpoint ''` rendered without checkpoints, exit 0.
+// A real took a hex float (`--time 0x10` ran 16 s) and a leading space; CLI11's range checks
+// let NaN through (every comparison with it is false), and a NaN --time would never end a render.
 #include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "core/text.hpp"
 
 namespace lucent::cli {
 
@@ -20,19 +26,14 @@ inline CLI::Validator non_empty() {
 inline constexpr const char kDecimalIntegers[] =
     "integers are plain decimal digits, without a leading zero or a base prefix (0x, 0b)";
 
-/// Whether `text` is an integer in plain decimal: an optional '-', then 0 or digits that do not
-/// start with 0.
-inline bool plain_decimal(const std::string& text) {
-  const size_t start = !text.empty() && text[0] == '-' ? 1 : 0;
-  if (text.size() == start || text.find_first_not_of("0123456789", start) != std::string::npos)
-    return false;
-  return text[start] != '0' || text.size() == start + 1;
-}
+/// What a real option's value must be, for the error line.
+inline constexpr const char kDecimalReals[] =
+    "reals are decimal numbers such as 2, 0.5 or 1e-3, without a base prefix (0x) or spaces";
 
 /// The first value given to an option of `app` or its subcommands whose CLI11 type name
 /// (get_type_name(): the type, then the validators' descriptions) `typed` accepts, that `bad`
-/// finds wrong, as "--name value" ("--name ''" for an empty one; "" when none). Each element of a
-/// comma-separated list is a value; an empty result is one empty value.
+/// finds wrong, as "--name value" (quoted when empty or holding a space: "--name ''"; "" when
+/// none). Each element of a comma-separated list is a value; an empty result is one empty value.
 template <class Typed, class Bad>
 std::string first_bad_value(const CLI::App& app, Typed typed, Bad bad) {
   std::vector<const CLI::App*> apps{&app};
@@ -47,7 +48,10 @@ std::string first_bad_value(const CLI::App& app, Typed typed, Bad bad) {
         bool any = false;
         while (std::getline(items, value, ',') || (!any && all.empty())) {
           any = true;
-          if (bad(value)) return o->get_name() + " " + (value.empty() ? "''" : value);
+          if (bad(value)) {
+            const bool quote = value.empty() || value.find_first_of(" \t") != std::string::npos;
+            return o->get_name() + " " + (quote ? "'" + value + "'" : value);
+          }
         }
       }
     }
@@ -65,7 +69,33 @@ inline std::string non_decimal_option(const CLI::App& app) {
         const std::string base = type.substr(0, type.find(':'));
         return base == "INT" || base == "UINT";
       },
-      [](const std::string& value) { return !plain_decimal(value); });
+      [](const std::string& value) { return !io::plain_decimal_integer(value); });
+}
+
+/// Whether a CLI11 type name (get_type_name()) is a real option's: "FLOAT", or "FLOAT:" and its
+/// validators' descriptions.
+inline bool real_type(const std::string& type) { return type.substr(0, type.find(':')) == "FLOAT"; }
+
+/// The usage error of the first option value that CLI11 took but no user means, as
+/// "--name value: what it must be" ("" when none): an integer that is not plain decimal, a real
+/// that is not finite, a real number that is not plain decimal. Checked whether or not the parse
+/// failed (with 0b11, CLI11's own range error came first).
+inline std::string refused_value(const CLI::App& app) {
+  if (std::string bad = non_decimal_option(app); !bad.empty()) return bad + ": " + kDecimalIntegers;
+  const std::string not_finite = first_bad_value(app, real_type, [](const std::string& value) {
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    return end != value.c_str() && *end == '\0' && !std::isfinite(v);
+  });
+  if (!not_finite.empty()) return not_finite + ": must be a finite number";
+  // (what strtod reads whole, as CLI11 does: a value that is no number keeps CLI11's message)
+  const std::string not_decimal = first_bad_value(app, real_type, [](const std::string& value) {
+    char* end = nullptr;
+    std::strtod(value.c_str(), &end);
+    return end != value.c_str() && *end == '\0' && !io::plain_decimal_real(value);
+  });
+  if (!not_decimal.empty()) return not_decimal + ": " + kDecimalReals;
+  return "";
 }
 
 }  // namespace lucent::cli

@@ -12,6 +12,16 @@ namespace lucent::io {
 /// a file name with a newline cannot break the one-line contract or drive the terminal.
 std::string one_line(const std::string& s);
 
+/// Whether `text` is an integer in plain decimal: an optional '-', then 0 or digits that do not
+/// start with 0. Option values and settings are read so (strtol and CLI11 took leading spaces, a
+/// '+', and CLI11 read a leading zero as octal: `--spp 010` rendered 8 samples per pixel).
+bool plain_decimal_integer(const std::string& text);
+
+/// Whether `text` is a real in plain decimal: an optional sign, digits with at most one '.' (at
+/// least one digit), then an optional exponent (e or E, an optional sign, digits). strtod also
+/// takes hex floats (`--time 0x10` ran 16 s), leading spaces, "inf" and "nan".
+bool plain_decimal_real(const std::string& text);
+
 /// While alive, this thread formats and parses numbers (printf, strtod) in the "C" locale,
 /// whatever setlocale() chose for the process: a Python program that called
 /// locale.setlocale(locale.LC_ALL, "") on a German system wrote "0,5" into CSV files and SVG

@@ -592,16 +592,15 @@ int main(int argc, char** argv) {
   std::string message;
   try {
     app.parse(argc, argv);
-    // (CLI11 read --spp 010 as octal 8)
-    if (const std::string bad = lucent::cli::non_decimal_option(app); !bad.empty())
-      throw CLI::ValidationError(bad + ": " + lucent::cli::kDecimalIntegers);
+    // (CLI11 read --spp 010 as octal 8, --time 0x10 as 16)
+    if (const std::string bad = lucent::cli::refused_value(app); !bad.empty())
+      throw CLI::ValidationError(bad);
   } catch (const CLI::ParseError& e) {
     failed = 1;
     code = e.get_exit_code();
     // an integer that is not plain decimal is named as such (0b11 was "not in range")
-    const std::string bad = lucent::cli::non_decimal_option(app);
-    const std::string said =
-        bad.empty() ? std::string(e.what()) : bad + ": " + lucent::cli::kDecimalIntegers;
+    const std::string bad = lucent::cli::refused_value(app);
+    const std::string said = bad.empty() ? std::string(e.what()) : bad;
     if (g_rank != 0) {
       message = said;
     } else if (code == 0) {

@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <tuple>
 
 #include "core/text.hpp"
 #include "image/plot_svg.hpp"
@@ -28,9 +29,10 @@ namespace lucent {
 namespace {
 
 int parse_int(const std::string& knob, const std::string& value, int min, int max) {
-  char* end = nullptr;
-  long v = std::strtol(value.c_str(), &end, 10);
-  if (value.empty() || *end != '\0' || v < min || v > max)
+  // plain decimal, as the command line's integers (strtol took " 3", "+3" and "03")
+  const long v =
+      io::plain_decimal_integer(value) ? std::strtol(value.c_str(), nullptr, 10) : min - 1L;
+  if (v < min || v > max)
     throw Error("setting " + knob + "=" + value + ": expected an integer from " +
                 std::to_string(min) + " to " + std::to_string(max));
   return static_cast<int>(v);
@@ -61,9 +63,10 @@ double log_log_slope(const std::vector<double>& x, const std::vector<double>& y)
 /// A finite number >= lo (> lo when `strict`).
 double parse_number(const std::string& knob, const std::string& value, double lo, bool strict) {
   io::CNumbers c_numbers;  // "0.5", whatever the process locale
-  char* end = nullptr;
-  double v = std::strtod(value.c_str(), &end);
-  if (value.empty() || *end != '\0' || !std::isfinite(v) || (strict ? !(v > lo) : !(v >= lo)))
+  // plain decimal, as the command line's reals (strtod took "0x10" and " 1")
+  const double v = io::plain_decimal_real(value) ? std::strtod(value.c_str(), nullptr)
+                                                 : std::numeric_limits<double>::quiet_NaN();
+  if (!std::isfinite(v) || (strict ? !(v > lo) : !(v >= lo)))
     throw Error("setting " + knob + ": expected a number " + (strict ? ">" : ">=") + " " +
                 std::to_string(static_cast<int>(lo)));
   // as the command line's real options (a larger clamp would be blamed on the scene file)
@@ -115,6 +118,16 @@ double reference_noise(const RenderResult& ref) {
   return sum / (3.0 * double(npix));
 }
 
+/// Whether two settings set the same knobs to the same values (their names aside).
+bool same_knobs(const ConvergeSetting& a, const ConvergeSetting& b) {
+  const auto knobs = [](const ConvergeSetting& s) {
+    return std::tie(s.fast_math, s.precision, s.specialize, s.mis, s.max_depth, s.rr_depth,
+                    s.filter, s.filter_radius, s.integrator, s.sampler, s.clamp, s.caustics,
+                    s.splits, s.adaptive, s.min_spp, s.target_error);
+  };
+  return knobs(a) == knobs(b);
+}
+
 }  // namespace
 
 void ConvergeSetting::apply(Scene& scene, RenderOptions& options) const {
@@ -142,10 +155,17 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
   ConvergeSetting s;
   s.name = text;
   if (text.empty()) throw Error("empty setting (expected e.g. default, fast-math, max_depth=2)");
-  std::stringstream ss(text);
-  std::string knob;
+  // every knob between two '+' (getline dropped a trailing empty one: "max_depth=3+" was read)
+  std::vector<std::string> knobs{""};
+  for (char c : text)
+    if (c == '+')
+      knobs.emplace_back();
+    else
+      knobs.back().push_back(c);
   std::map<std::string, std::string> given;  // what each knob sets -> the knob that set it
-  while (std::getline(ss, knob, '+')) {
+  for (const std::string& knob : knobs) {
+    if (knob.empty())
+      throw Error("setting '" + text + "': an empty knob (knobs are joined by one +)");
     std::string key = knob, value;
     std::size_t eq = knob.find('=');
     if (eq != std::string::npos) {
@@ -205,9 +225,8 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
                     type_names<FilterType>() + ", optionally :RADIUS)");
       s.filter = static_cast<int>(*t);
       if (!radius.empty()) {
-        char* end = nullptr;
-        double r = std::strtod(radius.c_str(), &end);
-        if (*end != '\0' || !(r > 0) || r > limits::kMaxFilterRadius)
+        const double r = io::plain_decimal_real(radius) ? std::strtod(radius.c_str(), nullptr) : 0;
+        if (!(r > 0) || r > limits::kMaxFilterRadius)
           throw Error("setting " + knob + ": filter radius must be a number in (0, " +
                       fmt("%g", limits::kMaxFilterRadius) + "] pixels");
         s.filter_radius = r;
@@ -258,6 +277,20 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
   if (s.min_spp > 0 && !s.adaptive && !(s.target_error > 0))
     throw Error("setting '" + text + "': min-spp needs adaptive or target-error");
   return s;
+}
+
+std::vector<ConvergeSetting> parse_converge_settings(const std::vector<std::string>& texts) {
+  std::vector<ConvergeSetting> out;
+  for (const std::string& text : texts) {
+    ConvergeSetting parsed = parse_converge_setting(text);
+    for (const ConvergeSetting& earlier : out)
+      if (same_knobs(earlier, parsed))
+        throw Error("'" + text + "' is " +
+                    (earlier.name == text ? std::string("given twice")
+                                          : "the same setting as '" + earlier.name + "'"));
+    out.push_back(std::move(parsed));
+  }
+  return out;
 }
 
 namespace {

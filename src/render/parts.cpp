@@ -276,7 +276,9 @@ std::string ranges_text(const std::vector<SampleRange>& rs) {
 SampleRange parse_sample_range(const std::string& text, const std::string& what, bool per_part) {
   const size_t colon = text.find(':');
   auto number = [&](const std::string& s, std::uint64_t* v) {
-    if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos || s.size() > 11)
+    // plain decimal, as the command line's integers ("010" read 10 where --spp 010 is refused)
+    if (s.find_first_not_of("0123456789") != std::string::npos || !io::plain_decimal_integer(s) ||
+        s.size() > 11)
       return false;
     *v = std::stoull(s);
     return true;
@@ -284,7 +286,7 @@ SampleRange parse_sample_range(const std::string& text, const std::string& what,
   SampleRange r;
   if (colon == std::string::npos || !number(text.substr(0, colon), &r.begin) ||
       !number(text.substr(colon + 1), &r.end))
-    throw Error(what + " '" + text + "': expected A:B, the sample indices [A, B)");
+    throw Error(what + " '" + text + "': expected A:B, the sample indices [A, B) in decimal");
   if (r.end <= r.begin || r.end > (1ull << 32))
     throw Error(what + " '" + text + "': need 0 <= A < B <= 4294967296");
   if (per_part && r.end - r.begin > static_cast<std::uint64_t>(limits::kMaxSpp))
