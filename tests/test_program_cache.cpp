@@ -267,6 +267,12 @@ TEST(ProgramCache, CliClearsTheCache) {
   fs::create_directories(dir + "/0000000000000000.bin");
   fs::create_directories(dir + "/fedcba9876543210.bin");
   lucent::test::write_file(dir + "/fedcba9876543210.bin/data.txt", "keep");
+  // nor a user's file whose name starts like an entry's (it was counted and removed), nor a link
+  // of an entry's name (info counted it, and its target's size, where clear left it)
+  lucent::test::write_file(dir + "/0123456789abcdef.bin.old.bin", "keep");
+  lucent::test::write_file(dir + "/.0123456789abcdef.bin.tmp-notes", "keep");
+  lucent::test::write_file(dir + "/elsewhere", std::string(5000, 'x'));
+  fs::create_symlink(dir + "/elsewhere", dir + "/1111111111111111.bin");
   r = lucent::test::run_cli("cache info", "LUCENT_CACHE_DIR='" + dir + "'");
   EXPECT_NE(r.out.find("programs: 1"), std::string::npos) << r.out;
   r = lucent::test::run_cli("cache clear", "LUCENT_CACHE_DIR='" + dir + "'");
@@ -277,6 +283,9 @@ TEST(ProgramCache, CliClearsTheCache) {
   EXPECT_TRUE(fs::exists(dir + "/0123456789ABCDEF.bin"));
   EXPECT_TRUE(fs::is_directory(dir + "/0000000000000000.bin"));
   EXPECT_TRUE(fs::exists(dir + "/fedcba9876543210.bin/data.txt"));
+  EXPECT_TRUE(fs::exists(dir + "/0123456789abcdef.bin.old.bin"));
+  EXPECT_TRUE(fs::exists(dir + "/.0123456789abcdef.bin.tmp-notes"));
+  EXPECT_TRUE(fs::is_symlink(dir + "/1111111111111111.bin"));
   EXPECT_FALSE(fs::exists(dir + "/0123456789abcdef.bin.lock"));
   EXPECT_FALSE(fs::exists(dir + "/.0123456789abcdef.bin.tmp-12-0"));
   // on PoCL with its cache on, where sessions leave caching to PoCL, it says so

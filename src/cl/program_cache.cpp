@@ -325,13 +325,19 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
 namespace {
 
 /// A file the cache writes: "<16 hex digits>.bin", its ".lock", or a write's hidden temporary
-/// (".<16 hex digits>.bin.tmp-..."). Nothing else in the directory is the cache's to delete: a
-/// cache directory given by mistake (".", a home directory) lost every *.bin file in it.
-bool cache_file_name(std::string name) {
-  if (!name.empty() && name[0] == '.') name.erase(0, 1);
-  if (name.size() < 20 || name.compare(16, 4, ".bin") != 0) return false;
-  return std::all_of(name.begin(), name.begin() + 16,
-                     [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
+/// (".<16 hex digits>.bin.tmp-<pid>-<n>"). Nothing else in the directory is the cache's to
+/// delete: a cache directory given by mistake (".", a home directory) lost every *.bin file in it,
+/// and a user's file named "<16 hex digits>.bin.old.bin" was counted and removed as an entry.
+bool cache_file_name(const std::string& name) {
+  const size_t at = !name.empty() && name[0] == '.' ? 1 : 0;  // a temporary's dot
+  if (name.size() < at + 20 || name.compare(at + 16, 4, ".bin") != 0 ||
+      !std::all_of(name.begin() + at, name.begin() + at + 16,
+                   [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); }))
+    return false;
+  const std::string tail = name.substr(at + 20);
+  if (at == 0) return tail.empty() || tail == ".lock";
+  return tail.compare(0, 5, ".tmp-") == 0 && tail.size() > 5 &&
+         tail.find_first_not_of("0123456789-", 5) == std::string::npos;
 }
 
 // The files of the cache directory `dir` that the cache wrote (none when `dir` does not exist).
@@ -363,9 +369,13 @@ std::vector<fs::directory_entry> cache_files(const std::string& dir) {
   return files;
 }
 
-// An entry, "<key>.bin" (not a lock, not a write's temporary).
+// An entry, "<key>.bin" (not a lock, not a write's temporary), as a file of its own: a directory
+// or a symbolic link of such a name is not one the cache wrote (info counted a link, and its
+// target's size, that clear left alone).
 bool is_entry(const fs::directory_entry& e) {
-  return e.path().extension() == ".bin" && e.path().filename().string()[0] != '.';
+  std::error_code ec, link_ec;
+  return e.path().extension() == ".bin" && e.path().filename().string()[0] != '.' &&
+         e.is_regular_file(ec) && !e.is_symlink(link_ec);
 }
 
 // Removes the lock file `path` unless a process holds it (one that opened it and waits for it
@@ -401,7 +411,7 @@ ProgramCacheUsage program_cache_usage(const std::string& dir) {
   ProgramCacheUsage usage;
   for (const fs::directory_entry& e : cache_files(dir)) {
     std::error_code ec;
-    if (!is_entry(e) || !e.is_regular_file(ec)) continue;
+    if (!is_entry(e)) continue;
     const std::uintmax_t bytes = e.file_size(ec);
     if (ec) continue;  // removed meanwhile
     ++usage.programs;
@@ -426,8 +436,8 @@ int evict_program_cache(const std::string& dir, std::uint64_t max_bytes, const s
   std::vector<Entry> entries;
   std::uint64_t total = 0;
   for (const fs::directory_entry& e : files) {
-    std::error_code ec, time_ec, size_ec;
-    if (!is_entry(e) || !e.is_regular_file(ec)) continue;
+    std::error_code time_ec, size_ec;
+    if (!is_entry(e)) continue;
     Entry entry{e.last_write_time(time_ec), e.file_size(size_ec), e.path()};
     if (time_ec || size_ec) continue;  // removed meanwhile
     total += entry.bytes;
