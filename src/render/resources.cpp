@@ -246,15 +246,21 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
 
 namespace {
 
+// `before_devices`: the devices are not chosen yet (lucent render's first check), so their
+// buffers, host memory on a CPU device, are not in `parts`: the need is a lower bound (it said
+// 20 GiB for a 16384x16384 film where lucent info said 40 on the CPU device).
 void check_host_parts(const Scene& scene, const std::vector<MemoryPart>& parts,
-                      std::uint64_t host_limit, const std::string& limit_what) {
+                      std::uint64_t host_limit, const std::string& limit_what,
+                      bool before_devices = false) {
   const std::uint64_t need = total_bytes(parts);
   if (need <= host_limit) return;
   const MemoryPart& big = largest(parts);
-  throw Error(scene_name(scene) + ": rendering needs about " + format_bytes(need) +
-              " of host memory, more than the limit of " + format_bytes(host_limit) + " (80% of " +
-              limit_what + "); the largest part is " + big.what + " (" + format_bytes(big.bytes) +
-              "): reduce " + big.reduce);
+  throw Error(scene_name(scene) + ": rendering needs " +
+              (before_devices ? "at least about " : "about ") + format_bytes(need) +
+              " of host memory" + (before_devices ? " before its devices' buffers" : "") +
+              ", more than the limit of " + format_bytes(host_limit) + " (80% of " + limit_what +
+              "); the largest part is " + big.what + " (" + format_bytes(big.bytes) + "): reduce " +
+              big.reduce);
 }
 
 }  // namespace
@@ -265,7 +271,7 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
   if (host_limit == 0) return;
   std::vector<MemoryPart> parts = estimate_host_memory(scene, devices, description_copies);
   parts.insert(parts.end(), extra.begin(), extra.end());
-  check_host_parts(scene, parts, host_limit, limit_what);
+  check_host_parts(scene, parts, host_limit, limit_what, devices.empty());
 }
 
 void check_output_host_memory(const Scene& scene, const std::vector<MemoryPart>& outputs) {

@@ -129,7 +129,8 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
 std::vector<MemoryPart> reserved_part(std::uint64_t reserved);
 
 /// Throws lucent::Error when the estimate, with `extra` parts, exceeds `host_limit` (0: no
-/// check), naming the largest part and the limit (80% of `limit_what`).
+/// check), naming the largest part and the limit (80% of `limit_what`). Without `devices` (not
+/// chosen yet) the estimate leaves their buffers out, and the error says "at least".
 void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devices,
                        std::uint64_t host_limit, const std::string& limit_what = "physical memory",
                        const std::vector<MemoryPart>& extra = {}, int description_copies = 2);
