@@ -437,7 +437,11 @@ double cli_samples_per_second(const std::string& scene, const std::string& out) 
   const CommandResult cal = run_cli("render '" + scene + "' --time 0.5 -o '" + out + "'");
   const size_t at = cal.err.find(" Msamples/s");
   const size_t open = at == std::string::npos ? at : cal.err.rfind('(', at);
-  if (cal.status != 0 || open == std::string::npos) return -1;
+  if (cal.status != 0 || open == std::string::npos) {
+    // what the render said, for the failure's report
+    std::fprintf(stderr, "calibration render (status %d) said:\n%s\n", cal.status, cal.err.c_str());
+    return -1;
+  }
   return std::atof(cal.err.c_str() + open + 1) * 1e6;
 }
 

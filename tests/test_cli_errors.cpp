@@ -496,7 +496,20 @@ TEST(CliErrors, EmptyNamesAreRefused) {
         {"converge " + q(scene) + " --spp-ladder 1,2 --reference-spp 4 --csv ''", "--csv"},
         {"converge " + q(scene) + " --spp-ladder 1,2 --save-reference ''", "--save-reference"},
         {"merge " + q(dir + "/p.exr") + " -o " + q(dir + "/m.exr") + " --expect ''", "--expect"},
-        {"compare " + q(scene) + " " + q(scene) + " --zmap ''", "--zmap"}}) {
+        {"compare " + q(scene) + " " + q(scene) + " --zmap ''", "--zmap"},
+        // the files themselves (an empty -o, --plot, --settings or input was an error of status
+        // 1, --plot's naming no file: ": unknown plot format ''")
+        {"render " + q(scene) + " -o ''", "--output"},
+        {"render '' -o " + q(dir + "/o.pfm"), "scene"},
+        {"info ''", "scene"},
+        {"converge '' --spp-ladder 1,2", "scene"},
+        {"converge " + q(scene) + " --spp-ladder 1,2 --reference-spp 4 --plot ''", "--plot"},
+        {"converge " + q(scene) + " --spp-ladder 1,2 --reference-spp 4 --settings ''",
+         "--settings"},
+        {"merge '' -o " + q(dir + "/m.exr"), "parts"},
+        {"merge " + q(dir + "/p.exr") + " -o ''", "--output"},
+        {"compare '' " + q(scene), "a"},
+        {"compare " + q(scene) + " ''", "b"}}) {
     CommandResult r = run_cli(args);
     EXPECT_EQ(expect_one_error_line(r), option + ": must not be empty (see lucent --help)") << args;
     EXPECT_EQ(r.status, 2) << args;

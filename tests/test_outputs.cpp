@@ -275,7 +275,8 @@ TEST(Outputs, InputsOfTheRenderAreRefused) {
       error_line(run_cli("render " + q(textured) + " -o " + q(dir + "/y.exr") + " --aov depth")),
       dir + "/y.depth.exr: is a directory");
   EXPECT_FALSE(fs::exists(dir + "/y.exr"));
-  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o ''")), "-o: the output path is empty");
+  EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o ''")),
+            "--output: must not be empty (see lucent --help)");
   // compare's z map and converge's outputs are checked the same way
   EXPECT_EQ(error_line(run_cli("compare " + q(dir + "/tex.pfm") + " " + q(dir + "/tex.pfm") +
                                " --zmap " + q(dir + "/./tex.pfm"))),

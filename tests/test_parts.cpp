@@ -1082,6 +1082,8 @@ TEST(Parts, MpiCommandLineErrorsAreOneLine) {
       // an empty --device fell back to LUCENT_DEVICE, an empty --checkpoint to none
       {q(scene) + " -o " + q(out) + " --device ''", "--device: must not be empty"},
       {q(scene) + " -o " + q(out) + " --checkpoint ''", "--checkpoint: must not be empty"},
+      {q(scene) + " -o ''", "--output: must not be empty"},
+      {"'' -o " + q(out), "scene: must not be empty"},
       {q(scene), "--output is required"}};
   for (const auto& [args, says] : cases) {
     CommandResult r = run_shell("timeout 60 " + prog + args, dir);

@@ -33,8 +33,12 @@ CLI::App* add_compare_command(CLI::App& app) {
   CompareArgs& a = compare_args();
   CLI::App* cmd = app.add_subcommand(
       "compare", "Compare two renders statistically (z-test per pixel; EXR with var.*/n layers)");
-  cmd->add_option("a", a.a, "First image (.exr with variance layers, or any image)")->required();
-  cmd->add_option("b", a.b, "Second image, the reference for relMSE")->required();
+  cmd->add_option("a", a.a, "First image (.exr with variance layers, or any image)")
+      ->required()
+      ->check(non_empty());
+  cmd->add_option("b", a.b, "Second image, the reference for relMSE")
+      ->required()
+      ->check(non_empty());
   cmd->add_option("--alpha", a.options.alpha, "Family-wise significance level (default 0.01)")
       ->check(lucent::cli::real_range(1e-12, 0.5));
   cmd->add_option("--min-pass", a.options.min_pass_fraction,

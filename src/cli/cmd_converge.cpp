@@ -139,14 +139,15 @@ CLI::App* add_converge_command(CLI::App& app) {
   ConvergeArgs& a = converge_args();
   CLI::App* cmd = app.add_subcommand(
       "converge", "Error against a reference for a ladder of spp or time budgets and settings");
-  cmd->add_option("scene", a.scene, "Scene file (JSON)")->required();
+  cmd->add_option("scene", a.scene, "Scene file (JSON)")->required()->check(non_empty());
   cmd->add_option("--csv", a.csv,
                   "Write setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s,"
                   "reference_noise_relmse,estimated_relmse,halves_relmse")
       ->check(non_empty());
   cmd->add_option("--plot", a.plots,
                   "Write a plot of relMSE against time (log-log): .svg, or .png (raster); may be "
-                  "given more than once");
+                  "given more than once")
+      ->check(non_empty());
   auto* ref = cmd->add_option("--reference", a.reference,
                               "Reference image (.exr with var.*/n layers, .pfm, ...)")
                   ->check(non_empty());
@@ -171,7 +172,8 @@ CLI::App* add_converge_command(CLI::App& app) {
                       ", sampler=" + type_names<SamplerType>("|") +
                       ", clamp=X, caustics, no-caustics, splits=N, adaptive, min-spp=N, "
                       "target-error=E (default: default)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(non_empty());
   auto* spp = cmd->add_option("--spp-ladder", a.spp_ladder, "Samples per pixel of each rung")
                   ->delimiter(',')
                   ->check(CLI::Range(1, limits::kMaxSpp));

@@ -85,7 +85,7 @@ void print_memory(const Scene& scene) {
 CLI::App* add_info_command(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("info", "Print scene statistics, its BVH and the kernel feature defines");
-  cmd->add_option("scene", info_args().scene, "Scene file (JSON)")->required();
+  cmd->add_option("scene", info_args().scene, "Scene file (JSON)")->required()->check(non_empty());
   cmd->add_option("--integrator", info_args().integrator,
                   "Show the scene with this integrator (as render --integrator): " +
                       type_names<IntegratorType>())

@@ -36,10 +36,13 @@ CLI::App* add_merge_command(CLI::App& app) {
   MergeArgs& a = merge_args();
   CLI::App* cmd = app.add_subcommand(
       "merge", "Merge the part files of sample-range renders (render --samples A:B) exactly");
-  cmd->add_option("parts", a.parts, "Part files (.exr written by render --samples)")->required();
+  cmd->add_option("parts", a.parts, "Part files (.exr written by render --samples)")
+      ->required()
+      ->check(non_empty());
   cmd->add_option("-o,--output", a.output,
                   "Merged image: .exr (a part file, mergeable again), .png or .pfm")
-      ->required();
+      ->required()
+      ->check(non_empty());
   cmd->add_flag("--complete", a.complete,
                 "Fail (and write nothing) when sample ranges are missing");
   cmd->add_option("--expect", a.expect,

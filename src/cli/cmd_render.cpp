@@ -617,13 +617,16 @@ const std::string& render_scene() { return render_args().scene; }
 CLI::App* add_render_command(CLI::App& app) {
   RenderArgs& ra = render_args();
   CLI::App* render = app.add_subcommand("render", "Render a JSON scene to an image");
-  render->add_option("scene", ra.scene, "Scene file (JSON)")->required();
+  render->add_option("scene", ra.scene, "Scene file (JSON)")
+      ->required()
+      ->check(lucent::cli::non_empty());
   render
       ->add_option(
           "-o,--output", ra.output,
           "Output image: .png (8-bit, the film's transfer, exposure and tone map), .pfm or .exr "
           "(linear)")
-      ->required();
+      ->required()
+      ->check(lucent::cli::non_empty());
   render
       ->add_option("--spp", ra.spp,
                    "Samples per pixel (default: the scene's integrator.spp; with --time alone, as "

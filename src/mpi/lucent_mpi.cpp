@@ -547,8 +547,12 @@ int main(int argc, char** argv) {
   CLI::App app{
       "lucent-mpi: one render split over MPI ranks (mpirun -np K lucent-mpi SCENE -o OUT)"};
   app.set_version_flag("--version", std::string("lucent-mpi ") + lucent::kVersion);
-  app.add_option("scene", a.scene, "Scene file (JSON)")->required();
-  app.add_option("-o,--output", a.output, "Output: .exr (a part file), .png or .pfm")->required();
+  app.add_option("scene", a.scene, "Scene file (JSON)")
+      ->required()
+      ->check(lucent::cli::non_empty());
+  app.add_option("-o,--output", a.output, "Output: .exr (a part file), .png or .pfm")
+      ->required()
+      ->check(lucent::cli::non_empty());
   app.add_option("--spp", a.spp, "Samples per pixel in all (default: the scene's)")
       ->check(CLI::Range(1, lucent::limits::kMaxSpp));
   // as `lucent render --time`: a finite number of seconds up to 1e7 (CLI::PositiveNumber let NaN
