@@ -28,6 +28,7 @@
 #include "lucent/image.hpp"
 #include "lucent/parts.hpp"
 #include "lucent/version.hpp"
+#include "render/part_write.hpp"
 #include "render/resources.hpp"
 #include "support.hpp"
 
@@ -344,11 +345,75 @@ TEST(Parts, MergerAndPartsMisusedAreErrors) {
             "part_result: inconsistent part (film and accumulation sizes differ)");
   lucent::RenderPart empty;
   lucent::PartMerger parts;
-  EXPECT_EQ(error_of([&] { parts.add("e", empty); }),
-            "e: inconsistent part (film and accumulation sizes differ)");
+  EXPECT_EQ(error_of([&] { parts.add("e", empty); }), "e: the part's film 0x0 has no pixels");
   parts.add("a", a);
   parts.add("b", b);
   EXPECT_EQ(parts.finish().merged.acc.count, (std::vector<std::uint32_t>{8}));
+}
+
+// A part made in memory (a library caller's) is checked as reading checks a file: a part whose
+// own ranges were out of order merged with another overlapping them, counting a sample twice,
+// and write_render_part wrote headers and sums that read_render_part then refused (a part of no
+// samples, make_part's before a render, wrote an attribute read back as a NUL, which cut the
+// reader's message off). The adversarial API tester's finds.
+TEST(Parts, PartsMadeInMemoryAreCheckedAsFilesAre) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string file = dir + "/p.exr";
+  struct Case {
+    std::function<void(lucent::RenderPart&)> alter;
+    std::string message;
+  };
+  const Case cases[] = {
+      {[](lucent::RenderPart& p) {
+         p.info.samples = p.info.requested = {{10, 14}, {0, 4}};
+       },
+       "the part's samples [10, 14), [0, 4): ranges must be non-empty, sorted, disjoint and end at "
+       "2^32 at most"},
+      {[](lucent::RenderPart& p) {
+         p.info.samples = p.info.requested = {{0, 4}, {2, 6}};
+       },
+       "the part's samples [0, 4), [2, 6): ranges must be non-empty, sorted, disjoint and end at "
+       "2^32 at most"},
+      {[](lucent::RenderPart& p) {
+         p.info.requested = {{0, 1ull << 40}};
+       },
+       "the part's requested [0, 1099511627776): ranges must be non-empty, sorted, disjoint and "
+       "end at 2^32 at most"},
+      {[](lucent::RenderPart& p) { p.info.requested.clear(); },
+       "the part requests no sample range"},
+      {[](lucent::RenderPart& p) { p.info.integrator = "bogus"; },
+       "the part's integrator 'bogus' is unknown"},
+      {[](lucent::RenderPart& p) { p.info.display.gamma = std::nan(""); },
+       "the part's display gamma must be finite and > 0, its exposure finite"},
+      {[](lucent::RenderPart& p) { p.acc.sum[1] = std::nan(""); },
+       "pixel 0, 0 holds an invalid sum (not finite, or a negative sum of squares)"},
+      {[](lucent::RenderPart& p) { p.acc.sumsq[2] = -1; },
+       "pixel 0, 0 holds an invalid sum (not finite, or a negative sum of squares)"}};
+  for (const Case& c : cases) {
+    lucent::RenderPart p = handmade_part({{0, 4}}, {0, 4});
+    c.alter(p);
+    EXPECT_EQ(error_of([&] { lucent::write_render_part(file, p); }),
+              file + ": cannot write part: " + c.message);
+    EXPECT_FALSE(fs::exists(file)) << c.message;
+    lucent::PartMerger merger;
+    EXPECT_EQ(error_of([&] { merger.add("p", p); }), "p: " + c.message);
+    lucent::PartMerger headers;
+    if (c.message.find("invalid sum") == std::string::npos) {
+      EXPECT_EQ(error_of([&] { headers.add_header("p", p.info); }), "p: " + c.message);
+    }
+  }
+  // an overlap within one part no longer hides from the merger: [0, 4) and [2, 3) were taken
+  lucent::PartMerger merger;
+  lucent::RenderPart unsorted = handmade_part({{10, 14}, {0, 4}}, {0, 16});
+  EXPECT_NE(error_of([&] { merger.add("a", unsorted); }), "");
+  // a part of no samples: refused by the writer (its samples attribute read back as "\0")
+  lucent::RenderPart none = handmade_part({}, {0, 4});
+  EXPECT_EQ(error_of([&] { lucent::write_render_part(file, none); }),
+            file + ": cannot write part: it holds no samples (render before make_part)");
+  EXPECT_FALSE(fs::exists(file));
+  // the good part writes and reads back
+  lucent::write_render_part(file, handmade_part({{0, 4}}, {0, 4}));
+  EXPECT_EQ(lucent::read_render_part(file).acc.count, (std::vector<std::uint32_t>{4}));
 }
 
 // Parts of two samplers (their headers say which) were refused only by their scene hashes, as
@@ -743,7 +808,11 @@ TEST(Parts, CountsDisagreeingWithTheHeaderAreOneLineErrors) {
     lucent::RenderPart damaged = good;
     d.alter(damaged);
     const std::string path = dir + "/damaged" + std::to_string(n++) + ".exr";
-    lucent::write_render_part(path, damaged);
+    // the writer refuses it too, naming the same mismatch; the unchecked writer makes the file
+    EXPECT_EQ(error_of([&] { lucent::write_render_part(path, damaged); }),
+              path + ": cannot write part: " + d.message);
+    EXPECT_FALSE(fs::exists(path));
+    lucent::parts_detail::write_part_unchecked(path, damaged);
     EXPECT_EQ(error_of([&] { lucent::read_render_part(path); }), path + ": " + d.message);
     EXPECT_EQ(error_line(run_cli("merge " + q(path) + " -o " + q(out))), path + ": " + d.message);
     EXPECT_FALSE(fs::exists(out)) << d.message;
@@ -788,7 +857,7 @@ TEST(Parts, CountsDisagreeingWithTheHeaderAreOneLineErrors) {
   for (size_t i = 0; i < counts.size(); ++i)
     if (fewer.acc.count[i] < 4) last = i;
   const std::string nf = std::to_string(hot.info.nonfinite);
-  lucent::write_render_part(dir + "/fewer.exr", fewer);
+  lucent::parts_detail::write_part_unchecked(dir + "/fewer.exr", fewer);
   EXPECT_EQ(error_of([&] { lucent::read_render_part(dir + "/fewer.exr"); }),
             dir + "/fewer.exr: channel n: pixel " + std::to_string(last % 12) + ", " +
                 std::to_string(last / 12) + " counts " + std::to_string(fewer.acc.count[last]) +
@@ -798,7 +867,7 @@ TEST(Parts, CountsDisagreeingWithTheHeaderAreOneLineErrors) {
   // one sample more: fewer missing than recorded
   lucent::RenderPart more = hot;
   more.acc.count[short_one] += 1;
-  lucent::write_render_part(dir + "/more.exr", more);
+  lucent::parts_detail::write_part_unchecked(dir + "/more.exr", more);
   EXPECT_EQ(error_of([&] { lucent::read_render_part(dir + "/more.exr"); }),
             dir + "/more.exr: attribute lucent.nonfinite: " + nf +
                 " non-finite samples recorded, but the pixels (channel n) miss " +

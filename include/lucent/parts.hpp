@@ -89,7 +89,9 @@ enum class PartCompression {
 
 /// Writes a part file (an OpenEXR: the render's R, G, B, var.*, n layers, which `lucent compare`
 /// reads, plus the raw double sums and the header as attributes, with a checksum of the sums;
-/// docs/parts.md), atomically.
+/// docs/parts.md), atomically. Throws lucent::Error, writing nothing, for a part that reading
+/// would refuse: no samples, ranges not sorted and disjoint, counts or sums that disagree with
+/// the header, a non-finite sum.
 void write_render_part(const std::string& path, const RenderPart& part,
                        PartCompression compression = PartCompression::zip);
 /// The host memory write_render_part allocates for a width x height part, beside the part

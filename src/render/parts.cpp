@@ -24,6 +24,7 @@
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
 #include "lucent/version.hpp"
+#include "render/part_write.hpp"
 #include "render/resources.hpp"
 #include "render/sample_stats.hpp"
 
@@ -241,6 +242,41 @@ void check_counts(const std::string& name, const PartInfo& info, const Accumulat
                 std::to_string(missing) + " of the part's " + part_spp + " per pixel");
 }
 
+/// What read_render_part takes back of a part's header and sums, for a part made in memory (a
+/// library caller's, make_part's): write_render_part wrote headers and sums that reading then
+/// refused, and a merger took a part whose own ranges overlapped, counting samples twice. Throws
+/// lucent::Error naming `name`.
+void check_part_contents(const std::string& name, const PartInfo& info, const Accumulation& a) {
+  if (info.width <= 0 || info.height <= 0)
+    throw Error(name + ": the part's film " + std::to_string(info.width) + "x" +
+                std::to_string(info.height) + " has no pixels");
+  for (const auto* list : {&info.samples, &info.requested})
+    for (size_t k = 0; k < list->size(); ++k) {
+      const SampleRange& r = (*list)[k];
+      if (r.end <= r.begin || r.end > (1ull << 32) || (k > 0 && r.begin < (*list)[k - 1].end))
+        throw Error(name + ": the part's " + (list == &info.samples ? "samples " : "requested ") +
+                    ranges_text(*list) +
+                    ": ranges must be non-empty, sorted, disjoint and end at 2^32 at most");
+    }
+  if (info.requested.empty()) throw Error(name + ": the part requests no sample range");
+  if (unite(info.requested, info.samples) != info.requested)
+    throw Error(name + ": the part's samples " + ranges_text(info.samples) +
+                " lie outside the requested " + ranges_text(info.requested));
+  if (!find_type<IntegratorType>(info.integrator))
+    throw Error(name + ": the part's integrator '" + info.integrator + "' is unknown");
+  if (!info.sampler.empty() && !find_type<SamplerType>(info.sampler))
+    throw Error(name + ": the part's sampler '" + info.sampler + "' is unknown");
+  if (!(info.seconds >= 0) || !std::isfinite(info.seconds))
+    throw Error(name + ": the part's time must be a finite number of seconds >= 0");
+  if (!(info.display.gamma > 0) || !std::isfinite(info.display.gamma) ||
+      !std::isfinite(info.display.exposure))
+    throw Error(name + ": the part's display gamma must be finite and > 0, its exposure finite");
+  for (size_t i = 0; i < a.sum.size() && i < a.sumsq.size(); ++i)
+    if (!std::isfinite(a.sum[i]) || !std::isfinite(a.sumsq[i]) || a.sumsq[i] < 0)
+      throw Error(name + ": " + pixel_text(i / 3, std::max(a.width, 1)) +
+                  " holds an invalid sum (not finite, or a negative sum of squares)");
+}
+
 }  // namespace
 
 std::string range_text(const SampleRange& r) {
@@ -319,6 +355,10 @@ RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
   info.scene = scene_path;
   if (p.acc.spp > 0) info.samples = {{p.acc.first_sample, p.acc.first_sample + p.acc.spp}};
   info.requested = {requested};
+  // (a range to 2^64 made a part file that reading refused)
+  if (requested.end <= requested.begin || requested.end > (1ull << 32))
+    throw Error("make_part: requested samples " + range_text(requested) +
+                ": need 0 <= A < B <= 4294967296");
   if (unite(info.requested, info.samples) != info.requested)
     throw Error("make_part: the session's samples " + ranges_text(info.samples) +
                 " lie outside the requested " + range_text(requested));
@@ -361,16 +401,31 @@ std::uint64_t part_write_bytes(int width, int height, PartCompression compressio
 
 void write_render_part(const std::string& path, const RenderPart& part,
                        PartCompression compression) {
-  io::CNumbers c_numbers;  // "0.5", whatever the process locale
   const PartInfo& info = part.info;
   const Accumulation& a = part.acc;
-  const size_t npix = static_cast<size_t>(a.width) * a.height;
   if (a.width != info.width || a.height != info.height || !sums_fit_film(a))
     throw Error(path + ": cannot write part: inconsistent accumulation");
   if (a.light_paths > 0)
     throw Error(path +
                 ": cannot write part: part files do not hold light-traced caustics "
                 "(integrator.caustics); render the scene without --samples A:B");
+  // what reading it back checks: a part made in memory wrote headers and sums that reading then
+  // refused (a part of no samples, make_part's before a render, an attribute read back as a NUL)
+  check_part_contents(path + ": cannot write part", info, a);
+  if (info.samples.empty())
+    throw Error(path + ": cannot write part: it holds no samples (render before make_part)");
+  check_counts(path + ": cannot write part", info, a);
+  parts_detail::write_part_unchecked(path, part, compression);
+}
+
+void parts_detail::write_part_unchecked(const std::string& path, const RenderPart& part,
+                                        PartCompression compression) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
+  const PartInfo& info = part.info;
+  const Accumulation& a = part.acc;
+  const size_t npix = static_cast<size_t>(std::max(a.width, 0)) * std::max(a.height, 0);
+  if (a.width != info.width || a.height != info.height || !sums_fit_film(a))
+    throw Error(path + ": cannot write part: inconsistent accumulation");
   // each double as two UINT channels: its high and low 32 bits (EXR has no 64-bit pixel type);
   // one block for the twelve, and one for the mean and variance planes read_render shows, made
   // here from the sums (no RenderResult copy of the images)
@@ -548,6 +603,7 @@ void PartMerger::check(const std::string& name, const PartInfo& info) {
 }
 
 void PartMerger::add_header(const std::string& name, const PartInfo& info) {
+  check_part_contents(name, info, Accumulation{});
   check(name, info);
   names_.push_back(name);
   infos_.push_back(info);
@@ -560,8 +616,9 @@ void PartMerger::check_part(const std::string& name, const RenderPart& part) {
     throw Error(name +
                 ": PartMerger: add() after add_header(): a merger checks headers or adds "
                 "parts, not both");
-  check(name, part.info);
   const Accumulation& a = part.acc;
+  check_part_contents(name, part.info, a);
+  check(name, part.info);
   if (a.width <= 0 || a.height <= 0 || !sums_fit_film(a) || a.width != part.info.width ||
       a.height != part.info.height)
     throw Error(name + ": inconsistent part (film and accumulation sizes differ)");
