@@ -502,6 +502,33 @@ TEST(Compare, InconsistentLayersAreAnInputError) {
   EXPECT_EQ(
       lucent::test::error_of([&] { lucent::write_render_exr(dir + "/e.exr", RenderResult{}); }),
       dir + "/e.exr: cannot write EXR: the image has no pixels");
+  // images of no pixels, or of negative sizes, compared: -1 x -3 counted 3 pixels through size_t,
+  // and 0 x 0 passed with nothing tested (the API tester's find)
+  RenderResult odd;
+  odd.mean = {-1, -3, std::vector<float>(9, 0.f)};
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::compare_images(odd, odd); }),
+            "compare: image A has no pixels (-1x-3)");
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::compare_images(RenderResult{}, RenderResult{}); }),
+            "compare: image A has no pixels (0x0)");
+  // statistics layers of another size were left out of the file without a word; a light
+  // variance that is not finite was written, and reading refused the file
+  RenderResult layers = constant_image(2, 2, 0.5f);
+  layers.variance = layers.mean;
+  layers.samples = {4, 4, 4};
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::write_render_exr(dir + "/l.exr", layers); }),
+            dir +
+                "/l.exr: cannot write EXR: the variance layer has 12 values and the sample "
+                "counts 3, where a 2x2 image has 12 and 4 (or none of either)");
+  layers.samples.assign(4, 4);
+  layers.light_mean_variance = lucent::LightMeanVariance{{std::nan(""), 0, 0}, {0, 0, 0}};
+  EXPECT_NE(lucent::test::error_of([&] {
+              lucent::write_render_exr(dir + "/l.exr", layers);
+            }).find("l.exr: cannot write EXR: attribute lucent.light_mean_var: expected 6 finite"),
+            std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/l.exr"));
+  layers.light_mean_variance.reset();
+  lucent::write_render_exr(dir + "/l.exr", layers);
+  EXPECT_EQ(lucent::read_render(dir + "/l.exr").samples.size(), 4u);
 }
 
 // The z map's path is checked before the images are read (a .txt z map was refused only after

@@ -57,6 +57,10 @@ double image_mean_variance(const RenderResult& r, double pixels, int c) {
 }
 
 void check_layers(const RenderResult& r, const char* which) {
+  // (a size of -1 x -3 counted 3 pixels through size_t, and 0 x 0 passed with nothing tested)
+  if (r.mean.width <= 0 || r.mean.height <= 0)
+    throw Error(std::string("compare: image ") + which + " has no pixels (" +
+                std::to_string(r.mean.width) + "x" + std::to_string(r.mean.height) + ")");
   size_t npix = static_cast<size_t>(r.mean.width) * r.mean.height;
   if (r.mean.rgb.size() != npix * 3)
     throw Error(std::string("compare: image ") + which + " has inconsistent pixel data");
@@ -133,10 +137,6 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
   r.statistical = !a.variance.rgb.empty() || !b.variance.rgb.empty();
   const size_t npix = static_cast<size_t>(r.width) * r.height;
   r.tested = npix * 3;
-  if (npix == 0) {
-    r.passed = true;
-    return r;
-  }
   // Sidak: each of m tests at 1 - (1 - alpha)^(1/m)
   r.z = Image{r.width, r.height, std::vector<float>(npix * 3)};
   double per_test = -std::expm1(std::log1p(-o.alpha) / static_cast<double>(r.tested));

@@ -26,9 +26,12 @@ void write_render_exr(const std::string& path, const RenderResult& r) {
   image_detail::ExrExtras extras;
   if (!r.sampler.empty())
     extras.attributes = {{"lucent.seed", std::to_string(r.seed)}, {"lucent.sampler", r.sampler}};
-  if (r.light_mean_variance)
-    extras.attributes.emplace_back("lucent.light_mean_var",
-                                   image_detail::light_mean_var_attribute(*r.light_mean_variance));
+  if (r.light_mean_variance) {
+    // what read_render takes back (a NaN was written, and the file then refused)
+    const std::string attribute = image_detail::light_mean_var_attribute(*r.light_mean_variance);
+    image_detail::parse_light_mean_var(path + ": cannot write EXR", attribute);
+    extras.attributes.emplace_back("lucent.light_mean_var", attribute);
+  }
   image_detail::write_render_exr(path, r, extras);
 }
 
@@ -72,7 +75,15 @@ LightMeanVariance parse_light_mean_var(const std::string& path, const std::strin
 void write_render_exr(const std::string& path, const RenderResult& r, const ExrExtras& extras) {
   const size_t n = static_cast<size_t>(r.mean.width) * r.mean.height;
   if (r.mean.rgb.size() != n * 3) throw Error(path + ": cannot write EXR: inconsistent image");
-  const bool stats = r.variance.rgb.size() == n * 3 && r.samples.size() == n;
+  // the statistics are both there, of the image's size, or both absent (layers of another size
+  // were left out without a word: a file meant to carry them came out with the mean alone)
+  const bool stats = !r.variance.rgb.empty() || !r.samples.empty();
+  if (stats && (r.variance.rgb.size() != n * 3 || r.samples.size() != n))
+    throw Error(path + ": cannot write EXR: the variance layer has " +
+                std::to_string(r.variance.rgb.size()) + " values and the sample counts " +
+                std::to_string(r.samples.size()) + ", where a " + std::to_string(r.mean.width) +
+                "x" + std::to_string(r.mean.height) + " image has " + std::to_string(n * 3) +
+                " and " + std::to_string(n) + " (or none of either)");
   write_image_exr(path, r.mean, stats ? &r.variance : nullptr, stats ? r.samples.data() : nullptr,
                   extras);
 }
