@@ -513,6 +513,19 @@ TEST(SceneJson, StringsWithANulCharacterAreRefused) {
             "scene.json: /materials: the key 'red\\u0000junk' contains a NUL character (\\u0000)");
   EXPECT_EQ(error_of(R"({"film\u0000x": {}})"),
             "scene.json: /: the key 'film\\u0000x' contains a NUL character (\\u0000)");
+  // a NUL byte in the text given to parse_scene (not an escape): the parser stopped there and
+  // took what came before it, as load_scene refuses such a file
+  const std::string text =
+      std::string(R"({"film":{"width":8,"height":8}})") + '\0' + R"({"film":{}})";
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::parse_scene(text, "mem.json"); }),
+            "mem.json: byte 32 is a NUL byte: not a text scene file");
+}
+
+// A NUL character in an error's message (a user's string) is shown as \0: what() is a C string,
+// and the rest of the line was cut off (a device selector "cp\0u" said "device 'cp").
+TEST(SceneJson, ErrorsShowANulCharacter) {
+  const lucent::Error e(std::string("a\0b", 3) + " and " + std::string("\0", 1));
+  EXPECT_STREQ(e.what(), "a\\0b and \\0");
 }
 
 // ---------------------------------------------------------------------------------------------

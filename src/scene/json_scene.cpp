@@ -170,6 +170,10 @@ Scene parse_scene_in(const std::string& text, const std::string& path, const fs:
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& path) {
+  // as load_scene reads a file (the parser stopped at a NUL and took what came before it)
+  if (const size_t at = text.find('\0'); at != std::string::npos)
+    throw Error(path + ": byte " + std::to_string(at + 1) +
+                " is a NUL byte: not a text scene file");
   return parse_scene_in(text, path, fs::path(path).parent_path());
 }
 
