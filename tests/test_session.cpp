@@ -396,6 +396,10 @@ TEST(Session, OnProgressMayReadTheSessionButNotChangeIt) {
     lucent::AdaptiveOptions a;
     a.budget_spp = 8;
     errors.push_back(error_of([&] { r.render_adaptive(a); }));
+    // moving the session away, or over it (the render went on in a moved or destroyed session:
+    // SIGSEGV; the API tester's find)
+    errors.push_back(error_of([&] { Renderer other = std::move(r); }));
+    errors.push_back(error_of([&] { r = Renderer(o); }));
   });
   EXPECT_GE(calls, 1);
   ASSERT_FALSE(errors.empty());
@@ -482,6 +486,21 @@ TEST(Session, OptionsOutOfRangeAreErrors) {
   EXPECT_EQ(error_of([](lucent::RenderOptions& o) { o.pass_seconds = std::nan(""); }),
             "SessionOptions::pass_seconds must be a positive number of seconds, got nan");
   EXPECT_EQ(error_of([](lucent::RenderOptions& o) { o.spp = 2; }), "");
+  // the API tester's finds: a pilot without a target was ignored, a precision of 5 taken for
+  // float, a negative reference spp or thread count taken for the scene's or the hardware's
+  EXPECT_EQ(error_of([](lucent::RenderOptions& o) { o.min_spp = 8; }),
+            "render: RenderOptions::min_spp is the pilot of an adaptive render: it needs a "
+            "target_error");
+  EXPECT_EQ(error_of([](lucent::RenderOptions& o) { o.precision = lucent::Precision(5); }),
+            "SessionOptions::precision must be Precision::Float or Precision::Double, got 5");
+  lucent::ReferenceOptions ro;
+  ro.spp = -1;
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::render_reference(s, ro); }),
+            "ReferenceOptions::spp must be 0 (the scene's) or positive, got -1");
+  ro.spp = 1;
+  ro.threads = -1000;
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::render_reference(s, ro); }),
+            "ReferenceOptions::threads must be 0 (the hardware's) or positive, got -1000");
 }
 
 // Sessions created at once from several threads, the process's first OpenCL calls among them:

@@ -114,8 +114,10 @@ class Renderer {
   /// Opens the device. Throws lucent::Error (no device, unknown selector, ...).
   explicit Renderer(SessionOptions options = {});
   ~Renderer();
-  Renderer(Renderer&&) noexcept;
-  Renderer& operator=(Renderer&&) noexcept;
+  /// Moves the session. Throws lucent::Error during a render of either session (from its
+  /// on_progress: the render would go on in a session moved away or destroyed).
+  Renderer(Renderer&&);
+  Renderer& operator=(Renderer&&);
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 

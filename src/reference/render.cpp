@@ -42,6 +42,13 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
   for (const std::string& note : scene_detail::radiance_notes(scene)) scene_detail::warn(note);
   const int W = scene.film.width, H = scene.film.height;
   if (W <= 0 || H <= 0) throw Error(scene.path + ": film size must be positive");
+  // checked, not defaulted (a negative count took the scene's, or the hardware's)
+  if (options.spp < 0)
+    throw Error("ReferenceOptions::spp must be 0 (the scene's) or positive, got " +
+                std::to_string(options.spp));
+  if (options.threads < 0)
+    throw Error("ReferenceOptions::threads must be 0 (the hardware's) or positive, got " +
+                std::to_string(options.threads));
   const int spp = options.spp > 0 ? options.spp : scene.integrator.spp;
   if (spp <= 0) throw Error(scene.path + ": samples per pixel must be positive");
   int threads = options.threads > 0

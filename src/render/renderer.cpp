@@ -58,6 +58,12 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   if (!(options.target_error >= 0) || !std::isfinite(options.target_error))
     throw Error("render: RenderOptions::target_error must be a finite number >= 0 (0: off), got " +
                 scene_detail::format_number(options.target_error));
+  // the pilot of an adaptive render: a uniform render has none (it was ignored without a word,
+  // as lucent render refuses --min-spp without --target-error)
+  if (options.min_spp > 0 && options.target_error == 0)
+    throw Error(
+        "render: RenderOptions::min_spp is the pilot of an adaptive render: it needs a "
+        "target_error");
   SessionOptions so;
   so.device = options.device;
   so.kernel_dir = options.kernel_dir;

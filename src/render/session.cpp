@@ -375,6 +375,10 @@ struct Renderer::Impl {
     if (!(options.pass_seconds > 0) || !std::isfinite(options.pass_seconds))
       throw Error("SessionOptions::pass_seconds must be a positive number of seconds, got " +
                   scene_detail::format_number(options.pass_seconds));
+    // (set_build_options refuses it; SessionOptions took 5 for float)
+    if (options.precision != Precision::Float && options.precision != Precision::Double)
+      throw Error("SessionOptions::precision must be Precision::Float or Precision::Double, got " +
+                  std::to_string(static_cast<int>(options.precision)));
     const std::vector<DeviceInfo> devices = select_devices(options.device, "device");
     // double precision on a device without fp64: refused here, not at the first set_scene
     for (const DeviceInfo& d : devices)
@@ -1466,8 +1470,19 @@ Renderer::Impl& Renderer::impl() const {
   return *impl_;
 }
 Renderer::~Renderer() = default;
-Renderer::Renderer(Renderer&&) noexcept = default;
-Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+// (moving a session from its own on_progress: the render went on in an Impl moved away, or
+// destroyed by the assignment: SIGSEGV)
+Renderer::Renderer(Renderer&& other) {
+  if (other.impl_) other.impl_->check_not_rendering("moving a Renderer");
+  impl_ = std::move(other.impl_);
+}
+Renderer& Renderer::operator=(Renderer&& other) {
+  if (this == &other) return *this;
+  if (impl_) impl_->check_not_rendering("assigning to a Renderer");
+  if (other.impl_) other.impl_->check_not_rendering("moving a Renderer");
+  impl_ = std::move(other.impl_);
+  return *this;
+}
 
 const DeviceInfo& Renderer::device() const { return impl().device_infos.front(); }
 std::vector<DeviceInfo> Renderer::devices() const { return impl().device_infos; }
