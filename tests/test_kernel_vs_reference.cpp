@@ -591,6 +591,38 @@ TEST(KernelVsReference, DepthAndNormalDeterministic) {
   }
 }
 
+// Vertex normals far from unit length, set directly (Scene.normals: the loaders and the builder
+// store unit ones): the shading normal is their interpolation's direction, whatever their
+// length. Normals of 1e-50 became 0 in the kernel's float, which then shaded with the geometric
+// normal while the reference used theirs (the API tester's find); 1e30 squared overflowed float.
+TEST(KernelVsReference, VertexNormalsOfAnyLength) {
+  CompareOptions o;
+  o.abs_epsilon = 1e-4;
+  o.rel_epsilon = 1e-4;
+  Scene unit = scene_from(scene_json(
+      R"({"type": "normal"})", kDiffuseMats,
+      R"({"type": "triangles", "material": "red",
+          "positions": [[-1,0.2,0],[1,0.2,0],[0,1.4,0]], "indices": [0,1,2],
+          "normals": [[-0.6,0,0.8],[0.6,0,0.8],[0,0.6,0.8]]})",
+      "", "", R"({"width": 16, "height": 16, "filter": {"type": "box", "radius": 1e-6}})"));
+  lucent::RenderOptions ko;
+  ko.spp = 1;
+  const RenderResult expected = lucent::test::render(unit, ko);
+  for (double scale : {1e-50, 1e-20, 1e20, 1e30}) {
+    SCOPED_TRACE(scale);
+    Scene s = unit;
+    for (glm::dvec3& n : s.normals) n *= scale;
+    const RenderResult k = lucent::test::render(s, ko);
+    ASSERT_EQ(k.mean.rgb.size(), expected.mean.rgb.size());
+    double worst = 0;
+    for (size_t i = 0; i < k.mean.rgb.size(); ++i)
+      worst = std::max(worst, double(std::abs(k.mean.rgb[i] - expected.mean.rgb[i])));
+    EXPECT_LT(worst, 1e-6);
+    Both b = render_both(s, 1, o);
+    EXPECT_AGREE(b);
+  }
+}
+
 // An equirectangular environment map (nearest texels) lighting a diffuse and a glossy sphere,
 // seen directly too.
 TEST(KernelVsReference, EnvironmentMap) {

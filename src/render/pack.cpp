@@ -537,8 +537,20 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
       for (int k = 1; k < 3; ++k) lo = glm::min(lo, scene.uvs[t.uv[k]]);
       if (std::isfinite(lo.x) && std::isfinite(lo.y)) whole = glm::floor(lo);
     }
+    // Normals far from unit length (set directly: Scene.normals, from Python) scaled, all three
+    // by one power of two, their largest component then in [1, 2): the interpolation's direction
+    // is the same, and normals as short as 1e-50 no longer became 0 in float, where the kernel
+    // then shaded with the geometric normal and the reference, in double, with theirs. (Unit
+    // normals, the loaders' and the builder's, are packed as they are.)
+    double n_scale = 1;
+    if (has_n) {
+      double m = 0;
+      for (int k = 0; k < 3; ++k) m = std::max(m, scene_detail::max_abs(scene.normals[t.n[k]]));
+      if (m > 0 && std::isfinite(m) && (m < 0x1p-32 || m > 0x1p32))
+        n_scale = std::ldexp(1.0, -std::ilogb(m));
+    }
     for (int k = 0; k < 3; ++k) {
-      if (has_n) put3(a.n + 3 * k, scene.normals[t.n[k]]);
+      if (has_n) put3(a.n + 3 * k, scene.normals[t.n[k]] * n_scale);
       if (has_uv) {
         a.uv[2 * k] = static_cast<float>(scene.uvs[t.uv[k]].x - whole.x);
         a.uv[2 * k + 1] = static_cast<float>(scene.uvs[t.uv[k]].y - whole.y);
