@@ -24,6 +24,7 @@
 
 #include "core/file_io.hpp"
 #include "lucent/compare.hpp"
+#include "scene/validate.hpp"
 #include "support.hpp"
 
 namespace {
@@ -412,6 +413,19 @@ TEST(Outputs, RenderWithoutAFiniteSampleWritesNothing) {
                          "beyond a float's range: a radiance or intensity above about 1.8e19?)\n");
     EXPECT_FALSE(fs::exists(dir + "/" + name));
   }
+  // a point light so bright is named too (it rendered black without a word), with the distance
+  // within which its samples overflow (sqrt(1e30 / 1.84e19) = 2.3e5)
+  const lucent::Scene point = lucent::parse_scene(R"({
+    "materials": {"grey": {"type": "diffuse"}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "grey"}],
+    "lights": [{"type": "point", "position": [0, 2, 0], "intensity": [1, 1e30, 1]}]
+  })",
+                                                  "p.json");
+  EXPECT_EQ(lucent::scene_detail::radiance_notes(point),
+            std::vector<std::string>{
+                "p.json: /lights/0/intensity 1e+30 is above 1.84e+19, where a sample's square "
+                "overflows a float within a distance of about 2.33e+05 of it: such samples are "
+                "dropped as non-finite (lower it and raise film.exposure)"});
   // a part keeps its counts (all 0) and merges into a part; not into an image (lucent-mpi writes
   // through the same function)
   ASSERT_EQ(

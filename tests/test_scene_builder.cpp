@@ -597,6 +597,10 @@ TEST(SceneBuilder, TexturesFromMemory) {
               lucent::texture_from_srgb8(1, 1, 5, {1, 2, 3, 4, 5});
             }),
             "texture_from_srgb8: channels must be 1 to 4, got 5");
+  // (it said "need 0 bytes, got 12")
+  EXPECT_EQ(
+      error_of([] { lucent::texture_from_srgb8(-2, -2, 3, std::vector<std::uint8_t>(12, 0)); }),
+      "texture_from_srgb8: the size must be positive, got -2x-2");
 }
 
 // A scene built in code is the scene its JSON twin loads to: same camera, materials, geometry

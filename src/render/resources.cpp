@@ -161,8 +161,10 @@ std::uint64_t description_bytes(const Scene& scene) {
 
 std::vector<MemoryPart> reserved_part(std::uint64_t reserved) {
   if (reserved == 0) return {};
+  // (lucent render declares its outputs, which the film size sets; a library caller's bytes may
+  // be anything: "reduce the film size" blamed the film for them)
   return {{"what the application keeps beside the session (its outputs, as it declared them)",
-           reserved, "the film size"}};
+           reserved, "the film size, or what the application declares it keeps"}};
 }
 
 std::vector<MemoryPart> estimate_host_memory(const Scene& scene,

@@ -33,6 +33,10 @@ Texture texture_from_srgb8(int width, int height, int channels,
                            const std::vector<std::uint8_t>& data, std::string name) {
   if (channels < 1 || channels > 4)
     throw Error("texture_from_srgb8: channels must be 1 to 4, got " + std::to_string(channels));
+  // (a size of -2 x -2 said "need 0 bytes, got 12")
+  if (width < 1 || height < 1)
+    throw Error("texture_from_srgb8: the size must be positive, got " + std::to_string(width) +
+                "x" + std::to_string(height));
   if (width < 1 || height < 1 ||
       data.size() != std::size_t(width) * std::size_t(height) * std::size_t(channels))
     throw Error("texture_from_srgb8: " + std::to_string(width) + "x" + std::to_string(height) +

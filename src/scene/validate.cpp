@@ -543,10 +543,20 @@ std::vector<std::string> radiance_notes(const Scene& s) {
       what = "material '" + m.name + "': emission";  // (an MTL material has no JSON place)
       break;
     }
+  std::string nearby;  // a point light's: where its samples overflow
   for (std::size_t i = 0; what.empty() && i < s.lights.size(); ++i) {
     const Light& l = s.lights[i];
     if (l.type == LightType::Environment && (value = largest(l.radiance)) > most)
       what = "/lights/" + std::to_string(i) + "/radiance";
+    // a point light's irradiance is intensity / r^2: an intensity of 1e30 rendered black (every
+    // lit sample non-finite) without a word, where an emission so bright had this note
+    if (l.type == LightType::Point && (value = largest(l.intensity)) > most) {
+      what = "/lights/" + std::to_string(i) + "/intensity";
+      char d[64];
+      std::snprintf(d, sizeof d, " within a distance of about %.3g of it", std::sqrt(value / most));
+      nearby = d;
+      continue;
+    }
     if (l.type != LightType::EnvironmentMap || l.texture < 0 ||
         static_cast<std::size_t>(l.texture) >= s.textures.size())
       continue;
@@ -558,9 +568,9 @@ std::vector<std::string> radiance_notes(const Scene& s) {
   if (what.empty()) return {};
   char buf[64];
   std::snprintf(buf, sizeof buf, " %.3g is above %.3g", value, most);
-  return {in_file(s.path, what + buf +
-                              ", where a sample's square overflows a float: such samples are "
-                              "dropped as non-finite (lower it and raise film.exposure)")};
+  return {in_file(s.path, what + buf + ", where a sample's square overflows a float" + nearby +
+                              ": such samples are dropped as non-finite (lower it and raise "
+                              "film.exposure)")};
 }
 
 std::vector<std::string> energy_gain_notes(const Scene& s) {
