@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <regex>
 #include <sstream>
@@ -339,6 +340,46 @@ TEST(Converge, SettingSyntax) {
       EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
     }
   }
+}
+
+// A ConvergeSetting made in code is checked as the parser's are (the API tester's finds): mis = 5
+// turned MIS on where caustics = 7 turned caustics off; a max_depth of -5, a NaN clamp or a NaN
+// target meant "the scene's" without a word; two settings of the same knobs rendered twice.
+TEST(Converge, SettingsMadeInCodeAreChecked) {
+  const std::pair<std::function<void(ConvergeSetting&)>, std::string> cases[] = {
+      {[](ConvergeSetting& s) { s.mis = 5; }, "mis must be -1 (the scene's), 0 or 1"},
+      {[](ConvergeSetting& s) { s.caustics = 7; }, "caustics must be -1 (the scene's), 0 or 1"},
+      {[](ConvergeSetting& s) { s.max_depth = -5; }, "max_depth must be 0 (the scene's) to 100000"},
+      {[](ConvergeSetting& s) { s.clamp = std::nan(""); },
+       "clamp must be < 0 (the scene's) or a number from 0 to 3.4e38"},
+      {[](ConvergeSetting& s) { s.target_error = std::nan(""); },
+       "target_error must be 0 (off) or a positive number"},
+      {[](ConvergeSetting& s) { s.integrator = 99; },
+       "integrator must be -1 (the scene's) or an IntegratorType"},
+      {[](ConvergeSetting& s) { s.splits = 9; }, "splits must be -1 (the scene's) to 4"},
+      {[](ConvergeSetting& s) { s.filter_radius = -1; },
+       "filter_radius must be 0 (the scene's) or in (0, 8]"}};
+  for (const auto& [alter, message] : cases) {
+    lucent::ConvergeOptions opt;
+    opt.spp_ladder = {1, 2};
+    ConvergeSetting s;
+    s.name = "made";
+    alter(s);
+    opt.settings = {s};
+    EXPECT_EQ(lucent::test::error_of([&] { lucent::check_convergence_options(opt); }),
+              "converge: setting 'made': " + message);
+  }
+  lucent::ConvergeOptions opt;
+  opt.spp_ladder = {1, 2};
+  ConvergeSetting a, b;
+  a.name = "a";
+  b.name = "b";
+  opt.settings = {a, b};
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::check_convergence_options(opt); }),
+            "converge: setting 'b' sets what setting 'a' sets (each would render the same)");
+  b.max_depth = 3;
+  opt.settings = {a, b};
+  EXPECT_NO_THROW(lucent::check_convergence_options(opt));
 }
 
 TEST(Converge, DefaultLadder) {

@@ -128,6 +128,44 @@ bool same_knobs(const ConvergeSetting& a, const ConvergeSetting& b) {
   return knobs(a) == knobs(b);
 }
 
+/// The fields of a setting made in code, each within what its knob takes (parse_converge_setting
+/// makes only such): mis = 5 turned MIS on where caustics = 7 turned caustics off, and a
+/// max_depth of -5, a NaN clamp or a NaN target meant "the scene's" without a word.
+void check_setting_fields(const ConvergeSetting& s) {
+  auto fail = [&](const std::string& what) {
+    throw Error("converge: setting '" + s.name + "': " + what);
+  };
+  auto tri = [&](int v, const char* name) {
+    if (v < -1 || v > 1) fail(std::string(name) + " must be -1 (the scene's), 0 or 1");
+  };
+  tri(s.mis, "mis");
+  tri(s.caustics, "caustics");
+  if (s.precision != -1 && s.precision != static_cast<int>(Precision::Float) &&
+      s.precision != static_cast<int>(Precision::Double))
+    fail("precision must be -1 (the options') or a Precision");
+  if (s.max_depth < 0 || s.max_depth > limits::kMaxDepth)
+    fail("max_depth must be 0 (the scene's) to " + std::to_string(limits::kMaxDepth));
+  if (s.rr_depth < 0 || s.rr_depth > limits::kMaxDepth)
+    fail("rr_depth must be 0 (the scene's) to " + std::to_string(limits::kMaxDepth));
+  if (s.filter != -1 && !find_entry(static_cast<FilterType>(s.filter)))
+    fail("filter must be -1 (the scene's) or a FilterType");
+  if (!(s.filter_radius >= 0) || s.filter_radius > limits::kMaxFilterRadius)
+    fail("filter_radius must be 0 (the scene's) or in (0, " + fmt("%g", limits::kMaxFilterRadius) +
+         "]");
+  if (s.integrator != -1 && !find_entry(static_cast<IntegratorType>(s.integrator)))
+    fail("integrator must be -1 (the scene's) or an IntegratorType");
+  if (s.sampler != -1 && !find_entry(static_cast<SamplerType>(s.sampler)))
+    fail("sampler must be -1 (the scene's) or a SamplerType");
+  if (std::isnan(s.clamp) || s.clamp > FLT_MAX)
+    fail("clamp must be < 0 (the scene's) or a number from 0 to 3.4e38");
+  if (s.splits < -1 || s.splits > limits::kMaxDielectricSplits)
+    fail("splits must be -1 (the scene's) to " + std::to_string(limits::kMaxDielectricSplits));
+  if (s.min_spp != 0 && (s.min_spp < 4 || s.min_spp > int(AdaptiveOptions{}.max_spp)))
+    fail("min_spp must be 0 (the default) or 4 to " + std::to_string(AdaptiveOptions{}.max_spp));
+  if (!(s.target_error >= 0) || s.target_error > FLT_MAX)
+    fail("target_error must be 0 (off) or a positive number");
+}
+
 }  // namespace
 
 void ConvergeSetting::apply(Scene& scene, RenderOptions& options) const {
@@ -402,7 +440,14 @@ void check_convergence_options(const ConvergeOptions& options, const Scene* scen
       throw Error(std::string("converge: time ladder values must be in (0, 1e7] seconds, got ") +
                   got);
     }
-  for (const ConvergeSetting& setting : options.settings) {
+  for (size_t i = 0; i < options.settings.size(); ++i) {
+    const ConvergeSetting& setting = options.settings[i];
+    check_setting_fields(setting);
+    // (parse_converge_settings refuses these; a ConvergeSetting made in code was taken twice)
+    for (size_t j = 0; j < i; ++j)
+      if (same_knobs(options.settings[j], setting))
+        throw Error("converge: setting '" + setting.name + "' sets what setting '" +
+                    options.settings[j].name + "' sets (each would render the same)");
     if ((setting.adaptive || setting.target_error > 0) && by_time)
       throw Error("converge: setting " + setting.name + " is adaptive: use an spp ladder");
     // a knob that the setting's integrator does not read would be a setting that changes
