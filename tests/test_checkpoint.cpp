@@ -198,6 +198,14 @@ TEST(Checkpoint, ResumedImageEqualsTheSingleRender) {
     EXPECT_FALSE(fs::exists(ck));
     EXPECT_LT(max_relative_difference(lucent::read_render(out), single), 1e-5);
   }
+  // resumed with --time alone (no --spp: the session's part requested [0, 0) before its first
+  // pass, which make_part refused: "make_part: requested samples [0, 0)"; the review's find)
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:3 -o " + q(ck)).status, 0);
+  CommandResult timed = run_cli("render " + q(scene) + " -q --time 0.2 --checkpoint " + q(ck) +
+                                " -o " + q(dir + "/timed.exr"));
+  ASSERT_EQ(timed.status, 0) << timed.err;
+  EXPECT_GT(lucent::read_render(dir + "/timed.exr").spp, 3u);
+  EXPECT_FALSE(fs::exists(ck));
   // a PNG output too (the 8-bit image of the same means)
   ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:5 -o " + q(ck)).status, 0);
   ASSERT_EQ(run_cli("render " + q(scene) + " -q --spp 64 -o " + q(dir + "/single.png")).status, 0);

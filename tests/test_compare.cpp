@@ -518,7 +518,7 @@ TEST(Compare, InconsistentLayersAreAnInputError) {
   EXPECT_EQ(lucent::test::error_of([&] { lucent::write_render_exr(dir + "/l.exr", layers); }),
             dir +
                 "/l.exr: cannot write EXR: the variance layer has 12 values and the sample "
-                "counts 3, where a 2x2 image has 12 and 4 (or none of either)");
+                "counts 3, where a 2x2 image has 12 and 4 (a variance needs the counts)");
   layers.samples.assign(4, 4);
   layers.light_mean_variance = lucent::LightMeanVariance{{std::nan(""), 0, 0}, {0, 0, 0}};
   EXPECT_NE(lucent::test::error_of([&] {

@@ -320,6 +320,11 @@ TEST(Converge, SettingSyntax) {
   EXPECT_EQ(lucent::parse_converge_setting("adaptive+min-spp=16383").min_spp, 16383);
   EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("max-depth=0"); }),
             "setting max-depth=0: expected an integer from 1 to 100000");
+  // a number that is no plain decimal says so (03 is in range, 0x10 is >= 0)
+  EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("max_depth=03"); }),
+            "setting max_depth=03: expected an integer from 1 to 100000 in plain decimal");
+  EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("clamp=0x10"); }),
+            "setting clamp=0x10: expected a number >= 0 in plain decimal");
 
   for (const char* bad :
        {"", "bogus", "max_depth=0", "max_depth=x", "max_depth", "fast-math=1", "filter=round",
@@ -358,7 +363,13 @@ TEST(Converge, SettingsMadeInCodeAreChecked) {
        "integrator must be -1 (the scene's) or an IntegratorType"},
       {[](ConvergeSetting& s) { s.splits = 9; }, "splits must be -1 (the scene's) to 4"},
       {[](ConvergeSetting& s) { s.filter_radius = -1; },
-       "filter_radius must be 0 (the scene's) or in (0, 8]"}};
+       "filter_radius must be 0 (the scene's) or in (0, 8]"},
+      {[](ConvergeSetting& s) {
+         s.adaptive = true;
+         s.target_error = 1e-3;
+       },
+       "adaptive and target-error exclude each other"},
+      {[](ConvergeSetting& s) { s.min_spp = 8; }, "min-spp needs adaptive or target-error"}};
   for (const auto& [alter, message] : cases) {
     lucent::ConvergeOptions opt;
     opt.spp_ladder = {1, 2};

@@ -608,7 +608,7 @@ TEST(KernelVsReference, VertexNormalsOfAnyLength) {
   lucent::RenderOptions ko;
   ko.spp = 1;
   const RenderResult expected = lucent::test::render(unit, ko);
-  for (double scale : {1e-50, 1e-20, 1e20, 1e30}) {
+  for (double scale : {1e-310, 1e-50, 1e-20, 1e20, 1e30}) {
     SCOPED_TRACE(scale);
     Scene s = unit;
     for (glm::dvec3& n : s.normals) n *= scale;

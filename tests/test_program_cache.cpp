@@ -358,8 +358,8 @@ TEST(ProgramCache, LimitFromTheEnvironment) {
   const struct {
     const char* value;
     std::uint64_t bytes;
-  } good[] = {{"", kDefault},       {"0", 0},   {"1", 1u << 20}, {"1.5", 3u << 19},
-              {"4096", 1ull << 32}, {"1e-9", 1}};
+  } good[] = {{"", kDefault},       {"0", 0},    {"1", 1u << 20}, {"1.5", 3u << 19},
+              {"4096", 1ull << 32}, {"1e-9", 1}, {"1e-400", 1}};  // (it underflowed to 0: no limit)
   for (const auto& g : good) {
     lucent::test::ScopedEnv env("LUCENT_CACHE_MAX_MB", g.value);
     lucent::test::CaptureWarnings warnings;

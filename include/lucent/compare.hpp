@@ -55,7 +55,7 @@ struct CompareResult {
 
 /// Compares two images pixel by pixel. `variance` and `samples` may be empty (a deterministic
 /// image: variance 0); a pixel with fewer than 2 samples also counts as variance 0. Throws
-/// lucent::Error when the sizes differ.
+/// lucent::Error when the sizes differ or an image has no pixels.
 CompareResult compare_images(const RenderResult& a, const RenderResult& b,
                              const CompareOptions& options = {});
 

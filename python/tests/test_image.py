@@ -293,7 +293,7 @@ def test_converge_by_time_and_errors(small_scene):
         assert r.render(2).samples_done == 2
 
 
-def test_result_from_arrays_refuses_what_no_render_holds():
+def test_result_from_arrays_refuses_what_no_render_holds(tmp_path):
     # counts are whole and in [0, 2^32): -1 wrapped to 4294967295 and 2.9 became 2
     with pytest.raises(ValueError, match=r"samples: counts must be in \[0, 2\^32\), got -1"):
         lucent.RenderResult(constant(1.0), samples=np.full((4, 5), -1))
@@ -312,6 +312,9 @@ def test_result_from_arrays_refuses_what_no_render_holds():
     # counts without a variance say nothing to compare(): a tolerance test, as for images
     counts = lucent.RenderResult(constant(1.0), samples=np.full((4, 5), 16))
     assert not lucent.compare(counts, constant(1.0)).statistical
+    # and write_render_exr() writes their mean, as before (no statistics without a variance)
+    lucent.write_render_exr(str(tmp_path / "counts.exr"), counts)
+    assert lucent.read_render(str(tmp_path / "counts.exr")).variance is None
     # a variance is finite and >= 0
     for bad in (-1.0, math.nan, math.inf):
         with pytest.raises(ValueError, match="variance: every value must be finite and >= 0"):

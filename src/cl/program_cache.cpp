@@ -393,8 +393,13 @@ std::uint64_t program_cache_max_bytes() {
   const double fallback_mb = 256;
   const char* v = std::getenv("LUCENT_CACHE_MAX_MB");
   if (!v || !*v) return static_cast<std::uint64_t>(fallback_mb) << 20;
-  // plain decimal, as the command line's numbers (strtod took "0x10" and " 16")
+  // plain decimal, as the command line's numbers (strtod took "0x10" and " 16"), in the "C"
+  // locale (a Python program's German locale read "0.5" as 0: no limit); a value that underflows
+  // (1e-400) is a tiny limit, not none
+  io::CNumbers c_numbers;
+  errno = 0;
   double mb = io::plain_decimal_real(v) ? std::strtod(v, nullptr) : -1;
+  if (mb == 0 && errno == ERANGE) mb = 1e-300;
   if (!std::isfinite(mb) || mb < 0) {
     warn_once(
         std::string("LUCENT_CACHE_MAX_MB='") + v +

@@ -170,7 +170,9 @@ void Checkpoint::remove() const {
 }
 
 lucent::SampleRange Checkpoint::requested(const lucent::Renderer& renderer) const {
-  return {begin_, std::max(target_, renderer.first_sample() + renderer.spp())};
+  // at least to the checkpoint's end: with --time alone (no target) a resumed render's session
+  // holds no sample yet when check() makes its part, whose range [0, 0) make_part refuses
+  return {begin_, std::max({target_, renderer.first_sample() + renderer.spp(), first_sample()})};
 }
 
 bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer,
@@ -178,6 +180,9 @@ bool finish_checkpoint(Checkpoint& ck, std::optional<lucent::Renderer>& renderer
                        std::optional<lucent::RenderPart>& kept) {
   const bool complete = ck.complete(*renderer, stopped);
   if (complete && !ck.resumed()) return true;  // the session's result is the image
+  // stopped before its first sample, with no checkpoint read: nothing to write (with --time alone
+  // its part would request no sample, [0, 0), which make_part refuses)
+  if (renderer->spp() == 0 && !ck.resumed()) return complete;
   lucent::RenderPart all;
   try {
     all = ck.whole(*renderer);

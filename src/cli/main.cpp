@@ -87,6 +87,12 @@ int main(int argc, char** argv) {
 
   lucent::cli::register_extra_commands(app);
 
+  if (const std::string bad = lucent::cli::empty_list_item(app, argc, argv); !bad.empty()) {
+    std::fprintf(stderr,
+                 "lucent: error: %s: an empty item in a comma-separated list (see lucent --help)\n",
+                 one_line(bad).c_str());
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

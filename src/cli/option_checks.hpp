@@ -72,6 +72,35 @@ inline std::string non_decimal_option(const CLI::App& app) {
       [](const std::string& value) { return !io::plain_decimal_integer(value); });
 }
 
+/// The first comma-separated list in `argv` given to an option of `app` or its subcommands that
+/// splits its values (a CLI11 delimiter) with an empty item, as "--name value" ("" when none):
+/// CLI11 drops empty items, so `converge --settings default,,mis` and `--spp-ladder 1,,2` ran
+/// without a word. Read from argv, before CLI11 splits the values.
+inline std::string empty_list_item(const CLI::App& app, int argc, const char* const* argv) {
+  std::vector<const CLI::App*> apps{&app};
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    apps.push_back(sub);
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--") break;
+    if (arg.rfind("--", 0) != 0) continue;
+    const size_t eq = arg.find('=');
+    const std::string name = arg.substr(0, eq);
+    for (const CLI::App* a : apps) {
+      const CLI::Option* o = a->get_option_no_throw(name);
+      if (!o || o->get_delimiter() == '\0') continue;
+      if (eq == std::string::npos && i + 1 >= argc) break;
+      const std::string value = eq != std::string::npos ? arg.substr(eq + 1) : argv[i + 1];
+      const char d = o->get_delimiter();
+      if (!value.empty() && (value.front() == d || value.back() == d ||
+                             value.find(std::string(2, d)) != std::string::npos))
+        return name + " " + value;
+      break;
+    }
+  }
+  return "";
+}
+
 /// Whether a CLI11 type name (get_type_name()) is a real option's: "FLOAT", or "FLOAT:" and its
 /// validators' descriptions.
 inline bool real_type(const std::string& type) { return type.substr(0, type.find(':')) == "FLOAT"; }

@@ -75,15 +75,18 @@ LightMeanVariance parse_light_mean_var(const std::string& path, const std::strin
 void write_render_exr(const std::string& path, const RenderResult& r, const ExrExtras& extras) {
   const size_t n = static_cast<size_t>(r.mean.width) * r.mean.height;
   if (r.mean.rgb.size() != n * 3) throw Error(path + ": cannot write EXR: inconsistent image");
-  // the statistics are both there, of the image's size, or both absent (layers of another size
-  // were left out without a word: a file meant to carry them came out with the mean alone)
-  const bool stats = !r.variance.rgb.empty() || !r.samples.empty();
-  if (stats && (r.variance.rgb.size() != n * 3 || r.samples.size() != n))
+  // a layer that is there has the image's size (layers of another size were left out without a
+  // word: a file meant to carry them came out with the mean alone), and a variance its counts.
+  // Counts without a variance (Python's RenderResult(mean, samples=...)) are no statistics: the
+  // mean alone is written, as before.
+  if ((!r.variance.rgb.empty() && (r.variance.rgb.size() != n * 3 || r.samples.size() != n)) ||
+      (!r.samples.empty() && r.samples.size() != n))
     throw Error(path + ": cannot write EXR: the variance layer has " +
                 std::to_string(r.variance.rgb.size()) + " values and the sample counts " +
                 std::to_string(r.samples.size()) + ", where a " + std::to_string(r.mean.width) +
                 "x" + std::to_string(r.mean.height) + " image has " + std::to_string(n * 3) +
-                " and " + std::to_string(n) + " (or none of either)");
+                " and " + std::to_string(n) + " (a variance needs the counts)");
+  const bool stats = !r.variance.rgb.empty();
   write_image_exr(path, r.mean, stats ? &r.variance : nullptr, stats ? r.samples.data() : nullptr,
                   extras);
 }

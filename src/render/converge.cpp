@@ -34,7 +34,8 @@ int parse_int(const std::string& knob, const std::string& value, int min, int ma
       io::plain_decimal_integer(value) ? std::strtol(value.c_str(), nullptr, 10) : min - 1L;
   if (v < min || v > max)
     throw Error("setting " + knob + "=" + value + ": expected an integer from " +
-                std::to_string(min) + " to " + std::to_string(max));
+                std::to_string(min) + " to " + std::to_string(max) +
+                (io::plain_decimal_integer(value) ? "" : " in plain decimal"));
   return static_cast<int>(v);
 }
 
@@ -68,7 +69,8 @@ double parse_number(const std::string& knob, const std::string& value, double lo
                                                  : std::numeric_limits<double>::quiet_NaN();
   if (!std::isfinite(v) || (strict ? !(v > lo) : !(v >= lo)))
     throw Error("setting " + knob + ": expected a number " + (strict ? ">" : ">=") + " " +
-                std::to_string(static_cast<int>(lo)));
+                std::to_string(static_cast<int>(lo)) +
+                (io::plain_decimal_real(value) ? "" : " in plain decimal"));
   // as the command line's real options (a larger clamp would be blamed on the scene file)
   if (std::abs(v) > FLT_MAX)
     throw Error("setting " + knob + ": must fit in a float (magnitude at most 3.4e38)");
@@ -164,6 +166,10 @@ void check_setting_fields(const ConvergeSetting& s) {
     fail("min_spp must be 0 (the default) or 4 to " + std::to_string(AdaptiveOptions{}.max_spp));
   if (!(s.target_error >= 0) || s.target_error > FLT_MAX)
     fail("target_error must be 0 (off) or a positive number");
+  // the parser's rules across knobs (a setting made in code combined or ignored them)
+  if (s.adaptive && s.target_error > 0) fail("adaptive and target-error exclude each other");
+  if (s.min_spp > 0 && !s.adaptive && !(s.target_error > 0))
+    fail("min-spp needs adaptive or target-error");
 }
 
 }  // namespace
@@ -266,7 +272,8 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
         const double r = io::plain_decimal_real(radius) ? std::strtod(radius.c_str(), nullptr) : 0;
         if (!(r > 0) || r > limits::kMaxFilterRadius)
           throw Error("setting " + knob + ": filter radius must be a number in (0, " +
-                      fmt("%g", limits::kMaxFilterRadius) + "] pixels");
+                      fmt("%g", limits::kMaxFilterRadius) + "] pixels" +
+                      (io::plain_decimal_real(radius) ? "" : " in plain decimal"));
         s.filter_radius = r;
       }
     } else if (key == "sampler") {

@@ -542,15 +542,19 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     // is the same, and normals as short as 1e-50 no longer became 0 in float, where the kernel
     // then shaded with the geometric normal and the reference, in double, with theirs. (Unit
     // normals, the loaders' and the builder's, are packed as they are.)
-    double n_scale = 1;
+    // (each component by ldexp: 2^-ilogb(m) itself is infinite for a subnormal m)
+    int n_exp = 0;
     if (has_n) {
       double m = 0;
       for (int k = 0; k < 3; ++k) m = std::max(m, scene_detail::max_abs(scene.normals[t.n[k]]));
-      if (m > 0 && std::isfinite(m) && (m < 0x1p-32 || m > 0x1p32))
-        n_scale = std::ldexp(1.0, -std::ilogb(m));
+      if (m > 0 && std::isfinite(m) && (m < 0x1p-32 || m > 0x1p32)) n_exp = -std::ilogb(m);
     }
     for (int k = 0; k < 3; ++k) {
-      if (has_n) put3(a.n + 3 * k, scene.normals[t.n[k]] * n_scale);
+      if (has_n) {
+        const glm::dvec3& n = scene.normals[t.n[k]];
+        put3(a.n + 3 * k,
+             glm::dvec3(std::ldexp(n.x, n_exp), std::ldexp(n.y, n_exp), std::ldexp(n.z, n_exp)));
+      }
       if (has_uv) {
         a.uv[2 * k] = static_cast<float>(scene.uvs[t.uv[k]].x - whole.x);
         a.uv[2 * k + 1] = static_cast<float>(scene.uvs[t.uv[k]].y - whole.y);

@@ -72,8 +72,15 @@ void surface(const Scene& scene, int i, const Ray&, const Hit& hit, Surface& s) 
   s.ns = s.ng;
   if (t.n[0] >= 0 && t.n[1] >= 0 && t.n[2] >= 0) {
     dvec3 n = b0 * scene.normals[t.n[0]] + b1 * scene.normals[t.n[1]] + b2 * scene.normals[t.n[2]];
-    double len = glm::length(n);
-    if (len > 0) s.ns = glm::dot(n, s.ng) < 0 ? -n / len : n / len;
+    // scaled by a power of two to unit size first: the square of a normal as short as 1e-160
+    // underflows (the geometric normal was used), of one as long as 1e160 overflows
+    const double m = max_abs(n);
+    if (m > 0 && std::isfinite(m)) {
+      const int e = -std::ilogb(m);
+      n = dvec3(std::ldexp(n.x, e), std::ldexp(n.y, e), std::ldexp(n.z, e));
+      const double len = glm::length(n);
+      s.ns = glm::dot(n, s.ng) < 0 ? -n / len : n / len;
+    }
   }
   if (t.uv[0] >= 0 && t.uv[1] >= 0 && t.uv[2] >= 0)
     s.uv = b0 * scene.uvs[t.uv[0]] + b1 * scene.uvs[t.uv[1]] + b2 * scene.uvs[t.uv[2]];
