@@ -463,10 +463,12 @@ TEST(Outputs, RenderWithoutAFiniteSampleWritesNothing) {
 
 /// Runs `lucent args...` (stderr to `err_path`), waits until `running(stderr)` says the render
 /// loop is under way, sends `sig` and waits for the end; returns the wait status, or fails the
-/// test if lucent does not stop within `stop_seconds`.
+/// test if lucent does not stop within `stop_seconds`. `second`: another signal sent 20 ms after
+/// `sig`; `start_ignored`: lucent starts with `sig` ignored (nohup, a script's background job).
 int interrupt_cli(const std::vector<std::string>& args, const std::string& err_path,
                   const std::function<bool(const std::string&)>& running, int sig,
-                  double stop_seconds, const std::vector<std::string>& env = {}, int poll_ms = 20) {
+                  double stop_seconds, const std::vector<std::string>& env = {}, int poll_ms = 20,
+                  int second = 0, bool start_ignored = false) {
   pid_t pid = ::fork();
   EXPECT_GE(pid, 0);
   if (pid == 0) {
@@ -477,7 +479,8 @@ int interrupt_cli(const std::vector<std::string>& args, const std::string& err_p
     ::dup2(null, 0);
     ::dup2(null, 1);
     ::dup2(fd, 2);
-    ::signal(sig, SIG_DFL);
+    ::signal(sig, start_ignored ? SIG_IGN : SIG_DFL);
+    if (second) ::signal(second, SIG_DFL);
     std::vector<char*> argv{const_cast<char*>("lucent")};
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
@@ -503,6 +506,10 @@ int interrupt_cli(const std::vector<std::string>& args, const std::string& err_p
   EXPECT_TRUE(started && !exited) << "not running: " << read_file(err_path);
   if (exited) return status;
   EXPECT_EQ(::kill(pid, sig), 0);
+  if (second) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ::kill(pid, second);
+  }
   if (!wait_for(stop_seconds, reaped)) {
     ::kill(pid, SIGKILL);
     ::waitpid(pid, &status, 0);
@@ -626,6 +633,90 @@ TEST(Outputs, SigtermEndsConvergeWithTheRungsDone) {
   EXPECT_EQ(rows.rfind("setting,spp,", 0), 0u) << rows;
   const auto lines = std::count(rows.begin(), rows.end(), '\n');
   EXPECT_TRUE(lines == 1 || lines == 2) << rows;
+}
+
+// The adversarial interruption tester's finds (30 Nov 2026), each reproduced at will:
+// - a second stop signal of another kind was a second graceful stop (SIGTERM then SIGHUP: exit
+//   129, "interrupted by SIGHUP"), where docs/reliability.md says a second signal stops at once;
+// - a signal the process started with ignored (nohup's SIGHUP) stopped the render.
+TEST(Outputs, ASecondStopSignalOfAnyKindEndsAtOnce) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  const std::string err_path = dir + "/stderr";
+  const int status = interrupt_cli(
+      {"render", scene, "-o", dir + "/x.exr", "--spp", "16777216", "--time", "120"}, err_path,
+      [](const std::string& err) { return err.find("Msamples/s  elapsed") != std::string::npos; },
+      SIGTERM, 60, {}, 20, SIGHUP);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "exit " << WEXITSTATUS(status) << "\n" << read_file(err_path);
+  EXPECT_EQ(WTERMSIG(status), SIGHUP);
+}
+
+TEST(Outputs, AStopSignalIgnoredAtTheStartStaysIgnored) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  const std::string out = dir + "/x.exr", err_path = dir + "/stderr";
+  // SIGHUP ignored (nohup) and sent while rendering: the render goes on to its end (--time 1.5)
+  const int status = interrupt_cli(
+      {"render", scene, "-o", out, "--spp", "16777216", "--time", "1.5"}, err_path,
+      [](const std::string& err) { return err.find("Msamples/s  elapsed") != std::string::npos; },
+      SIGHUP, 60, {}, 20, 0, true);
+  const std::string err = read_file(err_path);
+  ASSERT_TRUE(WIFEXITED(status)) << err;
+  EXPECT_EQ(WEXITSTATUS(status), 0) << err;
+  EXPECT_EQ(err.find("interrupted"), std::string::npos) << err;
+  EXPECT_TRUE(fs::exists(out));
+}
+
+// converge stopped while it renders its reference: 128 + the signal and one line, nothing
+// written (it was "lucent: error: interrupted while rendering the reference", exit 1).
+TEST(Outputs, ConvergeStoppedInItsReferenceWritesNothing) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  const std::string csv = dir + "/c.csv", err_path = dir + "/stderr";
+  const int status = interrupt_cli(
+      {"converge", scene, "--width", "16", "--height", "16", "--spp-ladder", "1,2",
+       "--reference-spp", "16777216", "--csv", csv},
+      err_path,
+      [](const std::string& err) {
+        if (err.find("spp with the kernel") == std::string::npos) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        return true;
+      },
+      SIGTERM, 60);
+  const std::string err = read_file(err_path);
+  ASSERT_TRUE(WIFEXITED(status)) << err;
+  EXPECT_EQ(WEXITSTATUS(status), 143) << err;
+  EXPECT_NE(err.find("lucent: interrupted by SIGTERM while rendering the reference: nothing "
+                     "written\n"),
+            std::string::npos)
+      << err;
+  EXPECT_FALSE(fs::exists(csv));
+}
+
+// render --aov stopped while an AOV's kernel builds, just after the main image is written: PoCL's
+// LLVM takes the signal too and the build fails. That said "kernel build failed", exit 1, with
+// the image written and the AOVs missing; it is an interruption (the tester's sweep hit the build
+// 8 times in 12 with the signal 10 ms after the main image's line).
+TEST(Outputs, SigtermDuringAnAovBuildIsAnInterruption) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  const std::string out = dir + "/o.exr", err_path = dir + "/stderr";
+  const int status = interrupt_cli(
+      {"render", scene, "-o", out, "--integrator", "path", "--spp", "256", "--aov", "albedo,depth"},
+      err_path,
+      [](const std::string& err) {
+        if (err.find("o.exr: 32x24") == std::string::npos) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        return true;
+      },
+      SIGTERM, 60, {}, 1);
+  const std::string err = read_file(err_path);
+  ASSERT_TRUE(WIFEXITED(status)) << err;
+  if (WEXITSTATUS(status) == 0) GTEST_SKIP() << "the AOVs were done before the signal: " << err;
+  EXPECT_EQ(WEXITSTATUS(status), 143) << err;
+  EXPECT_EQ(err.find("kernel build failed"), std::string::npos) << err;
+  EXPECT_NE(err.find("(AOVs not written: "), std::string::npos) << err;
+  EXPECT_TRUE(fs::exists(out));
 }
 
 // A stop signal during the kernel build is an interruption: PoCL's LLVM handles the signal too

@@ -159,22 +159,32 @@ class PyRenderer {
 
   /// Runs `f(renderer)` with the GIL released, one call at a time (`what`: its name, for
   /// messages); then raises what a warning callback raised.
+  /// A lucent::Error raised while Ctrl-C came is KeyboardInterrupt: PoCL's LLVM handles SIGINT
+  /// during a kernel build too (it removes its temporary files, then passes it on), and the build
+  /// fails. set_scene raised lucent.Error "kernel build failed", and the KeyboardInterrupt then
+  /// came out in the caller's except block.
   template <class F>
   auto call(const char* what, F&& f) {
     Busy busy(*this, what);
     Renderer& r = get();
     using Result = decltype(f(r));
     if constexpr (std::is_void_v<Result>) {
-      {
+      try {
         ReleaseGil release;
         f(r);
+      } catch (const Error&) {
+        if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+        throw;
       }
       warning_errors_->rethrow();
     } else {
       std::optional<Result> out;
-      {
+      try {
         ReleaseGil release;
         out.emplace(f(r));
+      } catch (const Error&) {
+        if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+        throw;
       }
       warning_errors_->rethrow();
       return std::move(*out);

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "cli/stop_signals.hpp"
 #include "core/file_io.hpp"
 #include "core/text.hpp"
 #include "lucent/types.hpp"
@@ -138,10 +139,6 @@ bool Checkpoint::save(const lucent::RenderPart& part) {
   ours_ = ours_ || ok;
   last_ = std::chrono::steady_clock::now();
   return ok;
-}
-
-const char* signal_name(int sig) {
-  return sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "SIGINT (Ctrl-C)";
 }
 
 bool Checkpoint::save_new(const lucent::RenderPart& part) {

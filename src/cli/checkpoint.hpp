@@ -14,10 +14,6 @@
 
 namespace lucent::cli {
 
-/// A stop signal's name in messages ("interrupted by SIGTERM ..."): SIGTERM, SIGHUP, else
-/// "SIGINT (Ctrl-C)".
-const char* signal_name(int sig);
-
 /// The seconds between two checkpoints without --checkpoint-every.
 constexpr double kDefaultCheckpointSeconds = 300;
 

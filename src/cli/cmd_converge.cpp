@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/stop_signals.hpp"
 #include "core/file_io.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
@@ -58,7 +59,7 @@ volatile std::sig_atomic_t g_stop_signal = 0;
 extern "C" void on_converge_signal(int sig) {
   g_stop_signal = sig;
   g_stop.store(true);
-  std::signal(sig, SIG_DFL);
+  stop_signals_to_default();
 }
 
 /// A file the command reads, by what it is for messages: "the scene file", "the --reference
@@ -295,9 +296,17 @@ int run_converge_command() {
   if (a.height > 0) scene.film.height = a.height;
   check_convergence_options(opt, &scene);  // the settings against the scene's integrator
 
-  const int stop_signals[] = {SIGINT, SIGTERM, SIGHUP};
-  void (*previous[3])(int);
-  for (int i = 0; i < 3; ++i) previous[i] = std::signal(stop_signals[i], on_converge_signal);
+  // until the outputs are written (they were given back after the last rung: a signal while the
+  // CSV and the plots were written killed the process, with none of them and a temporary file)
+  const StopSignalScope stop_signals(on_converge_signal);
+  // stopped before the ladder: nothing to write, 128 + the signal (it said "error: interrupted
+  // while rendering the reference", exit 1)
+  auto stopped_early = [](const char* during) {
+    const int sig = g_stop_signal ? static_cast<int>(g_stop_signal) : SIGINT;
+    std::fprintf(stderr, "lucent: interrupted by %s %s: nothing written\n", signal_name(sig),
+                 during);
+    return 128 + sig;
+  };
   // one session renders the kernel reference and every rung (a different seed is only data)
   Renderer renderer(session_options(a.device));
   renderer.set_cancel_flag(&g_stop);
@@ -322,18 +331,23 @@ int run_converge_command() {
       std::fprintf(stderr, "reference: %d spp with the %s (seed %u)...\n", spp,
                    a.reference_cpu ? "reference integrator" : "kernel",
                    static_cast<unsigned>(rs.integrator.seed));
-    if (a.reference_cpu) {
-      ReferenceOptions ro;
-      ro.spp = spp;
-      ro.cancel = &g_stop;
-      reference = render_reference(rs, ro);
-    } else {
-      renderer.set_scene(rs);
-      renderer.render(static_cast<std::uint64_t>(spp));
-      reference = renderer.result();
+    try {
+      if (a.reference_cpu) {
+        ReferenceOptions ro;
+        ro.spp = spp;
+        ro.cancel = &g_stop;
+        reference = render_reference(rs, ro);
+      } else {
+        renderer.set_scene(rs);
+        renderer.render(static_cast<std::uint64_t>(spp));
+        reference = renderer.result();
+      }
+    } catch (const Error&) {
+      // a stop signal during the kernel build: PoCL's LLVM handles it too (it removes its
+      // temporary files, then passes it on) and the build fails; that is the interruption
+      if (!g_stop.load()) throw;
     }
-    if (reference.cancelled || g_stop.load())
-      throw Error("interrupted while rendering the reference");
+    if (reference.cancelled || g_stop.load()) return stopped_early("while rendering the reference");
     if (!a.quiet)
       std::fprintf(stderr, "reference: %llu spp in %.1f s\n",
                    static_cast<unsigned long long>(reference.spp), reference.seconds);
@@ -352,7 +366,7 @@ int run_converge_command() {
     };
   }
   ConvergeResult result = run_convergence(scene, reference, opt);
-  for (int i = 0; i < 3; ++i) std::signal(stop_signals[i], previous[i]);
+  if (result.points.empty() && g_stop.load()) return stopped_early("before the first rung");
 
   std::printf("%sslope of log(relMSE) against log(time) (about -1 when unbiased; RMSE: half):\n",
               a.quiet ? "" : "\n");

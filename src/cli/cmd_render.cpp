@@ -19,6 +19,7 @@
 
 #include "cli/checkpoint.hpp"
 #include "cli/commands.hpp"
+#include "cli/stop_signals.hpp"
 #include "core/file_io.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
@@ -38,14 +39,12 @@ std::atomic<bool> g_interrupted{false};
 volatile std::sig_atomic_t g_signal = 0;
 
 // Ctrl-C (SIGINT), SIGTERM and SIGHUP: the render stops after the current pass, writes what it
-// has and exits with 128 + the signal. A second signal stops at once.
+// has and exits with 128 + the signal. A second signal stops at once (stop_signals.hpp).
 extern "C" void on_stop_signal(int sig) {
   g_signal = sig;
   g_interrupted.store(true);
-  std::signal(sig, SIG_DFL);
+  stop_signals_to_default();
 }
-
-const int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
 std::string format_duration(double s) {
   char buf[32];
@@ -127,7 +126,16 @@ std::vector<std::string> write_aovs(const RenderArgs& a, lucent::Renderer* rende
     } else {
       lucent::Scene s = renderer->scene();  // (the main scene, or the last AOV's: its type)
       s.integrator.type = lucent::cli::parse_integrator(name);
-      renderer->set_scene(std::move(s));
+      try {
+        renderer->set_scene(std::move(s));
+      } catch (const lucent::Error&) {
+        // a stop signal during the AOV's kernel build: PoCL's LLVM handles it too and the build
+        // fails; the AOV is not written, as one stopped in its render (it said "kernel build
+        // failed", exit 1, with the image written)
+        if (!g_interrupted.load()) throw;
+        missing.push_back(name);
+        continue;
+      }
       renderer->reset();
       renderer->render(std::max<std::uint64_t>(1, main_result.spp));
       lucent::RenderResult aov = renderer->result();
@@ -317,7 +325,7 @@ int render_with(const RenderArgs& a) {
     lucent::io::check_output_path(aov_path(a.output, name), {a.scene, a.output});
   if (!a.checkpoint.empty()) lucent::io::check_output_path(a.checkpoint, {a.scene, a.output});
   // from here on a stop signal lets the render end its pass and write what it has
-  for (int sig : kStopSignals) std::signal(sig, on_stop_signal);
+  install_stop_handler(on_stop_signal);
   std::signal(SIGPIPE, SIG_IGN);  // a closed stderr pipe must not cost the image
   lucent::Scene scene = lucent::load_scene(a.scene);
   {

@@ -29,6 +29,7 @@
 #include "cl/context.hpp"
 #include "cli/checkpoint.hpp"
 #include "cli/option_checks.hpp"
+#include "cli/stop_signals.hpp"
 #include "core/file_io.hpp"
 #include "core/text.hpp"
 #include "image/image_probe.hpp"
@@ -50,7 +51,7 @@ volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_stop_signal(int sig) {
   g_signal = sig;
   g_stop.store(true);
-  std::signal(sig, SIG_DFL);  // a second signal ends the rank at once, as with lucent render
+  lucent::cli::stop_signals_to_default();  // a second signal ends the rank at once, as lucent's
 }
 
 int g_rank = 0, g_size = 1;
@@ -541,7 +542,7 @@ int main(int argc, char** argv) {
   MPI_Init(&argc, &argv);
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &g_size);
-  for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, on_stop_signal);
+  lucent::cli::install_stop_handler(on_stop_signal);
 
   Args a;
   CLI::App app{

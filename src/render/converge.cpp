@@ -550,8 +550,15 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
     Scene s = scene;
     RenderOptions o = options.render;
     setting.apply(s, o);
-    renderer->set_build_options(o.precision, o.fast_math, o.specialize);
-    renderer->set_scene(s);
+    try {
+      renderer->set_build_options(o.precision, o.fast_math, o.specialize);
+      renderer->set_scene(s);
+    } catch (const Error&) {
+      // a stop signal during the setting's kernel build: PoCL's LLVM handles it too and the
+      // build fails; the study is cancelled and keeps its rungs (they were lost with the error)
+      if (cancel_scope.cancelled()) break;
+      throw;
+    }
     renderer->reset();
     AdaptiveOptions ao;
     if (setting.min_spp > 0) ao.min_spp = static_cast<std::uint32_t>(setting.min_spp);
