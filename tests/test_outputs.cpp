@@ -693,6 +693,35 @@ TEST(Outputs, ConvergeStoppedInItsReferenceWritesNothing) {
   EXPECT_FALSE(fs::exists(csv));
 }
 
+// converge stopped while it writes its plot: it gave the signals back after the last rung, and
+// one there killed it (no plot, no "interrupted" line, a temporary file left). The signal goes
+// once the CSV is written, while the eight PNG plots after it are (about 0.1 s each).
+TEST(Outputs, ConvergeStoppedWhileWritingKeepsItsOutputs) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  const std::string csv = dir + "/c.csv", err_path = dir + "/stderr";
+  std::vector<std::string> args{"converge",     scene, "--width",         "16", "--height", "16",
+                                "--spp-ladder", "1,2", "--reference-spp", "64", "--csv",    csv};
+  std::vector<std::string> names{"scene.json", "c.csv", "stderr"};
+  for (int i = 0; i < 8; ++i) {  // (eight plots: a window of the order of a second)
+    names.push_back("p" + std::to_string(i) + ".png");
+    args.insert(args.end(), {"--plot", dir + "/" + names.back()});
+  }
+  const int status = interrupt_cli(
+      args, err_path, [&](const std::string&) { return fs::exists(csv); }, SIGTERM, 60, {}, 1);
+  const std::string err = read_file(err_path);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
+  if (WEXITSTATUS(status) == 0) GTEST_SKIP() << "the plot was written before the signal";
+  EXPECT_EQ(WEXITSTATUS(status), 143) << err;
+  EXPECT_NE(err.find("lucent: interrupted: the results cover the rungs rendered so far"),
+            std::string::npos)
+      << err;
+  EXPECT_TRUE(fs::exists(csv));
+  for (size_t i = 3; i < names.size(); ++i)
+    EXPECT_GT(lucent::read_image(dir + "/" + names[i]).width, 0);
+  EXPECT_TRUE(others(dir, names).empty());
+}
+
 // render --aov stopped while an AOV's kernel builds, just after the main image is written: PoCL's
 // LLVM takes the signal too and the build fails. That said "kernel build failed", exit 1, with
 // the image written and the AOVs missing; it is an interruption (the tester's sweep hit the build
