@@ -842,8 +842,10 @@ TEST(Session, SceneWithoutLightWarns) {
 // An emission or environment radiance above sqrt(FLT_MAX) (about 1.84e19) makes samples whose
 // square overflows a float, which the kernel and the reference drop: the scene's first such
 // radiance is named before either renders (the lamp's pixels came out black, with a count of
-// non-finite samples and no word of why). A point light's intensity is not: it reaches a pixel
-// divided by a squared distance (1e20 at 1000 renders without a dropped sample).
+// non-finite samples and no word of why). A point light's intensity reaches a pixel divided by a
+// squared distance (1e20 at 1000 renders without a dropped sample): it is named when the
+// geometry's box lies within the distance where its squares overflow (1e30 rendered black
+// without a word).
 TEST(Session, RadianceBeyondFloatSquaresWarns) {
   Scene s = lucent::test::scene_from(kScene);
   s.film.width = s.film.height = 2;
@@ -888,9 +890,20 @@ TEST(Session, RadianceBeyondFloatSquaresWarns) {
   s.lights.erase(s.lights.begin());
   for (lucent::Light& l : s.lights)
     if (l.type == lucent::LightType::Point) l.intensity = glm::dvec3(1e20);
+  {
+    // (its squares overflow within 2.33 of it; the geometry's box is 3 away)
+    lucent::test::CaptureWarnings warnings;
+    lucent::render_detail::pack_scene(s);  // (its warnings: no kernel built)
+    EXPECT_EQ(warnings.count("is above 1.84e+19"), 0) << warnings.dump();
+  }
+  for (lucent::Light& l : s.lights)
+    if (l.type == lucent::LightType::Point) l.intensity = glm::dvec3(1e30);
   lucent::test::CaptureWarnings warnings;
-  lucent::render_detail::pack_scene(s);  // (its warnings: no kernel built)
-  EXPECT_EQ(warnings.count("is above 1.84e+19"), 0) << warnings.dump();
+  lucent::render_detail::pack_scene(s);
+  EXPECT_EQ(warnings.count("/intensity 1e+30 is above 1.84e+19, where a sample's square "
+                           "overflows a float within a distance of about 2.33e+05 of it"),
+            1)
+      << warnings.dump();
 }
 
 // Lights that all send out nothing render a black image as well: zero intensities and
