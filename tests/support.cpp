@@ -36,6 +36,10 @@ struct TempRoot {
   std::string path;
   TempRoot() {
     path = std::string(LUCENT_BINARY_DIR) + "/test_tmp/" + std::to_string(::getpid());
+    // a killed test process of the same pid left its directory (pids are reused): a test then
+    // found the files of another one's run in its own (a converge output "already written")
+    std::error_code ec;
+    fs::remove_all(path, ec);
     fs::create_directories(path);
   }
   ~TempRoot() {
