@@ -370,7 +370,17 @@ void run_interruptible(const std::function<void()>& work, std::atomic<bool>& can
     }
   }
   if (interrupt) std::rethrow_exception(interrupt);
-  if (failure) std::rethrow_exception(failure);
+  // a failure with Ctrl-C pending is the interruption: PoCL's LLVM fails a kernel build on SIGINT
+  // (converge's next setting, a render's first build) before this thread's next look at the
+  // signals, and lucent.Error came out instead of KeyboardInterrupt
+  if (failure) {
+    try {
+      std::rethrow_exception(failure);
+    } catch (const lucent::Error&) {
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+      throw;
+    }
+  }
 }
 
 namespace {

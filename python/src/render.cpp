@@ -163,32 +163,32 @@ class PyRenderer {
   /// during a kernel build too (it removes its temporary files, then passes it on), and the build
   /// fails. set_scene raised lucent.Error "kernel build failed", and the KeyboardInterrupt then
   /// came out in the caller's except block.
+  /// (The signals are looked at once the call is no longer busy: a Python handler may use the
+  /// session.)
   template <class F>
   auto call(const char* what, F&& f) {
-    Busy busy(*this, what);
-    Renderer& r = get();
-    using Result = decltype(f(r));
-    if constexpr (std::is_void_v<Result>) {
+    using Result = decltype(f(get()));
+    std::exception_ptr failed;
+    std::conditional_t<std::is_void_v<Result>, bool, std::optional<Result>> out{};
+    {
+      Busy busy(*this, what);
+      Renderer& r = get();
       try {
         ReleaseGil release;
-        f(r);
+        if constexpr (std::is_void_v<Result>)
+          f(r);
+        else
+          out.emplace(f(r));
       } catch (const Error&) {
-        if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-        throw;
+        failed = std::current_exception();
       }
-      warning_errors_->rethrow();
-    } else {
-      std::optional<Result> out;
-      try {
-        ReleaseGil release;
-        out.emplace(f(r));
-      } catch (const Error&) {
-        if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-        throw;
-      }
-      warning_errors_->rethrow();
-      return std::move(*out);
+      if (!failed) warning_errors_->rethrow();
     }
+    if (failed) {
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+      std::rethrow_exception(failed);
+    }
+    if constexpr (!std::is_void_v<Result>) return std::move(*out);
   }
 
   /// Runs `f(renderer, stop)`, one call at a time, on a worker thread while this one runs

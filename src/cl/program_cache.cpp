@@ -399,7 +399,7 @@ std::uint64_t program_cache_max_bytes() {
   io::CNumbers c_numbers;
   errno = 0;
   double mb = io::plain_decimal_real(v) ? std::strtod(v, nullptr) : -1;
-  if (mb == 0 && errno == ERANGE) mb = 1e-300;
+  if (mb == 0 && errno == ERANGE) mb = std::signbit(mb) ? -1 : 1e-300;  // (-1e-400: refused)
   if (!std::isfinite(mb) || mb < 0) {
     warn_once(
         std::string("LUCENT_CACHE_MAX_MB='") + v +

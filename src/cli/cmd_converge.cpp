@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,9 +58,9 @@ volatile std::sig_atomic_t g_stop_signal = 0;
 /// SIGINT, SIGTERM (Slurm's at a job's time limit; it killed the study, without the CSV or plots
 /// of the rungs done) and SIGHUP end the study after the current rung; a second one stops at once.
 extern "C" void on_converge_signal(int sig) {
+  if (!first_stop_signal(sig)) return;
   g_stop_signal = sig;
   g_stop.store(true);
-  stop_signals_to_default();
 }
 
 /// A file the command reads, by what it is for messages: "the scene file", "the --reference
@@ -298,13 +299,19 @@ int run_converge_command() {
 
   // until the outputs are written (they were given back after the last rung: a signal while the
   // CSV and the plots were written killed the process, with none of them and a temporary file)
-  const StopSignalScope stop_signals(on_converge_signal);
-  // stopped before the ladder: nothing to write, 128 + the signal (it said "error: interrupted
-  // while rendering the reference", exit 1)
-  auto stopped_early = [](const char* during) {
+  // (given back before the return: a stop between the last check and the end was swallowed)
+  std::optional<StopSignalScope> stop_signals;
+  stop_signals.emplace(on_converge_signal);
+  // stopped before a rung was done: no results to write, 128 + the signal (it said "error:
+  // interrupted while rendering the reference", exit 1); a reference rendered and saved is said
+  bool reference_saved = false;
+  auto stopped_early = [&](const char* during) {
     const int sig = g_stop_signal ? static_cast<int>(g_stop_signal) : SIGINT;
-    std::fprintf(stderr, "lucent: interrupted by %s %s: nothing written\n", signal_name(sig),
-                 during);
+    std::fprintf(stderr, "lucent: interrupted by %s %s: %s\n", signal_name(sig), during,
+                 reference_saved ? ("no results written (the reference is in " +
+                                    one_line(a.save_reference) + ")")
+                                       .c_str()
+                                 : "nothing written");
     return 128 + sig;
   };
   // one session renders the kernel reference and every rung (a different seed is only data)
@@ -351,7 +358,10 @@ int run_converge_command() {
     if (!a.quiet)
       std::fprintf(stderr, "reference: %llu spp in %.1f s\n",
                    static_cast<unsigned long long>(reference.spp), reference.seconds);
-    if (!a.save_reference.empty()) write_render_exr(a.save_reference, reference);
+    if (!a.save_reference.empty()) {
+      write_render_exr(a.save_reference, reference);
+      reference_saved = true;
+    }
   }
 
   if (!a.quiet) {
@@ -366,7 +376,7 @@ int run_converge_command() {
     };
   }
   ConvergeResult result = run_convergence(scene, reference, opt);
-  if (result.points.empty() && g_stop.load()) return stopped_early("before the first rung");
+  if (result.points.empty() && g_stop.load()) return stopped_early("before a rung was done");
 
   std::printf("%sslope of log(relMSE) against log(time) (about -1 when unbiased; RMSE: half):\n",
               a.quiet ? "" : "\n");
@@ -394,6 +404,7 @@ int run_converge_command() {
     else
       write_text(plot, convergence_svg(result, title));
   }
+  stop_signals.reset();  // a signal from here has its default action
   if (g_stop.load()) {
     const int sig = g_stop_signal ? static_cast<int>(g_stop_signal) : SIGINT;
     std::fprintf(stderr, "lucent: interrupted: the results cover the rungs rendered so far\n");

@@ -41,9 +41,9 @@ volatile std::sig_atomic_t g_signal = 0;
 // Ctrl-C (SIGINT), SIGTERM and SIGHUP: the render stops after the current pass, writes what it
 // has and exits with 128 + the signal. A second signal stops at once (stop_signals.hpp).
 extern "C" void on_stop_signal(int sig) {
+  if (!first_stop_signal(sig)) return;
   g_signal = sig;
   g_interrupted.store(true);
-  stop_signals_to_default();
 }
 
 std::string format_duration(double s) {

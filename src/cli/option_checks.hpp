@@ -77,9 +77,15 @@ inline std::string non_decimal_option(const CLI::App& app) {
 /// CLI11 drops empty items, so `converge --settings default,,mis` and `--spp-ladder 1,,2` ran
 /// without a word. Read from argv, before CLI11 splits the values.
 inline std::string empty_list_item(const CLI::App& app, int argc, const char* const* argv) {
+  // the options of `app` and of the subcommand argv names (the first word that is one)
   std::vector<const CLI::App*> apps{&app};
-  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
-    apps.push_back(sub);
+  for (int i = 1; i < argc && apps.size() == 1; ++i)
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+      if (sub->get_name() == argv[i]) apps.push_back(sub);
+  const auto has_empty_item = [](const std::string& value, char d) {
+    return !value.empty() && (value.front() == d || value.back() == d ||
+                              value.find(std::string(2, d)) != std::string::npos);
+  };
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--") break;
@@ -89,12 +95,12 @@ inline std::string empty_list_item(const CLI::App& app, int argc, const char* co
     for (const CLI::App* a : apps) {
       const CLI::Option* o = a->get_option_no_throw(name);
       if (!o || o->get_delimiter() == '\0') continue;
-      if (eq == std::string::npos && i + 1 >= argc) break;
-      const std::string value = eq != std::string::npos ? arg.substr(eq + 1) : argv[i + 1];
       const char d = o->get_delimiter();
-      if (!value.empty() && (value.front() == d || value.back() == d ||
-                             value.find(std::string(2, d)) != std::string::npos))
-        return name + " " + value;
+      if (eq != std::string::npos && has_empty_item(arg.substr(eq + 1), d))
+        return name + " " + arg.substr(eq + 1);
+      // the words after it, up to the next option (a list option takes them all)
+      for (int k = i + 1; eq == std::string::npos && k < argc && argv[k][0] != '-'; ++k)
+        if (has_empty_item(argv[k], d)) return name + " " + argv[k];
       break;
     }
   }

@@ -49,9 +49,10 @@ std::atomic<bool> g_stop{false};
 volatile std::sig_atomic_t g_signal = 0;
 
 extern "C" void on_stop_signal(int sig) {
+  // a second signal ends the rank at once, as lucent's (stop_signals.hpp)
+  if (!lucent::cli::first_stop_signal(sig)) return;
   g_signal = sig;
   g_stop.store(true);
-  lucent::cli::stop_signals_to_default();  // a second signal ends the rank at once, as lucent's
 }
 
 int g_rank = 0, g_size = 1;

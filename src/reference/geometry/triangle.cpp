@@ -71,16 +71,20 @@ void surface(const Scene& scene, int i, const Ray&, const Hit& hit, Surface& s) 
   s.ng = glm::normalize(glm::cross(v1 - v0, v2 - v0));
   s.ns = s.ng;
   if (t.n[0] >= 0 && t.n[1] >= 0 && t.n[2] >= 0) {
-    dvec3 n = b0 * scene.normals[t.n[0]] + b1 * scene.normals[t.n[1]] + b2 * scene.normals[t.n[2]];
-    // scaled by a power of two to unit size first: the square of a normal as short as 1e-160
-    // underflows (the geometric normal was used), of one as long as 1e160 overflows
-    const double m = max_abs(n);
-    if (m > 0 && std::isfinite(m)) {
-      const int e = -std::ilogb(m);
-      n = dvec3(std::ldexp(n.x, e), std::ldexp(n.y, e), std::ldexp(n.z, e));
-      const double len = glm::length(n);
-      s.ns = glm::dot(n, s.ng) < 0 ? -n / len : n / len;
-    }
+    // the three scaled by one power of two first when far from unit length (set directly:
+    // Scene.normals), as the kernel's packing does: the square of a normal as short as 1e-160
+    // underflowed (the geometric normal was used), and products with the barycentrics lost the
+    // bits of subnormal ones (unit normals keep their bits)
+    const double m = std::max({max_abs(scene.normals[t.n[0]]), max_abs(scene.normals[t.n[1]]),
+                               max_abs(scene.normals[t.n[2]])});
+    const int e = m > 0 && std::isfinite(m) && (m < 0x1p-32 || m > 0x1p32) ? -std::ilogb(m) : 0;
+    auto scaled = [e](const dvec3& v) {
+      return dvec3(std::ldexp(v.x, e), std::ldexp(v.y, e), std::ldexp(v.z, e));
+    };
+    const dvec3 n = b0 * scaled(scene.normals[t.n[0]]) + b1 * scaled(scene.normals[t.n[1]]) +
+                    b2 * scaled(scene.normals[t.n[2]]);
+    const double len = glm::length(n);
+    if (len > 0) s.ns = glm::dot(n, s.ng) < 0 ? -n / len : n / len;
   }
   if (t.uv[0] >= 0 && t.uv[1] >= 0 && t.uv[2] >= 0)
     s.uv = b0 * scene.uvs[t.uv[0]] + b1 * scene.uvs[t.uv[1]] + b2 * scene.uvs[t.uv[2]];
