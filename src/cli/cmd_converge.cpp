@@ -56,7 +56,8 @@ ConvergeArgs& converge_args() {
 std::atomic<bool> g_stop{false};
 volatile std::sig_atomic_t g_stop_signal = 0;
 /// SIGINT, SIGTERM (Slurm's at a job's time limit; it killed the study, without the CSV or plots
-/// of the rungs done) and SIGHUP end the study after the current rung; a second one stops at once.
+/// of the rungs done) and SIGHUP end the study after the current rung; a second one stops at once
+/// (stop_signals.hpp).
 extern "C" void on_converge_signal(int sig) {
   if (!first_stop_signal(sig)) return;
   g_stop_signal = sig;
