@@ -270,6 +270,13 @@ A array_or_null(py::handle object) {
   }
 }
 
+/// Refuses, as MemoryError naming `what`, converting `object` (an array, or what NumPy makes one
+/// of) when its values at `bytes_per_value` (the conversion's copy and the scene's own) exceed
+/// what lucent allows itself (render_detail::host_memory_allowed): a broadcast view of 12 bytes
+/// standing for 10^9 positions was copied whole, and the kernel killed the process.
+void check_conversion_memory(py::handle object, const std::string& what,
+                             std::uint64_t bytes_per_value);
+
 /// A C-contiguous array of T converted from `object` (array_or_null).
 template <class T>
 using CArray = py::array_t<T, py::array::c_style | py::array::forcecast>;

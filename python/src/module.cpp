@@ -2,6 +2,7 @@
 // helpers shared by the other parts (scene.cpp, render.cpp, image.cpp).
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
 #include <cstring>
 #include <future>
 #include <mutex>
@@ -17,6 +18,7 @@
 #include "lucent/error.hpp"
 #include "lucent/session.hpp"
 #include "lucent/version.hpp"
+#include "render/resources.hpp"
 
 namespace lucent::python {
 
@@ -183,6 +185,24 @@ py::array_t<double> copy_rows(const double* first, std::size_t n, py::ssize_t co
   if (n > 0) std::copy(first, first + n * cols, a.mutable_data());
   a.attr("flags").attr("writeable") = false;
   return a;
+}
+
+void check_conversion_memory(py::handle object, const std::string& what,
+                             std::uint64_t bytes_per_value) {
+  py::array a = array_or_null<py::array>(object);
+  if (!a) return;
+  std::string limit_what;
+  const std::uint64_t limit = render_detail::host_memory_allowed(&limit_what);
+  const double need = double(a.size()) * double(bytes_per_value);
+  if (limit == 0 || need <= double(limit)) return;
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                ": %lld values need about %.1f GiB to copy, more than the %.1f GiB lucent allows "
+                "itself (80%% of ",
+                static_cast<long long>(a.size()), need / double(1ull << 30),
+                double(limit) / double(1ull << 30));
+  PyErr_SetString(PyExc_MemoryError, (what + buf + limit_what + ")").c_str());
+  throw py::error_already_set();
 }
 
 void require_numbers(py::handle object, const std::string& what) {

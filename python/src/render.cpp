@@ -586,7 +586,10 @@ void bind_render(py::module_& m) {
   bind_device_shares(m, result);
   result
       .def(
-          py::init([](py::handle mean, py::handle variance, py::handle samples, std::uint64_t spp) {
+          py::init([](py::handle mean, py::handle variance, py::handle samples,
+                      const IntArg& spp_arg) {
+            // (an spp of 2^70 or -1 was pybind's "incompatible constructor arguments" TypeError)
+            const std::uint64_t spp = int_argument(spp_arg, "spp", 0, kSampleIndices, kSampleNote);
             RenderResult r;
             r.mean = image_from_array(mean, "mean");
             if (!variance.is_none()) {
@@ -919,7 +922,11 @@ void bind_render(py::module_& m) {
                 "instead and make a Renderer where they are used");
           },
           py::arg("protocol"))
-      .def("__enter__", [](py::object self) { return self; })
+      .def("__enter__",
+           [](py::object self) {
+             self.cast<PyRenderer&>().get();  // (a closed renderer entered a with block)
+             return self;
+           })
       .def("__exit__", [](PyRenderer& r, py::args) { r.close(); });
 
   m.def(

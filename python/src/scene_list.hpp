@@ -104,6 +104,24 @@ inline std::size_t wrap_index(py::ssize_t i, std::size_t n, const char* what) {
   return static_cast<std::size_t>(i);
 }
 
+/// The items of `items` as T, read first (`items` may be the list itself): TypeError naming the
+/// first that is no T (pybind's cast said RuntimeError "Unable to cast Python instance to C++
+/// type", with no word of which item).
+template <class T>
+std::vector<T> values_of(const py::iterable& items, const char* what) {
+  std::vector<T> values;
+  for (py::handle h : items) {
+    try {
+      values.push_back(h.cast<T>());
+    } catch (const py::cast_error&) {
+      throw py::type_error(std::string(what) + ": item " + std::to_string(values.size()) +
+                           " is a " + Py_TYPE(h.ptr())->tp_name + ", not a " +
+                           py::str(py::type::of<T>().attr("__name__")).operator std::string());
+    }
+  }
+  return values;
+}
+
 /// What a slice selects in a list: its first index and step, and the indices in its order.
 struct Selection {
   py::ssize_t start = 0, step = 1;
@@ -213,8 +231,7 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
       .def(
           "__setitem__",
           [](V& v, const py::slice& s, const py::iterable& items) {
-            V values;
-            for (py::handle h : items) values.push_back(h.cast<T>());
+            V values = list_detail::values_of<T>(items, "slice assignment");
             const list_detail::Selection sel = list_detail::slice_indices(s, v);
             const std::vector<std::size_t>& at = sel.indices;
             if (sel.step != 1) {  // an extended slice: one value per selected element
@@ -280,8 +297,7 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
       .def(
           "extend",
           [same](V& v, const py::iterable& items) {
-            V values;  // read first: `items` may be this list
-            for (py::handle h : items) values.push_back(h.cast<T>());
+            V values = list_detail::values_of<T>(items, "extend");  // (`items` may be this list)
             change(
                 v,
                 [&](V& x) {

@@ -297,6 +297,12 @@ def test_result_from_arrays_refuses_what_no_render_holds(tmp_path):
     # counts are whole and in [0, 2^32): -1 wrapped to 4294967295 and 2.9 became 2
     with pytest.raises(ValueError, match=r"samples: counts must be in \[0, 2\^32\), got -1"):
         lucent.RenderResult(constant(1.0), samples=np.full((4, 5), -1))
+    # spp as any integer argument: a ValueError naming it and its range (pybind's "incompatible
+    # constructor arguments" TypeError for 2**70 and -1)
+    for bad in (2 ** 70, -1, 2 ** 32 + 1):
+        with pytest.raises(ValueError, match=r"^spp must be an integer in \[0, 2\*\*32\]"):
+            lucent.RenderResult(constant(1.0), spp=bad)
+    assert lucent.RenderResult(constant(1.0), spp=7).spp == 7
     with pytest.raises(TypeError, match="samples: expected integer counts"):
         lucent.RenderResult(constant(1.0), samples=np.full((4, 5), 2.9))
     # unsigned counts are shown unsigned (2^63 was "got -9223372036854775808")

@@ -396,6 +396,10 @@ def test_session_errors(renderer, small_scene):
     renderer.close()
     with pytest.raises(lucent.Error, match="closed"):
         renderer.render(1)
+    # a with block too (__enter__ returned the closed renderer)
+    with pytest.raises(lucent.Error, match="closed"):
+        with renderer:
+            pass
 
 
 U32 = "the sampler's sample indices are 32-bit"

@@ -693,3 +693,18 @@ def test_bool_fields_take_only_bools(field):
         with pytest.raises(TypeError, match=rf"Integrator\.{field} must be True or False, got "):
             setattr(i, field, v)
     assert getattr(i, field) is True
+
+
+def test_huge_arrays_are_refused_before_they_are_copied():
+    # a broadcast view of 12 bytes standing for 10^9 positions was copied whole (24 GB of float64,
+    # then the scene's vector): the kernel killed the process; MemoryError now, before any copy.
+    # (10^10 rows here, 480 GB to copy: a host with more memory than that is skipped)
+    if os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") > 400e9:
+        pytest.skip("this host has more than 400 GB of memory")
+    s = lucent.Scene()
+    with pytest.raises(MemoryError, match=r"^positions: 30000000000 values need about"):
+        s.positions = np.broadcast_to(np.zeros(3, "f4"), (10 ** 10, 3))
+    assert s.positions.shape == (0, 3)
+    t = lucent.Texture()
+    with pytest.raises(MemoryError, match=r"^rgba: "):
+        t.rgba = np.broadcast_to(np.zeros(4, "f4"), (10 ** 6, 10 ** 6, 4))

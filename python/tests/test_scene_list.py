@@ -359,3 +359,17 @@ def test_slice_bounds_are_converted_before_the_list_is_measured():
     lst = filled()
     with pytest.raises(ValueError, match="extended slice of size 0"):
         lst[bound(lst):5:2] = [material("a")]
+
+
+def test_items_of_another_type_name_the_item(small_scene):
+    # extend and slice assignment with an item that is no Material raised pybind's RuntimeError
+    # "Unable to cast Python instance to C++ type", naming none (the Python API tester's find)
+    m = lucent.Material()
+    before = len(small_scene.materials)
+    with pytest.raises(TypeError, match=r"^extend: item 1 is a int, not a Material$"):
+        small_scene.materials.extend([m, 3])
+    with pytest.raises(TypeError, match=r"^extend: item 0 is a str, not a Material$"):
+        small_scene.materials.extend("ab")
+    with pytest.raises(TypeError, match=r"^slice assignment: item 1 is a int, not a Material$"):
+        small_scene.materials[0:1] = [m, 3]
+    assert len(small_scene.materials) == before
