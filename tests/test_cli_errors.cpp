@@ -176,7 +176,10 @@ TEST(CliErrors, UnknownOutputExtension) {
   EXPECT_EQ(expect_one_error_line(run_cli("render " + q(scene) + " -o " + q(dir + "/x.bmp"))),
             dir + "/x.bmp: unknown output format '.bmp' (use .png, .pfm or .exr)");
   EXPECT_EQ(expect_one_error_line(run_cli("render " + q(scene) + " -o " + q(dir + "/x"))),
-            dir + "/x: unknown output format '' (use .png, .pfm or .exr)");
+            dir + "/x: no extension to name the output format (use .png, .pfm or .exr)");
+  // a directory is named as one (it was "unknown output format ''")
+  EXPECT_EQ(expect_one_error_line(run_cli("render " + q(scene) + " -o " + q(dir))),
+            dir + ": is a directory");
   EXPECT_TRUE(fs::is_empty(dir));
 }
 

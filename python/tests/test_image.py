@@ -129,8 +129,11 @@ def test_compare_arrays_without_variance():
 
 
 def test_image_errors(tmp_path):
-    with pytest.raises(lucent.Error, match="unknown"):
+    with pytest.raises(lucent.Error, match=r"a\.tiff: unknown output format '\.tiff'"):
         lucent.write_image(tmp_path / "a.tiff", constant(1.0))
+    # a name without an extension said "unknown output format '.'"
+    with pytest.raises(lucent.Error, match="noext: no extension to name the output format"):
+        lucent.write_image(tmp_path / "noext", constant(1.0))
     with pytest.raises(lucent.Error, match="nodir"):
         lucent.write_image(tmp_path / "nodir" / "a.png", constant(1.0))
     with pytest.raises(lucent.Error):

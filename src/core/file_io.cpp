@@ -177,13 +177,19 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
+void unknown_output_format(const std::string& path, const std::string& ext, const char* formats) {
+  if (ext.empty())
+    throw Error(path + ": no extension to name the output format (use " + formats + ")");
+  throw Error(path + ": unknown output format '" + ext + "' (use " + formats + ")");
+}
+
 void check_output_path(const std::string& out, const std::vector<std::string>& inputs) {
   if (out.empty()) throw Error("-o: the output path is empty");
-  std::string ext = lower_extension(out);
-  if (ext != ".png" && ext != ".pfm" && ext != ".exr")
-    throw Error(out + ": unknown output format '" + ext + "' (use .png, .pfm or .exr)");
   std::error_code ec;
   if (fs::is_directory(out, ec)) throw Error(out + ": is a directory");
+  std::string ext = lower_extension(out);
+  if (ext != ".png" && ext != ".pfm" && ext != ".exr")
+    unknown_output_format(out, ext, ".png, .pfm or .exr");
   for (const std::string& in : inputs)
     if (same_file(out, in))
       throw Error(out + ": is an input of this render (" + in + "); refusing to overwrite it");

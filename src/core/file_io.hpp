@@ -67,6 +67,12 @@ std::string lower_extension(const std::string& path);
 /// `inputs` ("<out>: is an input of this render (<input>); refusing to overwrite it").
 void check_output_path(const std::string& out, const std::vector<std::string>& inputs);
 
+/// Throws the error of an output `path` whose extension `ext` (lower-case, with its dot; "" for
+/// none) names no format the writer has; `formats` lists them (".png, .pfm or .exr"). A name
+/// without one said "unknown output format ''", and the Python writer's said "'.'".
+[[noreturn]] void unknown_output_format(const std::string& path, const std::string& ext,
+                                        const char* formats);
+
 /// "1.5 GiB", "256 MiB", "12 KiB", "7 bytes": a size for messages.
 std::string format_size(std::uint64_t bytes);
 

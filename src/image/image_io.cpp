@@ -127,7 +127,7 @@ void write_image(const std::string& path, const Image& img, const DisplaySetting
   else if (ext == "png")
     io::write_file_atomic(path, encode_png(path, img, display));
   else
-    throw Error(path + ": unknown output format '." + ext + "' (use .png, .pfm or .exr)");
+    io::unknown_output_format(path, ext.empty() ? "" : "." + ext, ".png, .pfm or .exr");
 }
 
 Image read_image(const std::string& path) {

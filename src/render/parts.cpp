@@ -752,7 +752,7 @@ void write_merged(const std::string& path, const RenderPart& part) {
     render_detail::check_some_sample_finite(path, part.info.nonfinite, part.acc.count);
     write_image(path, part_result(part).mean, part.info.display);
   } else {
-    throw Error(path + ": unknown output format '" + ext + "' (use .exr, .png or .pfm)");
+    io::unknown_output_format(path, ext, ".exr, .png or .pfm");
   }
 }
 
