@@ -270,13 +270,6 @@ A array_or_null(py::handle object) {
   }
 }
 
-/// Refuses, as MemoryError naming `what`, converting `object` (an array, or what NumPy makes one
-/// of) when its values at `bytes_per_value` (the conversion's copy and the scene's own) exceed
-/// what lucent allows itself (render_detail::host_memory_allowed): a broadcast view of 12 bytes
-/// standing for 10^9 positions was copied whole, and the kernel killed the process.
-void check_conversion_memory(py::handle object, const std::string& what,
-                             std::uint64_t bytes_per_value);
-
 /// A C-contiguous array of T converted from `object` (array_or_null).
 template <class T>
 using CArray = py::array_t<T, py::array::c_style | py::array::forcecast>;
@@ -291,8 +284,12 @@ py::array_t<double> copy_rows(const double* first, std::size_t n, py::ssize_t co
 /// when the shape is not (H, W, 3) with H, W >= 1.
 Image image_from_array(py::handle array, const char* what);
 /// Raises TypeError unless `object` converts to an array of booleans, integers or floats (NumPy
-/// would otherwise convert strings such as "3e400" to numbers).
-void require_numbers(py::handle object, const std::string& what);
+/// would otherwise convert strings such as "3e400" to numbers). With `bytes_per_value` (the
+/// conversion's copy and the scene's own, per value): MemoryError naming `what` when the values
+/// would take more than lucent allows itself (render_detail::host_memory_allowed): a broadcast
+/// view of 12 bytes standing for 10^9 positions was copied whole, and the kernel killed the
+/// process.
+void require_numbers(py::handle object, const std::string& what, std::uint64_t bytes_per_value = 0);
 
 /// The image of a RenderResult or of an (H, W, 3) array.
 RenderResult render_result_from(py::handle object, const char* what);

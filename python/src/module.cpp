@@ -187,12 +187,16 @@ py::array_t<double> copy_rows(const double* first, std::size_t n, py::ssize_t co
   return a;
 }
 
-void check_conversion_memory(py::handle object, const std::string& what,
-                             std::uint64_t bytes_per_value) {
+void require_numbers(py::handle object, const std::string& what, std::uint64_t bytes_per_value) {
   py::array a = array_or_null<py::array>(object);
-  if (!a) return;
+  if (!a) return;  // not convertible at all: the caller's conversion says so
+  const char kind = a.dtype().kind();
+  if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
+    throw py::type_error(what + ": expected numbers, got an array of dtype " +
+                         py::str(a.dtype()).cast<std::string>());
   std::string limit_what;
-  const std::uint64_t limit = render_detail::host_memory_allowed(&limit_what);
+  const std::uint64_t limit =
+      bytes_per_value > 0 ? render_detail::host_memory_allowed(&limit_what) : 0;
   const double need = double(a.size()) * double(bytes_per_value);
   if (limit == 0 || need <= double(limit)) return;
   char buf[200];
@@ -203,15 +207,6 @@ void check_conversion_memory(py::handle object, const std::string& what,
                 double(limit) / double(1ull << 30));
   PyErr_SetString(PyExc_MemoryError, (what + buf + limit_what + ")").c_str());
   throw py::error_already_set();
-}
-
-void require_numbers(py::handle object, const std::string& what) {
-  py::array a = array_or_null<py::array>(object);
-  if (!a) return;  // not convertible at all: the caller's conversion says so
-  const char kind = a.dtype().kind();
-  if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
-    throw py::type_error(what + ": expected numbers, got an array of dtype " +
-                         py::str(a.dtype()).cast<std::string>());
 }
 
 Image image_from_array(py::handle object, const char* what) {

@@ -270,8 +270,7 @@ py::array_t<double> vectors_array(const std::vector<V>& v) {
 template <class V>
 std::vector<V> vectors_from(py::handle value, const std::string& name) {
   constexpr int D = V::length();
-  require_numbers(value, name);
-  check_conversion_memory(value, name, sizeof(double) + sizeof(typename V::value_type));
+  require_numbers(value, name, sizeof(double) + sizeof(typename V::value_type));
   auto a = array_or_null<CArray<double>>(value);
   if (!a)
     throw py::type_error(name + ": expected an array of shape (N, " + std::to_string(D) + ")");
@@ -312,8 +311,7 @@ py::array_t<float> texture_texels(const Texture& t) {
 
 /// Sets a texture's texels, width and height from an (H, W, 4) array of numbers (H, W >= 1).
 void set_texture_texels(py::handle self, py::handle value) {
-  require_numbers(value, "rgba");
-  check_conversion_memory(value, "rgba", 2 * sizeof(float));
+  require_numbers(value, "rgba", 2 * sizeof(float));
   auto a = array_or_null<CArray<float>>(value);
   if (!a || a.ndim() != 3 || a.shape(2) != 4 || a.shape(0) < 1 || a.shape(1) < 1)
     throw py::value_error("rgba: expected an array of shape (H, W, 4)");
