@@ -24,6 +24,8 @@
 
 #include "core/file_io.hpp"
 #include "lucent/compare.hpp"
+#include "lucent/image.hpp"
+#include "lucent/parts.hpp"
 #include "scene/validate.hpp"
 #include "support.hpp"
 
@@ -746,6 +748,73 @@ TEST(Outputs, ConvergeStoppedWhileWritingKeepsItsOutputs) {
   for (size_t i = 3; i < names.size(); ++i)
     EXPECT_GT(lucent::read_image(dir + "/" + names[i]).width, 0);
   EXPECT_TRUE(others(dir, names).empty());
+}
+
+// merge stopped while it writes: the output is written in full, then it exits with 128 + the
+// signal. Its signals kept their default action, and SIGTERM there killed it, leaving a hidden
+// temporary file beside the output. The signal follows the missing-samples warning, which merge
+// prints as the last step begins (its handlers already installed); 512x512 parts give the write
+// tens of milliseconds.
+TEST(Outputs, MergeStoppedWhileWritingWritesItsOutputInFull) {
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = scene_in(dir);
+  for (const char* range : {"0:1", "2:3"}) {
+    const std::string part = dir + "/p" + std::string(range).substr(0, 1) + ".exr";
+    CommandResult r = run_cli("render " + q(scene) + " --width 512 --height 512 --samples " +
+                              range + " -o " + q(part) + " -q");
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  const std::string out = dir + "/m.exr", err_path = dir + "/stderr";
+  const int status = interrupt_cli(
+      {"merge", dir + "/p0.exr", dir + "/p2.exr", "-o", out}, err_path,
+      [](const std::string& err) { return err.find("are missing") != std::string::npos; }, SIGTERM,
+      60, {}, 1);
+  const std::string err = read_file(err_path);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
+  if (WEXITSTATUS(status) == 0) GTEST_SKIP() << "merge ended before the signal";
+  EXPECT_EQ(WEXITSTATUS(status), 143) << err;
+  EXPECT_NE(err.find("lucent: interrupted by SIGTERM: wrote " + out + " in full first\n"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(lucent::read_render_part(out).info.samples.size(), 2u);
+  EXPECT_TRUE(others(dir, {"scene.json", "p0.exr", "p2.exr", "m.exr", "stderr"}).empty());
+}
+
+// compare stopped while it writes its z map: the same (the z map in full, 128 + the signal, no
+// temporary file left), where it was killed. The signal follows the temporary file's creation;
+// 1500x1500 images of noise (z values that do not compress) give the write tens of milliseconds.
+TEST(Outputs, CompareStoppedWhileWritingItsZMapWritesItInFull) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::Image img;
+  img.width = img.height = 1500;
+  img.rgb.resize(size_t(1500) * 1500 * 3);
+  std::uint32_t state = 12345;
+  auto noise = [&] {
+    state = state * 1664525u + 1013904223u;
+    return float(state >> 8) / float(1u << 24);
+  };
+  for (float& v : img.rgb) v = noise();
+  lucent::write_image(dir + "/a.pfm", img);
+  for (float& v : img.rgb) v = noise();
+  lucent::write_image(dir + "/b.pfm", img);
+  const std::string z = dir + "/z.exr", err_path = dir + "/stderr";
+  const int status = interrupt_cli(
+      {"compare", dir + "/a.pfm", dir + "/b.pfm", "--zmap", z}, err_path,
+      [&](const std::string&) {
+        for (const auto& e : fs::directory_iterator(dir))
+          if (e.path().filename().string().rfind(".z.exr.tmp-", 0) == 0) return true;
+        return false;
+      },
+      SIGTERM, 60, {}, 1);
+  const std::string err = read_file(err_path);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
+  if (WEXITSTATUS(status) <= 1) GTEST_SKIP() << "compare ended before the signal";
+  EXPECT_EQ(WEXITSTATUS(status), 143) << err;
+  EXPECT_NE(err.find("lucent: interrupted by SIGTERM: wrote " + z + " in full first\n"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(lucent::read_image(z).width, 1500);
+  EXPECT_TRUE(others(dir, {"a.pfm", "b.pfm", "z.exr", "stderr"}).empty());
 }
 
 // render --aov stopped while an AOV's kernel builds, just after the main image is written: PoCL's

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "cli/stop_signals.hpp"
 #include "core/file_io.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
@@ -92,7 +93,15 @@ int run_compare_command() {
                 std::to_string(rb.mean.height) + " differs from " + a.a + " (" +
                 std::to_string(ra.mean.width) + "x" + std::to_string(ra.mean.height) + ")");
   CompareResult r = compare_images(ra, rb, a.options);
-  if (!a.zmap.empty()) write_image(a.zmap, r.z);
+  // a stop signal in the z map's write lets it end (it killed compare there, leaving a hidden
+  // temporary file); the comparison is then not reported
+  if (!a.zmap.empty()) {
+    if (const int sig = run_with_stops_deferred([&] { write_image(a.zmap, r.z); })) {
+      std::fprintf(stderr, "lucent: interrupted by %s: wrote %s in full first\n", signal_name(sig),
+                   one_line(a.zmap).c_str());
+      return 128 + sig;
+    }
+  }
   std::printf("A             %s%s\nB             %s%s\n", one_line(a.a).c_str(),
               ra.variance.rgb.empty() ? " (no variance layers)" : "", one_line(a.b).c_str(),
               rb.variance.rgb.empty() ? " (no variance layers)" : "");

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/stop_signals.hpp"
 #include "lucent/error.hpp"
 #include "lucent/parts.hpp"
 #include "render/sample_stats.hpp"
@@ -62,11 +63,20 @@ int run_merge_command() {
   if (!a.expect.empty()) expect = parse_sample_range(a.expect, "--expect", false);
   MergeReport r = merge_render_parts(a.parts);
   const PartInfo& info = r.merged.info;
-  check_merge_coverage(r, expect, a.complete, "--expect", "--complete");
-  if (!r.missing.empty())
-    std::fprintf(stderr, "lucent: warning: samples %s are missing: the image has fewer samples\n",
-                 ranges_text(r.missing).c_str());
-  write_merged(a.output, r.merged);
+  // a stop signal from here on lets the output be written in full (it killed the merge in the
+  // write, leaving a hidden temporary file); before, it kills it with nothing written
+  const int sig = run_with_stops_deferred([&] {
+    check_merge_coverage(r, expect, a.complete, "--expect", "--complete");
+    if (!r.missing.empty())
+      std::fprintf(stderr, "lucent: warning: samples %s are missing: the image has fewer samples\n",
+                   ranges_text(r.missing).c_str());
+    write_merged(a.output, r.merged);
+  });
+  if (sig != 0) {
+    std::fprintf(stderr, "lucent: interrupted by %s: wrote %s in full first\n", signal_name(sig),
+                 one_line(a.output).c_str());
+    return 128 + sig;
+  }
   if (!a.quiet) {
     std::fprintf(stderr, "%s: %dx%d, %zu part(s), samples %s\n", one_line(a.output).c_str(),
                  info.width, info.height, r.order.size(), ranges_text(info.samples).c_str());

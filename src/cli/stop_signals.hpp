@@ -133,4 +133,27 @@ class StopSignalScope {
   sigset_t mask_{};
 };
 
+namespace stop_detail {
+/// The stop signal run_with_stops_deferred() recorded (0: none).
+inline std::atomic<int> deferred_signal{0};
+inline void record_deferred_stop(int sig) {
+  if (first_stop_signal(sig)) deferred_signal.store(sig);
+}
+}  // namespace stop_detail
+
+/// Runs `work`, a command's last step (merge's and compare's writing of their output), with a
+/// stop signal recorded instead of acted on: the output is written in full, as render's is, where
+/// the signal's default action killed the process in the write and left a hidden temporary file
+/// beside the output. A second signal ends the process at once (first_stop_signal). Before this
+/// step the signals keep their default action: a command killed while it reads has written
+/// nothing. Returns the first stop signal received during `work` (0: none); an exception of
+/// `work` passes through, the signal then lost.
+template <class Work>
+int run_with_stops_deferred(Work&& work) {
+  stop_detail::deferred_signal.store(0);
+  StopSignalScope scope(stop_detail::record_deferred_stop);
+  work();
+  return stop_detail::deferred_signal.load();
+}
+
 }  // namespace lucent::cli
