@@ -335,6 +335,18 @@ TEST(Parts, MergerAndPartsMisusedAreErrors) {
             "both");
   EXPECT_EQ(error_of([&] { headers.finish(); }),
             "merge: no parts added (add_header() checks headers, add() adds parts)");
+  // a merger spent by finish() says so (add() said "add() after add_header()", finish() "no
+  // parts added")
+  lucent::PartMerger spent;
+  spent.add("a", a);
+  EXPECT_EQ(spent.finish().merged.info.samples.size(), 1u);
+  const char* after = " after finish(): a merger gives its merged part once (use a new one)";
+  EXPECT_EQ(error_of([&] { spent.add("b", b); }), std::string("PartMerger: add()") + after);
+  EXPECT_EQ(error_of([&] { spent.add("b", lucent::RenderPart(b)); }),
+            std::string("PartMerger: add()") + after);
+  EXPECT_EQ(error_of([&] { spent.add_header("b", b.info); }),
+            std::string("PartMerger: add_header()") + after);
+  EXPECT_EQ(error_of([&] { spent.finish(); }), std::string("PartMerger: finish()") + after);
   lucent::RenderPart bad = a;
   bad.acc.width = bad.acc.height = 512;
   EXPECT_EQ(error_of([&] { lucent::part_result(bad); }),

@@ -131,15 +131,18 @@ class PartMerger {
   /// held once, not twice: `lucent render --checkpoint` merges beside its session).
   void add(const std::string& name, RenderPart&& part);
   bool empty() const { return names_.empty(); }
-  /// The merged part and its coverage. The sum is moved out: call it once.
+  /// The merged part and its coverage. The sum is moved out: call it once (a merger is spent
+  /// then: add(), add_header() and finish() throw).
   MergeReport finish();
 
  private:
   void check_part(const std::string& name, const RenderPart& part);
+  void check_not_finished(const char* call) const;
 
   std::vector<std::string> names_;
   std::vector<PartInfo> infos_;
   RenderPart total_;
+  bool finished_ = false;
 };
 
 /// Reads the headers of `paths`, checks them (same film, seed, integrator and scene hash; no

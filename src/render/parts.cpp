@@ -602,7 +602,15 @@ void PartMerger::check(const std::string& name, const PartInfo& info) {
   }
 }
 
+void PartMerger::check_not_finished(const char* call) const {
+  // (add() after finish() said "add() after add_header()", and finish() again "no parts added")
+  if (finished_)
+    throw Error(std::string("PartMerger: ") + call +
+                " after finish(): a merger gives its merged part once (use a new one)");
+}
+
 void PartMerger::add_header(const std::string& name, const PartInfo& info) {
+  check_not_finished("add_header()");
   check_part_contents(name, info, Accumulation{});
   check(name, info);
   names_.push_back(name);
@@ -610,6 +618,7 @@ void PartMerger::add_header(const std::string& name, const PartInfo& info) {
 }
 
 void PartMerger::check_part(const std::string& name, const RenderPart& part) {
+  check_not_finished("add()");
   // headers or parts, not both: after add_header there is no sum to add to (it read empty
   // vectors as a full film's)
   if (!names_.empty() && total_.info.width == 0)
@@ -667,12 +676,14 @@ void PartMerger::add(const std::string& name, const RenderPart& part) {
 }
 
 MergeReport PartMerger::finish() {
+  check_not_finished("finish()");
   if (names_.empty()) throw Error("merge: no parts");
   if (total_.info.width == 0)
     throw Error("merge: no parts added (add_header() checks headers, add() adds parts)");
   MergeReport r;
   r.merged = std::move(total_);  // (not copied: a film's sums)
   total_ = RenderPart{};
+  finished_ = true;
   r.order = names_;
   // missing: [0, the highest end requested) less what was rendered
   const std::uint64_t end =
