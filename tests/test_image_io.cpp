@@ -302,6 +302,66 @@ TEST(ImageIo, DamagedTiledExrIsRefused) {
       << error_of(huge);
 }
 
+// An OpenEXR image is its display window; its data window holds the pixels stored, which may cover
+// part of it (a crop: the rest is 0, as OpenEXR's readers leave it) or reach beyond it (overscan:
+// dropped). The data window alone was read as the image: a crop stretched over the whole texture,
+// an overscan border shown inside it. tinyexr writes both windows as [0, w) x [0, h); the tests
+// rewrite the display window's four numbers in place.
+TEST(ImageIo, ExrImageIsItsDisplayWindow) {
+  auto value = [](int c, int x, int y) { return 1 + float(x + 10 * y) + 0.25f * float(c); };
+  const std::string dir = lucent::test::temp_dir(), path = dir + "/w.exr";
+  for (int tile : {0, 2}) {
+    ExrLayout layout;
+    layout.tile = tile;
+    write_exr(path, 3, 2, {"B", "G", "R"}, value, layout);
+    const std::string good = lucent::test::read_file(path);
+    const std::string name("displayWindow\0box2i\0", 20);
+    const size_t at = good.find(name);
+    ASSERT_NE(at, std::string::npos);
+    auto with_display = [&](std::int32_t x0, std::int32_t y0, std::int32_t x1, std::int32_t y1) {
+      std::string bytes = good;
+      const std::int32_t box[4] = {x0, y0, x1, y1};
+      std::memcpy(&bytes[at + name.size() + 4], box, sizeof box);  // after the size (16)
+      lucent::test::write_file(path, bytes);
+      return lucent::read_image(path);
+    };
+    // the data window [0, 3) x [0, 2) at (1, 2) of a display window [-1, 4) x [-2, 1)
+    lucent::Image img = with_display(-1, -2, 3, 0);
+    ASSERT_EQ(img.width, 5);
+    ASSERT_EQ(img.height, 3);
+    for (int y = 0; y < 3; ++y)
+      for (int x = 0; x < 5; ++x)
+        for (int c = 0; c < 3; ++c) {
+          const bool stored = x >= 1 && x < 4 && y == 2;
+          EXPECT_EQ(img.pixel(x, y)[c], stored ? value(2 - c, x - 1, y - 2) : 0.0f)
+              << tile << ": " << x << ", " << y;
+        }
+    // overscan: a display window [1, 2) x [1, 2) inside the data window shows its pixel (1, 1)
+    img = with_display(1, 1, 1, 1);
+    ASSERT_EQ(img.width, 1);
+    ASSERT_EQ(img.height, 1);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(img.pixel(0, 0)[c], value(2 - c, 1, 1)) << tile;
+    // apart: black
+    img = with_display(100, 100, 101, 100);
+    ASSERT_EQ(img.width, 2);
+    for (float v : img.rgb) EXPECT_EQ(v, 0.0f);
+    // refused as the data window is: empty, or past the pixel limit
+    auto error_with = [&](std::int32_t x0, std::int32_t y0, std::int32_t x1, std::int32_t y1) {
+      try {
+        with_display(x0, y0, x1, y1);
+      } catch (const lucent::Error& e) {
+        return std::string(e.what());
+      }
+      return std::string();
+    };
+    EXPECT_EQ(error_with(0, 0, -1, 0),
+              path + ": OpenEXR header claims an empty display window (0x1)");
+    EXPECT_NE(error_with(0, 0, 2000000000, 0)
+                  .find("header claims 2000000001x1 pixels, more than the limit"),
+              std::string::npos);
+  }
+}
+
 // The chunkCount attribute of a scanline file: tinyexr sizes the offset table by it, allocating 8
 // bytes an entry before reading any (fuzz_render_image found a 735-byte file that asked for
 // 3.6 GB: docs/reliability.md), so the probe requires it to be the file's count of chunks, one

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <type_traits>
 
 #include "core/file_io.hpp"
 #include "core/host_memory.hpp"
@@ -212,7 +213,34 @@ ExrChannels read_exr_channels(const unsigned char* data, std::size_t size, const
       for (size_t i = 0; i < n; ++i) copy(c, image.images[c], i, i);
   }
   FreeEXRImage(&image);
+  // the image is the display window (the probe checked its size): the data window's pixels in
+  // their place, those it does not cover 0, as OpenEXR's readers leave them; the pixels beyond
+  // it (overscan) are dropped
+  const EXRBox2i dw = header.data_window, sw = header.display_window;
   FreeEXRHeader(&header);
+  if (sw.min_x != dw.min_x || sw.min_y != dw.min_y || sw.max_x != dw.max_x ||
+      sw.max_y != dw.max_y) {
+    const std::int64_t w = std::int64_t(sw.max_x) - sw.min_x + 1;
+    const std::int64_t h = std::int64_t(sw.max_y) - sw.min_y + 1;
+    const std::int64_t dx = std::int64_t(dw.min_x) - sw.min_x,
+                       dy = std::int64_t(dw.min_y) - sw.min_y;
+    auto place = [&](auto& plane) {
+      if (plane.empty()) return;
+      std::remove_reference_t<decltype(plane)> shown(static_cast<size_t>(w * h), 0);
+      for (std::int64_t y = 0; y < out.height; ++y) {
+        if (y + dy < 0 || y + dy >= h) continue;
+        for (std::int64_t x = 0; x < out.width; ++x)
+          if (x + dx >= 0 && x + dx < w)
+            shown[static_cast<size_t>((y + dy) * w + x + dx)] =
+                plane[static_cast<size_t>(y * out.width + x)];
+      }
+      plane = std::move(shown);
+    };
+    for (auto& plane : out.planes) place(plane);
+    for (auto& plane : out.uint_planes) place(plane);
+    out.width = static_cast<int>(w);
+    out.height = static_cast<int>(h);
+  }
   return out;
 }
 

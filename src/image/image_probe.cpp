@@ -506,6 +506,19 @@ class Checker {
     }
     // zlib expands at most 1032x; PIZ's Huffman runs a few hundred times
     ratio(p, u64(w) * u64(h) * bytes_per_pixel, n_, 2048, "file");
+    // the image is the display window: a data window of a part of it (a crop), or beyond it
+    // (overscan), was read as the image, stretched or shifted (read_exr_channels places it)
+    const EXRBox2i& sw = header.display_window;
+    if (sw.min_x != dw.min_x || sw.min_y != dw.min_y || sw.max_x != dw.max_x ||
+        sw.max_y != dw.max_y) {
+      const std::int64_t sw_w = std::int64_t(sw.max_x) - sw.min_x + 1;
+      const std::int64_t sw_h = std::int64_t(sw.max_y) - sw.min_y + 1;
+      if (sw_w <= 0 || sw_h <= 0)
+        fail("OpenEXR header claims an empty display window (" + std::to_string(sw_w) + "x" +
+             std::to_string(sw_h) + ")");
+      size(p, u64(sw_w), u64(sw_h));
+      p.decode_pixels = u64(w) * u64(h) + u64(sw_w) * u64(sw_h);
+    }
     if (out) {
       *out = header;
       guard.keep = true;
@@ -758,8 +771,9 @@ Probe probe_exr(const unsigned char* data, std::size_t size, const std::string& 
 
 void check_decode_memory(const std::string& path, const char* thing, const Probe& p,
                          std::uint64_t bytes_per_pixel, std::uint64_t file_bytes) {
-  const std::uint64_t need =
-      std::uint64_t(p.width) * std::uint64_t(p.height) * bytes_per_pixel + file_bytes;
+  const std::uint64_t pixels =
+      p.decode_pixels > 0 ? p.decode_pixels : std::uint64_t(p.width) * std::uint64_t(p.height);
+  const std::uint64_t need = pixels * bytes_per_pixel + file_bytes;
   std::string what;
   const std::uint64_t limit = sys::host_memory_allowed(&what);
   if (limit > 0 && need > limit)

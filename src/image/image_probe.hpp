@@ -55,6 +55,9 @@ struct Probe {
   bool sixteen_bit = false;  ///< a 16-bit PNG
   int channels = 0;          ///< an OpenEXR's channels
   int compression = -1;      ///< an OpenEXR's compression (TINYEXR_COMPRESSIONTYPE_*)
+  /// The pixels decoding holds at once, where not width * height: an OpenEXR whose data window
+  /// (the pixels stored) is not its display window (the image, width x height), both.
+  std::uint64_t decode_pixels = 0;
 };
 
 /// Identifies the format of `data` (PNG, JPEG, BMP, TGA, Radiance HDR, PFM, OpenEXR; anything
