@@ -811,6 +811,26 @@ TEST(Obj, ColourFormsXyzAndSpectral) {
   EXPECT_COLOUR(material_named(t, "t.obj:tex").albedo, 0, 0, 0);
 }
 
+// A colour of one number is grey, as the MTL format says ("Kd 0.5": g and b are r): lucent
+// refused the file, and tinyobjloader read 0.5 0 0. The number keeps its text ("1e-1").
+TEST(Obj, ColourOfOneNumberIsGrey) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "g.mtl",
+        "newmtl grey\nKd 0.5\nKs\t1e-1 \nillum 2\n"
+        "newmtl lamp\nKd 0\nKe 4\n"
+        "newmtl three\nKd 0.5 0.25 0.125\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, one_face_per_material(dir, "g.obj", "g.mtl", {"grey", "lamp", "three"}));
+  EXPECT_TRUE(w.all().empty()) << w.dump();
+  const Material& grey = material_named(s, "g.obj:grey");
+  EXPECT_EQ(grey.type, MaterialType::Plastic);
+  EXPECT_COLOUR(grey.albedo, 0.5, 0.5, 0.5);
+  EXPECT_COLOUR(grey.specular, 0.1, 0.1, 0.1);
+  EXPECT_COLOUR(material_named(s, "g.obj:lamp").emission, 4, 4, 4);
+  EXPECT_COLOUR(material_named(s, "g.obj:three").albedo, 0.5, 0.25, 0.125);
+}
+
 // Some exporters write the illumination model as a decimal ("illum 2.0"; Blender's importer
 // reads it, tinyobjloader's atoi reads 2): lucent refused the file. A decimal that is not a whole
 // number (which atoi would truncate) is still refused.

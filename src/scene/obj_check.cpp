@@ -473,9 +473,9 @@ void check_mtl_text(const std::string& path, const std::string& text) {
         if (std::max({rgb.x, rgb.y, rgb.z}) > double(FLT_MAX))
           fail(name + " xyz line: the colour is out of range for a float in sRGB");
       }
-      if (!xyz && n != 3)
-        fail(name + " line has " + std::to_string(n) + " number" + (n == 1 ? "" : "s") +
-             ", needs 3");
+      // (one number is r = g = b, as the MTL format says: read_colour_forms)
+      if (!xyz && n != 1 && n != 3)
+        fail(name + " line has " + std::to_string(n) + " numbers, needs 3 (or 1, for grey)");
     } else if (scalar) {
       std::string_view t = token(rest);
       if (t.empty()) fail(name + " line has no number");
@@ -626,8 +626,6 @@ std::string strip_texture_options(const std::string& text, std::vector<IgnoredOp
 
 std::string read_colour_forms(const std::string& path, const std::string& text,
                               std::vector<std::string>* warnings) {
-  if (text.find("xyz") == std::string::npos && text.find("spectral") == std::string::npos)
-    return text;
   io::CNumbers c_numbers;  // "0.5", whatever the process locale
   std::string out;
   out.reserve(text.size());
@@ -644,11 +642,19 @@ std::string read_colour_forms(const std::string& path, const std::string& text,
     if (!colour_tag(tag)) return;
     std::string_view args = rest;
     const std::string_view form = token(args);
+    // one number is grey, r = g = b, as the MTL format says: tinyobjloader read "Kd 0.5" as
+    // 0.5 0 0 (lucent refused it until 30 Nov 2026)
+    const bool grey = !form.empty() && form != "xyz" && form != "spectral" && token(args).empty();
     // Tf spectral stays: a transparent material is warned of it, and clear (MaterialMapper)
-    if (form != "xyz" && (form != "spectral" || tag == "Tf" || tag == "Kt")) return;
+    if (!grey && form != "xyz" && (form != "spectral" || tag == "Tf" || tag == "Kt")) return;
     const std::size_t at = static_cast<std::size_t>(line.data() - text.data());
     out.append(text, copied, at - copied);
     copied = at + line.size();
+    if (grey) {
+      const std::string v(form);
+      out += std::string(tag) + " " + v + " " + v + " " + v;
+      return;
+    }
     const std::string where = path + ":" + std::to_string(ln) + ": material '" + material + "': ";
     if (form == "spectral") {
       // 0 0 0 in its place (as without the statement, but for a map_Kd: tinyobjloader gives one

@@ -150,7 +150,7 @@ std::vector<MtlName> mtl_material_names(const std::string& text);
 /// linear sRGB (D65; one number is x = y = z), negative channels taken as 0 with a warning (but
 /// for Ka, which is not read); `Ka`/`Kd`/`Ks`/`Ke spectral file [factor]` made 0 0 0, with a
 /// warning (for Kd, Ks, Ke). `Tf` and `Kt spectral` stay (MaterialMapper warns of them on a
-/// transparent material).
+/// transparent material). A colour of one number is grey (`Kd 0.5` is `Kd 0.5 0.5 0.5`).
 std::string read_colour_forms(const std::string& path, const std::string& text,
                               std::vector<std::string>* warnings);
 
