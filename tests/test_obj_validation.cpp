@@ -154,6 +154,29 @@ TEST(ObjValidation, AbsurdIndicesAreErrors) {
   EXPECT_EQ(s.triangles.size(), 1u);
 }
 
+// A PLY, STL or glTF file named as a mesh (the Stanford bunny comes as PLY) loaded as an OBJ of no
+// faces: a warning, and an image without the mesh. A file that defines no vertex or face and has a
+// statement OBJ does not have is refused, naming its first such line; one of comments alone, or
+// an OBJ with statements lucent ignores, still loads.
+TEST(ObjValidation, FilesOfAnotherFormatAreRefused) {
+  const std::string not_obj =
+      "' is no OBJ statement, and the file defines no vertex or face: not a Wavefront OBJ file "
+      "(lucent reads meshes as OBJ)";
+  EXPECT_EQ(obj_error("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n"
+                      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+            "m.obj:1: 'ply" + not_obj);
+  EXPECT_EQ(obj_error("solid s\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n"
+                      "   vertex 1 0 0\n   vertex 0 1 0\n  endloop\n endfacet\nendsolid s\n"),
+            "m.obj:1: 'solid" + not_obj);
+  EXPECT_EQ(obj_error("# a comment\n\n{\"asset\": {\"version\": \"2.0\"}}\n"),
+            "m.obj:3: '{\"asset\":" + not_obj);
+  EXPECT_EQ(obj_error("# nothing but a comment\n"), "");
+  EXPECT_EQ(obj_error("g group\n"), "");
+  Scene s;
+  EXPECT_EQ(obj_error("vertex 0 0 0\n" + kTri + "f 1 2 3\n", "", glm::dmat4(1.0), &s), "");
+  EXPECT_EQ(s.triangles.size(), 1u);
+}
+
 // "f 1/ 2/ 3/ 4/1" passed the check (an empty texture coordinate taken as none), but
 // tinyobjloader's atoi skipped the space after "1/" and read the next corner's vertex index as its
 // texture coordinate: the quad loaded with UVs 2, 3, 4 and 1 without a word, and "f 1/ 2/ 3/ 4"

@@ -225,6 +225,23 @@ std::vector<std::string> lines_of(const std::string& text) {
   return out;
 }
 
+namespace {
+
+/// The OBJ format's statements (Wavefront's specification, and tinyobjloader's t and vw).
+bool obj_statement(std::string_view tag) {
+  static const char* const kStatements[] = {
+      "v",        "vt",       "vn",     "vp",         "f",         "l",      "p",
+      "g",        "o",        "s",      "mg",         "usemtl",    "mtllib", "cstype",
+      "deg",      "bmat",     "step",   "curv",       "curv2",     "surf",   "parm",
+      "trim",     "hole",     "scrv",   "sp",         "end",       "con",    "bevel",
+      "c_interp", "d_interp", "lod",    "shadow_obj", "trace_obj", "ctech",  "stech",
+      "call",     "csh",      "maplib", "usemap",     "t",         "vw"};
+  return std::any_of(std::begin(kStatements), std::end(kStatements),
+                     [&](const char* s) { return tag == s; });
+}
+
+}  // namespace
+
 TextCounts check_obj_text(const std::string& path, const std::string& text) {
   std::int64_t count[3] = {0, 0, 0};  // v, vt, vn defined so far
   // the largest positive index of each kind and its line: checked against the final counts
@@ -279,6 +296,10 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
     }
     std::string_view tag = token(rest);
     if (tag.empty()) return;
+    if (out.foreign_line == 0 && !obj_statement(tag)) {
+      out.foreign_line = ln;
+      out.foreign_statement = io::one_line(str(tag));
+    }
     int need = 0;
     const char* what = nullptr;
     if (tag == "v") {
@@ -381,6 +402,13 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
       fail("more than " + std::to_string(kMaxTriangles) + " triangles in one OBJ file");
   });
   reading(0);
+  // a PLY, STL or glTF file named as a mesh: an OBJ file of no vertex or face was a warning
+  // ("no faces") and an image without the mesh
+  if (count[0] == 0 && out.elements == 0 && out.foreign_line > 0)
+    LineError(path, out.foreign_line)(
+        "'" + out.foreign_statement +
+        "' is no OBJ statement, and the file defines no vertex or face: not a Wavefront OBJ "
+        "file (lucent reads meshes as OBJ)");
   for (int k = 0; k < 3; ++k)
     if (wanted[k] > count[k])
       LineError(path, wanted_line[k])(

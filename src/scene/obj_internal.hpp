@@ -76,6 +76,9 @@ struct TextCounts {
   /// order: a name is the rest of the line, trimmed ("usemtl my mat", "usemtl red # note"), where
   /// tinyobjloader reads the first word. The text it reads names them by alias (alias_usemtl).
   std::vector<std::string> usemtl_names;
+  /// The first line whose statement the OBJ format does not have, and the statement (0: none).
+  long foreign_line = 0;
+  std::string foreign_statement;
 };
 
 /// The host memory that loading an OBJ file holds at once (obj.cpp, load_obj), in order, never
