@@ -1057,6 +1057,50 @@ TEST(Obj, TextureOptionsThatChangeTheLookAreNamed) {
   }
 }
 
+// mtllib names as exporters write them: a tab separates two names and ends the line ('a.mtl\t'
+// was not found), "\ " escapes a space, a backslash before anything else is a Windows
+// separator ("sub\s.mtl" looked for "subs.mtl"), and an unescaped name with spaces is read whole
+// when it is a library and a name split from it is not ("my lib.mtl" looked for "my" and
+// "lib.mtl"). Each case gave its faces the default material, with a warning.
+TEST(Obj, MtllibNamesAsExportersWriteThem) {
+  std::string dir = lucent::test::temp_dir();
+  write(dir, "a.mtl", "newmtl a\nKd 1 0 0\n");
+  write(dir, "b.mtl", "newmtl b\nKd 0 1 0\n");
+  write(dir, "sub/s.mtl", "newmtl s\nKd 0 0 1\n");
+  write(dir, "my lib.mtl", "newmtl m\nKd 1 1 0\n");
+  write(dir, "c d.mtl", "newmtl c\nKd 0 1 1\n");
+  struct Case {
+    const char* line;
+    std::vector<const char*> materials;
+  } cases[] = {
+      {"mtllib a.mtl\t", {"a"}},
+      {"mtllib\ta.mtl\tb.mtl", {"a", "b"}},
+      {"mtllib sub\\s.mtl", {"s"}},
+      {"mtllib my lib.mtl", {"m"}},
+      {"mtllib c\\ d.mtl a.mtl", {"c", "a"}},
+      {"mtllib a.mtl b.mtl # both", {"a", "b"}},
+  };
+  for (const Case& c : cases) {
+    std::string obj = std::string(c.line) + "\nv 0 0 0\nv 1 0 0\nv 1 1 0\n";
+    for (const char* m : c.materials) obj += std::string("usemtl ") + m + "\nf 1 2 3\n";
+    const std::string path = write(dir, "m.obj", obj);
+    CaptureWarnings w;
+    Scene s;
+    load(s, path);
+    EXPECT_TRUE(w.all().empty()) << c.line << "\n" << w.dump();
+    ASSERT_EQ(s.triangles.size(), c.materials.size()) << c.line;
+    for (size_t k = 0; k < c.materials.size(); ++k)
+      EXPECT_EQ(s.materials[s.triangles[k].material].name, std::string("m.obj:") + c.materials[k])
+          << c.line;
+  }
+  // a name split from a line that is no library either: the names as split, each warned of
+  CaptureWarnings w;
+  Scene s;
+  load(s, write(dir, "x.obj", "mtllib no such.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n"));
+  EXPECT_EQ(w.count("material library 'no' not found"), 1) << w.dump();
+  EXPECT_EQ(w.count("material library 'such.mtl' not found"), 1) << w.dump();
+}
+
 // A usemtl before the file's mtllib: tinyobjloader looks the name up when it reads the usemtl,
 // and had read no library yet: the faces got the default material and the warning said the MTL
 // file has no such material. The libraries of every mtllib are read first; tinyobjloader's line

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <glm/glm.hpp>
 #include <map>
 #include <regex>
@@ -22,6 +23,8 @@
 #include "scene/obj_internal.hpp"
 
 namespace lucent::scene_detail::obj {
+
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -227,6 +230,12 @@ std::vector<std::string> lines_of(const std::string& text) {
 
 namespace {
 
+/// Whether the library `name` of the OBJ file `obj_path` exists (library_path).
+bool library_exists(const std::string& obj_path, const std::string& name) {
+  std::error_code ec;
+  return fs::is_regular_file(library_path(fs::path(obj_path).parent_path(), name), ec);
+}
+
 /// The OBJ format's statements (Wavefront's specification, and tinyobjloader's t and vw).
 bool obj_statement(std::string_view tag) {
   static const char* const kStatements[] = {
@@ -241,6 +250,20 @@ bool obj_statement(std::string_view tag) {
 }
 
 }  // namespace
+
+std::filesystem::path library_path(const std::filesystem::path& dir, const std::string& name) {
+  fs::path p(name);
+  if (!p.is_absolute()) p = dir / p;
+  std::error_code ec;  // names too long for the file system: no such file, no exception
+  if (!fs::exists(p, ec) && name.find('\\') != std::string::npos) {  // Windows' separators
+    std::string fixed = name;
+    std::replace(fixed.begin(), fixed.end(), '\\', '/');
+    fs::path q(fixed);
+    if (!q.is_absolute()) q = dir / q;
+    if (fs::exists(q, ec)) return q;
+  }
+  return p;
+}
 
 TextCounts check_obj_text(const std::string& path, const std::string& text) {
   std::int64_t count[3] = {0, 0, 0};  // v, vt, vn defined so far
@@ -277,21 +300,33 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
     }
     if (line.size() > 6 && line.substr(0, 6) == "mtllib" && (line[6] == ' ' || line[6] == '\t')) {
       mtllib_seen = true;
+      // names split at spaces and tabs ("a.mtl\t" named 'a.mtl\t'); "\ " escapes a space, and
+      // a backslash before anything else stays (a Windows path, "sub\s.mtl", was "subs.mtl")
       std::vector<std::string> names(1);
       for (std::size_t i = 7; i < line.size(); ++i) {
-        if (line[i] == '\\') {
-          if (i + 1 < line.size()) names.back() += line[++i];
-        } else if (line[i] != ' ') {
-          names.back() += line[i];
+        const char c = line[i];
+        if (c == '\\' && i + 1 < line.size() &&
+            (line[i + 1] == ' ' || line[i + 1] == '\t' || line[i + 1] == '\\')) {
+          names.back() += line[++i];
+        } else if (c != ' ' && c != '\t') {
+          names.back() += c;
         } else if (!names.back().empty()) {
           names.emplace_back();
         }
       }
-      for (const std::string& n : names) {
-        if (n.empty()) continue;
-        if (n[0] == '#') break;
+      if (names.back().empty()) names.pop_back();
+      for (std::size_t k = 0; k < names.size(); ++k)
+        if (names[k][0] == '#') names.resize(k);
+      // "mtllib my lib.mtl" unescaped, where "my lib.mtl" exists and a name split from it does
+      // not: the whole rest of the line, as Blender's importer reads it
+      const std::string whole = trim(std::string(line.substr(7)));
+      if (names.size() > 1 &&
+          !std::all_of(names.begin(), names.end(),
+                       [&](const std::string& n) { return library_exists(path, n); }) &&
+          library_exists(path, whole))
+        names = {whole};
+      for (const std::string& n : names)
         if (libraries.insert(n).second) out.libraries.push_back(n);
-      }
       return;
     }
     std::string_view tag = token(rest);

@@ -64,8 +64,9 @@ struct TextCounts {
   /// (kTextWindow) hold at once while it reads the text: the text read so far and the arrays
   /// made of it, at each line.
   std::uint64_t reading_bytes = 0;
-  /// The names of the `mtllib` statements, in order, each once (split as tinyobjloader splits
-  /// them: at spaces, `\ ` escaping one; a word starting with '#' ends the list)
+  /// The names of the `mtllib` statements, in order, each once (split at spaces and tabs, `\ `
+  /// escaping one; a word starting with '#' ends the list; the whole rest of the line when that
+  /// is a library and a name split from it is not)
   std::vector<std::string> libraries;
   /// A `usemtl` comes before the first `mtllib`.
   bool usemtl_before_mtllib = false;
@@ -106,6 +107,10 @@ std::string alias_usemtl(const std::string& text, const std::vector<std::string>
 /// negative ones relative to those defined so far), polygons of at most kMaxFaceVertices corners
 /// and at most kMaxTriangles triangles; notes the MTL libraries. Throws
 /// lucent::Error("<path>:<line>: ...").
+/// Where the OBJ file in `dir` finds its material library `name` (an `mtllib` name): relative to
+/// `dir`, with backslashes read as slashes when the name as given does not exist.
+std::filesystem::path library_path(const std::filesystem::path& dir, const std::string& name);
+
 TextCounts check_obj_text(const std::string& path, const std::string& text);
 
 /// Turns the comments at the end of `text`'s f, l and p lines ("f 1 2 3 # top") into spaces, in

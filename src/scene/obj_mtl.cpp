@@ -47,7 +47,7 @@ bool MtlReader::operator()(const std::string&, std::vector<tinyobj::material_t>*
   done_ = true;
   std::set<std::string> seen;  // canonical paths: a library named twice is read once
   for (const std::string& name : names_) {
-    fs::path p = fs::path(name).is_absolute() ? fs::path(name) : dir_ / name;
+    const fs::path p = library_path(dir_, name);
     std::error_code ec;
     fs::path canonical = fs::weakly_canonical(p, ec);
     if (!seen.insert(ec ? p.string() : canonical.string()).second) continue;
