@@ -25,6 +25,24 @@ std::string texture_key(const std::string& path) {
   return ec ? fs::path(path).lexically_normal().string() : p.string();
 }
 
+/// The bytes a pixel takes while it is decoded, the texture's own 16 (RGBA float) included: the
+/// decoder's output and working buffers beside it (stb_image's 8-bit RGBA image and its zlib
+/// stream's, tinyexr's planes). Counting the 16 alone let a texture pass that then took twice
+/// that (an 8192x8192 PNG: 1.0 GiB counted, 2.1 GB resident) and ended in "out of memory".
+std::uint64_t decode_bytes_per_pixel(const image_detail::Probe& p) {
+  using image_detail::Format;
+  switch (p.format) {
+    case Format::Exr:
+      return image_detail::exr_decode_bytes_per_pixel(p) + 16;
+    case Format::Pfm:
+      return 16;
+    case Format::Hdr:
+      return 16 + 16 + 4;
+    default:
+      return p.sixteen_bit ? 16 + 3 * 8 : 16 + 4 * 4;
+  }
+}
+
 }  // namespace
 
 Texture decode_texture(const unsigned char* data, std::size_t size, const std::string& path) {
@@ -92,6 +110,19 @@ int load_texture(Scene& scene, const std::string& path, ObjMaterials* known) {
                 std::to_string(scene.textures.size() + 1) + " textures need " +
                 sys::format_bytes(loaded + adds) + ", more than the limit of " +
                 sys::format_bytes(limit) + " (80% of " + what +
+                "): reduce the textures' resolution or number");
+  const std::uint64_t pixels =
+      p.decode_pixels > 0 ? p.decode_pixels : std::uint64_t(p.width) * std::uint64_t(p.height);
+  const std::uint64_t decoding =
+      sys::bytes_add(bytes.size(), sys::bytes_mul(pixels, decode_bytes_per_pixel(p)));
+  if (limit > 0 && sys::bytes_add(loaded, decoding) > limit)
+    throw Error(path + ": decoding this " + std::to_string(p.width) + "x" +
+                std::to_string(p.height) + " texture needs about " + sys::format_bytes(decoding) +
+                (scene.textures.empty()
+                     ? std::string()
+                     : " beside the scene's " + std::to_string(scene.textures.size()) +
+                           " texture(s) (" + sys::format_bytes(loaded) + ")") +
+                ", more than the limit of " + sys::format_bytes(limit) + " (80% of " + what +
                 "): reduce the textures' resolution or number");
   scene.textures.push_back(decode_texture(data, bytes.size(), path));
   const int index = static_cast<int>(scene.textures.size() - 1);
