@@ -171,6 +171,14 @@ TEST(ObjValidation, FilesOfAnotherFormatAreRefused) {
   EXPECT_EQ(obj_error("# a comment\n\n{\"asset\": {\"version\": \"2.0\"}}\n"),
             "m.obj:3: '{\"asset\":" + not_obj);
   EXPECT_EQ(obj_error("# nothing but a comment\n"), "");
+  // a line continued on the next (the OBJ specification's '\'), which tinyobjloader does not read
+  EXPECT_EQ(obj_error("v 0 0 \\\n  0\n"),
+            "m.obj:1: a '\\' at the end of a line continues it on the next, which lucent does "
+            "not read: join the two lines");
+  EXPECT_EQ(obj_error(kTri + "f 1 2 \\ \r\n3\n"),
+            "m.obj:4: a '\\' at the end of a line continues it on the next, which lucent does "
+            "not read: join the two lines");
+  EXPECT_EQ(obj_error(kTri + "f 1 2 3 # a comment \\\n"), "");
   EXPECT_EQ(obj_error("g group\n"), "");
   Scene s;
   EXPECT_EQ(obj_error("vertex 0 0 0\n" + kTri + "f 1 2 3\n", "", glm::dmat4(1.0), &s), "");

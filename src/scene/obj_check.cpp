@@ -331,6 +331,13 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
     }
     std::string_view tag = token(rest);
     if (tag.empty()) return;
+    // (the token after the statement's numbers was refused as "'\' is not a number")
+    if (const std::size_t e = rest.find_last_not_of(" \t\r");
+        e != std::string_view::npos && rest[e] == '\\' &&
+        rest.substr(0, e).find('#') == std::string_view::npos)
+      fail(
+          "a '\\' at the end of a line continues it on the next, which lucent does not read: "
+          "join the two lines");
     if (out.foreign_line == 0 && !obj_statement(tag)) {
       out.foreign_line = ln;
       out.foreign_statement = io::one_line(str(tag));
