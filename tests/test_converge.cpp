@@ -427,6 +427,16 @@ TEST(Converge, LaddersBeyondTheLimitsAreRefused) {
     EXPECT_EQ(msg.rfind("converge: time ladder values must be in (0, 1e7] seconds, got ", 0), 0u)
         << msg;
   }
+  // a rung given twice (an spp rung rendered the same image twice, and the fit said "n/a")
+  opt.time_ladder = {0.5, 1, 0.5};
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::check_convergence_options(opt); }),
+            "converge: the time ladder gives 0.5 s twice (each budget is one rung)");
+  opt.time_ladder.clear();
+  opt.spp_ladder = {4, 8, 4};
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::check_convergence_options(opt); }),
+            "converge: the spp ladder gives 4 twice (each sample count is one rung)");
+  opt.spp_ladder = {8, 4};  // (any order)
+  EXPECT_NO_THROW(lucent::check_convergence_options(opt));
 }
 
 TEST(Converge, FitOfSyntheticCurves) {

@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <tuple>
 
@@ -447,6 +448,21 @@ void check_convergence_options(const ConvergeOptions& options, const Scene* scen
       throw Error(std::string("converge: time ladder values must be in (0, 1e7] seconds, got ") +
                   got);
     }
+  // a rung given twice: an spp rung rendered the same samples twice, and the fit of two equal
+  // points said "slope n/a"; a time rung measured the same budget again
+  if (by_time) {
+    std::set<double> seen;
+    for (double t : options.time_ladder)
+      if (!seen.insert(t).second)
+        throw Error("converge: the time ladder gives " + fmt("%g", t) +
+                    " s twice (each budget is one rung)");
+  } else {
+    std::set<int> seen;
+    for (int s : options.spp_ladder)
+      if (!seen.insert(s).second)
+        throw Error("converge: the spp ladder gives " + std::to_string(s) +
+                    " twice (each sample count is one rung)");
+  }
   for (size_t i = 0; i < options.settings.size(); ++i) {
     const ConvergeSetting& setting = options.settings[i];
     check_setting_fields(setting);
