@@ -281,7 +281,7 @@ std::string glass_ball_scene(bool caustics, int max_depth, const std::string& mo
 }
 
 // A render cancelled before it starts keeps nothing and says so: no light paths traced (N = 0
-// divides nothing), every pixel empty.
+// divides nothing), every pixel empty, spp 0 (it said the 4 asked for).
 TEST(ReferenceCaustics, CancelledBeforeStart) {
   lucent::Scene scene = lucent::test::scene_from(mirror_scene(true, R"({"type": "box"})"));
   std::atomic<bool> cancel{true};
@@ -290,6 +290,7 @@ TEST(ReferenceCaustics, CancelledBeforeStart) {
   o.cancel = &cancel;
   RenderResult r = lucent::render_reference(scene, o);
   EXPECT_TRUE(r.cancelled);
+  EXPECT_EQ(r.spp, 0u);
   EXPECT_EQ(r.nonfinite, 0u);
   for (size_t i = 0; i < r.samples.size(); ++i) {
     EXPECT_EQ(r.samples[i], 0u);

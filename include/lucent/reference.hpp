@@ -20,7 +20,8 @@ struct ReferenceOptions {
 
 /// Renders `scene` with the reference integrator. The result has the same meaning as the
 /// kernel's (lucent::render): per-pixel mean, sample variance (of one sample, n - 1 in the
-/// denominator) and count of finite samples; `device` reads "reference (N threads)".
+/// denominator) and count of finite samples; `device` reads "reference (N threads)". Cancelled,
+/// its spp is the samples launched per pixel on average, rounded down.
 /// Throws lucent::Error for scenes it cannot render (e.g. an out-of-range material index).
 RenderResult render_reference(const Scene& scene, const ReferenceOptions& options = {});
 

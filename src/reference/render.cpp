@@ -72,7 +72,7 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
   std::vector<double> mean(npix * 3, 0.0), m2(npix * 3, 0.0);
   std::vector<std::uint32_t> count(npix, 0);
   std::atomic<int> next_row{0};
-  std::atomic<std::uint64_t> nonfinite{0}, rays{0}, light_paths{0};
+  std::atomic<std::uint64_t> nonfinite{0}, rays{0}, light_paths{0}, launched{0};
   std::atomic<bool> cancelled{false};
   // per thread: the sum and the sum of squares of the light paths' values per pixel and channel
   // (a light path's value at a pixel: the sum of its connections' shares there)
@@ -84,7 +84,7 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
 
   auto worker = [&](int thread) {
     ref::reset_ray_count();
-    std::uint64_t my_nonfinite = 0, my_paths = 0;
+    std::uint64_t my_nonfinite = 0, my_paths = 0, my_launched = 0;
     std::vector<ref::Splat> splats;
     if (caustics) {
       light_sum[thread].assign(npix * 3, 0.0);
@@ -103,6 +103,7 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
           ref::Sampler rng{static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k),
                            scene.integrator.seed, scene.integrator.sampler};
           glm::dvec3 v = ref::radiance(tracer, camera.ray(x, y, rng), rng);
+          ++my_launched;
           if (!square_fits_float(v)) {
             ++my_nonfinite;
             continue;
@@ -160,6 +161,7 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
     rays += ref::ray_count();
     nonfinite += my_nonfinite;
     light_paths += my_paths;
+    launched += my_launched;
   };
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) pool.emplace_back(worker, t);
@@ -207,7 +209,9 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
     r.light_mean_variance = render_detail::finite_or_none(lmv);
   }
   r.samples = std::move(count);
-  r.spp = static_cast<std::uint64_t>(spp);
+  // stopped: the samples launched per pixel on average, rounded down (it said the spp asked
+  // for, also when it stopped before any sample)
+  r.spp = cancelled ? launched / npix : static_cast<std::uint64_t>(spp);
   r.nonfinite = nonfinite;
   r.rays = rays;
   r.cancelled = cancelled;
