@@ -218,13 +218,22 @@ void text_property(py::class_<C>& c, const char* name, std::string C::*member,
       [member](py::handle self, const FileText& v) { assigned<C>(self).*member = v.bytes; }, doc);
 }
 
+/// A type's name given to an enum field or constructor: a str (bytes were read as their text,
+/// None and numbers raised pybind's "incompatible function arguments").
+std::string enum_text(py::handle v, const char* what) {
+  if (!py::isinstance<py::str>(v))
+    throw py::type_error(std::string(what) + " must be a str, got " +
+                         std::string(Py_TYPE(v.ptr())->tp_name));
+  return v.cast<std::string>();
+}
+
 /// A property holding an enum by its registry name.
 template <class C, class E>
 void enum_property(py::class_<C>& c, const char* name, E C::*member) {
   c.def_property(
       name, [member](const C& o) { return std::string(enum_name(o.*member)); },
-      [member](py::handle self, const std::string& v) {
-        const E x = parse_enum<E>(v);
+      [member, name](py::handle self, py::handle v) {
+        const E x = parse_enum<E>(enum_text(v, name));
         assigned<C>(self).*member = x;
       });
 }
@@ -962,9 +971,9 @@ void bind_scene(py::module_& m) {
       "setting type keeps the radius; Filter(type) has the type's default radius, as a scene "
       "file gives it (tent and gaussian 1.5).");
   filter.def(py::init<>())
-      .def(py::init([](const std::string& type) {
+      .def(py::init([](py::handle type) {
              Filter f;
-             f.type = parse_enum<FilterType>(type);
+             f.type = parse_enum<FilterType>(enum_text(type, "type"));
              f.radius = lucent::default_filter_radius(f.type);
              return f;
            }),
@@ -1011,8 +1020,8 @@ void bind_scene(py::module_& m) {
       "diffuse_mirror's reflectance 0.2); Material() has albedo 0.8, specular 1, ior 1.5, "
       "roughness 0.1, and setting its type changes nothing else.");
   material.def(py::init<>())
-      .def(py::init([](const std::string& type, const FileText& name) {
-             return material_of_type(parse_enum<MaterialType>(type), name.bytes);
+      .def(py::init([](py::handle type, const FileText& name) {
+             return material_of_type(parse_enum<MaterialType>(enum_text(type, "type")), name.bytes);
            }),
            py::arg("type"), py::arg("name") = FileText{})
       .def_property_readonly("emissive", &Material::emissive)

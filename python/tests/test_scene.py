@@ -356,6 +356,17 @@ def test_bad_field_values():
         lucent.Film().width = "wide"
     with pytest.raises(TypeError):
         m.type = 3
+    # a type's name is a str: bytes were read as their text, None raised pybind's own message
+    with pytest.raises(TypeError, match="^type must be a str, got bytes$"):
+        lucent.Integrator().type = b"path"
+    with pytest.raises(TypeError, match="^type must be a str, got NoneType$"):
+        lucent.Integrator().type = None
+    with pytest.raises(TypeError, match="^tonemap must be a str, got int$"):
+        lucent.Film().tonemap = 1
+    with pytest.raises(TypeError, match="^type must be a str, got bytes$"):
+        lucent.Filter(b"box")
+    with pytest.raises(TypeError, match="^type must be a str, got bytes$"):
+        lucent.Material(b"diffuse")
     with pytest.raises(ValueError, match="expected 3 indices"):
         lucent.Triangle().v = (1, 2)
     with pytest.raises(TypeError, match="expected 3 integer indices"):
