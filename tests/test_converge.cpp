@@ -804,20 +804,24 @@ TEST(Converge, ReferenceAtTheLaddersSeedIsRefused) {
 
 // An adaptive setting's rung below the one before starts over, as a uniform rung does: it
 // continued the render, which had more samples already, and a ladder 8,4 reported 8 spp twice.
+// The 4-spp rung after the 8-spp one is the render of a ladder of that rung alone.
 TEST(Converge, AdaptiveRungBelowThePreviousStartsOver) {
   lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
   scene.film.width = scene.film.height = 8;
+  const lucent::RenderResult reference = independent_reference(scene);
   lucent::ConvergeOptions opt;
   opt.render = lucent::test::render_options();
-  opt.spp_ladder = {8, 4, 8};
+  opt.spp_ladder = {8, 4};
   opt.settings = {lucent::parse_converge_setting("adaptive+min-spp=4"),
                   lucent::parse_converge_setting("default")};
-  const lucent::ConvergeResult r =
-      lucent::run_convergence(scene, independent_reference(scene), opt);
-  ASSERT_EQ(r.points.size(), 6u);
-  for (size_t i = 0; i < 6; ++i) EXPECT_EQ(r.points[i].spp, opt.spp_ladder[i % 3]) << i;
-  // the 8-spp rungs are the same render, before and after the 4-spp one
-  EXPECT_EQ(r.points[0].relmse, r.points[2].relmse);
+  const lucent::ConvergeResult r = lucent::run_convergence(scene, reference, opt);
+  ASSERT_EQ(r.points.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) EXPECT_EQ(r.points[i].spp, opt.spp_ladder[i % 2]) << i;
+  opt.spp_ladder = {4};
+  const lucent::ConvergeResult alone = lucent::run_convergence(scene, reference, opt);
+  ASSERT_EQ(alone.points.size(), 2u);
+  EXPECT_EQ(r.points[1].relmse, alone.points[0].relmse);
+  EXPECT_EQ(r.points[3].relmse, alone.points[1].relmse);
   EXPECT_NE(r.points[0].relmse, r.points[1].relmse);
 }
 

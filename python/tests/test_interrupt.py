@@ -80,8 +80,9 @@ SET_SCENE_CHILD = textwrap.dedent("""
     scene = lucent.scene_from_dict(json.loads(sys.argv[1]))
     for ms in range(5, 45, 5):
         r = lucent.Renderer(**lucent.environment())
-        threading.Timer(ms / 1000, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
         try:
+            # (inside the try: on a loaded machine the signal came before start() returned)
+            threading.Timer(ms / 1000, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
             r.set_scene(scene)
             time.sleep(0.2)  # a Ctrl-C that came after set_scene is raised here
             print(ms, "late", flush=True)

@@ -156,7 +156,7 @@ std::vector<std::string> write_aovs(const RenderArgs& a, lucent::Renderer* rende
 std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_spp,
                           double time_limit, bool reference) {
   char buf[200];
-  if (reference && !r.samples.empty() && r.spp > 0) {
+  if (reference && !r.samples.empty() && target_spp > 0) {
     // the reference renders pixel by pixel, and stops between two samples: its pixels hold
     // all their samples, some (the one it stopped in) or none
     size_t covered = 0;
@@ -165,12 +165,12 @@ std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_sp
       covered += n > 0;
       taken += n;
     }
-    const double all = double(r.samples.size()) * double(r.spp);
+    const double all = double(r.samples.size()) * double(target_spp);
     if (taken < all) {
       std::snprintf(buf, sizeof buf,
                     "%.1f%% of its %llu spp per pixel (%.1f%% of the pixels have samples, the "
                     "others are black)",
-                    100.0 * taken / all, static_cast<unsigned long long>(r.spp),
+                    100.0 * taken / all, static_cast<unsigned long long>(target_spp),
                     100.0 * double(covered) / double(r.samples.size()));
       return buf;
     }
