@@ -22,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "cli/stop_signals.hpp"
 #include "core/file_io.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/image.hpp"
@@ -466,11 +467,12 @@ TEST(Outputs, RenderWithoutAFiniteSampleWritesNothing) {
 /// Runs `lucent args...` (stderr to `err_path`), waits until `running(stderr)` says the render
 /// loop is under way, sends `sig` and waits for the end; returns the wait status, or fails the
 /// test if lucent does not stop within `stop_seconds`. `second`: another signal sent 20 ms after
-/// `sig`; `start_ignored`: lucent starts with `sig` ignored (nohup, a script's background job).
+/// `sig` (`second_ms` after it); `start_ignored`: lucent starts with `sig` ignored (nohup, a
+/// script's background job).
 int interrupt_cli(const std::vector<std::string>& args, const std::string& err_path,
                   const std::function<bool(const std::string&)>& running, int sig,
                   double stop_seconds, const std::vector<std::string>& env = {}, int poll_ms = 20,
-                  int second = 0, bool start_ignored = false) {
+                  int second = 0, bool start_ignored = false, int second_ms = 20) {
   pid_t pid = ::fork();
   EXPECT_GE(pid, 0);
   if (pid == 0) {
@@ -509,7 +511,7 @@ int interrupt_cli(const std::vector<std::string>& args, const std::string& err_p
   if (exited) return status;
   EXPECT_EQ(::kill(pid, sig), 0);
   if (second) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (second_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(second_ms));
     ::kill(pid, second);
   }
   if (!wait_for(stop_seconds, reaped)) {
@@ -644,26 +646,61 @@ TEST(Outputs, SigtermEndsConvergeWithTheRungsDone) {
 //   that second it is part of the same stop (LSF's bkill sends SIGINT and SIGTERM together, which
 //   a rule of "any second signal ends at once" turned into a kill with nothing written);
 // - a signal the process started with ignored (nohup's SIGHUP) stopped the render.
-TEST(Outputs, TwoStopSignalsTogetherAreOneStopTheSameTwiceEndsAtOnce) {
+//
+// Then GNU timeout's stop (the tester of 30 Nov 2026): it sends SIGTERM to the process and then to
+// its process group, the same signal twice microseconds apart, and the second ended the render at
+// once with nothing written (5 runs of 12). Any stop signal within a second of the first is now
+// part of its stop; from a second after it, one ends the process at once
+// (StopSignals.OneSecondMakesOneStop).
+TEST(Outputs, TwoStopSignalsTogetherAreOneStop) {
   std::string dir = lucent::test::temp_dir();
   std::string scene = scene_in(dir);
   const std::string out = dir + "/x.exr", err_path = dir + "/stderr";
   auto running = [](const std::string& err) {
     return err.find("Msamples/s  elapsed") != std::string::npos;
   };
-  int status = interrupt_cli({"render", scene, "-o", out, "--spp", "16777216", "--time", "120"},
-                             err_path, running, SIGINT, 60, {}, 20, SIGTERM);
-  std::string err = read_file(err_path);
-  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
-  EXPECT_EQ(WEXITSTATUS(status), 130) << err;
-  EXPECT_NE(err.find("lucent: interrupted by SIGINT (Ctrl-C): wrote "), std::string::npos) << err;
-  EXPECT_TRUE(fs::exists(out));
-  fs::remove(out);
-  status = interrupt_cli({"render", scene, "-o", out, "--spp", "16777216", "--time", "120"},
-                         err_path, running, SIGTERM, 60, {}, 20, SIGTERM);
-  ASSERT_TRUE(WIFSIGNALED(status)) << "exit " << WEXITSTATUS(status) << "\n" << read_file(err_path);
-  EXPECT_EQ(WTERMSIG(status), SIGTERM);
-  EXPECT_FALSE(fs::exists(out));
+  const struct {
+    int first, second, ms, status;
+    const char* name;
+  } cases[] = {{SIGINT, SIGTERM, 20, 130, "SIGINT (Ctrl-C)"},
+               {SIGTERM, SIGTERM, 0, 143, "SIGTERM"},
+               {SIGHUP, SIGHUP, 20, 129, "SIGHUP"}};
+  for (const auto& c : cases) {
+    fs::remove(out);
+    fs::remove(err_path);  // (the last case's progress line would start the signals at once)
+    const int status =
+        interrupt_cli({"render", scene, "-o", out, "--spp", "16777216", "--time", "120"}, err_path,
+                      running, c.first, 60, {}, 20, c.second, false, c.ms);
+    const std::string err = read_file(err_path);
+    ASSERT_TRUE(WIFEXITED(status)) << c.name << ": killed by signal " << WTERMSIG(status) << "\n"
+                                   << err;
+    EXPECT_EQ(WEXITSTATUS(status), c.status) << err;
+    EXPECT_NE(err.find(std::string("lucent: interrupted by ") + c.name + ": wrote "),
+              std::string::npos)
+        << err;
+    EXPECT_TRUE(fs::exists(out)) << c.name;
+  }
+}
+
+// The rule itself, at chosen times: the first stop signal starts the stop, any of the three
+// within a second of it is part of it, and from a second after it one ends the process.
+TEST(StopSignals, OneSecondMakesOneStop) {
+  using lucent::cli::classify_stop_signal;
+  using lucent::cli::StopSignal;
+  namespace sd = lucent::cli::stop_detail;
+  const long long t0 = 5000000000LL, second = sd::kSameStopNs;
+  sd::first_signal.store(0);
+  EXPECT_EQ(classify_stop_signal(SIGTERM, t0), StopSignal::First);
+  EXPECT_EQ(classify_stop_signal(SIGTERM, t0), StopSignal::SameStop);  // timeout's group kill
+  EXPECT_EQ(classify_stop_signal(SIGINT, t0 + 20000000), StopSignal::SameStop);  // bkill
+  EXPECT_EQ(classify_stop_signal(SIGHUP, t0 + second - 1), StopSignal::SameStop);
+  EXPECT_EQ(classify_stop_signal(SIGTERM, t0 + second), StopSignal::EndNow);
+  EXPECT_EQ(classify_stop_signal(SIGINT, t0 + 3 * second), StopSignal::EndNow);
+  EXPECT_EQ(sd::first_signal.load(), SIGTERM);
+  sd::first_signal.store(0);
+  EXPECT_EQ(classify_stop_signal(SIGHUP, t0 + 10 * second), StopSignal::First);
+  EXPECT_EQ(classify_stop_signal(SIGHUP, t0 + 10 * second + 1), StopSignal::SameStop);
+  sd::first_signal.store(0);
 }
 
 TEST(Outputs, AStopSignalIgnoredAtTheStartStaysIgnored) {

@@ -56,8 +56,8 @@ ConvergeArgs& converge_args() {
 std::atomic<bool> g_stop{false};
 volatile std::sig_atomic_t g_stop_signal = 0;
 /// SIGINT, SIGTERM (Slurm's at a job's time limit; it killed the study, without the CSV or plots
-/// of the rungs done) and SIGHUP end the study after the current rung; a second one stops at once
-/// (stop_signals.hpp).
+/// of the rungs done) and SIGHUP end the study after the current rung; a second one from a second
+/// after the first stops at once (stop_signals.hpp).
 extern "C" void on_converge_signal(int sig) {
   if (!first_stop_signal(sig)) return;
   g_stop_signal = sig;
@@ -347,6 +347,7 @@ int run_converge_command() {
         reference = render_reference(rs, ro);
       } else {
         renderer.set_scene(rs);
+        reclaim_stop_handler(on_converge_signal);  // from PoCL's LLVM (stop_signals.hpp)
         renderer.render(static_cast<std::uint64_t>(spp));
         reference = renderer.result();
       }
@@ -365,11 +366,14 @@ int run_converge_command() {
     }
   }
 
+  // each setting's kernel build may give PoCL's LLVM the handlers again: taken back at each rung
+  opt.on_point = [](const ConvergePoint&) { reclaim_stop_handler(on_converge_signal); };
   if (!a.quiet) {
     std::printf("%-22s %7s %9s %10s %11s %11s %11s\n", "setting", "spp", "seconds", "Msamples/s",
                 "RMSE", "relMSE", "noise");
     std::fflush(stdout);
     opt.on_point = [](const ConvergePoint& p) {
+      reclaim_stop_handler(on_converge_signal);
       std::printf("%-22s %7llu %9.3f %10.3f %11.4e %11.4e %11.4e\n", p.setting.c_str(),
                   static_cast<unsigned long long>(p.spp), p.seconds, p.samples_per_second * 1e-6,
                   p.rmse, p.relmse, p.noise_relmse);

@@ -39,7 +39,8 @@ std::atomic<bool> g_interrupted{false};
 volatile std::sig_atomic_t g_signal = 0;
 
 // Ctrl-C (SIGINT), SIGTERM and SIGHUP: the render stops after the current pass, writes what it
-// has and exits with 128 + the signal. A second signal stops at once (stop_signals.hpp).
+// has and exits with 128 + the signal. A second signal from a second after the first stops at once
+// (stop_signals.hpp).
 extern "C" void on_stop_signal(int sig) {
   if (!first_stop_signal(sig)) return;
   g_signal = sig;
@@ -128,6 +129,7 @@ std::vector<std::string> write_aovs(const RenderArgs& a, lucent::Renderer* rende
       s.integrator.type = lucent::cli::parse_integrator(name);
       try {
         renderer->set_scene(std::move(s));
+        reclaim_stop_handler(on_stop_signal);
       } catch (const lucent::Error&) {
         // a stop signal during the AOV's kernel build: PoCL's LLVM handles it too and the build
         // fails; the AOV is not written, as one stopped in its render (it said "kernel build
@@ -457,6 +459,7 @@ int render_with(const RenderArgs& a) {
     };
     try {
       renderer->set_scene(std::move(scene));
+      reclaim_stop_handler(on_stop_signal);  // from PoCL's LLVM (stop_signals.hpp)
       // a stop signal during set_scene (its kernel build, where the build did not fail; its BVH):
       // nothing rendered, and a render call takes at least one pass, which rendered the whole
       // image after the signal and wrote it as "1 of 64 spp"

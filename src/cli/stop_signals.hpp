@@ -1,11 +1,11 @@
 #pragma once
 // SIGINT, SIGTERM and SIGHUP for `lucent` and `lucent-mpi`: the first stops the work after the
-// current pass (a handler sets a flag). A second one ends the process at once: the same signal
-// at any time, another of the three from a second after the first. Another one within that
-// second is part of the same stop: LSF's bkill sends SIGINT and SIGTERM together (then SIGKILL
-// after its grace period), systemd SIGTERM then SIGHUP, and either killed the render with
-// nothing written. (Before 30 Nov 2026 only the same signal ended it, at any time, and SIGTERM
-// then SIGHUP was a second graceful stop named SIGHUP.)
+// current pass (a handler sets a flag). Any of the three within a second of the first is part of
+// the same stop; one from a second after the first ends the process at once. Signals come
+// together: GNU timeout sends its SIGTERM to the process and then to its process group (the same
+// signal twice, microseconds apart), LSF's bkill SIGINT and SIGTERM, systemd SIGTERM then SIGHUP;
+// each of these killed the render with nothing written while the same signal again ended it at
+// any time (until 30 Nov 2026; before that day another signal was a second graceful stop).
 //
 // A signal the process was started with ignored (nohup's SIGHUP, SIGINT of a script's background
 // job) stays ignored, and blocked: lucent stopped on them, against the shell's convention, and
@@ -31,7 +31,9 @@ namespace stop_detail {
 /// by the handlers of any thread (lock-free atomics are async-signal-safe).
 inline std::atomic<int> first_signal{0};
 inline std::atomic<long long> first_ns{0};
-/// A later signal of another kind within this of the first is part of the same stop.
+/// The stop signals (bit i: kStopSignals[i]) the process was started with ignored.
+inline std::atomic<unsigned> ignored_at_start{0};
+/// A later stop signal within this of the first is part of the same stop.
 inline constexpr long long kSameStopNs = 1000000000;
 
 inline long long monotonic_ns() {
@@ -56,22 +58,38 @@ inline sigset_t stop_set() {
 }
 }  // namespace stop_detail
 
-/// For a command's handler, first: true for the first stop signal (the handler then records its
-/// stop); for a later one false, having ended the process (the same signal again: its default
-/// action is back; another one a second or more after the first) or let it pass (another one
-/// within that second). Async-signal-safe.
-inline bool first_stop_signal(int sig) {
+/// What a stop signal is to the stop under way.
+enum class StopSignal {
+  First,     ///< the first: the handler records the stop
+  SameStop,  ///< within a second of the first: part of its stop
+  EndNow,    ///< a second or more after the first: the process ends at once
+};
+
+/// Classifies a stop signal `sig` received at `now_ns` (CLOCK_MONOTONIC), recording the first.
+/// Async-signal-safe.
+inline StopSignal classify_stop_signal(int sig, long long now_ns) {
   using namespace stop_detail;
-  const long long now = monotonic_ns();
   int none = 0;
   if (first_signal.compare_exchange_strong(none, sig)) {
-    first_ns.store(now);
-    default_action(sig);  // the same signal again ends the process
-    return true;
+    first_ns.store(now_ns);
+    return StopSignal::First;
   }
-  if (now - first_ns.load() >= kSameStopNs) {
-    default_action(sig);
-    ::raise(sig);  // pending until this handler returns (the signal is blocked in it)
+  return now_ns - first_ns.load() >= kSameStopNs ? StopSignal::EndNow : StopSignal::SameStop;
+}
+
+/// For a command's handler, first: true for the first stop signal (the handler then records its
+/// stop); for a later one false, having ended the process (a second or more after the first) or
+/// let it pass (within that second). Async-signal-safe.
+inline bool first_stop_signal(int sig) {
+  switch (classify_stop_signal(sig, stop_detail::monotonic_ns())) {
+    case StopSignal::First:
+      return true;
+    case StopSignal::EndNow:
+      stop_detail::default_action(sig);
+      ::raise(sig);  // pending until this handler returns (the signal is blocked in it)
+      return false;
+    case StopSignal::SameStop:
+      break;
   }
   return false;
 }
@@ -92,9 +110,11 @@ inline void install_stop_handler(void (*handler)(int)) {
   }
   sigset_t keep_blocked;
   sigemptyset(&keep_blocked);
+  unsigned ignored_bits = 0;
   for (int i = 0; i < 3; ++i) {
     if (ignored[i]) {
       sigaddset(&keep_blocked, kStopSignals[i]);
+      ignored_bits |= 1u << i;
       continue;
     }
     struct sigaction a {};
@@ -102,8 +122,40 @@ inline void install_stop_handler(void (*handler)(int)) {
     a.sa_mask = all;
     ::sigaction(kStopSignals[i], &a, nullptr);
   }
+  stop_detail::ignored_at_start.store(ignored_bits);
   ::pthread_sigmask(SIG_SETMASK, &before, nullptr);
   ::pthread_sigmask(SIG_BLOCK, &keep_blocked, nullptr);
+}
+
+/// Takes the stop signals back from a handler installed over `handler` (after
+/// install_stop_handler): PoCL's LLVM installs its own at the first kernel build and keeps it
+/// (SA_RESETHAND: the default action comes back as it is entered, before it gives the signal to
+/// the handler it replaced). A second signal microseconds after the first, as GNU timeout sends
+/// (to the process, then to its group), found the default action there and killed the process
+/// with nothing written. Called after each kernel build; a signal the process was started with
+/// ignored is ignored again.
+inline void reclaim_stop_handler(void (*handler)(int)) {
+  const sigset_t all = stop_detail::stop_set();
+  sigset_t before;
+  ::pthread_sigmask(SIG_BLOCK, &all, &before);
+  const unsigned ignored = stop_detail::ignored_at_start.load();
+  for (int i = 0; i < 3; ++i) {
+    struct sigaction now {};
+    ::sigaction(kStopSignals[i], nullptr, &now);
+    const bool info = (now.sa_flags & SA_SIGINFO) != 0;
+    struct sigaction a {};
+    a.sa_mask = all;
+    if (ignored & (1u << i)) {
+      if (!info && now.sa_handler == SIG_IGN) continue;
+      a.sa_handler = SIG_IGN;
+    } else {
+      // (the default action: a later signal's EndNow, which must stay)
+      if (!info && (now.sa_handler == handler || now.sa_handler == SIG_DFL)) continue;
+      a.sa_handler = handler;
+    }
+    ::sigaction(kStopSignals[i], &a, nullptr);
+  }
+  ::pthread_sigmask(SIG_SETMASK, &before, nullptr);
 }
 
 /// install_stop_handler() while alive (the first stop signal's record cleared); the dispositions
@@ -144,7 +196,8 @@ inline void record_deferred_stop(int sig) {
 /// Runs `work`, a command's last step (merge's and compare's writing of their output), with a
 /// stop signal recorded instead of acted on: the output is written in full, as render's is, where
 /// the signal's default action killed the process in the write and left a hidden temporary file
-/// beside the output. A second signal ends the process at once (first_stop_signal). Before this
+/// beside the output. A second signal from a second after the first ends the process at once
+/// (first_stop_signal). Before this
 /// step the signals keep their default action: a command killed while it reads has written
 /// nothing. Returns the first stop signal received during `work` (0: none); an exception of
 /// `work` passes through, the signal then lost.

@@ -49,7 +49,8 @@ std::atomic<bool> g_stop{false};
 volatile std::sig_atomic_t g_signal = 0;
 
 extern "C" void on_stop_signal(int sig) {
-  // a second signal ends the rank at once, as lucent's (stop_signals.hpp)
+  // a second signal from a second after the first ends the rank at once, as lucent's
+  // (stop_signals.hpp)
   if (!lucent::cli::first_stop_signal(sig)) return;
   g_signal = sig;
   g_stop.store(true);
@@ -370,7 +371,8 @@ int run(const Args& a) {
   // rank, which printed one line each and Open MPI's MPI_Abort report
   if (refused([&] {
         try {
-          renderer.set_scene(std::move(scene));  // held once, by the session
+          renderer.set_scene(std::move(scene));               // held once, by the session
+          lucent::cli::reclaim_stop_handler(on_stop_signal);  // from PoCL's LLVM
         } catch (const lucent::Error&) {
           // a stop signal during the kernel build: PoCL's LLVM handles it too (it removes its
           // temporary files, then passes it on), and the build fails. That is the interruption,
