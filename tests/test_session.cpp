@@ -1,6 +1,8 @@
 // The render session (lucent::Renderer): what a change of the scene rebuilds, progressive
 // accumulation, sample ranges, cancellation, warnings, and every error of its API.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -1610,4 +1612,38 @@ TEST(Session, TwoCpuDevicesShareThePackedArrays) {
     }
   }
   EXPECT_EQ(blocks_back_to(before), before);
+}
+
+// A process forked from one that had used OpenCL: its OpenCL calls hang for ever (the driver's
+// threads do not survive a fork; a Python multiprocessing worker of the default start method did,
+// in set_scene). Its first lucent call is an error saying so, in a session made before the fork
+// and in one made after it.
+TEST(Session, AForkOfAProcessThatUsedOpenClIsRefused) {
+  lucent::Renderer before(lucent::test::session_options());
+  const lucent::Scene scene = lucent::test::scene_from(R"({"film": {"width": 4, "height": 4},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, -3], "radius": 1, "material": "m"}]})");
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::alarm(60);  // a hang ends the child (SIGALRM), not the test
+    int refused = 0;
+    auto refuses = [&](const std::function<void()>& call) {
+      try {
+        call();
+      } catch (const lucent::Error& e) {
+        refused += std::string(e.what()).rfind("this process is a fork of one that had used OpenCL",
+                                               0) == 0;
+      }
+    };
+    refuses([&] { before.set_scene(scene); });
+    refuses([&] { before.render(1); });
+    refuses([&] { lucent::Renderer after(lucent::test::session_options()); });
+    refuses([&] { lucent::list_devices(); });
+    ::_exit(refused);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status)) << "signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 4);
 }

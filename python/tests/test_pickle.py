@@ -217,6 +217,25 @@ def test_a_worker_process_renders_a_scene_and_returns_its_result(rich_scene):
     assert np.array_equal(there.samples, here.samples)
 
 
+def render_or_error(scene):
+    try:
+        return render_here(scene)
+    except lucent.Error as e:
+        return str(e)
+
+
+def test_a_forked_worker_of_a_process_that_used_opencl_is_refused(small_scene):
+    """A worker forked (Linux's default start method before Python 3.14) from a process that had
+    used OpenCL (here: this test process's sessions) hung for ever in set_scene: the driver's
+    threads do not survive a fork. Its first lucent call now raises lucent.Error saying so."""
+    lucent.list_devices()  # (this process has used OpenCL)
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        there = pool.apply_async(render_or_error, (small_scene,)).get(timeout=WORKER_WAIT)
+    assert isinstance(there, str) and there.startswith(
+        "this process is a fork of one that had used OpenCL"), there
+    assert 'multiprocessing.get_context("spawn")' in there
+
+
 @pytest.mark.parametrize("name, round_trip", round_trips())
 def test_a_render_result_round_trips_exactly(renderer, small_scene, name, round_trip):
     renderer.set_scene(small_scene)

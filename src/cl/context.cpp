@@ -1,10 +1,12 @@
 #include "cl/context.hpp"
 
+#include <pthread.h>
 #include <sys/resource.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -239,7 +241,25 @@ std::string pocl_empty_cache_dir_problem() {
   return "POCL_CACHE_DIR is set but empty, which PoCL aborts on: unset it or name a directory";
 }
 
+namespace {
+std::atomic<bool> g_forked_after_opencl{false};
+void on_fork_child() { g_forked_after_opencl.store(true); }
+}  // namespace
+
+void check_not_forked() {
+  if (g_forked_after_opencl.load())
+    throw Error(
+        "this process is a fork of one that had used OpenCL, whose driver threads do not survive "
+        "a fork (OpenCL calls would hang): use lucent in the parent only after the workers are "
+        "forked, or start them with spawn or forkserver (Python: "
+        "multiprocessing.get_context(\"spawn\"))");
+}
+
 std::vector<Device> enumerate_devices() {
+  check_not_forked();
+  // a child forked from here on is recorded: its OpenCL calls would hang (check_not_forked)
+  static std::once_flag fork_handler;
+  std::call_once(fork_handler, [] { ::pthread_atfork(nullptr, nullptr, on_fork_child); });
   // one enumeration at a time in the process: the ICD loader and PoCL initialise on the first
   // call, and sessions created at once from several threads crashed there (SIGSEGV) or saw no
   // platform

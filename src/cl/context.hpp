@@ -79,6 +79,12 @@ std::string pocl_cache_dir(std::string* origin = nullptr);
 /// the directory, as PoCL would, when only trying tells whether it can be made.
 std::string pocl_cache_dir_problem();
 
+/// Throws lucent::Error in a process forked from one that had used OpenCL (enumerate_devices()
+/// registers the fork handler that records it): the drivers' threads (PoCL's workers) do not
+/// survive a fork, and OpenCL calls there hang for ever (a Python multiprocessing worker of the
+/// default start method, forked from a parent that had listed devices or rendered).
+void check_not_forked();
+
 /// Builds `source` (already assembled, with #line markers) for the context's device. On a build
 /// failure throws lucent::Error holding the build log, whose lines name kernels/<file>:<line>,
 /// followed by "clBuildProgram: CL_BUILD_PROGRAM_FAILURE".

@@ -397,6 +397,7 @@ struct Renderer::Impl {
   /// still running (two devices: a crash in the driver; one: a render that claimed its samples
   /// and held none).
   void check_not_rendering(const char* call) const {
+    cl_util::check_not_forked();  // (a session made before a fork: its calls would hang)
     if (rendering.load()) throw rendering_error(call);
   }
   static Error rendering_error(const char* call) {
@@ -408,6 +409,7 @@ struct Renderer::Impl {
   struct RenderCall {
     Impl& s;
     RenderCall(Impl& impl, const char* call) : s(impl) {
+      cl_util::check_not_forked();
       if (s.rendering.exchange(true)) throw rendering_error(call);
     }
     ~RenderCall() { s.rendering = false; }
