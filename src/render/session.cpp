@@ -402,10 +402,14 @@ struct Renderer::Impl {
   }
   static Error rendering_error(const char* call) {
     return Error(std::string(call) +
-                 ": a render of this session is in progress (a session runs one call at a time; "
-                 "its on_progress may read result(), spp() and stats(), or cancel())");
+                 ": a render of this session is in progress, or another call that changes it "
+                 "(a session runs one call at a time; a render's on_progress may read result(), "
+                 "spp() and stats(), or cancel())");
   }
-  /// Marks a render call in progress while it lives (and refuses a render within a render).
+  /// Marks a call in progress while it lives, a render or one that changes the session
+  /// (set_scene, set_camera, reset, set_build_options), and refuses another: set_scene from
+  /// another thread passed check_not_rendering just before a render began, and replaced its
+  /// buffers under it (SIGSEGV).
   struct RenderCall {
     Impl& s;
     RenderCall(Impl& impl, const char* call) : s(impl) {
@@ -1491,7 +1495,7 @@ std::vector<DeviceInfo> Renderer::devices() const { return impl().device_infos; 
 const SessionOptions& Renderer::options() const { return impl().options; }
 
 void Renderer::set_build_options(Precision precision, bool fast_math, bool specialize) {
-  impl().check_not_rendering("set_build_options");
+  Impl::RenderCall busy(impl(), "set_build_options");
   if (precision != Precision::Float && precision != Precision::Double)  // (7 was taken as float)
     throw Error("set_build_options: unknown precision " +
                 std::to_string(static_cast<int>(precision)));
@@ -1521,17 +1525,17 @@ void Renderer::set_build_options(Precision precision, bool fast_math, bool speci
 }
 
 void Renderer::set_scene(const Scene& scene) {
-  impl().check_not_rendering("set_scene");
+  Impl::RenderCall busy(impl(), "set_scene");
   impl().set_scene(scene);
 }
 
 void Renderer::set_scene(Scene&& scene) {
-  impl().check_not_rendering("set_scene");
+  Impl::RenderCall busy(impl(), "set_scene");
   impl().set_scene(scene, &scene);
 }
 
 void Renderer::set_camera(const Camera& camera) {
-  impl().check_not_rendering("set_camera");
+  Impl::RenderCall busy(impl(), "set_camera");
   impl().set_camera(camera);
 }
 
@@ -1568,7 +1572,7 @@ RenderProgress Renderer::render(std::uint64_t spp, double max_seconds,
 }
 
 void Renderer::reset(std::uint64_t first_sample) {
-  impl().check_not_rendering("reset");
+  Impl::RenderCall busy(impl(), "reset");
   if (first_sample > 0xffffffffull) throw Error("reset: the first sample index must be below 2^32");
   impl().clear_accumulation(first_sample);
 }
