@@ -386,6 +386,20 @@ TEST(Session, CallsThatChangeTheSessionHoldItAsARenderDoes) {
   EXPECT_EQ(r.spp(), 2u);
 }
 
+// A session destroyed from its own render's on_progress: the render went on in freed memory
+// (SIGSEGV, or PoCL's abort on a destroyed mutex). The destructor cannot refuse: it ends the
+// process with one line saying why.
+TEST(SessionDeathTest, DestroyedDuringItsOwnRenderAbortsWithALine) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_DEATH(
+      {
+        auto r = std::make_unique<Renderer>(lucent::test::session_options());
+        r->set_scene(lucent::test::scene_from(kScene));
+        r->render(1000, [&](const lucent::RenderProgress&) { r.reset(); });
+      },
+      "lucent: a lucent::Renderer was destroyed during one of its own calls");
+}
+
 // The kernel cache directory is the session's: "off" compiles, a directory is filled and then
 // read by the next session (where the driver keeps no cache of its own: PoCL with its cache off).
 // image_hash covers the kernel source of the session's program. A kernel directory whose build

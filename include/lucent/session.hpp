@@ -108,11 +108,17 @@ struct AdaptiveOptions {
   double max_seconds = 0;         ///< stop after this much time (0: no limit)
 };
 
-/// One device and one scene, rendered progressively. Not thread-safe, except cancel().
+/// One device and one scene, rendered progressively. One call at a time: a render, set_scene,
+/// set_camera, reset or set_build_options made during another of them (from a callback, or
+/// another thread) throws lucent::Error. cancel() may be called at any time, from any thread; a
+/// render's on_progress may read result(), spp() and stats(). Other uses from several threads
+/// are not supported.
 class Renderer {
  public:
   /// Opens the device. Throws lucent::Error (no device, unknown selector, ...).
   explicit Renderer(SessionOptions options = {});
+  /// Destroying a session during one of its own calls (from its on_progress) ends the process
+  /// with a line on stderr (the call would go on in freed memory).
   ~Renderer();
   /// Moves the session. Throws lucent::Error during a render of either session (from its
   /// on_progress: the render would go on in a session moved away or destroyed).

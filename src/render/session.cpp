@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -1475,7 +1476,18 @@ Renderer::Impl& Renderer::impl() const {
   if (!impl_) throw Error("this lucent::Renderer was moved from: it holds no session");
   return *impl_;
 }
-Renderer::~Renderer() = default;
+Renderer::~Renderer() {
+  // destroyed during its own call (from a render's on_progress, set_scene's warning sink, or
+  // another thread): the call would go on in freed memory (SIGSEGV, or PoCL's abort on a
+  // destroyed mutex). A destructor cannot refuse: end the process with a line saying why.
+  if (impl_ && impl_->rendering.load()) {
+    std::fputs(
+        "lucent: a lucent::Renderer was destroyed during one of its own calls (from its "
+        "on_progress or warning sink, or another thread): aborting\n",
+        stderr);
+    std::abort();
+  }
+}
 // (moving a session from its own on_progress: the render went on in an Impl moved away, or
 // destroyed by the assignment: SIGSEGV)
 Renderer::Renderer(Renderer&& other) {
