@@ -6,6 +6,7 @@
 #include <limits>
 #include <mutex>
 #include <optional>
+#include <thread>
 
 #include "common.hpp"
 #include "core/file_io.hpp"
@@ -113,11 +114,18 @@ class PyRenderer {
     o.pass_seconds = pass_seconds;
     o.reserved_host_bytes = int_argument(reserved_host_bytes, "reserved_host_bytes", 0,
                                          std::numeric_limits<std::uint64_t>::max());
-    WarningSink sink = python_warning_sink(SharedObject(std::move(on_warning)), warning_errors_);
-    o.on_warning = [this, sink](const std::string& message) {
+    sink_ = python_warning_sink(SharedObject(std::move(on_warning)), warning_errors_);
+    o.on_warning = [this](const std::string& message) {
+      // a call_interruptible's worker thread has no Python frame: warnings.warn named "sys:1";
+      // the warning is given on the caller's thread once the call returns (flush_warnings)
+      if (deferring_.load() && std::this_thread::get_id() != caller_thread_) {
+        std::lock_guard<std::mutex> lock(deferred_mutex_);
+        deferred_warnings_.push_back(message);
+        return;
+      }
       WithChain chain(caller_chain_);  // on a device thread, the chain of the call's caller
       InCallback frame(this, "warning callback");
-      sink(message);
+      sink_(message);
     };
     caller_chain_ = t_callbacks;  // the warnings of the construction are its caller's callbacks
     ReleaseGil release;
@@ -194,13 +202,38 @@ class PyRenderer {
   /// Runs `f(renderer, stop)`, one call at a time, on a worker thread while this one runs
   /// Python's signal handlers (run_interruptible): KeyboardInterrupt raises `stop`, the
   /// session's cancel flag, and a render in progress ends after its current pass.
+  /// The warnings of the call's worker thread are given on this thread when it returns, so that
+  /// warnings.warn names the line that made the call.
   template <class F>
   void call_interruptible(const char* what, F&& f) {
     Busy busy(*this, what);
     Renderer& r = get();
     stop_ = false;
-    run_interruptible([&] { f(r, stop_); }, stop_);
+    caller_thread_ = std::this_thread::get_id();
+    deferring_ = true;
+    try {
+      run_interruptible([&] { f(r, stop_); }, stop_);
+    } catch (...) {
+      flush_warnings();
+      throw;
+    }
+    flush_warnings();
     warning_errors_->rethrow();
+  }
+
+  /// Gives the warnings deferred by a call_interruptible (the GIL held, the call still busy).
+  void flush_warnings() {
+    deferring_ = false;
+    std::vector<std::string> messages;
+    {
+      std::lock_guard<std::mutex> lock(deferred_mutex_);
+      messages.swap(deferred_warnings_);
+    }
+    for (const std::string& m : messages) {
+      WithChain chain(caller_chain_);
+      InCallback frame(this, "warning callback");
+      sink_(m);
+    }
   }
 
   /// A render call: `progress(p)` runs after each pass (on the rendering thread, with the GIL);
@@ -275,6 +308,7 @@ class PyRenderer {
     {
       ReleaseGil release;
       renderer_.reset();
+      sink_ = nullptr;  // (the on_warning callable goes with the session)
     }
     busy_ = false;
   }
@@ -326,6 +360,12 @@ class PyRenderer {
 
   std::optional<Renderer> renderer_;
   std::shared_ptr<CallbackErrors> warning_errors_;
+  WarningSink sink_;  ///< the session's warnings to Python (on_warning, or warnings.warn)
+  /// A call_interruptible's worker thread's warnings, given when it returns (flush_warnings).
+  std::atomic<bool> deferring_{false};
+  std::thread::id caller_thread_;
+  std::mutex deferred_mutex_;
+  std::vector<std::string> deferred_warnings_;
   std::atomic<bool> busy_{false};  ///< a call (or close()) is in progress
   bool closed_ = false;            ///< close() began (GIL)
   bool paused_ = false;            ///< the call in progress is in its progress callback (GIL)
@@ -755,8 +795,9 @@ void bind_render(py::module_& m) {
           "set_build_options",
           [](PyRenderer& r, const std::string& precision, bool fast_math, bool specialize) {
             Precision p = parse_enum<Precision>(precision);
-            r.call("set_build_options",
-                   [&](Renderer& rr) { rr.set_build_options(p, fast_math, specialize); });
+            r.call_interruptible("set_build_options", [&](Renderer& rr, std::atomic<bool>&) {
+              rr.set_build_options(p, fast_math, specialize);
+            });
           },
           py::kw_only(), py::arg("precision") = "float", py::arg("fast_math") = false,
           py::arg("specialize") = true, "Build settings for the next set_scene/render.")
@@ -764,7 +805,10 @@ void bind_render(py::module_& m) {
           "set_scene",
           [](PyRenderer& r, const Scene& scene) {
             Scene copy = scene;  // Python threads may change `scene` while the GIL is released
-            r.call("set_scene", [&](Renderer& rr) { rr.set_scene(copy); });
+            // interruptible: Ctrl-C stops a wait for another process's build of the kernel
+            // (up to 600 s; it was ignored there)
+            r.call_interruptible("set_scene",
+                                 [&](Renderer& rr, std::atomic<bool>&) { rr.set_scene(copy); });
           },
           py::arg("scene"),
           "Makes a copy of `scene` the session's scene; keeps the BVH, the kernel and the "
@@ -773,7 +817,8 @@ void bind_render(py::module_& m) {
           "set_camera",
           [](PyRenderer& r, const Camera& camera) {
             const Camera copy = camera;  // (as set_scene's copy of its scene)
-            r.call("set_camera", [&](Renderer& rr) { rr.set_camera(copy); });
+            r.call_interruptible("set_camera",
+                                 [&](Renderer& rr, std::atomic<bool>&) { rr.set_camera(copy); });
           },
           py::arg("camera"),
           "Moves the camera of the session's scene: what set_scene() of the scene with `camera` "
