@@ -625,6 +625,22 @@ TEST(Session, SeveralDevicesShareTheSamples) {
   std::atomic<bool> flag{true};
   both.set_cancel_flag(&flag);
   EXPECT_EQ(both.render(100).samples_done, 0u);
+  both.set_cancel_flag(nullptr);
+
+  // accumulation() from on_progress while the other device's pass is under way: the samples are
+  // not one range yet, and the error said a device's pass had failed
+  both.reset();
+  std::vector<std::string> errors;
+  both.render(64, [&](const lucent::RenderProgress&) {
+    const std::string e = error_of([&] { both.accumulation(); });
+    if (!e.empty()) errors.push_back(e);
+  });
+  for (const std::string& e : errors)
+    EXPECT_NE(e.find(" (another device's pass is still under way): read it once the render has "
+                     "returned"),
+              std::string::npos)
+        << e;
+  EXPECT_EQ(both.accumulation().spp, 64u);
 }
 
 // SessionStats counts set_scene() calls (scene_packs, kernel_reuses) once per call and work on

@@ -1611,12 +1611,21 @@ Accumulation Renderer::accumulation() const {
   a.light_paths = m.light_paths;
   // with a gap (a device's pass failed, later passes of others were kept) the samples are not one
   // range from first_sample: a part claiming [first, first + spp) would be wrong
-  if (m.end_index != m.first + m.done)
-    throw Error("accumulation: the session holds " + std::to_string(m.done) +
-                " samples per pixel of [" + std::to_string(m.first) + ", " +
-                std::to_string(m.end_index) + "), not one range from " + std::to_string(m.first) +
+  if (m.end_index != m.first + m.done) {
+    const std::string held = "accumulation: the session holds " + std::to_string(m.done) +
+                             " samples per pixel of [" + std::to_string(m.first) + ", " +
+                             std::to_string(m.end_index) + "), not one range from " +
+                             std::to_string(m.first);
+    // (from a render's on_progress with several devices: another device's pass is not done
+    // yet; this blamed a failed pass)
+    if (m.rendering.load())
+      throw Error(held +
+                  " (another device's pass is still under way): read it once the render has "
+                  "returned");
+    throw Error(held +
                 " (a device's pass failed while others' later passes were kept); call reset() to "
                 "render a part again");
+  }
   a.first_sample = m.first;
   a.spp = m.done;
   a.nonfinite = m.nonfinite;
