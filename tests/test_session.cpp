@@ -348,6 +348,30 @@ TEST(Session, WarningsGoToTheSessionsSink) {
   EXPECT_EQ(got[1].rfind("skipped 1 degenerate or non-finite triangle", 0), 0u) << got[1];
 }
 
+// A sink that throws (an application that makes warnings errors) fails set_scene; the same scene
+// set again fails again: the warning was counted as given, and the second call passed without a
+// word.
+TEST(Session, AWarningTheSinkRefusedIsGivenAgain) {
+  int calls = 0;
+  lucent::SessionOptions o = lucent::test::session_options();
+  o.on_warning = [&](const std::string& m) {
+    ++calls;
+    throw lucent::Error("strict: " + m);
+  };
+  Renderer r(o);
+  Scene s = lucent::test::scene_from(kScene);
+  s.positions.push_back(s.positions[0]);  // a degenerate triangle: two equal vertices
+  lucent::Triangle t;
+  t.v[0] = 0;
+  t.v[1] = static_cast<int>(s.positions.size()) - 1;
+  t.v[2] = 1;
+  s.triangles.push_back(t);
+  for (int i = 1; i <= 2; ++i) {
+    EXPECT_NE(error_of([&] { r.set_scene(s); }).find("strict: "), std::string::npos) << i;
+    EXPECT_EQ(calls, i);
+  }
+}
+
 // A call that changes the session holds it as a render does: a render, or another set_scene,
 // from inside set_scene (its warning sink) is refused, as set_scene from another thread during a
 // render now is (it passed the check just before the render began, and replaced the buffers

@@ -526,8 +526,14 @@ struct Renderer::Impl {
     CallNotes& operator=(const CallNotes&) = delete;
     const std::function<void(const std::string&)>& collect() const { return collect_; }
     void give() const {
+      // a note counts as given once the sink took it: one that throws (an application that
+      // makes warnings errors) fails the call, and the same scene set again was accepted
+      // without a word
       for (const std::string& note : notes_)
-        if (given_.insert(note).second) scene_detail::warn(note);
+        if (given_.count(note) == 0) {
+          scene_detail::warn(note);
+          given_.insert(note);
+        }
     }
 
    private:
