@@ -79,7 +79,8 @@ template <class V>
 py::class_<V> bind_vector_type(py::module_& m, const char* name) {
   constexpr int N = V::length();
   // (the vector read after the index is converted: assigned())
-  auto get = [](py::handle self, py::ssize_t i) {
+  auto get = [](py::handle self, py::handle index) {
+    py::ssize_t i = list_detail::index_of(index, "vector indices must be integers");
     if (i < 0) i += N;
     if (i < 0 || i >= N) throw py::index_error(std::string("index out of range"));
     return assigned<V>(self)[static_cast<int>(i)];
@@ -91,7 +92,8 @@ py::class_<V> bind_vector_type(py::module_& m, const char* name) {
   c.def("__len__", [](const V&) { return N; })
       .def("__getitem__", get)
       .def("__setitem__",
-           [](py::handle self, py::ssize_t i, double value) {
+           [](py::handle self, py::handle index, double value) {
+             py::ssize_t i = list_detail::index_of(index, "vector indices must be integers");
              if (i < 0) i += N;
              if (i < 0 || i >= N) throw py::index_error(std::string("index out of range"));
              assigned<V>(self)[static_cast<int>(i)] = value;

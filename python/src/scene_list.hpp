@@ -104,6 +104,31 @@ inline std::size_t wrap_index(py::ssize_t i, std::size_t n, const char* what) {
   return static_cast<std::size_t>(i);
 }
 
+/// An index as a Python list reads it (operator.index), before the list's length is read (its
+/// __index__ may change the list): IndexError for an integer past Py_ssize_t and TypeError
+/// naming the type of anything else, "<indices_must>, not float" (pybind's "incompatible
+/// function arguments" TypeError said neither).
+inline py::ssize_t index_of(py::handle i, const char* indices_must) {
+  if (!PyIndex_Check(i.ptr()))
+    throw py::type_error(std::string(indices_must) + ", not " + Py_TYPE(i.ptr())->tp_name);
+  const Py_ssize_t n = PyNumber_AsSsize_t(i.ptr(), PyExc_IndexError);
+  if (n == -1 && PyErr_Occurred()) throw py::error_already_set();
+  return n;
+}
+inline constexpr const char* kListIndices = "list indices must be integers or slices";
+
+/// `value` as T: TypeError "<what>: expected a Material, not float".
+template <class T>
+T value_of(py::handle value, const char* what) {
+  try {
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+    throw py::type_error(std::string(what) + ": expected a " +
+                         py::str(py::type::of<T>().attr("__name__")).operator std::string() +
+                         ", not " + Py_TYPE(value.ptr())->tp_name);
+  }
+}
+
 /// The items of `items` as T, read first (`items` may be the list itself): TypeError naming the
 /// first that is no T (pybind's cast said RuntimeError "Unable to cast Python instance to C++
 /// type", with no word of which item).
@@ -207,27 +232,20 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
       }))
       .def("__len__", &V::size)
       .def("__bool__", [](const V& v) { return !v.empty(); })
-      .def(
-          "__getitem__",
-          [](V& v, py::ssize_t i) -> T& {
-            return v[list_detail::wrap_index(i, v.size(), "list index out of range")];
-          },
-          py::return_value_policy::reference_internal)
+      // (the slices' overloads first: the others take any index, as a Python list does)
       .def("__getitem__",
            [](const V& v, const py::slice& s) {
              V out;
              for (std::size_t i : list_detail::slice_indices(s, v).indices) out.push_back(v[i]);
              return out;
            })
-      .def("__setitem__",
-           [](V& v, py::ssize_t i, const T& value) {
-             const std::size_t k =
-                 list_detail::wrap_index(i, v.size(), "list assignment index out of range");
-             T copy = value;  // `value` may be an element of v
-             change(
-                 v, [&](V& x) { x[k] = std::move(copy); },
-                 [k](std::size_t j) { return j == k ? -1 : static_cast<std::ptrdiff_t>(j); });
-           })
+      .def(
+          "__getitem__",
+          [](V& v, py::handle i) -> T& {
+            const py::ssize_t n = list_detail::index_of(i, list_detail::kListIndices);
+            return v[list_detail::wrap_index(n, v.size(), "list index out of range")];
+          },
+          py::return_value_policy::reference_internal)
       .def(
           "__setitem__",
           [](V& v, const py::slice& s, const py::iterable& items) {
@@ -271,19 +289,32 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
                   return static_cast<std::ptrdiff_t>(j) + shift;
                 });
           })
-      .def("__delitem__",
-           [](V& v, py::ssize_t i) {
+      .def("__setitem__",
+           [](V& v, py::handle i, py::handle value) {
+             if (py::isinstance<py::slice>(i)) throw py::type_error("can only assign an iterable");
+             const py::ssize_t n = list_detail::index_of(i, list_detail::kListIndices);
+             // `value` may be an element of v: a copy
+             T copy = list_detail::value_of<T>(value, "list assignment");
              const std::size_t k =
-                 list_detail::wrap_index(i, v.size(), "list assignment index out of range");
-             std::vector<char> gone(v.size(), 0);
-             gone[k] = 1;
-             list_detail::erase(v, gone);
+                 list_detail::wrap_index(n, v.size(), "list assignment index out of range");
+             change(
+                 v, [&](V& x) { x[k] = std::move(copy); },
+                 [k](std::size_t j) { return j == k ? -1 : static_cast<std::ptrdiff_t>(j); });
            })
       .def("__delitem__",
            [](V& v, const py::slice& s) {
              const list_detail::Selection sel = list_detail::slice_indices(s, v);
              std::vector<char> gone(v.size(), 0);
              for (std::size_t i : sel.indices) gone[i] = 1;
+             list_detail::erase(v, gone);
+           })
+      .def("__delitem__",
+           [](V& v, py::handle i) {
+             const py::ssize_t n = list_detail::index_of(i, list_detail::kListIndices);
+             const std::size_t k =
+                 list_detail::wrap_index(n, v.size(), "list assignment index out of range");
+             std::vector<char> gone(v.size(), 0);
+             gone[k] = 1;
              list_detail::erase(v, gone);
            })
       .def(

@@ -373,3 +373,33 @@ def test_items_of_another_type_name_the_item(small_scene):
     with pytest.raises(TypeError, match=r"^slice assignment: item 1 is a int, not a Material$"):
         small_scene.materials[0:1] = [m, 3]
     assert len(small_scene.materials) == before
+
+
+def test_indices_are_read_as_a_python_list_reads_them(small_scene):
+    # an int past Py_ssize_t, a float or a value of another type raised pybind's "incompatible
+    # function arguments" TypeError (the Python API tester's find); as a Python list: IndexError
+    # for the first, TypeError naming the type for the others
+    mats, v = small_scene.materials, lucent.Vec3((1, 2, 3))
+    for index in (2 ** 70, -2 ** 70):
+        with pytest.raises(IndexError, match="cannot fit 'int' into an index-sized integer"):
+            mats[index]
+        with pytest.raises(IndexError, match="cannot fit 'int' into an index-sized integer"):
+            del mats[index]
+        with pytest.raises(IndexError, match="cannot fit 'int' into an index-sized integer"):
+            v[index]
+    with pytest.raises(TypeError, match=r"^list indices must be integers or slices, not float$"):
+        mats[1.5]
+    with pytest.raises(TypeError, match=r"^list indices must be integers or slices, not str$"):
+        mats["0"] = lucent.Material()
+    with pytest.raises(TypeError, match=r"^vector indices must be integers, not NoneType$"):
+        v[None]
+    with pytest.raises(TypeError, match=r"^list assignment: expected a Material, not int$"):
+        mats[0] = 5
+    with pytest.raises(TypeError, match=r"^can only assign an iterable$"):
+        mats[0:1] = 5
+    # what a list takes: bool and numpy integers, negative indices, slices
+    first = mats[0].name
+    assert mats[False].name == first and mats[np.int64(0)].name == first
+    assert mats[-len(mats)].name == first and v[-1] == 3
+    mats[0:1] = [lucent.Material("mirror")]
+    assert mats[0].type == "mirror"
