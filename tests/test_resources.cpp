@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/host_blocks.hpp"
+#include "core/host_memory.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/parts.hpp"
@@ -108,6 +109,19 @@ std::string film_culprit(const std::string& film, const std::string& accum) {
 }
 
 // The estimate made before packing covers what packing then allocates, within a small factor.
+// Sizes in messages: each in the largest unit it reaches, up to EiB, so that a count just
+// below the saturated one is not "17179869184.0 GiB" beside its "16.0 EiB or more".
+TEST(Resources, SizesAreInTheirLargestUnit) {
+  using lucent::sys::format_bytes;
+  EXPECT_EQ(format_bytes(100), "100 bytes");
+  EXPECT_EQ(format_bytes(std::uint64_t(3) << 29), "1.5 GiB");
+  EXPECT_EQ(format_bytes(std::uint64_t(1) << 40), "1.0 TiB");
+  EXPECT_EQ(format_bytes(std::uint64_t(5) << 49), "2.5 PiB");
+  EXPECT_EQ(format_bytes(std::uint64_t(1) << 60), "1.0 EiB");
+  EXPECT_EQ(format_bytes(~std::uint64_t(0) - 1), "16.0 EiB");
+  EXPECT_EQ(format_bytes(~std::uint64_t(0)), "16.0 EiB or more");
+}
+
 TEST(Resources, HostEstimateCoversThePackedScene) {
   Scene s = lucent::test::scene_from(grid_scene(40, 32));
   s.textures.push_back({"t.png", 64, 32, std::vector<float>(64 * 32 * 4, 0.5f)});

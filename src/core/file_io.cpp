@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "core/host_memory.hpp"
 #include "lucent/error.hpp"
 
 namespace lucent::io {
@@ -103,19 +104,7 @@ bool is_temp_name(const std::string& file, const std::string& name) {
 
 }  // namespace
 
-std::string format_size(std::uint64_t b) {
-  char buf[48];
-  const double k = 1024.0;
-  if (b >= (1ull << 30))
-    std::snprintf(buf, sizeof buf, "%.1f GiB", double(b) / (k * k * k));
-  else if (b >= (1ull << 20))
-    std::snprintf(buf, sizeof buf, "%.1f MiB", double(b) / (k * k));
-  else if (b >= (1ull << 10))
-    std::snprintf(buf, sizeof buf, "%.1f KiB", double(b) / k);
-  else
-    std::snprintf(buf, sizeof buf, "%llu bytes", static_cast<unsigned long long>(b));
-  return buf;
-}
+std::string format_size(std::uint64_t b) { return sys::format_bytes(b); }
 
 std::string read_file(const std::string& path, const ReadSpec& spec) {
   const std::string what = spec.what;

@@ -73,7 +73,7 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
 [[noreturn]] void unknown_output_format(const std::string& path, const std::string& ext,
                                         const char* formats);
 
-/// "1.5 GiB", "256 MiB", "12 KiB", "7 bytes": a size for messages.
+/// "1.5 GiB", "256.0 MiB", "12.0 KiB", "7 bytes": a size for messages (sys::format_bytes).
 std::string format_size(std::uint64_t bytes);
 
 }  // namespace lucent::io

@@ -89,7 +89,14 @@ std::string format_bytes(std::uint64_t bytes) {
   if (bytes == ~std::uint64_t(0)) return "16.0 EiB or more";
   char buf[64];
   const double b = double(bytes);
-  if (bytes >= (1ull << 30))
+  // (up to 2^64 - 2: "17179869184.0 GiB" beside the saturated count's "16.0 EiB or more")
+  if (bytes >= (1ull << 60))
+    std::snprintf(buf, sizeof buf, "%.1f EiB", b / double(1ull << 60));
+  else if (bytes >= (1ull << 50))
+    std::snprintf(buf, sizeof buf, "%.1f PiB", b / double(1ull << 50));
+  else if (bytes >= (1ull << 40))
+    std::snprintf(buf, sizeof buf, "%.1f TiB", b / double(1ull << 40));
+  else if (bytes >= (1ull << 30))
     std::snprintf(buf, sizeof buf, "%.1f GiB", b / double(1ull << 30));
   else if (bytes >= (1ull << 20))
     std::snprintf(buf, sizeof buf, "%.1f MiB", b / double(1ull << 20));

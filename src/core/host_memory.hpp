@@ -39,8 +39,8 @@ void return_free_memory();
 std::uint64_t bytes_mul(std::uint64_t a, std::uint64_t b);
 std::uint64_t bytes_add(std::uint64_t a, std::uint64_t b);
 
-/// Bytes as "12.3 GiB", "512.0 MiB", "96.0 KiB", "100 bytes"; the saturated count 2^64 - 1 as
-/// "16.0 EiB or more".
+/// Bytes as "12.3 GiB", "512.0 MiB", "96.0 KiB", "100 bytes" (TiB, PiB and EiB above); the
+/// saturated count 2^64 - 1 as "16.0 EiB or more".
 std::string format_bytes(std::uint64_t bytes);
 
 }  // namespace lucent::sys
