@@ -689,7 +689,7 @@ TEST(StopSignals, OneSecondMakesOneStop) {
   using lucent::cli::StopSignal;
   namespace sd = lucent::cli::stop_detail;
   const long long t0 = 5000000000LL, second = sd::kSameStopNs;
-  sd::first_signal.store(0);
+  sd::first_ns.store(0);
   EXPECT_EQ(classify_stop_signal(SIGTERM, t0), StopSignal::First);
   EXPECT_EQ(classify_stop_signal(SIGTERM, t0), StopSignal::SameStop);  // timeout's group kill
   EXPECT_EQ(classify_stop_signal(SIGINT, t0 + 20000000), StopSignal::SameStop);  // bkill
@@ -697,10 +697,52 @@ TEST(StopSignals, OneSecondMakesOneStop) {
   EXPECT_EQ(classify_stop_signal(SIGTERM, t0 + second), StopSignal::EndNow);
   EXPECT_EQ(classify_stop_signal(SIGINT, t0 + 3 * second), StopSignal::EndNow);
   EXPECT_EQ(sd::first_signal.load(), SIGTERM);
-  sd::first_signal.store(0);
+  sd::first_ns.store(0);
   EXPECT_EQ(classify_stop_signal(SIGHUP, t0 + 10 * second), StopSignal::First);
   EXPECT_EQ(classify_stop_signal(SIGHUP, t0 + 10 * second + 1), StopSignal::SameStop);
+  sd::first_ns.store(0);
   sd::first_signal.store(0);
+}
+
+namespace {
+void test_stop_handler(int) {}
+void llvm_like_handler(int) {}
+}  // namespace
+
+// PoCL's LLVM installs its own handlers at its first kernel build (SA_RESETHAND: the default
+// action comes back as one is entered) over lucent's: a second signal microseconds after the
+// first (GNU timeout's) found the default action and killed the render. reclaim_stop_handler
+// puts lucent's back and leaves alone a default action (a later signal's EndNow) and a signal
+// the process was started with ignored.
+TEST(StopSignals, HandlersAreTakenBackFromAnotherOne) {
+  struct sigaction saved[3];
+  for (int i = 0; i < 3; ++i) ::sigaction(lucent::cli::kStopSignals[i], nullptr, &saved[i]);
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  ::sigaction(SIGHUP, &ignore, nullptr);  // started with SIGHUP ignored (nohup)
+  sigset_t mask;
+  ::pthread_sigmask(SIG_SETMASK, nullptr, &mask);
+  lucent::cli::install_stop_handler(test_stop_handler);
+  struct sigaction llvm {};
+  llvm.sa_handler = llvm_like_handler;
+  llvm.sa_flags = SA_RESETHAND | SA_NODEFER;
+  for (int sig : lucent::cli::kStopSignals) ::sigaction(sig, &llvm, nullptr);
+  lucent::cli::reclaim_stop_handler(test_stop_handler);
+  auto handler_of = [](int sig) {
+    struct sigaction now {};
+    ::sigaction(sig, nullptr, &now);
+    return now.sa_handler;
+  };
+  EXPECT_EQ(handler_of(SIGINT), &test_stop_handler);
+  EXPECT_EQ(handler_of(SIGTERM), &test_stop_handler);
+  EXPECT_EQ(handler_of(SIGHUP), SIG_IGN);
+  struct sigaction dfl {};
+  dfl.sa_handler = SIG_DFL;
+  ::sigaction(SIGTERM, &dfl, nullptr);
+  lucent::cli::reclaim_stop_handler(test_stop_handler);
+  EXPECT_EQ(handler_of(SIGTERM), SIG_DFL);
+  for (int i = 0; i < 3; ++i) ::sigaction(lucent::cli::kStopSignals[i], &saved[i], nullptr);
+  ::pthread_sigmask(SIG_SETMASK, &mask, nullptr);
 }
 
 TEST(Outputs, AStopSignalIgnoredAtTheStartStaysIgnored) {
@@ -807,6 +849,10 @@ TEST(Outputs, MergeStoppedWhileWritingWritesItsOutputInFull) {
       [](const std::string& err) { return err.find("are missing") != std::string::npos; }, SIGTERM,
       60, {}, 1);
   const std::string err = read_file(err_path);
+  // (after the write, the handlers given back: the signal's default action, the output whole)
+  if (WIFSIGNALED(status) && fs::exists(out) &&
+      others(dir, {"scene.json", "p0.exr", "p2.exr", "m.exr", "stderr"}).empty())
+    GTEST_SKIP() << "the signal came after the write";
   ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
   if (WEXITSTATUS(status) == 0) GTEST_SKIP() << "merge ended before the signal";
   EXPECT_EQ(WEXITSTATUS(status), 143) << err;
@@ -818,7 +864,7 @@ TEST(Outputs, MergeStoppedWhileWritingWritesItsOutputInFull) {
 }
 
 // compare stopped while it writes its z map: the same (the z map in full, 128 + the signal, no
-// temporary file left), where it was killed. The signal follows the temporary file's creation;
+// temporary file left), where it was killed. The signal follows the temporary file's first bytes;
 // 1500x1500 images of noise (z values that do not compress) give the write tens of milliseconds.
 TEST(Outputs, CompareStoppedWhileWritingItsZMapWritesItInFull) {
   std::string dir = lucent::test::temp_dir();
@@ -838,12 +884,19 @@ TEST(Outputs, CompareStoppedWhileWritingItsZMapWritesItInFull) {
   const int status = interrupt_cli(
       {"compare", dir + "/a.pfm", dir + "/b.pfm", "--zmap", z}, err_path,
       [&](const std::string&) {
+        // (with bytes: the output check's empty probe of the same name comes first)
+        std::error_code ec;
         for (const auto& e : fs::directory_iterator(dir))
-          if (e.path().filename().string().rfind(".z.exr.tmp-", 0) == 0) return true;
+          if (e.path().filename().string().rfind(".z.exr.tmp-", 0) == 0 &&
+              fs::file_size(e.path(), ec) > 0)
+            return true;
         return false;
       },
       SIGTERM, 60, {}, 1);
   const std::string err = read_file(err_path);
+  if (WIFSIGNALED(status) && fs::exists(z) &&
+      others(dir, {"a.pfm", "b.pfm", "z.exr", "stderr"}).empty())
+    GTEST_SKIP() << "the signal came after the write";
   ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << "\n" << err;
   if (WEXITSTATUS(status) <= 1) GTEST_SKIP() << "compare ended before the signal";
   EXPECT_EQ(WEXITSTATUS(status), 143) << err;

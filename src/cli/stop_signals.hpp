@@ -27,10 +27,12 @@ inline const char* signal_name(int sig) {
 }
 
 namespace stop_detail {
-/// The first stop signal received (0: none yet) and when (CLOCK_MONOTONIC, ns): read and written
-/// by the handlers of any thread (lock-free atomics are async-signal-safe).
-inline std::atomic<int> first_signal{0};
+/// When the first stop signal came (CLOCK_MONOTONIC, ns; 0: none yet), and which it was: read
+/// and written by the handlers of any thread (lock-free atomics are async-signal-safe). The time
+/// decides: a handler that saw the signal set but not yet its time (two signals on two threads
+/// at once, as GNU timeout sends them) took 0 for it and ended the process.
 inline std::atomic<long long> first_ns{0};
+inline std::atomic<int> first_signal{0};
 /// The stop signals (bit i: kStopSignals[i]) the process was started with ignored.
 inline std::atomic<unsigned> ignored_at_start{0};
 /// A later stop signal within this of the first is part of the same stop.
@@ -69,12 +71,12 @@ enum class StopSignal {
 /// Async-signal-safe.
 inline StopSignal classify_stop_signal(int sig, long long now_ns) {
   using namespace stop_detail;
-  int none = 0;
-  if (first_signal.compare_exchange_strong(none, sig)) {
-    first_ns.store(now_ns);
+  long long first = 0;
+  if (first_ns.compare_exchange_strong(first, now_ns)) {
+    first_signal.store(sig);
     return StopSignal::First;
   }
-  return now_ns - first_ns.load() >= kSameStopNs ? StopSignal::EndNow : StopSignal::SameStop;
+  return now_ns - first >= kSameStopNs ? StopSignal::EndNow : StopSignal::SameStop;
 }
 
 /// For a command's handler, first: true for the first stop signal (the handler then records its
@@ -167,6 +169,7 @@ class StopSignalScope {
     const sigset_t all = stop_detail::stop_set();
     ::pthread_sigmask(SIG_BLOCK, &all, &mask_);
     for (int i = 0; i < 3; ++i) ::sigaction(kStopSignals[i], nullptr, &before_[i]);
+    stop_detail::first_ns.store(0);
     stop_detail::first_signal.store(0);
     ::pthread_sigmask(SIG_SETMASK, &mask_, nullptr);
     install_stop_handler(handler);
@@ -204,8 +207,11 @@ inline void record_deferred_stop(int sig) {
 template <class Work>
 int run_with_stops_deferred(Work&& work) {
   stop_detail::deferred_signal.store(0);
-  StopSignalScope scope(stop_detail::record_deferred_stop);
-  work();
+  {
+    StopSignalScope scope(stop_detail::record_deferred_stop);
+    work();
+  }
+  // (read once the handlers are given back: one that came in between was recorded, and lost)
   return stop_detail::deferred_signal.load();
 }
 
