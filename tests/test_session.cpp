@@ -1711,14 +1711,16 @@ TEST(Session, TwoCpuDevicesShareThePackedArrays) {
 // in set_scene). Its first lucent call is an error saying so, in a session made before the fork
 // and in one made after it.
 TEST(Session, AForkOfAProcessThatUsedOpenClIsRefused) {
-  lucent::Renderer before(lucent::test::session_options());
+  auto before = std::make_unique<lucent::Renderer>(lucent::test::session_options());
   const lucent::Scene scene = lucent::test::scene_from(R"({"film": {"width": 4, "height": 4},
     "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
     "shapes": [{"type": "sphere", "center": [0, 0, -3], "radius": 1, "material": "m"}]})");
+  before->set_scene(scene);
+  before->render(1);  // (its release hung in the child only after a render)
   const pid_t pid = ::fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
-    ::alarm(60);  // a hang ends the child (SIGALRM), not the test
+    ::alarm(30);  // a hang ends the child (SIGALRM), not the test
     int refused = 0;
     auto refuses = [&](const std::function<void()>& call) {
       try {
@@ -1728,10 +1730,12 @@ TEST(Session, AForkOfAProcessThatUsedOpenClIsRefused) {
                                                0) == 0;
       }
     };
-    refuses([&] { before.set_scene(scene); });
-    refuses([&] { before.render(1); });
+    refuses([&] { before->set_scene(scene); });
+    refuses([&] { before->render(1); });
     refuses([&] { lucent::Renderer after(lucent::test::session_options()); });
     refuses([&] { lucent::list_devices(); });
+    // destroying the session made before the fork hung too (releasing its OpenCL objects)
+    before.reset();
     ::_exit(refused);
   }
   int status = 0;

@@ -246,6 +246,8 @@ std::atomic<bool> g_forked_after_opencl{false};
 void on_fork_child() { g_forked_after_opencl.store(true); }
 }  // namespace
 
+bool forked_after_opencl() { return g_forked_after_opencl.load(); }
+
 void check_not_forked() {
   if (g_forked_after_opencl.load())
     throw Error(
@@ -257,9 +259,6 @@ void check_not_forked() {
 
 std::vector<Device> enumerate_devices() {
   check_not_forked();
-  // a child forked from here on is recorded: its OpenCL calls would hang (check_not_forked)
-  static std::once_flag fork_handler;
-  std::call_once(fork_handler, [] { ::pthread_atfork(nullptr, nullptr, on_fork_child); });
   // one enumeration at a time in the process: the ICD loader and PoCL initialise on the first
   // call, and sessions created at once from several threads crashed there (SIGSEGV) or saw no
   // platform
@@ -268,6 +267,9 @@ std::vector<Device> enumerate_devices() {
   // before PoCL reads it (it is read once, on the first call)
   if (std::string problem = pocl_thread_count_problem(); !problem.empty()) throw Error(problem);
   if (std::string problem = pocl_empty_cache_dir_problem(); !problem.empty()) throw Error(problem);
+  // a child forked from here on is recorded: its OpenCL calls would hang (check_not_forked)
+  static std::once_flag fork_handler;
+  std::call_once(fork_handler, [] { ::pthread_atfork(nullptr, nullptr, on_fork_child); });
   std::vector<cl::Platform> platforms;
   try {
     cl::Platform::get(&platforms);

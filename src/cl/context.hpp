@@ -84,6 +84,9 @@ std::string pocl_cache_dir_problem();
 /// survive a fork, and OpenCL calls there hang for ever (a Python multiprocessing worker of the
 /// default start method, forked from a parent that had listed devices or rendered).
 void check_not_forked();
+/// Whether this process is such a fork (its sessions' OpenCL objects are left unreleased:
+/// releasing them hung too).
+bool forked_after_opencl();
 
 /// Builds `source` (already assembled, with #line markers) for the context's device. On a build
 /// failure throws lucent::Error holding the build log, whose lines name kernels/<file>:<line>,

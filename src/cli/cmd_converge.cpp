@@ -366,7 +366,9 @@ int run_converge_command() {
     }
   }
 
-  // each setting's kernel build may give PoCL's LLVM the handlers again: taken back at each rung
+  // each setting's kernel build may give PoCL's LLVM the handlers: taken back after each pass
+  // of a rung (the first setting's first rung came before any reclaim) and at each rung
+  opt.render.on_progress = [](const RenderProgress&) { reclaim_stop_handler(on_converge_signal); };
   opt.on_point = [](const ConvergePoint&) { reclaim_stop_handler(on_converge_signal); };
   if (!a.quiet) {
     std::printf("%-22s %7s %9s %10s %11s %11s %11s\n", "setting", "spp", "seconds", "Msamples/s",

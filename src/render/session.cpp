@@ -1483,6 +1483,12 @@ Renderer::Impl& Renderer::impl() const {
   return *impl_;
 }
 Renderer::~Renderer() {
+  // in a process forked from the one that made the session: releasing its OpenCL objects hangs
+  // (the driver's threads stayed in the parent), as every other call would (check_not_forked)
+  if (impl_ && cl_util::forked_after_opencl()) {
+    (void)impl_.release();  // left to the process's end
+    return;
+  }
   // destroyed during its own call (from a render's on_progress, set_scene's warning sink, or
   // another thread): the call would go on in freed memory (SIGSEGV, or PoCL's abort on a
   // destroyed mutex). A destructor cannot refuse: end the process with a line saying why.
