@@ -145,4 +145,5 @@ def test_sigint_stops_set_scene_waiting_for_another_build(tmp_path):
     assert child.returncode == 0, child.stderr
     words = child.stdout.split()
     assert words and words[0] == "keyboard", child.stdout + child.stderr
-    assert float(words[1]) < 10, child.stdout
+    # (the signal at 1 s; the wait looks at the cancel flag every 20 ms, Python's loop every 50)
+    assert float(words[1]) < 3, child.stdout

@@ -165,9 +165,9 @@ class BuildLock {
     fs::create_directories(fs::path(path).parent_path(), ec);
     auto t0 = std::chrono::steady_clock::now();
     auto give_up = [&] {
-      return (stop && stop()) ||
-             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >
-                 max_wait;
+      if (stop && stop()) return stopped_ = true;
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >
+             max_wait;
     };
     for (;;) {
       fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
@@ -191,10 +191,25 @@ class BuildLock {
   }
   BuildLock(const BuildLock&) = delete;
   BuildLock& operator=(const BuildLock&) = delete;
+  /// The wait ended on `stop` (the caller then builds nothing: build_program_cached throws).
+  bool stopped() const { return stopped_; }
 
  private:
   int fd_ = -1;
+  bool stopped_ = false;
 };
+
+namespace {
+/// A wait for another process's build that `stop` ended: the build is the caller's to skip
+/// (it built the kernel anyway, seconds to minutes, and a Ctrl-C in Python came after it).
+void throw_if_stopped(const BuildLock& lock, const std::string& path) {
+  if (lock.stopped())
+    throw Error(
+        "kernel build cancelled while it waited for another process's build of the same "
+        "kernel (" +
+        path + ")");
+}
+}  // namespace
 
 std::string default_program_cache_dir() {
   const char* xdg = std::getenv("XDG_CACHE_HOME");
@@ -281,6 +296,7 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
   if (!dir.empty() && !entries) {
     const std::string file = dir + "/" + hex(fnv1a(key.data(), key.size())) + ".bin";
     entry.lock_ = std::make_unique<BuildLock>(file + ".lock", 600, stop);
+    throw_if_stopped(*entry.lock_, file + ".lock");
   } else if (!dir.empty()) {
     bi.cache_file = dir + "/" + hex(fnv1a(key.data(), key.size())) + ".bin";
     std::string why;
@@ -305,6 +321,7 @@ cl::Program build_program_cached(const Context& ctx, const std::string& source,
     if (load(p)) return finish(p);
     // a miss: wait for another process that may be building this entry, then look again
     entry.lock_ = std::make_unique<BuildLock>(bi.cache_file + ".lock", 600, stop);
+    throw_if_stopped(*entry.lock_, bi.cache_file + ".lock");
     if (load(p)) return finish(p);
     if (!why.empty()) {
       bi.note = (why.rfind(bi.cache_file, 0) == 0 ? why : bi.cache_file + ": " + why) + "; rebuilt";

@@ -76,9 +76,10 @@ class DeferredEntry {
 /// With `entries` false (a driver that caches its own builds) no entry is read or written, but
 /// the build still takes the entry's lock (held by `deferred` until store()), so that processes
 /// building the same program at once wait for the first and then build from the driver's cache.
-/// The wait for another process's lock (at most 600 s) ends early, building without the lock,
-/// once `stop` returns true (a cancelled render: a stopped or stuck holder kept an interrupted
-/// render waiting for the whole 600 s).
+/// The wait for another process's lock (at most 600 s) ends early once `stop` returns true (a
+/// cancelled render: a stopped or stuck holder kept an interrupted render waiting for the whole
+/// 600 s), and the build is then cancelled: lucent::Error "kernel build cancelled while it waited
+/// ..." (until 30 Nov 2026 it built without the lock, which kept a Ctrl-C waiting for a build).
 cl::Program build_program_cached(const Context& ctx, const std::string& source,
                                  const std::string& options, const std::string& cache_dir,
                                  ProgramBuildInfo* info = nullptr,
