@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/host_memory.hpp"
 #include "fuzz_common.hpp"
 #include "lucent/compare.hpp"
 #include "support.hpp"
@@ -354,6 +355,12 @@ TEST(ImageIo, ExrImageIsItsDisplayWindow) {
       }
       return std::string();
     };
+    // a display window far larger than the file: within the host's memory (read_image had no
+    // check: a 341-byte file took 418 MiB at 4096x4096)
+    lucent::sys::set_host_limit_override(std::uint64_t(1) << 30);
+    const std::string huge = error_with(0, 0, 16383, 16383);
+    lucent::sys::set_host_limit_override(0);
+    EXPECT_EQ(huge.rfind(path + ": reading this 16384x16384 image needs about ", 0), 0u) << huge;
     EXPECT_EQ(error_with(0, 0, -1, 0),
               path + ": OpenEXR header claims an empty display window (0x1)");
     EXPECT_NE(error_with(0, 0, 2000000000, 0)

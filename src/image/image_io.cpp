@@ -133,6 +133,14 @@ void write_image(const std::string& path, const Image& img, const DisplaySetting
 Image read_image(const std::string& path) {
   const std::string bytes = io::read_file(path, image_detail::image_read_spec());
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  // within the host's memory, as read_render's: a 341-byte OpenEXR of a 1x1 data window in a
+  // 16384x16384 display window decodes to 3 GB
+  const image_detail::Probe p =
+      image_detail::probe_image(data, bytes.size(), path, image_detail::kMaxImagePixels);
+  image_detail::check_decode_memory(
+      path, "image", p,
+      p.format == image_detail::Format::Exr ? image_detail::exr_decode_bytes_per_pixel(p) : 32,
+      bytes.size());
   image_detail::Decoded d =
       image_detail::decode_image(data, bytes.size(), path, 3, image_detail::kMaxImagePixels);
   return Image{d.width, d.height, std::move(d.pixels)};
