@@ -98,6 +98,42 @@ struct type_caster<lucent::python::IntArg> {
 
 namespace lucent::python {
 
+/// A text argument as given (a type's or a mode's name: "float", "zip", a device selector), for
+/// text_argument() to check: a std::string parameter took bytes as their text, and None or a
+/// number raised pybind11's "incompatible function arguments"; the signature still says "str".
+struct TextArg {
+  py::object value;
+};
+
+}  // namespace lucent::python
+
+namespace pybind11::detail {
+template <>
+struct type_caster<lucent::python::TextArg> {
+  PYBIND11_TYPE_CASTER(lucent::python::TextArg, const_name("str"));
+  bool load(handle src, bool) {
+    value.value = reinterpret_borrow<object>(src);
+    return true;
+  }
+  static handle cast(const lucent::python::TextArg& arg, return_value_policy, handle) {
+    return arg.value.inc_ref();
+  }
+};
+}  // namespace pybind11::detail
+
+namespace lucent::python {
+
+/// `v` as text: a str, else TypeError "<what> must be a str, got bytes".
+inline std::string enum_text(py::handle v, const char* what) {
+  if (!py::isinstance<py::str>(v))
+    throw py::type_error(std::string(what) + " must be a str, got " +
+                         std::string(Py_TYPE(v.ptr())->tp_name));
+  return v.cast<std::string>();
+}
+inline std::string text_argument(const TextArg& a, const char* what) {
+  return enum_text(a.value, what);
+}
+
 /// `bytes` as a str (FileText).
 inline py::str file_text(const std::string& bytes) {
   return py::reinterpret_steal<py::str>(py::cast(FileText{bytes}).release());

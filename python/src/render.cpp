@@ -93,11 +93,12 @@ void bind_device_shares(py::module_& m, py::class_<T>& c) {
 /// before any other thread can start a call (or resume the render).
 class PyRenderer {
  public:
-  PyRenderer(const std::string& device, const FileText& kernel_dir, const FileText& cache_dir,
-             const std::string& precision, bool fast_math, bool specialize, double pass_seconds,
+  PyRenderer(const TextArg& device_arg, const FileText& kernel_dir, const FileText& cache_dir,
+             const TextArg& precision, bool fast_math, bool specialize, double pass_seconds,
              const IntArg& reserved_host_bytes, py::object on_warning)
       : warning_errors_(std::make_shared<CallbackErrors>()) {
     check_callable(on_warning, "on_warning");
+    const std::string device = text_argument(device_arg, "device");
     refuse_nul(device, "device");
     refuse_nul(kernel_dir.bytes, "kernel_dir");
     refuse_nul(cache_dir.bytes, "cache_dir");
@@ -108,7 +109,7 @@ class PyRenderer {
     o.device = device;
     o.kernel_dir = kernel_dir.bytes;
     o.cache_dir = cache_dir.bytes;
-    o.precision = parse_enum<Precision>(precision);
+    o.precision = parse_enum<Precision>(text_argument(precision, "precision"));
     o.fast_math = fast_math;
     o.specialize = specialize;
     o.pass_seconds = pass_seconds;
@@ -757,8 +758,8 @@ void bind_render(py::module_& m) {
       "the `lucent` command's defaults.");
   bind_session_devices<Renderer>(renderer);
   renderer
-      .def(py::init<const std::string&, const FileText&, const FileText&, const std::string&, bool,
-                    bool, double, const IntArg&, py::object>(),
+      .def(py::init<const TextArg&, const FileText&, const FileText&, const TextArg&, bool, bool,
+                    double, const IntArg&, py::object>(),
            py::kw_only(), py::arg("device") = "", py::arg("kernel_dir") = "",
            py::arg("cache_dir") = "", py::arg("precision") = "float", py::arg("fast_math") = false,
            py::arg("specialize") = true, py::arg("pass_seconds") = 0.25,
@@ -793,8 +794,8 @@ void bind_render(py::module_& m) {
           "another thread's call runs.")
       .def(
           "set_build_options",
-          [](PyRenderer& r, const std::string& precision, bool fast_math, bool specialize) {
-            Precision p = parse_enum<Precision>(precision);
+          [](PyRenderer& r, const TextArg& precision, bool fast_math, bool specialize) {
+            Precision p = parse_enum<Precision>(text_argument(precision, "precision"));
             r.call_interruptible("set_build_options", [&](Renderer& rr, std::atomic<bool>&) {
               rr.set_build_options(p, fast_math, specialize);
             });
@@ -901,7 +902,8 @@ void bind_render(py::module_& m) {
       .def(
           "write_part",
           [](PyRenderer& r, const std::filesystem::path& path, py::object requested,
-             const std::string& compression) {
+             const TextArg& compression_arg) {
+            const std::string compression = text_argument(compression_arg, "compression");
             const std::string p = path.string();
             PartCompression c = PartCompression::zip;
             if (compression == "piz")

@@ -220,15 +220,6 @@ void text_property(py::class_<C>& c, const char* name, std::string C::*member,
       [member](py::handle self, const FileText& v) { assigned<C>(self).*member = v.bytes; }, doc);
 }
 
-/// A type's name given to an enum field or constructor: a str (bytes were read as their text,
-/// None and numbers raised pybind's "incompatible function arguments").
-std::string enum_text(py::handle v, const char* what) {
-  if (!py::isinstance<py::str>(v))
-    throw py::type_error(std::string(what) + " must be a str, got " +
-                         std::string(Py_TYPE(v.ptr())->tp_name));
-  return v.cast<std::string>();
-}
-
 /// A property holding an enum by its registry name.
 template <class C, class E>
 void enum_property(py::class_<C>& c, const char* name, E C::*member) {
@@ -868,10 +859,10 @@ auto with_warnings(py::object on_warning, F&& load) {
 
 /// What `lucent info` prints, as a dict: the packed scene's counts, its BVH and the kernel's
 /// feature defines and build options for these settings. Needs no device.
-py::dict scene_info(const Scene& scene, const std::string& precision, bool fast_math,
-                    bool specialize, py::object on_warning) {
+py::dict scene_info(const Scene& scene, const TextArg& precision, bool fast_math, bool specialize,
+                    py::object on_warning) {
   RenderOptions options;
-  options.precision = parse_enum<Precision>(precision);
+  options.precision = parse_enum<Precision>(text_argument(precision, "precision"));
   options.fast_math = fast_math;
   options.specialize = specialize;
   Scene copy = scene;

@@ -101,6 +101,8 @@ def test_refusals(small_scene, tmp_path):
         r.render(1)
         with pytest.raises(ValueError, match="compression must be 'zip' or 'piz', got 'lzw'"):
             r.write_part(tmp_path / "p.exr", compression="lzw")
+        with pytest.raises(TypeError, match="^compression must be a str, got bytes$"):
+            r.write_part(tmp_path / "p.exr", compression=b"zip")
         with pytest.raises(lucent.Error, match="write_part writes a part file: use an .exr name"):
             r.write_part(tmp_path / "p.png")
     assert not (tmp_path / "p.exr").exists() and not (tmp_path / "p.png").exists()

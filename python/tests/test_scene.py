@@ -367,6 +367,13 @@ def test_bad_field_values():
         lucent.Filter(b"box")
     with pytest.raises(TypeError, match="^type must be a str, got bytes$"):
         lucent.Material(b"diffuse")
+    # and the other names given as arguments (the reviewer's find)
+    with pytest.raises(TypeError, match="^precision must be a str, got bytes$"):
+        lucent.Renderer(precision=b"float")
+    with pytest.raises(TypeError, match="^device must be a str, got NoneType$"):
+        lucent.Renderer(device=None)
+    with pytest.raises(TypeError, match="^precision must be a str, got int$"):
+        lucent.scene_info(lucent.Scene(), precision=3)
     with pytest.raises(ValueError, match="expected 3 indices"):
         lucent.Triangle().v = (1, 2)
     with pytest.raises(TypeError, match="expected 3 integer indices"):
