@@ -362,6 +362,8 @@ struct Renderer::Impl {
   /// A render call (render, render_for, render_adaptive) is in progress: its on_progress may read
   /// the session (result, spp, stats) but not change it (check_not_rendering)
   std::atomic<bool> rendering{false};
+  /// A render call (a RenderCall of a render) is in progress: its passes run.
+  std::atomic<bool> in_render{false};
 
   std::set<std::string> notes_given;  ///< the warnings about its scenes this session has given
   std::atomic<bool> cancel_requested{false};
@@ -413,11 +415,16 @@ struct Renderer::Impl {
   /// buffers under it (SIGSEGV).
   struct RenderCall {
     Impl& s;
-    RenderCall(Impl& impl, const char* call) : s(impl) {
+    /// `render`: a render call (passes run: in_render), not one that changes the session.
+    RenderCall(Impl& impl, const char* call, bool render = false) : s(impl) {
       cl_util::check_not_forked();
       if (s.rendering.exchange(true)) throw rendering_error(call);
+      s.in_render = render;
     }
-    ~RenderCall() { s.rendering = false; }
+    ~RenderCall() {
+      s.in_render = false;
+      s.rendering = false;
+    }
     RenderCall(const RenderCall&) = delete;
     RenderCall& operator=(const RenderCall&) = delete;
   };
@@ -973,7 +980,7 @@ struct Renderer::Impl {
   /// each takes the next range of sample indices when its pass is done.
   RenderProgress run(std::uint64_t target_spp, double time_limit,
                      const std::function<void(const RenderProgress&)>& on_progress) {
-    RenderCall call(*this, "render");
+    RenderCall call(*this, "render", true);
     if (!scene) throw Error("render: the session has no scene (call set_scene first)");
     check_not_stale("render");
     if (adaptive)
@@ -1176,7 +1183,7 @@ struct Renderer::Impl {
 
   RenderProgress run_adaptive(const AdaptiveOptions& o,
                               const std::function<void(const RenderProgress&)>& on_progress) {
-    RenderCall call(*this, "render_adaptive");
+    RenderCall call(*this, "render_adaptive", true);
     if (!scene) throw Error("render_adaptive: the session has no scene (call set_scene first)");
     check_not_stale("render_adaptive");
     if (!(o.target_error > 0) == !(o.budget_spp > 0) || !std::isfinite(o.target_error) ||
@@ -1630,7 +1637,7 @@ Accumulation Renderer::accumulation() const {
                              std::to_string(m.first);
     // (from a render's on_progress with several devices: another device's pass is not done
     // yet; this blamed a failed pass)
-    if (m.rendering.load())
+    if (m.in_render.load())
       throw Error(held +
                   " (another device's pass is still under way): read it once the render has "
                   "returned");
