@@ -179,6 +179,7 @@ TEST(ObjValidation, FilesOfAnotherFormatAreRefused) {
             "m.obj:4: a '\\' at the end of a line continues it on the next, which lucent does "
             "not read: join the two lines");
   EXPECT_EQ(obj_error(kTri + "f 1 2 3 # a comment \\\n"), "");
+  EXPECT_EQ(obj_error("g name\\\n" + kTri + "f 1 2 3\n"), "");  // a name, as tinyobjloader reads it
   EXPECT_EQ(obj_error("g group\n"), "");
   Scene s;
   EXPECT_EQ(obj_error("vertex 0 0 0\n" + kTri + "f 1 2 3\n", "", glm::dmat4(1.0), &s), "");

@@ -331,9 +331,12 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
     }
     std::string_view tag = token(rest);
     if (tag.empty()) return;
-    // (the token after the statement's numbers was refused as "'\' is not a number")
+    // the statements of numbers and indices (the token after them was refused as "'\' is not
+    // a number"); a name ending with one (g, o, usemtl) is read as it is
+    const bool data = tag == "v" || tag == "vt" || tag == "vn" || tag == "vp" || tag == "f" ||
+                      tag == "l" || tag == "p";
     if (const std::size_t e = rest.find_last_not_of(" \t\r");
-        e != std::string_view::npos && rest[e] == '\\' &&
+        data && e != std::string_view::npos && rest[e] == '\\' &&
         rest.substr(0, e).find('#') == std::string_view::npos)
       fail(
           "a '\\' at the end of a line continues it on the next, which lucent does not read: "
