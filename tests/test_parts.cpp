@@ -1380,6 +1380,33 @@ TEST(Parts, MpiCheckpointCompleteRunLeavesNoCheckpoint) {
   EXPECT_LT(max_relative_difference(with.acc, without.acc), 1e-5);
 }
 
+// A checkpoint of a run that asked for more samples (another --spp, the scene's spp edited),
+// resumed by one that asks for fewer: the output requests this run's samples. It kept the
+// checkpoint's request, so that a merge said samples were missing from a complete render (one
+// rank), and rank 0 refused a rank's share once it was rendered, at every rerun (several).
+TEST(Parts, MpiCheckpointOfALargerRequestResumesToThisRunsRequest) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir), ck = dir + "/ck.exr", out = dir + "/out.exr";
+  auto command = [&](const std::string& spp, const std::string& time) {
+    return mpirun("-np 1 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " --spp " + spp +
+                  time + " -o " + q(out) + " --checkpoint " + q(ck));
+  };
+  CommandResult r = run_shell(command("16000000", " --time 0.3"), dir);  // stopped short
+  const std::string rank_ck = dir + "/ck.rank0-of-1.exr";
+  ASSERT_TRUE(fs::exists(rank_ck)) << r.err;
+  const lucent::PartInfo held = lucent::read_part_info(rank_ck);
+  ASSERT_EQ(held.requested, (std::vector<lucent::SampleRange>{{0, 16000000}}));
+  const std::uint64_t spp = held.samples.back().end + 4;
+  r = run_shell(command(std::to_string(spp), ""), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const lucent::PartInfo whole = lucent::read_part_info(out);
+  EXPECT_EQ(whole.samples, (std::vector<lucent::SampleRange>{{0, spp}}));
+  EXPECT_EQ(whole.requested, (std::vector<lucent::SampleRange>{{0, spp}}));
+  r = run_cli("merge --complete " + q(out) + " -o " + q(dir + "/m.exr"));
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
 // mpirun's A : B gives ranks arguments of their own: --checkpoint on some ranks only is refused
 // with one line before anything is written or locked. The ranks with a checkpoint take collective
 // steps that the others skip, and such a job hung for ever (here: until the timeout, status 124).

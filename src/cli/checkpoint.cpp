@@ -111,12 +111,19 @@ void Checkpoint::on_pass(const lucent::Renderer& renderer) {
 }
 
 lucent::RenderPart Checkpoint::whole(const lucent::Renderer& renderer) const {
-  lucent::RenderPart part = lucent::make_part(renderer, requested(renderer), scene_);
+  const lucent::SampleRange asked = requested(renderer);
+  lucent::RenderPart part = lucent::make_part(renderer, asked, scene_);
   if (!old_) return part;
   lucent::PartMerger merger;
   merger.add(scene_, std::move(part));  // (moved: the film's sums are not copied)
   merger.add(path_, *old_);
-  return merger.finish().merged;
+  lucent::RenderPart merged = merger.finish().merged;
+  // this run's request, not its union with the checkpoint's: a checkpoint of a run that asked for
+  // more (another --spp, or the scene's spp edited) kept that request, and lucent-mpi's rank 0
+  // refused the rank's share after it was rendered ("another --spp?"), at every rerun; with one
+  // rank the output claimed samples missing from a complete render
+  merged.info.requested = {asked};
+  return merged;
 }
 
 bool Checkpoint::save(const lucent::RenderPart& part) {
