@@ -996,7 +996,30 @@ TEST(Parts, SlurmArrayScriptsRenderAndMerge) {
   raw = std::system(bad.c_str());
   EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 2);
   EXPECT_EQ(lucent::test::read_file(dir + "/submit.err"),
-            "submit: SPP must be a number of at least the 3 tasks (no leading zero), got '010'\n");
+            "submit: SPP must be a number of at least the 3 tasks and at most 4294967296 (no "
+            "leading zero), got '010'\n");
+  // an SPP that every task would fail on (a share past a part's 2^24 samples), or past 2^32, or
+  // too long for bash's arithmetic (it wrapped, and the tasks got negative ranges): refused
+  // before anything is queued (the jobs were queued and all failed)
+  const std::pair<const char*, const char*> refused[] = {
+      {" 40000000 2 ",
+       "submit: 40000000 samples in 2 tasks give a task more than the 16777216 samples a part "
+       "holds: use at least 3 tasks\n"},
+      {" 4294967297 300 ",
+       "submit: SPP must be a number of at least the 300 tasks and at most 4294967296 (no "
+       "leading zero), got '4294967297'\n"},
+      {" 99999999999999999999 3 ",
+       "submit: SPP must be a number of at least the 3 tasks and at most 4294967296 (no "
+       "leading zero), got '99999999999999999999'\n"},
+      {" 8 99999999999999999999 ",
+       "submit: TASKS must be a number from 1 to 4000001, got '99999999999999999999'\n"}};
+  for (const auto& [args, message] : refused) {
+    std::string c = cmd;
+    c.replace(c.find(" 8 3 "), 5, args);
+    raw = std::system(c.c_str());
+    EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 2) << args;
+    EXPECT_EQ(lucent::test::read_file(dir + "/submit.err"), message);
+  }
 }
 
 #ifdef LUCENT_MPI_PATH

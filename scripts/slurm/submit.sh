@@ -14,13 +14,22 @@ fi
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 scene=$1 spp=$2 tasks=$3 parts=$4 out=$5
 shift 5
-if ! [[ $tasks =~ ^[1-9][0-9]*$ ]]; then
-  echo "submit: TASKS must be a positive number, got '$tasks'" >&2
+# (at most Slurm's largest array, 4000001 tasks; digits counted first: bash's arithmetic wraps)
+if ! [[ $tasks =~ ^[1-9][0-9]{0,6}$ ]] || ((tasks > 4000001)); then
+  echo "submit: TASKS must be a number from 1 to 4000001, got '$tasks'" >&2
   exit 2
 fi
 # checked here too, before anything is queued (a leading zero read as octal split 010 as 8)
-if ! [[ $spp =~ ^[1-9][0-9]*$ ]] || ((spp < tasks)); then
-  echo "submit: SPP must be a number of at least the $tasks tasks (no leading zero), got '$spp'" >&2
+if ! [[ $spp =~ ^[1-9][0-9]*$ ]] || ((${#spp} > 10)) || ((spp < tasks)) ||
+  ((spp > 4294967296)); then
+  echo "submit: SPP must be a number of at least the $tasks tasks and at most 4294967296 (no" \
+    "leading zero), got '$spp'" >&2
+  exit 2
+fi
+# a part holds at most 2^24 samples (lucent render --samples): every task would fail
+if (((spp + tasks - 1) / tasks > 16777216)); then
+  echo "submit: $spp samples in $tasks tasks give a task more than the 16777216 samples a part" \
+    "holds: use at least $(((spp + 16777215) / 16777216)) tasks" >&2
   exit 2
 fi
 # shellcheck disable=SC2086
