@@ -1208,6 +1208,14 @@ TEST(Parts, MpiCommandLineErrorsAreOneLine) {
             "lucent-mpi: error: POCL_CACHE_DIR is set but empty, which PoCL aborts on: unset it "
             "or name a directory\n");
   EXPECT_FALSE(fs::exists(out));
+  // a thread count PoCL cannot read: it crashed in the singleton's daemon (SIGSEGV), then Open
+  // MPI's reports
+  cache = run_shell(
+      "timeout 60 env POCL_MAX_PTHREAD_COUNT=-1 " + prog + q(scene) + " -o " + q(out) + " --spp 2",
+      dir);
+  EXPECT_EQ(cache.status, 1) << cache.err;
+  EXPECT_EQ(cache.err.rfind("lucent-mpi: error: POCL_MAX_PTHREAD_COUNT", 0), 0u) << cache.err;
+  EXPECT_EQ(std::count(cache.err.begin(), cache.err.end(), '\n'), 1) << cache.err;
   CommandResult help = run_shell("timeout 60 " + prog + "--help", dir);
   EXPECT_EQ(help.status, 0) << help.err;
   EXPECT_NE(help.out.find("--time"), std::string::npos) << help.out;

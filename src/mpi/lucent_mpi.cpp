@@ -536,12 +536,14 @@ int run(const Args& a) {
 
 int main(int argc, char** argv) {
   // before MPI_Init: an MPI singleton's daemon (orted) probes OpenCL devices through hwloc, and
-  // PoCL aborts on an empty POCL_CACHE_DIR there (mpirun itself does so before any rank starts)
-  if (const std::string problem = lucent::cl_util::pocl_empty_cache_dir_problem();
-      !problem.empty()) {
-    std::fprintf(stderr, "lucent-mpi: error: %s\n", problem.c_str());
-    return 1;
-  }
+  // PoCL aborts on an empty POCL_CACHE_DIR there, and crashes (SIGSEGV) on a thread count it
+  // cannot read (mpirun itself does so before any rank starts)
+  for (const std::string& problem : {lucent::cl_util::pocl_empty_cache_dir_problem(),
+                                     lucent::cl_util::pocl_thread_count_problem()})
+    if (!problem.empty()) {
+      std::fprintf(stderr, "lucent-mpi: error: %s\n", problem.c_str());
+      return 1;
+    }
   MPI_Init(&argc, &argv);
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &g_size);
