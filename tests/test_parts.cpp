@@ -271,7 +271,12 @@ TEST(Parts, OverlapsAndMismatchesAreOneLineErrors) {
   EXPECT_EQ(error_line(run_cli("merge --complete --expect 0:10 " + a + " " + g + " -o " + q(out))),
             "merge: samples [4, 6), [8, 10) are missing (--complete)");
   EXPECT_EQ(error_line(run_cli("merge --expect 0:6 " + a + " " + g + " -o " + q(out))),
-            "merge: the parts hold samples [0, 4), [6, 8), outside --expect [0, 6)");
+            "merge: the parts hold samples [6, 8) outside --expect [0, 6) (they hold [0, 4), "
+            "[6, 8))");
+  // only what lies outside (it named all of the parts' samples)
+  EXPECT_EQ(error_line(run_cli("merge --expect 2:7 " + a + " " + g + " -o " + q(out))),
+            "merge: the parts hold samples [0, 2), [7, 8) outside --expect [2, 7) (they hold "
+            "[0, 4), [6, 8))");
   EXPECT_FALSE(fs::exists(out));
   CommandResult r = run_cli("merge " + a + " " + g + " -o " + q(out));
   ASSERT_EQ(r.status, 0) << r.err;

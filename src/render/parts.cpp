@@ -718,10 +718,16 @@ void check_merge_coverage(MergeReport& report, const std::optional<SampleRange>&
                           const std::string& complete_name) {
   const std::vector<SampleRange>& samples = report.merged.info.samples;
   if (expect) {
-    for (const SampleRange& s : samples)
-      if (s.begin < expect->begin || s.end > expect->end)
-        throw Error("merge: the parts hold samples " + ranges_text(samples) + ", outside " +
-                    expect_name + " " + range_text(*expect));
+    // the samples outside it (it named all of the parts' samples: "[0, 12)" for [0, 4))
+    std::vector<SampleRange> outside;
+    for (const SampleRange& s : samples) {
+      if (s.begin < expect->begin) outside.push_back({s.begin, std::min(s.end, expect->begin)});
+      if (s.end > expect->end) outside.push_back({std::max(s.begin, expect->end), s.end});
+    }
+    if (!outside.empty())
+      throw Error("merge: the parts hold samples " + ranges_text(outside) + " outside " +
+                  expect_name + " " + range_text(*expect) + " (they hold " + ranges_text(samples) +
+                  ")");
     report.missing = missing_ranges(samples, *expect);
   }
   if (complete && !report.missing.empty())
