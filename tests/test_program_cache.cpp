@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/file.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -258,7 +259,15 @@ TEST(ProgramCache, CliClearsTheCache) {
   fs::create_directories(dir);
   lucent::test::write_file(dir + "/0123456789abcdef.bin", "x");
   lucent::test::write_file(dir + "/0123456789abcdef.bin.lock", "");
-  lucent::test::write_file(dir + "/.0123456789abcdef.bin.tmp-12-0", "x");
+  // an interrupted write's temporary file (its process gone: a child reaped), and a write in
+  // progress (this process's), which clear removed under it
+  const pid_t gone = ::fork();
+  if (gone == 0) ::_exit(0);
+  ::waitpid(gone, nullptr, 0);
+  const std::string dead = "/.0123456789abcdef.bin.tmp-" + std::to_string(gone) + "-0",
+                    live = "/.0123456789abcdef.bin.tmp-" + std::to_string(::getpid()) + "-3";
+  lucent::test::write_file(dir + dead, "x");
+  lucent::test::write_file(dir + live, "x");
   // files the cache did not write stay, whatever their extension (a cache directory given by
   // mistake, ".", lost every *.bin file in it)
   lucent::test::write_file(dir + "/weights.bin", "keep");
@@ -287,7 +296,8 @@ TEST(ProgramCache, CliClearsTheCache) {
   EXPECT_TRUE(fs::exists(dir + "/.0123456789abcdef.bin.tmp-notes"));
   EXPECT_TRUE(fs::is_symlink(dir + "/1111111111111111.bin"));
   EXPECT_FALSE(fs::exists(dir + "/0123456789abcdef.bin.lock"));
-  EXPECT_FALSE(fs::exists(dir + "/.0123456789abcdef.bin.tmp-12-0"));
+  EXPECT_FALSE(fs::exists(dir + dead));
+  EXPECT_TRUE(fs::exists(dir + live));
   // on PoCL with its cache on, where sessions leave caching to PoCL, it says so
   bool pocl = false;
   for (const lucent::cl_util::Device& d : lucent::cl_util::enumerate_devices())

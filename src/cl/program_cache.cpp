@@ -1,6 +1,7 @@
 #include "cl/program_cache.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -488,6 +489,21 @@ int evict_program_cache(const std::string& dir, std::uint64_t max_bytes, const s
   return removed;
 }
 
+namespace {
+/// Whether the temporary file `name` (".<key>.bin.tmp-<pid>-<n>") is a write in progress: its
+/// process is alive. `cache clear` removed those too, and the writer then warned "<key>.bin:
+/// cannot write (No such file or directory)".
+bool write_in_progress(const std::string& name) {
+  const size_t at = name.rfind(".tmp-");
+  if (at == std::string::npos) return false;
+  const std::string tail = name.substr(at + 5);
+  const size_t dash = tail.find('-');
+  if (dash == 0 || dash == std::string::npos || dash > 9) return false;
+  const long pid = std::strtol(tail.substr(0, dash).c_str(), nullptr, 10);
+  return pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM);
+}
+}  // namespace
+
 int clear_program_cache(const std::string& dir) {
   int n = 0;
   for (const fs::directory_entry& e : cache_files(dir)) {
@@ -503,8 +519,8 @@ int clear_program_cache(const std::string& dir) {
     // entries, counted as info counts them, and the temporary files of interrupted writes
     if (is_entry(e)) {
       if (fs::remove(e.path(), ec)) ++n;
-    } else if (name.find(".bin.tmp") != std::string::npos) {
-      fs::remove(e.path(), ec);
+    } else if (name.find(".bin.tmp") != std::string::npos && !write_in_progress(name)) {
+      fs::remove(e.path(), ec);  // an interrupted write's
     }
   }
   return n;
