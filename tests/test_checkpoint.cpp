@@ -221,6 +221,35 @@ TEST(Checkpoint, ResumedImageEqualsTheSingleRender) {
   for (size_t i = 0; i < a.rgb.size(); ++i) EXPECT_NEAR(a.rgb[i], b.rgb[i], 0.009) << i;
 }
 
+// An output named as the checkpoint of a render in progress (its lock held): that render's next
+// checkpoint write replaced the output with a part file, and its end removed it. Refused before
+// rendering, by render and merge.
+TEST(Checkpoint, AnOutputThatIsACheckpointInUseIsRefused) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir), shared = dir + "/shared.exr";
+  const int fd = ::open((shared + ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);  // (a render's CheckpointLock)
+  const std::string refused = shared + ": is the checkpoint of a render in progress (" + shared +
+                              ".lock is locked): give the output another name";
+  // the only line of stderr, after "lucent: error: "
+  auto error_line = [](const CommandResult& r) {
+    EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+    const std::string prefix = "lucent: error: ";
+    EXPECT_EQ(r.err.rfind(prefix, 0), 0u) << r.err;
+    return r.err.substr(prefix.size(), r.err.find('\n') - prefix.size());
+  };
+  CommandResult r = run_cli("render " + q(scene) + " -q --spp 2 -o " + q(shared));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(error_line(r), refused);
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:2 -o " + q(dir + "/p.exr")).status, 0);
+  r = run_cli("merge -q " + q(dir + "/p.exr") + " -o " + q(shared));
+  EXPECT_EQ(error_line(r), refused);
+  EXPECT_FALSE(fs::exists(shared));
+  ::close(fd);  // the render ended: the name is free
+  EXPECT_EQ(run_cli("render " + q(scene) + " -q --spp 2 -o " + q(shared)).status, 0);
+}
+
 // Two renders given one checkpoint wrote over each other's samples (each run's work lost to the
 // other's next write): a render holds <checkpoint>.lock while it runs, and a second one is
 // refused with one line, before it reads the file, writing nothing. The lock goes with the

@@ -325,7 +325,8 @@ int render_with(const RenderArgs& a) {
   lucent::io::check_output_path(a.output, {a.scene});
   for (const std::string& name : a.aovs)
     lucent::io::check_output_path(aov_path(a.output, name), {a.scene, a.output});
-  if (!a.checkpoint.empty()) lucent::io::check_output_path(a.checkpoint, {a.scene, a.output});
+  if (!a.checkpoint.empty())
+    lucent::io::check_output_path(a.checkpoint, {a.scene, a.output}, /*is_checkpoint=*/true);
   // from here on a stop signal lets the render end its pass and write what it has
   install_stop_handler(on_stop_signal);
   std::signal(SIGPIPE, SIG_IGN);  // a closed stderr pipe must not cost the image
@@ -336,7 +337,8 @@ int render_with(const RenderArgs& a) {
     lucent::io::check_output_path(a.output, inputs);
     for (const std::string& name : a.aovs)
       lucent::io::check_output_path(aov_path(a.output, name), inputs);
-    if (!a.checkpoint.empty()) lucent::io::check_output_path(a.checkpoint, inputs);
+    if (!a.checkpoint.empty())
+      lucent::io::check_output_path(a.checkpoint, inputs, /*is_checkpoint=*/true);
   }
   if (g_interrupted.load()) {
     std::fprintf(stderr, "lucent: interrupted by %s before rendering: nothing written\n",

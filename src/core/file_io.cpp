@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -172,7 +173,8 @@ void unknown_output_format(const std::string& path, const std::string& ext, cons
   throw Error(path + ": unknown output format '" + ext + "' (use " + formats + ")");
 }
 
-void check_output_path(const std::string& out, const std::vector<std::string>& inputs) {
+void check_output_path(const std::string& out, const std::vector<std::string>& inputs,
+                       bool is_checkpoint) {
   if (out.empty()) throw Error("-o: the output path is empty");
   std::error_code ec;
   if (fs::is_directory(out, ec)) throw Error(out + ": is a directory");
@@ -186,6 +188,18 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
     throw Error(out + ": cannot write output (" + std::strerror(errno) + ")");
   const fs::path target = write_target(out);  // the directory the write will go to
   check_writable_kind(out, target);
+  // the checkpoint of a render in progress (its lock held, lucent::cli::CheckpointLock): that
+  // render's next write replaced the output with a part file, and its end removed it
+  const std::string lock = target.string() + ".lock";
+  if (int lfd =
+          is_checkpoint ? -1 : ::open(lock.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+      lfd >= 0) {
+    const bool held = ::flock(lfd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+    ::close(lfd);
+    if (held)
+      throw Error(out + ": is the checkpoint of a render in progress (" + lock +
+                  " is locked): give the output another name");
+  }
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   const std::string name = target.filename().string();
   // the name itself, which only the final rename would refuse

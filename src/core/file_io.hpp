@@ -65,7 +65,10 @@ std::string lower_extension(const std::string& path);
 /// to (tested by creating the temporary file the final write goes through), a name longer than
 /// the file system allows, a read-only file, or one of
 /// `inputs` ("<out>: is an input of this render (<input>); refusing to overwrite it").
-void check_output_path(const std::string& out, const std::vector<std::string>& inputs);
+/// Unless `is_checkpoint` (whose own lock then says so), an output whose `<target>.lock` another
+/// process holds, the checkpoint of a render in progress, is refused too.
+void check_output_path(const std::string& out, const std::vector<std::string>& inputs,
+                       bool is_checkpoint = false);
 
 /// Throws the error of an output `path` whose extension `ext` (lower-case, with its dot; "" for
 /// none) names no format the writer has; `formats` lists them (".png, .pfm or .exr"). A name
