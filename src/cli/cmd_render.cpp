@@ -131,9 +131,10 @@ std::vector<std::string> write_aovs(const RenderArgs& a, lucent::Renderer* rende
         renderer->set_scene(std::move(s));
         reclaim_stop_handler(on_stop_signal);
       } catch (const lucent::Error&) {
-        // a stop signal during the AOV's kernel build: PoCL's LLVM handles it too and the build
-        // fails; the AOV is not written, as one stopped in its render (it said "kernel build
-        // failed", exit 1, with the image written)
+        // a stop signal during the AOV's kernel build: where PoCL's LLVM handles it too (its
+        // handlers installed again, which reclaim_stop_handler undoes after each build) the
+        // build fails; the AOV is not written, as one stopped in its render (it said "kernel
+        // build failed", exit 1, with the image written)
         if (!g_interrupted.load()) throw;
         missing.push_back(name);
         continue;
