@@ -323,19 +323,25 @@ TEST(Session, CancelAfterTheLastPassLeavesTheRenderComplete) {
   EXPECT_TRUE(r.result().cancelled);
 }
 
+/// kScene with a degenerate triangle (two equal vertices), which packing warns of.
+Scene with_degenerate_triangle() {
+  Scene s = lucent::test::scene_from(kScene);
+  s.positions.push_back(s.positions[0]);
+  lucent::Triangle t;
+  t.v[0] = 0;
+  t.v[1] = static_cast<int>(s.positions.size()) - 1;
+  t.v[2] = 1;
+  s.triangles.push_back(t);
+  return s;
+}
+
 // Warnings of packing go to the session's sink, not to stderr.
 TEST(Session, WarningsGoToTheSessionsSink) {
   std::vector<std::string> got;
   lucent::SessionOptions o = lucent::test::session_options();
   o.on_warning = [&](const std::string& m) { got.push_back(m); };
   Renderer r(o);
-  Scene s = lucent::test::scene_from(kScene);
-  s.positions.push_back(s.positions[0]);  // a degenerate triangle: two equal vertices
-  lucent::Triangle t;
-  t.v[0] = 0;
-  t.v[1] = static_cast<int>(s.positions.size()) - 1;
-  t.v[2] = 1;
-  s.triangles.push_back(t);
+  Scene s = with_degenerate_triangle();
   r.set_scene(s);
   ASSERT_EQ(got.size(), 1u);
   EXPECT_NE(got[0].find("skipped 1 degenerate or non-finite triangle"), std::string::npos)
@@ -359,13 +365,7 @@ TEST(Session, AWarningTheSinkRefusedIsGivenAgain) {
     throw lucent::Error("strict: " + m);
   };
   Renderer r(o);
-  Scene s = lucent::test::scene_from(kScene);
-  s.positions.push_back(s.positions[0]);  // a degenerate triangle: two equal vertices
-  lucent::Triangle t;
-  t.v[0] = 0;
-  t.v[1] = static_cast<int>(s.positions.size()) - 1;
-  t.v[2] = 1;
-  s.triangles.push_back(t);
+  Scene s = with_degenerate_triangle();
   for (int i = 1; i <= 2; ++i) {
     EXPECT_NE(error_of([&] { r.set_scene(s); }).find("strict: "), std::string::npos) << i;
     EXPECT_EQ(calls, i);
@@ -389,13 +389,7 @@ TEST(Session, CallsThatChangeTheSessionHoldItAsARenderDoes) {
   };
   Renderer r(o);
   self = &r;
-  Scene degenerate = s;
-  degenerate.positions.push_back(degenerate.positions[0]);  // a warning while it packs
-  lucent::Triangle t;
-  t.v[0] = 0;
-  t.v[1] = static_cast<int>(degenerate.positions.size()) - 1;
-  t.v[2] = 1;
-  degenerate.triangles.push_back(t);
+  const Scene degenerate = with_degenerate_triangle();  // a warning while it packs
   r.set_scene(degenerate);
   ASSERT_EQ(errors.size(), 3u);
   const char* calls[] = {"render", "set_scene", "reset"};
