@@ -1,6 +1,7 @@
 #include "cl/context.hpp"
 
 #include <pthread.h>
+#include <signal.h>
 #include <sys/resource.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
@@ -248,6 +249,36 @@ void on_fork_child() { g_forked_after_opencl.store(true); }
 
 bool forked_after_opencl() { return g_forked_after_opencl.load(); }
 
+namespace {
+/// Keeps the process's own SIGINT, SIGTERM and SIGHUP handlers across OpenCL calls that
+/// initialise a driver: PoCL's LLVM installs its own over them (SA_RESETHAND, and it gives the
+/// signal to the saved handler only after it cleaned up), at PoCL's first enumeration, and keeps
+/// them. Two signals microseconds apart (GNU timeout's) then found the default action in between
+/// and killed lucent with no word, also during a later kernel build, and Python's SIGINT handler
+/// stayed behind LLVM's for the module's life. LLVM registers its handlers once: given back here,
+/// they stay the process's (until a signal of LLVM's own kind, SIGSEGV and such, unregisters it).
+class KeepStopHandlers {
+ public:
+  KeepStopHandlers() {
+    for (int i = 0; i < 3; ++i) ::sigaction(kSignals[i], nullptr, &saved_[i]);
+  }
+  ~KeepStopHandlers() {
+    for (int i = 0; i < 3; ++i) {
+      struct sigaction now {};
+      ::sigaction(kSignals[i], nullptr, &now);
+      if (now.sa_handler != saved_[i].sa_handler || now.sa_flags != saved_[i].sa_flags)
+        ::sigaction(kSignals[i], &saved_[i], nullptr);
+    }
+  }
+  KeepStopHandlers(const KeepStopHandlers&) = delete;
+  KeepStopHandlers& operator=(const KeepStopHandlers&) = delete;
+
+ private:
+  static constexpr int kSignals[3] = {SIGINT, SIGTERM, SIGHUP};
+  struct sigaction saved_[3]{};
+};
+}  // namespace
+
 void check_not_forked() {
   if (g_forked_after_opencl.load())
     throw Error(
@@ -270,6 +301,7 @@ std::vector<Device> enumerate_devices() {
   // a child forked from here on is recorded: its OpenCL calls would hang (check_not_forked)
   static std::once_flag fork_handler;
   std::call_once(fork_handler, [] { ::pthread_atfork(nullptr, nullptr, on_fork_child); });
+  const KeepStopHandlers keep;  // PoCL initialises in the calls below
   std::vector<cl::Platform> platforms;
   try {
     cl::Platform::get(&platforms);
@@ -364,6 +396,7 @@ Device pick_device(const std::string& selector, const std::string& origin) {
 
 Context::Context(const std::string& selector, const std::string& origin)
     : device(pick_device(selector, origin)) {
+  const KeepStopHandlers keep;
   try {
     context = cl::Context(device.device);
     queue = cl::CommandQueue(context, device.device);
