@@ -229,7 +229,14 @@ TEST(Checkpoint, AnOutputThatIsACheckpointInUseIsRefused) {
   const std::string scene = noisy_scene(dir), shared = dir + "/shared.exr";
   const int fd = ::open((shared + ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   ASSERT_GE(fd, 0);
-  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);  // (a render's CheckpointLock)
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  // a lock of that name taken by other means (flock(1) around the command): no checkpoint's
+  CommandResult other = run_cli("render " + q(scene) + " -q --spp 2 -o " + q(shared));
+  EXPECT_EQ(other.status, 0) << other.err;
+  fs::remove(shared);
+  // a render's CheckpointLock: marked
+  const ssize_t mark = sizeof lucent::io::kCheckpointLockMark - 1;
+  ASSERT_EQ(::write(fd, lucent::io::kCheckpointLockMark, size_t(mark)), mark);
   const std::string refused = shared + ": is the checkpoint of a render in progress (" + shared +
                               ".lock is locked): give the output another name";
   // the only line of stderr, after "lucent: error: "

@@ -35,7 +35,14 @@ CheckpointLock::CheckpointLock(const std::string& checkpoint)
   if (fd_ < 0)
     throw lucent::Error(path_ + ": cannot create the checkpoint's lock (" + std::strerror(errno) +
                         ")");
-  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
+  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) {
+    // the mark that tells another command's output check this lock is a checkpoint's
+    if (::ftruncate(fd_, 0) == 0) {
+      const std::size_t n = sizeof lucent::io::kCheckpointLockMark - 1;
+      (void)!::pwrite(fd_, lucent::io::kCheckpointLockMark, n, 0);
+    }
+    return;
+  }
   const int e = errno;
   ::close(fd_);
   fd_ = -1;

@@ -194,7 +194,11 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
   if (int lfd =
           is_checkpoint ? -1 : ::open(lock.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
       lfd >= 0) {
-    const bool held = ::flock(lfd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+    char mark[sizeof kCheckpointLockMark] = {};
+    const ssize_t n = ::pread(lfd, mark, sizeof mark - 1, 0);
+    const bool held = n == ssize_t(sizeof mark - 1) &&
+                      std::memcmp(mark, kCheckpointLockMark, sizeof mark - 1) == 0 &&
+                      ::flock(lfd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
     ::close(lfd);
     if (held)
       throw Error(out + ": is the checkpoint of a render in progress (" + lock +

@@ -65,8 +65,13 @@ std::string lower_extension(const std::string& path);
 /// to (tested by creating the temporary file the final write goes through), a name longer than
 /// the file system allows, a read-only file, or one of
 /// `inputs` ("<out>: is an input of this render (<input>); refusing to overwrite it").
-/// Unless `is_checkpoint` (whose own lock then says so), an output whose `<target>.lock` another
-/// process holds, the checkpoint of a render in progress, is refused too.
+/// Unless `is_checkpoint` (whose own lock then says so), an output that is the checkpoint of a
+/// render in progress is refused too: its `<target>.lock` is held (flock) and begins with
+/// kCheckpointLockMark (a lock of that name taken by other means, `flock out.exr.lock lucent
+/// ...`, is not a checkpoint's).
+/// What a checkpoint's lock file holds while a render holds the lock (lucent::cli::CheckpointLock).
+inline constexpr char kCheckpointLockMark[] = "lucent checkpoint lock\n";
+
 void check_output_path(const std::string& out, const std::vector<std::string>& inputs,
                        bool is_checkpoint = false);
 

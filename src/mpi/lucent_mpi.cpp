@@ -308,7 +308,7 @@ int run(const Args& a) {
         std::vector<std::string> inputs = lucent::scene_detail::scene_inputs(a.scene, scene);
         inputs.push_back(a.scene);
         inputs.push_back(a.output);
-        lucent::io::check_output_path(ck_path, inputs);
+        lucent::io::check_output_path(ck_path, inputs, /*is_checkpoint=*/true);
         if (root) refuse_other_rank_counts(a.checkpoint, g_size);
       }))
     return 1;
@@ -374,8 +374,9 @@ int run(const Args& a) {
           renderer.set_scene(std::move(scene));               // held once, by the session
           lucent::cli::reclaim_stop_handler(on_stop_signal);  // from PoCL's LLVM
         } catch (const lucent::Error&) {
-          // a stop signal during the kernel build: PoCL's LLVM handles it too (it removes its
-          // temporary files, then passes it on), and the build fails. That is the interruption,
+          // a stop signal during the kernel build, where the build failed on it (PoCL's LLVM,
+          // when its handlers were in place) or it cancelled a wait for another process's
+          // build: the interruption,
           // as `lucent render` reports it, not a build error (it ended the job through
           // MPI_Abort, "kernel build failed", exit 1)
           if (!g_stop.load()) throw;
