@@ -522,6 +522,21 @@ TEST(ProgramCache, CancelledSessionStopsWaitingForABuildLock) {
             0u)
       << error;
   EXPECT_LT(seconds, 4.0) << "waited for the lock although the render was cancelled";
+
+  // a cancel() left from a render that had ended is dropped by the next set_scene, as by the
+  // next render: it waits for the lock's holder (here 0.5 s) and builds (it gave up at once)
+  const int fd2 = ::open((second + "/" + lock).c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  ASSERT_GE(fd2, 0);
+  ASSERT_EQ(::flock(fd2, LOCK_EX), 0);
+  std::thread holder2([fd2] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    ::close(fd2);
+  });
+  lucent::Renderer left(o);
+  left.cancel();  // (no render runs: dropped)
+  error = lucent::test::error_of([&] { left.set_scene(scene); });
+  holder2.join();
+  EXPECT_EQ(error, "");
 }
 
 }  // namespace

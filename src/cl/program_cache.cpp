@@ -155,10 +155,10 @@ bool still_at(int fd, const std::string& path) {
 /// An exclusive flock on `path` held while alive: processes that miss the same entry at the same
 /// time build it once (the others wait, then read what the first wrote) instead of each compiling
 /// it. Waits at most `max_wait` seconds (a holder stuck in a driver must not stall every other
-/// process), or until `stop` returns true (the render was cancelled), then builds without the
-/// lock; any failure to lock only costs a redundant build. A lock file removed while this process
-/// opened it or waited on it is opened again: two builders locking two files of one name would
-/// both build.
+/// process), then builds without the lock, or until `stop` returns true (the render was
+/// cancelled: stopped(), and build_program_cached builds nothing); any failure to lock only costs a
+/// redundant build. A lock file removed while this process opened it or waited on it is opened
+/// again: two builders locking two files of one name would both build.
 class BuildLock {
  public:
   BuildLock(const std::string& path, double max_wait, const std::function<bool()>& stop) {

@@ -420,6 +420,10 @@ struct Renderer::Impl {
       cl_util::check_not_forked();
       if (s.rendering.exchange(true)) throw rendering_error(call);
       s.in_render = render;
+      // a cancel of an earlier render is dropped here too, as a render's begin_call drops it: a
+      // set_scene that met another process's build lock after a cancelled render gave up its
+      // wait at once ("kernel build cancelled")
+      if (!render && s.cancel_scopes == 0) s.cancel_requested = false;
     }
     ~RenderCall() {
       s.in_render = false;
