@@ -549,7 +549,9 @@ PYBIND11_MODULE(lucent, m) {
   m.def("list_devices", &list_devices, "Every OpenCL device of every platform.");
   m.def(
       "select_device",
-      [](const std::string& selector, const std::string& origin) {
+      [](const TextArg& selector_arg, const TextArg& origin_arg) {
+        const std::string selector = text_argument(selector_arg, "selector"),
+                          origin = text_argument(origin_arg, "origin");
         refuse_nul(selector, "selector");
         refuse_nul(origin, "origin");
         return select_device(selector, origin);

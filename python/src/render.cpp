@@ -168,10 +168,10 @@ class PyRenderer {
 
   /// Runs `f(renderer)` with the GIL released, one call at a time (`what`: its name, for
   /// messages); then raises what a warning callback raised.
-  /// A lucent::Error raised while Ctrl-C came is KeyboardInterrupt: PoCL's LLVM handles SIGINT
-  /// during a kernel build too (it removes its temporary files, then passes it on), and the build
-  /// fails. set_scene raised lucent.Error "kernel build failed", and the KeyboardInterrupt then
-  /// came out in the caller's except block.
+  /// A lucent::Error raised while Ctrl-C came is KeyboardInterrupt: PoCL's LLVM, while its
+  /// handlers were in place (the library gives the process's back), failed a kernel build on
+  /// SIGINT, and set_scene raised lucent.Error "kernel build failed", the KeyboardInterrupt then
+  /// coming out in the caller's except block.
   /// (The signals are looked at once the call is no longer busy: a Python handler may use the
   /// session.)
   template <class F>

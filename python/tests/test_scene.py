@@ -374,6 +374,8 @@ def test_bad_field_values():
         lucent.Renderer(device=None)
     with pytest.raises(TypeError, match="^precision must be a str, got int$"):
         lucent.scene_info(lucent.Scene(), precision=3)
+    with pytest.raises(TypeError, match="^selector must be a str, got bytes$"):
+        lucent.select_device(b"0")
     with pytest.raises(ValueError, match="expected 3 indices"):
         lucent.Triangle().v = (1, 2)
     with pytest.raises(TypeError, match="expected 3 integer indices"):

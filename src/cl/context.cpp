@@ -263,10 +263,13 @@ class KeepStopHandlers {
     for (int i = 0; i < 3; ++i) ::sigaction(kSignals[i], nullptr, &saved_[i]);
   }
   ~KeepStopHandlers() {
+    // only over LLVM's (its mark: SA_RESETHAND where the process's had none): a handler another
+    // thread of the application set meanwhile (Python's signal.signal while a Renderer is made
+    // without the GIL) stays
     for (int i = 0; i < 3; ++i) {
       struct sigaction now {};
       ::sigaction(kSignals[i], nullptr, &now);
-      if (now.sa_handler != saved_[i].sa_handler || now.sa_flags != saved_[i].sa_flags)
+      if ((now.sa_flags & SA_RESETHAND) && !(saved_[i].sa_flags & SA_RESETHAND))
         ::sigaction(kSignals[i], &saved_[i], nullptr);
     }
   }
@@ -407,6 +410,7 @@ Context::Context(const std::string& selector, const std::string& origin)
 
 cl::Program build_program(const Context& ctx, const std::string& source,
                           const std::string& options) {
+  const KeepStopHandlers keep;  // (LLVM registers again after one of its handlers ran)
   cl::Program program;
   try {
     program = cl::Program(ctx.context, source);

@@ -352,8 +352,9 @@ int run_converge_command() {
         reference = renderer.result();
       }
     } catch (const Error&) {
-      // a stop signal during the kernel build: PoCL's LLVM handles it too (it removes its
-      // temporary files, then passes it on) and the build fails; that is the interruption
+      // a stop signal during the kernel build, where the build failed on it (PoCL's LLVM, when
+      // its handlers were in place) or it cancelled a wait for another process's build: the
+      // interruption
       if (!g_stop.load()) throw;
     }
     if (reference.cancelled || g_stop.load()) return stopped_early("while rendering the reference");

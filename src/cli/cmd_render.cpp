@@ -483,9 +483,9 @@ int render_with(const RenderArgs& a) {
       wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       r = renderer->result();
     } catch (const lucent::Error&) {
-      // a stop signal during the kernel build: PoCL's LLVM handles it too (it removes its
-      // temporary files, then passes it on), and the build fails. That is the interruption,
-      // not a build error (it was reported as "kernel build failed", exit 1).
+      // a stop signal during the kernel build, where the build failed on it (PoCL's LLVM, when
+      // its handlers were in place), or cancelled a wait for another process's build: the
+      // interruption, not a build error (it was reported as "kernel build failed", exit 1)
       if (!g_interrupted.load()) throw;
       return interrupted_before_rendering();
     }

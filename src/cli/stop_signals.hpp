@@ -9,7 +9,8 @@
 //
 // A signal the process was started with ignored (nohup's SIGHUP, SIGINT of a script's background
 // job) stays ignored, and blocked: lucent stopped on them, against the shell's convention, and
-// PoCL's LLVM, which installs handlers of its own while it builds, failed a kernel build on one.
+// PoCL's LLVM, whose handlers were then in place (the library gives the process's back), failed a
+// kernel build on one.
 #include <pthread.h>
 #include <signal.h>
 #include <time.h>
@@ -130,9 +131,10 @@ inline void install_stop_handler(void (*handler)(int)) {
 }
 
 /// Takes the stop signals back from a handler installed over `handler` (after
-/// install_stop_handler): PoCL's LLVM installs its own at the first kernel build and keeps it
-/// (SA_RESETHAND: the default action comes back as it is entered, before it gives the signal to
-/// the handler it replaced). A second signal microseconds after the first, as GNU timeout sends
+/// install_stop_handler): PoCL's LLVM installs its own when PoCL initialises and keeps it (the
+/// library gives the process's back then, cl_util's KeepStopHandlers; this is the CLI's second
+/// line) (SA_RESETHAND: the default action comes back as it is entered, before it gives the signal
+/// to the handler it replaced). A second signal microseconds after the first, as GNU timeout sends
 /// (to the process, then to its group), found the default action there and killed the process
 /// with nothing written. Called after each kernel build; a signal the process was started with
 /// ignored is ignored again.

@@ -570,8 +570,9 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
       renderer->set_build_options(o.precision, o.fast_math, o.specialize);
       renderer->set_scene(s);
     } catch (const Error&) {
-      // a stop signal during the setting's kernel build: PoCL's LLVM handles it too and the
-      // build fails; the study is cancelled and keeps its rungs (they were lost with the error)
+      // a stop during the setting's kernel build, where the build failed on it (PoCL's LLVM,
+      // when its handlers were in place) or it cancelled a wait for another process's build:
+      // the study is cancelled and keeps its rungs (they were lost with the error)
       if (cancel_scope.cancelled()) break;
       throw;
     }
