@@ -124,9 +124,7 @@ class PyRenderer {
         deferred_warnings_.push_back(message);
         return;
       }
-      WithChain chain(caller_chain_);  // on a device thread, the chain of the call's caller
-      InCallback frame(this, "warning callback");
-      sink_(message);
+      give_warning(message);
     };
     caller_chain_ = t_callbacks;  // the warnings of the construction are its caller's callbacks
     ReleaseGil release;
@@ -230,11 +228,14 @@ class PyRenderer {
       std::lock_guard<std::mutex> lock(deferred_mutex_);
       messages.swap(deferred_warnings_);
     }
-    for (const std::string& m : messages) {
-      WithChain chain(caller_chain_);
-      InCallback frame(this, "warning callback");
-      sink_(m);
-    }
+    for (const std::string& m : messages) give_warning(m);
+  }
+
+  /// A warning to the session's sink, as a callback of the call in progress.
+  void give_warning(const std::string& message) {
+    WithChain chain(caller_chain_);  // on a device thread, the chain of the call's caller
+    InCallback frame(this, "warning callback");
+    sink_(message);
   }
 
   /// A render call: `progress(p)` runs after each pass (on the rendering thread, with the GIL);

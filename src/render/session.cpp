@@ -359,8 +359,9 @@ struct Renderer::Impl {
   render_detail::LightTotals light_totals;  // the light paths' totals, for the image mean
   double render_seconds = 0;
   bool last_cancelled = false;
-  /// A render call (render, render_for, render_adaptive) is in progress: its on_progress may read
-  /// the session (result, spp, stats) but not change it (check_not_rendering)
+  /// A call is in progress (RenderCall): a render (render, render_for, render_adaptive), whose
+  /// on_progress may read the session (result, spp, stats) but not change it, or one that
+  /// changes the session (set_scene, set_camera, reset, set_build_options)
   std::atomic<bool> rendering{false};
   /// A render call (a RenderCall of a render) is in progress: its passes run.
   std::atomic<bool> in_render{false};
