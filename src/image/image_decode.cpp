@@ -218,10 +218,9 @@ ExrChannels read_exr_channels(const unsigned char* data, std::size_t size, const
   // it (overscan) are dropped
   const EXRBox2i dw = header.data_window, sw = header.display_window;
   FreeEXRHeader(&header);
-  if (sw.min_x != dw.min_x || sw.min_y != dw.min_y || sw.max_x != dw.max_x ||
-      sw.max_y != dw.max_y) {
-    const std::int64_t w = std::int64_t(sw.max_x) - sw.min_x + 1;
-    const std::int64_t h = std::int64_t(sw.max_y) - sw.min_y + 1;
+  if (!exr_windows_equal(dw, sw)) {
+    const ExrWindowSize shown = exr_window_size(sw);
+    const std::int64_t w = shown.width, h = shown.height;
     const std::int64_t dx = std::int64_t(dw.min_x) - sw.min_x,
                        dy = std::int64_t(dw.min_y) - sw.min_y;
     auto place = [&](auto& plane) {

@@ -457,13 +457,18 @@ class Checker {
         if (!keep) FreeEXRHeader(h);
       }
     } guard{&header, false};
+    // a window's size, refused when empty; the size the probe checks (its width and height)
+    auto window = [&](const EXRBox2i& b, const char* which) {
+      const ExrWindowSize s = exr_window_size(b);
+      if (s.width <= 0 || s.height <= 0)
+        fail(std::string("OpenEXR header claims an empty ") + which + " window (" +
+             std::to_string(s.width) + "x" + std::to_string(s.height) + ")");
+      size(p, u64(s.width), u64(s.height));
+      return s;
+    };
     const EXRBox2i& dw = header.data_window;
-    const std::int64_t w = std::int64_t(dw.max_x) - dw.min_x + 1;
-    const std::int64_t h = std::int64_t(dw.max_y) - dw.min_y + 1;
-    if (w <= 0 || h <= 0)
-      fail("OpenEXR header claims an empty data window (" + std::to_string(w) + "x" +
-           std::to_string(h) + ")");
-    size(p, u64(w), u64(h));
+    const ExrWindowSize data = window(dw, "data");
+    const std::int64_t w = data.width, h = data.height;
     if (header.num_channels <= 0) fail("OpenEXR header has no channels");
     p.channels = header.num_channels;
     p.compression = header.compression_type;
@@ -508,16 +513,9 @@ class Checker {
     ratio(p, u64(w) * u64(h) * bytes_per_pixel, n_, 2048, "file");
     // the image is the display window: a data window of a part of it (a crop), or beyond it
     // (overscan), was read as the image, stretched or shifted (read_exr_channels places it)
-    const EXRBox2i& sw = header.display_window;
-    if (sw.min_x != dw.min_x || sw.min_y != dw.min_y || sw.max_x != dw.max_x ||
-        sw.max_y != dw.max_y) {
-      const std::int64_t sw_w = std::int64_t(sw.max_x) - sw.min_x + 1;
-      const std::int64_t sw_h = std::int64_t(sw.max_y) - sw.min_y + 1;
-      if (sw_w <= 0 || sw_h <= 0)
-        fail("OpenEXR header claims an empty display window (" + std::to_string(sw_w) + "x" +
-             std::to_string(sw_h) + ")");
-      size(p, u64(sw_w), u64(sw_h));
-      p.decode_pixels = u64(w) * u64(h) + u64(sw_w) * u64(sw_h);
+    if (!exr_windows_equal(dw, header.display_window)) {
+      const ExrWindowSize shown = window(header.display_window, "display");
+      p.decode_pixels = u64(w) * u64(h) + u64(shown.width) * u64(shown.height);
     }
     if (out) {
       *out = header;

@@ -90,6 +90,19 @@ void check_decode_memory(const std::string& path, const char* thing, const Probe
 Probe probe_exr(const unsigned char* data, std::size_t size, const std::string& path,
                 std::uint64_t max_pixels, EXRHeader& header);
 
+/// An OpenEXR window's width and height, in 64 bits (its corners are int32: a width can pass
+/// 2^31, and an inverted window gives 0 or less).
+struct ExrWindowSize {
+  std::int64_t width = 0, height = 0;
+};
+inline ExrWindowSize exr_window_size(const EXRBox2i& b) {
+  return {std::int64_t(b.max_x) - b.min_x + 1, std::int64_t(b.max_y) - b.min_y + 1};
+}
+/// Whether a file's data window (the pixels stored) is its display window (the image).
+inline bool exr_windows_equal(const EXRBox2i& a, const EXRBox2i& b) {
+  return a.min_x == b.min_x && a.min_y == b.min_y && a.max_x == b.max_x && a.max_y == b.max_y;
+}
+
 /// tinyexr's error text on one line (it ends its messages with newlines); frees `err`.
 std::string exr_message(const char* err);
 
