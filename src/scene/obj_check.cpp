@@ -230,10 +230,10 @@ std::vector<std::string> lines_of(const std::string& text) {
 
 namespace {
 
-/// Whether the library `name` of the OBJ file `obj_path` exists (library_path).
+/// Whether the library `name` of the OBJ file `obj_path` exists (named_file).
 bool library_exists(const std::string& obj_path, const std::string& name) {
   std::error_code ec;
-  return fs::is_regular_file(library_path(fs::path(obj_path).parent_path(), name), ec);
+  return fs::is_regular_file(named_file(fs::path(obj_path).parent_path(), name), ec);
 }
 
 /// The OBJ format's statements (Wavefront's specification, and tinyobjloader's t and vw).
@@ -251,16 +251,14 @@ bool obj_statement(std::string_view tag) {
 
 }  // namespace
 
-std::filesystem::path library_path(const std::filesystem::path& dir, const std::string& name) {
+std::filesystem::path named_file(const std::filesystem::path& dir, const std::string& name) {
   fs::path p(name);
   if (!p.is_absolute()) p = dir / p;
   std::error_code ec;  // names too long for the file system: no such file, no exception
   if (!fs::exists(p, ec) && name.find('\\') != std::string::npos) {  // Windows' separators
     std::string fixed = name;
     std::replace(fixed.begin(), fixed.end(), '\\', '/');
-    fs::path q(fixed);
-    if (!q.is_absolute()) q = dir / q;
-    if (fs::exists(q, ec)) return q;
+    return named_file(dir, fixed);
   }
   return p;
 }

@@ -101,16 +101,18 @@ std::string usemtl_alias(std::size_t k);
 /// "usemtl <usemtl_alias(k)>" (the lines kept).
 std::string alias_usemtl(const std::string& text, const std::vector<std::string>& names);
 
+/// A file an OBJ or MTL file names (an `mtllib` library, a map's texture): `name` relative to `dir`
+/// (the naming file's directory), its backslashes read as slashes when the name as given does not
+/// exist (a Windows path).
+std::filesystem::path named_file(const std::filesystem::path& dir, const std::string& name);
+
 /// Checks an OBJ file's text before tinyobjloader sees it: every number of a v, vn and vt line
 /// (present, a number, finite, within float range), every index of an f, l and p element (an
 /// integer, not 0, within the vertices, texture coordinates and normals the file defines, the
 /// negative ones relative to those defined so far), polygons of at most kMaxFaceVertices corners
-/// and at most kMaxTriangles triangles; notes the MTL libraries. Throws
-/// lucent::Error("<path>:<line>: ...").
-/// Where the OBJ file in `dir` finds its material library `name` (an `mtllib` name): relative to
-/// `dir`, with backslashes read as slashes when the name as given does not exist.
-std::filesystem::path library_path(const std::filesystem::path& dir, const std::string& name);
-
+/// and at most kMaxTriangles triangles, no such line continued with a backslash, and a file of no
+/// vertex or face with a statement OBJ does not have (a PLY, STL or glTF file); notes the MTL
+/// libraries. Throws lucent::Error("<path>:<line>: ...").
 TextCounts check_obj_text(const std::string& path, const std::string& text);
 
 /// Turns the comments at the end of `text`'s f, l and p lines ("f 1 2 3 # top") into spaces, in

@@ -26,15 +26,7 @@ double max3(const glm::dvec3& c) { return std::max(c.x, std::max(c.y, c.z)); }
 
 // A texture named in an MTL file, relative to that file's directory.
 fs::path texture_path(const std::string& mtl_path, const std::string& name) {
-  fs::path p(name);
-  if (!p.is_absolute()) p = fs::path(mtl_path).parent_path() / p;
-  std::error_code ec;  // names too long for the file system: no such file, no exception
-  if (!fs::exists(p, ec) && name.find('\\') != std::string::npos) {  // Windows-style separators
-    std::string fixed = name;
-    std::replace(fixed.begin(), fixed.end(), '\\', '/');
-    return texture_path(mtl_path, fixed);
-  }
-  return p;
+  return named_file(fs::path(mtl_path).parent_path(), name);
 }
 
 }  // namespace
@@ -47,7 +39,7 @@ bool MtlReader::operator()(const std::string&, std::vector<tinyobj::material_t>*
   done_ = true;
   std::set<std::string> seen;  // canonical paths: a library named twice is read once
   for (const std::string& name : names_) {
-    const fs::path p = library_path(dir_, name);
+    const fs::path p = named_file(dir_, name);
     std::error_code ec;
     fs::path canonical = fs::weakly_canonical(p, ec);
     if (!seen.insert(ec ? p.string() : canonical.string()).second) continue;
