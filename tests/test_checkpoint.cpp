@@ -291,6 +291,38 @@ TEST(Checkpoint, ACheckpointInUseIsRefused) {
   EXPECT_FALSE(fs::exists(ck + ".lock"));
 }
 
+// The lock goes with the checkpoint: a render that fails before its first write (here a device
+// that is not there, after the lock was taken) leaves no checkpoint, and no lock alone beside
+// where it would be (it stayed for ever). A checkpoint refused stays, with its lock; a lock held
+// by another render is not touched.
+TEST(Checkpoint, ARenderThatWroteNoCheckpointLeavesNoLock) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string ck = dir + "/ck.exr", out = dir + "/out.exr";
+  CommandResult r = run_cli("render " + q(scene) + " -q --spp 8 --device 99 --checkpoint " + q(ck) +
+                            " -o " + q(out));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("--device 99"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(ck));
+  EXPECT_FALSE(fs::exists(ck + ".lock"));
+  // a checkpoint that is not a part file: refused, and kept as it was, with its lock
+  lucent::test::write_file(ck, "not a part");
+  r = run_cli("render " + q(scene) + " -q --spp 8 --checkpoint " + q(ck) + " -o " + q(out));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(lucent::test::read_file(ck), "not a part");
+  EXPECT_TRUE(fs::exists(ck + ".lock"));
+  fs::remove(ck);
+  // another render's lock (held): refused, and the lock stays
+  const int fd = ::open((ck + ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  r = run_cli("render " + q(scene) + " -q --spp 8 --checkpoint " + q(ck) + " -o " + q(out));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_TRUE(fs::exists(ck + ".lock"));
+  ::close(fd);
+  EXPECT_FALSE(fs::exists(out));
+}
+
 // SIGTERM: the output of the samples so far is written, and the checkpoint holds them too (it
 // stays, for the next run), as the line before the last says.
 TEST(Checkpoint, SigtermKeepsTheCheckpoint) {

@@ -56,7 +56,11 @@ CheckpointLock::~CheckpointLock() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-void CheckpointLock::remove() const { ::unlink(path_.c_str()); }
+void CheckpointLock::remove() const {
+  // once: a second unlink could remove the lock of a render that began meanwhile
+  if (!removed_) ::unlink(path_.c_str());
+  removed_ = true;
+}
 
 Checkpoint::Checkpoint(std::string path, std::string scene_path, double every, std::string program,
                        std::uint64_t begin)
@@ -66,6 +70,12 @@ Checkpoint::Checkpoint(std::string path, std::string scene_path, double every, s
       every_(every),
       begin_(begin),
       held_(begin) {}
+
+Checkpoint::~Checkpoint() {
+  if (!lock_ || ours_) return;
+  std::error_code ec;
+  if (!std::filesystem::exists(path_, ec) && !ec) lock_->remove();  // (a link's target's)
+}
 
 void Checkpoint::read() {
   lock_.emplace(path_);  // first: the file read is no other render's work in progress

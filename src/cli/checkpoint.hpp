@@ -34,6 +34,7 @@ class CheckpointLock {
  private:
   std::string path_;
   int fd_ = -1;
+  mutable bool removed_ = false;
 };
 
 /// A render's checkpoint: a part file of the samples [B, K) of the render's samples [B, N)
@@ -46,6 +47,11 @@ class Checkpoint {
   /// `program`: the messages' prefix ("lucent", "lucent-mpi: rank 1 of 4"). `begin`: B.
   Checkpoint(std::string path, std::string scene_path, double every, std::string program = "lucent",
              std::uint64_t begin = 0);
+  Checkpoint(const Checkpoint&) = delete;
+  Checkpoint& operator=(const Checkpoint&) = delete;
+  /// The lock goes with the checkpoint: a render that ends with no file there (refused, failed
+  /// or stopped before its first write) removes the lock it holds (it stayed alone, for ever).
+  ~Checkpoint();
 
   /// Before the session: locks the checkpoint, then reads it when there is one, so that a file
   /// that is not a part, or a corrupt one, is refused before a device is opened.
