@@ -1146,6 +1146,13 @@ TEST(Parts, MpiFailingRankEndsTheJobWithoutOutput) {
                        "--bogus (its arguments are not rank 0's)"),
             std::string::npos)
       << r.err;
+  // --help on a rank other than 0: CLI11's "This should be caught in your main function"
+  r = run_shell("timeout 60 env " + mpirun("-np 1 " + prog + " : -np 1 " + prog + " --help"), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("lucent-mpi: error: rank 1 of 2: --help or --version is for rank 0 alone "
+                       "(its arguments are not rank 0's)"),
+            std::string::npos)
+      << r.err;
   r = run_shell(mpirun("-np 1 " + prog + " --spp 8 : -np 1 " + prog + " --spp 100"), dir);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("rank 1 was given samples [50, 100), its share of rank 0's is [4, 8) "

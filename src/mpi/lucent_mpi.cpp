@@ -613,7 +613,8 @@ int main(int argc, char** argv) {
     const std::string bad = lucent::cli::refused_value(app);
     const std::string said = bad.empty() ? std::string(e.what()) : bad;
     if (g_rank != 0) {
-      message = said;
+      // (--help and --version: CLI11's what() is "This should be caught in your main function")
+      message = code == 0 ? "--help or --version is for rank 0 alone" : said;
     } else if (code == 0) {
       parse_status = app.exit(e);  // --help, --version: stdout, status 0
     } else {
