@@ -305,6 +305,14 @@ TEST(ProgramCache, CliClearsTheCache) {
   EXPECT_EQ(r.out.find("kernels are cached by PoCL") != std::string::npos, pocl) << r.out;
   r = lucent::test::run_cli("cache clear", "POCL_KERNEL_CACHE=0 LUCENT_CACHE_DIR='" + dir + "'");
   EXPECT_EQ(r.out.find("kernels are cached by PoCL"), std::string::npos) << r.out;
+  // with it off, sessions build from source (keeps_program_binaries): it says that too
+  bool pocl_device = false;
+  for (const lucent::cl_util::Device& d : lucent::cl_util::enumerate_devices())
+    pocl_device = pocl_device || !lucent::cl_util::keeps_program_binaries(d);
+  EXPECT_EQ(r.out.find("kernels are built from source each time: PoCL's kernel cache is off") !=
+                std::string::npos,
+            pocl_device)
+      << r.out;
   EXPECT_FALSE(fs::exists(dir + "/0123456789abcdef.bin"));
 }
 

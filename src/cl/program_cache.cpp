@@ -256,6 +256,8 @@ std::string driver_program_cache(const Device& device) {
   return "PoCL's kernel cache";
 }
 
+bool keeps_program_binaries(const Device& device) { return !is_pocl(device.info); }
+
 DeferredEntry::DeferredEntry() = default;
 DeferredEntry::~DeferredEntry() = default;
 DeferredEntry::DeferredEntry(DeferredEntry&&) noexcept = default;

@@ -20,7 +20,8 @@
 // work-group compile of its own (0.5 s, the largest part of a cold build). The session therefore
 // leaves caching to such a driver (driver_program_cache) and stores an entry only for the others,
 // after the first launch (DeferredEntry), so that the entry also holds what the driver compiled
-// there: a hit then launches at once instead of compiling again.
+// there: a hit then launches at once instead of compiling again. On PoCL with its cache off the
+// session stores no entry either (keeps_program_binaries).
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -45,6 +46,15 @@ std::string default_program_cache_dir();
 /// add nothing to them: "PoCL's kernel cache" on PoCL unless POCL_KERNEL_CACHE is set to a value
 /// that PoCL reads as off (one not starting with 1); "" otherwise.
 std::string driver_program_cache(const Device& device);
+
+/// Whether a session keeps the programs it builds for `device` in lucent's cache: not on PoCL.
+/// With its kernel cache on, PoCL's own serves (above). With it off, PoCL (3.1) unpacks a program
+/// made from a binary into a directory named after the binary (POCL_CACHE_DIR/_UNCACHED_...)
+/// and removes that directory when the program is released: two processes that loaded one entry
+/// shared it, and one aborted when the other's release removed it ("Can't get stat() on ...":
+/// lucent-mpi's ranks, 2 jobs of 3; two renders, 1 pair in 60). A program built from source gets
+/// a directory of its own.
+bool keeps_program_binaries(const Device& device);
 
 class BuildLock;
 

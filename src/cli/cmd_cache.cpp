@@ -16,19 +16,26 @@ namespace lucent::cli {
 namespace {
 std::string g_action;
 
-// On PoCL, sessions leave caching to PoCL's own cache (cl/program_cache.hpp): says where it is.
+// On PoCL, sessions leave caching to PoCL's own cache (cl/program_cache.hpp): says where it is,
+// or that it is off.
 void say_where_pocl_caches() {
   try {
-    for (const cl_util::Device& d : cl_util::enumerate_devices())
-      if (!cl_util::driver_program_cache(d).empty()) {
+    for (const cl_util::Device& d : cl_util::enumerate_devices()) {
+      if (cl_util::keeps_program_binaries(d)) continue;
+      if (!cl_util::driver_program_cache(d).empty())
         // (the directory PoCL uses: it said "default ~/.cache/pocl/kcache" whatever
         // XDG_CACHE_HOME chose)
         std::printf(
             "%s: kernels are cached by PoCL in %s (POCL_CACHE_DIR), not here; remove that "
             "directory to rebuild them from source\n",
             d.info.name.c_str(), one_line(cl_util::pocl_cache_dir()).c_str());
-        return;
-      }
+      else
+        std::printf(
+            "%s: kernels are built from source each time: PoCL's kernel cache is off "
+            "(POCL_KERNEL_CACHE), and lucent keeps no PoCL programs here\n",
+            d.info.name.c_str());
+      return;
+    }
   } catch (const Error&) {
     // no OpenCL platform: nothing more to say
   }
@@ -56,8 +63,8 @@ CLI::App* add_cache_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "cache",
       "Manage the kernel binary cache (LUCENT_CACHE_DIR, default $XDG_CACHE_HOME/lucent or "
-      "~/.cache/lucent; unused on PoCL while POCL_KERNEL_CACHE is on, PoCL's own cache serving "
-      "instead). It keeps its programs under LUCENT_CACHE_MAX_MB MiB (default 256, 0 for no "
+      "~/.cache/lucent; unused on PoCL, whose own cache serves while POCL_KERNEL_CACHE is on). It "
+      "keeps its programs under LUCENT_CACHE_MAX_MB MiB (default 256, 0 for no "
       "limit) by removing the least recently used after each write");
   cmd->add_option("action", g_action,
                   "clear: remove every cached program; dir: print the directory; info: the "

@@ -453,7 +453,7 @@ struct Renderer::Impl {
 
   /// The worker's program for these build options, built (or loaded from the cache) or reused.
   /// A new build's cache entry is left in `entry`, to be stored after the warm-up launch; no entry
-  /// where the driver caches its own builds (cl/program_cache.hpp).
+  /// on PoCL (cl/program_cache.hpp, keeps_program_binaries).
   Program& get_program(Worker& w, const std::string& opts, const std::string& source,
                        cl_util::DeferredEntry& entry) {
     auto it = w.programs.find(opts);
@@ -462,7 +462,7 @@ struct Renderer::Impl {
     cl_util::ProgramBuildInfo info;
     Program p;
     try {
-      const bool entries = cl_util::driver_program_cache(w.ctx.device).empty();
+      const bool entries = cl_util::keeps_program_binaries(w.ctx.device);
       p.program = cl_util::build_program_cached(
           w.ctx, source, opts + render_detail::device_defines(w.ctx.device.info), cache_dir, &info,
           &entry, entries, [this] { return cancelled(); });
