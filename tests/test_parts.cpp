@@ -1318,6 +1318,46 @@ int lucent_mpi_lines(const std::string& err) {
   return n;
 }
 
+// Every rank loads the scene and builds the session, and each printed the scene's warnings: a
+// job of K ranks printed each K times. Rank 0 prints them once (the other ranks' own too, naming
+// the rank), before the one line of a job that fails.
+TEST(Parts, MpiWarningsArePrintedOnce) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  const std::string dir = lucent::test::temp_dir();
+  std::string text = lucent::test::read_file(noisy_scene(dir));
+  const std::string grey = "[0.25, 0.5, 0.75]";
+  ASSERT_NE(text.find(grey), std::string::npos);
+  text.replace(text.find(grey), grey.size(), "[1.25, 0.5, 0.75]");
+  const std::string scene = dir + "/bright.json";
+  lucent::test::write_file(scene, text);
+  auto count = [](const std::string& err) {
+    int n = 0;
+    for (size_t at = 0; (at = err.find("albedo 1.25 in red is above 1", at)) != std::string::npos;
+         ++at)
+      ++n;
+    return n;
+  };
+  const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene);
+  CommandResult r =
+      run_shell(mpirun("-np 3 " + prog + " --spp 6 -q -o " + q(dir + "/mpi.exr")), dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(count(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("lucent: warning: " + scene + ": material 'm'", 0), 0u) << r.err;
+  // a job that fails after the session's build (rank 0's checkpoint is of another seed): the
+  // warning, then the failure's line
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --seed 9 --samples 0:2 -o " +
+                    q(dir + "/ck.rank0-of-3.exr"))
+                .status,
+            0);
+  r = run_shell(mpirun("-np 3 " + prog + " --spp 6 -q --checkpoint " + q(dir + "/ck.exr") + " -o " +
+                       q(dir + "/mpi.exr")),
+                dir);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(count(r.err), 1) << r.err;
+  EXPECT_EQ(lucent_mpi_lines(r.err), 1) << r.err;
+  EXPECT_LT(r.err.find("albedo 1.25"), r.err.find("lucent-mpi: error: rank 0 of 3")) << r.err;
+}
+
 // Errors before rendering are agreed by the ranks: one line naming the lowest failing rank,
 // status 1, no output. A scene no rank can read (the commonest mistake), too many ranks for the
 // samples and a kernel that does not build (an error injected into a copy of the kernel sources,

@@ -22,7 +22,9 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -77,6 +79,61 @@ void print_failure(const std::string& what, const std::string& details = "") {
   std::_Exit(1);  // not reached
 }
 
+/// Warnings (the scene's, the session's): rank 0 prints its own as they come; the other ranks
+/// hold theirs until share_warnings() sends them to rank 0, which prints those it has not
+/// printed, once, naming the first rank that gave each. Every rank loads the same scene, and a
+/// job printed each of its warnings once per rank.
+std::mutex g_warnings_mutex;
+std::vector<std::string> g_warnings;  // rank 0: printed; another rank: held
+std::set<std::string> g_printed;      // rank 0
+
+void on_warning(const std::string& message) {
+  std::lock_guard<std::mutex> lock(g_warnings_mutex);
+  if (g_rank != 0) {
+    g_warnings.push_back(message);
+  } else if (g_printed.insert(message).second) {
+    std::fprintf(stderr, "lucent: warning: %s\n", one_line(message).c_str());
+    std::fflush(stderr);
+  }
+}
+
+/// Collective: the other ranks' held warnings, to rank 0 (see on_warning).
+void share_warnings() {
+  std::string mine;
+  {
+    std::lock_guard<std::mutex> lock(g_warnings_mutex);
+    if (g_rank != 0)
+      for (const std::string& w : g_warnings) mine += one_line(w) + '\n';
+    g_warnings.clear();
+  }
+  const int length = static_cast<int>(std::min<std::size_t>(mine.size(), 1 << 20));
+  std::vector<int> lengths(g_rank == 0 ? g_size : 0), at(g_rank == 0 ? g_size : 0);
+  MPI_Gather(&length, 1, MPI_INT, lengths.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  std::string all;
+  if (g_rank == 0) {
+    std::size_t total = 0;
+    for (int r = 0; r < g_size; ++r) at[r] = static_cast<int>(total), total += lengths[r];
+    all.resize(total);
+  }
+  MPI_Gatherv(mine.data(), length, MPI_CHAR, all.data(), lengths.data(), at.data(), MPI_CHAR, 0,
+              MPI_COMM_WORLD);
+  if (g_rank != 0) return;
+  std::lock_guard<std::mutex> lock(g_warnings_mutex);
+  for (int r = 1; r < g_size; ++r) {
+    std::size_t from = at[r];
+    const std::size_t end = from + lengths[r];
+    while (from < end) {
+      std::size_t eol = all.find('\n', from);
+      if (eol == std::string::npos || eol > end) eol = end;
+      const std::string w = all.substr(from, eol - from);
+      from = eol + 1;
+      if (w.empty() || !g_printed.insert(w).second) continue;
+      std::fprintf(stderr, "lucent: warning: rank %d of %d: %s\n", r, g_size, w.c_str());
+    }
+  }
+  std::fflush(stderr);
+}
+
 /// A step every rank takes, whose failure on any rank stops them all: the lowest failing rank
 /// prints its line (as fail() does) and every rank gets true, to end with status 1. One line,
 /// where a check that fails on every rank (a checkpoint of another seed) printed one per rank
@@ -94,6 +151,7 @@ bool refused(const std::function<void()>& step) {
     what = e.what();
     mine = g_rank;
   }
+  share_warnings();  // (before the failure's line: what led to it)
   MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   if (first == g_rank) print_failure(what, details);
   return first < g_size;
@@ -251,6 +309,7 @@ lucent::RenderPart receive_part(int from, const lucent::PartInfo& mine,
 
 int run(const Args& a) {
   const bool root = g_rank == 0;
+  lucent::scene_detail::set_warning_sink(on_warning);
   // the scene, the output and the shares, agreed by all ranks: one line, status 1 (a scene no
   // rank could read, the commonest mistake, printed one line per rank and Open MPI's MPI_Abort
   // report)
@@ -414,6 +473,7 @@ int run(const Args& a) {
   // with a checkpoint: the render is complete when every rank's is; until then each rank's
   // samples go to its checkpoint, before they are sent (a SIGKILL that follows a SIGTERM during
   // the merge or the output's write loses nothing)
+  share_warnings();  // the render's
   int complete = ck ? ck->complete(renderer, g_stop.load()) : 1, all_complete = 1;
   MPI_Allreduce(&complete, &all_complete, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   lucent::RenderPart part = ck ? ck->whole(renderer) : lucent::make_part(renderer, range, a.scene);
