@@ -412,18 +412,26 @@ FileText resolved_cache_dir(const FileText& given) {
 }
 
 /// Gives every class of the module without a __reduce_ex__ of its own one for every pickle
-/// protocol. Protocols 0 and 1 otherwise reduce an object through copyreg._reduce_ex, which calls
-/// pybind11's base type on it: a C++ exception that nothing catches, and the interpreter aborts
-/// ("instance allocation failed: new instance has no pybind11-registered base types", pybind11
-/// issue 3745). A class with py::pickle reduces as protocol 2 does (copyreg.__newobj__, then
-/// __setstate__ with its state), in any protocol; the others raise the TypeError that protocol 2
-/// raises for them. The iterators of the bound lists (ShapeList, ...: a pybind11 'iterator'
-/// class each, in pybind11_builtins, not in the module) raise it too.
+/// protocol, and the same __reduce__. Protocols 0 and 1 otherwise reduce an object through
+/// copyreg._reduce_ex, which calls pybind11's base type on it: a C++ exception that nothing
+/// catches, and the interpreter aborts ("instance allocation failed: new instance has no
+/// pybind11-registered base types", pybind11 issue 3745); object.__reduce__(), called by hand,
+/// took the same path. A class with py::pickle reduces as protocol 2 does (copyreg.__newobj__,
+/// then __setstate__ with its state), in any protocol; the others raise the TypeError that
+/// protocol 2 raises for them. The iterators of the bound lists (ShapeList, ...: a pybind11
+/// 'iterator' class each, in pybind11_builtins, not in the module) raise it too.
 void reduce_in_every_protocol(py::module_& m) {
   const py::object newobj = py::module_::import("copyreg").attr("__newobj__");
   const auto is_bound = [](py::handle cls) {
     return PyType_Check(cls.ptr()) &&
            py::detail::get_type_info(reinterpret_cast<PyTypeObject*>(cls.ptr()));
+  };
+  // __reduce_ex__(protocol) and __reduce__() of `cls`, both `reduce`
+  const auto set_reduce = [](py::handle cls, const std::function<py::object(py::handle)>& reduce) {
+    cls.attr("__reduce_ex__") =
+        py::cpp_function([reduce](py::handle self, int) { return reduce(self); },
+                         py::is_method(cls), py::arg("protocol"));
+    cls.attr("__reduce__") = py::cpp_function(reduce, py::is_method(cls));
   };
   for (auto item : py::reinterpret_borrow<py::dict>(m.attr("__dict__"))) {
     py::handle cls = item.second;
@@ -436,30 +444,30 @@ void reduce_in_every_protocol(py::module_& m) {
     }
     py::object iterator = py::type::of(py::iter(empty));
     if (!is_bound(iterator) || iterator.attr("__dict__").contains("__reduce_ex__")) continue;
-    iterator.attr("__reduce_ex__") = py::cpp_function(
-        [](py::handle, int) -> py::object {
-          throw py::type_error("cannot pickle 'iterator' object");
-        },
-        py::is_method(iterator), py::arg("protocol"));
+    set_reduce(iterator, [](py::handle) -> py::object {
+      throw py::type_error("cannot pickle 'iterator' object");
+    });
   }
   for (auto item : py::reinterpret_borrow<py::dict>(m.attr("__dict__"))) {
     py::handle cls = item.second;
-    if (!is_bound(cls) || cls.attr("__dict__").contains("__reduce_ex__"))
-      continue;  // not a bound class (lucent.Error), or one that says itself (Renderer)
-    if (py::hasattr(cls, "__setstate__")) {
-      cls.attr("__reduce_ex__") = py::cpp_function(
-          [newobj](py::handle self, int) {
-            return py::make_tuple(newobj, py::make_tuple(py::type::handle_of(self)),
-                                  self.attr("__getstate__")());
-          },
-          py::is_method(cls), py::arg("protocol"));
+    if (!is_bound(cls)) continue;  // not a bound class (lucent.Error)
+    if (cls.attr("__dict__").contains("__reduce_ex__")) {
+      // one that says itself (Renderer): its __reduce__ says the same
+      if (!cls.attr("__dict__").contains("__reduce__")) {
+        const py::object own = cls.attr("__reduce_ex__");
+        cls.attr("__reduce__") =
+            py::cpp_function([own](py::handle self) { return own(self, 2); }, py::is_method(cls));
+      }
+    } else if (py::hasattr(cls, "__setstate__")) {
+      set_reduce(cls, [newobj](py::handle self) -> py::object {
+        return py::make_tuple(newobj, py::make_tuple(py::type::handle_of(self)),
+                              self.attr("__getstate__")());
+      });
     } else {
       const std::string name = cls.attr("__name__").cast<std::string>();
-      cls.attr("__reduce_ex__") = py::cpp_function(
-          [name](py::handle, int) -> py::object {
-            throw py::type_error("cannot pickle 'lucent." + name + "' object");
-          },
-          py::is_method(cls), py::arg("protocol"));
+      set_reduce(cls, [name](py::handle) -> py::object {
+        throw py::type_error("cannot pickle 'lucent." + name + "' object");
+      });
     }
   }
 }

@@ -348,7 +348,7 @@ import pickle, sys
 import numpy as np
 import lucent
 values = pickle.load(sys.stdin.buffer)
-refused = []
+refused, reduced = [], []
 scene = lucent.Scene()
 scene.materials.append(lucent.Material())
 # the iterators of the bound lists: pybind11 classes outside the module (pybind11_builtins)
@@ -361,8 +361,14 @@ with lucent.Renderer(**lucent.environment()) as r:
                 refused.append("pickled")
             except TypeError as e:
                 refused.append(str(e))
+        try:  # obj.__reduce__(), called by hand, took the same path (object's)
+            obj.__reduce__()
+            reduced.append("reduced")
+        except TypeError as e:
+            reduced.append(str(e))
 pickles = [[pickle.dumps(v, protocol) for protocol in (0, 1)] for v in values]
-pickle.dump((pickles, refused), sys.stdout.buffer, 2)
+states = [v.__reduce__()[2] for v in values]
+pickle.dump((pickles, refused, reduced, states), sys.stdout.buffer, 2)
 """
 
 
@@ -375,10 +381,12 @@ def test_protocols_0_and_1_pickle_or_refuse_and_never_abort(rich_scene):
     child = subprocess.run([sys.executable, "-c", OLD_PROTOCOLS], capture_output=True,
                            input=pickle.dumps(values, pickle.HIGHEST_PROTOCOL), timeout=WORKER_WAIT)
     assert child.returncode == 0, child.stderr.decode()
-    pickles, refused = pickle.loads(child.stdout)
-    for v, by_protocol in zip(values, pickles):
+    pickles, refused, reduced, states = pickle.loads(child.stdout)
+    for v, by_protocol, state in zip(values, pickles, states):
         for data in by_protocol:
             same(v.__getstate__(), pickle.loads(data).__getstate__(), type(v).__name__)
+        same(v.__getstate__(), state, type(v).__name__)
+    assert reduced == refused[::2], (reduced, refused)
     renderer_refused = [r for r in refused[:2] if r.startswith("cannot pickle or copy a lucent.")]
     assert len(renderer_refused) == 2, refused
     assert refused[2:] == ["cannot pickle 'lucent.CompareResult' object"] * 2 + [
