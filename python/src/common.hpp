@@ -387,6 +387,12 @@ class SharedObject {
   explicit SharedObject(py::object o);
   py::object get() const { return object_ ? *object_ : py::none(); }
   explicit operator bool() const { return object_ && !object_->is_none(); }
+  /// For a holder's tp_traverse (the GIL held): the object, or null.
+  PyObject* ptr() const { return object_ ? object_->ptr() : nullptr; }
+  /// For a holder's tp_clear (the GIL held): None from now on, in every copy.
+  void clear() {
+    if (object_) *object_ = py::none();
+  }
 
  private:
   std::shared_ptr<py::object> object_;

@@ -115,7 +115,8 @@ class PyRenderer {
     o.pass_seconds = pass_seconds;
     o.reserved_host_bytes = int_argument(reserved_host_bytes, "reserved_host_bytes", 0,
                                          std::numeric_limits<std::uint64_t>::max());
-    sink_ = python_warning_sink(SharedObject(std::move(on_warning)), warning_errors_);
+    on_warning_ = SharedObject(std::move(on_warning));
+    sink_ = python_warning_sink(on_warning_, warning_errors_);
     o.on_warning = [this](const std::string& message) {
       // a call_interruptible's worker thread has no Python frame: warnings.warn named "sys:1";
       // the warning is given on the caller's thread once the call returns (flush_warnings)
@@ -302,6 +303,13 @@ class PyRenderer {
   /// Destroys the session (with the GIL released: a device may take a while to let go). Refused
   /// while a call runs; claims the session first, so that no call starts meanwhile. Closing a
   /// closed renderer does nothing.
+  /// The Python objects the renderer holds, for the type's tp_traverse and tp_clear.
+  int visit_references(visitproc visit, void* arg) const {
+    Py_VISIT(on_warning_.ptr());
+    return 0;
+  }
+  void clear_references() { on_warning_.clear(); }
+
   void close() {
     if (closed_) return;
     if (busy_.exchange(true))
@@ -312,6 +320,7 @@ class PyRenderer {
       renderer_.reset();
       sink_ = nullptr;  // (the on_warning callable goes with the session)
     }
+    on_warning_ = SharedObject();  // (with the GIL: the garbage collector reads it under it)
     busy_ = false;
   }
 
@@ -362,6 +371,11 @@ class PyRenderer {
 
   std::optional<Renderer> renderer_;
   std::shared_ptr<CallbackErrors> warning_errors_;
+  /// on_warning, which sink_ holds too: visited and cleared by Python's garbage collector, so
+  /// that a renderer whose on_warning refers back to it (a bound method of the object that
+  /// holds the renderer) is collected; such a cycle kept the session, its buffers and its device
+  /// for the process's life (118 MiB a 1024x1024 session).
+  SharedObject on_warning_;
   WarningSink sink_;  ///< the session's warnings to Python (on_warning, or warnings.warn)
   /// A call_interruptible's worker thread's warnings, given when it returns (flush_warnings).
   std::atomic<bool> deferring_{false};
@@ -380,6 +394,38 @@ class PyRenderer {
   std::mutex counters_mutex_;
   Counters counters_;  ///< the counters while a call runs (counters_mutex_)
 };
+
+/// The C++ object of a bound instance, or null before its __init__ has made it (cls.__new__).
+template <class T>
+T* constructed(PyObject* self) {
+  auto* inst = reinterpret_cast<py::detail::instance*>(self);
+  py::detail::value_and_holder v_h = inst->get_value_and_holder(nullptr, false);
+  return v_h && v_h.holder_constructed() ? v_h.value_ptr<T>() : nullptr;
+}
+
+/// A py::custom_type_setup that makes T's instances known to Python's garbage collector
+/// through T's visit_references and clear_references: a cycle through the Python objects a T
+/// holds is collected.
+template <class T>
+void collected_by_python(PyHeapTypeObject* heap_type) {
+  PyTypeObject* type = &heap_type->ht_type;
+  type->tp_flags |= Py_TPFLAGS_HAVE_GC;
+  type->tp_traverse = [](PyObject* self, visitproc visit, void* arg) {
+    Py_VISIT(Py_TYPE(self));  // (a heap type's instances visit it)
+    const T* t = constructed<T>(self);
+    return t ? t->visit_references(visit, arg) : 0;
+  };
+  type->tp_clear = [](PyObject* self) {
+    if (T* t = constructed<T>(self)) t->clear_references();
+    return 0;
+  };
+  // untracked before the C++ object goes: a collection during its destructor (another
+  // thread's, while the destructor waits for the device) visited a half-destroyed object
+  type->tp_dealloc = [](PyObject* self) {
+    PyObject_GC_UnTrack(self);
+    reinterpret_cast<PyTypeObject*>(py::detail::get_internals().instance_base)->tp_dealloc(self);
+  };
+}
 
 /// Renderer.devices: every device of the session, when the library has several per session.
 template <class R>
@@ -751,7 +797,7 @@ void bind_render(py::module_& m) {
       .def("__repr__", &result_repr);
 
   py::class_<PyRenderer> renderer(
-      m, "Renderer",
+      m, "Renderer", py::custom_type_setup(collected_by_python<PyRenderer>),
       "A render session: one device and one scene, rendered progressively. set_scene() packs "
       "the scene and builds only what changed (a camera move rebuilds neither the BVH nor the "
       "kernel, and set_camera() packs nothing again: see stats). Environment variables are not "

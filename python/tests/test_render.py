@@ -1,11 +1,13 @@
 """The render session from Python: NumPy results without copies, progressive accumulation, what a
 change rebuilds (stats), AOVs, callbacks, the GIL, cancellation, and every error of the API."""
+import gc
 import inspect
 import pathlib
 import re
 import threading
 import time
 import warnings
+import weakref
 
 import numpy as np
 import pytest
@@ -551,3 +553,29 @@ def test_reprs_say_what_they_hold(renderer, small_scene):
     assert re.fullmatch(r"<lucent\.CompareResult passed, max \|z\| 0\.0+, RMSE 0\.0+>",
                         repr(lucent.compare(res.mean, res.mean)))
     assert repr(lucent.compare(res.mean, res.mean + 1)).startswith("<lucent.CompareResult FAILED")
+
+
+def test_a_renderer_in_a_cycle_through_its_on_warning_is_collected(small_scene):
+    """A renderer whose on_warning refers back to it (a bound method of the object that holds
+    it) was never collected: Python's garbage collector did not see the callable the renderer
+    held, and the session, its buffers and its device stayed for the process's life."""
+
+    class App:
+        def __init__(self):
+            self.renderer = session(on_warning=self.log)
+            self.renderer.set_scene(small_scene)
+
+        def log(self, message):
+            pass
+
+    app = App()
+    alive = weakref.ref(app)
+    del app
+    gc.collect()
+    assert alive() is None
+    # one never initialised (cls.__new__) is visited and collected too
+    bare = lucent.Renderer.__new__(lucent.Renderer)
+    cycle = [bare]
+    cycle.append(cycle)
+    del bare, cycle
+    gc.collect()
