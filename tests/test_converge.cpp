@@ -2,6 +2,7 @@
 // synthetic curves, then kernel ladders against a kernel reference (error falls as 1/spp for the
 // scene's own setting; a shallow max_depth is flagged biased), the CSV, the SVG plot and the CLI.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <atomic>
 #include <cctype>
@@ -1153,6 +1154,22 @@ TEST(Converge, CommandOutputsOverwriteNoInputAndNoOtherOutput) {
             "lucent: error: " + dir +
                 "/p.svg: given as --plot and as --plot; give each output "
                 "its own file\n");
+  // a FIFO (its open waited for a reader for ever) and a device (refused by the write, after
+  // the whole study): refused before rendering, as `render -o` refuses them
+  for (const char* option : {"--csv", "--plot", "--save-reference"}) {
+    const std::string fifo = dir + "/fifo" +
+                             (option[2] == 'c'   ? ".csv"
+                              : option[2] == 'p' ? ".svg"
+                                                 : ".exr");
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+    EXPECT_EQ(error("--reference-spp 4 " + std::string(option) + " " + q(fifo)),
+              "lucent: error: " + fifo +
+                  ": is a pipe, not a regular file (outputs are written to a temporary file "
+                  "renamed into place)\n");
+  }
+  EXPECT_EQ(error("--reference-spp 4 --csv /dev/full"),
+            "lucent: error: /dev/full: is a device, not a regular file (outputs are written to a "
+            "temporary file renamed into place)\n");
   for (size_t k = 0; k < before.size(); ++k)
     EXPECT_EQ(read_file(dir + "/" + files[k]), before[k]) << files[k] << " was overwritten";
   for (const char* f : {"/c.svg", "/p.svg"}) EXPECT_FALSE(std::filesystem::exists(dir + f)) << f;

@@ -71,19 +71,13 @@ struct Input {
 };
 
 /// Fails before any rendering when `path` cannot be written or is one of `inputs` (whose content
-/// it would replace).
+/// it would replace). (It opened the file to test it: a FIFO waited for a reader for ever, and a
+/// device was refused only by the write after the whole study.)
 void check_writable(const std::string& path, const std::vector<Input>& inputs) {
   for (const Input& in : inputs)
     if (io::same_file(path, in.path))
       throw Error(path + ": is " + in.what + "; refusing to overwrite it");
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory");
-  bool existed = std::filesystem::exists(path, ec);
-  errno = 0;
-  std::FILE* f = std::fopen(path.c_str(), "ab");
-  if (!f) throw Error(path + ": cannot write (" + std::string(std::strerror(errno)) + ")");
-  std::fclose(f);
-  if (!existed) std::filesystem::remove(path, ec);
+  io::check_output_file(path, {});
 }
 
 /// The outputs, each with its option: --csv, every --plot, --save-reference.

@@ -181,6 +181,13 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
   std::string ext = lower_extension(out);
   if (ext != ".png" && ext != ".pfm" && ext != ".exr")
     unknown_output_format(out, ext, ".png, .pfm or .exr");
+  check_output_file(out, inputs, is_checkpoint);
+}
+
+void check_output_file(const std::string& out, const std::vector<std::string>& inputs,
+                       bool is_checkpoint) {
+  std::error_code ec;
+  if (fs::is_directory(out, ec)) throw Error(out + ": is a directory");
   for (const std::string& in : inputs)
     if (same_file(out, in))
       throw Error(out + ": is an input of this render (" + in + "); refusing to overwrite it");

@@ -60,19 +60,24 @@ bool same_file(const std::string& a, const std::string& b);
 /// The extension of `path` with its dot, lower-cased: ".exr", ".png", "" when none.
 std::string lower_extension(const std::string& path);
 
-/// Fails early (before rendering) when `out` cannot be written as an image: not a format lucent
-/// writes (.png, .pfm, .exr), a directory, a directory that does not exist or cannot be written
-/// to (tested by creating the temporary file the final write goes through), a name longer than
-/// the file system allows, a read-only file, or one of
-/// `inputs` ("<out>: is an input of this render (<input>); refusing to overwrite it").
-/// Unless `is_checkpoint` (whose own lock then says so), an output that is the checkpoint of a
-/// render in progress is refused too: its `<target>.lock` is held (flock) and begins with
-/// kCheckpointLockMark (a lock of that name taken by other means, `flock out.exr.lock lucent
-/// ...`, is not a checkpoint's).
 /// What a checkpoint's lock file holds while a render holds the lock (lucent::cli::CheckpointLock).
 inline constexpr char kCheckpointLockMark[] = "lucent checkpoint lock\n";
 
+/// Fails early (before rendering) when `out` cannot be written as an image: not a format lucent
+/// writes (.png, .pfm, .exr), or check_output_file's reasons.
 void check_output_path(const std::string& out, const std::vector<std::string>& inputs,
+                       bool is_checkpoint = false);
+
+/// Fails early (before rendering) when the file `out` cannot be written: a directory, a FIFO or
+/// a device (or a link to one; check_writable_kind), a directory that does not exist or cannot
+/// be written to (tested by creating the temporary file the final write goes through), a name
+/// longer than the file system allows, a read-only file, or one of `inputs` ("<out>: is an
+/// input of this render (<input>); refusing to overwrite it"). Unless `is_checkpoint` (whose own
+/// lock then says so), an output that is the checkpoint of a render in progress is refused too:
+/// its `<target>.lock` is held (flock) and begins with kCheckpointLockMark (a lock of that name
+/// taken by other means, `flock out.exr.lock lucent ...`, is not a checkpoint's). Opens nothing
+/// at `out` itself (a FIFO's open waited for a reader for ever).
+void check_output_file(const std::string& out, const std::vector<std::string>& inputs,
                        bool is_checkpoint = false);
 
 /// Throws the error of an output `path` whose extension `ext` (lower-case, with its dot; "" for
