@@ -279,6 +279,20 @@ TEST(Outputs, InputsOfTheRenderAreRefused) {
       error_line(run_cli("render " + q(textured) + " -o " + q(dir + "/y.exr") + " --aov depth")),
       dir + "/y.depth.exr: is a directory");
   EXPECT_FALSE(fs::exists(dir + "/y.exr"));
+  // outputs that are one file through a link: two AOVs (the last written replaced the other,
+  // exit 0), an AOV and the main output
+  fs::create_symlink("z.normal.exr", dir + "/z.albedo.exr");
+  EXPECT_EQ(error_line(run_cli("render " + q(textured) + " -o " + q(dir + "/z.exr") +
+                               " --aov albedo,normal")),
+            dir + "/z.normal.exr: is the albedo AOV's output (" + dir +
+                "/z.albedo.exr) too: give each output its own file");
+  fs::create_symlink("z.exr", dir + "/z.depth.exr");
+  EXPECT_EQ(
+      error_line(run_cli("render " + q(textured) + " -o " + q(dir + "/z.exr") + " --aov depth")),
+      dir + "/z.depth.exr: is the output (-o " + dir +
+          "/z.exr) too: give each output its own file");
+  EXPECT_FALSE(fs::exists(dir + "/z.exr"));
+  EXPECT_FALSE(fs::exists(dir + "/z.normal.exr"));
   EXPECT_EQ(error_line(run_cli("render " + q(scene) + " -o ''")),
             "--output: must not be empty (see lucent --help)");
   // compare's z map and converge's outputs are checked the same way

@@ -324,6 +324,18 @@ int render_with(const RenderArgs& a) {
                           ": is the output too: give --checkpoint a file of its own");
   }
   lucent::io::check_output_path(a.output, {a.scene});
+  // the outputs against each other (a link made two of them one file, and the last AOV written
+  // replaced the other without a word)
+  for (size_t i = 0; i < a.aovs.size(); ++i) {
+    const std::string path = aov_path(a.output, a.aovs[i]);
+    if (lucent::io::same_file(path, a.output))
+      throw lucent::Error(path + ": is the output (-o " + a.output +
+                          ") too: give each output its own file");
+    for (size_t j = 0; j < i; ++j)
+      if (lucent::io::same_file(path, aov_path(a.output, a.aovs[j])))
+        throw lucent::Error(path + ": is the " + a.aovs[j] + " AOV's output (" +
+                            aov_path(a.output, a.aovs[j]) + ") too: give each output its own file");
+  }
   for (const std::string& name : a.aovs)
     lucent::io::check_output_path(aov_path(a.output, name), {a.scene, a.output});
   if (!a.checkpoint.empty())
