@@ -127,8 +127,9 @@ class Renderer;
 
 struct ConvergeOptions {
   std::vector<ConvergeSetting> settings;  ///< empty: {default}
-  std::vector<int> spp_ladder;            ///< samples per pixel of each rung
-  std::vector<double> time_ladder;        ///< seconds per rung; used instead of spp_ladder if set
+  /// Samples per pixel of each rung, rendered (and its points given) in ascending order.
+  std::vector<int> spp_ladder;
+  std::vector<double> time_ladder;  ///< seconds per rung, as spp_ladder; used instead if set
   /// Device, kernel and cache directories, pass_seconds, cancel, on_progress (spp and time are
   /// the ladder's; precision, fast math and specialisation the settings').
   RenderOptions render;
@@ -144,7 +145,7 @@ struct ConvergeOptions {
 };
 
 struct ConvergeResult {
-  std::vector<ConvergePoint> points;  ///< setting by setting, each in ladder order
+  std::vector<ConvergePoint> points;  ///< setting by setting, each in ascending rung order
   std::vector<ConvergeFit> fits;      ///< one per setting, in the order given
 };
 

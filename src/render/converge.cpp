@@ -508,7 +508,13 @@ void check_convergence_options(const ConvergeOptions& options, const Scene* scen
 }
 
 ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference,
-                               const ConvergeOptions& options) {
+                               const ConvergeOptions& given) {
+  // the rungs in ascending order: the verdict reads the last point as the largest rung, the fit
+  // the last three, the time to a common error the first and the last (a ladder 1024,4,8 was
+  // judged at 8 spp: "unbiased" for a setting judged biased on 4,8,1024)
+  ConvergeOptions options = given;
+  std::sort(options.spp_ladder.begin(), options.spp_ladder.end());
+  std::sort(options.time_ladder.begin(), options.time_ladder.end());
   check_comparable_image(reference, "the reference image");  // every error against it would be NaN
   if (reference.mean.width != scene.film.width || reference.mean.height != scene.film.height)
     throw Error("the reference image is " + std::to_string(reference.mean.width) + "x" +
