@@ -440,6 +440,20 @@ TEST(Converge, LaddersBeyondTheLimitsAreRefused) {
   EXPECT_NO_THROW(lucent::check_convergence_options(opt));
 }
 
+// The default reference renders 16 x the top rung, at most 2^24 spp (--reference-spp's largest):
+// a rung past 2^20 made it 2^28 without a word. (Stopped once the reference's line is out.)
+TEST(Converge, DefaultReferenceStaysWithinTheSampleLimit) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/s.json", R"({
+    "film": {"width": 1, "height": 1},
+    "materials": {"m": {"type": "diffuse"}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]})");
+  lucent::test::CommandResult r = lucent::test::run_cli(
+      "converge '" + dir + "/s.json' --spp-ladder 1048577", "timeout -s TERM 4");
+  EXPECT_EQ(r.err.rfind("reference: 16777216 spp with the kernel", 0), 0u) << r.err;
+}
+
 TEST(Converge, FitOfSyntheticCurves) {
   // pure noise, relMSE = 0.5 / spp: slope exactly -1 against spp and against time (t ~ spp)
   std::vector<double> e, floor_e, flat_noise;

@@ -150,7 +150,8 @@ CLI::App* add_converge_command(CLI::App& app) {
                   ->check(non_empty());
   auto* ref_spp = cmd->add_option("--reference-spp", a.reference_spp,
                                   "Render the reference with this many spp (default: 16 x the "
-                                  "largest rung, at least 256; 1024 with --time-ladder)")
+                                  "largest rung, at least 256, at most 2^24; 1024 with "
+                                  "--time-ladder)")
                       ->check(CLI::Range(1, limits::kMaxSpp));
   auto* ref_cpu = cmd->add_flag("--reference-cpu", a.reference_cpu,
                                 "Render the reference with the scalar reference integrator");
@@ -323,8 +324,11 @@ int run_converge_command() {
   } else {
     int largest = 0;
     for (int s : opt.spp_ladder) largest = std::max(largest, s);
+    // (at most --reference-spp's largest, 2^24: 16 x a top rung past 2^20 went past it, to 2^28)
     int spp = a.reference_spp > 0 ? a.reference_spp
-                                  : (opt.time_ladder.empty() ? std::max(256, 16 * largest) : 1024);
+                                  : (opt.time_ladder.empty()
+                                         ? std::min(std::max(256, 16 * largest), limits::kMaxSpp)
+                                         : 1024);
     Scene rs = scene;
     rs.integrator.seed = reference_seed(scene.integrator.seed);  // independent of the ladder
     // independent samples: the reference's own noise is what its variances say
