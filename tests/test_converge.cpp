@@ -519,8 +519,14 @@ TEST(Converge, FitOfSyntheticCurves) {
     EXPECT_FALSE(g.biased);
     EXPECT_NE(g.verdict.find("unbiased (error/noise 1.00"), std::string::npos) << g.verdict;
   }
+  // no variance estimate and fewer than three rungs: nothing tells (it said "unbiased"); an
+  // error of 0 does
   EXPECT_EQ(lucent::fit_convergence(synthetic({e[0]}, {0.0})).verdict,
-            "unbiased (no variance estimate, and too few rungs for a slope)");
+            "undetermined (no variance estimate, and too few rungs for a slope)");
+  EXPECT_EQ(lucent::fit_convergence(synthetic({e[0], e[1]}, {0.0, 0.0})).verdict,
+            "undetermined (no variance estimate, and too few rungs for a slope)");
+  EXPECT_EQ(lucent::fit_convergence(synthetic({0.0, 0.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 0.0})).verdict,
+            "unbiased (no error at the last rung)");
 }
 
 TEST(Converge, KernelLadderAgainstKernelReference) {
@@ -847,9 +853,10 @@ TEST(Converge, ReferenceAtTheLaddersSeedIsRefused) {
   EXPECT_EQ(lucent::run_convergence(scene, independent_reference(scene), opt).points.size(), 1u);
 }
 
-// An adaptive setting's rung below the one before starts over, as a uniform rung does: it
-// continued the render, which had more samples already, and a ladder 8,4 reported 8 spp twice.
-// The 4-spp rung after the 8-spp one is the render of a ladder of that rung alone.
+// A ladder 8,4: an adaptive setting continued the 8-spp render for the 4-spp rung, and reported
+// 8 spp twice. The rungs are now taken in ascending order (Converge.RungsAreTakenInAscendingOrder),
+// adaptive ones too: the 4-spp rung comes first and is the render of a ladder of that rung alone,
+// for each setting.
 TEST(Converge, AdaptiveRungBelowThePreviousStartsOver) {
   lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
   scene.film.width = scene.film.height = 8;
@@ -861,12 +868,12 @@ TEST(Converge, AdaptiveRungBelowThePreviousStartsOver) {
                   lucent::parse_converge_setting("default")};
   const lucent::ConvergeResult r = lucent::run_convergence(scene, reference, opt);
   ASSERT_EQ(r.points.size(), 4u);
-  for (size_t i = 0; i < 4; ++i) EXPECT_EQ(r.points[i].spp, opt.spp_ladder[i % 2]) << i;
+  for (size_t i = 0; i < 4; ++i) EXPECT_EQ(r.points[i].spp, i % 2 ? 8u : 4u) << i;
   opt.spp_ladder = {4};
   const lucent::ConvergeResult alone = lucent::run_convergence(scene, reference, opt);
   ASSERT_EQ(alone.points.size(), 2u);
-  EXPECT_EQ(r.points[1].relmse, alone.points[0].relmse);
-  EXPECT_EQ(r.points[3].relmse, alone.points[1].relmse);
+  EXPECT_EQ(r.points[0].relmse, alone.points[0].relmse);
+  EXPECT_EQ(r.points[2].relmse, alone.points[1].relmse);
   EXPECT_NE(r.points[0].relmse, r.points[1].relmse);
 }
 

@@ -403,11 +403,15 @@ ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
   }
   f.bias_relmse = std::max(0.0, last.relmse - last.noise_relmse);
   if (!f.biased) {
+    // without a variance estimate (1-spp rungs, a constant image) only the tail's slope tells,
+    // over three rungs or more: fewer said "unbiased" of a setting whose error was 0.47 (a
+    // clamp at 0.01) on one rung of 1 spp
     f.verdict =
         last.noise_relmse > 0
             ? "unbiased (error/noise " + fmt("%.2f", f.excess_ratio) + " at the last rung)"
-        : std::isnan(f.tail_slope_spp)
-            ? "unbiased (no variance estimate, and too few rungs for a slope)"
+        : last.relmse == 0 ? std::string("unbiased (no error at the last rung)")
+        : points.size() < 3 || std::isnan(f.tail_slope_spp)
+            ? "undetermined (no variance estimate, and too few rungs for a slope)"
             : "unbiased (no variance estimate; tail slope " + fmt("%.2f", f.tail_slope_spp) + ")";
     return f;
   }
