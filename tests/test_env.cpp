@@ -31,7 +31,11 @@ std::string small_scene() {
 }
 
 // (With PoCL's own cache off: where the driver caches its builds, lucent's directory is unused.)
+// On PoCL, whose sessions keep no entries in lucent's cache (keeps_program_binaries), the
+// directory holds build locks only, and one that cannot serve goes unsaid: the render is the same.
 TEST(Env, UnusableCacheDirWarnsAndRenders) {
+  const bool entries = lucent::cl_util::keeps_program_binaries(
+      lucent::cl_util::Context(lucent::test::device()).device);
   std::string dir = lucent::test::temp_dir();
   std::string file = dir + "/a-file";
   lucent::test::write_file(file, "x");
@@ -48,7 +52,7 @@ TEST(Env, UnusableCacheDirWarnsAndRenders) {
     CommandResult r = run_cli("render " + q(small_scene()) + " -o " + q(out) + " --quiet",
                               "POCL_KERNEL_CACHE=0 LUCENT_CACHE_DIR=" + q(c.value));
     EXPECT_EQ(r.status, 0) << r.err;
-    EXPECT_EQ(r.err, c.warning);
+    EXPECT_EQ(r.err, entries ? c.warning : "");
     EXPECT_EQ(lucent::read_image(out).width, 8);
     fs::remove(out);
   }
@@ -61,8 +65,9 @@ TEST(Env, UnusableCacheDirWarnsAndRenders) {
                 "POCL_KERNEL_CACHE=0 LUCENT_CACHE_DIR=" + q(ro));
     ::chmod(ro.c_str(), 0755);
     EXPECT_EQ(r.status, 0) << r.err;
-    EXPECT_EQ(r.err, "lucent: warning: kernel cache " + ro +
-                         ": Permission denied; kernels are built without the cache\n");
+    EXPECT_EQ(r.err, entries ? "lucent: warning: kernel cache " + ro +
+                                   ": Permission denied; kernels are built without the cache\n"
+                             : "");
   }
 }
 
