@@ -443,6 +443,28 @@ TEST(Outputs, RenderWithoutAFiniteSampleWritesNothing) {
                 "p.json: /lights/0/intensity 1e+30 is above 1.84e+19, where a sample's square "
                 "overflows a float within a distance of about 2.33e+05 of it: such samples are "
                 "dropped as non-finite (lower it and raise film.exposure)"});
+  // the other end: below the smallest normal float, in which the kernel keeps it, a value is
+  // rounded (5e-45 lit a tiny scene 12% too brightly, 5e-46 not at all), in double precision too
+  const lucent::Scene faint = lucent::parse_scene(R"({
+    "materials": {"grey": {"type": "diffuse"}, "glow": {"type": "diffuse", "emission": [1, 1, 1]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "grey"}],
+    "lights": [{"type": "point", "position": [0, 2, 0], "intensity": [1, 5e-45, 1]},
+               {"type": "environment", "radiance": [1.2e-38, 1.2e-38, 1.2e-38]}]
+  })",
+                                                  "f.json");
+  EXPECT_EQ(lucent::scene_detail::radiance_notes(faint),
+            std::vector<std::string>{
+                "f.json: /lights/0/intensity 5e-45 is below 1.18e-38, the smallest normal float, "
+                "in which the kernel keeps it: it is rounded (to 0 below 7e-46), and so is the "
+                "light it gives (raise it and lower film.exposure)"});
+  lucent::Scene dim = faint;
+  dim.lights.erase(dim.lights.begin());  // 1.2e-38: a normal float
+  EXPECT_EQ(lucent::scene_detail::radiance_notes(dim), std::vector<std::string>{});
+  dim.materials[1].emission = glm::dvec3(0, 1e-40, 0);
+  ASSERT_EQ(lucent::scene_detail::radiance_notes(dim).size(), 1u);
+  EXPECT_EQ(lucent::scene_detail::radiance_notes(dim)[0].rfind(
+                "f.json: material 'glow': emission 1e-40 is below 1.18e-38", 0),
+            0u);
   // a part keeps its counts (all 0) and merges into a part; not into an image (lucent-mpi writes
   // through the same function)
   ASSERT_EQ(
