@@ -735,6 +735,9 @@ TEST(Parts, DamagedPartFilesAreOneLineErrors) {
   };
   const size_t hash = value_at("lucent.hash");
   const std::string hash_value = bytes.substr(hash, 16);
+  // the display settings in the fewest digits that read back (gamma 2.2 was 2.2000000000000002)
+  const size_t display = value_at("lucent.display");
+  EXPECT_EQ(bytes.substr(display - 4, 20), std::string("\x10\0\0\0srgb,2.2,0,clamp", 20));
   struct Damage {
     std::string attribute, from, to, message;
   };

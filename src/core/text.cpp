@@ -1,6 +1,7 @@
 #include "core/text.hpp"
 
 #include <cstdio>
+#include <cstdlib>
 
 namespace lucent::io {
 
@@ -68,6 +69,15 @@ bool plain_decimal_real(const std::string& text) {
     while (digit(i)) ++i;
   }
   return i == text.size();
+}
+
+std::string shortest_real(double v) {
+  char text[64];
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, v);
+    if (std::strtod(text, nullptr) == v) break;
+  }
+  return text;
 }
 
 }  // namespace lucent::io

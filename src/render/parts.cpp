@@ -465,9 +465,9 @@ void parts_detail::write_part_unchecked(const std::string& path, const RenderPar
       for (bool high : {true, false})
         extras.uint_channels.emplace_back(channel_name(plane, c, high),
                                           words.data() + size_t(k++) * npix);
-  char gamma[64], exposure[64], seconds[64];
-  std::snprintf(gamma, sizeof gamma, "%.17g", info.display.gamma);
-  std::snprintf(exposure, sizeof exposure, "%.17g", info.display.exposure);
+  char seconds[64];
+  const std::string gamma = io::shortest_real(info.display.gamma),
+                    exposure = io::shortest_real(info.display.exposure);
   std::snprintf(seconds, sizeof seconds, "%.6f", info.seconds);
   extras.attributes = {
       {"lucent.format", kFormat},
