@@ -123,6 +123,41 @@ struct type_caster<lucent::python::TextArg> {
 
 namespace lucent::python {
 
+/// A True/False argument as given, for flag_argument() to check: a bool parameter took anything
+/// with a truth value (fast_math=0.5 turned fast math on, complete=None off), as the scene's bool
+/// fields did before bool_property; the signature still says "bool".
+struct FlagArg {
+  py::object value;
+};
+
+}  // namespace lucent::python
+
+namespace pybind11::detail {
+template <>
+struct type_caster<lucent::python::FlagArg> {
+  PYBIND11_TYPE_CASTER(lucent::python::FlagArg, const_name("bool"));
+  bool load(handle src, bool) {
+    value.value = reinterpret_borrow<object>(src);
+    return true;
+  }
+  static handle cast(const lucent::python::FlagArg& arg, return_value_policy, handle) {
+    return arg.value.inc_ref();
+  }
+};
+}  // namespace pybind11::detail
+
+namespace lucent::python {
+
+/// `v` as a bool: True, False or a NumPy bool, else TypeError "<what> must be True or False,
+/// got 0.5".
+inline bool flag_value(py::handle v, const std::string& what) {
+  const std::string type = Py_TYPE(v.ptr())->tp_name;
+  if (!py::isinstance<py::bool_>(v) && type != "numpy.bool_" && type != "numpy.bool")
+    throw py::type_error(what + " must be True or False, got " + py::repr(v).cast<std::string>());
+  return v.cast<bool>();
+}
+inline bool flag_argument(const FlagArg& a, const char* what) { return flag_value(a.value, what); }
+
 /// `v` as text: a str, else TypeError "<what> must be a str, got bytes".
 inline std::string enum_text(py::handle v, const char* what) {
   if (!py::isinstance<py::str>(v))

@@ -164,7 +164,9 @@ void bind_image(py::module_& m) {
   m.def(
       "merge_parts",
       [](const std::vector<std::filesystem::path>& paths,
-         std::optional<std::filesystem::path> output, py::object expect, bool complete) {
+         std::optional<std::filesystem::path> output, py::object expect,
+         const FlagArg& complete_arg) {
+        const bool complete = flag_argument(complete_arg, "complete");
         std::vector<std::string> inputs;
         for (const auto& p : paths) inputs.push_back(p.string());
         if (inputs.empty()) throw py::value_error("merge_parts: no part files given");
@@ -241,7 +243,8 @@ void bind_image(py::module_& m) {
   m.def(
       "compare",
       [](py::handle a, py::handle b, double alpha, double min_pass_fraction, double abs_epsilon,
-         double rel_epsilon, bool image_mean_test) {
+         double rel_epsilon, const FlagArg& image_mean_test_arg) {
+        const bool image_mean_test = flag_argument(image_mean_test_arg, "image_mean_test");
         // the library's and the command line's range (0.7 passed here, then failed there)
         if (!(alpha >= 1e-12 && alpha <= 0.5))
           throw py::value_error("alpha must be in [1e-12, 0.5], got " + std::to_string(alpha));

@@ -94,8 +94,8 @@ void bind_device_shares(py::module_& m, py::class_<T>& c) {
 class PyRenderer {
  public:
   PyRenderer(const TextArg& device_arg, const FileText& kernel_dir, const FileText& cache_dir,
-             const TextArg& precision, bool fast_math, bool specialize, double pass_seconds,
-             const IntArg& reserved_host_bytes, py::object on_warning)
+             const TextArg& precision, const FlagArg& fast_math, const FlagArg& specialize,
+             double pass_seconds, const IntArg& reserved_host_bytes, py::object on_warning)
       : warning_errors_(std::make_shared<CallbackErrors>()) {
     check_callable(on_warning, "on_warning");
     const std::string device = text_argument(device_arg, "device");
@@ -110,8 +110,8 @@ class PyRenderer {
     o.kernel_dir = kernel_dir.bytes;
     o.cache_dir = cache_dir.bytes;
     o.precision = parse_enum<Precision>(text_argument(precision, "precision"));
-    o.fast_math = fast_math;
-    o.specialize = specialize;
+    o.fast_math = flag_argument(fast_math, "fast_math");
+    o.specialize = flag_argument(specialize, "specialize");
     o.pass_seconds = pass_seconds;
     o.reserved_host_bytes = int_argument(reserved_host_bytes, "reserved_host_bytes", 0,
                                          std::numeric_limits<std::uint64_t>::max());
@@ -439,6 +439,7 @@ void bind_session_devices(py::class_<PyRenderer>& c) {
 // reset() starts below 2**32.
 constexpr std::uint64_t kSampleIndices = std::uint64_t(1) << 32;
 constexpr const char* kSampleNote = " (the sampler's sample indices are 32-bit)";
+constexpr const char* kCountNote = " (a pixel's sample count is 32-bit)";
 constexpr std::uint64_t kMaxAdaptiveSpp = std::numeric_limits<std::uint32_t>::max();
 
 /// A time limit: as checked_seconds, and at most the command line's 1e7 s (--time; a render_for
@@ -805,8 +806,8 @@ void bind_render(py::module_& m) {
       "the `lucent` command's defaults.");
   bind_session_devices<Renderer>(renderer);
   renderer
-      .def(py::init<const TextArg&, const FileText&, const FileText&, const TextArg&, bool, bool,
-                    double, const IntArg&, py::object>(),
+      .def(py::init<const TextArg&, const FileText&, const FileText&, const TextArg&,
+                    const FlagArg&, const FlagArg&, double, const IntArg&, py::object>(),
            py::kw_only(), py::arg("device") = "", py::arg("kernel_dir") = "",
            py::arg("cache_dir") = "", py::arg("precision") = "float", py::arg("fast_math") = false,
            py::arg("specialize") = true, py::arg("pass_seconds") = 0.25,
@@ -841,8 +842,11 @@ void bind_render(py::module_& m) {
           "another thread's call runs.")
       .def(
           "set_build_options",
-          [](PyRenderer& r, const TextArg& precision, bool fast_math, bool specialize) {
+          [](PyRenderer& r, const TextArg& precision, const FlagArg& fast_math_arg,
+             const FlagArg& specialize_arg) {
             Precision p = parse_enum<Precision>(text_argument(precision, "precision"));
+            const bool fast_math = flag_argument(fast_math_arg, "fast_math"),
+                       specialize = flag_argument(specialize_arg, "specialize");
             r.call_interruptible("set_build_options", [&](Renderer& rr, std::atomic<bool>&) {
               rr.set_build_options(p, fast_math, specialize);
             });
@@ -880,7 +884,9 @@ void bind_render(py::module_& m) {
       .def(
           "render",
           [](PyRenderer& r, const IntArg& spp_arg, double seconds, py::object progress) {
-            const std::uint64_t spp = int_argument(spp_arg, "spp", 0, kSampleIndices, kSampleNote);
+            // (2**32 passed here, and the session refused it: a pixel's count holds 2**32 - 1)
+            const std::uint64_t spp =
+                int_argument(spp_arg, "spp", 0, kSampleIndices - 1, kCountNote);
             seconds = checked_time_limit(seconds, "seconds");
             if (spp == 0 && seconds == 0)
               throw py::value_error(

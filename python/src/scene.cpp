@@ -201,12 +201,7 @@ void bool_property(py::class_<C>& c, const char* name, bool C::*member, const ch
   c.def_property(
       name, [member](const C& o) { return o.*member; },
       [member, what](py::handle self, py::object v) {
-        const bool numpy_bool = std::string(Py_TYPE(v.ptr())->tp_name) == "numpy.bool_" ||
-                                std::string(Py_TYPE(v.ptr())->tp_name) == "numpy.bool";
-        if (!py::isinstance<py::bool_>(v) && !numpy_bool)
-          throw py::type_error(what + " must be True or False, got " +
-                               py::repr(v).cast<std::string>());
-        assigned<C>(self).*member = v.cast<bool>();
+        assigned<C>(self).*member = flag_value(v, what);
       },
       doc);
 }
@@ -859,12 +854,13 @@ auto with_warnings(py::object on_warning, F&& load) {
 
 /// What `lucent info` prints, as a dict: the packed scene's counts, its BVH and the kernel's
 /// feature defines and build options for these settings. Needs no device.
-py::dict scene_info(const Scene& scene, const TextArg& precision, bool fast_math, bool specialize,
-                    py::object on_warning) {
+py::dict scene_info(const Scene& scene, const TextArg& precision, const FlagArg& fast_math_arg,
+                    const FlagArg& specialize_arg, py::object on_warning) {
   RenderOptions options;
   options.precision = parse_enum<Precision>(text_argument(precision, "precision"));
-  options.fast_math = fast_math;
-  options.specialize = specialize;
+  options.fast_math = flag_argument(fast_math_arg, "fast_math");
+  options.specialize = flag_argument(specialize_arg, "specialize");
+  const bool specialize = options.specialize;
   Scene copy = scene;
   auto packed = with_warnings(std::move(on_warning), [&] {
     scene_detail::validate_scene(copy);  // fields set from Python may index past the lists
@@ -909,7 +905,7 @@ py::dict scene_info(const Scene& scene, const TextArg& precision, bool fast_math
   d["bvh"] = bvh;
   d["feature_defines"] = define_list;
   d["precision"] = precision_name(options.precision);
-  d["fast_math"] = fast_math;
+  d["fast_math"] = options.fast_math;
   d["build_options"] = render_detail::build_options(copy, packed, options);
   // what a session's set_scene checks before rendering on a CPU device (the scene held twice:
   // the application's and the session's copy), as `lucent info` prints it

@@ -370,7 +370,7 @@ def test_session_errors(renderer, small_scene):
     with pytest.raises(lucent.Error, match="no scene"):
         renderer.scene
     renderer.set_scene(small_scene)
-    with pytest.raises(ValueError, match=r"spp must be an integer in \[0, 2\*\*32\]"):
+    with pytest.raises(ValueError, match=r"spp must be an integer in \[0, 2\*\*32 - 1\]"):
         renderer.render(-1)
     with pytest.raises(ValueError, match="render: give spp > 0, seconds > 0 or both"):
         renderer.render(0)
@@ -413,14 +413,16 @@ def test_session_errors(renderer, small_scene):
 
 
 U32 = "the sampler's sample indices are 32-bit"
+COUNT = "a pixel's sample count is 32-bit"
 
 
 @pytest.mark.parametrize("call, message", [
     # integers out of range, whatever their size: ValueError naming the argument and its range
-    (lambda r: r.render(2 ** 32 + 1), r"^spp must be an integer in \[0, 2\*\*32\] \(%s\), got "
-     r"4294967297$" % U32),
-    (lambda r: r.render(2 ** 63), r"^spp must be an integer in \[0, 2\*\*32\] \(%s\), got "
-     r"9223372036854775808$" % U32),
+    # (2**32 passed the range, and the session refused it: a pixel's count holds 2**32 - 1)
+    (lambda r: r.render(2 ** 32), r"^spp must be an integer in \[0, 2\*\*32 - 1\] \(%s\), got "
+     r"4294967296$" % COUNT),
+    (lambda r: r.render(2 ** 63), r"^spp must be an integer in \[0, 2\*\*32 - 1\] \(%s\), got "
+     r"9223372036854775808$" % COUNT),
     (lambda r: r.render(2 ** 64), r"^spp must be .*, got 18446744073709551616$"),
     (lambda r: r.render(-2 ** 70), r"^spp must be .*, got -1180591620717411303424$"),
     (lambda r: r.render(0), r"^render: give spp > 0, seconds > 0 or both, got spp=0 and seconds=0$"),
@@ -579,3 +581,26 @@ def test_a_renderer_in_a_cycle_through_its_on_warning_is_collected(small_scene):
     cycle.append(cycle)
     del bare, cycle
     gc.collect()
+
+
+def test_flags_take_true_or_false_only(small_scene):
+    """A bool argument took anything with a truth value: fast_math=0.5 turned fast math on,
+    complete=None off, image_mean_test=0.3 on (the scene's bool fields refuse them already)."""
+    img = np.ones((2, 2, 3), np.float32)
+    calls = {
+        "fast_math": lambda: lucent.Renderer(fast_math=0.5),
+        "specialize": lambda: lucent.Renderer(specialize=None),
+        "image_mean_test": lambda: lucent.compare(img, img, image_mean_test=0.3),
+        "complete": lambda: lucent.merge_parts(["a.exr"], complete="yes"),
+    }
+    for name, call in calls.items():
+        with pytest.raises(TypeError, match=r"^%s must be True or False, got " % name):
+            call()
+    with pytest.raises(TypeError, match=r"^fast_math must be True or False, got 2\.0$"):
+        lucent.scene_info(small_scene, fast_math=2.0)
+    with session() as r:
+        with pytest.raises(TypeError, match=r"^specialize must be True or False, got 1$"):
+            r.set_build_options(specialize=1)
+        r.set_build_options(fast_math=np.bool_(True))  # a NumPy bool is a bool
+        assert r.options["fast_math"] is True
+    assert lucent.scene_info(small_scene, fast_math=True)["fast_math"] is True
