@@ -5,11 +5,11 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
-#include <pybind11/stl/filesystem.h>
 
 #include <atomic>
 #include <cstdint>
 #include <exception>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -56,16 +56,65 @@ template <>
 struct type_caster<lucent::python::FileText> {
   PYBIND11_TYPE_CASTER(lucent::python::FileText, const_name("str"));
   bool load(handle src, bool) {
-    if (PyBytes_Check(src.ptr())) {
-      value.bytes.assign(PyBytes_AS_STRING(src.ptr()),
-                         static_cast<std::size_t>(PyBytes_GET_SIZE(src.ptr())));
+    object text = reinterpret_borrow<object>(src);
+    // an os.PathLike (pathlib.Path) as os.fspath gives it: Renderer(cache_dir=Path(...)) was
+    // pybind's "incompatible function arguments", where every other path argument took one
+    if (!PyBytes_Check(src.ptr()) && !PyUnicode_Check(src.ptr()) &&
+        PyObject_HasAttrString(src.ptr(), "__fspath__")) {
+      text = reinterpret_steal<object>(PyOS_FSPath(src.ptr()));
+      if (!text) {
+        PyErr_Clear();
+        return false;
+      }
+    }
+    if (PyBytes_Check(text.ptr())) {
+      value.bytes.assign(PyBytes_AS_STRING(text.ptr()),
+                         static_cast<std::size_t>(PyBytes_GET_SIZE(text.ptr())));
       return true;
     }
-    return PyUnicode_Check(src.ptr()) && lucent::python::file_bytes(src, value.bytes);
+    return PyUnicode_Check(text.ptr()) && lucent::python::file_bytes(text, value.bytes);
   }
   static handle cast(const lucent::python::FileText& text, return_value_policy, handle) {
     return PyUnicode_DecodeUTF8(text.bytes.data(), static_cast<Py_ssize_t>(text.bytes.size()),
                                 "surrogateescape");
+  }
+};
+}  // namespace pybind11::detail
+
+namespace lucent::python {
+void refuse_nul(const std::string& text, const char* what);
+}  // namespace lucent::python
+
+namespace pybind11::detail {
+/// A file path (write_image, read_image, load_scene, ...): a str, bytes or os.PathLike, as
+/// pybind11's own caster takes them, but a NUL in it is ValueError "path: embedded null character
+/// in ..." (pybind11's said "incompatible function arguments", naming neither, where cache_dir
+/// and the device selector said the former).
+template <>
+struct type_caster<std::filesystem::path> {
+  PYBIND11_TYPE_CASTER(std::filesystem::path, const_name("os.PathLike"));
+  bool load(handle src, bool) {
+    object text = reinterpret_steal<object>(PyOS_FSPath(src.ptr()));
+    if (!text) {
+      PyErr_Clear();
+      return false;
+    }
+    std::string bytes;
+    if (PyBytes_Check(text.ptr()))
+      bytes.assign(PyBytes_AS_STRING(text.ptr()),
+                   static_cast<std::size_t>(PyBytes_GET_SIZE(text.ptr())));
+    else if (!lucent::python::file_bytes(text, bytes))
+      return false;
+    lucent::python::refuse_nul(bytes, "path");
+    value = bytes;
+    return true;
+  }
+  static handle cast(const std::filesystem::path& path, return_value_policy, handle) {
+    const std::string& bytes = path.native();
+    object text = reinterpret_steal<object>(PyUnicode_DecodeUTF8(
+        bytes.data(), static_cast<Py_ssize_t>(bytes.size()), "surrogateescape"));
+    if (!text) return nullptr;
+    return module_::import("pathlib").attr("Path")(text).release();
   }
 };
 }  // namespace pybind11::detail

@@ -116,6 +116,8 @@ inline py::ssize_t index_of(py::handle i, const char* indices_must) {
   return n;
 }
 inline constexpr const char* kListIndices = "list indices must be integers or slices";
+/// (a list's insert and pop say "'float' object cannot be interpreted as an integer")
+inline constexpr const char* kIndexMust = "the index must be an integer";
 
 /// `value` as T: TypeError "<what>: expected a Material, not float".
 template <class T>
@@ -225,10 +227,9 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
   py::class_<V> c(m, name);
   c.def(py::init<>())
       .def(py::init<const V&>())
-      .def(py::init([](const py::iterable& items) {
-        V v;
-        for (py::handle h : items) v.push_back(h.cast<T>());
-        return v;
+      .def(py::init([label = std::string(name) + "()"](const py::iterable& items) {
+        // (an item that is no T was pybind's RuntimeError "Unable to cast Python instance")
+        return list_detail::values_of<T>(items, label.c_str());
       }))
       .def("__len__", &V::size)
       .def("__bool__", [](const V& v) { return !v.empty(); })
@@ -340,8 +341,10 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
           py::arg("items"), "Adds the items at the end.")
       .def(
           "insert",
-          [](V& v, py::ssize_t i, const T& value) {
-            // as list.insert: an index beyond either end inserts at that end
+          [](V& v, py::handle index, const T& value) {
+            // as list.insert: an index beyond either end inserts at that end (one past
+            // Py_ssize_t: IndexError, as a list's, where pybind's TypeError said "incompatible")
+            py::ssize_t i = list_detail::index_of(index, list_detail::kIndexMust);
             const py::ssize_t n = static_cast<py::ssize_t>(v.size());
             if (i < 0) i = std::max<py::ssize_t>(0, i + n);
             const std::size_t k = static_cast<std::size_t>(std::min(i, n));
@@ -356,7 +359,8 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
           py::arg("i"), py::arg("x"), "Inserts an item before index i.")
       .def(
           "pop",
-          [](V& v, py::ssize_t i) {
+          [](V& v, py::handle index) {
+            const py::ssize_t i = list_detail::index_of(index, list_detail::kIndexMust);
             if (v.empty()) throw py::index_error("pop from empty list");
             const std::size_t k = list_detail::wrap_index(i, v.size(), "pop index out of range");
             T out = v[k];
@@ -394,13 +398,26 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
 template <class C, class T>
 void list_property(py::class_<C>& c, const char* name, std::vector<T> C::*member,
                    const char* doc = "") {
-  c.def_property(name,
-                 py::cpp_function([member](C& o) -> std::vector<T>& { return o.*member; },
-                                  py::return_value_policy::reference_internal),
-                 py::cpp_function([member](C& o, const std::vector<T>& value) {
-                   assign_list(o.*member, value);
-                 }),
-                 doc);
+  c.def_property(
+      name,
+      py::cpp_function([member](C& o) -> std::vector<T>& { return o.*member; },
+                       py::return_value_policy::reference_internal),
+      // (a value of another kind, or an item that is no T, was pybind's "(): incompatible
+      // function arguments" TypeError, which named neither the list nor the item)
+      py::cpp_function([member, what = c.attr("__name__").template cast<std::string>() + "." +
+                                       name](C& o, py::handle value) {
+        if (py::isinstance<std::vector<T>>(value)) {
+          assign_list(o.*member, value.cast<std::vector<T>>());
+          return;
+        }
+        if (!py::isinstance<py::iterable>(value) || py::isinstance<py::str>(value) ||
+            py::isinstance<py::bytes>(value))
+          throw py::type_error(what + " must be a list, got " +
+                               std::string(Py_TYPE(value.ptr())->tp_name));
+        assign_list(o.*member, list_detail::values_of<T>(
+                                   py::reinterpret_borrow<py::iterable>(value), what.c_str()));
+      }),
+      doc);
 }
 
 }  // namespace lucent::python

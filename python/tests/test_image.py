@@ -399,3 +399,19 @@ def test_non_finite_inputs_are_errors_not_results(small_scene):
     with pytest.raises(lucent.Error, match=r"the reference image: pixel \(0, 0\) channel R is "
                                            r"not finite \(inf\)"):
         lucent.converge(small_scene, ref, spp_ladder=[1])
+
+
+def test_paths_with_a_nul_and_path_like_directories(tmp_path):
+    """A NUL in a file path was pybind's "incompatible function arguments" (cache_dir and the device
+    selector said ValueError), and Renderer(cache_dir=Path) was refused where every other path
+    argument took an os.PathLike."""
+    img = np.ones((2, 2, 3), np.float32)
+    for call in (lambda: lucent.write_image("a\x00.png", img), lambda: lucent.read_image("a\x00.png"),
+                 lambda: lucent.load_scene(b"a\x00.json"),
+                 lambda: lucent.read_part_info("a\x00.exr")):
+        with pytest.raises(ValueError, match=r"^path: embedded null character in 'a\\x00\."):
+            call()
+    lucent.write_image(tmp_path / "p.pfm", img)
+    assert lucent.read_image(tmp_path / "p.pfm").shape == (2, 2, 3)
+    with lucent.Renderer(cache_dir=tmp_path / "cache") as r:
+        assert r.options["cache_dir"] == str(tmp_path / "cache")

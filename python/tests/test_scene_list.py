@@ -403,3 +403,29 @@ def test_indices_are_read_as_a_python_list_reads_them(small_scene):
     assert mats[-len(mats)].name == first and v[-1] == 3
     mats[0:1] = [lucent.Material("mirror")]
     assert mats[0].type == "mirror"
+
+
+def test_lists_name_what_is_wrong_as_a_python_list_does():
+    """The list constructor and the scene's list properties named neither the list nor the item
+    that is no element (pybind's RuntimeError "Unable to cast Python instance", and "(): incompatible
+    function arguments"), and pop or insert at an index past Py_ssize_t said "incompatible function
+    arguments" where a list raises IndexError."""
+    m = lucent.Material("mirror")
+    with pytest.raises(TypeError, match=r"^MaterialList\(\): item 1 is a int, not a Material$"):
+        lucent.MaterialList([m, 5])
+    s = lucent.Scene()
+    with pytest.raises(TypeError, match=r"^Scene.materials: item 1 is a int, not a Material$"):
+        s.materials = [m, 5]
+    with pytest.raises(TypeError, match=r"^Scene.materials must be a list, got int$"):
+        s.materials = 5
+    s.materials = (m, m)
+    s.materials = s.materials
+    assert len(s.materials) == 2
+    items = lucent.MaterialList([m])
+    for call in (lambda: items.pop(2 ** 70), lambda: items.insert(2 ** 70, m)):
+        with pytest.raises(IndexError, match="cannot fit 'int' into an index-sized integer"):
+            call()
+    with pytest.raises(TypeError, match=r"^the index must be an integer, not float$"):
+        items.pop(1.5)
+    items.insert(-(2 ** 40), m)  # as a list: before the first
+    assert len(items) == 2 and items.pop(-1).type == "mirror"
