@@ -1149,6 +1149,17 @@ TEST(Session, FloatRoundingLargeAgainstTheSceneWarns) {
   ground.spheres[0].radius = 0.01;
   EXPECT_EQ(warnings_for(ground, lucent::Precision::Float), 1);
   EXPECT_EQ(warnings_for(ground, lucent::Precision::Double), 0);
+  // a sphere of 0.1 resting on a floor of +-1e4 (offsets of 0.0095, 1/10.5 of it): its contact
+  // shadow rendered up to 1.8 times too bright (image-mean z 13 at 1024 spp), silently under
+  // the 1/8 first chosen; on a floor of +-2e3 (1/52) it is not said
+  for (const double floor : {1e4, 2e3}) {
+    Scene contact = plain;
+    for (glm::dvec3& p : contact.positions) p *= floor / 5;  // (kScene's floor spans +-5)
+    contact.spheres.resize(1);
+    contact.spheres[0].radius = 0.05;
+    contact.spheres[0].center = glm::dvec3(0, contact.positions[0].y + 0.05, 0);
+    EXPECT_EQ(warnings_for(contact, lucent::Precision::Float), floor > 5e3 ? 1 : 0) << floor;
+  }
   Scene far = plain;  // the whole scene (size about 14) moved to 1e5
   for (glm::dvec3& p : far.positions) p.x += 1e5;
   far.spheres[0].center.x += 1e5;

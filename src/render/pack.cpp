@@ -281,13 +281,16 @@ std::string float_rounding_note(const PackedScene& packed) {
                   diagonal, kTinySceneSize);
     return buf;
   }
-  // offsets beyond 1/8 of the small features (a huge ground triangle under small objects), or
+  // offsets beyond 1/16 of the small features (a huge ground triangle under small objects: 1/8
+  // first, under which a sphere of 0.1 on a floor of +-1e4, at 1/10.5, had contact shadows 1.8
+  // times too bright, image-mean z 13 against the reference; the dragon on a quad of +-100, at
+  // 1/32 of its 10th-percentile edge, renders the same in both precisions), or
   // coordinates 100 times the scene's size (a scene far from the origin: its offsets and the
   // rounding of its hit points, 1e-4 of its size, let rays out of closed shells at their edges
   // and move shadow rays towards the lights; at 700 times, under the 1000 first chosen, a sphere
   // light over a plane rendered 0.8% bright, a decal 1e-4 of the scene above a floor 0.9%, a
   // thin slab's shadow 2.6%, all without a word; at 70 times they render right)
-  if (!(offset > feature / 8) && !(largest > 100 * diagonal)) return "";
+  if (!(offset > feature / 16) && !(largest > 100 * diagonal)) return "";
   char buf[640];
   std::snprintf(buf, sizeof buf,
                 "in float precision, rays leave surfaces offset by their rounding, up to %.2g "
