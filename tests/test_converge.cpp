@@ -310,6 +310,15 @@ TEST(Converge, SettingSyntax) {
             static_cast<int>(lucent::IntegratorType::Direct));
   EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("caustics+no-caustics"); }),
             "setting 'caustics+no-caustics': no-caustics and caustics set the same thing");
+  // default twice was taken (fast-math twice refused), an empty filter radius read as none, and a
+  // value starting with + was split at it ("setting max_depth=: ...")
+  EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("default+default"); }),
+            "setting 'default+default': default and default set the same thing");
+  EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("filter=box:"); }),
+            "setting filter=box:: an empty radius after ':' (filter=box alone, or "
+            "filter=box:RADIUS)");
+  EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("max_depth=+3"); }),
+            "setting 'max_depth=+3': a value cannot start with + (+ joins knobs)");
   // a number's knob as written, and the pilot's true range (it said min_spp, from 1)
   EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("adaptive+min-spp=-4"); }),
             "setting min-spp=-4: expected an integer from 4 to 16384");

@@ -200,6 +200,9 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
   ConvergeSetting s;
   s.name = text;
   if (text.empty()) throw Error("empty setting (expected e.g. default, fast-math, max_depth=2)");
+  // (split at the '+', "max_depth=+3" said "setting max_depth=: ...")
+  if (text.find("=+") != std::string::npos)
+    throw Error("setting '" + text + "': a value cannot start with + (+ joins knobs)");
   // every knob between two '+' (getline dropped a trailing empty one: "max_depth=3+" was read)
   std::vector<std::string> knobs{""};
   for (char c : text)
@@ -225,7 +228,7 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
     if (key == "no_caustics") field = "caustics";
     if (key == "no_mis") field = "mis";
     if (key == "double" || key == "float") field = "precision";
-    if (key != "default") {
+    {  // (default+default was taken, fast-math+fast-math refused)
       auto [it, fresh] = given.emplace(field, knob);
       if (!fresh)
         throw Error("setting '" + text + "': " + knob + " and " + it->second +
@@ -263,6 +266,9 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
       if (colon != std::string::npos) {
         type = value.substr(0, colon);
         radius = value.substr(colon + 1);
+        if (radius.empty())  // ("filter=box:" was taken as filter=box)
+          throw Error("setting " + knob + ": an empty radius after ':' (filter=" + type +
+                      " alone, or filter=" + type + ":RADIUS)");
       }
       std::optional<FilterType> t = find_type<FilterType>(type);
       if (!t)
