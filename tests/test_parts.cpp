@@ -789,6 +789,48 @@ TEST(Parts, DamagedPartFilesAreOneLineErrors) {
   }
 }
 
+// A part file's display channels (R, G, B) are not covered by its checksum; its sums are.
+// read_image read the display channels: a checkpoint whose PIZ chunk was damaged there read as a
+// changed image without a word, where read_render and compare read the sums. read_image of a
+// part now gives the sums' image too. (The damaged file: the part's channels and attributes
+// written again with its R channel changed.)
+TEST(Parts, ReadImageOfAPartIsItsSumsImage) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::Renderer renderer(lucent::test::session_options());
+  renderer.set_scene(lucent::load_scene(noisy_scene(dir)));
+  const lucent::RenderPart part = render_range(renderer, 0, 4);
+  const std::string good = dir + "/good.exr", bad = dir + "/bad.exr";
+  lucent::write_render_part(good, part);
+  const lucent::Image sums_image = lucent::read_render(good).mean;
+  EXPECT_EQ(lucent::read_image(good).rgb, sums_image.rgb);
+
+  const std::string bytes = lucent::test::read_file(good);
+  lucent::image_detail::ExrChannels exr = lucent::image_detail::read_exr_channels(
+      reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), good,
+      lucent::image_detail::kMaxImagePixels);
+  const int r = exr.find("R");
+  ASSERT_GE(r, 0);
+  for (float& v : exr.planes[size_t(r)]) v = 1.5e24f;  // the damage
+  lucent::image_detail::RenderPlanes planes;
+  planes.width = exr.width;
+  planes.height = exr.height;
+  const char* rgb[3] = {"R", "G", "B"};
+  const char* var[3] = {"var.R", "var.G", "var.B"};
+  for (int c = 0; c < 3; ++c) {
+    planes.mean[c] = exr.planes[size_t(exr.find(rgb[c]))].data();
+    planes.variance[c] = exr.planes[size_t(exr.find(var[c]))].data();
+  }
+  planes.samples = exr.uint_planes[size_t(exr.find("n"))].data();
+  lucent::image_detail::ExrExtras extras;
+  for (size_t i = 0; i < exr.names.size(); ++i)
+    if (!exr.uint_planes[i].empty() && exr.names[i] != "n")
+      extras.uint_channels.emplace_back(exr.names[i], exr.uint_planes[i].data());
+  for (const auto& [name, value] : exr.attributes) extras.attributes.emplace_back(name, value);
+  lucent::image_detail::write_render_planes(bad, planes, extras);
+  ASSERT_EQ(lucent::read_render_part(bad).acc.sum, part.acc.sum);  // the sums are intact
+  EXPECT_EQ(lucent::read_image(bad).rgb, sums_image.rgb);
+}
+
 // A part's counts agree with its header: each pixel holds the part's samples (the total of its
 // ranges) less its non-finite ones, and those add up to lucent.nonfinite. Reading checked only that
 // no count exceeded the samples: a part whose counts, ranges or non-finite count were altered

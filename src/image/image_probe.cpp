@@ -472,6 +472,9 @@ class Checker {
     if (header.num_channels <= 0) fail("OpenEXR header has no channels");
     p.channels = header.num_channels;
     p.compression = header.compression_type;
+    for (int a = 0; a < header.num_custom_attributes; ++a)
+      if (std::strcmp(header.custom_attributes[a].name, "lucent.checksum") == 0)
+        p.lucent_part = true;
     u64 bytes_per_pixel = 0;
     for (int c = 0; c < header.num_channels; ++c)
       bytes_per_pixel += header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF ? 2 : 4;

@@ -58,6 +58,9 @@ struct Probe {
   /// The pixels decoding holds at once, where not width * height: an OpenEXR whose data window
   /// (the pixels stored) is not its display window (the image, width x height), both.
   std::uint64_t decode_pixels = 0;
+  /// An OpenEXR with lucent's checksum attribute (a part file: a checkpoint, a --samples part),
+  /// whose image read_image takes from its checksummed sums.
+  bool lucent_part = false;
 };
 
 /// Identifies the format of `data` (PNG, JPEG, BMP, TGA, Radiance HDR, PFM, OpenEXR; anything
