@@ -503,6 +503,8 @@ class CallbackErrors {
   void rethrow() {
     if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
   }
+  /// Forgets the exception kept (the call failed on its own error, which is raised instead).
+  void clear() { error_ = nullptr; }
 
  private:
   std::exception_ptr error_;

@@ -190,7 +190,12 @@ class PyRenderer {
       } catch (const Error&) {
         failed = std::current_exception();
       }
-      if (!failed) warning_errors_->rethrow();
+      // a failed call raises its own error; what its on_warning raised goes with it (it was
+      // kept, and raised by the next call, which had given no warning)
+      if (failed)
+        warning_errors_->clear();
+      else
+        warning_errors_->rethrow();
     }
     if (failed) {
       if (PyErr_CheckSignals() != 0) throw py::error_already_set();
@@ -215,6 +220,7 @@ class PyRenderer {
       run_interruptible([&] { f(r, stop_); }, stop_);
     } catch (...) {
       flush_warnings();
+      warning_errors_->clear();  // (as call's: the failure is raised, not a later call's)
       throw;
     }
     flush_warnings();

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import lucent
-from conftest import add_degenerate_triangle, header_fields, session
+from conftest import SMALL, add_degenerate_triangle, header_fields, session
 
 
 def kernel_builds(stats):
@@ -604,3 +604,22 @@ def test_flags_take_true_or_false_only(small_scene):
         r.set_build_options(fast_math=np.bool_(True))  # a NumPy bool is a bool
         assert r.options["fast_math"] is True
     assert lucent.scene_info(small_scene, fast_math=True)["fast_math"] is True
+
+
+def test_a_failed_calls_warning_callback_error_is_not_raised_by_the_next_call(small_scene):
+    """A call that failed on its own error kept what its on_warning had raised, and the next call,
+    which gave no warning, raised it."""
+    bright = lucent.scene_from_dict(SMALL)
+    bright.materials[0].albedo = (1.25, 0.5, 0.5)  # a warning, then the memory check fails
+    seen = []
+
+    def raiser(message):
+        seen.append(message)
+        raise RuntimeError("from on_warning")
+
+    with session(on_warning=raiser, reserved_host_bytes=2 ** 62) as r:
+        with pytest.raises(lucent.Error, match="host memory"):
+            r.set_scene(bright)
+        assert len(seen) == 1
+        r.set_build_options(fast_math=True)  # raised "from on_warning"
+        assert r.options["fast_math"] is True
