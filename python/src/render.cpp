@@ -402,9 +402,13 @@ class PyRenderer {
 };
 
 /// The C++ object of a bound instance, or null before its __init__ has made it (cls.__new__).
+/// (Also while pybind11 lays the instance out: a GC type is tracked from its allocation on, and
+/// the layout of a Python subclass's first instance makes objects, which may collect, before it
+/// exists: its status pointer was null, and the collector crashed, the review's find.)
 template <class T>
 T* constructed(PyObject* self) {
   auto* inst = reinterpret_cast<py::detail::instance*>(self);
+  if (!inst->simple_layout && !inst->nonsimple.values_and_holders) return nullptr;
   py::detail::value_and_holder v_h = inst->get_value_and_holder(nullptr, false);
   return v_h && v_h.holder_constructed() ? v_h.value_ptr<T>() : nullptr;
 }

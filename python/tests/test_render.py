@@ -4,6 +4,8 @@ import gc
 import inspect
 import pathlib
 import re
+import subprocess
+import sys
 import threading
 import time
 import warnings
@@ -623,3 +625,16 @@ def test_a_failed_calls_warning_callback_error_is_not_raised_by_the_next_call(sm
         assert len(seen) == 1
         r.set_build_options(fast_math=True)  # raised "from on_warning"
         assert r.options["fast_math"] is True
+
+
+def test_the_collector_meets_a_subclass_renderer_being_laid_out():
+    """A Renderer is tracked by the garbage collector from its allocation on: a collection while
+    pybind11 laid out a Python subclass's first instance read its null status pointer, and the
+    interpreter crashed (SIGSEGV; the review's find, with gc.set_threshold(1))."""
+    code = ("import gc, lucent\ngc.set_threshold(1)\n"
+            "class S(lucent.Renderer):\n    pass\n"
+            "s = S(**lucent.environment())\ndel s\ngc.collect()\n"
+            "t = S.__new__(S)\ngc.collect()\nprint('collected')\n")
+    child = subprocess.run([sys.executable, "-c", code], capture_output=True, timeout=120)
+    assert child.returncode == 0, child.stderr.decode()
+    assert child.stdout == b"collected\n"
