@@ -56,9 +56,33 @@ template <>
 struct type_caster<lucent::python::FileText> {
   PYBIND11_TYPE_CASTER(lucent::python::FileText, const_name("str"));
   bool load(handle src, bool) {
+    if (PyBytes_Check(src.ptr())) {
+      value.bytes.assign(PyBytes_AS_STRING(src.ptr()),
+                         static_cast<std::size_t>(PyBytes_GET_SIZE(src.ptr())));
+      return true;
+    }
+    return PyUnicode_Check(src.ptr()) && lucent::python::file_bytes(src, value.bytes);
+  }
+  static handle cast(const lucent::python::FileText& text, return_value_policy, handle) {
+    return PyUnicode_DecodeUTF8(text.bytes.data(), static_cast<Py_ssize_t>(text.bytes.size()),
+                                "surrogateescape");
+  }
+};
+}  // namespace pybind11::detail
+
+namespace lucent::python {
+/// A directory argument (cache_dir, kernel_dir): FileText, or an os.PathLike as os.fspath gives
+/// it (Renderer(cache_dir=Path(...)) was pybind's "incompatible function arguments", where
+/// every file path argument took one). Names that are not paths (a material's) stay FileText.
+struct DirText : FileText {};
+}  // namespace lucent::python
+
+namespace pybind11::detail {
+template <>
+struct type_caster<lucent::python::DirText> {
+  PYBIND11_TYPE_CASTER(lucent::python::DirText, const_name("os.PathLike"));
+  bool load(handle src, bool convert) {
     object text = reinterpret_borrow<object>(src);
-    // an os.PathLike (pathlib.Path) as os.fspath gives it: Renderer(cache_dir=Path(...)) was
-    // pybind's "incompatible function arguments", where every other path argument took one
     if (!PyBytes_Check(src.ptr()) && !PyUnicode_Check(src.ptr()) &&
         PyObject_HasAttrString(src.ptr(), "__fspath__")) {
       text = reinterpret_steal<object>(PyOS_FSPath(src.ptr()));
@@ -67,16 +91,13 @@ struct type_caster<lucent::python::FileText> {
         return false;
       }
     }
-    if (PyBytes_Check(text.ptr())) {
-      value.bytes.assign(PyBytes_AS_STRING(text.ptr()),
-                         static_cast<std::size_t>(PyBytes_GET_SIZE(text.ptr())));
-      return true;
-    }
-    return PyUnicode_Check(text.ptr()) && lucent::python::file_bytes(text, value.bytes);
+    type_caster<lucent::python::FileText> file;
+    if (!file.load(text, convert)) return false;
+    value.bytes = std::move(static_cast<lucent::python::FileText&>(file).bytes);
+    return true;
   }
-  static handle cast(const lucent::python::FileText& text, return_value_policy, handle) {
-    return PyUnicode_DecodeUTF8(text.bytes.data(), static_cast<Py_ssize_t>(text.bytes.size()),
-                                "surrogateescape");
+  static handle cast(const lucent::python::DirText& text, return_value_policy p, handle h) {
+    return type_caster<lucent::python::FileText>::cast(text, p, h);
   }
 };
 }  // namespace pybind11::detail

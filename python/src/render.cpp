@@ -93,7 +93,7 @@ void bind_device_shares(py::module_& m, py::class_<T>& c) {
 /// before any other thread can start a call (or resume the render).
 class PyRenderer {
  public:
-  PyRenderer(const TextArg& device_arg, const FileText& kernel_dir, const FileText& cache_dir,
+  PyRenderer(const TextArg& device_arg, const DirText& kernel_dir, const DirText& cache_dir,
              const TextArg& precision, const FlagArg& fast_math, const FlagArg& specialize,
              double pass_seconds, const IntArg& reserved_host_bytes, py::object on_warning)
       : warning_errors_(std::make_shared<CallbackErrors>()) {
@@ -816,8 +816,8 @@ void bind_render(py::module_& m) {
       "the `lucent` command's defaults.");
   bind_session_devices<Renderer>(renderer);
   renderer
-      .def(py::init<const TextArg&, const FileText&, const FileText&, const TextArg&,
-                    const FlagArg&, const FlagArg&, double, const IntArg&, py::object>(),
+      .def(py::init<const TextArg&, const DirText&, const DirText&, const TextArg&, const FlagArg&,
+                    const FlagArg&, double, const IntArg&, py::object>(),
            py::kw_only(), py::arg("device") = "", py::arg("kernel_dir") = "",
            py::arg("cache_dir") = "", py::arg("precision") = "float", py::arg("fast_math") = false,
            py::arg("specialize") = true, py::arg("pass_seconds") = 0.25,

@@ -108,10 +108,13 @@ inline std::size_t wrap_index(py::ssize_t i, std::size_t n, const char* what) {
 /// __index__ may change the list): IndexError for an integer past Py_ssize_t and TypeError
 /// naming the type of anything else, "<indices_must>, not float" (pybind's "incompatible
 /// function arguments" TypeError said neither).
-inline py::ssize_t index_of(py::handle i, const char* indices_must) {
+/// `overflow`: the exception of an integer past Py_ssize_t (a subscript's IndexError; pop and
+/// insert raise OverflowError, as a list's do).
+inline py::ssize_t index_of(py::handle i, const char* indices_must,
+                            PyObject* overflow = PyExc_IndexError) {
   if (!PyIndex_Check(i.ptr()))
     throw py::type_error(std::string(indices_must) + ", not " + Py_TYPE(i.ptr())->tp_name);
-  const Py_ssize_t n = PyNumber_AsSsize_t(i.ptr(), PyExc_IndexError);
+  const Py_ssize_t n = PyNumber_AsSsize_t(i.ptr(), overflow);
   if (n == -1 && PyErr_Occurred()) throw py::error_already_set();
   return n;
 }
@@ -142,8 +145,9 @@ std::vector<T> values_of(const py::iterable& items, const char* what) {
       values.push_back(h.cast<T>());
     } catch (const py::cast_error&) {
       throw py::type_error(std::string(what) + ": item " + std::to_string(values.size()) +
-                           " is a " + Py_TYPE(h.ptr())->tp_name + ", not a " +
-                           py::str(py::type::of<T>().attr("__name__")).operator std::string());
+                           ": expected a " +
+                           py::str(py::type::of<T>().attr("__name__")).operator std::string() +
+                           ", not " + Py_TYPE(h.ptr())->tp_name);
     }
   }
   return values;
@@ -343,8 +347,9 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
           "insert",
           [](V& v, py::handle index, const T& value) {
             // as list.insert: an index beyond either end inserts at that end (one past
-            // Py_ssize_t: IndexError, as a list's, where pybind's TypeError said "incompatible")
-            py::ssize_t i = list_detail::index_of(index, list_detail::kIndexMust);
+            // Py_ssize_t: OverflowError, as a list's, where pybind's TypeError said "incompatible")
+            py::ssize_t i =
+                list_detail::index_of(index, list_detail::kIndexMust, PyExc_OverflowError);
             const py::ssize_t n = static_cast<py::ssize_t>(v.size());
             if (i < 0) i = std::max<py::ssize_t>(0, i + n);
             const std::size_t k = static_cast<std::size_t>(std::min(i, n));
@@ -360,7 +365,8 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
       .def(
           "pop",
           [](V& v, py::handle index) {
-            const py::ssize_t i = list_detail::index_of(index, list_detail::kIndexMust);
+            const py::ssize_t i =
+                list_detail::index_of(index, list_detail::kIndexMust, PyExc_OverflowError);
             if (v.empty()) throw py::index_error("pop from empty list");
             const std::size_t k = list_detail::wrap_index(i, v.size(), "pop index out of range");
             T out = v[k];
@@ -412,8 +418,9 @@ void list_property(py::class_<C>& c, const char* name, std::vector<T> C::*member
         }
         if (!py::isinstance<py::iterable>(value) || py::isinstance<py::str>(value) ||
             py::isinstance<py::bytes>(value))
-          throw py::type_error(what + " must be a list, got " +
-                               std::string(Py_TYPE(value.ptr())->tp_name));
+          throw py::type_error(what + ": expected a list of " +
+                               py::str(py::type::of<T>().attr("__name__")).operator std::string() +
+                               ", not " + std::string(Py_TYPE(value.ptr())->tp_name));
         assign_list(o.*member, list_detail::values_of<T>(
                                    py::reinterpret_borrow<py::iterable>(value), what.c_str()));
       }),

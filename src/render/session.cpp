@@ -463,9 +463,15 @@ struct Renderer::Impl {
     Program p;
     try {
       const bool entries = cl_util::keeps_program_binaries(w.ctx.device);
+      // without entries the directory serves the build locks, so that processes building one
+      // program together build it once: worth it where the driver's cache then serves the
+      // others, not on PoCL with its cache off, where they waited to build it again each (the
+      // review's find)
+      const bool locks = entries || !cl_util::driver_program_cache(w.ctx.device).empty();
       p.program = cl_util::build_program_cached(
-          w.ctx, source, opts + render_detail::device_defines(w.ctx.device.info), cache_dir, &info,
-          &entry, entries, [this] { return cancelled(); });
+          w.ctx, source, opts + render_detail::device_defines(w.ctx.device.info),
+          locks ? cache_dir : std::string(), &info, &entry, entries,
+          [this] { return cancelled(); });
     } catch (const Error& e) {
       // the place of a build error is "kernels/<file>:<line>": the file in the kernel directory
       // in use when the sources came from one
@@ -670,8 +676,8 @@ struct Renderer::Impl {
         }
         if (entry.pending()) {
           // after the warm-up, so that the entry holds the work-group function the driver
-          // compiled at that launch (PoCL without its own cache: a hit launches at once); a
-          // driver that caches its own builds has had them cached under the lock
+          // compiled at that launch (a hit then launches at once); a driver that caches its own
+          // builds (PoCL) has had them cached under the lock
           auto t0 = clock_type::now();
           entry.store(w.program->program);
           const double s = seconds_since(t0);
