@@ -91,7 +91,7 @@ void on_warning(const std::string& message) {
   std::lock_guard<std::mutex> lock(g_warnings_mutex);
   if (g_rank != 0) {
     g_warnings.push_back(message);
-  } else if (g_printed.insert(message).second) {
+  } else if (g_printed.insert(one_line(message)).second) {  // (as the other ranks send it)
     std::fprintf(stderr, "lucent: warning: %s\n", one_line(message).c_str());
     std::fflush(stderr);
   }
