@@ -170,6 +170,11 @@ std::uint32_t reference_seed(std::uint32_t scene_seed);
 /// Powers of two from 1 to max_spp (max_spp included when it is not a power of two).
 std::vector<int> default_spp_ladder(int max_spp);
 
+/// The samples per pixel of the reference `lucent converge` renders for a ladder: 16 times its
+/// top rung, at least 256 and at most 2^24 (limits::kMaxSpp; a top rung past 2^20 asked for up
+/// to 2^28); 1024 for a time ladder (`spp_ladder` empty).
+int default_reference_spp(const std::vector<int>& spp_ladder);
+
 /// CSV: setting,spp,seconds,samples_per_s,rmse,relmse,noise_relmse,rays_per_s,
 /// reference_noise_relmse,estimated_relmse,halves_relmse; one row a point.
 std::string convergence_csv(const ConvergeResult& result);

@@ -322,13 +322,8 @@ int run_converge_command() {
                   std::to_string(reference.mean.height) + " differs from the scene's film (" +
                   std::to_string(scene.film.width) + "x" + std::to_string(scene.film.height) + ")");
   } else {
-    int largest = 0;
-    for (int s : opt.spp_ladder) largest = std::max(largest, s);
-    // (at most --reference-spp's largest, 2^24: 16 x a top rung past 2^20 went past it, to 2^28)
-    int spp = a.reference_spp > 0 ? a.reference_spp
-                                  : (opt.time_ladder.empty()
-                                         ? std::min(std::max(256, 16 * largest), limits::kMaxSpp)
-                                         : 1024);
+    // (opt.spp_ladder is empty with a time ladder)
+    const int spp = a.reference_spp > 0 ? a.reference_spp : default_reference_spp(opt.spp_ladder);
     Scene rs = scene;
     rs.integrator.seed = reference_seed(scene.integrator.seed);  // independent of the ladder
     // independent samples: the reference's own noise is what its variances say

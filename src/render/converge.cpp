@@ -379,6 +379,12 @@ std::vector<int> default_spp_ladder(int max_spp) {
   return out;
 }
 
+int default_reference_spp(const std::vector<int>& spp_ladder) {
+  if (spp_ladder.empty()) return 1024;
+  const std::int64_t top = *std::max_element(spp_ladder.begin(), spp_ladder.end());
+  return static_cast<int>(std::clamp<std::int64_t>(16 * top, 256, limits::kMaxSpp));
+}
+
 ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
   ConvergeFit f;
   f.points = points.size();
@@ -522,6 +528,7 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
   // the rungs in ascending order: the verdict reads the last point as the largest rung, the fit
   // the last three, the time to a common error the first and the last (a ladder 1024,4,8 was
   // judged at 8 spp: "unbiased" for a setting judged biased on 4,8,1024)
+  check_convergence_options(given, &scene);  // first: a NaN rung is no order for std::sort
   ConvergeOptions options = given;
   std::sort(options.spp_ladder.begin(), options.spp_ladder.end());
   std::sort(options.time_ladder.begin(), options.time_ladder.end());
@@ -538,7 +545,6 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
     throw Error("the reference image was rendered with seed " + std::to_string(reference.seed) +
                 ", the ladder's: its samples include the rungs' own, which would hide their "
                 "error; render it with another seed (lucent::reference_seed)");
-  check_convergence_options(options, &scene);
   std::vector<ConvergeSetting> settings = options.settings;
   if (settings.empty()) settings.push_back(ConvergeSetting{});
   const bool by_time = !options.time_ladder.empty();
@@ -609,8 +615,8 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
       } else if (setting.adaptive) {
         // the rungs' budgets rise: each continues the previous rung's render
         if (options.spp_ladder[i] < static_cast<int>(ao.min_spp)) continue;
-        // a rung below the previous one starts over, as a uniform rung does (it continued the
-        // render, which had more samples already: a ladder 16,8 reported 16 spp twice)
+        // (the rungs ascend: a rung below the previous one would continue a render of more
+        // samples, as a ladder 16,8 given unsorted did, reporting 16 spp twice; kept as a guard)
         if (ao.budget_spp > 0 && options.spp_ladder[i] < ao.budget_spp) renderer->reset();
         ao.budget_spp = options.spp_ladder[i];
         renderer->render_adaptive(ao, options.render.on_progress);
