@@ -142,14 +142,6 @@ bool write_entry(const std::string& path, const std::string& key,
   }
 }
 
-// Whether `fd` is still the file at `path`: a lock file may be removed (`cache clear`, an
-// eviction) while another process waits on it or has just opened it.
-bool still_at(int fd, const std::string& path) {
-  struct stat open_file, named;
-  return ::fstat(fd, &open_file) == 0 && ::stat(path.c_str(), &named) == 0 &&
-         open_file.st_ino == named.st_ino && open_file.st_dev == named.st_dev;
-}
-
 }  // namespace
 
 /// An exclusive flock on `path` held while alive: processes that miss the same entry at the same
@@ -181,7 +173,7 @@ class BuildLock {
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
-      if (still_at(fd_, path)) return;
+      if (io::is_file_at(fd_, path)) return;
       ::close(fd_);
       fd_ = -1;
       if (give_up()) return;
@@ -403,7 +395,7 @@ bool is_entry(const fs::directory_entry& e) {
 void remove_unused_lock(const std::string& path) {
   int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
   if (fd < 0) return;
-  if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && still_at(fd, path)) ::unlink(path.c_str());
+  if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && io::is_file_at(fd, path)) ::unlink(path.c_str());
   ::close(fd);
 }
 

@@ -31,19 +31,29 @@ using io::one_line;
 // other's write in progress as a stale temporary file)
 CheckpointLock::CheckpointLock(const std::string& checkpoint)
     : path_(lucent::io::write_target_path(checkpoint) + ".lock") {
-  fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd_ < 0)
-    throw lucent::Error(path_ + ": cannot create the checkpoint's lock (" + std::strerror(errno) +
-                        ")");
-  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) {
-    // the mark that tells another command's output check this lock is a checkpoint's
-    if (::ftruncate(fd_, 0) == 0) {
-      const std::size_t n = sizeof lucent::io::kCheckpointLockMark - 1;
-      (void)!::pwrite(fd_, lucent::io::kCheckpointLockMark, n, 0);
+  // a lock file removed by the render that held it (its end, or one that wrote no checkpoint)
+  // after this one opened it: locked, it is no longer the file of that name, which a third render
+  // may create and lock, and two renders held the checkpoint (the review's find); opened again
+  int e = 0;
+  for (int attempt = 0;; ++attempt) {
+    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0)
+      throw lucent::Error(path_ + ": cannot create the checkpoint's lock (" + std::strerror(errno) +
+                          ")");
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      e = errno;
+      break;
     }
-    return;
+    if (lucent::io::is_file_at(fd_, path_) || attempt == 100) {
+      // the mark that tells another command's output check this lock is a checkpoint's
+      if (::ftruncate(fd_, 0) == 0) {
+        const std::size_t n = sizeof lucent::io::kCheckpointLockMark - 1;
+        (void)!::pwrite(fd_, lucent::io::kCheckpointLockMark, n, 0);
+      }
+      return;
+    }
+    ::close(fd_);
   }
-  const int e = errno;
   ::close(fd_);
   fd_ = -1;
   if (e == EWOULDBLOCK)

@@ -53,6 +53,10 @@ int remove_stale_temporaries(const std::string& path);
 /// throws lucent::Error("<path>: cannot write (<reason>)") on failure. `path` names it.
 void write_all(int fd, const void* data, std::size_t size, const std::string& path);
 
+/// Whether the open file `fd` is still the file at `path` (a lock file may be removed, by its
+/// owner or `cache clear`, while another process has just opened it or waits on it).
+bool is_file_at(int fd, const std::string& path);
+
 /// Whether `a` and `b` name the same file: the same file when both exist (symbolic and hard
 /// links included), else the same path once made canonical.
 bool same_file(const std::string& a, const std::string& b);
