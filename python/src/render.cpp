@@ -306,9 +306,6 @@ class PyRenderer {
     if (busy_) stop_ = true;
   }
 
-  /// Destroys the session (with the GIL released: a device may take a while to let go). Refused
-  /// while a call runs; claims the session first, so that no call starts meanwhile. Closing a
-  /// closed renderer does nothing.
   /// The Python objects the renderer holds, for the type's tp_traverse and tp_clear.
   int visit_references(visitproc visit, void* arg) const {
     Py_VISIT(on_warning_.ptr());
@@ -316,6 +313,9 @@ class PyRenderer {
   }
   void clear_references() { on_warning_.clear(); }
 
+  /// Destroys the session (with the GIL released: a device may take a while to let go). Refused
+  /// while a call runs; claims the session first, so that no call starts meanwhile. Closing a
+  /// closed renderer does nothing.
   void close() {
     if (closed_) return;
     if (busy_.exchange(true))

@@ -47,7 +47,7 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous = nullptr
 
 /// In float precision, rays leave a surface offset by its rounding, which scales with the
 /// coordinates of its primitive (kernels/util/math.cl, lc_spawn_origin): a warning's text when
-/// the largest primitives' offsets exceed 1/8 of the scene's small features (the 10th
+/// the largest primitives' offsets exceed 1/16 of the scene's small features (the 10th
 /// percentile of primitive sizes: a triangle's longest edge, a sphere's diameter) or when its
 /// coordinates reach 100 times the size of its bounds, "" otherwise.
 /// A ground triangle of 1e6 under a sphere of 0.01 rendered 16% too dark, a box of size 2 at 1e4
