@@ -460,7 +460,8 @@ TEST(Outputs, RenderWithoutAFiniteSampleWritesNothing) {
   lucent::Scene dim = faint;
   dim.lights.erase(dim.lights.begin());  // 1.2e-38: a normal float
   EXPECT_EQ(lucent::scene_detail::radiance_notes(dim), std::vector<std::string>{});
-  dim.materials[1].emission = glm::dvec3(0, 1e-40, 0);
+  for (lucent::Material& m : dim.materials)
+    if (m.name == "glow") m.emission = glm::dvec3(0, 1e-40, 0);
   ASSERT_EQ(lucent::scene_detail::radiance_notes(dim).size(), 1u);
   EXPECT_EQ(lucent::scene_detail::radiance_notes(dim)[0].rfind(
                 "f.json: material 'glow': emission 1e-40 is below 1.18e-38", 0),
