@@ -1011,6 +1011,29 @@ TEST(Parts, SlurmArrayScriptsRenderAndMerge) {
   EXPECT_EQ(merged.info.samples, (std::vector<lucent::SampleRange>{{0, 8}}));
   EXPECT_LT(max_relative_difference(merged.acc, lucent::read_render_part(dir + "/one.exr").acc),
             1e-5);
+  // the merge's own options, LUCENT_MERGE_OPTS (submit.sh had no way to pass --complete): a task
+  // that fails (a lucent that fails on task 1's samples) leaves samples [2, 5) missing, which
+  // --complete makes the merge's error, writing nothing
+  {
+    const std::string failing = dir + "/failing-lucent";
+    lucent::test::write_file(failing,
+                             "#!/bin/sh\ncase \"$*\" in *'--samples 2:5'*) exit 1;; esac\n"
+                             "exec '" +
+                                 std::string(LUCENT_CLI_PATH) + "' \"$@\"\n");
+    fs::permissions(failing, fs::perms::owner_all);
+    std::string complete = "LUCENT_MERGE_OPTS=--complete " + cmd;
+    complete.replace(complete.find("LUCENT=" + q(LUCENT_CLI_PATH)),
+                     ("LUCENT=" + q(LUCENT_CLI_PATH)).size(), "LUCENT=" + q(failing));
+    complete.replace(complete.find(q(dir + "/parts")), q(dir + "/parts").size(),
+                     q(dir + "/parts2"));
+    complete.replace(complete.find(q(out)), q(out).size(), q(dir + "/complete.exr"));
+    std::remove(log.c_str());
+    ASSERT_EQ(std::system(complete.c_str()), 0);
+    const std::string e = lucent::test::read_file(dir + "/submit.err");
+    EXPECT_NE(e.find("samples [2, 5) are missing"), std::string::npos) << e;
+    EXPECT_NE(lucent::test::read_file(log).find(": exit 1\n"), std::string::npos);
+    EXPECT_FALSE(fs::exists(dir + "/complete.exr"));
+  }
 
   // one task again (sbatch --array=1): with the job's task count it renders its own range into
   // its own file; without it the one-task array is refused (it took itself for a whole job of

@@ -5,7 +5,9 @@
 #
 # TASKS array tasks each render SPP/TASKS samples per pixel (render-part.sbatch); a merge job
 # (merge.sbatch) waits for all of them (afterany) and writes OUT. Extra sbatch options for both:
-# SBATCH_OPTS (e.g. "--partition=gpu --time=02:00:00"). Prints the two job ids.
+# SBATCH_OPTS (e.g. "--partition=gpu --time=02:00:00"). Options of the merge (`lucent merge`):
+# LUCENT_MERGE_OPTS (e.g. "--complete": the merge fails, writing nothing, when a task's samples
+# are missing). Prints the two job ids.
 set -euo pipefail
 if [[ $# -lt 5 ]]; then
   echo "usage: submit.sh SCENE SPP TASKS PARTS_DIR OUT [lucent render options]" >&2
@@ -39,5 +41,5 @@ array=$(LUCENT_TASKS=$tasks sbatch --parsable ${SBATCH_OPTS:-} --array="0-$((tas
 array=${array%%;*}  # "jobid;cluster" on federated clusters
 # shellcheck disable=SC2086
 merge=$(sbatch --parsable ${SBATCH_OPTS:-} --dependency="afterany:$array" \
-  "$here/merge.sbatch" "$parts" "$out" --expect "0:$spp")
+  "$here/merge.sbatch" "$parts" "$out" --expect "0:$spp" ${LUCENT_MERGE_OPTS:-})
 echo "render array job $array ($tasks tasks), merge job ${merge%%;*} -> $out"
