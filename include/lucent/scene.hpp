@@ -11,6 +11,18 @@
 
 namespace lucent {
 
+// The structs below hold GLM's vectors and matrices, whose layout follows the GLM macros of the
+// program that includes this header: lucent is built with GLM's defaults, and a program that
+// makes them aligned (GLM_FORCE_DEFAULT_ALIGNED_GENTYPES with GLM_FORCE_INTRINSICS: a dvec3 of
+// 32 bytes) passed scenes the library misread (a camera's up read as zero) without a word.
+static_assert(sizeof(glm::dvec2) == 2 * sizeof(double) &&
+                  sizeof(glm::dvec3) == 3 * sizeof(double) &&
+                  sizeof(glm::dmat4) == 16 * sizeof(double) &&
+                  alignof(glm::dvec3) == alignof(double),
+              "lucent's structs need GLM's default layout: build without "
+              "GLM_FORCE_DEFAULT_ALIGNED_GENTYPES (and other GLM macros that change the size or "
+              "alignment of its types)");
+
 // The type enums are generated from the registries (lucent/registry.h, kernels/shared/registry.h
 // in the source tree): one enumerator per entry, with the entry's value.
 #define LUCENT_REGISTRY_ENUMERATOR(ID, Name, value, ...) Name = value,

@@ -39,6 +39,22 @@ if(rc)
   message(FATAL_ERROR "the consumer failed: ${rc}")
 endif()
 
+# a consumer that makes GLM's types aligned (a dvec3 of 32 bytes) cannot build: the library
+# would misread its structs (a camera's up read as zero), which it did without a word
+execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/package/consumer
+                        -B ${WORK_DIR}/build-aligned -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix
+                        "-DCMAKE_CXX_FLAGS=-DGLM_FORCE_DEFAULT_ALIGNED_GENTYPES -DGLM_FORCE_INTRINSICS"
+                RESULT_VARIABLE rc OUTPUT_QUIET)
+if(rc)
+  message(FATAL_ERROR "configuring the aligned-GLM consumer failed: ${rc}")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK_DIR}/build-aligned RESULT_VARIABLE rc
+                OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc OR NOT "${out}${err}" MATCHES "lucent's structs need GLM's default layout")
+  message(FATAL_ERROR "a consumer with GLM_FORCE_DEFAULT_ALIGNED_GENTYPES built (exit ${rc}), or "
+                      "failed for another reason: ${out}${err}")
+endif()
+
 # the Python module, when it was built: installed where PYTHON_INSTALL_DIR says, imported from
 # there by the interpreter it was built for
 if(PYTHON_EXECUTABLE AND PYTHON_INSTALL_DIR)
