@@ -140,7 +140,9 @@ struct ConvergeOptions {
   /// cancel() (or the flag) stops the study after the current pass, or before the next rung when
   /// asked for between two; the result has the points of the rungs finished.
   Renderer* renderer = nullptr;
-  /// Called after each rung (progress output).
+  /// Called after each rung (progress output). It may read the study's session (result(),
+  /// spp(), stats()) and cancel() it; a call that changes it (set_scene, render, reset,
+  /// set_build_options) throws lucent::Error, which ends the study.
   std::function<void(const ConvergePoint&)> on_point;
 };
 

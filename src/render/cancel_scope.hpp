@@ -2,6 +2,8 @@
 // Several calls of one session as one operation for Renderer::cancel(): run_convergence's ladder
 // (src/render/converge.cpp) renders rung after rung on one session, and a call clears the cancel
 // asked for before it began, so a cancel between two rungs was forgotten and the ladder went on.
+#include <functional>
+
 #include "lucent/session.hpp"
 
 namespace lucent::render_detail {
@@ -20,6 +22,12 @@ class CancelScope {
 
   /// cancel() was called since the scope began, or the session's cancel flag is raised.
   bool cancelled() const;
+
+  /// Runs `f` (a callback of the operation: run_convergence's on_point), holding the session as a
+  /// call does: a call that changes it (set_scene, render, reset, ...) is refused from `f`,
+  /// naming `what` ("run_convergence's on_point": a study whose on_point set another scene
+  /// measured that scene's error against the reference, without a word); reads and cancel() work.
+  void hold(const char* what, const std::function<void()>& f);
 
  private:
   Renderer& renderer_;

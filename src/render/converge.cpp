@@ -649,7 +649,8 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
       p.reference_noise_relmse = ref_noise;
       p.estimated_relmse = r.estimated_relmse;
       p.halves_relmse = r.halves_relmse;
-      if (options.on_point) options.on_point(p);
+      if (options.on_point)
+        cancel_scope.hold("run_convergence's on_point", [&] { options.on_point(p); });
       pts.push_back(p);
     }
     if (!pts.empty()) {

@@ -404,12 +404,18 @@ struct Renderer::Impl {
     cl_util::check_not_forked();  // (a session made before a fork: its calls would hang)
     if (rendering.load()) throw rendering_error(call);
   }
-  static Error rendering_error(const char* call) {
+  Error rendering_error(const char* call) const {
+    if (held_by)
+      return Error(std::string(call) + ": cannot change the session from " + held_by +
+                   ", which runs on it (it may read result(), spp() and stats(), or cancel())");
     return Error(std::string(call) +
                  ": a render of this session is in progress, or another call that changes it "
                  "(a session runs one call at a time; a render's on_progress may read result(), "
                  "spp() and stats(), or cancel())");
   }
+  /// What holds the session outside a call (CancelScope::hold: run_convergence's on_point),
+  /// for the refusal's message; null otherwise.
+  const char* held_by = nullptr;
   /// Marks a call in progress while it lives, a render or one that changes the session
   /// (set_scene, set_camera, reset, set_build_options), and refuses another: set_scene from
   /// another thread passed check_not_rendering just before a render began, and replaced its
@@ -419,7 +425,7 @@ struct Renderer::Impl {
     /// `render`: a render call (passes run: in_render), not one that changes the session.
     RenderCall(Impl& impl, const char* call, bool render = false) : s(impl) {
       cl_util::check_not_forked();
-      if (s.rendering.exchange(true)) throw rendering_error(call);
+      if (s.rendering.exchange(true)) throw s.rendering_error(call);
       s.in_render = render;
       // a cancel of an earlier render is dropped here too, as a render's begin_call drops it: a
       // set_scene that met another process's build lock after a cancelled render gave up its
@@ -1704,6 +1710,19 @@ CancelScope::CancelScope(Renderer& renderer) : renderer_(renderer) {
 }
 CancelScope::~CancelScope() { --renderer_.impl_->cancel_scopes; }
 bool CancelScope::cancelled() const { return renderer_.impl_->cancelled(); }
+void CancelScope::hold(const char* what, const std::function<void()>& f) {
+  Renderer::Impl& s = *renderer_.impl_;
+  if (s.rendering.exchange(true)) throw s.rendering_error(what);
+  s.held_by = what;
+  struct Release {
+    Renderer::Impl& s;
+    ~Release() {
+      s.held_by = nullptr;
+      s.rendering = false;
+    }
+  } release{s};
+  f();
+}
 
 }  // namespace render_detail
 
