@@ -175,7 +175,8 @@ class Renderer {
   /// render returned. Returns the progress at the end.
   RenderProgress render(std::uint64_t spp,
                         const std::function<void(const RenderProgress&)>& on_progress = {});
-  /// Adds samples for about `seconds` (at least one pass).
+  /// Adds samples for about `seconds` (at least one pass, unless cancelled: see
+  /// set_cancel_flag).
   RenderProgress render_for(double seconds,
                             const std::function<void(const RenderProgress&)>& on_progress = {});
   /// Adds `spp` samples per pixel or samples for `max_seconds`, whichever comes first (0: no
@@ -219,7 +220,10 @@ class Renderer {
   /// when the next one starts, but during a convergence study on this session
   /// (ConvergeOptions::renderer), which it stops, between two rungs too.
   void cancel();
-  /// An external flag checked before each pass, as cancel() (e.g. set by a SIGINT handler).
+  /// An external flag checked before each pass, as cancel() (e.g. set by a SIGINT handler). A
+  /// render that starts with the flag raised still renders one pass when the accumulation holds
+  /// no sample yet, so that what a stopped render writes is an image (a stop during the kernel
+  /// build rendered a pass the caller reports); with samples it renders none.
   void set_cancel_flag(const std::atomic<bool>* flag);
   /// The flag set_cancel_flag gave (null: none).
   const std::atomic<bool>* cancel_flag() const;
