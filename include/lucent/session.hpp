@@ -222,8 +222,8 @@ class Renderer {
   void cancel();
   /// An external flag checked before each pass, as cancel() (e.g. set by a SIGINT handler). A
   /// render that starts with the flag raised still renders one pass when the accumulation holds
-  /// no sample yet, so that what a stopped render writes is an image (a stop during the kernel
-  /// build rendered a pass the caller reports); with samples it renders none.
+  /// no sample yet (with samples, none): check the flag before calling to render nothing, as
+  /// `lucent render` does after set_scene.
   void set_cancel_flag(const std::atomic<bool>* flag);
   /// The flag set_cancel_flag gave (null: none).
   const std::atomic<bool>* cancel_flag() const;
