@@ -141,7 +141,10 @@ class Renderer {
   /// otherwise (the next sample index is then the last reset()'s first_sample, 0 by default).
   /// Throws lucent::Error for a scene it cannot render, first checking the whole scene
   /// as SceneBuilder checks each element (its fields may have been set directly), with the place
-  /// of the first problem ("scene.json: /shapes/1 (triangle 4)/v/2: must index one of ...").
+  /// of the first problem ("scene.json: /shapes/1 (triangle 4)/v/2: must index one of ..."),
+  /// except where it allows more: a film of any size from 1 (the host and device memory checks
+  /// bound it, not limits::kMaxImageSize), materials of any names (the scene's references are
+  /// indices), and spheres or positions that are not finite (never hit; a warning).
   void set_scene(const Scene& scene);
   /// set_scene() that takes the scene instead of copying it: its arrays (a large mesh's
   /// vertices, a texture's texels) are then held once, by the session, not also by the caller.
