@@ -683,36 +683,6 @@ TEST(Converge, AdaptiveAndTargetErrorSettings) {
   }
 }
 
-// The rungs are taken in ascending order, whatever order the ladder gives them in: the verdict
-// reads the last point as the largest rung and the fit the last three (a ladder 1024,4,8 was
-// judged at 8 spp, "unbiased" for a clamp judged biased on 4,8,1024), and the plot joined the
-// points in the order given.
-TEST(Converge, RungsAreTakenInAscendingOrder) {
-  lucent::Scene scene =
-      lucent::test::with_independent_samples(lucent::parse_scene(kScene, "t.json"));
-  scene.film.width = scene.film.height = 8;
-  lucent::Scene ref_scene = scene;
-  ref_scene.integrator.seed = lucent::reference_seed(scene.integrator.seed);
-  lucent::RenderOptions ro;
-  ro.spp = 64;
-  lucent::RenderResult reference = lucent::test::render(ref_scene, ro);
-  lucent::ConvergeOptions opt;
-  opt.render = lucent::test::render_options();
-  opt.spp_ladder = {16, 2, 4};
-  lucent::ConvergeResult given = lucent::run_convergence(scene, reference, opt);
-  opt.spp_ladder = {2, 4, 16};
-  lucent::ConvergeResult sorted = lucent::run_convergence(scene, reference, opt);
-  ASSERT_EQ(given.points.size(), 3u);
-  ASSERT_EQ(sorted.points.size(), 3u);
-  for (size_t i = 0; i < 3; ++i) {
-    EXPECT_EQ(given.points[i].spp, opt.spp_ladder[i]) << i;
-    EXPECT_EQ(given.points[i].relmse, sorted.points[i].relmse) << i;
-  }
-  ASSERT_EQ(given.fits.size(), 1u);
-  EXPECT_EQ(given.fits[0].verdict, sorted.fits[0].verdict);
-  EXPECT_EQ(given.fits[0].slope_spp, sorted.fits[0].slope_spp);
-}
-
 // An adaptive setting skips the rungs below its pilot: with none at or above it, it rendered
 // nothing and vanished from the table, the CSV and the plot (exit 0, after the reference). It is
 // refused up front, naming the setting, its pilot and the largest rung.
@@ -835,6 +805,32 @@ lucent::RenderResult independent_reference(const lucent::Scene& scene) {
   lucent::Scene ref_scene = scene;
   ref_scene.integrator.seed = lucent::reference_seed(scene.integrator.seed);
   return lucent::test::render(ref_scene, lucent::test::render_options());
+}
+
+// The rungs are taken in ascending order, whatever order the ladder gives them in: the verdict
+// reads the last point as the largest rung and the fit the last three (a ladder 1024,4,8 was
+// judged at 8 spp, "unbiased" for a clamp judged biased on 4,8,1024), and the plot joined the
+// points in the order given.
+TEST(Converge, RungsAreTakenInAscendingOrder) {
+  lucent::Scene scene =
+      lucent::test::with_independent_samples(lucent::parse_scene(kScene, "t.json"));
+  scene.film.width = scene.film.height = 8;
+  const lucent::RenderResult reference = independent_reference(scene);
+  lucent::ConvergeOptions opt;
+  opt.render = lucent::test::render_options();
+  opt.spp_ladder = {16, 2, 4};
+  lucent::ConvergeResult given = lucent::run_convergence(scene, reference, opt);
+  opt.spp_ladder = {2, 4, 16};
+  lucent::ConvergeResult sorted = lucent::run_convergence(scene, reference, opt);
+  ASSERT_EQ(given.points.size(), 3u);
+  ASSERT_EQ(sorted.points.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(given.points[i].spp, opt.spp_ladder[i]) << i;
+    EXPECT_EQ(given.points[i].relmse, sorted.points[i].relmse) << i;
+  }
+  ASSERT_EQ(given.fits.size(), 1u);
+  EXPECT_EQ(given.fits[0].verdict, sorted.fits[0].verdict);
+  EXPECT_EQ(given.fits[0].slope_spp, sorted.fits[0].slope_spp);
 }
 
 // A lucent render at the ladder's own seed holds the rungs' own samples and hides their error:
