@@ -319,6 +319,8 @@ TEST(Converge, SettingSyntax) {
             "filter=box:RADIUS)");
   EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("max_depth=+3"); }),
             "setting 'max_depth=+3': a value cannot start with + (+ joins knobs)");
+  EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("filter=gaussian:+1"); }),
+            "setting 'filter=gaussian:+1': a value cannot start with + (+ joins knobs)");
   // a number's knob as written, and the pilot's true range (it said min_spp, from 1)
   EXPECT_EQ(lucent::test::error_of([] { lucent::parse_converge_setting("adaptive+min-spp=-4"); }),
             "setting min-spp=-4: expected an integer from 4 to 16384");
@@ -909,8 +911,8 @@ TEST(Converge, OnPointCannotChangeTheStudysSession) {
     };
     const std::string error =
         lucent::test::error_of([&] { lucent::run_convergence(scene, reference, opt); });
-    EXPECT_NE(error.find(": cannot change the session from run_convergence's on_point, which "
-                         "runs on it"),
+    EXPECT_NE(error.find(": cannot change the session while run_convergence's on_point runs, "
+                         "which holds it"),
               std::string::npos)
         << error;
     EXPECT_EQ(points, 1);

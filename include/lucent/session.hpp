@@ -117,8 +117,9 @@ class Renderer {
  public:
   /// Opens the device. Throws lucent::Error (no device, unknown selector, ...).
   explicit Renderer(SessionOptions options = {});
-  /// Destroying a session during one of its own calls (from its on_progress) ends the process
-  /// with a line on stderr (the call would go on in freed memory).
+  /// Destroying a session during one of its own calls (from its on_progress, or from
+  /// run_convergence's on_point on it) ends the process with a line on stderr (the call would
+  /// go on in freed memory).
   ~Renderer();
   /// Moves the session. Throws lucent::Error during a render of either session (from its
   /// on_progress: the render would go on in a session moved away or destroyed).
@@ -178,8 +179,8 @@ class Renderer {
   /// render returned. Returns the progress at the end.
   RenderProgress render(std::uint64_t spp,
                         const std::function<void(const RenderProgress&)>& on_progress = {});
-  /// Adds samples for about `seconds` (at least one pass, unless cancelled: see
-  /// set_cancel_flag).
+  /// Adds samples for about `seconds` (at least one pass, but none when cancelled with samples
+  /// accumulated: set_cancel_flag).
   RenderProgress render_for(double seconds,
                             const std::function<void(const RenderProgress&)>& on_progress = {});
   /// Adds `spp` samples per pixel or samples for `max_seconds`, whichever comes first (0: no

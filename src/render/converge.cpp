@@ -201,7 +201,7 @@ ConvergeSetting parse_converge_setting(const std::string& text) {
   s.name = text;
   if (text.empty()) throw Error("empty setting (expected e.g. default, fast-math, max_depth=2)");
   // (split at the '+', "max_depth=+3" said "setting max_depth=: ...")
-  if (text.find("=+") != std::string::npos)
+  if (text.find("=+") != std::string::npos || text.find(":+") != std::string::npos)
     throw Error("setting '" + text + "': a value cannot start with + (+ joins knobs)");
   // every knob between two '+' (getline dropped a trailing empty one: "max_depth=3+" was read)
   std::vector<std::string> knobs{""};

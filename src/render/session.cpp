@@ -405,9 +405,10 @@ struct Renderer::Impl {
     if (rendering.load()) throw rendering_error(call);
   }
   Error rendering_error(const char* call) const {
-    if (held_by)
-      return Error(std::string(call) + ": cannot change the session from " + held_by +
-                   ", which runs on it (it may read result(), spp() and stats(), or cancel())");
+    if (const char* by = held_by.load())
+      return Error(std::string(call) + ": cannot change the session while " + by +
+                   " runs, which holds it (it may read result(), spp() and stats(), or "
+                   "cancel())");
     return Error(std::string(call) +
                  ": a render of this session is in progress, or another call that changes it "
                  "(a session runs one call at a time; a render's on_progress may read result(), "
@@ -415,7 +416,7 @@ struct Renderer::Impl {
   }
   /// What holds the session outside a call (CancelScope::hold: run_convergence's on_point),
   /// for the refusal's message; null otherwise.
-  const char* held_by = nullptr;
+  std::atomic<const char*> held_by{nullptr};
   /// Marks a call in progress while it lives, a render or one that changes the session
   /// (set_scene, set_camera, reset, set_build_options), and refuses another: set_scene from
   /// another thread passed check_not_rendering just before a render began, and replaced its
@@ -1519,7 +1520,8 @@ Renderer::~Renderer() {
   if (impl_ && impl_->rendering.load()) {
     std::fputs(
         "lucent: a lucent::Renderer was destroyed during one of its own calls (from its "
-        "on_progress or warning sink, or another thread): aborting\n",
+        "on_progress or warning sink, run_convergence's on_point, or another thread): "
+        "aborting\n",
         stderr);
     std::abort();
   }
