@@ -71,16 +71,17 @@ struct type_caster<lucent::python::FileText> {
 }  // namespace pybind11::detail
 
 namespace lucent::python {
-/// A directory argument (cache_dir, kernel_dir): FileText, or an os.PathLike as os.fspath gives
-/// it (Renderer(cache_dir=Path(...)) was pybind's "incompatible function arguments", where
-/// every file path argument took one). Names that are not paths (a material's) stay FileText.
-struct DirText : FileText {};
+/// A path (cache_dir, kernel_dir, Texture.path, Scene.path, ShapeEntry.file and .libraries):
+/// FileText, or an os.PathLike as os.fspath gives it (Renderer(cache_dir=Path(...)) was
+/// pybind's "incompatible function arguments", where every file path argument took one). Names
+/// that are not paths (a material's) stay FileText.
+struct PathText : FileText {};
 }  // namespace lucent::python
 
 namespace pybind11::detail {
 template <>
-struct type_caster<lucent::python::DirText> {
-  PYBIND11_TYPE_CASTER(lucent::python::DirText, const_name("os.PathLike"));
+struct type_caster<lucent::python::PathText> {
+  PYBIND11_TYPE_CASTER(lucent::python::PathText, const_name("os.PathLike"));
   bool load(handle src, bool convert) {
     object text = reinterpret_borrow<object>(src);
     if (!PyBytes_Check(src.ptr()) && !PyUnicode_Check(src.ptr()) &&
@@ -96,7 +97,7 @@ struct type_caster<lucent::python::DirText> {
     value.bytes = std::move(static_cast<lucent::python::FileText&>(file).bytes);
     return true;
   }
-  static handle cast(const lucent::python::DirText& text, return_value_policy p, handle h) {
+  static handle cast(const lucent::python::PathText& text, return_value_policy p, handle h) {
     return type_caster<lucent::python::FileText>::cast(text, p, h);
   }
 };

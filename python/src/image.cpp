@@ -88,7 +88,8 @@ void bind_image(py::module_& m) {
       },
       py::arg("path"),
       "Reads .pfm, .exr (linear) or an 8-bit image (decoded to linear) as an (H, W, 3) float32 "
-      "array.");
+      "array; a lucent part file gives the image of its checksummed sums (a damaged one "
+      "raises).");
   m.def(
       "write_render_exr",
       [](const std::filesystem::path& path, py::handle result) {

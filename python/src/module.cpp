@@ -404,7 +404,7 @@ namespace {
 /// the default directory, as for Renderer(), which reads no environment variable unless asked
 /// (it read LUCENT_CACHE_DIR, so clear_cache() emptied another directory than the sessions'
 /// and removed none of their entries). The lucent command's: lucent.environment()["cache_dir"].
-FileText resolved_cache_dir(const DirText& given) {
+FileText resolved_cache_dir(const PathText& given) {
   const std::string& d = given.bytes;
   refuse_nul(d, "cache_dir");
   if (d == "off") return {};
@@ -576,7 +576,7 @@ PYBIND11_MODULE(lucent, m) {
         "\"\" when disabled (\"off\").");
   m.def(
       "clear_cache",
-      [](const DirText& dir) {
+      [](const PathText& dir) {
         return cl_util::clear_program_cache(resolved_cache_dir(dir).bytes);
       },
       py::arg("cache_dir") = "",
@@ -584,7 +584,7 @@ PYBIND11_MODULE(lucent, m) {
       "wrote); returns how many.");
   m.def(
       "cache_info",
-      [](const DirText& dir) {
+      [](const PathText& dir) {
         const FileText resolved = resolved_cache_dir(dir);
         const cl_util::ProgramCacheUsage usage = cl_util::program_cache_usage(resolved.bytes);
         py::dict d;

@@ -93,7 +93,7 @@ void bind_device_shares(py::module_& m, py::class_<T>& c) {
 /// before any other thread can start a call (or resume the render).
 class PyRenderer {
  public:
-  PyRenderer(const TextArg& device_arg, const DirText& kernel_dir, const DirText& cache_dir,
+  PyRenderer(const TextArg& device_arg, const PathText& kernel_dir, const PathText& cache_dir,
              const TextArg& precision, const FlagArg& fast_math, const FlagArg& specialize,
              double pass_seconds, const IntArg& reserved_host_bytes, py::object on_warning)
       : warning_errors_(std::make_shared<CallbackErrors>()) {
@@ -189,6 +189,9 @@ class PyRenderer {
           out.emplace(f(r));
       } catch (const Error&) {
         failed = std::current_exception();
+      } catch (...) {
+        warning_errors_->clear();  // (as below: the failure is raised)
+        throw;
       }
       // a failed call raises its own error; what its on_warning raised goes with it (it was
       // kept, and raised by the next call, which had given no warning)
@@ -287,6 +290,21 @@ class PyRenderer {
     errors.rethrow();
     return out;
   }
+
+  /// While alive (the GIL held), the call in progress is paused in a callback of its own between
+  /// two passes or rungs (converge's on_point): result(), scene and options can be read there,
+  /// as in a progress callback (the library holds the session, so nothing in it changes).
+  struct PausedInCallback {
+    PyRenderer* r;
+    explicit PausedInCallback(PyRenderer* renderer) : r(renderer) {
+      if (r) r->paused_ = true;
+    }
+    ~PausedInCallback() {
+      if (r) r->paused_ = false;
+    }
+    PausedInCallback(const PausedInCallback&) = delete;
+    PausedInCallback& operator=(const PausedInCallback&) = delete;
+  };
 
   /// The accumulation: a call of its own, or, while a render is paused in its progress callback
   /// (between passes, nothing in the session changes: Renderer::result() is safe there), read
@@ -816,8 +834,8 @@ void bind_render(py::module_& m) {
       "the `lucent` command's defaults.");
   bind_session_devices<Renderer>(renderer);
   renderer
-      .def(py::init<const TextArg&, const DirText&, const DirText&, const TextArg&, const FlagArg&,
-                    const FlagArg&, double, const IntArg&, py::object>(),
+      .def(py::init<const TextArg&, const PathText&, const PathText&, const TextArg&,
+                    const FlagArg&, const FlagArg&, double, const IntArg&, py::object>(),
            py::kw_only(), py::arg("device") = "", py::arg("kernel_dir") = "",
            py::arg("cache_dir") = "", py::arg("precision") = "float", py::arg("fast_math") = false,
            py::arg("specialize") = true, py::arg("pass_seconds") = 0.25,
@@ -1134,11 +1152,13 @@ void bind_render(py::module_& m) {
         CallbackErrors errors;
         std::atomic<bool>* stop = nullptr;
         // on_point is a callback of the session's converge call when it renders in one
-        const PyRenderer* session = renderer.is_none() ? nullptr : &renderer.cast<PyRenderer&>();
+        PyRenderer* session = renderer.is_none() ? nullptr : &renderer.cast<PyRenderer&>();
         if (!on_point.is_none())
           o.on_point = [&](const ConvergePoint& p) {
             AcquireGil gil;
             InCallback frame(session, "on_point callback");
+            // result() reads there, as run_convergence's on_point may (it was refused)
+            PyRenderer::PausedInCallback paused(session);
             if (!errors.run([&] { on_point(p); })) *stop = true;
           };
         ConvergeResult out;

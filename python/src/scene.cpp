@@ -214,6 +214,14 @@ void text_property(py::class_<C>& c, const char* name, std::string C::*member,
       name, [member](const C& o) { return FileText{o.*member}; },
       [member](py::handle self, const FileText& v) { assigned<C>(self).*member = v.bytes; }, doc);
 }
+/// text_property of a path: an os.PathLike too (PathText).
+template <class C>
+void path_property(py::class_<C>& c, const char* name, std::string C::*member,
+                   const char* doc = "") {
+  c.def_property(
+      name, [member](const C& o) { return FileText{o.*member}; },
+      [member](py::handle self, const PathText& v) { assigned<C>(self).*member = v.bytes; }, doc);
+}
 
 /// A property holding an enum by its registry name.
 template <class C, class E>
@@ -1069,7 +1077,7 @@ void bind_scene(py::module_& m) {
           "rgba", &texture_texels, &set_texture_texels,
           "(H, W, 4) float32, linear, row 0 at the top: a read-only copy (assign an array to "
           "change it)");
-  text_property(texture, "path", &Texture::path);
+  path_property(texture, "path", &Texture::path);
   def_pickle(texture);
 
   py::class_<ShapeEntry> shape_entry(
@@ -1087,12 +1095,12 @@ void bind_scene(py::module_& m) {
             for (const std::string& l : e.libraries) out.push_back({l});
             return out;
           },
-          [](py::handle self, const std::vector<FileText>& libraries) {
+          [](py::handle self, const std::vector<PathText>& libraries) {
             ShapeEntry& e = assigned<ShapeEntry>(self);
             e.libraries.clear();
-            for (const FileText& l : libraries) e.libraries.push_back(l.bytes);
+            for (const PathText& l : libraries) e.libraries.push_back(l.bytes);
           });
-  text_property(shape_entry, "file", &ShapeEntry::file);
+  path_property(shape_entry, "file", &ShapeEntry::file);
   enum_property(shape_entry, "type", &ShapeEntry::type);
   def_pickle(shape_entry);
 
@@ -1117,7 +1125,7 @@ void bind_scene(py::module_& m) {
       .def_readwrite("camera", &Scene::camera)
       .def_readwrite("film", &Scene::film)
       .def_readwrite("integrator", &Scene::integrator);
-  text_property(scene, "path", &Scene::path, "the file the scene came from, for messages");
+  path_property(scene, "path", &Scene::path, "the file the scene came from, for messages");
   list_property(scene, "materials", &Scene::materials);
   list_property(scene, "spheres", &Scene::spheres);
   list_property(scene, "triangles", &Scene::triangles);

@@ -415,3 +415,8 @@ def test_paths_with_a_nul_and_path_like_directories(tmp_path):
     assert lucent.read_image(tmp_path / "p.pfm").shape == (2, 2, 3)
     with lucent.Renderer(cache_dir=tmp_path / "cache") as r:
         assert r.options["cache_dir"] == str(tmp_path / "cache")
+    scene = lucent.Scene()  # the scene's paths too, not the names that are no paths
+    scene.path = tmp_path / "scene.json"
+    assert scene.path == str(tmp_path / "scene.json")
+    with pytest.raises(TypeError):
+        lucent.Material("diffuse", tmp_path)

@@ -296,11 +296,17 @@ def test_calls_from_a_warning_callback_of_set_scene_say_so(small_scene):
 
 
 def test_calls_from_converges_own_on_point_callback_say_so(renderer, small_scene):
+    """From on_point the study's session is read as from a progress callback: result() gives
+    the rung's image (it was refused, where the library's on_point may read it), and a call
+    that changes the session is refused."""
     renderer.set_scene(small_scene)
     got = []
     lucent.converge(small_scene, np.zeros((12, 16, 3), np.float32), renderer=renderer,
-                    spp_ladder=[1, 2], on_point=lambda p: got.append(error_of(renderer.result)))
-    assert got == [reentry("call", "result", "on_point callback", "converge")] * 2
+                    spp_ladder=[1, 2],
+                    on_point=lambda p: got.append((p.spp, renderer.result().spp,
+                                                   error_of(lambda: renderer.render(1)))))
+    assert got == [(n, n, reentry("call", "render", "on_point callback", "converge"))
+                   for n in (1, 2)]
 
 
 @pytest.mark.parametrize("b_options", [{}, {"device": "0,0"}], ids=["one device", "two contexts"])
