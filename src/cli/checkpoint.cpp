@@ -44,7 +44,14 @@ CheckpointLock::CheckpointLock(const std::string& checkpoint)
       e = errno;
       break;
     }
-    if (lucent::io::is_file_at(fd_, path_) || attempt == 100) {
+    if (attempt == 100) {  // (removed 100 times over while this render opened it)
+      ::close(fd_);
+      fd_ = -1;
+      throw lucent::Error(path_ +
+                          ": cannot lock the checkpoint (its lock file keeps being "
+                          "removed by another render)");
+    }
+    if (lucent::io::is_file_at(fd_, path_)) {
       // the mark that tells another command's output check this lock is a checkpoint's
       if (::ftruncate(fd_, 0) == 0) {
         const std::size_t n = sizeof lucent::io::kCheckpointLockMark - 1;
