@@ -27,7 +27,9 @@ struct DisplaySettings {
 /// .exr (linear float). Throws lucent::Error naming the path on failure.
 void write_image(const std::string& path, const Image& image, const DisplaySettings& display = {});
 
-/// Reads .pfm, .exr (linear) or an 8-bit format (decoded from sRGB to linear).
+/// Reads .pfm, .exr (linear) or an 8-bit format (decoded from sRGB to linear). A lucent part
+/// file (an .exr with lucent.checksum: a checkpoint, a --samples part) gives the image of its
+/// checksummed sums, as read_render does, and a damaged one throws.
 Image read_image(const std::string& path);
 
 /// Linear value to 8-bit display value.

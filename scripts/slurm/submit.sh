@@ -7,7 +7,8 @@
 # (merge.sbatch) waits for all of them (afterany) and writes OUT. Extra sbatch options for both:
 # SBATCH_OPTS (e.g. "--partition=gpu --time=02:00:00"). Options of the merge (`lucent merge`):
 # LUCENT_MERGE_OPTS (e.g. "--complete": the merge fails, writing nothing, when a task's samples
-# are missing). Prints the two job ids.
+# are missing). Both are split at spaces, as a shell splits words (no quoting inside them).
+# Prints the two job ids.
 set -euo pipefail
 if [[ $# -lt 5 ]]; then
   echo "usage: submit.sh SCENE SPP TASKS PARTS_DIR OUT [lucent render options]" >&2
