@@ -835,6 +835,24 @@ TEST(Converge, RungsAreTakenInAscendingOrder) {
   EXPECT_EQ(given.fits[0].slope_spp, sorted.fits[0].slope_spp);
 }
 
+// The options are checked before the rungs are sorted: a NaN rung given to the library broke
+// std::sort's ordering (undefined behaviour; past 16 rungs libstdc++'s insertion sort may read
+// out of bounds, which the sanitizer build would report).
+TEST(Converge, ANanRungIsRefusedBeforeSorting) {
+  lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
+  scene.film.width = scene.film.height = 4;
+  lucent::RenderResult reference;
+  reference.mean = lucent::Image{4, 4, std::vector<float>(48, 0.5f)};
+  lucent::ConvergeOptions opt;
+  opt.render = lucent::test::render_options();
+  for (int i = 0; i < 40; ++i)
+    opt.time_ladder.push_back(i % 5 == 0 ? std::nan("") : 0.001 * (40 - i));
+  EXPECT_EQ(lucent::test::error_of([&] {
+              lucent::run_convergence(scene, reference, opt);
+            }).rfind("converge: time ladder values must be in (0, 1e7] seconds, got nan", 0),
+            0u);
+}
+
 // A lucent render at the ladder's own seed holds the rungs' own samples and hides their error:
 // `lucent converge` refused such a --reference, but run_convergence (and so Python's converge)
 // took it, and an unbiased ladder measured relMSE ~0.6x its noise against it. Refused by the

@@ -509,6 +509,14 @@ TEST(Session, CacheDirectoryIsAnOption) {
   EXPECT_EQ(c.stats().kernel_cache_loads, entries ? 1u : 0u);
   EXPECT_EQ(c.stats().kernel_compiles, entries ? 0u : 1u);
   EXPECT_EQ(lucent::cl_util::program_cache_usage(o.cache_dir).programs, entries ? 1 : 0);
+  // nor a build lock there: a process waiting on it built the program again anyway
+  int locks = 0;
+  std::error_code ec;
+  for (const auto& f : std::filesystem::directory_iterator(o.cache_dir, ec))
+    locks += f.path().extension() == ".lock";
+  if (!entries) {
+    EXPECT_EQ(locks, 0);
+  }
 }
 
 // Where the driver caches its own builds (PoCL with POCL_KERNEL_CACHE on, its default), the
