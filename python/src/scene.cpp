@@ -206,21 +206,14 @@ void bool_property(py::class_<C>& c, const char* name, bool C::*member, const ch
       doc);
 }
 
-/// A property holding text from files (FileText: a file name, a name in an MTL file).
-template <class C>
+/// A property holding text from files (FileText: a file name, a name in an MTL file); `Text`
+/// PathText for a path, which takes an os.PathLike too.
+template <class Text = FileText, class C>
 void text_property(py::class_<C>& c, const char* name, std::string C::*member,
                    const char* doc = "") {
   c.def_property(
       name, [member](const C& o) { return FileText{o.*member}; },
-      [member](py::handle self, const FileText& v) { assigned<C>(self).*member = v.bytes; }, doc);
-}
-/// text_property of a path: an os.PathLike too (PathText).
-template <class C>
-void path_property(py::class_<C>& c, const char* name, std::string C::*member,
-                   const char* doc = "") {
-  c.def_property(
-      name, [member](const C& o) { return FileText{o.*member}; },
-      [member](py::handle self, const PathText& v) { assigned<C>(self).*member = v.bytes; }, doc);
+      [member](py::handle self, const Text& v) { assigned<C>(self).*member = v.bytes; }, doc);
 }
 
 /// A property holding an enum by its registry name.
@@ -1077,7 +1070,7 @@ void bind_scene(py::module_& m) {
           "rgba", &texture_texels, &set_texture_texels,
           "(H, W, 4) float32, linear, row 0 at the top: a read-only copy (assign an array to "
           "change it)");
-  path_property(texture, "path", &Texture::path);
+  text_property<PathText>(texture, "path", &Texture::path);
   def_pickle(texture);
 
   py::class_<ShapeEntry> shape_entry(
@@ -1100,7 +1093,7 @@ void bind_scene(py::module_& m) {
             e.libraries.clear();
             for (const PathText& l : libraries) e.libraries.push_back(l.bytes);
           });
-  path_property(shape_entry, "file", &ShapeEntry::file);
+  text_property<PathText>(shape_entry, "file", &ShapeEntry::file);
   enum_property(shape_entry, "type", &ShapeEntry::type);
   def_pickle(shape_entry);
 
@@ -1125,7 +1118,8 @@ void bind_scene(py::module_& m) {
       .def_readwrite("camera", &Scene::camera)
       .def_readwrite("film", &Scene::film)
       .def_readwrite("integrator", &Scene::integrator);
-  path_property(scene, "path", &Scene::path, "the file the scene came from, for messages");
+  text_property<PathText>(scene, "path", &Scene::path,
+                          "the file the scene came from, for messages");
   list_property(scene, "materials", &Scene::materials);
   list_property(scene, "spheres", &Scene::spheres);
   list_property(scene, "triangles", &Scene::triangles);
