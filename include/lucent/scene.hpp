@@ -140,6 +140,7 @@ struct Light {
 
 /// Shape types: spheres, and triangles (inline triangle lists and OBJ meshes alike).
 enum class ShapeType { LC_SHAPE_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
+#undef LUCENT_REGISTRY_ENUMERATOR  // (it stayed defined in every program that included this)
 
 /// One entry of the scene's shape list, in the order given (the JSON "shapes" array, or
 /// SceneBuilder's add_sphere / add_mesh / add_obj calls): the primitives it made. Error messages

@@ -6,6 +6,15 @@
 #include <lucent/lucent.hpp>
 #include <string>
 
+// the umbrella header is every public header (compare, converge and reference were missing),
+// and leaves no macro of its own making behind
+#ifdef LUCENT_REGISTRY_ENUMERATOR
+#error "lucent/scene.hpp left LUCENT_REGISTRY_ENUMERATOR defined"
+#endif
+static_assert(sizeof(lucent::CompareOptions) > 0 && sizeof(lucent::ConvergeOptions) > 0 &&
+                  sizeof(lucent::ReferenceOptions) > 0,
+              "lucent/lucent.hpp includes compare.hpp, converge.hpp and reference.hpp");
+
 namespace {
 
 int fail(const char* what) {
