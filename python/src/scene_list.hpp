@@ -122,14 +122,19 @@ inline constexpr const char* kListIndices = "list indices must be integers or sl
 /// (a list's insert and pop say "'float' object cannot be interpreted as an integer")
 inline constexpr const char* kIndexMust = "the index must be an integer";
 
+/// The Python name of the bound type T ("Material"), for messages.
+template <class T>
+std::string bound_name() {
+  return py::str(py::type::of<T>().attr("__name__"));
+}
+
 /// `value` as T: TypeError "<what>: expected a Material, not float".
 template <class T>
 T value_of(py::handle value, const char* what) {
   try {
     return value.cast<T>();
   } catch (const py::cast_error&) {
-    throw py::type_error(std::string(what) + ": expected a " +
-                         py::str(py::type::of<T>().attr("__name__")).operator std::string() +
+    throw py::type_error(std::string(what) + ": expected a " + list_detail::bound_name<T>() +
                          ", not " + Py_TYPE(value.ptr())->tp_name);
   }
 }
@@ -145,9 +150,8 @@ std::vector<T> values_of(const py::iterable& items, const char* what) {
       values.push_back(h.cast<T>());
     } catch (const py::cast_error&) {
       throw py::type_error(std::string(what) + ": item " + std::to_string(values.size()) +
-                           ": expected a " +
-                           py::str(py::type::of<T>().attr("__name__")).operator std::string() +
-                           ", not " + Py_TYPE(h.ptr())->tp_name);
+                           ": expected a " + list_detail::bound_name<T>() + ", not " +
+                           Py_TYPE(h.ptr())->tp_name);
     }
   }
   return values;
@@ -418,8 +422,7 @@ void list_property(py::class_<C>& c, const char* name, std::vector<T> C::*member
         }
         if (!py::isinstance<py::iterable>(value) || py::isinstance<py::str>(value) ||
             py::isinstance<py::bytes>(value))
-          throw py::type_error(what + ": expected a list of " +
-                               py::str(py::type::of<T>().attr("__name__")).operator std::string() +
+          throw py::type_error(what + ": expected a list of " + list_detail::bound_name<T>() +
                                ", not " + std::string(Py_TYPE(value.ptr())->tp_name));
         assign_list(o.*member, list_detail::values_of<T>(
                                    py::reinterpret_borrow<py::iterable>(value), what.c_str()));
