@@ -84,15 +84,16 @@ void print_failure(const std::string& what, const std::string& details = "") {
 /// printed, once, naming the first rank that gave each. Every rank loads the same scene, and a
 /// job printed each of its warnings once per rank.
 std::mutex g_warnings_mutex;
-std::vector<std::string> g_warnings;  // rank 0: printed; another rank: held
-std::set<std::string> g_printed;      // rank 0
+std::vector<std::string> g_warnings;  // another rank's, held (as one line each)
+std::set<std::string> g_printed;      // rank 0's, printed (as one line each)
 
 void on_warning(const std::string& message) {
+  const std::string line = one_line(message);  // (as the other ranks send it)
   std::lock_guard<std::mutex> lock(g_warnings_mutex);
   if (g_rank != 0) {
-    g_warnings.push_back(message);
-  } else if (g_printed.insert(one_line(message)).second) {  // (as the other ranks send it)
-    std::fprintf(stderr, "lucent: warning: %s\n", one_line(message).c_str());
+    g_warnings.push_back(line);
+  } else if (g_printed.insert(line).second) {
+    std::fprintf(stderr, "lucent: warning: %s\n", line.c_str());
     std::fflush(stderr);
   }
 }
@@ -103,7 +104,7 @@ void share_warnings() {
   {
     std::lock_guard<std::mutex> lock(g_warnings_mutex);
     if (g_rank != 0)
-      for (const std::string& w : g_warnings) mine += one_line(w) + '\n';
+      for (const std::string& w : g_warnings) mine += w + '\n';
     g_warnings.clear();
   }
   const int length = static_cast<int>(std::min<std::size_t>(mine.size(), 1 << 20));
