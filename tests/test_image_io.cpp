@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <string>
 #include <utility>
@@ -130,6 +131,37 @@ TEST(ImageIo, UnknownExtensionAndUnwritablePathAreErrors) {
   EXPECT_THROW(lucent::write_image(lucent::test::temp_dir() + "/x.bmpx", img), lucent::Error);
   EXPECT_THROW(lucent::write_image("/nonexistent-dir/x.png", img), lucent::Error);
   EXPECT_THROW(lucent::read_image(lucent::test::temp_dir() + "/missing.pfm"), lucent::Error);
+}
+
+// Display settings the scene format refuses are refused by write_image too, naming the path and
+// writing nothing (a gamma of 0 wrote a black PNG, an unknown transfer a linear one).
+TEST(ImageIo, InvalidDisplaySettingsAreRefused) {
+  const lucent::Image img = gradient(2, 2);
+  const std::string path = lucent::test::temp_dir() + "/display.png";
+  const auto refused = [&](const DisplaySettings& d) {
+    std::remove(path.c_str());
+    const std::string e = lucent::test::error_of([&] { lucent::write_image(path, img, d); });
+    EXPECT_TRUE(e.empty() || e.rfind(path + ": ", 0) == 0) << e;
+    EXPECT_EQ(std::ifstream(path).good(), e.empty()) << e;
+    return e;
+  };
+  DisplaySettings d;
+  d.transfer = lucent::Transfer::Gamma;
+  for (double gamma : {0.0, -1.0, double(NAN), double(INFINITY)}) {
+    d.gamma = gamma;
+    EXPECT_NE(refused(d).find("gamma must be finite and > 0"), std::string::npos) << gamma;
+  }
+  d.gamma = 2.2;
+  d.exposure = NAN;
+  EXPECT_NE(refused(d).find("exposure finite"), std::string::npos);
+  d.exposure = 0;
+  d.transfer = static_cast<lucent::Transfer>(7);
+  EXPECT_NE(refused(d).find("unknown display transfer or tone map (7, 0)"), std::string::npos);
+  d.transfer = lucent::Transfer::Srgb;
+  d.tonemap = static_cast<lucent::ToneMap>(-1);
+  EXPECT_NE(refused(d).find("(0, -1)"), std::string::npos);
+  d.tonemap = lucent::ToneMap::Aces;
+  EXPECT_EQ(refused(d), "");  // the last of each list is valid
 }
 
 using lucent::fuzz::ExrLayout;

@@ -24,7 +24,9 @@ struct DisplaySettings {
 };
 
 /// Writes `image` in the format named by the extension: .png (8-bit, display-encoded), .pfm or
-/// .exr (linear float). Throws lucent::Error naming the path on failure.
+/// .exr (linear float). Throws lucent::Error naming the path on failure, and for display
+/// settings a scene's film may not have (a gamma not finite and > 0, an exposure not finite, a
+/// transfer or tone map outside its enum).
 void write_image(const std::string& path, const Image& image, const DisplaySettings& display = {});
 
 /// Reads .pfm, .exr (linear) or an 8-bit format (decoded from sRGB to linear). A lucent part

@@ -11,6 +11,7 @@
 
 #include "core/file_io.hpp"
 #include "core/host_memory.hpp"
+#include "core/text.hpp"
 #include "image/image_probe.hpp"
 #include "lucent/error.hpp"
 #include "lucent/image.hpp"
@@ -119,6 +120,17 @@ void write_image(const std::string& path, const Image& img, const DisplaySetting
   if (img.width <= 0 || img.height <= 0 ||
       img.rgb.size() != static_cast<size_t>(img.width) * img.height * 3)
     throw Error(path + ": refusing to write an empty or inconsistent image");
+  // as a scene's film: a gamma of 0 wrote a black PNG, an unknown transfer a linear one
+  if (!(display.gamma > 0) || !std::isfinite(display.gamma) || !std::isfinite(display.exposure))
+    throw Error(path + ": the display gamma must be finite and > 0, the exposure finite (gamma " +
+                io::shortest_real(display.gamma) + ", exposure " +
+                io::shortest_real(display.exposure) + ")");
+  const auto transfer = static_cast<int>(display.transfer);
+  const auto tonemap = static_cast<int>(display.tonemap);
+  if (transfer < 0 || transfer > static_cast<int>(Transfer::Linear) || tonemap < 0 ||
+      tonemap > static_cast<int>(ToneMap::Aces))
+    throw Error(path + ": unknown display transfer or tone map (" + std::to_string(transfer) +
+                ", " + std::to_string(tonemap) + ")");
   std::string ext = extension(path);
   if (ext == "pfm")
     io::write_file_atomic(path, encode_pfm(img));
