@@ -850,6 +850,18 @@ void bind_render(py::module_& m) {
       .def_property_readonly(
           "device", [](PyRenderer& r) { return r.get().device(); },
           "The session's (first) device (any thread, at any time until close()).")
+      .def("__repr__",
+           [](py::handle self) -> std::string {
+             // (never raises: a closed renderer says so)
+             PyRenderer* r = constructed<PyRenderer>(self.ptr());
+             if (!r) return "<lucent.Renderer (not initialised)>";
+             try {
+               return "<lucent.Renderer device=" +
+                      py::repr(py::cast(r->get().device())).cast<std::string>() + ">";
+             } catch (const Error&) {
+               return "<lucent.Renderer (closed)>";
+             }
+           })
       .def_property_readonly(
           "options",
           [](PyRenderer& r) {
@@ -1109,6 +1121,19 @@ void bind_render(py::module_& m) {
   py::class_<ConvergeResult>(m, "ConvergeResult", "Points (setting by setting) and fits.")
       .def_readonly("points", &ConvergeResult::points)
       .def_readonly("fits", &ConvergeResult::fits)
+      .def("__repr__",
+           [](const ConvergeResult& r) {
+             // `<lucent.ConvergeResult of 8 points: default: unbiased; clamp=1: biased>`
+             std::string s =
+                 "<lucent.ConvergeResult of " + std::to_string(r.points.size()) + " points";
+             // (each verdict's first words: its reasons follow " (" or "; ")
+             for (std::size_t i = 0; i < r.fits.size(); ++i) {
+               const std::string& v = r.fits[i].verdict;
+               s += (i ? "; " : ": ") + r.fits[i].setting + ": " +
+                    v.substr(0, std::min(v.find(" ("), v.find(';')));
+             }
+             return s + ">";
+           })
       .def("csv", &convergence_csv, "setting,spp,seconds,samples_per_s,rmse,relmse,... rows")
       .def("svg", &convergence_svg, py::arg("title") = "relMSE against render time",
            "Log-log plot of relMSE against time, as SVG text.")

@@ -7,9 +7,9 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 
 #include "common.hpp"
+#include "core/text.hpp"
 #include "lucent/error.hpp"
 #include "lucent/types.hpp"
 #include "render/features.hpp"
@@ -32,12 +32,9 @@ namespace lucent::python {
 
 namespace {
 
-std::string format_number(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
+/// The fewest digits that read back as `v` (Vec3(0, 2.2, 9), not 2.2000000000000002), as
+/// Python's repr of a float.
+std::string format_number(double v) { return io::shortest_real(v); }
 
 /// The object a setter assigns to (or a method reads), taken from `self` after the value (or an
 /// index, or the other side of a comparison) was converted. Converting
@@ -927,6 +924,20 @@ py::dict scene_info(const Scene& scene, const TextArg& precision, const FlagArg&
   return d;
 }
 
+/// `<lucent.Name field=repr, ...>` for C: each field read through its Python property, so the
+/// repr shows what reading it gives (Vec3(0, 0, 5), 'box').
+template <class C>
+void fields_repr(py::class_<C>& c, std::vector<const char*> fields) {
+  c.def("__repr__", [name = py::str(c.attr("__name__")).cast<std::string>(),
+                     fields = std::move(fields)](py::handle self) {
+    std::string s = "<lucent." + name;
+    for (std::size_t i = 0; i < fields.size(); ++i)
+      s += std::string(i ? ", " : " ") + fields[i] + "=" +
+           py::repr(self.attr(fields[i])).cast<std::string>();
+    return s + ">";
+  });
+}
+
 std::string scene_repr(const Scene& s) {
   return "<lucent.Scene " + py::repr(file_text(s.path)).cast<std::string>() + ": " +
          std::to_string(s.film.width) + "x" + std::to_string(s.film.height) + ", " +
@@ -1139,6 +1150,18 @@ void bind_scene(py::module_& m) {
   vector_array_property(scene, "positions", &Scene::positions);
   vector_array_property(scene, "normals", &Scene::normals);
   vector_array_property(scene, "uvs", &Scene::uvs);
+
+  fields_repr(camera, {"position", "look_at", "up", "fov_degrees", "roll_degrees", "aperture",
+                       "focus_distance"});
+  fields_repr(filter, {"type", "radius"});
+  fields_repr(film, {"width", "height", "filter", "transfer", "gamma", "exposure", "tonemap"});
+  fields_repr(integrator, {"type", "max_depth", "rr_depth", "spp", "seed", "sampler", "mis",
+                           "clamp", "caustics", "dielectric_splits", "ao_distance"});
+  fields_repr(sphere, {"center", "radius", "material"});
+  fields_repr(triangle, {"v", "n", "uv", "material"});
+  fields_repr(light, {"type", "position", "intensity", "radiance", "texture"});
+  fields_repr(texture, {"path", "width", "height"});
+  fields_repr(shape_entry, {"type", "file", "first", "count", "libraries"});
 
   m.def(
       "load_scene",

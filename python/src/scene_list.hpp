@@ -241,6 +241,17 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
       }))
       .def("__len__", &V::size)
       .def("__bool__", [](const V& v) { return !v.empty(); })
+      // `<lucent.MaterialList of 3: [<lucent.Material 'white' diffuse>, ...]>`, the first 8
+      // items (a mesh's TriangleList holds millions)
+      .def("__repr__",
+           [name = std::string(name)](const V& v) {
+             constexpr std::size_t kShown = 8;
+             std::string s = "<lucent." + name + " of " + std::to_string(v.size()) + ": [";
+             for (std::size_t i = 0; i < v.size() && i < kShown; ++i)
+               s += (i ? ", " : "") + py::repr(py::cast(v[i])).template cast<std::string>();
+             if (v.size() > kShown) s += ", ... " + std::to_string(v.size() - kShown) + " more";
+             return s + "]>";
+           })
       // (the slices' overloads first: the others take any index, as a Python list does)
       .def("__getitem__",
            [](const V& v, const py::slice& s) {

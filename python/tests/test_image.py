@@ -197,6 +197,10 @@ def test_converge(small_scene):
     assert default.points == 3 and default.slope_spp < -0.5 and not default.biased
     # max_depth 1 sees emitters only: the lit scene renders black, far from the reference
     assert direct_only.biased and res.points[-1].relmse > 10 * res.points[2].relmse
+    # each fit's verdict, its first words
+    assert re.fullmatch(r"<lucent\.ConvergeResult of 6 points: default: (unbiased|undetermined); "
+                        r"max_depth=1: biased: error stops decreasing at ~relMSE \S+>",
+                        repr(res)), repr(res)
     assert res.csv().startswith("setting,spp,seconds,samples_per_s,rmse,relmse")
     assert res.csv().count("\n") == 7
     assert res.svg("t").lstrip().startswith("<")

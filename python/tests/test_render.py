@@ -557,6 +557,10 @@ def test_reprs_say_what_they_hold(renderer, small_scene):
     assert re.fullmatch(r"<lucent\.CompareResult passed, max \|z\| 0\.0+, RMSE 0\.0+>",
                         repr(lucent.compare(res.mean, res.mean)))
     assert repr(lucent.compare(res.mean, res.mean + 1)).startswith("<lucent.CompareResult FAILED")
+    assert repr(renderer) == "<lucent.Renderer device=%r>" % d
+    closed = session()
+    closed.close()
+    assert repr(closed) == "<lucent.Renderer (closed)>"
 
 
 def test_a_renderer_in_a_cycle_through_its_on_warning_is_collected(small_scene):

@@ -412,6 +412,33 @@ def test_scene_repr_counts_what_it_holds(small_scene):
                         r"1 lights, 0 textures>", repr(small_scene)), repr(small_scene)
 
 
+def test_every_scene_type_repr_shows_its_fields():
+    scene = lucent.load_scene(SOURCE_DIR / "scenes" / "materials.json")
+    assert repr(scene.camera) == ("<lucent.Camera position=Vec3(0, 2.2, 9), look_at=Vec3(0, 1, 0), "
+                                  "up=Vec3(0, 1, 0), fov_degrees=38.0, roll_degrees=0.0, "
+                                  "aperture=0.0, focus_distance=0.0>")
+    assert repr(scene.film) == ("<lucent.Film width=640, height=360, filter=<lucent.Filter "
+                                "type='gaussian', radius=1.5>, transfer='srgb', gamma=2.2, "
+                                "exposure=0.3, tonemap='aces'>")
+    assert repr(scene.integrator).startswith("<lucent.Integrator type='path', max_depth=10, ")
+    assert repr(scene.spheres[0]) == "<lucent.Sphere center=Vec3(-4, 1, 0), radius=1.0, material=0>"
+    assert repr(scene.lights[1]) == ("<lucent.Light type='environment', position=Vec3(0, 0, 0), "
+                                     "intensity=Vec3(0, 0, 0), radiance=Vec3(0.05, 0.06, 0.08), "
+                                     "texture=-1>")
+    assert repr(scene.triangles[0]) == ("<lucent.Triangle v=(0, 3, 2), n=(-1, -1, -1), "
+                                        "uv=(-1, -1, -1), material=1>")
+    assert repr(scene.shapes[0]) == ("<lucent.ShapeEntry type='triangles', file='', first=0, "
+                                     "count=2, libraries=[]>")
+    assert repr(lucent.Texture()) == "<lucent.Texture path='', width=0, height=0>"
+    # lists show their first 8 items and count the rest (a mesh holds millions)
+    assert repr(lucent.TextureList()) == "<lucent.TextureList of 0: []>"
+    assert repr(scene.materials).startswith(
+        "<lucent.MaterialList of 9: [<lucent.Material 'diffuse' diffuse>, ")
+    assert repr(scene.materials).endswith(", ... 1 more]>")
+    many = lucent.TriangleList([lucent.Triangle()] * 100000)
+    assert len(repr(many)) < 1000 and repr(many).endswith(", ... 99992 more]>")
+
+
 def test_array_fields_refuse_what_is_not_numbers():
     with pytest.raises(TypeError, match="positions: expected numbers, got an array of dtype"):
         lucent.Scene().positions = [["a", "b", "c"]]
