@@ -736,9 +736,9 @@ void bind_render(py::module_& m) {
                                           std::to_string(wide.data()[k]));
               };
               if (kind == 'u')
-                check(py::array_t<std::uint64_t, py::array::forcecast>(given));
+                check(CArray<std::uint64_t>(given));
               else
-                check(py::array_t<std::int64_t, py::array::forcecast>(given));
+                check(CArray<std::int64_t>(given));
               auto a = array_or_null<CArray<std::uint32_t>>(samples);
               if (!a || a.ndim() != 2 || a.shape(0) != r.mean.height || a.shape(1) != r.mean.width)
                 throw py::value_error("samples: expected an array of shape (H, W) like the mean's");

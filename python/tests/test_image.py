@@ -317,6 +317,15 @@ def test_result_from_arrays_refuses_what_no_render_holds(tmp_path):
         lucent.RenderResult(constant(1.0), samples=np.full((4, 5), 2 ** 63, np.uint64))
     with pytest.raises(ValueError, match=r"got 4294967296$"):
         lucent.RenderResult(constant(1.0), samples=np.full((4, 5), 2 ** 32, np.uint64))
+    # a strided array of 64-bit counts is checked element by element (its buffer was read as if
+    # contiguous: 2**40 in the last row passed and became 0, other strides read past the end)
+    for dtype in (np.uint64, np.int64):
+        wide = np.ones((4, 10), dtype)
+        wide[3, 8] = 2 ** 40
+        with pytest.raises(ValueError, match=r"got 1099511627776$"):
+            lucent.RenderResult(constant(1.0), samples=wide[:, ::2])
+        counts = np.arange(1, 21, dtype=dtype).reshape(4, 5)[::-1, ::-1]
+        assert lucent.RenderResult(constant(1.0), samples=counts).samples.tolist() == counts.tolist()
     # a variance is per sample: without the counts compare() took one sample a pixel and
     # write_render_exr() dropped it
     with pytest.raises(ValueError, match=r"^variance: a variance needs the per-pixel sample counts "
