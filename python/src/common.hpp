@@ -590,8 +590,26 @@ inline const CallbackFrame* callback_of(const void* session) {
   return nullptr;
 }
 
+/// The callbacks of a call of run_interruptible, waiting to run on the thread that made the call
+/// (defined in module.cpp).
+class CallerQueue;
+
+/// The queue of the call of run_interruptible that this thread (its worker) works for, or
+/// nullptr.
+inline thread_local CallerQueue* t_caller_queue = nullptr;
+
+/// Runs `f` with the GIL held, and returns when it has run: on the thread that made the call of
+/// run_interruptible whose queue is `queue`, or on this thread when `queue` is nullptr. A
+/// callback then runs on the thread that called lucent, as Python code expects: Ctrl-C
+/// interrupts it (a second Ctrl-C was lost while a progress callback blocked: it ran on the
+/// worker, where no signal handler runs), and it sees that thread's contextvars, threading.local
+/// values and current_thread() (it saw a thread of its own). An exception of `f` is rethrown
+/// here.
+void run_with_gil(CallerQueue* queue, const std::function<void()>& f);
+
 /// Runs `work` on a worker thread with the GIL released while this thread checks Python's
-/// signals every 50 ms: on KeyboardInterrupt (or any exception of a signal handler) `cancel` is
+/// signals every 50 ms and runs the work's callbacks (run_with_gil with t_caller_queue, which
+/// the worker has): on KeyboardInterrupt (or any exception of a signal handler) `cancel` is
 /// set, the work is awaited (it stops early on the flag) and the exception is raised. The worker
 /// has this thread's chain of callbacks. Interpreter exit sets `cancel` too, and waits a while
 /// for the call to end (a daemon thread's render would otherwise run on while the process tears

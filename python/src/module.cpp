@@ -242,17 +242,19 @@ SharedObject::SharedObject(py::object o)
 
 WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackErrors> errors) {
   return [callback, errors](const std::string& message) {
-    AcquireGil gil;
-    errors->run([&] {
-      if (callback) {
-        callback.get()(message_text(message));
-      } else {
-        // stacklevel 1: the innermost Python frame, the line that called into lucent (warn is
-        // called from C++, not from a Python function of lucent's: 2 named the caller's caller)
-        py::module_ lucent = py::module_::import("lucent");
-        py::module_::import("warnings")
-            .attr("warn")(message_text(message), lucent.attr("LucentWarning"), 1);
-      }
+    // (on the thread that made the call, when a worker of run_interruptible gives the warning)
+    run_with_gil(t_caller_queue, [&] {
+      errors->run([&] {
+        if (callback) {
+          callback.get()(message_text(message));
+        } else {
+          // stacklevel 1: the innermost Python frame, the line that called into lucent (warn is
+          // called from C++, not from a Python function of lucent's: 2 named the caller's caller)
+          py::module_ lucent = py::module_::import("lucent");
+          py::module_::import("warnings")
+              .attr("warn")(message_text(message), lucent.attr("LucentWarning"), 1);
+        }
+      });
     });
   };
 }
@@ -353,6 +355,77 @@ AcquireGil::AcquireGil() {
 #endif
 }
 
+/// The callbacks of one call of run_interruptible: its worker (or a thread of the library that
+/// works for it) posts one at a time and waits; the thread that made the call runs them between
+/// its looks at Python's signals.
+class CallerQueue {
+ public:
+  /// What the calling thread found when wait() returned.
+  enum class Event { Timeout, Job, Finished };
+
+  /// Posts `job` and waits until the calling thread has run it; rethrows its exception.
+  void post(const std::function<void()>& job) {
+    std::lock_guard<std::mutex> one_at_a_time(post_mutex_);
+    std::unique_lock<std::mutex> lock(mutex_);
+    job_ = &job;
+    error_ = nullptr;
+    wake_.notify_all();
+    ran_.wait(lock, [&] { return job_ == nullptr; });
+    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+  }
+
+  /// The work has ended (its worker, as it returns): the calling thread stops waiting.
+  void finish() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    finished_ = true;
+    wake_.notify_all();
+  }
+
+  /// (the calling thread) Waits up to `timeout` for a job or the work's end.
+  Event wait(std::chrono::milliseconds timeout) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    wake_.wait_for(lock, timeout, [&] { return job_ || finished_; });
+    return job_ ? Event::Job : finished_ ? Event::Finished : Event::Timeout;
+  }
+
+  /// (the calling thread, the GIL held) Runs the job posted and wakes its poster.
+  void run_job() {
+    const std::function<void()>* job;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      job = job_;
+    }
+    std::exception_ptr error;
+    try {
+      (*job)();
+    } catch (...) {
+      error = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    error_ = error;
+    job_ = nullptr;
+    ran_.notify_all();
+  }
+
+ private:
+  std::mutex post_mutex_;  ///< one poster at a time
+  std::mutex mutex_;
+  std::condition_variable wake_;  ///< the calling thread: a job, or the end
+  std::condition_variable ran_;   ///< the poster: its job ran
+  const std::function<void()>* job_ = nullptr;
+  std::exception_ptr error_;
+  bool finished_ = false;
+};
+
+void run_with_gil(CallerQueue* queue, const std::function<void()>& f) {
+  if (queue) {
+    queue->post(f);
+    return;
+  }
+  AcquireGil gil;
+  f();
+}
+
 void run_interruptible(const std::function<void()>& work, std::atomic<bool>& cancel) {
   InProgress in_progress(cancel);  // ends once this thread holds the GIL again
   std::exception_ptr interrupt;
@@ -360,13 +433,28 @@ void run_interruptible(const std::function<void()>& work, std::atomic<bool>& can
   {
     ReleaseGil release;
     const CallbackFrame* callbacks = t_callbacks;  // valid while this thread waits
+    CallerQueue queue;
     std::packaged_task<void()> task([&] {
       t_callbacks = callbacks;
+      t_caller_queue = &queue;
+      struct Finish {
+        CallerQueue& queue;
+        ~Finish() { queue.finish(); }
+      } finish{queue};
       work();
     });
     std::future<void> done = task.get_future();
     std::thread worker(std::move(task));
-    while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+    for (;;) {
+      const CallerQueue::Event event = queue.wait(std::chrono::milliseconds(50));
+      if (event == CallerQueue::Event::Finished) break;
+      if (event == CallerQueue::Event::Job) {
+        // (after an interruption too: the worker waits for it)
+        restore_gil(release.state(), &cancel);
+        queue.run_job();
+        PyEval_SaveThread();
+        continue;
+      }
       if (interrupt) continue;
       // at interpreter exit the thread parks here with the work cancelled (the worker stays
       // joinable)

@@ -220,7 +220,12 @@ class PyRenderer {
     caller_thread_ = std::this_thread::get_id();
     deferring_ = true;
     try {
-      run_interruptible([&] { f(r, stop_); }, stop_);
+      run_interruptible(
+          [&] {
+            caller_queue_ = t_caller_queue;
+            f(r, stop_);
+          },
+          stop_);
     } catch (...) {
       flush_warnings();
       warning_errors_->clear();  // (as call's: the failure is raised, not a later call's)
@@ -248,7 +253,7 @@ class PyRenderer {
     sink_(message);
   }
 
-  /// A render call: `progress(p)` runs after each pass (on the rendering thread, with the GIL);
+  /// A render call: `progress(p)` runs after each pass (on the calling thread, with the GIL);
   /// an exception it raises, or Ctrl-C, stops the render after the current pass and is raised
   /// once the render returned. The accumulation keeps what was rendered.
   /// `what`: render or render_for, for messages.
@@ -278,12 +283,14 @@ class PyRenderer {
     ProgressFn on_progress = [&](const RenderProgress& p) {
       save_counters();
       if (!has_progress) return;
-      AcquireGil gil;
-      WithChain chain(caller_chain_);  // on a device thread, the chain of the call's caller
-      InCallback frame(this, "progress callback");
-      paused_ = true;  // scene and options can be read until the callback returns
-      if (!errors.run([&] { progress(p); })) stop_ = true;
-      paused_ = false;
+      // on the thread that called render (from the worker, or a device thread of a session
+      // with several devices), with its chain of callbacks
+      run_with_gil(caller_queue_, [&] {
+        InCallback frame(this, "progress callback");
+        paused_ = true;  // scene and options can be read until the callback returns
+        if (!errors.run([&] { progress(p); })) stop_ = true;
+        paused_ = false;
+      });
     };
     RenderProgress out;
     call_interruptible(what, [&](Renderer& r, std::atomic<bool>&) { out = f(r, on_progress); });
@@ -414,6 +421,9 @@ class PyRenderer {
   /// session), for its callbacks on threads of the library. Set with the GIL before the call
   /// starts the threads that read it, unchanged until it returned.
   const CallbackFrame* caller_chain_ = nullptr;
+  /// The queue of the call_interruptible in progress, for its callbacks on threads of the
+  /// library (set by its worker before the call starts them).
+  CallerQueue* caller_queue_ = nullptr;
   std::atomic<bool> stop_{false};  ///< the session's cancel flag
   std::mutex counters_mutex_;
   Counters counters_;  ///< the counters while a call runs (counters_mutex_)
@@ -1180,11 +1190,13 @@ void bind_render(py::module_& m) {
         PyRenderer* session = renderer.is_none() ? nullptr : &renderer.cast<PyRenderer&>();
         if (!on_point.is_none())
           o.on_point = [&](const ConvergePoint& p) {
-            AcquireGil gil;
-            InCallback frame(session, "on_point callback");
-            // result() reads there, as run_convergence's on_point may (it was refused)
-            PyRenderer::PausedInCallback paused(session);
-            if (!errors.run([&] { on_point(p); })) *stop = true;
+            // (on the thread that called converge)
+            run_with_gil(t_caller_queue, [&] {
+              InCallback frame(session, "on_point callback");
+              // result() reads there, as run_convergence's on_point may (it was refused)
+              PyRenderer::PausedInCallback paused(session);
+              if (!errors.run([&] { on_point(p); })) *stop = true;
+            });
           };
         ConvergeResult out;
         if (renderer.is_none()) {

@@ -147,3 +147,41 @@ def test_sigint_stops_set_scene_waiting_for_another_build(tmp_path):
     assert words and words[0] == "keyboard", child.stdout + child.stderr
     # (the signal at 1 s; the wait looks at the cancel flag every 20 ms, Python's loop every 50)
     assert float(words[1]) < 3, child.stdout
+
+
+BLOCKED_CALLBACK_CHILD = textwrap.dedent("""
+    import json, os, signal, sys, threading, time
+    import lucent
+    scene = lucent.scene_from_dict(json.loads(sys.argv[1]))
+    r = lucent.Renderer(**lucent.environment())
+    r.set_scene(scene)
+    entered = threading.Event()
+
+    def progress(p):
+        entered.set()
+        time.sleep(60)  # a callback that blocks (a deadlock, a dialog left open)
+
+    def interrupt():
+        entered.wait()
+        time.sleep(0.2)
+        os.kill(os.getpid(), signal.SIGINT)
+    threading.Thread(target=interrupt, daemon=True).start()
+    t0 = time.monotonic()
+    try:
+        r.render(10 ** 9, progress=progress)
+    except KeyboardInterrupt:
+        print("keyboard", round(time.monotonic() - t0, 1), r.result().spp > 0, flush=True)
+""")
+
+
+def test_sigint_interrupts_a_blocked_progress_callback():
+    # The callback runs on the thread that called render, where Python handles the signal: it
+    # raised in the callback at once. (It ran on the render's worker thread, where no signal
+    # handler runs: Ctrl-C was seen between passes only, then render waited for the callback,
+    # and further Ctrl-Cs went unseen until it returned: a blocked callback could not be stopped.)
+    child = subprocess.run([sys.executable, "-c", BLOCKED_CALLBACK_CHILD, json.dumps(SMALL)],
+                           capture_output=True, text=True, timeout=50, env=dict(os.environ))
+    assert child.returncode == 0, child.stderr
+    word, seconds, kept = child.stdout.split()
+    assert word == "keyboard" and kept == "True", child.stdout
+    assert float(seconds) < 30, child.stdout

@@ -426,3 +426,35 @@ def test_cancel_from_a_thread_that_saw_the_call_begin_stops_it(renderer, small_s
         t.join()
         assert "error" not in outcome, outcome
         assert renderer.result().cancelled and seconds < 10, (attempt, seconds)
+
+
+def test_callbacks_run_on_the_calling_thread_in_its_context(renderer, small_scene):
+    """Progress callbacks and converge's on_point run on the thread that called, as Python code
+    expects: they see its contextvars, threading.local values and
+    current_thread() (they ran on a thread of the call's own, with an empty context)."""
+    import contextvars
+    var = contextvars.ContextVar("var", default="unset")
+    local = threading.local()
+
+    def seen(*_):
+        return (threading.get_ident(), var.get(), getattr(local, "value", "unset"))
+
+    def on(thread_name):
+        var.set("set on " + thread_name)
+        local.value = thread_name
+        renderer.set_scene(small_scene)
+        progress, points = [], []
+        renderer.render(2, progress=lambda p: progress.append(seen()))
+        reference = lucent.RenderResult(renderer.result().mean)
+        lucent.converge(small_scene, reference, spp_ladder=[1], renderer=renderer,
+                        on_point=lambda p: points.append(seen()))
+        return progress, points, (threading.get_ident(), "set on " + thread_name, thread_name)
+
+    results = [on("main")]
+    t = threading.Thread(target=lambda: results.append(on("other")))
+    t.start()
+    t.join()
+    assert len(results) == 2
+    for progress, points, expected in results:
+        assert progress and set(progress) == {expected}
+        assert points and set(points) == {expected}
