@@ -217,7 +217,6 @@ class PyRenderer {
     Busy busy(*this, what);
     Renderer& r = get();
     stop_ = false;
-    caller_thread_ = std::this_thread::get_id();
     deferring_ = true;
     try {
       run_interruptible(
@@ -365,6 +364,7 @@ class PyRenderer {
         throw Error(r.refusal("call", what, "a session renders one call at a time"));
       r.call_ = what;
       r.caller_chain_ = t_callbacks;
+      r.caller_thread_ = std::this_thread::get_id();
       try {
         r.save_counters();  // what other threads read during the call
       } catch (...) {
@@ -388,6 +388,12 @@ class PyRenderer {
       return std::string("cannot ") + verb + " " + what + " from the " + f->callback +
              " of this renderer's own " + call_ + " (a session runs one call at a time: " + verb +
              " it once " + call_ + " has returned)";
+    // this thread's call, waiting for its worker, runs Python's signal handlers
+    if (std::this_thread::get_id() == caller_thread_)
+      return std::string("cannot ") + verb + " " + what +
+             " from a signal handler that runs during this renderer's own " + call_ +
+             " on the same thread (a session runs one call at a time: " + verb + " it once " +
+             call_ + " has returned, or from its progress callback)";
     return std::string("the renderer is in use by another thread (") + hint + ")";
   }
 

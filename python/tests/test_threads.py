@@ -458,3 +458,29 @@ def test_callbacks_run_on_the_calling_thread_in_its_context(renderer, small_scen
     for progress, points, expected in results:
         assert progress and set(progress) == {expected}
         assert points and set(points) == {expected}
+
+
+def test_a_signal_handler_during_the_threads_own_render_is_told_so(renderer, small_scene):
+    """A signal handler runs on the thread whose render waits for its worker: a call from it
+    was refused as "in use by another thread", which it is not."""
+    import os
+    import signal
+    renderer.set_scene(small_scene)
+    errors = []
+
+    def handler(signum, frame):
+        try:
+            renderer.result()
+        except lucent.Error as e:
+            errors.append(str(e))
+        renderer.cancel()
+
+    previous = signal.signal(signal.SIGUSR1, handler)
+    try:
+        threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGUSR1)).start()
+        renderer.render(10 ** 9)
+    finally:
+        signal.signal(signal.SIGUSR1, previous)
+    assert errors == ["cannot call result from a signal handler that runs during this renderer's "
+                      "own render on the same thread (a session runs one call at a time: call it "
+                      "once render has returned, or from its progress callback)"]
