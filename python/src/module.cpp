@@ -210,7 +210,9 @@ void require_numbers(py::handle object, const std::string& what, std::uint64_t b
 }
 
 Image image_from_array(py::handle object, const char* what) {
-  require_numbers(object, what);
+  // (the float32 copy and the image's own: a broadcast view of one value standing for
+  // 40000x40000 pixels was copied whole, 17.9 GiB)
+  require_numbers(object, what, 2 * sizeof(float));
   auto a = array_or_null<CArray<float>>(object);
   if (!a) throw py::type_error(std::string(what) + ": expected an array of shape (H, W, 3)");
   if (a.ndim() != 3 || a.shape(2) != 3 || a.shape(0) < 1 || a.shape(1) < 1) {

@@ -755,3 +755,12 @@ def test_huge_arrays_are_refused_before_they_are_copied():
     t = lucent.Texture()
     with pytest.raises(MemoryError, match=r"^rgba: "):
         t.rgba = np.broadcast_to(np.zeros(4, "f4"), (10 ** 6, 10 ** 6, 4))
+    # images given to compare, write_image, RenderResult and converge alike
+    huge = np.broadcast_to(np.float32(1), (10 ** 5, 10 ** 5, 3))  # 240 GB to copy
+    with pytest.raises(MemoryError, match=r"^image: 30000000000 values need about"):
+        lucent.write_image("never.pfm", huge)
+    with pytest.raises(MemoryError, match=r"^mean: 30000000000 values need about"):
+        lucent.RenderResult(huge)
+    with pytest.raises(MemoryError, match=r"^a: 30000000000 values need about"):
+        lucent.compare(huge, huge)
+    assert not os.path.exists("never.pfm")
