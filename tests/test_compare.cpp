@@ -91,6 +91,43 @@ TEST(Compare, SmallGlobalBiasFails) {
   EXPECT_TRUE(per_pixel.passed) << per_pixel.summary();
 }
 
+// One rare, bright sample (a near-mirror's highlight of a point light, found by one sample of
+// 64) decides the image means' variance: the image-mean |z| is then about 1 however far the means
+// are, and the comparison passes. The summary says so and names the pixel; two ordinary renders
+// get no warning.
+TEST(Compare, AVarianceThatOnePixelDecidesIsReported) {
+  const int w = 16, h = 16, n = 64;
+  const auto image = [&](float value, float variance) {
+    RenderResult r = constant_image(w, h, value);
+    r.variance = lucent::Image{w, h, std::vector<float>(static_cast<size_t>(w) * h * 3, variance)};
+    r.samples.assign(static_cast<size_t>(w) * h, n);
+    return r;
+  };
+  RenderResult a = image(1, 0.01f), b = image(1, 0.01f);
+  // pixel (5, 3) of A: 63 samples of 1 and one of 1e4
+  const double x = 1e4, mean = (63 + x) / n;
+  const double variance = (63 * (1 - mean) * (1 - mean) + (x - mean) * (x - mean)) / (n - 1);
+  for (int c = 0; c < 3; ++c) {
+    a.mean.pixel(5, 3)[c] = static_cast<float>(mean);
+    a.variance.pixel(5, 3)[c] = static_cast<float>(variance);
+  }
+  const CompareResult c = lucent::compare_images(a, b);
+  EXPECT_GT(c.mean_a[0], 1.5 * c.mean_b[0]);
+  EXPECT_NEAR(c.mean_z[0], 1.0, 0.01);  // the means' difference over its own sample's weight
+  EXPECT_TRUE(c.passed);                // (what the warning is for)
+  EXPECT_GT(c.mean_variance_share, 0.99);
+  EXPECT_EQ(c.mean_variance_x, 5);
+  EXPECT_EQ(c.mean_variance_y, 3);
+  EXPECT_EQ(c.mean_variance_channel, 0);
+  EXPECT_NE(c.summary().find("warning       pixel (5, 3) channel R holds 100.0% of the image "
+                             "means' variance"),
+            std::string::npos)
+      << c.summary();
+  const CompareResult ordinary = lucent::compare_images(render_ref(1), render_ref(2));
+  EXPECT_LT(ordinary.mean_variance_share, CompareResult::kDominatedShare);
+  EXPECT_EQ(ordinary.summary().find("warning"), std::string::npos) << ordinary.summary();
+}
+
 // A localized error: a block of 4x4 pixels 50% too bright fails the per-pixel test there.
 TEST(Compare, LocalErrorFailsPixels) {
   RenderResult a = render_ref(1, 64), b = render_ref(2, 64);

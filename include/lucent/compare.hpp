@@ -46,9 +46,17 @@ struct CompareResult {
   /// The image-mean test took image A's (B's) light-traced part from its light paths' totals
   /// (RenderResult::light_mean_variance, caustics); otherwise from its pixels, as independent.
   bool light_paths_a = false, light_paths_b = false;
-  double rmse = 0;              ///< sqrt(mean over pixel-channels of (A - B)^2)
-  double relmse = 0;            ///< mean of (A - B)^2 / (B^2 + 0.01)
-  double max_abs_error = 0;     ///< largest |A - B|
+  /// The largest share one pixel-channel holds of the image means' variance (the pixels' part:
+  /// A's and B's var / n summed), and where. Above 0.5 one rare, bright sample (a heavy-tailed
+  /// estimate) decides the standard error and the image-mean |z| stays near 1 however far the
+  /// means are (a near-mirror lit by a point light: means 0.33 and 0.052, z 1.000): the summary
+  /// warns, and the test cannot be trusted until both images have more samples.
+  double mean_variance_share = 0;
+  int mean_variance_x = 0, mean_variance_y = 0, mean_variance_channel = 0;
+  static constexpr double kDominatedShare = 0.5;  ///< the summary's warning from this share
+  double rmse = 0;                                ///< sqrt(mean over pixel-channels of (A - B)^2)
+  double relmse = 0;                              ///< mean of (A - B)^2 / (B^2 + 0.01)
+  double max_abs_error = 0;                       ///< largest |A - B|
   Image z;                      ///< per pixel-channel z = (A - B) / standard error (signed)
   std::string summary() const;  ///< multi-line report, as `lucent compare` prints it
 };

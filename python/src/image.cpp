@@ -224,6 +224,13 @@ void bind_image(py::module_& m) {
                     "the image-mean test took A's light-traced part (caustics) from its light "
                     "paths' totals (RenderResult.light_mean_variance), not from its pixels")
       .def_readonly("light_paths_b", &CompareResult::light_paths_b)
+      .def_readonly("mean_variance_share", &CompareResult::mean_variance_share,
+                    "the largest share one pixel-channel holds of the image means' variance "
+                    "(above 0.5: a heavy-tailed estimate, and the image-mean test cannot be "
+                    "trusted)")
+      .def_readonly("mean_variance_x", &CompareResult::mean_variance_x)
+      .def_readonly("mean_variance_y", &CompareResult::mean_variance_y)
+      .def_readonly("mean_variance_channel", &CompareResult::mean_variance_channel)
       .def_readonly("rmse", &CompareResult::rmse)
       .def_readonly("relmse", &CompareResult::relmse)
       .def_readonly("max_abs_error", &CompareResult::max_abs_error)

@@ -143,6 +143,8 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
   r.z_threshold = normal_two_sided_critical(per_test);
 
   double sq = 0, rel = 0, sum_var_a[3] = {0, 0, 0}, sum_var_b[3] = {0, 0, 0};
+  double largest_var[3] = {0, 0, 0};  // the pixel with the largest var_a + var_b, per channel
+  size_t largest_at[3] = {0, 0, 0};
   for (size_t i = 0; i < npix; ++i) {
     bool pixel_ok = true;
     for (int c = 0; c < 3; ++c) {
@@ -169,6 +171,10 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
       r.mean_b[c] += vb;
       sum_var_a[c] += var_a;
       sum_var_b[c] += var_b;
+      if (var > largest_var[c]) {
+        largest_var[c] = var;
+        largest_at[c] = i;
+      }
       sq += d * d;
       rel += d * d / (vb * vb + 0.01);
       r.max_abs_error = std::max(r.max_abs_error, std::isfinite(d) ? std::abs(d) : INFINITY);
@@ -193,6 +199,13 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
     const double var = image_mean_variance(a, sum_var_a[c] / (n * n), c) +
                        image_mean_variance(b, sum_var_b[c] / (n * n), c);
     r.mean_z[c] = z_score(r.mean_a[c] - r.mean_b[c], var + eps * eps);
+    const double pixels_var = sum_var_a[c] + sum_var_b[c];
+    if (pixels_var > 0 && largest_var[c] / pixels_var > r.mean_variance_share) {
+      r.mean_variance_share = largest_var[c] / pixels_var;
+      r.mean_variance_x = static_cast<int>(largest_at[c] % r.width);
+      r.mean_variance_y = static_cast<int>(largest_at[c] / r.width);
+      r.mean_variance_channel = c;
+    }
     if (o.image_mean_test && !(std::abs(r.mean_z[c]) <= r.mean_z_threshold))
       r.mean_test_passed = false;
   }
@@ -217,6 +230,16 @@ std::string CompareResult::summary() const {
     s += light_paths_a && light_paths_b ? "A and B\n"
          : light_paths_a ? "A (B's pixels taken as independent: no lucent.light_mean_var)\n"
                          : "B (A's pixels taken as independent: no lucent.light_mean_var)\n";
+  }
+  if (mean_variance_share > kDominatedShare) {
+    std::snprintf(buf, sizeof buf,
+                  "warning       pixel (%d, %d) channel %c holds %.1f%% of the image means' "
+                  "variance: one rare, bright sample decides it (a heavy-tailed estimate), and "
+                  "the image-mean |z| stays near 1 however far the means are; compare with more "
+                  "samples in both\n",
+                  mean_variance_x, mean_variance_y, "RGB"[mean_variance_channel],
+                  100 * mean_variance_share);
+    s += buf;
   }
   std::snprintf(buf, sizeof buf, "RMSE          %.6g\nrelMSE        %.6g\nmax abs error %.6g\n",
                 rmse, relmse, max_abs_error);
