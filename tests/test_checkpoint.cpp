@@ -348,6 +348,35 @@ TEST(Checkpoint, SigtermKeepsTheCheckpoint) {
       << text;
 }
 
+// A checkpoint removed after its last write (here with its directory, so that the writes since
+// fail) holds nothing: the last line says so (it said the file that was gone held the samples).
+TEST(Checkpoint, ACheckpointRemovedSinceItsLastWriteIsNotSaidToHoldTheSamples) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string sub = dir + "/sub", ck = sub + "/ck.exr", out = dir + "/out.exr",
+                    err = dir + "/err";
+  fs::create_directories(sub);
+  // SIGTERM once a periodic checkpoint was written and its directory removed
+  const std::string script =
+      "'" + std::string(LUCENT_CLI_PATH) + "' render " + q(scene) + " --spp 16000000 -o " + q(out) +
+      " --checkpoint " + q(ck) + " --checkpoint-every 0.1 2>" + q(err) +
+      " </dev/null & pid=$!; for i in $(seq 600); do test -f " + q(ck) +
+      " && break; sleep 0.1; done; rm -rf " + q(sub) + "; kill -TERM " + "$pid; wait $pid";
+  const int raw = std::system(("bash -c " + q(script)).c_str());
+  const std::string text = lucent::test::read_file(err);
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 143) << text;
+  EXPECT_NE(text.find("lucent: warning: checkpoint not written: " + ck), std::string::npos) << text;
+  EXPECT_NE(
+      text.find("lucent: no checkpoint holds the samples (" + ck + ", written with samples [0, "),
+      std::string::npos)
+      << text;
+  EXPECT_NE(text.find("), no longer exists): the same command renders them again\n"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("holds samples"), std::string::npos) << text;
+  EXPECT_TRUE(fs::exists(out)) << text;  // (the output keeps what was rendered)
+}
+
 // (c) a checkpoint of another image (seed, scene, film), of other samples or of more than the
 // render asks for: one line naming it, status 1, no output, the checkpoint untouched.
 TEST(Checkpoint, CheckpointOfAnotherRenderIsRefused) {

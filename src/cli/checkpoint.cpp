@@ -276,11 +276,19 @@ void keep_samples_of_failed_output(Checkpoint& ck, bool complete,
 
 void say_kept(const Checkpoint& ck, bool all) {
   const unsigned long long begin = ck.begin(), held = ck.held();
+  std::error_code ec;
   if (held == begin)
     std::fprintf(stderr,
                  "%s: no checkpoint holds the samples (%s not written): the same command "
                  "renders them again\n",
                  ck.program().c_str(), one_line(ck.path()).c_str());
+  else if (!std::filesystem::exists(ck.path(), ec) && !ec)
+    // removed since its last write (its directory too, and the writes since failed): it said
+    // the file that was gone held the samples
+    std::fprintf(stderr,
+                 "%s: no checkpoint holds the samples (%s, written with samples [%llu, %llu), "
+                 "no longer exists): the same command renders them again\n",
+                 ck.program().c_str(), one_line(ck.path()).c_str(), begin, held);
   else if (all)
     std::fprintf(stderr,
                  "%s: %s holds all the samples, [%llu, %llu): the same command writes the "
