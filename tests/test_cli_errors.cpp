@@ -157,6 +157,11 @@ TEST(CliErrors, UnwritableOutputPath) {
     EXPECT_EQ(expect_one_error_line(r), c.message);
   }
   EXPECT_FALSE(fs::exists(dir + "/missing"));
+  // a checkpoint's says checkpoint (it said output)
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(dir + "/out.exr") + " --checkpoint " +
+                            q(dir + "/missing/ck.exr"));
+  EXPECT_EQ(expect_one_error_line(r),
+            dir + "/missing/ck.exr: cannot write checkpoint (No such file or directory)");
 }
 
 TEST(CliErrors, ReadOnlyDirectoryWhenNotRoot) {

@@ -186,13 +186,16 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
 
 void check_output_file(const std::string& out, const std::vector<std::string>& inputs,
                        bool is_checkpoint) {
+  // (a checkpoint's errors say "checkpoint": "cannot write output" named the wrong file's role)
+  const std::string cannot =
+      is_checkpoint ? ": cannot write checkpoint (" : ": cannot write output (";
   std::error_code ec;
   if (fs::is_directory(out, ec)) throw Error(out + ": is a directory");
   for (const std::string& in : inputs)
     if (same_file(out, in))
       throw Error(out + ": is an input of this render (" + in + "); refusing to overwrite it");
   if (fs::exists(out, ec) && ::access(out.c_str(), W_OK) != 0)
-    throw Error(out + ": cannot write output (" + std::strerror(errno) + ")");
+    throw Error(out + cannot + std::strerror(errno) + ")");
   const fs::path target = write_target(out);  // the directory the write will go to
   check_writable_kind(out, target);
   // the checkpoint of a render in progress (its lock held, lucent::cli::CheckpointLock): that
@@ -216,12 +219,12 @@ void check_output_file(const std::string& out, const std::vector<std::string>& i
   // the name itself, which only the final rename would refuse
   const long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
   if (name_max > 0 && name.size() > static_cast<size_t>(name_max))
-    throw Error(out + ": cannot write output (a file name of " + std::to_string(name.size()) +
+    throw Error(out + cannot + "a file name of " + std::to_string(name.size()) +
                 " bytes, more than the " + std::to_string(name_max) + " this file system allows)");
   // the temporary file the write goes through
   const std::string probe = temp_path(dir, name).string();
   int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) throw Error(out + ": cannot write output (" + std::strerror(errno) + ")");
+  if (fd < 0) throw Error(out + cannot + std::strerror(errno) + ")");
   ::close(fd);
   ::unlink(probe.c_str());
 }
