@@ -1622,6 +1622,15 @@ TEST(Parts, MpiCheckpointRefusedResumeIsOneLine) {
             std::string::npos)
       << r.err;
   EXPECT_EQ(lucent::test::read_file(dir + "/ck.rank1-of-2.exr"), bytes1);
+  // the output's name as the checkpoint's, as `lucent render` refuses it (the ranks' files have
+  // names of their own, and it was taken)
+  r = run_shell("timeout 60 env " + mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " +
+                                           q(scene) + " --spp 4 -o " + q(dir + "/out.exr") +
+                                           " --checkpoint " + q(dir + "/out.exr")),
+                dir);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(lucent_mpi_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(dir + "/out.exr: is the output too"), std::string::npos) << r.err;
 }
 
 // A rank whose checkpoint write fails (a full disk; here a file size limit on rank 1 alone, under

@@ -363,8 +363,11 @@ int run(const Args& a) {
         if (a.checkpoint.empty()) return;
         if (lucent::io::lower_extension(a.checkpoint) != ".exr")
           throw lucent::Error(a.checkpoint + ": --checkpoint writes part files: use an .exr name");
-        if (lucent::io::same_file(ck_path, a.output))
-          throw lucent::Error(ck_path + ": is the output too: give --checkpoint a name of its own");
+        // (the name given too, as `lucent render` refuses it: the ranks' files have other names,
+        // but the name was the output's, which docs/parts.md says is refused)
+        for (const std::string& name : {a.checkpoint, ck_path})
+          if (lucent::io::same_file(name, a.output))
+            throw lucent::Error(name + ": is the output too: give --checkpoint a name of its own");
         std::vector<std::string> inputs = lucent::scene_detail::scene_inputs(a.scene, scene);
         inputs.push_back(a.scene);
         inputs.push_back(a.output);
