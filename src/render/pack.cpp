@@ -419,6 +419,20 @@ std::string point_light_note(const PackedScene& packed, bool float_arithmetic) {
   return buf;
 }
 
+bool light_traced_caustics(const Scene& scene) {
+  if (!scene.integrator.caustics || scene.integrator.type != IntegratorType::Path) return false;
+  const auto delta = [&scene](int mi) {
+    if (mi < 0 || static_cast<std::size_t>(mi) >= scene.materials.size()) return false;
+    const Material& m = scene.materials[static_cast<std::size_t>(mi)];
+    const auto is_delta = scene_detail::material_type_def(m.type).delta;
+    return is_delta && is_delta(m);
+  };
+  return std::any_of(scene.spheres.begin(), scene.spheres.end(),
+                     [&](const Sphere& s) { return delta(s.material); }) ||
+         std::any_of(scene.triangles.begin(), scene.triangles.end(),
+                     [&](const Triangle& t) { return delta(t.material); });
+}
+
 PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bvh_reused) {
   // what the kernel's 32-bit indices can reach, before anything is built: the BVH's leaf blocks
   // (one per primitive at worst) and the texels (a texture's offset and offset + y w + x are

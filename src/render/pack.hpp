@@ -39,6 +39,12 @@ bool set_triangle_normal(lc_triangle& t);
 /// The camera basis (right, up, forward, with roll applied) as the kernel uses it.
 lc_camera pack_camera(const Camera& camera, int width, int height);
 
+/// Whether `scene` renders light-traced caustics: integrator.caustics on the path integrator and
+/// a primitive whose material can scatter by a delta lobe (MaterialTypeDef::delta: a mirror,
+/// smooth glass, a rough dielectric of ior 1). Without one pack_scene turns caustics off. (The
+/// primitives as given: a degenerate one that packing skips counts.)
+bool light_traced_caustics(const Scene& scene);
+
 /// Converts and validates the scene, builds the BVH and the light table. With `previous` (an
 /// earlier packing) whose geometry (triangle vertices, sphere centres and radii) is the same, its
 /// BVH is reused instead of built again; *bvh_reused says which happened.

@@ -24,6 +24,7 @@
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
 #include "lucent/version.hpp"
+#include "render/pack.hpp"
 #include "render/part_write.hpp"
 #include "render/resources.hpp"
 #include "render/sample_stats.hpp"
@@ -332,7 +333,9 @@ SampleRange parse_sample_range(const std::string& text, const std::string& what,
 }
 
 void check_part_scene(const Scene& scene, const std::string& scene_path) {
-  if (scene.integrator.caustics && scene.integrator.type == IntegratorType::Path)
+  // (caustics asked for in a scene without a mirror or smooth glass render none: such a scene's
+  // parts, checkpoints and MPI ranks were refused all the same)
+  if (render_detail::light_traced_caustics(scene))
     throw Error(scene_path +
                 ": integrator.caustics: part files and MPI ranks cannot hold light-traced "
                 "caustics yet; render this scene in one process, or without caustics");

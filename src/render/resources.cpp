@@ -10,6 +10,7 @@
 #include "lucent/error.hpp"
 #include "render/device_scene.hpp"
 #include "render/features.hpp"
+#include "render/pack.hpp"
 
 namespace lucent::render_detail {
 
@@ -177,9 +178,10 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
   // result's mean and variance (3 + 3 floats) and sample counts
   parts.push_back({"the accumulation and result images of the " + film + " film",
                    bytes_mul(npix, kAccumulationPixelBytes + kResultPixelBytes), "the film size"});
-  // caustics: the light paths' sums and sums of squares (3 + 3 doubles per pixel); an upper
-  // bound (pack_scene drops caustics from a scene without a delta surface)
-  const bool caustics = scene.integrator.caustics && scene.integrator.type == IntegratorType::Path;
+  // caustics: the light paths' sums and sums of squares (3 + 3 doubles per pixel), when the
+  // scene has a delta surface (pack_scene drops caustics from one without: `lucent info` counted
+  // 7 MiB of them for a scene whose caustics it said were off)
+  const bool caustics = light_traced_caustics(scene);
   if (caustics)
     parts.push_back({"the caustics light sums of the " + film + " film",
                      bytes_mul(npix, 6 * sizeof(double)),
@@ -292,13 +294,22 @@ void check_reference_host_memory(const Scene& scene, int threads) {
   // the kernel's estimate without devices: the reference's accumulation (mean and M2 in double,
   // a count) and result images take what the session's do; with caustics each thread keeps its
   // own light sums (src/reference/render.cpp)
+  // (the reference traces light paths whenever caustics are asked for on the path integrator,
+  // a delta surface or not, where the kernel's estimate counts them only with one)
   std::vector<MemoryPart> parts = estimate_host_memory(scene, {});
-  for (MemoryPart& p : parts)
-    if (p.what.rfind("the caustics light sums", 0) == 0) {
-      p.bytes = bytes_mul(p.bytes, std::uint64_t(std::max(threads, 1)));
-      p.what += ", one per thread (" + std::to_string(threads) + ")";
-      p.reduce = "the film size or the reference's threads, or render without caustics";
-    }
+  parts.erase(std::remove_if(parts.begin(), parts.end(),
+                             [](const MemoryPart& p) {
+                               return p.what.rfind("the caustics light sums", 0) == 0;
+                             }),
+              parts.end());
+  if (scene.integrator.caustics && scene.integrator.type == IntegratorType::Path) {
+    const std::uint64_t npix = std::uint64_t(scene.film.width) * std::uint64_t(scene.film.height);
+    parts.push_back(
+        {"the caustics light sums of the " + film_size(scene.film.width, scene.film.height) +
+             " film, one per thread (" + std::to_string(threads) + ")",
+         bytes_mul(bytes_mul(npix, 6 * sizeof(double)), std::uint64_t(std::max(threads, 1))),
+         "the film size or the reference's threads, or render without caustics"});
+  }
   check_host_parts(scene, parts, limit, what);
 }
 
