@@ -627,7 +627,11 @@ TEST(CliErrors, IgnoredOptionsAreRefused) {
       // (not ignored, but exceeded: an odd pilot's halves round it up, and the cap of 5 spp
       // rendered 6)
       {"--target-error 0.05 --min-spp 5 --spp 5",
-       "--spp 5 is below the adaptive pilot (--min-spp 5, rounded up to the even 6)"}};
+       "--spp 5 is below the adaptive pilot (--min-spp 5, rounded up to the even 6)"},
+      // without --spp the cap is the default's (the message named --spp 16384, not given)
+      {"--target-error 0.05 --min-spp 20000",
+       "the default cap of 16384 samples per pixel (--spp) is below the adaptive pilot "
+       "(--min-spp 20000)"}};
   for (const auto& [args, want] : cases) {
     CommandResult r = run_cli(render + args);
     EXPECT_EQ(expect_one_error_line(r), want) << args;

@@ -630,7 +630,7 @@ TEST(AdaptivePlan, TargetShortfallIsReportedAbove1Point5TimesTheTarget) {
   EXPECT_EQ(lucent::target_shortfall(r),
             "the halves' difference estimates relMSE 0.0022, 2.2 times the target 0.001 (rare "
             "bright samples that no pilot foresees, or the --spp cap): lower --target-error or "
-            "raise --spp; integrator.clamp trades such samples for bias");
+            "raise --spp (the path integrator's clamp trades such samples for bias)");
   // a target far below what a float holds: the ratio in three digits (it printed hundreds, and
   // the line lost its advice)
   r.target_error = 1e-300;
@@ -638,7 +638,7 @@ TEST(AdaptivePlan, TargetShortfallIsReportedAbove1Point5TimesTheTarget) {
   EXPECT_EQ(lucent::target_shortfall(r),
             "the halves' difference estimates relMSE 1.57e-05, 1.57e+295 times the target 1e-300 "
             "(rare bright samples that no pilot foresees, or the --spp cap): lower --target-error "
-            "or raise --spp; integrator.clamp trades such samples for bias");
+            "or raise --spp (the path integrator's clamp trades such samples for bias)");
   r.cancelled = true;
   EXPECT_EQ(lucent::target_shortfall(r), "");
 }

@@ -73,10 +73,13 @@ AdaptiveOptions adaptive_options(const SamplingArgs& a, int max_spp, double time
   // the pilot's two halves hold (min_spp + 1) / 2 samples each: an odd --min-spp rounds up
   const std::uint32_t pilot = 2 * ((o.min_spp + 1) / 2);
   if (o.max_spp < pilot)
-    throw Error("--spp " + std::to_string(o.max_spp) + " is below the adaptive pilot (--min-spp " +
-                std::to_string(o.min_spp) +
-                (pilot != o.min_spp ? ", rounded up to the even " + std::to_string(pilot) : "") +
-                ")");
+    // (without --spp the cap is the default's: "--spp 16384" named an option not given)
+    throw Error(
+        (max_spp > 0
+             ? "--spp " + std::to_string(o.max_spp)
+             : "the default cap of " + std::to_string(o.max_spp) + " samples per pixel (--spp)") +
+        " is below the adaptive pilot (--min-spp " + std::to_string(o.min_spp) +
+        (pilot != o.min_spp ? ", rounded up to the even " + std::to_string(pilot) : "") + ")");
   o.max_seconds = time_limit;
   return o;
 }

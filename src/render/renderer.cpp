@@ -39,11 +39,13 @@ std::string target_shortfall(const RenderResult& r) {
                   static_cast<unsigned long long>(r.spp),
                   static_cast<unsigned long long>(r.planned_spp));
   else
-    std::snprintf(line, sizeof line,
-                  "the halves' difference estimates relMSE %.3g, %.3g times the target %.3g (rare "
-                  "bright samples that no pilot foresees, or the --spp cap): lower "
-                  "--target-error or raise --spp; integrator.clamp trades such samples for bias",
-                  r.halves_relmse, r.halves_relmse / r.target_error, r.target_error);
+    std::snprintf(
+        line, sizeof line,
+        "the halves' difference estimates relMSE %.3g, %.3g times the target %.3g (rare "
+        "bright samples that no pilot foresees, or the --spp cap): lower "
+        "--target-error or raise --spp (the path integrator's clamp trades such samples for "
+        "bias)",
+        r.halves_relmse, r.halves_relmse / r.target_error, r.target_error);
   return line;
 }
 
