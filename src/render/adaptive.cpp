@@ -244,6 +244,7 @@ HalfPlans plan_halves(const Pilot& a, const Pilot& b, const Pilot& c, int width,
     const Pilot& o = *other[h];
     if (target > 0) {
       out.calib[h] = calibrate_model(o.sum, o.sumsq, o.count, c.sum, c.sumsq, c.count);
+      if (out.calib[h].pixels < kMinCalibrationPixels) out.calib[h].gain = 1;
       out.radius[h] = choose_radius(o, c, width, height, &out.under[h]);
     }
     out.plan[h] = plan_samples(o.v, width, height, 2 * target, budget / 2, min_n, max_n,

@@ -218,6 +218,12 @@ struct HalfPlans {
 HalfPlans plan_halves(const Pilot& a, const Pilot& b, const Pilot& c, int width, int height,
                       double target, double budget, std::uint32_t min_n, std::uint32_t max_n);
 
+/// The fewest calibration pixels whose gain a plan uses: a gain measured on fewer (a film of
+/// fewer pixels) is noise, and the plan takes gain 1, the model of independent samples
+/// (conservative for Sobol). On a 1x1 film the gains ranged over 0.016-4 for both samplers, and
+/// renders reached 2.8-3.2 E on average; at 4x4 0.6-0.8 E.
+inline constexpr std::size_t kMinCalibrationPixels = 16;
+
 /// The pixels of stream C's pilot: every `stride`-th pixel of every `stride`-th row (offset
 /// stride / 2), stride the largest in 1..4 that keeps at least `min_pixels` of them (1: the
 /// whole film). Returns the stride.
@@ -232,7 +238,11 @@ int calibration_stride(int width, int height, std::size_t min_pixels = 4096);
 /// Noisy per pixel (one degree of freedom), fine over an image. Reported, never read by a
 /// decision.
 /// `value` (3 per pixel; neighbour_values of the average) weighs the errors in place of
-/// (A_p + B_p) / 2, which is correlated with (A_p - B_p)^2 (neighbour_values).
+/// (A_p + B_p) / 2, which is correlated with (A_p - B_p)^2 (neighbour_values). (The smaller
+/// half's mean where lower, or its geometric mean with the neighbours' value, were tried for a
+/// pixel whose rare bright sample beside a bright lamp this weight hides, and left out: at the
+/// lamp's edges, where one half's samples hit it and the other's miss, they over-estimated 20 to
+/// 10^4 times, docs/rendering-model.md.)
 double halves_relmse(const std::vector<double>& sum_a, const std::vector<std::uint32_t>& n_a,
                      const std::vector<double>& sum_b, const std::vector<std::uint32_t>& n_b,
                      const std::vector<double>* value = nullptr);
