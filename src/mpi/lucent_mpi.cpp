@@ -568,8 +568,8 @@ int run(const Args& a) {
   if (!a.quiet)
     std::fprintf(stderr, "%s: %dx%d, samples %s from %d rank%s (%.2f s of kernel time in all)\n",
                  one_line(a.output).c_str(), m.merged.info.width, m.merged.info.height,
-                 lucent::ranges_text(m.merged.info.samples).c_str(), g_size,
-                 g_size == 1 ? "" : "s", m.merged.info.seconds);
+                 lucent::ranges_text(m.merged.info.samples).c_str(), g_size, g_size == 1 ? "" : "s",
+                 m.merged.info.seconds);
   if (m.merged.info.nonfinite > 0)
     std::fprintf(
         stderr, "lucent-mpi: warning: %s\n",
