@@ -447,23 +447,28 @@ void run_interruptible(const std::function<void()>& work, std::atomic<bool>& can
     });
     std::future<void> done = task.get_future();
     std::thread worker(std::move(task));
+    constexpr auto kSignalsEvery = std::chrono::milliseconds(50);
+    auto signals_seen = std::chrono::steady_clock::now();
     for (;;) {
-      const CallerQueue::Event event = queue.wait(std::chrono::milliseconds(50));
+      const CallerQueue::Event event = queue.wait(kSignalsEvery);
       if (event == CallerQueue::Event::Finished) break;
-      if (event == CallerQueue::Event::Job) {
-        // (after an interruption too: the worker waits for it)
-        restore_gil(release.state(), &cancel);
-        queue.run_job();
-        PyEval_SaveThread();
-        continue;
-      }
-      if (interrupt) continue;
+      const auto now = std::chrono::steady_clock::now();
+      // Python's signals every 50 ms, jobs or not: a callback that no signal interrupts (a C
+      // function such as list.append) posted every few milliseconds by short passes kept this
+      // thread from ever looking, and Ctrl-C went unseen (the review's find)
+      const bool look = !interrupt && (event == CallerQueue::Event::Timeout ||
+                                       now - signals_seen >= kSignalsEvery);
+      if (event != CallerQueue::Event::Job && !look) continue;
       // at interpreter exit the thread parks here with the work cancelled (the worker stays
       // joinable)
       restore_gil(release.state(), &cancel);
-      if (PyErr_CheckSignals() != 0) {
-        interrupt = std::make_exception_ptr(py::error_already_set());
-        cancel.store(true);
+      if (event == CallerQueue::Event::Job) queue.run_job();  // (after an interruption too)
+      if (look) {
+        signals_seen = now;
+        if (PyErr_CheckSignals() != 0) {
+          interrupt = std::make_exception_ptr(py::error_already_set());
+          cancel.store(true);
+        }
       }
       PyEval_SaveThread();
     }
