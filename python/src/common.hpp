@@ -532,9 +532,17 @@ class CallbackErrors {
   std::exception_ptr error_;
 };
 
+class CallerQueue;
+
 /// A warning sink that calls `callback(message)`, or warnings.warn(message, LucentWarning)
-/// when `callback` is None. Exceptions go to `errors`.
-WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackErrors> errors);
+/// when `callback` is None. Exceptions go to `errors`. With `queue` (the address where a call of
+/// run_interruptible stores its queue), on the thread that made that call from any thread of
+/// the call (a device thread of a session with several devices too), else from its worker
+/// (t_caller_queue); with `stop`, a KeyboardInterrupt raised in it (Ctrl-C on the calling
+/// thread while it runs) sets `*stop`, as an exception of a progress callback stops a render.
+WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackErrors> errors,
+                                CallerQueue* const* queue = nullptr,
+                                std::atomic<bool>* stop = nullptr);
 
 /// A callback of a session's call in progress (the progress callback of a render, a warning
 /// callback, converge's on_point), in the chain of those running on this thread, innermost

@@ -242,19 +242,28 @@ SharedObject::SharedObject(py::object o)
         delete p;
       }) {}
 
-WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackErrors> errors) {
-  return [callback, errors](const std::string& message) {
-    // (on the thread that made the call, when a worker of run_interruptible gives the warning)
-    run_with_gil(t_caller_queue, [&] {
+WarningSink python_warning_sink(SharedObject callback, std::shared_ptr<CallbackErrors> errors,
+                                CallerQueue* const* queue, std::atomic<bool>* stop) {
+  return [callback, errors, queue, stop](const std::string& message) {
+    // (on the thread that made the call, when a thread of a call of run_interruptible gives it)
+    run_with_gil(queue && *queue ? *queue : t_caller_queue, [&] {
       errors->run([&] {
-        if (callback) {
-          callback.get()(message_text(message));
-        } else {
-          // stacklevel 1: the innermost Python frame, the line that called into lucent (warn is
-          // called from C++, not from a Python function of lucent's: 2 named the caller's caller)
-          py::module_ lucent = py::module_::import("lucent");
-          py::module_::import("warnings")
-              .attr("warn")(message_text(message), lucent.attr("LucentWarning"), 1);
+        try {
+          if (callback) {
+            callback.get()(message_text(message));
+          } else {
+            // stacklevel 1: the innermost Python frame, the line that called into lucent (warn
+            // is called from C++, not from a Python function of lucent's: 2 named the caller's
+            // caller)
+            py::module_ lucent = py::module_::import("lucent");
+            py::module_::import("warnings")
+                .attr("warn")(message_text(message), lucent.attr("LucentWarning"), 1);
+          }
+        } catch (py::error_already_set& e) {
+          // Ctrl-C while it ran on the calling thread: the call stops, as for a progress
+          // callback (converge ran its whole ladder before raising it)
+          if (stop && e.matches(PyExc_KeyboardInterrupt)) stop->store(true);
+          throw;
         }
       });
     });

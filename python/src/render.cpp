@@ -1207,11 +1207,18 @@ void bind_render(py::module_& m) {
         ConvergeResult out;
         if (renderer.is_none()) {
           auto warning_errors = std::make_shared<CallbackErrors>();
-          o.render.on_warning = python_warning_sink(SharedObject(py::none()), warning_errors);
           std::atomic<bool> cancel{false};
+          CallerQueue* queue = nullptr;  // (the call's, for warnings from its device threads)
+          o.render.on_warning =
+              python_warning_sink(SharedObject(py::none()), warning_errors, &queue, &cancel);
           stop = &cancel;
           o.render.cancel = &cancel;
-          run_interruptible([&] { out = run_convergence(copy, ref, o); }, cancel);
+          run_interruptible(
+              [&] {
+                queue = t_caller_queue;
+                out = run_convergence(copy, ref, o);
+              },
+              cancel);
           warning_errors->rethrow();
         } else {
           // the session given renders every rung, with its own cancel flag

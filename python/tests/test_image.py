@@ -433,3 +433,24 @@ def test_paths_with_a_nul_and_path_like_directories(tmp_path):
     assert scene.path == str(tmp_path / "scene.json")
     with pytest.raises(TypeError):
         lucent.Material("diffuse", tmp_path)
+
+
+def test_a_keyboard_interrupt_in_a_converge_warning_stops_the_study(small_scene):
+    """converge without a renderer gives its warnings on the calling thread, where Ctrl-C can
+    land while warnings.warn runs: the study stops there, as for an exception of on_point (the
+    ladder ran to its end before KeyboardInterrupt came out; the review's find)."""
+    import time
+    import warnings
+    add_degenerate_triangle(small_scene)  # a packing warning at the first rung
+    reference = reference_of(small_scene, 16)
+
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    t0 = time.monotonic()
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = interrupt
+        with pytest.raises(KeyboardInterrupt):
+            lucent.converge(small_scene, reference, spp_ladder=[1, 2 ** 22])
+    assert time.monotonic() - t0 < 30
