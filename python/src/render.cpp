@@ -393,7 +393,7 @@ class PyRenderer {
       return std::string("cannot ") + verb + " " + what +
              " from a signal handler that runs during this renderer's own " + call_ +
              " on the same thread (a session runs one call at a time: " + verb + " it once " +
-             call_ + " has returned, or from its progress callback)";
+             call_ + " has returned)";
     return std::string("the renderer is in use by another thread (") + hint + ")";
   }
 

@@ -483,4 +483,4 @@ def test_a_signal_handler_during_the_threads_own_render_is_told_so(renderer, sma
         signal.signal(signal.SIGUSR1, previous)
     assert errors == ["cannot call result from a signal handler that runs during this renderer's "
                       "own render on the same thread (a session runs one call at a time: call it "
-                      "once render has returned, or from its progress callback)"]
+                      "once render has returned)"]
