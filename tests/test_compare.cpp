@@ -119,10 +119,25 @@ TEST(Compare, AVarianceThatOnePixelDecidesIsReported) {
   EXPECT_EQ(c.mean_variance_x, 5);
   EXPECT_EQ(c.mean_variance_y, 3);
   EXPECT_EQ(c.mean_variance_channel, 0);
+  EXPECT_NEAR(c.mean_variance_samples, 1.0, 0.05);  // its mean is one sample of 1e4's
+  EXPECT_TRUE(c.mean_variance_dominated());
   EXPECT_NE(c.summary().find("warning       pixel (5, 3) channel R holds 100.0% of the image "
-                             "means' variance"),
+                             "means' variance, and its mean rests on about 1.0 samples"),
             std::string::npos)
       << c.summary();
+  // a pixel whose variance is real (a small lamp, a relative sd of 10 at 4096 samples) holds the
+  // same share at any count, but its mean rests on many samples: no warning (the review's find:
+  // the warning could not be cleared by more samples)
+  for (RenderResult* x : {&a, &b}) x->samples.assign(static_cast<size_t>(w) * h, 4096);
+  for (int k = 0; k < 3; ++k) {
+    a.mean.pixel(5, 3)[k] = 10;
+    a.variance.pixel(5, 3)[k] = 1e4;
+  }
+  const CompareResult lamp = lucent::compare_images(a, b);
+  EXPECT_GT(lamp.mean_variance_share, 0.9);
+  EXPECT_NEAR(lamp.mean_variance_samples, 100.0 * 4096 / 1e4, 1e-6);
+  EXPECT_FALSE(lamp.mean_variance_dominated());
+  EXPECT_EQ(lamp.summary().find("warning"), std::string::npos) << lamp.summary();
   const CompareResult ordinary = lucent::compare_images(render_ref(1), render_ref(2));
   EXPECT_LT(ordinary.mean_variance_share, CompareResult::kDominatedShare);
   EXPECT_EQ(ordinary.summary().find("warning"), std::string::npos) << ordinary.summary();

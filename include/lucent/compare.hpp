@@ -47,16 +47,26 @@ struct CompareResult {
   /// (RenderResult::light_mean_variance, caustics); otherwise from its pixels, as independent.
   bool light_paths_a = false, light_paths_b = false;
   /// The largest share one pixel-channel holds of the image means' variance (the pixels' part:
-  /// A's and B's var / n summed), and where. Above 0.5 one rare, bright sample (a heavy-tailed
-  /// estimate) decides the standard error and the image-mean |z| stays near 1 however far the
-  /// means are (a near-mirror lit by a point light: means 0.33 and 0.052, z 1.000): the summary
-  /// warns, and the test cannot be trusted until both images have more samples.
+  /// A's and B's var / n summed), and where; and how many samples that pixel's mean rests on, in
+  /// the image holding most of its variance: mean² n / var (about k where k samples of one rare
+  /// value make the mean; n / CV² for an ordinary estimate). A share above 0.5 with fewer than
+  /// 10 such samples is a rare, bright sample (a heavy-tailed estimate) deciding the standard
+  /// error, and the image-mean |z| stays near 1 however far the means are (a near-mirror lit by a
+  /// point light: means 0.33 and 0.052, z 1.000): the summary warns, and the test cannot be
+  /// trusted until more samples find that value often. (A pixel whose variance is real, a small
+  /// lamp, holds its share at any count: its mean then rests on many samples, and no warning.)
   double mean_variance_share = 0;
   int mean_variance_x = 0, mean_variance_y = 0, mean_variance_channel = 0;
-  static constexpr double kDominatedShare = 0.5;  ///< the summary's warning from this share
-  double rmse = 0;                                ///< sqrt(mean over pixel-channels of (A - B)^2)
-  double relmse = 0;                              ///< mean of (A - B)^2 / (B^2 + 0.01)
-  double max_abs_error = 0;                       ///< largest |A - B|
+  double mean_variance_samples = 0;
+  static constexpr double kDominatedShare = 0.5;  ///< the summary warns above this share
+  static constexpr double kFewSamples = 10;       ///< and below this mean_variance_samples
+  /// Whether the summary warns (the two conditions above).
+  bool mean_variance_dominated() const {
+    return mean_variance_share > kDominatedShare && mean_variance_samples < kFewSamples;
+  }
+  double rmse = 0;              ///< sqrt(mean over pixel-channels of (A - B)^2)
+  double relmse = 0;            ///< mean of (A - B)^2 / (B^2 + 0.01)
+  double max_abs_error = 0;     ///< largest |A - B|
   Image z;                      ///< per pixel-channel z = (A - B) / standard error (signed)
   std::string summary() const;  ///< multi-line report, as `lucent compare` prints it
 };

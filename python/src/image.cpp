@@ -226,11 +226,13 @@ void bind_image(py::module_& m) {
       .def_readonly("light_paths_b", &CompareResult::light_paths_b)
       .def_readonly("mean_variance_share", &CompareResult::mean_variance_share,
                     "the largest share one pixel-channel holds of the image means' variance "
-                    "(above 0.5: a heavy-tailed estimate, and the image-mean test cannot be "
-                    "trusted)")
+                    "(see mean_variance_samples)")
       .def_readonly("mean_variance_x", &CompareResult::mean_variance_x)
       .def_readonly("mean_variance_y", &CompareResult::mean_variance_y)
       .def_readonly("mean_variance_channel", &CompareResult::mean_variance_channel)
+      .def_readonly("mean_variance_samples", &CompareResult::mean_variance_samples,
+                    "the samples that pixel's mean rests on (mean^2 n / var); the summary warns "
+                    "when mean_variance_share > 0.5 and this < 10")
       .def_readonly("rmse", &CompareResult::rmse)
       .def_readonly("relmse", &CompareResult::relmse)
       .def_readonly("max_abs_error", &CompareResult::max_abs_error)

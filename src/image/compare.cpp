@@ -205,6 +205,11 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
       r.mean_variance_x = static_cast<int>(largest_at[c] % r.width);
       r.mean_variance_y = static_cast<int>(largest_at[c] / r.width);
       r.mean_variance_channel = c;
+      // the samples its mean rests on, in the image holding most of its variance
+      const size_t i = largest_at[c];
+      const double va = variance_of_mean(a, i, c), vb = variance_of_mean(b, i, c);
+      const double m = va >= vb ? a.mean.rgb[i * 3 + c] : b.mean.rgb[i * 3 + c];
+      r.mean_variance_samples = m * m / std::max(va, vb);
     }
     if (o.image_mean_test && !(std::abs(r.mean_z[c]) <= r.mean_z_threshold))
       r.mean_test_passed = false;
@@ -231,14 +236,14 @@ std::string CompareResult::summary() const {
          : light_paths_a ? "A (B's pixels taken as independent: no lucent.light_mean_var)\n"
                          : "B (A's pixels taken as independent: no lucent.light_mean_var)\n";
   }
-  if (mean_variance_share > kDominatedShare) {
+  if (mean_variance_dominated()) {
     std::snprintf(buf, sizeof buf,
                   "warning       pixel (%d, %d) channel %c holds %.1f%% of the image means' "
-                  "variance: one rare, bright sample decides it (a heavy-tailed estimate), and "
-                  "the image-mean |z| stays near 1 however far the means are; compare with more "
-                  "samples in both\n",
+                  "variance, and its mean rests on about %.1f samples: a rare, bright value "
+                  "decides it (a heavy-tailed estimate), and the image-mean |z| stays near 1 "
+                  "however far the means are; compare with more samples in both\n",
                   mean_variance_x, mean_variance_y, "RGB"[mean_variance_channel],
-                  100 * mean_variance_share);
+                  100 * mean_variance_share, mean_variance_samples);
     s += buf;
   }
   std::snprintf(buf, sizeof buf, "RMSE          %.6g\nrelMSE        %.6g\nmax abs error %.6g\n",
