@@ -210,9 +210,12 @@ void require_numbers(py::handle object, const std::string& what, std::uint64_t b
 }
 
 Image image_from_array(py::handle object, const char* what) {
-  // (the float32 copy and the image's own: a broadcast view of one value standing for
-  // 40000x40000 pixels was copied whole, 17.9 GiB)
-  require_numbers(object, what, 2 * sizeof(float));
+  // (the image's own copy, and the float32 conversion's unless the array is one already: a
+  // broadcast view of one value standing for 40000x40000 pixels was copied whole, 17.9 GiB)
+  const bool no_conversion =
+      py::isinstance<py::array_t<float>>(object) &&
+      (py::reinterpret_borrow<py::array>(object).flags() & py::array::c_style);
+  require_numbers(object, what, (no_conversion ? 1 : 2) * sizeof(float));
   auto a = array_or_null<CArray<float>>(object);
   if (!a) throw py::type_error(std::string(what) + ": expected an array of shape (H, W, 3)");
   if (a.ndim() != 3 || a.shape(2) != 3 || a.shape(0) < 1 || a.shape(1) < 1) {
