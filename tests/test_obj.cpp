@@ -271,6 +271,63 @@ TEST(Obj, MissingMtlWarnsOnceAndUsesOneDefaultMaterial) {
   for (const Triangle& t : s.triangles) EXPECT_EQ(t.material, 1);
 }
 
+// A UTF-8 byte-order mark (Notepad's, other Windows tools') is skipped: tinyobjloader read it as
+// part of the first statement, which vanished without a word (a first vertex lost and every
+// index shifted by one; a first mtllib or newmtl not read: the default material, with a warning
+// that the file names no library).
+TEST(Obj, AUtf8ByteOrderMarkIsSkipped) {
+  const std::string dir = lucent::test::temp_dir(), bom = "\xEF\xBB\xBF";
+  CaptureWarnings w;
+  Scene s;
+  load(s, write(dir, "v.obj", bom + "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nv 5 5 5\nf 1 2 3\n"));
+  ASSERT_EQ(s.positions.size(), 4u);
+  ASSERT_EQ(s.triangles.size(), 1u);
+  EXPECT_EQ(pos(s, s.triangles[0], 0), glm::dvec3(-1, -1, 0));
+  EXPECT_EQ(pos(s, s.triangles[0], 2), glm::dvec3(0, 1, 0));
+  write(dir, "m.mtl", bom + "newmtl red\nKd 1 0 0\n");
+  Scene m;
+  load(m,
+       write(dir, "m.obj", bom + "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n"));
+  EXPECT_TRUE(w.all().empty()) << w.dump();
+  EXPECT_COLOUR(material_named(m, "m.obj:red").albedo, 1, 0, 0);
+}
+
+// One library of several not found: only the materials it would define are lost, and a usemtl
+// that no library read defines still warns (the warning said every face used the default
+// material while the others had theirs, and such usemtl names went unsaid). A library that is a
+// symbolic link loop is unreadable, not "not found".
+TEST(Obj, ALibraryNotFoundBesideOthersLosesOnlyItsMaterials) {
+  const std::string dir = lucent::test::temp_dir();
+  write(dir, "m.mtl", "newmtl red\nKd 1 0 0\n");
+  const std::string path = write(dir, "x.obj",
+                                 "mtllib nothere.mtl m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                 "usemtl red\nf 1 2 3\nusemtl blue\nf 1 3 2\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  EXPECT_WARNED_ONCE(w, path + ": material library 'nothere.mtl' not found (" + dir +
+                            "/nothere.mtl); faces whose material only it would define use the "
+                            "default material");
+  EXPECT_WARNED_ONCE(w, path +
+                            ": usemtl 'blue' names no material of the MTL files read (a "
+                            "library was not read, above); faces use the default material");
+  EXPECT_EQ(w.all().size(), 2u) << w.dump();
+  EXPECT_COLOUR(material_named(s, "x.obj:red").albedo, 1, 0, 0);
+  ASSERT_EQ(s.triangles.size(), 2u);
+  EXPECT_EQ(s.materials[s.triangles[0].material].name, "x.obj:red");
+  // a symbolic link loop
+  std::filesystem::create_symlink("b.mtl", dir + "/a.mtl");
+  std::filesystem::create_symlink("a.mtl", dir + "/b.mtl");
+  const std::string loop =
+      write(dir, "loop.obj", "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
+  CaptureWarnings w2;
+  Scene l;
+  load(l, loop);
+  ASSERT_EQ(w2.all().size(), 1u) << w2.dump();
+  EXPECT_NE(w2.all()[0].find("Too many levels of symbolic links"), std::string::npos) << w2.dump();
+  EXPECT_EQ(w2.all()[0].find("not found"), std::string::npos) << w2.dump();
+}
+
 TEST(Obj, CrlfFilesLoadLikeLfFiles) {
   std::string dir = lucent::test::temp_dir();
   const unsigned char px[] = {200, 100, 50};

@@ -283,6 +283,7 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   spec.max_bytes = obj::kMaxObjBytes;
   spec.text = true;
   std::string text = io::read_file(path, spec);
+  obj::strip_utf8_bom(text);
   const obj::TextCounts counts = obj::check_obj_text(path, text);  // before tinyobjloader
   check_mesh_memory(scene, path, text.size(), counts);
   const bool use_mtl = material_override < 0;
@@ -343,18 +344,27 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
     if (s.mesh.indices.size() != corners) throw Error(path + ": inconsistent face list");
   }
 
-  // warnings: the missing MTL libraries, then the library's own remarks once each
+  // warnings: the missing MTL libraries, then the library's own remarks once each. Where other
+  // libraries were read, only the materials the missing ones would define are lost (it said
+  // every face used the default material, and the faces that named another library's material
+  // had it)
+  const bool some_read = reader.libraries.size() > reader.unreadable.size();
+  const bool some_lost = !reader.missing.empty() || !reader.unreadable.empty();
+  const std::string lost = some_read ? "; faces whose material only it would define use the "
+                                       "default material"
+                                     : "; faces use the default material";
   for (const std::string& m : reader.missing)
     warn(path + ": material library '" + fs::path(m).filename().string() + "' not found (" + m +
-         "); faces use the default material");
-  for (const std::string& m : reader.unreadable) warn(m + "; faces use the default material");
+         ")" + lost);
+  for (const std::string& m : reader.unreadable) warn(m + lost);
   for (const std::string& w : reader.warnings) warn(w);
   std::set<std::string> seen;
   for (const std::string& w : lines_of(twarn + terr)) {
     if (!seen.insert(w).second) continue;
     if (w.rfind("Failed to load material file", 0) == 0) continue;  // reported above
     if (w.rfind("material [", 0) == 0) {
-      if (!use_mtl || !reader.missing.empty() || !reader.unreadable.empty()) continue;
+      // (with no library read, the warnings above say it all)
+      if (!use_mtl || (some_lost && !some_read)) continue;
       size_t a = w.find('\''), b = w.rfind('\'');
       std::string name = (a != std::string::npos && b > a) ? w.substr(a + 1, b - a - 1) : w;
       for (size_t k = 0; k < counts.usemtl_names.size(); ++k)
@@ -372,7 +382,9 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
       }
       warn(path + ": usemtl '" + name +
            (counts.libraries.empty() ? "' but the file names no material library (mtllib)"
-                                     : "' names no material of the MTL file") +
+            : some_lost ? "' names no material of the MTL files read (a library was not read, "
+                          "above)"
+                        : "' names no material of the MTL file") +
            hint + "; faces use the default material");
       continue;
     }

@@ -167,6 +167,14 @@ std::string read_colour_forms(const std::string& path, const std::string& text,
 /// `s` without the spaces and tabs at its ends.
 std::string trim(const std::string& s);
 
+/// Removes a UTF-8 byte-order mark (EF BB BF, which Notepad and other Windows tools write) from
+/// the start of `text`: tinyobjloader read it as part of the first statement, which vanished
+/// without a word (a first vertex lost and every index shifted by one; a first mtllib or newmtl
+/// not read).
+inline void strip_utf8_bom(std::string& text) {
+  if (text.size() >= 3 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
+}
+
 /// Line (1-based) of the `n`-th (0-based) statement `tag` of `text`, or 0.
 long line_of_statement(const std::string& text, const char* tag, std::int64_t n);
 

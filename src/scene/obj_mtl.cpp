@@ -76,8 +76,10 @@ bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* 
     spec.text = true;
     text = io::read_file(path, spec);
   } catch (const Error& e) {
+    // (a path that cannot be looked at, a symbolic link loop, is unreadable, not missing: it was
+    // "not found")
     std::error_code ec;
-    if (!fs::exists(path, ec)) {
+    if (!fs::exists(path, ec) && !ec) {
       missing.push_back(path);
     } else {
       libraries.push_back(path);
@@ -86,6 +88,7 @@ bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* 
     return true;
   }
   libraries.push_back(path);
+  strip_utf8_bom(text);
   try {
     check_mtl_text(path, text);
   } catch (const Error& e) {
