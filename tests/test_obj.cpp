@@ -498,6 +498,31 @@ TEST(Obj, TexturesAreRelativeToTheMtlFileAndMissingOnesWarn) {
   for (const auto& msg : w.all()) EXPECT_NE(msg.find("m.mtl"), std::string::npos) << msg;
 }
 
+// A texture named by another machine's path (Windows' or an absolute one) that is not found is
+// looked for by its file name beside the MTL file, as Blender's importer does, with a warning
+// naming both; an unused map found so is not reported missing.
+TEST(Obj, ATextureOfAnotherMachinesPathIsFoundBesideTheMtlFile) {
+  const std::string dir = lucent::test::temp_dir();
+  std::filesystem::create_directories(dir + "/lib");
+  const unsigned char px[] = {255, 255, 255, 0, 0, 0};
+  ASSERT_TRUE(stbi_write_png((dir + "/lib/q.png").c_str(), 2, 1, 3, px, 6));
+  write(dir, "lib/m.mtl",
+        "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd C:\\Users\\me\\textures\\q.png\n"
+        "newmtl b\nKd 0.2 0.2 0.2\nmap_Kd /nowhere/at/all/q.png\nmap_bump /nowhere/q.png\n");
+  const std::string path = write(dir, "mesh.obj",
+                                 "mtllib lib/m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n"
+                                 "usemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.textures.size(), 1u) << w.dump();
+  EXPECT_EQ(material_named(s, "mesh.obj:a").albedo_texture, 0);
+  EXPECT_EQ(material_named(s, "mesh.obj:b").albedo_texture, 0);
+  EXPECT_EQ(w.count("its file name beside the MTL file"), 2) << w.dump();
+  EXPECT_EQ(w.count("using " + dir + "/lib/q.png"), 2) << w.dump();
+  EXPECT_EQ(w.all().size(), 2u) << w.dump();  // (not map_bump's)
+}
+
 TEST(Obj, UnreadableTextureWarnsAndFallsBack) {
   std::string dir = lucent::test::temp_dir();
   write(dir, "junk.png", "not an image");

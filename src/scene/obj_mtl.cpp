@@ -29,6 +29,17 @@ fs::path texture_path(const std::string& mtl_path, const std::string& name) {
   return named_file(fs::path(mtl_path).parent_path(), name);
 }
 
+/// Where a texture named by a path that is not found (another machine's: `C:\Users\me\q.png`,
+/// `/home/me/q.png`) is looked for next, as Blender's importer does: its file name beside the MTL
+/// file; "" when there is no such other file.
+fs::path texture_beside(const std::string& mtl_path, const std::string& name) {
+  const std::size_t cut = name.find_last_of("/\\");
+  if (cut == std::string::npos || cut + 1 >= name.size()) return {};
+  const fs::path p = fs::path(mtl_path).parent_path() / name.substr(cut + 1);
+  std::error_code ec;
+  return fs::exists(p, ec) ? p : fs::path();
+}
+
 }  // namespace
 
 bool MtlReader::operator()(const std::string&, std::vector<tinyobj::material_t>* materials,
@@ -321,6 +332,13 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
     fs::path p = texture_path(mtl_path, t.diffuse_texname);
     std::error_code ec;
     if (!fs::exists(p, ec) && !ec) {
+      if (fs::path beside = texture_beside(mtl_path, t.diffuse_texname); !beside.empty()) {
+        warn(where + ": map_Kd texture '" + t.diffuse_texname + "' not found (" + p.string() +
+             "); using " + beside.string() + ", its file name beside the MTL file");
+        p = beside;
+      }
+    }
+    if (!fs::exists(p, ec) && !ec) {
       warn(where + ": map_Kd texture '" + t.diffuse_texname + "' not found (" + p.string() +
            "); using Kd");
     } else {
@@ -350,7 +368,8 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
     if (file->empty()) continue;
     fs::path p = texture_path(mtl_path, *file);
     std::error_code ec;
-    if (!fs::exists(p, ec) && warned_.insert(p.string()).second)
+    if (!fs::exists(p, ec) && texture_beside(mtl_path, *file).empty() &&
+        warned_.insert(p.string()).second)
       warn(where + ": " + key + " texture '" + *file + "' not found (" + p.string() +
            "); ignored (lucent does not use " + key + ")");
   }
