@@ -328,6 +328,24 @@ TEST(Obj, ALibraryNotFoundBesideOthersLosesOnlyItsMaterials) {
   EXPECT_EQ(w2.all()[0].find("not found"), std::string::npos) << w2.dump();
 }
 
+// A statement OBJ does not have, in a file with vertices and faces, is ignored with one warning
+// naming the first and counting the others: a typo ("f1 2 3") lost its face without a word.
+// Every statement of the format (curves and surfaces included) is silent.
+TEST(Obj, StatementsObjDoesNotHaveAreNamed) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string path = write(dir, "typo.obj",
+                                 "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf1 1 3 4\n"
+                                 "o name\ns off\ncstype bezier\nfo 1 3 4\n");
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  EXPECT_EQ(s.triangles.size(), 1u);
+  EXPECT_WARNED_ONCE(w, path +
+                            ":6: 'f1' is no OBJ statement; the line is ignored (and 1 more "
+                            "such lines)");
+  EXPECT_EQ(w.all().size(), 1u) << w.dump();
+}
+
 TEST(Obj, CrlfFilesLoadLikeLfFiles) {
   std::string dir = lucent::test::temp_dir();
   const unsigned char px[] = {200, 100, 50};

@@ -357,6 +357,14 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
     warn(path + ": material library '" + fs::path(m).filename().string() + "' not found (" + m +
          ")" + lost);
   for (const std::string& m : reader.unreadable) warn(m + lost);
+  // statements OBJ does not have, in a file that has vertices or faces (a file of none is
+  // refused): a typo lost its line without a word ("f1 2 3", "fo 1 2 3": a face gone)
+  if (counts.foreign_lines > 0)
+    warn(path + ":" + std::to_string(counts.foreign_line) + ": '" + counts.foreign_statement +
+         "' is no OBJ statement; the line is ignored" +
+         (counts.foreign_lines > 1
+              ? " (and " + std::to_string(counts.foreign_lines - 1) + " more such lines)"
+              : std::string()));
   for (const std::string& w : reader.warnings) warn(w);
   std::set<std::string> seen;
   for (const std::string& w : lines_of(twarn + terr)) {

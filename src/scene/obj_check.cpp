@@ -339,7 +339,7 @@ TextCounts check_obj_text(const std::string& path, const std::string& text) {
       fail(
           "a '\\' at the end of a line continues it on the next, which lucent does not read: "
           "join the two lines");
-    if (out.foreign_line == 0 && !obj_statement(tag)) {
+    if (!obj_statement(tag) && ++out.foreign_lines == 1) {
       out.foreign_line = ln;
       out.foreign_statement = io::one_line(str(tag));
     }

@@ -80,6 +80,7 @@ struct TextCounts {
   /// The first line whose statement the OBJ format does not have, and the statement (0: none).
   long foreign_line = 0;
   std::string foreign_statement;
+  long foreign_lines = 0;  ///< lines of statements OBJ does not have (ignored, with a warning)
 };
 
 /// The host memory that loading an OBJ file holds at once (obj.cpp, load_obj), in order, never
