@@ -49,8 +49,11 @@ struct CompareResult {
   /// The largest share one pixel-channel holds of the image means' variance (the pixels' part:
   /// A's and B's var / n summed), and where; and how many samples that pixel's mean rests on, in
   /// the image holding most of its variance: mean² n / var (about k where k samples of one rare
-  /// value make the mean; n / CV² for an ordinary estimate). A share above 0.5 with fewer than
-  /// 10 such samples is a rare, bright sample (a heavy-tailed estimate) deciding the standard
+  /// value make the mean; n / CV² for an ordinary estimate), or the excess over the other
+  /// image's mean in place of the mean where the other image has under a tenth of its variance
+  /// per sample (it missed the rare value: the pixel's own light is no evidence); infinite for a
+  /// mean of 0 or below. Each channel is looked at: a share above 0.5 with fewer than 10 such
+  /// samples is a rare, bright sample (a heavy-tailed estimate) deciding the standard
   /// error, and the image-mean |z| stays near 1 however far the means are (a near-mirror lit by a
   /// point light: means 0.33 and 0.052, z 1.000): the summary warns, and the test cannot be
   /// trusted until more samples find that value often. (A pixel whose variance is real, a small

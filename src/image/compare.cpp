@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "lucent/error.hpp"
 
@@ -34,6 +35,25 @@ double variance_of_mean(const RenderResult& r, size_t i, int c) {
   double n = r.samples.empty() ? 1.0 : static_cast<double>(r.samples[i]);
   if (n < 2) return 0;
   return std::max(0.0, static_cast<double>(r.variance.rgb[i * 3 + c])) / n;
+}
+
+/// How many samples the mean of pixel i, channel c rests on, in the image (X) holding most of
+/// its variance: mean² / (var / n), about k where k samples of one rare value V make it. Where
+/// the other image (Y) has far less variance per sample there, it missed that value, and the
+/// excess of X over Y is what the rare samples made: (m_X - m_Y)² / (var / n) (the pixel's
+/// ordinary light, counted in m_X, made a highlight on a lit surface look like many samples).
+/// Infinite (no claim) for a mean of 0 or below (a signed AOV).
+double samples_of_mean(const RenderResult& a, const RenderResult& b, size_t i, int c) {
+  const double va = variance_of_mean(a, i, c), vb = variance_of_mean(b, i, c);
+  const bool x_is_a = va >= vb;
+  const RenderResult &x = x_is_a ? a : b, &y = x_is_a ? b : a;
+  const double vx = std::max(va, vb);
+  const double mx = x.mean.rgb[i * 3 + c], my = y.mean.rgb[i * 3 + c];
+  const auto per_sample = [](const RenderResult& r, size_t k, int ch) {
+    return r.variance.rgb.empty() ? 0.0 : std::max(0.0, double(r.variance.rgb[k * 3 + ch]));
+  };
+  if (per_sample(y, i, c) < 0.1 * per_sample(x, i, c)) return (mx - my) * (mx - my) / vx;
+  return mx > 0 ? mx * mx / vx : std::numeric_limits<double>::infinity();
 }
 
 /// The z score of a difference d with standard error sqrt(var_eps) (both standard errors and
@@ -199,17 +219,22 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
     const double var = image_mean_variance(a, sum_var_a[c] / (n * n), c) +
                        image_mean_variance(b, sum_var_b[c] / (n * n), c);
     r.mean_z[c] = z_score(r.mean_a[c] - r.mean_b[c], var + eps * eps);
+    // the channel whose largest pixel share warns, or else the largest share (each channel
+    // checked: a lamp in one channel hid a rare highlight in another)
     const double pixels_var = sum_var_a[c] + sum_var_b[c];
-    if (pixels_var > 0 && largest_var[c] / pixels_var > r.mean_variance_share) {
-      r.mean_variance_share = largest_var[c] / pixels_var;
-      r.mean_variance_x = static_cast<int>(largest_at[c] % r.width);
-      r.mean_variance_y = static_cast<int>(largest_at[c] / r.width);
-      r.mean_variance_channel = c;
-      // the samples its mean rests on, in the image holding most of its variance
+    if (pixels_var > 0) {
+      const double share = largest_var[c] / pixels_var;
       const size_t i = largest_at[c];
-      const double va = variance_of_mean(a, i, c), vb = variance_of_mean(b, i, c);
-      const double m = va >= vb ? a.mean.rgb[i * 3 + c] : b.mean.rgb[i * 3 + c];
-      r.mean_variance_samples = m * m / std::max(va, vb);
+      const double samples = samples_of_mean(a, b, i, c);
+      const bool dominated =
+          share > CompareResult::kDominatedShare && samples < CompareResult::kFewSamples;
+      if (dominated != r.mean_variance_dominated() ? dominated : share > r.mean_variance_share) {
+        r.mean_variance_share = share;
+        r.mean_variance_x = static_cast<int>(i % r.width);
+        r.mean_variance_y = static_cast<int>(i / r.width);
+        r.mean_variance_channel = c;
+        r.mean_variance_samples = samples;
+      }
     }
     if (o.image_mean_test && !(std::abs(r.mean_z[c]) <= r.mean_z_threshold))
       r.mean_test_passed = false;
