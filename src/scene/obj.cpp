@@ -362,9 +362,9 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   if (counts.foreign_lines > 0)
     warn(path + ":" + std::to_string(counts.foreign_line) + ": '" + counts.foreign_statement +
          "' is no OBJ statement; the line is ignored" +
-         (counts.foreign_lines > 1
-              ? " (and " + std::to_string(counts.foreign_lines - 1) + " more such lines)"
-              : std::string()));
+         (counts.foreign_lines > 1 ? " (and " + std::to_string(counts.foreign_lines - 1) +
+                                         " more such line" + (counts.foreign_lines > 2 ? "s)" : ")")
+                                   : std::string()));
   for (const std::string& w : reader.warnings) warn(w);
   std::set<std::string> seen;
   for (const std::string& w : lines_of(twarn + terr)) {

@@ -239,12 +239,13 @@ bool library_exists(const std::string& obj_path, const std::string& name) {
 /// The OBJ format's statements (Wavefront's specification, and tinyobjloader's t and vw).
 bool obj_statement(std::string_view tag) {
   static const char* const kStatements[] = {
-      "v",        "vt",       "vn",     "vp",         "f",         "l",      "p",
-      "g",        "o",        "s",      "mg",         "usemtl",    "mtllib", "cstype",
-      "deg",      "bmat",     "step",   "curv",       "curv2",     "surf",   "parm",
-      "trim",     "hole",     "scrv",   "sp",         "end",       "con",    "bevel",
-      "c_interp", "d_interp", "lod",    "shadow_obj", "trace_obj", "ctech",  "stech",
-      "call",     "csh",      "maplib", "usemap",     "t",         "vw"};
+      "v",         "vt",    "vn",    "vp",     "f",        "l",        "p",      "g",
+      "o",         "s",     "mg",    "usemtl", "mtllib",   "cstype",   "deg",    "bmat",
+      "step",      "curv",  "curv2", "surf",   "parm",     "trim",     "hole",   "scrv",
+      "sp",        "end",   "con",   "bevel",  "c_interp", "d_interp", "lod",    "shadow_obj",
+      "trace_obj", "ctech", "stech", "call",   "csh",      "maplib",   "usemap", "t",
+      "vw",        "bsp",   "bzp",   "cdc",    "cdp",      "res"};  // (the last five: the format's
+                                                                    // older ones)
   return std::any_of(std::begin(kStatements), std::end(kStatements),
                      [&](const char* s) { return tag == s; });
 }

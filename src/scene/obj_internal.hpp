@@ -168,12 +168,17 @@ std::string read_colour_forms(const std::string& path, const std::string& text,
 /// `s` without the spaces and tabs at its ends.
 std::string trim(const std::string& s);
 
-/// Removes a UTF-8 byte-order mark (EF BB BF, which Notepad and other Windows tools write) from
-/// the start of `text`: tinyobjloader read it as part of the first statement, which vanished
-/// without a word (a first vertex lost and every index shifted by one; a first mtllib or newmtl
-/// not read).
+/// Removes the UTF-8 byte-order marks (EF BB BF, which Notepad and other Windows tools write)
+/// at the start of `text`, and blanks those at the start of a line (files joined with `cat`):
+/// tinyobjloader read one as part of its statement, which vanished without a word (a vertex lost
+/// and every later index shifted by one; an mtllib or newmtl not read).
 inline void strip_utf8_bom(std::string& text) {
-  if (text.size() >= 3 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
+  static const char kBom[] = "\xEF\xBB\xBF";
+  std::size_t lead = 0;
+  while (text.compare(lead, 3, kBom) == 0) lead += 3;
+  text.erase(0, lead);
+  for (std::size_t at = text.find(kBom); at != std::string::npos; at = text.find(kBom, at + 3))
+    if (at > 0 && text[at - 1] == '\n') text.replace(at, 3, "   ");  // (the lines kept)
 }
 
 /// Line (1-based) of the `n`-th (0-based) statement `tag` of `text`, or 0.

@@ -35,9 +35,11 @@ fs::path texture_path(const std::string& mtl_path, const std::string& name) {
 fs::path texture_beside(const std::string& mtl_path, const std::string& name) {
   const std::size_t cut = name.find_last_of("/\\");
   if (cut == std::string::npos || cut + 1 >= name.size()) return {};
-  const fs::path p = fs::path(mtl_path).parent_path() / name.substr(cut + 1);
+  const std::string file = name.substr(cut + 1);
+  if (file == "." || file == "..") return {};
+  const fs::path p = fs::path(mtl_path).parent_path() / file;
   std::error_code ec;
-  return fs::exists(p, ec) ? p : fs::path();
+  return fs::is_regular_file(p, ec) ? p : fs::path();  // (a directory there is no texture)
 }
 
 }  // namespace
@@ -333,8 +335,10 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
     std::error_code ec;
     if (!fs::exists(p, ec) && !ec) {
       if (fs::path beside = texture_beside(mtl_path, t.diffuse_texname); !beside.empty()) {
-        warn(where + ": map_Kd texture '" + t.diffuse_texname + "' not found (" + p.string() +
-             "); using " + beside.string() + ", its file name beside the MTL file");
+        // (once per name: an exporter's library names every texture so, material by material)
+        if (warned_.insert(mtl_path + "\n" + t.diffuse_texname).second)
+          warn(where + ": map_Kd texture '" + t.diffuse_texname + "' not found (" + p.string() +
+               "); using " + beside.string() + ", its file name beside the MTL file");
         p = beside;
       }
     }
