@@ -303,7 +303,8 @@ TEST(Obj, ALibraryNotFoundBesideOthersLosesOnlyItsMaterials) {
   write(dir, "m.mtl", "newmtl red\nKd 1 0 0\n");
   const std::string path = write(dir, "x.obj",
                                  "mtllib nothere.mtl m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
-                                 "usemtl red\nf 1 2 3\nusemtl blue\nf 1 3 2\n");
+                                 "usemtl red\nf 1 2 3\nusemtl blue\nf 1 3 2\n"
+                                 "usemtl green\nf 2 1 3\n");
   CaptureWarnings w;
   Scene s;
   load(s, path);
@@ -311,11 +312,12 @@ TEST(Obj, ALibraryNotFoundBesideOthersLosesOnlyItsMaterials) {
                             "/nothere.mtl); faces whose material only it would define use the "
                             "default material");
   EXPECT_WARNED_ONCE(w, path +
-                            ": usemtl 'blue' names no material of the MTL files read (a "
-                            "library was not read, above); faces use the default material");
+                            ": usemtl 'blue', 'green' name no material of the MTL files "
+                            "read (a library was not read, above); faces use the default "
+                            "material");
   EXPECT_EQ(w.all().size(), 2u) << w.dump();
   EXPECT_COLOUR(material_named(s, "x.obj:red").albedo, 1, 0, 0);
-  ASSERT_EQ(s.triangles.size(), 2u);
+  ASSERT_EQ(s.triangles.size(), 3u);
   EXPECT_EQ(s.materials[s.triangles[0].material].name, "x.obj:red");
   // a symbolic link loop
   std::filesystem::create_symlink("b.mtl", dir + "/a.mtl");

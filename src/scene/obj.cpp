@@ -367,6 +367,7 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
                                    : std::string()));
   for (const std::string& w : reader.warnings) warn(w);
   std::set<std::string> seen;
+  std::vector<std::string> unread_names;  // usemtl names no library read defines, one not read
   for (const std::string& w : lines_of(twarn + terr)) {
     if (!seen.insert(w).second) continue;
     if (w.rfind("Failed to load material file", 0) == 0) continue;  // reported above
@@ -388,15 +389,27 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
                "': a '#' on a newmtl line is part of the name, not a comment)";
         break;
       }
+      if (some_lost) {  // (one line for them all: the library not read may define each)
+        unread_names.push_back(name);
+        continue;
+      }
       warn(path + ": usemtl '" + name +
            (counts.libraries.empty() ? "' but the file names no material library (mtllib)"
-            : some_lost ? "' names no material of the MTL files read (a library was not read, "
-                          "above)"
-                        : "' names no material of the MTL file") +
+                                     : "' names no material of the MTL file") +
            hint + "; faces use the default material");
       continue;
     }
     warn(path + ": " + w);
+  }
+  if (!unread_names.empty()) {
+    std::string list;
+    const std::size_t shown = std::min<std::size_t>(unread_names.size(), 4);
+    for (std::size_t k = 0; k < shown; ++k) list += (k ? ", '" : "'") + unread_names[k] + "'";
+    if (unread_names.size() > shown)
+      list += " and " + std::to_string(unread_names.size() - shown) + " more";
+    warn(path + ": usemtl " + list + (unread_names.size() == 1 ? " names" : " name") +
+         " no material of the MTL files read (a library was not read, above); faces use the "
+         "default material");
   }
 
   // The scene's arrays are filled in the order that holds the least at once: normals and texture
