@@ -197,16 +197,19 @@ SHORT_PASSES_CHILD = textwrap.dedent("""
     r.set_scene(scene)
     seen = []
 
+    first = []
+
     def interrupt():
         while len(seen) < 20:
-            time.sleep(0.01)
+            time.sleep(0.001)
+        first.append(time.monotonic() - t0)  # 20 passes: short ones, under 50 ms each?
         os.kill(os.getpid(), signal.SIGINT)
-    threading.Thread(target=interrupt, daemon=True).start()
     t0 = time.monotonic()
+    threading.Thread(target=interrupt, daemon=True).start()
     try:
         r.render(10 ** 9, progress=seen.append)  # a C function: no signal interrupts it
     except KeyboardInterrupt:
-        print("keyboard", round(time.monotonic() - t0, 1), flush=True)
+        print("keyboard", round(time.monotonic() - t0, 1), round(first[0], 3), flush=True)
 """)
 
 
@@ -217,5 +220,7 @@ def test_sigint_stops_a_render_of_short_passes_with_a_c_callback():
     child = subprocess.run([sys.executable, "-c", SHORT_PASSES_CHILD, json.dumps(SMALL)],
                            capture_output=True, text=True, timeout=60, env=dict(os.environ))
     assert child.returncode == 0, child.stderr
-    word, seconds = child.stdout.split()
+    word, seconds, twenty = child.stdout.split()
     assert word == "keyboard" and float(seconds) < 30, child.stdout
+    if float(twenty) > 20 * 0.05:  # (what the test needs: callbacks more often than 50 ms)
+        pytest.skip("passes of %.0f ms here: too long to test this" % (1000 * float(twenty) / 20))
