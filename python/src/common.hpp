@@ -2,6 +2,7 @@
 // Shared pieces of the Python module: enum names from the registries, vectors from sequences,
 // arrays that own or view C++ vectors, images from arrays, and calling Python back from a render
 // that released the GIL.
+#include <pybind11/eval.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

@@ -528,6 +528,17 @@ FileText resolved_cache_dir(const PathText& given) {
 /// protocol 2 raises for them. The iterators of the bound lists (ShapeList, ...: a pybind11
 /// 'iterator' class each, in pybind11_builtins, not in the module) raise it too.
 void reduce_in_every_protocol(py::module_& m) {
+  // a Python function, which pickle names by reference (a bound C++ function pickles as its
+  // capsule, which cannot be)
+  py::exec(R"(
+def _restore(cls, state, attributes):
+    """(pickle's) An object of a Python subclass of a lucent class: its state and attributes."""
+    obj = cls.__new__(cls)
+    obj.__setstate__(state)
+    obj.__dict__.update(attributes)
+    return obj
+)",
+           m.attr("__dict__"));
   const py::object newobj = py::module_::import("copyreg").attr("__newobj__");
   const auto is_bound = [](py::handle cls) {
     return PyType_Check(cls.ptr()) &&
@@ -566,9 +577,16 @@ void reduce_in_every_protocol(py::module_& m) {
             py::cpp_function([own](py::handle self) { return own(self, 2); }, py::is_method(cls));
       }
     } else if (py::hasattr(cls, "__setstate__")) {
-      set_reduce(cls, [newobj](py::handle self) -> py::object {
-        return py::make_tuple(newobj, py::make_tuple(py::type::handle_of(self)),
-                              self.attr("__getstate__")());
+      // a Python subclass's attributes (its __dict__) come back too, through
+      // lucent._restore (the state alone lost them); other objects keep copyreg's form
+      const py::object restore = m.attr("_restore");
+      set_reduce(cls, [newobj, restore](py::handle self) -> py::object {
+        const py::object state = self.attr("__getstate__")();
+        const py::object attributes = py::getattr(self, "__dict__", py::none());
+        if (!attributes.is_none() && py::len(attributes) > 0)
+          return py::make_tuple(restore,
+                                py::make_tuple(py::type::handle_of(self), state, attributes));
+        return py::make_tuple(newobj, py::make_tuple(py::type::handle_of(self)), state);
       });
     } else {
       const std::string name = cls.attr("__name__").cast<std::string>();

@@ -938,6 +938,22 @@ void fields_repr(py::class_<C>& c, std::vector<const char*> fields) {
   });
 }
 
+/// copy.copy (memo nullptr) or copy.deepcopy of a Scene: the C++ copy, of the object's own class
+/// with its attributes (shallow or deep) for a Python subclass.
+py::object copy_of_scene(py::handle self, py::dict* memo) {
+  if (reinterpret_cast<PyObject*>(Py_TYPE(self.ptr())) == py::type::of<Scene>().ptr())
+    return py::cast(Scene(self.cast<const Scene&>()));
+  py::handle cls = py::type::handle_of(self);
+  py::object obj = cls.attr("__new__")(cls);
+  obj.attr("__setstate__")(self.attr("__getstate__")());
+  py::object attributes = py::getattr(self, "__dict__", py::none());
+  if (!attributes.is_none()) {
+    if (memo) attributes = py::module_::import("copy").attr("deepcopy")(attributes, *memo);
+    obj.attr("__dict__").attr("update")(attributes);
+  }
+  return obj;
+}
+
 std::string scene_repr(const Scene& s) {
   return "<lucent.Scene " + py::repr(file_text(s.path)).cast<std::string>() + ": " +
          std::to_string(s.film.width) + "x" + std::to_string(s.film.height) + ", " +
@@ -1143,8 +1159,10 @@ void bind_scene(py::module_& m) {
           [](const Scene& s, const FileText& name) { return s.find_material(name.bytes); },
           py::arg("name"), "Index of the material named `name`, or -1.")
       .def("copy", [](const Scene& s) { return Scene(s); })
-      .def("__copy__", [](const Scene& s) { return Scene(s); })
-      .def("__deepcopy__", [](const Scene& s, py::dict) { return Scene(s); })
+      // (a Python subclass's copy is of its class, with its attributes: it was a Scene)
+      .def("__copy__", [](py::object self) { return copy_of_scene(self, nullptr); })
+      .def("__deepcopy__",
+           [](py::object self, py::dict memo) { return copy_of_scene(self, &memo); })
       .def("__repr__", &scene_repr);
   def_pickle(scene);
   vector_array_property(scene, "positions", &Scene::positions);

@@ -2,6 +2,7 @@
 protocol 2, the highest protocol, copy.deepcopy, a multiprocessing worker), a round-tripped scene
 renders the same image, and a corrupted state raises a ValueError naming the class and the key."""
 import copy
+import copyreg
 import math
 import multiprocessing
 import pickle
@@ -150,6 +151,37 @@ def test_a_scene_round_trips_exactly(rich_scene, name, round_trip):
     c.materials[0].roughness = 0.9
     c.textures[0].rgba = np.zeros((1, 1, 4))
     assert s.materials[0].roughness == 0.1 and s.textures[0].width == 5
+
+
+class TaggedScene(lucent.Scene):
+    """A subclass with attributes of its own (module level: pickle names it)."""
+
+    def __init__(self):
+        super().__init__()
+        self.notes = ["from the asset library"]
+
+
+class TaggedCamera(lucent.Camera):
+    pass
+
+
+@pytest.mark.parametrize("name, round_trip", round_trips())
+def test_a_subclass_keeps_its_class_and_attributes(name, round_trip):
+    # copies and pickles of a Python subclass were of the base class (Scene's copy), or lost the
+    # instance's attributes (every class's pickle)
+    s = TaggedScene()
+    s.film.width = 7
+    c = round_trip(s)
+    assert type(c) is TaggedScene and c.notes == ["from the asset library"] and c.film.width == 7
+    assert (c.notes is s.notes) == (name == "copy")  # a shallow copy shares them
+    cam = TaggedCamera()
+    cam.fov_degrees = 12
+    cam.label = "left"
+    k = round_trip(cam)
+    assert type(k) is TaggedCamera and k.label == "left" and k.fov_degrees == 12
+    # the base classes keep their form: copyreg's, the state alone
+    assert pickle.loads(pickle.dumps(lucent.Camera())).__class__ is lucent.Camera
+    assert lucent.Camera().__reduce_ex__(2)[0] is copyreg.__newobj__
 
 
 @pytest.mark.parametrize("name, round_trip", round_trips())
