@@ -116,6 +116,11 @@ TEST(ProgramCache, HitsMissesAndRebuildsCorruptEntries) {
   EXPECT_EQ(lucent::test::error_of([] { lucent::cl_util::program_cache_usage("/etc/passwd/a/b"); }),
             "/etc/passwd/a/b: cannot be the kernel cache (LUCENT_CACHE_DIR): /etc/passwd is not a "
             "directory");
+  // a path that cannot be looked at says why (it said "not a directory")
+  const std::string long_name = "/tmp/" + std::string(300, '0') + "/x";
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::cl_util::clear_program_cache(long_name); }),
+            long_name + ": cannot look at the kernel cache (" +
+                std::make_error_code(std::errc::filename_too_long).message() + ")");
   EXPECT_GE(lucent::cl_util::clear_program_cache(cache.dir), 2);
   ProgramBuildInfo h;
   lucent::cl_util::build_program_cached(ctx, src, "-cl-std=CL1.2", cache.dir, &h);
@@ -545,6 +550,32 @@ TEST(ProgramCache, CancelledSessionStopsWaitingForABuildLock) {
   error = lucent::test::error_of([&] { left.set_scene(scene); });
   holder2.join();
   EXPECT_EQ(error, "");
+}
+
+}  // namespace
+
+namespace {
+
+// `lucent cache clear` that cannot remove an entry (a read-only directory, for a user other than
+// root) says so and fails: it said "removed 0 cached program(s)", status 0, and the entry stayed.
+TEST(ProgramCache, AClearThatCannotRemoveAnEntryFails) {
+  const bool root = ::geteuid() == 0;
+  if (root && std::system("command -v setpriv >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "root ignores the directory's permissions, and setpriv is absent";
+  const std::string dir = lucent::test::temp_dir() + "/cache";
+  std::filesystem::create_directories(dir);
+  lucent::test::write_file(dir + "/0123456789abcdef.bin", "an entry");
+  ::chmod(lucent::test::temp_dir().c_str(), 0755);
+  ::chmod(dir.c_str(), 0555);
+  const std::string as_user = (root ? "setpriv --reuid 65534 --regid 65534 --clear-groups " : "") +
+                              std::string("env LUCENT_CACHE_DIR='") + dir + "'";
+  const lucent::test::CommandResult r = lucent::test::run_cli("cache clear", as_user);
+  ::chmod(dir.c_str(), 0755);
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_EQ(r.err,
+            "lucent: error: cannot remove 1 cached program(s) (" + dir + "/0123456789abcdef.bin: " +
+                std::make_error_code(std::errc::permission_denied).message() + "); removed 0\n");
+  EXPECT_TRUE(std::filesystem::exists(dir + "/0123456789abcdef.bin"));
 }
 
 }  // namespace

@@ -545,6 +545,20 @@ TEST(Resources, HostCountsSaturateInsteadOfWrapping) {
   EXPECT_EQ(lucent::sys::host_block_bytes(~std::uint64_t(0) - 5), ~std::uint64_t(0));
 }
 
+// LUCENT_HUGE_PAGES is 0 or 1: another value ("off", "false") turned the advice on without a
+// word; it is taken as 1 with a warning, once.
+TEST(Resources, HugePagesVariableIsZeroOrOne) {
+  lucent::test::ScopedEnv env("LUCENT_HUGE_PAGES", "off");
+  testing::internal::CaptureStderr();
+  for (int k = 0; k < 2; ++k)
+    lucent::sys::release_host_block(
+        lucent::sys::allocate_host_block(lucent::sys::kHugePageMinBuffer));
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(err,
+            "lucent: warning: LUCENT_HUGE_PAGES='off' is neither 0 (no huge-page advice) nor 1 "
+            "(the default); taken as 1\n");
+}
+
 // Before upload, per device: each buffer against the largest allocation, by its registry
 // description, and all of them against global memory.
 TEST(Resources, DeviceLimitsNameTheBuffer) {

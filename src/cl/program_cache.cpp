@@ -376,6 +376,8 @@ std::vector<fs::directory_entry> cache_files(const std::string& dir) {
       }
     return files;
   }
+  // (a path that cannot be looked at was "not a directory": permission denied, a name too long)
+  if (ec) throw Error(dir + ": cannot look at the kernel cache (" + ec.message() + ")");
   if (!fs::is_directory(dir, ec))
     throw Error(dir + ": not a directory (the kernel cache, LUCENT_CACHE_DIR)");
   fs::directory_iterator it(dir, ec);
@@ -504,6 +506,8 @@ bool write_in_progress(const std::string& name) {
 
 int clear_program_cache(const std::string& dir) {
   int n = 0;
+  std::string failed;  // the first entry not removed, and why (it said "removed 0", status 0)
+  int not_removed = 0;
   for (const fs::directory_entry& e : cache_files(dir)) {
     const std::string name = e.path().filename().string();
     std::error_code ec;
@@ -516,11 +520,18 @@ int clear_program_cache(const std::string& dir) {
     }
     // entries, counted as info counts them, and the temporary files of interrupted writes
     if (is_entry(e)) {
-      if (fs::remove(e.path(), ec)) ++n;
+      if (fs::remove(e.path(), ec)) {
+        ++n;
+      } else if (ec) {
+        if (not_removed++ == 0) failed = e.path().string() + ": " + ec.message();
+      }
     } else if (name.find(".bin.tmp") != std::string::npos && !write_in_progress(name)) {
       fs::remove(e.path(), ec);  // an interrupted write's
     }
   }
+  if (not_removed > 0)
+    throw Error("cannot remove " + std::to_string(not_removed) + " cached program(s) (" + failed +
+                "); removed " + std::to_string(n));
   return n;
 }
 

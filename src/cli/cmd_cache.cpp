@@ -9,6 +9,7 @@
 #include "cl/program_cache.hpp"
 #include "cli/commands.hpp"
 #include "core/host_memory.hpp"
+#include "core/text.hpp"
 #include "lucent/error.hpp"
 
 namespace lucent::cli {
@@ -43,7 +44,7 @@ void say_where_pocl_caches() {
 
 // The size of lucent's cache, its limit (LUCENT_CACHE_MAX_MB) and where PoCL caches instead.
 void print_info(const std::string& dir) {
-  std::printf("directory: %s\n", dir.empty() ? "(disabled)" : dir.c_str());
+  std::printf("directory: %s\n", dir.empty() ? "(disabled)" : io::one_line(dir).c_str());
   if (!dir.empty()) {
     const cl_util::ProgramCacheUsage usage = cl_util::program_cache_usage(dir);
     std::printf("programs: %d, %llu bytes", usage.programs,
@@ -86,7 +87,7 @@ int run_cache_command() {
   }
   int n = cl_util::clear_program_cache(dir);
   std::printf("removed %d cached program(s) from %s\n", n,
-              dir.empty() ? "(disabled)" : dir.c_str());
+              dir.empty() ? "(disabled)" : io::one_line(dir).c_str());
   say_where_pocl_caches();
   return 0;
 }

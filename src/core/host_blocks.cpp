@@ -1,11 +1,14 @@
 #include "core/host_blocks.hpp"
 
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <unordered_map>
 #if defined(__linux__)
 #include <sys/mman.h>
+
+#include "core/text.hpp"
 #endif
 
 namespace lucent::sys {
@@ -31,7 +34,17 @@ Registry& registry() {
 
 bool huge_pages_wanted() {
   const char* e = std::getenv("LUCENT_HUGE_PAGES");
-  return !(e && std::strcmp(e, "0") == 0);
+  if (!e || !*e || std::strcmp(e, "1") == 0) return true;
+  if (std::strcmp(e, "0") == 0) return false;
+  // ("off", "false", "no" turned them on without a word)
+  static std::once_flag once;
+  std::call_once(once, [e] {
+    std::fprintf(stderr,
+                 "lucent: warning: LUCENT_HUGE_PAGES='%s' is neither 0 (no huge-page advice) nor "
+                 "1 (the default); taken as 1\n",
+                 io::one_line(e).c_str());
+  });
+  return true;
 }
 
 }  // namespace
