@@ -174,16 +174,21 @@ std::string pocl_cache_dir_problem() {
     return name + " cannot be created (" + ec.message() + ")";
   // a full disk: PoCL writes the kernel's source, bitcode and shared object there (a few MiB);
   // its build failed with an empty log
+  return pocl_cache_space_problem(16.0 * 1024 * 1024);
+}
+
+std::string pocl_cache_space_problem(double min_bytes) {
+  std::string origin;
+  const std::string dir = pocl_cache_dir(&origin);
   struct statvfs fsinfo {};
-  if (::statvfs(dir.c_str(), &fsinfo) == 0) {
-    const double free_bytes = double(fsinfo.f_bavail) * double(fsinfo.f_frsize);
-    if (free_bytes < 16.0 * 1024 * 1024) {
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "%.0f KiB", free_bytes / 1024.0);
-      return name + " has only " + buf + " free";
-    }
-  }
-  return "";
+  if (::statvfs(dir.c_str(), &fsinfo) != 0) return "";
+  const double free_bytes = double(fsinfo.f_bavail) * double(fsinfo.f_frsize);
+  if (free_bytes >= min_bytes) return "";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.0f KiB", free_bytes / 1024.0);
+  return (origin == "POCL_CACHE_DIR" ? "POCL_CACHE_DIR=" + dir
+                                     : "PoCL's cache directory " + dir + " (" + origin + ")") +
+         " has only " + buf + " free";
 }
 
 namespace {
@@ -411,6 +416,16 @@ Context::Context(const std::string& selector, const std::string& origin)
 cl::Program build_program(const Context& ctx, const std::string& source,
                           const std::string& options) {
   const KeepStopHandlers keep;  // (LLVM registers again after one of its handlers ran)
+  // PoCL's compiler writes the kernel's files in its cache directory, and on a full disk LLVM
+  // ended the process ("LLVM ERROR: IO failure on output stream: No space left on device"),
+  // before any message of lucent's: refused first (4 MiB: a cold build writes about 2-5 MiB)
+  if (is_pocl(ctx.device.info)) {
+    const std::string problem = pocl_cache_space_problem(4.0 * 1024 * 1024);
+    if (!problem.empty())
+      throw Error("kernel build: " + problem +
+                  ", which PoCL needs for its kernels (free space there, or set POCL_CACHE_DIR "
+                  "to another directory)");
+  }
   cl::Program program;
   try {
     program = cl::Program(ctx.context, source);

@@ -79,6 +79,10 @@ std::string pocl_cache_dir(std::string* origin = nullptr);
 /// the directory, as PoCL would, when only trying tells whether it can be made.
 std::string pocl_cache_dir_problem();
 
+/// "POCL_CACHE_DIR=... has only N KiB free" when PoCL's cache directory (pocl_cache_dir) has less
+/// than `min_bytes` free, "" otherwise (or when it cannot be looked at).
+std::string pocl_cache_space_problem(double min_bytes);
+
 /// Throws lucent::Error in a process forked from one that had used OpenCL (enumerate_devices()
 /// registers the fork handler that records it): the drivers' threads (PoCL's workers) do not
 /// survive a fork, and OpenCL calls there hang for ever (a Python multiprocessing worker of the
