@@ -147,15 +147,24 @@ std::string pocl_cache_dir(std::string* origin) {
   return dir;
 }
 
+namespace {
+
+/// PoCL's cache directory as messages name it: "POCL_CACHE_DIR=/x", or "PoCL's cache directory
+/// /home/u/.cache/pocl/kcache (HOME=/home/u)" with what chose it.
+std::string pocl_cache_dir_name(const std::string& dir, const std::string& origin) {
+  return origin == "POCL_CACHE_DIR" ? "POCL_CACHE_DIR=" + dir
+                                    : "PoCL's cache directory " + dir + " (" + origin + ")";
+}
+
+}  // namespace
+
 std::string pocl_cache_dir_problem() {
   namespace fs = std::filesystem;
   // the directory PoCL uses, not only POCL_CACHE_DIR: an XDG_CACHE_HOME that was a file or
   // read-only gave "no OpenCL device found on any platform" and nothing more
   std::string origin;
   const std::string dir = pocl_cache_dir(&origin);
-  const std::string name = origin == "POCL_CACHE_DIR"
-                               ? "POCL_CACHE_DIR=" + dir
-                               : "PoCL's cache directory " + dir + " (" + origin + ")";
+  const std::string name = pocl_cache_dir_name(dir, origin);
   std::error_code ec;
   fs::path p(dir);
   // the directory itself, else the nearest ancestor that exists (PoCL creates the rest)
@@ -186,9 +195,7 @@ std::string pocl_cache_space_problem(double min_bytes) {
   if (free_bytes >= min_bytes) return "";
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.0f KiB", free_bytes / 1024.0);
-  return (origin == "POCL_CACHE_DIR" ? "POCL_CACHE_DIR=" + dir
-                                     : "PoCL's cache directory " + dir + " (" + origin + ")") +
-         " has only " + buf + " free";
+  return pocl_cache_dir_name(dir, origin) + " has only " + buf + " free";
 }
 
 namespace {
