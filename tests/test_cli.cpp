@@ -74,6 +74,27 @@ TEST(Cli, Version) {
   EXPECT_TRUE(r.err.empty()) << r.err;
 }
 
+// `lucent devices` is a table whose columns line up, however long a device's name (PoCL's CPU
+// device names itself in 49 characters, wider than the column was, and shifted every column
+// after it).
+TEST(Cli, DevicesColumnsLineUp) {
+  const CommandResult r = run_cli("devices");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string header, row;
+  ASSERT_TRUE(std::getline(lines, header));
+  const std::size_t type = header.find(" type ");
+  ASSERT_NE(type, std::string::npos) << header;
+  int rows = 0;
+  while (std::getline(lines, row)) {
+    ++rows;
+    ASSERT_GT(row.size(), type + 1) << row;
+    EXPECT_EQ(row[type], ' ') << row;      // the device column ends where the header's does
+    EXPECT_NE(row[type + 1], ' ') << row;  // and the type starts under "type"
+  }
+  EXPECT_GE(rows, 1);
+}
+
 TEST(Cli, HelpOnEachSubcommand) {
   CommandResult r = run_cli("--help");
   ASSERT_EQ(r.status, 0);

@@ -2,6 +2,7 @@
 // line on stderr ("lucent: error: ...") and a non-zero exit status. Subcommands live in
 // cmd_*.cpp.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -33,11 +34,18 @@ std::string format_bytes(std::uint64_t b) {
 
 int cmd_devices() {
   auto devices = lucent::list_devices();
-  std::printf("%-3s %-28s %-40s %-5s %4s %10s  %-22s %s\n", "#", "platform", "device", "type",
-              "CUs", "memory", "OpenCL C", "fp64");
+  // columns as wide as their longest entry (PoCL's 49-character device name shifted every column
+  // after it)
+  int platform_width = 28, device_width = 40;
+  for (const auto& d : devices) {
+    platform_width = std::max(platform_width, static_cast<int>(d.platform.size()));
+    device_width = std::max(device_width, static_cast<int>(d.name.size()));
+  }
+  std::printf("%-3s %-*s %-*s %-5s %4s %10s  %-22s %s\n", "#", platform_width, "platform",
+              device_width, "device", "type", "CUs", "memory", "OpenCL C", "fp64");
   for (const auto& d : devices)
-    std::printf("%-3d %-28s %-40s %-5s %4u %10s  %-22s %s\n", d.index, d.platform.c_str(),
-                d.name.c_str(), d.type.c_str(), d.compute_units,
+    std::printf("%-3d %-*s %-*s %-5s %4u %10s  %-22s %s\n", d.index, platform_width,
+                d.platform.c_str(), device_width, d.name.c_str(), d.type.c_str(), d.compute_units,
                 format_bytes(d.global_memory).c_str(), d.opencl_c_version.c_str(),
                 d.fp64 ? "yes" : "no");
   return 0;
