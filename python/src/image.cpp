@@ -231,8 +231,14 @@ void bind_image(py::module_& m) {
       .def_readonly("mean_variance_y", &CompareResult::mean_variance_y)
       .def_readonly("mean_variance_channel", &CompareResult::mean_variance_channel)
       .def_readonly("mean_variance_samples", &CompareResult::mean_variance_samples,
-                    "the samples that pixel's mean rests on (mean^2 n / var); the summary warns "
-                    "when mean_variance_share > 0.5 and this < 10")
+                    "the samples that pixel's mean rests on, in the image holding most of its "
+                    "variance: mean^2 n / var, or the excess over the other image's mean in "
+                    "place of the mean where the other image has under a tenth of its variance "
+                    "per sample; infinite for a mean of 0 or below")
+      .def_property_readonly(
+          "mean_variance_dominated", &CompareResult::mean_variance_dominated,
+          "mean_variance_share > 0.5 and mean_variance_samples < 10: one rare, bright value "
+          "decides the image-mean test, and the summary warns (docs/compare.md)")
       .def_readonly("rmse", &CompareResult::rmse)
       .def_readonly("relmse", &CompareResult::relmse)
       .def_readonly("max_abs_error", &CompareResult::max_abs_error)

@@ -1241,7 +1241,9 @@ void bind_render(py::module_& m) {
       "(\"default\", \"fast-math\", \"max_depth=2+no-mis\", ...: see `lucent converge`) and "
       "measures each rung's error against `reference` (a RenderResult or an array); returns a "
       "ConvergeResult. renderer: a Renderer to render with (default: a new session with the "
-      "default options). Ctrl-C stops after the current pass and raises KeyboardInterrupt.");
+      "default options). on_point(ConvergePoint): called after each rung, on the calling thread "
+      "(an exception it raises stops the study and is raised). Ctrl-C stops after the current "
+      "pass and raises KeyboardInterrupt.");
 }
 
 }  // namespace lucent::python

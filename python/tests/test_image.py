@@ -454,3 +454,23 @@ def test_a_keyboard_interrupt_in_a_converge_warning_stops_the_study(small_scene)
         with pytest.raises(KeyboardInterrupt):
             lucent.converge(small_scene, reference, spp_ladder=[1, 2 ** 22])
     assert time.monotonic() - t0 < 30
+
+
+def test_compare_says_when_one_rare_sample_decides_the_image_mean_test():
+    """CompareResult.mean_variance_dominated: one pixel-channel holds most of the image means'
+    variance and its mean rests on about one sample (63 samples of 1 and one of 1e4 in A)."""
+    n = 64
+    mean = (63 + 1e4) / n
+    var = (63 * (1 - mean) ** 2 + (1e4 - mean) ** 2) / (n - 1)
+    a_mean, a_var = constant(1.0), constant(0.01)
+    a_mean[3, 2, :], a_var[3, 2, :] = mean, var
+    counts = np.full((4, 5), n, np.uint32)
+    a = lucent.RenderResult(a_mean, a_var, counts)
+    b = lucent.RenderResult(constant(1.0), constant(0.01), counts)
+    c = lucent.compare(a, b)
+    assert c.passed and c.mean_variance_dominated
+    assert (c.mean_variance_x, c.mean_variance_y) == (2, 3) and c.mean_variance_share > 0.99
+    assert abs(c.mean_variance_samples - 1) < 0.05
+    assert "channel R holds 100.0% of the image means' variance, and its mean rests on about " \
+           "1.0 samples" in c.summary()
+    assert not lucent.compare(b, b).mean_variance_dominated
