@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cl/context.hpp"
+#include "lucent/device.hpp"
 #include "support.hpp"
 
 namespace {
@@ -135,6 +136,25 @@ TEST(CliErrors, UnknownIntegrator) {
   std::string msg =
       expect_one_error_line(run_cli("render " + q(scene) + " -o " + q(out) + " --integrator bdpt"));
   EXPECT_EQ(msg.rfind("--integrator bdpt: unknown integrator", 0), 0u) << msg;
+}
+
+// A file size limit under which PoCL's compiler cannot write a kernel's files ended the process
+// with LLVM's "IO failure on output stream", or a build failure naming no cause: one line names
+// the limit first.
+TEST(CliErrors, AFileSizeLimitTooSmallForAKernelBuildIsNamed) {
+  if (lucent::select_device(lucent::test::device()).platform.find("Portable Computing") ==
+      std::string::npos)
+    GTEST_SKIP() << "a PoCL device's check";
+  const std::string scene = small_scene();
+  const std::string dir = lucent::test::temp_dir();
+  const std::string limited = dir + "/limited.sh";
+  lucent::test::write_file(limited, "ulimit -f 20\nexec \"$@\"\n");  // (bash's unit: KiB)
+  const CommandResult r =
+      run_cli("render " + q(scene) + " -o " + q(dir + "/x.png"), "bash " + q(limited));
+  EXPECT_EQ(expect_one_error_line(r),
+            "kernel build: the file size limit (ulimit -f) is 20 KiB, less than PoCL's compiler "
+            "writes for a kernel (a few MiB): raise it");
+  EXPECT_FALSE(fs::exists(dir + "/x.png"));
 }
 
 TEST(CliErrors, UnwritableOutputPath) {

@@ -432,6 +432,15 @@ cl::Program build_program(const Context& ctx, const std::string& source,
       throw Error("kernel build: " + problem +
                   ", which PoCL needs for its kernels (free space there, or set POCL_CACHE_DIR "
                   "to another directory)");
+    // and a file size limit under which no build writes its files, even from a warm cache (ulimit
+    // -f 20: LLVM's "IO failure on output stream", or a build failure naming no cause); between
+    // 1 and about 5 MiB a cold build can still fail so, a warm one not
+    struct rlimit fsize {};
+    if (::getrlimit(RLIMIT_FSIZE, &fsize) == 0 && fsize.rlim_cur != RLIM_INFINITY &&
+        fsize.rlim_cur < (rlim_t(1) << 20))
+      throw Error("kernel build: the file size limit (ulimit -f) is " +
+                  std::to_string(fsize.rlim_cur / 1024) +
+                  " KiB, less than PoCL's compiler writes for a kernel (a few MiB): raise it");
   }
   cl::Program program;
   try {
