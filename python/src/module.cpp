@@ -14,6 +14,7 @@
 
 #include "cl/program_cache.hpp"
 #include "common.hpp"
+#include "core/text.hpp"
 #include "lucent/device.hpp"
 #include "lucent/error.hpp"
 #include "lucent/session.hpp"
@@ -167,7 +168,10 @@ void refuse_nul(const std::string& text, const char* what) {
                           "'");
 }
 
-py::str message_text(const std::string& message) {
+py::str message_text(const std::string& raw) {
+  // one line, as the command line prints it: a name with a newline or an escape sequence (a
+  // material "a\nb") came through raw in lucent.Error and in warnings
+  const std::string message = io::one_line(raw);
   PyObject* text = PyUnicode_DecodeUTF8(message.data(), static_cast<Py_ssize_t>(message.size()),
                                         "backslashreplace");
   if (!text) throw py::error_already_set();

@@ -764,3 +764,18 @@ def test_huge_arrays_are_refused_before_they_are_copied():
     with pytest.raises(MemoryError, match=r"^a: 30000000000 values need about"):
         lucent.compare(huge, huge)
     assert not os.path.exists("never.pfm")
+
+
+def test_errors_and_warnings_are_one_line(tmp_path, small_dict):
+    """A name with a newline or an escape sequence came through raw in lucent.Error and in
+    warnings; they are one line, as the command line prints them."""
+    small_dict["shapes"][0]["material"] = "a\nc\x1b[31m"
+    with pytest.raises(lucent.Error) as e:
+        lucent.scene_from_dict(small_dict)
+    assert "\n" not in str(e.value) and "\x1b" not in str(e.value)
+    assert "'a\\nc\\x1b[31m'" in str(e.value), str(e.value)
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(small_dict))
+    with pytest.raises(lucent.Error) as f:
+        lucent.load_scene(path)
+    assert "'a\\nc\\x1b[31m'" in str(f.value) and "\n" not in str(f.value)
