@@ -780,10 +780,19 @@ nlohmann::json to_json(py::handle o, const std::string& path, const std::string&
   if (o.is_none()) return nullptr;
   if (py::isinstance<py::bool_>(o)) return o.cast<bool>();
   if (py::isinstance<py::int_>(o)) {
+    // as the JSON text of the number would be parsed: up to 2^64 - 1 an integer, beyond it a
+    // float, whose range error the reader gives as for a file (it said "integer out of range:
+    // 9223372036854775808", where a file said "must be in [1, 16384], got ...")
     py::int_ i = py::reinterpret_borrow<py::int_>(o);
-    if (i.attr("bit_length")().cast<int>() > 63)
+    const int bits = i.attr("bit_length")().cast<int>();
+    if (bits <= 63) return o.cast<long long>();
+    if (bits == 64 && o.attr("__gt__")(py::int_(0)).cast<bool>())
+      return o.cast<unsigned long long>();
+    try {
+      return py::float_(py::reinterpret_borrow<py::object>(o)).cast<double>();
+    } catch (py::error_already_set&) {  // (beyond a double: OverflowError)
       return fail("integer out of range: " + py::str(o).cast<std::string>());
-    return o.cast<long long>();
+    }
   }
   if (py::isinstance<py::float_>(o)) {
     double d = o.cast<double>();

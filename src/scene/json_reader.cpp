@@ -1,7 +1,10 @@
 // The JSON reading helpers (json_reader.hpp).
 #include "scene/json_reader.hpp"
 
+#include <cmath>
 #include <cstdint>
+
+#include "core/text.hpp"
 
 namespace lucent::scene_detail {
 
@@ -91,6 +94,13 @@ double JsonReader::number(const json& j, const std::string& ptr) const {
 }
 
 long long JsonReader::integer(const json& j, const std::string& ptr, IntRange range) const {
+  // an integer beyond 64 bits, which the parser holds as a float (18446744073709551616): out of
+  // range, as 2^63 is (it was "must be an integer, got a number 1.8446744073709552e+19")
+  if (j.is_number_float()) {
+    const double d = j.get<double>();
+    if (std::isfinite(d) && std::floor(d) == d && std::abs(d) >= 9223372036854775808.0)
+      fail_range(at(ptr), range, io::shortest_real(d));
+  }
   if (!j.is_number_integer() && !j.is_number_unsigned())
     fail(ptr, "must be an integer, got " + described(j));
   // beyond the signed 64-bit range: reported as written, not wrapped around
