@@ -355,6 +355,41 @@ TEST(Session, WarningsGoToTheSessionsSink) {
   EXPECT_EQ(got[1].rfind("skipped 1 degenerate or non-finite triangle", 0), 0u) << got[1];
 }
 
+// A scene whose only lights are emissive triangles that packing skips (degenerate) has none left:
+// a warning says so (the image was black after a warning of skipped triangles alone; the light
+// notes, read before packing, saw the emitter). Not for a scene with a light entry, nor for an
+// AOV.
+TEST(Session, EmittersAllSkippedLeaveNoLightAndSaySo) {
+  Scene s = lucent::test::scene_from(kScene);
+  s.lights.clear();
+  lucent::Material lamp;
+  lamp.albedo = glm::dvec3(0);
+  lamp.emission = glm::dvec3(5);
+  lamp.name = "lamp";
+  s.materials.push_back(lamp);
+  for (const glm::dvec3& p : {glm::dvec3(0, 3, 0), glm::dvec3(1, 3, 0), glm::dvec3(2, 3, 0)})
+    s.positions.push_back(p);  // collinear
+  lucent::Triangle t;
+  for (int k = 0; k < 3; ++k) t.v[k] = static_cast<int>(s.positions.size()) - 3 + k;
+  t.material = static_cast<int>(s.materials.size()) - 1;
+  s.triangles.push_back(t);
+  std::vector<std::string> got;
+  lucent::SessionOptions o = lucent::test::session_options();
+  o.on_warning = [&](const std::string& m) { got.push_back(m); };
+  Renderer r(o);
+  r.set_scene(s);
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_NE(got[0].find("skipped 1 degenerate"), std::string::npos) << got[0];
+  EXPECT_NE(got[1].find("the scene has no light left (its emissive shapes were all skipped"),
+            std::string::npos)
+      << got[1];
+  got.clear();
+  s.integrator.type = lucent::IntegratorType::Albedo;
+  Renderer aov(o);
+  aov.set_scene(s);
+  EXPECT_EQ(got.size(), 1u);  // (the skipped triangle only)
+}
+
 // A sink that throws (an application that makes warnings errors) fails set_scene; the same scene
 // set again fails again: the warning was counted as given, and the second call passed without a
 // word.

@@ -662,6 +662,15 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   P.num_spheres = static_cast<lc_uint>(p.spheres.size());
   P.num_lights = static_cast<lc_uint>(p.lights.size());
   P.num_nodes = static_cast<lc_uint>(p.nodes.size());
+  // emissive shapes were its only lights, and packing left none (degenerate or non-finite
+  // triangles skipped, above): the scene's light notes, read before packing, said nothing, and
+  // the image was black after a warning about skipped triangles alone
+  if (p.lights.empty() && scene.lights.empty() && !is_aov(scene.integrator.type) &&
+      scene_detail::light_notes(scene).empty())  // (else the note of no light at all was given)
+    scene_detail::warn(
+        scene_detail::in_file(scene.path,
+                              "the scene has no light left (its emissive shapes were all skipped: "
+                              "degenerate, non-finite or of no area): the image is black"));
   return p;
 }
 
