@@ -532,17 +532,24 @@ FileText resolved_cache_dir(const PathText& given) {
 /// protocol 2 raises for them. The iterators of the bound lists (ShapeList, ...: a pybind11
 /// 'iterator' class each, in pybind11_builtins, not in the module) raise it too.
 void reduce_in_every_protocol(py::module_& m) {
-  // a Python function, which pickle names by reference (a bound C++ function pickles as its
-  // capsule, which cannot be)
+  // a Python subclass's state is ("lucent.subclass", the class's state, its __dict__), which
+  // each bound class's __setstate__ reads (the attributes after the object exists: pickle and
+  // deepcopy have memoized it, so attributes that refer back to it do so); any other state goes
+  // to the class's own __setstate__, as before (old pickles load)
   py::exec(R"(
-def _restore(cls, state, attributes):
-    """(pickle's) An object of a Python subclass of a lucent class: its state and attributes."""
-    obj = cls.__new__(cls)
-    obj.__setstate__(state)
-    obj.__dict__.update(attributes)
-    return obj
+def _subclass_setstate(original):
+    def __setstate__(self, state):
+        if type(state) is tuple and len(state) == 3 and state[0] == "lucent.subclass":
+            original(self, state[1])
+            self.__dict__.update(state[2])
+        else:
+            original(self, state)
+    __setstate__.__doc__ = original.__doc__
+    return __setstate__
 )",
            m.attr("__dict__"));
+  const py::object subclass_setstate = m.attr("_subclass_setstate");
+  py::delattr(m, "_subclass_setstate");
   const py::object newobj = py::module_::import("copyreg").attr("__newobj__");
   const auto is_bound = [](py::handle cls) {
     return PyType_Check(cls.ptr()) &&
@@ -581,15 +588,13 @@ def _restore(cls, state, attributes):
             py::cpp_function([own](py::handle self) { return own(self, 2); }, py::is_method(cls));
       }
     } else if (py::hasattr(cls, "__setstate__")) {
-      // a Python subclass's attributes (its __dict__) come back too, through
-      // lucent._restore (the state alone lost them); other objects keep copyreg's form
-      const py::object restore = m.attr("_restore");
-      set_reduce(cls, [newobj, restore](py::handle self) -> py::object {
-        const py::object state = self.attr("__getstate__")();
+      // a Python subclass's attributes (its __dict__) come back too (the state alone lost them)
+      cls.attr("__setstate__") = subclass_setstate(cls.attr("__setstate__"));
+      set_reduce(cls, [newobj](py::handle self) -> py::object {
+        py::object state = self.attr("__getstate__")();
         const py::object attributes = py::getattr(self, "__dict__", py::none());
         if (!attributes.is_none() && py::len(attributes) > 0)
-          return py::make_tuple(restore,
-                                py::make_tuple(py::type::handle_of(self), state, attributes));
+          state = py::make_tuple("lucent.subclass", state, attributes);
         return py::make_tuple(newobj, py::make_tuple(py::type::handle_of(self)), state);
       });
     } else {

@@ -788,6 +788,9 @@ nlohmann::json to_json(py::handle o, const std::string& path, const std::string&
     if (bits <= 63) return o.cast<long long>();
     if (bits == 64 && o.attr("__gt__")(py::int_(0)).cast<bool>())
       return o.cast<unsigned long long>();
+    if (bits == 64 &&
+        o.attr("__eq__")(py::int_(std::numeric_limits<long long>::min())).cast<bool>())
+      return std::numeric_limits<long long>::min();  // (-2^63: a long long, as a file's)
     try {
       return py::float_(py::reinterpret_borrow<py::object>(o)).cast<double>();
     } catch (py::error_already_set&) {  // (beyond a double: OverflowError)
@@ -957,7 +960,12 @@ py::object copy_of_scene(py::handle self, py::dict* memo) {
   obj.attr("__setstate__")(self.attr("__getstate__")());
   py::object attributes = py::getattr(self, "__dict__", py::none());
   if (!attributes.is_none()) {
-    if (memo) attributes = py::module_::import("copy").attr("deepcopy")(attributes, *memo);
+    if (memo) {
+      // the copy first, so that attributes referring back to the object refer to it (a second
+      // copy was made: the review's find)
+      (*memo)[py::int_(reinterpret_cast<std::uintptr_t>(self.ptr()))] = obj;
+      attributes = py::module_::import("copy").attr("deepcopy")(attributes, *memo);
+    }
     obj.attr("__dict__").attr("update")(attributes);
   }
   return obj;

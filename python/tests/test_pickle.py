@@ -179,6 +179,15 @@ def test_a_subclass_keeps_its_class_and_attributes(name, round_trip):
     cam.label = "left"
     k = round_trip(cam)
     assert type(k) is TaggedCamera and k.label == "left" and k.fov_degrees == 12
+    # attributes that refer back to the object refer to the copy (the attributes were restored
+    # before the object was memoized: .me was lost, or a second copy; the third review's find)
+    cam.me = cam
+    s.me = s
+    k, c = round_trip(cam), round_trip(s)
+    if name == "copy":
+        assert k.me is cam and c.me is s
+    else:
+        assert k.me is k and k.label == "left" and c.me is c and c.notes == s.notes
     # the base classes keep their form: copyreg's, the state alone
     assert pickle.loads(pickle.dumps(lucent.Camera())).__class__ is lucent.Camera
     assert lucent.Camera().__reduce_ex__(2)[0] is copyreg.__newobj__

@@ -785,7 +785,8 @@ def test_errors_and_warnings_are_one_line(tmp_path, small_dict):
 
 @pytest.mark.parametrize("value, shown", [(2 ** 63, "9223372036854775808"),
                                           (2 ** 64, "1.8446744073709552e+19"),
-                                          (-2 ** 63 - 1, "-9.223372036854776e+18")])
+                                          (-2 ** 63 - 1, "-9.223372036854776e+18"),
+                                          (-2 ** 63, "-9223372036854775808")])
 def test_integers_beyond_64_bits_get_the_fields_range_error(tmp_path, value, shown):
     """An integer field given an integer beyond the signed 64 bits: its range, from a file and
     from a dict alike (a file said "must be an integer, got a number 1.8446744073709552e+19",

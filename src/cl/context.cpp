@@ -187,10 +187,16 @@ std::string pocl_cache_dir_problem() {
 }
 
 std::string pocl_cache_space_problem(double min_bytes) {
+  namespace fs = std::filesystem;
   std::string origin;
   const std::string dir = pocl_cache_dir(&origin);
+  // the directory, else the nearest ancestor that exists (a first build into a new directory
+  // on a full disk: the review's find)
+  std::error_code ec;
+  fs::path p(dir);
+  while (!fs::exists(p, ec) && p.has_parent_path() && p != p.parent_path()) p = p.parent_path();
   struct statvfs fsinfo {};
-  if (::statvfs(dir.c_str(), &fsinfo) != 0) return "";
+  if (::statvfs(p.c_str(), &fsinfo) != 0) return "";
   const double free_bytes = double(fsinfo.f_bavail) * double(fsinfo.f_frsize);
   if (free_bytes >= min_bytes) return "";
   char buf[64];

@@ -1,15 +1,17 @@
 #include "core/host_blocks.hpp"
 
-#include <cstdio>
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <string>
 #include <unordered_map>
 #if defined(__linux__)
 #include <sys/mman.h>
+#endif
 
 #include "core/text.hpp"
-#endif
+#include "scene/loaders.hpp"  // scene_detail::warn
 
 namespace lucent::sys {
 
@@ -36,14 +38,12 @@ bool huge_pages_wanted() {
   const char* e = std::getenv("LUCENT_HUGE_PAGES");
   if (!e || !*e || std::strcmp(e, "1") == 0) return true;
   if (std::strcmp(e, "0") == 0) return false;
-  // ("off", "false", "no" turned them on without a word)
-  static std::once_flag once;
-  std::call_once(once, [e] {
-    std::fprintf(stderr,
-                 "lucent: warning: LUCENT_HUGE_PAGES='%s' is neither 0 (no huge-page advice) nor "
-                 "1 (the default); taken as 1\n",
-                 io::one_line(e).c_str());
-  });
+  // ("off", "false", "no" turned them on without a word); once, through the warning sink of the
+  // call that allocates (a session's on_warning, Python's warnings), as the other variables'
+  static std::atomic<bool> said{false};
+  if (!said.exchange(true))
+    scene_detail::warn("LUCENT_HUGE_PAGES='" + io::one_line(e) +
+                       "' is neither 0 (no huge-page advice) nor 1 (the default); taken as 1");
   return true;
 }
 
