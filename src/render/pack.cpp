@@ -21,6 +21,13 @@ namespace {
 
 using scene_detail::put3;
 
+/// Whether material `m` can scatter by a delta lobe (MaterialTypeDef::delta: a mirror, smooth
+/// glass, a rough dielectric of ior 1): a surface a caustic path needs.
+bool scatters_by_delta(const Material& m) {
+  const auto is_delta = scene_detail::material_type_def(m.type).delta;
+  return is_delta && is_delta(m);
+}
+
 bool finite3(const glm::dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
@@ -422,10 +429,8 @@ std::string point_light_note(const PackedScene& packed, bool float_arithmetic) {
 bool light_traced_caustics(const Scene& scene) {
   if (!scene.integrator.caustics || scene.integrator.type != IntegratorType::Path) return false;
   const auto delta = [&scene](int mi) {
-    if (mi < 0 || static_cast<std::size_t>(mi) >= scene.materials.size()) return false;
-    const Material& m = scene.materials[static_cast<std::size_t>(mi)];
-    const auto is_delta = scene_detail::material_type_def(m.type).delta;
-    return is_delta && is_delta(m);
+    return mi >= 0 && static_cast<std::size_t>(mi) < scene.materials.size() &&
+           scatters_by_delta(scene.materials[static_cast<std::size_t>(mi)]);
   };
   return std::any_of(scene.spheres.begin(), scene.spheres.end(),
                      [&](const Sphere& s) { return delta(s.material); }) ||
@@ -599,11 +604,7 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   // mirror, smooth glass, a rough dielectric of ior 1), no caustic path: the kernel is built and
   // run without light paths
   if (P.flags & LC_FLAG_CAUSTICS) {
-    auto delta = [&scene](lc_uint mi) {
-      const Material& m = scene.materials[mi];
-      const auto is_delta = scene_detail::material_type_def(m.type).delta;
-      return is_delta && is_delta(m);
-    };
+    auto delta = [&scene](lc_uint mi) { return scatters_by_delta(scene.materials[mi]); };
     bool any = false;
     for (const lc_sphere& sp : p.spheres) any = any || delta(sp.material);
     for (const lc_triangle& t : p.triangles) any = any || delta(t.material);
