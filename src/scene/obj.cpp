@@ -402,11 +402,8 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
     warn(path + ": " + w);
   }
   if (!unread_names.empty()) {
-    std::string list;
-    const std::size_t shown = std::min<std::size_t>(unread_names.size(), 4);
-    for (std::size_t k = 0; k < shown; ++k) list += (k ? ", '" : "'") + unread_names[k] + "'";
-    if (unread_names.size() > shown)
-      list += " and " + std::to_string(unread_names.size() - shown) + " more";
+    const std::string list = obj::first_items(
+        unread_names.size(), 4, [&](std::size_t k) { return "'" + unread_names[k] + "'"; });
     warn(path + ": usemtl " + list + (unread_names.size() == 1 ? " names" : " name") +
          " no material of the MTL files read (a library was not read, above); faces use the "
          "default material");

@@ -168,6 +168,15 @@ std::string read_colour_forms(const std::string& path, const std::string& text,
 /// `s` without the spaces and tabs at its ends.
 std::string trim(const std::string& s);
 
+/// "a, b, c, d and 3 more", for messages: the first `shown` of `n` items, `item(i)` writing each.
+template <class Item>
+std::string first_items(std::size_t n, std::size_t shown, const Item& item) {
+  std::string list;
+  for (std::size_t i = 0; i < n && i < shown; ++i) list += (i ? ", " : "") + item(i);
+  if (n > shown) list += " and " + std::to_string(n - shown) + " more";
+  return list;
+}
+
 /// Removes the UTF-8 byte-order marks (EF BB BF, which Notepad and other Windows tools write)
 /// at the start of `text`, and blanks those at the start of a line (files joined with `cat`):
 /// tinyobjloader read one as part of its statement, which vanished without a word (a vertex lost

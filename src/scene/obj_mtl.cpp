@@ -125,12 +125,9 @@ bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* 
   // the textures would render otherwise than the file asks, without a word: one line per file
   // (an exporter may write an option on every material), its first options and their lines
   if (!ignored.empty()) {
-    std::string list;
-    const size_t shown = std::min<size_t>(ignored.size(), 4);
-    for (size_t i = 0; i < shown; ++i)
-      list += (i ? ", '" : "'") + ignored[i].option + "' (line " + std::to_string(ignored[i].line) +
-              ")";
-    if (ignored.size() > shown) list += " and " + std::to_string(ignored.size() - shown) + " more";
+    const std::string list = first_items(ignored.size(), 4, [&](std::size_t i) {
+      return "'" + ignored[i].option + "' (line " + std::to_string(ignored[i].line) + ")";
+    });
     warnings.push_back(path + ": map_Kd options that lucent does not support are ignored: " + list +
                        " (the image is mapped once per uv unit, repeating, as decoded)");
   }
