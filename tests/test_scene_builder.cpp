@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <string>
 #include <vector>
@@ -304,11 +305,11 @@ std::vector<Case> cases() {
        mesh([](auto& t) {
          t.normals = {{0, 0, 1}, {0, 0, 1}};
        }),
-       "scene.json: /shapes/0/normals: must have one entry per position (3)"},
+       "scene.json: /shapes/0/normals: must have one entry per position (3), got 2"},
       {"uvs", tri_json(tri_pos + R"("indices": [0, 1, 2], "uvs": [[0, 0]])"), mesh([](auto& t) {
          t.uvs = {{0, 0}};
        }),
-       "scene.json: /shapes/0/uvs: must have one entry per position (3)"},
+       "scene.json: /shapes/0/uvs: must have one entry per position (3), got 1"},
       {"intensity",
        R"({"lights": [{"type": "point", "position": [0,0,0], "intensity": [1,-1,1]}]})",
        [](SceneBuilder& b) {
@@ -468,6 +469,37 @@ TEST(SceneBuilder, CodeOnlyErrors) {
 // reference check the whole scene before packing it, with the builder's messages and places. A
 // NaN camera position crashed the kernel's traversal before; an index out of range read past
 // the scene's arrays when packing.
+// A transform's scale does not decide whether it is invertible, nor which way its normals and
+// front sides face: a uniform scale of 1e-110 (determinant 1e-330, which underflows) was refused
+// as "not invertible", and one of -1e-110 would have kept the unmirrored winding.
+TEST(SceneBuilder, TransformsOfAnyScaleKeepNormalsAndWinding) {
+  for (const double s : {1e-110, -1e-110, 1e11, -1e11, 1.0, -1.0}) {
+    SCOPED_TRACE(s);
+    SceneBuilder b("scene.json");
+    add_m(b);
+    lucent::MeshShape t = triangle();
+    t.normals.assign(3, {0, 0, 1});
+    t.transform = glm::dmat4(s);
+    t.transform[3][3] = 1;
+    b.add_mesh(t);
+    const lucent::Scene scene = b.build();
+    ASSERT_EQ(scene.normals.size(), 3u);
+    EXPECT_EQ(scene.normals[0], glm::dvec3(0, 0, s > 0 ? 1 : -1));  // exactly: a diagonal
+    ASSERT_EQ(scene.triangles.size(), 1u);
+    EXPECT_EQ(scene.triangles[0].v[1], s > 0 ? 1 : 2);  // mirrored: the winding is reversed
+  }
+  // scales of 1e-200 along x and y (determinant 1e-400): a normal (1, 1, 1) leans to (1, 1, 0)
+  SceneBuilder b("scene.json");
+  add_m(b);
+  lucent::MeshShape t = triangle();
+  t.normals.assign(3, {1, 1, 1});
+  t.transform = glm::scale(glm::dmat4(1.0), glm::dvec3(1e-200, 1e-200, 1));
+  b.add_mesh(t);
+  const lucent::Scene scene = b.build();
+  ASSERT_EQ(scene.normals.size(), 3u);
+  EXPECT_LT(glm::length(scene.normals[0] - glm::dvec3(1, 1, 0) / std::sqrt(2.0)), 1e-15);
+}
+
 TEST(SceneBuilder, ScenesEditedDirectlyAreCheckedBeforeRendering) {
   SceneBuilder b("scene.json");
   add_m(b);

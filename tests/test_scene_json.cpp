@@ -257,7 +257,7 @@ TEST(SceneJson, TriangleListErrors) {
             "scene.json: /shapes/0/positions: must be a non-empty array of [x, y, z]");
   EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1,2],
                    "normals": [[0,0,1],[0,0,1]])"),
-            "scene.json: /shapes/0/normals: must have one entry per position (3)");
+            "scene.json: /shapes/0/normals: must have one entry per position (3), got 2");
   EXPECT_EQ(tri(R"("positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [0,1,2],
                    "uvs": [[0,0],[1,0],[0,1,2]])"),
             "scene.json: /shapes/0/uvs/2: must be an array of 2 numbers");
@@ -405,6 +405,10 @@ TEST(SceneJson, BadTransformSteps) {
             "transforms only)");
   EXPECT_EQ(error_of(with_transform(R"([{"matrix": [[1,0,0,0],[2,0,0,0],[0,0,1,0],[0,0,0,1]]}])")),
             "scene.json: /shapes/0/transform/0/matrix: must be invertible");
+  // nearly parallel columns: singular in all but name
+  EXPECT_EQ(
+      error_of(with_transform(R"([{"matrix": [[1,1,0,0],[0,1e-14,0,0],[0,0,1,0],[0,0,0,1]]}])")),
+      "scene.json: /shapes/0/transform/0/matrix: must be invertible");
   EXPECT_EQ(
       error_of(with_transform(R"([{"matrix": [[1,0,0,"inf"],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}])")),
       "scene.json: /shapes/0/transform/0/matrix/0/3: must be a finite number, got inf");

@@ -413,8 +413,8 @@ std::vector<std::string> load_obj(Scene& scene, const std::string& path,
   // coordinates, each array of tinyobjloader's freed once converted; the faces, each shape's
   // arrays freed once converted; the positions last (the faces' polygons read tinyobjloader's).
   // The vertices are checked first, so that an error comes before any face is converted.
-  const glm::dmat3 nxf = glm::transpose(glm::inverse(glm::dmat3(transform)));
-  const bool mirrored = glm::determinant(glm::dmat3(transform)) < 0;
+  const glm::dmat3 nxf = scene_detail::normal_transform(glm::dmat3(transform));
+  const bool mirrored = scene_detail::unit_determinant(glm::dmat3(transform)) < 0;
   const int vbase = static_cast<int>(scene.positions.size());
   const int nbase = static_cast<int>(scene.normals.size());
   const int tbase = static_cast<int>(scene.uvs.size());

@@ -127,8 +127,8 @@ void SceneBuilder::add_mesh(const MeshShape& mesh) {
   scene_detail::validate_mesh(mesh, Reporter(scene_.path, p));
 
   const glm::dmat4& xf = mesh.transform;
-  const glm::dmat3 nxf = glm::transpose(glm::inverse(glm::dmat3(xf)));
-  const bool mirrored = glm::determinant(glm::dmat3(xf)) < 0;
+  const glm::dmat3 nxf = scene_detail::normal_transform(glm::dmat3(xf));
+  const bool mirrored = scene_detail::unit_determinant(glm::dmat3(xf)) < 0;
   const int base = static_cast<int>(scene_.positions.size());
   const int nbase = static_cast<int>(scene_.normals.size());
   const int uvbase = static_cast<int>(scene_.uvs.size());

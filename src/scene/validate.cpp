@@ -120,7 +120,42 @@ void check_affine(const Reporter& at, const glm::dmat4& m) {
         at.at(r).at(c).fail("must be a finite number, got " + format_number(m[c][r]));
   if (m[0][3] != 0 || m[1][3] != 0 || m[2][3] != 0 || m[3][3] != 1)
     at.fail("the last row must be [0, 0, 0, 1] (affine transforms only)");
-  if (std::abs(glm::determinant(m)) < 1e-300) at.fail("must be invertible");
+  // (scale-free: the determinant alone underflowed for a uniform scale of 1e-110)
+  if (!(std::abs(unit_determinant(glm::dmat3(m))) > 1e-12)) at.fail("must be invertible");
+}
+
+namespace {
+
+/// `m`'s columns made unit length, and the lengths they had (0 for a zero column).
+glm::dmat3 unit_columns(const glm::dmat3& m, glm::dvec3& lengths) {
+  glm::dmat3 unit(0.0);
+  for (int c = 0; c < 3; ++c) {
+    const double largest = max_abs(m[c]);  // divided first: the length of (1e-200, 0, 0) underflows
+    lengths[c] = largest == 0 ? 0 : largest * glm::length(m[c] / largest);
+    if (largest != 0) unit[c] = glm::normalize(m[c] / largest);
+  }
+  return unit;
+}
+
+}  // namespace
+
+double unit_determinant(const glm::dmat3& m) {
+  glm::dvec3 lengths;
+  const glm::dmat3 unit = unit_columns(m, lengths);
+  return lengths.x == 0 || lengths.y == 0 || lengths.z == 0 ? 0 : glm::determinant(unit);
+}
+
+glm::dmat3 normal_transform(const glm::dmat3& m) {
+  // m = U diag(lengths), so its inverse transpose is U^-T diag(1 / lengths): U (unit columns,
+  // determinant above 1e-12) inverts without overflow, and diag(shortest / lengths) is the second
+  // factor up to a positive one, with no entry above 1 (glm's inverse of m itself divides by a
+  // determinant that underflows for a scale of 1e-110, or of (1, 1, 1e300))
+  glm::dvec3 lengths;
+  const glm::dmat3 unit = unit_columns(m, lengths);
+  const double shortest = std::min({lengths.x, lengths.y, lengths.z});
+  glm::dmat3 diagonal(0.0);
+  for (int c = 0; c < 3; ++c) diagonal[c][c] = shortest / lengths[c];
+  return glm::transpose(glm::inverse(unit)) * diagonal;
 }
 
 void check_texture_index(const Reporter& at, int index, std::size_t textures, bool optional) {
@@ -312,11 +347,13 @@ void validate_mesh(const MeshShape& m, const Reporter& at) {
     if (m.indices[i] < 0 || static_cast<std::size_t>(m.indices[i]) >= n)
       check_range(at.at("indices").at(i), m.indices[i], rules::vertex_index(n));
   if (!m.normals.empty() && m.normals.size() != n)
-    at.at("normals").fail("must have one entry per position (" + std::to_string(n) + ")");
+    at.at("normals").fail("must have one entry per position (" + std::to_string(n) + "), got " +
+                          std::to_string(m.normals.size()));
   for (std::size_t i = 0; i < m.normals.size(); ++i)
     if (!finite(m.normals[i])) check_point(at.at("normals").at(i), m.normals[i]);
   if (!m.uvs.empty() && m.uvs.size() != n)
-    at.at("uvs").fail("must have one entry per position (" + std::to_string(n) + ")");
+    at.at("uvs").fail("must have one entry per position (" + std::to_string(n) + "), got " +
+                      std::to_string(m.uvs.size()));
   for (std::size_t i = 0; i < m.uvs.size(); ++i)
     if (!finite(glm::dvec3(m.uvs[i], 0)))
       for (int c = 0; c < 2; ++c) check_finite(at.at("uvs").at(i).at(c), m.uvs[i][c]);

@@ -93,6 +93,12 @@ void check_nonzero(const Reporter& at, const glm::dvec3& v);  ///< finite and no
 void check_scale(const Reporter& at, const glm::dvec3& s);
 /// An affine, invertible 4x4 matrix of finite numbers; entries are named /row/column.
 void check_affine(const Reporter& at, const glm::dmat4& m);
+/// The determinant of `m` with its columns scaled to unit length: its sign is the orientation,
+/// and it is 0 (or near it) only for a singular matrix, whatever its scale.
+double unit_determinant(const glm::dmat3& m);
+/// The inverse transpose of `m` up to a positive factor: what takes normals (to be made unit
+/// length) through `m`.
+glm::dmat3 normal_transform(const glm::dmat3& m);
 /// A texture index below `textures`, or -1 when `optional`.
 void check_texture_index(const Reporter& at, int index, std::size_t textures, bool optional);
 /// A light type a scene's "lights" may hold: the emissive shapes' types are refused.
