@@ -219,6 +219,37 @@ TEST(PrecisionDouble, KernelMatchesReference) {
   EXPECT_SAME_IMAGE(k, r, "A = kernel in double, B = reference");
 }
 
+// The only light an emissive triangle that the rounding of its vertices to float makes collinear
+// (1e-5 deep at 1000 from the origin): still a light of its double-precision area
+// (docs/rendering-model.md). In double the kernel took its normal from the float vertices, a zero
+// vector, and rendered black without a word. Same test against the reference.
+TEST(PrecisionDouble, AnEmitterCollinearOnlyInFloatStillLights) {
+  REQUIRE_FP64();
+  Scene s = scene_from(R"({
+    "camera": {"position": [0, 1, 1003.5], "look_at": [0, 0.5, 1000], "fov": 40},
+    "film": {"width": 16, "height": 16},
+    "integrator": {"type": "path", "max_depth": 3},
+    "materials": {"floor": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]},
+                  "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1e5, 1e5, 1e5]}},
+    "shapes": [{"type": "triangles", "material": "floor",
+                "positions": [[-5,0,995],[5,0,995],[5,0,1005],[-5,0,1005]],
+                "indices": [0,2,1, 0,3,2]},
+               {"type": "triangles", "material": "lamp",
+                "positions": [[-0.5,1.5,1004],[0.5,1.5,1004],[0,1.5,1004.00001]],
+                "indices": [0,1,2]}]
+  })");
+  RenderResult k = render(s, 64, 31, Precision::Double);
+  Scene rs = s;
+  rs.integrator.seed = 32;
+  lucent::ReferenceOptions ro;
+  ro.spp = 64;
+  RenderResult r = lucent::render_reference(rs, ro);
+  double sum = 0;
+  for (float v : k.mean.rgb) sum += v;
+  EXPECT_GT(sum, 0.0) << "a black image";
+  EXPECT_SAME_IMAGE(k, r, "A = kernel in double, B = reference");
+}
+
 // Thin-lens camera rays in double (the direct integrator: point lights only): same test.
 TEST(PrecisionDouble, ThinLensMatchesReference) {
   REQUIRE_FP64();

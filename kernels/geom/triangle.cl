@@ -105,11 +105,15 @@ static inline lc_real3 triangle_point_error(lc_real b0, lc_real b1, lc_real b2, 
 
 /* The unit geometric normal, normalize((v1 - v0) x (v2 - v0)): lc_triangle.ng_x, ng_y, ng_z,
  * computed on the host in double and rounded once (the cross product and normalize in float took
- * ~100 instructions per hit and per light sample); under LC_DOUBLE computed here in double. */
+ * ~100 instructions per hit and per light sample); under LC_DOUBLE computed here in double, but
+ * the host's for a triangle that the rounding of its vertices to float made collinear (an
+ * emitter still: a zero normal made every light sample on it dark). */
 static inline lc_real3 triangle_normal(__global const lc_triangle* tri, lc_real3 v0, lc_real3 v1,
                                        lc_real3 v2) {
 #ifdef LC_DOUBLE
-  return normalize(cross(v1 - v0, v2 - v0));
+  lc_real3 n = cross(v1 - v0, v2 - v0);
+  lc_real len = length(n);
+  return len > LC_REAL(0.0) ? n / len : (lc_real3)(tri->ng_x, tri->ng_y, tri->ng_z);
 #else
   return (lc_real3)(tri->ng_x, tri->ng_y, tri->ng_z);
 #endif
