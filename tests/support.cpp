@@ -13,6 +13,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 #include "cl/kernel_source.hpp"
 #include "cl/program_cache.hpp"
@@ -120,6 +121,47 @@ void write_file(const std::string& path, const std::string& text) {
 }
 
 std::string read_file(const std::string& path) { return read_all(path); }
+
+namespace {
+
+std::uint32_t crc32(const std::string& data) {
+  std::uint32_t c = 0xFFFFFFFFu;
+  for (unsigned char b : data) {
+    c ^= b;
+    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+  }
+  return ~c;
+}
+
+std::string be32(std::uint32_t v) { return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; }
+
+}  // namespace
+
+std::string png_file(int width, int height, int bit_depth, int colour_type,
+                     const std::vector<std::pair<std::string, std::string>>& chunks,
+                     const std::string& rows) {
+  if (rows.size() >= 65536) throw std::runtime_error("png_file: rows must fit one stored block");
+  std::uint32_t a = 1, b = 0;
+  for (unsigned char c : rows) {
+    a = (a + c) % 65521;
+    b = (b + a) % 65521;
+  }
+  const std::uint16_t len = static_cast<std::uint16_t>(rows.size()),
+                      nlen = static_cast<std::uint16_t>(~len);
+  std::string z = "\x78\x01";
+  z += '\x01';  // final stored block
+  z += {char(len & 0xFF), char(len >> 8), char(nlen & 0xFF), char(nlen >> 8)};
+  z += rows + be32((b << 16) | a);
+  auto chunk = [](const std::string& tag, const std::string& data) {
+    return be32(static_cast<std::uint32_t>(data.size())) + tag + data + be32(crc32(tag + data));
+  };
+  std::string ihdr = be32(static_cast<std::uint32_t>(width)) +
+                     be32(static_cast<std::uint32_t>(height)) + char(bit_depth) +
+                     char(colour_type) + std::string(3, '\0');
+  std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr);
+  for (const auto& [tag, data] : chunks) png += chunk(tag, data);
+  return png + chunk("IDAT", z) + chunk("IEND", "");
+}
 
 std::string error_of(const std::function<void()>& f) {
   try {

@@ -3,6 +3,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lucent/lucent.hpp"
@@ -46,6 +47,14 @@ void write_file(const std::string& path, const std::string& text);
 
 /// The content of `path` ("" when it cannot be read).
 std::string read_file(const std::string& path);
+
+/// A PNG file written by hand (stb_image_write writes neither 16 bits nor palettes): the IHDR of
+/// `width` x `height`, `bit_depth` and `colour_type`, then `chunks` (tag and data: a PLTE), then
+/// `rows` (each row's filter byte included) as one zlib stream of stored deflate blocks; CRC-32
+/// and Adler-32 computed here. `rows` must be under 64 KiB.
+std::string png_file(int width, int height, int bit_depth, int colour_type,
+                     const std::vector<std::pair<std::string, std::string>>& chunks,
+                     const std::string& rows);
 
 /// The message of the lucent::Error that `f` throws, "" when it throws none, and "unexpected
 /// exception type: ..." for any other exception.

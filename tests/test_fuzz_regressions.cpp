@@ -71,8 +71,10 @@ const std::map<std::string, std::string> kExpected = {
     // stb_image's bit reader shifted by 32 (code_bits negative): ubsan.supp, a decoding error
     {"jpeg-negative-code-bits.jpg", ": cannot decode JPEG: unknown marker"},
     // stb_image's DC predictor overflows int on this corrupt baseline JPEG (suppressed in
-    // tests/fuzz/ubsan.supp: the value is cast to short, garbage pixels); it decodes
-    {"jpeg-dc-overflow.jpg", ""},
+    // tests/fuzz/ubsan.supp: the value is cast to short, garbage pixels); it decoded, with a
+    // quantisation table that no DQT defines (its two tables are both 0): now refused for that
+    {"jpeg-dc-overflow.jpg",
+     ": JPEG scan at byte 593 uses quantisation table 1, which no DQT segment before it defines"},
     // a tiled EXR whose "tiles" attribute has 1 byte: tinyexr read 9 (heap over-read)
     {"exr-short-tiles-attribute.exr", ": OpenEXR header attribute 'tiles' has 1 bytes, not 9"},
     {"exr-offset-table-overread.exr",

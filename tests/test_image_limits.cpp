@@ -122,6 +122,41 @@ TEST(ImageLimits, LyingSizesAreRefusedBeforeAllocating) {
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
 }
 
+// A JPEG claiming more pixels than its bytes can code (each 8x8 block takes at least two bits in
+// a baseline file: 256 pixels a byte), and one whose component names a quantisation table that no
+// DQT defines, are refused; stb_image decoded the first to a texture of stripes (a 96 KB file
+// claiming 8192x8192 took 2 GB) and the second from memory it never set. A side beyond
+// stb_image's 2^24 is named (it said "too large").
+TEST(ImageLimits, JpegsThatCannotHoldTheirPixelsOrTablesAreRefused) {
+  std::vector<unsigned char> noise(96 * 96 * 3);
+  std::uint32_t state = 12345;
+  for (unsigned char& v : noise)
+    v = static_cast<unsigned char>((state = state * 1664525u + 1013904223u) >> 24);
+  std::string jpeg;
+  ASSERT_TRUE(stbi_write_jpg_to_func(append, &jpeg, 96, 96, 3, noise.data(), 100));
+  ASSERT_EQ(texture_error(jpeg), "");
+  const std::size_t sof = jpeg.find("\xFF\xC0"), sos = jpeg.find("\xFF\xDA");
+  ASSERT_NE(sof, std::string::npos);
+  ASSERT_NE(sos, std::string::npos);
+  // 600 pixels a byte: more than a baseline file holds, less than the 1024 allowed before
+  const auto side = static_cast<unsigned>(std::sqrt(600.0 * jpeg.size()));
+  std::string lying = jpeg;
+  lying.replace(sof + 5, 4, be16(side) + be16(side));
+  EXPECT_EQ(texture_error(lying), "JPEG header claims " + std::to_string(side) + "x" +
+                                      std::to_string(side) + " pixels, more than " +
+                                      std::to_string(jpeg.size()) + " bytes can hold (corrupt)");
+  std::string no_table = jpeg;
+  ASSERT_EQ(no_table[sof + 9], 3) << "three components";
+  no_table[sof + 12] = 3;  // the first component's quantisation table
+  EXPECT_EQ(texture_error(no_table),
+            "JPEG scan at byte " + std::to_string(sos) +
+                " uses quantisation table 3, which no DQT segment before it defines (corrupt)");
+  std::string ihdr = be32((1u << 24) + 1) + be32(1) + std::string("\x08\x02\x00\x00\x00", 5);
+  EXPECT_EQ(texture_error(std::string("\x89PNG\r\n\x1a\n", 8) + be32(13) + "IHDR" + ihdr + be32(0)),
+            "PNG header claims 16777217x1 pixels: lucent reads PNG files of at most 16777216 "
+            "pixels a side (PFM and OpenEXR files are not limited so)");
+}
+
 TEST(ImageLimits, TruncatedFilesAreRefused) {
   std::vector<unsigned char> px(16 * 8 * 3);
   for (size_t i = 0; i < px.size(); ++i) px[i] = static_cast<unsigned char>(i * 7);
@@ -318,6 +353,48 @@ TEST(ImageLimits, OnePixelRowAndColumnImagesDecode) {
     ASSERT_EQ(t.height, s.h);
     for (size_t i = 0; i < f.size(); ++i) EXPECT_NEAR(t.rgba[i / 3 * 4 + i % 3], f[i], f[i] / 64);
   }
+}
+
+// An 8-bit BMP of `w` x 1 pixels `indices` into `palette` (entries B, G, R, 0), written by hand
+// (stb_image_write writes no palettes).
+std::string palette_bmp(const std::string& palette, const std::string& indices) {
+  std::string row = indices + std::string((4 - indices.size() % 4) % 4, '\0');
+  const std::uint32_t offset = 14 + 40 + static_cast<std::uint32_t>(palette.size());
+  return "BM" + le32(offset + static_cast<std::uint32_t>(row.size())) + le32(0) + le32(offset) +
+         le32(40) + le32(static_cast<std::uint32_t>(indices.size())) + le32(1) + le16(1) + le16(8) +
+         le32(0) + le32(static_cast<std::uint32_t>(row.size())) + le32(2835) + le32(2835) +
+         le32(static_cast<std::uint32_t>(palette.size() / 4)) + le32(0) + palette + row;
+}
+
+// A palette shorter than its indices can name (2 entries for 8-bit indices) is valid, and decodes
+// to its colours; a pixel that names an entry past it is refused. stb_image read such an entry
+// from memory it never set: the texture, and renders with it, changed from run to run, and
+// `lucent compare` of such a file with itself failed (the image output campaign). The palettes
+// hold black and (1, 0, 0), the first colours that the padding could have taken.
+TEST(ImageLimits, PaletteIndicesPastThePaletteAreRefused) {
+  const std::string rgb = std::string("\0\0\0\x01\0\0", 6);
+  auto png8 = [&](int depth, const std::string& palette, const std::string& packed_row) {
+    return lucent::test::png_file(static_cast<int>(depth == 8 ? packed_row.size() : 8), 1, depth, 3,
+                                  {{"PLTE", palette}}, '\0' + packed_row);
+  };
+  const float k1 = static_cast<float>(lucent::image_detail::srgb_to_linear(1 / 255.0));
+  lucent::Texture t = texture(png8(8, rgb + "\xC8\x64\x32", std::string("\0\x01\x02\x01", 4)));
+  ASSERT_EQ(t.width, 4);
+  const float expected[4] = {
+      0, k1, static_cast<float>(lucent::image_detail::srgb_to_linear(200 / 255.0)), k1};
+  for (int x = 0; x < 4; ++x) EXPECT_FLOAT_EQ(t.rgba[4 * x], expected[x]) << x;
+  EXPECT_EQ(texture_error(png8(8, rgb, std::string("\0\x01\0\x05", 4))),
+            "PNG pixel (3, 0) names a colour past the 2 entries of its palette (corrupt)");
+  // 1-bit indices and a palette of one entry: the eighth pixel names entry 1
+  EXPECT_EQ(texture_error(png8(1, rgb.substr(0, 3), "\x01")),
+            "PNG pixel (7, 0) names a colour past the 1 entries of its palette (corrupt)");
+  const std::string bgr0 = std::string("\0\0\0\0\0\0\x01\0", 8);
+  t = texture(palette_bmp(bgr0, std::string("\x01\0\x01", 3)));
+  ASSERT_EQ(t.width, 3);
+  EXPECT_FLOAT_EQ(t.rgba[0], k1);
+  EXPECT_FLOAT_EQ(t.rgba[4], 0);
+  EXPECT_EQ(texture_error(palette_bmp(bgr0, std::string("\x01\xC8\0", 3))),
+            "BMP pixel (1, 0) names a colour past the 2 entries of its palette (corrupt)");
 }
 
 // An environment map of one pixel, or of one row of equal pixels, is a constant sky: a diffuse

@@ -118,19 +118,6 @@ TEST(Texture, HdrAndPfmStayLinear) {
   }
 }
 
-// A 16-bit RGB PNG written by hand (stb_image_write has no 16-bit writer): zlib stream of stored
-// (uncompressed) deflate blocks, CRC-32 and Adler-32 computed here.
-std::uint32_t crc32(const std::string& data) {
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (unsigned char b : data) {
-    c ^= b;
-    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
-  }
-  return ~c;
-}
-
-std::string be32(std::uint32_t v) { return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; }
-
 void write_png16(const std::string& path, int w, int h, const std::vector<std::uint16_t>& rgb) {
   std::string raw;
   for (int y = 0; y < h; ++y) {
@@ -141,25 +128,7 @@ void write_png16(const std::string& path, int w, int h, const std::vector<std::u
       raw += char(v & 0xFF);
     }
   }
-  ASSERT_LT(raw.size(), 65536u) << "one stored block";
-  std::uint32_t a = 1, b = 0;
-  for (unsigned char c : raw) {
-    a = (a + c) % 65521;
-    b = (b + a) % 65521;
-  }
-  std::uint16_t len = static_cast<std::uint16_t>(raw.size()),
-                nlen = static_cast<std::uint16_t>(~len);
-  std::string z = "\x78\x01";
-  z += '\x01';  // final stored block
-  z += {char(len & 0xFF), char(len >> 8), char(nlen & 0xFF), char(nlen >> 8)};
-  z += raw + be32((b << 16) | a);
-  auto chunk = [](const std::string& tag, const std::string& data) {
-    return be32(static_cast<std::uint32_t>(data.size())) + tag + data + be32(crc32(tag + data));
-  };
-  std::string ihdr = be32(w) + be32(h) + std::string("\x10\x02\x00\x00\x00", 5);  // 16-bit RGB
-  std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) + chunk("IDAT", z) +
-                    chunk("IEND", "");
-  lucent::test::write_file(path, png);
+  lucent::test::write_file(path, lucent::test::png_file(w, h, 16, 2, {}, raw));  // 16-bit RGB
 }
 
 TEST(Texture, SixteenBitPngKeepsItsPrecision) {

@@ -36,6 +36,53 @@ struct StbFree {
   void operator()(void* p) const { stbi_image_free(p); }
 };
 
+/// A copy of the file of `p`, a short palette's (Probe::ShortPalette), with its palette padded to
+/// every entry its indices can name, in a colour (`*colour`, RGB) that none of its entries has.
+std::vector<unsigned char> pad_palette(const unsigned char* data, std::size_t size, const Probe& p,
+                                       std::array<unsigned char, 3>* colour) {
+  const Probe::ShortPalette& pal = p.short_palette;
+  const bool bgr = p.format == Format::Bmp;
+  // 257 candidates (k mod 256, k / 256, 0): at most 256 are taken
+  std::array<unsigned char, 3> pick{0, 0, 0};
+  for (unsigned k = 0; k < 257; ++k) {
+    const unsigned char r = static_cast<unsigned char>(k & 255),
+                        g = static_cast<unsigned char>(k >> 8);
+    bool taken = false;
+    for (std::uint64_t e = 0; e < pal.entries && !taken; ++e) {
+      const unsigned char* c = data + pal.start + e * pal.entry_bytes;
+      taken = c[bgr ? 2 : 0] == r && c[1] == g && c[bgr ? 0 : 2] == 0;
+    }
+    if (!taken) {
+      pick = {r, g, 0};
+      break;
+    }
+  }
+  *colour = pick;
+  const std::uint64_t at = pal.start + pal.entries * pal.entry_bytes;
+  const std::uint64_t added = (pal.names - pal.entries) * pal.entry_bytes;
+  std::vector<unsigned char> out;
+  out.reserve(size + added);
+  out.insert(out.end(), data, data + at);
+  for (std::uint64_t e = pal.entries; e < pal.names; ++e) {
+    const unsigned char entry[4] = {bgr ? pick[2] : pick[0], pick[1], bgr ? pick[0] : pick[2], 0};
+    out.insert(out.end(), entry, entry + pal.entry_bytes);
+  }
+  out.insert(out.end(), data + at, data + size);
+  // the PLTE chunk's length (its CRC is left as it was: stb_image skips CRCs), or the BMP's
+  // offset of its pixels
+  unsigned char* field = out.data() + pal.length_field;
+  if (bgr) {
+    std::uint32_t v = std::uint32_t(field[0]) | std::uint32_t(field[1]) << 8 |
+                      std::uint32_t(field[2]) << 16 | std::uint32_t(field[3]) << 24;
+    v += static_cast<std::uint32_t>(added);
+    for (int i = 0; i < 4; ++i) field[i] = static_cast<unsigned char>(v >> (8 * i));
+  } else {
+    const std::uint32_t v = static_cast<std::uint32_t>(pal.names * 3);
+    for (int i = 0; i < 4; ++i) field[i] = static_cast<unsigned char>(v >> (8 * (3 - i)));
+  }
+  return out;
+}
+
 }  // namespace
 
 io::ReadSpec image_read_spec(const char* what) {
@@ -317,8 +364,20 @@ Decoded decode_image(const unsigned char* data, std::size_t size, const std::str
       out.pixels[i] = static_cast<float>(i % channels == 3 ? v : srgb_to_linear(v));
     }
   } else {
-    std::unique_ptr<stbi_uc, StbFree> px(stbi_load_from_memory(data, len, &w, &h, &n, channels));
+    std::vector<unsigned char> padded;
+    std::array<unsigned char, 3> padding{};
+    if (p.short_palette.entries > 0) padded = pad_palette(data, size, p, &padding);
+    std::unique_ptr<stbi_uc, StbFree> px(
+        padded.empty() ? stbi_load_from_memory(data, len, &w, &h, &n, channels)
+                       : stbi_load_from_memory(padded.data(), static_cast<int>(padded.size()), &w,
+                                               &h, &n, channels));
     if (!px) fail(std::string("cannot decode ") + format_name(p.format) + ": " + stb_reason());
+    if (!padded.empty() && w == p.width && h == p.height)
+      for (std::size_t i = 0; i < std::size_t(w) * std::size_t(h); ++i)
+        if (std::equal(padding.begin(), padding.end(), px.get() + i * channels))
+          fail(std::string(format_name(p.format)) + " pixel (" + std::to_string(i % w) + ", " +
+               std::to_string(i / w) + ") names a colour past the " +
+               std::to_string(p.short_palette.entries) + " entries of its palette (corrupt)");
     allocate(w, h);
     for (size_t i = 0; i < out.pixels.size(); ++i) {
       stbi_uc v = px.get()[i];

@@ -50,6 +50,12 @@ class Checker {
       fail(std::string(fmt) + " header claims " + std::to_string(w) + "x" + std::to_string(h) +
            " pixels, more than the limit of " + std::to_string(max_pixels_) +
            " pixels (corrupt, or too large)");
+    // stb_image's own limit (STBI_MAX_DIMENSIONS): it said only "too large"
+    const u64 side = u64(1) << 24;
+    if (p.format != Format::Pfm && p.format != Format::Exr && (w > side || h > side))
+      fail(std::string(fmt) + " header claims " + std::to_string(w) + "x" + std::to_string(h) +
+           " pixels: lucent reads " + fmt + " files of at most " + std::to_string(side) +
+           " pixels a side (PFM and OpenEXR files are not limited so)");
     p.width = static_cast<int>(w);
     p.height = static_cast<int>(h);
   }
@@ -109,6 +115,11 @@ class Checker {
       if (len > n_ - pos - 12)
         fail("PNG file is truncated: the chunk at byte " + std::to_string(pos) + " needs " +
              std::to_string(len) + " bytes, the file has " + std::to_string(n_ - pos - 12));
+      // the first PLTE before the image data, as stb_image reads it (of 1 to 256 entries)
+      const u64 names = std::min<u64>(256, u64(1) << depth);
+      if (type == 3 && idat == 0 && p.short_palette.length_field == 0 &&
+          std::memcmp(d_ + pos + 4, "PLTE", 4) == 0 && len % 3 == 0 && len > 0 && len / 3 < names)
+        p.short_palette = {len / 3, names, 3, pos + 8, pos};
       if (std::memcmp(d_ + pos + 4, "IDAT", 4) == 0) idat += len;
       if (std::memcmp(d_ + pos + 4, "IEND", 4) == 0) {
         end = true;
@@ -126,7 +137,9 @@ class Checker {
     Probe p{Format::Jpeg};
     u64 pos = 2;
     bool frame = false, scan = false, progressive = false;
-    unsigned tables = 0;  // Huffman tables defined so far: bit 4 * class + id
+    unsigned tables = 0;     // Huffman tables defined so far: bit 4 * class + id
+    unsigned quantised = 0;  // quantisation tables defined so far: bit id
+    std::vector<std::pair<unsigned, unsigned>> components;  // the frame's: id, quantisation table
     while (true) {
       if (pos >= n_) break;
       if (d_[pos] != 0xFF) {
@@ -141,8 +154,13 @@ class Checker {
       if (m == 0xD9) {
         if (!frame || !scan) fail("JPEG file has no image data before its end marker");
         const u64 px = u64(p.width) * u64(p.height);
-        // at least one bit per 8x8 block for the DC coefficients: 512 pixels per byte at best
-        if (px > (1u << 20) && px / 1024 > n_)
+        // every 8x8 block of the full-resolution component takes a Huffman code of at least one
+        // bit for its DC coefficient and, in a baseline scan, one for its AC coefficients (an
+        // end-of-block at least): 256 pixels a byte at best, 512 for a progressive file (its AC
+        // scans may skip runs of blocks). A 96 KB file claiming 8192x8192 decoded to 1 GiB of
+        // stripes.
+        const u64 per_byte = progressive ? 512 : 256;
+        if (px > (1u << 20) && px / per_byte > n_)
           fail("JPEG header claims " + std::to_string(p.width) + "x" + std::to_string(p.height) +
                " pixels, more than " + std::to_string(n_) + " bytes can hold (corrupt)");
         return p;
@@ -153,16 +171,22 @@ class Checker {
       const bool sof = (m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC);
       if (sof) {
         if (len < 8) fail("JPEG frame header is too short");
-        if (!frame) size(p, be16(d_ + pos + 5), be16(d_ + pos + 3));
+        if (!frame) {
+          size(p, be16(d_ + pos + 5), be16(d_ + pos + 3));
+          for (u64 k = 0; k < d_[pos + 7] && 8 + 3 * k + 3 <= len; ++k)
+            components.emplace_back(d_[pos + 8 + 3 * k], d_[pos + 10 + 3 * k]);
+        }
         frame = true;
         progressive = progressive || m == 0xC2;
       }
       if (m == 0xDA) {
         if (!frame) fail("JPEG file has image data before its frame header");
         scan_tables(pos - 2, pos + 2, len - 2, progressive, tables);
+        scan_quantisation(pos - 2, pos + 2, len - 2, components, quantised);
         scan = true;
       }
       if (m == 0xC4) tables |= huffman_tables(pos + 2, len - 2);
+      if (m == 0xDB) quantised |= quantisation_tables(pos + 2, len - 2);
       pos += len;
     }
     fail("JPEG file is truncated: no end-of-image marker");
@@ -190,6 +214,37 @@ class Checker {
                ", which no DHT segment before it defines (corrupt)");
       }
     }
+  }
+
+  // A scan header (SOS at byte `at`): the quantisation table of each of its components must have
+  // been defined by a DQT segment before it. stb_image dequantises with a table no DQT defined
+  // from memory it never set (a file that named table 3 decoded to a grey that valgrind traced
+  // to uninitialised values).
+  void scan_quantisation(u64 at, u64 pos, u64 left,
+                         const std::vector<std::pair<unsigned, unsigned>>& components,
+                         unsigned quantised) const {
+    if (left < 1) return;
+    const unsigned count = d_[pos];
+    for (unsigned k = 0; k < count && 1 + 2 * u64(k) < left; ++k)
+      for (const auto& [id, table] : components)
+        if (id == d_[pos + 1 + 2 * k] && table <= 3 && !(quantised & (1u << table)))
+          fail("JPEG scan at byte " + std::to_string(at) + " uses quantisation table " +
+               std::to_string(table) + ", which no DQT segment before it defines (corrupt)");
+  }
+
+  // A DQT segment's tables, read as stb_image reads them: returns the tables it defines (bit id).
+  unsigned quantisation_tables(u64 pos, u64 left) const {
+    unsigned defined = 0;
+    while (left > 0 && pos < n_) {
+      const unsigned q = d_[pos], precision = q >> 4, id = q & 15;
+      if (precision > 1 || id > 3) return defined;  // stb_image refuses the table itself
+      const u64 bytes = precision ? 129 : 65;
+      if (bytes > left) return defined;  // stb_image refuses a segment that ends inside a table
+      defined |= 1u << id;
+      pos += bytes;
+      left -= bytes;
+    }
+    return defined;
   }
 
   // A DHT segment's tables, read as stb_image reads them (on past the segment if its length
@@ -244,6 +299,14 @@ class Checker {
     const u64 stride = (w * bpp + 31) / 32 * 4;
     const u64 start = std::max<u64>(offset, 14 + hsz);
     need(p, start + stride * h, n_, "header and pixel rows");
+    if (bpp <= 8) {
+      // the palette's entries as stb_image counts them: from the pixels' offset (an OS/2
+      // header's from 24 bytes past its end, as stb_image reads it)
+      const std::int64_t entries = hsz == 12 ? (std::int64_t(offset) - 38) / 3
+                                             : (std::int64_t(offset) - 14 - std::int64_t(hsz)) / 4;
+      if (entries > 0 && u64(entries) < (u64(1) << bpp))
+        p.short_palette = {u64(entries), u64(1) << bpp, hsz == 12 ? 3u : 4u, 14 + hsz, 10};
+    }
     return p;
   }
 

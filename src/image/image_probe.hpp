@@ -61,6 +61,18 @@ struct Probe {
   /// An OpenEXR with lucent's checksum attribute (a part file: a checkpoint, a --samples part),
   /// whose image read_image takes from its checksummed sums.
   bool lucent_part = false;
+  /// A palette image (a PNG of colour type 3, a BMP of 8 bits or fewer a pixel) whose palette
+  /// has fewer entries than its indices can name. stb_image reads an index past the palette from
+  /// memory it never set (a texture, and the render, changed from run to run): decode_image pads
+  /// the palette with a colour none of its entries has, and refuses a pixel of that colour.
+  struct ShortPalette {
+    std::uint64_t entries = 0;       ///< the palette's entries; 0: not a short palette
+    std::uint64_t names = 0;         ///< the entries the indices can name (2^bits, at most 256)
+    std::uint64_t entry_bytes = 0;   ///< 3 (PNG: R, G, B; an OS/2 BMP: B, G, R) or 4 (BMP)
+    std::uint64_t start = 0;         ///< the palette's first entry in the file
+    std::uint64_t length_field = 0;  ///< PNG: the PLTE chunk's length; BMP: the pixels' offset
+  };
+  ShortPalette short_palette = {};
 };
 
 /// Identifies the format of `data` (PNG, JPEG, BMP, TGA, Radiance HDR, PFM, OpenEXR; anything
