@@ -291,6 +291,37 @@ TEST(Checkpoint, ACheckpointInUseIsRefused) {
   EXPECT_FALSE(fs::exists(ck + ".lock"));
 }
 
+// A lock file that is a symbolic or hard link (planted in a shared directory) is refused, and the
+// file it names is left as it was: the render truncated the link's target and wrote its mark in
+// it, then removed the link (the parts campaign).
+TEST(Checkpoint, ALockThatIsALinkIsRefusedAndWhatItNamesKept) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string ck = dir + "/ck.exr", out = dir + "/out.exr", victim = dir + "/victim.txt";
+  lucent::test::write_file(victim, "precious");
+  for (const bool symbolic : {true, false}) {
+    SCOPED_TRACE(symbolic ? "symbolic link" : "hard link");
+    if (symbolic)
+      fs::create_symlink(victim, ck + ".lock");
+    else
+      fs::create_hard_link(victim, ck + ".lock");
+    CommandResult r =
+        run_cli("render " + q(scene) + " -q --spp 4 --checkpoint " + q(ck) + " -o " + q(out));
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(ck + ".lock: the checkpoint's lock is " +
+                         (symbolic ? std::string("a symbolic link")
+                                   : std::string("a file of 2 names (hard links)")) +
+                         ", not a file lucent made (remove it)"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(lucent::test::read_file(victim), "precious");
+    EXPECT_TRUE(fs::is_symlink(ck + ".lock") == symbolic);
+    EXPECT_FALSE(fs::exists(out));
+    fs::remove(ck + ".lock");
+  }
+}
+
 // The lock goes with the checkpoint: a render that fails before its first write (here a device
 // that is not there, after the lock was taken) leaves no checkpoint, and no lock alone beside
 // where it would be (it stayed for ever). A checkpoint refused stays, with its lock; a lock held

@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -36,10 +37,29 @@ CheckpointLock::CheckpointLock(const std::string& checkpoint)
   // may create and lock, and two renders held the checkpoint (the review's find); opened again
   int e = 0;
   for (int attempt = 0;; ++attempt) {
-    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    // not through a symbolic link, and only a file of one name: the lock is truncated and
+    // written below, and a link planted in its place (a shared scratch directory) had the render
+    // overwrite the file it named
+    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd_ < 0 && errno == ELOOP)
+      throw lucent::Error(path_ +
+                          ": the checkpoint's lock is a symbolic link, not a file lucent made "
+                          "(remove it)");
     if (fd_ < 0)
       throw lucent::Error(path_ + ": cannot create the checkpoint's lock (" + std::strerror(errno) +
                           ")");
+    struct stat st {};
+    const bool regular = ::fstat(fd_, &st) == 0 && S_ISREG(st.st_mode);
+    if (!regular || st.st_nlink != 1) {
+      const bool links = regular && st.st_nlink > 1;
+      ::close(fd_);
+      fd_ = -1;
+      throw lucent::Error(path_ + ": the checkpoint's lock is " +
+                          (links
+                               ? "a file of " + std::to_string(st.st_nlink) + " names (hard links)"
+                               : std::string("not a regular file")) +
+                          ", not a file lucent made (remove it)");
+    }
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
       e = errno;
       break;
