@@ -239,6 +239,12 @@ TEST(Parts, OverlapsAndMismatchesAreOneLineErrors) {
                 " (their kernels may differ: render every part with one version)");
   EXPECT_EQ(error_line(run_cli("merge " + a + " " + a + " -o " + q(out))),
             dir + "/a.exr: given twice (as " + dir + "/a.exr)");
+  fs::create_symlink(dir + "/a.exr", dir + "/link.exr");
+  fs::create_hard_link(dir + "/a.exr", dir + "/hard.exr");
+  EXPECT_EQ(error_line(run_cli("merge " + a + " " + q(dir + "/link.exr") + " -o " + q(out))),
+            dir + "/link.exr: given twice (as " + dir + "/a.exr)");
+  EXPECT_EQ(error_line(run_cli("merge " + q(dir + "/hard.exr") + " " + a + " -o " + q(out))),
+            dir + "/a.exr: given twice (as " + dir + "/hard.exr)");
   // a render EXR that is not a part
   ASSERT_EQ(run_cli("render " + q(scene) + " -q --spp 2 -o " + q(dir + "/plain.exr")).status, 0);
   EXPECT_EQ(error_line(run_cli("merge " + a + " " + q(dir + "/plain.exr") + " -o " + q(out))),
@@ -340,6 +346,14 @@ TEST(Parts, MergerAndPartsMisusedAreErrors) {
             "both");
   EXPECT_EQ(error_of([&] { headers.finish(); }),
             "merge: no parts added (add_header() checks headers, add() adds parts)");
+  // nor the other way round: the header's samples were never added, and finish() said "missing
+  // none" (the API campaign)
+  lucent::PartMerger added;
+  added.add("a", a);
+  EXPECT_EQ(error_of([&] { added.add_header("b", b.info); }),
+            "b: PartMerger: add_header() after add(): a merger checks headers or adds parts, not "
+            "both");
+  EXPECT_EQ(added.finish().merged.info.samples.size(), 1u);
   // a merger spent by finish() says so (add() said "add() after add_header()", finish() "no
   // parts added")
   lucent::PartMerger spent;

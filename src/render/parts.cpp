@@ -3,6 +3,8 @@
 // as pairs of UINT channels and the header as string attributes. Format: docs/parts.md.
 #include "lucent/parts.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cinttypes>
@@ -614,6 +616,12 @@ void PartMerger::check_not_finished(const char* call) const {
 
 void PartMerger::add_header(const std::string& name, const PartInfo& info) {
   check_not_finished("add_header()");
+  // (after add(), a header was taken: its samples were then never added, and finish() said
+  // "missing none")
+  if (total_.info.width != 0)
+    throw Error(name +
+                ": PartMerger: add_header() after add(): a merger checks headers or adds "
+                "parts, not both");
   check_part_contents(name, info, Accumulation{});
   check(name, info);
   names_.push_back(name);
@@ -746,9 +754,15 @@ MergeReport merge_render_parts(const std::vector<std::string>& paths) {
   };
   std::vector<Entry> entries;
   PartMerger headers;  // every header is checked before any pixel is read
+  // a file given twice, by its identity (links and copies of a name included): compared pairwise,
+  // 4000 parts took 2 million stat calls and 31 s
+  std::map<std::pair<dev_t, ino_t>, std::string> files;
   for (const std::string& p : paths) {
-    for (const Entry& e : entries)
-      if (io::same_file(e.path, p)) throw Error(p + ": given twice (as " + e.path + ")");
+    struct stat st {};
+    if (::stat(p.c_str(), &st) == 0) {
+      const auto [it, fresh] = files.emplace(std::make_pair(st.st_dev, st.st_ino), p);
+      if (!fresh) throw Error(p + ": given twice (as " + it->second + ")");
+    }
     entries.push_back(Entry{p, read_part_info(p)});
     headers.add_header(p, entries.back().info);
   }
