@@ -1225,6 +1225,27 @@ TEST(Session, FloatRoundingLargeAgainstTheSceneWarns) {
   EXPECT_EQ(warnings_for(odd, lucent::Precision::Float), 0);
 }
 
+// Both precisions store the scene's coordinates in float: a ground sphere of radius 1e7 whose
+// centre, -9999999.7, rounds to -1e7 moves the ground 0.3 under kScene's sphere of 0.5 (which then
+// floats above it), and double rendered that without a word (image-mean z -24 against the
+// reference), after float's warning had recommended double. Said in both precisions now; not for
+// a centre that floats hold, nor for kScene.
+TEST(Session, StoredRoundingLargeAgainstTheSceneWarnsInBothPrecisions) {
+  const std::string what = "the scene's coordinates are stored in float in either precision";
+  const Scene plain = lucent::test::scene_from(kScene);
+  for (const auto precision : {lucent::Precision::Float, lucent::Precision::Double}) {
+    SCOPED_TRACE(lucent::precision_name(precision));
+    EXPECT_EQ(warnings_containing(plain, precision, what), 0);
+    for (const double centre : {-9999999.7, -1e7}) {
+      Scene ground = plain;
+      ground.spheres.push_back(ground.spheres[0]);
+      ground.spheres.back().center = glm::dvec3(0, centre, 0);
+      ground.spheres.back().radius = 1e7;
+      EXPECT_EQ(warnings_containing(ground, precision, what), centre == -1e7 ? 0 : 1) << centre;
+    }
+  }
+}
+
 // In float precision the triangle test's products of three coordinate differences underflow in a
 // tiny scene (a Cornell box scaled by 1e-15 rendered half as bright, by 1e-16 black, without a
 // word; double renders it right): a warning says so below a size of 1e-10, in float only.

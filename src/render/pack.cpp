@@ -309,6 +309,50 @@ std::string float_rounding_note(const PackedScene& packed) {
   return buf;
 }
 
+std::string stored_rounding_note(const Scene& scene) {
+  double worst = 0;  // the largest move of a surface by the rounding of its coordinates to float
+  std::vector<double> sizes;
+  const size_t n = scene.triangles.size() + scene.spheres.size();
+  const size_t stride = std::max<size_t>(1, n / 100000);  // a sample of at most ~1e5 sizes
+  size_t i = 0;
+  auto moved = [](const glm::dvec3& p) { return glm::length(p - glm::dvec3(glm::vec3(p))); };
+  for (const Triangle& t : scene.triangles) {
+    glm::dvec3 v[3];
+    bool valid = true;
+    for (int k = 0; k < 3; ++k) {
+      valid = valid && t.v[k] >= 0 && static_cast<size_t>(t.v[k]) < scene.positions.size();
+      if (valid) v[k] = scene.positions[static_cast<size_t>(t.v[k])];
+    }
+    if (!valid) continue;
+    const double edge =
+        std::max({glm::length(v[1] - v[0]), glm::length(v[2] - v[1]), glm::length(v[0] - v[2])});
+    if (!(edge > 0) || !std::isfinite(edge)) continue;  // dropped by pack_scene
+    worst = std::max({worst, moved(v[0]), moved(v[1]), moved(v[2])});
+    if (i++ % stride == 0) sizes.push_back(edge);
+  }
+  for (const Sphere& sp : scene.spheres) {
+    if (!(sp.radius > 0) || !std::isfinite(sp.radius) || !std::isfinite(moved(sp.center))) continue;
+    worst = std::max(worst, moved(sp.center) + std::abs(double(float(sp.radius)) - sp.radius));
+    if (i++ % stride == 0) sizes.push_back(2.0 * sp.radius);
+  }
+  if (sizes.empty()) return "";
+  const size_t k = (sizes.size() - 1) / 10;
+  std::nth_element(sizes.begin(), sizes.begin() + k, sizes.end());
+  const double feature = sizes[k];
+  if (!(worst > feature / 16)) return "";
+  char buf[720];
+  std::snprintf(buf, sizeof buf,
+                "the scene's coordinates are stored in float in either precision, which moves a "
+                "surface by up to %.2g here, more than 1/16 of its small features (%.2g, the "
+                "10th percentile of primitive sizes): small objects' contacts and shadows are "
+                "those of the moved surface, with --precision double too (a ground sphere of "
+                "radius 1e7 whose centre rounded by 0.3 left a sphere of 0.5 floating); give "
+                "coordinates that floats hold near the small objects, use triangles instead of a "
+                "huge sphere, or move the scene nearer the origin",
+                worst, feature);
+  return buf;
+}
+
 std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic) {
   const size_t most_emitters = most_against_every_primitive(packed);
   size_t emitters = 0;

@@ -62,6 +62,15 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous = nullptr
 /// differences underflow float (a Cornell box at 1e-16 rendered black, at 1e-15 half as bright).
 std::string float_rounding_note(const PackedScene& packed);
 
+/// The rounding of the scene's coordinates to float, which both precisions store: a warning's
+/// text when it moves a surface (a triangle's corner, a sphere's centre and radius) by more than
+/// 1/16 of the scene's small features (as float_rounding_note's), "" otherwise. A ground sphere of
+/// radius 1e7 whose centre, -9999999.7, was stored as -1e7 left a sphere of radius 0.5 floating
+/// 0.3 above it: double rendered that without a word (image-mean z -24 against the reference),
+/// after float's warning had recommended double. Coordinates that floats hold exactly (a quad of
+/// +-1e6) are not said.
+std::string stored_rounding_note(const Scene& scene);
+
 /// A sphere light cut by another surface (a sphere's or a triangle's) into a thin part: a
 /// warning's text when the larger of the two primitives' rounding exceeds 1/16 of that part's
 /// depth, "" otherwise. With float arithmetic that rounding is the cutter's spawn offsets and the

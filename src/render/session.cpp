@@ -594,6 +594,8 @@ struct Renderer::Impl {
       if (options.precision == Precision::Float)
         if (std::string note = render_detail::float_rounding_note(next); !note.empty())
           scene_detail::warn(scene_detail::in_file(s.path, note));
+      if (std::string note = render_detail::stored_rounding_note(s); !note.empty())
+        scene_detail::warn(scene_detail::in_file(s.path, note));
       for (auto note_of : {&render_detail::emitter_cut_note, &render_detail::point_light_note})
         if (std::string note = note_of(next, options.precision == Precision::Float); !note.empty())
           scene_detail::warn(scene_detail::in_file(s.path, note));
