@@ -34,7 +34,9 @@ if(NOT _lucent_mpi STREQUAL "OFF")
     target_compile_options(lucent_mpi PRIVATE -Wall -Wextra)
     # the C API only: no deprecated C++ bindings (their symbols are in another library)
     target_compile_definitions(lucent_mpi PRIVATE OMPI_SKIP_MPICXX=1 MPICH_SKIP_MPICXX=1)
-    target_link_libraries(lucent_mpi PRIVATE lucent CLI11::CLI11 MPI::MPI_C)
+    # OpenCL too, as for the CLI: it includes cl/context.hpp, and a shared lucent does not pass
+    # its private link on (-DBUILD_SHARED_LIBS=ON failed to link lucent-mpi)
+    target_link_libraries(lucent_mpi PRIVATE lucent CLI11::CLI11 MPI::MPI_C OpenCL::OpenCL)
     target_include_directories(lucent_mpi PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src
                                                   ${CMAKE_CURRENT_SOURCE_DIR}/kernels)
     install(TARGETS lucent_mpi RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
