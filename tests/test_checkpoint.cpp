@@ -418,9 +418,19 @@ TEST(Checkpoint, CheckpointOfAnotherRenderIsRefused) {
   ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:4 -o " + q(ck)).status, 0);
   ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 4:8 -o " + q(later)).status, 0);
   const std::string bytes = lucent::test::read_file(ck);
+  // its pixels damaged (the last bytes: the sums' last chunk): the header is compared with the
+  // render's first, and the pixels read after (they were read first: a forged header of another
+  // film took 13 GB and a minute before the mismatch was said), and refused there
+  const std::string damaged = dir + "/damaged.exr";
+  std::string broken = bytes;
+  for (std::size_t i = broken.size() - 16; i < broken.size(); ++i) broken[i] = char(~broken[i]);
+  lucent::test::write_file(damaged, broken);
   const struct {
     std::string args, error;
   } cases[] = {
+      {q(scene) + " --width 13 --checkpoint " + q(damaged),
+       damaged + ": film 12x10 differs from " + scene + "'s 13x10"},
+      {q(scene) + " --checkpoint " + q(damaged), damaged + ": "},
       {q(scene) + " --seed 9 --checkpoint " + q(ck),
        ck + ": seed 3 differs from " + scene + "'s 9"},
       {q(other) + " --checkpoint " + q(ck), ck + ": scene hash "},

@@ -53,10 +53,11 @@ class Checkpoint {
   /// or stopped before its first write) removes the lock it holds (it stayed alone, for ever).
   ~Checkpoint();
 
-  /// Before the session: locks the checkpoint, then reads it when there is one, so that a file
-  /// that is not a part, or a corrupt one, is refused before a device is opened.
+  /// Before the session: locks the checkpoint, then reads its header when there is one, so
+  /// that a file that is not a part, or one of a corrupt header, is refused before a device is
+  /// opened (its pixels: check()).
   void read();
-  bool resumed() const { return old_.has_value(); }
+  bool resumed() const { return header_.has_value(); }
   /// K: the sample the checkpoint ends at (B without one), where this render starts.
   std::uint64_t first_sample() const;
   /// B.
@@ -64,7 +65,8 @@ class Checkpoint {
 
   /// After set_scene, before rendering: refuses a checkpoint of another image (PartMerger's
   /// checks: film, seed, sampler, integrator, lucent's version, scene hash), one that is not of
-  /// the samples [B, K), or one that ends after `target` (N; 0: a time limit alone).
+  /// the samples [B, K), or one that ends after `target` (N; 0: a time limit alone); then reads
+  /// its pixels.
   void check(const lucent::Renderer& renderer, std::uint64_t target);
 
   /// From on_progress, after each pass: writes the checkpoint when --checkpoint-every seconds
@@ -87,7 +89,10 @@ class Checkpoint {
   std::uint64_t held() const { return held_; }
 
   /// The checkpoint's part, no longer needed (its samples are in a whole() part).
-  void drop() { old_.reset(); }
+  void drop() {
+    old_.reset();
+    header_.reset();
+  }
 
   /// After the output was written: the render is complete, its checkpoint of no further use.
   /// Only a file this render resumed from or wrote: none may be there, or another's (a file
@@ -105,7 +110,8 @@ class Checkpoint {
   double every_;
   std::uint64_t begin_ = 0;
   std::uint64_t target_ = 0;
-  std::optional<lucent::RenderPart> old_;  ///< the checkpoint resumed from
+  std::optional<lucent::PartInfo> header_;  ///< the checkpoint's header (read())
+  std::optional<lucent::RenderPart> old_;   ///< the checkpoint resumed from (check())
   std::chrono::steady_clock::time_point last_;
   std::uint64_t saved_spp_ = 0;  ///< the session's samples per pixel in the last checkpoint
   std::uint64_t held_ = 0;
