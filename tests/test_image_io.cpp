@@ -2,6 +2,8 @@
 // values, and round trips through PNG, PFM and EXR; OpenEXR inputs that lucent does not write
 // itself (tiled, a single grey channel).
 #include <gtest/gtest.h>
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
 #include <tinyexr.h>
 
 #include <algorithm>
@@ -11,6 +13,7 @@
 #include <fstream>
 #include <functional>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -124,6 +127,39 @@ TEST(ImageIo, PngRoundTripWithinQuantisation) {
     // most 2.4/1.055 = 2.275 (at 1): 0.0045 in linear terms
     EXPECT_NEAR(back.rgb[i], v, 0.0046) << i;
   }
+}
+
+// stb_image and stb_image_write keep their flip settings for the process (stb_image also for a
+// thread), and the library is shared with the application: lucent's reads and writes neither
+// depend on them nor change them. It set the process's read setting to 0 before each read (the
+// application's own reads then came unflipped), a thread's setting turned its reads upside down,
+// and an application's stbi_flip_vertically_on_write(1) its PNGs (the API campaign).
+TEST(ImageIo, TheApplicationsStbFlipSettingsAreNeitherUsedNorChanged) {
+  struct Restore {
+    ~Restore() {
+      stbi_set_flip_vertically_on_load(0);
+      stbi_flip_vertically_on_write(0);
+    }
+  } restore;
+  const std::string dir = lucent::test::temp_dir(), a = dir + "/a.png", b = dir + "/b.png";
+  const lucent::Image img{1, 2, {1, 1, 1, 0, 0, 0}};  // white above black
+  lucent::write_image(a, img);
+  stbi_set_flip_vertically_on_load(1);
+  EXPECT_EQ(lucent::read_image(a).rgb[0], 1.0f);
+  int w = 0, h = 0, n = 0;
+  unsigned char* own = stbi_load(a.c_str(), &w, &h, &n, 3);  // the application's read: flipped
+  ASSERT_NE(own, nullptr);
+  EXPECT_EQ(own[0], 0);
+  stbi_image_free(own);
+  stbi_set_flip_vertically_on_load(0);
+  std::thread([&] {
+    stbi_set_flip_vertically_on_load_thread(1);
+    EXPECT_EQ(lucent::read_image(a).rgb[0], 1.0f);
+  }).join();
+  stbi_flip_vertically_on_write(1);
+  lucent::write_image(b, img);
+  stbi_flip_vertically_on_write(0);
+  EXPECT_EQ(lucent::read_image(b).rgb[0], 1.0f);
 }
 
 TEST(ImageIo, UnknownExtensionAndUnwritablePathAreErrors) {

@@ -83,6 +83,21 @@ std::vector<unsigned char> pad_palette(const unsigned char* data, std::size_t si
   return out;
 }
 
+/// Whether stb_image flips the rows it decodes (the process's setting, or this thread's).
+bool stb_flips_on_load() {
+  // a grey PNG of 1x2 pixels, white above black
+  static const unsigned char kProbe[] = {
+      0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48,
+      0x44, 0x52, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x02, 0x08, 0x00, 0x00, 0x00,
+      0x00, 0xbc, 0xea, 0xe9, 0xfb, 0x00, 0x00, 0x00, 0x0c, 0x49, 0x44, 0x41, 0x54, 0x78,
+      0xda, 0x63, 0xf8, 0xcf, 0xc0, 0x00, 0x00, 0x03, 0x01, 0x01, 0x00, 0xf7, 0x03, 0x41,
+      0x43, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
+  int w = 0, h = 0, n = 0;
+  std::unique_ptr<stbi_uc, StbFree> px(
+      stbi_load_from_memory(kProbe, static_cast<int>(sizeof kProbe), &w, &h, &n, 1));
+  return px && w == 1 && h == 2 && px.get()[0] == 0;
+}
+
 }  // namespace
 
 io::ReadSpec image_read_spec(const char* what) {
@@ -347,7 +362,10 @@ Decoded decode_image(const unsigned char* data, std::size_t size, const std::str
     return out;
   }
 
-  stbi_set_flip_vertically_on_load(0);  // a global setting: rows must come top first
+  // stb_image's flip setting is the process's (the application's: the library is shared, and
+  // lucent set it to 0 before each read, for the application too); rows come top first here
+  // whatever it is, read after each decode and undone (a thread's own setting, which overrides
+  // the process's, turned textures upside down)
   const int len = static_cast<int>(std::min<std::size_t>(size, 0x7fffffff));
   int w = 0, h = 0, n = 0;
   if (p.format == Format::Hdr) {
@@ -376,8 +394,9 @@ Decoded decode_image(const unsigned char* data, std::size_t size, const std::str
       for (std::size_t i = 0; i < std::size_t(w) * std::size_t(h); ++i)
         if (std::equal(padding.begin(), padding.end(), px.get() + i * channels))
           fail(std::string(format_name(p.format)) + " pixel (" + std::to_string(i % w) + ", " +
-               std::to_string(i / w) + ") names a colour past the " +
-               std::to_string(p.short_palette.entries) + " entries of its palette (corrupt)");
+               std::to_string(stb_flips_on_load() ? h - 1 - int(i / w) : int(i / w)) +
+               ") names a colour past the " + std::to_string(p.short_palette.entries) +
+               " entries of its palette (corrupt)");
     allocate(w, h);
     for (size_t i = 0; i < out.pixels.size(); ++i) {
       stbi_uc v = px.get()[i];
@@ -388,6 +407,13 @@ Decoded decode_image(const unsigned char* data, std::size_t size, const std::str
     fail(std::string(format_name(p.format)) + " decoded to " + std::to_string(w) + "x" +
          std::to_string(h) + " pixels, its header claims " + std::to_string(p.width) + "x" +
          std::to_string(p.height));
+  if (stb_flips_on_load()) {
+    const std::size_t row = std::size_t(w) * std::size_t(channels);
+    for (int y = 0; y < h / 2; ++y)
+      std::swap_ranges(out.pixels.begin() + std::ptrdiff_t(row * std::size_t(y)),
+                       out.pixels.begin() + std::ptrdiff_t(row * std::size_t(y + 1)),
+                       out.pixels.begin() + std::ptrdiff_t(row * std::size_t(h - 1 - y)));
+  }
   return out;
 }
 

@@ -59,14 +59,33 @@ std::string encode_pfm(const Image& img) {
   return out;
 }
 
+void append_bytes(void* context, void* data, int size) {
+  static_cast<std::string*>(context)->append(static_cast<const char*>(data),
+                                             static_cast<size_t>(size));
+}
+
+/// Whether stb_image_write flips the rows it writes: its setting is the process's (the
+/// application's too: the library is shared), which lucent neither depends on nor changes (an
+/// application's stbi_flip_vertically_on_write(1), common in OpenGL screenshot code, wrote
+/// lucent's PNGs upside down).
+bool stb_flips_on_write() {
+  const unsigned char px[6] = {255, 255, 255, 0, 0, 0};  // white above black
+  std::string bmp;
+  stbi_write_bmp_to_func(append_bytes, &bmp, 1, 2, 3, px);
+  // a BMP's rows are stored bottom first (its pixels from byte 54): black first, unless flipped
+  return bmp.size() > 54 && static_cast<unsigned char>(bmp[54]) == 255;
+}
+
 std::string encode_png(const std::string& path, const Image& img, const DisplaySettings& display) {
   std::vector<unsigned char> bytes(img.rgb.size());
-  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = encode_display(img.rgb[i], display);
+  const size_t row = size_t(img.width) * 3;
+  const bool flipped = stb_flips_on_write();  // (rows given bottom first: flipped back)
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    const size_t y = i / row, from = flipped ? (size_t(img.height) - 1 - y) * row + i % row : i;
+    bytes[i] = encode_display(img.rgb[from], display);
+  }
   std::string out;
-  auto append = [](void* context, void* data, int size) {
-    static_cast<std::string*>(context)->append(static_cast<const char*>(data),
-                                               static_cast<size_t>(size));
-  };
+  auto append = append_bytes;
   if (!stbi_write_png_to_func(append, &out, img.width, img.height, 3, bytes.data(), img.width * 3))
     throw Error(path + ": cannot encode PNG");
   return out;
