@@ -525,11 +525,21 @@ TEST(SceneJson, StringsWithANulCharacterAreRefused) {
             "mem.json: byte 32 is a NUL byte: not a text scene file");
 }
 
-// A NUL character in an error's message (a user's string) is shown as \0: what() is a C string,
-// and the rest of the line was cut off (a device selector "cp\0u" said "device 'cp").
-TEST(SceneJson, ErrorsShowANulCharacter) {
+// Control characters in an error's message (a user's string) are escaped as the command line
+// shows them: a NUL cut the C string of what() off (a device selector "cp\0u" said "device
+// 'cp"), and a JSON key, a material's or a file's name with a newline made what() two lines (the
+// API campaign). From a file and from a builder alike.
+TEST(SceneJson, ErrorsAreOneLineWhateverTheirNamesHold) {
   const lucent::Error e(std::string("a\0b", 3) + " and " + std::string("\0", 1));
-  EXPECT_STREQ(e.what(), "a\\0b and \\0");
+  EXPECT_STREQ(e.what(), "a\\x00b and \\x00");
+  EXPECT_EQ(error_of(with_material(R"("shapes": [{"type": "sphere", "center": [0,0,0], "radius": 1,
+                                       "material": "m", "a\nb": 1}])")),
+            "scene.json: /shapes/0/a\\nb: unknown key (allowed: type, center, radius, material)");
+  lucent::SceneBuilder b("scene\x1b[31m.json");
+  EXPECT_EQ(lucent::test::error_of([&] {
+              b.add_sphere({{0, 0, 0}, 1, "no\tsuch"});
+            }),
+            "scene\\x1b[31m.json: /shapes/0/material: unknown material 'no\\tsuch'");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -7,8 +7,9 @@ namespace lucent {
 /// Every failure lucent reports: one line naming the file, the place in it and what is wrong,
 /// or the OpenCL call and the error's name (`clBuildProgram: CL_BUILD_PROGRAM_FAILURE`).
 /// Some carry details that explain the line (a kernel's build log), to be shown before it.
-/// A NUL character in the message (from a user's string: a device selector, a file's attribute)
-/// is shown as \0: what() is a C string, which ended there and cut the rest of the line off.
+/// Control characters in the message (from a user's string: a JSON key, a material's or a file's
+/// name, a device selector) are escaped as the command line shows them (\n, \t, \x1b, \0...):
+/// what() is one line (a name with a newline made two), and a NUL no longer ends its C string.
 class Error : public std::runtime_error {
  public:
   explicit Error(const std::string& message) : std::runtime_error(shown(message)) {}
@@ -18,12 +19,7 @@ class Error : public std::runtime_error {
   const std::string& details() const noexcept { return details_; }
 
  private:
-  static std::string shown(std::string message) {
-    for (std::size_t at = message.find('\0'); at != std::string::npos;
-         at = message.find('\0', at + 2))
-      message.replace(at, 1, "\\0");
-    return message;
-  }
+  static std::string shown(const std::string& message);
   std::string details_;
 };
 
