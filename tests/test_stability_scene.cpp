@@ -137,6 +137,35 @@ TEST(StabilityScale, ReferenceSameImageAt1em12) {
                     "A = reference scaled by 1e-12, B = reference unit scene");
 }
 
+// The reference's rays leave surfaces 1e-12 of their coordinates away: on a ground sphere of
+// radius 1e11 (offsets of 0.2) a sphere of 0.5 lost its contact shadow (image-mean z +5 against
+// the kernel in double, which was right), without a word. It warns now; not on a ground sphere
+// of 1e9 (offsets of 0.002), which renders right.
+TEST(StabilityScale, ReferenceSaysWhenItsOffsetsReachTheSmallFeatures) {
+  for (const double radius : {1e11, 1e9}) {
+    SCOPED_TRACE(radius);
+    Scene s = scene_from(R"({
+      "camera": {"position": [0, 1, 4], "look_at": [0, 0.5, 0], "fov": 40},
+      "film": {"width": 4, "height": 4},
+      "materials": {"m": {"type": "diffuse"}},
+      "shapes": [{"type": "sphere", "center": [0, 0.5, 0], "radius": 0.5, "material": "m"},
+                 {"type": "sphere", "center": [0, -1, 0], "radius": 1, "material": "m"}],
+      "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [20, 20, 20]}]})");
+    s.spheres[1].center.y = -radius;
+    s.spheres[1].radius = radius;
+    lucent::test::CaptureWarnings warnings;
+    lucent::ReferenceOptions o;
+    o.spp = 1;
+    lucent::render_reference(s, o);
+    int said = 0;
+    for (const std::string& w : warnings.all())
+      said += w.find(
+                  "the reference renderer's rays leave surfaces 1e-12 of their coordinates "
+                  "away") != std::string::npos;
+    EXPECT_EQ(said, radius > 1e10 ? 1 : 0);
+  }
+}
+
 // Negative control: the comparison above sees a 5% change of the point light's intensity.
 TEST(StabilityScale, NegativeControlBrighterPointLight) {
   Scene a = scene_from(lucent::test::stability_scene_json());

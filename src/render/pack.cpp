@@ -283,8 +283,9 @@ std::string float_rounding_note(const PackedScene& packed) {
     std::snprintf(buf, sizeof buf,
                   "in float precision, the intersection tests multiply coordinate differences "
                   "whose products fall below float's range in a scene this small (size %.3g, "
-                  "below %.0e): primitives may be missed and the image too dark or black; use "
-                  "--precision double or scale the scene up",
+                  "below %.0e): primitives may be missed or met at wrong distances, and the "
+                  "image too dark, black or too bright (a scene of size 1e-30 under a sphere "
+                  "light rendered white); use --precision double or scale the scene up",
                   diagonal, kTinySceneSize);
     return buf;
   }
@@ -309,8 +310,8 @@ std::string float_rounding_note(const PackedScene& packed) {
   return buf;
 }
 
-std::string stored_rounding_note(const Scene& scene) {
-  double worst = 0;  // the largest move of a surface by the rounding of its coordinates to float
+SceneScale scene_scale(const Scene& scene) {
+  SceneScale out;
   std::vector<double> sizes;
   const size_t n = scene.triangles.size() + scene.spheres.size();
   const size_t stride = std::max<size_t>(1, n / 100000);  // a sample of at most ~1e5 sizes
@@ -327,19 +328,28 @@ std::string stored_rounding_note(const Scene& scene) {
     const double edge =
         std::max({glm::length(v[1] - v[0]), glm::length(v[2] - v[1]), glm::length(v[0] - v[2])});
     if (!(edge > 0) || !std::isfinite(edge)) continue;  // dropped by pack_scene
-    worst = std::max({worst, moved(v[0]), moved(v[1]), moved(v[2])});
+    out.rounding = std::max({out.rounding, moved(v[0]), moved(v[1]), moved(v[2])});
+    out.largest = std::max({out.largest, scene_detail::max_abs(v[0]), scene_detail::max_abs(v[1]),
+                            scene_detail::max_abs(v[2])});
     if (i++ % stride == 0) sizes.push_back(edge);
   }
   for (const Sphere& sp : scene.spheres) {
     if (!(sp.radius > 0) || !std::isfinite(sp.radius) || !std::isfinite(moved(sp.center))) continue;
-    worst = std::max(worst, moved(sp.center) + std::abs(double(float(sp.radius)) - sp.radius));
+    out.rounding =
+        std::max(out.rounding, moved(sp.center) + std::abs(double(float(sp.radius)) - sp.radius));
+    out.largest = std::max(out.largest, scene_detail::max_abs(sp.center) + sp.radius);
     if (i++ % stride == 0) sizes.push_back(2.0 * sp.radius);
   }
-  if (sizes.empty()) return "";
+  if (sizes.empty()) return out;
   const size_t k = (sizes.size() - 1) / 10;
   std::nth_element(sizes.begin(), sizes.begin() + k, sizes.end());
-  const double feature = sizes[k];
-  if (!(worst > feature / 16)) return "";
+  out.feature = sizes[k];
+  return out;
+}
+
+std::string stored_rounding_note(const Scene& scene) {
+  const SceneScale scale = scene_scale(scene);
+  if (!(scale.rounding > scale.feature / 16)) return "";
   char buf[720];
   std::snprintf(buf, sizeof buf,
                 "the scene's coordinates are stored in float in either precision, which moves a "
@@ -349,7 +359,7 @@ std::string stored_rounding_note(const Scene& scene) {
                 "radius 1e7 whose centre rounded by 0.3 left a sphere of 0.5 floating); give "
                 "coordinates that floats hold near the small objects, use triangles instead of a "
                 "huge sphere, or move the scene nearer the origin",
-                worst, feature);
+                scale.rounding, scale.feature);
   return buf;
 }
 

@@ -71,6 +71,16 @@ std::string float_rounding_note(const PackedScene& packed);
 /// +-1e6) are not said.
 std::string stored_rounding_note(const Scene& scene);
 
+/// What the rounding notes weigh, from the scene's own (double) primitives, those pack_scene
+/// keeps: the largest coordinate magnitude of a primitive (a sphere's centre plus its radius),
+/// the small features (the 10th percentile of primitive sizes: a triangle's longest edge, a
+/// sphere's diameter; 0 without a primitive) and the largest move of a surface by the rounding of
+/// its coordinates to float.
+struct SceneScale {
+  double largest = 0, feature = 0, rounding = 0;
+};
+SceneScale scene_scale(const Scene& scene);
+
 /// A sphere light cut by another surface (a sphere's or a triangle's) into a thin part: a
 /// warning's text when the larger of the two primitives' rounding exceeds 1/16 of that part's
 /// depth, "" otherwise. With float arithmetic that rounding is the cutter's spawn offsets and the

@@ -52,7 +52,7 @@ void surface(const Scene& scene, int i, const Ray& ray, const Hit& hit, Surface&
   s.uv = dvec2(0.5 + std::atan2(n.z, n.x) / (2 * kPi),
                0.5 + std::asin(std::clamp(n.y, -1.0, 1.0)) / kPi);
   s.material = sp.material;
-  s.err = 1e-12 * (max_abs(sp.center) + sp.radius);  // as a triangle's (triangle.cpp)
+  s.err = kSpawnOffset * (max_abs(sp.center) + sp.radius);  // as a triangle's (triangle.cpp)
 }
 
 }  // namespace

@@ -94,7 +94,7 @@ void surface(const Scene& scene, int i, const Ray&, const Hit& hit, Surface& s) 
   // the offset of spawned rays: thousands of double ulps of the coordinates (1e-9 of them lost
   // contact shadows on large primitives: an offset of 1 on a floor of 1e9), relative only (an
   // absolute 1e-12 more was a tenth of a scene of size 1e-11, which rendered 11% too dark)
-  s.err = 1e-12 * std::max(max_abs(v0), std::max(max_abs(v1), max_abs(v2)));
+  s.err = kSpawnOffset * std::max(max_abs(v0), std::max(max_abs(v1), max_abs(v2)));
 }
 
 }  // namespace

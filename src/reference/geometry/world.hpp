@@ -20,6 +20,11 @@ struct Hit {
 };
 
 /// The surface at a hit, oriented towards the incoming ray.
+/// Rays spawned from a surface leave it this fraction of its primitive's largest coordinate
+/// (Surface::err: thousands of double ulps, which Moller-Trumbore's error on thin triangles
+/// needs); render_reference warns when that reaches 1/16 of the scene's small features.
+constexpr double kSpawnOffset = 1e-12;
+
 struct Surface {
   dvec3 p;   ///< position
   dvec3 ng;  ///< geometric normal on the incoming side
