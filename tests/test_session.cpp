@@ -1246,6 +1246,39 @@ TEST(Session, StoredRoundingLargeAgainstTheSceneWarnsInBothPrecisions) {
   }
 }
 
+// A setting the scene's integrator or camera does not read, given a value other than its default,
+// is said (the scene file took rr_depth and mis for whitted, max_depth for direct and a
+// focus_distance with aperture 0 without a word; the command line refuses such options).
+TEST(Session, SettingsThatChangeNothingAreSaid) {
+  const std::string what = ": the setting has no effect";
+  const Scene plain = lucent::test::scene_from(kScene);
+  auto said = [&](const std::function<void(Scene&)>& edit) {
+    Scene s = plain;
+    edit(s);
+    return warnings_containing(s, lucent::Precision::Float, what);
+  };
+  EXPECT_EQ(said([](Scene&) {}), 0);
+  EXPECT_EQ(said([](Scene& s) { s.integrator.rr_depth = 2; }), 0);  // path reads it
+  EXPECT_EQ(said([](Scene& s) { s.integrator.type = lucent::IntegratorType::Whitted; }), 0);
+  EXPECT_EQ(said([](Scene& s) {
+              s.integrator.type = lucent::IntegratorType::Whitted;
+              s.integrator.rr_depth = 2;
+              s.integrator.mis = false;
+            }),
+            2);
+  EXPECT_EQ(said([](Scene& s) {
+              s.integrator.type = lucent::IntegratorType::Direct;
+              s.integrator.max_depth = 3;
+            }),
+            1);
+  EXPECT_EQ(said([](Scene& s) { s.camera.focus_distance = 3; }), 1);
+  EXPECT_EQ(said([](Scene& s) {
+              s.camera.focus_distance = 3;
+              s.camera.aperture = 0.1;
+            }),
+            0);
+}
+
 // In float precision the triangle test's products of three coordinate differences underflow in a
 // tiny scene (a Cornell box scaled by 1e-15 rendered half as bright, by 1e-16 black, without a
 // word; double renders it right): a warning says so below a size of 1e-10, in float only.
