@@ -113,6 +113,11 @@ double environment_radius(const Camera& camera, const PackedScene& packed);
 void pack_lights(const Scene& scene, PackedScene& packed, std::vector<double> area_power,
                  double env_radius);
 
+/// Appends the light-selection CDF of the probabilities `w` (summing to 1) to `cdf`: the running
+/// sums on the kernel's 2^-24 lattice, each light of a positive probability given one lattice step
+/// at least (up to 2^24 lights), taken from the largest.
+void append_selection_cdf(const std::vector<double>& w, sys::HostVector<float>& cdf);
+
 /// What a packing holds that depends on the camera, for `camera` in place of scene.camera
 /// (Renderer::set_camera): everything else of pack_scene(scene) is the same for any camera (the
 /// film, whose size sets the aspect ratio and the session's buffers, is the scene's).
