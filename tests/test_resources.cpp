@@ -413,6 +413,29 @@ TEST(Resources, JsonDocumentIsFreedWithoutAllocating) {
       << "the control: nlohmann's destructor allocates (status " << destroyed << ")";
 }
 
+// Packing outside a render (lucent info, Python's scene_info) is checked against the host limit
+// first, the film left out (info allocates none): info built the BVH of 6.9M triangles past an
+// address-space limit and ended in a bare "out of memory", where render refused at once (the
+// BVH campaign).
+TEST(Resources, PackingOutsideARenderIsCheckedAgainstTheHostLimit) {
+  const Scene s = lucent::test::scene_from(grid_scene(100, 2048));
+  std::uint64_t packing = 0, film = 0;
+  for (const MemoryPart& p : lucent::render_detail::estimate_host_memory(s, {}, 1))
+    (p.reduce.rfind("the film size", 0) == 0 ? film : packing) += p.bytes;
+  ASSERT_GT(film, packing);  // a 2048x2048 film: more than the scene's packing
+  DeviceLimits lim;
+  lim.host_mem = packing + (1 << 20);
+  {
+    ScopedLimitOverride o(lim);
+    EXPECT_EQ(error_of([&] { lucent::render_detail::check_packing_host_memory(s); }), "");
+  }
+  lim.host_mem = packing / 2;
+  ScopedLimitOverride o(lim);
+  const std::string msg = error_of([&] { lucent::render_detail::check_packing_host_memory(s); });
+  EXPECT_NE(msg.find(": packing it (its BVH and buffers) needs about "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("the largest part is the BVH of 20001 primitives"), std::string::npos) << msg;
+}
+
 // Each OBJ file is bounded, and so are all of a scene's meshes together: as they load, the
 // scene's arrays (as they grow) and the file being read must stay within the host limit. Twelve
 // copies of a 10^6-triangle soup under `ulimit -v` 2 GB read for 14 s and ended in a bare "out

@@ -874,6 +874,7 @@ py::dict scene_info(const Scene& scene, const TextArg& precision, const FlagArg&
   Scene copy = scene;
   auto packed = with_warnings(std::move(on_warning), [&] {
     scene_detail::validate_scene(copy);  // fields set from Python may index past the lists
+    render_detail::check_packing_host_memory(copy);
     return render_detail::pack_scene(copy);
   });
   py::dict lights;

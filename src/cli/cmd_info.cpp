@@ -107,6 +107,7 @@ int run_info_command() {
   if (!info_args().integrator.empty())
     scene.integrator.type = parse_integrator(info_args().integrator);
   apply_sampling_options(info_args().sampling, scene);
+  render_detail::check_packing_host_memory(scene);
   render_detail::PackedScene packed = render_detail::pack_scene(scene);
 
   std::printf("scene         %s\n", one_line(path).c_str());

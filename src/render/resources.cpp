@@ -269,11 +269,11 @@ namespace {
 // 20 GiB for a 16384x16384 film where lucent info said 40 on the CPU device).
 void check_host_parts(const Scene& scene, const std::vector<MemoryPart>& parts,
                       std::uint64_t host_limit, const std::string& limit_what,
-                      bool before_devices = false) {
+                      bool before_devices = false, const char* doing = "rendering") {
   const std::uint64_t need = total_bytes(parts);
   if (need <= host_limit) return;
   const MemoryPart& big = largest(parts);
-  throw Error(scene_name(scene) + ": rendering needs " +
+  throw Error(scene_name(scene) + ": " + doing + " needs " +
               (before_devices ? "at least about " : "about ") + format_bytes(need) +
               " of host memory" + (before_devices ? " before its devices' buffers" : "") +
               ", more than the limit of " + format_bytes(host_limit) + " (80% of " + limit_what +
@@ -290,6 +290,16 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
   std::vector<MemoryPart> parts = estimate_host_memory(scene, devices, description_copies);
   parts.insert(parts.end(), extra.begin(), extra.end());
   check_host_parts(scene, parts, host_limit, limit_what, devices.empty());
+}
+
+void check_packing_host_memory(const Scene& scene) {
+  std::string what;
+  const std::uint64_t limit = host_memory_allowed(&what);
+  if (limit == 0) return;
+  std::vector<MemoryPart> parts;  // the estimate less the film's parts (their reduce names it)
+  for (MemoryPart& p : estimate_host_memory(scene, {}, 1))
+    if (p.reduce.rfind("the film size", 0) != 0) parts.push_back(std::move(p));
+  check_host_parts(scene, parts, limit, what, false, "packing it (its BVH and buffers)");
 }
 
 void check_output_host_memory(const Scene& scene, const std::vector<MemoryPart>& outputs) {

@@ -135,6 +135,12 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
                        std::uint64_t host_limit, const std::string& limit_what = "physical memory",
                        const std::vector<MemoryPart>& extra = {}, int description_copies = 2);
 
+/// Before pack_scene outside a render (lucent info, Python's scene_info): throws lucent::Error as
+/// check_host_memory does when the packed scene and its BVH, beside the description, exceed
+/// host_memory_allowed() (info built 6.9M triangles' BVH past the limit, then said only "out of
+/// memory", where render refused at once).
+void check_packing_host_memory(const Scene& scene);
+
 /// What the scene description's arrays hold on the host (their capacities), in bytes.
 std::uint64_t description_bytes(const Scene& scene);
 
