@@ -222,6 +222,30 @@ TEST(CliInfo, IntegratorKnobsSayWhenTheRenderLeavesThemUnused) {
   EXPECT_EQ(m["glass splits"], "0");
 }
 
+// info gives the warnings a render of the scene gives (an albedo above 1, a setting its integrator
+// does not read, float's rounding against the small features): it gave only the loader's.
+TEST(CliInfo, SaysWhatARenderSays) {
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/s.json", R"({"integrator": {"type": "whitted", "rr_depth": 2},
+      "materials": {"m": {"type": "diffuse", "albedo": [1.5, 0.5, 0.5]}},
+      "shapes": [{"type": "sphere", "center": [1e5, 0, 0], "radius": 0.01, "material": "m"},
+                 {"type": "sphere", "center": [1e5, 1, 0], "radius": 0.01, "material": "m"}],
+      "lights": [{"type": "point", "position": [1e5, 3, 3], "intensity": [1, 1, 1]}]})");
+  for (const std::string& args :
+       {std::string("info"), std::string("render --spp 1 -o '") + dir + "/o.png'"}) {
+    SCOPED_TRACE(args);
+    CommandResult r = run_cli(args + " '" + dir + "/s.json'");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("material 'm': albedo 1.5 in red is above 1"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("/integrator/rr_depth: only the path integrator has it"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("in float precision, rays leave surfaces offset by their rounding"),
+              std::string::npos)
+        << r.err;
+  }
+}
+
 // info needs no OpenCL device: it works with every driver hidden.
 TEST(CliInfo, NeedsNoOpenClPlatform) {
   std::string dir = lucent::test::temp_dir();

@@ -17,6 +17,7 @@
 #include "render/integrator_knobs.hpp"
 #include "render/pack.hpp"
 #include "render/resources.hpp"
+#include "scene/validate.hpp"
 
 namespace lucent::cli {
 
@@ -109,6 +110,13 @@ int run_info_command() {
   apply_sampling_options(info_args().sampling, scene);
   render_detail::check_packing_host_memory(scene);
   render_detail::PackedScene packed = render_detail::pack_scene(scene);
+  // what a render of it says (an albedo above 1, float's rounding, settings that change nothing)
+  for (const std::string& note : scene_detail::energy_gain_notes(scene)) scene_detail::warn(note);
+  for (const std::string& note : scene_detail::unused_setting_notes(scene))
+    scene_detail::warn(note);
+  for (const std::string& note : render_detail::packing_notes(
+           scene, packed, parse_precision(info_args().precision) == Precision::Float))
+    scene_detail::warn(note);
 
   std::printf("scene         %s\n", one_line(path).c_str());
   std::printf("film          %dx%d\n", scene.film.width, scene.film.height);

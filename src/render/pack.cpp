@@ -363,6 +363,16 @@ std::string stored_rounding_note(const Scene& scene) {
   return buf;
 }
 
+std::vector<std::string> packing_notes(const Scene& scene, const PackedScene& packed,
+                                       bool float_arithmetic) {
+  std::vector<std::string> notes;
+  for (std::string note :
+       {float_arithmetic ? float_rounding_note(packed) : std::string(), stored_rounding_note(scene),
+        emitter_cut_note(packed, float_arithmetic), point_light_note(packed, float_arithmetic)})
+    if (!note.empty()) notes.push_back(scene_detail::in_file(scene.path, note));
+  return notes;
+}
+
 std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic) {
   const size_t most_emitters = most_against_every_primitive(packed);
   size_t emitters = 0;

@@ -62,6 +62,12 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous = nullptr
 /// differences underflow float (a Cornell box at 1e-16 rendered black, at 1e-15 half as bright).
 std::string float_rounding_note(const PackedScene& packed);
 
+/// The notes above that apply to `packed` (pack_scene of `scene`), each "<scene path>: ...":
+/// float_rounding_note with float arithmetic, stored_rounding_note, emitter_cut_note and
+/// point_light_note. What a render says once its scene is packed, and `lucent info` with it.
+std::vector<std::string> packing_notes(const Scene& scene, const PackedScene& packed,
+                                       bool float_arithmetic);
+
 /// The rounding of the scene's coordinates to float, which both precisions store: a warning's
 /// text when it moves a surface (a triangle's corner, a sphere's centre and radius) by more than
 /// 1/16 of the scene's small features (as float_rounding_note's), "" otherwise. A ground sphere of

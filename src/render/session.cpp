@@ -593,14 +593,9 @@ struct Renderer::Impl {
         render_detail::check_precision_support(d, options.precision);
       t0 = clock_type::now();
       next = render_detail::pack_scene(s, uploaded ? &packed : nullptr, &bvh_reused);
-      if (options.precision == Precision::Float)
-        if (std::string note = render_detail::float_rounding_note(next); !note.empty())
-          scene_detail::warn(scene_detail::in_file(s.path, note));
-      if (std::string note = render_detail::stored_rounding_note(s); !note.empty())
-        scene_detail::warn(scene_detail::in_file(s.path, note));
-      for (auto note_of : {&render_detail::emitter_cut_note, &render_detail::point_light_note})
-        if (std::string note = note_of(next, options.precision == Precision::Float); !note.empty())
-          scene_detail::warn(scene_detail::in_file(s.path, note));
+      for (const std::string& note :
+           render_detail::packing_notes(s, next, options.precision == Precision::Float))
+        scene_detail::warn(note);
     } catch (...) {
       notes.give();
       throw;
