@@ -1272,6 +1272,10 @@ TEST(Session, SettingsThatChangeNothingAreSaid) {
             }),
             1);
   EXPECT_EQ(said([](Scene& s) { s.camera.focus_distance = 3; }), 1);
+  EXPECT_EQ(said([](Scene& s) {  // the look-at distance, the default's (README's example)
+              s.camera.focus_distance = glm::length(s.camera.look_at - s.camera.position);
+            }),
+            0);
   EXPECT_EQ(said([](Scene& s) {
               s.camera.focus_distance = 3;
               s.camera.aperture = 0.1;

@@ -691,7 +691,9 @@ std::vector<std::string> unused_setting_notes(const Scene& s) {
         notes.push_back(in_file(s.path, std::string("/integrator/") + k.key + ": " + why +
                                             ", and this scene's integrator is " +
                                             type_name(in.type) + ": the setting has no effect"));
-  if (s.camera.focus_distance > 0 && !(s.camera.aperture > 0))
+  // (the look-at distance is the default's, which README's example spells out)
+  if (s.camera.focus_distance > 0 && !(s.camera.aperture > 0) &&
+      s.camera.focus_distance != glm::length(s.camera.look_at - s.camera.position))
     notes.push_back(in_file(s.path,
                             "/camera/focus_distance: the aperture is 0 (a pinhole camera, "
                             "everything in focus): the setting has no effect"));
