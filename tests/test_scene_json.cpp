@@ -542,6 +542,37 @@ TEST(SceneJson, ErrorsAreOneLineWhateverTheirNamesHold) {
             "scene\\x1b[31m.json: /shapes/0/material: unknown material 'no\\tsuch'");
 }
 
+// A setting the file's integrator or camera does not read is said when the file is read (the
+// file took rr_depth and mis for whitted, max_depth for direct and a focus_distance with aperture
+// 0 without a word; the command line refuses such options). From the file's own keys and
+// integrator: a path scene's max_depth rendered with `--integrator direct` is not blamed.
+TEST(SceneJson, SettingsThatChangeNothingAreSaid) {
+  auto said = [](const std::string& integrator, const std::string& camera = "") {
+    lucent::test::CaptureWarnings warnings;
+    lucent::parse_scene(R"({"integrator": )" + integrator +
+                            R"(, "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0])" + camera +
+                            "}}",
+                        "scene.json");
+    return warnings.all();
+  };
+  EXPECT_TRUE(said(R"({"type": "path", "max_depth": 5, "rr_depth": 2, "mis": false})").empty());
+  EXPECT_TRUE(said(R"({"type": "whitted", "max_depth": 5})").empty());
+  EXPECT_TRUE(said(R"({"type": "ao", "max_depth": 5})").empty());  // an AOV reads none of them
+  const std::vector<std::string> whitted =
+      said(R"({"type": "whitted", "rr_depth": 2, "mis": true})");
+  ASSERT_EQ(whitted.size(), 2u);
+  EXPECT_EQ(whitted[0],
+            "scene.json: /integrator/rr_depth: only the path integrator has it, and this file's "
+            "integrator is whitted: the setting has no effect");
+  EXPECT_EQ(said(R"({"type": "direct", "max_depth": 3})").size(), 1u);
+  EXPECT_EQ(said(R"({"type": "path"})", R"(, "focus_distance": 3)"),
+            std::vector<std::string>{"scene.json: /camera/focus_distance: the aperture is 0 (a "
+                                     "pinhole camera, everything in focus): the setting has no "
+                                     "effect"});
+  EXPECT_TRUE(said(R"({"type": "path"})", R"(, "focus_distance": 5)").empty());  // the look-at's
+  EXPECT_TRUE(said(R"({"type": "path"})", R"(, "focus_distance": 3, "aperture": 0.1)").empty());
+}
+
 // ---------------------------------------------------------------------------------------------
 // The whole format
 

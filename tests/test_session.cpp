@@ -1246,41 +1246,22 @@ TEST(Session, StoredRoundingLargeAgainstTheSceneWarnsInBothPrecisions) {
   }
 }
 
-// A setting the scene's integrator or camera does not read, given a value other than its default,
-// is said (the scene file took rr_depth and mis for whitted, max_depth for direct and a
-// focus_distance with aperture 0 without a word; the command line refuses such options).
-TEST(Session, SettingsThatChangeNothingAreSaid) {
-  const std::string what = ": the setting has no effect";
-  const Scene plain = lucent::test::scene_from(kScene);
-  auto said = [&](const std::function<void(Scene&)>& edit) {
-    Scene s = plain;
-    edit(s);
-    return warnings_containing(s, lucent::Precision::Float, what);
-  };
-  EXPECT_EQ(said([](Scene&) {}), 0);
-  EXPECT_EQ(said([](Scene& s) { s.integrator.rr_depth = 2; }), 0);  // path reads it
-  EXPECT_EQ(said([](Scene& s) { s.integrator.type = lucent::IntegratorType::Whitted; }), 0);
-  EXPECT_EQ(said([](Scene& s) {
-              s.integrator.type = lucent::IntegratorType::Whitted;
-              s.integrator.rr_depth = 2;
-              s.integrator.mis = false;
-            }),
-            2);
-  EXPECT_EQ(said([](Scene& s) {
-              s.integrator.type = lucent::IntegratorType::Direct;
-              s.integrator.max_depth = 3;
-            }),
-            1);
-  EXPECT_EQ(said([](Scene& s) { s.camera.focus_distance = 3; }), 1);
-  EXPECT_EQ(said([](Scene& s) {  // the look-at distance, the default's (README's example)
-              s.camera.focus_distance = glm::length(s.camera.look_at - s.camera.position);
-            }),
-            0);
-  EXPECT_EQ(said([](Scene& s) {
-              s.camera.focus_distance = 3;
-              s.camera.aperture = 0.1;
-            }),
-            0);
+// An emitter below 1e-18 of the scene's size: light sampling's density (1 / its solid angle)
+// overflows float, and its light is lost in either precision (a sphere light of radius 1e-20 and
+// emission 1e38 rendered black, the reference 5e-4, without a word; the BVH and lights
+// campaigns). Said now; not for a sphere light of 1e-3.
+TEST(Session, EmittersTooSmallForLightSamplingWarn) {
+  const std::string what = "subtends less than light sampling's float density can hold";
+  for (const double radius : {1e-20, 1e-3}) {
+    Scene s = lucent::test::scene_from(kScene);
+    lucent::Material lamp = s.materials[0];
+    lamp.name = "lamp";
+    lamp.emission = {1, 1, 1};
+    s.materials.push_back(lamp);
+    s.spheres.push_back({{0, 2, 0}, radius, static_cast<int>(s.materials.size()) - 1});
+    EXPECT_EQ(warnings_containing(s, lucent::Precision::Float, what), radius < 1e-18 ? 1 : 0)
+        << radius;
+  }
 }
 
 // In float precision the triangle test's products of three coordinate differences underflow in a

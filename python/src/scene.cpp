@@ -874,12 +874,10 @@ py::dict scene_info(const Scene& scene, const TextArg& precision, const FlagArg&
   Scene copy = scene;
   auto packed = with_warnings(std::move(on_warning), [&] {
     scene_detail::validate_scene(copy);  // fields set from Python may index past the lists
-    render_detail::check_packing_host_memory(copy);
+    render_detail::check_packing_host_memory(copy, 2);  // (the caller's scene and this copy)
     render_detail::PackedScene p = render_detail::pack_scene(copy);
     // what a render of it says, as `lucent info` does
     for (const std::string& note : scene_detail::energy_gain_notes(copy)) scene_detail::warn(note);
-    for (const std::string& note : scene_detail::unused_setting_notes(copy))
-      scene_detail::warn(note);
     for (const std::string& note :
          render_detail::packing_notes(copy, p, options.precision == Precision::Float))
       scene_detail::warn(note);

@@ -645,10 +645,9 @@ def test_the_collector_meets_a_subclass_renderer_being_laid_out():
 
 
 def test_scene_info_gives_the_warnings_a_render_gives(small_scene):
-    """scene_info says what a render of the scene says (as `lucent info` does): a setting its
-    integrator does not read, here; it gave only the packing's own warnings."""
-    small_scene.integrator.type = "whitted"
-    small_scene.integrator.rr_depth = 2
+    """scene_info says what a render of the scene says (as `lucent info` does): an albedo above 1,
+    here; it gave only the packing's own warnings."""
+    small_scene.materials[0].albedo = (1.5, 0.5, 0.5)
     got = []
     lucent.scene_info(small_scene, on_warning=got.append)
-    assert any("/integrator/rr_depth: only the path integrator has it" in str(w) for w in got), got
+    assert any("is above 1" in str(w) for w in got), got

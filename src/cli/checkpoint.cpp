@@ -50,6 +50,11 @@ CheckpointLock::CheckpointLock(const std::string& checkpoint)
                           ")");
     struct stat st {};
     const bool regular = ::fstat(fd_, &st) == 0 && S_ISREG(st.st_mode);
+    if (regular && st.st_nlink == 0 && attempt < 100) {
+      // removed by the render that held it since this one opened it: opened again, as below
+      ::close(fd_);
+      continue;
+    }
     if (!regular || st.st_nlink != 1) {
       const bool links = regular && st.st_nlink > 1;
       ::close(fd_);

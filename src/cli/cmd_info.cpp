@@ -112,8 +112,6 @@ int run_info_command() {
   render_detail::PackedScene packed = render_detail::pack_scene(scene);
   // what a render of it says (an albedo above 1, float's rounding, settings that change nothing)
   for (const std::string& note : scene_detail::energy_gain_notes(scene)) scene_detail::warn(note);
-  for (const std::string& note : scene_detail::unused_setting_notes(scene))
-    scene_detail::warn(note);
   for (const std::string& note : render_detail::packing_notes(
            scene, packed, parse_precision(info_args().precision) == Precision::Float))
     scene_detail::warn(note);

@@ -40,8 +40,6 @@ bool square_fits_float(const glm::dvec3& v) {
 RenderResult render_reference(const Scene& scene, const ReferenceOptions& options) {
   scene_detail::validate_scene(scene);  // fields set directly may not have been checked
   for (const std::string& note : scene_detail::energy_gain_notes(scene)) scene_detail::warn(note);
-  for (const std::string& note : scene_detail::unused_setting_notes(scene))
-    scene_detail::warn(note);
   for (const std::string& note : scene_detail::light_notes(scene)) scene_detail::warn(note);
   for (const std::string& note : scene_detail::radiance_notes(scene)) scene_detail::warn(note);
   const int W = scene.film.width, H = scene.film.height;

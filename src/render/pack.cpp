@@ -363,12 +363,40 @@ std::string stored_rounding_note(const Scene& scene) {
   return buf;
 }
 
+std::string tiny_emitter_note(const PackedScene& packed) {
+  double diagonal = 0;  // of the scene's bounds
+  for (int c = 0; c < 3; ++c) {
+    const double e = double(packed.bounds_max[c]) - packed.bounds_min[c];
+    diagonal += e * e;
+  }
+  diagonal = std::sqrt(diagonal);
+  double smallest = INFINITY;  // an emitter's size: a sphere's radius, a triangle's sqrt(area)
+  for (const lc_light& l : packed.lights) {
+    if (l.type == LC_LIGHT_SPHERE && l.p.sphere.sphere < packed.spheres.size())
+      smallest = std::min(smallest, double(packed.spheres[l.p.sphere.sphere].radius));
+    if (l.type == LC_LIGHT_TRIANGLE)
+      smallest = std::min(smallest, std::sqrt(double(l.p.triangle.area)));
+  }
+  // light sampling's density, 1 / the emitter's solid angle, is a float: past 3.4e38 (an emitter
+  // below about 1e-19 of its distance) it is infinite and the sample gives nothing (a sphere light
+  // of radius 1e-20 with emission 1e38 rendered black, the reference 5e-4; at 1e-19 2.7% dark)
+  if (!(diagonal > 0) || !(smallest < 1e-18 * diagonal)) return "";
+  char buf[600];
+  std::snprintf(buf, sizeof buf,
+                "an emitter of size %.2g in a scene of size %.3g subtends less than light "
+                "sampling's float density can hold: its light may be lost in either precision (a "
+                "sphere light of radius 1e-20 rendered black); make it larger and dimmer, or use a "
+                "point light",
+                smallest, diagonal);
+  return buf;
+}
+
 std::vector<std::string> packing_notes(const Scene& scene, const PackedScene& packed,
                                        bool float_arithmetic) {
   std::vector<std::string> notes;
-  for (std::string note :
-       {float_arithmetic ? float_rounding_note(packed) : std::string(), stored_rounding_note(scene),
-        emitter_cut_note(packed, float_arithmetic), point_light_note(packed, float_arithmetic)})
+  for (std::string note : {float_arithmetic ? float_rounding_note(packed) : std::string(),
+                           stored_rounding_note(scene), emitter_cut_note(packed, float_arithmetic),
+                           point_light_note(packed, float_arithmetic), tiny_emitter_note(packed)})
     if (!note.empty()) notes.push_back(scene_detail::in_file(scene.path, note));
   return notes;
 }

@@ -62,9 +62,16 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous = nullptr
 /// differences underflow float (a Cornell box at 1e-16 rendered black, at 1e-15 half as bright).
 std::string float_rounding_note(const PackedScene& packed);
 
+/// An emitter (a sphere light's radius, a triangle light's square root of area) below 1e-18 of
+/// the scene's size: light sampling's density, 1 / its solid angle, overflows float there and
+/// its samples give nothing, in either precision (a sphere light of radius 1e-20 rendered black).
+/// A warning's text, or "".
+std::string tiny_emitter_note(const PackedScene& packed);
+
 /// The notes above that apply to `packed` (pack_scene of `scene`), each "<scene path>: ...":
-/// float_rounding_note with float arithmetic, stored_rounding_note, emitter_cut_note and
-/// point_light_note. What a render says once its scene is packed, and `lucent info` with it.
+/// float_rounding_note with float arithmetic, stored_rounding_note, emitter_cut_note,
+/// point_light_note and tiny_emitter_note. What a render says once its scene is packed, and `lucent
+/// info` with it.
 std::vector<std::string> packing_notes(const Scene& scene, const PackedScene& packed,
                                        bool float_arithmetic);
 

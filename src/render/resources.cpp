@@ -292,12 +292,12 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
   check_host_parts(scene, parts, host_limit, limit_what, devices.empty());
 }
 
-void check_packing_host_memory(const Scene& scene) {
+void check_packing_host_memory(const Scene& scene, int description_copies) {
   std::string what;
   const std::uint64_t limit = host_memory_allowed(&what);
   if (limit == 0) return;
   std::vector<MemoryPart> parts;  // the estimate less the film's parts (their reduce names it)
-  for (MemoryPart& p : estimate_host_memory(scene, {}, 1))
+  for (MemoryPart& p : estimate_host_memory(scene, {}, description_copies))
     if (p.reduce.rfind("the film size", 0) != 0) parts.push_back(std::move(p));
   check_host_parts(scene, parts, limit, what, false, "packing it (its BVH and buffers)");
 }

@@ -138,8 +138,9 @@ void check_host_memory(const Scene& scene, const std::vector<DeviceLimits>& devi
 /// Before pack_scene outside a render (lucent info, Python's scene_info): throws lucent::Error as
 /// check_host_memory does when the packed scene and its BVH, beside the description, exceed
 /// host_memory_allowed() (info built 6.9M triangles' BVH past the limit, then said only "out of
-/// memory", where render refused at once).
-void check_packing_host_memory(const Scene& scene);
+/// memory", where render refused at once). `description_copies`: the scene descriptions held
+/// (Python's scene_info packs a copy of the caller's: 2).
+void check_packing_host_memory(const Scene& scene, int description_copies = 1);
 
 /// What the scene description's arrays hold on the host (their capacities), in bytes.
 std::uint64_t description_bytes(const Scene& scene);

@@ -583,8 +583,6 @@ struct Renderer::Impl {
       scene_detail::ScopedWarningSink capture(notes.collect());
       scene_detail::validate_scene(s);  // fields set directly may not have been checked
       for (const std::string& note : scene_detail::energy_gain_notes(s)) scene_detail::warn(note);
-      for (const std::string& note : scene_detail::unused_setting_notes(s))
-        scene_detail::warn(note);
       for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
       render_detail::check_host_memory(s, limits, limits.front().host_mem, limits.front().host_what,
                                        render_detail::reserved_part(options.reserved_host_bytes),

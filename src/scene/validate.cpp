@@ -10,7 +10,6 @@
 
 #include "lucent/error.hpp"
 #include "lucent/types.hpp"
-#include "render/integrator_knobs.hpp"
 #include "scene/loaders.hpp"
 #include "scene/material_type.hpp"
 
@@ -664,39 +663,6 @@ std::vector<std::string> radiance_notes(const Scene& s) {
                                         "below 7e-46), and so is the light it gives (raise it and "
                                         "lower film.exposure)"));
   }
-  return notes;
-}
-
-std::vector<std::string> unused_setting_notes(const Scene& s) {
-  std::vector<std::string> notes;
-  const Integrator defaults;
-  const Integrator& in = s.integrator;
-  // (an AOV reads none of them: `--aov` renders a path scene's AOVs, which are no one's mistake)
-  if (is_aov(in.type)) return notes;
-  using render_detail::IntegratorKnob;
-  const struct {
-    bool set;
-    IntegratorKnob knob;
-    const char* key;
-  } knobs[] = {{in.max_depth != defaults.max_depth, IntegratorKnob::MaxDepth, "max_depth"},
-               {in.rr_depth != defaults.rr_depth, IntegratorKnob::RrDepth, "rr_depth"},
-               {in.mis != defaults.mis, IntegratorKnob::Mis, "mis"},
-               {in.clamp != defaults.clamp, IntegratorKnob::Clamp, "clamp"},
-               {in.caustics != defaults.caustics, IntegratorKnob::Caustics, "caustics"},
-               {in.dielectric_splits != defaults.dielectric_splits, IntegratorKnob::Splits,
-                "dielectric_splits"}};
-  for (const auto& k : knobs)
-    if (k.set)
-      if (const char* why = render_detail::knob_ignored(in.type, k.knob))
-        notes.push_back(in_file(s.path, std::string("/integrator/") + k.key + ": " + why +
-                                            ", and this scene's integrator is " +
-                                            type_name(in.type) + ": the setting has no effect"));
-  // (the look-at distance is the default's, which README's example spells out)
-  if (s.camera.focus_distance > 0 && !(s.camera.aperture > 0) &&
-      s.camera.focus_distance != glm::length(s.camera.look_at - s.camera.position))
-    notes.push_back(in_file(s.path,
-                            "/camera/focus_distance: the aperture is 0 (a pinhole camera, "
-                            "everything in focus): the setting has no effect"));
   return notes;
 }
 

@@ -144,13 +144,6 @@ void validate_scene(const Scene& scene);
 /// each once (Renderer::set_scene), the reference each time.
 std::vector<std::string> energy_gain_notes(const Scene& scene);
 
-/// Settings that change nothing for the scene's integrator or camera (render_detail::
-/// knob_ignored: rr_depth or mis for whitted, max_depth for direct; focus_distance with aperture
-/// 0), when they differ from their defaults: one warning's text each (none for the AOV
-/// integrators, which read none of them: --aov renders a path scene's). The scene file accepted
-/// them without a word (the command line refuses its options for the wrong integrator).
-std::vector<std::string> unused_setting_notes(const Scene& scene);
-
 /// A light-transport integrator's black image, said rather than silently rendered: "the scene
 /// has no light" (no light entry and no shape of an emissive material), or "every light of the
 /// scene emits nothing" (point intensities and environment radiances of 0, environment maps
