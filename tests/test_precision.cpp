@@ -178,6 +178,19 @@ TEST(Precision, Cli) {
   EXPECT_EQ(finfo.out.find("LC_DOUBLE"), std::string::npos) << finfo.out;
 }
 
+/// Renders `s` with the kernel in double (`spp`, `seed`) and the reference (`spp`, seed + 1), and
+/// expects the same image (two-sample z-test, see the top); returns the kernel's render.
+RenderResult expect_double_matches_reference(const Scene& s, int spp, std::uint32_t seed) {
+  RenderResult k = render(s, spp, seed, Precision::Double);
+  Scene rs = s;
+  rs.integrator.seed = seed + 1;
+  lucent::ReferenceOptions ro;
+  ro.spp = spp;
+  const RenderResult r = lucent::render_reference(rs, ro);
+  EXPECT_SAME_IMAGE(k, r, "A = kernel in double, B = reference");
+  return k;
+}
+
 // ------------------------------------------------------------------------------------------
 // The kernel in double against the scalar reference (double throughout): spheres and triangles,
 // point, sphere and triangle lights with MIS, a constant environment, a mirror and a glass sphere
@@ -210,13 +223,7 @@ TEST(PrecisionDouble, KernelMatchesReference) {
     "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [30, 28, 25]},
                {"type": "environment", "radiance": [0.25, 0.3, 0.4]}]
   })");
-  RenderResult k = render(s, 256, 11, Precision::Double);
-  Scene rs = s;
-  rs.integrator.seed = 12;
-  lucent::ReferenceOptions ro;
-  ro.spp = 256;
-  RenderResult r = lucent::render_reference(rs, ro);
-  EXPECT_SAME_IMAGE(k, r, "A = kernel in double, B = reference");
+  expect_double_matches_reference(s, 256, 11);
 }
 
 // The only light an emissive triangle that the rounding of its vertices to float makes collinear
@@ -238,16 +245,10 @@ TEST(PrecisionDouble, AnEmitterCollinearOnlyInFloatStillLights) {
                 "positions": [[-0.5,1.5,1004],[0.5,1.5,1004],[0,1.5,1004.00001]],
                 "indices": [0,1,2]}]
   })");
-  RenderResult k = render(s, 64, 31, Precision::Double);
-  Scene rs = s;
-  rs.integrator.seed = 32;
-  lucent::ReferenceOptions ro;
-  ro.spp = 64;
-  RenderResult r = lucent::render_reference(rs, ro);
+  RenderResult k = expect_double_matches_reference(s, 64, 31);
   double sum = 0;
   for (float v : k.mean.rgb) sum += v;
   EXPECT_GT(sum, 0.0) << "a black image";
-  EXPECT_SAME_IMAGE(k, r, "A = kernel in double, B = reference");
 }
 
 // Thin-lens camera rays in double (the direct integrator: point lights only): same test.
@@ -266,13 +267,7 @@ TEST(PrecisionDouble, ThinLensMatchesReference) {
                {"type": "sphere", "center": [0.9, 0.5, 2.4], "radius": 0.5, "material": "red"}],
     "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [30, 28, 25]}]
   })");
-  RenderResult k = render(s, 256, 21, Precision::Double);
-  Scene rs = s;
-  rs.integrator.seed = 22;
-  lucent::ReferenceOptions ro;
-  ro.spp = 256;
-  RenderResult r = lucent::render_reference(rs, ro);
-  EXPECT_SAME_IMAGE(k, r, "A = kernel in double, B = reference");
+  expect_double_matches_reference(s, 256, 21);
 }
 
 // The Whitted integrator in double (reflected and refracted rays spawned from its explicit
@@ -295,13 +290,7 @@ TEST(PrecisionDouble, WhittedMatchesReference) {
     "lights": [{"type": "point", "position": [2, 4, 3], "intensity": [30, 28, 25]},
                {"type": "environment", "radiance": [0.25, 0.3, 0.4]}]
   })");
-  RenderResult k = render(s, 64, 31, Precision::Double);
-  Scene rs = s;
-  rs.integrator.seed = 32;
-  lucent::ReferenceOptions ro;
-  ro.spp = 64;
-  RenderResult r = lucent::render_reference(rs, ro);
-  EXPECT_SAME_IMAGE(k, r, "A = kernel in double, B = reference");
+  expect_double_matches_reference(s, 64, 31);
 }
 
 // ------------------------------------------------------------------------------------------
