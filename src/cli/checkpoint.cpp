@@ -194,21 +194,22 @@ lucent::RenderPart Checkpoint::whole(const lucent::Renderer& renderer) const {
 }
 
 bool Checkpoint::save(const lucent::RenderPart& part) {
-  bool ok = true;
+  std::string failure;
   try {
     // PIZ: a render pauses for the write (and a stopped job's SIGKILL may follow soon), and reads
     // the file once
     lucent::write_render_part(path_, part, lucent::PartCompression::piz);
   } catch (const lucent::Error& e) {
-    std::fprintf(stderr, "%s: warning: checkpoint not written: %s\n", program_.c_str(),
-                 one_line(e.what()).c_str());
-    ok = false;
+    failure = one_line(e.what());
   } catch (const std::bad_alloc&) {
     // (the encoder's buffers, under an address-space limit tighter than the count)
-    std::fprintf(stderr, "%s: warning: checkpoint not written: %s: out of memory\n",
-                 program_.c_str(), one_line(path_).c_str());
-    ok = false;
+    failure = one_line(path_) + ": out of memory";
   }
+  const bool ok = failure.empty();
+  if (!ok && failure != failed_)
+    std::fprintf(stderr, "%s: warning: checkpoint not written: %s\n", program_.c_str(),
+                 failure.c_str());
+  failed_ = failure;
   if (ok) held_ = part.info.samples.empty() ? begin_ : part.info.samples.back().end;
   ours_ = ours_ || ok;
   last_ = std::chrono::steady_clock::now();

@@ -77,7 +77,9 @@ class Checkpoint {
   lucent::RenderPart whole(const lucent::Renderer& renderer) const;
 
   /// Writes `part` to the checkpoint, atomically; a failure (a full disk) is a warning: the
-  /// render goes on, and the previous checkpoint stays as it was.
+  /// render goes on, and the previous checkpoint stays as it was. The warning is said once for
+  /// failures in a row that say the same (a full disk with --checkpoint-every 0.05 said it at
+  /// every interval), and again after a write that succeeded.
   bool save(const lucent::RenderPart& part);
   /// save(), unless the file holds the part's samples already (written by the last checkpoint,
   /// or read); true when the file holds them after it.
@@ -115,7 +117,8 @@ class Checkpoint {
   std::chrono::steady_clock::time_point last_;
   std::uint64_t saved_spp_ = 0;  ///< the session's samples per pixel in the last checkpoint
   std::uint64_t held_ = 0;
-  bool ours_ = false;  ///< the file at path_ is this render's: resumed from, or written
+  bool ours_ = false;   ///< the file at path_ is this render's: resumed from, or written
+  std::string failed_;  ///< the last write's failure, said; empty after a write succeeded
   std::optional<CheckpointLock> lock_;
 };
 
