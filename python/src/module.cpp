@@ -535,10 +535,22 @@ void reduce_in_every_protocol(py::module_& m) {
   // a Python subclass's state is ("lucent.subclass", the class's state, its __dict__), which
   // each bound class's __setstate__ reads (the attributes after the object exists: pickle and
   // deepcopy have memoized it, so attributes that refer back to it do so); any other state goes
-  // to the class's own __setstate__, as before (old pickles load)
-  py::exec(R"(
-def _subclass_setstate(original):
+  // to the class's own __setstate__, as before (old pickles load). On an object that exists
+  // already (made by its constructor, or set before) pybind11 skips the call and returns None:
+  // `scene.__setstate__(other.__getstate__())` left the scene as it was without a word; it is
+  // refused
+  m.def("_constructed", [](py::handle self) {
+    auto* inst = reinterpret_cast<py::detail::instance*>(self.ptr());
+    return inst->get_value_and_holder().holder_constructed();
+  });
+  py::exec(R"py(
+def _subclass_setstate(original, constructed):
     def __setstate__(self, state):
+        if constructed(self):
+            name = type(self).__name__
+            raise TypeError(f"{name}.__setstate__: this {name} exists already; its state is set "
+                            "only on the object that pickle or copy makes (pickle.loads, "
+                            "copy.copy)")
         if type(state) is tuple and len(state) == 3 and state[0] == "lucent.subclass":
             original(self, state[1])
             self.__dict__.update(state[2])
@@ -546,10 +558,12 @@ def _subclass_setstate(original):
             original(self, state)
     __setstate__.__doc__ = original.__doc__
     return __setstate__
-)",
+)py",
            m.attr("__dict__"));
   const py::object subclass_setstate = m.attr("_subclass_setstate");
+  const py::object constructed = m.attr("_constructed");
   py::delattr(m, "_subclass_setstate");
+  py::delattr(m, "_constructed");
   const py::object newobj = py::module_::import("copyreg").attr("__newobj__");
   const auto is_bound = [](py::handle cls) {
     return PyType_Check(cls.ptr()) &&
@@ -589,7 +603,7 @@ def _subclass_setstate(original):
       }
     } else if (py::hasattr(cls, "__setstate__")) {
       // a Python subclass's attributes (its __dict__) come back too (the state alone lost them)
-      cls.attr("__setstate__") = subclass_setstate(cls.attr("__setstate__"));
+      cls.attr("__setstate__") = subclass_setstate(cls.attr("__setstate__"), constructed);
       set_reduce(cls, [newobj](py::handle self) -> py::object {
         py::object state = self.attr("__getstate__")();
         const py::object attributes = py::getattr(self, "__dict__", py::none());

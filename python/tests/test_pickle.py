@@ -277,6 +277,27 @@ def test_a_forked_worker_of_a_process_that_used_opencl_is_refused(small_scene):
     assert 'multiprocessing.get_context("spawn")' in there
 
 
+def test_setstate_on_an_object_that_exists_is_refused(rich_scene):
+    # pybind11 skips a __setstate__ on an object its constructor made and returns None: the
+    # scene stayed as it was without a word
+    s, other = rich_scene, lucent.Scene()
+    before = s.__getstate__()
+    values = [(s, other), (lucent.Vec3((1, 2, 3)), lucent.Vec3((4, 5, 6))),
+              (lucent.Camera(), s.camera), (lucent.RenderResult(np.zeros((1, 1, 3))),
+                                            lucent.RenderResult(np.ones((2, 1, 3))))]
+    for mine, theirs in values:
+        name = type(mine).__name__
+        with pytest.raises(TypeError, match=f"^{name}.__setstate__: this {name} exists already"):
+            mine.__setstate__(theirs.__getstate__())
+    same(before, s.__getstate__())
+    # the object pickle makes is set, once
+    fresh = lucent.Scene.__new__(lucent.Scene)
+    fresh.__setstate__(before)
+    same(before, fresh.__getstate__())
+    with pytest.raises(TypeError, match="exists already"):
+        fresh.__setstate__(other.__getstate__())
+
+
 @pytest.mark.parametrize("name, round_trip", round_trips())
 def test_a_render_result_round_trips_exactly(renderer, small_scene, name, round_trip):
     renderer.set_scene(small_scene)
