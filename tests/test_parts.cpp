@@ -1241,13 +1241,23 @@ TEST(Parts, MpiFailingRankEndsTheJobWithoutOutput) {
                        "(its arguments are not rank 0's)"),
             std::string::npos)
       << r.err;
-  r = run_shell(mpirun("-np 1 " + prog + " --spp 8 : -np 1 " + prog + " --spp 100"), dir);
-  EXPECT_NE(r.status, 0);
-  EXPECT_NE(r.err.find("rank 1 was given samples [50, 100), its share of rank 0's is [4, 8) "
-                       "(another --spp?)"),
-            std::string::npos)
-      << r.err;
-  EXPECT_FALSE(fs::exists(out));
+  // (refused before rendering, as a rank of another seed, precision or scene: each rendered its
+  // whole share, hours on a cluster, before rank 0 refused its part; here a render of 1.6e7 spp
+  // would outlast the timeout)
+  const std::pair<std::string, std::string> differ[] = {
+      {" --spp 8 : -np 1 " + prog + " --spp 100",
+       "rank 1 is given samples [50, 100), its share of rank 0's is [4, 8) (another --spp?)"},
+      {" --spp 16000000 : -np 1 " + prog + " --spp 16000000 --seed 5",
+       "rank 1: seed 5 differs from rank 0's 3"},
+      {" --spp 16000000 : -np 1 " + prog + " --spp 16000000 --precision double",
+       "rank 1: scene hash "}};
+  for (const auto& [args, says] : differ) {
+    r = run_shell("timeout 60 env " + mpirun("-np 1 " + prog + args), dir);
+    EXPECT_EQ(r.status, 1) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find("lucent-mpi: error: rank 0 of 2 ("), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
   // a rank that stops early (here by a time limit that rank 0 has not): the image is written,
   // and the exit status and the last line say that samples are missing
   r = run_shell(mpirun("-np 1 " + prog + " --spp 8 : -np 1 " + prog + " --spp 8 --time 1e-9"), dir);
@@ -1387,6 +1397,69 @@ TEST(Parts, MpiSigtermToMpirunWritesWhatTheRanksRendered) {
       << text;
 }
 
+// scripts/slurm/mpi.sbatch: Slurm's SIGTERM to the batch shell (--signal=B:TERM) reaches the
+// ranks, which write their checkpoints and the partial output (exec: mpirun is the shell; a bash
+// that ran mpirun in the foreground died on it without passing it on, the ranks rendering on).
+TEST(Parts, SlurmMpiScriptPassesTheStopToTheRanks) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  const std::string out = dir + "/mpi.exr", ck = dir + "/ck.exr", err = dir + "/mpi.err";
+  const std::string script = dir + "/stop.sh";
+  // (a grace of 2 s, not the script's 30)
+  lucent::test::write_file(
+      script,
+      "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+      "OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_odls_base_sigkill_timeout=2 "
+      "MPIRUN_ARGS='--oversubscribe -np 2' MPIRUN='" +
+          std::string(LUCENT_MPIEXEC) + "' LUCENT_MPI='" + LUCENT_MPI_PATH + "' bash " +
+          q(lucent::test::source_path("scripts/slurm/mpi.sbatch")) + " " + q(scene) + " " + q(out) +
+          " " + q(ck) + " --spp 16000000 2>" + q(err) +
+          " </dev/null & pid=$!\nfor i in $(seq 600); do grep -q 'rank 0 of 2:' " + q(err) +
+          " && break; sleep 0.1; done\nkill -TERM $pid\nwait $pid\n");
+  int raw = std::system(("timeout 120 bash " + q(script)).c_str());
+  ASSERT_TRUE(WIFEXITED(raw));
+  const std::string text = lucent::test::read_file(err);
+  EXPECT_NE(WEXITSTATUS(raw), 0) << text;
+  ASSERT_TRUE(fs::exists(out)) << text;
+  EXPECT_EQ(lucent::read_part_info(out).samples.size(), 2u) << text;
+  for (int r = 0; r < 2; ++r) {
+    const std::string rank = dir + "/ck.rank" + std::to_string(r) + "-of-2.exr";
+    ASSERT_TRUE(fs::exists(rank)) << text;
+    EXPECT_EQ(lucent::read_part_info(rank).samples.size(), 1u) << text;
+  }
+  EXPECT_NE(text.find("the same command with 2 ranks resumes the render"), std::string::npos)
+      << text;
+}
+
+// A stop signal to one rank alone (a node drained) is an interruption of the job, whether or not
+// --time was given: under --time the image was written short with exit 0 and no word, its
+// missing samples taken for the time limit's.
+TEST(Parts, MpiSigtermToOneRankUnderATimeLimitIsAnInterruption) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  const std::string out = dir + "/mpi.exr", err = dir + "/mpi.err";
+  const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) +
+                           " --spp 16000000 --time 3 -o " + q(out);
+  // rank 1's command line ends in -q (mpirun's holds it too, but does not start with the program)
+  const std::string script = dir + "/stop.sh";
+  lucent::test::write_file(
+      script, mpirun("-np 1 " + prog + " : -np 1 " + prog + " -q") + " 2>" + q(err) +
+                  " </dev/null & pid=$!\nfor i in $(seq 600); do grep -q 'rank 0 of 2:' " + q(err) +
+                  " && break; sleep 0.1; done\npkill -TERM -f " +
+                  q("^" + std::string(LUCENT_MPI_PATH) + " .* -q$") + "\nwait $pid\n");
+  int raw = std::system(("bash " + q(script)).c_str());
+  ASSERT_TRUE(WIFEXITED(raw));
+  const std::string text = lucent::test::read_file(err);
+  EXPECT_EQ(WEXITSTATUS(raw), 143) << text;
+  ASSERT_TRUE(fs::exists(out)) << text;
+  EXPECT_NE(text.find("lucent-mpi: interrupted (a stop signal on rank 1 of 2): " + out +
+                      " holds samples [0, "),
+            std::string::npos)
+      << text;
+}
+
 /// The names in `dir` that contain `part`.
 std::vector<std::string> names_with(const std::string& dir, const std::string& part) {
   std::vector<std::string> names;
@@ -1461,9 +1534,27 @@ TEST(Parts, MpiSceneErrorsAreOneLine) {
   const std::string kernels = lucent::test::kernel_copy();
   std::ofstream(kernels + "/megakernel.cl", std::ios::app) << "\nlucent_injected_error here;\n";
   const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' ";
+  // a scene with light-traced caustics (scenes/course.json): refused, and rendered with
+  // --no-caustics (ranks could not render it without editing the file)
+  std::string text = lucent::test::read_file(scene);
+  const auto edit = [&text](const std::string& from, const std::string& to) {
+    text.replace(text.find(from), from.size(), to);
+  };
+  edit("\"spp\": 8", "\"spp\": 8, \"caustics\": true");
+  edit("\"materials\": {", "\"materials\": {\"glass\": {\"type\": \"dielectric\", \"ior\": 1.5}, ");
+  edit("\"radius\": 0.5, \"material\": \"m\"", "\"radius\": 0.5, \"material\": \"glass\"");
+  const std::string caustics = dir + "/caustics.json";
+  lucent::test::write_file(caustics, text);
+  CommandResult r =
+      run_shell(mpirun("-np 2 " + prog + q(caustics) + " --no-caustics -o " + q(out)), dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out)) << r.err;
+  fs::remove(out);
   const std::pair<std::string, std::string> cases[] = {
       {q(dir + "/none.json") + " -o " + q(out), "none.json: cannot open scene file"},
       {q(scene) + " --spp 1 -o " + q(out), "2 ranks for 1 samples per pixel"},
+      {q(caustics) + " -o " + q(out),
+       "integrator.caustics: part files and MPI ranks cannot hold light-traced caustics yet"},
       {"-x LUCENT_KERNEL_DIR=" + q(kernels) + " " + prog + q(scene) + " -o " + q(out),
        "megakernel.cl:"}};
   for (const auto& [args, says] : cases) {

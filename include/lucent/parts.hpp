@@ -69,6 +69,11 @@ struct RenderPart {
 /// not per-pixel samples. Called by make_part, and by front ends before they render.
 void check_part_scene(const Scene& scene, const std::string& scene_path);
 
+/// The header of the part `renderer` makes of `requested`, without its samples (no sample
+/// range, no counts, no sums copied): to check parts against each other before rendering them.
+PartInfo part_header(const Renderer& renderer, const SampleRange& requested,
+                     const std::string& scene_path);
+
 /// The part a session holds after reset(range.begin) and render(range.end - range.begin),
 /// possibly cut short: samples [first_sample, first_sample + spp) of `requested`. `scene_path`
 /// is recorded for information.

@@ -148,8 +148,8 @@ void Checkpoint::check(const lucent::Renderer& renderer, std::uint64_t target) {
                         ", K) (a part of `lucent render --samples`, or a lucent-mpi rank's "
                         "checkpoint: of another rank, or of another --spp, which moves the ranks' "
                         "shares?)");
-  lucent::PartMerger merger;  // (the session's part holds no sample yet)
-  merger.add_header(scene_, lucent::make_part(renderer, requested(renderer), scene_).info);
+  lucent::PartMerger merger;  // (the session holds no sample yet: its header, no sums copied)
+  merger.add_header(scene_, lucent::part_header(renderer, requested(renderer), scene_));
   merger.check(path_, *header_);
   if (target > 0 && first_sample() > target)
     throw lucent::Error(path_ + ": holds " + std::to_string(first_sample() - begin_) +

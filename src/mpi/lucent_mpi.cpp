@@ -179,6 +179,7 @@ struct Args {
   long long seed = -1;
   double time_limit = 0;
   bool fast_math = false, quiet = false;
+  bool no_caustics = false;     ///< integrator.caustics off (ranks cannot hold light tracing's)
   std::string checkpoint;       ///< CK: each rank's checkpoint is rank_checkpoint(CK, r, K)
   double checkpoint_every = 0;  ///< seconds; 0: not given
 };
@@ -245,19 +246,81 @@ struct Header {
   char integrator[32];
 };
 
-void send_part(const lucent::RenderPart& p) {
+Header to_header(const lucent::PartInfo& info) {
   Header h{};
-  h.width = p.info.width;
-  h.height = p.info.height;
-  h.hash = p.info.scene_hash;
-  h.seed = p.info.seed;
-  if (!p.info.samples.empty()) h.begin = p.info.samples[0].begin, h.end = p.info.samples[0].end;
-  h.req_begin = p.info.requested[0].begin;
-  h.req_end = p.info.requested[0].end;
-  h.nonfinite = p.info.nonfinite;
-  h.rays = p.info.rays;
-  h.seconds = p.info.seconds;
-  std::strncpy(h.integrator, p.info.integrator.c_str(), sizeof h.integrator - 1);
+  h.width = info.width;
+  h.height = info.height;
+  h.hash = info.scene_hash;
+  h.seed = info.seed;
+  if (!info.samples.empty()) h.begin = info.samples[0].begin, h.end = info.samples[0].end;
+  h.req_begin = info.requested[0].begin;
+  h.req_end = info.requested[0].end;
+  h.nonfinite = info.nonfinite;
+  h.rays = info.rays;
+  h.seconds = info.seconds;
+  std::strncpy(h.integrator, info.integrator.c_str(), sizeof h.integrator - 1);
+  return h;
+}
+
+/// Rank `from`'s header `h` as a PartInfo, its film and its share checked against rank 0's
+/// (`mine`, whose share for `from` is `expected`); the rest (seed, integrator, scene hash) is
+/// PartMerger's to check. The fields that are not sent (display, version, scene) are rank 0's.
+lucent::PartInfo check_header(Header h, int from, const lucent::PartInfo& mine,
+                              const lucent::SampleRange& expected) {
+  if (h.width != std::uint64_t(mine.width) || h.height != std::uint64_t(mine.height))
+    throw lucent::Error("rank " + std::to_string(from) + " renders a " + std::to_string(h.width) +
+                        "x" + std::to_string(h.height) + " film, rank 0 " +
+                        std::to_string(mine.width) + "x" + std::to_string(mine.height));
+  // its share of rank 0's samples per pixel (another --spp made a merge with a gap, exit 0)
+  if (h.req_begin != expected.begin || h.req_end != expected.end)
+    throw lucent::Error("rank " + std::to_string(from) + " is given samples " +
+                        lucent::range_text({h.req_begin, h.req_end}) +
+                        ", its share of rank 0's is " + lucent::range_text(expected) +
+                        " (another --spp?)");
+  lucent::PartInfo info = mine;
+  info.scene_hash = h.hash;
+  info.seed = static_cast<std::uint32_t>(h.seed);
+  info.samples.clear();
+  if (h.end > h.begin) info.samples.push_back({h.begin, h.end});
+  info.requested = {{h.req_begin, h.req_end}};
+  info.nonfinite = h.nonfinite;
+  info.rays = h.rays;
+  info.seconds = h.seconds;
+  h.integrator[sizeof h.integrator - 1] = 0;
+  info.integrator = h.integrator;
+  return info;
+}
+
+/// Before rendering: every rank's part header (film, share, seed, integrator, scene hash) agrees
+/// with rank 0's, or rank 0 throws naming the first rank that differs. A node with another scene
+/// file, --seed, --spp or --precision rendered its whole share, for hours, before rank 0 refused
+/// its part (and with --checkpoint again at every rerun).
+/// (A rank whose header cannot be made sends an empty one, which rank 0 skips, and then throws:
+/// its own line.)
+void check_headers(const std::function<lucent::PartInfo()>& header,
+                   const std::function<lucent::SampleRange(int)>& share) {
+  std::optional<lucent::PartInfo> info;
+  std::exception_ptr failure;
+  try {
+    info = header();
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  const Header h = info ? to_header(*info) : Header{};
+  std::vector<Header> all(g_rank == 0 ? g_size : 0);
+  MPI_Gather(&h, sizeof h, MPI_BYTE, all.data(), sizeof h, MPI_BYTE, 0, MPI_COMM_WORLD);
+  if (failure) std::rethrow_exception(failure);
+  if (g_rank != 0) return;
+  lucent::PartMerger merger;
+  merger.add_header("rank 0", *info);
+  for (int r = 1; r < g_size; ++r)
+    if (all[size_t(r)].width > 0)
+      merger.add_header("rank " + std::to_string(r),
+                        check_header(all[size_t(r)], r, *info, share(r)));
+}
+
+void send_part(const lucent::RenderPart& p) {
+  const Header h = to_header(p.info);
   MPI_Send(&h, sizeof h, MPI_BYTE, 0, 0, MPI_COMM_WORLD);
   MPI_Send(p.acc.sum.data(), static_cast<int>(p.acc.sum.size()), MPI_DOUBLE, 0, 1, MPI_COMM_WORLD);
   MPI_Send(p.acc.sumsq.data(), static_cast<int>(p.acc.sumsq.size()), MPI_DOUBLE, 0, 2,
@@ -266,33 +329,18 @@ void send_part(const lucent::RenderPart& p) {
            MPI_COMM_WORLD);
 }
 
-/// Rank `from`'s part; the header fields that are not sent (display, version, scene) are
-/// rank 0's.
+/// Rank `from`'s part, its film and share checked (check_headers() checked them before
+/// rendering; the merger checks the rest).
 lucent::RenderPart receive_part(int from, const lucent::PartInfo& mine,
                                 const lucent::SampleRange& expected) {
   Header h{};
   MPI_Recv(&h, sizeof h, MPI_BYTE, from, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-  if (h.width != std::uint64_t(mine.width) || h.height != std::uint64_t(mine.height))
-    fail("rank " + std::to_string(from) + " rendered a " + std::to_string(h.width) + "x" +
-         std::to_string(h.height) + " film, rank 0 " + std::to_string(mine.width) + "x" +
-         std::to_string(mine.height));
-  // its share of rank 0's samples per pixel (another --spp made a merge with a gap, exit 0)
-  if (h.req_begin != expected.begin || h.req_end != expected.end)
-    fail("rank " + std::to_string(from) + " was given samples " +
-         lucent::range_text({h.req_begin, h.req_end}) + ", its share of rank 0's is " +
-         lucent::range_text(expected) + " (another --spp?)");
   lucent::RenderPart p;
-  p.info = mine;
-  p.info.scene_hash = h.hash;
-  p.info.seed = static_cast<std::uint32_t>(h.seed);
-  p.info.samples.clear();
-  if (h.end > h.begin) p.info.samples.push_back({h.begin, h.end});
-  p.info.requested = {{h.req_begin, h.req_end}};
-  p.info.nonfinite = h.nonfinite;
-  p.info.rays = h.rays;
-  p.info.seconds = h.seconds;
-  h.integrator[sizeof h.integrator - 1] = 0;
-  p.info.integrator = h.integrator;
+  try {
+    p.info = check_header(h, from, mine, expected);
+  } catch (const lucent::Error& e) {
+    fail(e.what());
+  }
   const size_t npix = static_cast<size_t>(mine.width) * mine.height;
   p.acc.width = mine.width;
   p.acc.height = mine.height;
@@ -322,6 +370,7 @@ int run(const Args& a) {
         if (a.width > 0) scene.film.width = a.width;
         if (a.height > 0) scene.film.height = a.height;
         if (a.seed >= 0) scene.integrator.seed = static_cast<std::uint32_t>(a.seed);
+        if (a.no_caustics) scene.integrator.caustics = false;
         // nor a file the scene reads (a texture or mesh: rank 0 replaced it)
         if (root)
           lucent::io::check_output_path(a.output,
@@ -449,6 +498,10 @@ int run(const Args& a) {
   // a rank stopped before rendering ends the job, every rank with 128 + the signal: nothing was
   // rendered, and a rank that went on alone would wait for the others for ever
   if (const int sig = stopped_before_rendering(); sig > 0) return 128 + sig;
+  if (refused([&] {
+        check_headers([&] { return lucent::part_header(renderer, range, a.scene); }, share);
+      }))
+    return 1;
   renderer.reset(range.begin);
   // a checkpoint of another image, of other samples (another --spp) or of more than the rank's
   // share: refused before rendering; else the rank starts after its samples
@@ -478,6 +531,14 @@ int run(const Args& a) {
   // samples go to its checkpoint, before they are sent (a SIGKILL that follows a SIGTERM during
   // the merge or the output's write loses nothing)
   share_warnings();  // the render's
+  // a stop signal on any rank, agreed: the highest signal, and the lowest rank that had one (a
+  // rank signalled alone, a node drained, under --time wrote a short image with exit 0 and no
+  // word: its missing samples were taken for the time limit's)
+  const int my_signal = g_stop.load() ? (g_signal ? int(g_signal) : SIGINT) : 0;
+  int stop_signal = 0, stopped_rank = g_size;
+  const int my_stop_rank = my_signal ? g_rank : g_size;
+  MPI_Allreduce(&my_signal, &stop_signal, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(&my_stop_rank, &stopped_rank, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   int complete = ck ? ck->complete(renderer, g_stop.load()) : 1, all_complete = 1;
   MPI_Allreduce(&complete, &all_complete, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   lucent::RenderPart part = ck ? ck->whole(renderer) : lucent::make_part(renderer, range, a.scene);
@@ -576,11 +637,16 @@ int run(const Args& a) {
         lucent::render_detail::nonfinite_warning(m.merged.info.nonfinite, m.merged.acc.count)
             .c_str());
   if (ck && !all_complete) say_kept(m.merged.info.samples);
-  if (g_stop.load()) {
-    std::fprintf(stderr, "lucent-mpi: interrupted: %s holds samples %s of [0, %llu)\n",
-                 one_line(a.output).c_str(), lucent::ranges_text(m.merged.info.samples).c_str(),
+  if (stop_signal > 0) {
+    const std::string who = stopped_rank == 0
+                                ? ""
+                                : " (a stop signal on rank " + std::to_string(stopped_rank) +
+                                      " of " + std::to_string(g_size) + ")";
+    std::fprintf(stderr, "lucent-mpi: interrupted%s: %s holds samples %s of [0, %llu)\n",
+                 who.c_str(), one_line(a.output).c_str(),
+                 lucent::ranges_text(m.merged.info.samples).c_str(),
                  static_cast<unsigned long long>(n));
-    return 128 + (g_signal ? int(g_signal) : SIGINT);
+    return 128 + stop_signal;
   }
   // a rank stopped early (a signal to that rank alone) without --time: the image is written,
   // with fewer samples than asked, which it said nothing about (exit 0, and a PNG looks
@@ -653,6 +719,11 @@ int main(int argc, char** argv) {
   app.add_option("--precision", a.precision, "float or double")
       ->check(CLI::IsMember({"float", "double"}));
   app.add_flag("--fast-math", a.fast_math, "Build the kernel with -cl-fast-relaxed-math");
+  // (a scene with integrator.caustics, scenes/course.json, could not be rendered by ranks
+  // without editing it)
+  app.add_flag("--no-caustics", a.no_caustics,
+               "Caustic paths by the camera path alone (integrator.caustics off: ranks cannot "
+               "hold light-traced caustics)");
   app.add_flag("-q,--quiet", a.quiet, "No progress line or summary");
   app.add_option("--checkpoint", a.checkpoint,
                  "Each rank writes the samples it rendered so far to CK.rank<r>-of-<K>.exr every "

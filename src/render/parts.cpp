@@ -343,32 +343,41 @@ void check_part_scene(const Scene& scene, const std::string& scene_path) {
                 "caustics yet; render this scene in one process, or without caustics");
 }
 
-RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
+PartInfo part_header(const Renderer& renderer, const SampleRange& requested,
                      const std::string& scene_path) {
   check_part_scene(renderer.scene(), scene_path);
-  RenderPart p;
-  p.acc = renderer.accumulation();
   const Scene& scene = renderer.scene();
-  PartInfo& info = p.info;
-  info.width = p.acc.width;
-  info.height = p.acc.height;
+  PartInfo info;
+  info.width = scene.film.width;
+  info.height = scene.film.height;
   info.scene_hash = renderer.image_hash();
   info.seed = scene.integrator.seed;
   info.sampler = type_name(scene.integrator.sampler);
   info.integrator = type_name(scene.integrator.type);
   info.version = kVersion;
   info.scene = scene_path;
-  if (p.acc.spp > 0) info.samples = {{p.acc.first_sample, p.acc.first_sample + p.acc.spp}};
   info.requested = {requested};
   // (a range to 2^64 made a part file that reading refused)
   if (requested.end <= requested.begin || requested.end > (1ull << 32))
     throw Error("make_part: requested samples " + range_text(requested) +
                 ": need 0 <= A < B <= 4294967296");
+  info.display = DisplaySettings{scene.film.transfer, scene.film.gamma, scene.film.exposure,
+                                 scene.film.tonemap};
+  return info;
+}
+
+RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
+                     const std::string& scene_path) {
+  RenderPart p;
+  p.info = part_header(renderer, requested, scene_path);
+  p.acc = renderer.accumulation();
+  PartInfo& info = p.info;
+  info.width = p.acc.width;  // (the session's film: its scene's)
+  info.height = p.acc.height;
+  if (p.acc.spp > 0) info.samples = {{p.acc.first_sample, p.acc.first_sample + p.acc.spp}};
   if (unite(info.requested, info.samples) != info.requested)
     throw Error("make_part: the session's samples " + ranges_text(info.samples) +
                 " lie outside the requested " + range_text(requested));
-  info.display = DisplaySettings{scene.film.transfer, scene.film.gamma, scene.film.exposure,
-                                 scene.film.tonemap};
   info.nonfinite = p.acc.nonfinite;
   info.rays = p.acc.rays;
   info.seconds = p.acc.seconds;
