@@ -91,6 +91,71 @@ TEST(Compare, SmallGlobalBiasFails) {
   EXPECT_TRUE(per_pixel.passed) << per_pixel.summary();
 }
 
+/// A 32x32 render of `spp` samples per pixel of one estimator, computed here: each sample is
+/// 0.1 + shift, plus 2 with probability 1/64 (a rare bright path), its mean, sample variance and
+/// count per pixel as a renderer writes them.
+RenderResult rare_paths(int spp, std::uint32_t seed, double shift = 0) {
+  const int w = 32, h = 32;
+  RenderResult r = constant_image(w, h, 0.0f);
+  r.variance = r.mean;
+  r.samples.assign(size_t(w) * h, std::uint32_t(spp));
+  std::uint64_t state = 0x9e3779b97f4a7c15ull * (seed + 1);
+  for (size_t i = 0; i < size_t(w) * h; ++i) {
+    int hits = 0;
+    for (int k = 0; k < spp; ++k) {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      hits += (state >> 40) % 64 == 0;
+    }
+    const double p = double(hits) / spp, mean = 0.1 + shift + 2 * p;
+    const double var = 4 * p * (1 - p) * spp / (spp - 1);  // (n - 1 in the denominator)
+    for (int c = 0; c < 3; ++c) {
+      r.mean.rgb[i * 3 + c] = float(mean);
+      r.variance.rgb[i * 3 + c] = float(var);
+    }
+  }
+  r.spp = std::uint32_t(spp);
+  return r;
+}
+
+// A render of few samples against a converged one of the same estimator: the pixels whose few
+// samples all missed the rare value have a sample variance of 0 (here 60% of them), and with
+// each image's own variances they failed (z about -16) at every try, where the docs promise a
+// false alarm with probability alpha. Each pixel's variance is the larger of the two images'
+// per-sample variances (compare_images); a bias of 15% of the pixels' means still fails.
+TEST(Compare, FewSamplesAgainstManyOfTheSameEstimatorPass) {
+  const RenderResult many = rare_paths(16384, 1);
+  int passed = 0;
+  for (std::uint32_t seed = 2; seed < 12; ++seed) {
+    const CompareResult c = lucent::compare_images(rare_paths(32, seed), many);
+    passed += c.passed;
+    EXPECT_EQ(c.few_sample_pixels, 0u);
+    EXPECT_LT(c.max_z, 6.0) << c.summary();
+  }
+  EXPECT_GE(passed, 9);
+  const CompareResult biased = lucent::compare_images(rare_paths(32, 20, 0.02), many);
+  EXPECT_FALSE(biased.passed) << biased.summary();
+  EXPECT_FALSE(biased.mean_test_passed) << biased.summary();
+  // an image without variances (a deterministic reference) still counts as exact
+  const CompareResult exact =
+      lucent::compare_images(rare_paths(32, 3), constant_image(32, 32, 0.1f + 2.0f / 64));
+  EXPECT_TRUE(exact.statistical);
+  EXPECT_GT(exact.max_z, 10.0) << exact.summary();
+}
+
+// Pixels of fewer than 8 samples: their sample variances are unreliable (two correct renders of
+// 2 samples per pixel failed at every try), and the summary says so.
+TEST(Compare, FewSamplesPerPixelAreSaid) {
+  const CompareResult c = lucent::compare_images(rare_paths(2, 1), rare_paths(2, 2));
+  EXPECT_EQ(c.few_sample_pixels, 32u * 32u);
+  EXPECT_NE(c.summary().find("warning       1024 of 1024 pixels rest on fewer than 8 samples in "
+                             "an image: their sample variances are unreliable"),
+            std::string::npos)
+      << c.summary();
+  const CompareResult enough = lucent::compare_images(rare_paths(8, 1), rare_paths(64, 2));
+  EXPECT_EQ(enough.few_sample_pixels, 0u);
+  EXPECT_EQ(enough.summary().find("rest on fewer"), std::string::npos);
+}
+
 // One rare, bright sample (a near-mirror's highlight of a point light, found by one sample of
 // 64) decides the image means' variance: the image-mean |z| is then about 1 however far the means
 // are, and the comparison passes. The summary says so and names the pixel; two ordinary renders

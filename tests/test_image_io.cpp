@@ -552,6 +552,20 @@ TEST(ImageIo, FloatSampleCountsAreWholeNumbers) {
   write_exr(dir + "/n.exr", 4, 2, {"B", "G", "R", "n", "var.B", "var.G", "var.R"},
             [](int c, int, int) { return c == 3 ? 16.0f : 0.25f; });
   EXPECT_EQ(lucent::read_render(dir + "/n.exr").samples, std::vector<std::uint32_t>(8, 16));
+  // some of the statistics layers: variances without their counts were dropped without a word,
+  // and a noisy image was compared as an exact one
+  write_exr(dir + "/v.exr", 4, 2, {"B", "G", "R", "var.B", "var.G", "var.R"},
+            [](int, int, int) { return 0.25f; });
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::read_render(dir + "/v.exr"); }),
+            dir +
+                "/v.exr: has some of the statistics channels var.R, var.G, var.B and n, not n (a "
+                "variance per sample needs its count, n): write all four, or none");
+  write_exr(dir + "/v.exr", 4, 2, {"B", "G", "R", "n", "var.R"},
+            [](int c, int, int) { return c == 3 ? 16.0f : 0.25f; });
+  EXPECT_NE(lucent::test::error_of([&] {
+              lucent::read_render(dir + "/v.exr");
+            }).find("not var.G, var.B (a variance"),
+            std::string::npos);
 }
 
 // A single-channel OpenEXR file (Y, or one channel of any name but R, G or B) is grey; one with

@@ -246,7 +246,17 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
     for (size_t i = 0; i < n; ++i) r.mean.rgb[i * 3 + c] = exr.planes[rgb[c]][i];
   const int var[3] = {exr.find("var.R"), exr.find("var.G"), exr.find("var.B")};
   const int cnt = exr.find("n");
-  if (var[0] < 0 || var[1] < 0 || var[2] < 0 || cnt < 0) return r;
+  const int stats = (var[0] >= 0) + (var[1] >= 0) + (var[2] >= 0) + (cnt >= 0);
+  if (stats == 0) return r;
+  // some of the layers alone: their variances were dropped without a word, and a noisy image
+  // was compared as an exact one (a tolerance test, which it failed)
+  if (stats < 4) {
+    std::string missing;
+    for (const char* name : {"var.R", "var.G", "var.B", "n"})
+      if (exr.find(name) < 0) missing += std::string(missing.empty() ? "" : ", ") + name;
+    throw Error(path + ": has some of the statistics channels var.R, var.G, var.B and n, not " +
+                missing + " (a variance per sample needs its count, n): write all four, or none");
+  }
   r.variance = Image{w, h, std::vector<float>(n * 3)};
   for (int c = 0; c < 3; ++c)
     for (size_t i = 0; i < n; ++i) r.variance.rgb[i * 3 + c] = exr.planes[var[c]][i];
