@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "common.hpp"
+#include "core/file_io.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/parts.hpp"
@@ -67,6 +68,19 @@ void bind_image(py::module_& m) {
         DisplaySettings d = display_settings(film, transfer, gamma, exposure, tonemap);
         RenderResult r = render_result_from(image, "image");
         std::string p = path.string();
+        // display settings given for a linear file change nothing: refused, as the CLI refuses
+        // options that change nothing (they were dropped without a word)
+        const std::string ext = io::lower_extension(p);
+        if (ext == ".exr" || ext == ".pfm")
+          for (const auto& [given, name] : {std::pair{&transfer, "transfer"},
+                                            {&gamma, "gamma"},
+                                            {&exposure, "exposure"},
+                                            {&tonemap, "tonemap"}})
+            if (!given->is_none())
+              throw py::value_error(std::string("write_image: ") + name +
+                                    " is a display setting, "
+                                    "for .png; " +
+                                    ext + " holds linear values");
         ReleaseGil release;
         write_image(p, r.mean, d);
       },
@@ -95,6 +109,9 @@ void bind_image(py::module_& m) {
       [](const std::filesystem::path& path, py::handle result) {
         RenderResult r = render_result_from(result, "result");
         std::string p = path.string();
+        // OpenEXR whatever the name said (w.png was an EXR); as converge's save_reference
+        if (io::lower_extension(p) != ".exr")
+          throw Error(p + ": write_render_exr writes OpenEXR: use an .exr file");
         ReleaseGil release;
         write_render_exr(p, r);
       },
@@ -175,12 +192,22 @@ void bind_image(py::module_& m) {
         // what the parts hold together (many parts of at most 2**24 samples each)
         std::optional<SampleRange> want;
         if (!expect.is_none()) want = range_argument(expect, "expect", std::uint64_t(1) << 32);
-        ReleaseGil release;
-        // as `lucent merge`: the output checked before any part is read
-        if (!out.empty()) check_merge_output(out, inputs);
-        MergeReport r = merge_render_parts(inputs);
-        check_merge_coverage(r, want, complete, "expect", "complete");
-        if (!out.empty()) write_merged(out, r.merged);
+        MergeReport r;
+        {
+          ReleaseGil release;
+          // as `lucent merge`: the output checked before any part is read
+          if (!out.empty()) check_merge_output(out, inputs);
+          r = merge_render_parts(inputs);
+          check_merge_coverage(r, want, complete, "expect", "complete");
+          if (!out.empty()) write_merged(out, r.merged);
+        }
+        // as `lucent merge` says it (a script's output= was an image of fewer samples without a
+        // word; `missing` said it only to a caller who looked)
+        if (!r.missing.empty())
+          py::module_::import("warnings")
+              .attr("warn")(
+                  "samples " + ranges_text(r.missing) + " are missing: the image has fewer samples",
+                  py::module_::import("lucent").attr("LucentWarning"), 1);
         MergedParts m;
         m.result = part_result(r.merged);
         m.info = r.merged.info;
@@ -239,6 +266,9 @@ void bind_image(py::module_& m) {
           "mean_variance_dominated", &CompareResult::mean_variance_dominated,
           "mean_variance_share > 0.5 and mean_variance_samples < 10: one rare, bright value "
           "decides the image-mean test, and the summary warns (docs/compare.md)")
+      .def_readonly("few_sample_pixels", &CompareResult::few_sample_pixels,
+                    "pixels resting on fewer than 8 samples in an image carrying variances: "
+                    "their sample variances are unreliable, and the summary warns")
       .def_readonly("rmse", &CompareResult::rmse)
       .def_readonly("relmse", &CompareResult::relmse)
       .def_readonly("max_abs_error", &CompareResult::max_abs_error)

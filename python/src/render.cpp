@@ -900,15 +900,26 @@ void bind_render(py::module_& m) {
           "set_build_options",
           [](PyRenderer& r, const TextArg& precision, const FlagArg& fast_math_arg,
              const FlagArg& specialize_arg) {
-            Precision p = parse_enum<Precision>(text_argument(precision, "precision"));
-            const bool fast_math = flag_argument(fast_math_arg, "fast_math"),
-                       specialize = flag_argument(specialize_arg, "specialize");
+            // a setting not given (None) stays the session's: set_build_options(fast_math=True)
+            // turned a double-precision session into a float one without a word
+            std::optional<Precision> p;
+            std::optional<bool> fast_math, specialize;
+            if (!precision.value.is_none())
+              p = parse_enum<Precision>(text_argument(precision, "precision"));
+            if (!fast_math_arg.value.is_none())
+              fast_math = flag_argument(fast_math_arg, "fast_math");
+            if (!specialize_arg.value.is_none())
+              specialize = flag_argument(specialize_arg, "specialize");
             r.call_interruptible("set_build_options", [&](Renderer& rr, std::atomic<bool>&) {
-              rr.set_build_options(p, fast_math, specialize);
+              const SessionOptions& o = rr.options();
+              rr.set_build_options(p.value_or(o.precision), fast_math.value_or(o.fast_math),
+                                   specialize.value_or(o.specialize));
             });
           },
-          py::kw_only(), py::arg("precision") = "float", py::arg("fast_math") = false,
-          py::arg("specialize") = true, "Build settings for the next set_scene/render.")
+          py::kw_only(), py::arg("precision") = py::none(), py::arg("fast_math") = py::none(),
+          py::arg("specialize") = py::none(),
+          "Build settings for the next set_scene/render; a setting not given (None) stays as it "
+          "is.")
       .def(
           "set_scene",
           [](PyRenderer& r, const Scene& scene) {

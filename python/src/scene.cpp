@@ -794,7 +794,10 @@ nlohmann::json to_json(py::handle o, const std::string& path, const std::string&
     try {
       return py::float_(py::reinterpret_borrow<py::object>(o)).cast<double>();
     } catch (py::error_already_set&) {  // (beyond a double: OverflowError)
-      return fail("integer out of range: " + py::str(o).cast<std::string>());
+      // its digits named by their count (a line of 401 digits; past sys.get_int_max_str_digits,
+      // 4300, str() raised its own ValueError naming no place)
+      return fail("integer out of range (not a finite double): an integer of about " +
+                  std::to_string(static_cast<int>(bits * 0.30102999566398120) + 1) + " digits");
     }
   }
   if (py::isinstance<py::float_>(o)) {

@@ -361,6 +361,10 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
       .def(
           "insert",
           [](V& v, py::handle index, const T& value) {
+            // copied first: `value` may be an element of this list, and the index's __index__
+            // may change the list (clear() freed the element, which was then copied: ASan's
+            // heap-use-after-free, a garbage sphere inserted without a word)
+            T copy = value;
             // as list.insert: an index beyond either end inserts at that end (one past
             // Py_ssize_t: OverflowError, as a list's, where pybind's TypeError said "incompatible")
             py::ssize_t i =
@@ -368,7 +372,6 @@ py::class_<std::vector<T>> bind_scene_list(py::module_& m, const char* name) {
             const py::ssize_t n = static_cast<py::ssize_t>(v.size());
             if (i < 0) i = std::max<py::ssize_t>(0, i + n);
             const std::size_t k = static_cast<std::size_t>(std::min(i, n));
-            T copy = value;
             change(
                 v,
                 [&](V& x) {

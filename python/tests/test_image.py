@@ -128,6 +128,24 @@ def test_compare_arrays_without_variance():
     assert lucent.compare(a, a, alpha=0.5).passed
 
 
+def test_linear_files_take_no_display_settings_and_render_exr_is_exr(tmp_path):
+    # display settings for a linear file were dropped without a word
+    for ext in ("exr", "pfm"):
+        for name, value in (("exposure", 2.0), ("tonemap", "aces"), ("gamma", 3.0),
+                            ("transfer", "gamma")):
+            with pytest.raises(ValueError, match=rf"^write_image: {name} is a display setting, "
+                                                 rf"for \.png; \.{ext} holds linear values$"):
+                lucent.write_image(tmp_path / f"a.{ext}", constant(1.0), **{name: value})
+        assert not (tmp_path / f"a.{ext}").exists()
+        lucent.write_image(tmp_path / f"a.{ext}", constant(1.0), film=lucent.Film())
+    lucent.write_image(tmp_path / "a.png", constant(1.0), exposure=2.0)
+    # write_render_exr wrote OpenEXR under any name (w.png)
+    with pytest.raises(lucent.Error, match=r"w\.png: write_render_exr writes OpenEXR: use an "
+                                           r"\.exr file$"):
+        lucent.write_render_exr(tmp_path / "w.png", lucent.RenderResult(constant(0.5)))
+    assert not (tmp_path / "w.png").exists()
+
+
 def test_image_errors(tmp_path):
     with pytest.raises(lucent.Error, match=r"a\.tiff: unknown output format '\.tiff'"):
         lucent.write_image(tmp_path / "a.tiff", constant(1.0))

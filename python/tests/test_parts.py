@@ -48,7 +48,11 @@ def test_missing_and_overlapping_ranges(small_scene, tmp_path):
     render_part(small_scene, b, 2, 4)
     with pytest.raises(lucent.Error, match=r"samples \[2, 6\) overlap .*a\.exr's \[0, 4\)"):
         lucent.merge_parts([a, b])
-    merged = lucent.merge_parts([a], expect=(0, 12))
+    # said, as `lucent merge` says it (a script's output was an image of fewer samples without a
+    # word)
+    with pytest.warns(lucent.LucentWarning,
+                      match=r"^samples \[4, 12\) are missing: the image has fewer samples$"):
+        merged = lucent.merge_parts([a], expect=(0, 12))
     assert merged.missing == [(4, 12)]
     assert "missing [4, 12)" in repr(merged)
     # refused before the output is written
@@ -82,7 +86,8 @@ def test_a_render_cut_short_records_the_range_it_was_asked_for(small_scene, tmp_
         r.write_part(part, requested=(8, 16))
         assert lucent.read_part_info(part).samples == [(8, 12)]
         assert lucent.read_part_info(part).requested == [(8, 16)]
-        assert lucent.merge_parts([part]).missing == [(0, 8), (12, 16)]
+        with pytest.warns(lucent.LucentWarning, match="are missing"):
+            assert lucent.merge_parts([part]).missing == [(0, 8), (12, 16)]
         # a range that does not hold the samples rendered
         with pytest.raises(lucent.Error, match=r"lie outside the requested \[0, 10\)"):
             r.write_part(tmp_path / "q.exr", requested=(0, 10))

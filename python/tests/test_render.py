@@ -320,9 +320,17 @@ def test_session_options_and_devices(small_scene):
         r.set_scene(small_scene)
         opts = r.result().build_options
         assert "-cl-fast-relaxed-math" in opts and "LC_HAS_CONDUCTOR" in opts
+        # a setting not given stays (precision="float" alone turned fast math and the full
+        # kernel off, and fast_math=True alone a double-precision session into a float one)
+        r.set_build_options(precision="double")
+        assert r.options["fast_math"] and not r.options["specialize"]
+        r.set_build_options(fast_math=False)
+        assert r.options["precision"] == "double" and not r.options["specialize"]
         r.set_build_options(precision="float")
         r.set_scene(small_scene)
         assert "-cl-fast-relaxed-math" not in r.result().build_options
+        assert r.options == {**r.options, "precision": "float", "fast_math": False,
+                             "specialize": False}
         assert r.scene.film.width == 16
     assert set(lucent.environment()) == {"device", "kernel_dir", "cache_dir"}
 

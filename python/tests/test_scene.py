@@ -218,12 +218,21 @@ def test_parser_errors_are_lucent_errors_with_the_json_path(small_dict):
     (math.inf, "/camera/fov: must be a finite number, got inf"),
     # an int beyond 64 bits is the float its JSON text would be: the value's own range error
     (2 ** 70, "/camera/fov: must be in (0, 180) degrees, got 1.18059e+21"),
-    (10 ** 400, "/camera/fov: integer out of range"),
+    (10 ** 400, "/camera/fov: integer out of range (not a finite double): an integer of about "
+                "401 digits"),
     (object(), "/camera/fov: cannot be written as JSON"),
 ])
 def test_dict_values_json_cannot_hold(value, message):
     with pytest.raises(lucent.Error, match=re.escape(message)):
         lucent.scene_from_dict({"camera": {"fov": value}})
+
+
+def test_an_integer_too_long_to_print_is_named_by_its_digits():
+    # past sys.get_int_max_str_digits (4300): str() raised its own ValueError, naming no place
+    with pytest.raises(lucent.Error, match=re.escape(
+            "/camera/fov: integer out of range (not a finite double): an integer of about 5001 "
+            "digits")):
+        lucent.scene_from_dict({"camera": {"fov": 10 ** 5000}})
 
 
 def test_dict_paths_escape_slash_and_tilde_in_keys():

@@ -335,6 +335,24 @@ def test_sequence_and_array_values_are_converted_before_the_element_is_taken():
     assert c[Hostile(1, scene.spheres, other.spheres, far_sphere)] == 7
 
 
+def test_insert_of_an_element_of_the_list_survives_an_index_that_clears_it():
+    """insert(i, x) with x an element of the same list and an index whose __index__ clears the
+    list: x was copied after the index, from freed memory (ASan: heap-use-after-free; a release
+    build raised basic_string::_M_create for a material, inserted a garbage sphere)."""
+    other = lucent.Scene()
+    for make, lst_of, check in [
+            (lambda i: material(chr(65 + i) * 200), lambda s: s.materials, lambda m: m.name),
+            (lambda i: lucent.Sphere((i, 2 * i, 3 * i), 0.5 + i, 1), lambda s: s.spheres,
+             lambda sp: (tuple(sp.center), sp.radius))]:
+        s = lucent.Scene()
+        lst = lst_of(s)
+        for i in range(4):
+            lst.append(make(i))
+        expected = check(lst[2])
+        lst.insert(Hostile(0, lst, lst_of(other), lambda: make(9)), lst[2])
+        assert len(lst) == 1 and check(lst[0]) == expected
+
+
 def test_slice_bounds_are_converted_before_the_list_is_measured():
     """A slice's bounds (__index__) can change the list: it is measured after them, as a Python
     list is. With the length read first, reads, deletions and assignments went past the end."""
