@@ -756,6 +756,34 @@ TEST(Converge, TimeToTheErrorOfASettingBelowItAtItsFirstRungIsABound) {
       << r.out;
 }
 
+// Standard output closed early (`converge ... | head`): the table's write fails, and the CSV and
+// the plots are written all the same, with one line and status 1 (SIGPIPE killed the study
+// there, its files never written, with no line and status 141).
+TEST(Converge, AClosedPipeOnStandardOutputLosesNoFile) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/t.json", R"({
+    "film": {"width": 8, "height": 8},
+    "integrator": {"type": "path", "max_depth": 2},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, -3], "radius": 1, "material": "m"}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}]
+  })");
+  const std::string err = dir + "/err", status = dir + "/status";
+  const std::string cmd = "('" + std::string(LUCENT_CLI_PATH) + "' converge '" + dir +
+                          "/t.json' --spp-ladder 1,2 --reference-spp 16 --csv '" + dir +
+                          "/c.csv' --plot '" + dir + "/c.svg' 2>'" + err + "'; echo $? >'" +
+                          status + "') | head -c 0";
+  lucent::test::write_file(dir + "/pipe.sh", cmd + "\n");
+  ASSERT_EQ(std::system(("bash '" + dir + "/pipe.sh'").c_str()), 0);
+  const std::string text = read_file(err);
+  EXPECT_EQ(read_file(status), "1\n") << text;
+  EXPECT_NE(text.find("lucent: error: standard output: cannot write (Broken pipe)"),
+            std::string::npos)
+      << text;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/c.csv")) << text;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/c.svg")) << text;
+}
+
 // A setting whose knob the integrator it renders with does not read changes nothing, and the
 // study reported it as if it did (clamp=1 on a whitted scene: "x0.53 of default", noise): it is
 // refused, by the library and by the command before the reference is rendered; the same knob

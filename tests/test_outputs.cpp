@@ -64,6 +64,55 @@ std::string scene_in(const std::string& dir, const std::string& name = "scene.js
   return path;
 }
 
+// A standard descriptor the caller closed (`2>&-`) is held on /dev/null: the program's next
+// open() took it (a checkpoint's lock file became stderr, and the progress lines went into it),
+// and writes to it still fail as to a closed one (EBADF: "standard output: cannot write").
+TEST(Outputs, ClosedStandardDescriptorsAreNotTakenByFiles) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string file = dir + "/f";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::close(1);
+    ::close(2);
+    lucent::io::hold_standard_descriptors();
+    const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT, 0600);
+    const bool ebadf = ::write(2, "x", 1) == -1 && errno == EBADF;
+    ::_exit(fd > 2 && ebadf ? 0 : fd <= 2 ? 1 : 2);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "1: the file took a standard descriptor; 2: it wrote";
+  // the program does so: its stdout closed, a table is an error still
+  const std::string scene = scene_in(dir), err = dir + "/err";
+  const int raw = std::system(
+      ("'" + std::string(LUCENT_CLI_PATH) + "' info " + q(scene) + " </dev/null >&- 2>" + q(err))
+          .c_str());
+  const std::string text = read_file(err);
+  EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 1) << text;
+  EXPECT_NE(text.find("standard output: cannot write (Bad file descriptor)"), std::string::npos)
+      << text;
+}
+
+// A write killed half-way leaves its hidden temporary file (.<name>.tmp-<pid>-<n>). In a
+// container (a pid namespace) the next run has the same pid and counter: it rendered in full and
+// then failed with "cannot write (File exists)", at every rerun. Taken names are passed over.
+TEST(Outputs, ATemporaryFileLeftByAKilledWriteDoesNotStopTheNext) {
+  if (std::system("unshare -p -f --mount-proc true >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "cannot make a pid namespace here (unshare -p)";
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = scene_in(dir), out = dir + "/out.png";
+  // lucent is pid 1 in its namespace: what a killed run of it left
+  for (int n = 0; n < 8; ++n)
+    lucent::test::write_file(dir + "/.out.png.tmp-1-" + std::to_string(n), "x");
+  const CommandResult r =
+      run_cli("render " + q(scene) + " -q -o " + q(out), "unshare -p -f --mount-proc");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(lucent::read_image(out).width, 32);
+  EXPECT_TRUE(fs::exists(dir + "/.out.png.tmp-1-0"));  // (another run's, perhaps: not removed)
+}
+
 /// The error line's message, checking the one-line contract.
 std::string error_line(const CommandResult& r) {
   EXPECT_NE(r.status, 0);

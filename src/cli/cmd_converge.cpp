@@ -252,6 +252,10 @@ void print_time_to_common_error(const ConvergeResult& result) {
 
 int run_converge_command() {
   ConvergeArgs& a = converge_args();
+  // the table goes to standard output before the CSV and the plots are written: a pipe closed
+  // early (`| head`) killed the study there, its files never written, with no line; the write
+  // fails instead, and the status is 1 with "standard output: cannot write (Broken pipe)"
+  std::signal(SIGPIPE, SIG_IGN);
   for (const std::string& plot : a.plots) {
     std::string ext = io::lower_extension(plot);
     if (ext != ".svg" && ext != ".png")

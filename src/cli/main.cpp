@@ -15,6 +15,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/option_checks.hpp"
+#include "core/file_io.hpp"
 #include "core/text.hpp"
 #include "lucent/lucent.hpp"
 
@@ -84,6 +85,7 @@ int help_written(const CLI::App& app, const CLI::Error& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  lucent::io::hold_standard_descriptors();  // (`2>&-`: a lock file became stderr)
   // a file size limit (ulimit -f) must end in an error naming the file, not in a kill
   std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"lucent: a physically based OpenCL path tracer", "lucent"};

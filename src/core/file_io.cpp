@@ -90,6 +90,19 @@ fs::path temp_path(const fs::path& dir, const std::string& name) {
                 std::to_string(counter++));
 }
 
+// Creates a new temporary file for a write of `name` into `dir` (O_EXCL), its name in `tmp`;
+// -1 and errno as open() when it cannot. A name taken by another file is passed over: a write
+// killed half-way leaves its temporary file, and in a container (a pid namespace) the next run
+// has the same pid and counter, so that every rerun rendered in full and then failed with
+// "cannot write (File exists)" on a file the message did not name.
+int open_temp(const fs::path& dir, const std::string& name, mode_t mode, std::string& tmp) {
+  for (int tries = 0;; ++tries) {
+    tmp = temp_path(dir, name).string();
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
+    if (fd >= 0 || errno != EEXIST || tries == 1000) return fd;
+  }
+}
+
 // Whether `file` is a name temp_path(dir, name) gives: ".<name>.tmp-<digits>-<digits>".
 bool is_temp_name(const std::string& file, const std::string& name) {
   const std::string head = "." + name + ".tmp-";
@@ -106,6 +119,18 @@ bool is_temp_name(const std::string& file, const std::string& name) {
 }  // namespace
 
 std::string format_size(std::uint64_t b) { return sys::format_bytes(b); }
+
+void hold_standard_descriptors() {
+  for (int fd = 0; fd < 3; ++fd) {
+    if (::fcntl(fd, F_GETFD) != -1 || errno != EBADF) continue;
+    // (the lowest free descriptor: fd itself, those below it being open)
+    const int held = ::open("/dev/null", O_RDONLY);
+    if (held >= 0 && held != fd) {
+      ::dup2(held, fd);
+      ::close(held);
+    }
+  }
+}
 
 std::string read_file(const std::string& path, const ReadSpec& spec) {
   const std::string what = spec.what;
@@ -222,8 +247,8 @@ void check_output_file(const std::string& out, const std::vector<std::string>& i
     throw Error(out + cannot + "a file name of " + std::to_string(name.size()) +
                 " bytes, more than the " + std::to_string(name_max) + " this file system allows)");
   // the temporary file the write goes through
-  const std::string probe = temp_path(dir, name).string();
-  int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  std::string probe;
+  int fd = open_temp(dir, name, 0600, probe);
   if (fd < 0) throw Error(out + cannot + std::strerror(errno) + ")");
   ::close(fd);
   ::unlink(probe.c_str());
@@ -301,8 +326,8 @@ void write_file_atomic(const std::string& path, const void* data, std::size_t si
     throw Error(path + ": cannot write (not a file name)");
   check_writable_kind(path, target);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  const std::string tmp = temp_path(dir, name).string();
-  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  std::string tmp;
+  int fd = open_temp(dir, name, 0666, tmp);
   if (fd < 0) throw Error(path + ": cannot write (" + reason(errno) + ")");
   // a file replaced keeps its permissions (a new file's mode comes from the umask: a private
   // image became readable by all), set before any byte is written; as it is a new file, its

@@ -49,6 +49,12 @@ std::string write_target_path(const std::string& path);
 /// share). Returns how many were removed; failures are ignored.
 int remove_stale_temporaries(const std::string& path);
 
+/// For a program's main(), first: the standard descriptors 0, 1 and 2 that the caller closed
+/// (`2>&-`) are held open on /dev/null, read-only, so that the program's next open() does not take
+/// them (with stderr closed, a checkpoint's lock file was opened as descriptor 2 and the progress
+/// lines went into it, over its mark); writes to them still fail (EBADF), as to a closed one.
+void hold_standard_descriptors();
+
 /// Writes all `size` bytes to the open descriptor `fd` (retrying short writes and EINTR);
 /// throws lucent::Error("<path>: cannot write (<reason>)") on failure. `path` names it.
 void write_all(int fd, const void* data, std::size_t size, const std::string& path);

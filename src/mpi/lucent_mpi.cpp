@@ -667,6 +667,7 @@ int run(const Args& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  lucent::io::hold_standard_descriptors();  // (`2>&-`: a checkpoint's lock became stderr)
   // before MPI_Init: an MPI singleton's daemon (orted) probes OpenCL devices through hwloc, and
   // PoCL aborts on an empty POCL_CACHE_DIR there, and crashes (SIGSEGV) on a thread count it
   // cannot read (mpirun itself does so before any rank starts)
