@@ -292,6 +292,12 @@ TEST(Devices, SelectorListErrors) {
             "--device '0,all': 'all' selects every device and stands alone, not in a list");
   EXPECT_EQ(error_of("all"), "");
   EXPECT_EQ(lucent::select_devices("0, 0", "--device").size(), 2u);
+  // a selector alone is read as a list's items are: spaces around it, 'all' in any case (' 0'
+  // matched no name, where '0, 0' was taken)
+  EXPECT_EQ(lucent::select_devices(" 0 ", "--device").at(0).index, 0);
+  EXPECT_EQ(lucent::select_devices(" ALL", "--device").size(), lucent::list_devices().size());
+  EXPECT_EQ(error_of("0,All"),
+            "--device '0,All': 'all' selects every device and stands alone, not in a list");
 }
 
 // A name selector: a device's whole name picks it, even listed after a device whose name contains

@@ -386,8 +386,11 @@ int device_by_name(const std::vector<DeviceInfo>& devices, const std::string& se
   return -1;
 }
 
-Device pick_device(const std::string& selector, const std::string& origin) {
+Device pick_device(const std::string& given, const std::string& origin) {
   auto devices = enumerate_devices();
+  // spaces around it, as around a list's items (' 0' matched no name, where '0, 0' was taken)
+  const std::string trimmed = trim(given);
+  const std::string& selector = trimmed.empty() ? given : trimmed;
   if (selector.empty()) {
     for (auto& d : devices)
       if (d.info.type == "GPU") return d;
@@ -489,7 +492,7 @@ DeviceInfo select_device(const std::string& selector, const std::string& origin)
 }
 
 std::vector<DeviceInfo> select_devices(const std::string& selectors, const std::string& origin) {
-  if (selectors == "all") return list_devices();
+  if (cl_util::lower(cl_util::trim(selectors)) == "all") return list_devices();
   std::vector<DeviceInfo> out;
   if (selectors.find(',') == std::string::npos) {
     out.push_back(select_device(selectors, origin));
@@ -505,7 +508,7 @@ std::vector<DeviceInfo> select_devices(const std::string& selectors, const std::
     if (b == std::string::npos)
       throw Error(origin + " '" + selectors + "': an empty selector in the list");
     const std::string selector = item.substr(b, e - b + 1);
-    if (selector == "all")
+    if (cl_util::lower(selector) == "all")
       throw Error(origin + " '" + selectors +
                   "': 'all' selects every device and stands alone, not in a list");
     out.push_back(select_device(selector, origin));
