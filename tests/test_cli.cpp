@@ -325,6 +325,16 @@ TEST(Cli, ProgressLineAndTimeLimit) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err, "");
   EXPECT_EQ(r.out, "");
+
+  // --spp N that the time limit stopped short: said (the summary's "2651 spp" said not of what)
+  r = run_cli("render " + q(scene) + " -o " + q(out) + " --time 0.5 --spp 16777216");
+  ASSERT_EQ(r.status, 0) << r.err;
+  lines = lines_of(r.err);
+  ASSERT_GE(lines.size(), 2u) << r.err;
+  EXPECT_TRUE(std::regex_match(
+      lines.back(),
+      std::regex(".*o\\.png: the time limit stopped it at \\d+ of the 16777216 spp asked for")))
+      << r.err;
 }
 
 // --target-error with a --time that ends the render in its pilot: the summary says so and the

@@ -606,6 +606,13 @@ int render_with(const RenderArgs& a) {
                  one_line(a.output).c_str(), static_cast<unsigned long long>(r.spp),
                  r.estimated_relmse, r.target_error, r.model_gain_a, r.model_gain_b,
                  r.halves_relmse, stopped_early.c_str());
+  // a uniform render of --spp N that --time stopped short: said as the adaptive one says it (the
+  // summary's "2651 spp" did not say of what, and the status is 0: the limit was asked for)
+  if (!a.quiet && !(r.target_error > 0) && a.time_limit > 0 && a.spp > 0 &&
+      r.spp < std::uint64_t(a.spp) && !r.cancelled && !g_interrupted.load())
+    std::fprintf(stderr, "%s: the time limit stopped it at %llu of the %llu spp asked for\n",
+                 one_line(a.output).c_str(), static_cast<unsigned long long>(r.spp),
+                 static_cast<unsigned long long>(a.spp));
   if (std::string s = lucent::target_shortfall(r); !s.empty())
     std::fprintf(stderr, "lucent: warning: %s: %s\n", one_line(a.output).c_str(), s.c_str());
   std::vector<std::string> missing_aovs;
