@@ -223,6 +223,39 @@ TEST(ProgramCache, DriverCacheIsPoclsWhileItIsOn) {
   }
 }
 
+// A program PoCL's kernel cache gives back damaged (an empty program.bc, after a power loss: PoCL
+// does not fsync) has no kernel: the error names the cache and the remedy (it said only
+// "clCreateKernel: CL_INVALID_KERNEL_NAME"). Removing the directory, as it says, mends it.
+TEST(ProgramCache, ADamagedPoclCacheIsNamed) {
+  const std::string dir = lucent::test::temp_dir(), pocl = dir + "/pocl";
+  const std::string scene = dir + "/s.json";
+  lucent::test::write_file(scene, R"({
+    "film": {"width": 8, "height": 8},
+    "integrator": {"type": "albedo", "spp": 1},
+    "materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.25, 0.75]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, -3], "radius": 1, "material": "m"}]
+  })");
+  const std::string env = "POCL_CACHE_DIR='" + pocl + "' LUCENT_CACHE_DIR='" + dir + "/lc'";
+  const std::string cmd = "render '" + scene + "' -q -o '" + dir + "/o.pfm'";
+  auto r = lucent::test::run_cli(cmd, env);
+  ASSERT_EQ(r.status, 0) << r.err;
+  int damaged = 0;
+  for (const auto& e : fs::recursive_directory_iterator(pocl))
+    if (e.path().filename() == "program.bc") {
+      fs::resize_file(e.path(), 0);
+      ++damaged;
+    }
+  if (damaged == 0) GTEST_SKIP() << "no PoCL cache entry here (not PoCL, or its cache is off)";
+  r = lucent::test::run_cli(cmd, env);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(r.err,
+            "lucent: error: clCreateKernel: CL_INVALID_KERNEL_NAME: the program PoCL's "
+            "kernel cache gave back has no kernel: that cache, in " +
+                pocl + ", may be damaged; remove the directory\n");
+  fs::remove_all(pocl);
+  EXPECT_EQ(lucent::test::run_cli(cmd, env).status, 0);
+}
+
 // A deferred entry is written by store(), not by the build; dropped unstored it writes nothing
 // and releases its lock (the next build is a miss that does not wait).
 TEST(ProgramCache, DeferredEntriesAreWrittenByStore) {

@@ -486,7 +486,17 @@ struct Renderer::Impl {
       if (options.kernel_dir.empty() || what.rfind("kernels/", 0) != 0) throw;
       throw Error(options.kernel_dir + what.substr(7), e.details());
     }
-    p.kernel = cl::Kernel(p.program, "lucent_render");
+    try {
+      p.kernel = cl::Kernel(p.program, "lucent_render");
+    } catch (const cl::Error& e) {
+      // a program the driver's cache gave back damaged (PoCL's, after a power loss: an empty
+      // program.bc) has no kernel: the error named neither the cache nor the remedy
+      const std::string driver_cache = cl_util::driver_program_cache(w.ctx.device);
+      if (e.err() != CL_INVALID_KERNEL_NAME || driver_cache.empty()) throw;
+      throw Error(std::string("clCreateKernel: ") + cl_util::error_name(e.err()) +
+                  ": the program " + driver_cache + " gave back has no kernel: that cache, in " +
+                  cl_util::pocl_cache_dir() + ", may be damaged; remove the directory");
+    }
     p.work_group = render_detail::work_group_size(
         kWorkGroupSize, w.ctx.device.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>(),
         w.ctx.device.device.getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>().at(0),
