@@ -192,6 +192,8 @@ py::array_t<double> copy_rows(const double* first, std::size_t n, py::ssize_t co
 }
 
 void require_numbers(py::handle object, const std::string& what, std::uint64_t bytes_per_value) {
+  // (NumPy makes an array of dtype object of None: "got an array of dtype object" named no None)
+  if (object.is_none()) throw py::type_error(what + ": expected numbers, got None");
   py::array a = array_or_null<py::array>(object);
   if (!a) return;  // not convertible at all: the caller's conversion says so
   const char kind = a.dtype().kind();

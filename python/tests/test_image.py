@@ -362,6 +362,11 @@ def test_result_from_arrays_refuses_what_no_render_holds(tmp_path):
     # strings are not numbers
     with pytest.raises(TypeError, match="mean: expected numbers"):
         lucent.RenderResult(np.full((2, 2, 3), "0.5"))
+    # None is named (NumPy made it an array of dtype object, which the message named)
+    with pytest.raises(TypeError, match="^mean: expected numbers, got None$"):
+        lucent.RenderResult(None)
+    with pytest.raises(TypeError, match="^image: expected numbers, got None$"):
+        lucent.write_image(tmp_path / "n.png", None)
 
 
 class OutOfMemory:
