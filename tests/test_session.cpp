@@ -233,7 +233,10 @@ TEST(Session, ResetStartsAtASampleIndex) {
 // samples would repeat those of index 0 on), one that ends there is rendered, and a render by
 // time stops there.
 TEST(Session, SampleIndicesStopAt2To32) {
-  Renderer r = session();
+  std::vector<std::string> warnings;
+  lucent::SessionOptions o = lucent::test::session_options();
+  o.on_warning = [&](const std::string& m) { warnings.push_back(m); };
+  Renderer r(o);
   r.set_scene(lucent::test::scene_from(kScene));
   const std::uint64_t end = std::uint64_t(1) << 32;
   r.reset(end - 4);
@@ -241,9 +244,13 @@ TEST(Session, SampleIndicesStopAt2To32) {
   EXPECT_EQ(r.spp(), 0u) << "nothing rendered";
   r.render(3);
   EXPECT_EQ(r.spp(), 3u);
+  EXPECT_TRUE(warnings.empty());
   lucent::RenderProgress p = r.render_for(5.0);
   EXPECT_EQ(p.samples_done, 1u) << "stops at 2^32";
   EXPECT_EQ(r.spp(), 4u);
+  // and says so (it returned long before its time without a word)
+  EXPECT_EQ(warnings, std::vector<std::string>{"render: stopped at sample index 4294967296 before "
+                                               "the time limit: 2^32 is the sampler's range"});
   EXPECT_THROW(r.render(1), lucent::Error);
   // a count that wraps past 2^64 is named as given (it read "[6, 5)")
   r.reset(6);

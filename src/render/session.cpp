@@ -1053,6 +1053,17 @@ struct Renderer::Impl {
     dispatch(cs, time_limit, done > 0, next, finish, on_pass);
     // a cancel once every sample was rendered (from the last pass's callback) cut nothing short
     if (target_spp > 0 && finished >= target_spp) last_cancelled = false;
+    // a time-limited render that the samples' range stopped, before its time (render_for from
+    // sample 2^32 - 3 returned after 3 samples without a word)
+    if (target_spp == 0 && started >= room && !last_cancelled) {
+      scene_detail::ScopedWarningSink sink(options.on_warning);
+      scene_detail::warn("render: stopped at sample index " + std::to_string(start_index + room) +
+                         " before the time limit: " +
+                         (room == index_end - start_index
+                              ? std::string("2^32 is the sampler's range")
+                              : std::string("2^32 - 1 samples per pixel is the most a pixel's "
+                                            "count holds")));
+    }
     return make_progress(cs, finished, target_spp, time_limit);
   }
 
