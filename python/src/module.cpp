@@ -541,15 +541,22 @@ void reduce_in_every_protocol(py::module_& m) {
   // already (made by its constructor, or set before) pybind11 skips the call and returns None:
   // `scene.__setstate__(other.__getstate__())` left the scene as it was without a word; it is
   // refused
-  m.def("_constructed", [](py::handle self) {
+  // (an object of `cls` only: another one, 5 or object(), is the original's to refuse with its
+  // TypeError; read as a pybind11 instance it crashed the interpreter)
+  m.def("_constructed", [](py::handle self, py::handle cls) {
+    if (!PyType_Check(cls.ptr()) ||
+        !PyObject_TypeCheck(self.ptr(), reinterpret_cast<PyTypeObject*>(cls.ptr())))
+      return false;
+    auto* type = py::detail::get_type_info(reinterpret_cast<PyTypeObject*>(cls.ptr()));
+    if (!type) return false;
     auto* inst = reinterpret_cast<py::detail::instance*>(self.ptr());
-    return inst->get_value_and_holder().holder_constructed();
+    return inst->get_value_and_holder(type).holder_constructed();
   });
   py::exec(R"py(
-def _subclass_setstate(original, constructed):
+def _subclass_setstate(original, constructed, cls):
     def __setstate__(self, state):
-        if constructed(self):
-            name = type(self).__name__
+        if constructed(self, cls):
+            name = cls.__name__
             raise TypeError(f"{name}.__setstate__: this {name} exists already; its state is set "
                             "only on the object that pickle or copy makes (pickle.loads, "
                             "copy.copy)")
@@ -605,7 +612,7 @@ def _subclass_setstate(original, constructed):
       }
     } else if (py::hasattr(cls, "__setstate__")) {
       // a Python subclass's attributes (its __dict__) come back too (the state alone lost them)
-      cls.attr("__setstate__") = subclass_setstate(cls.attr("__setstate__"), constructed);
+      cls.attr("__setstate__") = subclass_setstate(cls.attr("__setstate__"), constructed, cls);
       set_reduce(cls, [newobj](py::handle self) -> py::object {
         py::object state = self.attr("__getstate__")();
         const py::object attributes = py::getattr(self, "__dict__", py::none());

@@ -1125,6 +1125,7 @@ void bind_render(py::module_& m) {
       .def_readonly("relmse", &ConvergePoint::relmse)
       .def_readonly("noise_relmse", &ConvergePoint::noise_relmse)
       .def_readonly("reference_noise_relmse", &ConvergePoint::reference_noise_relmse)
+      .def_readonly("excess_standard_error", &ConvergePoint::excess_standard_error)
       .def_readonly("estimated_relmse", &ConvergePoint::estimated_relmse)
       .def_readonly("halves_relmse", &ConvergePoint::halves_relmse)
       .def("__repr__", [](const ConvergePoint& p) {

@@ -296,6 +296,11 @@ def test_setstate_on_an_object_that_exists_is_refused(rich_scene):
     same(before, fresh.__getstate__())
     with pytest.raises(TypeError, match="exists already"):
         fresh.__setstate__(other.__getstate__())
+    # called on something else: the original's TypeError (read as an instance, it crashed)
+    for stranger in (5, object(), lucent.Vec3((1, 2, 3))):
+        with pytest.raises(TypeError) as e:
+            lucent.Scene.__setstate__(stranger, before)
+        assert "Vec3.__setstate__" not in str(e.value)
 
 
 @pytest.mark.parametrize("name, round_trip", round_trips())
