@@ -142,6 +142,30 @@ TEST(Compare, FewSamplesAgainstManyOfTheSameEstimatorPass) {
   EXPECT_GT(exact.max_z, 10.0) << exact.summary();
 }
 
+// A render of many samples keeps nearly its own variance: a kernel of 64 spp and variance 0.01
+// against a reference of 4096 spp and variance 1, with a local bias of +-25% in 96 pixels that
+// leaves the image mean as it was, fails the per-pixel test (taking the larger variance of the
+// two, the first version of the fix, passed it: z 2 where each image's own gave 12.5).
+TEST(Compare, ALowVarianceRenderKeepsItsPowerAgainstANoisyReference) {
+  const int w = 32, h = 32;
+  const auto image = [&](float variance, std::uint32_t n) {
+    RenderResult r = constant_image(w, h, 1.0f);
+    r.variance = constant_image(w, h, variance).mean;
+    r.samples.assign(size_t(w) * h, n);
+    r.spp = n;
+    return r;
+  };
+  RenderResult kernel = image(0.01f, 64);
+  const RenderResult reference = image(1.0f, 4096);
+  for (int p = 0; p < 96; ++p)
+    for (int c = 0; c < 3; ++c) kernel.mean.rgb[size_t(p * 10) * 3 + c] = p < 48 ? 1.25f : 0.75f;
+  const CompareResult r = lucent::compare_images(kernel, reference);
+  EXPECT_TRUE(r.mean_test_passed) << r.summary();
+  EXPECT_FALSE(r.passed) << r.summary();
+  EXPECT_EQ(r.failed_pixels, 96u) << r.summary();
+  EXPECT_GT(r.max_z, 7.0) << r.summary();
+}
+
 // Pixels of fewer than 8 samples: their sample variances are unreliable (two correct renders of
 // 2 samples per pixel failed at every try), and the summary says so.
 TEST(Compare, FewSamplesPerPixelAreSaid) {

@@ -67,22 +67,22 @@ struct CompareResult {
   bool mean_variance_dominated() const {
     return mean_variance_share > kDominatedShare && mean_variance_samples < kFewSamples;
   }
-  /// Pixels that rest on fewer than kFewPixelSamples samples in an image carrying variances:
-  /// their sample variances are unreliable (two correct renders of 2 samples per pixel failed
-  /// the per-pixel test at every try, of 4 in one try of 5), and the summary warns.
-  std::size_t few_sample_pixels = 0;
-  static constexpr double kFewPixelSamples = 8;
   double rmse = 0;              ///< sqrt(mean over pixel-channels of (A - B)^2)
   double relmse = 0;            ///< mean of (A - B)^2 / (B^2 + 0.01)
   double max_abs_error = 0;     ///< largest |A - B|
   Image z;                      ///< per pixel-channel z = (A - B) / standard error (signed)
   std::string summary() const;  ///< multi-line report, as `lucent compare` prints it
+  /// Pixels that rest on fewer than kFewPixelSamples samples in an image carrying variances:
+  /// their sample variances are unreliable (two correct renders of 2 samples per pixel failed
+  /// the per-pixel test at every try, of 4 in one try of 5), and the summary warns.
+  std::size_t few_sample_pixels = 0;
+  static constexpr double kFewPixelSamples = 8;
 };
 
 /// Compares two images pixel by pixel. `variance` and `samples` may be empty (a deterministic
 /// image: variance 0); a pixel with fewer than 2 samples has no variance of its own. Where both
-/// images carry variances, the per-pixel test takes each pixel's per-sample variance as the
-/// larger of the two (docs/compare.md, "The test"). Throws
+/// images carry variances, each image's per-sample variance in the per-pixel test borrows three
+/// samples' worth of the other's (docs/compare.md, "The test"). Throws
 /// lucent::Error when the sizes differ or an image has no pixels.
 CompareResult compare_images(const RenderResult& a, const RenderResult& b,
                              const CompareOptions& options = {});
