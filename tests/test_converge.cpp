@@ -499,6 +499,17 @@ TEST(Converge, FitOfSyntheticCurves) {
   // the squared bias is half the last rung's noise: the noise falls to it at twice that rung's
   // time (0.64 s), i.e. 128 spp
   EXPECT_NEAR(b15.floor_seconds, 1.28, 1e-9);
+  // ... unless that excess is within 3 standard errors of 0: a few pixels' rare bright samples
+  // (the Cornell box was "biased" for 2 seeds of 15); over 3, biased
+  std::vector<ConvergePoint> tail = synthetic(e15, e);
+  tail.back().excess_standard_error = 0.5 * e.back() / 2.5;  // 2.5 standard errors
+  const ConvergeFit t = lucent::fit_convergence(tail);
+  EXPECT_FALSE(t.biased) << t.verdict;
+  EXPECT_EQ(t.verdict,
+            "unbiased (error/noise 1.50 at the last rung, not significant: 2.5 standard errors, "
+            "where a few pixels hold the error: rare bright samples)");
+  tail.back().excess_standard_error = 0.5 * e.back() / 3.5;
+  EXPECT_TRUE(lucent::fit_convergence(tail).biased);
 
   // the reference's share of the noise does not fall with time: only the render's own share is
   // extrapolated. A reference of the top rung's spp (64) holds half the noise at that rung: the

@@ -83,6 +83,11 @@ struct ConvergePoint {
   /// The reference's own share of noise_relmse: mean over pixel-channels of var_R / n_R /
   /// (R^2 + 0.01) (0 without its variance); its expected contribution to relmse.
   double reference_noise_relmse = 0;
+  /// The standard error of relmse - noise_relmse where the setting is unbiased, from the spread
+  /// of the pixels' terms ((A - R)^2 - var_A / n_A - var_R / n_R) / (R^2 + 0.01), the three
+  /// channels of a pixel summed as one (0 without a variance estimate). Large where a few pixels
+  /// hold the error (rare bright samples, a heavy-tailed estimate), small where a bias spreads.
+  double excess_standard_error = 0;
   /// Adaptive renders: the relMSE the render's own variances predict (RenderResult).
   double estimated_relmse = 0;
   /// Adaptive renders: the a-posteriori relMSE from the halves' difference (RenderResult).
@@ -106,6 +111,11 @@ struct ConvergeFit {
   /// unbiased setting stays near 1: the measured error and the variance estimate come from the
   /// same samples, over every pixel-channel.
   static constexpr double kBiasRatio = 1.3;
+  /// ... and the excess is significant: over kBiasSigmas standard errors
+  /// (ConvergePoint::excess_standard_error). An unbiased path tracer of the Cornell box at 32x32,
+  /// 64 spp, was "biased" for 2 seeds of 15 (error/noise 1.4-1.6: a few pixels' rare bright
+  /// paths), against a reference of 16 times the samples.
+  static constexpr double kBiasSigmas = 3;
   /// run_convergence adds to the verdict that it is unreliable when the reference's own noise is
   /// above this share of noise_relmse at the last rung (a reference about as noisy as the rung:
   /// relMSE divides by its noisy values), and, for an unbiased verdict on Sobol samples, that

@@ -107,6 +107,32 @@ double noise_relmse(const RenderResult& a, const RenderResult& ref) {
   return sum / (3.0 * double(npix));
 }
 
+/// ConvergePoint::excess_standard_error of render `a` against `ref` (0 where noise_relmse has no
+/// variance estimate).
+double excess_standard_error(const RenderResult& a, const RenderResult& ref) {
+  const std::size_t npix = static_cast<std::size_t>(a.mean.width) * a.mean.height;
+  if (npix < 2 || a.variance.rgb.size() != npix * 3 || a.samples.size() != npix ||
+      ref.mean.rgb.size() != npix * 3)
+    return 0;
+  const bool ref_var = ref.variance.rgb.size() == npix * 3 && ref.samples.size() == npix;
+  double sum = 0, sumsq = 0;
+  for (std::size_t i = 0; i < npix; ++i) {
+    double x = 0;  // the pixel's three channels: they share its paths
+    for (int c = 0; c < 3; ++c) {
+      double var = a.samples[i] >= 2 ? a.variance.rgb[i * 3 + c] / double(a.samples[i]) : 0;
+      if (ref_var && ref.samples[i] >= 2)
+        var += ref.variance.rgb[i * 3 + c] / double(ref.samples[i]);
+      const double r = ref.mean.rgb[i * 3 + c], d = a.mean.rgb[i * 3 + c] - r;
+      x += (d * d - var) / (r * r + 0.01);
+    }
+    sum += x;
+    sumsq += x * x;
+  }
+  const double n = double(npix), mean = sum / n;
+  const double spread = std::max(0.0, (sumsq - n * mean * mean) / (n - 1));
+  return std::sqrt(spread / n) / 3.0;  // (relMSE averages over 3 n pixel-channels)
+}
+
 /// The reference's own expected share of a relMSE against it: mean of var_R / n_R / (R^2 + 0.01).
 double reference_noise(const RenderResult& ref) {
   const std::size_t npix = static_cast<std::size_t>(ref.mean.width) * ref.mean.height;
@@ -407,9 +433,13 @@ ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
   f.tail_slope_spp = log_log_slope(std::vector<double>(spp.end() - k, spp.end()),
                                    std::vector<double>(e.end() - k, e.end()));
   const ConvergePoint& last = points.back();
+  // how many standard errors the excess over the noise is (infinite without an estimate of it)
+  double sigmas = INFINITY;
   if (last.noise_relmse > 0) {
     f.excess_ratio = last.relmse / last.noise_relmse;
-    f.biased = f.excess_ratio > ConvergeFit::kBiasRatio;
+    if (last.excess_standard_error > 0)
+      sigmas = (last.relmse - last.noise_relmse) / last.excess_standard_error;
+    f.biased = f.excess_ratio > ConvergeFit::kBiasRatio && sigmas > ConvergeFit::kBiasSigmas;
   } else {
     f.biased = points.size() >= 3 && f.tail_slope_spp > -0.5;
   }
@@ -419,7 +449,11 @@ ConvergeFit fit_convergence(const std::vector<ConvergePoint>& points) {
     // over three rungs or more: fewer said "unbiased" of a setting whose error was 0.47 (a
     // clamp at 0.01) on one rung of 1 spp
     f.verdict =
-        last.noise_relmse > 0
+        last.noise_relmse > 0 && f.excess_ratio > ConvergeFit::kBiasRatio
+            ? "unbiased (error/noise " + fmt("%.2f", f.excess_ratio) +
+                  " at the last rung, not significant: " + fmt("%.1f", sigmas) +
+                  " standard errors, where a few pixels hold the error: rare bright samples)"
+        : last.noise_relmse > 0
             ? "unbiased (error/noise " + fmt("%.2f", f.excess_ratio) + " at the last rung)"
         : last.relmse == 0 ? std::string("unbiased (no error at the last rung)")
         : points.size() < 3 || std::isnan(f.tail_slope_spp)
@@ -646,6 +680,7 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
       p.rmse = c.rmse;
       p.relmse = c.relmse;
       p.noise_relmse = noise_relmse(r, reference);
+      if (p.noise_relmse > 0) p.excess_standard_error = excess_standard_error(r, reference);
       p.reference_noise_relmse = ref_noise;
       p.estimated_relmse = r.estimated_relmse;
       p.halves_relmse = r.halves_relmse;
