@@ -1440,15 +1440,26 @@ TEST(Parts, MpiSigtermToOneRankUnderATimeLimitIsAnInterruption) {
   std::string dir = lucent::test::temp_dir();
   std::string scene = noisy_scene(dir);
   const std::string out = dir + "/mpi.exr", err = dir + "/mpi.err";
-  const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) +
-                           " --spp 16000000 --time 3 -o " + q(out);
-  // rank 1's command line ends in -q (mpirun's holds it too, but does not start with the program)
+  const std::string prog =
+      "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " --spp 16000000 -o " + q(out);
+  // rank 0 stops at its time limit; rank 1, without one, only by the signal, whenever it comes.
+  // Its command line ends in -q (mpirun's holds it too, but does not start with the program),
+  // and holds this test's scene (in a directory of this test's own)
+  const auto literal = [](const std::string& text) {  // (a regex matching `text` alone)
+    std::string escaped;
+    for (char c : text) {
+      if (std::string("\\.+*?()[]{}|^$").find(c) != std::string::npos) escaped += '\\';
+      escaped += c;
+    }
+    return escaped;
+  };
+  const std::string escaped = "^" + literal(LUCENT_MPI_PATH) + " " + literal(scene) + " .* -q$";
   const std::string script = dir + "/stop.sh";
   lucent::test::write_file(
-      script, mpirun("-np 1 " + prog + " : -np 1 " + prog + " -q") + " 2>" + q(err) +
+      script, "timeout 120 env " + mpirun("-np 1 " + prog + " --time 3 : -np 1 " + prog + " -q") +
+                  " 2>" + q(err) +
                   " </dev/null & pid=$!\nfor i in $(seq 600); do grep -q 'rank 0 of 2:' " + q(err) +
-                  " && break; sleep 0.1; done\npkill -TERM -f " +
-                  q("^" + std::string(LUCENT_MPI_PATH) + " .* -q$") + "\nwait $pid\n");
+                  " && break; sleep 0.1; done\npkill -TERM -f " + q(escaped) + "\nwait $pid\n");
   int raw = std::system(("bash " + q(script)).c_str());
   ASSERT_TRUE(WIFEXITED(raw));
   const std::string text = lucent::test::read_file(err);

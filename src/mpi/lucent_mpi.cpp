@@ -539,7 +539,8 @@ int run(const Args& a) {
   const int my_stop_rank = my_signal ? g_rank : g_size;
   MPI_Allreduce(&my_signal, &stop_signal, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
   MPI_Allreduce(&my_stop_rank, &stopped_rank, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  int complete = ck ? ck->complete(renderer, g_stop.load()) : 1, all_complete = 1;
+  // (this rank's stop as agreed above: a signal since then is the next run's)
+  int complete = ck ? ck->complete(renderer, my_signal != 0) : 1, all_complete = 1;
   MPI_Allreduce(&complete, &all_complete, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   lucent::RenderPart part = ck ? ck->whole(renderer) : lucent::make_part(renderer, range, a.scene);
   session.reset();  // its sums and device buffers: the part is what is sent, merged and written
