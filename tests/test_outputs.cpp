@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -97,20 +98,29 @@ TEST(Outputs, ClosedStandardDescriptorsAreNotTakenByFiles) {
 
 // A write killed half-way leaves its hidden temporary file (.<name>.tmp-<pid>-<n>). In a
 // container (a pid namespace) the next run has the same pid and counter: it rendered in full and
-// then failed with "cannot write (File exists)", at every rerun. Taken names are passed over.
+// then failed with "cannot write (File exists)", at every rerun. A name held by a write in
+// progress (its flock) is passed over; a leftover that nobody holds is removed (each killed
+// rerun left another full-size hidden file).
 TEST(Outputs, ATemporaryFileLeftByAKilledWriteDoesNotStopTheNext) {
   if (std::system("unshare -p -f --mount-proc true >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "cannot make a pid namespace here (unshare -p)";
   const std::string dir = lucent::test::temp_dir();
   const std::string scene = scene_in(dir), out = dir + "/out.png";
-  // lucent is pid 1 in its namespace: what a killed run of it left
-  for (int n = 0; n < 8; ++n)
-    lucent::test::write_file(dir + "/.out.png.tmp-1-" + std::to_string(n), "x");
+  // lucent is pid 1 in its namespace: what a killed run of it left, and one name a write of
+  // another process holds
+  const auto temp = [&](int n) { return dir + "/.out.png.tmp-1-" + std::to_string(n); };
+  for (int n = 0; n < 8; ++n) lucent::test::write_file(temp(n), "x");
+  const int held = ::open(temp(3).c_str(), O_RDONLY | O_CLOEXEC);
+  ASSERT_GE(held, 0);
+  ASSERT_EQ(::flock(held, LOCK_EX), 0);
   const CommandResult r =
       run_cli("render " + q(scene) + " -q -o " + q(out), "unshare -p -f --mount-proc");
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(lucent::read_image(out).width, 32);
-  EXPECT_TRUE(fs::exists(dir + "/.out.png.tmp-1-0"));  // (another run's, perhaps: not removed)
+  EXPECT_TRUE(fs::exists(temp(3)));  // (a write in progress: not touched)
+  ::close(held);
+  EXPECT_FALSE(fs::exists(temp(0)));  // the leftovers whose names the run took
+  EXPECT_FALSE(fs::exists(temp(1)));
 }
 
 /// The error line's message, checking the one-line contract.

@@ -94,11 +94,23 @@ fs::path temp_path(const fs::path& dir, const std::string& name) {
 // -1 and errno as open() when it cannot. A name taken by another file is passed over: a write
 // killed half-way leaves its temporary file, and in a container (a pid namespace) the next run
 // has the same pid and counter, so that every rerun rendered in full and then failed with
-// "cannot write (File exists)" on a file the message did not name.
+// "cannot write (File exists)" on a file the message did not name. A write holds an flock on its
+// temporary file (write_file_atomic): one that no process holds is such a leftover, and goes
+// (each killed rerun left another full-size hidden file beside the output).
 int open_temp(const fs::path& dir, const std::string& name, mode_t mode, std::string& tmp) {
   for (int tries = 0;; ++tries) {
     tmp = temp_path(dir, name).string();
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
+    int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
+    if (fd < 0 && errno == EEXIST) {
+      const int old = ::open(tmp.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+      struct stat st {};
+      if (old >= 0 && ::fstat(old, &st) == 0 && S_ISREG(st.st_mode) &&
+          ::flock(old, LOCK_EX | LOCK_NB) == 0 && is_file_at(old, tmp))
+        ::unlink(tmp.c_str());  // (no writer holds it; the name is retried)
+      if (old >= 0) ::close(old);
+      fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
+      errno = fd < 0 ? errno : 0;
+    }
     if (fd >= 0 || errno != EEXIST || tries == 1000) return fd;
   }
 }
@@ -329,6 +341,9 @@ void write_file_atomic(const std::string& path, const void* data, std::size_t si
   std::string tmp;
   int fd = open_temp(dir, name, 0666, tmp);
   if (fd < 0) throw Error(path + ": cannot write (" + reason(errno) + ")");
+  // held while the write lasts: a file of its name that no process holds is a killed write's
+  // leftover (open_temp)
+  (void)::flock(fd, LOCK_EX | LOCK_NB);
   // a file replaced keeps its permissions (a new file's mode comes from the umask: a private
   // image became readable by all), set before any byte is written; as it is a new file, its
   // other hard links keep the old content
