@@ -113,7 +113,8 @@ TEST(SceneGuard, NumbersBeyondFloatRangeNameTheirPointer) {
     "shapes": [{"type": "triangles", "positions": [[1, 0, 0], [0, 0, 0], [0, 1, 0]],
                 "indices": [0, 1, 2], "material": "m",
                 "transform": [{"scale": 1e30}, {"scale": 1e30}]}]})")),
-            ": /shapes/0/positions/0: its largest coordinate after the transform, 1e+60, is "
+            ": /shapes/0/positions/0: its largest coordinate after the transform, "
+            "1.0000000000000001e+60, is "
             "beyond lucent's geometry range (coordinates of magnitude at most 1e+12, where the "
             "kernel's float intersection arithmetic still holds)");
 }
@@ -132,7 +133,8 @@ TEST(SceneGuard, GeometryBeyondRangeNamesItsPlace) {
             ": /shapes/0/center/1: -1e+20" + range);
   EXPECT_EQ(after_path(parse_error("{" + m + R"("shapes": [{"type": "sphere",
     "center": [0, -1e12, 0], "radius": 1e6, "material": "m"}]})")),
-            ": /shapes/0/radius: the sphere's farthest coordinate, 1e+12," + range);
+            // (the value itself: "1e+12 is beyond ... at most 1e+12" contradicted itself)
+            ": /shapes/0/radius: the sphere's farthest coordinate, 1.000001e+12," + range);
   EXPECT_EQ(after_path(parse_error("{" + m + R"("shapes": [{"type": "sphere",
     "center": [0, 0, 0], "radius": 1e19, "material": "m"}]})")),
             ": /shapes/0/radius: the sphere's farthest coordinate, 1e+19," + range);
@@ -291,3 +293,16 @@ TEST(SceneGuard, OneEnvironmentAlsoForScenesBuiltDirectly) {
   EXPECT_EQ(after_path(lucent::test::error_of([&] { lucent::scene_detail::validate_scene(s); })),
             ": /lights/1: only one environment light is allowed");
 }
+
+namespace {
+// A value just past its limit is shown as given: an ior of 20.0000001 was "must be in [0.05, 20],
+// got 20" (six significant digits), which named no mistake.
+TEST(SceneGuard, AValueJustPastItsLimitIsShownAsGiven) {
+  EXPECT_NE(parse_error(R"({"materials": {"m": {"type": "dielectric", "ior": 20.0000001}}})")
+                .find("/materials/m/ior: must be in [0.05, 20], got 20.0000001"),
+            std::string::npos);
+  EXPECT_NE(parse_error(R"({"camera": {"fov": 180.0000001}})")
+                .find("/camera/fov: must be in (0, 180) degrees, got 180.0000001"),
+            std::string::npos);
+}
+}  // namespace

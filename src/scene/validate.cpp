@@ -6,6 +6,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include "lucent/error.hpp"
@@ -31,9 +32,14 @@ void Reporter::fail(const std::string& what) const {
 }
 
 std::string format_number(double v) {
-  std::ostringstream ss;
-  ss << v;
-  return ss.str();
+  // six significant digits where they give the value back, else as many as it takes (at most
+  // 17): an ior of 20.0000001 was "must be in [0.05, 20], got 20"
+  char text[64];
+  for (int digits = 6; digits <= 17; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, v);
+    if (!std::isfinite(v) || std::strtod(text, nullptr) == v) break;
+  }
+  return text;
 }
 
 // ---------------------------------------------------------------------------------------------
