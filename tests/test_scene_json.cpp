@@ -557,7 +557,17 @@ TEST(SceneJson, SettingsThatChangeNothingAreSaid) {
   };
   EXPECT_TRUE(said(R"({"type": "path", "max_depth": 5, "rr_depth": 2, "mis": false})").empty());
   EXPECT_TRUE(said(R"({"type": "whitted", "max_depth": 5})").empty());
-  EXPECT_TRUE(said(R"({"type": "ao", "max_depth": 5})").empty());  // an AOV reads none of them
+  // the AOV integrators read none of them, and only ao reads ao_distance (said for the AOVs
+  // too: the command line refuses those options for them)
+  EXPECT_EQ(said(R"({"type": "ao", "max_depth": 5, "ao_distance": 2})"),
+            std::vector<std::string>{"scene.json: /integrator/max_depth: only the path and "
+                                     "whitted integrators have it, and this file's integrator is "
+                                     "ao: the setting has no effect"});
+  EXPECT_EQ(said(R"({"type": "path", "ao_distance": 2})"),
+            std::vector<std::string>{"scene.json: /integrator/ao_distance: only the ao "
+                                     "integrator has it, and this file's integrator is path: the "
+                                     "setting has no effect"});
+  EXPECT_EQ(said(R"({"type": "albedo", "clamp": 1, "mis": false})").size(), 2u);
   const std::vector<std::string> whitted =
       said(R"({"type": "whitted", "rr_depth": 2, "mis": true})");
   ASSERT_EQ(whitted.size(), 2u);

@@ -89,8 +89,8 @@ void parse_integrator(const JsonReader& r, const json& j, SceneBuilder& b) {
   b.set_integrator(in);
   // a setting the file's integrator does not read changes nothing: said, from the keys the file
   // writes and its own integrator (the command line refuses such options; a check of the scene
-  // after `--integrator direct` blamed a path scene's max_depth). Not for the AOV integrators,
-  // which read none of them.
+  // after `--integrator direct` blamed a path scene's max_depth). The AOV integrators read none
+  // of them, and only ao reads ao_distance.
   using render_detail::IntegratorKnob;
   const std::pair<const char*, IntegratorKnob> knobs[] = {
       {"max_depth", IntegratorKnob::MaxDepth},
@@ -99,12 +99,16 @@ void parse_integrator(const JsonReader& r, const json& j, SceneBuilder& b) {
       {"clamp", IntegratorKnob::Clamp},
       {"caustics", IntegratorKnob::Caustics},
       {"dielectric_splits", IntegratorKnob::Splits}};
-  if (!is_aov(in.type))
-    for (const auto& [key, knob] : knobs)
-      if (j.contains(key))
-        if (const char* why = render_detail::knob_ignored(in.type, knob))
-          warn(in_file(r.file(), p + "/" + key + ": " + why + ", and this file's integrator is " +
-                                     type_name(in.type) + ": the setting has no effect"));
+  for (const auto& [key, knob] : knobs)
+    if (j.contains(key))
+      if (const char* why = render_detail::knob_ignored(in.type, knob))
+        warn(in_file(r.file(), p + "/" + key + ": " + why + ", and this file's integrator is " +
+                                   type_name(in.type) + ": the setting has no effect"));
+  if (j.contains("ao_distance") && in.type != IntegratorType::Ao)
+    warn(in_file(r.file(), p +
+                               "/ao_distance: only the ao integrator has it, and this file's "
+                               "integrator is " +
+                               type_name(in.type) + ": the setting has no effect"));
 }
 
 }  // namespace lucent::scene_detail
