@@ -630,11 +630,16 @@ TEST(CliErrors, IgnoredOptionsAreRefused) {
       {"--reference --precision float", "--precision is not supported with --reference"},
       {"--reference --fast-math", "--fast-math is not supported with --reference"},
       {"--reference --no-specialize", "--no-specialize is not supported with --reference"},
+      // (its glass does not split: the option was taken in silence)
+      {"--reference --dielectric-splits 3",
+       "--dielectric-splits is not supported with --reference"},
       // what only the path integrator reads, for another (an AOV render took them in silence)
       {"--integrator albedo --clamp 0.1",
        "--clamp: only the path integrator has it, and this render's is albedo"},
       {"--integrator direct --caustics",
        "--caustics: only the path integrator has it, and this render's is direct"},
+      {"--integrator whitted --no-caustics",
+       "--no-caustics: only the path integrator has it, and this render's is whitted"},
       {"--integrator whitted --dielectric-splits 4",
        "--dielectric-splits: only the path integrator has it, and this render's is whitted"},
       // depths an integrator does not read (direct took --max-depth in silence)

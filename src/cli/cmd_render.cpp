@@ -284,7 +284,9 @@ int render_with(const RenderArgs& a) {
         {!a.device.empty(), "--device"},
         {!a.precision.empty(), "--precision"},
         {a.fast_math, "--fast-math"},
-        {a.no_specialize, "--no-specialize"}};
+        {a.no_specialize, "--no-specialize"},
+        // (its glass does not split: docs/rendering-model.md, "Glass splitting")
+        {a.sampling.splits >= 0, "--dielectric-splits"}};
     for (const auto& [given, name] : kernel_only)
       if (given) throw lucent::Error(std::string(name) + " is not supported with --reference");
   }

@@ -58,7 +58,9 @@ void apply_sampling_options(const SamplingArgs& a, Scene& scene) {
   // what only the path integrator reads: refused for another, rather than ignored without a word
   using render_detail::IntegratorKnob;
   check_knob(scene, a.clamp >= 0, IntegratorKnob::Clamp, "--clamp");
-  check_knob(scene, a.caustics == 1, IntegratorKnob::Caustics, "--caustics");
+  // (--no-caustics too: it changes nothing for them either)
+  check_knob(scene, a.caustics >= 0, IntegratorKnob::Caustics,
+             a.caustics == 1 ? "--caustics" : "--no-caustics");
   check_knob(scene, a.splits >= 0, IntegratorKnob::Splits, "--dielectric-splits");
   if (a.clamp >= 0) scene.integrator.clamp = a.clamp;
   if (a.caustics >= 0) scene.integrator.caustics = a.caustics == 1;
