@@ -1114,7 +1114,7 @@ TEST(Converge, CommandWritesCsvAndPlot) {
   EXPECT_EQ(again.status, 0) << again.err;
   EXPECT_EQ(lucent::test::count_lines(again.err), 0) << again.err;
   // one rung: no slope to print (it printed 0.00)
-  EXPECT_NE(again.out.find("  default                   n/a  (against spp   n/a, last 3 rungs   "
+  EXPECT_NE(again.out.find("  default                   n/a  (against spp   n/a, last 1 rung   "
                            "n/a)  unbiased"),
             std::string::npos)
       << again.out;

@@ -393,8 +393,10 @@ int run_converge_command() {
                          : std::string(buf);
   };
   for (const ConvergeFit& f : result.fits)
-    std::printf("  %-22s %s  (against spp %s, last 3 rungs %s)  %s\n", f.setting.c_str(),
+    // (the tail's rungs as many as there are, up to 3: two said "last 3 rungs")
+    std::printf("  %-22s %s  (against spp %s, last %zu rung%s %s)  %s\n", f.setting.c_str(),
                 slope(f.slope_time, 6).c_str(), slope(f.slope_spp, 5).c_str(),
+                std::min<std::size_t>(3, f.points), f.points == 1 ? "" : "s",
                 slope(f.tail_slope_spp, 5).c_str(), f.verdict.c_str());
 
   print_time_to_common_error(result);
