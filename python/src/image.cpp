@@ -55,6 +55,11 @@ DisplaySettings display_settings(const Film* film, py::object transfer, py::obje
     throw py::value_error("gamma must be a finite number > 0, got " +
                           py::repr(py::float_(d.gamma)).cast<std::string>());
   if (!std::isfinite(d.exposure)) throw py::value_error("exposure must be finite");
+  // as a scene file's film refuses it: a gamma shapes the "gamma" transfer only (it was dropped
+  // without a word with srgb or linear)
+  if (!gamma.is_none() && d.transfer != Transfer::Gamma)
+    throw py::value_error(std::string("gamma: only used with transfer 'gamma' (the transfer is ") +
+                          (d.transfer == Transfer::Srgb ? "srgb" : "linear") + ")");
   return d;
 }
 
@@ -65,8 +70,6 @@ void bind_image(py::module_& m) {
       "write_image",
       [](const std::filesystem::path& path, py::handle image, const Film* film, py::object transfer,
          py::object gamma, py::object exposure, py::object tonemap) {
-        DisplaySettings d = display_settings(film, transfer, gamma, exposure, tonemap);
-        RenderResult r = render_result_from(image, "image");
         std::string p = path.string();
         // display settings given for a linear file change nothing: refused, as the CLI refuses
         // options that change nothing (they were dropped without a word)
@@ -81,6 +84,8 @@ void bind_image(py::module_& m) {
                                     " is a display setting, "
                                     "for .png; " +
                                     ext + " holds linear values");
+        DisplaySettings d = display_settings(film, transfer, gamma, exposure, tonemap);
+        RenderResult r = render_result_from(image, "image");
         ReleaseGil release;
         write_image(p, r.mean, d);
       },

@@ -418,7 +418,14 @@ def test_display_settings_of_the_wrong_type_name_the_setting(tmp_path):
         lucent.write_image(tmp_path / "a.png", constant(1.0), transfer=3)
     with pytest.raises(TypeError, match="gamma: expected a number, got 'x'"):
         lucent.write_image(tmp_path / "a.png", constant(1.0), gamma="x")
-    lucent.write_image(tmp_path / "a.png", constant(1.0), gamma=np.float32(2.2), exposure=1)
+    lucent.write_image(tmp_path / "a.png", constant(1.0), gamma=np.float32(2.2), exposure=1,
+                       transfer="gamma")
+    # a gamma shapes the "gamma" transfer only, as a scene file's film says (it was dropped
+    # without a word)
+    for transfer in ("srgb", "linear"):
+        with pytest.raises(ValueError, match=rf"^gamma: only used with transfer 'gamma' \(the "
+                                             rf"transfer is {transfer}\)$"):
+            lucent.write_image(tmp_path / "a.png", constant(1.0), gamma=2.0, transfer=transfer)
 
 
 def test_non_finite_inputs_are_errors_not_results(small_scene):
