@@ -305,6 +305,28 @@ TEST(Cli, AovsAreWrittenBesideTheImage) {
   EXPECT_GT(*std::max_element(var.begin(), var.end()), 0.0f) << "path tracing is noisy";
 }
 
+// An AOV whose values are not radiance (depth, normal, primitive), written as an 8-bit image: the
+// display transform and [0, 1] clip it in a file that looks complete (a depth image of a scene 5
+// away was a white silhouette): a warning says so, and names the formats that keep them.
+TEST(Cli, AovValuesToAnEightBitImageAreSaidToBeClipped) {
+  const std::string scene = plane_scene(0, 1);
+  const std::string dir = lucent::test::temp_dir();
+  for (const char* integrator : {"depth", "normal", "primitive", "albedo"}) {
+    CommandResult r =
+        run_cli("render " + q(scene) + " -o " + q(dir + "/a.png") + " --integrator " + integrator);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string warning = "lucent: warning: " + dir + "/a.png: the " + integrator +
+                                " integrator's values are not radiance: an 8-bit image clips "
+                                "them to [0, 1] after the film's display transform; write .exr "
+                                "or .pfm to keep them\n";
+    EXPECT_EQ(r.err.find(warning) != std::string::npos, std::string(integrator) != "albedo")
+        << r.err;
+    r = run_cli("render " + q(scene) + " -o " + q(dir + "/a.exr") + " --integrator " + integrator);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  }
+}
+
 TEST(Cli, ProgressLineAndTimeLimit) {
   std::string scene = plane_scene(0, 1 << 24);
   std::string out = lucent::test::temp_dir() + "/o.png";

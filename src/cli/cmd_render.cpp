@@ -373,6 +373,22 @@ int render_with(const RenderArgs& a) {
   if (a.max_depth > 0) scene.integrator.max_depth = a.max_depth;
   if (a.rr_depth > 0) scene.integrator.rr_depth = a.rr_depth;
   lucent::cli::apply_sampling_options(a.sampling, scene);
+  // values that are not radiance, to an 8-bit image: the display transform and [0, 1] clip them
+  // (a depth image of a scene 5 away was a white silhouette, primitive ids white, normals' negative
+  // components black), in a file that looks complete
+  {
+    using lucent::IntegratorType;
+    const IntegratorType t = scene.integrator.type;
+    const std::string ext = lucent::io::lower_extension(a.output);
+    if ((t == IntegratorType::Depth || t == IntegratorType::Normal ||
+         t == IntegratorType::Primitive) &&
+        ext != ".exr" && ext != ".pfm" && !a.quiet)
+      std::fprintf(stderr,
+                   "lucent: warning: %s: the %s integrator's values are not radiance: an 8-bit "
+                   "image clips them to [0, 1] after the film's display transform; write .exr "
+                   "or .pfm to keep them\n",
+                   one_line(a.output).c_str(), lucent::type_name(t));
+  }
   if (range) lucent::check_part_scene(scene, a.scene);
   std::optional<Checkpoint> checkpoint;
   if (!a.checkpoint.empty()) {
