@@ -122,8 +122,6 @@ void write_file(const std::string& path, const std::string& text) {
 
 std::string read_file(const std::string& path) { return read_all(path); }
 
-namespace {
-
 std::uint32_t crc32(const std::string& data) {
   std::uint32_t c = 0xFFFFFFFFu;
   for (unsigned char b : data) {
@@ -132,6 +130,8 @@ std::uint32_t crc32(const std::string& data) {
   }
   return ~c;
 }
+
+namespace {
 
 std::string be32(std::uint32_t v) { return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; }
 

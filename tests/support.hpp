@@ -48,6 +48,9 @@ void write_file(const std::string& path, const std::string& text);
 /// The content of `path` ("" when it cannot be read).
 std::string read_file(const std::string& path);
 
+/// CRC-32 (ISO 3309), as PNG chunks carry it, computed here.
+std::uint32_t crc32(const std::string& data);
+
 /// A PNG file written by hand (stb_image_write writes neither 16 bits nor palettes): the IHDR of
 /// `width` x `height`, `bit_depth` and `colour_type`, then `chunks` (tag and data: a PLTE), then
 /// `rows` (each row's filter byte included) as one zlib stream of stored deflate blocks; CRC-32

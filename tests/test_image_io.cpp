@@ -537,6 +537,57 @@ TEST(ImageIo, PizExrReadsAndDamagedHuffmanTablesAreRefused) {
             at + "a run of zero code lengths passes the last symbol of its Huffman table");
 }
 
+// A PNG says how its values encode light: sRGB (with the gAMA of 1/2.2 beside it), gAMA 1/gamma
+// for the gamma transfer, 1 for linear, after IHDR and before the image data, each with its CRC.
+// Without them a viewer took a linear or gamma-1.8 PNG for sRGB (too dark or too light).
+TEST(ImageIo, PngsSayTheirTransfer) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::Image img{2, 1, {0.0f, 0.5f, 1.0f, 0.25f, 0.125f, 2.0f}};
+  const auto be32 = [](const std::string& b, size_t at) {
+    return std::uint32_t(std::uint8_t(b[at])) << 24 | std::uint32_t(std::uint8_t(b[at + 1])) << 16 |
+           std::uint32_t(std::uint8_t(b[at + 2])) << 8 | std::uint32_t(std::uint8_t(b[at + 3]));
+  };
+  struct Case {
+    lucent::Transfer transfer;
+    double gamma;
+    std::string srgb;
+    std::uint32_t gama;
+  };
+  const Case cases[] = {{lucent::Transfer::Srgb, 2.2, std::string(1, '\0'), 45455},
+                        {lucent::Transfer::Gamma, 2.2, "", 45455},
+                        {lucent::Transfer::Gamma, 1.8, "", 55556},
+                        {lucent::Transfer::Linear, 2.2, "", 100000}};
+  for (const Case& c : cases) {
+    lucent::DisplaySettings d;
+    d.transfer = c.transfer;
+    d.gamma = c.gamma;
+    lucent::write_image(dir + "/t.png", img, d);
+    const std::string png = lucent::test::read_file(dir + "/t.png");
+    std::vector<std::string> tags;
+    std::string srgb, gama;
+    for (size_t at = 8; at + 12 <= png.size();) {
+      const std::uint32_t len = be32(png, at);
+      const std::string tag = png.substr(at + 4, 4), data = png.substr(at + 8, len);
+      EXPECT_EQ(be32(png, at + 8 + len), lucent::test::crc32(tag + data)) << tag;
+      if (tag == "sRGB") srgb = data;
+      if (tag == "gAMA") gama = data;
+      if (tags.empty() || tags.back() != tag) tags.push_back(tag);
+      at += 12 + len;
+    }
+    const std::vector<std::string> order =
+        c.srgb.empty() ? std::vector<std::string>{"IHDR", "gAMA", "IDAT", "IEND"}
+                       : std::vector<std::string>{"IHDR", "sRGB", "gAMA", "IDAT", "IEND"};
+    EXPECT_EQ(tags, order) << c.gamma;
+    EXPECT_EQ(srgb, c.srgb);
+    ASSERT_EQ(gama.size(), 4u);
+    EXPECT_EQ(be32(gama, 0), c.gama) << c.gamma;
+    // the pixels read back as they were encoded (decoders skip the chunks they do not use)
+    const lucent::Image back = lucent::read_image(dir + "/t.png");
+    EXPECT_EQ(back.width, 2);
+    EXPECT_EQ(back.rgb.size(), 6u);
+  }
+}
+
 // An OpenEXR file's n layer in float (not lucent's UINT) holds whole counts: 16.5, a negative or
 // a NaN count is an error naming the file, the pixel and the value (16.5 was read as 16).
 TEST(ImageIo, FloatSampleCountsAreWholeNumbers) {

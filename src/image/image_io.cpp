@@ -76,6 +76,41 @@ bool stb_flips_on_write() {
   return bmp.size() > 54 && static_cast<unsigned char>(bmp[54]) == 255;
 }
 
+/// A PNG chunk: its length, tag, data and CRC-32 (ISO 3309, as the PNG specification gives it).
+std::string png_chunk(const char* tag, const std::string& data) {
+  const auto be32 = [](std::uint32_t v) {
+    return std::string{char(v >> 24), char(v >> 16 & 0xFF), char(v >> 8 & 0xFF), char(v & 0xFF)};
+  };
+  const std::string body = std::string(tag, 4) + data;
+  std::uint32_t crc = 0xFFFFFFFFu;
+  for (unsigned char b : body) {
+    crc ^= b;
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return be32(static_cast<std::uint32_t>(data.size())) + body + be32(~crc);
+}
+
+/// The chunks that say how the 8-bit values encode light, after IHDR: sRGB (and the gAMA of 1/2.2
+/// the specification asks beside it for older decoders), or gAMA 1/gamma for the gamma transfer
+/// and 1 for linear. Without them a viewer takes any PNG for sRGB, and showed a linear or
+/// gamma-1.8 image too dark or too light with nothing in the file to say otherwise.
+std::string png_colour_chunks(const DisplaySettings& display) {
+  const auto gama = [](double file_gamma) {
+    const auto v = static_cast<std::uint32_t>(std::lround(std::clamp(file_gamma, 1e-5, 4e4) * 1e5));
+    return png_chunk("gAMA", std::string{char(v >> 24), char(v >> 16 & 0xFF), char(v >> 8 & 0xFF),
+                                         char(v & 0xFF)});
+  };
+  switch (display.transfer) {
+    case Transfer::Srgb:
+      return png_chunk("sRGB", std::string(1, '\0')) + gama(1 / 2.2);
+    case Transfer::Gamma:
+      return gama(1 / display.gamma);
+    case Transfer::Linear:
+      break;
+  }
+  return gama(1.0);
+}
+
 std::string encode_png(const std::string& path, const Image& img, const DisplaySettings& display) {
   std::vector<unsigned char> bytes(img.rgb.size());
   const size_t row = size_t(img.width) * 3;
@@ -88,6 +123,9 @@ std::string encode_png(const std::string& path, const Image& img, const DisplayS
   auto append = append_bytes;
   if (!stbi_write_png_to_func(append, &out, img.width, img.height, 3, bytes.data(), img.width * 3))
     throw Error(path + ": cannot encode PNG");
+  // (after the signature and IHDR, 8 + 25 bytes: before the image data, as the chunks must be)
+  if (out.size() < 33 || out.compare(12, 4, "IHDR") != 0) throw Error(path + ": cannot encode PNG");
+  out.insert(33, png_colour_chunks(display));
   return out;
 }
 
