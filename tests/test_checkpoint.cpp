@@ -379,6 +379,36 @@ TEST(Checkpoint, SigtermKeepsTheCheckpoint) {
       << text;
 }
 
+// A render stopped after its every checkpoint write failed (here a file size limit: the PNG
+// output fits, the part file of a noisy 500x400 film, whose doubles do not compress, does not) says
+// last that no checkpoint holds its samples (it said only "wrote out.png with ... spp"; the warning
+// before it alone told).
+TEST(Checkpoint, AStoppedRenderWhoseCheckpointWasNeverWrittenSaysSo) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir);
+  const std::string ck = dir + "/ck.exr", out = dir + "/out.png", err = dir + "/err";
+  const std::string script =
+      "ulimit -f 1500; '" + std::string(LUCENT_CLI_PATH) + "' render " + q(scene) +
+      " --width 500 --height 400 --spp 16000000 -o " + q(out) + " --checkpoint " + q(ck) +
+      " --checkpoint-every 0.05 2>" + q(err) +
+      " </dev/null & pid=$!; for i in $(seq 600); do grep -q 'checkpoint not written' " + q(err) +
+      " && break; sleep 0.1; done; kill -TERM $pid; wait $pid";
+  lucent::test::write_file(dir + "/stop.sh", script + "\n");
+  const int raw = std::system(("bash " + q(dir + "/stop.sh")).c_str());
+  const std::string text = lucent::test::read_file(err);
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 143) << text;
+  EXPECT_NE(text.find("lucent: warning: checkpoint not written: " + ck +
+                      ": cannot write (File too large)"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("lucent: no checkpoint holds the samples (" + ck +
+                      " not written): the same command renders them again\n"),
+            std::string::npos)
+      << text;
+  EXPECT_TRUE(fs::exists(out)) << text;
+  EXPECT_FALSE(fs::exists(ck)) << text;
+}
+
 // A checkpoint removed after its last write (here with its directory, so that the writes since
 // fail) holds nothing: the last line says so (it said the file that was gone held the samples).
 // The writes that fail in a row, every 0.1 s for a second, say so once (they said it at each).

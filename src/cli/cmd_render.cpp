@@ -566,9 +566,12 @@ int render_with(const RenderArgs& a) {
   }
   if (a.aovs.empty()) renderer.reset();
   kept.reset();
+  // what the checkpoint holds after a render that did not end complete: samples, or none when
+  // every write failed (a full disk from the start: the last line said only "wrote out.png with
+  // 174 of 2000 spp", the earlier warning alone telling that no checkpoint existed)
   if (checkpoint_done)
     checkpoint->remove();
-  else if (checkpoint && checkpoint->held() > 0)
+  else if (checkpoint && (checkpoint->held() > 0 || r.spp > 0))
     say_kept(*checkpoint, false);
   // (a stopped render's pixels without a sample may be the ones it never reached)
   if (r.nonfinite > 0)
