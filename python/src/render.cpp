@@ -504,6 +504,9 @@ double checked_seconds(double s, const char* what) {
 }
 
 std::vector<ConvergeSetting> parse_settings(const std::vector<std::string>& names) {
+  // (an empty list ran ['default'] without a word, where an empty ladder is an error)
+  if (names.empty())
+    throw py::value_error("settings: an empty list (give ['default'] for the scene's own)");
   for (const std::string& n : names) refuse_nul(n, "settings");
   try {
     return parse_converge_settings(names);

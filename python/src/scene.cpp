@@ -906,8 +906,8 @@ py::dict scene_info(const Scene& scene, const TextArg& precision, const FlagArg&
   bvh["binary_max_depth"] = b.binary_max_depth;
   bvh["max_depth"] = b.max_depth;
   bvh["sah_cost"] = b.sah_cost;
-  double texel_bytes = 0;
-  for (const Texture& t : copy.textures) texel_bytes += double(t.width) * t.height * 16;
+  std::uint64_t texel_bytes = 0;  // (a count, an int as the others: it was a float)
+  for (const Texture& t : copy.textures) texel_bytes += std::uint64_t(t.width) * t.height * 16;
   std::string defines = render_detail::feature_defines(copy, packed, specialize);
   py::list define_list;
   std::istringstream words(defines);

@@ -255,6 +255,9 @@ def test_converge_without_a_session(small_scene):
 
 
 def test_converge_by_time_and_errors(small_scene):
+    # an empty list of settings ran ['default'] without a word, where an empty ladder is an error
+    with pytest.raises(ValueError, match=r"^settings: an empty list \(give \['default'\]"):
+        lucent.converge(small_scene, lucent.render_reference(small_scene, spp=4), settings=[])
     reference = reference_of(small_scene, 16)
     with session() as r:
         res = lucent.converge(small_scene, reference, time_ladder=[0.02, 0.05], renderer=r)

@@ -466,6 +466,9 @@ def test_scene_info_matches_the_cli(tmp_path, small_dict):
     assert info["lights"]["point"] == 1 and info["lights"]["sphere"] == 1
     assert info["lights"]["triangle"] == 0 and info["skipped_triangles"] == 0
     assert info["bvh"]["primitives"] == 4 and info["bvh"]["nodes"] >= 1
+    # counts are ints (texture_bytes was a float)
+    assert all(type(info[k]) is int for k in ("triangles", "spheres", "vertices", "materials",
+                                              "textures", "texture_bytes"))
     for define in ("LC_HAS_SPHERES", "LC_HAS_TRIANGLES", "LC_HAS_POINT_LIGHTS",
                    "LC_HAS_SPHERE_LIGHTS", "LC_HAS_DIFFUSE", "LC_HAS_INTEGRATOR_PATH"):
         assert define in info["feature_defines"], define
