@@ -135,11 +135,19 @@ TEST(Compare, FewSamplesAgainstManyOfTheSameEstimatorPass) {
   const CompareResult biased = lucent::compare_images(rare_paths(32, 20, 0.02), many);
   EXPECT_FALSE(biased.passed) << biased.summary();
   EXPECT_FALSE(biased.mean_test_passed) << biased.summary();
-  // an image without variances (a deterministic reference) still counts as exact
+  // an image without variances (a deterministic reference) still counts as exact: the pixels
+  // whose samples all missed the rare value fail, and the summary says why they may have
   const CompareResult exact =
       lucent::compare_images(rare_paths(32, 3), constant_image(32, 32, 0.1f + 2.0f / 64));
   EXPECT_TRUE(exact.statistical);
   EXPECT_GT(exact.max_z, 10.0) << exact.summary();
+  EXPECT_GT(exact.zero_variance_failures, 300u) << exact.summary();
+  EXPECT_NE(exact.summary().find(" failing pixel-channels have no variance in either image: the "
+                                 "samples of the image with variances agreed there, from fewer "
+                                 "than 64,"),
+            std::string::npos)
+      << exact.summary();
+  EXPECT_EQ(lucent::compare_images(rare_paths(32, 4), many).zero_variance_failures, 0u);
 }
 
 // A render of many samples keeps nearly its own variance: a kernel of 64 spp and variance 0.01

@@ -77,6 +77,13 @@ struct CompareResult {
   /// the per-pixel test at every try, of 4 in one try of 5), and the summary warns.
   std::size_t few_sample_pixels = 0;
   static constexpr double kFewPixelSamples = 8;
+  /// Failing pixel-channels where only one image carries variances and its pixel has none from
+  /// fewer than kFewSamplesOfNoVariance samples (they all agreed): tested as exact, they may
+  /// have missed what the pixel rarely sees, which the image without variances cannot show (a
+  /// render of 32 spp failed against a converged PFM and passed against the same image as an EXR
+  /// with variances). The summary warns.
+  std::size_t zero_variance_failures = 0;
+  static constexpr double kFewSamplesOfNoVariance = 64;
 };
 
 /// Compares two images pixel by pixel. `variance` and `samples` may be empty (a deterministic

@@ -274,6 +274,9 @@ void bind_image(py::module_& m) {
       .def_readonly("few_sample_pixels", &CompareResult::few_sample_pixels,
                     "pixels resting on fewer than 8 samples in an image carrying variances: "
                     "their sample variances are unreliable, and the summary warns")
+      .def_readonly("zero_variance_failures", &CompareResult::zero_variance_failures,
+                    "failing pixel-channels where only one image carries variances and its pixel "
+                    "has none from fewer than 64 samples: the summary warns")
       .def_readonly("rmse", &CompareResult::rmse)
       .def_readonly("relmse", &CompareResult::relmse)
       .def_readonly("max_abs_error", &CompareResult::max_abs_error)

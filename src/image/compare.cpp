@@ -220,6 +220,13 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
       if (!ok) {
         ++r.failed_channels;
         pixel_ok = false;
+        // no variance in either image there, the one with statistics at few samples: its
+        // samples agreed, perhaps all missing what the pixel rarely sees, and nothing in the
+        // other image can say so (a PFM reference; the same one as an EXR with variances passed)
+        const bool a_stats = !a.variance.rgb.empty(), b_stats = !b.variance.rgb.empty();
+        if (a_stats != b_stats && pixel_test_variance(a, b, i, c) == 0 &&
+            sample_count(a_stats ? a : b, i) < CompareResult::kFewSamplesOfNoVariance)
+          ++r.zero_variance_failures;
       }
       double az = std::isfinite(z) ? std::abs(z) : INFINITY;
       if (az > r.max_z || (i == 0 && c == 0)) {
@@ -310,6 +317,15 @@ std::string CompareResult::summary() const {
                   "however far the means are; compare with more samples in both\n",
                   mean_variance_x, mean_variance_y, "RGB"[mean_variance_channel],
                   100 * mean_variance_share, mean_variance_samples);
+    s += buf;
+  }
+  if (zero_variance_failures > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "warning       %zu failing pixel-channels have no variance in either image: "
+                  "the samples of the image with variances agreed there, from fewer than %g, "
+                  "and may all have missed what the pixel rarely sees; compare against an image "
+                  "with variances (an EXR lucent wrote), or with more samples\n",
+                  zero_variance_failures, kFewSamplesOfNoVariance);
     s += buf;
   }
   if (few_sample_pixels > 0) {
