@@ -110,17 +110,19 @@ TEST(Outputs, ATemporaryFileLeftByAKilledWriteDoesNotStopTheNext) {
   // another process holds
   const auto temp = [&](int n) { return dir + "/.out.png.tmp-1-" + std::to_string(n); };
   for (int n = 0; n < 8; ++n) lucent::test::write_file(temp(n), "x");
-  const int held = ::open(temp(3).c_str(), O_RDONLY | O_CLOEXEC);
+  const int held = ::open(temp(0).c_str(), O_RDONLY | O_CLOEXEC);
   ASSERT_GE(held, 0);
   ASSERT_EQ(::flock(held, LOCK_EX), 0);
   const CommandResult r =
       run_cli("render " + q(scene) + " -q -o " + q(out), "unshare -p -f --mount-proc");
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(lucent::read_image(out).width, 32);
-  EXPECT_TRUE(fs::exists(temp(3)));  // (a write in progress: not touched)
+  // (the run's first name: a write in progress there is not touched, the name passed over)
+  EXPECT_TRUE(fs::exists(temp(0)));
+  EXPECT_EQ(lucent::test::read_file(temp(0)), "x");
   ::close(held);
-  EXPECT_FALSE(fs::exists(temp(0)));  // the leftovers whose names the run took
-  EXPECT_FALSE(fs::exists(temp(1)));
+  EXPECT_FALSE(fs::exists(temp(1)));  // the leftovers whose names the run took
+  EXPECT_FALSE(fs::exists(temp(2)));
 }
 
 /// The error line's message, checking the one-line contract.

@@ -114,7 +114,9 @@ struct ConvergeFit {
   /// ... and the excess is significant: over kBiasSigmas standard errors
   /// (ConvergePoint::excess_standard_error). An unbiased path tracer of the Cornell box at 32x32,
   /// 64 spp, was "biased" for 2 seeds of 15 (error/noise 1.4-1.6: a few pixels' rare bright
-  /// paths), against a reference of 16 times the samples.
+  /// paths), against a reference of 16 times the samples. An excess above kBiasRatio that is not
+  /// significant is "undetermined": a few pixels hold it, and k biased pixels score about
+  /// sqrt(k) standard errors whatever their bias, as rare bright samples in them would.
   static constexpr double kBiasSigmas = 3;
   /// run_convergence adds to the verdict that it is unreliable when the reference's own noise is
   /// above this share of noise_relmse at the last rung (a reference about as noisy as the rung:

@@ -382,7 +382,7 @@ int render_with(const RenderArgs& a) {
     const std::string ext = lucent::io::lower_extension(a.output);
     if ((t == IntegratorType::Depth || t == IntegratorType::Normal ||
          t == IntegratorType::Primitive) &&
-        ext != ".exr" && ext != ".pfm" && !a.quiet)
+        ext != ".exr" && ext != ".pfm")  // (a warning: said with -q too)
       std::fprintf(stderr,
                    "lucent: warning: %s: the %s integrator's values are not radiance: an 8-bit "
                    "image clips them to [0, 1] after the film's display transform; write .exr "

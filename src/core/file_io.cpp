@@ -97,21 +97,35 @@ fs::path temp_path(const fs::path& dir, const std::string& name) {
 // "cannot write (File exists)" on a file the message did not name. A write holds an flock on its
 // temporary file (write_file_atomic): one that no process holds is such a leftover, and goes
 // (each killed rerun left another full-size hidden file beside the output).
+// The new file is returned locked (flock, exclusive) and checked to be the file of its name: a
+// process that took the name between the open and the lock (a leftover's reaper) makes the name
+// retried. On a file system whose flock is not that (NFS emulates it with fcntl locks, which an
+// exclusive lock needs the file open for writing for), the lock may fail: the file is used all
+// the same, unlocked, and another run takes it for a leftover only where its lock succeeds.
 int open_temp(const fs::path& dir, const std::string& name, mode_t mode, std::string& tmp) {
   for (int tries = 0;; ++tries) {
     tmp = temp_path(dir, name).string();
     int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
     if (fd < 0 && errno == EEXIST) {
-      const int old = ::open(tmp.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+      // a regular file (lstat first: opening a device node of that name can act on the device)
       struct stat st {};
-      if (old >= 0 && ::fstat(old, &st) == 0 && S_ISREG(st.st_mode) &&
-          ::flock(old, LOCK_EX | LOCK_NB) == 0 && is_file_at(old, tmp))
-        ::unlink(tmp.c_str());  // (no writer holds it; the name is retried)
-      if (old >= 0) ::close(old);
+      if (::lstat(tmp.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
+        int old = ::open(tmp.c_str(), O_RDWR | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+        if (old < 0) old = ::open(tmp.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+        if (old >= 0 && ::flock(old, LOCK_EX | LOCK_NB) == 0 && is_file_at(old, tmp))
+          ::unlink(tmp.c_str());  // (no writer holds it; the name is retried)
+        if (old >= 0) ::close(old);
+      }
       fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
       errno = fd < 0 ? errno : 0;
     }
-    if (fd >= 0 || errno != EEXIST || tries == 1000) return fd;
+    if (fd >= 0) {
+      const int lock_error = ::flock(fd, LOCK_EX | LOCK_NB) == 0 ? 0 : errno;
+      if (is_file_at(fd, tmp) && lock_error != EWOULDBLOCK) return fd;
+      ::close(fd);  // (taken from under it: another name)
+      errno = EEXIST;
+    }
+    if (errno != EEXIST || tries == 1000) return -1;
   }
 }
 
@@ -262,8 +276,8 @@ void check_output_file(const std::string& out, const std::vector<std::string>& i
   std::string probe;
   int fd = open_temp(dir, name, 0600, probe);
   if (fd < 0) throw Error(out + cannot + std::strerror(errno) + ")");
+  ::unlink(probe.c_str());  // (while it holds the lock: the name is no one else's yet)
   ::close(fd);
-  ::unlink(probe.c_str());
 }
 
 bool is_file_at(int fd, const std::string& path) {
@@ -339,11 +353,10 @@ void write_file_atomic(const std::string& path, const void* data, std::size_t si
   check_writable_kind(path, target);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::string tmp;
+  // locked while the write lasts, its rename included: a file of its name that no process holds
+  // is a killed write's leftover (open_temp)
   int fd = open_temp(dir, name, 0666, tmp);
   if (fd < 0) throw Error(path + ": cannot write (" + reason(errno) + ")");
-  // held while the write lasts: a file of its name that no process holds is a killed write's
-  // leftover (open_temp)
-  (void)::flock(fd, LOCK_EX | LOCK_NB);
   // a file replaced keeps its permissions (a new file's mode comes from the umask: a private
   // image became readable by all), set before any byte is written; as it is a new file, its
   // other hard links keep the old content
@@ -364,10 +377,14 @@ void write_file_atomic(const std::string& path, const void* data, std::size_t si
   }
   // a full disk or an I/O error may only show when the data reaches the device
   if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) fail(errno);
+  // the lock kept through the rename by a second descriptor (closing the first, whose error
+  // counts, released it: a finished file could be taken for a leftover before its rename)
+  const int held = ::dup(fd);
   int rc = ::close(fd);
-  fd = -1;
+  fd = held;
   if (rc != 0 && errno != EINTR) fail(errno);
   if (::rename(tmp.c_str(), target.c_str()) != 0) fail(errno);
+  if (fd >= 0) ::close(fd);
 }
 
 }  // namespace lucent::io

@@ -1,5 +1,6 @@
 #include "core/text.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 
@@ -71,9 +72,9 @@ bool plain_decimal_real(const std::string& text) {
   return i == text.size();
 }
 
-std::string shortest_real(double v) {
+std::string shortest_real(double v, int min_digits) {
   char text[64];
-  for (int digits = 15; digits <= 17; ++digits) {
+  for (int digits = std::min(min_digits, 17); digits <= 17; ++digits) {
     std::snprintf(text, sizeof text, "%.*g", digits, v);
     if (std::strtod(text, nullptr) == v) break;
   }

@@ -22,10 +22,10 @@ bool plain_decimal_integer(const std::string& text);
 /// takes hex floats (`--time 0x10` ran 16 s), leading spaces, "inf" and "nan".
 bool plain_decimal_real(const std::string& text);
 
-/// `v` in the fewest significant digits (15 to 17, "%g") that read back as `v`: "2.2", where
-/// "%.17g" wrote "2.2000000000000002" into a part file's header. Call it in the "C" locale
-/// (CNumbers).
-std::string shortest_real(double v);
+/// `v` in the fewest significant digits (`min_digits`, 15 by default, to 17, "%g") that read
+/// back as `v`: "2.2", where "%.17g" wrote "2.2000000000000002" into a part file's header. Call
+/// it in the "C" locale (CNumbers).
+std::string shortest_real(double v, int min_digits = 15);
 
 /// While alive, this thread formats and parses numbers (printf, strtod) in the "C" locale,
 /// whatever setlocale() chose for the process: a Python program that called

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "core/text.hpp"
 #include "lucent/error.hpp"
 #include "lucent/types.hpp"
 #include "scene/loaders.hpp"
@@ -33,13 +34,10 @@ void Reporter::fail(const std::string& what) const {
 
 std::string format_number(double v) {
   // six significant digits where they give the value back, else as many as it takes (at most
-  // 17): an ior of 20.0000001 was "must be in [0.05, 20], got 20"
-  char text[64];
-  for (int digits = 6; digits <= 17; ++digits) {
-    std::snprintf(text, sizeof text, "%.*g", digits, v);
-    if (!std::isfinite(v) || std::strtod(text, nullptr) == v) break;
-  }
-  return text;
+  // 17): an ior of 20.0000001 was "must be in [0.05, 20], got 20". In the "C" locale, as
+  // ostream's classic one was ("got 180,5" after a German setlocale)
+  const io::CNumbers c_numbers;
+  return io::shortest_real(v, 6);
 }
 
 // ---------------------------------------------------------------------------------------------
