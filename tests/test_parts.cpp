@@ -15,6 +15,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <clocale>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -676,6 +677,60 @@ TEST(Parts, ReadingAPartStaysWithinTheReadersCount) {
 // 32-bit words as pairs of 16-bit values), and checks them: its attribute lucent.checksum. A PIZ
 // chunk has no check of its own (ZIP's has Adler-32), so a damaged one that still decoded gave
 // other sums without a word; a damaged file now reads as its sums or is refused in one line.
+// A part file's attributes and a caustics render's lucent.light_mean_var are read and written in
+// the "C" locale, whatever the process's: after a library caller's setlocale to a decimal-comma
+// locale (Qt applications do it at start), every part file was refused ("attribute lucent.display:
+// invalid 'srgb,2.2,0,clamp'") and a caustics EXR was written with "9,92e-07", which the command
+// line then refused (the fuzz runner's find). A comma locale installed, or made by localedef
+// into a temporary directory (LOCPATH); skipped when there is none.
+TEST(Parts, AttributesIgnoreTheProcessLocale) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string scene = noisy_scene(dir), part = dir + "/p.exr";
+  ASSERT_EQ(run_cli("render " + q(scene) + " -q --samples 0:4 -o " + q(part)).status, 0);
+  const std::string before = std::setlocale(LC_ALL, nullptr);
+  struct Restore {
+    std::string name;
+    ~Restore() { std::setlocale(LC_ALL, name.c_str()); }
+  } restore{before};
+  const auto comma = [] {
+    return std::setlocale(LC_ALL, nullptr) && std::string(std::localeconv()->decimal_point) == ",";
+  };
+  bool found = false;
+  for (const char* name : {"de_DE.UTF-8", "de_DE.utf8", "fr_FR.UTF-8", "fr_FR.utf8"})
+    if (std::setlocale(LC_ALL, name) && comma()) {
+      found = true;
+      break;
+    }
+  if (!found &&
+      std::system(("localedef -i de_DE -f UTF-8 " + q(dir + "/de_DE.UTF-8") + " >/dev/null 2>&1")
+                      .c_str()) == 0) {
+    ::setenv("LOCPATH", dir.c_str(), 1);
+    found = std::setlocale(LC_ALL, "de_DE.UTF-8") && comma();
+    ::unsetenv("LOCPATH");
+  }
+  if (!found) GTEST_SKIP() << "no locale with a decimal comma here, and localedef made none";
+  char probe[16];
+  std::snprintf(probe, sizeof probe, "%.1f", 0.5);
+  ASSERT_STREQ(probe, "0,5");
+
+  const lucent::PartInfo info = lucent::read_part_info(part);
+  EXPECT_EQ(info.display.gamma, 2.2);
+  EXPECT_EQ(lucent::read_render_part(part).info.samples, info.samples);
+  // a render's light part of the image mean, written and read back
+  lucent::RenderResult r;
+  r.mean = lucent::Image{2, 1, std::vector<float>(6, 0.5f)};
+  r.variance = r.mean;
+  r.samples = {4, 4};
+  r.light_mean_variance = lucent::LightMeanVariance{{0.5, 0.25, 1e-7}, {0.125, 0.5, 0.75}};
+  lucent::write_render_exr(dir + "/c.exr", r);
+  const lucent::RenderResult back = lucent::read_render(dir + "/c.exr");
+  ASSERT_TRUE(back.light_mean_variance.has_value());
+  EXPECT_EQ(back.light_mean_variance->paths[2], 1e-7);
+  EXPECT_EQ(back.light_mean_variance->pixels[0], 0.125);
+  std::setlocale(LC_ALL, before.c_str());
+  EXPECT_EQ(lucent::read_render(dir + "/c.exr").light_mean_variance->paths[0], 0.5);
+}
+
 TEST(Parts, PartFilesKeepAndCheckTheirSums) {
   const std::string dir = lucent::test::temp_dir();
   const lucent::RenderPart part = noisy_part(dir, 64, 48, 4);

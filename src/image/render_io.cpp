@@ -14,6 +14,7 @@
 
 #include "core/file_io.hpp"
 #include "core/host_memory.hpp"
+#include "core/text.hpp"
 #include "image/image_probe.hpp"
 #include "image/part_sums.hpp"
 #include "lucent/compare.hpp"
@@ -38,6 +39,7 @@ void write_render_exr(const std::string& path, const RenderResult& r) {
 namespace image_detail {
 
 std::string light_mean_var_attribute(const LightMeanVariance& v) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
   std::string s;
   char buf[32];
   for (const double* part : {v.paths, v.pixels})
@@ -49,6 +51,7 @@ std::string light_mean_var_attribute(const LightMeanVariance& v) {
 }
 
 LightMeanVariance parse_light_mean_var(const std::string& path, const std::string& text) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
   LightMeanVariance v;
   double* const values[6] = {&v.paths[0],  &v.paths[1],  &v.paths[2],
                              &v.pixels[0], &v.pixels[1], &v.pixels[2]};

@@ -176,6 +176,7 @@ PartInfo info_from_attributes(const std::string& path,
     throw Error(path + ": attribute lucent.seconds: negative time '" + get("seconds") + "'");
   // display: transfer,gamma,exposure,tonemap
   const std::string& d = get("display");
+  io::CNumbers c_numbers;  // "2.2", whatever the process locale (the writer's, part_write)
   char transfer[16] = {0}, tonemap[16] = {0};
   double gamma = 0, exposure = 0;
   int end = 0;  // the whole value (trailing characters, 'clampX', were ignored)
