@@ -3,10 +3,13 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
+#include <system_error>
 
 #include "image/image_probe.hpp"
 #include "scene/loaders.hpp"
@@ -66,13 +69,25 @@ std::string make_bundle(const std::string& main,
 }
 
 std::string write_bundle(const Bundle& b, const std::string& main_name) {
-  static const std::string dir = [] {
-    std::string base =
-        fs::is_directory("/dev/shm") ? "/dev/shm" : fs::temp_directory_path().string();
-    std::string d = base + "/lucent-fuzz-" + std::to_string(::getpid());
-    fs::create_directories(d);
-    return d;
-  }();
+  // a directory of this process's own (mkdtemp: a stale one of a process with the same pid held
+  // another run's files, which an input naming a file it did not carry then loaded), removed
+  // when the process ends (one a process was left, 160 of them, one per test run)
+  struct Dir {
+    std::string path;
+    Dir() {
+      const std::string base =
+          fs::is_directory("/dev/shm") ? "/dev/shm" : fs::temp_directory_path().string();
+      std::string pattern = base + "/lucent-fuzz-XXXXXX";
+      if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp " + pattern);
+      path = pattern;
+    }
+    ~Dir() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  };
+  static const Dir bundle_dir;
+  const std::string& dir = bundle_dir.path;
   for (const std::string& f : written()) ::unlink(f.c_str());
   written().clear();
   auto put = [&](const std::string& name, const std::string& body) {
