@@ -74,6 +74,9 @@ std::vector<SampleRange> parse_ranges(const std::string& path, const std::string
       throw Error(path + ": attribute " + what + ": ranges must be non-empty, sorted and disjoint");
     out.push_back(r);
     at = comma + 1;
+    // (a trailing comma, "0:4,", was taken for the end of the list)
+    if (comma + 1 == s.size())
+      throw Error(path + ": attribute " + what + ": '" + s + "' ends in a comma");
   }
   return out;
 }
