@@ -354,6 +354,11 @@ class PyRenderer {
     busy_ = false;
   }
 
+  /// The files the session's scene reads, made absolute when set_scene took it (with the GIL):
+  /// write_part refuses them whatever the current directory is since (after an os.chdir the
+  /// scene's relative names meant other files, and a part was written over its environment map).
+  std::vector<std::string> inputs_at_set_scene;
+
  private:
   /// Marks the session in use for a call named `what` (the GIL held); a second call gets an
   /// error.
@@ -927,10 +932,17 @@ void bind_render(py::module_& m) {
           "set_scene",
           [](PyRenderer& r, const Scene& scene) {
             Scene copy = scene;  // Python threads may change `scene` while the GIL is released
+            std::vector<std::string> inputs;
+            for (const std::string& in : scene_detail::scene_inputs(copy.path, copy)) {
+              std::error_code ec;
+              const std::filesystem::path absolute = std::filesystem::absolute(in, ec);
+              if (!ec && !in.empty()) inputs.push_back(absolute.string());
+            }
             // interruptible: Ctrl-C stops a wait for another process's build of the kernel
             // (up to 600 s; it was ignored there)
             r.call_interruptible("set_scene",
                                  [&](Renderer& rr, std::atomic<bool>&) { rr.set_scene(copy); });
+            r.inputs_at_set_scene = std::move(inputs);
           },
           py::arg("scene"),
           "Makes a copy of `scene` the session's scene; keeps the BVH, the kernel and the "
@@ -1041,8 +1053,12 @@ void bind_render(py::module_& m) {
               asked = range_argument(requested, "requested", kSampleIndices, kSampleNote);
             r.call("write_part", [&](Renderer& rr) {
               const Scene& scene = rr.scene();  // (raises without a scene)
-              // not over the scene or a file it reads (a part written over scene.json)
-              io::check_output_path(p, scene_detail::scene_inputs(scene.path, scene));
+              // not over the scene or a file it reads (a part written over scene.json), by the
+              // names set_scene resolved too
+              std::vector<std::string> inputs = scene_detail::scene_inputs(scene.path, scene);
+              inputs.insert(inputs.end(), r.inputs_at_set_scene.begin(),
+                            r.inputs_at_set_scene.end());
+              io::check_output_path(p, inputs);
               if (rr.spp() == 0)
                 throw Error(p + ": the session holds no samples to write (render first)");
               const SampleRange rendered{rr.first_sample(), rr.first_sample() + rr.spp()};

@@ -129,3 +129,29 @@ def test_refusals(small_scene, tmp_path):
         lucent.merge_parts([tmp_path / "p.exr"], expect=(4, 4))
     with pytest.raises(lucent.Error, match="p.exr"):
         lucent.read_part_info(tmp_path / "p.exr")
+
+
+
+def test_write_part_refuses_the_scenes_files_after_a_change_of_directory(tmp_path, small_dict,
+                                                                         monkeypatch):
+    # the scene's relative names meant other files after os.chdir, and a part was written over
+    # its environment map (the Python tester's find): the names set_scene resolved are refused
+    import json
+    (tmp_path / "sub").mkdir()
+    monkeypatch.chdir(tmp_path)
+    lucent.write_image("env.exr", np.full((4, 8, 3), 0.5, np.float32))
+    small_dict["lights"].append({"type": "environment_map", "file": "env.exr"})
+    (tmp_path / "s.json").write_text(json.dumps(small_dict))
+    scene = lucent.load_scene("s.json")
+    before = (tmp_path / "env.exr").read_bytes()
+    with session() as r:
+        r.set_scene(scene)
+        r.render(2)
+        with pytest.raises(lucent.Error, match="is an input of this render"):
+            r.write_part("env.exr")
+        monkeypatch.chdir(tmp_path / "sub")
+        with pytest.raises(lucent.Error, match="is an input of this render"):
+            r.write_part(tmp_path / "env.exr")
+        r.write_part(tmp_path / "p.exr")  # (another name is written)
+    assert (tmp_path / "env.exr").read_bytes() == before
+    assert lucent.read_part_info(tmp_path / "p.exr").samples == [(0, 2)]
