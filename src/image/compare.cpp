@@ -203,10 +203,11 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
   double sq = 0, rel = 0, sum_var_a[3] = {0, 0, 0}, sum_var_b[3] = {0, 0, 0};
   double largest_var[3] = {0, 0, 0};  // the pixel with the largest var_a + var_b, per channel
   size_t largest_at[3] = {0, 0, 0};
+  const bool a_stats = !a.variance.rgb.empty(), b_stats = !b.variance.rgb.empty();
   for (size_t i = 0; i < npix; ++i) {
     bool pixel_ok = true;
-    if ((!a.variance.rgb.empty() && sample_count(a, i) < CompareResult::kFewPixelSamples) ||
-        (!b.variance.rgb.empty() && sample_count(b, i) < CompareResult::kFewPixelSamples))
+    if ((a_stats && sample_count(a, i) < CompareResult::kFewPixelSamples) ||
+        (b_stats && sample_count(b, i) < CompareResult::kFewPixelSamples))
       ++r.few_sample_pixels;
     for (int c = 0; c < 3; ++c) {
       double va = a.mean.rgb[i * 3 + c], vb = b.mean.rgb[i * 3 + c];
@@ -214,7 +215,8 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
       const double var_a = variance_of_mean(a, i, c), var_b = variance_of_mean(b, i, c);
       double var = var_a + var_b;
       double eps = o.abs_epsilon + o.rel_epsilon * std::max(std::abs(va), std::abs(vb));
-      double z = z_score(d, pixel_test_variance(a, b, i, c) + eps * eps);
+      const double pixel_var = pixel_test_variance(a, b, i, c);
+      double z = z_score(d, pixel_var + eps * eps);
       r.z.rgb[i * 3 + c] = static_cast<float>(z);
       bool ok = std::isfinite(z) && std::abs(z) <= r.z_threshold;
       if (!ok) {
@@ -223,8 +225,7 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
         // no variance in either image there, the one with statistics at few samples: its
         // samples agreed, perhaps all missing what the pixel rarely sees, and nothing in the
         // other image can say so (a PFM reference; the same one as an EXR with variances passed)
-        const bool a_stats = !a.variance.rgb.empty(), b_stats = !b.variance.rgb.empty();
-        if (a_stats != b_stats && pixel_test_variance(a, b, i, c) == 0 &&
+        if (a_stats != b_stats && pixel_var == 0 &&
             sample_count(a_stats ? a : b, i) < CompareResult::kFewSamplesOfNoVariance)
           ++r.zero_variance_failures;
       }
