@@ -87,6 +87,15 @@ std::string fmt(const char* f, double v) {
 
 /// The relMSE explained by noise: sum over pixel-channels of the variances of both means,
 /// weighted as relMSE weights squared errors. 0 when `a` has no variance estimate.
+/// The variance of a render's pixel-channel mean plus, with `ref_var`, the reference's: what noise
+/// alone puts into (A - R)^2 there (a pixel of fewer than 2 samples adds none).
+double noise_variance(const RenderResult& a, const RenderResult& ref, bool ref_var, std::size_t i,
+                      int c) {
+  double var = a.samples[i] >= 2 ? a.variance.rgb[i * 3 + c] / double(a.samples[i]) : 0;
+  if (ref_var && ref.samples[i] >= 2) var += ref.variance.rgb[i * 3 + c] / double(ref.samples[i]);
+  return var;
+}
+
 double noise_relmse(const RenderResult& a, const RenderResult& ref) {
   const std::size_t npix = static_cast<std::size_t>(a.mean.width) * a.mean.height;
   if (npix == 0 || a.variance.rgb.size() != npix * 3 || a.samples.size() != npix) return 0;
@@ -96,11 +105,8 @@ double noise_relmse(const RenderResult& a, const RenderResult& ref) {
   for (std::size_t i = 0; i < npix; ++i) {
     if (a.samples[i] >= 2) ++usable;
     for (int c = 0; c < 3; ++c) {
-      double var = a.samples[i] >= 2 ? a.variance.rgb[i * 3 + c] / double(a.samples[i]) : 0;
-      if (ref_var && ref.samples[i] >= 2)
-        var += ref.variance.rgb[i * 3 + c] / double(ref.samples[i]);
-      double r = ref.mean.rgb[i * 3 + c];
-      sum += var / (r * r + 0.01);
+      const double r = ref.mean.rgb[i * 3 + c];
+      sum += noise_variance(a, ref, ref_var, i, c) / (r * r + 0.01);
     }
   }
   if (usable * 2 < npix) return 0;  // most pixels without a variance estimate: none
@@ -119,11 +125,8 @@ double excess_standard_error(const RenderResult& a, const RenderResult& ref) {
   for (std::size_t i = 0; i < npix; ++i) {
     double x = 0;  // the pixel's three channels: they share its paths
     for (int c = 0; c < 3; ++c) {
-      double var = a.samples[i] >= 2 ? a.variance.rgb[i * 3 + c] / double(a.samples[i]) : 0;
-      if (ref_var && ref.samples[i] >= 2)
-        var += ref.variance.rgb[i * 3 + c] / double(ref.samples[i]);
       const double r = ref.mean.rgb[i * 3 + c], d = a.mean.rgb[i * 3 + c] - r;
-      x += (d * d - var) / (r * r + 0.01);
+      x += (d * d - noise_variance(a, ref, ref_var, i, c)) / (r * r + 0.01);
     }
     sum += x;
     sumsq += x * x;
