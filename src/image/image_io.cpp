@@ -76,11 +76,13 @@ bool stb_flips_on_write() {
   return bmp.size() > 54 && static_cast<unsigned char>(bmp[54]) == 255;
 }
 
+/// `v` as 4 bytes, most significant first (PNG's integers).
+std::string be32(std::uint32_t v) {
+  return std::string{char(v >> 24), char(v >> 16 & 0xFF), char(v >> 8 & 0xFF), char(v & 0xFF)};
+}
+
 /// A PNG chunk: its length, tag, data and CRC-32 (ISO 3309, as the PNG specification gives it).
 std::string png_chunk(const char* tag, const std::string& data) {
-  const auto be32 = [](std::uint32_t v) {
-    return std::string{char(v >> 24), char(v >> 16 & 0xFF), char(v >> 8 & 0xFF), char(v & 0xFF)};
-  };
   const std::string body = std::string(tag, 4) + data;
   std::uint32_t crc = 0xFFFFFFFFu;
   for (unsigned char b : body) {
@@ -97,8 +99,7 @@ std::string png_chunk(const char* tag, const std::string& data) {
 std::string png_colour_chunks(const DisplaySettings& display) {
   const auto gama = [](double file_gamma) {
     const auto v = static_cast<std::uint32_t>(std::lround(std::clamp(file_gamma, 1e-5, 4e4) * 1e5));
-    return png_chunk("gAMA", std::string{char(v >> 24), char(v >> 16 & 0xFF), char(v >> 8 & 0xFF),
-                                         char(v & 0xFF)});
+    return png_chunk("gAMA", be32(v));
   };
   switch (display.transfer) {
     case Transfer::Srgb:
