@@ -420,7 +420,9 @@ TEST(Parts, PartsMadeInMemoryAreCheckedAsFilesAre) {
       {[](lucent::RenderPart& p) { p.acc.sum[1] = std::nan(""); },
        "pixel 0, 0 holds an invalid sum (not finite, or a negative sum of squares)"},
       {[](lucent::RenderPart& p) { p.acc.sumsq[2] = -1; },
-       "pixel 0, 0 holds an invalid sum (not finite, or a negative sum of squares)"}};
+       "pixel 0, 0 holds an invalid sum (not finite, or a negative sum of squares)"},
+      {[](lucent::RenderPart& p) { p.acc.sum[0] = 4e39; },
+       "pixel 0, 0: its mean or sample variance is beyond a float's range (no render's is)"}};
   for (const Case& c : cases) {
     lucent::RenderPart p = handmade_part({{0, 4}}, {0, 4});
     c.alter(p);
@@ -430,7 +432,7 @@ TEST(Parts, PartsMadeInMemoryAreCheckedAsFilesAre) {
     lucent::PartMerger merger;
     EXPECT_EQ(error_of([&] { merger.add("p", p); }), "p: " + c.message);
     lucent::PartMerger headers;
-    if (c.message.find("invalid sum") == std::string::npos) {
+    if (c.message.find("pixel 0, 0") == std::string::npos) {
       EXPECT_EQ(error_of([&] { headers.add_header("p", p.info); }), "p: " + c.message);
     }
   }
@@ -1004,6 +1006,57 @@ TEST(Parts, CountsDisagreeingWithTheHeaderAreOneLineErrors) {
                 " non-finite samples recorded, but the pixels (channel n) miss " +
                 std::to_string(hot.info.nonfinite - 1) +
                 " of the part's 4 (samples [0, 4)) per pixel");
+}
+
+// Sums that no render makes, in a crafted part whose checksum matches: a mean past a float's range
+// merged into an infinite PFM pixel without a word, two parts of 1e308 seconds each failed at the
+// output's writer (the error named the output), and rays past 2^64 wrapped. Each is refused now,
+// naming the part, before the merge changes.
+TEST(Parts, SumsNoRenderMakesAreRefusedNamingThePart) {
+  const std::string dir = lucent::test::temp_dir();
+  auto part = [](std::uint64_t begin, double sum, double sumsq) {
+    lucent::RenderPart p = handmade_part({{begin, begin + 4}}, {0, 8});
+    p.acc.sum = {sum, 0.5, 0.5};
+    p.acc.sumsq = {sumsq, 0.5, 0.5};
+    return p;
+  };
+  const std::string beyond =
+      "pixel 0, 0: its mean or sample variance is beyond a float's range (no render's is)";
+  // a mean of 1e39 in 4 samples: refused by the writer, by merge and, in a file, by read_render
+  const lucent::RenderPart huge = part(0, 4e39, 4e78);
+  EXPECT_EQ(error_of([&] { lucent::write_render_part(dir + "/w.exr", huge); }),
+            dir + "/w.exr: cannot write part: " + beyond);
+  lucent::parts_detail::write_part_unchecked(dir + "/huge.exr", huge);
+  EXPECT_EQ(error_line(run_cli("merge " + q(dir + "/huge.exr") + " -o " + q(dir + "/o.pfm"))),
+            dir + "/huge.exr: " + beyond);
+  EXPECT_FALSE(fs::exists(dir + "/o.pfm"));
+  EXPECT_EQ(error_of([&] { lucent::read_render(dir + "/huge.exr"); }),
+            dir + "/huge.exr: " + beyond);
+  // each part fits (a mean of m = 3e38, then of 0; variances 0), their merge does not: its
+  // variance is 2 m^2 / 7
+  const double m = 3e38;
+  lucent::PartMerger merger;
+  merger.add("a", part(0, 4 * m, 4 * m * m));
+  EXPECT_EQ(error_of([&] { merger.add("b", part(4, 0, 0)); }),
+            "b: pixel 0, 0: merged with the parts before it, its mean or sample variance is beyond "
+            "a float's range (no render's is)");
+  // times and rays
+  lucent::RenderPart a = part(0, 2, 1), b = part(4, 2, 1);
+  a.info.seconds = b.info.seconds = 1e308;
+  lucent::PartMerger times;
+  times.add("a", a);
+  EXPECT_EQ(error_of([&] { times.add("b", b); }),
+            "b: attribute lucent.seconds: the parts' times add up past a double's range");
+  a = part(0, 2, 1);
+  b = part(4, 2, 1);
+  a.info.rays = b.info.rays = 1ull << 63;
+  lucent::PartMerger rays;
+  rays.add("a", a);
+  EXPECT_EQ(error_of([&] { rays.add("b", b); }),
+            "b: attribute lucent.rays: the parts' rays add up past 2^64");
+  b.info.rays -= 1;  // 2^64 - 1 in all
+  rays.add("b", b);
+  EXPECT_EQ(rays.finish().merged.info.rays, ~std::uint64_t(0));
 }
 
 // A part stopped by SIGTERM (Slurm's signal at a job's time limit) keeps the samples it finished,

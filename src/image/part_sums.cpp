@@ -42,7 +42,13 @@ std::string hex64(std::uint64_t v) {
   return buf;
 }
 
-void part_image(int width, int height, const std::vector<double>& sum,
+bool sums_fit_float(double sum, double sumsq, double n) {
+  const double mean = n > 0 ? sum / n : 0;
+  return std::isfinite(static_cast<float>(mean)) &&
+         std::isfinite(static_cast<float>(render_detail::sample_variance(sum, sumsq, n)));
+}
+
+void part_image(const std::string& name, int width, int height, const std::vector<double>& sum,
                 const std::vector<double>& sumsq, const std::vector<std::uint32_t>& count,
                 Image& mean, Image& variance) {
   const size_t npix = static_cast<size_t>(width) * height;
@@ -52,6 +58,10 @@ void part_image(int width, int height, const std::vector<double>& sum,
     const double n = count[i];
     for (int c = 0; c < 3; ++c) {
       const double s = sum[i * 3 + c], s2 = sumsq[i * 3 + c];
+      if (!sums_fit_float(s, s2, n))
+        throw Error(name + ": pixel " + std::to_string(i % width) + ", " +
+                    std::to_string(i / width) +
+                    ": its mean or sample variance is beyond a float's range (no render's is)");
       mean.rgb[i * 3 + c] = static_cast<float>(n > 0 ? s / n : 0);
       variance.rgb[i * 3 + c] = static_cast<float>(render_detail::sample_variance(s, s2, n));
     }

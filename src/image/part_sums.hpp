@@ -30,10 +30,16 @@ struct PartSums {
   std::vector<std::uint32_t> count;  ///< per pixel
 };
 
+/// Whether n samples of sums `sum` and `sumsq` have a mean and a per-sample variance that a float
+/// holds. A render's pixels always do (the kernel drops a sample whose square overflows a float
+/// as non-finite); a crafted part's, or a merge of such parts, may not.
+bool sums_fit_float(double sum, double sumsq, double n);
+
 /// A part's image from its sums: each pixel's mean and the variance of one of its samples, per
 /// channel, in floats (what part_result gives, read_render reads from a part file, and
-/// write_render_part's display channels hold).
-void part_image(int width, int height, const std::vector<double>& sum,
+/// write_render_part's display channels hold). Throws lucent::Error naming `name` and the pixel
+/// where a mean or variance is beyond a float's range (it would be written as infinite).
+void part_image(const std::string& name, int width, int height, const std::vector<double>& sum,
                 const std::vector<double>& sumsq, const std::vector<std::uint32_t>& count,
                 Image& mean, Image& variance);
 

@@ -239,7 +239,7 @@ RenderResult read_render_memory(const unsigned char* data, std::size_t size,
   if (part) {
     // mean and variance as write_render_part wrote them from the sums (part_result's)
     PartSums s = part_sums_from_channels(exr, path);
-    part_image(w, h, s.sum, s.sumsq, s.count, r.mean, r.variance);
+    part_image(path, w, h, s.sum, s.sumsq, s.count, r.mean, r.variance);
     r.samples = std::move(s.count);
     r.spp = r.samples.empty() ? 0 : *std::max_element(r.samples.begin(), r.samples.end());
     return r;

@@ -282,6 +282,10 @@ void check_part_contents(const std::string& name, const PartInfo& info, const Ac
     if (!std::isfinite(a.sum[i]) || !std::isfinite(a.sumsq[i]) || a.sumsq[i] < 0)
       throw Error(name + ": " + pixel_text(i / 3, std::max(a.width, 1)) +
                   " holds an invalid sum (not finite, or a negative sum of squares)");
+  for (size_t i = 0; i < a.sum.size() && i < a.sumsq.size() && i / 3 < a.count.size(); ++i)
+    if (!image_detail::sums_fit_float(a.sum[i], a.sumsq[i], a.count[i / 3]))
+      throw Error(name + ": " + pixel_text(i / 3, std::max(a.width, 1)) +
+                  ": its mean or sample variance is beyond a float's range (no render's is)");
 }
 
 }  // namespace
@@ -393,7 +397,8 @@ RenderResult part_result(const RenderPart& part) {
   if (!sums_fit_film(a))
     throw Error("part_result: inconsistent part (film and accumulation sizes differ)");
   RenderResult r;
-  image_detail::part_image(a.width, a.height, a.sum, a.sumsq, a.count, r.mean, r.variance);
+  image_detail::part_image("part_result", a.width, a.height, a.sum, a.sumsq, a.count, r.mean,
+                           r.variance);
   r.samples = a.count;
   r.spp = total(part.info.samples);
   r.seed = part.info.seed;
@@ -678,6 +683,22 @@ void PartMerger::add(const std::string& name, const RenderPart& part) {
       if (std::uint64_t(t.count[i]) + a.count[i] > 0xffffffffull)
         throw Error(name + ": pixel " + std::to_string(i % a.width) + ", " +
                     std::to_string(i / a.width) + ": more than 2^32 samples in all");
+    // what only crafted parts reach, refused before the merge changes: sums past a double's
+    // range, or a merged mean or variance past a float's (written as infinite), a time past a
+    // double's (the output's writer refused it, naming the output), rays past 2^64 (wrapped)
+    for (size_t i = 0; i < npix * 3; ++i) {
+      const double s = t.sum[i] + a.sum[i], s2 = t.sumsq[i] + a.sumsq[i];
+      if (!std::isfinite(s) || !std::isfinite(s2) ||
+          !image_detail::sums_fit_float(s, s2, double(t.count[i / 3]) + a.count[i / 3]))
+        throw Error(name + ": " + pixel_text(i / 3, a.width) +
+                    ": merged with the parts before it, its mean or sample variance is beyond a "
+                    "float's range (no render's is)");
+    }
+    if (!std::isfinite(total_.info.seconds + part.info.seconds))
+      throw Error(name +
+                  ": attribute lucent.seconds: the parts' times add up past a double's range");
+    if (total_.info.rays + part.info.rays < total_.info.rays)
+      throw Error(name + ": attribute lucent.rays: the parts' rays add up past 2^64");
     for (size_t i = 0; i < npix * 3; ++i) {
       t.sum[i] += a.sum[i];
       t.sumsq[i] += a.sumsq[i];
