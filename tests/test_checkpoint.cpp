@@ -689,6 +689,26 @@ TEST(Checkpoint, StaleTemporariesAreOnlyTheWritesOwnFiles) {
   EXPECT_EQ(lucent::test::read_file(dir + "/precious.exr"), "someone's");
 }
 
+// A write in progress holds an flock on its temporary file (io::open_temp), but
+// remove_stale_temporaries removed every file of a temporary's name, a write in progress too (of
+// another process that writes the name: its rename then failed). Only files no process holds go.
+TEST(Checkpoint, StaleTemporariesLeaveAWriteInProgress) {
+  const std::string dir = lucent::test::temp_dir();
+  const std::string ck = dir + "/ck.exr";
+  const std::string held = dir + "/.ck.exr.tmp-20-0", left = dir + "/.ck.exr.tmp-21-0";
+  lucent::test::write_file(held, "a write in progress");
+  lucent::test::write_file(left, "a killed write's");
+  const int fd = ::open(held.c_str(), O_RDONLY | O_CLOEXEC);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);  // (another open file: its lock conflicts)
+  EXPECT_EQ(lucent::io::remove_stale_temporaries(ck), 1);
+  EXPECT_TRUE(fs::exists(held));
+  EXPECT_FALSE(fs::exists(left));
+  ::close(fd);
+  EXPECT_EQ(lucent::io::remove_stale_temporaries(ck), 1);
+  EXPECT_FALSE(fs::exists(held));
+}
+
 // The progress line of a resumed render counts its checkpoint's samples ("20 + 1234 spp") and
 // its percentage is of the whole render; it counted this run's samples alone.
 TEST(Checkpoint, ProgressOfAResumedRenderCountsTheCheckpoint) {

@@ -399,12 +399,7 @@ bool is_entry(const fs::directory_entry& e) {
 
 // Removes the lock file `path` unless a process holds it (one that opened it and waits for it
 // sees that it is gone: BuildLock).
-void remove_unused_lock(const std::string& path) {
-  int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
-  if (fd < 0) return;
-  if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && io::is_file_at(fd, path)) ::unlink(path.c_str());
-  ::close(fd);
-}
+void remove_unused_lock(const std::string& path) { io::remove_if_unheld(path); }
 
 }  // namespace
 

@@ -107,15 +107,7 @@ int open_temp(const fs::path& dir, const std::string& name, mode_t mode, std::st
     tmp = temp_path(dir, name).string();
     int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
     if (fd < 0 && errno == EEXIST) {
-      // a regular file (lstat first: opening a device node of that name can act on the device)
-      struct stat st {};
-      if (::lstat(tmp.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
-        int old = ::open(tmp.c_str(), O_RDWR | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
-        if (old < 0) old = ::open(tmp.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
-        if (old >= 0 && ::flock(old, LOCK_EX | LOCK_NB) == 0 && is_file_at(old, tmp))
-          ::unlink(tmp.c_str());  // (no writer holds it; the name is retried)
-        if (old >= 0) ::close(old);
-      }
+      remove_if_unheld(tmp);  // (a killed write's; the name is retried)
       fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
       errno = fd < 0 ? errno : 0;
     }
@@ -280,6 +272,18 @@ void check_output_file(const std::string& out, const std::vector<std::string>& i
   ::close(fd);
 }
 
+bool remove_if_unheld(const std::string& path) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
+  int fd = ::open(path.c_str(), O_RDWR | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool removed =
+      ::flock(fd, LOCK_EX | LOCK_NB) == 0 && is_file_at(fd, path) && ::unlink(path.c_str()) == 0;
+  ::close(fd);
+  return removed;
+}
+
 bool is_file_at(int fd, const std::string& path) {
   struct stat open_file, named;
   return ::fstat(fd, &open_file) == 0 && ::stat(path.c_str(), &named) == 0 &&
@@ -338,8 +342,7 @@ int remove_stale_temporaries(const std::string& path) {
     if (!is_temp_name(it->path().filename().string(), name) ||
         !fs::is_regular_file(it->symlink_status(type_ec)))
       continue;
-    std::error_code rm_ec;
-    removed += fs::remove(it->path(), rm_ec) ? 1 : 0;
+    removed += remove_if_unheld(it->path().string()) ? 1 : 0;  // (not a write in progress)
   }
   return removed;
 }

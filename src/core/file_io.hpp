@@ -43,8 +43,8 @@ std::string write_target_path(const std::string& path);
 /// Removes the temporary files that write_file_atomic(path) leaves behind when it is killed in
 /// the middle of a write (SIGKILL, the OOM killer, a power loss): the regular files of the names
 /// it gives them beside `path`'s target, ".<name>.tmp-<pid>-<n>" (not a directory or a symbolic
-/// link of such a name), and no other file. For a caller that alone writes `path` (the holder of
-/// a checkpoint's lock): a write in progress goes through such a file too. A name over 128 bytes
+/// link of such a name), and no other file, and of those only the ones no process holds
+/// (remove_if_unheld: a write in progress holds its temporary file). A name over 128 bytes
 /// is left alone (its temporary files carry only its first 128 bytes, which another name may
 /// share). Returns how many were removed; failures are ignored.
 int remove_stale_temporaries(const std::string& path);
@@ -62,6 +62,15 @@ void write_all(int fd, const void* data, std::size_t size, const std::string& pa
 /// Whether the open file `fd` is still the file at `path` (a lock file may be removed, by its
 /// owner or `cache clear`, while another process has just opened it or waits on it).
 bool is_file_at(int fd, const std::string& path);
+
+/// Removes the regular file `path` (not a symbolic link, a directory or a device node: lstat first,
+/// and opening a device can act on it) unless a process holds an flock on it, and returns whether
+/// it did. A write's temporary file (write_file_atomic) and a kernel build's lock are held so for
+/// their lives: one that no process holds is a killed process's leftover. The lock is taken on
+/// the file opened for writing where it can be (NFS emulates flock with fcntl locks, which an
+/// exclusive lock needs that for) and the file is unlinked under it, checked to be still the
+/// file of that name (another process may have removed it and made a new one meanwhile).
+bool remove_if_unheld(const std::string& path);
 
 /// Whether `a` and `b` name the same file: the same file when both exist (symbolic and hard
 /// links included), else the same path once made canonical.
