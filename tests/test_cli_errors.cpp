@@ -98,6 +98,33 @@ TEST(CliErrors, UnknownOptionIsNamed) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// The words after "--" are arguments: `render s.json -- -o a.png` said "unknown option -o", and
+// `render -o a.png -- s.json --spp 1` "unknown option --". An option before it is still unknown.
+TEST(CliErrors, WordsAfterTwoDashesAreArguments) {
+  const std::string scene = small_scene();
+  const std::string out = lucent::test::temp_dir() + "/o.png";
+  const std::pair<std::string, std::string> cases[] = {
+      {"render " + q(scene) + " -- -o " + q(out), "unexpected argument -o after --"},
+      {"render -o " + q(out) + " -- " + q(scene) + " --spp 1",
+       "unexpected argument --spp after --"},
+      {"render " + q(scene) + " -o " + q(out) + " --bogus -- x", "unknown option --bogus"}};
+  for (const auto& [args, message] : cases) {
+    CommandResult r = run_cli(args);
+    EXPECT_EQ(
+        expect_one_error_line(r),
+        message +
+            (message.rfind("unexpected", 0) == 0 ? " (the words after -- are arguments)" : "") +
+            " (see lucent --help)")
+        << args;
+    EXPECT_EQ(r.status, 2) << args;
+  }
+  EXPECT_FALSE(fs::exists(out));
+  // a scene path after "--" renders
+  CommandResult ok = run_cli("render -q -o " + q(out) + " --spp 1 -- " + q(scene));
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_TRUE(fs::exists(out));
+}
+
 // A word that names no command is named, with the commands there are (it said "A subcommand is
 // required", as if none had been given). Found by running `lucent rendr`.
 TEST(CliErrors, UnknownCommandIsNamed) {
@@ -451,7 +478,9 @@ TEST(CliErrors, IntegerOptionsArePlainDecimal) {
       {render + "--seed 00", "--seed 00"},
       {render + "--max-depth 1e2", "--max-depth 1e2"},
       {render + "--target-error 0.1 --min-spp 010", "--min-spp 010"},
-      {"converge " + q(scene) + " --spp-ladder 1,010 --reference-spp 4", "--spp-ladder 010"}};
+      {"converge " + q(scene) + " --spp-ladder 1,010 --reference-spp 4", "--spp-ladder 010"},
+      // one value, not a list: it was named by its last comma-separated piece ("--spp 000")
+      {render + "--spp 1,000", "--spp 1,000"}};
   for (const auto& [args, bad] : cases) {
     CommandResult r = run_cli(args);
     EXPECT_EQ(expect_one_error_line(r), bad + tail) << args;

@@ -114,16 +114,25 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (refused_option_value(app)) return 2;  // before CLI11's range text
     std::string msg = e.what();
-    // CLI11 reports a missing argument before an unexpected one: name the unknown option first
-    for (const std::string& extra : app.remaining(true))
-      if (extra.size() > 1 && extra[0] == '-') {
+    // CLI11 reports a missing argument before an unexpected one: name the unknown option first.
+    // A word after "--" is an argument, not an option: `render s.json -- -o a.png` said "unknown
+    // option -o", and `render -o a.png -- s.json --spp 1` "unknown option --".
+    const std::vector<std::string> extras = app.remaining(true);
+    const std::vector<std::string> before_dashes(
+        argv + 1, std::find_if(argv + 1, argv + argc,
+                               [](const char* w) { return std::strcmp(w, "--") == 0; }));
+    for (const std::string& extra : extras) {
+      if (extra == "--" || extra.size() < 2 || extra[0] != '-') continue;
+      if (std::find(before_dashes.begin(), before_dashes.end(), extra) == before_dashes.end()) {
+        msg = "unexpected argument " + extra + " after -- (the words after -- are arguments)";
+      } else {
         msg = "unknown option " + extra;
         if (extra.find_first_of("./") != std::string::npos)  // a file name, most likely
           msg += " (a file whose name starts with '-' can be given as ./" + extra + ")";
-        break;
       }
+      break;
+    }
     // a word that names no command: CLI11 says "A subcommand is required"
-    const std::vector<std::string> extras = app.remaining(true);
     if (app.get_subcommands().empty() && !extras.empty() && !extras[0].empty() &&
         extras[0][0] != '-') {
       std::string names;

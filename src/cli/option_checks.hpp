@@ -33,7 +33,8 @@ inline constexpr const char kDecimalReals[] =
 /// The first value given to an option of `app` or its subcommands whose CLI11 type name
 /// (get_type_name(): the type, then the validators' descriptions) `typed` accepts, that `bad`
 /// finds wrong, as "--name value" (quoted when empty or holding a space: "--name ''"; "" when
-/// none). Each element of a comma-separated list is a value; an empty result is one empty value.
+/// none). Each element of a comma-separated list is a value, for an option that splits its values
+/// (a CLI11 delimiter: `--spp 1,000` was named as "--spp 000"); an empty result is one empty value.
 template <class Typed, class Bad>
 std::string first_bad_value(const CLI::App& app, Typed typed, Bad bad) {
   std::vector<const CLI::App*> apps{&app};
@@ -42,17 +43,20 @@ std::string first_bad_value(const CLI::App& app, Typed typed, Bad bad) {
   for (const CLI::App* a : apps)
     for (const CLI::Option* o : a->get_options()) {
       if (!typed(o->get_type_name())) continue;
+      const char delimiter = o->get_delimiter();
       for (const std::string& all : o->results()) {
+        std::vector<std::string> values;
         std::string value;
         std::istringstream items(all);
-        bool any = false;
-        while (std::getline(items, value, ',') || (!any && all.empty())) {
-          any = true;
-          if (bad(value)) {
-            const bool quote = value.empty() || value.find_first_of(" \t") != std::string::npos;
-            return o->get_name() + " " + (quote ? "'" + value + "'" : value);
+        if (delimiter == '\0' || all.empty())
+          values.push_back(all);
+        else
+          while (std::getline(items, value, delimiter)) values.push_back(value);
+        for (const std::string& v : values)
+          if (bad(v)) {
+            const bool quote = v.empty() || v.find_first_of(" \t") != std::string::npos;
+            return o->get_name() + " " + (quote ? "'" + v + "'" : v);
           }
-        }
       }
     }
   return "";
