@@ -689,7 +689,8 @@ CLI::App* add_render_command(CLI::App& app) {
       ->check(CLI::Range(1, lucent::limits::kMaxSpp));
   render
       ->add_option("--time", ra.time_limit,
-                   "Stop after this many seconds of rendering (alone: render until then)")
+                   "Stop after this many seconds of rendering (alone: render until then; "
+                   "--aov images then render as many samples, after it)")
       ->check(lucent::cli::seconds_limit());
   render->add_option("--width", ra.width, "Image width (overrides the scene)")
       ->check(CLI::Range(1, lucent::limits::kMaxImageSize));
