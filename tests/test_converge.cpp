@@ -14,6 +14,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <random>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -26,6 +27,7 @@
 #include "lucent/error.hpp"
 #include "lucent/limits.hpp"
 #include "lucent/session.hpp"
+#include "render/converge_noise.hpp"
 #include "support.hpp"
 
 namespace {
@@ -461,6 +463,86 @@ TEST(Converge, DefaultReferenceStaysWithinTheSampleLimit) {
   EXPECT_EQ(lucent::default_reference_spp({(1 << 20) + 1}), lucent::limits::kMaxSpp);
   EXPECT_EQ(lucent::default_reference_spp({lucent::limits::kMaxSpp}), lucent::limits::kMaxSpp);
   EXPECT_EQ(lucent::default_reference_spp({}), 1024);
+}
+
+// excess_standard_error against synthetic renders of a known answer: each channel of 20x20 pixels
+// the mean of n = 16 Gaussian samples around the reference R (spreads differing per pixel), its
+// variance estimated from the samples as a render's is. Unbiased, z = (relMSE - noise_relmse) /
+// excess_standard_error is standard normal to within the 400 pixels' central limit: over 300
+// renders its mean is within 4 standard errors of 0 (|m| < 4 / sqrt(300) = 0.23) and its standard
+// deviation in [0.85, 1.15] (that of 300 normals has a standard deviation of 0.04). A bias spread
+// over every pixel, of the noise's size, is more than 4 standard errors out (about 6.5: "biased"
+// needs 3); the same squared bias in 2 pixels about sqrt(2) (ConvergeFit's "undetermined": a few
+// pixels hold it).
+TEST(Converge, ExcessStandardErrorIsCalibrated) {
+  using lucent::converge_detail::excess_standard_error;
+  using lucent::converge_detail::noise_relmse;
+  const int w = 20, h = 20, n = 16;
+  const size_t channels = size_t(w) * h * 3;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> gauss;
+  lucent::RenderResult ref;
+  ref.mean = lucent::Image{w, h, std::vector<float>(channels)};
+  std::vector<double> sigma(channels);
+  double noise = 0;  // the expected noise_relmse
+  for (size_t i = 0; i < channels; ++i) {
+    ref.mean.rgb[i] = static_cast<float>(0.1 + 0.9 * double((i * 37) % 101) / 100.0);
+    sigma[i] = 0.05 + 0.5 * double((i * 53) % 97) / 96.0;
+    const double r = ref.mean.rgb[i];
+    noise += sigma[i] * sigma[i] / n / (r * r + 0.01) / double(channels);
+  }
+  auto render = [&](const std::vector<double>& bias) {
+    lucent::RenderResult a;
+    a.mean = lucent::Image{w, h, std::vector<float>(channels)};
+    a.variance = lucent::Image{w, h, std::vector<float>(channels)};
+    a.samples.assign(channels / 3, n);
+    for (size_t i = 0; i < channels; ++i) {
+      double s = 0, s2 = 0;
+      for (int k = 0; k < n; ++k) {
+        const double x = ref.mean.rgb[i] + bias[i] + sigma[i] * gauss(rng);
+        s += x;
+        s2 += x * x;
+      }
+      a.mean.rgb[i] = static_cast<float>(s / n);
+      a.variance.rgb[i] = static_cast<float>((s2 - s * s / n) / (n - 1));
+    }
+    return a;
+  };
+  auto z = [&](const lucent::RenderResult& a) {
+    double relmse = 0;
+    for (size_t i = 0; i < channels; ++i) {
+      const double r = ref.mean.rgb[i], d = a.mean.rgb[i] - r;
+      relmse += d * d / (r * r + 0.01) / double(channels);
+    }
+    const double se = excess_standard_error(a, ref);
+    EXPECT_GT(se, 0);
+    return (relmse - noise_relmse(a, ref)) / se;
+  };
+  const std::vector<double> none(channels, 0.0);
+  const int renders = 300;
+  double sum = 0, sumsq = 0;
+  for (int t = 0; t < renders; ++t) {
+    const double v = z(render(none));
+    sum += v;
+    sumsq += v * v;
+  }
+  const double mean = sum / renders, sd = std::sqrt((sumsq - sum * mean) / (renders - 1));
+  EXPECT_LT(std::abs(mean), 0.23);
+  EXPECT_GT(sd, 0.85);
+  EXPECT_LT(sd, 1.15);
+  // a squared bias of the noise's size (relMSE twice the noise), over every pixel-channel
+  std::vector<double> spread(channels);
+  for (size_t i = 0; i < channels; ++i) spread[i] = sigma[i] / std::sqrt(double(n));
+  EXPECT_GT(z(render(spread)), 4);
+  // the same, in the 6 channels of pixels 0 and 1
+  std::vector<double> confined(channels, 0.0);
+  for (size_t i = 0; i < 6; ++i) {
+    const double r = ref.mean.rgb[i];
+    confined[i] = std::sqrt(noise * double(channels) / 6 * (r * r + 0.01));
+  }
+  const double zc = z(render(confined));
+  EXPECT_GT(zc, 0.5);
+  EXPECT_LT(zc, 3);
 }
 
 TEST(Converge, FitOfSyntheticCurves) {

@@ -23,6 +23,7 @@
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
 #include "render/cancel_scope.hpp"
+#include "render/converge_noise.hpp"
 #include "render/integrator_knobs.hpp"
 
 namespace lucent {
@@ -83,57 +84,6 @@ std::string fmt(const char* f, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, f, v);
   return buf;
-}
-
-/// The relMSE explained by noise: sum over pixel-channels of the variances of both means,
-/// weighted as relMSE weights squared errors. 0 when `a` has no variance estimate.
-/// The variance of a render's pixel-channel mean plus, with `ref_var`, the reference's: what noise
-/// alone puts into (A - R)^2 there (a pixel of fewer than 2 samples adds none).
-double noise_variance(const RenderResult& a, const RenderResult& ref, bool ref_var, std::size_t i,
-                      int c) {
-  double var = a.samples[i] >= 2 ? a.variance.rgb[i * 3 + c] / double(a.samples[i]) : 0;
-  if (ref_var && ref.samples[i] >= 2) var += ref.variance.rgb[i * 3 + c] / double(ref.samples[i]);
-  return var;
-}
-
-double noise_relmse(const RenderResult& a, const RenderResult& ref) {
-  const std::size_t npix = static_cast<std::size_t>(a.mean.width) * a.mean.height;
-  if (npix == 0 || a.variance.rgb.size() != npix * 3 || a.samples.size() != npix) return 0;
-  const bool ref_var = ref.variance.rgb.size() == npix * 3 && ref.samples.size() == npix;
-  double sum = 0;
-  std::size_t usable = 0;
-  for (std::size_t i = 0; i < npix; ++i) {
-    if (a.samples[i] >= 2) ++usable;
-    for (int c = 0; c < 3; ++c) {
-      const double r = ref.mean.rgb[i * 3 + c];
-      sum += noise_variance(a, ref, ref_var, i, c) / (r * r + 0.01);
-    }
-  }
-  if (usable * 2 < npix) return 0;  // most pixels without a variance estimate: none
-  return sum / (3.0 * double(npix));
-}
-
-/// ConvergePoint::excess_standard_error of render `a` against `ref` (0 where noise_relmse has no
-/// variance estimate).
-double excess_standard_error(const RenderResult& a, const RenderResult& ref) {
-  const std::size_t npix = static_cast<std::size_t>(a.mean.width) * a.mean.height;
-  if (npix < 2 || a.variance.rgb.size() != npix * 3 || a.samples.size() != npix ||
-      ref.mean.rgb.size() != npix * 3)
-    return 0;
-  const bool ref_var = ref.variance.rgb.size() == npix * 3 && ref.samples.size() == npix;
-  double sum = 0, sumsq = 0;
-  for (std::size_t i = 0; i < npix; ++i) {
-    double x = 0;  // the pixel's three channels: they share its paths
-    for (int c = 0; c < 3; ++c) {
-      const double r = ref.mean.rgb[i * 3 + c], d = a.mean.rgb[i * 3 + c] - r;
-      x += (d * d - noise_variance(a, ref, ref_var, i, c)) / (r * r + 0.01);
-    }
-    sum += x;
-    sumsq += x * x;
-  }
-  const double n = double(npix), mean = sum / n;
-  const double spread = std::max(0.0, (sumsq - n * mean * mean) / (n - 1));
-  return std::sqrt(spread / n) / 3.0;  // (relMSE averages over 3 n pixel-channels)
 }
 
 /// The reference's own expected share of a relMSE against it: mean of var_R / n_R / (R^2 + 0.01).
@@ -203,6 +153,61 @@ void check_setting_fields(const ConvergeSetting& s) {
 }
 
 }  // namespace
+
+namespace converge_detail {
+
+namespace {
+
+/// The variance of a render's pixel-channel mean plus, with `ref_var`, the reference's: what noise
+/// alone puts into (A - R)^2 there (a pixel of fewer than 2 samples adds none).
+double noise_variance(const RenderResult& a, const RenderResult& ref, bool ref_var, std::size_t i,
+                      int c) {
+  double var = a.samples[i] >= 2 ? a.variance.rgb[i * 3 + c] / double(a.samples[i]) : 0;
+  if (ref_var && ref.samples[i] >= 2) var += ref.variance.rgb[i * 3 + c] / double(ref.samples[i]);
+  return var;
+}
+
+}  // namespace
+
+double noise_relmse(const RenderResult& a, const RenderResult& ref) {
+  const std::size_t npix = static_cast<std::size_t>(a.mean.width) * a.mean.height;
+  if (npix == 0 || a.variance.rgb.size() != npix * 3 || a.samples.size() != npix) return 0;
+  const bool ref_var = ref.variance.rgb.size() == npix * 3 && ref.samples.size() == npix;
+  double sum = 0;
+  std::size_t usable = 0;
+  for (std::size_t i = 0; i < npix; ++i) {
+    if (a.samples[i] >= 2) ++usable;
+    for (int c = 0; c < 3; ++c) {
+      const double r = ref.mean.rgb[i * 3 + c];
+      sum += noise_variance(a, ref, ref_var, i, c) / (r * r + 0.01);
+    }
+  }
+  if (usable * 2 < npix) return 0;  // most pixels without a variance estimate: none
+  return sum / (3.0 * double(npix));
+}
+
+double excess_standard_error(const RenderResult& a, const RenderResult& ref) {
+  const std::size_t npix = static_cast<std::size_t>(a.mean.width) * a.mean.height;
+  if (npix < 2 || a.variance.rgb.size() != npix * 3 || a.samples.size() != npix ||
+      ref.mean.rgb.size() != npix * 3)
+    return 0;
+  const bool ref_var = ref.variance.rgb.size() == npix * 3 && ref.samples.size() == npix;
+  double sum = 0, sumsq = 0;
+  for (std::size_t i = 0; i < npix; ++i) {
+    double x = 0;  // the pixel's three channels: they share its paths
+    for (int c = 0; c < 3; ++c) {
+      const double r = ref.mean.rgb[i * 3 + c], d = a.mean.rgb[i * 3 + c] - r;
+      x += (d * d - noise_variance(a, ref, ref_var, i, c)) / (r * r + 0.01);
+    }
+    sum += x;
+    sumsq += x * x;
+  }
+  const double n = double(npix), mean = sum / n;
+  const double spread = std::max(0.0, (sumsq - n * mean * mean) / (n - 1));
+  return std::sqrt(spread / n) / 3.0;  // (relMSE averages over 3 n pixel-channels)
+}
+
+}  // namespace converge_detail
 
 void ConvergeSetting::apply(Scene& scene, RenderOptions& options) const {
   if (fast_math) options.fast_math = true;
@@ -687,8 +692,9 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
       p.rays_per_second = r.seconds > 0 ? double(r.rays) / r.seconds : 0;
       p.rmse = c.rmse;
       p.relmse = c.relmse;
-      p.noise_relmse = noise_relmse(r, reference);
-      if (p.noise_relmse > 0) p.excess_standard_error = excess_standard_error(r, reference);
+      p.noise_relmse = converge_detail::noise_relmse(r, reference);
+      if (p.noise_relmse > 0)
+        p.excess_standard_error = converge_detail::excess_standard_error(r, reference);
       p.reference_noise_relmse = ref_noise;
       p.estimated_relmse = r.estimated_relmse;
       p.halves_relmse = r.halves_relmse;
