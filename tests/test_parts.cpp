@@ -1540,6 +1540,21 @@ TEST(Parts, SlurmMpiScriptPassesTheStopToTheRanks) {
       << text;
 }
 
+/// A pattern (pkill -f) of the command line of the lucent-mpi rank given `-q` last: it starts with
+/// the program (mpirun's holds the rank's arguments too, but does not start with it) and holds
+/// `scene` (in a directory of the test's own: no other test's ranks match).
+std::string quiet_rank_pattern(const std::string& program, const std::string& scene) {
+  const auto literal = [](const std::string& text) {  // (a regex matching `text` alone)
+    std::string escaped;
+    for (char c : text) {
+      if (std::string("\\.+*?()[]{}|^$").find(c) != std::string::npos) escaped += '\\';
+      escaped += c;
+    }
+    return escaped;
+  };
+  return "^" + literal(program) + " " + literal(scene) + " .* -q$";
+}
+
 // A stop signal to one rank alone (a node drained) is an interruption of the job, whether or not
 // --time was given: under --time the image was written short with exit 0 and no word, its
 // missing samples taken for the time limit's.
@@ -1550,24 +1565,14 @@ TEST(Parts, MpiSigtermToOneRankUnderATimeLimitIsAnInterruption) {
   const std::string out = dir + "/mpi.exr", err = dir + "/mpi.err";
   const std::string prog =
       "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " --spp 16000000 -o " + q(out);
-  // rank 0 stops at its time limit; rank 1, without one, only by the signal, whenever it comes.
-  // Its command line ends in -q (mpirun's holds it too, but does not start with the program),
-  // and holds this test's scene (in a directory of this test's own)
-  const auto literal = [](const std::string& text) {  // (a regex matching `text` alone)
-    std::string escaped;
-    for (char c : text) {
-      if (std::string("\\.+*?()[]{}|^$").find(c) != std::string::npos) escaped += '\\';
-      escaped += c;
-    }
-    return escaped;
-  };
-  const std::string escaped = "^" + literal(LUCENT_MPI_PATH) + " " + literal(scene) + " .* -q$";
+  // rank 0 stops at its time limit; rank 1, without one, only by the signal, whenever it comes
   const std::string script = dir + "/stop.sh";
   lucent::test::write_file(
       script, "timeout 120 env " + mpirun("-np 1 " + prog + " --time 3 : -np 1 " + prog + " -q") +
                   " 2>" + q(err) +
                   " </dev/null & pid=$!\nfor i in $(seq 600); do grep -q 'rank 0 of 2:' " + q(err) +
-                  " && break; sleep 0.1; done\npkill -TERM -f " + q(escaped) + "\nwait $pid\n");
+                  " && break; sleep 0.1; done\npkill -TERM -f " +
+                  q(quiet_rank_pattern(LUCENT_MPI_PATH, scene)) + "\nwait $pid\n");
   int raw = std::system(("bash " + q(script)).c_str());
   ASSERT_TRUE(WIFEXITED(raw));
   const std::string text = lucent::test::read_file(err);
@@ -1577,6 +1582,50 @@ TEST(Parts, MpiSigtermToOneRankUnderATimeLimitIsAnInterruption) {
                       " holds samples [0, "),
             std::string::npos)
       << text;
+}
+
+// A stop signal to one rank alone stops every rank within a few passes: the ranks agree on it
+// while they render (lucent-mpi's StopAgreement), and each keeps what it rendered. They agreed
+// only once each had ended its render, and the others rendered their whole share first (here
+// 5.3 million samples per pixel each, hours: the job ran until `timeout` stopped all of it). Rank
+// 2 ends its share early (--time 1) and waits for the others, in the agreement: a rank that has
+// finished takes part until every rank has.
+TEST(Parts, MpiSigtermToOneRankStopsEveryRankAfterTheirPass) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  const std::string out = dir + "/mpi.exr", err = dir + "/mpi.err";
+  const std::uint64_t n = 16000000;
+  const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " --spp " +
+                           std::to_string(n) + " -o " + q(out);
+  // SIGTERM to rank 1 (given -q) once rank 0's progress line shows the render running; `timeout`
+  // (status 124) ends a job whose ranks render on
+  const std::string script = dir + "/stop.sh";
+  lucent::test::write_file(
+      script,
+      "timeout 30 env " +
+          mpirun("-np 1 " + prog + " : -np 1 " + prog + " -q : -np 1 " + prog + " --time 1") +
+          " 2>" + q(err) + " </dev/null & pid=$!\nfor i in $(seq 600); do grep -q 'rank 0 of 3:' " +
+          q(err) + " && break; sleep 0.1; done\npkill -TERM -f " +
+          q(quiet_rank_pattern(LUCENT_MPI_PATH, scene)) + "\nwait $pid\n");
+  int raw = std::system(("bash " + q(script)).c_str());
+  ASSERT_TRUE(WIFEXITED(raw));
+  const std::string text = lucent::test::read_file(err);
+  EXPECT_EQ(WEXITSTATUS(raw), 143) << text;
+  EXPECT_NE(text.find("lucent-mpi: interrupted (a stop signal on rank 1 of 3): " + out +
+                      " holds samples [0, "),
+            std::string::npos)
+      << text;
+  ASSERT_TRUE(fs::exists(out)) << text;
+  // every rank rendered some of its share, and stopped short of it (rank 2 at its time limit)
+  const lucent::PartInfo info = lucent::read_part_info(out);
+  ASSERT_EQ(info.samples.size(), 3u) << text;
+  for (std::uint64_t r = 0; r < 3; ++r) {
+    const lucent::SampleRange share = {n * r / 3, n * (r + 1) / 3};
+    EXPECT_EQ(info.samples[r].begin, share.begin) << r << "\n" << text;
+    EXPECT_GT(info.samples[r].end, share.begin) << r << "\n" << text;
+    EXPECT_LT(info.samples[r].end, share.end) << r << "\n" << text;
+  }
 }
 
 /// The names in `dir` that contain `part`.

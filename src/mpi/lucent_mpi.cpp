@@ -6,7 +6,8 @@
 // the checkpoints) are agreed by the ranks: the lowest failing rank prints one line naming it,
 // every rank exits 1. A rank that fails later prints one line and ends the job with MPI_Abort.
 // Either way nothing is written. SIGINT, SIGTERM and SIGHUP stop every rank after its current
-// pass; what they rendered is merged and written (an .exr records the ranges it holds).
+// pass, also when one rank alone has the signal (the ranks agree on it while they render:
+// StopAgreement); what they rendered is merged and written (an .exr records the ranges it holds).
 // --checkpoint CK: each rank keeps a checkpoint of its own range, CK with ".rank<r>-of-<K>" before
 // its extension (src/cli/checkpoint.hpp, as `lucent render --checkpoint`), resumed by the same
 // command with the same number of ranks (docs/parts.md, "Checkpoints of lucent-mpi").
@@ -16,6 +17,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -26,6 +28,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cl/context.hpp"
@@ -157,6 +160,85 @@ bool refused(const std::function<void()>& step) {
   if (first == g_rank) print_failure(what, details);
   return first < g_size;
 }
+
+/// The ranks' agreement on a stop while they render, so that a stop signal to one rank (a node
+/// drained, or the signal reaching the ranks at different times) stops every rank within a few
+/// passes: the other ranks rendered their whole share (or to their --time) before the agreement
+/// after the render, hours on a cluster. Rounds of MPI_Iallreduce: each rank contributes
+/// whether it has a stop signal and whether it still renders, and posts the next round when one
+/// completes. A round that says a rank is stopped ends the rounds and cancels every rank's render
+/// after its current pass; one that says no rank renders any more ends them too. Every rank sees
+/// each round's same result, so every rank posts the same rounds (the MPI rule for collectives).
+/// A rank polls from its render's progress callback (poll(): after each pass), then, its render
+/// ended, until the rounds end (finish()): a rank that finished its share takes part until then,
+/// and its own signal during that wait stops the others too.
+class StopAgreement {
+ public:
+  /// Posts the first round. `rendering`: this rank has samples to render.
+  /// `any_thread`: MPI may be called from a thread other than the main one, one at a time
+  /// (MPI_THREAD_SERIALIZED): the progress callback of a render on several devices runs on the
+  /// devices' threads (one at a time, under the session's lock); without it only the main
+  /// thread's callbacks poll, and a stop waits for the render's end.
+  StopAgreement(bool rendering, bool any_thread)
+      : any_thread_(any_thread), main_(std::this_thread::get_id()) {
+    post(rendering);
+  }
+  StopAgreement(const StopAgreement&) = delete;
+  StopAgreement& operator=(const StopAgreement&) = delete;
+
+  /// From the render's progress callback: true once the ranks have agreed on a stop (the caller
+  /// then cancels its render). Never waits.
+  bool poll() {
+    if (stop_) return true;
+    if (over_ || (!any_thread_ && std::this_thread::get_id() != main_)) return false;
+    // (a few rounds at most: each needs every rank's post, which another rank makes at its own
+    // pass boundary or, its render ended, within a millisecond)
+    for (int i = 0; i < 4 && step(/*rendering=*/true); ++i) {
+    }
+    return stop_;
+  }
+
+  /// After the render (also when it rendered nothing): takes part in the rounds until they end.
+  /// Returns whether they ended on a stop.
+  bool finish() {
+    while (!over_) {
+      if (!step(/*rendering=*/false)) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return stop_;
+  }
+
+ private:
+  /// Posts a round of this rank's state.
+  void post(bool rendering) {
+    mine_[0] = g_stop.load() ? 1 : 0;
+    mine_[1] = rendering ? 1 : 0;
+    MPI_Iallreduce(mine_, all_, 2, MPI_INT, MPI_MAX, MPI_COMM_WORLD, &request_);
+  }
+  /// Tests the round posted; when it is complete, ends the rounds or posts the next. True when a
+  /// round completed.
+  bool step(bool rendering) {
+    int done = 0;
+    MPI_Test(&request_, &done, MPI_STATUS_IGNORE);
+    if (!done) return false;
+    if (all_[0] > 0) {
+      stop_ = over_ = true;
+    } else if (all_[1] == 0) {
+      over_ = true;  // no rank renders: the render is over, no stop among the rounds
+    } else {
+      post(rendering);
+    }
+    return true;
+  }
+
+  const bool any_thread_;
+  const std::thread::id main_;
+  int mine_[2] = {0, 0}, all_[2] = {0, 0};
+  MPI_Request request_ = MPI_REQUEST_NULL;
+  bool stop_ = false, over_ = false;
+};
+
+/// Whether MPI may be called from any thread, one at a time (MPI_Init_thread's answer).
+bool g_mpi_any_thread = false;
 
 /// Whether a rank has a stop signal, agreed by all ranks: its number (the highest any rank has),
 /// else 0. The lowest stopped rank says so, in one line.
@@ -514,8 +596,12 @@ int run(const Args& a) {
   const std::uint64_t resumed = ck ? ck->first_sample() - range.begin : 0;
   const bool tty = isatty(STDERR_FILENO);
   double last = -10;
+  // from here until agreement.finish() the ranks' only MPI calls are the agreement's
+  StopAgreement agreement(todo > 0, g_mpi_any_thread);
   auto progress = [&](const lucent::RenderProgress& p) {
     if (ck) ck->on_pass(renderer);
+    // a stop agreed (a signal on another rank): this rank stops after this pass, as for its own
+    if (agreement.poll()) renderer.cancel();
     if (!root || a.quiet || p.elapsed < 1.0 || (!tty && p.elapsed - last < 2.0)) return;
     last = p.elapsed;
     // rank 0's share, its checkpoint's samples counted
@@ -527,6 +613,8 @@ int run(const Args& a) {
   };
   if (todo > 0) renderer.render(todo, a.time_limit, progress);
   if (root && !a.quiet && last > 0 && tty) std::fprintf(stderr, "\n");
+  // every rank's render has ended: its share, its --time, its own stop signal or another rank's
+  agreement.finish();
   // with a checkpoint: the render is complete when every rank's is; until then each rank's
   // samples go to its checkpoint, before they are sent (a SIGKILL that follows a SIGTERM during
   // the merge or the output's write loses nothing)
@@ -678,7 +766,11 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "lucent-mpi: error: %s\n", problem.c_str());
       return 1;
     }
-  MPI_Init(&argc, &argv);
+  // MPI_THREAD_SERIALIZED: a render on several devices calls its progress callback, which polls
+  // the ranks' stop agreement (StopAgreement), from the devices' threads, one at a time
+  int provided = MPI_THREAD_SINGLE;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided);
+  g_mpi_any_thread = provided >= MPI_THREAD_SERIALIZED;
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &g_size);
   lucent::cli::install_stop_handler(on_stop_signal);
