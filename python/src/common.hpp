@@ -327,13 +327,16 @@ py::tuple enum_name_tuple() {
 // Vectors and arrays
 // ------------------------------------------------------------------------------------------
 
-/// A glm vector from a Vec3/Vec2 or a sequence of N numbers (tuple, list, NumPy array), with
-/// clear errors: ValueError for a wrong length, TypeError for anything else.
+/// A glm vector from a Vec3/Vec2 or a sequence of N numbers (tuple, list, NumPy array; not bytes),
+/// with clear errors: ValueError for a wrong length or a str, TypeError for anything else.
 template <class V>
 V to_vec(py::handle o) {
   constexpr int N = V::length();
   if (py::isinstance<V>(o)) return o.cast<V>();
-  if (!py::isinstance<py::sequence>(o) || py::isinstance<py::str>(o)) {
+  // bytes are a sequence of integers: Vec3(b"abc") was (97, 98, 99)
+  const bool bytes_like = py::isinstance<py::bytes>(o) || PyByteArray_Check(o.ptr()) ||
+                          PyMemoryView_Check(o.ptr());
+  if (!py::isinstance<py::sequence>(o) || py::isinstance<py::str>(o) || bytes_like) {
     if (py::isinstance<py::str>(o))
       throw py::value_error("expected a sequence of " + std::to_string(N) + " numbers, got " +
                             py::repr(o).cast<std::string>());
@@ -397,6 +400,16 @@ std::string range_bound(std::uint64_t n);
 template <class T>
 py::array_t<T> view(const std::vector<T>& data, std::vector<py::ssize_t> shape, py::handle owner) {
   return py::array_t<T>(std::move(shape), data.data(), owner);
+}
+
+/// view(), read-only: for values the object checked when it was made (a RenderResult's variance
+/// and counts), which a write through a view would bypass.
+template <class T>
+py::array_t<T> readonly_view(const std::vector<T>& data, std::vector<py::ssize_t> shape,
+                             py::handle owner) {
+  py::array_t<T> a = view(data, std::move(shape), owner);
+  a.attr("flags").attr("writeable") = false;
+  return a;
 }
 
 /// `object` as an array of type A (py::array, or py::array_t with its flags: converted as NumPy

@@ -721,9 +721,10 @@ void bind_render(py::module_& m) {
 
   py::class_<RenderResult> result(
       m, "RenderResult",
-      "An accumulation: mean and variance (H, W, 3) float32 and samples (H, W) uint32 are NumPy "
-      "views of this object's memory (no copy); variance and samples are None for images that "
-      "carry none.");
+      "An accumulation: mean and variance (H, W, 3) float32 and samples (H, W) uint32 are "
+      "read-only NumPy views of this object's memory (no copy; to change them, copy them and make "
+      "a RenderResult of the copies, which checks them); variance and samples are None for images "
+      "that carry none.");
   bind_device_shares(m, result);
   result
       .def(
@@ -778,23 +779,24 @@ void bind_render(py::module_& m) {
           }),
           py::arg("mean"), py::arg("variance") = py::none(), py::arg("samples") = py::none(),
           py::arg("spp") = 0)
-      .def_property_readonly("mean",
-                             [](py::object self) {
-                               const RenderResult& r = self.cast<const RenderResult&>();
-                               return view(r.mean.rgb, {r.mean.height, r.mean.width, 3}, self);
-                             })
+      .def_property_readonly(
+          "mean",
+          [](py::object self) {
+            const RenderResult& r = self.cast<const RenderResult&>();
+            return readonly_view(r.mean.rgb, {r.mean.height, r.mean.width, 3}, self);
+          })
       .def_property_readonly(
           "variance",
           [](py::object self) -> py::object {
             const RenderResult& r = self.cast<const RenderResult&>();
             if (r.variance.rgb.empty()) return py::none();
-            return view(r.variance.rgb, {r.variance.height, r.variance.width, 3}, self);
+            return readonly_view(r.variance.rgb, {r.variance.height, r.variance.width, 3}, self);
           })
       .def_property_readonly("samples",
                              [](py::object self) -> py::object {
                                const RenderResult& r = self.cast<const RenderResult&>();
                                if (r.samples.empty()) return py::none();
-                               return view(r.samples, {r.mean.height, r.mean.width}, self);
+                               return readonly_view(r.samples, {r.mean.height, r.mean.width}, self);
                              })
       .def_property_readonly("width", [](const RenderResult& r) { return r.mean.width; })
       .def_property_readonly("height", [](const RenderResult& r) { return r.mean.height; })

@@ -79,6 +79,16 @@ def test_result_from_arrays():
     r = lucent.RenderResult(constant(1.0), variance=constant(0.5), samples=np.full((4, 5), 3),
                             spp=3)
     assert r.spp == 3 and r.samples.dtype == np.uint32 and r.variance[0, 0, 0] == 0.5
+    # the views are read-only: a negative variance or count written through one bypassed the
+    # checks above (copies change, and a RenderResult of them checks them)
+    for view in (r.mean, r.variance, r.samples):
+        assert not view.flags.writeable
+        with pytest.raises(ValueError, match="read-only"):
+            view[0, 0] = -1
+    copy = np.array(r.variance)
+    copy[0, 0] = -1
+    with pytest.raises(ValueError, match="variance: every value must be finite and >= 0"):
+        lucent.RenderResult(r.mean, variance=copy, samples=r.samples)
     with pytest.raises(ValueError, match="variance: its shape differs"):
         lucent.RenderResult(constant(1.0), variance=constant(1.0, 2, 2))
     with pytest.raises(ValueError, match=r"samples: expected an array of shape \(H, W\)"):

@@ -363,6 +363,12 @@ def test_bad_field_values():
         m.albedo = 0.5
     with pytest.raises(TypeError):
         m.albedo = ("a", "b", "c")
+    # bytes are a sequence of integers: b"abc" was the albedo (97, 98, 99)
+    for raw in (b"abc", bytearray(b"abc"), memoryview(b"abc")):
+        with pytest.raises(TypeError, match="expected a sequence of 3 numbers"):
+            m.albedo = raw
+        with pytest.raises(TypeError, match="expected a sequence of 3 numbers"):
+            lucent.Vec3(raw)
     with pytest.raises(TypeError):
         lucent.Film().width = "wide"
     with pytest.raises(TypeError):
