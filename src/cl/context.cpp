@@ -233,10 +233,6 @@ std::string no_platform() {
 
 }  // namespace
 
-bool is_pocl(const DeviceInfo& device) {
-  return device.platform.find(kPoclPlatform) != std::string::npos;
-}
-
 std::string pocl_thread_count_problem() {
   const char* v = std::getenv("POCL_MAX_PTHREAD_COUNT");
   if (!v || !*v) return "";

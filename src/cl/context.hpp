@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "cl/opencl.hpp"
+#include "cl/pocl.hpp"
 #include "lucent/device.hpp"
 
 namespace lucent::cl_util {
@@ -23,12 +24,6 @@ Device pick_device(const std::string& selector, const std::string& origin = "--d
 /// The device a name selector picks among `devices` (its index), or -1: the device whose whole
 /// name it is (case-insensitive), else the first whose name contains it.
 int device_by_name(const std::vector<DeviceInfo>& devices, const std::string& selector);
-
-/// PoCL's platform name (CL_PLATFORM_NAME).
-inline constexpr const char* kPoclPlatform = "Portable Computing Language";
-
-/// The device is PoCL's (any of its drivers: they share its kernel cache and POCL_* variables).
-bool is_pocl(const DeviceInfo& device);
 
 /// A context and an in-order queue on one device.
 struct Context {

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "cl/context.hpp"
+#include "cl/pocl.hpp"
 #include "lucent/error.hpp"
 #include "render/pack.hpp"
 #include "scene/material_type.hpp"

@@ -23,12 +23,8 @@
 #include "image/part_sums.hpp"
 #include "lucent/error.hpp"
 #include "lucent/limits.hpp"
-#include "lucent/session.hpp"
 #include "lucent/types.hpp"
-#include "lucent/version.hpp"
-#include "render/pack.hpp"
 #include "render/part_write.hpp"
-#include "render/resources.hpp"
 #include "render/sample_stats.hpp"
 
 namespace lucent {
@@ -342,56 +338,6 @@ SampleRange parse_sample_range(const std::string& text, const std::string& what,
   return r;
 }
 
-void check_part_scene(const Scene& scene, const std::string& scene_path) {
-  // (caustics asked for in a scene without a mirror or smooth glass render none: such a scene's
-  // parts, checkpoints and MPI ranks were refused all the same)
-  if (render_detail::light_traced_caustics(scene))
-    throw Error(scene_path +
-                ": integrator.caustics: part files and MPI ranks cannot hold light-traced "
-                "caustics yet; render this scene in one process, or without caustics");
-}
-
-PartInfo part_header(const Renderer& renderer, const SampleRange& requested,
-                     const std::string& scene_path) {
-  check_part_scene(renderer.scene(), scene_path);
-  const Scene& scene = renderer.scene();
-  PartInfo info;
-  info.width = scene.film.width;
-  info.height = scene.film.height;
-  info.scene_hash = renderer.image_hash();
-  info.seed = scene.integrator.seed;
-  info.sampler = type_name(scene.integrator.sampler);
-  info.integrator = type_name(scene.integrator.type);
-  info.version = kVersion;
-  info.scene = scene_path;
-  info.requested = {requested};
-  // (a range to 2^64 made a part file that reading refused)
-  if (requested.end <= requested.begin || requested.end > (1ull << 32))
-    throw Error("make_part: requested samples " + range_text(requested) +
-                ": need 0 <= A < B <= 4294967296");
-  info.display = DisplaySettings{scene.film.transfer, scene.film.gamma, scene.film.exposure,
-                                 scene.film.tonemap};
-  return info;
-}
-
-RenderPart make_part(const Renderer& renderer, const SampleRange& requested,
-                     const std::string& scene_path) {
-  RenderPart p;
-  p.info = part_header(renderer, requested, scene_path);
-  p.acc = renderer.accumulation();
-  PartInfo& info = p.info;
-  info.width = p.acc.width;  // (the session's film: its scene's)
-  info.height = p.acc.height;
-  if (p.acc.spp > 0) info.samples = {{p.acc.first_sample, p.acc.first_sample + p.acc.spp}};
-  if (unite(info.requested, info.samples) != info.requested)
-    throw Error("make_part: the session's samples " + ranges_text(info.samples) +
-                " lie outside the requested " + range_text(requested));
-  info.nonfinite = p.acc.nonfinite;
-  info.rays = p.acc.rays;
-  info.seconds = p.acc.seconds;
-  return p;
-}
-
 RenderResult part_result(const RenderPart& part) {
   const Accumulation& a = part.acc;
   if (!sums_fit_film(a))
@@ -523,7 +469,7 @@ void check_part_file_size(const std::string& path) {
   std::error_code ec;
   const std::uint64_t size = std::filesystem::file_size(path, ec);
   std::string what;
-  const std::uint64_t limit = render_detail::host_memory_allowed(&what);
+  const std::uint64_t limit = sys::host_memory_allowed(&what);
   if (!ec && limit > 0 && size > limit)
     throw Error(path + ": this part file (" + sys::format_bytes(size) +
                 ") is larger than the memory limit of " + sys::format_bytes(limit) + " (80% of " +
