@@ -311,6 +311,19 @@ lucent::RenderPart handmade_part(const std::vector<lucent::SampleRange>& samples
   return p;
 }
 
+// A part's time is written in full: the attribute was printed into 64 characters, so a time above
+// 1e56 (a part file's lucent.seconds of 1e308, which reading takes) was written cut to its first
+// 63 digits, 1e308 as 1.0000000000000000109e62, without a word.
+TEST(Parts, LargeTimesAreWrittenInFull) {
+  const std::string dir = lucent::test::temp_dir();
+  for (const double seconds : {1e308, 1.7976931348623157e308, 123456.5}) {
+    lucent::RenderPart p = handmade_part({{0, 4}}, {0, 4});
+    p.info.seconds = seconds;
+    lucent::write_render_part(dir + "/p.exr", p);
+    EXPECT_EQ(lucent::read_part_info(dir + "/p.exr").seconds, seconds);
+  }
+}
+
 // A part holds at most 2^24 samples (--samples), but parts together may hold up to 2^32:
 // `merge --expect` took the per-part limit, so a Slurm job of more than 2^24 spp
 // (scripts/slurm/submit.sh passes --expect 0:SPP) rendered every part, then failed to merge.

@@ -434,7 +434,10 @@ void parts_detail::write_part_unchecked(const std::string& path, const RenderPar
       for (bool high : {true, false})
         extras.uint_channels.emplace_back(channel_name(plane, c, high),
                                           words.data() + size_t(k++) * npix);
-  char seconds[64];
+  // "%.6f" of any finite time: up to 309 digits before the point (DBL_MAX), the point and six
+  // decimals (a buffer of 64 cut a time above 1e56 to its first 63 characters: 1e308, which
+  // reading takes, was written as 1e62)
+  char seconds[320];
   const std::string gamma = io::shortest_real(info.display.gamma),
                     exposure = io::shortest_real(info.display.exposure);
   std::snprintf(seconds, sizeof seconds, "%.6f", info.seconds);
