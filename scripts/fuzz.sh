@@ -4,7 +4,7 @@
 #
 #   scripts/fuzz.sh [--if-available] [SECONDS] [TARGET...]
 #
-# TARGET: scene, obj, texture, render_image (default: all four). FUZZ_JOBS=N runs N targets at
+# TARGET: scene, obj, texture, render_image, part (default: all five). FUZZ_JOBS=N runs N targets at
 # once (default 1). The corpus of each target grows in build-fuzz/fuzz/corpus/TARGET (seeded on
 # every run from scenes/ and assets/ by lucent_fuzz_seeds); crashes, leaks and UB reports land in
 # build-fuzz/fuzz/artifacts/TARGET/ and make the script fail. --if-available exits 0 with a
@@ -26,7 +26,7 @@ fi
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-if [[ ${#targets[@]} -eq 0 ]]; then targets=(scene obj texture render_image); fi
+if [[ ${#targets[@]} -eq 0 ]]; then targets=(scene obj texture render_image part); fi
 jobs="${FUZZ_JOBS:-1}"
 cc="${FUZZ_CC:-clang}"
 cxx="${FUZZ_CXX:-clang++}"
@@ -69,7 +69,8 @@ run_one() {
     scene) dict=scene.dict max_len=16384 ;;
     obj) dict=obj.dict max_len=16384 ;;
     texture | render_image) dict=image.dict max_len=16384 ;;
-    *) echo "fuzz: unknown target '$t' (scene, obj, texture, render_image)" >&2; return 2 ;;
+    part) dict=part.dict max_len=16384 ;;
+    *) echo "fuzz: unknown target '$t' (scene, obj, texture, render_image, part)" >&2; return 2 ;;
   esac
   mkdir -p "$work/corpus/$t" "$work/artifacts/$t"
   # each target in its own directory: libFuzzer writes crash files to the working directory

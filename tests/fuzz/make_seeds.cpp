@@ -2,7 +2,7 @@
 // small images of every format, written here) rather than committed as binaries, plus the
 // inputs the fuzzers found (tests/fuzz/regressions):
 //   lucent_fuzz_seeds SOURCE_DIR OUT_DIR
-// writes OUT_DIR/{scene,obj,texture,render_image}/.
+// writes OUT_DIR/{scene,obj,texture,render_image,part}/.
 #include <stb/stb_image_write.h>
 #include <tinyexr.h>
 #include <zlib.h>
@@ -21,6 +21,7 @@
 #include "image/image_probe.hpp"
 #include "lucent/compare.hpp"
 #include "lucent/image.hpp"
+#include "lucent/parts.hpp"
 
 namespace fs = std::filesystem;
 using Parts = std::vector<std::pair<std::string, std::string>>;
@@ -144,6 +145,164 @@ Parts images() {
   return out;
 }
 
+// Images whose palette has fewer entries than their indices can name (image_decode.cpp,
+// pad_palette): PNGs of colour type 3 at each bit depth with a short PLTE, and BMPs of 1, 4 and
+// 8 bits with a short colour table (a Windows header's 4-byte entries, an OS/2 header's 3-byte).
+Parts short_palettes() {
+  Parts out;
+  auto chunk = [](const std::string& tag, const std::string& data) {
+    const std::string td = tag + data;
+    return be32(static_cast<std::uint32_t>(data.size())) + td +
+           be32(static_cast<std::uint32_t>(
+               crc32(0, reinterpret_cast<const Bytef*>(td.data()), td.size())));
+  };
+  const int w = 5, h = 3;
+  for (int depth : {1, 2, 4, 8}) {
+    const int entries = depth == 1 ? 1 : 3;  // of 2, 4, 16, 256
+    const int stride = (w * depth + 7) / 8;
+    std::string raw;
+    for (int y = 0; y < h; ++y) {
+      raw += '\0';
+      for (int i = 0; i < stride; ++i)  // indices past the palette's entries too
+        raw += char((y * 37 + i * 91) & 0xff);
+    }
+    uLongf zlen = compressBound(raw.size());
+    std::string z(zlen, '\0');
+    compress2(reinterpret_cast<Bytef*>(&z[0]), &zlen, reinterpret_cast<const Bytef*>(raw.data()),
+              raw.size(), 9);
+    z.resize(zlen);
+    std::string plte;
+    for (int e = 0; e < entries; ++e) plte += {char(40 * e), char(200 - 30 * e), char(7 * e)};
+    const std::string ihdr = be32(w) + be32(h) + std::string{char(depth), 3, 0, 0, 0};
+    out.emplace_back("palette" + std::to_string(depth) + ".png",
+                     std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) +
+                         chunk("PLTE", plte) + chunk("IDAT", z) + chunk("IEND", ""));
+  }
+  auto le = [](std::uint32_t v, int n) {
+    std::string s;
+    for (int i = 0; i < n; ++i) s += char(v >> (8 * i));
+    return s;
+  };
+  for (int bpp : {1, 4, 8})
+    for (bool os2 : {false, true}) {
+      const int entries = bpp == 1 ? 1 : 3, entry = os2 ? 3 : 4, hsz = os2 ? 12 : 40;
+      const int stride = (w * bpp + 31) / 32 * 4;
+      const std::uint32_t offset = 14 + hsz + entries * entry;
+      std::string f = "BM" + le(offset + stride * h, 4) + le(0, 4) + le(offset, 4) + le(hsz, 4);
+      if (os2)
+        f += le(w, 2) + le(h, 2) + le(1, 2) + le(bpp, 2);
+      else
+        f += le(w, 4) + le(h, 4) + le(1, 2) + le(bpp, 2) + le(0, 4) + le(stride * h, 4) +
+             le(2835, 4) + le(2835, 4) + le(entries, 4) + le(0, 4);
+      for (int e = 0; e < entries; ++e)
+        f += std::string{char(9 * e), char(120 + 40 * e), char(250 - 60 * e)} +
+             std::string(entry - 3, '\0');
+      for (int i = 0; i < stride * h; ++i) f += char((i * 53 + 11) & 0xff);
+      out.emplace_back("palette" + std::to_string(bpp) + (os2 ? "-os2" : "") + ".bmp", f);
+    }
+  return out;
+}
+
+// `exr` (an OpenEXR's bytes) stored uncompressed, its channels and attributes as they were: part
+// seeds whose sums and counts the fuzzer reaches byte for byte (the writer compresses).
+std::string uncompressed_exr(const std::string& exr) {
+  const auto* d = reinterpret_cast<const unsigned char*>(exr.data());
+  EXRVersion version;
+  EXRHeader header;
+  EXRImage image;
+  InitEXRHeader(&header);
+  InitEXRImage(&image);
+  const char* err = nullptr;
+  if (ParseEXRVersionFromMemory(&version, d, exr.size()) != TINYEXR_SUCCESS ||
+      ParseEXRHeaderFromMemory(&header, &version, d, exr.size(), &err) != TINYEXR_SUCCESS ||
+      LoadEXRImageFromMemory(&image, &header, d, exr.size(), &err) != TINYEXR_SUCCESS) {
+    if (err) FreeEXRErrorMessage(err);
+    std::fprintf(stderr, "lucent_fuzz_seeds: cannot read back a part seed\n");
+    std::exit(1);
+  }
+  header.compression_type = TINYEXR_COMPRESSIONTYPE_NONE;
+  for (int c = 0; c < header.num_channels; ++c)
+    header.requested_pixel_types[c] = header.pixel_types[c];
+  std::string out = lucent::image_detail::save_exr_to_memory("uncompressed_exr", image, header);
+  FreeEXRImage(&image);
+  FreeEXRHeader(&header);
+  return out;
+}
+
+// Part files and checkpoints of 2x2 to 8x8 pixels made by write_render_part (ZIP, PIZ, and the
+// same uncompressed), and renders with lucent's attributes (a caustics render's light variance,
+// a seed and sampler, with and without the variance layers): what the part readers and
+// read_render take.
+Parts part_files() {
+  Parts out;
+  const std::string tmp = (fs::temp_directory_path() / "lucent-part-seed.exr").string();
+  auto part = [](int w, int h, std::vector<lucent::SampleRange> samples,
+                 std::vector<lucent::SampleRange> requested, std::uint64_t nonfinite) {
+    lucent::RenderPart p;
+    lucent::PartInfo& info = p.info;
+    info.width = w;
+    info.height = h;
+    info.scene_hash = 0x0123456789abcdefull;
+    info.seed = 7;
+    info.sampler = "sobol";
+    info.integrator = "path";
+    info.version = "0.1.0";
+    info.scene = "scene.json";
+    info.samples = std::move(samples);
+    info.requested = std::move(requested);
+    info.rays = 12345;
+    info.seconds = 0.25;
+    std::uint64_t spp = 0;
+    for (const auto& r : info.samples) spp += r.end - r.begin;
+    lucent::Accumulation& a = p.acc;
+    a.width = w;
+    a.height = h;
+    const size_t n = size_t(w) * h;
+    a.count.assign(n, static_cast<std::uint32_t>(spp));
+    for (std::uint64_t k = 0; k < nonfinite; ++k) a.count[k % n] -= 1;  // (nonfinite <= n)
+    info.nonfinite = nonfinite;
+    for (size_t i = 0; i < n * 3; ++i) {
+      const double v = 0.125 * double((i * 7) % 11), c = a.count[i / 3];
+      a.sum.push_back(v * c);
+      a.sumsq.push_back(v * v * c + 0.5 * (i % 2));
+    }
+    return p;
+  };
+  auto put_part = [&](const std::string& name, const lucent::RenderPart& p,
+                      lucent::PartCompression c) {
+    lucent::write_render_part(tmp, p, c);
+    out.emplace_back(name + ".exr", read(tmp));
+    out.emplace_back(name + "-raw.exr", uncompressed_exr(read(tmp)));
+    fs::remove(tmp);
+  };
+  using lucent::PartCompression;
+  put_part("part2x2", part(2, 2, {{0, 4}}, {{0, 4}}, 0), PartCompression::zip);
+  // a checkpoint (PIZ): [0, 3) of [0, 8), one non-finite sample
+  put_part("checkpoint3x2", part(3, 2, {{0, 3}}, {{0, 8}}, 1), PartCompression::piz);
+  // a merge of two ranges, of a part file without a sampler (before 24 Nov 2026), a display
+  lucent::RenderPart merged = part(8, 8, {{0, 4}, {8, 12}}, {{0, 16}}, 3);
+  merged.info.sampler.clear();
+  merged.info.display = {lucent::Transfer::Gamma, 1.8, -0.5, lucent::ToneMap::Aces};
+  put_part("merged8x8", merged, PartCompression::zip);
+  // renders: a caustics render's light variance with its statistics, the mean alone
+  lucent::RenderResult r;
+  r.mean = lucent::Image{4, 3, std::vector<float>(36, 0.5f)};
+  r.variance = lucent::Image{4, 3, std::vector<float>(36, 0.0625f)};
+  r.samples.assign(12, 16);
+  r.seed = 3;
+  r.sampler = "independent";
+  r.light_mean_variance = lucent::LightMeanVariance{{1e-3, 2e-3, 0}, {4e-4, 0, 5e-5}};
+  lucent::write_render_exr(tmp, r);
+  out.emplace_back("caustics4x3.exr", read(tmp));
+  r.variance = {};
+  r.samples.clear();
+  r.light_mean_variance.reset();
+  lucent::write_render_exr(tmp, r);
+  out.emplace_back("seeded-mean4x3.exr", read(tmp));
+  fs::remove(tmp);
+  return out;
+}
+
 const char* const kObjs[] = {
     "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\n"
     "f 1/1/1 2/2/1 3/3/1 4/1/1\n",
@@ -208,6 +367,14 @@ int main(int argc, char** argv) {
     put(out / "texture", name, bytes);
     put(out / "render_image", name, bytes);
   }
+  for (const auto& [name, bytes] : short_palettes()) {
+    put(out / "texture", name, bytes);
+    put(out / "render_image", name, bytes);
+  }
+  for (const auto& [name, bytes] : part_files()) {
+    put(out / "part", name, bytes);
+    put(out / "render_image", name, bytes);
+  }
   for (const auto& e : fs::recursive_directory_iterator(src / "assets")) {
     if (!e.is_regular_file()) continue;
     const std::string ext = e.path().extension().string();
@@ -258,7 +425,7 @@ int main(int argc, char** argv) {
   }
   // the inputs the fuzzers found (crashes, leaks, over-reads): every run replays them
   const fs::path found = src / "tests/fuzz/regressions";
-  for (const char* target : {"scene", "obj", "texture", "render_image"})
+  for (const char* target : {"scene", "obj", "texture", "render_image", "part"})
     if (fs::is_directory(found / target))
       for (const auto& e : fs::directory_iterator(found / target))
         put(out / target, "regression-" + e.path().filename().string(), read(e.path()));
