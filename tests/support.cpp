@@ -496,7 +496,7 @@ std::string flat_lamp_scene(const std::string& dir) {
   write_file(path, R"({
     "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
     "film": {"width": 500, "height": 400},
-    "integrator": {"type": "path", "spp": 16, "seed": 3},
+    "integrator": {"type": "path", "spp": 4, "seed": 3},
     "materials": {"lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1, 0.5, 0.25]}},
     "shapes": [{"type": "triangles", "material": "lamp",
                 "positions": [[-10,-10,0],[0.3,-10,0],[0.9,10,0],[-10,10,0]], "indices": [0,1,2, 0,2,3]}]

@@ -742,7 +742,7 @@ TEST(Checkpoint, ProgressOfAResumedRenderCountsTheCheckpoint) {
 }
 
 // The output's write fails after a complete render (a full disk; here a file size limit of 1.5 MB,
-// which the 2.4 MB PFM exceeds and the 80 KB checkpoint does not): the samples go to the
+// which the 2.4 MB PFM exceeds and the 75 KB checkpoint does not): the samples go to the
 // checkpoint, all of them (it held none: the default --checkpoint-every is 300 s, and a render
 // that ran that long lost up to 300 s of work), and two lines say so. The same command then
 // renders nothing and writes the image of the uninterrupted render.
@@ -759,17 +759,17 @@ TEST(Checkpoint, FailedOutputWriteKeepsTheSamplesInTheCheckpoint) {
                             "bash " + q(limited));
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_EQ(r.err, "lucent: error: " + out + ": cannot write (File too large)\nlucent: " + ck +
-                       " holds all the samples, [0, 16): the same command writes the output\n");
+                       " holds all the samples, [0, 4): the same command writes the output\n");
   EXPECT_FALSE(fs::exists(out));
   ASSERT_TRUE(fs::exists(ck)) << r.err;
-  EXPECT_EQ(lucent::read_part_info(ck).samples, (std::vector<lucent::SampleRange>{{0, 16}}));
+  EXPECT_EQ(lucent::read_part_info(ck).samples, (std::vector<lucent::SampleRange>{{0, 4}}));
 
   r = run_cli("render " + q(scene) + " -o " + q(out) + " --checkpoint " + q(ck));
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.err.find("lucent: resuming from " + ck + ", which holds samples [0, 16)"),
+  EXPECT_NE(r.err.find("lucent: resuming from " + ck + ", which holds samples [0, 4)"),
             std::string::npos)
       << r.err;
-  EXPECT_NE(r.err.find(", 16 spp (16 of them from " + ck + ") in 0.000 s ("), std::string::npos)
+  EXPECT_NE(r.err.find(", 4 spp (4 of them from " + ck + ") in 0.000 s ("), std::string::npos)
       << r.err;  // (nothing rendered)
   EXPECT_FALSE(fs::exists(ck));
   EXPECT_FALSE(fs::exists(ck + ".lock"));

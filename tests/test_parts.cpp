@@ -1959,7 +1959,7 @@ TEST(Parts, MpiCheckpointFailedWriteIsNotClaimed) {
 }
 
 // Rank 0's write of the output fails after a complete render (a full disk; here a file size limit
-// on rank 0 alone, which the 2.4 MB PFM exceeds and the 80 KB checkpoints of this flat image do
+// on rank 0 alone, which the 2.4 MB PFM exceeds and the 75 KB checkpoints of this flat image do
 // not): every rank's checkpoint then holds its whole share (they held none: the default
 // --checkpoint-every is 300 s, up to which every rank's work was lost), rank 0 says so after one
 // line for the output, and the same command renders nothing and writes the uninterrupted image.
@@ -1969,7 +1969,7 @@ TEST(Parts, MpiCheckpointFailedOutputWriteKeepsEveryRanksSamples) {
   // them; the sanitizer build runs the other lucent-mpi entries, which take the same paths)
   if (lucent::test::kAddressSanitizer) GTEST_SKIP() << "slow under AddressSanitizer";
   const std::string dir = lucent::test::temp_dir();
-  const std::string scene = lucent::test::flat_lamp_scene(dir);  // 80 KB parts, 2.4 MB PFMs
+  const std::string scene = lucent::test::flat_lamp_scene(dir);  // 75 KB parts, 2.4 MB PFMs
   const std::string ck = dir + "/ck.exr", out = dir + "/out.pfm", full = dir + "/full.pfm";
   const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " -q -o ";
   // (first: the kernel caches are filled, whose files the limit would refuse)
@@ -1988,7 +1988,7 @@ TEST(Parts, MpiCheckpointFailedOutputWriteKeepsEveryRanksSamples) {
   EXPECT_NE(r.err.find("): " + out + ": cannot write (File too large)\n"), std::string::npos)
       << r.err;
   EXPECT_NE(r.err.find("lucent-mpi: the checkpoints " + dir +
-                       "/ck.rank<r>-of-2.exr hold samples [0, 16) of [0, 16): the same command "
+                       "/ck.rank<r>-of-2.exr hold samples [0, 4) of [0, 4): the same command "
                        "with 2 ranks writes the output\n"),
             std::string::npos)
       << r.err;
@@ -1996,9 +1996,9 @@ TEST(Parts, MpiCheckpointFailedOutputWriteKeepsEveryRanksSamples) {
   ASSERT_TRUE(fs::exists(dir + "/ck.rank0-of-2.exr") && fs::exists(dir + "/ck.rank1-of-2.exr"))
       << r.err;
   EXPECT_EQ(lucent::read_part_info(dir + "/ck.rank0-of-2.exr").samples,
-            (std::vector<lucent::SampleRange>{{0, 8}}));
+            (std::vector<lucent::SampleRange>{{0, 2}}));
   EXPECT_EQ(lucent::read_part_info(dir + "/ck.rank1-of-2.exr").samples,
-            (std::vector<lucent::SampleRange>{{8, 16}}));
+            (std::vector<lucent::SampleRange>{{2, 4}}));
 
   // the same command: nothing rendered (each rank's checkpoint holds its share), the output
   // written, the checkpoints gone
