@@ -80,11 +80,16 @@ SET_SCENE_CHILD = textwrap.dedent("""
     scene = lucent.scene_from_dict(json.loads(sys.argv[1]))
     for ms in range(5, 45, 5):
         r = lucent.Renderer(**lucent.environment())
+        timer = threading.Timer(ms / 1000, lambda: os.kill(os.getpid(), signal.SIGINT))
         try:
             # (inside the try: on a loaded machine the signal came before start() returned)
-            threading.Timer(ms / 1000, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+            timer.start()
             r.set_scene(scene)
-            time.sleep(0.2)  # a Ctrl-C that came after set_scene is raised here
+            # a Ctrl-C that comes after set_scene is raised here: in the wait for the timer's
+            # thread, or at the next line once it has sent it (a fixed 0.2 s sleep did not
+            # wait for a timer late on a loaded machine, and took 1.6 s in all)
+            timer.join()
+            time.sleep(0.01)
             print(ms, "late", flush=True)
         except KeyboardInterrupt:
             print(ms, "keyboard", flush=True)
