@@ -1035,7 +1035,7 @@ TEST(Parts, SumsNoRenderMakesAreRefusedNamingThePart) {
   };
   const std::string beyond =
       "pixel 0, 0: its mean or sample variance is beyond a float's range (no render's is)";
-  // a mean of 1e39 in 4 samples: refused by the writer, by merge and, in a file, by read_render
+  // a mean of 1e39 in 4 samples: refused by the writer, the merger and, in a file, the readers
   const lucent::RenderPart huge = part(0, 4e39, 4e78);
   EXPECT_EQ(error_of([&] { lucent::write_render_part(dir + "/w.exr", huge); }),
             dir + "/w.exr: cannot write part: " + beyond);
@@ -1044,6 +1044,8 @@ TEST(Parts, SumsNoRenderMakesAreRefusedNamingThePart) {
             dir + "/huge.exr: " + beyond);
   EXPECT_FALSE(fs::exists(dir + "/o.pfm"));
   EXPECT_EQ(error_of([&] { lucent::read_render(dir + "/huge.exr"); }),
+            dir + "/huge.exr: " + beyond);
+  EXPECT_EQ(error_of([&] { lucent::read_render_part(dir + "/huge.exr"); }),
             dir + "/huge.exr: " + beyond);
   // each part fits (a mean of m = 3e38, then of 0; variances 0), their merge does not: its
   // variance is 2 m^2 / 7

@@ -99,6 +99,12 @@ PartSums part_sums_from_channels(const ExrChannels& exr, const std::string& path
       sum != exr.attributes.end() &&
       sum->second != hex64(part_sums_checksum(p.sum, p.sumsq, p.count)))
     throw Error(path + ": part file is damaged: its samples do not match its checksum");
+  // a mean or variance no render has, that a float image would show as infinite (a crafted file)
+  for (size_t i = 0; i < npix * 3; ++i)
+    if (!sums_fit_float(p.sum[i], p.sumsq[i], p.count[i / 3]))
+      throw Error(path + ": pixel " + std::to_string(i / 3 % exr.width) + ", " +
+                  std::to_string(i / 3 / exr.width) +
+                  ": its mean or sample variance is beyond a float's range (no render's is)");
   return p;
 }
 

@@ -44,8 +44,9 @@ void part_image(const std::string& name, int width, int height, const std::vecto
                 Image& mean, Image& variance);
 
 /// The sums, sums of squares and counts of the part file `path` from its decoded channels: each
-/// sum finite, each sum of squares >= 0, and all of them matching lucent.checksum where the file
-/// has one (part files written before 30 Nov 2026 have none). Throws lucent::Error naming `path`.
+/// sum finite, each sum of squares >= 0, all of them matching lucent.checksum where the file has
+/// one (part files written before 30 Nov 2026 have none), and each pixel's mean and variance
+/// within a float's range (sums_fit_float). Throws lucent::Error naming `path`.
 PartSums part_sums_from_channels(const ExrChannels& exr, const std::string& path);
 
 }  // namespace lucent::image_detail
