@@ -832,6 +832,31 @@ TEST(Resources, OutputTooLargeToWriteIsRefusedBeforeRendering) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/p.exr"));
 }
 
+// The outputs that `lucent render --aov` or `--checkpoint` keeps beside the session are named as
+// the command line gives them: the error said "what the application keeps beside the session (its
+// outputs, as it declared them)", the library's wording, and named no --aov or checkpoint.
+TEST(Resources, OutputsBesideTheSessionAreNamedByTheirOptions) {
+  if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer cannot run under ulimit -v";
+  std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/s.json", grid_scene(2, 4));
+  const std::string render = "render " + q(dir + "/s.json") + " -o " + q(dir + "/o.exr") +
+                             " --width 4096 --height 4096 --spp 1 -q ";
+  const std::pair<std::string, std::string> cases[] = {
+      {"--aov albedo,depth",
+       "the largest part is writing " + dir + "/o.exr and then each --aov image (4096x4096)"},
+      {"--checkpoint " + q(dir + "/ck.exr"),
+       "the largest part is the checkpoint's sums and the write of its file (4096x4096)"}};
+  for (const auto& [options, named] : cases) {
+    auto r = lucent::test::run_cli(render + options, ulimit_v("1500000"));
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(lucent::test::count_lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(named), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("): reduce the film size"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/o.exr"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/ck.exr"));
+}
+
 // What an application keeps beside a session (SessionOptions::reserved_host_bytes: `lucent
 // render` declares its outputs there) counts in the session's estimate.
 TEST(Resources, SessionCountsWhatTheApplicationReserves) {

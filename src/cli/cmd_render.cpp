@@ -208,6 +208,7 @@ std::string progress_note(const lucent::RenderResult& r, std::uint64_t target_sp
 /// with them it lives on, and the writes are declared beside it (`beside`).
 struct OutputMemory {
   std::uint64_t beside = 0;
+  std::string beside_what;  ///< what `beside` holds, for the error line
   std::vector<lucent::render_detail::MemoryPart> after;
 };
 
@@ -227,6 +228,7 @@ OutputMemory output_memory(const RenderArgs& a, int fw, int fh, bool part, bool 
     // checkpoint, itself held throughout) and the write of its file; after it, a resumed render's
     // image is made from that part (--checkpoint is refused with --aov and --samples)
     m.beside = checkpoint_beside_bytes(fw, fh, resumed);
+    m.beside_what = "the checkpoint's sums and the write of its file (" + film + ")";
     if (resumed)
       m.after.push_back({"the sums of the checkpoint and this render (" + film + ")", acc_bytes,
                          "the film size"});
@@ -234,6 +236,7 @@ OutputMemory output_memory(const RenderArgs& a, int fw, int fh, bool part, bool 
   if (!a.aovs.empty()) {
     // the main image's write, then each AOV's result and file
     m.beside = write_bytes;
+    m.beside_what = "writing " + one_line(a.output) + " and then each --aov image (" + film + ")";
     for (const std::string& name : a.aovs)
       m.beside =
           std::max(m.beside,
@@ -242,7 +245,11 @@ OutputMemory output_memory(const RenderArgs& a, int fw, int fh, bool part, bool 
                        : result_bytes + lucent::image_detail::render_exr_write_bytes(fw, fh, true));
     return m;
   }
-  if (part) m.beside += acc_bytes;  // the part's copy of the sums, made before the session goes
+  if (part) {  // the part's copy of the sums, made before the session goes
+    m.beside += acc_bytes;
+    if (m.beside_what.empty())
+      m.beside_what = "the part's copy of the sums of the " + film + " film";
+  }
   const std::string kept = part ? "the part's sums of the " + film + " film"
                                 : "the result images of the " + film + " film";
   m.after.push_back({kept, part ? acc_bytes : result_bytes, "the film size"});
@@ -460,8 +467,11 @@ int render_with(const RenderArgs& a) {
   if (!a.reference) {
     std::string what;
     const std::uint64_t limit = lucent::render_detail::host_memory_allowed(&what);
-    lucent::render_detail::check_host_memory(
-        scene, {}, limit, what, lucent::render_detail::reserved_part(memory.beside), 1);
+    // (the outputs named as the command line gives them: the library's wording, "what the
+    // application keeps beside the session", named no --aov)
+    std::vector<lucent::render_detail::MemoryPart> outputs;
+    if (memory.beside > 0) outputs.push_back({memory.beside_what, memory.beside, "the film size"});
+    lucent::render_detail::check_host_memory(scene, {}, limit, what, outputs, 1);
   }
   if (!memory.after.empty()) lucent::render_detail::check_output_host_memory(scene, memory.after);
 
