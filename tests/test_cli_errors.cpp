@@ -107,7 +107,10 @@ TEST(CliErrors, WordsAfterTwoDashesAreArguments) {
       {"render " + q(scene) + " -- -o " + q(out), "unexpected argument -o after --"},
       {"render -o " + q(out) + " -- " + q(scene) + " --spp 1",
        "unexpected argument --spp after --"},
-      {"render " + q(scene) + " -o " + q(out) + " --bogus -- x", "unknown option --bogus"}};
+      {"render " + q(scene) + " -o " + q(out) + " --bogus -- x", "unknown option --bogus"},
+      // a piece of combined short flags is in argv in neither place
+      {"render " + q(scene) + " -o " + q(out) + " -qZ", "unknown option -Z"},
+      {"render " + q(scene) + " -o " + q(out) + " -qZ -- x", "unknown option -Z"}};
   for (const auto& [args, message] : cases) {
     CommandResult r = run_cli(args);
     EXPECT_EQ(

@@ -118,12 +118,17 @@ int main(int argc, char** argv) {
     // A word after "--" is an argument, not an option: `render s.json -- -o a.png` said "unknown
     // option -o", and `render -o a.png -- s.json --spp 1` "unknown option --".
     const std::vector<std::string> extras = app.remaining(true);
-    const std::vector<std::string> before_dashes(
-        argv + 1, std::find_if(argv + 1, argv + argc,
-                               [](const char* w) { return std::strcmp(w, "--") == 0; }));
+    // (a word given after "--" and not before it: a piece of combined short flags, "-Z" of
+    // "-qZ", is in argv in neither place, and is an unknown option)
+    char** const dashes = std::find_if(argv + 1, argv + argc,
+                                       [](const char* w) { return std::strcmp(w, "--") == 0; });
+    auto given = [](char** first, char** last, const std::string& word) {
+      return std::find_if(first, last, [&](const char* w) { return word == w; }) != last;
+    };
     for (const std::string& extra : extras) {
       if (extra == "--" || extra.size() < 2 || extra[0] != '-') continue;
-      if (std::find(before_dashes.begin(), before_dashes.end(), extra) == before_dashes.end()) {
+      if (dashes != argv + argc && given(dashes + 1, argv + argc, extra) &&
+          !given(argv + 1, dashes, extra)) {
         msg = "unexpected argument " + extra + " after -- (the words after -- are arguments)";
       } else {
         msg = "unknown option " + extra;
