@@ -1656,7 +1656,7 @@ TEST(Parts, MpiSigtermToOneRankStopsEveryRankAfterTheirPass) {
   const std::string script = dir + "/stop.sh";
   lucent::test::write_file(
       script,
-      "timeout 30 env " +
+      "timeout 120 env " +
           mpirun("-np 1 " + prog + " : -np 1 " + prog + " -q : -np 1 " + prog + " --time 1") +
           " 2>" + q(err) + " </dev/null & pid=$!\nfor i in $(seq 600); do grep -q 'rank 0 of 3:' " +
           q(err) + " && break; sleep 0.1; done\npkill -TERM -f " +

@@ -334,8 +334,12 @@ V to_vec(py::handle o) {
   constexpr int N = V::length();
   if (py::isinstance<V>(o)) return o.cast<V>();
   // bytes are a sequence of integers: Vec3(b"abc") was (97, 98, 99)
-  const bool bytes_like =
-      py::isinstance<py::bytes>(o) || PyByteArray_Check(o.ptr()) || PyMemoryView_Check(o.ptr());
+  // (a memoryview of bytes too; one of numbers, a NumPy array's, is numbers)
+  bool bytes_like = py::isinstance<py::bytes>(o) || PyByteArray_Check(o.ptr());
+  if (PyMemoryView_Check(o.ptr())) {
+    const std::string format = py::str(o.attr("format"));
+    bytes_like = format == "B" || format == "b" || format == "c";
+  }
   if (!py::isinstance<py::sequence>(o) || py::isinstance<py::str>(o) || bytes_like) {
     if (py::isinstance<py::str>(o))
       throw py::value_error("expected a sequence of " + std::to_string(N) + " numbers, got " +

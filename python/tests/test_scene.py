@@ -369,6 +369,8 @@ def test_bad_field_values():
             m.albedo = raw
         with pytest.raises(TypeError, match="expected a sequence of 3 numbers"):
             lucent.Vec3(raw)
+    # a memoryview of numbers is numbers
+    assert tuple(lucent.Vec3(memoryview(np.array([1.0, 2.0, 3.0])))) == (1, 2, 3)
     with pytest.raises(TypeError):
         lucent.Film().width = "wide"
     with pytest.raises(TypeError):

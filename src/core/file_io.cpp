@@ -278,8 +278,11 @@ bool remove_if_unheld(const std::string& path) {
   int fd = ::open(path.c_str(), O_RDWR | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return false;
-  const bool removed =
-      ::flock(fd, LOCK_EX | LOCK_NB) == 0 && is_file_at(fd, path) && ::unlink(path.c_str()) == 0;
+  // (a FIFO or a device put there since the lstat is not removed either)
+  struct stat opened {};
+  const bool removed = ::fstat(fd, &opened) == 0 && S_ISREG(opened.st_mode) &&
+                       ::flock(fd, LOCK_EX | LOCK_NB) == 0 && is_file_at(fd, path) &&
+                       ::unlink(path.c_str()) == 0;
   ::close(fd);
   return removed;
 }

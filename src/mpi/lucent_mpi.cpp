@@ -178,7 +178,8 @@ class StopAgreement {
   /// `any_thread`: MPI may be called from a thread other than the main one, one at a time
   /// (MPI_THREAD_SERIALIZED): the progress callback of a render on several devices runs on the
   /// devices' threads (one at a time, under the session's lock); without it only the main
-  /// thread's callbacks poll, and a stop waits for the render's end.
+  /// thread's callbacks poll, and a rank rendering on several devices takes no part in the rounds
+  /// until its render ends: every round, and so a stop on any rank, waits for it.
   StopAgreement(bool rendering, bool any_thread)
       : any_thread_(any_thread), main_(std::this_thread::get_id()) {
     post(rendering);
