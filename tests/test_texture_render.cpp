@@ -80,4 +80,59 @@ TEST(TextureRender, TexturedObjQuadShowsTheImageUpright) {
   }
 }
 
+// A sphere shows its texture unmirrored, as an Earth map on a globe: the image's centre faces +z,
+// its top row the north pole, and u grows to the right seen from outside. It was mirrored left to
+// right (u = 0.5 + atan2(n.z, n.x) / 2 pi put u = 0.75 in front and grew to the left), in the
+// kernel and the reference alike, so that their comparison could not see it. The 8x8 texture of
+// 4x4 blocks (top-left red, top-right green, bottom-left blue, bottom-right grey) on a unit sphere
+// seen from +z: each quadrant of the sphere's disc shows its block.
+TEST(TextureRender, TexturedSphereShowsTheImageUnmirrored) {
+  std::string dir = lucent::test::temp_dir();
+  const unsigned char red[] = {255, 0, 0}, green[] = {0, 255, 0}, blue[] = {0, 0, 255},
+                      grey[] = {128, 128, 128};
+  std::vector<unsigned char> px;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      const unsigned char* c = y < 4 ? (x < 4 ? red : green) : (x < 4 ? blue : grey);
+      px.insert(px.end(), c, c + 3);
+    }
+  ASSERT_TRUE(stbi_write_png((dir + "/globe.png").c_str(), 8, 8, 3, px.data(), 24));
+  const std::string json = R"({
+    "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 30},
+    "film": {"width": 32, "height": 32},
+    "integrator": {"type": "albedo", "spp": 4},
+    "materials": {"t": {"type": "diffuse", "albedo": {"texture": ")" +
+                           dir + R"(/globe.png"}}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "t"}]
+  })";
+  lucent::test::write_file(dir + "/globe.json", json);
+  const lucent::RenderResult kernel = lucent::test::render_json(json, 4);
+  lucent::ReferenceOptions ro;
+  ro.spp = 4;
+  const lucent::RenderResult reference =
+      lucent::render_reference(lucent::load_scene(dir + "/globe.json"), ro);
+  // pixels (8, 8) and the like lie at n = (+-0.5, +-0.5, 0.7): u = 0.5 -+ 0.1, v = 0.5 +- 0.17,
+  // texels of one block each
+  struct Probe {
+    int x, y, channel;
+    const char* what;
+  };
+  const Probe probes[] = {{8, 8, 0, "top-left red"},
+                          {23, 8, 1, "top-right green"},
+                          {8, 23, 2, "bottom-left blue"},
+                          {23, 23, -1, "bottom-right grey"}};
+  for (const lucent::RenderResult* r : {&kernel, &reference})
+    for (const Probe& p : probes) {
+      const float* c = r->mean.pixel(p.x, p.y);
+      SCOPED_TRACE(std::string(p.what) + (r == &kernel ? " (kernel)" : " (reference)"));
+      if (p.channel < 0) {
+        EXPECT_NEAR(c[0], 0.2158605f, 1e-3);
+        EXPECT_NEAR(c[1], 0.2158605f, 1e-3);
+        EXPECT_NEAR(c[2], 0.2158605f, 1e-3);
+      } else {
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], k == p.channel ? 1.0f : 0.0f, 1e-3) << k;
+      }
+    }
+}
+
 }  // namespace

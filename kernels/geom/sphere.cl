@@ -50,11 +50,12 @@ static inline void sphere_interaction(const lc_scene* s, lc_ray ray, const lc_hi
   it->ng = n;
   float3 nf = lc_float3_from_real3(n);
   it->ns = nf;
-  /* equirectangular uv: u along longitude around +y, v from the south to the north pole; only
+  /* equirectangular uv: u along longitude around +y, eastward (to the right seen from outside,
+   * the image's centre at +z: atan2(z, x) mirrored it), v from the south to the north pole; only
    * textures read it (atan2 and asin cost ~8% of a scene of large untextured spheres) */
 #ifdef LC_HAS_TEXTURES
   if (sp->flags & LC_SPHERE_TEXTURED)
-    it->uv = (float2)(0.5f + atan2(nf.z, nf.x) * (0.5f * LC_INV_PI),
+    it->uv = (float2)(0.5f + atan2(nf.x, nf.z) * (0.5f * LC_INV_PI),
                       0.5f + asin(clamp(nf.y, -1.0f, 1.0f)) * LC_INV_PI);
 #endif
   it->material = sp->material;

@@ -49,7 +49,8 @@ void surface(const Scene& scene, int i, const Ray& ray, const Hit& hit, Surface&
   dvec3 n = glm::normalize(ray.o + hit.t * ray.d - sp.center);
   s.p = sp.center + sp.radius * n;
   s.ng = s.ns = n;
-  s.uv = dvec2(0.5 + std::atan2(n.z, n.x) / (2 * kPi),
+  // u eastward seen from outside, the image's centre at +z (docs/rendering-model.md)
+  s.uv = dvec2(0.5 + std::atan2(n.x, n.z) / (2 * kPi),
                0.5 + std::asin(std::clamp(n.y, -1.0, 1.0)) / kPi);
   s.material = sp.material;
   s.err = kSpawnOffset * (max_abs(sp.center) + sp.radius);  // as a triangle's (triangle.cpp)
