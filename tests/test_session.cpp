@@ -984,6 +984,48 @@ TEST(Session, SceneWithoutLightWarns) {
   EXPECT_EQ(warnings.all().size(), 0u) << warnings.dump();
 }
 
+// Whitted and direct light surfaces by point lights alone: a scene lit by an environment or by
+// emissive shapes rendered black but for what the camera sees emit, without a word (the visual
+// review: scenes/course.json with --integrator whitted, 4074 of 4096 pixels black). A warning
+// says so, from the session and the reference; none with a point light or for path.
+TEST(Session, WhittedAndDirectWithoutAPointLightWarn) {
+  Scene s = lucent::test::scene_from(kScene);
+  s.film.width = s.film.height = 2;
+  s.lights.front().type = lucent::LightType::Environment;
+  s.lights.front().radiance = glm::dvec3(1.0);
+  const std::string note =
+      " lights surfaces by point lights alone, and the scene has no point light that emits: its "
+      "emissive shapes and environment show only where seen, and its surfaces are black (path "
+      "lights them)";
+  Renderer r = full_kernel_session();
+  lucent::ReferenceOptions ro;
+  ro.spp = 1;
+  for (const auto type : {lucent::IntegratorType::Whitted, lucent::IntegratorType::Direct}) {
+    s.integrator.type = type;
+    const std::string name = type == lucent::IntegratorType::Whitted ? "whitted" : "direct";
+    {
+      lucent::test::CaptureWarnings warnings;
+      r.set_scene(s);
+      EXPECT_EQ(warnings.count("integrator " + name + note), 1) << warnings.dump();
+    }
+    lucent::test::CaptureWarnings warnings;
+    lucent::render_reference(s, ro);
+    EXPECT_EQ(warnings.count("integrator " + name + note), 1) << warnings.dump();
+  }
+  // with a point light that emits, or with path: nothing said
+  for (const bool point : {true, false}) {
+    Scene t = s;
+    if (point) {
+      t.lights.push_back(lucent::test::scene_from(kScene).lights.front());
+    } else {
+      t.integrator.type = lucent::IntegratorType::Path;
+    }
+    lucent::test::CaptureWarnings warnings;
+    r.set_scene(t);
+    EXPECT_EQ(warnings.count("point lights alone"), 0) << warnings.dump();
+  }
+}
+
 // An emission or environment radiance above sqrt(FLT_MAX) (about 1.84e19) makes samples whose
 // square overflows a float, which the kernel and the reference drop: the scene's first such
 // radiance is named before either renders (the lamp's pixels came out black, with a count of

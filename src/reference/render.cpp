@@ -41,6 +41,7 @@ RenderResult render_reference(const Scene& scene, const ReferenceOptions& option
   scene_detail::validate_scene(scene);  // fields set directly may not have been checked
   for (const std::string& note : scene_detail::energy_gain_notes(scene)) scene_detail::warn(note);
   for (const std::string& note : scene_detail::light_notes(scene)) scene_detail::warn(note);
+  for (const std::string& note : scene_detail::point_light_notes(scene)) scene_detail::warn(note);
   for (const std::string& note : scene_detail::radiance_notes(scene)) scene_detail::warn(note);
   const int W = scene.film.width, H = scene.film.height;
   if (W <= 0 || H <= 0) throw Error(scene.path + ": film size must be positive");

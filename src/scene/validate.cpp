@@ -574,6 +574,20 @@ std::vector<std::string> light_notes(const Scene& s) {
   return {};
 }
 
+std::vector<std::string> point_light_notes(const Scene& s) {
+  const IntegratorType t = s.integrator.type;
+  if (t != IntegratorType::Whitted && t != IntegratorType::Direct) return {};
+  if (!light_notes(s).empty()) return {};  // (no light at all: said there)
+  if (std::any_of(s.lights.begin(), s.lights.end(),
+                  [&s](const Light& l) { return l.type == LightType::Point && light_emits(s, l); }))
+    return {};
+  const std::string name = t == IntegratorType::Whitted ? "whitted" : "direct";
+  return {in_file(s.path, "integrator " + name +
+                              " lights surfaces by point lights alone, and the scene has no "
+                              "point light that emits: its emissive shapes and environment show "
+                              "only where seen, and its surfaces are black (path lights them)")};
+}
+
 std::vector<std::string> radiance_notes(const Scene& s) {
   const double most = std::sqrt(double(FLT_MAX));
   auto largest = [](const glm::dvec3& c) { return std::max({c.x, c.y, c.z}); };

@@ -151,6 +151,12 @@ std::vector<std::string> energy_gain_notes(const Scene& scene);
 /// integrators, which need no light. The session (pack_scene) and the reference give them.
 std::vector<std::string> light_notes(const Scene& scene);
 
+/// Whitted and direct light surfaces by point lights alone (docs/rendering-model.md): a scene lit
+/// otherwise (emissive shapes, an environment) rendered black but for what the camera sees emit,
+/// without a word (`scenes/course.json --integrator whitted`: 4074 pixels of 4096 black). A
+/// warning for such a scene with either integrator; none where light_notes gives one.
+std::vector<std::string> point_light_notes(const Scene& scene);
+
 /// The first emission or environment radiance (or a map's scale times its brightest texel) above
 /// sqrt(FLT_MAX), about 1.84e19,
 /// as a warning: the kernel and the reference drop a sample whose square overflows a float (the
