@@ -13,18 +13,25 @@
 
 namespace {
 
-TEST(TextureRender, TexturedObjQuadShowsTheImageUpright) {
-  std::string dir = lucent::test::temp_dir();
-  // 4x4 texture of 2x2 blocks: top-left red, top-right green, bottom-left blue, bottom-right grey
+/// A size x size PNG of four blocks: top-left red, top-right green, bottom-left blue, bottom-right
+/// grey (8-bit 128).
+bool write_block_png(const std::string& path, int size) {
   const unsigned char red[] = {255, 0, 0}, green[] = {0, 255, 0}, blue[] = {0, 0, 255},
                       grey[] = {128, 128, 128};
   std::vector<unsigned char> px;
-  for (int y = 0; y < 4; ++y)
-    for (int x = 0; x < 4; ++x) {
-      const unsigned char* c = y < 2 ? (x < 2 ? red : green) : (x < 2 ? blue : grey);
+  const int half = size / 2;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const unsigned char* c = y < half ? (x < half ? red : green) : (x < half ? blue : grey);
       px.insert(px.end(), c, c + 3);
     }
-  ASSERT_TRUE(stbi_write_png((dir + "/quad.png").c_str(), 4, 4, 3, px.data(), 12));
+  return stbi_write_png(path.c_str(), size, size, 3, px.data(), size * 3) != 0;
+}
+
+TEST(TextureRender, TexturedObjQuadShowsTheImageUpright) {
+  std::string dir = lucent::test::temp_dir();
+  // 4x4 texture of 2x2 blocks
+  ASSERT_TRUE(write_block_png(dir + "/quad.png", 4));
   lucent::test::write_file(dir + "/quad.mtl", "newmtl tex\nKd 1 1 1\nmap_Kd quad.png\n");
   lucent::test::write_file(dir + "/quad.obj",
                            "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
@@ -88,15 +95,7 @@ TEST(TextureRender, TexturedObjQuadShowsTheImageUpright) {
 // seen from +z: each quadrant of the sphere's disc shows its block.
 TEST(TextureRender, TexturedSphereShowsTheImageUnmirrored) {
   std::string dir = lucent::test::temp_dir();
-  const unsigned char red[] = {255, 0, 0}, green[] = {0, 255, 0}, blue[] = {0, 0, 255},
-                      grey[] = {128, 128, 128};
-  std::vector<unsigned char> px;
-  for (int y = 0; y < 8; ++y)
-    for (int x = 0; x < 8; ++x) {
-      const unsigned char* c = y < 4 ? (x < 4 ? red : green) : (x < 4 ? blue : grey);
-      px.insert(px.end(), c, c + 3);
-    }
-  ASSERT_TRUE(stbi_write_png((dir + "/globe.png").c_str(), 8, 8, 3, px.data(), 24));
+  ASSERT_TRUE(write_block_png(dir + "/globe.png", 8));
   const std::string json = R"({
     "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 30},
     "film": {"width": 32, "height": 32},
