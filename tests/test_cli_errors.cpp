@@ -110,7 +110,9 @@ TEST(CliErrors, WordsAfterTwoDashesAreArguments) {
       {"render " + q(scene) + " -o " + q(out) + " --bogus -- x", "unknown option --bogus"},
       // a piece of combined short flags is in argv in neither place
       {"render " + q(scene) + " -o " + q(out) + " -qZ", "unknown option -Z"},
-      {"render " + q(scene) + " -o " + q(out) + " -qZ -- x", "unknown option -Z"}};
+      {"render " + q(scene) + " -o " + q(out) + " -qZ -- x", "unknown option -Z"},
+      // a known option repeated after it is an argument there
+      {"render " + q(scene) + " -o " + q(out) + " -q -- -q", "unexpected argument -q after --"}};
   for (const auto& [args, message] : cases) {
     CommandResult r = run_cli(args);
     EXPECT_EQ(

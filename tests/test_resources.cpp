@@ -877,6 +877,15 @@ TEST(Resources, SessionCountsWhatTheApplicationReserves) {
               std::string::npos)
         << msg;
   }
+  {  // named as the application says (lucent render names its outputs by their options)
+    so.reserved_host_what = "writing o.exr and then each --aov image (64x64)";
+    lucent::Renderer r(so);
+    const std::string msg = error_of([&] { r.set_scene(s); });
+    EXPECT_NE(msg.find("the largest part is writing o.exr and then each --aov image (64x64) (10.0 "
+                       "MiB): reduce the film size"),
+              std::string::npos)
+        << msg;
+  }
   so.reserved_host_bytes = 1 << 20;
   lucent::Renderer r(so);
   EXPECT_EQ(error_of([&] { r.set_scene(s); }), "");

@@ -90,12 +90,12 @@ TEST(TextureRender, TexturedObjQuadShowsTheImageUpright) {
 // A sphere shows its texture unmirrored, as an Earth map on a globe: the image's centre faces +z,
 // its top row the north pole, and u grows to the right seen from outside. It was mirrored left to
 // right (u = 0.5 + atan2(n.z, n.x) / 2 pi put u = 0.75 in front and grew to the left), in the
-// kernel and the reference alike, so that their comparison could not see it. The 8x8 texture of
-// 4x4 blocks (top-left red, top-right green, bottom-left blue, bottom-right grey) on a unit sphere
+// kernel and the reference alike, so that their comparison could not see it. The 16x16 texture of
+// 8x8 blocks (top-left red, top-right green, bottom-left blue, bottom-right grey) on a unit sphere
 // seen from +z: each quadrant of the sphere's disc shows its block.
 TEST(TextureRender, TexturedSphereShowsTheImageUnmirrored) {
   std::string dir = lucent::test::temp_dir();
-  ASSERT_TRUE(write_block_png(dir + "/globe.png", 8));
+  ASSERT_TRUE(write_block_png(dir + "/globe.png", 16));
   const std::string json = R"({
     "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 30},
     "film": {"width": 32, "height": 32},
@@ -110,8 +110,9 @@ TEST(TextureRender, TexturedSphereShowsTheImageUnmirrored) {
   ro.spp = 4;
   const lucent::RenderResult reference =
       lucent::render_reference(lucent::load_scene(dir + "/globe.json"), ro);
-  // pixels (8, 8) and the like lie at n = (+-0.5, +-0.5, 0.7): u = 0.5 -+ 0.1, v = 0.5 +- 0.17,
-  // texels of one block each
+  // pixels (8, 8) and the like lie at n = (-+0.40, +-0.40, 0.83): u = 0.5 -+ 0.07, v = 0.5 +- 0.13,
+  // texel columns 6.4 (red) or 8.6 (green), rows 5.4 or 9.6: texels of one block each (the old u
+  // read column 14.1 in front of the camera, green, whichever side)
   struct Probe {
     int x, y, channel;
     const char* what;

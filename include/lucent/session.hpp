@@ -57,6 +57,9 @@ struct SessionOptions {
   /// render_adaptive refuse, before rendering, a film too large for the host's memory, so that a
   /// render is not lost to its write. `lucent render` declares its outputs here.
   std::uint64_t reserved_host_bytes = 0;
+  /// What reserved_host_bytes holds, for the error that refuses a film (empty: "what the
+  /// application keeps beside the session (its outputs, as it declared them)").
+  std::string reserved_host_what;
   /// Warnings of scene packing (skipped triangles, ...); null: "lucent: warning: ..." on stderr.
   /// A session gives each warning about its scenes once, however often set_scene meets it.
   WarningSink on_warning;

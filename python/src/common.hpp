@@ -334,11 +334,18 @@ V to_vec(py::handle o) {
   constexpr int N = V::length();
   if (py::isinstance<V>(o)) return o.cast<V>();
   // bytes are a sequence of integers: Vec3(b"abc") was (97, 98, 99)
-  // (a memoryview of bytes too; one of numbers, a NumPy array's, is numbers)
+  // (a memoryview of bytes too, ctypes' "<B" included; one of other numbers is numbers, and a
+  // released one is refused here rather than by the error of its format)
   bool bytes_like = py::isinstance<py::bytes>(o) || PyByteArray_Check(o.ptr());
   if (PyMemoryView_Check(o.ptr())) {
-    const std::string format = py::str(o.attr("format"));
-    bytes_like = format == "B" || format == "b" || format == "c";
+    try {
+      std::string format = py::str(o.attr("format"));
+      if (!format.empty() && std::string("@=<>!").find(format[0]) != std::string::npos)
+        format.erase(0, 1);
+      bytes_like = format == "B" || format == "b" || format == "c";
+    } catch (py::error_already_set&) {
+      bytes_like = true;
+    }
   }
   if (!py::isinstance<py::sequence>(o) || py::isinstance<py::str>(o) || bytes_like) {
     if (py::isinstance<py::str>(o))

@@ -369,8 +369,14 @@ def test_bad_field_values():
             m.albedo = raw
         with pytest.raises(TypeError, match="expected a sequence of 3 numbers"):
             lucent.Vec3(raw)
-    # a memoryview of numbers is numbers
+    # a memoryview of numbers is numbers; one of bytes (ctypes' "<B" too) or released is refused
     assert tuple(lucent.Vec3(memoryview(np.array([1.0, 2.0, 3.0])))) == (1, 2, 3)
+    import ctypes
+    released = memoryview(np.array([1.0, 2.0, 3.0]))
+    released.release()
+    for raw in (memoryview((ctypes.c_ubyte * 3)(1, 2, 3)), released):
+        with pytest.raises(TypeError, match="expected a sequence of 3 numbers"):
+            lucent.Vec3(raw)
     with pytest.raises(TypeError):
         lucent.Film().width = "wide"
     with pytest.raises(TypeError):

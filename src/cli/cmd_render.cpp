@@ -469,9 +469,9 @@ int render_with(const RenderArgs& a) {
     const std::uint64_t limit = lucent::render_detail::host_memory_allowed(&what);
     // (the outputs named as the command line gives them: the library's wording, "what the
     // application keeps beside the session", named no --aov)
-    std::vector<lucent::render_detail::MemoryPart> outputs;
-    if (memory.beside > 0) outputs.push_back({memory.beside_what, memory.beside, "the film size"});
-    lucent::render_detail::check_host_memory(scene, {}, limit, what, outputs, 1);
+    lucent::render_detail::check_host_memory(
+        scene, {}, limit, what,
+        lucent::render_detail::reserved_part(memory.beside, memory.beside_what), 1);
   }
   if (!memory.after.empty()) lucent::render_detail::check_output_host_memory(scene, memory.after);
 
@@ -492,6 +492,7 @@ int render_with(const RenderArgs& a) {
     so.fast_math = opt.fast_math;
     so.specialize = opt.specialize;
     so.reserved_host_bytes = memory.beside;
+    so.reserved_host_what = memory.beside_what;  // (the session's check names them the same)
     renderer.emplace(so);
     renderer->set_cancel_flag(&g_interrupted);
     auto interrupted_before_rendering = [&] {

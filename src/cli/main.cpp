@@ -118,17 +118,24 @@ int main(int argc, char** argv) {
     // A word after "--" is an argument, not an option: `render s.json -- -o a.png` said "unknown
     // option -o", and `render -o a.png -- s.json --spp 1` "unknown option --".
     const std::vector<std::string> extras = app.remaining(true);
-    // (a word given after "--" and not before it: a piece of combined short flags, "-Z" of
-    // "-qZ", is in argv in neither place, and is an unknown option)
+    // (a word given after "--" more often than before it: a piece of combined short flags, "-Z"
+    // of "-qZ", is in argv in neither place, and is an unknown option)
     char** const dashes = std::find_if(argv + 1, argv + argc,
                                        [](const char* w) { return std::strcmp(w, "--") == 0; });
+    // (and a known option left over: given before "--", it would have been read: `-q -- -q`)
     auto given = [](char** first, char** last, const std::string& word) {
-      return std::find_if(first, last, [&](const char* w) { return word == w; }) != last;
+      return std::count_if(first, last, [&](const char* w) { return word == w; });
+    };
+    auto known = [&app](const std::string& word) {
+      if (app.get_option_no_throw(word)) return true;
+      for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+        if (sub->get_option_no_throw(word)) return true;
+      return false;
     };
     for (const std::string& extra : extras) {
       if (extra == "--" || extra.size() < 2 || extra[0] != '-') continue;
-      if (dashes != argv + argc && given(dashes + 1, argv + argc, extra) &&
-          !given(argv + 1, dashes, extra)) {
+      if (dashes != argv + argc && given(dashes + 1, argv + argc, extra) > 0 &&
+          (known(extra) || given(argv + 1, dashes, extra) == 0)) {
         msg = "unexpected argument " + extra + " after -- (the words after -- are arguments)";
       } else {
         msg = "unknown option " + extra;

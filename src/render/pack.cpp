@@ -737,7 +737,9 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
   // a light-transport integrator with nothing that emits renders a black image: said, not
   // silently written
   for (const std::string& note : scene_detail::light_notes(scene)) scene_detail::warn(note);
-  for (const std::string& note : scene_detail::point_light_notes(scene)) scene_detail::warn(note);
+  // (not with every light skipped: "no light left", below, says more)
+  if (!p.lights.empty() || !scene.lights.empty())
+    for (const std::string& note : scene_detail::point_light_notes(scene)) scene_detail::warn(note);
   for (const std::string& note : scene_detail::radiance_notes(scene)) scene_detail::warn(note);
 
   // reserved: a large array's capacity is the block it holds (and a CPU device shares)

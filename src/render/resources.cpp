@@ -160,8 +160,9 @@ std::uint64_t description_bytes(const Scene& scene) {
   return b;
 }
 
-std::vector<MemoryPart> reserved_part(std::uint64_t reserved) {
+std::vector<MemoryPart> reserved_part(std::uint64_t reserved, const std::string& what) {
   if (reserved == 0) return {};
+  if (!what.empty()) return {{what, reserved, "the film size"}};
   // (lucent render declares its outputs, which the film size sets; a library caller's bytes may
   // be anything: "reduce the film size" blamed the film for them)
   return {{"what the application keeps beside the session (its outputs, as it declared them)",

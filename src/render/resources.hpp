@@ -126,7 +126,7 @@ std::vector<MemoryPart> estimate_host_memory(const Scene& scene,
 
 /// The application's part of an estimate: what it declared it holds beside the session
 /// (SessionOptions::reserved_host_bytes; none when 0).
-std::vector<MemoryPart> reserved_part(std::uint64_t reserved);
+std::vector<MemoryPart> reserved_part(std::uint64_t reserved, const std::string& what = "");
 
 /// Throws lucent::Error when the estimate, with `extra` parts, exceeds `host_limit` (0: no
 /// check), naming the largest part and the limit (80% of `limit_what`). Without `devices` (not

@@ -594,9 +594,10 @@ struct Renderer::Impl {
       scene_detail::validate_scene(s);  // fields set directly may not have been checked
       for (const std::string& note : scene_detail::energy_gain_notes(s)) scene_detail::warn(note);
       for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
-      render_detail::check_host_memory(s, limits, limits.front().host_mem, limits.front().host_what,
-                                       render_detail::reserved_part(options.reserved_host_bytes),
-                                       take ? 1 : 2);
+      render_detail::check_host_memory(
+          s, limits, limits.front().host_mem, limits.front().host_what,
+          render_detail::reserved_part(options.reserved_host_bytes, options.reserved_host_what),
+          take ? 1 : 2);
       for (const DeviceInfo& d : device_infos)
         render_detail::check_precision_support(d, options.precision);
       t0 = clock_type::now();
@@ -1246,7 +1247,8 @@ struct Renderer::Impl {
       for (auto& w : workers) limits.push_back(render_detail::DeviceLimits::of(w->ctx.device));
       render_detail::check_adaptive_host_memory(
           *scene, limits, (packed.params.flags & LC_FLAG_CAUSTICS) != 0, limits.front().host_mem,
-          limits.front().host_what, render_detail::reserved_part(options.reserved_host_bytes),
+          limits.front().host_what,
+          render_detail::reserved_part(options.reserved_host_bytes, options.reserved_host_what),
           scene_taken ? 1 : 2);
       adaptive = true;
       pilot = m;

@@ -585,7 +585,8 @@ std::vector<std::string> point_light_notes(const Scene& s) {
   return {in_file(s.path, "integrator " + name +
                               " lights surfaces by point lights alone, and the scene has no "
                               "point light that emits: its emissive shapes and environment show "
-                              "only where seen, and its surfaces are black (path lights them)")};
+                              "only where seen, and its non-specular surfaces are black (path "
+                              "lights them)")};
 }
 
 std::vector<std::string> radiance_notes(const Scene& s) {
