@@ -336,9 +336,9 @@ def mitsuba_scene(args, tmpdir):
     d["integrator"] = {"type": "path", "max_depth": args.max_depth}
     d["sensor"] = {
         "type": "perspective",
-        "fov": cam.get("fov", 60),
+        "fov": cam.get("fov", 45),  # (lucent's defaults: include/lucent/scene.hpp)
         "fov_axis": "y",
-        "to_world": mi.ScalarTransform4f().look_at(origin=cam.get("position", [0, 0, 55]),
+        "to_world": mi.ScalarTransform4f().look_at(origin=cam.get("position", [0, 0, 5]),
                                                    target=cam.get("look_at", [0, 0, 0]),
                                                    up=cam.get("up", [0, 1, 0])),
         "film": {"type": "hdrfilm", "width": w, "height": h, "rfilter": {"type": "box"},
