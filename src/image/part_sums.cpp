@@ -1,5 +1,6 @@
 #include "image/part_sums.hpp"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -48,9 +49,20 @@ bool sums_fit_float(double sum, double sumsq, double n) {
          std::isfinite(static_cast<float>(render_detail::sample_variance(sum, sumsq, n)));
 }
 
+void check_sums_fit_float(const std::string& name, int width, const std::vector<double>& sum,
+                          const std::vector<double>& sumsq,
+                          const std::vector<std::uint32_t>& count) {
+  const size_t w = static_cast<size_t>(std::max(width, 1));
+  for (size_t i = 0; i < sum.size() && i < sumsq.size() && i / 3 < count.size(); ++i)
+    if (!sums_fit_float(sum[i], sumsq[i], count[i / 3]))
+      throw Error(name + ": pixel " + std::to_string(i / 3 % w) + ", " + std::to_string(i / 3 / w) +
+                  ": its mean or sample variance is beyond a float's range (no render's is)");
+}
+
 void part_image(const std::string& name, int width, int height, const std::vector<double>& sum,
                 const std::vector<double>& sumsq, const std::vector<std::uint32_t>& count,
                 Image& mean, Image& variance) {
+  check_sums_fit_float(name, width, sum, sumsq, count);
   const size_t npix = static_cast<size_t>(width) * height;
   mean = Image{width, height, std::vector<float>(npix * 3)};
   variance = Image{width, height, std::vector<float>(npix * 3)};
@@ -58,10 +70,6 @@ void part_image(const std::string& name, int width, int height, const std::vecto
     const double n = count[i];
     for (int c = 0; c < 3; ++c) {
       const double s = sum[i * 3 + c], s2 = sumsq[i * 3 + c];
-      if (!sums_fit_float(s, s2, n))
-        throw Error(name + ": pixel " + std::to_string(i % width) + ", " +
-                    std::to_string(i / width) +
-                    ": its mean or sample variance is beyond a float's range (no render's is)");
       mean.rgb[i * 3 + c] = static_cast<float>(n > 0 ? s / n : 0);
       variance.rgb[i * 3 + c] = static_cast<float>(render_detail::sample_variance(s, s2, n));
     }
@@ -100,11 +108,7 @@ PartSums part_sums_from_channels(const ExrChannels& exr, const std::string& path
       sum->second != hex64(part_sums_checksum(p.sum, p.sumsq, p.count)))
     throw Error(path + ": part file is damaged: its samples do not match its checksum");
   // a mean or variance no render has, that a float image would show as infinite (a crafted file)
-  for (size_t i = 0; i < npix * 3; ++i)
-    if (!sums_fit_float(p.sum[i], p.sumsq[i], p.count[i / 3]))
-      throw Error(path + ": pixel " + std::to_string(i / 3 % exr.width) + ", " +
-                  std::to_string(i / 3 / exr.width) +
-                  ": its mean or sample variance is beyond a float's range (no render's is)");
+  check_sums_fit_float(path, exr.width, p.sum, p.sumsq, p.count);
   return p;
 }
 

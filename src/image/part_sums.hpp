@@ -35,6 +35,13 @@ struct PartSums {
 /// as non-finite); a crafted part's, or a merge of such parts, may not.
 bool sums_fit_float(double sum, double sumsq, double n);
 
+/// Throws lucent::Error "<name>: pixel X, Y: its mean or sample variance is beyond a float's
+/// range" for the first pixel-channel (of those the three vectors all hold) whose sums do not
+/// fit (sums_fit_float); rows of `width` pixels.
+void check_sums_fit_float(const std::string& name, int width, const std::vector<double>& sum,
+                          const std::vector<double>& sumsq,
+                          const std::vector<std::uint32_t>& count);
+
 /// A part's image from its sums: each pixel's mean and the variance of one of its samples, per
 /// channel, in floats (what part_result gives, read_render reads from a part file, and
 /// write_render_part's display channels hold). Throws lucent::Error naming `name` and the pixel

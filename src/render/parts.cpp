@@ -278,10 +278,7 @@ void check_part_contents(const std::string& name, const PartInfo& info, const Ac
     if (!std::isfinite(a.sum[i]) || !std::isfinite(a.sumsq[i]) || a.sumsq[i] < 0)
       throw Error(name + ": " + pixel_text(i / 3, std::max(a.width, 1)) +
                   " holds an invalid sum (not finite, or a negative sum of squares)");
-  for (size_t i = 0; i < a.sum.size() && i < a.sumsq.size() && i / 3 < a.count.size(); ++i)
-    if (!image_detail::sums_fit_float(a.sum[i], a.sumsq[i], a.count[i / 3]))
-      throw Error(name + ": " + pixel_text(i / 3, std::max(a.width, 1)) +
-                  ": its mean or sample variance is beyond a float's range (no render's is)");
+  image_detail::check_sums_fit_float(name, a.width, a.sum, a.sumsq, a.count);
 }
 
 }  // namespace
