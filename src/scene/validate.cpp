@@ -581,8 +581,7 @@ std::vector<std::string> point_light_notes(const Scene& s) {
   if (std::any_of(s.lights.begin(), s.lights.end(),
                   [&s](const Light& l) { return l.type == LightType::Point && light_emits(s, l); }))
     return {};
-  const std::string name = t == IntegratorType::Whitted ? "whitted" : "direct";
-  return {in_file(s.path, "integrator " + name +
+  return {in_file(s.path, std::string("integrator ") + type_name(t) +
                               " lights surfaces by point lights alone, and the scene has no "
                               "point light that emits: its emissive shapes and environment show "
                               "only where seen, and its non-specular surfaces are black (path "
