@@ -46,14 +46,10 @@ static inline lc_real3 frame_to_world_dir(const lc_frame* f, float3 v) {
 #endif
 }
 
-/* Unoccluded test from a spawned origin o towards a sampled light point (or direction) at
- * distance dist from o. Area lights are sampled from o itself, not from the surface point: the
- * offset of o is large on huge spheres (it scales with their float precision), and a direction
- * computed from the surface point would, seen from o, pass just inside a sphere light near its
- * silhouette. Point lights are sampled from the surface point (light/light.cl), and their
- * shadow rays go from o to the light (shadow_visible_to). */
-
-/* rel_margin: the light sample's (lc_light_sample.rel_margin, light/light.cl): how far short
+/* Unoccluded test from a spawned origin o along wi, up to distance dist from o (a sampled light
+ * point; INFINITY for an environment). Lights are sampled from the surface point
+ * (light/light.cl), and their shadow rays go from o to the sampled point (shadow_visible_sample).
+ * rel_margin: the light sample's (lc_light_sample.rel_margin, light/light.cl): how far short
  * of the sampled point, relative to dist, the ray stops. */
 static inline int shadow_visible(const lc_scene* s, lc_real3 o, lc_real3 wi, lc_real dist,
                                  lc_real rel_margin, lc_uint* rays) {
@@ -81,15 +77,18 @@ static inline int shadow_visible_to(const lc_scene* s, lc_real3 o, lc_real3 q, l
   return shadow_visible(s, o, to / dist, dist, rel_margin, rays);
 }
 
-/* Unoccluded test of a light sample drawn from the point `from` (the origin o in front of the
- * surface of `it`, or the surface point for a point light) whose direction passes behind the
- * surface (a transmitting BSDF): the shadow ray leaves from an origin behind the surface towards
- * the sampled point (or along the direction, for environments). */
-static inline int shadow_visible_behind(const lc_scene* s, const lc_interaction* it, lc_real3 from,
+/* Unoccluded test of light sample ls, drawn from the surface point p, from the shadow ray's origin
+ * o (in front of the surface, or behind it for a transmitting BSDF): towards the sampled point,
+ * up to where the light's own surface comes first (light_shadow_end), or along the direction
+ * for an environment. */
+static inline int shadow_visible_sample(const lc_scene* s, lc_real3 o, lc_real3 p,
                                         const lc_light_sample* ls, lc_uint* rays) {
-  lc_real3 ob = lc_spawn_origin(it->p, it->perr, -it->ng);
-  if (isinf(ls->dist)) return shadow_visible(s, ob, ls->wi, ls->dist, ls->rel_margin, rays);
-  return shadow_visible_to(s, ob, from + ls->dist * ls->wi, ls->rel_margin, rays);
+  if (isinf(ls->dist)) return shadow_visible(s, o, ls->wi, ls->dist, ls->rel_margin, rays);
+  lc_real3 to = p + ls->dist * ls->wi - o;
+  lc_real dist = sqrt(dot(to, to)); /* as the light files measure their samples' distances */
+  if (!(dist > LC_REAL(0.0))) return 0;
+  lc_real3 d = to / dist;
+  return shadow_visible(s, o, d, light_shadow_end(s, ls, o, d, dist), ls->rel_margin, rays);
 }
 
 /* Sum over point lights of f * cos * I / r^2 (direct and whitted integrators): f is the BSDF b,

@@ -95,13 +95,14 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
       float3 wo_l = frame_to_local(&fr, lc_float3_from_real3(-ray.d));
       if (wo_l.z <= 0.0f) break;
 
-      /* next-event estimation, from the origin that the shadow ray will use; a BSDF that transmits
-       * also takes light from behind the surface, with a shadow ray from an origin behind it */
+      /* next-event estimation: the light sampled from the surface point, the shadow ray from the
+       * origin o off the surface (the next ray's too); a BSDF that transmits also takes light
+       * from behind the surface, with a shadow ray from an origin behind it */
       lc_real3 o = lc_spawn_origin(it.p, it.perr, it.ng);
       lc_uint lobes = bsdf_lobes(&b);
       if (!(lobes & LC_BSDF_DELTA) && P->num_lights > 0) {
         lc_light_sample ls;
-        if (light_sample(s, it.p, o, it.light, u_light.z, u_light.x, u_light.y, u_bsdf.w, &ls) &&
+        if (light_sample(s, it.p, it.light, u_light.z, u_light.x, u_light.y, u_bsdf.w, &ls) &&
             ls.pdf > 0.0f) {
           int behind = !(dot(ls.wi, it.ng) > LC_REAL(0.0));
           float3 wi_l = frame_to_local(&fr, lc_float3_from_real3(ls.wi));
@@ -111,13 +112,11 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
               (behind ? wi_l.z < 0.0f : wi_l.z > 0.0f)) {
             float pdf_b;
             float3 f = bsdf_eval(&b, wo_l, wi_l, &pdf_b);
-            /* (a point light was sampled from it.p: the shadow ray goes from o to it) */
-            lc_real3 from = ls.delta ? it.p : o;
+            /* the light was sampled from it.p; the shadow ray leaves from o, or from behind the
+             * surface */
             if (lc_max3(f) > 0.0f &&
-                (behind ? shadow_visible_behind(s, &it, from, &ls, rays)
-                        : (ls.delta ? shadow_visible_to(s, o, from + ls.dist * ls.wi, ls.rel_margin,
-                                                        rays)
-                                    : shadow_visible(s, o, ls.wi, ls.dist, ls.rel_margin, rays)))) {
+                shadow_visible_sample(s, behind ? lc_spawn_origin(it.p, it.perr, -it.ng) : o, it.p,
+                                      &ls, rays)) {
               float w = (ls.delta || no_mis) ? 1.0f : mis_power(ls.pdf, pdf_b);
               L += path_clamp(beta * f * ls.L * (fabs(wi_l.z) * w / ls.pdf), P->clamp);
             }
@@ -151,7 +150,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
             lc_path_branch* w = &waiting[nwaiting++];
             w->o = t_transmit ? lc_spawn_origin(it.p, it.perr, -it.ng) : o;
             w->d = wt;
-            w->prev_p = o;
+            w->prev_p = it.p;
             w->beta = t_beta;
             w->depth = depth + 1;
             w->splits = splits;
@@ -174,7 +173,7 @@ static inline float3 integrator_path(const lc_scene* s, lc_ray ray, const lc_rng
       prev_delta = bs.delta;
       prev_pdf = bs.pdf;
       ray.o = transmit ? lc_spawn_origin(it.p, it.perr, -it.ng) : o;
-      prev_p = o; /* light pdfs for MIS are evaluated from where light sampling sampled */
+      prev_p = it.p; /* light pdfs for MIS are evaluated from where light sampling sampled */
       ray.d = wi;
       /* Russian roulette: survive with probability max(beta) while it is below 1, so the
        * throughput after the division never exceeds 1 (a cap such as min(0.95, max(beta)) makes

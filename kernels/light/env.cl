@@ -17,6 +17,12 @@ static inline float light_env_pdf(const lc_scene* s, __global const lc_light* L,
   return L->pdf_select * (0.25f * LC_INV_PI);
 }
 
+/* at infinity */ static inline lc_real light_env_shadow_end(const lc_scene* s,
+                                                             __global const lc_light* L, lc_real3 o,
+                                                             lc_real3 d, lc_real dist) {
+  return dist;
+}
+
 static inline float3 light_env_emitted(const lc_scene* s, __global const lc_light* L, float3 d) {
   return lc_load3(L->p.env.radiance);
 }

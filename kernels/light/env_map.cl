@@ -55,6 +55,13 @@ static inline float light_env_map_pdf(const lc_scene* s, __global const lc_light
   return L->pdf_select * (pr * (float)(tex->width * tex->height) / (2.0f * LC_PI * LC_PI * sin_t));
 }
 
+/* at infinity */ static inline lc_real light_env_map_shadow_end(const lc_scene* s,
+                                                                 __global const lc_light* L,
+                                                                 lc_real3 o, lc_real3 d,
+                                                                 lc_real dist) {
+  return dist;
+}
+
 static inline float3 light_env_map_emitted(const lc_scene* s, __global const lc_light* L,
                                            float3 d) {
   lc_uint texel;

@@ -11,6 +11,12 @@
  *                           lc_real dist, float cos_l)
  *            the solid-angle pdf (selection included) with which _sample from p produces the
  *            direction d meeting the light at distance dist with light-side cosine cos_l
+ *   lc_real light_<file>_shadow_end(const lc_scene* s, __global const lc_light* L, lc_real3 o,
+ *                                   lc_real3 d, lc_real dist)
+ *            where a shadow ray from o along d towards a sampled point at distance dist meets the
+ *            light's own surface first: dist, unless the light can hide its sampled point from o
+ *            (a sphere light: o lies off the surface point that sampled it, and from there a
+ *            point near the silhouette can be on the far side)
  *   float3 light_<file>_emitted(const lc_scene* s, __global const lc_light* L, float3 d)
  *            radiance of a ray escaping the scene in direction d (environments; 0 for others,
  *            whose emission is their material's)
@@ -46,6 +52,7 @@ typedef struct {
   lc_real rel_margin; /* how far short of dist, relative to it, the shadow ray stops:
                          LC_SHADOW_REL_MARGIN unless the light type knows better (0 for a
                          point light, which has no surface; a triangle light's own bound) */
+  lc_uint light;      /* the light sampled (light_shadow_end)                       */
 } lc_light_sample;
 
 /* Index i with cdf[i-1] <= u < cdf[i] over n entries (cdf[n-1] = 1): the number of entries
@@ -104,21 +111,20 @@ static inline float light_pdf(const lc_scene* s, lc_uint light, lc_real3 p, floa
 
 #define LC_LIGHT_SAMPLE(ID, Name, value, name, feature, file, params) \
   if (LC_ENABLED(feature) && L->type == LC_LIGHT_##ID)                \
-    return light_##file##_sample(s, L, LC_LIGHT_##ID == LC_LIGHT_POINT ? p : o, u1, u2, u3, ls);
-/* Chooses a light with us and samples it with u1, u2, u3: from the shading point p for a point
- * light, from o (p offset off the surface, the shadow ray's origin) for the others. A point
- * light has no surface, and measured from o its distance and direction were off by the offset,
- * which scales with a primitive's float precision: under a light at height 1 over a ground
- * sphere of radius 1e5 the lighting came out 32% too bright, and black at radius 1e6. An area
- * light is sampled from o: a direction from p, seen from o, could pass just inside a sphere
- * light near its silhouette (integrator/common.cl). p and o are the same point for a caller
- * without an offset. Choosing light `self` (the shading point's own emitter, LC_INVALID for
- * none) gives no sample: an emitter never lights its own surface (a sphere is convex, a triangle
- * flat), but sampled from o, just outside a sphere light that p lies on, its cone is almost a
- * hemisphere, and an emissive rough glass sphere took those samples through its own back face,
- * up to 25% too bright. */
-static inline int light_sample(const lc_scene* s, lc_real3 p, lc_real3 o, lc_uint self, float us,
-                               float u1, float u2, float u3, lc_light_sample* ls) {
+    return light_##file##_sample(s, L, p, u1, u2, u3, ls);
+/* Chooses a light with us and samples it with u1, u2, u3 from the shading point p itself (as
+ * pbrt-v4's LightSampleContext does), and the integrator's shadow ray goes from its offset origin
+ * to the sampled point (integrator/path.cl). Sampled from that origin instead, an area light lit
+ * the surface as it lights a point an offset above it: a relative bias of about
+ * offset (3 cos^2 phi - 1) / h for a light at height h and angle phi off the normal, +1% for a
+ * small lamp 0.01 over a floor of +-60 in float (RenderAnalytic.AreaLightsLightTheSurfacePoint),
+ * and a point light 32% too bright over a ground sphere of radius 1e5. Choosing light `self`
+ * (the shading point's own emitter, LC_INVALID for none) gives no sample: an emitter never
+ * lights its own surface (a sphere is convex, a triangle flat), and from a point on (or, by
+ * rounding, just outside) a sphere light its cone is almost a hemisphere: an emissive rough
+ * glass sphere took those samples through its own back face, up to 25% too bright. */
+static inline int light_sample(const lc_scene* s, lc_real3 p, lc_uint self, float us, float u1,
+                               float u2, float u3, lc_light_sample* ls) {
   __global const lc_params* P = s->params;
   if (P->num_lights == 0) return 0;
   lc_uint li = lc_cdf_search(s->light_cdf, P->num_lights, us);
@@ -126,10 +132,25 @@ static inline int light_sample(const lc_scene* s, lc_real3 p, lc_real3 o, lc_uin
   if (li == self) return 0;
   ls->delta = 0;
   ls->rel_margin = LC_SHADOW_REL_MARGIN;
+  ls->light = li;
   LC_LIGHT_TYPES(LC_LIGHT_SAMPLE)
   return 0;
 }
 #undef LC_LIGHT_SAMPLE
+
+#define LC_LIGHT_SHADOW_END(ID, Name, value, name, feature, file, params) \
+  if (LC_ENABLED(feature) && L->type == LC_LIGHT_##ID)                    \
+    return light_##file##_shadow_end(s, L, o, d, dist);
+/* How far a shadow ray from o along d may go towards the point of light sample ls at distance
+ * dist from o before it meets that light's own surface (integrator/common.cl,
+ * shadow_visible_sample). */
+static inline lc_real light_shadow_end(const lc_scene* s, const lc_light_sample* ls, lc_real3 o,
+                                       lc_real3 d, lc_real dist) {
+  __global const lc_light* L = &s->lights[ls->light];
+  LC_LIGHT_TYPES(LC_LIGHT_SHADOW_END)
+  return dist;
+}
+#undef LC_LIGHT_SHADOW_END
 
 #define LC_LIGHT_EMIT(ID, Name, value, name, feature, file, params) \
   if (LC_ENABLED(feature) && L->type == LC_LIGHT_##ID) ok = light_##file##_emit(s, L, u, ray, beta);

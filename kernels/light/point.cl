@@ -24,6 +24,13 @@ static inline float light_point_pdf(const lc_scene* s, __global const lc_light* 
   return 0.0f;
 }
 
+/* no surface */ static inline lc_real light_point_shadow_end(const lc_scene* s,
+                                                              __global const lc_light* L,
+                                                              lc_real3 o, lc_real3 d,
+                                                              lc_real dist) {
+  return dist;
+}
+
 static inline float3 light_point_emitted(const lc_scene* s, __global const lc_light* L, float3 d) {
   return (float3)(0.0f);
 }

@@ -77,6 +77,19 @@ static inline float light_sphere_pdf(const lc_scene* s, __global const lc_light*
   return L->pdf_select / (2.0f * LC_PI * one_minus);
 }
 
+/* The sphere's first point along the shadow ray. The sample's point q is on the part of the sphere
+ * that the surface point p sees, but the shadow ray leaves from o, off the surface, and from o a
+ * point near the silhouette seen from p can lie on the far side: the ray from o to q then enters
+ * the lamp before q and the lamp shadowed itself. Over a ground sphere of radius 3e5 (offsets of
+ * 0.1 in float) a lamp 2 above lit the floor 1.6% too dark, and with offsets above the lamp (radius
+ * 1e6) 73% too dark (RenderAnalytic.SphereLightOverAHugeGroundSphere). The shadow ray stops
+ * where it meets the lamp, found as traversal will find it. */
+static inline lc_real light_sphere_shadow_end(const lc_scene* s, __global const lc_light* L,
+                                              lc_real3 o, lc_real3 d, lc_real dist) {
+  __global const lc_sphere* sp = &s->spheres[L->p.sphere.sphere];
+  return fmin(dist, sphere_intersect(lc_load3r(sp->center), sp->radius, o, d, LC_REAL(0.0), dist));
+}
+
 static inline float3 light_sphere_emitted(const lc_scene* s, __global const lc_light* L, float3 d) {
   return (float3)(0.0f);
 }

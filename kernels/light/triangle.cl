@@ -39,6 +39,12 @@ static inline float light_triangle_pdf(const lc_scene* s, __global const lc_ligh
   return 0.0f;
 }
 
+/* flat: a segment from o to a point of it meets its plane there only */ static inline lc_real
+light_triangle_shadow_end(const lc_scene* s, __global const lc_light* L, lc_real3 o, lc_real3 d,
+                          lc_real dist) {
+  return dist;
+}
+
 static inline float3 light_triangle_emitted(const lc_scene* s, __global const lc_light* L,
                                             float3 d) {
   return (float3)(0.0f);

@@ -16,7 +16,7 @@ __kernel void probe_light_sample(LC_SCENE_KERNEL_ARGS, float4 p, __global float4
   lc_scene s = LC_SCENE_FROM_KERNEL_ARGS;
   lc_uint i = (lc_uint)get_global_id(0);
   lc_light_sample ls;
-  int ok = light_sample(&s, p.xyz, p.xyz, LC_INVALID, lc_rng_uniform(0u, i, 0u, 3u),
+  int ok = light_sample(&s, p.xyz, LC_INVALID, lc_rng_uniform(0u, i, 0u, 3u),
                         lc_rng_uniform(0u, i, 1u, 3u), lc_rng_uniform(0u, i, 2u, 3u),
                         lc_rng_uniform(0u, i, 3u, 3u), &ls);
   /* delta (point) lights have no density: reported as not produced */
@@ -30,7 +30,7 @@ __kernel void probe_light_sample_with(LC_SCENE_KERNEL_ARGS, float4 p, __global c
   lc_scene s = LC_SCENE_FROM_KERNEL_ARGS;
   size_t i = get_global_id(0);
   lc_light_sample ls;
-  int ok = light_sample(&s, p.xyz, p.xyz, LC_INVALID, u[i].x, u[i].y, u[i].z, u[i].w, &ls);
+  int ok = light_sample(&s, p.xyz, LC_INVALID, u[i].x, u[i].y, u[i].z, u[i].w, &ls);
   out[i] = ok && !ls.delta && ls.pdf > 0.0f ? (float4)(ls.wi, ls.pdf)
                                             : (float4)(0.0f, 0.0f, 0.0f, -1.0f);
 }
