@@ -64,6 +64,34 @@ TEST(RenderAnalytic, DiffusePlaneUnderPointLight) {
   EXPECT_EQ(r.nonfinite, 0u);
 }
 
+// The image mean of the plane z = 0 (albedo 0.6) seen by the camera of
+// PointLightOverAHugeGroundSphere (at (0, 0, 5), fov 20) under a point light of intensity I at
+// (0.7, 0.4, 2): the plane's radiance over the film, midpoint rule.
+double plane_under_point_light_mean(double I) {
+  const double albedo = 0.6, lx = 0.7, ly = 0.4, lz = 2.0;
+  const double t = std::tan(10.0 * M_PI / 180.0);
+  double expected = 0;
+  for (int j = 0; j < 256; ++j)
+    for (int i = 0; i < 256; ++i) {
+      double px = (2.0 * (i + 0.5) / 256 - 1) * t * 5.0, py = (1 - 2.0 * (j + 0.5) / 256) * t * 5.0;
+      double dx = lx - px, dy = ly - py, r2 = dx * dx + dy * dy + lz * lz;
+      expected += albedo / M_PI * I * (lz / std::sqrt(r2)) / r2;
+    }
+  return expected / (256 * 256);
+}
+
+// The 32x32 render of `scene` at spp has the image mean `expected` (red) within 1%, and no
+// non-finite sample.
+void expect_image_mean(const std::string& scene, int spp, double expected,
+                       const std::string& what) {
+  lucent::RenderResult r = lucent::test::render_json(scene, spp, false);
+  double sum = 0;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) sum += r.mean.pixel(x, y)[0];
+  EXPECT_NEAR(sum / 1024 / expected, 1.0, 0.01) << what;
+  EXPECT_EQ(r.nonfinite, 0u) << what;
+}
+
 // The plane above, but the top of a huge ground sphere (smallpt's walls are spheres of radius
 // 1e5), rendered by the path integrator. Float knows points of such a sphere only to about its
 // ulp (0.008 at 1e5), and the shadow ray's origin is pushed off the surface by 8 times that
@@ -73,16 +101,7 @@ TEST(RenderAnalytic, DiffusePlaneUnderPointLight) {
 // image to float's precision there: each pixel's radiance moves by up to about 1% with its
 // point's error, so the test is the image mean within 1% of the analytic one.
 TEST(RenderAnalytic, PointLightOverAHugeGroundSphere) {
-  const double albedo = 0.6, I = 50.0, lx = 0.7, ly = 0.4, lz = 2.0;
-  const double t = std::tan(10.0 * M_PI / 180.0);
-  double expected = 0;  // the image mean: the plane's radiance over the film, midpoint rule
-  for (int j = 0; j < 256; ++j)
-    for (int i = 0; i < 256; ++i) {
-      double px = (2.0 * (i + 0.5) / 256 - 1) * t * 5.0, py = (1 - 2.0 * (j + 0.5) / 256) * t * 5.0;
-      double dx = lx - px, dy = ly - py, r2 = dx * dx + dy * dy + lz * lz;
-      expected += albedo / M_PI * I * (lz / std::sqrt(r2)) / r2;
-    }
-  expected /= 256 * 256;
+  const double expected = plane_under_point_light_mean(50.0);
   for (const char* radius : {"1e5", "1e6"}) {
     const std::string scene = std::string(R"({
       "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 20},
@@ -93,12 +112,7 @@ TEST(RenderAnalytic, PointLightOverAHugeGroundSphere) {
                               radius + R"(], "radius": )" + radius + R"(, "material": "white"}],
       "lights": [{"type": "point", "position": [0.7, 0.4, 2.0], "intensity": [50, 50, 50]}]
     })";
-    lucent::RenderResult r = lucent::test::render_json(scene, 16, false);
-    double sum = 0;
-    for (int y = 0; y < 32; ++y)
-      for (int x = 0; x < 32; ++x) sum += r.mean.pixel(x, y)[0];
-    EXPECT_NEAR(sum / 1024 / expected, 1.0, 0.01) << "radius " << radius;
-    EXPECT_EQ(r.nonfinite, 0u);
+    expect_image_mean(scene, 16, expected, std::string("radius ") + radius);
   }
 }
 
@@ -112,16 +126,7 @@ TEST(RenderAnalytic, PointLightOverAHugeGroundSphere) {
 // mean is the plane's within 1%, as for the point light; the closed form is the point light's
 // (a sphere fully above the horizon lights a plane as a point of the same intensity).
 TEST(RenderAnalytic, SphereLightOverAHugeGroundSphere) {
-  const double albedo = 0.6, I = M_PI, lx = 0.7, ly = 0.4, lz = 2.0;
-  const double t = std::tan(10.0 * M_PI / 180.0);
-  double expected = 0;
-  for (int j = 0; j < 256; ++j)
-    for (int i = 0; i < 256; ++i) {
-      double px = (2.0 * (i + 0.5) / 256 - 1) * t * 5.0, py = (1 - 2.0 * (j + 0.5) / 256) * t * 5.0;
-      double dx = lx - px, dy = ly - py, r2 = dx * dx + dy * dy + lz * lz;
-      expected += albedo / M_PI * I * (lz / std::sqrt(r2)) / r2;
-    }
-  expected /= 256 * 256;
+  const double expected = plane_under_point_light_mean(M_PI);
   for (const char* radius : {"1e5", "3e5", "1e6"}) {
     const std::string scene = std::string(R"({
       "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 20},
@@ -133,12 +138,7 @@ TEST(RenderAnalytic, SphereLightOverAHugeGroundSphere) {
                  {"type": "sphere", "center": [0, 0, -)") +
                               radius + R"(], "radius": )" + radius + R"(, "material": "white"}]
     })";
-    lucent::RenderResult r = lucent::test::render_json(scene, 64, false);
-    double sum = 0;
-    for (int y = 0; y < 32; ++y)
-      for (int x = 0; x < 32; ++x) sum += r.mean.pixel(x, y)[0];
-    EXPECT_NEAR(sum / 1024 / expected, 1.0, 0.01) << "radius " << radius;
-    EXPECT_EQ(r.nonfinite, 0u);
+    expect_image_mean(scene, 64, expected, std::string("radius ") + radius);
   }
 }
 
