@@ -200,12 +200,11 @@ class StopAgreement {
   }
 
   /// After the render (also when it rendered nothing): takes part in the rounds until they end.
-  /// Returns whether they ended on a stop.
-  bool finish() {
+  /// (Which signal stopped which rank is agreed after it, by the ranks' own MPI_Allreduce.)
+  void finish() {
     while (!over_) {
       if (!step(/*rendering=*/false)) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
-    return stop_;
   }
 
  private:
