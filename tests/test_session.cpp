@@ -584,6 +584,27 @@ TEST(Session, DriverWithItsOwnCacheGetsNoEntries) {
   EXPECT_EQ(a.spp(), 1u);
 }
 
+// The one-shot render()'s sample budget: RenderOptions::spp 0 is the scene's integrator.spp, but
+// with a time limit alone the render goes on until the limit, as the CLI's --time without --spp
+// (the header said "the scene's" in both cases; a caller reading it got 84,153 spp in 1 s where
+// it expected 2). The timed render stops by its cancel flag once past the scene's count.
+TEST(Session, OneShotRenderWithATimeLimitAloneRendersUntilIt) {
+  Scene s = lucent::test::scene_from(kScene);
+  s.integrator.spp = 3;
+  lucent::RenderOptions o = lucent::test::render_options();
+  EXPECT_EQ(lucent::render(s, o).spp, 3u);
+  std::atomic<bool> cancel{false};
+  o.time_limit = 600;
+  o.cancel = &cancel;
+  o.on_progress = [&](const lucent::RenderProgress& p) {
+    EXPECT_EQ(p.samples_target, 0u);
+    if (p.samples_done > 3) cancel = true;
+  };
+  lucent::RenderResult r = lucent::render(s, o);
+  EXPECT_GT(r.spp, 3u);
+  EXPECT_TRUE(r.cancelled);
+}
+
 // Options out of range are errors, not defaults: a NaN pass duration made every pass 0 samples
 // long and render() never returned; a negative spp or a NaN target fell back to the scene's.
 TEST(Session, OptionsOutOfRangeAreErrors) {

@@ -44,12 +44,12 @@ using WarningSink = std::function<void(const std::string&)>;
 
 /// Options of the one-shot render() (a session's options, SessionOptions, plus the sample budget).
 struct RenderOptions {
-  std::string device;                         ///< selector, see select_device()
-  std::string kernel_dir;                     ///< "" : embedded kernel sources (see SessionOptions)
-  std::string cache_dir;                      ///< "" : the default cache directory; "off": none
-  WarningSink on_warning;                     ///< null: stderr
-  int spp = 0;                                ///< 0: the scene's integrator.spp
-  double time_limit = 0;                      ///< seconds; 0: none
+  std::string device;      ///< selector, see select_device()
+  std::string kernel_dir;  ///< "" : embedded kernel sources (see SessionOptions)
+  std::string cache_dir;   ///< "" : the default cache directory; "off": none
+  WarningSink on_warning;  ///< null: stderr
+  int spp = 0;             ///< 0: the scene's integrator.spp, or with a time_limit unbounded
+  double time_limit = 0;   ///< seconds; 0: none
   const std::atomic<bool>* cancel = nullptr;  ///< set to stop after the current pass
   std::function<void(const RenderProgress&)> on_progress;
   double pass_seconds = 0.25;  ///< target duration of one launch
@@ -140,8 +140,10 @@ struct RenderResult {
 std::string target_shortfall(const RenderResult& result);
 
 /// Renders `scene` with the OpenCL megakernel: a one-shot lucent::Renderer session
-/// (lucent/session.hpp) that stops at options.spp samples per pixel (0: the scene's) or after
-/// options.time_limit seconds, whichever comes first; with options.target_error, adaptively.
+/// (lucent/session.hpp) that stops at options.spp samples per pixel or after options.time_limit
+/// seconds, whichever comes first. options.spp 0 is the scene's integrator.spp without a time
+/// limit, and unbounded with one (as many samples as the time allows, as the CLI's --time without
+/// --spp). With options.target_error, adaptively.
 RenderResult render(const Scene& scene, const RenderOptions& options = {});
 
 }  // namespace lucent
