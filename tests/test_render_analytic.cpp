@@ -275,49 +275,86 @@ double polygon_irradiance(dvec3 p, const std::vector<dvec3>& verts, double L) {
   return std::abs(0.5 * L * sum);
 }
 
-// A small lamp 0.01 above a floor of +-60, and a pixel that sees the floor's point under it: the
-// floor's radiance there is albedo / pi times the closed-form irradiance, pi L sin^2(theta_max)
-// for a sphere of angular radius theta_max straight above, Lambert's polygon formula for a
-// square. The path integrator sampled area lights from the shadow ray's origin, which float
-// pushes off the floor by its rounding at 60 (about 3e-5), and lit the floor as the point that
-// far above it: +1.0% for both lamps (about 2 offset / height; docs/rendering-model.md,
-// "Precision"), with no warning. Sampled from the surface point, the image is the closed form to
-// within Sobol's noise at 4096 spp (about 1e-4 here): tolerance 2e-3, a fifth of the old bias.
+// Small lamps just above a floor of +-60, each seen by a pixel (1e-5 or less across) at the
+// floor's point under it: the floor's radiance there is albedo / pi times the closed-form
+// irradiance, pi L sin^2(theta_max) for a sphere of angular radius theta_max straight above,
+// Lambert's polygon formula for a square. Float pushes rays off the floor by its rounding at 60
+// (about 3e-5), and each case failed in float (double was right):
+// - a sphere of radius 0.003 and a square of side 0.001, both 0.01 up: +1.0% while lights were
+//   sampled from the pushed origin (the floor lit as the point that far above it);
+// - a square of side 0.006 at 0.003 (+1.4%) and one of 0.02 at 1e-4 (+0.5%): sampled from the
+//   floor's point, BSDF hits were MIS-weighted with the light's pdf at the distance from the
+//   pushed origin, so the two strategies' weights did not sum to 1;
+// - a sphere of radius 0.01 whose bottom is 3e-5 up (-57%) and a square of side 2e-4 at 2e-5
+//   (-83%): the pushed origin lies inside the sphere or above the square, where BSDF-sampled
+//   rays never reach their emitting side, but MIS still gave those rays their share.
+// Tolerances: a fifth of the old error or less, and 4-8 times the scatter of Sobol's estimate
+// over seeds at these spp (the last case, sampled by area under a lamp 10 times wider than
+// high, scatters by 3%).
 TEST(RenderAnalytic, AreaLightsLightTheSurfacePoint) {
-  const double h = 0.01, albedo = 0.5;
-  // the camera 0.02 from the floor's point at 36 degrees of elevation, a pixel 1e-5 across: the
-  // irradiance varies by ~1e-6 over it
-  const double e = 0.635, dist = 0.02;
-  const dvec3 cam = dist * dvec3(0.6 * std::cos(e), std::sin(e), 0.8 * std::cos(e));
-  const double fov = 2 * std::atan(0.5e-5 / dist) * 180 / M_PI;
-  const double half = 0.001 / 2;  // the square lamp's half side (0.1 h)
-  const std::vector<dvec3> square = {
-      {-half, h, -half}, {half, h, -half}, {half, h, half}, {-half, h, half}};
-  struct Lamp {
-    std::string name, shape;
-    double expected;
+  const double albedo = 0.5;
+  auto square = [](double side, double h) {
+    const double a = side / 2;
+    return std::vector<dvec3>{{-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}};
   };
-  const double r = h * std::sin(0.3);  // the sphere's radius: theta_max = 0.3
-  char sphere[256], quad[512];
-  std::snprintf(
-      sphere, sizeof sphere,
-      R"({"type": "sphere", "center": [0, %.17g, 0], "radius": %.17g, "material": "lamp"})", h, r);
-  // facing down: (v1 - v0) x (v2 - v0) along -y for the triangles (0, 1, 2) and (0, 2, 3)
-  std::snprintf(quad, sizeof quad,
-                R"({"type": "triangles", "material": "lamp", "indices": [0,1,2, 0,2,3],
-                    "positions": [[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],
-                                  [%.17g,%.17g,%.17g]]})",
-                square[0].x, square[0].y, square[0].z, square[1].x, square[1].y, square[1].z,
-                square[2].x, square[2].y, square[2].z, square[3].x, square[3].y, square[3].z);
-  const Lamp lamps[] = {
-      {"sphere", sphere, albedo * std::pow(std::sin(0.3), 2)},
-      {"square", quad, albedo / M_PI * polygon_irradiance(dvec3(0), square, 1.0)}};
-  for (const Lamp& lamp : lamps) {
+  auto square_json = [](const std::vector<dvec3>& v) {
+    // facing down: (v1 - v0) x (v2 - v0) along -y for the triangles (0, 1, 2) and (0, 2, 3)
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  R"({"type": "triangles", "material": "lamp", "indices": [0,1,2, 0,2,3],
+                      "positions": [[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],
+                                    [%.17g,%.17g,%.17g]]})",
+                  v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z, v[2].x, v[2].y, v[2].z, v[3].x,
+                  v[3].y, v[3].z);
+    return std::string(buf);
+  };
+  auto square_lamp = [&](double side, double h) {
+    return std::make_pair(square_json(square(side, h)),
+                          albedo / M_PI * polygon_irradiance(dvec3(0), square(side, h), 1.0));
+  };
+  auto sphere_lamp = [&](double r, double centre) {
+    char buf[256];
+    std::snprintf(
+        buf, sizeof buf,
+        R"({"type": "sphere", "center": [0, %.17g, 0], "radius": %.17g, "material": "lamp"})",
+        centre, r);
+    return std::make_pair(std::string(buf), albedo * (r / centre) * (r / centre));
+  };
+  struct Case {
+    std::string name;
+    std::pair<std::string, double> lamp;  // its shape, the expected radiance
+    dvec3 camera;
+    double fov;
+    int spp;
+    double tolerance;
+  };
+  // the first two: the camera 0.02 from the point at 36 degrees of elevation
+  const dvec3 at36 = 0.02 * dvec3(0.6 * std::cos(0.635), std::sin(0.635), 0.8 * std::cos(0.635));
+  const double fov36 = 2 * std::atan(0.5e-5 / 0.02) * 180 / M_PI;
+  const Case cases[] = {
+      {"sphere 0.003 at 0.01", sphere_lamp(0.01 * std::sin(0.3), 0.01), at36, fov36, 4096, 2e-3},
+      {"square 0.001 at 0.01", square_lamp(0.001, 0.01), at36, fov36, 4096, 2e-3},
+      {"square 0.006 at 0.003",
+       square_lamp(0.006, 0.003),
+       {0.02866, 0.014776, 0.038213},
+       0.0115,
+       65536,
+       5e-3},
+      {"square 0.02 at 1e-4", square_lamp(0.02, 1e-4), {0.001, 5e-5, 0.001}, 0.001, 16384, 2e-3},
+      {"sphere 0.01, 3e-5 above",
+       sphere_lamp(0.01, 0.01003),
+       {0.001, 1.5e-5, 0.001},
+       0.001,
+       16384,
+       1e-2},
+      {"square 2e-4 at 2e-5", square_lamp(2e-4, 2e-5), {1e-4, 5e-6, 1e-4}, 0.001, 65536, 0.12},
+  };
+  for (const Case& c : cases) {
     char camera[256];
     std::snprintf(camera, sizeof camera,
                   R"("camera": {"position": [%.17g, %.17g, %.17g], "look_at": [0, 0, 0],
                                 "up": [0, 1, 0], "fov": %.17g})",
-                  cam.x, cam.y, cam.z, fov);
+                  c.camera.x, c.camera.y, c.camera.z, c.fov);
     const std::string scene = std::string("{") + camera + R"(,
       "film": {"width": 1, "height": 1},
       "integrator": {"type": "path", "max_depth": 2},
@@ -325,10 +362,10 @@ TEST(RenderAnalytic, AreaLightsLightTheSurfacePoint) {
                     "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [1, 1, 1]}},
       "shapes": [{"type": "triangles", "material": "floor", "indices": [0,1,2, 0,2,3],
                   "positions": [[-60,0,-60],[-60,0,60],[60,0,60],[60,0,-60]]}, )" +
-                              lamp.shape + "]}";
-    lucent::RenderResult res = lucent::test::render_json(scene, 4096, false);
-    EXPECT_EQ(res.nonfinite, 0u);
-    EXPECT_NEAR(res.mean.pixel(0, 0)[1] / lamp.expected, 1.0, 2e-3) << lamp.name;
+                              c.lamp.first + "]}";
+    lucent::RenderResult res = lucent::test::render_json(scene, c.spp, false);
+    EXPECT_EQ(res.nonfinite, 0u) << c.name;
+    EXPECT_NEAR(res.mean.pixel(0, 0)[1] / c.lamp.second, 1.0, c.tolerance) << c.name;
   }
 }
 

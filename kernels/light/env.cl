@@ -23,6 +23,10 @@ static inline float light_env_pdf(const lc_scene* s, __global const lc_light* L,
   return dist;
 }
 
+static inline int light_env_seen_from(const lc_scene* s, __global const lc_light* L, lc_real3 o) {
+  return 1;
+}
+
 static inline float3 light_env_emitted(const lc_scene* s, __global const lc_light* L, float3 d) {
   return lc_load3(L->p.env.radiance);
 }

@@ -62,6 +62,11 @@ static inline float light_env_map_pdf(const lc_scene* s, __global const lc_light
   return dist;
 }
 
+static inline int light_env_map_seen_from(const lc_scene* s, __global const lc_light* L,
+                                          lc_real3 o) {
+  return 1;
+}
+
 static inline float3 light_env_map_emitted(const lc_scene* s, __global const lc_light* L,
                                            float3 d) {
   lc_uint texel;

@@ -10,13 +10,18 @@
  *   float  light_<file>_pdf(const lc_scene* s, __global const lc_light* L, lc_real3 p, float3 d,
  *                           lc_real dist, float cos_l)
  *            the solid-angle pdf (selection included) with which _sample from p produces the
- *            direction d meeting the light at distance dist with light-side cosine cos_l
+ *            direction d meeting the light at distance dist from p with light-side cosine cos_l
+ *            (dist 0: p is behind the light's plane, where _sample gives nothing)
  *   lc_real light_<file>_shadow_end(const lc_scene* s, __global const lc_light* L, lc_real3 o,
  *                                   lc_real3 d, lc_real dist)
  *            where a shadow ray from o along d towards a sampled point at distance dist meets the
  *            light's own surface first: dist, unless the light can hide its sampled point from o
  *            (a sphere light: o lies off the surface point that sampled it, and from there a
  *            point near the silhouette can be on the far side)
+ *   int    light_<file>_seen_from(const lc_scene* s, __global const lc_light* L, lc_real3 o)
+ *            whether a ray from o can meet the light's emitting side: 0 for o inside a sphere
+ *            light or not in front of a triangle light's plane (where a surface's offset origin
+ *            lands when the lamp nearly touches it), so BSDF sampling from o never reaches it
  *   float3 light_<file>_emitted(const lc_scene* s, __global const lc_light* L, float3 d)
  *            radiance of a ray escaping the scene in direction d (environments; 0 for others,
  *            whose emission is their material's)
@@ -137,6 +142,17 @@ static inline int light_sample(const lc_scene* s, lc_real3 p, lc_uint self, floa
   return 0;
 }
 #undef LC_LIGHT_SAMPLE
+
+#define LC_LIGHT_SEEN_FROM(ID, Name, value, name, feature, file, params) \
+  if (LC_ENABLED(feature) && L->type == LC_LIGHT_##ID) return light_##file##_seen_from(s, L, o);
+/* Whether BSDF-sampled rays from o can reach the emitting side of the light of sample ls
+ * (integrator/path.cl: if not, the light sample is the only strategy for that light). */
+static inline int light_seen_from(const lc_scene* s, const lc_light_sample* ls, lc_real3 o) {
+  __global const lc_light* L = &s->lights[ls->light];
+  LC_LIGHT_TYPES(LC_LIGHT_SEEN_FROM)
+  return 1;
+}
+#undef LC_LIGHT_SEEN_FROM
 
 #define LC_LIGHT_SHADOW_END(ID, Name, value, name, feature, file, params) \
   if (LC_ENABLED(feature) && L->type == LC_LIGHT_##ID)                    \

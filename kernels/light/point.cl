@@ -31,6 +31,10 @@ static inline float light_point_pdf(const lc_scene* s, __global const lc_light* 
   return dist;
 }
 
+static inline int light_point_seen_from(const lc_scene* s, __global const lc_light* L, lc_real3 o) {
+  return 1;
+}
+
 static inline float3 light_point_emitted(const lc_scene* s, __global const lc_light* L, float3 d) {
   return (float3)(0.0f);
 }

@@ -90,6 +90,15 @@ static inline lc_real light_sphere_shadow_end(const lc_scene* s, __global const 
   return fmin(dist, sphere_intersect(lc_load3r(sp->center), sp->radius, o, d, LC_REAL(0.0), dist));
 }
 
+/* from outside only: it emits outwards */
+static inline int light_sphere_seen_from(const lc_scene* s, __global const lc_light* L,
+                                         lc_real3 o) {
+  __global const lc_sphere* sp = &s->spheres[L->p.sphere.sphere];
+  lc_real3 d = o - lc_load3r(sp->center);
+  lc_real r = sp->radius;
+  return dot(d, d) > r * r;
+}
+
 static inline float3 light_sphere_emitted(const lc_scene* s, __global const lc_light* L, float3 d) {
   return (float3)(0.0f);
 }

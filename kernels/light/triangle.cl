@@ -45,6 +45,14 @@ light_triangle_shadow_end(const lc_scene* s, __global const lc_light* L, lc_real
   return dist;
 }
 
+/* one-sided: seen from the front of its plane only */
+static inline int light_triangle_seen_from(const lc_scene* s, __global const lc_light* L,
+                                           lc_real3 o) {
+  __global const lc_triangle* tri = &s->triangles[L->p.triangle.triangle];
+  lc_real3 v0 = lc_load3ra(tri->v0), v1 = lc_load3ra(tri->v1), v2 = lc_load3ra(tri->v2);
+  return dot(o - v0, triangle_normal(tri, v0, v1, v2)) > LC_REAL(0.0);
+}
+
 static inline float3 light_triangle_emitted(const lc_scene* s, __global const lc_light* L,
                                             float3 d) {
   return (float3)(0.0f);
