@@ -16,6 +16,8 @@
 #include "support/reorder.hpp"
 #include "support/test_meshes.hpp"
 
+namespace test_bvh_build {
+
 namespace {
 
 using lucent::bvh::BuildOptions;
@@ -407,3 +409,5 @@ TEST(BvhBuild, BoxWallsGetFlatLeaves) {
 }
 
 }  // namespace
+
+}  // namespace test_bvh_build

@@ -13,6 +13,8 @@
 #include "bvh/bvh.hpp"
 #include "support.hpp"
 
+namespace test_bvh_memory {
+
 namespace {
 
 /// `n` small separate triangles scattered in a box: leaves of one triangle, the most nodes and
@@ -59,3 +61,5 @@ TEST(BvhMemory, BuildPeakOfASoupIsNotTheBinaryTreeTwice) {
   // and the measure sees the tree: not a bound that anything passes
   EXPECT_GT(per_prim, 200.0) << per_prim << " bytes a primitive";
 }
+
+}  // namespace test_bvh_memory

@@ -34,6 +34,8 @@
 #include "support/device_tracer.hpp"
 #include "support/test_meshes.hpp"
 
+namespace test_bvh_trace {
+
 namespace {
 
 using lucent::bvh::Bvh;
@@ -791,3 +793,5 @@ TEST_F(BvhTrace, CoincidentTriangles) {
 }
 
 }  // namespace
+
+}  // namespace test_bvh_trace

@@ -17,6 +17,8 @@
 #include "support/reorder.hpp"
 #include "support/test_meshes.hpp"
 
+namespace test_bvh_wide {
+
 namespace {
 
 using lucent::bvh::BuildOptions;
@@ -517,3 +519,5 @@ TEST(BvhWide, BuildIsTheCollapseOfTheBinaryTreeBitForBit) {
 }
 
 }  // namespace
+
+}  // namespace test_bvh_wide

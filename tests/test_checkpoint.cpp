@@ -31,6 +31,8 @@
 #include "lucent/parts.hpp"
 #include "support.hpp"
 
+namespace test_checkpoint {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -803,3 +805,5 @@ TEST(Checkpoint, FailedOutputWriteKeepsTheSamplesInTheCheckpoint) {
 }
 
 }  // namespace
+
+}  // namespace test_checkpoint

@@ -16,6 +16,8 @@
 #include "lucent/compare.hpp"
 #include "support.hpp"
 
+namespace test_cli {
+
 namespace {
 
 using lucent::test::CommandResult;
@@ -414,3 +416,5 @@ TEST(Cli, ProgressLineOnATerminal) {
 }
 
 }  // namespace
+
+}  // namespace test_cli

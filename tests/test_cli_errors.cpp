@@ -13,6 +13,8 @@
 #include "lucent/device.hpp"
 #include "support.hpp"
 
+namespace test_cli_errors {
+
 namespace {
 
 using lucent::test::CommandResult;
@@ -742,3 +744,5 @@ TEST(CliErrors, WarningAndSummaryLinesShowControlCharactersEscaped) {
 }
 
 }  // namespace
+
+}  // namespace test_cli_errors

@@ -9,6 +9,8 @@
 #include "render/pack.hpp"
 #include "support.hpp"
 
+namespace test_cli_info {
+
 namespace {
 
 using lucent::test::CommandResult;
@@ -271,3 +273,5 @@ TEST(CliInfo, BadSceneIsOneErrorLine) {
 }
 
 }  // namespace
+
+}  // namespace test_cli_info

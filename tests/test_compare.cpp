@@ -14,6 +14,8 @@
 #include "render/resources.hpp"
 #include "support.hpp"
 
+namespace test_compare {
+
 namespace {
 
 using lucent::CompareOptions;
@@ -748,3 +750,5 @@ TEST(Compare, ZmapPathIsCheckedBeforeReading) {
 }
 
 }  // namespace
+
+}  // namespace test_compare

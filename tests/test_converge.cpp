@@ -30,6 +30,8 @@
 #include "render/converge_noise.hpp"
 #include "support.hpp"
 
+namespace test_converge {
+
 namespace {
 
 using lucent::ConvergeFit;
@@ -1510,3 +1512,5 @@ TEST(Converge, VerdictSaysWhereItIsWeak) {
   EXPECT_NE(many.fits[0].verdict.find(sobol), std::string::npos) << many.fits[0].verdict;
   EXPECT_EQ(many.fits[1].verdict.find(sobol), std::string::npos) << many.fits[1].verdict;
 }
+
+}  // namespace test_converge

@@ -16,6 +16,8 @@
 #include "lucent/session.hpp"
 #include "support.hpp"
 
+namespace test_devices {
+
 namespace {
 
 struct RawDevice {
@@ -338,3 +340,5 @@ TEST(Devices, CliRenderUsesTheSelectedDevice) {
 }
 
 }  // namespace
+
+}  // namespace test_devices

@@ -14,6 +14,8 @@
 #include "lucent/session.hpp"
 #include "support.hpp"
 
+namespace test_dielectric_splits {
+
 namespace {
 
 using lucent::RenderResult;
@@ -177,3 +179,5 @@ TEST(DielectricSplits, MostSplitsMatchTheReference) {
 }
 
 }  // namespace
+
+}  // namespace test_dielectric_splits

@@ -13,6 +13,8 @@
 #include "cl/program_cache.hpp"
 #include "support.hpp"
 
+namespace test_env {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -103,3 +105,5 @@ TEST(Env, CacheEntriesThatAreNotFilesAreRebuilt) {
 }
 
 }  // namespace
+
+}  // namespace test_env

@@ -10,6 +10,8 @@
 #include "render/pack.hpp"
 #include "support.hpp"
 
+namespace test_features {
+
 namespace {
 
 const char* kDiffuseScene = R"({
@@ -169,3 +171,5 @@ TEST(Features, SplittingOnlyWithSmoothGlass) {
 }
 
 }  // namespace
+
+}  // namespace test_features

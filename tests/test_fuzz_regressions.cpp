@@ -16,6 +16,8 @@
 #include "scene/loaders.hpp"
 #include "support.hpp"
 
+namespace test_fuzz_regressions {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -145,3 +147,5 @@ TEST(FuzzRegressions, EveryFoundInputIsRefusedWithOneLineOrLoads) {
 }
 
 }  // namespace
+
+}  // namespace test_fuzz_regressions

@@ -22,6 +22,8 @@
 #include "lucent/compare.hpp"
 #include "support.hpp"
 
+namespace test_image_io {
+
 namespace {
 
 using lucent::DisplaySettings;
@@ -664,3 +666,5 @@ TEST(ImageIo, GreyExrIsGreyAndOtherChannelsAreRefused) {
 }
 
 }  // namespace
+
+}  // namespace test_image_io

@@ -21,6 +21,8 @@
 #include "scene/loaders.hpp"
 #include "support.hpp"
 
+namespace test_image_limits {
+
 namespace {
 
 using lucent::scene_detail::decode_texture;
@@ -432,3 +434,5 @@ TEST(ImageLimits, OnePixelAndOneRowEnvironmentMapsAreConstantSkies) {
 }
 
 }  // namespace
+
+}  // namespace test_image_limits

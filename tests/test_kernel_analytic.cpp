@@ -15,6 +15,8 @@
 
 #include "support.hpp"
 
+namespace test_kernel_analytic {
+
 namespace {
 
 using lucent::RenderResult;
@@ -459,3 +461,5 @@ TEST(KernelAnalytic, EnvironmentMapOverPlane) {
 }
 
 }  // namespace
+
+}  // namespace test_kernel_analytic

@@ -20,6 +20,8 @@
 #include "shared/types.h"
 #include "support.hpp"
 
+namespace test_kernel_bsdf {
+
 namespace {
 
 struct Probe {
@@ -470,3 +472,5 @@ TEST(KernelBsdf, GgxEvalMatchesReferenceAtSmallRoughness) {
 }
 
 }  // namespace
+
+}  // namespace test_kernel_bsdf

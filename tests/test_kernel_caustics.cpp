@@ -17,6 +17,8 @@
 #include "lucent/session.hpp"
 #include "support.hpp"
 
+namespace test_kernel_caustics {
+
 namespace {
 
 // The diffuse plane z = 0 of test_render_analytic.cpp seen straight on, lit by a point light at
@@ -494,3 +496,5 @@ TEST(KernelCaustics, LightMeanVariancePixelsIsWhatCompareReadsOfTheVarianceLayer
 }
 
 }  // namespace
+
+}  // namespace test_kernel_caustics

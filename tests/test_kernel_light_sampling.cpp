@@ -15,6 +15,8 @@
 #include "render/pack.hpp"
 #include "support.hpp"
 
+namespace test_kernel_light_sampling {
+
 namespace {
 
 struct Probe {
@@ -379,3 +381,5 @@ TEST(KernelLightSampling, CdfSearchPicksTheIntervalOfU) {
   EXPECT_GT(checked, 10000u);
 }
 }  // namespace
+
+}  // namespace test_kernel_light_sampling

@@ -21,6 +21,8 @@
 #include "render/features.hpp"
 #include "support.hpp"
 
+namespace test_kernel_source {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -392,3 +394,5 @@ TEST(KernelSource, PhysicalLinePlacesMapThroughLineMarkers) {
 }
 
 }  // namespace
+
+}  // namespace test_kernel_source

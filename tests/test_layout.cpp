@@ -14,6 +14,8 @@
 #include "shared/types.h"
 #include "support.hpp"
 
+namespace test_layout {
+
 namespace {
 
 struct Entry {
@@ -98,3 +100,5 @@ TEST(Layout, ProbeListCoversEveryField) {
 }
 
 }  // namespace
+
+}  // namespace test_layout

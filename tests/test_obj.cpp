@@ -22,6 +22,8 @@
 #include "scene/obj_internal.hpp"
 #include "support.hpp"
 
+namespace test_obj {
+
 namespace {
 
 using lucent::Material;
@@ -1369,3 +1371,9 @@ TEST(Obj, MeshesAppendToTheScene) {
 }
 
 }  // namespace
+
+}  // namespace test_obj
+
+// (the next file of its unity batch may define its own)
+#undef EXPECT_COLOUR
+#undef EXPECT_WARNED_ONCE

@@ -12,6 +12,8 @@
 #include "scene/loaders.hpp"
 #include "support.hpp"
 
+namespace test_obj_assets {
+
 namespace {
 
 using lucent::Scene;
@@ -156,3 +158,5 @@ TEST(ObjAssets, ProjectScenesLoad) {
 }
 
 }  // namespace
+
+}  // namespace test_obj_assets

@@ -12,6 +12,8 @@
 #include "scene/obj_internal.hpp"
 #include "support.hpp"
 
+namespace test_obj_memory {
+
 namespace {
 
 /// The peak resident memory that load_scene(`scene`) adds, in bytes, measured in a child process,
@@ -48,3 +50,5 @@ TEST(ObjMemory, PeakOfALargeMeshIsWithinTheLoadersCount) {
   EXPECT_GE(peak, 0.6 * count) << "peak " << peak / mib << " MiB, counted " << count / mib
                                << " MiB";
 }
+
+}  // namespace test_obj_memory

@@ -16,6 +16,8 @@
 #include "scene/loaders.hpp"
 #include "support.hpp"
 
+namespace test_obj_validation {
+
 namespace {
 
 using lucent::Scene;
@@ -344,3 +346,5 @@ TEST(ObjValidation, FilesThatAreNotRegularAreRefused) {
 }
 
 }  // namespace
+
+}  // namespace test_obj_validation

@@ -31,6 +31,8 @@
 #include "scene/validate.hpp"
 #include "support.hpp"
 
+namespace test_outputs {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -1147,3 +1149,5 @@ TEST(Outputs, SigintStopsTheReferenceWithinAPixel) {
 }
 
 }  // namespace
+
+}  // namespace test_outputs

@@ -9,6 +9,8 @@
 #include "render/pack.hpp"
 #include "support.hpp"
 
+namespace test_pack_triangles {
+
 namespace {
 
 using lucent::render_detail::set_triangle_normal;
@@ -111,3 +113,5 @@ TEST(PackTriangles, PackSceneSetsEveryNormal) {
 }
 
 }  // namespace
+
+}  // namespace test_pack_triangles

@@ -33,6 +33,8 @@
 #include "render/resources.hpp"
 #include "support.hpp"
 
+namespace test_parts {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -2264,3 +2266,5 @@ TEST(Parts, MpiTwoRanksRenderTheOneProcessImage) {
 #endif
 
 }  // namespace
+
+}  // namespace test_parts

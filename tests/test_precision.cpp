@@ -26,6 +26,8 @@
 #include "stability_scene.hpp"
 #include "support.hpp"
 
+namespace test_precision {
+
 namespace {
 
 using glm::dvec3;
@@ -367,3 +369,9 @@ TEST(PrecisionTranslateScene, DoubleAt1e5MatchesTheStoredSceneAtOrigin) {
 }
 
 }  // namespace
+
+}  // namespace test_precision
+
+// (the next file of its unity batch may define its own)
+#undef REQUIRE_FP64
+#undef EXPECT_SAME_IMAGE

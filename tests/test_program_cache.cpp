@@ -21,6 +21,8 @@
 #include "cl/program_cache.hpp"
 #include "support.hpp"
 
+namespace test_program_cache {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -612,3 +614,5 @@ TEST(ProgramCache, AClearThatCannotRemoveAnEntryFails) {
 }
 
 }  // namespace
+
+}  // namespace test_program_cache

@@ -20,6 +20,8 @@
 #include "cl/program_cache.hpp"
 #include "support.hpp"
 
+namespace test_program_cache_lock {
+
 namespace {
 
 using lucent::cl_util::ProgramBuildInfo;
@@ -187,3 +189,5 @@ TEST(ProgramCacheLock, EvictionsRacingLoadsCostRebuilds) {
 }
 
 }  // namespace
+
+}  // namespace test_program_cache_lock

@@ -17,6 +17,8 @@
 #include "reference/bsdf/parts.hpp"
 #include "support.hpp"
 
+namespace test_reference_analytic {
+
 namespace {
 
 using lucent::RenderResult;
@@ -444,3 +446,5 @@ TEST(ReferenceAnalytic, AovsOnAPlane) {
 }
 
 }  // namespace
+
+}  // namespace test_reference_analytic

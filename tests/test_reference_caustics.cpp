@@ -17,6 +17,8 @@
 #include "lucent/reference.hpp"
 #include "support.hpp"
 
+namespace test_reference_caustics {
+
 namespace {
 
 using glm::dvec3;
@@ -459,3 +461,5 @@ TEST(ReferenceCaustics, ImageMeanZOfRendersDifferingInSeedIsStandardNormal) {
 }
 
 }  // namespace
+
+}  // namespace test_reference_caustics

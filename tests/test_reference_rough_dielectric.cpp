@@ -17,6 +17,8 @@
 #include "reference/bsdf/bsdf.hpp"
 #include "support.hpp"
 
+namespace test_reference_rough_dielectric {
+
 namespace {
 
 using glm::dvec3;
@@ -337,3 +339,5 @@ TEST(ReferenceRoughDielectric, WhittedAndAlbedoAsTheSmoothDielectric) {
 }
 
 }  // namespace
+
+}  // namespace test_reference_rough_dielectric

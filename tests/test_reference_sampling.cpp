@@ -17,6 +17,8 @@
 #include "reference/light/light.hpp"
 #include "support.hpp"
 
+namespace test_reference_sampling {
+
 namespace {
 
 using glm::dvec3;
@@ -413,3 +415,5 @@ TEST(ReferenceSampling, UniformMixture) {
 }
 
 }  // namespace
+
+}  // namespace test_reference_sampling

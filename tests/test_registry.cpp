@@ -15,6 +15,8 @@
 #include "lucent/lucent.hpp"
 #include "support.hpp"
 
+namespace test_registry {
+
 namespace {
 
 using lucent::TypeEntry;
@@ -239,3 +241,5 @@ TEST(Registry, NameLookups) {
 }
 
 }  // namespace
+
+}  // namespace test_registry

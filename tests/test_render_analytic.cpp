@@ -12,6 +12,8 @@
 #include "lucent/reference.hpp"
 #include "support.hpp"
 
+namespace test_render_analytic {
+
 namespace {
 
 using glm::dvec3;
@@ -492,3 +494,5 @@ TEST(RenderAnalytic, SkyTexelsLightSamplingNeverPicksAreLitWithoutMis) {
 }
 
 }  // namespace
+
+}  // namespace test_render_analytic

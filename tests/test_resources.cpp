@@ -30,6 +30,8 @@
 #include "scene/json_guard.hpp"
 #include "support.hpp"
 
+namespace test_resources {
+
 namespace {
 
 using lucent::Scene;
@@ -1145,3 +1147,5 @@ TEST(Resources, TexelsBeyondTheKernelsOffsetsAreRefused) {
             "t.json: the textures hold 4900000000 texels, more than the kernel's 32-bit texel "
             "offsets reach (4294967295): reduce the textures' resolution");
 }
+
+}  // namespace test_resources

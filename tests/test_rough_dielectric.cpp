@@ -12,6 +12,8 @@
 #include "lucent/reference.hpp"
 #include "support.hpp"
 
+namespace test_rough_dielectric {
+
 namespace {
 
 using lucent::RenderResult;
@@ -130,3 +132,5 @@ TEST(RoughDielectric, KernelMatchesReference) {
 }
 
 }  // namespace
+
+}  // namespace test_rough_dielectric

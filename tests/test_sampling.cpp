@@ -26,6 +26,8 @@
 #include "shared/rng.h"
 #include "support.hpp"
 
+namespace test_sampling {
+
 namespace {
 
 using lucent::RenderResult;
@@ -1052,3 +1054,5 @@ TEST(Clamp, KernelMatchesReferenceAndTheBiasIsVisible) {
 }
 
 }  // namespace
+
+}  // namespace test_sampling

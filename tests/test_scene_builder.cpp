@@ -18,6 +18,8 @@
 #include "lucent/reference.hpp"
 #include "support.hpp"
 
+namespace test_scene_builder {
+
 namespace {
 
 using lucent::SceneBuilder;
@@ -841,3 +843,5 @@ TEST(SceneBuilder, EqualsTheSameSceneFromJson) {
 }
 
 }  // namespace
+
+}  // namespace test_scene_builder

@@ -17,6 +17,8 @@
 #include "scene/validate.hpp"
 #include "support.hpp"
 
+namespace test_scene_guard {
+
 namespace {
 
 using lucent::test::CommandResult;
@@ -306,3 +308,5 @@ TEST(SceneGuard, AValueJustPastItsLimitIsShownAsGiven) {
             std::string::npos);
 }
 }  // namespace
+
+}  // namespace test_scene_guard

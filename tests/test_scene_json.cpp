@@ -15,6 +15,8 @@
 #include "scene/validate.hpp"
 #include "support.hpp"
 
+namespace test_scene_json {
+
 namespace {
 
 using lucent::Scene;
@@ -869,3 +871,8 @@ TEST(SceneJson, DefaultsWhenKeysAreLeftOut) {
 }
 
 }  // namespace
+
+}  // namespace test_scene_json
+
+// (the next file of its unity batch may define its own)
+#undef EXPECT_STARTS_WITH

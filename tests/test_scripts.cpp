@@ -13,6 +13,8 @@
 
 #include "support.hpp"
 
+namespace test_scripts {
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -307,3 +309,5 @@ TEST(BenchScripts, IntelCpuCachesAreInTheBuildDirectory) {
   // its ICD directory is removed (one was left in TMPDIR per run)
   EXPECT_TRUE(fs::is_empty(dir + "/tmp"));
 }
+
+}  // namespace test_scripts

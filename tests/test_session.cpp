@@ -31,6 +31,8 @@
 #include "support.hpp"
 #include "support/test_meshes.hpp"
 
+namespace test_session {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -1945,3 +1947,5 @@ TEST(Session, TheProcesssSignalHandlersStayItsOwn) {
     EXPECT_EQ(now.sa_flags & (SA_RESETHAND | SA_NODEFER), 0) << signals[i];
   }
 }
+
+}  // namespace test_session

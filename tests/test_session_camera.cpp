@@ -18,6 +18,8 @@
 #include "render/resources.hpp"
 #include "support.hpp"
 
+namespace test_session_camera {
+
 namespace {
 
 using lucent::Camera;
@@ -348,3 +350,5 @@ TEST(SessionCamera, MoveDropsAnAdaptiveRender) {
 }
 
 }  // namespace
+
+}  // namespace test_session_camera

@@ -32,6 +32,8 @@
 #include "stability_scene.hpp"
 #include "support.hpp"
 
+namespace test_stability_scene {
+
 namespace {
 
 using glm::dvec3;
@@ -563,3 +565,9 @@ TEST(StabilityDepth, ClosedBoxAlbedo099RussianRouletteStaysFinite) {
 }
 
 }  // namespace
+
+}  // namespace test_stability_scene
+
+// (the next file of its unity batch may define its own)
+#undef EXPECT_CLEAN
+#undef EXPECT_SAME_IMAGE

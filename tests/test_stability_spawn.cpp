@@ -21,6 +21,8 @@
 #include "shared/types.h"
 #include "support.hpp"
 
+namespace test_stability_spawn {
+
 namespace {
 
 struct SpawnProbe {
@@ -220,3 +222,5 @@ INSTANTIATE_TEST_SUITE_P(Magnitudes, StabilitySpawnDouble,
                          });
 
 }  // namespace
+
+}  // namespace test_stability_spawn

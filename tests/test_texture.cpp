@@ -15,6 +15,8 @@
 #include "scene/loaders.hpp"
 #include "support.hpp"
 
+namespace test_texture {
+
 namespace {
 
 using lucent::Scene;
@@ -180,3 +182,5 @@ TEST(Texture, ErrorsNameTheFile) {
 }
 
 }  // namespace
+
+}  // namespace test_texture

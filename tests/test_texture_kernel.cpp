@@ -16,6 +16,8 @@
 #include "render/pack.hpp"
 #include "support.hpp"
 
+namespace test_texture_kernel {
+
 namespace {
 
 struct Probe {
@@ -238,3 +240,5 @@ TEST(TextureKernel, ReferenceLookupMatchesTheKernelAtNonFiniteUvs) {
   const glm::dvec3 at_zero = lucent::ref::texture_rgb(s.textures[1], {0.0, 0.3});
   for (int c = 0; c < 3; ++c) EXPECT_EQ(at_nan[c], at_zero[c]);
 }
+
+}  // namespace test_texture_kernel

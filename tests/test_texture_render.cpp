@@ -11,6 +11,8 @@
 #include "lucent/lucent.hpp"
 #include "support.hpp"
 
+namespace test_texture_render {
+
 namespace {
 
 /// A size x size PNG of four blocks: top-left red, top-right green, bottom-left blue, bottom-right
@@ -136,3 +138,5 @@ TEST(TextureRender, TexturedSphereShowsTheImageUnmirrored) {
 }
 
 }  // namespace
+
+}  // namespace test_texture_render
