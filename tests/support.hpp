@@ -36,6 +36,10 @@ constexpr bool kAddressSanitizer = false;
 /// assignments placed before the command (e.g. "LUCENT_DEVICE=foo").
 CommandResult run_cli(const std::string& args, const std::string& env = "");
 
+/// The environment assignment under which `lucent render` prints its progress line from its
+/// first pass, and `lucent-mpi` (rank 0) once every rank has rendered a pass, not after a second of
+/// rendering: the stop-signal tests wait for that line before their signal (docs/testing.md).
+inline constexpr char kEarlyProgress[] = "LUCENT_TEST_EARLY_PROGRESS=1";
 /// A fresh directory under the build tree, removed at the end of the test program.
 std::string temp_dir();
 /// Writes the kernel sources this build embeds into a fresh directory and returns it (for

@@ -362,12 +362,12 @@ TEST(Checkpoint, SigtermKeepsTheCheckpoint) {
   const std::string dir = lucent::test::temp_dir();
   const std::string scene = noisy_scene(dir);
   const std::string ck = dir + "/ck.exr", out = dir + "/out.exr", err = dir + "/err";
-  // SIGTERM once the progress line shows the render loop running
-  const std::string script = "'" + std::string(LUCENT_CLI_PATH) + "' render " + q(scene) +
-                             " --spp 16000000 -o " + q(out) + " --checkpoint " + q(ck) + " 2>" +
-                             q(err) + " </dev/null & pid=$!; for i in $(seq 600); do grep -q " +
-                             "Msamples/s " + q(err) + " && break; sleep 0.1; done; kill -TERM " +
-                             "$pid; wait $pid";
+  // SIGTERM once the progress line shows the render loop running (from its first pass)
+  const std::string script =
+      std::string(lucent::test::kEarlyProgress) + " '" + std::string(LUCENT_CLI_PATH) +
+      "' render " + q(scene) + " --spp 16000000 -o " + q(out) + " --checkpoint " + q(ck) + " 2>" +
+      q(err) + " </dev/null & pid=$!; for i in $(seq 600); do grep -q " + "Msamples/s " + q(err) +
+      " && break; sleep 0.1; done; kill -TERM " + "$pid; wait $pid";
   const int raw = std::system(("bash -c " + q(script)).c_str());
   const std::string text = lucent::test::read_file(err);
   ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 143) << text;

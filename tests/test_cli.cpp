@@ -361,6 +361,25 @@ TEST(Cli, ProgressLineAndTimeLimit) {
       << r.err;
 }
 
+// A render shorter than a second prints no progress line; under LUCENT_TEST_EARLY_PROGRESS=1 (the
+// stop-signal tests' sign that the render loop runs, kEarlyProgress) it does from its first pass.
+TEST(Cli, ProgressLineFromTheFirstPassForTheStopSignalTests) {
+  const std::string scene = plane_scene(0, 4);
+  const std::string out = lucent::test::temp_dir() + "/o.png";
+  const std::regex progress(R"(^ *\d+\.\d%  \d+ spp  \d+\.\d\d Msamples/s  elapsed )");
+  CommandResult r = run_cli("render " + q(scene) + " -o " + q(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> lines = lines_of(r.err);
+  ASSERT_EQ(lines.size(), 1u) << r.err;
+  EXPECT_EQ(lines[0].rfind(out + ": ", 0), 0u) << r.err;
+  r = run_cli("render " + q(scene) + " -o " + q(out), lucent::test::kEarlyProgress);
+  ASSERT_EQ(r.status, 0) << r.err;
+  lines = lines_of(r.err);
+  ASSERT_EQ(lines.size(), 2u) << r.err;
+  EXPECT_TRUE(std::regex_search(lines[0], progress)) << r.err;
+  EXPECT_EQ(lines[1].rfind(out + ": ", 0), 0u) << r.err;
+}
+
 // --target-error with a --time that ends the render in its pilot: the summary says so and the
 // warning line names the time limit (it printed neither: the render looked complete, exit 0).
 TEST(Cli, AdaptiveStoppedInThePilotByTheTimeLimitSaysSo) {

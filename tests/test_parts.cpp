@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <regex>
 #include <string>
 #include <tuple>
 
@@ -1083,7 +1084,9 @@ TEST(Parts, SigtermedPartRecordsItsRangeAndMerges) {
   std::string scene = noisy_scene(dir);
   std::string part = dir + "/long.exr", err = dir + "/long.err";
   // started in the background; SIGTERM once the progress line shows the render loop running
-  std::string script = "'" + std::string(LUCENT_CLI_PATH) + "' render " + q(scene) +
+  // (from its first pass)
+  std::string script = std::string(lucent::test::kEarlyProgress) + " '" +
+                       std::string(LUCENT_CLI_PATH) + "' render " + q(scene) +
                        " --samples 0:16000000 -o " + q(part) + " 2>" + q(err) +
                        " </dev/null & pid=$!; for i in $(seq 600); do grep -q Msamples/s " +
                        q(err) + " && break; sleep 0.1; done; kill -TERM $pid; wait $pid";
@@ -1331,6 +1334,24 @@ TEST(Parts, MpiTwoRanksRenderTheOneProcessImage) {
   EXPECT_LT(max_relative_difference(mpi.acc, one.acc), 1e-5);
 }
 
+// Rank 0's progress line starts after a second of rendering; under LUCENT_TEST_EARLY_PROGRESS=1
+// (the stop-signal tests' sign that every rank renders, kEarlyProgress) once every rank has
+// rendered a pass: here within a render of half a second.
+TEST(Parts, MpiProgressLineOnceEveryRankRendersForTheStopSignalTests) {
+  if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
+  std::string dir = lucent::test::temp_dir();
+  std::string scene = noisy_scene(dir);
+  CommandResult r =
+      run_shell(std::string(lucent::test::kEarlyProgress) + " " +
+                    mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) +
+                           " --spp 16000000 --time 0.5 -o " + q(dir + "/mpi.exr")),
+                dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::regex_search(r.err, std::regex("(^|\n)rank 0 of 2: +[0-9.]+%  [0-9]+ of "
+                                                  "8000000 spp  [0-9.]+ Msamples/s\n")))
+      << r.err;
+}
+
 // Rank 0 merges the parts and writes the image after every rank has rendered: a write the
 // host's memory cannot hold (a 2048x2048 part file, under an address-space limit the session
 // fits) is refused before rendering, naming the write, instead of failing after the job's work.
@@ -1535,11 +1556,13 @@ TEST(Parts, MpiSigtermToMpirunWritesWhatTheRanksRendered) {
   std::string dir = lucent::test::temp_dir();
   std::string scene = noisy_scene(dir);
   const std::string out = dir + "/mpi.exr", err = dir + "/mpi.err";
-  // in the background; SIGTERM to mpirun once rank 0's progress line shows its render running
+  // in the background; SIGTERM to mpirun once rank 0's progress line shows that every rank has
+  // rendered a pass
   const std::string script = dir + "/stop.sh";
-  lucent::test::write_file(script, mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " +
-                                              q(scene) + " --spp 16000000 -o " + q(out),
-                                          Grace::mpirun_default) +
+  lucent::test::write_file(script, std::string(lucent::test::kEarlyProgress) + " " +
+                                       mpirun("-np 2 '" + std::string(LUCENT_MPI_PATH) + "' " +
+                                                  q(scene) + " --spp 16000000 -o " + q(out),
+                                              Grace::mpirun_default) +
                                        " 2>" + q(err) +
                                        " </dev/null & pid=$!\nfor i in $(seq 600); do grep -q " +
                                        "'rank 0 of 2:' " + q(err) +
@@ -1573,7 +1596,7 @@ TEST(Parts, SlurmMpiScriptPassesTheStopToTheRanks) {
   // (a grace of 2 s, not the script's 30)
   lucent::test::write_file(
       script,
-      std::string(kOmpiSettings) +
+      std::string(lucent::test::kEarlyProgress) + " " + kOmpiSettings +
           "OMPI_MCA_odls_base_sigkill_timeout=2 MPIRUN_ARGS='--oversubscribe -np 2' MPIRUN='" +
           std::string(LUCENT_MPIEXEC) + "' LUCENT_MPI='" + LUCENT_MPI_PATH + "' bash " +
           q(lucent::test::source_path("scripts/slurm/mpi.sbatch")) + " " + q(scene) + " " + q(out) +
@@ -1623,8 +1646,8 @@ TEST(Parts, MpiSigtermToOneRankUnderATimeLimitIsAnInterruption) {
   // rank 0 stops at its time limit; rank 1, without one, only by the signal, whenever it comes
   const std::string script = dir + "/stop.sh";
   lucent::test::write_file(
-      script, "timeout 120 env " + mpirun("-np 1 " + prog + " --time 3 : -np 1 " + prog + " -q") +
-                  " 2>" + q(err) +
+      script, "timeout 120 env " + std::string(lucent::test::kEarlyProgress) + " " +
+                  mpirun("-np 1 " + prog + " --time 3 : -np 1 " + prog + " -q") + " 2>" + q(err) +
                   " </dev/null & pid=$!\nfor i in $(seq 600); do grep -q 'rank 0 of 2:' " + q(err) +
                   " && break; sleep 0.1; done\npkill -TERM -f " +
                   q(quiet_rank_pattern(LUCENT_MPI_PATH, scene)) + "\nwait $pid\n");
@@ -1643,8 +1666,8 @@ TEST(Parts, MpiSigtermToOneRankUnderATimeLimitIsAnInterruption) {
 // while they render (lucent-mpi's StopAgreement), and each keeps what it rendered. They agreed
 // only once each had ended its render, and the others rendered their whole share first (here
 // 5.3 million samples per pixel each, hours: the job ran until `timeout` stopped all of it). Rank
-// 2 ends its share early (--time 1) and waits for the others, in the agreement: a rank that has
-// finished takes part until every rank has.
+// 2 ends its share early (--time 0.001: after its first pass) and waits for the others, in the
+// agreement: a rank that has finished takes part until every rank has.
 TEST(Parts, MpiSigtermToOneRankStopsEveryRankAfterTheirPass) {
   if (!have_mpirun()) GTEST_SKIP() << LUCENT_MPIEXEC << " is absent";
   std::string dir = lucent::test::temp_dir();
@@ -1653,13 +1676,13 @@ TEST(Parts, MpiSigtermToOneRankStopsEveryRankAfterTheirPass) {
   const std::uint64_t n = 16000000;
   const std::string prog = "'" + std::string(LUCENT_MPI_PATH) + "' " + q(scene) + " --spp " +
                            std::to_string(n) + " -o " + q(out);
-  // SIGTERM to rank 1 (given -q) once rank 0's progress line shows the render running; `timeout`
-  // (status 124) ends a job whose ranks render on
+  // SIGTERM to rank 1 (given -q) once rank 0's progress line shows that every rank has rendered a
+  // pass (rank 2 its last); `timeout` (status 124) ends a job whose ranks render on
   const std::string script = dir + "/stop.sh";
   lucent::test::write_file(
       script,
-      "timeout 120 env " +
-          mpirun("-np 1 " + prog + " : -np 1 " + prog + " -q : -np 1 " + prog + " --time 1") +
+      "timeout 120 env " + std::string(lucent::test::kEarlyProgress) + " " +
+          mpirun("-np 1 " + prog + " : -np 1 " + prog + " -q : -np 1 " + prog + " --time 0.001") +
           " 2>" + q(err) + " </dev/null & pid=$!\nfor i in $(seq 600); do grep -q 'rank 0 of 3:' " +
           q(err) + " && break; sleep 0.1; done\npkill -TERM -f " +
           q(quiet_rank_pattern(LUCENT_MPI_PATH, scene)) + "\nwait $pid\n");

@@ -19,6 +19,7 @@
 
 #include "cli/checkpoint.hpp"
 #include "cli/commands.hpp"
+#include "cli/progress_start.hpp"
 #include "cli/stop_signals.hpp"
 #include "core/file_io.hpp"
 #include "image/image_probe.hpp"
@@ -429,8 +430,10 @@ int render_with(const RenderArgs& a) {
   // its percentage of the whole render; it said "1200 spp", 40% where the image was at 80%)
   const std::uint64_t resumed_from = checkpoint ? checkpoint->first_sample() : 0;
   if (!a.quiet) {
-    opt.on_progress = [&](const lucent::RenderProgress& p) {
-      if (p.elapsed < 1.0) return;  // short renders stay silent
+    // short renders stay silent (the stop-signal tests' renders: from the first pass)
+    const double progress_start = lucent::cli::early_progress_for_tests() ? 0.0 : 1.0;
+    opt.on_progress = [&, progress_start](const lucent::RenderProgress& p) {
+      if (p.elapsed < progress_start) return;
       if (!tty && p.elapsed - last_print < 2.0) return;
       last_print = p.elapsed;
       double frac = p.samples_target > 0 ? double(p.samples_done) / double(p.samples_target)

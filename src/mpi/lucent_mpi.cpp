@@ -34,6 +34,7 @@
 #include "cl/context.hpp"
 #include "cli/checkpoint.hpp"
 #include "cli/option_checks.hpp"
+#include "cli/progress_start.hpp"
 #include "cli/stop_signals.hpp"
 #include "core/file_io.hpp"
 #include "core/text.hpp"
@@ -207,6 +208,10 @@ class StopAgreement {
     }
   }
 
+  /// The rounds completed: 2 or more once every rank has posted from a pass's end (poll) or from
+  /// the end of its render (finish), the first round being posted before any renders.
+  int rounds() const { return rounds_; }
+
  private:
   /// Posts a round of this rank's state.
   void post(bool rendering) {
@@ -220,6 +225,7 @@ class StopAgreement {
     int done = 0;
     MPI_Test(&request_, &done, MPI_STATUS_IGNORE);
     if (!done) return false;
+    ++rounds_;
     if (all_[0] > 0) {
       stop_ = over_ = true;
     } else if (all_[1] == 0) {
@@ -235,6 +241,7 @@ class StopAgreement {
   int mine_[2] = {0, 0}, all_[2] = {0, 0};
   MPI_Request request_ = MPI_REQUEST_NULL;
   bool stop_ = false, over_ = false;
+  int rounds_ = 0;
 };
 
 /// Whether MPI may be called from any thread, one at a time (MPI_Init_thread's answer).
@@ -598,11 +605,16 @@ int run(const Args& a) {
   double last = -10;
   // from here until agreement.finish() the ranks' only MPI calls are the agreement's
   StopAgreement agreement(todo > 0, g_mpi_any_thread);
+  // the line after a second of rendering; the stop-signal tests' (LUCENT_TEST_EARLY_PROGRESS=1)
+  // once every rank has rendered a pass, which a signal to any rank then leaves in its part
+  const bool early = lucent::cli::early_progress_for_tests();
   auto progress = [&](const lucent::RenderProgress& p) {
     if (ck) ck->on_pass(renderer);
     // a stop agreed (a signal on another rank): this rank stops after this pass, as for its own
     if (agreement.poll()) renderer.cancel();
-    if (!root || a.quiet || p.elapsed < 1.0 || (!tty && p.elapsed - last < 2.0)) return;
+    if (!root || a.quiet || (early ? agreement.rounds() < 2 : p.elapsed < 1.0) ||
+        (!tty && p.elapsed - last < 2.0))
+      return;
     last = p.elapsed;
     // rank 0's share, its checkpoint's samples counted
     const std::uint64_t done = resumed + p.samples_done, all = range.end - range.begin;
