@@ -18,6 +18,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -1134,6 +1135,70 @@ TEST(Converge, CallersSessionsCancelBetweenRungsStopsTheStudy) {
   session.cancel();
   opt.on_point = nullptr;
   EXPECT_EQ(lucent::run_convergence(scene, reference, opt).points.size(), 6u);
+}
+
+// run_convergence on a session busy with a render (another thread's, or the study started from
+// that render's own on_progress) is refused before it changes anything: it cleared the render's
+// pending cancel() (its CancelScope began) and swapped in the study's cancel flag, then failed at
+// set_build_options, and the render ran on for its whole budget (the API tester's find).
+TEST(Converge, RefusedOnABusySessionKeepsTheRendersCancel) {
+  lucent::Scene scene = lucent::parse_scene(kScene, "t.json");
+  scene.film.width = scene.film.height = 8;
+  const lucent::RenderResult reference = independent_reference(scene);
+  lucent::Renderer session(lucent::test::session_options());
+  session.set_scene(scene);
+  lucent::ConvergeOptions opt;
+  opt.render = lucent::test::render_options();
+  opt.spp_ladder = {1};
+  opt.renderer = &session;
+  std::atomic<bool> study_flag{false};
+  opt.render.cancel = &study_flag;
+  const std::string refused = "run_convergence: a render of this session is in progress";
+  const std::uint64_t budget = 1000000;
+  // from the render's own on_progress, after its cancel()
+  int passes = 0;
+  std::string error;
+  session.render(budget, [&](const lucent::RenderProgress&) {
+    if (++passes == 1) {
+      session.cancel();
+      error = lucent::test::error_of([&] { lucent::run_convergence(scene, reference, opt); });
+      EXPECT_EQ(session.cancel_flag(), nullptr) << "the study's flag was left in place";
+    }
+    if (passes == 3) session.cancel();  // (where the cancel was lost: ends the render)
+  });
+  EXPECT_EQ(error.find(refused), 0u) << error;
+  EXPECT_LT(passes, 3) << "the render went on after its cancel()";
+  EXPECT_LT(session.spp(), budget);
+  EXPECT_TRUE(session.result().cancelled);
+
+  // another thread's render, held in its on_progress while the study is refused
+  session.reset();
+  passes = 0;
+  error.clear();
+  std::atomic<bool> started{false}, released{false};
+  std::thread render([&] {
+    session.render(budget, [&](const lucent::RenderProgress&) {
+      if (++passes == 1) {
+        started = true;
+        while (!released) std::this_thread::yield();
+      }
+      if (passes == 3) session.cancel();
+    });
+  });
+  while (!started) std::this_thread::yield();
+  session.cancel();
+  error = lucent::test::error_of([&] { lucent::run_convergence(scene, reference, opt); });
+  released = true;
+  render.join();
+  EXPECT_EQ(error.find(refused), 0u) << error;
+  EXPECT_LT(passes, 3) << "the render went on after its cancel()";
+  EXPECT_TRUE(session.result().cancelled);
+  EXPECT_EQ(session.cancel_flag(), nullptr);
+
+  // and the session takes a study once free
+  study_flag = false;
+  EXPECT_EQ(lucent::run_convergence(scene, reference, opt).points.size(), 1u);
+  EXPECT_EQ(session.cancel_flag(), nullptr);
 }
 
 TEST(Converge, XmlCheckerRejectsMalformedDocuments) {

@@ -1683,7 +1683,7 @@ TEST(Session, CancelBetweenTheCallsOfAScopeStopsTheNext) {
   r.set_scene(lucent::test::scene_from(kScene));
   r.cancel();  // before the scope: not its operation's
   {
-    lucent::render_detail::CancelScope scope(r);
+    lucent::render_detail::CancelScope scope(r, "a test");
     EXPECT_FALSE(scope.cancelled());
     r.render(1);
     EXPECT_FALSE(r.result().cancelled);

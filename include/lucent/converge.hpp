@@ -150,7 +150,10 @@ struct ConvergeOptions {
   /// given here ends with the last setting's scene, build options and accumulation; its cancel
   /// flag is `render.cancel` during the study (when set) and its own again afterwards. Its
   /// cancel() (or the flag) stops the study after the current pass, or before the next rung when
-  /// asked for between two; the result has the points of the rungs finished.
+  /// asked for between two; the result has the points of the rungs finished. A session busy
+  /// with another call (another thread's render, or the study started from a render's
+  /// on_progress) is refused before anything changes: lucent::Error naming run_convergence, the
+  /// render's cancel() and cancel flag untouched.
   Renderer* renderer = nullptr;
   /// Called after each rung (progress output). It may read the study's session (result(),
   /// spp(), stats()) and cancel() it; a call that changes it (set_scene, render, reset,

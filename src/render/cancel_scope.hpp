@@ -2,6 +2,7 @@
 // Several calls of one session as one operation for Renderer::cancel(): run_convergence's ladder
 // (src/render/converge.cpp) renders rung after rung on one session, and a call clears the cancel
 // asked for before it began, so a cancel between two rungs was forgotten and the ladder went on.
+#include <atomic>
 #include <functional>
 
 #include "lucent/session.hpp"
@@ -15,7 +16,13 @@ namespace lucent::render_detail {
 /// Created and destroyed on the thread that makes the calls; scopes may nest.
 class CancelScope {
  public:
-  explicit CancelScope(Renderer& renderer);
+  /// Begins the operation `call` ("run_convergence"), whose cancel flag is `flag` while it lives
+  /// (null: the session's own). Throws lucent::Error naming `call`, changing nothing, while a call
+  /// of the session is in progress (another thread's render, or this call made from a render's
+  /// on_progress): run_convergence there had already cleared the render's pending cancel and
+  /// replaced its cancel flag when its first set_build_options was refused, so that the render
+  /// ran its full time.
+  CancelScope(Renderer& renderer, const char* call, const std::atomic<bool>* flag = nullptr);
   ~CancelScope();
   CancelScope(const CancelScope&) = delete;
   CancelScope& operator=(const CancelScope&) = delete;
@@ -31,6 +38,8 @@ class CancelScope {
 
  private:
   Renderer& renderer_;
+  const std::atomic<bool>* flag_before_ = nullptr;  ///< the session's flag, given back at the end
+  bool flag_replaced_ = false;
 };
 
 }  // namespace lucent::render_detail

@@ -612,18 +612,14 @@ ConvergeResult run_convergence(const Scene& scene, const RenderResult& reference
     so.on_warning = options.render.on_warning;
     renderer = &own.emplace(so);
   }
-  // the study's cancel flag while it runs, the session's own again afterwards (a caller's
-  // session kept a pointer to a flag that may not outlive this call)
-  struct CancelFlag {
-    Renderer& r;
-    const std::atomic<bool>* before;
-    ~CancelFlag() { r.set_cancel_flag(before); }
-  } cancel_flag{*renderer, renderer->cancel_flag()};
-  if (options.render.cancel) renderer->set_cancel_flag(options.render.cancel);
   // the study is one operation for the session's cancel(): one asked for between two rungs (from
   // on_point, or another thread while a rung is compared or a setting's kernel built) stops it
-  // too; each render call cleared it as it began, and the ladder went on
-  render_detail::CancelScope cancel_scope(*renderer);
+  // too; each render call cleared it as it began, and the ladder went on. Its cancel flag is the
+  // study's while it runs, the session's own again afterwards (a caller's session kept a pointer
+  // to a flag that may not outlive this call). Refused first, changing nothing, while the session
+  // is busy: the study cleared the cancel() of another thread's render and swapped its flag, then
+  // failed on set_build_options, and that render ran its full time.
+  render_detail::CancelScope cancel_scope(*renderer, "run_convergence", options.render.cancel);
 
   ConvergeResult result;
   CompareOptions co;

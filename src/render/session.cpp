@@ -368,10 +368,11 @@ struct Renderer::Impl {
 
   std::set<std::string> notes_given;  ///< the warnings about its scenes this session has given
   std::atomic<bool> cancel_requested{false};
-  const std::atomic<bool>* cancel_flag = nullptr;
+  /// (atomic: set_cancel_flag and a CancelScope's end may come from another thread than a render's)
+  std::atomic<const std::atomic<bool>*> cancel_flag{nullptr};
   /// render_detail::CancelScopes alive: while one is, the calls are one operation, whose cancel a
   /// call's start keeps (begin_call)
-  int cancel_scopes = 0;
+  std::atomic<int> cancel_scopes{0};
   SessionStats stats;
 
   explicit Impl(SessionOptions o) : options(std::move(o)) {
@@ -394,7 +395,10 @@ struct Renderer::Impl {
     cache_dir = resolve_cache_dir(options.cache_dir);
   }
 
-  bool cancelled() const { return cancel_requested.load() || (cancel_flag && cancel_flag->load()); }
+  bool cancelled() const {
+    const std::atomic<bool>* flag = cancel_flag.load();
+    return cancel_requested.load() || (flag && flag->load());
+  }
 
   /// Refuses `call` during a render call of this session (from its on_progress callback, or
   /// another thread): set_scene there replaced the buffers and the accumulation under the passes
@@ -1727,10 +1731,25 @@ SessionStats Renderer::stats() const { return impl().stats; }
 
 namespace render_detail {
 
-CancelScope::CancelScope(Renderer& renderer) : renderer_(renderer) {
-  if (renderer_.impl_->cancel_scopes++ == 0) renderer_.impl_->cancel_requested = false;
+CancelScope::CancelScope(Renderer& renderer, const char* call, const std::atomic<bool>* flag)
+    : renderer_(renderer) {
+  Renderer::Impl& s = renderer_.impl();
+  // the session held while the scope begins, as a call holds it: refused (nothing changed) during
+  // another call, and no render starts between the check and the changes
+  cl_util::check_not_forked();
+  if (s.rendering.exchange(true)) throw s.rendering_error(call);
+  if (s.cancel_scopes++ == 0) s.cancel_requested = false;
+  if (flag) {
+    flag_before_ = s.cancel_flag.exchange(flag);
+    flag_replaced_ = true;
+  }
+  s.rendering = false;
 }
-CancelScope::~CancelScope() { --renderer_.impl_->cancel_scopes; }
+CancelScope::~CancelScope() {
+  Renderer::Impl& s = *renderer_.impl_;
+  if (flag_replaced_) s.cancel_flag = flag_before_;
+  --s.cancel_scopes;
+}
 bool CancelScope::cancelled() const { return renderer_.impl_->cancelled(); }
 void CancelScope::hold(const char* what, const std::function<void()>& f) {
   Renderer::Impl& s = *renderer_.impl_;
