@@ -54,6 +54,15 @@ TEST(Compare, NormalCriticalValues) {
   EXPECT_NEAR(lucent::normal_two_sided_critical(0.05), 1.959964, 1e-5);
   EXPECT_NEAR(lucent::normal_two_sided_critical(0.01), 2.575829, 1e-5);
   EXPECT_NEAR(lucent::normal_two_sided_critical(1e-6), 4.891638, 1e-5);
+  // the ends of [0, 1], and no probability (NaN gave 0, a threshold every difference passes)
+  EXPECT_EQ(lucent::normal_two_sided_critical(1), 0);
+  EXPECT_EQ(lucent::normal_two_sided_critical(0), INFINITY);
+  EXPECT_EQ(lucent::test::error_of([] { lucent::normal_two_sided_critical(std::nan("")); }),
+            "normal_two_sided_critical: p must be a probability in [0, 1], got nan");
+  EXPECT_EQ(lucent::test::error_of([] { lucent::normal_two_sided_critical(1.5); }),
+            "normal_two_sided_critical: p must be a probability in [0, 1], got 1.5");
+  EXPECT_EQ(lucent::test::error_of([] { lucent::normal_two_sided_critical(-1e-300); }),
+            "normal_two_sided_critical: p must be a probability in [0, 1], got -1e-300");
 }
 
 TEST(Compare, IdenticalImagesPass) {

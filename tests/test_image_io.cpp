@@ -54,9 +54,38 @@ TEST(ImageIo, PositiveInfinityEncodesAsWhite) {
     d.exposure = 1e30;
     EXPECT_EQ(encode_display(INFINITY, d), 255);
   }
-  DisplaySettings nan_exposure;  // (only the C++ API can make one): black, not lround(NaN)
-  nan_exposure.exposure = NAN;
-  EXPECT_EQ(encode_display(0.5, nan_exposure), 0);
+}
+
+// encode_display refuses the display settings write_image refuses, as its message says (only the
+// C++ API can make them): it took a NaN exposure and a NaN gamma as black, and a transfer of 77
+// as linear (0.5 gave 128; the API tester's find).
+TEST(ImageIo, EncodeDisplayRefusesWhatWriteImageRefuses) {
+  const std::string bad_gamma =
+      "encode_display: the display gamma must be finite and > 0, the exposure finite";
+  DisplaySettings d;
+  d.transfer = lucent::Transfer::Gamma;
+  for (double gamma : {double(NAN), 0.0, -2.2, double(INFINITY)}) {
+    d.gamma = gamma;
+    EXPECT_EQ(lucent::test::error_of([&] { encode_display(0.5, d); }).find(bad_gamma), 0u) << gamma;
+  }
+  d = DisplaySettings{};
+  d.exposure = NAN;
+  EXPECT_EQ(lucent::test::error_of([&] { encode_display(0.5, d); }),
+            bad_gamma + " (gamma 2.2, exposure nan)");
+  d = DisplaySettings{};
+  d.transfer = static_cast<lucent::Transfer>(77);
+  EXPECT_EQ(lucent::test::error_of([&] { encode_display(0.5, d); }),
+            "encode_display: unknown display transfer or tone map (77, 0)");
+  d = DisplaySettings{};
+  d.tonemap = static_cast<lucent::ToneMap>(-1);
+  EXPECT_EQ(lucent::test::error_of([&] { encode_display(0.5, d); }),
+            "encode_display: unknown display transfer or tone map (0, -1)");
+  // write_image says the same of its file
+  const std::string path = lucent::test::temp_dir() + "/x.png";
+  EXPECT_EQ(lucent::test::error_of([&] {
+              lucent::write_image(path, lucent::Image{1, 1, {0.5f, 0.5f, 0.5f}}, d);
+            }),
+            path + ": unknown display transfer or tone map (0, -1)");
 }
 
 TEST(ImageIo, GammaExposureAndToneMaps) {

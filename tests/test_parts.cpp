@@ -351,6 +351,16 @@ TEST(Parts, ExpectMayCoverMoreSamplesThanOnePart) {
             "--samples '0:16777217': at most 16777216 samples per part");
 }
 
+// The estimate of a part's write takes no film of a negative or zero size (-1 x 5 was 0 x 5:
+// 1 MiB; the API tester's find).
+TEST(Parts, PartWriteBytesRefusesAFilmSizeNotPositive) {
+  EXPECT_EQ(lucent::test::error_of([] { lucent::part_write_bytes(-1, 5); }),
+            "part_write_bytes: the film size must be positive, got -1x5");
+  EXPECT_EQ(lucent::test::error_of([] { lucent::part_write_bytes(4, 0); }),
+            "part_write_bytes: the film size must be positive, got 4x0");
+  EXPECT_GT(lucent::part_write_bytes(1, 1), 0u);
+}
+
 // Misuse of the library's merger and parts by another tool is a lucent::Error: add() after
 // add_header() read empty sums as a film's (a segfault), finish() after headers alone returned a
 // 0x0 image, and part_result read past the vectors of a part whose sizes disagree.

@@ -114,6 +114,9 @@ TEST(Precision, ParseAndNames) {
   EXPECT_EQ(lucent::parse_precision("double"), Precision::Double);
   EXPECT_STREQ(lucent::precision_name(Precision::Double), "double");
   EXPECT_STREQ(lucent::precision_name(Precision::Float), "float");
+  // a value outside the enum was "float"
+  EXPECT_EQ(lucent::test::error_of([] { lucent::precision_name(static_cast<Precision>(7)); }),
+            "precision_name: Precision must be Float or Double, got 7");
   try {
     lucent::parse_precision("half", "--precision");
     FAIL() << "no error";

@@ -102,7 +102,8 @@ CompareResult compare_images(const RenderResult& a, const RenderResult& b,
 /// non-finite) for an exact black one and pass it.
 void check_comparable_image(const RenderResult& image, const std::string& what);
 
-/// Upper two-sided critical value of the standard normal: P(|Z| > z) = p.
+/// Upper two-sided critical value of the standard normal: P(|Z| > z) = p, for p in [0, 1] (0
+/// gives infinity, 1 gives 0). Throws lucent::Error for p outside it or NaN.
 double normal_two_sided_critical(double p);
 
 /// Writes an OpenEXR file with channels R, G, B (mean), var.R, var.G, var.B (sample variance of

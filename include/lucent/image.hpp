@@ -34,7 +34,9 @@ void write_image(const std::string& path, const Image& image, const DisplaySetti
 /// checksummed sums, as read_render does, and a damaged one throws.
 Image read_image(const std::string& path);
 
-/// Linear value to 8-bit display value.
+/// Linear value to 8-bit display value. Throws lucent::Error for the display settings
+/// write_image refuses (a gamma not finite and > 0, an exposure not finite, a transfer or tone
+/// map outside its enum).
 unsigned char encode_display(double linear, const DisplaySettings& display);
 
 }  // namespace lucent

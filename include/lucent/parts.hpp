@@ -101,7 +101,7 @@ void write_render_part(const std::string& path, const RenderPart& part,
                        PartCompression compression = PartCompression::zip);
 /// The host memory write_render_part allocates for a width x height part, beside the part
 /// itself (its planes, the sums' 32-bit words and the EXR encoder), at most: for a front end's
-/// check before it renders.
+/// check before it renders. Throws lucent::Error for a size not positive.
 std::uint64_t part_write_bytes(int width, int height,
                                PartCompression compression = PartCompression::zip);
 /// Reads a part file; throws lucent::Error naming the file and what is wrong.

@@ -33,7 +33,7 @@ struct RenderProgress {
 /// or double on devices with fp64 (radiance, BSDFs, textures and buffers stay float).
 enum class Precision { Float, Double };
 
-/// "float" or "double".
+/// "float" or "double"; throws lucent::Error for a value outside the enum.
 const char* precision_name(Precision p);
 
 /// Parses "float" or "double"; throws lucent::Error naming `what` (e.g. "--precision") otherwise.

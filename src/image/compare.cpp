@@ -9,12 +9,17 @@
 #include <limits>
 
 #include "lucent/error.hpp"
+#include "scene/validate.hpp"
 
 namespace lucent {
 
 double normal_two_sided_critical(double p) {
-  if (!(p < 1)) return 0;
-  if (!(p > 0)) return INFINITY;
+  // (NaN gave 0, a threshold every difference passes)
+  if (!(p >= 0 && p <= 1))
+    throw Error("normal_two_sided_critical: p must be a probability in [0, 1], got " +
+                scene_detail::format_number(p));
+  if (p == 1) return 0;
+  if (p == 0) return INFINITY;
   // P(|Z| > z) = erfc(z / sqrt 2) decreases in z: bisect
   double lo = 0, hi = 40;
   for (int i = 0; i < 200; ++i) {

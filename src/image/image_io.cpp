@@ -112,27 +112,24 @@ std::string png_colour_chunks(const DisplaySettings& display) {
   return gama(1.0);
 }
 
-std::string encode_png(const std::string& path, const Image& img, const DisplaySettings& display) {
-  std::vector<unsigned char> bytes(img.rgb.size());
-  const size_t row = size_t(img.width) * 3;
-  const bool flipped = stb_flips_on_write();  // (rows given bottom first: flipped back)
-  for (size_t i = 0; i < bytes.size(); ++i) {
-    const size_t y = i / row, from = flipped ? (size_t(img.height) - 1 - y) * row + i % row : i;
-    bytes[i] = encode_display(img.rgb[from], display);
-  }
-  std::string out;
-  auto append = append_bytes;
-  if (!stbi_write_png_to_func(append, &out, img.width, img.height, 3, bytes.data(), img.width * 3))
-    throw Error(path + ": cannot encode PNG");
-  // (after the signature and IHDR, 8 + 25 bytes: before the image data, as the chunks must be)
-  if (out.size() < 33 || out.compare(12, 4, "IHDR") != 0) throw Error(path + ": cannot encode PNG");
-  out.insert(33, png_colour_chunks(display));
-  return out;
+/// Refuses display settings a scene's film may not have, as `<where>: ...`: a gamma of 0 wrote
+/// a black PNG, an unknown transfer a linear one (and encode_display took a gamma of NaN as 0
+/// and a transfer of 77 as linear where write_image refused them).
+void check_display(const std::string& where, const DisplaySettings& display) {
+  if (!(display.gamma > 0) || !std::isfinite(display.gamma) || !std::isfinite(display.exposure))
+    throw Error(where + ": the display gamma must be finite and > 0, the exposure finite (gamma " +
+                io::shortest_real(display.gamma) + ", exposure " +
+                io::shortest_real(display.exposure) + ")");
+  const auto transfer = static_cast<int>(display.transfer);
+  const auto tonemap = static_cast<int>(display.tonemap);
+  if (transfer < 0 || transfer > static_cast<int>(Transfer::Linear) || tonemap < 0 ||
+      tonemap > static_cast<int>(ToneMap::Aces))
+    throw Error(where + ": unknown display transfer or tone map (" + std::to_string(transfer) +
+                ", " + std::to_string(tonemap) + ")");
 }
 
-}  // namespace
-
-unsigned char encode_display(double v, const DisplaySettings& d) {
+/// encode_display, of settings already checked (check_display).
+unsigned char encode_checked(double v, const DisplaySettings& d) {
   // NaN/Inf never reach a render's film, but lucent::write_image and Python's write_image take
   // any array: NaN has no brightness (black); +inf is brighter than any finite value and is
   // encoded as one (it was black, next to a white 3e38), whatever the exposure (+inf times a
@@ -157,6 +154,31 @@ unsigned char encode_display(double v, const DisplaySettings& d) {
   return static_cast<unsigned char>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
 }
 
+std::string encode_png(const std::string& path, const Image& img, const DisplaySettings& display) {
+  std::vector<unsigned char> bytes(img.rgb.size());
+  const size_t row = size_t(img.width) * 3;
+  const bool flipped = stb_flips_on_write();  // (rows given bottom first: flipped back)
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    const size_t y = i / row, from = flipped ? (size_t(img.height) - 1 - y) * row + i % row : i;
+    bytes[i] = encode_checked(img.rgb[from], display);
+  }
+  std::string out;
+  auto append = append_bytes;
+  if (!stbi_write_png_to_func(append, &out, img.width, img.height, 3, bytes.data(), img.width * 3))
+    throw Error(path + ": cannot encode PNG");
+  // (after the signature and IHDR, 8 + 25 bytes: before the image data, as the chunks must be)
+  if (out.size() < 33 || out.compare(12, 4, "IHDR") != 0) throw Error(path + ": cannot encode PNG");
+  out.insert(33, png_colour_chunks(display));
+  return out;
+}
+
+}  // namespace
+
+unsigned char encode_display(double v, const DisplaySettings& d) {
+  check_display("encode_display", d);
+  return encode_checked(v, d);
+}
+
 namespace image_detail {
 
 std::uint64_t image_write_bytes(const std::string& path, int width, int height) {
@@ -178,17 +200,7 @@ void write_image(const std::string& path, const Image& img, const DisplaySetting
   if (img.width <= 0 || img.height <= 0 ||
       img.rgb.size() != static_cast<size_t>(img.width) * img.height * 3)
     throw Error(path + ": refusing to write an empty or inconsistent image");
-  // as a scene's film: a gamma of 0 wrote a black PNG, an unknown transfer a linear one
-  if (!(display.gamma > 0) || !std::isfinite(display.gamma) || !std::isfinite(display.exposure))
-    throw Error(path + ": the display gamma must be finite and > 0, the exposure finite (gamma " +
-                io::shortest_real(display.gamma) + ", exposure " +
-                io::shortest_real(display.exposure) + ")");
-  const auto transfer = static_cast<int>(display.transfer);
-  const auto tonemap = static_cast<int>(display.tonemap);
-  if (transfer < 0 || transfer > static_cast<int>(Transfer::Linear) || tonemap < 0 ||
-      tonemap > static_cast<int>(ToneMap::Aces))
-    throw Error(path + ": unknown display transfer or tone map (" + std::to_string(transfer) +
-                ", " + std::to_string(tonemap) + ")");
+  check_display(path, display);  // as a scene's film
   std::string ext = extension(path);
   if (ext == "pfm")
     io::write_file_atomic(path, encode_pfm(img));

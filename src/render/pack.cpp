@@ -802,7 +802,13 @@ CameraPacking repack_camera(const Scene& scene, const PackedScene& packed, const
 
 namespace lucent {
 
-const char* precision_name(Precision p) { return p == Precision::Double ? "double" : "float"; }
+const char* precision_name(Precision p) {
+  // (Precision(7) was "float")
+  if (p == Precision::Float) return "float";
+  if (p == Precision::Double) return "double";
+  throw Error("precision_name: Precision must be Float or Double, got " +
+              std::to_string(static_cast<int>(p)));
+}
 
 Precision parse_precision(const std::string& text, const std::string& what) {
   if (text == "float") return Precision::Float;

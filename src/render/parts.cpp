@@ -353,12 +353,16 @@ RenderResult part_result(const RenderPart& part) {
 }
 
 std::uint64_t part_write_bytes(int width, int height, PartCompression compression) {
-  const std::uint64_t npix = std::uint64_t(std::max(width, 0)) * std::uint64_t(std::max(height, 0));
+  // (-1 x 5 was taken as 0 x 5: 1 MiB)
+  if (width <= 0 || height <= 0)
+    throw Error("part_write_bytes: the film size must be positive, got " + std::to_string(width) +
+                "x" + std::to_string(height));
+  const std::uint64_t npix = std::uint64_t(width) * std::uint64_t(height);
   // write_render_part's twelve 32-bit words and six float planes; the encoder's input is those
   // and the counts: 19 channels of 4 bytes. tinyexr's PIZ encoder holds, for each chunk of 32
   // lines beside its output, its input, twice its size of blocks and a temporary copy, and 2 MB
   // of Huffman tables: films of few lines (16384 x 32: about 200 MB) took more than the rest
-  const std::uint64_t piz_chunk = std::uint64_t(std::max(width, 0)) * 32 * 19 * 4;
+  const std::uint64_t piz_chunk = std::uint64_t(width) * 32 * 19 * 4;
   return sys::bytes_add(
       sys::bytes_add(sys::bytes_mul(npix, 12 * sizeof(std::uint32_t) + 6 * sizeof(float)),
                      image_detail::exr_encoder_bytes(sys::bytes_mul(npix, 19 * 4))),
