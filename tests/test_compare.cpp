@@ -690,6 +690,15 @@ TEST(Compare, InconsistentLayersAreAnInputError) {
               lucent::compare_images(short_n, short_n, o);
             }).find("min_pass_fraction must be in [0, 1]"),
             std::string::npos);
+  // the value as it reads back: std::to_string said "got 1.000000" of 1.0000001 and "got
+  // 0.000000" of an alpha of 1e-13 (the API tester's find)
+  o.min_pass_fraction = 1.0000001;
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::compare_images(short_n, short_n, o); }),
+            "compare: min_pass_fraction must be in [0, 1], got 1.0000001");
+  o = lucent::CompareOptions{};
+  o.alpha = 1e-13;
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::compare_images(short_n, short_n, o); }),
+            "compare: alpha must be in [1e-12, 0.5], got 1e-13");
   const std::string dir = lucent::test::temp_dir();
   EXPECT_EQ(
       lucent::test::error_of([&] { lucent::write_render_exr(dir + "/e.exr", RenderResult{}); }),

@@ -7,6 +7,7 @@
 #include "lucent/compare.hpp"
 #include "lucent/error.hpp"
 #include "lucent/parts.hpp"
+#include "scene/validate.hpp"
 
 namespace lucent::python {
 
@@ -299,12 +300,14 @@ void bind_image(py::module_& m) {
       [](py::handle a, py::handle b, double alpha, double min_pass_fraction, double abs_epsilon,
          double rel_epsilon, const FlagArg& image_mean_test_arg) {
         const bool image_mean_test = flag_argument(image_mean_test_arg, "image_mean_test");
-        // the library's and the command line's range (0.7 passed here, then failed there)
+        // the library's and the command line's range (0.7 passed here, then failed there), the
+        // value as it reads back (std::to_string said "got 0.000000" of 1e-13)
         if (!(alpha >= 1e-12 && alpha <= 0.5))
-          throw py::value_error("alpha must be in [1e-12, 0.5], got " + std::to_string(alpha));
+          throw py::value_error("alpha must be in [1e-12, 0.5], got " +
+                                scene_detail::format_number(alpha));
         if (!(min_pass_fraction >= 0 && min_pass_fraction <= 1))
           throw py::value_error("min_pass_fraction must be in [0, 1], got " +
-                                std::to_string(min_pass_fraction));
+                                scene_detail::format_number(min_pass_fraction));
         if (!(abs_epsilon >= 0) || !(rel_epsilon >= 0) || !std::isfinite(abs_epsilon) ||
             !std::isfinite(rel_epsilon))
           throw py::value_error("abs_epsilon and rel_epsilon must be finite and >= 0");

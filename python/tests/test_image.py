@@ -135,6 +135,11 @@ def test_compare_arrays_without_variance():
     for bad in (0, 1e-13, 0.7, 1, math.nan):
         with pytest.raises(ValueError, match=r"alpha must be in \[1e-12, 0.5\]"):
             lucent.compare(a, a, alpha=bad)
+    # the value as it reads back ("got 0.000000" of 1e-13, "got 1.000000" of 1.0000001)
+    with pytest.raises(ValueError, match=r"alpha must be in \[1e-12, 0.5\], got 1e-13$"):
+        lucent.compare(a, a, alpha=1e-13)
+    with pytest.raises(ValueError, match=r"min_pass_fraction must be in \[0, 1\], got 1.0000001$"):
+        lucent.compare(a, a, min_pass_fraction=1.0000001)
     assert lucent.compare(a, a, alpha=0.5).passed
 
 

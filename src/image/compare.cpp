@@ -179,12 +179,14 @@ void check_comparable_image(const RenderResult& image, const std::string& path) 
 CompareResult compare_images(const RenderResult& a, const RenderResult& b,
                              const CompareOptions& o) {
   // as the command line's ranges: an alpha of NaN or 2 made the threshold 0, and every
-  // comparison passed
+  // comparison passed. The value as it reads back (std::to_string's six decimals said "must be in
+  // [0, 1], got 1.000000" of 1.0000001, and "got 0.000000" of an alpha of 1e-13)
   if (!(o.alpha >= 1e-12 && o.alpha <= 0.5))
-    throw Error("compare: alpha must be in [1e-12, 0.5], got " + std::to_string(o.alpha));
+    throw Error("compare: alpha must be in [1e-12, 0.5], got " +
+                scene_detail::format_number(o.alpha));
   if (!(o.min_pass_fraction >= 0 && o.min_pass_fraction <= 1))
     throw Error("compare: min_pass_fraction must be in [0, 1], got " +
-                std::to_string(o.min_pass_fraction));
+                scene_detail::format_number(o.min_pass_fraction));
   if (!(o.abs_epsilon >= 0) || !(o.rel_epsilon >= 0) || !std::isfinite(o.abs_epsilon) ||
       !std::isfinite(o.rel_epsilon))
     throw Error("compare: abs_epsilon and rel_epsilon must be finite and >= 0");
