@@ -351,6 +351,30 @@ TEST(Parts, ExpectMayCoverMoreSamplesThanOnePart) {
             "--samples '0:16777217': at most 16777216 samples per part");
 }
 
+// check_merge_coverage refuses the expected range the command line's A:B refuses: an inverted
+// one ({8, 0}) was taken, and every sample was "outside" it twice, below its begin and above its
+// end ("the parts hold samples [0, 4), [0, 4) outside --expect [8, 0)"; the API tester's find).
+TEST(Parts, MergeCoverageRefusesAnEmptyOrInvertedExpect) {
+  lucent::MergeReport r;
+  r.merged.info.samples = {{0, 4}};
+  auto coverage = [&](lucent::SampleRange expect) {
+    return lucent::test::error_of(
+        [&] { lucent::check_merge_coverage(r, expect, false, "--expect", "--complete"); });
+  };
+  EXPECT_EQ(coverage({8, 0}), "merge: --expect [8, 0): need 0 <= begin < end <= 4294967296");
+  EXPECT_EQ(coverage({4, 4}), "merge: --expect [4, 4): need 0 <= begin < end <= 4294967296");
+  EXPECT_EQ(coverage({0, (1ull << 32) + 1}),
+            "merge: --expect [0, 4294967297): need 0 <= begin < end <= 4294967296");
+  // a range below and above the parts' is each side once
+  r.merged.info.samples = {{0, 8}};
+  EXPECT_EQ(coverage({2, 6}),
+            "merge: the parts hold samples [0, 2), [6, 8) outside --expect [2, 6) (they hold "
+            "[0, 8))");
+  r.merged.info.samples = {{0, 4}};
+  EXPECT_EQ(coverage({0, 8}), "");
+  EXPECT_EQ(r.missing, (std::vector<lucent::SampleRange>{{4, 8}}));
+}
+
 // The estimate of a part's write takes no film of a negative or zero size (-1 x 5 was 0 x 5:
 // 1 MiB; the API tester's find).
 TEST(Parts, PartWriteBytesRefusesAFilmSizeNotPositive) {

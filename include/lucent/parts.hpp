@@ -162,7 +162,8 @@ void check_merge_output(const std::string& output, const std::vector<std::string
 
 /// After a merge: the parts' samples lie within `expect` (when given), whose ranges they miss
 /// replace `report.missing`; with `complete`, none may be missing. Throws lucent::Error naming
-/// the options as `expect_name` and `complete_name` ("--expect", "--complete").
+/// the options as `expect_name` and `complete_name` ("--expect", "--complete"), and for an
+/// `expect` that is empty, inverted or past 2^32.
 void check_merge_coverage(MergeReport& report, const std::optional<SampleRange>& expect,
                           bool complete, const std::string& expect_name,
                           const std::string& complete_name);

@@ -712,6 +712,11 @@ void check_merge_coverage(MergeReport& report, const std::optional<SampleRange>&
                           bool complete, const std::string& expect_name,
                           const std::string& complete_name) {
   const std::vector<SampleRange>& samples = report.merged.info.samples;
+  // as the command line's A:B: an inverted range ({8, 0}) was taken, and every sample was
+  // "outside" it twice, below its begin and above its end ("[0, 4), [0, 4) outside [8, 0)")
+  if (expect && (expect->end <= expect->begin || expect->end > (std::uint64_t(1) << 32)))
+    throw Error("merge: " + expect_name + " " + range_text(*expect) +
+                ": need 0 <= begin < end <= 4294967296");
   if (expect) {
     // the samples outside it (it named all of the parts' samples: "[0, 12)" for [0, 4))
     std::vector<SampleRange> outside;
