@@ -6,6 +6,7 @@
 // scene file, the tables below hold a scene for it; a registry entry without one fails too.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <map>
 #include <set>
 #include <sstream>
@@ -238,6 +239,45 @@ TEST(Registry, NameLookups) {
                                            lucent::type_names<lucent::FilterType>() + ")");
   }
   EXPECT_STREQ(lucent::type_name(static_cast<lucent::LightType>(77)), "unknown");
+}
+
+}  // namespace
+
+namespace {
+
+// A program that includes lucent's headers gets the registry's type lists, not the kernel's
+// helper macros (LC_ENABLED, LC_PARAMS, LC_SCENE_BUFFERS, ... were defined in every such file),
+// and the headers compile clean under a strict consumer's warnings (-Wsign-conversion warned of
+// Image::pixel, clang's -Wcomma of types.hpp; the API tester's finds): each compiler found checks
+// a file that includes them all, as tests/package's consumer does in the installed tree.
+TEST(Registry, PublicHeadersLeaveNoKernelMacrosAndCompileCleanUnderStrictWarnings) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::test::write_file(dir + "/consumer.cpp", R"(#include <lucent/lucent.hpp>
+#if defined(LC_ENABLED) || defined(LC_ENABLED_1) || defined(LC_ON_1) || defined(LC_PARAMS) || \
+    defined(LC_OTHER_FEATURES) || defined(LC_SCENE_BUFFERS) || defined(LUCENT_REGISTRY_TYPES_ONLY)
+#error "a kernel helper macro of the registry is defined"
+#endif
+#ifndef LC_MATERIAL_TYPES
+#error "no type lists"
+#endif
+int main() {
+  lucent::Image image{1, 1, {0.5f, 0.5f, 0.5f}};
+  return image.pixel(0, 0)[0] > 0 && lucent::is_shape_light(lucent::LightType::Sphere) ? 0 : 1;
+}
+)");
+  int compilers = 0;
+  for (const std::string cxx : {"g++", "clang++"}) {
+    if (std::system(("command -v " + cxx + " >/dev/null 2>&1").c_str()) != 0) continue;
+    ++compilers;
+    const std::string log = dir + "/" + cxx + ".log";
+    const std::string cmd =
+        cxx + " -std=c++17 -fsyntax-only -Wall -Wextra -Wpedantic -Wshadow -Wsign-conversion " +
+        (cxx == "clang++" ? "-Wcomma " : "") +
+        "-Werror -I'" LUCENT_SOURCE_DIR "/include' -I'" LUCENT_BINARY_DIR "/generated/include' '" +
+        dir + "/consumer.cpp' >'" + log + "' 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cxx << ":\n" << lucent::test::read_file(log);
+  }
+  if (compilers == 0) GTEST_SKIP() << "neither g++ nor clang++ is installed";
 }
 
 }  // namespace

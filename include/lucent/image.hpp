@@ -1,4 +1,5 @@
 #pragma once
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -11,8 +12,13 @@ struct Image {
   int width = 0;
   int height = 0;
   std::vector<float> rgb;  ///< width * height * 3
-  float* pixel(int x, int y) { return &rgb[(static_cast<size_t>(y) * width + x) * 3]; }
-  const float* pixel(int x, int y) const { return &rgb[(static_cast<size_t>(y) * width + x) * 3]; }
+  // (every conversion spelt out: a consumer's -Wsign-conversion warned of this header)
+  float* pixel(int x, int y) {
+    return &rgb[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 3];
+  }
+  const float* pixel(int x, int y) const {
+    return &rgb[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 3];
+  }
 };
 
 /// How 8-bit outputs encode linear values.

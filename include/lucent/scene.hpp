@@ -7,7 +7,11 @@
 #include <string>
 #include <vector>
 
+// the registry's type lists alone: its kernel helper macros (LC_ENABLED, LC_PARAMS,
+// LC_SCENE_BUFFERS, ...) were defined in every file of a program that included lucent's headers
+#define LUCENT_REGISTRY_TYPES_ONLY
 #include "lucent/registry.h"
+#undef LUCENT_REGISTRY_TYPES_ONLY
 
 namespace lucent {
 

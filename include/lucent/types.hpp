@@ -154,7 +154,10 @@ constexpr double default_filter_radius(FilterType t) {
 /// shape type has the same file (kernels/geom/<file>.cl and kernels/light/<file>.cl).
 namespace detail {
 constexpr bool same_name(const char* a, const char* b) {
-  while (*a && *a == *b) ++a, ++b;
+  while (*a && *a == *b) {  // (no comma operator: clang's -Wcomma in a consumer's build)
+    ++a;
+    ++b;
+  }
   return *a == *b;
 }
 }  // namespace detail

@@ -27,27 +27,6 @@
 #ifndef LUCENT_SHARED_REGISTRY_H
 #define LUCENT_SHARED_REGISTRY_H
 
-/* LC_ENABLED(LC_HAS_X) is 1 when the feature define LC_HAS_X is set to 1 (as -D LC_HAS_X does;
- * a define in a source file must say `#define LC_HAS_X 1`) and 0 otherwise, so that generated
- * dispatch code can test a feature in an expression
- * (`if (LC_ENABLED(feature) && type == ...)`), which the compiler folds: a type that is not
- * enabled costs no code. The feature's expansion is pasted onto LC_ON_: a set feature gives
- * LC_ON_1, which is 1; one that is not set stays a name, LC_ON_LC_HAS_X, which
- * generated/features_off.cl (written by src/cl/kernel_source.cpp from every feature column and
- * LC_OTHER_FEATURES) defines as 0. Kernel code only: the kernel is OpenCL C 1.2, which has no
- * variadic macros (NVIDIA's compiler refuses them), so the Linux kernel's IS_ENABLED technique,
- * which needs one, is not used. */
-#define LC_ON_1 1
-#define LC_ENABLED(feature) LC_ENABLED_1(feature)
-#define LC_ENABLED_1(value) LC_ON_##value
-#ifdef __OPENCL_C_VERSION__
-#include "generated/features_off.cl"
-#endif
-
-/* The fields of a parameter struct, written inside one registry entry: declarations ending in
- * `;`, one name per declaration (no commas: the fields are one macro argument). */
-#define LC_PARAMS(fields) fields
-
 /* ------------------------------------------------------------------------------------------ */
 /* Materials: X(ID, Name, value, name, feature, file, params)                                  */
 /* The kernel's BSDF is kernels/bsdf/<file>.cl, the reference's src/reference/bsdf/<file>.cpp,  */
@@ -135,6 +114,38 @@
   X(SOBOL, Sobol, 0, "sobol", LC_HAS_SAMPLER_SOBOL, sobol) \
   X(INDEPENDENT, Independent, 1, "independent", LC_HAS_SAMPLER_INDEPENDENT, independent)
 
+#endif /* LUCENT_SHARED_REGISTRY_H */
+
+/* The kernel's and the library's part: its helper macros and the lists no public header uses.
+ * Left out where LUCENT_REGISTRY_TYPES_ONLY is defined, as lucent/scene.hpp defines it to include
+ * the type lists alone, so that a program that includes lucent's headers gets no LC_ENABLED,
+ * LC_PARAMS, LC_SCENE_BUFFERS, ... of the kernel's (they were defined in every such file). Its
+ * own guard: a library file that included lucent/scene.hpp first gets it when it includes this
+ * header. */
+#if !defined(LUCENT_REGISTRY_TYPES_ONLY) && !defined(LUCENT_SHARED_REGISTRY_KERNEL_PART)
+#define LUCENT_SHARED_REGISTRY_KERNEL_PART
+
+/* LC_ENABLED(LC_HAS_X) is 1 when the feature define LC_HAS_X is set to 1 (as -D LC_HAS_X does;
+ * a define in a source file must say `#define LC_HAS_X 1`) and 0 otherwise, so that generated
+ * dispatch code can test a feature in an expression
+ * (`if (LC_ENABLED(feature) && type == ...)`), which the compiler folds: a type that is not
+ * enabled costs no code. The feature's expansion is pasted onto LC_ON_: a set feature gives
+ * LC_ON_1, which is 1; one that is not set stays a name, LC_ON_LC_HAS_X, which
+ * generated/features_off.cl (written by src/cl/kernel_source.cpp from every feature column and
+ * LC_OTHER_FEATURES) defines as 0. Kernel code only: the kernel is OpenCL C 1.2, which has no
+ * variadic macros (NVIDIA's compiler refuses them), so the Linux kernel's IS_ENABLED technique,
+ * which needs one, is not used. */
+#define LC_ON_1 1
+#define LC_ENABLED(feature) LC_ENABLED_1(feature)
+#define LC_ENABLED_1(value) LC_ON_##value
+#ifdef __OPENCL_C_VERSION__
+#include "generated/features_off.cl"
+#endif
+
+/* The fields of a parameter struct, written inside one registry entry: declarations ending in
+ * `;`, one name per declaration (no commas: the fields are one macro argument). */
+#define LC_PARAMS(fields) fields
+
 /* ------------------------------------------------------------------------------------------ */
 /* Other kernel features: X(feature, what). With the type lists' feature column they make every   */
 /* feature define (src/render/features.cpp decides which a scene uses).                         */
@@ -167,4 +178,4 @@
   X(textures, lc_texture, "texture headers")                                 \
   X(texels, lc_float4, "texture texels")
 
-#endif /* LUCENT_SHARED_REGISTRY_H */
+#endif /* LUCENT_SHARED_REGISTRY_KERNEL_PART */

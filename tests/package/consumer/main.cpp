@@ -11,6 +11,14 @@
 #ifdef LUCENT_REGISTRY_ENUMERATOR
 #error "lucent/scene.hpp left LUCENT_REGISTRY_ENUMERATOR defined"
 #endif
+// nor the kernel's helper macros of lucent/registry.h: only its type lists
+#if defined(LC_ENABLED) || defined(LC_ENABLED_1) || defined(LC_ON_1) || defined(LC_PARAMS) || \
+    defined(LC_OTHER_FEATURES) || defined(LC_SCENE_BUFFERS) || defined(LUCENT_REGISTRY_TYPES_ONLY)
+#error "lucent's headers define the kernel's registry macros (LC_ENABLED, LC_PARAMS, ...)"
+#endif
+#ifndef LC_MATERIAL_TYPES
+#error "lucent/scene.hpp does not give the registry's type lists"
+#endif
 static_assert(sizeof(lucent::CompareOptions) > 0 && sizeof(lucent::ConvergeOptions) > 0 &&
                   sizeof(lucent::ReferenceOptions) > 0,
               "lucent/lucent.hpp includes compare.hpp, converge.hpp and reference.hpp");
