@@ -870,6 +870,62 @@ TEST(SceneJson, DefaultsWhenKeysAreLeftOut) {
             1.5);
 }
 
+// A C++ caller can take the library's warnings, as Python's on_warning does: load_scene,
+// parse_scene, SceneBuilder::add_obj (its OBJ and MTL files) and render_reference printed
+// "lucent: warning: ..." on stderr, with no way to capture or silence them (the API tester's
+// find). A ScopedWarningSink takes them on its thread while it lives (innermost first), and
+// ReferenceOptions::on_warning takes render_reference's before it.
+TEST(SceneJson, ScopedWarningSinkTakesTheLoadersAndTheReferencesWarnings) {
+  lucent::test::CaptureWarnings stderr_sink;  // the process-wide hook: stderr's stand-in
+  const std::string dir = lucent::test::temp_dir();
+  const std::string text = R"({"camera": {"position": [0, 0, 4], "focus_distance": 3},
+    "film": {"width": 4, "height": 4}, "materials": {"w": {"type": "diffuse"}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "w"}]})";
+  lucent::test::write_file(dir + "/s.json", text);
+  lucent::test::write_file(dir + "/x.obj",
+                           "mtllib nothere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string focus = "/camera/focus_distance: the aperture is 0";
+  std::vector<std::string> got;
+  Scene scene;
+  {
+    lucent::ScopedWarningSink sink([&](const std::string& w) { got.push_back(w); });
+    scene = lucent::parse_scene(text, "p.json");
+    ASSERT_EQ(got.size(), 1u);
+    EXPECT_EQ(got[0].find("p.json: " + focus), 0u) << got[0];
+    lucent::load_scene(dir + "/s.json");
+    ASSERT_EQ(got.size(), 2u);
+    EXPECT_EQ(got[1].find(dir + "/s.json: " + focus), 0u) << got[1];
+    lucent::SceneBuilder b("built");
+    b.add_obj({dir + "/x.obj", glm::dmat4(1.0), ""});
+    ASSERT_EQ(got.size(), 3u);
+    EXPECT_NE(got[2].find("material library 'nothere.mtl' not found"), std::string::npos) << got[2];
+    lucent::ReferenceOptions o;
+    o.spp = 1;
+    o.threads = 1;
+    lucent::render_reference(scene, o);
+    ASSERT_EQ(got.size(), 4u);
+    EXPECT_NE(got[3].find("the scene has no light"), std::string::npos) << got[3];
+    {
+      // nested: the inner sink takes them; a null one changes nothing
+      std::vector<std::string> inner;
+      lucent::ScopedWarningSink inner_sink([&](const std::string& w) { inner.push_back(w); });
+      lucent::ScopedWarningSink null_sink(nullptr);
+      lucent::parse_scene(text, "p.json");
+      EXPECT_EQ(inner.size(), 1u);
+    }
+    EXPECT_EQ(got.size(), 4u);
+    // render_reference's own sink before the thread's
+    std::vector<std::string> own;
+    o.on_warning = [&](const std::string& w) { own.push_back(w); };
+    lucent::render_reference(scene, o);
+    EXPECT_EQ(own.size(), 1u);
+    EXPECT_EQ(got.size(), 4u);
+  }
+  EXPECT_TRUE(stderr_sink.all().empty()) << stderr_sink.dump();
+  lucent::parse_scene(text, "p.json");  // the scope ended: stderr's again
+  EXPECT_EQ(stderr_sink.count(focus), 1) << stderr_sink.dump();
+}
+
 }  // namespace
 
 }  // namespace test_scene_json

@@ -16,3 +16,4 @@
 #include "lucent/session.hpp"
 #include "lucent/types.hpp"
 #include "lucent/version.hpp"
+#include "lucent/warnings.hpp"

@@ -16,6 +16,9 @@ struct ReferenceOptions {
   int spp = 0;      ///< samples per pixel; 0: the scene's integrator.spp
   int threads = 0;  ///< worker threads (rows are shared out); 0: the hardware's concurrency
   const std::atomic<bool>* cancel = nullptr;  ///< set to stop after the rows under way
+  /// Its warnings (a scene without lights, degenerate triangles skipped, ...); null: the calling
+  /// thread's ScopedWarningSink (lucent/warnings.hpp), else "lucent: warning: ..." on stderr.
+  WarningSink on_warning;
 };
 
 /// Renders `scene` with the reference integrator. The result has the same meaning as the

@@ -9,6 +9,7 @@
 
 #include "lucent/image.hpp"
 #include "lucent/scene.hpp"
+#include "lucent/warnings.hpp"
 
 namespace lucent {
 
@@ -39,15 +40,12 @@ const char* precision_name(Precision p);
 /// Parses "float" or "double"; throws lucent::Error naming `what` (e.g. "--precision") otherwise.
 Precision parse_precision(const std::string& text, const std::string& what = "--precision");
 
-/// Receives warnings (one line each, without the "lucent: warning: " prefix).
-using WarningSink = std::function<void(const std::string&)>;
-
 /// Options of the one-shot render() (a session's options, SessionOptions, plus the sample budget).
 struct RenderOptions {
   std::string device;      ///< selector, see select_device()
   std::string kernel_dir;  ///< "" : embedded kernel sources (see SessionOptions)
   std::string cache_dir;   ///< "" : the default cache directory; "off": none
-  WarningSink on_warning;  ///< null: stderr
+  WarningSink on_warning;  ///< null: the thread's ScopedWarningSink, else stderr
   int spp = 0;             ///< 0: the scene's integrator.spp, or with a time_limit unbounded
   double time_limit = 0;   ///< seconds; 0: none
   const std::atomic<bool>* cancel = nullptr;  ///< set to stop after the current pass

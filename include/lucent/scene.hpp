@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "lucent/warnings.hpp"
 // the registry's type lists alone: its kernel helper macros (LC_ENABLED, LC_PARAMS,
 // LC_SCENE_BUFFERS, ...) were defined in every file of a program that included lucent's headers
 #define LUCENT_REGISTRY_TYPES_ONLY
@@ -187,6 +188,8 @@ struct Scene {
 
 /// Loads a JSON scene (format: README.md, "Scene format"). Throws lucent::Error naming the file
 /// and the JSON path of the first problem (`scene.json: /shapes/3/radius: must be > 0, got -1`).
+/// Its warnings (a focus_distance without an aperture, an OBJ's missing MTL file, ...) go to the
+/// calling thread's ScopedWarningSink (lucent/warnings.hpp), else to stderr; parse_scene's too.
 Scene load_scene(const std::string& path);
 
 /// Parses a JSON scene held in memory; `path` is used for messages and relative file names.

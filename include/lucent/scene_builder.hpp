@@ -14,7 +14,9 @@
 //
 // Places: set_camera "/camera", set_film "/film", set_integrator "/integrator", add_material
 // "/materials/<name>", the n-th add_sphere / add_mesh / add_obj "/shapes/<n>", the n-th add_light
-// "/lights/<n>", the n-th add_texture "/textures/<n>" (0-based, in call order).
+// "/lights/<n>", the n-th add_texture "/textures/<n>" (0-based, in call order). Warnings (add_obj's
+// missing MTL file or texture, ...) go to the calling thread's ScopedWarningSink
+// (lucent/warnings.hpp), else to stderr.
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <map>

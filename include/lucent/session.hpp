@@ -60,7 +60,8 @@ struct SessionOptions {
   /// What reserved_host_bytes holds, for the error that refuses a film (empty: "what the
   /// application keeps beside the session (its outputs, as it declared them)").
   std::string reserved_host_what;
-  /// Warnings of scene packing (skipped triangles, ...); null: "lucent: warning: ..." on stderr.
+  /// Warnings of scene packing (skipped triangles, ...); null: to the calling thread's
+  /// ScopedWarningSink (lucent/warnings.hpp), else "lucent: warning: ..." on stderr.
   /// A session gives each warning about its scenes once, however often set_scene meets it.
   WarningSink on_warning;
 

@@ -38,6 +38,7 @@ bool square_fits_float(const glm::dvec3& v) {
 }  // namespace
 
 RenderResult render_reference(const Scene& scene, const ReferenceOptions& options) {
+  scene_detail::ScopedWarningSink sink(options.on_warning);
   scene_detail::validate_scene(scene);  // fields set directly may not have been checked
   for (const std::string& note : scene_detail::energy_gain_notes(scene)) scene_detail::warn(note);
   for (const std::string& note : scene_detail::light_notes(scene)) scene_detail::warn(note);

@@ -1,4 +1,5 @@
 #include <cstdio>
+#include <utility>
 
 #include "core/text.hpp"
 #include "scene/loaders.hpp"
@@ -28,3 +29,14 @@ ScopedWarningSink::ScopedWarningSink(const std::function<void(const std::string&
 ScopedWarningSink::~ScopedWarningSink() { t_sink = previous_; }
 
 }  // namespace lucent::scene_detail
+
+namespace lucent {
+
+// (the public scope: its own copy of the sink, which a caller's temporary lambda may be)
+ScopedWarningSink::ScopedWarningSink(WarningSink sink)
+    : sink_(std::move(sink)), previous_(scene_detail::t_sink) {
+  if (sink_) scene_detail::t_sink = &sink_;
+}
+ScopedWarningSink::~ScopedWarningSink() { scene_detail::t_sink = previous_; }
+
+}  // namespace lucent

@@ -102,6 +102,18 @@ int main() {
     }
     if (message != "consumer.json: /shapes/0/material: unknown material 'white'")
       return fail("the builder's error is not the loader's line");
+
+    // the library's warnings reach a ScopedWarningSink (lucent/warnings.hpp), not stderr
+    std::string warning;
+    {
+      lucent::ScopedWarningSink sink([&](const std::string& w) { warning = w; });
+      lucent::parse_scene(R"({"camera": {"position": [0, 0, 4], "focus_distance": 3},
+        "materials": {"w": {"type": "diffuse"}},
+        "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "w"}]})",
+                          "warned.json");
+    }
+    if (warning.find("warned.json: /camera/focus_distance: the aperture is 0") != 0)
+      return fail("parse_scene's warning did not reach the ScopedWarningSink");
   } catch (const lucent::Error& e) {
     return fail(e.what());
   }
