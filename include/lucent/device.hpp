@@ -30,7 +30,7 @@ std::vector<DeviceInfo> list_devices();
 DeviceInfo select_device(const std::string& selector = "", const std::string& origin = "--device");
 
 /// Several devices: "all" (every device), or a comma-separated list of selectors, each as for
-/// select_device ("0,2", "nvidia,cpu"; a device may be listed twice); a single selector gives
+/// select_device ("0,2", "nvidia,pthread"; a device may be listed twice); a single selector gives
 /// one device. Throws lucent::Error naming the selector that matches nothing, or an empty one.
 std::vector<DeviceInfo> select_devices(const std::string& selectors,
                                        const std::string& origin = "--device");

@@ -38,9 +38,9 @@ class CancelScope;  // src/render/cancel_scope.hpp
 struct SessionOptions {
   /// Device selector: an index from list_devices() or a case-insensitive substring of a device
   /// name; "" picks the first GPU, else the first CPU device. Several devices: a comma-separated
-  /// list of selectors ("0,2", "nvidia,cpu"), or "all" for every device; they share each render's
-  /// passes (each device takes the next pass when it is done, its pass size tuned to its speed)
-  /// into one accumulation. A device listed twice opens two contexts on it.
+  /// list of selectors ("0,2", "nvidia,pthread"), or "all" for every device; they share each
+  /// render's passes (each device takes the next pass when it is done, its pass size tuned to its
+  /// speed) into one accumulation. A device listed twice opens two contexts on it.
   std::string device;
   /// Kernel sources: "" uses the copy embedded in the library; a directory loads kernels/ files
   /// from there instead (kernel development without rebuilding).
