@@ -1119,22 +1119,36 @@ void bind_render(py::module_& m) {
 
   m.def(
       "render_reference",
-      [](const Scene& scene, const IntArg& spp, const IntArg& threads_arg) {
+      [](const Scene& scene, const IntArg& spp, const IntArg& threads_arg, py::object on_warning) {
         const int threads = static_cast<int>(
             int_argument(threads_arg, "threads", 0, std::numeric_limits<int>::max()));
+        check_callable(on_warning, "on_warning");
         Scene copy = scene;
         std::atomic<bool> cancel{false};
         ReferenceOptions o;
         o.spp = static_cast<int>(int_argument(spp, "spp", 0, std::uint64_t(1) << 30));
         o.threads = threads;
         o.cancel = &cancel;
+        // its warnings (no light, energy notes) to Python, as converge's: they went to stderr
+        auto warning_errors = std::make_shared<CallbackErrors>();
+        CallerQueue* queue = nullptr;  // (the call's: warnings come from its worker thread)
+        o.on_warning = python_warning_sink(SharedObject(std::move(on_warning)), warning_errors,
+                                           &queue, &cancel);
         RenderResult out;
-        run_interruptible([&] { out = render_reference(copy, o); }, cancel);
+        run_interruptible(
+            [&] {
+              queue = t_caller_queue;
+              out = render_reference(copy, o);
+            },
+            cancel);
+        warning_errors->rethrow();
         return out;
       },
       py::arg("scene"), py::arg("spp") = 0, py::arg("threads") = 0,
+      py::arg("on_warning") = py::none(),
       "Renders with the scalar double-precision reference integrator (spp 0: the scene's; "
-      "threads 0: all cores). Ctrl-C stops it and raises KeyboardInterrupt.");
+      "threads 0: all cores). Ctrl-C stops it and raises KeyboardInterrupt. Its warnings go to "
+      "on_warning(message), or warnings.warn(message, LucentWarning) when None.");
 
   py::class_<ConvergePoint>(m, "ConvergePoint", "One rung of a convergence ladder.")
       .def_readonly("setting", &ConvergePoint::setting)

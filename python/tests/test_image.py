@@ -95,6 +95,22 @@ def test_result_from_arrays():
         lucent.RenderResult(constant(1.0), samples=np.ones((5, 4)))
 
 
+def test_reference_warnings_reach_python(small_scene, capfd):
+    """render_reference's warnings (here: a scene without light) are Python warnings, or go to
+    on_warning; they were printed to stderr, out of the caller's reach."""
+    small_scene.lights = []
+    for m in small_scene.materials:
+        m.emission = (0, 0, 0)
+    with pytest.warns(lucent.LucentWarning, match="no light"):
+        lucent.render_reference(small_scene, spp=1)
+    got = []
+    lucent.render_reference(small_scene, spp=1, on_warning=got.append)
+    assert len(got) == 1 and "no light" in got[0], got
+    assert "no light" not in capfd.readouterr().err
+    with pytest.raises(TypeError, match="on_warning"):
+        lucent.render_reference(small_scene, spp=1, on_warning=3)
+
+
 def test_compare_kernel_against_the_reference(small_scene):
     """The kernel and the independent reference integrator agree on the small scene (the
     z-test of `lucent compare`), and a 30% albedo change is detected (negative control)."""
