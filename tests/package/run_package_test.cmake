@@ -102,16 +102,5 @@ endif()
 # the Python module, when it was built: installed where PYTHON_INSTALL_DIR says, imported from
 # there by the interpreter it was built for
 if(PYTHON_EXECUTABLE AND PYTHON_INSTALL_DIR)
-  set(module_dir ${WORK_DIR}/prefix/${PYTHON_INSTALL_DIR})
-  file(GLOB module ${module_dir}/lucent*.so)
-  if(NOT module)
-    message(FATAL_ERROR "the Python module is not installed in ${module_dir}")
-  endif()
-  execute_process(COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${module_dir}
-                          ${PYTHON_EXECUTABLE} ${SOURCE_DIR}/tests/package/check_python.py
-                          ${WORK_DIR}/prefix ${VERSION}
-                  WORKING_DIRECTORY ${WORK_DIR} RESULT_VARIABLE rc)
-  if(rc)
-    message(FATAL_ERROR "importing the installed Python module failed: ${rc}")
-  endif()
+  include(${CMAKE_CURRENT_LIST_DIR}/python_module_check.cmake)
 endif()
