@@ -83,6 +83,34 @@ TEST(Features, EachUsedFeatureAppears) {
     EXPECT_FALSE(has(f, not_want)) << not_want;
 }
 
+// A texture mapped otherwise than by default (a wrap mode other than repeat, a uv scale or
+// offset) compiles the mapping code (LC_HAS_TEXTURE_MAPPING, kernels/texture/texture.cl); a
+// texture mapped by default, or a mapped material no shape uses, does not.
+TEST(Features, TextureMappingOnlyWhereAUsedMaterialMapsItsTexture) {
+  lucent::Scene s;
+  s.textures.push_back(lucent::texture_from_rgba(1, 1, {0.5f, 0.5f, 0.5f, 1}));
+  lucent::Material plain, clamped;
+  plain.name = "plain";
+  plain.albedo_texture = 0;
+  clamped = plain;
+  clamped.name = "clamped";
+  clamped.albedo_wrap_v = lucent::TextureWrap::Clamp;
+  s.materials = {plain, clamped};
+  s.spheres.push_back({{0, 0, 0}, 1, 0});
+  auto features = [&] {
+    return lucent::render_detail::scene_features(s, lucent::render_detail::pack_scene(s));
+  };
+  EXPECT_TRUE(has(features(), "LC_HAS_TEXTURES"));
+  EXPECT_FALSE(has(features(), "LC_HAS_TEXTURE_MAPPING"));
+  s.spheres[0].material = 1;
+  EXPECT_TRUE(has(features(), "LC_HAS_TEXTURE_MAPPING"));
+  s.materials[1].albedo_wrap_v = lucent::TextureWrap::Repeat;
+  s.materials[1].albedo_uv_offset = {0.5, 0};
+  EXPECT_TRUE(has(features(), "LC_HAS_TEXTURE_MAPPING"));
+  s.materials[1].albedo_texture = -1;  // a mapping without a texture maps nothing
+  EXPECT_FALSE(has(features(), "LC_HAS_TEXTURE_MAPPING"));
+}
+
 TEST(Features, FullKernelHasEveryFeatureAndRendersTheSameImage) {
   lucent::Scene s = lucent::parse_scene(kDiffuseScene, "features.json");
   lucent::RenderOptions spec, full;

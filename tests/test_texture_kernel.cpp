@@ -22,10 +22,17 @@ namespace {
 
 struct Probe {
   lucent::cl_util::Context ctx{lucent::test::device()};
-  cl::Program program = lucent::cl_util::build_program(
-      ctx,
-      lucent::detail::assemble_kernel_source("test/texture_probe.cl", lucent::test::kernel_dir()),
-      "-cl-std=CL1.2");
+  std::string source =
+      lucent::detail::assemble_kernel_source("test/texture_probe.cl", lucent::test::kernel_dir());
+  cl::Program program = lucent::cl_util::build_program(ctx, source, "-cl-std=CL1.2");
+  /// with the texture mapping (wrap modes, uv scale and offset) compiled in
+  cl::Program mapped_program;
+  cl::Program& mapped() {
+    if (mapped_program() == nullptr)
+      mapped_program =
+          lucent::cl_util::build_program(ctx, source, "-cl-std=CL1.2 -D LC_HAS_TEXTURE_MAPPING");
+    return mapped_program;
+  }
 };
 
 Probe& probe() {
@@ -51,7 +58,8 @@ struct Query {
   float u, v;
 };
 
-std::vector<cl_float4> lookup(const lucent::Scene& scene, const std::vector<Query>& q) {
+std::vector<cl_float4> lookup(const lucent::Scene& scene, const std::vector<Query>& q,
+                              bool mapping = false) {
   lucent::render_detail::PackedScene packed = lucent::render_detail::pack_scene(scene);
   Probe& p = probe();
   std::vector<cl_int> index;
@@ -70,7 +78,7 @@ std::vector<cl_float4> lookup(const lucent::Scene& scene, const std::vector<Quer
   cl::Buffer b_uv(c, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, uv.size() * sizeof(cl_float2),
                   uv.data());
   cl::Buffer b_out(c, CL_MEM_WRITE_ONLY, q.size() * sizeof(cl_float4));
-  cl::Kernel k(p.program, "probe_texture_lookup");
+  cl::Kernel k(mapping ? p.mapped() : p.program, "probe_texture_lookup");
   lucent::test::set_args(k, 0, b_tex, b_texels, b_index, b_uv, b_out);
   lucent::test::launch_probe(p.ctx.queue, k, q.size());
   std::vector<cl_float4> out = lucent::test::read_back<cl_float4>(p.ctx.queue, b_out, q.size());
@@ -240,5 +248,195 @@ TEST(TextureKernel, ReferenceLookupMatchesTheKernelAtNonFiniteUvs) {
   const glm::dvec3 at_zero = lucent::ref::texture_rgb(s.textures[1], {0.0, 0.3});
   for (int c = 0; c < 3; ++c) EXPECT_EQ(at_nan[c], at_zero[c]);
 }
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Texture mapping (docs/rendering-model.md, "Textures"): a material reads its texture at
+// uv * scale + offset, wrapped in u and v by repeat, clamp (to edge) or mirror. The cases below
+// name the texel a lookup must give by hand: a lookup at a texel's centre gives that texel, and
+// the wrap modes put texel centres outside [0, 1] where the closed forms say (clamp: the edge
+// texel; mirror: period 2, [1, 2] the image backwards; repeat: period 1).
+
+using lucent::TextureWrap;
+constexpr TextureWrap kRepeat = TextureWrap::Repeat, kClamp = TextureWrap::Clamp,
+                      kMirror = TextureWrap::Mirror;
+
+struct Mapping {
+  TextureWrap wu, wv;
+  double su, sv, ou, ov;
+};
+
+// the centre of column x and row y (from the top) of texture 1 (3 x 5) in texture space
+double cu(int x) { return (x + 0.5) / 3; }
+double cv(int y) { return 1 - (y + 0.5) / 5; }
+
+struct MappedCase {
+  Mapping m;
+  double tu, tv;  ///< where the lookup lands in texture space (uv * scale + offset)
+  int x, y;       ///< the texel it must give (-1: the half-and-half mix of columns 2 and 0)
+};
+
+const MappedCase kMappedCases[] = {
+    // clamp: every coordinate beyond an edge reads the edge texel
+    {{kClamp, kClamp, 1, 1, 0, 0}, cu(1), 7.0, 1, 0},
+    {{kClamp, kClamp, 1, 1, 0, 0}, -2.3, cv(3), 0, 3},
+    {{kClamp, kClamp, 1, 1, 0, 0}, 5.1, -0.4, 2, 4},
+    {{kClamp, kClamp, 1, 1, 0, 0}, 1e5, -1e5, 2, 4},
+    {{kClamp, kClamp, 1, 1, 0, 0}, 0.0, 1.0, 0, 0},  // the corner: no mix with the far edge
+    // mirror: [1, 2] is [0, 1] backwards, period 2 both ways
+    {{kMirror, kMirror, 1, 1, 0, 0}, 2 - cu(0), cv(1), 0, 1},
+    {{kMirror, kMirror, 1, 1, 0, 0}, -cu(2), 2 + cv(4), 2, 4},
+    {{kMirror, kMirror, 1, 1, 0, 0}, 4 - cu(1), -cv(3), 1, 3},
+    {{kMirror, kMirror, 1, 1, 0, 0}, -3 + cu(0), cv(2), 2, 2},
+    {{kMirror, kMirror, 1, 1, 0, 0}, 0.0, 0.0, 0, 4},  // an edge reads its own texel both sides
+    {{kMirror, kMirror, 1, 1, 0, 0}, 1.0, 1.0, 2, 0},
+    // each axis its own mode: u repeats, v clamps
+    {{kRepeat, kClamp, 1, 1, 0, 0}, cu(1) + 5, 9.0, 1, 0},
+    {{kRepeat, kClamp, 1, 1, 0, 0}, cu(2) - 3, -9.0, 2, 4},
+    {{kRepeat, kClamp, 1, 1, 0, 0}, 0.0, cv(2), -1, 2},  // u = 0 still mixes the far column
+    // scales (negative: the image mirrored) and offsets (large: reduced by whole periods)
+    {{kRepeat, kRepeat, 2, -3, 0.25, 0.5}, cu(0) + 1, cv(2) - 2, 0, 2},
+    {{kRepeat, kRepeat, 2, -3, 0.25, 0.5}, cu(2) - 4, cv(4) + 7, 2, 4},
+    {{kClamp, kClamp, 0.5, 4, -0.25, 0.1}, cu(2), cv(1), 2, 1},
+    {{kClamp, kClamp, 0.5, 4, -0.25, 0.1}, -1.0, 3.0, 0, 0},
+    {{kMirror, kMirror, -1.5, 0.75, 3.5, -7.25}, 2 - cu(1), cv(0) + 2, 1, 0},
+    {{kMirror, kMirror, -1.5, 0.75, 3.5, -7.25}, -cu(0), -cv(3), 0, 3},
+    {{kRepeat, kRepeat, 1, 1, 1000.25, -999.5}, cu(1) + 1000, cv(3) - 999, 1, 3},
+};
+
+lucent::Material mapped_material(const Mapping& m, int texture) {
+  lucent::Material mat;
+  mat.name = "mapped";
+  mat.albedo_texture = texture;
+  mat.albedo_wrap_u = m.wu;
+  mat.albedo_wrap_v = m.wv;
+  mat.albedo_uv_scale = {m.su, m.sv};
+  mat.albedo_uv_offset = {m.ou, m.ov};
+  return mat;
+}
+
+// The uv at which a case's lookup lands where it says.
+glm::dvec2 case_uv(const MappedCase& c) {
+  return {(c.tu - c.m.ou) / c.m.su, (c.tv - c.m.ov) / c.m.sv};
+}
+
+std::vector<float> case_value(const lucent::Texture& t, const MappedCase& c) {
+  if (c.x >= 0) return host_texel(t, c.x, c.y);
+  std::vector<float> r(4);
+  for (int k = 0; k < 4; ++k) r[k] = 0.5f * (host_texel(t, 2, c.y)[k] + host_texel(t, 0, c.y)[k]);
+  return r;
+}
+
+std::string case_name(const MappedCase& c) {
+  return std::string("wrap ") + lucent::texture_wrap_name(c.m.wu) + "/" +
+         lucent::texture_wrap_name(c.m.wv) + " scale (" + std::to_string(c.m.su) + ", " +
+         std::to_string(c.m.sv) + ") offset (" + std::to_string(c.m.ou) + ", " +
+         std::to_string(c.m.ov) + ") at texture-space (" + std::to_string(c.tu) + ", " +
+         std::to_string(c.tv) + ")";
+}
+
+// three_textures() and a material per case mapping texture 1; the device texture each material's
+// lookups read (pack_scene's header for its mapping) in `index`.
+lucent::Scene mapped_scene(std::vector<int>& index) {
+  lucent::Scene s = three_textures();
+  for (const MappedCase& c : kMappedCases) s.materials.push_back(mapped_material(c.m, 1));
+  lucent::render_detail::PackedScene packed = lucent::render_detail::pack_scene(s);
+  index.clear();
+  for (const lc_material& m : packed.materials) index.push_back(m.p.diffuse.albedo_tex);
+  return s;
+}
+
+TEST(TextureKernel, WrapModesScalesAndOffsetsGiveTheClosedFormsTexels) {
+  std::vector<int> index;
+  lucent::Scene s = mapped_scene(index);
+  std::vector<Query> q;
+  for (std::size_t i = 0; i < std::size(kMappedCases); ++i) {
+    const glm::dvec2 uv = case_uv(kMappedCases[i]);
+    q.push_back({index[i], float(uv.x), float(uv.y)});
+  }
+  std::vector<cl_float4> got = lookup(s, q, true);
+  for (std::size_t i = 0; i < q.size(); ++i)
+    expect_value(got[i], case_value(s.textures[1], kMappedCases[i]), case_name(kMappedCases[i]));
+}
+
+TEST(TextureKernel, ReferenceWrapModesScalesAndOffsetsGiveTheClosedFormsTexels) {
+  const lucent::Texture t = three_textures().textures[1];
+  for (const MappedCase& c : kMappedCases) {
+    const glm::dvec3 got =
+        lucent::ref::texture_rgb(t, case_uv(c), c.m.wu, c.m.wv, {c.m.su, c.m.sv}, {c.m.ou, c.m.ov});
+    const std::vector<float> want = case_value(t, c);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], 1e-9) << case_name(c);
+  }
+}
+
+// Between texel centres too: the kernel (texel indices wrapped) and the reference (coordinates
+// folded into [0, 1], then clamped) agree on a grid of uvs over [-2.2, 2.2]^2 for every case's
+// mapping. Every mode's lookup is continuous in uv, so float and double differ by rounding only.
+TEST(TextureKernel, MappedLookupsMatchTheReferenceBetweenTexelCentres) {
+  std::vector<int> index;
+  lucent::Scene s = mapped_scene(index);
+  std::vector<Query> q;
+  std::vector<std::size_t> which;
+  for (std::size_t i = 0; i < std::size(kMappedCases); ++i)
+    for (double u = -2.2; u <= 2.2; u += 0.37)
+      for (double v = -2.2; v <= 2.2; v += 0.29) {
+        q.push_back({index[i], float(u), float(v)});
+        which.push_back(i);
+      }
+  std::vector<cl_float4> got = lookup(s, q, true);
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    const Mapping& m = kMappedCases[which[i]].m;
+    const glm::dvec3 ref = lucent::ref::texture_rgb(s.textures[1], {q[i].u, q[i].v}, m.wu, m.wv,
+                                                    {m.su, m.sv}, {m.ou, m.ov});
+    for (int k = 0; k < 3; ++k)
+      ASSERT_NEAR(got[i].s[k], ref[k], 2e-3)
+          << case_name(kMappedCases[which[i]]) << " uv (" << q[i].u << ", " << q[i].v << ")";
+  }
+}
+
+// The default mapping is today's lookup to the bit: a kernel built with the mapping code reads a
+// texture mapped by default (its header's scale 1, offset 0, repeat) as the kernel without it.
+TEST(TextureKernel, DefaultMappingIsTheRepeatLookupToTheBit) {
+  lucent::Scene s = three_textures();
+  std::vector<Query> q;
+  for (int id = 0; id < 3; ++id)
+    for (float u = -3.1f; u < 3.2f; u += 0.173f)
+      for (float v = -2.9f; v < 3.0f; v += 0.231f) q.push_back({id, u, v});
+  std::vector<cl_float4> plain = lookup(s, q, false), mapped = lookup(s, q, true);
+  for (std::size_t i = 0; i < q.size(); ++i)
+    for (int c = 0; c < 4; ++c)
+      ASSERT_EQ(plain[i].s[c], mapped[i].s[c]) << "uv (" << q[i].u << ", " << q[i].v << ")";
+}
+
+// An image is held once however its materials map it: a header per (texture, mapping), on the
+// same texels; the scene's textures keep their indices (mapped by default: environment maps and
+// default materials read them).
+TEST(TextureKernel, MappedTexturesShareTheirTexels) {
+  lucent::Scene s = three_textures();
+  const Mapping clamp{kClamp, kClamp, 1, 1, 0, 0}, scaled{kRepeat, kMirror, 2, 2, 0.5, 0};
+  s.materials = {mapped_material(clamp, 1), mapped_material(scaled, 1), mapped_material(clamp, 1),
+                 mapped_material({kRepeat, kRepeat, 1, 1, 0, 0}, 1), mapped_material(clamp, 0)};
+  const lucent::render_detail::PackedScene p = lucent::render_detail::pack_scene(s);
+  ASSERT_EQ(p.texels.size(), 4u * 2 + 3 * 5 + 1);
+  ASSERT_EQ(p.textures.size(), 3u + 3);  // the scene's three, then clamp-1, scaled-1, clamp-0
+  std::vector<int> tex;
+  for (const lc_material& m : p.materials) tex.push_back(m.p.diffuse.albedo_tex);
+  EXPECT_EQ(tex, (std::vector<int>{3, 4, 3, 1, 5}));
+  for (int i : {1, 3, 4}) EXPECT_EQ(p.textures[i].offset, p.textures[1].offset) << i;
+  EXPECT_EQ(p.textures[5].offset, p.textures[0].offset);
+  EXPECT_EQ(p.textures[3].wrap, LC_WRAP_CLAMP | (LC_WRAP_CLAMP << LC_WRAP_V_SHIFT));
+  EXPECT_EQ(p.textures[4].wrap, LC_WRAP_REPEAT | (LC_WRAP_MIRROR << LC_WRAP_V_SHIFT));
+  EXPECT_EQ(p.textures[4].uv_scale[0], 2.0f);
+  EXPECT_EQ(p.textures[4].uv_offset[0], 0.5f);
+  for (int i : {0, 1, 2}) {
+    EXPECT_EQ(p.textures[i].wrap, 0u) << i;
+    EXPECT_EQ(p.textures[i].uv_scale[0], 1.0f) << i;
+    EXPECT_EQ(p.textures[i].uv_scale[1], 1.0f) << i;
+    EXPECT_EQ(p.textures[i].uv_offset[0], 0.0f) << i;
+  }
+}
+
+}  // namespace
 
 }  // namespace test_texture_kernel

@@ -104,16 +104,38 @@ struct Integrator {
 
 enum class MaterialType { LC_MATERIAL_TYPES(LUCENT_REGISTRY_ENUMERATOR) };
 
+/// How a texture coordinate outside [0, 1] reads the image (docs/rendering-model.md,
+/// "Textures"): repeat (the image tiles), clamp (clamp to edge: the border texels extend) or
+/// mirror (tiles, every other one mirrored). The values are the kernel's LC_WRAP_*.
+enum class TextureWrap { Repeat, Clamp, Mirror };
+
+/// The scene format's names of the wrap modes ("repeat", "clamp", "mirror").
+inline const char* texture_wrap_name(TextureWrap w) {
+  return w == TextureWrap::Repeat ? "repeat" : w == TextureWrap::Clamp ? "clamp" : "mirror";
+}
+
 struct Material {
   std::string name;
   MaterialType type = MaterialType::Diffuse;
   glm::dvec3 albedo{0.8, 0.8, 0.8};
   int albedo_texture = -1;  ///< index into Scene::textures, -1 for none
+  /// How the albedo texture covers the surface: it is read at uv' = uv * albedo_uv_scale +
+  /// albedo_uv_offset, wrapped in u and v by albedo_wrap_u and albedo_wrap_v (the defaults read
+  /// the image once per uv unit, repeating). Unused without a texture.
+  TextureWrap albedo_wrap_u = TextureWrap::Repeat;
+  TextureWrap albedo_wrap_v = TextureWrap::Repeat;
+  glm::dvec2 albedo_uv_scale{1, 1};
+  glm::dvec2 albedo_uv_offset{0, 0};
   glm::dvec3 emission{0, 0, 0};
   glm::dvec3 specular{1, 1, 1};  ///< mirror reflectance / glass tint / glossy F0 colour
   double ior = 1.5;
   double roughness = 0.1;  ///< GGX alpha
   bool emissive() const { return emission.x > 0 || emission.y > 0 || emission.z > 0; }
+  /// The albedo texture is read as by default: repeating, uv as given.
+  bool default_albedo_mapping() const {
+    return albedo_wrap_u == TextureWrap::Repeat && albedo_wrap_v == TextureWrap::Repeat &&
+           albedo_uv_scale == glm::dvec2(1, 1) && albedo_uv_offset == glm::dvec2(0, 0);
+  }
 };
 
 struct Sphere {

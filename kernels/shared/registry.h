@@ -150,13 +150,14 @@
 /* Other kernel features: X(feature, what). With the type lists' feature column they make every   */
 /* feature define (src/render/features.cpp decides which a scene uses).                         */
 /* ------------------------------------------------------------------------------------------ */
-#define LC_OTHER_FEATURES(X)                                            \
-  X(LC_HAS_SMOOTH_NORMALS, "interpolated vertex normals")               \
-  X(LC_HAS_UVS, "texture coordinates of triangles")                     \
-  X(LC_HAS_TEXTURES, "textured materials")                              \
-  X(LC_HAS_THIN_LENS, "thin-lens depth of field")                       \
-  X(LC_HAS_CLAMP, "clamped path contributions (integrator.clamp)")      \
-  X(LC_HAS_CAUSTICS, "caustics by light tracing (integrator.caustics)") \
+#define LC_OTHER_FEATURES(X)                                             \
+  X(LC_HAS_SMOOTH_NORMALS, "interpolated vertex normals")                \
+  X(LC_HAS_UVS, "texture coordinates of triangles")                      \
+  X(LC_HAS_TEXTURES, "textured materials")                               \
+  X(LC_HAS_TEXTURE_MAPPING, "texture wrap modes, uv scales and offsets") \
+  X(LC_HAS_THIN_LENS, "thin-lens depth of field")                        \
+  X(LC_HAS_CLAMP, "clamped path contributions (integrator.clamp)")       \
+  X(LC_HAS_CAUSTICS, "caustics by light tracing (integrator.caustics)")  \
   X(LC_HAS_SPLITTING, "both lobes of smooth glass on camera paths (integrator.dielectric_splits)")
 
 /* ------------------------------------------------------------------------------------------ */

@@ -273,15 +273,26 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_light, pdf_select) == 4, light_pdf_select);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_light, p) == 16, light_params);
 
 /* ------------------------------------------------------------------------------------------ */
-/* Textures: texels of every texture packed into one float4 buffer (linear RGBA).             */
+/* Textures: texels of every texture packed into one float4 buffer (linear RGBA). A header per */
+/* (image, mapping): an image several materials map differently has several headers with the  */
+/* same texels; the first ones, one per scene texture, map it by default (environment maps).  */
+/* The mapping is read only with LC_HAS_TEXTURE_MAPPING (texture/texture.cl).                 */
 /* ------------------------------------------------------------------------------------------ */
+/* wrap modes (lucent::TextureWrap): lc_texture.wrap holds u's in bits 0-7, v's in bits 8-15 */
+#define LC_WRAP_REPEAT 0u
+#define LC_WRAP_CLAMP 1u
+#define LC_WRAP_MIRROR 2u
+#define LC_WRAP_V_SHIFT 8u
 typedef struct LC_ALIGN16 lc_texture {
-  lc_uint offset; /* first texel in the texel buffer */
+  lc_uint offset; /* first texel in the texel buffer                             */
   lc_uint width;
   lc_uint height;
-  lc_uint pad;
-} lc_texture; /* total: 16 bytes */
-LC_STATIC_ASSERT(sizeof(lc_texture) == 16, texture_size);
+  lc_uint wrap;      /* LC_WRAP_* of u | LC_WRAP_* of v << LC_WRAP_V_SHIFT           */
+  float uv_scale[2]; /* the lookup reads uv * uv_scale + uv_offset, then wraps it     */
+  float uv_offset[2];
+} lc_texture; /* total: 32 bytes */
+LC_STATIC_ASSERT(sizeof(lc_texture) == 32, texture_size);
+LC_STATIC_ASSERT(LC_OFFSETOF(lc_texture, uv_scale) == 16, texture_uv_scale);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Camera and launch parameters                                                               */

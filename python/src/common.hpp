@@ -276,6 +276,8 @@ const EnumNames<Transfer>& enum_names<Transfer>();
 template <>
 const EnumNames<ToneMap>& enum_names<ToneMap>();
 template <>
+const EnumNames<TextureWrap>& enum_names<TextureWrap>();
+template <>
 const EnumNames<Precision>& enum_names<Precision>();
 
 /// The registry name of `value`.

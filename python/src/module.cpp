@@ -80,6 +80,15 @@ const EnumNames<ToneMap>& enum_names<ToneMap>() {
   return t;
 }
 template <>
+const EnumNames<TextureWrap>& enum_names<TextureWrap>() {
+  static const EnumNames<TextureWrap> t{
+      "wrap mode",
+      {{TextureWrap::Repeat, texture_wrap_name(TextureWrap::Repeat)},
+       {TextureWrap::Clamp, texture_wrap_name(TextureWrap::Clamp)},
+       {TextureWrap::Mirror, texture_wrap_name(TextureWrap::Mirror)}}};
+  return t;
+}
+template <>
 const EnumNames<Precision>& enum_names<Precision>() {
   static const EnumNames<Precision> t{"precision",
                                       {{Precision::Float, "float"}, {Precision::Double, "double"}}};
@@ -694,6 +703,7 @@ PYBIND11_MODULE(lucent, m) {
   m.attr("SAMPLERS") = enum_name_tuple<SamplerType>();
   m.attr("TRANSFERS") = enum_name_tuple<Transfer>();
   m.attr("TONEMAPS") = enum_name_tuple<ToneMap>();
+  m.attr("TEXTURE_WRAPS") = enum_name_tuple<TextureWrap>();
 
   py::class_<DeviceInfo>(m, "DeviceInfo", "An OpenCL device, as `lucent devices` lists it.")
       .def_readonly("index", &DeviceInfo::index)

@@ -332,6 +332,7 @@ void set_texture_texels(py::handle self, py::handle value) {
 // ------------------------------------------------------------------------------------------
 
 py::tuple vec_state(const glm::dvec3& v) { return py::make_tuple(v.x, v.y, v.z); }
+py::tuple vec_state(const glm::dvec2& v) { return py::make_tuple(v.x, v.y); }
 py::tuple triple_state(const int (&v)[3]) { return py::make_tuple(v[0], v[1], v[2]); }
 
 /// Each pickled class's state (`state`) and the value a state gives back (`from`, ValueError
@@ -457,6 +458,10 @@ struct Pickled<Material> {
     d["type"] = enum_name(m.type);
     d["albedo"] = vec_state(m.albedo);
     d["albedo_texture"] = m.albedo_texture;
+    d["albedo_wrap_u"] = enum_name(m.albedo_wrap_u);
+    d["albedo_wrap_v"] = enum_name(m.albedo_wrap_v);
+    d["albedo_uv_scale"] = vec_state(m.albedo_uv_scale);
+    d["albedo_uv_offset"] = vec_state(m.albedo_uv_offset);
     d["emission"] = vec_state(m.emission);
     d["specular"] = vec_state(m.specular);
     d["ior"] = m.ior;
@@ -470,6 +475,10 @@ struct Pickled<Material> {
     m.type = r.name<MaterialType>("type");
     m.albedo = r.vec<glm::dvec3>("albedo");
     m.albedo_texture = r.integer<int>("albedo_texture");
+    m.albedo_wrap_u = r.name<TextureWrap>("albedo_wrap_u");
+    m.albedo_wrap_v = r.name<TextureWrap>("albedo_wrap_v");
+    m.albedo_uv_scale = r.vec<glm::dvec2>("albedo_uv_scale");
+    m.albedo_uv_offset = r.vec<glm::dvec2>("albedo_uv_offset");
     m.emission = r.vec<glm::dvec3>("emission");
     m.specular = r.vec<glm::dvec3>("specular");
     m.ior = r.number("ior");
@@ -1077,6 +1086,13 @@ void bind_scene(py::module_& m) {
   number_property(material, "roughness", &Material::roughness);
   int_property(material, "albedo_texture", &Material::albedo_texture,
                "index into Scene.textures or -1");
+  // how the albedo texture covers the surface: read at uv * albedo_uv_scale + albedo_uv_offset,
+  // wrapped in u and v by TEXTURE_WRAPS (the scene format's "wrap", "uv_scale", "uv_offset")
+  enum_property(material, "albedo_wrap_u", &Material::albedo_wrap_u);
+  enum_property(material, "albedo_wrap_v", &Material::albedo_wrap_v);
+  vec_property(material, "albedo_uv_scale", &Material::albedo_uv_scale,
+               "the albedo texture is read at uv * albedo_uv_scale + albedo_uv_offset");
+  vec_property(material, "albedo_uv_offset", &Material::albedo_uv_offset);
   text_property(material, "name", &Material::name);
   vec_property(material, "albedo", &Material::albedo);
   vec_property(material, "emission", &Material::emission);

@@ -83,6 +83,8 @@ def rich_scene(small_scene):
     s.textures.append(albedo)
     s.textures.append(env)
     s.materials[0].albedo_texture = 0
+    s.materials[0].albedo_wrap_v, s.materials[0].albedo_uv_scale = "mirror", (2, -0.5)
+    s.materials[0].albedo_uv_offset = (0.25, 1 / 3)
     s.materials[1].type, s.materials[1].roughness, s.materials[1].ior = "conductor", 0.3, 1.7
     s.materials[1].specular = (0.9, 0.8, 0.1 + 1e-17)
     lamp = lucent.Material()
@@ -135,6 +137,9 @@ def test_a_scene_round_trips_exactly(rich_scene, name, round_trip):
                                                                        4294967295)
     assert c.integrator.caustics and not c.integrator.mis and c.integrator.sampler == "independent"
     assert c.materials[1].specular == (0.9, 0.8, 0.1 + 1e-17) and c.materials[2].emissive
+    assert (c.materials[0].albedo_wrap_u, c.materials[0].albedo_wrap_v) == ("repeat", "mirror")
+    assert c.materials[0].albedo_uv_scale == (2, -0.5)
+    assert c.materials[0].albedo_uv_offset == (0.25, 1 / 3)
     assert c.spheres[1].radius == 1 / 3 and c.spheres[1].material == 2
     assert c.triangles[1].n == (0, 3, 2) and c.triangles[1].uv == (0, 3, 2)
     assert c.lights[1].type == "environment_map" and c.lights[1].texture == 1

@@ -44,6 +44,7 @@ def test_registry_names():
     assert lucent.LIGHT_TYPES[0] == "point" and "environment_map" in lucent.LIGHT_TYPES
     assert lucent.TRANSFERS == ("srgb", "gamma", "linear")
     assert lucent.TONEMAPS == ("clamp", "reinhard", "aces")
+    assert lucent.TEXTURE_WRAPS == ("repeat", "clamp", "mirror")
     # the registry header is the source of the names: every scene-file name of it is exposed
     registry = (SOURCE_DIR / "kernels" / "shared" / "registry.h").read_text()
     for name in re.findall(r'X\(\w+, \w+, \d+, "(\w+)"', registry):
@@ -131,6 +132,44 @@ def test_scene_built_in_code_renders(renderer):
     # the albedo AOV of a sphere filling the centre is the material's albedo
     _, centre = albedo_of_a_sphere(renderer, m)
     assert centre == pytest.approx([0.5, 0.25, 1.0], rel=1e-6)
+
+
+def test_texture_mapping_from_python(renderer):
+    """A material's texture mapping (the scene format's "wrap", "uv_scale", "uv_offset"): a 1x2
+    texture, red over blue, on a sphere whose front (v = 0.5) reads v + 0.5 = 1: the top edge,
+    red when clamped, and half red, half blue repeating (the edge's texels mix with the bottom
+    row's)."""
+    m = lucent.Material()
+    assert (m.albedo_wrap_u, m.albedo_wrap_v) == ("repeat", "repeat")
+    assert m.albedo_uv_scale == (1, 1) and m.albedo_uv_offset == (0, 0)
+    m.albedo = (1, 1, 1)
+    m.albedo_texture = 0
+    m.albedo_uv_offset = (0, 0.5)
+    s = lucent.Scene()
+    s.film.width, s.film.height = 8, 8
+    s.camera.position = (0, 0, 4)
+    s.camera.look_at = (0, 0, 0)
+    t = lucent.Texture()
+    t.rgba = np.array([[[1, 0, 0, 1]], [[0, 0, 1, 1]]], np.float32)
+    s.textures.append(t)
+    s.materials.append(m)
+    s.spheres.append(lucent.Sphere((0, 0, 0), 1.5))
+    s.integrator.type = "albedo"
+
+    def centre():
+        renderer.set_scene(s)
+        renderer.render(1)
+        return renderer.result().mean[4, 4]
+
+    assert centre()[2] > 0.2  # repeating: the bottom row's blue
+    s.materials[0].albedo_wrap_v = "clamp"
+    assert s.materials[0].albedo_wrap_v == "clamp"
+    assert centre() == pytest.approx([1, 0, 0], abs=1e-5)
+    with pytest.raises(ValueError, match="wrap"):
+        s.materials[0].albedo_wrap_u = "border"
+    s.materials[0].albedo_uv_scale = (0, 1)
+    with pytest.raises(lucent.Error, match=r"/materials/0/albedo/uv_scale/0: must be between "):
+        renderer.set_scene(s)
 
 
 def test_diffuse_mirror_from_python(renderer, small_dict):

@@ -55,11 +55,14 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
   std::vector<char> used(scene.materials.size(), 0);
   for (const lc_sphere& sp : packed.spheres) used[sp.material] = 1;
   for (const lc_triangle& t : packed.triangles) used[t.material] = 1;
-  bool textured = false;
+  bool textured = false, mapped = false;
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     if (!used[i]) continue;
-    material[static_cast<int>(scene.materials[i].type)] = true;
-    textured = textured || scene.materials[i].albedo_texture >= 0;
+    const Material& m = scene.materials[i];
+    material[static_cast<int>(m.type)] = true;
+    textured = textured || m.albedo_texture >= 0;
+    // a texture read otherwise than repeating at uv as given (its texture header says how)
+    mapped = mapped || (m.albedo_texture >= 0 && !m.default_albedo_mapping());
   }
   for (const lc_light& l : packed.lights) light[l.type] = true;
   filter[static_cast<int>(scene.film.filter.type)] = true;
@@ -79,7 +82,7 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
     split_lobes =
         split_lobes || (used[i] && scene_detail::material_type_def(scene.materials[i].type).splits);
   const bool splitting = packed.params.splits > 0 && split_lobes;
-  const bool other[] = {smooth,  uvs && textured, textured, camera_has_lens(scene.camera),
+  const bool other[] = {smooth,  uvs && textured, textured, mapped, camera_has_lens(scene.camera),
                         clamped, caustics,        splitting};
 #define LUCENT_COUNT(feature, what) +1
   static_assert(sizeof(other) / sizeof(other[0]) == 0 LC_OTHER_FEATURES(LUCENT_COUNT),

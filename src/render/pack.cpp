@@ -7,6 +7,7 @@
 #include <cstring>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <map>
 
 #include "lucent/error.hpp"
 #include "lucent/limits.hpp"
@@ -60,6 +61,46 @@ void put_normal(lc_triangle& t, const glm::dvec3& n) {
   t.ng_x = f(n.x);
   t.ng_y = f(n.y);
   t.ng_z = f(n.z);
+}
+
+static_assert(static_cast<lc_uint>(TextureWrap::Repeat) == LC_WRAP_REPEAT &&
+                  static_cast<lc_uint>(TextureWrap::Clamp) == LC_WRAP_CLAMP &&
+                  static_cast<lc_uint>(TextureWrap::Mirror) == LC_WRAP_MIRROR,
+              "lucent::TextureWrap's values are the kernel's LC_WRAP_*");
+
+/// The period of a wrap mode in texture space (repeat 1, mirror 2; clamp has none: 0).
+double wrap_period(TextureWrap w) {
+  return w == TextureWrap::Repeat ? 1 : w == TextureWrap::Mirror ? 2 : 0;
+}
+
+/// The texture header of texture `t` (its texels from `offset`) mapped as material `m` says.
+/// An offset is reduced by whole periods of its wrap mode (the same lookups), so that a large
+/// one keeps its fraction in float.
+lc_texture texture_header(const Texture& t, lc_uint offset, const Material& m) {
+  lc_texture d{};
+  d.offset = offset;
+  d.width = static_cast<lc_uint>(t.width);
+  d.height = static_cast<lc_uint>(t.height);
+  d.wrap = static_cast<lc_uint>(m.albedo_wrap_u) |
+           (static_cast<lc_uint>(m.albedo_wrap_v) << LC_WRAP_V_SHIFT);
+  const TextureWrap wrap[2] = {m.albedo_wrap_u, m.albedo_wrap_v};
+  for (int k = 0; k < 2; ++k) {
+    d.uv_scale[k] = static_cast<float>(m.albedo_uv_scale[k]);
+    const double period = wrap_period(wrap[k]), o = m.albedo_uv_offset[k];
+    d.uv_offset[k] = static_cast<float>(period > 0 ? o - period * std::floor(o / period) : o);
+  }
+  return d;
+}
+
+/// What the whole part of a triangle's uvs may be taken off by in axis k (pack_scene) with its
+/// material's texture reading the same texels: a multiple of the result, 0 when none may. The
+/// lookup reads uv * scale + offset: a shift by n moves it by n * scale, a whole number of the
+/// wrap mode's periods when n is a multiple of the period and the scale a whole number.
+double uv_shift_step(const Material& m, int k) {
+  if (m.albedo_texture < 0 || m.default_albedo_mapping()) return 1;
+  const double s = m.albedo_uv_scale[k];
+  if (s != std::floor(s)) return 0;
+  return wrap_period(k == 0 ? m.albedo_wrap_u : m.albedo_wrap_v);
 }
 
 }  // namespace
@@ -581,12 +622,37 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
 
   if (scene.materials.empty() && (!scene.spheres.empty() || !scene.triangles.empty()))
     throw Error(scene_detail::in_file(scene.path, "shapes need at least one material"));
+  // The texture headers: one per texture, mapped by default (an environment map's, and the
+  // index of a material that maps its texture so), then one per other (texture, mapping) a
+  // material asks for, on the same texels: an image is held once however it is mapped.
+  std::vector<lc_uint> texel_offset;
+  {
+    std::uint64_t at = 0;
+    for (const Texture& t : scene.textures) {
+      texel_offset.push_back(static_cast<lc_uint>(at));
+      at += t.rgba.size() / 4;  // (as the texels are packed, below)
+    }
+    const Material plain;
+    for (std::size_t i = 0; i < scene.textures.size(); ++i)
+      p.textures.push_back(texture_header(scene.textures[i], texel_offset[i], plain));
+  }
+  std::map<std::vector<unsigned char>, int> mapped_headers;  // header bytes -> index
   for (const Material& m : scene.materials) {
     lc_material d;
     std::fill(std::begin(d.p.words), std::end(d.p.words), 0.0f);
     put3(d.emission, m.emission);
     d.type = static_cast<lc_uint>(m.type);
-    scene_detail::material_type_def(m.type).pack(m, d.p);
+    Material device = m;
+    const std::size_t t = static_cast<std::size_t>(m.albedo_texture);
+    if (m.albedo_texture >= 0 && t < scene.textures.size() && !m.default_albedo_mapping()) {
+      const lc_texture h = texture_header(scene.textures[t], texel_offset[t], m);
+      const unsigned char* b = reinterpret_cast<const unsigned char*>(&h);
+      auto [it, added] = mapped_headers.insert(
+          {std::vector<unsigned char>(b, b + sizeof h), static_cast<int>(p.textures.size())});
+      if (added) p.textures.push_back(h);
+      device.albedo_texture = it->second;
+    }
+    scene_detail::material_type_def(m.type).pack(device, d.p);
     p.materials.push_back(d);
   }
 
@@ -645,11 +711,16 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     // The uvs less the whole part of their smallest: texture lookups repeat with period 1, so
     // the image is the same, and the kernel's float interpolation keeps the fraction (uvs near
     // 1e7 lost it: a texture there rendered as blocks, 64 standard errors off the reference).
+    // A texture mapped otherwise allows whole periods of its mapping (uv_shift_step), or none.
     glm::dvec2 whole(0.0);
     if (has_uv) {
       glm::dvec2 lo = scene.uvs[t.uv[0]];
       for (int k = 1; k < 3; ++k) lo = glm::min(lo, scene.uvs[t.uv[k]]);
-      if (std::isfinite(lo.x) && std::isfinite(lo.y)) whole = glm::floor(lo);
+      if (std::isfinite(lo.x) && std::isfinite(lo.y))
+        for (int k = 0; k < 2; ++k) {
+          const double step = uv_shift_step(scene.materials[t.material], k);
+          if (step > 0) whole[k] = step * std::floor(lo[k] / step);
+        }
     }
     // Normals far from unit length (set directly: Scene.normals, from Python) scaled, all three
     // by one power of two, their largest component then in [1, 2): the interpolation's direction
@@ -744,12 +815,7 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
 
   // reserved: a large array's capacity is the block it holds (and a CPU device shares)
   p.texels.reserve(static_cast<std::size_t>(texels));
-  for (const Texture& t : scene.textures) {
-    lc_texture d{};
-    d.offset = static_cast<lc_uint>(p.texels.size());
-    d.width = static_cast<lc_uint>(t.width);
-    d.height = static_cast<lc_uint>(t.height);
-    p.textures.push_back(d);
+  for (const Texture& t : scene.textures) {  // (their headers are made with the materials)
     for (size_t i = 0; i + 3 < t.rgba.size(); i += 4)
       p.texels.push_back({{t.rgba[i], t.rgba[i + 1], t.rgba[i + 2], t.rgba[i + 3]}});
   }

@@ -273,12 +273,36 @@ void validate_texture(const Texture& t, const Reporter& at) {
       check_non_negative(at.at("rgba").at(i), t.rgba[i]);
 }
 
+void check_texture_mapping(const Material& m, const Reporter& at) {
+  const TextureWrap wrap[2] = {m.albedo_wrap_u, m.albedo_wrap_v};
+  for (int k = 0; k < 2; ++k) {
+    if (wrap[k] != TextureWrap::Repeat && wrap[k] != TextureWrap::Clamp &&
+        wrap[k] != TextureWrap::Mirror)
+      at.at("wrap").at(k).fail("unknown wrap mode " + std::to_string(static_cast<int>(wrap[k])) +
+                               " (expected one of: repeat, clamp, mirror)");
+    const double s = check_finite(at.at("uv_scale").at(k), m.albedo_uv_scale[k]);
+    if (!(std::fabs(s) >= limits::kMinUvScale && std::fabs(s) <= limits::kMaxUvScale))
+      at.at("uv_scale")
+          .at(k)
+          .fail("must be between " + format_number(limits::kMinUvScale) + " and " +
+                format_number(limits::kMaxUvScale) +
+                " in magnitude (negative mirrors the image), got " + format_number(s));
+    const double o = check_finite(at.at("uv_offset").at(k), m.albedo_uv_offset[k]);
+    if (!(std::fabs(o) <= limits::kMaxUvOffset))
+      at.at("uv_offset")
+          .at(k)
+          .fail("must be at most " + format_number(limits::kMaxUvOffset) + " in magnitude, got " +
+                format_number(o));
+  }
+}
+
 void validate_material(const Material& m, const std::vector<Texture>& textures,
                        const Reporter& at) {
   if (m.name.empty()) at.fail("material names must not be empty");
   check_type(at.at("type"), m.type);
   check_colour(at.at("emission"), m.emission);
   check_texture_index(at.at("albedo").at("texture"), m.albedo_texture, textures.size(), true);
+  check_texture_mapping(m, at.at("albedo"));
   // the type's parameters, by its parameter table (src/scene/materials/<file>.cpp)
   const MaterialTypeDef& def = material_type_def(m.type);
   for (const MaterialParam& param : def.params) {

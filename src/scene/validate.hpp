@@ -116,6 +116,9 @@ void validate_integrator(const Integrator& integrator, const Reporter& at);
 /// Its size (width and height from 1, 4 floats per texel), then every texel finite and
 /// non-negative.
 void validate_texture(const Texture& texture, const Reporter& at);
+/// How a material maps its albedo texture, at `at` (its "albedo"): wrap modes that exist, uv
+/// scales and offsets finite and within limits (lucent/limits.hpp).
+void check_texture_mapping(const Material& material, const Reporter& at);
 /// The parameters every material has (name, type, emission, albedo texture), then its type's
 /// own, by the type's parameter table and its own check (scene/material_type.hpp).
 void validate_material(const Material& material, const std::vector<Texture>& textures,

@@ -35,7 +35,8 @@ WhittedLobes Bsdf::mirror_lobe(const dvec3& wo, const dvec3& weight) const {
 dvec3 albedo_at(const Scene& scene, const Material& m, dvec2 uv) {
   int tex = m.albedo_texture;
   if (tex >= 0 && tex < static_cast<int>(scene.textures.size()))
-    return texture_rgb(scene.textures[tex], uv);
+    return texture_rgb(scene.textures[tex], uv, m.albedo_wrap_u, m.albedo_wrap_v, m.albedo_uv_scale,
+                       m.albedo_uv_offset);
   return m.albedo;
 }
 
