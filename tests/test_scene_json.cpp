@@ -461,6 +461,66 @@ TEST(SceneJson, MissingMeshAndTextureFiles) {
   }
 }
 
+// A texture reference's mapping: "wrap" (a mode, or [u, v]), "uv_scale" and "uv_offset"
+// ([u, v]; the lookup reads uv * uv_scale + uv_offset). Bad values are one-line errors at their
+// place, the same from a file and from SceneBuilder (docs/rendering-model.md, "Textures").
+TEST(SceneJson, TextureMappingIsReadAndBadValuesAreErrors) {
+  const std::string dir = lucent::test::temp_dir();
+  lucent::write_image(dir + "/t.pfm", lucent::Image{2, 1, std::vector<float>(6, 0.5f)});
+  auto scene = [&](const std::string& mapping) {
+    return R"({"materials": {"m": {"type": "diffuse", "albedo": {"texture": ")" + dir +
+           R"(/t.pfm")" + mapping + "}}}}";
+  };
+  using W = lucent::TextureWrap;
+  Scene s = lucent::parse_scene(
+      scene(R"(, "wrap": ["mirror", "clamp"], "uv_scale": [2, -0.5], "uv_offset": [0.25, 3])"),
+      "scene.json");
+  const lucent::Material& m = s.materials.at(0);
+  EXPECT_EQ(m.albedo_wrap_u, W::Mirror);
+  EXPECT_EQ(m.albedo_wrap_v, W::Clamp);
+  EXPECT_EQ(m.albedo_uv_scale, glm::dvec2(2, -0.5));
+  EXPECT_EQ(m.albedo_uv_offset, glm::dvec2(0.25, 3));
+  s = lucent::parse_scene(scene(R"(, "wrap": "clamp")"), "scene.json");
+  EXPECT_EQ(s.materials.at(0).albedo_wrap_u, W::Clamp);
+  EXPECT_EQ(s.materials.at(0).albedo_wrap_v, W::Clamp);
+  s = lucent::parse_scene(scene(""), "scene.json");  // the defaults: repeat, uv as given
+  EXPECT_TRUE(s.materials.at(0).default_albedo_mapping());
+  EXPECT_EQ(s.materials.at(0).albedo_uv_scale, glm::dvec2(1, 1));
+
+  const std::string at = "scene.json: /materials/m/albedo/";
+  EXPECT_EQ(error_of(scene(R"(, "wrap": "border")")),
+            at + "wrap: unknown value 'border' (expected one of: repeat, clamp, mirror)");
+  EXPECT_EQ(error_of(scene(R"(, "wrap": ["repeat"])")),
+            at + "wrap: must be a wrap mode or [u, v] of two, got an array of 1");
+  EXPECT_EQ(error_of(scene(R"(, "wrap": ["repeat", "mirrored"])")),
+            at + "wrap/1: unknown value 'mirrored' (expected one of: repeat, clamp, mirror)");
+  EXPECT_EQ(error_of(scene(R"(, "uv_scale": [0, 1])")),
+            at + "uv_scale/0: must be between 1e-06 and 1e+06 in magnitude (negative mirrors the "
+                 "image), got 0");
+  EXPECT_EQ(error_of(scene(R"(, "uv_scale": [1, -1e7])")),
+            at + "uv_scale/1: must be between 1e-06 and 1e+06 in magnitude (negative mirrors the "
+                 "image), got -1e+07");
+  EXPECT_EQ(error_of(scene(R"(, "uv_offset": [0, -2e6])")),
+            at + "uv_offset/1: must be at most 1e+06 in magnitude, got -2e+06");
+  for (const char* bad : {R"(, "uv_scale": [1])", R"(, "uv_offset": "x")",
+                          R"(, "uv_scale": [1, "nan"])", R"(, "wrap": 1)", R"(, "scale": 2)"}) {
+    const std::string e = error_of(scene(bad));
+    EXPECT_STARTS_WITH(e, at) << bad;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  }
+  // a scene built in code: the same places
+  lucent::SceneBuilder b("scene.json");
+  lucent::Material bad;
+  bad.name = "m";
+  bad.albedo_uv_scale = {std::nan(""), 1};
+  EXPECT_EQ(lucent::test::error_of([&] { b.add_material(bad); }),
+            at + "uv_scale/0: must be a finite number, got nan");
+  bad.albedo_uv_scale = {1, 1};
+  bad.albedo_wrap_v = static_cast<W>(7);
+  EXPECT_EQ(lucent::test::error_of([&] { b.add_material(bad); }),
+            at + "wrap/1: unknown wrap mode 7 (expected one of: repeat, clamp, mirror)");
+}
+
 // "gamma" without "transfer": "gamma" changed nothing: the default srgb transfer was used.
 TEST(SceneJson, GammaNeedsTheGammaTransfer) {
   EXPECT_EQ(error_of(R"({"film": {"gamma": 2.4}})"),

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <stb/stb_image_write.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -135,6 +137,164 @@ TEST(TextureRender, TexturedSphereShowsTheImageUnmirrored) {
         for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], k == p.channel ? 1.0f : 0.0f, 1e-3) << k;
       }
     }
+}
+
+// A texture's mapping (docs/rendering-model.md, "Textures"), end to end: the block texture on
+// three quads side by side, each mapping it at uv * scale + offset (beyond [0, 1] over most of
+// the quad) with its wrap modes: clamp, mirror, and repeat in u with clamp in v under a negative
+// v scale. Every pixel whose samples all read texels of one block (the closed form: the mapped
+// coordinate folded into [0, 1] by the mode, half a texel from a block's edge, and for repeat
+// from the image's edge, whose texels mix with the far side) shows that block's colour, in the
+// kernel and in the reference.
+TEST(TextureRender, WrapModesScalesAndOffsetsOnQuads) {
+  std::string dir = lucent::test::temp_dir();
+  ASSERT_TRUE(write_block_png(dir + "/blocks.png", 4));
+  const std::string png = dir + "/blocks.png";
+  struct Quad {
+    const char* wrap;  // the JSON
+    lucent::TextureWrap wu, wv;
+    double su, sv, ou, ov;
+  };
+  using W = lucent::TextureWrap;
+  // (the mapped coordinates span [-1, 2] in both axes, [0.25, 2.75] in the third quad's u)
+  const Quad quads[] = {{R"("clamp")", W::Clamp, W::Clamp, 3, 3, -4, 2},
+                        {R"("mirror")", W::Mirror, W::Mirror, 3, 3, -4, 2},
+                        {R"(["repeat", "clamp"])", W::Repeat, W::Clamp, 2.5, -3, -2.25, -1}};
+  std::string materials, shapes;
+  for (int k = 0; k < 3; ++k) {
+    const Quad& q = quads[k];
+    char m[512], sh[512];
+    std::snprintf(m, sizeof m,
+                  R"(%s"q%d": {"type": "diffuse", "albedo": {"texture": "%s", "wrap": %s,
+                     "uv_scale": [%g, %g], "uv_offset": [%g, %g]}})",
+                  k ? ", " : "", k, png.c_str(), q.wrap, q.su, q.sv, q.ou, q.ov);
+    const double x0 = -3 + 2 * k;
+    std::snprintf(sh, sizeof sh,
+                  R"(%s{"type": "triangles", "material": "q%d",
+                     "positions": [[%g, -1, 0], [%g, -1, 0], [%g, 1, 0], [%g, 1, 0]],
+                     "uvs": [[1, -1], [2, -1], [2, 0], [1, 0]], "indices": [0, 1, 2, 0, 2, 3]})",
+                  k ? ", " : "", k, x0, x0 + 2, x0 + 2, x0);
+    materials += m;
+    shapes += sh;
+  }
+  // the quads exactly fill a 90-degree (vertical) view of aspect 3 from distance 1: pixel (px,
+  // py) sees quad px / 32 over u in 1 + [px % 32, px % 32 + 1] / 32, v in -1 + [31 - py, 32 - py]
+  // / 32 (uvs moved by whole numbers: the host takes whole parts off a triangle's uvs only by
+  // whole periods of its mapping, 2 for the mirror, none for a scale of 2.5 or a clamp)
+  const std::string json = R"({
+    "camera": {"position": [0, 0, 1], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 90},
+    "film": {"width": 96, "height": 32},
+    "integrator": {"type": "albedo", "spp": 4},
+    "materials": {)" + materials +
+                           R"(},
+    "shapes": [)" + shapes +
+                           R"(]})";
+  lucent::test::write_file(dir + "/quads.json", json);
+  const lucent::RenderResult kernel = lucent::test::render_json(json, 4);
+  lucent::ReferenceOptions ro;
+  ro.spp = 4;
+  const lucent::RenderResult reference =
+      lucent::render_reference(lucent::load_scene(dir + "/quads.json"), ro);
+
+  // the mapped coordinate folded into [0, 1], where the 4-texel image's blocks meet at 0.5
+  auto fold = [](double t, W w) {
+    if (w == W::Clamp) return std::clamp(t, 0.0, 1.0);
+    if (w == W::Mirror) {
+      const double m = t - 2 * std::floor(t / 2);
+      return m <= 1 ? m : 2 - m;
+    }
+    return t - std::floor(t);
+  };
+  // the block (0: left or bottom, 1: right or top) every sample of [a, b] reads, or -1
+  auto block = [&](double a, double b, double scale, double offset, W w) {
+    int seen = -1;
+    for (int i = 0; i <= 16; ++i) {
+      const double f = fold((a + (b - a) * i / 16) * scale + offset, w);
+      if (std::abs(f - 0.5) < 0.13) return -1;  // bilinear within half a texel (0.125)
+      if (w == W::Repeat && (f < 0.13 || f > 0.87)) return -1;
+      const int side = f > 0.5;
+      if (seen >= 0 && side != seen) return -1;
+      seen = side;
+    }
+    return seen;
+  };
+  const float k128 = 0.2158605f;
+  const float colour[2][2][3] = {{{0, 0, 1}, {k128, k128, k128}},  // bottom: blue, grey
+                                 {{1, 0, 0}, {0, 1, 0}}};          // top: red, green
+  for (int k = 0; k < 3; ++k) {
+    const Quad& q = quads[k];
+    int pure = 0, outside = 0;
+    for (int py = 0; py < 32; ++py)
+      for (int px = 0; px < 32; ++px) {
+        const double u0 = 1 + px / 32.0, u1 = 1 + (px + 1) / 32.0;
+        const double v0 = -1 + (31 - py) / 32.0, v1 = -1 + (32 - py) / 32.0;
+        const int bu = block(u0, u1, q.su, q.ou, q.wu), bv = block(v0, v1, q.sv, q.ov, q.wv);
+        if (bu < 0 || bv < 0) continue;
+        ++pure;
+        const double tu = (u0 + u1) / 2 * q.su + q.ou, tv = (v0 + v1) / 2 * q.sv + q.ov;
+        outside += tu < 0 || tu > 1 || tv < 0 || tv > 1;
+        for (const lucent::RenderResult* r : {&kernel, &reference}) {
+          const float* c = r->mean.pixel(32 * k + px, py);
+          for (int ch = 0; ch < 3; ++ch)
+            ASSERT_NEAR(c[ch], colour[bv][bu][ch], 1e-3)
+                << "quad " << k << " (wrap " << q.wrap << ") pixel (" << px << ", " << py
+                << ") channel " << ch << (r == &kernel ? " (kernel)" : " (reference)");
+        }
+      }
+    // most of each quad is checked, most of it beyond [0, 1]
+    EXPECT_GT(pure, 250) << "quad " << k;
+    EXPECT_GT(outside, 200) << "quad " << k;
+  }
+}
+
+// A sphere's uv reaches v = 1 at the north pole, where the half-texel cap (v above the top row's
+// centre) blends the top row with the next one beyond the edge: repeating, the image's bottom
+// row (docs/rendering-model.md, "Geometry"). Clamped in v, the cap shows the top row's colour
+// alone. An 8x4 texture, its top row red, then two green rows and a blue bottom row, seen from
+// above the pole: the central 6x6 pixels lie within 12 degrees of the pole (the cap is 22.5).
+TEST(TextureRender, ClampedSpherePoleShowsOnlyTheTopRow) {
+  std::string dir = lucent::test::temp_dir();
+  std::vector<unsigned char> px;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 8; ++x) {
+      const unsigned char on = 255, off = 0;
+      const unsigned char c[3] = {y == 0 ? on : off, (y == 1 || y == 2) ? on : off,
+                                  y == 3 ? on : off};
+      px.insert(px.end(), c, c + 3);
+    }
+  ASSERT_TRUE(stbi_write_png((dir + "/rows.png").c_str(), 8, 4, 3, px.data(), 8 * 3));
+  auto scene = [&](const std::string& mapping) {
+    return R"({
+      "camera": {"position": [0, 4, 0], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov": 30},
+      "film": {"width": 32, "height": 32},
+      "integrator": {"type": "albedo", "spp": 4},
+      "materials": {"t": {"type": "diffuse", "albedo": {"texture": ")" +
+           dir + R"(/rows.png")" + mapping + R"(}}},
+      "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "t"}]})";
+  };
+  // repeating (the default) the pole bleeds: its centre is half red, half blue
+  const lucent::RenderResult repeat = lucent::test::render_json(scene(""), 4);
+  const float* centre = repeat.mean.pixel(16, 16);
+  EXPECT_GT(centre[2], 0.3f) << "the repeating pole shows the bottom row";
+  EXPECT_LT(centre[0], 0.7f);
+
+  const std::string clamped = scene(R"(, "wrap": ["repeat", "clamp"])");
+  lucent::test::write_file(dir + "/pole.json", clamped);
+  const lucent::RenderResult kernel = lucent::test::render_json(clamped, 4);
+  lucent::ReferenceOptions ro;
+  ro.spp = 4;
+  const lucent::RenderResult reference =
+      lucent::render_reference(lucent::load_scene(dir + "/pole.json"), ro);
+  for (const lucent::RenderResult* r : {&kernel, &reference})
+    for (int y = 13; y <= 18; ++y)
+      for (int x = 13; x <= 18; ++x) {
+        const float* c = r->mean.pixel(x, y);
+        SCOPED_TRACE("pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")" +
+                     (r == &kernel ? " (kernel)" : " (reference)"));
+        EXPECT_NEAR(c[0], 1.0f, 1e-4);
+        EXPECT_NEAR(c[1], 0.0f, 1e-4);
+        EXPECT_NEAR(c[2], 0.0f, 1e-4);
+      }
 }
 
 }  // namespace

@@ -14,6 +14,36 @@ void parse_materials(const JsonReader& r, const json& j, SceneBuilder& b) {
         parse_material(r, it.value(), "/materials/" + pointer_key(it.key()), it.key(), b));
 }
 
+namespace {
+
+TextureWrap wrap_mode(const JsonReader& r, const json& j, const std::string& p) {
+  const std::string w = r.choice(j, p, {"repeat", "clamp", "mirror"});
+  return w == "repeat" ? TextureWrap::Repeat
+                       : (w == "clamp" ? TextureWrap::Clamp : TextureWrap::Mirror);
+}
+
+/// A texture reference's mapping: "wrap" (one mode, or [u, v]), "uv_scale" and "uv_offset"
+/// ([u, v]), into m's albedo mapping; their values are checked by SceneBuilder::add_material
+/// (check_texture_mapping), at the same places.
+void parse_texture_mapping(const JsonReader& r, const json& v, const std::string& p, Material& m) {
+  if (v.contains("wrap")) {
+    const json& w = v["wrap"];
+    if (w.is_array()) {
+      if (w.size() != 2)
+        r.fail(p + "/wrap",
+               "must be a wrap mode or [u, v] of two, got an array of " + std::to_string(w.size()));
+      m.albedo_wrap_u = wrap_mode(r, w[0], p + "/wrap/0");
+      m.albedo_wrap_v = wrap_mode(r, w[1], p + "/wrap/1");
+    } else {
+      m.albedo_wrap_u = m.albedo_wrap_v = wrap_mode(r, w, p + "/wrap");
+    }
+  }
+  if (v.contains("uv_scale")) m.albedo_uv_scale = r.vec2(v["uv_scale"], p + "/uv_scale");
+  if (v.contains("uv_offset")) m.albedo_uv_offset = r.vec2(v["uv_offset"], p + "/uv_offset");
+}
+
+}  // namespace
+
 Material parse_material(const JsonReader& r, const json& j, const std::string& p,
                         const std::string& name, SceneBuilder& b) {
   r.check_object(j, p);
@@ -27,8 +57,9 @@ Material parse_material(const JsonReader& r, const json& j, const std::string& p
     if (!j.contains(param.key)) continue;
     const json& v = j[param.key];
     if (param.kind == MaterialParam::ColourOrTexture && v.is_object()) {
-      r.check_keys(v, pp, {"texture"});
+      r.check_keys(v, pp, {"texture", "wrap", "uv_scale", "uv_offset"});
       std::string file = r.file_path(r.require(v, pp, "texture"), pp + "/texture");
+      parse_texture_mapping(r, v, pp, m);
       try {
         m.*param.colour = glm::dvec3(1.0);
         m.albedo_texture = b.load_texture(file);
