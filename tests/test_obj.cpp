@@ -1160,18 +1160,20 @@ TEST(Obj, TextureOptionsKeepTheFileName) {
   }
   EXPECT_EQ(w.count("'nothere.dds' not found"), 1) << w.dump();
   // and the options that would change the look are named once (TextureOptionsThatChangeTheLook)
-  EXPECT_EQ(w.count("m.mtl: map_Kd options that lucent does not support are ignored: '-o 0.5' "
-                    "(line 3), '-s 2' (line 6), '-t 0.1 0.2' (line 9), '-o 0.5 0.5 0' (line 12) "
-                    "and 6 more (the image is mapped once per uv unit"),
+  // but for -s, -o and -clamp, which are read (MapKdScaleOffsetAndClampAreRead)
+  EXPECT_EQ(w.count("m.mtl: map_Kd options that lucent does not support are ignored: "
+                    "'-t 0.1 0.2' (line 9), '-cc on' (line 27) (of map_Kd's options lucent reads "
+                    "-s, -o and -clamp"),
             1)
       << w.dump();
   EXPECT_EQ(w.all().size(), 2u) << w.dump();
 }
 
-// lucent reads a map_Kd image once per uv unit, repeating, as decoded: a model whose MTL tiles,
-// shifts or clamps its textures rendered otherwise than it asked, without a word. One warning
-// per MTL file names such options; those at their defaults, and those without an effect on a
-// colour map here, are not named.
+// lucent reads a map_Kd image as decoded, honouring -s, -o and -clamp only: a model whose MTL
+// asks for turbulence, a colour remapping (-mm) or another colour space rendered otherwise than
+// it asked, without a word. One warning per MTL file names such options; those at their
+// defaults, those lucent reads, and those without an effect on a colour map here, are not
+// named (-s, -o and -clamp were, until lucent read them).
 TEST(Obj, TextureOptionsThatChangeTheLookAreNamed) {
   std::string dir = lucent::test::temp_dir();
   const unsigned char px[] = {255, 255, 255, 0, 0, 0};
@@ -1179,7 +1181,8 @@ TEST(Obj, TextureOptionsThatChangeTheLookAreNamed) {
   write(dir, "quiet.mtl",
         "newmtl a\nmap_Kd -s 1 1 1 -o 0 0 -t 0 -mm 0 1 -clamp off -cc off -colorspace sRGB "
         "-blendu off -boost 2 -texres 64 -imfchan r t.png\n"
-        "newmtl b\nmap_Ks -s 4 4 t.png\nmap_bump -bm 2 -clamp on t.png\n");
+        "newmtl b\nmap_Ks -s 4 4 t.png\nmap_bump -bm 2 -clamp on t.png\n"
+        "newmtl c\nmap_Kd -s 4 4 -o 0.5 0.25 -clamp on t.png\n");
   write(dir, "loud.mtl",
         "newmtl a\nKd 1 1 1\n\nmap_Kd -mm 0.2 1 -colorspace linear t.png\n"
         "newmtl b\nmap_Kd -mm 0 2 -s 1 3 t.png\n");
@@ -1195,11 +1198,97 @@ TEST(Obj, TextureOptionsThatChangeTheLookAreNamed) {
       EXPECT_EQ(w.all().size(), 0u) << w.dump();
     } else {
       EXPECT_EQ(w.count("loud.mtl: map_Kd options that lucent does not support are ignored: "
-                        "'-mm 0.2 1' (line 4), '-colorspace linear' (line 4), '-mm 0 2' (line 6), "
-                        "'-s 1 3' (line 6) (the image"),
+                        "'-mm 0.2 1' (line 4), '-colorspace linear' (line 4), '-mm 0 2' (line 6) "
+                        "(of map_Kd's options"),
                 1)
           << w.dump();
       EXPECT_EQ(w.all().size(), 1u) << w.dump();
+    }
+  }
+}
+
+// map_Kd's -s u [v [w]] and -o u [v [w]] are the texture's uv scale and offset (the lookup reads
+// uv * scale + offset; v defaults to 1 and 0, w is ignored) and -clamp on clamps it to edge in u
+// and v (`-clamp` alone is on); the last map_Kd of a material is the one read, options included.
+// lucent stripped them with a warning (the image was mapped once per uv unit, repeating). A
+// texture that is not found leaves Kd, and no mapping.
+TEST(Obj, MapKdScaleOffsetAndClampAreRead) {
+  std::string dir = lucent::test::temp_dir();
+  const unsigned char px[] = {255, 255, 255, 0, 0, 0};
+  ASSERT_TRUE(stbi_write_png((dir + "/t.png").c_str(), 2, 1, 3, px, 6));
+  const char* maps[] = {"-s 2 3 1 -o 0.25 0.5 0 -clamp on t.png",
+                        "-s 2 t.png",
+                        "-o -0.5 t.png",
+                        "-clamp t.png",
+                        "-clamp off -s 4 4 t.png\nmap_Kd t.png",
+                        "-clamp on -t 0.1 t.png",
+                        "-s 2 2 missing.png"};
+  std::string mtl, obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n";
+  for (std::size_t i = 0; i < std::size(maps); ++i) {
+    mtl += "newmtl m" + std::to_string(i) + "\nKd 0.1 0.2 0.3\nmap_Kd " + maps[i] + "\n";
+    obj += "usemtl m" + std::to_string(i) + "\nf 1 2 3\n";
+  }
+  write(dir, "m.mtl", mtl);
+  const std::string path = write(dir, "m.obj", obj);
+  CaptureWarnings w;
+  Scene s;
+  load(s, path);
+  ASSERT_EQ(s.triangles.size(), std::size(maps));
+  struct Want {
+    glm::dvec2 scale, offset;
+    lucent::TextureWrap wrap;
+    int texture;
+  };
+  using W = lucent::TextureWrap;
+  const Want want[] = {{{2, 3}, {0.25, 0.5}, W::Clamp, 0}, {{2, 1}, {0, 0}, W::Repeat, 0},
+                       {{1, 1}, {-0.5, 0}, W::Repeat, 0},  {{1, 1}, {0, 0}, W::Clamp, 0},
+                       {{1, 1}, {0, 0}, W::Repeat, 0},     {{1, 1}, {0, 0}, W::Clamp, 0},
+                       {{1, 1}, {0, 0}, W::Repeat, -1}};
+  for (std::size_t i = 0; i < std::size(maps); ++i) {
+    const Material& m = s.materials[s.triangles[i].material];
+    SCOPED_TRACE(std::string("map_Kd ") + maps[i]);
+    EXPECT_EQ(m.albedo_texture, want[i].texture);
+    EXPECT_EQ(m.albedo_uv_scale, want[i].scale);
+    EXPECT_EQ(m.albedo_uv_offset, want[i].offset);
+    EXPECT_EQ(m.albedo_wrap_u, want[i].wrap);
+    EXPECT_EQ(m.albedo_wrap_v, want[i].wrap);
+  }
+  // only -t is named, and the missing texture
+  EXPECT_EQ(w.count("m.mtl: map_Kd options that lucent does not support are ignored: "
+                    "'-t 0.1' (line 19) (of map_Kd's options lucent reads -s, -o and -clamp; the "
+                    "image is otherwise used as decoded)"),
+            1)
+      << w.dump();
+  EXPECT_EQ(w.count("'missing.png' not found"), 1) << w.dump();
+  EXPECT_EQ(w.all().size(), 2u) << w.dump();
+}
+
+// A scale or offset the scene format refuses is an error at the map_Kd's line, named by its
+// option (docs/obj-mtl.md).
+TEST(Obj, MapKdScaleAndOffsetOutOfRangeAreErrors) {
+  std::string dir = lucent::test::temp_dir();
+  const unsigned char px[] = {255, 255, 255, 0, 0, 0};
+  ASSERT_TRUE(stbi_write_png((dir + "/t.png").c_str(), 2, 1, 3, px, 6));
+  const std::string obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\n";
+  const std::pair<const char*, const char*> cases[] = {
+      {"-s 0 1",
+       "m.mtl:3: material 'a': albedo/uv_scale/0 (map_Kd -s): must be between 1e-06 "
+       "and 1e+06 in magnitude (negative mirrors the image), got 0"},
+      {"-s 1 1e999", "m.mtl:3: material 'a': albedo/uv_scale/1 (map_Kd -s): must be a finite "},
+      {"-o 0 -2e6",
+       "m.mtl:3: material 'a': albedo/uv_offset/1 (map_Kd -o): must be at most "
+       "1e+06 in magnitude, got -2e+06"}};
+  for (const auto& [options, message] : cases) {
+    write(dir, "m.mtl", std::string("newmtl a\nKd 1 1 1\nmap_Kd ") + options + " t.png\n");
+    const std::string path = write(dir, "m.obj", obj);
+    Scene s;
+    try {
+      load(s, path);
+      ADD_FAILURE() << "no error for map_Kd " << options;
+    } catch (const lucent::Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(message), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
     }
   }
 }

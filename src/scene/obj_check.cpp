@@ -611,8 +611,9 @@ constexpr TextureOption kTextureOptions[] = {
     {"-s", 3, Arg::Number},      {"-t", 3, Arg::Number},       {"-imfchan", 1, Arg::Word},
     {"-type", 1, Arg::Word},     {"-colorspace", 1, Arg::Word}};
 
-// An option of map_Kd whose arguments change what the texture looks like: lucent reads the
-// image once per uv unit, repeating, as decoded (docs/obj-mtl.md).
+// An option of map_Kd that lucent does not read whose arguments change what the texture looks
+// like: lucent reads the image as decoded (docs/obj-mtl.md). (-s, -o and -clamp it reads:
+// read_kd_option.)
 bool changes_the_look(std::string_view name, const std::vector<std::string_view>& args) {
   io::CNumbers c_numbers;         // "0.5", whatever the process locale
   auto all = [&](double value) {  // every argument the given number (missing ones default)
@@ -620,21 +621,35 @@ bool changes_the_look(std::string_view name, const std::vector<std::string_view>
       if (std::strtod(std::string(a).c_str(), nullptr) != value) return false;
     return true;
   };
-  if (name == "-s") return !all(1);
-  if (name == "-o" || name == "-t") return !all(0);
+  if (name == "-t") return !all(0);
   if (name == "-mm")  // base 0, gain 1
     return (args.size() > 0 && std::strtod(std::string(args[0]).c_str(), nullptr) != 0) ||
            (args.size() > 1 && std::strtod(std::string(args[1]).c_str(), nullptr) != 1);
-  if (name == "-clamp" || name == "-cc") return args.empty() || args[0] != "off";
+  if (name == "-cc") return args.empty() || args[0] != "off";
   if (name == "-colorspace")  // tinyobjloader's: 8-bit images are decoded from sRGB
     return args.empty() || (args[0] != "sRGB" && args[0] != "srgb");
-  return false;  // -blendu, -blendv, -boost, -texres, -bm, -imfchan, -type: no effect here
+  // -s, -o, -clamp: read; -blendu, -blendv, -boost, -texres, -bm, -imfchan, -type: no effect here
+  return false;
+}
+
+// A map_Kd option that lucent reads, into `m`: -s and -o (u, and v when given; w ignored) and
+// -clamp (on unless its argument is off).
+void read_kd_option(std::string_view name, const std::vector<std::string_view>& args, MtlName& m) {
+  io::CNumbers c_numbers;  // "0.5", whatever the process locale
+  auto number = [&](std::size_t k, double otherwise) {
+    return k < args.size() ? std::strtod(std::string(args[k]).c_str(), nullptr) : otherwise;
+  };
+  if (name == "-s") m.kd_scale = glm::dvec2(number(0, 1), number(1, 1));
+  if (name == "-o") m.kd_offset = glm::dvec2(number(0, 0), number(1, 0));
+  if (name == "-clamp") m.kd_clamp = args.empty() || args[0] != "off";
 }
 
 // Where the file name of a texture statement's `args` (the line after the tag and its space)
 // starts: after the options and their arguments. The last word is always (part of) the name.
-// `look`, if given, receives the options (with their arguments) that changes_the_look.
-std::size_t texture_name_start(std::string_view args, std::vector<std::string>* look = nullptr) {
+// `look`, if given, receives the options (with their arguments) that changes_the_look; `kd`, if
+// given, the options that read_kd_option reads.
+std::size_t texture_name_start(std::string_view args, std::vector<std::string>* look = nullptr,
+                               MtlName* kd = nullptr) {
   std::vector<Word> words;
   for (std::size_t i = 0; i < args.size();) {
     std::size_t b = args.find_first_not_of(" \t", i);
@@ -662,6 +677,7 @@ std::size_t texture_name_start(std::string_view args, std::vector<std::string>* 
       if (!fits) break;
       taken.push_back(a);
     }
+    if (kd) read_kd_option(option->name, taken, *kd);
     if (look && changes_the_look(option->name, taken)) {
       std::string text = option->name;
       for (std::string_view a : taken) (text += ' ') += a;
@@ -777,6 +793,19 @@ std::vector<MtlName> mtl_material_names(const std::string& text) {
       out.back().tf_line = ln;
       out.back().tf_tag = std::string(line.substr(b, 2));
       out.back().tf_numbers = first != "spectral";  // (the xyz form is numbers by now)
+      return;
+    }
+    // map_Kd: the options lucent reads, of the material's last one (tinyobjloader keeps the
+    // last map_Kd's file)
+    if (line.compare(b, 6, "map_Kd") == 0 && b + 6 < line.size() &&
+        (line[b + 6] == ' ' || line[b + 6] == '\t')) {
+      if (out.empty()) return;  // before any newmtl: tinyobjloader's unnamed material
+      MtlName& m = out.back();
+      m.kd_line = ln;
+      m.kd_scale = glm::dvec2(1, 1);
+      m.kd_offset = glm::dvec2(0, 0);
+      m.kd_clamp = false;
+      texture_name_start(line.substr(b + 7), nullptr, &m);
       return;
     }
     if (line.compare(b, 6, "newmtl") != 0 || b + 6 >= line.size() ||

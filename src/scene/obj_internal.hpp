@@ -127,13 +127,13 @@ void blank_element_comments(std::string& text);
 void check_mtl_text(const std::string& path, const std::string& text);
 
 /// The MTL text tinyobjloader reads: `text` with the options of its texture statements (map_Kd,
-/// bump, ...: `-o u [v [w]]`, `-clamp on`, ...) removed, lucent using none of them. Each option
-/// takes the arguments that fit it, up to its count (tinyobjloader takes three numbers after
-/// -o, -s and -t, and `map_Kd -o 0.5 tex.png` lost its file name); the last word of a statement
-/// is always (part of) the file name. The lines are kept. `ignored`, if given, receives each
-/// option of a map_Kd statement that would change the texture's look had lucent read it (`-s`,
-/// `-o`, `-t` other than their defaults, `-mm` other than 0 1, `-clamp on`, `-cc on`,
-/// `-colorspace` other than sRGB), with its arguments, and its line.
+/// bump, ...: `-o u [v [w]]`, `-clamp on`, ...) removed: lucent reads map_Kd's -s, -o and -clamp
+/// itself (mtl_material_names) and no others. Each option takes the arguments that fit it, up to
+/// its count (tinyobjloader takes three numbers after -o, -s and -t, and `map_Kd -o 0.5 tex.png`
+/// lost its file name); the last word of a statement is always (part of) the file name. The lines
+/// are kept. `ignored`, if given, receives each option of a map_Kd statement that lucent does not
+/// read and that would change the texture's look had it read it (`-t` other than 0, `-mm` other
+/// than 0 1, `-cc on`, `-colorspace` other than sRGB), with its arguments, and its line.
 struct IgnoredOption {
   long line = 0;
   std::string option;  ///< "-s 4 4"
@@ -147,6 +147,14 @@ std::string strip_texture_options(const std::string& text,
 struct MtlName {
   std::string name;
   long line = 0;
+  /// its last map_Kd statement's line (0 when it has none) and the options of it that lucent
+  /// reads: `-s u [v [w]]` (uv scale; v 1 when not given), `-o u [v [w]]` (uv offset; v 0), w
+  /// ignored; `-clamp on` (clamp to edge in u and v; `-clamp` alone is on, as `-clamp off` is
+  /// off)
+  long kd_line = 0;
+  glm::dvec2 kd_scale{1, 1};
+  glm::dvec2 kd_offset{0, 0};
+  bool kd_clamp = false;
   /// its last Tf (or Kt) statement's line, 0 when it has none, and its tag (for messages);
   /// `tf_numbers`: that statement gives numbers (not the `spectral` form, which tinyobjloader
   /// misreads; the `xyz` form is put in numbers first, read_colour_forms)

@@ -129,7 +129,8 @@ bool MtlReader::read(const std::string& path, std::vector<tinyobj::material_t>* 
       return "'" + ignored[i].option + "' (line " + std::to_string(ignored[i].line) + ")";
     });
     warnings.push_back(path + ": map_Kd options that lucent does not support are ignored: " + list +
-                       " (the image is mapped once per uv unit, repeating, as decoded)");
+                       " (of map_Kd's options lucent reads -s, -o and -clamp; the image is "
+                       "otherwise used as decoded)");
   }
   size_t before = materials->size();
   std::string mtl_warn, mtl_err;
@@ -231,10 +232,17 @@ void MaterialMapper::check_converted(const Material& m, const std::string& mtl_p
     static const std::pair<const char*, const char*> kFrom[] = {
         {"/ior", "Ni"},  {"/albedo", "Kd"},   {"/specular", "Ks"}, {"/reflectance", "Ks"},
         {"/tint", "Tf"}, {"/emission", "Ke"}, {"/roughness", "Ns"}};
+    // map_Kd's -s and -o, at the map_Kd's line: "albedo/uv_scale/0 (map_Kd -s)"
+    long line = def.line;
+    const bool option = key.rfind("/albedo/uv_", 0) == 0;
+    if (option) {
+      key += key.rfind("/albedo/uv_scale", 0) == 0 ? " (map_Kd -s)" : " (map_Kd -o)";
+      line = def.kd_line;
+    }
     for (const auto& [name, tag] : kFrom)
-      if (key.substr(0, key.find('/', 1)) == name) key += std::string(" (") + tag + ")";
+      if (!option && key.substr(0, key.find('/', 1)) == name) key += std::string(" (") + tag + ")";
     if (!key.empty() && key[0] == '/') key.erase(0, 1);
-    throw Error(mtl_path + ":" + std::to_string(def.line) + ": " + head +
+    throw Error(mtl_path + ":" + std::to_string(line) + ": " + head +
                 (key.empty() ? "" : ": " + key) + tail);
   }
 }
@@ -346,6 +354,10 @@ int MaterialMapper::convert(const tinyobj::material_t& t, const std::string& mtl
       try {
         m.albedo_texture = load_texture(scene_, p.string(), &known_);
         m.albedo = glm::dvec3(1.0);
+        // map_Kd's -s, -o and -clamp (docs/obj-mtl.md): uv * scale + offset, clamped to edge
+        m.albedo_uv_scale = def.kd_scale;
+        m.albedo_uv_offset = def.kd_offset;
+        if (def.kd_clamp) m.albedo_wrap_u = m.albedo_wrap_v = TextureWrap::Clamp;
       } catch (const Error& e) {
         warn(std::string(e.what()) + " (map_Kd of " + where + "); using Kd");
       }
