@@ -1441,6 +1441,46 @@ TEST(Session, PointLightCloseToASurfaceAgainstTheRoundingWarns) {
             0);
 }
 
+// An area light within its own size of a surface whose float offsets are large against it:
+// BSDF-sampled rays leave from the offset origin and see the lamp's edges shifted, so the share of
+// its light MIS gives them is biased (a square lamp of side 0.006 at 0.003 over a floor of +-60
+// rendered 0.12% bright, a sphere lamp of radius 0.0078 whose centre is 0.01 above it 0.18%:
+// the light-sampling reviewer, forty-fourth session), without a word. Said now in float; not in
+// double, nor for a lamp farther than its size (radius 0.003 at 0.01, whose error measured
+// within noise), nor for a square lamp of side 0.1 at 0.003 (offsets 1/1700 of its size).
+TEST(Session, AreaLightWithinItsSizeOfACoarseSurfaceWarns) {
+  const std::string what = "in float precision, an area light of size";
+  auto scene = [](const std::string& lamp) {
+    return lucent::test::scene_from(R"({
+      "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "fov": 40},
+      "film": {"width": 8, "height": 8},
+      "integrator": {"type": "path", "spp": 1},
+      "materials": {"g": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
+                    "lamp": {"type": "diffuse", "albedo": [0, 0, 0], "emission": [5, 5, 5]}},
+      "shapes": [{"type": "triangles", "material": "g",
+                  "positions": [[-60, 0, -60], [60, 0, -60], [60, 0, 60], [-60, 0, 60]],
+                  "indices": [0, 2, 1, 0, 3, 2]}, )" +
+                                    lamp + "]}");
+  };
+  auto square = [&](double side, double height) {
+    const std::string a = std::to_string(side / 2), h = std::to_string(height);
+    return scene(R"({"type": "triangles", "material": "lamp", "positions": [[-)" + a + ", " + h +
+                 ", -" + a + "], [" + a + ", " + h + ", -" + a + "], [" + a + ", " + h + ", " + a +
+                 "], [-" + a + ", " + h + ", " + a + R"(]], "indices": [0, 1, 2, 0, 2, 3]})");
+  };
+  auto sphere = [&](double radius, double height) {
+    return scene(R"({"type": "sphere", "material": "lamp", "center": [0, )" +
+                 std::to_string(height) + ", 0], \"radius\": " + std::to_string(radius) + "}");
+  };
+  using lucent::Precision;
+  EXPECT_EQ(warnings_containing(square(0.006, 0.003), Precision::Float, what), 1);
+  EXPECT_EQ(warnings_containing(square(0.006, 0.003), Precision::Double, what), 0);
+  EXPECT_EQ(warnings_containing(sphere(0.0078, 0.01), Precision::Float, what), 1);
+  EXPECT_EQ(warnings_containing(sphere(0.003, 0.01), Precision::Float, what), 0);
+  EXPECT_EQ(warnings_containing(square(0.1, 0.003), Precision::Float, what), 0);
+  EXPECT_EQ(warnings_containing(square(0.006, 1.0), Precision::Float, what), 0);
+}
+
 // Caustics reach a pixel through its filter only: with a near-delta filter (radius 1e-3) they
 // vanished from an image that looked complete, without a word (the film review). Not said for
 // a radius of 0.5, nor without a surface that makes caustics (the light paths are dropped).

@@ -113,6 +113,18 @@ std::string emitter_cut_note(const PackedScene& packed, bool float_arithmetic);
 /// primitives pass 2e7.
 std::string point_light_note(const PackedScene& packed, bool float_arithmetic);
 
+/// In float precision, an area light (a sphere light or an emissive triangle) within its own size
+/// S of another surface whose spawn offsets (2^-20 of its coordinates) exceed 1/256 of S: a
+/// warning's text, "" otherwise (and always "" in double). BSDF-sampled rays leave that surface
+/// from its offset origin and see the lamp's edges shifted by the offset, so the share of its
+/// light MIS gives them keeps a bias of about a tenth to a quarter of offset / S: a square lamp
+/// of side 0.006 at 0.003 over a floor of +-60 rendered 0.12% bright, a sphere lamp of radius
+/// 0.0078 whose centre is 0.01 above it 0.18% (docs/rendering-model.md, "Precision"). S is a
+/// sphere's radius or sqrt of a triangle's area; the distance is from the lamp's vertices and
+/// centroid (a sphere's surface) to the nearest non-emitting surface. The first emitters only
+/// where emitters x primitives pass 2e7.
+std::string area_light_note(const PackedScene& packed, bool float_arithmetic);
+
 /// The radius of the region over which pack_lights reckons an environment light's power: the
 /// bounding radius of `packed`'s primitives (1 without any), but no more than `camera`'s distance
 /// to what it looks at. The one part of the light table that follows the camera.
