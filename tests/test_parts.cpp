@@ -385,6 +385,20 @@ TEST(Parts, PartWriteBytesRefusesAFilmSizeNotPositive) {
   EXPECT_GT(lucent::part_write_bytes(1, 1), 0u);
 }
 
+// A compression outside the enum (a cast integer, as a binding may pass) was taken as zip, by the
+// estimate and the writer alike; both refuse it now, the writer before writing anything.
+TEST(Parts, AnUnknownCompressionIsRefused) {
+  const auto bad = static_cast<lucent::PartCompression>(7);
+  EXPECT_EQ(lucent::test::error_of([&] { lucent::part_write_bytes(4, 4, bad); }),
+            "part_write_bytes: unknown part compression 7 (zip or piz)");
+  const std::string path = lucent::test::temp_dir() + "/p.exr";
+  EXPECT_EQ(lucent::test::error_of([&] {
+              lucent::write_render_part(path, handmade_part({{0, 4}}, {0, 4}), bad);
+            }),
+            path + ": cannot write part: unknown part compression 7 (zip or piz)");
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
 // Misuse of the library's merger and parts by another tool is a lucent::Error: add() after
 // add_header() read empty sums as a film's (a segfault), finish() after headers alone returned a
 // 0x0 image, and part_result read past the vectors of a part whose sizes disagree.

@@ -352,7 +352,19 @@ RenderResult part_result(const RenderPart& part) {
   return r;
 }
 
+namespace {
+
+/// Refuses a PartCompression outside the enum (a cast integer), which was taken as zip.
+void check_compression(const std::string& where, PartCompression compression) {
+  if (compression != PartCompression::zip && compression != PartCompression::piz)
+    throw Error(where + ": unknown part compression " +
+                std::to_string(static_cast<int>(compression)) + " (zip or piz)");
+}
+
+}  // namespace
+
 std::uint64_t part_write_bytes(int width, int height, PartCompression compression) {
+  check_compression("part_write_bytes", compression);
   // (-1 x 5 was taken as 0 x 5: 1 MiB)
   if (width <= 0 || height <= 0)
     throw Error("part_write_bytes: the film size must be positive, got " + std::to_string(width) +
@@ -371,6 +383,7 @@ std::uint64_t part_write_bytes(int width, int height, PartCompression compressio
 
 void write_render_part(const std::string& path, const RenderPart& part,
                        PartCompression compression) {
+  check_compression(path + ": cannot write part", compression);
   const PartInfo& info = part.info;
   const Accumulation& a = part.acc;
   if (a.width != info.width || a.height != info.height || !sums_fit_film(a))
