@@ -1447,10 +1447,14 @@ TEST(Session, PointLightCloseToASurfaceAgainstTheRoundingWarns) {
 // rendered 0.12% bright, a sphere lamp of radius 0.0078 whose centre is 0.01 above it 0.18%:
 // the light-sampling reviewer, forty-fourth session), without a word. Said now in float; not in
 // double, nor for a lamp farther than its size (radius 0.003 at 0.01, whose error measured
-// within noise), nor for a square lamp of side 0.1 at 0.003 (offsets 1/1700 of its size).
+// within noise), nor for a square lamp of side 0.1 at 0.003 (offsets 1/1700 of its size). The
+// session's reviewer: a small object beside the lamp hid the floor (only the nearest surface
+// counted), a lamp facing away from the floor and a sphere inside a lamp warned, and a sliver
+// of a lamp through the floor did not (its vertices and centroid were all far from it).
 TEST(Session, AreaLightWithinItsSizeOfACoarseSurfaceWarns) {
-  const std::string what = "in float precision, an area light of size";
-  auto scene = [](const std::string& lamp) {
+  const std::string what = "in float precision, ";
+  const std::string tail = "a surface whose rays leave offset by up to";
+  auto scene = [](const std::string& shapes) {
     return lucent::test::scene_from(R"({
       "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "fov": 40},
       "film": {"width": 8, "height": 8},
@@ -1460,25 +1464,54 @@ TEST(Session, AreaLightWithinItsSizeOfACoarseSurfaceWarns) {
       "shapes": [{"type": "triangles", "material": "g",
                   "positions": [[-60, 0, -60], [60, 0, -60], [60, 0, 60], [-60, 0, 60]],
                   "indices": [0, 2, 1, 0, 3, 2]}, )" +
-                                    lamp + "]}");
+                                    shapes + "]}");
   };
-  auto square = [&](double side, double height) {
-    const std::string a = std::to_string(side / 2), h = std::to_string(height);
-    return scene(R"({"type": "triangles", "material": "lamp", "positions": [[-)" + a + ", " + h +
-                 ", -" + a + "], [" + a + ", " + h + ", -" + a + "], [" + a + ", " + h + ", " + a +
-                 "], [-" + a + ", " + h + ", " + a + R"(]], "indices": [0, 1, 2, 0, 2, 3]})");
+  auto n = [](double x) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.17g", x);
+    return std::string(b);
   };
-  auto sphere = [&](double radius, double height) {
-    return scene(R"({"type": "sphere", "material": "lamp", "center": [0, )" +
-                 std::to_string(height) + ", 0], \"radius\": " + std::to_string(radius) + "}");
+  // a square lamp facing down (or up), centred above the floor's origin
+  auto square = [&](double side, double height, bool up = false) {
+    const std::string a = n(side / 2), h = n(height);
+    return R"({"type": "triangles", "material": "lamp", "positions": [[-)" + a + ", " + h + ", -" +
+           a + "], [" + a + ", " + h + ", -" + a + "], [" + a + ", " + h + ", " + a + "], [-" + a +
+           ", " + h + ", " + a +
+           "]], \"indices\": " + (up ? "[0, 2, 1, 0, 3, 2]}" : "[0, 1, 2, 0, 2, 3]}");
+  };
+  auto sphere = [&](const std::string& material, double radius, glm::dvec3 c) {
+    return R"({"type": "sphere", "material": ")" + material + R"(", "center": [)" + n(c.x) + ", " +
+           n(c.y) + ", " + n(c.z) + "], \"radius\": " + n(radius) + "}";
+  };
+  auto warnings = [&](const std::string& shapes, lucent::Precision p = lucent::Precision::Float) {
+    Renderer r = full_kernel_session(p);
+    lucent::test::CaptureWarnings w;
+    r.set_scene(scene(shapes));
+    int count = 0;
+    for (const std::string& line : w.all())
+      count += line.find(what) != std::string::npos && line.find(tail) != std::string::npos;
+    return count;
   };
   using lucent::Precision;
-  EXPECT_EQ(warnings_containing(square(0.006, 0.003), Precision::Float, what), 1);
-  EXPECT_EQ(warnings_containing(square(0.006, 0.003), Precision::Double, what), 0);
-  EXPECT_EQ(warnings_containing(sphere(0.0078, 0.01), Precision::Float, what), 1);
-  EXPECT_EQ(warnings_containing(sphere(0.003, 0.01), Precision::Float, what), 0);
-  EXPECT_EQ(warnings_containing(square(0.1, 0.003), Precision::Float, what), 0);
-  EXPECT_EQ(warnings_containing(square(0.006, 1.0), Precision::Float, what), 0);
+  EXPECT_EQ(warnings(square(0.006, 0.003)), 1);
+  EXPECT_EQ(warnings(square(0.006, 0.003), Precision::Double), 0);
+  EXPECT_EQ(warnings(square(0.006, 0.003, true)), 0);  // it lights the sky, not the floor
+  EXPECT_EQ(warnings(sphere("lamp", 0.0078, {0, 0.01, 0})), 1);
+  // a small, precise sphere beside the lamp: the floor still counts
+  EXPECT_EQ(
+      warnings(sphere("lamp", 0.0078, {0, 0.01, 0}) + ", " + sphere("g", 0.001, {0.0093, 0.01, 0})),
+      1);
+  EXPECT_EQ(warnings(sphere("lamp", 0.003, {0, 0.01, 0})), 0);
+  EXPECT_EQ(warnings(square(0.1, 0.003)), 0);
+  EXPECT_EQ(warnings(square(0.006, 1.0)), 0);
+  // a sphere inside a lamp far from the floor sees the lamp's dark inside only
+  EXPECT_EQ(warnings(sphere("lamp", 0.01, {100, 5, 0}) + ", " + sphere("g", 0.001, {100, 5, 0})),
+            0);
+  // a sliver of a lamp through the floor: its ends far from it, its middle in it
+  EXPECT_EQ(warnings(R"({"type": "triangles", "material": "lamp",
+                         "positions": [[-1e-6, -0.01, 0], [1e-6, -0.01, 0], [0, 0.01, 0]],
+                         "indices": [0, 1, 2]})"),
+            1);
 }
 
 // Caustics reach a pixel through its filter only: with a near-delta filter (radius 1e-3) they

@@ -96,12 +96,13 @@ enum class PartCompression {
 /// reads, plus the raw double sums and the header as attributes, with a checksum of the sums;
 /// docs/parts.md), atomically. Throws lucent::Error, writing nothing, for a part that reading
 /// would refuse: no samples, ranges not sorted and disjoint, counts or sums that disagree with
-/// the header, a non-finite sum.
+/// the header, a non-finite sum, a `compression` outside the enum.
 void write_render_part(const std::string& path, const RenderPart& part,
                        PartCompression compression = PartCompression::zip);
 /// The host memory write_render_part allocates for a width x height part, beside the part
 /// itself (its planes, the sums' 32-bit words and the EXR encoder), at most: for a front end's
-/// check before it renders. Throws lucent::Error for a size not positive.
+/// check before it renders. Throws lucent::Error for a size not positive or a `compression`
+/// outside the enum.
 std::uint64_t part_write_bytes(int width, int height,
                                PartCompression compression = PartCompression::zip);
 /// Reads a part file; throws lucent::Error naming the file and what is wrong.

@@ -562,63 +562,101 @@ std::string point_light_note(const PackedScene& packed, bool float_arithmetic) {
 
 std::string area_light_note(const PackedScene& packed, bool float_arithmetic) {
   if (!float_arithmetic) return "";  // double's offsets are 2^-29 of float's: none measured
-  const size_t most_emitters = most_against_every_primitive(packed);
-  size_t emitters = 0;
+  // each emitter costs a test per point and primitive: 1 point for a sphere, 7 for a triangle
+  const size_t budget = most_against_every_primitive(packed);
+  size_t spent = 0;
   double worst = 0, worst_s = 0, worst_h = 0, worst_m = 0;
-  // the emitter's points the distance is taken from: a triangle's vertices and centroid; a
-  // sphere's centre, whose distances then lose its radius
+  glm::dvec3 worst_at(0.0);
+  bool worst_sphere = false;
+  // An emitter's points (a sphere's centre, whose distances then lose its radius; a triangle's
+  // vertices, edge midpoints and centroid, so that a sliver crossing a surface is seen), its
+  // size, and the side it lights: a triangle's front (its plane through `a` with normal `n`), a
+  // sphere's outside. Every lit non-emitting surface within `size` counts, the coarsest one
+  // deciding (a small object beside the lamp hid the floor under it when only the nearest did).
   auto consider = [&](const std::vector<glm::dvec3>& points, double radius, double size,
-                      size_t self_sphere, size_t self_triangle) {
-    double h = INFINITY, cutter = 0;  // the nearest non-emitting surface and its coordinates
+                      const glm::dvec3& a, const glm::dvec3& n, size_t self_sphere,
+                      size_t self_triangle, const glm::dvec3& at, bool sphere) {
+    double h = INFINITY, m = 0;
+    auto take = [&](double d, double coords) {
+      if (!(d < size)) return;
+      const double offset = coords * std::ldexp(1.0, -20);  // that surface's spawn offsets
+      if (offset > m) m = offset, h = d;
+    };
+    auto in_front = [&](const glm::dvec3& q) { return sphere || glm::dot(q - a, n) > 0; };
     for (size_t i = 0; i < packed.spheres.size(); ++i) {
       const lc_sphere& sp = packed.spheres[i];
       if (i == self_sphere || sp.light != LC_INVALID || !hittable(sp)) continue;
       const glm::dvec3 c(sp.center[0], sp.center[1], sp.center[2]);
+      const double r = sp.radius;
+      if (!sphere && glm::dot(c - a, n) + r <= 0) continue;  // behind the lamp's plane
+      double d = INFINITY;
       for (const glm::dvec3& q : points) {
-        const double d = std::max(0.0, std::abs(glm::length(c - q) - sp.radius) - radius);
-        if (d < h) h = d, cutter = max_abs3(sp.center) + sp.radius;
+        const double e = glm::length(c - q);
+        if (sphere && e + r <= radius) continue;  // inside the lamp: sees its dark inside
+        d = std::min(d, std::max(0.0, std::abs(e - r) - radius));
       }
+      take(d, max_abs3(sp.center) + r);
     }
     for (size_t i = 0; i < packed.triangles.size(); ++i) {
       const lc_triangle& t = packed.triangles[i];
       if (i == self_triangle || t.light != LC_INVALID) continue;
-      const glm::dvec3 a(t.v0[0], t.v0[1], t.v0[2]), b(t.v1[0], t.v1[1], t.v1[2]),
-          c(t.v2[0], t.v2[1], t.v2[2]);
-      for (const glm::dvec3& q : points) {
-        if (bounds_apart(a, b, c, q, std::min(h, size) + radius)) continue;
-        const double d = std::max(0.0, point_triangle_distance(q, a, b, c) - radius);
-        if (d < h) h = d, cutter = std::max({max_abs3(t.v0), max_abs3(t.v1), max_abs3(t.v2)});
-      }
+      const glm::dvec3 b0(t.v0[0], t.v0[1], t.v0[2]), b1(t.v1[0], t.v1[1], t.v1[2]),
+          b2(t.v2[0], t.v2[1], t.v2[2]);
+      if (!in_front(b0) && !in_front(b1) && !in_front(b2)) continue;
+      if (sphere && glm::length(b0 - points[0]) < radius && glm::length(b1 - points[0]) < radius &&
+          glm::length(b2 - points[0]) < radius)
+        continue;  // inside the lamp
+      double d = INFINITY;
+      for (const glm::dvec3& q : points)
+        if (!bounds_apart(b0, b1, b2, q, size + radius))
+          d = std::min(d, std::max(0.0, point_triangle_distance(q, b0, b1, b2) - radius));
+      take(d, std::max({max_abs3(t.v0), max_abs3(t.v1), max_abs3(t.v2)}));
     }
-    const double m = cutter * std::ldexp(1.0, -20);  // that surface's spawn offsets
-    if (h < size && size > 0 && m / size > worst)
-      worst = m / size, worst_s = size, worst_h = h, worst_m = m;
+    if (size > 0 && m / size > worst)
+      worst = m / size, worst_s = size, worst_h = h, worst_m = m, worst_at = at,
+      worst_sphere = sphere;
   };
-  for (size_t i = 0; i < packed.spheres.size() && emitters < most_emitters; ++i) {
+  for (size_t i = 0; i < packed.spheres.size() && spent < budget; ++i) {
     const lc_sphere& sp = packed.spheres[i];
     if (sp.light == LC_INVALID || !hittable(sp)) continue;
-    ++emitters;
-    consider({glm::dvec3(sp.center[0], sp.center[1], sp.center[2])}, sp.radius, sp.radius, i,
-             LC_INVALID);
+    spent += 1;
+    const glm::dvec3 c(sp.center[0], sp.center[1], sp.center[2]);
+    consider({c}, sp.radius, sp.radius, c, glm::dvec3(0.0), i, LC_INVALID, c, true);
   }
-  for (size_t i = 0; i < packed.triangles.size() && emitters < most_emitters; ++i) {
+  for (size_t i = 0; i < packed.triangles.size() && spent + 7 <= std::max<size_t>(budget, 7); ++i) {
     const lc_triangle& t = packed.triangles[i];
     if (t.light == LC_INVALID) continue;
-    ++emitters;
+    spent += 7;
     const glm::dvec3 a(t.v0[0], t.v0[1], t.v0[2]), b(t.v1[0], t.v1[1], t.v1[2]),
         c(t.v2[0], t.v2[1], t.v2[2]);
-    const double size = std::sqrt(0.5 * glm::length(glm::cross(b - a, c - a)));
-    consider({a, b, c, (a + b + c) / 3.0}, 0.0, size, LC_INVALID, i);
+    const glm::dvec3 n = glm::cross(b - a, c - a);
+    const double size = std::sqrt(0.5 * glm::length(n));
+    const glm::dvec3 centroid = (a + b + c) / 3.0;
+    consider({a, b, c, (a + b) / 2.0, (b + c) / 2.0, (c + a) / 2.0, centroid}, 0.0, size, a, n,
+             LC_INVALID, i, centroid, false);
   }
   if (!(worst > 1.0 / 256)) return "";
-  char buf[640];
+  char where[160], buf[800];
+  if (worst_sphere)
+    std::snprintf(where, sizeof where, "a sphere light of radius %.2g at (%.6g, %.6g, %.6g)",
+                  worst_s, worst_at.x, worst_at.y, worst_at.z);
+  else
+    std::snprintf(where, sizeof where,
+                  "an emissive triangle of size %.2g (the square root of its area) at (%.6g, "
+                  "%.6g, %.6g)",
+                  worst_s, worst_at.x, worst_at.y, worst_at.z);
+  char distance[64];
+  if (worst_h > 0)
+    std::snprintf(distance, sizeof distance, "lies %.2g from", worst_h);
+  else
+    std::snprintf(distance, sizeof distance, "touches");
   std::snprintf(buf, sizeof buf,
-                "in float precision, an area light of size %.2g lies %.2g from a surface whose "
-                "rays leave offset by up to %.2g, %.2g of the light's size: the light it casts "
-                "there may be biased by about a tenth of that (a square lamp of side 0.006 at "
-                "0.003 over a floor of +-60 rendered 0.12%% bright); use --precision double, or "
-                "a larger lamp or one farther from the surface",
-                worst_s, worst_h, worst_m, worst);
+                "in float precision, %s %s a surface whose rays leave offset by up to %.2g, "
+                "%.2g of the light's size: the light it casts there may be biased by about a "
+                "tenth of that (a square lamp of side 0.006 at 0.003 over a floor of +-60 "
+                "rendered 0.12%% bright); use --precision double, or a larger lamp or one "
+                "farther from the surface",
+                where, distance, worst_m, worst);
   return buf;
 }
 
