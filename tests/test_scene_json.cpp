@@ -492,6 +492,8 @@ TEST(SceneJson, TextureMappingIsReadAndBadValuesAreErrors) {
             at + "wrap: unknown value 'border' (expected one of: repeat, clamp, mirror)");
   EXPECT_EQ(error_of(scene(R"(, "wrap": ["repeat"])")),
             at + "wrap: must be a wrap mode or [u, v] of two, got an array of 1");
+  EXPECT_EQ(error_of(scene(R"(, "wrap": 1)")),
+            at + "wrap: must be a wrap mode or [u, v] of two, got a number 1");
   EXPECT_EQ(error_of(scene(R"(, "wrap": ["repeat", "mirrored"])")),
             at + "wrap/1: unknown value 'mirrored' (expected one of: repeat, clamp, mirror)");
   EXPECT_EQ(error_of(scene(R"(, "uv_scale": [0, 1])")),

@@ -35,6 +35,8 @@ void parse_texture_mapping(const JsonReader& r, const json& v, const std::string
       m.albedo_wrap_u = wrap_mode(r, w[0], p + "/wrap/0");
       m.albedo_wrap_v = wrap_mode(r, w[1], p + "/wrap/1");
     } else {
+      if (!w.is_string())
+        r.fail(p + "/wrap", "must be a wrap mode or [u, v] of two, got " + described(w));
       m.albedo_wrap_u = m.albedo_wrap_v = wrap_mode(r, w, p + "/wrap");
     }
   }

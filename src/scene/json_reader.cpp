@@ -38,12 +38,11 @@ std::string show(const json& j) {
   return s;
 }
 
-/// "a number 1.5", "a string \"x\"", ...: the type and the value (null is both: not "null null").
+}  // namespace
+
 std::string described(const json& j) {
   return j.is_null() ? json_type_name(j) : json_type_name(j) + " " + show(j);
 }
-
-}  // namespace
 
 const json& JsonReader::require(const json& obj, const std::string& ptr, const char* key) const {
   auto it = obj.find(key);

@@ -74,5 +74,8 @@ class JsonReader {
 
 /// "a string", "an array", ... for messages.
 std::string json_type_name(const json& j);
+/// "a number 1.5", "a string \"x\"", ...: the type and the value (null is both: not "null null"),
+/// for "got ..." in messages.
+std::string described(const json& j);
 
 }  // namespace lucent::scene_detail
