@@ -111,6 +111,63 @@ TEST(Features, TextureMappingOnlyWhereAUsedMaterialMapsItsTexture) {
   EXPECT_FALSE(has(features(), "LC_HAS_TEXTURE_MAPPING"));
 }
 
+// A mapping that reads the texels of the default one is the default: repeating, a whole offset
+// (uv shifted by whole periods) is the image as given, and costs neither the mapping code nor a
+// texture header of its own. A mirror's offset counts in periods of 2: offsets 2 and 0 share a
+// header. Triangles read the mapping from their uvs (the host maps them): a scale or offset on a
+// repeating texture that no sphere uses needs no mapping code either.
+TEST(Features, MappingsEquivalentToTheDefaultCostNothing) {
+  lucent::Scene s;
+  s.textures.push_back(lucent::texture_from_rgba(1, 1, {0.5f, 0.5f, 0.5f, 1}));
+  lucent::Material m;
+  m.name = "m";
+  m.albedo_texture = 0;
+  m.albedo_uv_offset = {1, -3};
+  s.materials = {m};
+  s.spheres.push_back({{0, 0, 0}, 1, 0});
+  auto packed = [&] { return lucent::render_detail::pack_scene(s); };
+  auto mapping = [&] {
+    return has(lucent::render_detail::scene_features(s, packed()), "LC_HAS_TEXTURE_MAPPING");
+  };
+  EXPECT_FALSE(mapping());
+  EXPECT_EQ(packed().textures.size(), 1u);
+  EXPECT_EQ(packed().materials[0].p.diffuse.albedo_tex, 0);
+  s.materials[0].albedo_uv_offset = {1.5, 0};  // half a period: another image
+  EXPECT_TRUE(mapping());
+  EXPECT_EQ(packed().textures.size(), 2u);
+
+  // mirror: offsets by whole periods (2) share a header
+  lucent::Material a = m, b = m;
+  a.name = "a";
+  b.name = "b";
+  a.albedo_wrap_u = b.albedo_wrap_u = lucent::TextureWrap::Mirror;
+  a.albedo_uv_offset = {0, 0};
+  b.albedo_uv_offset = {-4, 7};
+  s.materials = {a, b};
+  s.spheres.push_back({{3, 0, 0}, 1, 1});
+  EXPECT_TRUE(mapping());
+  EXPECT_EQ(packed().textures.size(), 2u);
+  EXPECT_EQ(packed().materials[0].p.diffuse.albedo_tex, packed().materials[1].p.diffuse.albedo_tex);
+
+  // a repeating texture scaled and offset on triangles alone: mapped on the host
+  lucent::Material t = m;
+  t.albedo_uv_scale = {2.5, -3};
+  t.albedo_uv_offset = {0.25, 0};
+  s.materials = {t};
+  s.spheres.clear();
+  s.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  s.uvs = {{0, 0}, {1, 0}, {0, 1}};
+  lucent::Triangle tri;
+  tri.v[0] = tri.uv[0] = 0;
+  tri.v[1] = tri.uv[1] = 1;
+  tri.v[2] = tri.uv[2] = 2;
+  tri.material = 0;
+  s.triangles = {tri};
+  EXPECT_FALSE(mapping());
+  s.materials[0].albedo_wrap_v = lucent::TextureWrap::Clamp;  // a wrap mode is the kernel's
+  EXPECT_TRUE(mapping());
+}
+
 TEST(Features, FullKernelHasEveryFeatureAndRendersTheSameImage) {
   lucent::Scene s = lucent::parse_scene(kDiffuseScene, "features.json");
   lucent::RenderOptions spec, full;

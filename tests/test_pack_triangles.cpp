@@ -5,6 +5,7 @@
 #include <cmath>
 #include <glm/glm.hpp>
 #include <random>
+#include <vector>
 
 #include "render/pack.hpp"
 #include "support.hpp"
@@ -110,6 +111,50 @@ TEST(PackTriangles, PackSceneSetsEveryNormal) {
   ASSERT_EQ(p.triangles.size(), 2u);
   EXPECT_EQ(ng(p.triangles[0]), glm::dvec3(-1, 0, 0));
   EXPECT_NEAR(glm::length(ng(p.triangles[1]) - glm::dvec3(0, 0, 1)), 0.0, 1e-7);
+}
+
+// A triangle's uvs are packed in its material's texture space (docs/rendering-model.md,
+// "Textures"): uv * scale + offset in double, less the whole periods (repeat 1, mirror 2, clamp
+// none) of their smallest; a triangle without uvs gets its barycentrics' mapping, (0, 0), (1, 0),
+// (0, 1) mapped. By hand: scale (2.5, -3), offset (0.25, 0), repeat in u and mirror in v, uvs
+// (0, 0), (1, 0), (0, 1) map to (0.25, 0), (2.75, 0), (0.25, -3), less (0, -4): v 4, 4, 1.
+// Clamped in v, nothing comes off v; far uvs (1e5 + ...) under a scale of 1.5 come out near 0.
+TEST(PackTriangles, UvsArePackedMappedAndLessWholePeriods) {
+  lucent::Scene s;
+  s.textures.push_back(lucent::texture_from_rgba(1, 1, {0.5f, 0.5f, 0.5f, 1}));
+  lucent::Material m;
+  m.name = "m";
+  m.albedo_texture = 0;
+  m.albedo_wrap_v = lucent::TextureWrap::Mirror;
+  m.albedo_uv_scale = {2.5, -3};
+  m.albedo_uv_offset = {0.25, 0};
+  lucent::Material c = m, far = m;
+  c.name = "c";
+  c.albedo_wrap_v = lucent::TextureWrap::Clamp;
+  far.name = "far";
+  far.albedo_wrap_v = lucent::TextureWrap::Repeat;
+  far.albedo_uv_scale = {1.5, 1.5};
+  far.albedo_uv_offset = {0, 0};
+  s.materials = {m, c, far};
+  s.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  s.uvs = {{0, 0}, {1, 0}, {0, 1}, {1e5, 1e5}, {1e5 + 0.5, 1e5}, {1e5, 1e5 + 0.5}};
+  lucent::Triangle with_uvs, without;
+  for (int k = 0; k < 3; ++k) with_uvs.v[k] = without.v[k] = with_uvs.uv[k] = k;
+  lucent::Triangle clamped = with_uvs, far_uvs = with_uvs;
+  clamped.material = 1;
+  far_uvs.material = 2;
+  for (int k = 0; k < 3; ++k) far_uvs.uv[k] = 3 + k;
+  s.triangles = {with_uvs, without, clamped, far_uvs};
+  const lucent::render_detail::PackedScene p = lucent::render_detail::pack_scene(s);
+  ASSERT_EQ(p.tri_attrs.size(), 4u);
+  const std::vector<float> want[4] = {{0.25f, 4, 2.75f, 4, 0.25f, 1},
+                                      {0.25f, 4, 2.75f, 4, 0.25f, 1},
+                                      {0.25f, 0, 2.75f, 0, 0.25f, -3},
+                                      {0, 0, 0.75f, 0, 0, 0.75f}};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_TRUE(p.triangles[i].flags & LC_TRI_HAS_UVS) << i;
+    EXPECT_EQ(std::vector<float>(p.tri_attrs[i].uv, p.tri_attrs[i].uv + 6), want[i]) << i;
+  }
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -179,8 +180,8 @@ TEST(TextureRender, WrapModesScalesAndOffsetsOnQuads) {
   }
   // the quads exactly fill a 90-degree (vertical) view of aspect 3 from distance 1: pixel (px,
   // py) sees quad px / 32 over u in 1 + [px % 32, px % 32 + 1] / 32, v in -1 + [31 - py, 32 - py]
-  // / 32 (uvs moved by whole numbers: the host takes whole parts off a triangle's uvs only by
-  // whole periods of its mapping, 2 for the mirror, none for a scale of 2.5 or a clamp)
+  // / 32 (uvs moved by whole numbers: the host maps a triangle's uvs, then takes whole periods
+  // of its wrap modes off them, 2 for the mirror, none for a clamp)
   const std::string json = R"({
     "camera": {"position": [0, 0, 1], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 90},
     "film": {"width": 96, "height": 32},
@@ -244,6 +245,101 @@ TEST(TextureRender, WrapModesScalesAndOffsetsOnQuads) {
     // most of each quad is checked, most of it beyond [0, 1]
     EXPECT_GT(pure, 250) << "quad " << k;
     EXPECT_GT(outside, 200) << "quad " << k;
+  }
+}
+
+// Texture coordinates far from 0 under a mapping: the kernel's float uvs hold about 7 digits,
+// so a triangle's uvs near 1e5 or 1e6 keep their texels only if the host brings them near 0
+// first. Three quads (16x8 texture of random 0/1 texels, one quad each): repeat under a scale of
+// 1.5 with uvs near 1e5, clamp with uvs near 1e6 and an offset of -1e6, mirror under scales 0.75
+// and -1.25 with uvs near -3e5 and 2e5. A box filter of radius 1e-4 pixel samples each pixel at
+// its centre, where the closed form (bilinear between texel centres, indices wrapped by the
+// mode, in double) gives its colour; kernel and reference must both show it (the lookup is
+// continuous in uv: float rounding near 0 moves it by under 1e-4; the old host kept these uvs
+// as they were, their float rounding, up to 0.03 in uv, moved the lookup by up to a texel).
+TEST(TextureRender, MappedUvsFarFromZeroKeepTheirTexels) {
+  std::string dir = lucent::test::temp_dir();
+  const int W = 16, H = 8;
+  std::vector<unsigned char> px(W * H * 3);
+  std::uint32_t state = 12345;
+  for (unsigned char& c : px) {
+    state = state * 1664525u + 1013904223u;
+    c = (state >> 31) ? 255 : 0;  // sRGB 0 and 255: linear 0 and 1
+  }
+  ASSERT_TRUE(stbi_write_png((dir + "/random.png").c_str(), W, H, 3, px.data(), W * 3));
+  using Wr = lucent::TextureWrap;
+  struct Quad {
+    const char* wrap;  // the JSON
+    Wr wu, wv;
+    double su, sv, ou, ov;
+    double u0, v0, du, dv;  // the quad's uvs: [u0, u0 + du] x [v0, v0 + dv]
+  };
+  const Quad quads[] = {
+      {R"("repeat")", Wr::Repeat, Wr::Repeat, 1.5, 1.5, 0, 0, 1e5, 1e5, 0.5, 0.5},
+      {R"("clamp")", Wr::Clamp, Wr::Clamp, 1, 1, -1e6, -1e6, 1e6 - 0.1, 1e6 - 0.1, 1.2, 1.2},
+      {R"("mirror")", Wr::Mirror, Wr::Mirror, 0.75, -1.25, 0.3, 0.1, -3e5, 2e5, 1.5, 1}};
+  std::string materials, shapes;
+  for (int k = 0; k < 3; ++k) {
+    const Quad& q = quads[k];
+    char m[512], sh[768];
+    std::snprintf(m, sizeof m,
+                  R"(%s"q%d": {"type": "diffuse", "albedo": {"texture": "%s/random.png",
+                     "wrap": %s, "uv_scale": [%.17g, %.17g], "uv_offset": [%.17g, %.17g]}})",
+                  k ? ", " : "", k, dir.c_str(), q.wrap, q.su, q.sv, q.ou, q.ov);
+    const double x0 = -3 + 2 * k;
+    std::snprintf(sh, sizeof sh,
+                  R"(%s{"type": "triangles", "material": "q%d",
+                     "positions": [[%g, -1, 0], [%g, -1, 0], [%g, 1, 0], [%g, 1, 0]],
+                     "uvs": [[%.17g, %.17g], [%.17g, %.17g], [%.17g, %.17g], [%.17g, %.17g]],
+                     "indices": [0, 1, 2, 0, 2, 3]})",
+                  k ? ", " : "", k, x0, x0 + 2, x0 + 2, x0, q.u0, q.v0, q.u0 + q.du, q.v0,
+                  q.u0 + q.du, q.v0 + q.dv, q.u0, q.v0 + q.dv);
+    materials += m;
+    shapes += sh;
+  }
+  // the quads exactly fill a 90-degree (vertical) view of aspect 3 from distance 1
+  const std::string json = R"({
+    "camera": {"position": [0, 0, 1], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 90},
+    "film": {"width": 96, "height": 32, "filter": {"type": "box", "radius": 1e-4}},
+    "integrator": {"type": "albedo", "spp": 2},
+    "materials": {)" + materials +
+                           R"(},
+    "shapes": [)" + shapes +
+                           R"(]})";
+  lucent::test::write_file(dir + "/far.json", json);
+  const lucent::RenderResult kernel = lucent::test::render_json(json, 2);
+  lucent::ReferenceOptions ro;
+  ro.spp = 2;
+  const lucent::RenderResult reference =
+      lucent::render_reference(lucent::load_scene(dir + "/far.json"), ro);
+
+  auto wrap = [](long i, long n, Wr w) {
+    if (w == Wr::Clamp) return std::clamp(i, 0L, n - 1);
+    const long p = w == Wr::Mirror ? 2 * n : n;
+    const long r = ((i % p) + p) % p;
+    return r < n ? r : p - 1 - r;
+  };
+  auto texel = [&](long x, long y, const Quad& q, int ch) {
+    return px[3 * (wrap(y, H, q.wv) * W + wrap(x, W, q.wu)) + ch] ? 1.0 : 0.0;
+  };
+  for (int k = 0; k < 3; ++k) {
+    const Quad& q = quads[k];
+    for (int py = 0; py < 32; ++py)
+      for (int pxi = 0; pxi < 32; ++pxi) {
+        const double u = q.u0 + q.du * (pxi + 0.5) / 32, v = q.v0 + q.dv * (31.5 - py) / 32;
+        const double x = (u * q.su + q.ou) * W - 0.5, y = (1 - (v * q.sv + q.ov)) * H - 0.5;
+        const double fx = std::floor(x), fy = std::floor(y), ax = x - fx, ay = y - fy;
+        const long ix = static_cast<long>(fx), iy = static_cast<long>(fy);
+        for (int ch = 0; ch < 3; ++ch) {
+          const double want =
+              (1 - ay) * ((1 - ax) * texel(ix, iy, q, ch) + ax * texel(ix + 1, iy, q, ch)) +
+              ay * ((1 - ax) * texel(ix, iy + 1, q, ch) + ax * texel(ix + 1, iy + 1, q, ch));
+          for (const lucent::RenderResult* r : {&kernel, &reference})
+            ASSERT_NEAR(r->mean.pixel(32 * k + pxi, py)[ch], want, 2e-3)
+                << "quad " << k << " (wrap " << q.wrap << ") pixel (" << pxi << ", " << py
+                << ") channel " << ch << (r == &kernel ? " (kernel)" : " (reference)");
+        }
+      }
   }
 }
 

@@ -30,8 +30,9 @@ inline constexpr double kMaxCoordinate = 1e12;
 /// Random seed: 0 .. kMaxSeed (32 bits).
 inline constexpr std::uint32_t kMaxSeed = 0xffffffffu;
 /// A texture's uv scale (Material::albedo_uv_scale): each component kMinUvScale .. kMaxUvScale
-/// in magnitude (negative mirrors the image). 0 would read one point of the image everywhere, and
-/// the kernel's float uvs lose the texels beyond about 1e6 repetitions.
+/// in magnitude (negative mirrors the image about uv 0, docs/rendering-model.md "Textures"). 0
+/// would read one point of the image everywhere, and a sphere's float uvs (mapped in the kernel)
+/// lose the texels beyond about 1e6 repetitions.
 inline constexpr double kMinUvScale = 1e-6;
 inline constexpr double kMaxUvScale = 1e6;
 /// A texture's uv offset (Material::albedo_uv_offset): each component at most kMaxUvOffset in

@@ -7,6 +7,8 @@
 #ifndef LUCENT_GEOM_SPHERE_CL
 #define LUCENT_GEOM_SPHERE_CL
 
+#include "texture/texture.cl"
+
 /* Returns the nearest t in (tmin, tmax) or INFINITY. */
 static inline lc_real sphere_intersect(lc_real3 center, lc_real radius, lc_real3 o, lc_real3 d,
                                        lc_real tmin, lc_real tmax) {
@@ -52,11 +54,13 @@ static inline void sphere_interaction(const lc_scene* s, lc_ray ray, const lc_hi
   it->ns = nf;
   /* equirectangular uv: u along longitude around +y, eastward (to the right seen from outside,
    * the image's centre at +z: atan2(z, x) mirrored it), v from the south to the north pole; only
-   * textures read it (atan2 and asin cost ~8% of a scene of large untextured spheres) */
+   * textures read it (atan2 and asin cost ~8% of a scene of large untextured spheres), in the
+   * texture space of its material's texture (texture_map_uv) */
 #ifdef LC_HAS_TEXTURES
   if (sp->flags & LC_SPHERE_TEXTURED)
-    it->uv = (float2)(0.5f + atan2(nf.x, nf.z) * (0.5f * LC_INV_PI),
-                      0.5f + asin(clamp(nf.y, -1.0f, 1.0f)) * LC_INV_PI);
+    it->uv = texture_map_uv(s, (int)sp->texture,
+                            (float2)(0.5f + atan2(nf.x, nf.z) * (0.5f * LC_INV_PI),
+                                     0.5f + asin(clamp(nf.y, -1.0f, 1.0f)) * LC_INV_PI));
 #endif
   it->material = sp->material;
   it->light = sp->light;

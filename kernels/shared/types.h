@@ -150,8 +150,9 @@ typedef struct LC_ALIGN16 lc_sphere {
   lc_uint material; /* index into materials                     */
   lc_uint light;    /* index into lights if emissive, LC_INVALID */
   lc_uint flags;    /* LC_SPHERE_TEXTURED                         */
-  lc_uint pad0;
-} lc_sphere; /* total: 32 bytes */
+  lc_uint texture;  /* textured: its material's albedo texture header, whose uv scale  */
+                    /* and offset map the sphere's uvs (LC_HAS_TEXTURE_MAPPING)         */
+} lc_sphere;        /* total: 32 bytes */
 LC_STATIC_ASSERT(sizeof(lc_sphere) == 32, sphere_size);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_sphere, radius) == 12, sphere_radius);
 LC_STATIC_ASSERT(LC_OFFSETOF(lc_sphere, material) == 16, sphere_material);
@@ -276,7 +277,10 @@ LC_STATIC_ASSERT(LC_OFFSETOF(lc_light, p) == 16, light_params);
 /* Textures: texels of every texture packed into one float4 buffer (linear RGBA). A header per */
 /* (image, mapping): an image several materials map differently has several headers with the  */
 /* same texels; the first ones, one per scene texture, map it by default (environment maps).  */
-/* The mapping is read only with LC_HAS_TEXTURE_MAPPING (texture/texture.cl).                 */
+/* The mapping is read only with LC_HAS_TEXTURE_MAPPING (texture/texture.cl). A hit's uv is   */
+/* in texture space (uv * uv_scale + uv_offset) before the lookup, which wraps it: the host   */
+/* maps triangles' uvs (in double, then takes whole periods off: render_detail::pack_scene),  */
+/* the kernel maps spheres' (texture_map_uv, with the header's uv_scale and uv_offset).       */
 /* ------------------------------------------------------------------------------------------ */
 /* wrap modes (lucent::TextureWrap): lc_texture.wrap holds u's in bits 0-7, v's in bits 8-15 */
 #define LC_WRAP_REPEAT 0u
@@ -288,7 +292,7 @@ typedef struct LC_ALIGN16 lc_texture {
   lc_uint width;
   lc_uint height;
   lc_uint wrap;      /* LC_WRAP_* of u | LC_WRAP_* of v << LC_WRAP_V_SHIFT           */
-  float uv_scale[2]; /* the lookup reads uv * uv_scale + uv_offset, then wraps it     */
+  float uv_scale[2]; /* texture space is uv * uv_scale + uv_offset (spheres' uvs)     */
   float uv_offset[2];
 } lc_texture; /* total: 32 bytes */
 LC_STATIC_ASSERT(sizeof(lc_texture) == 32, texture_size);

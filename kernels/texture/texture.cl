@@ -1,7 +1,8 @@
 /* lucent kernel: texture lookups, bilinear filtering between texel centres. Texels are linear
  * RGBA. Textures repeat; with LC_HAS_TEXTURE_MAPPING (a scene whose textured material maps its
  * texture otherwise) each header's wrap modes, uv scale and offset are read (lucent::TextureWrap,
- * docs/rendering-model.md, "Textures"). */
+ * docs/rendering-model.md, "Textures"). A lookup reads texture space (uv * scale + offset):
+ * triangles' uvs are mapped so by the host, spheres' by texture_map_uv. */
 #ifndef LUCENT_TEXTURE_TEXTURE_CL
 #define LUCENT_TEXTURE_TEXTURE_CL
 
@@ -41,13 +42,25 @@ static inline float texture_reduce(float u, lc_uint mode) {
   return u - floor(u);
 }
 
-/* uv (0,0) is the bottom-left corner of the image (OBJ convention), v grows upwards. */
+/* A surface's uv in texture `index`'s texture space: uv * uv_scale + uv_offset (one rounding:
+ * a large offset under clamp keeps the fraction of the sum), or uv without
+ * LC_HAS_TEXTURE_MAPPING. For the uvs the kernel computes (spheres'); the host maps triangles'. */
+static inline float2 texture_map_uv(const lc_scene* s, int index, float2 uv) {
+#ifdef LC_HAS_TEXTURE_MAPPING
+  __global const lc_texture* tex = &s->textures[index];
+  return fma(uv, (float2)(tex->uv_scale[0], tex->uv_scale[1]),
+             (float2)(tex->uv_offset[0], tex->uv_offset[1]));
+#else
+  return uv;
+#endif
+}
+
+/* The texel colour at uv in texture space (texture_map_uv), wrapped by the header's modes. uv
+ * (0,0) is the bottom-left corner of the image (OBJ convention), v grows upwards. */
 static inline float4 texture_lookup(const lc_scene* s, int index, float2 uv) {
   __global const lc_texture* tex = &s->textures[index];
 #ifdef LC_HAS_TEXTURE_MAPPING
   const lc_uint wrap_u = tex->wrap & 0xffu, wrap_v = (tex->wrap >> LC_WRAP_V_SHIFT) & 0xffu;
-  uv = uv * (float2)(tex->uv_scale[0], tex->uv_scale[1]) +
-       (float2)(tex->uv_offset[0], tex->uv_offset[1]);
 #else
   const lc_uint wrap_u = LC_WRAP_REPEAT, wrap_v = LC_WRAP_REPEAT;
 #endif

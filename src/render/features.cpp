@@ -52,8 +52,8 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
   shape[LC_SHAPE_SPHERE] = !packed.spheres.empty();
   shape[LC_SHAPE_TRIANGLE] = !packed.triangles.empty();
   // materials some primitive uses (a declared but unused material costs nothing)
-  std::vector<char> used(scene.materials.size(), 0);
-  for (const lc_sphere& sp : packed.spheres) used[sp.material] = 1;
+  std::vector<char> used(scene.materials.size(), 0), on_spheres(scene.materials.size(), 0);
+  for (const lc_sphere& sp : packed.spheres) used[sp.material] = on_spheres[sp.material] = 1;
   for (const lc_triangle& t : packed.triangles) used[t.material] = 1;
   bool textured = false, mapped = false;
   for (size_t i = 0; i < scene.materials.size(); ++i) {
@@ -61,8 +61,9 @@ std::vector<std::string> scene_features(const Scene& scene, const PackedScene& p
     const Material& m = scene.materials[i];
     material[static_cast<int>(m.type)] = true;
     textured = textured || m.albedo_texture >= 0;
-    // a texture read otherwise than repeating at uv as given (its texture header says how)
-    mapped = mapped || (m.albedo_texture >= 0 && !m.default_albedo_mapping());
+    // a texture read otherwise than repeating, or a sphere's uvs scaled or offset (the host maps
+    // triangles' uvs; a mapping equivalent to the default is the default)
+    mapped = mapped || needs_mapping_code(m, scene.textures.size(), on_spheres[i]);
   }
   for (const lc_light& l : packed.lights) light[l.type] = true;
   filter[static_cast<int>(scene.film.filter.type)] = true;

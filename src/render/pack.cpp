@@ -73,9 +73,8 @@ double wrap_period(TextureWrap w) {
   return w == TextureWrap::Repeat ? 1 : w == TextureWrap::Mirror ? 2 : 0;
 }
 
-/// The texture header of texture `t` (its texels from `offset`) mapped as material `m` says.
-/// An offset is reduced by whole periods of its wrap mode (the same lookups), so that a large
-/// one keeps its fraction in float.
+/// The texture header of texture `t` (its texels from `offset`) mapped as `m` says (a
+/// device_texture_mapping: its offsets reduced, so that a large one keeps its fraction in float).
 lc_texture texture_header(const Texture& t, lc_uint offset, const Material& m) {
   lc_texture d{};
   d.offset = offset;
@@ -83,27 +82,40 @@ lc_texture texture_header(const Texture& t, lc_uint offset, const Material& m) {
   d.height = static_cast<lc_uint>(t.height);
   d.wrap = static_cast<lc_uint>(m.albedo_wrap_u) |
            (static_cast<lc_uint>(m.albedo_wrap_v) << LC_WRAP_V_SHIFT);
-  const TextureWrap wrap[2] = {m.albedo_wrap_u, m.albedo_wrap_v};
   for (int k = 0; k < 2; ++k) {
     d.uv_scale[k] = static_cast<float>(m.albedo_uv_scale[k]);
-    const double period = wrap_period(wrap[k]), o = m.albedo_uv_offset[k];
-    d.uv_offset[k] = static_cast<float>(period > 0 ? o - period * std::floor(o / period) : o);
+    d.uv_offset[k] = static_cast<float>(m.albedo_uv_offset[k]);
   }
   return d;
 }
 
-/// What the whole part of a triangle's uvs may be taken off by in axis k (pack_scene) with its
-/// material's texture reading the same texels: a multiple of the result, 0 when none may. The
-/// lookup reads uv * scale + offset: a shift by n moves it by n * scale, a whole number of the
-/// wrap mode's periods when n is a multiple of the period and the scale a whole number.
-double uv_shift_step(const Material& m, int k) {
-  if (m.albedo_texture < 0 || m.default_albedo_mapping()) return 1;
-  const double s = m.albedo_uv_scale[k];
-  if (s != std::floor(s)) return 0;
-  return wrap_period(k == 0 ? m.albedo_wrap_u : m.albedo_wrap_v);
+}  // namespace
+
+Material device_texture_mapping(const Material& m, std::size_t texture_count) {
+  Material d;
+  if (m.albedo_texture < 0 || static_cast<std::size_t>(m.albedo_texture) >= texture_count) return d;
+  d.albedo_wrap_u = m.albedo_wrap_u;
+  d.albedo_wrap_v = m.albedo_wrap_v;
+  d.albedo_uv_scale = m.albedo_uv_scale;
+  const TextureWrap wrap[2] = {m.albedo_wrap_u, m.albedo_wrap_v};
+  for (int k = 0; k < 2; ++k) {
+    const double period = wrap_period(wrap[k]), o = m.albedo_uv_offset[k];
+    double r = o;
+    if (period > 0 && std::isfinite(o)) {
+      r = o - period * std::floor(o / period);
+      if (r >= period) r -= period;  // (o a tiny negative number: the sum rounds up to period)
+      if (r == 0) r = 0;             // not -0
+    }
+    d.albedo_uv_offset[k] = r;
+  }
+  return d;
 }
 
-}  // namespace
+bool needs_mapping_code(const Material& m, std::size_t texture_count, bool on_spheres) {
+  const Material d = device_texture_mapping(m, texture_count);
+  if (d.albedo_wrap_u != TextureWrap::Repeat || d.albedo_wrap_v != TextureWrap::Repeat) return true;
+  return on_spheres && !d.default_albedo_mapping();
+}
 
 bool set_triangle_normal(lc_triangle& t) {
   glm::dvec3 v0(t.v0[0], t.v0[1], t.v0[2]), v1(t.v1[0], t.v1[1], t.v1[2]);
@@ -738,6 +750,9 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
       p.textures.push_back(texture_header(scene.textures[i], texel_offset[i], plain));
   }
   std::map<std::vector<unsigned char>, int> mapped_headers;  // header bytes -> index
+  // per material: its mapping as the device reads it, and its texture's header (or -1)
+  std::vector<Material> mappings;
+  std::vector<int> material_texture;
   for (const Material& m : scene.materials) {
     lc_material d;
     std::fill(std::begin(d.p.words), std::end(d.p.words), 0.0f);
@@ -745,14 +760,17 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     d.type = static_cast<lc_uint>(m.type);
     Material device = m;
     const std::size_t t = static_cast<std::size_t>(m.albedo_texture);
-    if (m.albedo_texture >= 0 && t < scene.textures.size() && !m.default_albedo_mapping()) {
-      const lc_texture h = texture_header(scene.textures[t], texel_offset[t], m);
+    const Material mapping = device_texture_mapping(m, scene.textures.size());
+    if (!mapping.default_albedo_mapping()) {
+      const lc_texture h = texture_header(scene.textures[t], texel_offset[t], mapping);
       const unsigned char* b = reinterpret_cast<const unsigned char*>(&h);
       auto [it, added] = mapped_headers.insert(
           {std::vector<unsigned char>(b, b + sizeof h), static_cast<int>(p.textures.size())});
       if (added) p.textures.push_back(h);
       device.albedo_texture = it->second;
     }
+    mappings.push_back(mapping);
+    material_texture.push_back(device.albedo_texture);
     scene_detail::material_type_def(m.type).pack(device, d.p);
     p.materials.push_back(d);
   }
@@ -778,6 +796,8 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     d.light = LC_INVALID;
     const Material& m = scene.materials[s.material];
     d.flags = m.albedo_texture >= 0 ? LC_SPHERE_TEXTURED : 0u;
+    d.texture =
+        m.albedo_texture >= 0 ? static_cast<lc_uint>(material_texture[s.material]) : LC_INVALID;
     if (m.emissive()) {
       lc_light l{};
       l.type = LC_LIGHT_SPHERE;
@@ -809,19 +829,32 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
     lc_triangle_attr a{};
     bool has_n = t.n[0] >= 0 && t.n[1] >= 0 && t.n[2] >= 0;
     bool has_uv = t.uv[0] >= 0 && t.uv[1] >= 0 && t.uv[2] >= 0;
-    // The uvs less the whole part of their smallest: texture lookups repeat with period 1, so
-    // the image is the same, and the kernel's float interpolation keeps the fraction (uvs near
-    // 1e7 lost it: a texture there rendered as blocks, 64 standard errors off the reference).
-    // A texture mapped otherwise allows whole periods of its mapping (uv_shift_step), or none.
-    glm::dvec2 whole(0.0);
-    if (has_uv) {
-      glm::dvec2 lo = scene.uvs[t.uv[0]];
-      for (int k = 1; k < 3; ++k) lo = glm::min(lo, scene.uvs[t.uv[k]]);
-      if (std::isfinite(lo.x) && std::isfinite(lo.y))
-        for (int k = 0; k < 2; ++k) {
-          const double step = uv_shift_step(scene.materials[t.material], k);
-          if (step > 0) whole[k] = step * std::floor(lo[k] / step);
+    // The uvs in the texture space of the material's texture (uv * scale + offset, in double:
+    // affine, so the kernel's barycentric interpolation of the mapped uvs is the mapping of the
+    // interpolated ones; a triangle without uvs has (0, 0), (1, 0), (0, 1), the barycentrics
+    // the kernel reads otherwise), then less the whole periods (repeat 1, mirror 2; clamp none)
+    // of their smallest: the lookup reads the same texels, and the kernel's float interpolation
+    // keeps the fraction (uvs near 1e7 lost it: a texture there rendered as blocks, 64 standard
+    // errors off the reference; uvs near 1e5 under a scale of 1.5, mapped in the kernel, read
+    // texels up to one off). The kernel applies no scale or offset to triangles' uvs.
+    const Material& mapping = mappings[t.material];
+    const bool mapped = !mapping.default_albedo_mapping();
+    glm::dvec2 uv[3] = {};
+    if (has_uv || mapped) {
+      for (int k = 0; k < 3; ++k) {
+        uv[k] = has_uv ? scene.uvs[t.uv[k]] : glm::dvec2(k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0);
+        if (mapped) uv[k] = uv[k] * mapping.albedo_uv_scale + mapping.albedo_uv_offset;
+      }
+      has_uv = true;
+      glm::dvec2 lo = glm::min(uv[0], glm::min(uv[1], uv[2]));
+      const TextureWrap wrap[2] = {mapping.albedo_wrap_u, mapping.albedo_wrap_v};
+      for (int c = 0; c < 2; ++c) {
+        const double period = wrap_period(wrap[c]);
+        if (period > 0 && std::isfinite(lo[c])) {
+          const double whole = period * std::floor(lo[c] / period);
+          for (int k = 0; k < 3; ++k) uv[k][c] -= whole;
         }
+      }
     }
     // Normals far from unit length (set directly: Scene.normals, from Python) scaled, all three
     // by one power of two, their largest component then in [1, 2): the interpolation's direction
@@ -842,8 +875,8 @@ PackedScene pack_scene(const Scene& scene, const PackedScene* previous, bool* bv
              glm::dvec3(std::ldexp(n.x, n_exp), std::ldexp(n.y, n_exp), std::ldexp(n.z, n_exp)));
       }
       if (has_uv) {
-        a.uv[2 * k] = static_cast<float>(scene.uvs[t.uv[k]].x - whole.x);
-        a.uv[2 * k + 1] = static_cast<float>(scene.uvs[t.uv[k]].y - whole.y);
+        a.uv[2 * k] = static_cast<float>(uv[k].x);
+        a.uv[2 * k + 1] = static_cast<float>(uv[k].y);
       }
     }
     d.flags = (has_n ? LC_TRI_HAS_NORMALS : 0u) | (has_uv ? LC_TRI_HAS_UVS : 0u);

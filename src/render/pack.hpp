@@ -36,6 +36,18 @@ struct PackedScene {
 /// vertices are collinear.
 bool set_triangle_normal(lc_triangle& t);
 
+/// How material `m` maps its albedo texture, in the terms the device reads
+/// (docs/rendering-model.md, "Textures"): m's wrap modes and uv scale, its uv offset less whole
+/// periods of its wrap mode (repeat 1, mirror 2; the same lookups), in [0, period). A mapping that
+/// reads the texels of the default one (repeat, scale 1, a whole offset) is then the default
+/// (Material:: default_albedo_mapping()). Without a texture (or one out of range), the default.
+Material device_texture_mapping(const Material& m, std::size_t texture_count);
+
+/// Whether the kernel must be built with its texture mapping code (LC_HAS_TEXTURE_MAPPING) for
+/// material `m` on spheres (`on_spheres`) or triangles: a wrap mode other than repeat, or a uv
+/// scale or offset the kernel applies (spheres'; the host maps triangles' uvs).
+bool needs_mapping_code(const Material& m, std::size_t texture_count, bool on_spheres);
+
 /// The camera basis (right, up, forward, with roll applied) as the kernel uses it.
 lc_camera pack_camera(const Camera& camera, int width, int height);
 
