@@ -33,6 +33,20 @@ bool write_block_png(const std::string& path, int size) {
   return stbi_write_png(path.c_str(), size, size, 3, px.data(), size * 3) != 0;
 }
 
+/// The kernel's and the reference's renders of a JSON scene at spp samples per pixel (the scene
+/// written as dir/name first: the reference loads it from there, resolving its texture paths).
+struct KernelAndReference {
+  lucent::RenderResult kernel, reference;
+};
+KernelAndReference render_both(const std::string& dir, const std::string& name,
+                               const std::string& json, int spp) {
+  lucent::test::write_file(dir + "/" + name, json);
+  lucent::ReferenceOptions ro;
+  ro.spp = spp;
+  return {lucent::test::render_json(json, spp),
+          lucent::render_reference(lucent::load_scene(dir + "/" + name), ro)};
+}
+
 TEST(TextureRender, TexturedObjQuadShowsTheImageUpright) {
   std::string dir = lucent::test::temp_dir();
   // 4x4 texture of 2x2 blocks
@@ -109,12 +123,8 @@ TEST(TextureRender, TexturedSphereShowsTheImageUnmirrored) {
                            dir + R"(/globe.png"}}},
     "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "t"}]
   })";
-  lucent::test::write_file(dir + "/globe.json", json);
-  const lucent::RenderResult kernel = lucent::test::render_json(json, 4);
-  lucent::ReferenceOptions ro;
-  ro.spp = 4;
-  const lucent::RenderResult reference =
-      lucent::render_reference(lucent::load_scene(dir + "/globe.json"), ro);
+  const KernelAndReference both = render_both(dir, "globe.json", json, 4);
+  const lucent::RenderResult &kernel = both.kernel, &reference = both.reference;
   // pixels (8, 8) and the like lie at n = (-+0.40, +-0.40, 0.83): u = 0.5 -+ 0.07, v = 0.5 +- 0.13,
   // texel columns 6.4 (red) or 8.6 (green), rows 5.4 or 9.6: texels of one block each (the old u
   // read column 14.1 in front of the camera, green, whichever side)
@@ -190,12 +200,8 @@ TEST(TextureRender, WrapModesScalesAndOffsetsOnQuads) {
                            R"(},
     "shapes": [)" + shapes +
                            R"(]})";
-  lucent::test::write_file(dir + "/quads.json", json);
-  const lucent::RenderResult kernel = lucent::test::render_json(json, 4);
-  lucent::ReferenceOptions ro;
-  ro.spp = 4;
-  const lucent::RenderResult reference =
-      lucent::render_reference(lucent::load_scene(dir + "/quads.json"), ro);
+  const KernelAndReference both = render_both(dir, "quads.json", json, 4);
+  const lucent::RenderResult &kernel = both.kernel, &reference = both.reference;
 
   // the mapped coordinate folded into [0, 1], where the 4-texel image's blocks meet at 0.5
   auto fold = [](double t, W w) {
@@ -306,12 +312,8 @@ TEST(TextureRender, MappedUvsFarFromZeroKeepTheirTexels) {
                            R"(},
     "shapes": [)" + shapes +
                            R"(]})";
-  lucent::test::write_file(dir + "/far.json", json);
-  const lucent::RenderResult kernel = lucent::test::render_json(json, 2);
-  lucent::ReferenceOptions ro;
-  ro.spp = 2;
-  const lucent::RenderResult reference =
-      lucent::render_reference(lucent::load_scene(dir + "/far.json"), ro);
+  const KernelAndReference both = render_both(dir, "far.json", json, 2);
+  const lucent::RenderResult &kernel = both.kernel, &reference = both.reference;
 
   auto wrap = [](long i, long n, Wr w) {
     if (w == Wr::Clamp) return std::clamp(i, 0L, n - 1);
@@ -375,12 +377,8 @@ TEST(TextureRender, ClampedSpherePoleShowsOnlyTheTopRow) {
   EXPECT_LT(centre[0], 0.7f);
 
   const std::string clamped = scene(R"(, "wrap": ["repeat", "clamp"])");
-  lucent::test::write_file(dir + "/pole.json", clamped);
-  const lucent::RenderResult kernel = lucent::test::render_json(clamped, 4);
-  lucent::ReferenceOptions ro;
-  ro.spp = 4;
-  const lucent::RenderResult reference =
-      lucent::render_reference(lucent::load_scene(dir + "/pole.json"), ro);
+  const KernelAndReference both = render_both(dir, "pole.json", clamped, 4);
+  const lucent::RenderResult &kernel = both.kernel, &reference = both.reference;
   for (const lucent::RenderResult* r : {&kernel, &reference})
     for (int y = 13; y <= 18; ++y)
       for (int x = 13; x <= 18; ++x) {
