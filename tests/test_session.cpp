@@ -1496,6 +1496,8 @@ TEST(Session, AreaLightWithinItsSizeOfACoarseSurfaceWarns) {
   EXPECT_EQ(warnings(square(0.006, 0.003)), 1);
   EXPECT_EQ(warnings(square(0.006, 0.003), Precision::Double), 0);
   EXPECT_EQ(warnings(square(0.006, 0.003, true)), 0);  // it lights the sky, not the floor
+  // nor a coarse sphere under it (its plane's normal, not unit, made the sphere count)
+  EXPECT_EQ(warnings(square(0.006, 0.003, true) + ", " + sphere("g", 60, {0, -60, 0})), 0);
   EXPECT_EQ(warnings(sphere("lamp", 0.0078, {0, 0.01, 0})), 1);
   // a small, precise sphere beside the lamp: the floor still counts
   EXPECT_EQ(

@@ -600,7 +600,8 @@ std::string area_light_note(const PackedScene& packed, bool float_arithmetic) {
       if (i == self_sphere || sp.light != LC_INVALID || !hittable(sp)) continue;
       const glm::dvec3 c(sp.center[0], sp.center[1], sp.center[2]);
       const double r = sp.radius;
-      if (!sphere && glm::dot(c - a, n) + r <= 0) continue;  // behind the lamp's plane
+      // wholly behind the lamp's plane (n is not unit: r is scaled by its length)
+      if (!sphere && glm::dot(c - a, n) + r * glm::length(n) <= 0) continue;
       double d = INFINITY;
       for (const glm::dvec3& q : points) {
         const double e = glm::length(c - q);
