@@ -1273,7 +1273,7 @@ TEST(Obj, MapKdScaleAndOffsetOutOfRangeAreErrors) {
   const std::pair<const char*, const char*> cases[] = {
       {"-s 0 1",
        "m.mtl:3: material 'a': albedo/uv_scale/0 (map_Kd -s): must be between 1e-06 "
-       "and 1e+06 in magnitude (negative mirrors the image), got 0"},
+       "and 1e+06 in magnitude (either sign), got 0"},
       {"-s 1 1e999", "m.mtl:3: material 'a': albedo/uv_scale/1 (map_Kd -s): must be a finite "},
       {"-o 0 -2e6",
        "m.mtl:3: material 'a': albedo/uv_offset/1 (map_Kd -o): must be at most "

@@ -497,11 +497,11 @@ TEST(SceneJson, TextureMappingIsReadAndBadValuesAreErrors) {
   EXPECT_EQ(error_of(scene(R"(, "wrap": ["repeat", "mirrored"])")),
             at + "wrap/1: unknown value 'mirrored' (expected one of: repeat, clamp, mirror)");
   EXPECT_EQ(error_of(scene(R"(, "uv_scale": [0, 1])")),
-            at + "uv_scale/0: must be between 1e-06 and 1e+06 in magnitude (negative mirrors the "
-                 "image), got 0");
+            at + "uv_scale/0: must be between 1e-06 and 1e+06 in magnitude (either sign), "
+                 "got 0");
   EXPECT_EQ(error_of(scene(R"(, "uv_scale": [1, -1e7])")),
-            at + "uv_scale/1: must be between 1e-06 and 1e+06 in magnitude (negative mirrors the "
-                 "image), got -1e+07");
+            at + "uv_scale/1: must be between 1e-06 and 1e+06 in magnitude (either sign), "
+                 "got -1e+07");
   EXPECT_EQ(error_of(scene(R"(, "uv_offset": [0, -2e6])")),
             at + "uv_offset/1: must be at most 1e+06 in magnitude, got -2e+06");
   for (const char* bad : {R"(, "uv_scale": [1])", R"(, "uv_offset": "x")",

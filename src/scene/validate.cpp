@@ -285,8 +285,8 @@ void check_texture_mapping(const Material& m, const Reporter& at) {
       at.at("uv_scale")
           .at(k)
           .fail("must be between " + format_number(limits::kMinUvScale) + " and " +
-                format_number(limits::kMaxUvScale) +
-                " in magnitude (negative mirrors the image), got " + format_number(s));
+                format_number(limits::kMaxUvScale) + " in magnitude (either sign), got " +
+                format_number(s));
     const double o = check_finite(at.at("uv_offset").at(k), m.albedo_uv_offset[k]);
     if (!(std::fabs(o) <= limits::kMaxUvOffset))
       at.at("uv_offset")
