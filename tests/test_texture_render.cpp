@@ -47,6 +47,23 @@ KernelAndReference render_both(const std::string& dir, const std::string& name,
           lucent::render_reference(lucent::load_scene(dir + "/" + name), ro)};
 }
 
+/// The albedo of three quads (`shapes`, with their `materials`) that exactly fill a 90-degree
+/// (vertical) view of aspect 3 from distance 1, on a 96x32 film (`film_extra`: more film keys).
+std::string three_quads_scene(const std::string& materials, const std::string& shapes,
+                              const std::string& film_extra, int spp) {
+  return R"({
+    "camera": {"position": [0, 0, 1], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 90},
+    "film": {"width": 96, "height": 32)" +
+         film_extra + R"(},
+    "integrator": {"type": "albedo", "spp": )" +
+         std::to_string(spp) + R"(},
+    "materials": {)" +
+         materials +
+         R"(},
+    "shapes": [)" +
+         shapes + R"(]})";
+}
+
 TEST(TextureRender, TexturedObjQuadShowsTheImageUpright) {
   std::string dir = lucent::test::temp_dir();
   // 4x4 texture of 2x2 blocks
@@ -192,14 +209,7 @@ TEST(TextureRender, WrapModesScalesAndOffsetsOnQuads) {
   // py) sees quad px / 32 over u in 1 + [px % 32, px % 32 + 1] / 32, v in -1 + [31 - py, 32 - py]
   // / 32 (uvs moved by whole numbers: the host maps a triangle's uvs, then takes whole periods
   // of its wrap modes off them, 2 for the mirror, none for a clamp)
-  const std::string json = R"({
-    "camera": {"position": [0, 0, 1], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 90},
-    "film": {"width": 96, "height": 32},
-    "integrator": {"type": "albedo", "spp": 4},
-    "materials": {)" + materials +
-                           R"(},
-    "shapes": [)" + shapes +
-                           R"(]})";
+  const std::string json = three_quads_scene(materials, shapes, "", 4);
   const KernelAndReference both = render_both(dir, "quads.json", json, 4);
   const lucent::RenderResult &kernel = both.kernel, &reference = both.reference;
 
@@ -304,14 +314,8 @@ TEST(TextureRender, MappedUvsFarFromZeroKeepTheirTexels) {
     shapes += sh;
   }
   // the quads exactly fill a 90-degree (vertical) view of aspect 3 from distance 1
-  const std::string json = R"({
-    "camera": {"position": [0, 0, 1], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 90},
-    "film": {"width": 96, "height": 32, "filter": {"type": "box", "radius": 1e-4}},
-    "integrator": {"type": "albedo", "spp": 2},
-    "materials": {)" + materials +
-                           R"(},
-    "shapes": [)" + shapes +
-                           R"(]})";
+  const std::string json =
+      three_quads_scene(materials, shapes, R"(, "filter": {"type": "box", "radius": 1e-4})", 2);
   const KernelAndReference both = render_both(dir, "far.json", json, 2);
   const lucent::RenderResult &kernel = both.kernel, &reference = both.reference;
 
